@@ -1,0 +1,207 @@
+# undulate — one hand-written Makefile.
+#
+# Layout convention (keeps this file stable as modules grow):
+#   every component directory holds one program's `main.c` and any number of
+#   other .c files; the other files form a static library that unit tests link
+#   against, so a test can exercise a module without the program's main().
+#
+#   make            build everything into $(BUILD)/
+#   make test       install missing packages, build, run every test
+#   make test-long  the long sweeps (paper experiments over many separations)
+#   make bench      benchmarks; figures printed, written to $(BUILD)/bench.md
+#   make demo       robots on the simulated bus, watched live
+#   make SAN=1 test the same tests under AddressSanitizer + UBSan (build-san/)
+#   make fuzz       libFuzzer target for the packet parser (needs clang)
+
+SAN      ?=
+ifeq ($(SAN),1)
+BUILD    ?= build-san
+SANFLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+else
+BUILD    ?= build
+SANFLAGS :=
+endif
+
+CC       ?= cc
+PREFIX   ?= /usr/local
+DESTDIR  ?=
+BIN      := $(BUILD)/bin
+OBJ      := $(BUILD)/obj
+LIB      := $(BUILD)/lib
+GEN      := $(BUILD)/lcmgen
+
+PKGS     := lcm libserialport inih
+PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+
+WARN     := -Wall -Wextra -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
+            -Wpointer-arith -Wcast-qual -Wundef -Wvla -Wformat-security -Werror
+STD      := -std=c11 -D_DEFAULT_SOURCE -D_XOPEN_SOURCE=700
+OPT      ?= -O2 -g
+CPPFLAGS += -Iprotocol -Iprotocol/io -I$(GEN) -MMD -MP
+CFLAGS   += $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS)
+LDFLAGS  += $(SANFLAGS)
+LDLIBS   += $(PKG_LIBS) -lm
+
+# lcm-gen output is not ours: compile it without our warning set.
+GEN_WARN := -w
+
+# ---- components -------------------------------------------------------------
+# name : directory
+COMPONENTS := protocol daemon sim bench dxl top analyze
+DIR_protocol := protocol protocol/io
+DIR_daemon   := daemon
+DIR_sim      := sim-bridge
+DIR_bench    := bench
+DIR_dxl      := tools/dxl
+DIR_top      := tools/top
+DIR_analyze  := tools/analyze
+
+# programs: binary name -> component, and the libraries each links (in order)
+PROG_undulated        := daemon
+PROG_undulate-sim     := sim
+PROG_dxl              := dxl
+PROG_undulate-top     := top
+PROG_undulate-analyze := analyze
+PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze
+DEPS_daemon   := daemon protocol
+DEPS_sim      := sim protocol
+DEPS_dxl      := dxl protocol
+DEPS_top      := top protocol
+DEPS_analyze  := analyze protocol
+DEPS_bench    := bench protocol
+DEPS_protocol := protocol
+
+srcs_of   = $(foreach d,$(DIR_$(1)),$(wildcard $(d)/*.c))
+libsrcs_of = $(filter-out %/main.c,$(call srcs_of,$(1)))
+objs      = $(patsubst %.c,$(OBJ)/%.o,$(1))
+libs_of   = $(foreach c,$(DEPS_$(1)),$(LIB)/lib$(c).a)
+
+# ---- lcmtypes ---------------------------------------------------------------
+LCM_SRC  := $(wildcard lcmtypes/*.lcm)
+LCM_STAMP := $(GEN)/.stamp
+# lcm-gen names files <package>_<type>.c; the package is `undulate`.
+LCM_GEN_C = $(wildcard $(GEN)/*.c)
+
+.PHONY: all deps test test-long bench demo fuzz spy-jar spy install uninstall clean lcmtypes
+all: $(foreach p,$(PROGRAMS),$(BIN)/$(p)) unit-tests
+
+$(LCM_STAMP): $(LCM_SRC)
+	@mkdir -p $(GEN)
+	@rm -f $(GEN)/*.c $(GEN)/*.h
+	lcm-gen -c --c-cpath $(GEN) --c-hpath $(GEN) $(LCM_SRC)
+	@touch $@
+lcmtypes: $(LCM_STAMP)
+
+# The generated file list is only known after lcm-gen ran: build the library
+# through a recursive step so the wildcard is evaluated afterwards.
+$(LIB)/liblcmtypes.a: $(LCM_STAMP)
+	@$(MAKE) --no-print-directory lcmtypes-lib
+
+.PHONY: lcmtypes-lib
+lcmtypes-lib:
+	@mkdir -p $(OBJ)/lcmgen $(LIB)
+	@set -e; for c in $(GEN)/*.c; do \
+	  o=$(OBJ)/lcmgen/$$(basename $$c .c).o; \
+	  if [ ! -f $$o ] || [ $$c -nt $$o ]; then \
+	    echo "CC (lcm-gen) $$c"; \
+	    $(CC) $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS) -I$(GEN) $(GEN_WARN) -c $$c -o $$o; \
+	  fi; \
+	done; \
+	rm -f $(LIB)/liblcmtypes.a; ar rcs $(LIB)/liblcmtypes.a $(OBJ)/lcmgen/*.o
+
+# ---- objects and libraries --------------------------------------------------
+$(OBJ)/%.o: %.c $(LCM_STAMP)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(WARN) -c $< -o $@
+
+define component_lib
+$(LIB)/lib$(1).a: $(call objs,$(call libsrcs_of,$(1)))
+	@mkdir -p $(LIB)
+	@rm -f $$@
+	ar rcs $$@ $$^
+endef
+$(foreach c,$(COMPONENTS),$(eval $(call component_lib,$(c))))
+
+# The protocol framing must stay pure: no I/O, no clock (STYLE.md).
+.PHONY: check-pure
+check-pure:
+	@! grep -nE '#include <(unistd|libserialport|time|poll|fcntl|termios)\.h>|clock_gettime' protocol/*.c protocol/*.h \
+	  || { echo "protocol/ framing must not do I/O or read a clock (use protocol/io/)"; exit 1; }
+
+define program
+$(BIN)/$(1): $(OBJ)/$(firstword $(DIR_$(PROG_$(1))))/main.o $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a
+	@mkdir -p $(BIN)
+	$(CC) $(LDFLAGS) -o $$@ $$< $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a $(LDLIBS)
+endef
+$(foreach p,$(PROGRAMS),$(eval $(call program,$(p))))
+
+# ---- unit tests ---------------------------------------------------------------
+# tests/unit/test_<component>_<what>.c: one cmocka program each, linked against
+# that component's libraries (e.g. test_sim_world.c -> libsim.a libprotocol.a).
+# tests/unit/*.c not named test_* are shared helpers linked into every test.
+UNIT_SRC   := $(wildcard tests/unit/test_*.c)
+UNIT_BINS  := $(patsubst tests/unit/%.c,$(BUILD)/tests/%,$(UNIT_SRC))
+TEST_HELPERS := $(call objs,$(filter-out tests/unit/test_%.c,$(wildcard tests/unit/*.c)))
+.PHONY: unit-tests
+unit-tests: $(UNIT_BINS)
+test_component = $(word 2,$(subst _, ,$(1)))
+
+define unit_test
+$(BUILD)/tests/$(1): $(OBJ)/tests/unit/$(1).o $(TEST_HELPERS) $(call libs_of,$(call test_component,$(1))) $(LIB)/liblcmtypes.a
+	@mkdir -p $$(dir $$@)
+	$(CC) $(LDFLAGS) -o $$@ $$< $(TEST_HELPERS) $(call libs_of,$(call test_component,$(1))) $(LIB)/liblcmtypes.a $(LDLIBS) -lcmocka
+endef
+$(foreach t,$(patsubst tests/unit/%.c,%,$(UNIT_SRC)),$(eval $(call unit_test,$(t))))
+
+# ---- entry points -----------------------------------------------------------
+deps:
+	@scripts/deps.sh
+
+test: deps
+	@$(MAKE) --no-print-directory check-pure all
+	@BUILD=$(BUILD) tests/run.sh
+
+test-long: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) TEST_LONG=1 tests/run.sh
+
+bench: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bench/run.sh
+
+DEMO_SECONDS ?=
+demo: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) scripts/demo.sh
+
+# libFuzzer: clang only, its own build directory.
+fuzz:
+	@$(MAKE) --no-print-directory lcmtypes
+	@mkdir -p $(BUILD)/fuzz
+	clang $(STD) -g -O1 -fsanitize=fuzzer,address,undefined $(CPPFLAGS) -MF /dev/null \
+	  tests/fuzz/fuzz_parser.c protocol/*.c -o $(BUILD)/fuzz/fuzz_parser -lm
+	@echo "run: $(BUILD)/fuzz/fuzz_parser -max_total_time=60"
+
+# lcm-spy needs our types in a jar: javac + lcm.jar (liblcm-java).
+LCM_JAR ?= /usr/share/java/lcm.jar
+spy-jar: $(BUILD)/undulate-types.jar
+$(BUILD)/undulate-types.jar: $(LCM_SRC)
+	@command -v javac >/dev/null || { echo "spy-jar: javac not found (apt-get install default-jdk-headless)"; exit 1; }
+	@rm -rf $(BUILD)/java && mkdir -p $(BUILD)/java/src $(BUILD)/java/classes
+	lcm-gen -j --jpath $(BUILD)/java/src $(LCM_SRC)
+	javac -nowarn -cp $(LCM_JAR) -d $(BUILD)/java/classes $$(find $(BUILD)/java/src -name '*.java')
+	jar cf $@ -C $(BUILD)/java/classes .
+
+spy: spy-jar
+	@scripts/spy.sh $(BUILD)/undulate-types.jar
+
+install: all
+	@PREFIX=$(PREFIX) DESTDIR=$(DESTDIR) BUILD=$(BUILD) scripts/install.sh install
+uninstall:
+	@PREFIX=$(PREFIX) DESTDIR=$(DESTDIR) BUILD=$(BUILD) scripts/install.sh uninstall
+
+clean:
+	rm -rf build build-san
+
+-include $(shell find $(OBJ) -name '*.d' 2>/dev/null)

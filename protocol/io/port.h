@@ -1,0 +1,75 @@
+/*
+ * port.h — serial transports for the Dynamixel bus (the I/O half of protocol/).
+ *
+ * Two backends behind one interface:
+ *  - libserialport for real ports (enumeration with USB VID/PID, 8N1 at any
+ *    Dynamixel baud including 1 Mbps, flush);
+ *  - a raw termios fd for pseudo-terminals, which libserialport 0.1.1 cannot
+ *    open (it wants a sysfs entry and TIOCMGET). The simulator's buses are ptys.
+ * Either way the fd is non-blocking so the caller can poll() it in its own loop.
+ */
+#ifndef UNDULATE_PORT_H
+#define UNDULATE_PORT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "bus.h"
+
+struct port; /* opaque */
+
+enum port_backend { PORT_BACKEND_TERMIOS, PORT_BACKEND_SERIALPORT };
+
+struct port_options {
+	long baud;                  /* bps; must be a rate the backend can set */
+	bool force_termios;         /* use the termios backend even for a real tty */
+	bool low_latency;           /* try to set the FTDI latency timer to 1 ms */
+};
+
+/* Open path (a device or a symlink to one). On failure returns NULL and
+ * writes one clear line into err. */
+struct port *port_open(const char *path, const struct port_options *opt, char *err, size_t errcap);
+void port_close(struct port *p);
+int port_fd(const struct port *p);
+const char *port_path(const struct port *p);
+enum port_backend port_backend(const struct port *p);
+int port_set_baud(struct port *p, long baud);
+long port_baud(const struct port *p);
+/* Non-blocking read: >= 0 bytes, or DXL_E_IO / DXL_E_DISCONNECTED (EIO, HUP, EOF). */
+long port_read(struct port *p, uint8_t *buf, size_t cap);
+/* Write everything (waits for the fd to drain if needed). */
+int port_write(struct port *p, const uint8_t *buf, size_t n);
+/* Wait up to timeout_us for input: 1 readable, 0 timeout, negative error. */
+int port_wait(struct port *p, uint32_t timeout_us);
+void port_flush_input(struct port *p);
+/* Fill a bus_io that drives this port (clock: CLOCK_MONOTONIC). */
+void port_bus_io(struct port *p, struct bus_io *io);
+uint64_t port_now_us(void);
+
+/* ---- adapter latency (FTDI) -------------------------------------------------- */
+struct port_latency {
+	bool known;                 /* found a latency_timer for this tty */
+	int timer_ms;               /* its value (FTDI default 16) */
+	bool lowered;               /* we set it to 1 (or ASYNC_LOW_LATENCY) */
+	char note[160];             /* human-readable outcome, e.g. why it stays at 16 */
+};
+/* Inspect (and if `lower`, try to lower) the adapter latency behind path. The
+ * sysfs file is /sys/bus/usb-serial/devices/<tty>/latency_timer. */
+void port_latency_check(const char *path, bool lower, struct port_latency *out);
+
+/* ---- enumeration ------------------------------------------------------------- */
+struct port_info {
+	char path[128];
+	char description[128];
+	char serial[64];            /* USB serial number, "" if none */
+	int usb_vid, usb_pid;       /* -1 when not a USB device */
+	const char *adapter;        /* "U2D2", "USB2Dynamixel", "USB2AX" or NULL */
+};
+/* Fill up to cap entries; returns the number of ports found (may exceed cap),
+ * or a negative dxl_status. */
+int port_list(struct port_info *out, size_t cap);
+/* Name of a known Dynamixel adapter for a VID:PID, or NULL. */
+const char *port_adapter_name(int vid, int pid);
+
+#endif

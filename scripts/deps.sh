@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian packages undulate needs, when they are missing.
+# As root: runs apt-get. Otherwise: prints the exact command and stops.
+set -eu
+# build + runtime: compiler, LCM (pkg-config lcm needs glib's .pc), serial
+# ports, config parsing (inih), unit tests (cmocka); tests and tools: socat,
+# gnuplot for plots, cyclictest for the jitter benchmark, tmux for the demo.
+need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
+      libinih-dev libcmocka-dev gnuplot-nox rt-tests procps)
+[ -n "${DEPS_EXTRA:-}" ] && need+=($DEPS_EXTRA)
+missing=()
+for p in "${need[@]}"; do
+	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q '^install ok installed' || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+cmd="apt-get install -y --no-install-recommends ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+	echo "undulate needs these Debian packages: ${missing[*]}" >&2
+	echo "run:  sudo apt-get update && sudo $cmd" >&2
+	exit 1
+fi
+echo "installing: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -1,0 +1,74 @@
+# tests/lib.sh — shared by the integration tests (source it).
+#
+#   tap_ok NAME / tap_fail NAME [WHY] / tap_check NAME CMD...   -> TAP lines
+#   spawn NAME CMD...      start a background process; its PID is remembered
+#                          and killed by the EXIT trap; stdout+stderr -> $T/NAME.log
+#   wait_for TIMEOUT_S CMD...   poll (every 20 ms) until CMD succeeds
+#   wait_log NAME REGEX [TIMEOUT_S]  poll a spawned process's log for a line
+#   lcm_url PORT           udpm URL on its own multicast port, ttl=0
+#
+# Every test uses its own multicast port so tests never hear each other.
+# Port ranges: protocol 7600-7649, sim 7650-7699, daemon 7700-7749,
+# tools 7750-7799, systemd 7800-7849, end-to-end 7850-7899, bench 7900-7949.
+set -u
+top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+BUILD=${BUILD:-$top/build}
+case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
+B="$BUILD/bin"
+T=$(mktemp -d "${TMPDIR:-/tmp}/undulate-test.XXXXXX")
+_pids=()
+_tap_n=0
+_tap_failed=0
+
+_cleanup() {
+	local pid
+	for pid in "${_pids[@]}"; do kill -TERM "$pid" 2>/dev/null; done
+	for pid in "${_pids[@]}"; do
+		for _ in $(seq 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.02; done
+		kill -KILL "$pid" 2>/dev/null
+		wait "$pid" 2>/dev/null
+	done
+	[ -n "${KEEP_TEST_DIR:-}" ] || rm -rf "$T"
+}
+trap _cleanup EXIT
+trap 'exit 130' INT TERM
+
+tap_ok()   { _tap_n=$((_tap_n + 1)); echo "ok $_tap_n - $1"; }
+tap_fail() {
+	_tap_n=$((_tap_n + 1)); _tap_failed=$((_tap_failed + 1))
+	echo "not ok $_tap_n - $1"
+	[ $# -gt 1 ] && echo "# ${2//$'\n'/$'\n'# }"
+	return 0
+}
+tap_check() { local name=$1; shift; if "$@"; then tap_ok "$name"; else tap_fail "$name" "command failed: $*"; fi; }
+tap_done() { echo "1..$_tap_n"; [ "$_tap_failed" -eq 0 ]; }
+
+spawn() {
+	local name=$1; shift
+	"$@" >"$T/$name.log" 2>&1 &
+	local pid=$!
+	_pids+=("$pid")
+	eval "pid_${name//[^A-Za-z0-9_]/_}=$pid"
+}
+# stop NAME [SIGNAL]: signal a spawned process and wait for it; prints its exit status.
+stop() {
+	local var="pid_${1//[^A-Za-z0-9_]/_}" sig=${2:-TERM}
+	local pid=${!var}
+	kill -"$sig" "$pid" 2>/dev/null
+	local rc=0
+	wait "$pid" 2>/dev/null || rc=$?
+	echo "$rc"
+}
+alive() { local var="pid_${1//[^A-Za-z0-9_]/_}"; kill -0 "${!var}" 2>/dev/null; }
+
+wait_for() {
+	local timeout=$1; shift
+	local deadline=$(( $(date +%s%N) + timeout * 1000000000 ))
+	until "$@" >/dev/null 2>&1; do
+		[ "$(date +%s%N)" -lt "$deadline" ] || return 1
+		sleep 0.02
+	done
+}
+wait_log() { wait_for "${3:-10}" grep -qE "$2" "$T/$1.log"; }
+
+lcm_url() { echo "udpm://239.255.76.67:$1?ttl=0"; }
