@@ -73,6 +73,8 @@ enum bus_step_result {
 };
 
 #define BUS_NSERVOS 254
+/* Echo bytes remembered: a reply-less request's echo plus the next request. */
+#define BUS_ECHO_QUEUE (2 * DXL_MAX_PACKET)
 
 struct bus {
 	struct bus_io io;
@@ -83,15 +85,27 @@ struct bus {
 	bool pending;
 	uint8_t req_id, req_instr;
 	int expect_params;         /* parameter count the reply must have; -1 = no reply */
-	size_t echo_left;          /* echoed bytes still to discard */
-	uint8_t echo_buf[DXL_MAX_PACKET];
-	size_t echo_len;
+	/* Echo cancelling: bytes written and not yet read back, in order. A request
+	 * that expects no reply returns at once, so its echo may still be on its
+	 * way when the next request starts: the queue holds up to two packets. */
+	size_t echo_left;          /* echoed bytes still to discard (the queue's tail) */
+	uint8_t echo_buf[BUS_ECHO_QUEUE];
+	size_t echo_len;           /* bytes in echo_buf; the first echo_len - echo_left matched */
 	uint64_t started_us, deadline_us;
 	struct dxl_packet reply;
+	/* The request as written. With echo off, a packet identical to it may be
+	 * an unexpected echo — or a genuine reply (a PING answered with the
+	 * input-voltage bit reads FF FF ID 02 01 CHK both ways): it is held in
+	 * `reply` and delivered only if nothing else comes before the deadline. */
+	uint8_t req_buf[DXL_MAX_PACKET];
+	size_t req_len;
+	bool reply_held;
 	/* counters */
 	struct bus_servo_stats servo[BUS_NSERVOS];
 	uint32_t stray_packets;    /* packets nobody asked for */
 	uint32_t io_errors;
+	uint32_t echo_errors;      /* echo cancelling saw other bytes than sent */
+	uint32_t unexpected_echoes; /* echo off, yet our request came back: wiring echoes? */
 	uint64_t bytes_out, bytes_in;
 };
 

@@ -26,6 +26,11 @@
 #define DXL_MAX_PARAMS   (DXL_MAX_LEN - 2)
 #define DXL_MAX_PACKET   (DXL_MAX_LEN + 4)   /* bytes on the wire, header included */
 #define DXL_HEADER_BYTES 4                    /* FF FF ID LEN */
+/* Our encoders write at most 250 bytes a packet (ROBOTIS's SDK buffer size;
+ * a SYNC_WRITE of 4 bytes per servo then fits 48 servos). The parser still
+ * accepts anything up to DXL_MAX_PACKET. */
+#define DXL_MAX_TX_PACKET 250
+#define DXL_MAX_TX_PARAMS (DXL_MAX_TX_PACKET - 6)
 
 /* Instructions. REBOOT and BULK_READ do not exist on the AX-12 (MX/X only). */
 enum dxl_instruction {
@@ -146,8 +151,13 @@ void dxl_parser_init(struct dxl_parser *p, enum dxl_parse_kind kind);
 void dxl_parser_reset(struct dxl_parser *p);
 /*
  * Feed up to n bytes. Returns DXL_NEED_MORE, DXL_FRAME or a negative error;
- * *used tells how many of the n bytes were consumed (call again with the rest
- * after a frame or an error). Resync rule (ROBOTIS's good part): reject a
+ * *used tells how many of the n bytes were consumed. After a frame or an error
+ * call again with the rest — even when the rest is empty — until it returns
+ * DXL_NEED_MORE: after an error the bytes still buffered may already hold a
+ * whole packet (e.g. one inside a damaged packet's parameters). A frame is
+ * reported the moment its last byte is fed; *used never runs past it.
+ * Invariant: bytes fed = bytes of frames delivered + bytes_dropped + have.
+ * Resync rule (ROBOTIS's good part): reject a
  * header whose ID > 0xFD (0xFE allowed for instructions), LEN > 250 or < 2,
  * or (status) error byte > 0x7F; drop one byte, rescan what is buffered.
  */

@@ -1,0 +1,484 @@
+/*
+ * bus.c — Dynamixel 1.0 transactions over struct bus_io.
+ *
+ * Pure like the framing: time comes only from io->now_us, waiting only through
+ * io->wait (in the blocking wrappers). The asynchronous core is bus_begin /
+ * bus_step; the blocking calls are a loop of bus_step and io->wait.
+ */
+#include "bus.h"
+
+#include <string.h>
+
+/* 8N1: start bit, 8 data bits, stop bit. */
+#define BUS_BITS_PER_BYTE 10u
+/* Used when the timing names no baud: the AX-12's factory rate. */
+#define BUS_DEFAULT_BAUD 1000000L
+/* Bytes read from the transport per call in bus_step (a status packet is at
+ * most DXL_MAX_PACKET; more is simply read on the next turn of the loop). */
+#define BUS_READ_CHUNK 256
+/* Wire bytes of a packet with n parameters: FF FF ID LEN CODE ... CHK. */
+#define BUS_PACKET_BYTES(n) ((size_t)(n) + 6u)
+
+void bus_init(struct bus *b, const struct bus_io *io, const struct bus_timing *timing, bool echo)
+{
+	memset(b, 0, sizeof *b);
+	if (io)
+		b->io = *io;
+	if (timing)
+		b->timing = *timing;
+	b->echo = echo;
+	b->expect_params = -1;
+	dxl_parser_init(&b->parser, DXL_PARSE_STATUS);
+}
+
+void bus_set_timing(struct bus *b, const struct bus_timing *timing)
+{
+	if (timing)
+		b->timing = *timing;
+}
+
+uint32_t bus_wire_time_us(const struct bus *b, size_t nbytes)
+{
+	uint64_t baud = b->timing.baud > 0 ? (uint64_t)b->timing.baud : (uint64_t)BUS_DEFAULT_BAUD;
+	uint64_t bits = (uint64_t)nbytes * BUS_BITS_PER_BYTE;
+	/* rounded up: a timeout must never be shorter than the wire time */
+	return (uint32_t)((bits * 1000000u + baud - 1) / baud);
+}
+
+uint32_t bus_timeout_us(const struct bus *b, size_t req_bytes, size_t reply_bytes)
+{
+	return bus_wire_time_us(b, req_bytes + reply_bytes) + b->timing.return_delay_us +
+	       b->timing.adapter_latency_us + b->timing.margin_us;
+}
+
+void bus_reset_stats(struct bus *b)
+{
+	memset(b->servo, 0, sizeof b->servo);
+	b->stray_packets = 0;
+	b->io_errors = 0;
+	b->echo_errors = 0;
+	b->bytes_out = 0;
+	b->bytes_in = 0;
+}
+
+/* ---- echo cancelling -------------------------------------------------------- */
+
+static void bus_echo_clear(struct bus *b)
+{
+	b->echo_len = 0;
+	b->echo_left = 0;
+}
+
+/* Remember bytes just written; they must come back before anything else. */
+static void bus_echo_push(struct bus *b, const uint8_t *pkt, size_t n)
+{
+	if (!b->echo)
+		return;
+	size_t matched = b->echo_len - b->echo_left;
+	memmove(b->echo_buf, b->echo_buf + matched, b->echo_left);
+	b->echo_len = b->echo_left;
+	if (b->echo_len + n > sizeof b->echo_buf) {
+		/* an older echo never came back (wiring without echo?): forget it;
+		 * if it arrives after all, the mismatch is reported then */
+		bus_echo_clear(b);
+	}
+	memcpy(b->echo_buf + b->echo_len, pkt, n);
+	b->echo_len += n;
+	b->echo_left += n;
+}
+
+/* Match received bytes against the echo queue. Returns how many of the n
+ * bytes were echo (discarded), or DXL_E_ECHO on the first differing byte. */
+static long bus_echo_eat(struct bus *b, const uint8_t *data, size_t n)
+{
+	size_t i = 0;
+	while (i < n && b->echo_left > 0) {
+		if (data[i] != b->echo_buf[b->echo_len - b->echo_left]) {
+			b->echo_errors++;
+			bus_echo_clear(b);
+			return DXL_E_ECHO;
+		}
+		b->echo_left--;
+		i++;
+	}
+	if (b->echo_left == 0)
+		b->echo_len = 0;
+	return (long)i;
+}
+
+/* Before a request: read back what already arrived of an earlier request's
+ * echo, so that flushing cannot cut an echo in half. */
+static int bus_echo_drain(struct bus *b)
+{
+	uint8_t chunk[BUS_READ_CHUNK];
+	while (b->echo_left > 0) {
+		size_t want = b->echo_left < sizeof chunk ? b->echo_left : sizeof chunk;
+		long got = b->io.read(b->io.ctx, chunk, want);
+		if (got < 0) {
+			b->io_errors++;
+			return (int)got;
+		}
+		if (got == 0)
+			return DXL_OK;
+		b->bytes_in += (uint64_t)got;
+		long r = bus_echo_eat(b, chunk, (size_t)got);
+		if (r < 0)
+			return (int)r;
+	}
+	return DXL_OK;
+}
+
+/* ---- sending ------------------------------------------------------------------ */
+
+/* Stale input goes before a request; kept only while an echo is still due. */
+static int bus_prepare(struct bus *b)
+{
+	if (b->pending)
+		return DXL_E_BUSY;
+	int r = bus_echo_drain(b);
+	if (r == DXL_E_ECHO && b->io.flush_input)
+		b->io.flush_input(b->io.ctx);
+	if (r < 0)
+		return r;
+	if (b->echo_left == 0 && b->io.flush_input)
+		b->io.flush_input(b->io.ctx);
+	dxl_parser_reset(&b->parser);
+	return DXL_OK;
+}
+
+static int bus_send(struct bus *b, const uint8_t *pkt, size_t n)
+{
+	int r = b->io.write(b->io.ctx, pkt, n);
+	if (r < 0) {
+		b->io_errors++;
+		return r;
+	}
+	b->bytes_out += n;
+	bus_echo_push(b, pkt, n);
+	return DXL_OK;
+}
+
+int bus_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, size_t nparams,
+              int reply_params)
+{
+	uint8_t pkt[DXL_MAX_PACKET];
+	if (reply_params > DXL_MAX_PARAMS)
+		return DXL_E_ARG;
+	/* a broadcast is never answered (a broadcast PING is answered by every
+	 * servo at once: a collision, not a reply); SYNC_WRITE is always broadcast */
+	if (id == DXL_BROADCAST_ID || instr == DXL_INST_SYNC_WRITE)
+		reply_params = -1;
+	int n = dxl_encode_instruction(pkt, sizeof pkt, id, instr, params, nparams);
+	if (n < 0)
+		return n;
+	int r = bus_prepare(b);
+	if (r < 0)
+		return r;
+	uint64_t now = b->io.now_us(b->io.ctx);
+	r = bus_send(b, pkt, (size_t)n);
+	if (r < 0)
+		return r;
+	if (reply_params < 0)
+		return DXL_OK;
+	memcpy(b->req_buf, pkt, (size_t)n);
+	b->req_len = (size_t)n;
+	b->reply_held = false;
+	b->pending = true;
+	b->req_id = id;
+	b->req_instr = instr;
+	b->expect_params = reply_params;
+	b->started_us = now;
+	b->deadline_us = now + bus_timeout_us(b, (size_t)n, BUS_PACKET_BYTES(reply_params));
+	b->servo[id].transactions++;
+	return DXL_OK;
+}
+
+int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n)
+{
+	if (pkt == NULL || n == 0 || n > DXL_MAX_PACKET)
+		return DXL_E_ARG;
+	int r = bus_prepare(b);
+	if (r < 0)
+		return r;
+	return bus_send(b, pkt, n);
+}
+
+/* ---- receiving ------------------------------------------------------------------ */
+
+static void bus_finish(struct bus *b)
+{
+	b->pending = false;
+	b->expect_params = -1;
+	b->reply_held = false;
+}
+
+/* Is this packet byte for byte the request we sent (read as a status)? */
+static bool bus_is_own_request(const struct bus *b, const struct dxl_packet *pkt)
+{
+	return b->req_len == BUS_PACKET_BYTES(pkt->nparams) && pkt->id == b->req_buf[2] &&
+	       pkt->code == b->req_buf[4] && memcmp(pkt->params, b->req_buf + 5, pkt->nparams) == 0;
+}
+
+/* A whole packet arrived while a request is pending: check it against the
+ * request (libmodbus's check_confirmation). */
+static int bus_match(struct bus *b, const struct dxl_packet *pkt, uint64_t now,
+                     struct dxl_packet *reply)
+{
+	struct bus_servo_stats *st = &b->servo[b->req_id];
+	int expect_params = b->expect_params;
+	bus_finish(b);
+	if (pkt->id != b->req_id) {
+		st->wrong_id++;
+		return DXL_E_WRONG_ID;
+	}
+	if (pkt->nparams != expect_params) {
+		st->wrong_length++;
+		return DXL_E_WRONG_LENGTH;
+	}
+	uint32_t rtt = (uint32_t)(now - b->started_us);
+	st->replies++;
+	st->rtt_last_us = rtt;
+	if (rtt > st->rtt_max_us)
+		st->rtt_max_us = rtt;
+	st->rtt_sum_us += rtt;
+	st->last_errbits = pkt->code;
+	st->errbits_seen |= pkt->code;
+	if (pkt->code)
+		st->error_replies++;
+	if (reply)
+		*reply = *pkt;
+	return DXL_OK;
+}
+
+/* Feed received bytes to the parser. Returns BUS_PENDING while the reply is
+ * incomplete, else the transaction's outcome; packets beyond the reply are
+ * counted as strays. */
+static int bus_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t now,
+                       struct dxl_packet *reply)
+{
+	int outcome = BUS_PENDING;
+	struct dxl_packet pkt;
+	size_t off = 0;
+	for (;;) {
+		size_t used = 0;
+		int r = dxl_parser_feed(&b->parser, data + off, n - off, &used, &pkt);
+		off += used;
+		if (r == DXL_NEED_MORE)
+			break;
+		if (r == DXL_FRAME) {
+			if (!b->pending) {
+				b->stray_packets++;
+			} else if (!b->echo && !b->reply_held && bus_is_own_request(b, &pkt)) {
+				b->reply_held = true;
+				b->reply = pkt;
+			} else {
+				if (b->reply_held)
+					b->unexpected_echoes++;
+				outcome = bus_match(b, &pkt, now, reply);
+			}
+		} else if (b->pending) {
+			struct bus_servo_stats *st = &b->servo[b->req_id];
+			if (r == DXL_E_CHECKSUM) {
+				/* the reply is damaged; waiting longer cannot repair it */
+				st->checksum_errors++;
+				bus_finish(b);
+				outcome = DXL_E_CHECKSUM;
+			} else {
+				st->resyncs++;
+			}
+		}
+	}
+	return outcome;
+}
+
+int bus_step(struct bus *b, struct dxl_packet *reply)
+{
+	if (!b->pending)
+		return DXL_OK;
+	uint64_t now = b->io.now_us(b->io.ctx);
+	uint8_t chunk[BUS_READ_CHUNK];
+	int outcome = BUS_PENDING;
+	for (;;) {
+		long got = b->io.read(b->io.ctx, chunk, sizeof chunk);
+		if (got < 0) {
+			b->io_errors++;
+			bus_abort(b);
+			return (int)got;
+		}
+		if (got == 0)
+			break;
+		b->bytes_in += (uint64_t)got;
+		size_t off = 0;
+		long echoed = bus_echo_eat(b, chunk, (size_t)got);
+		if (echoed < 0) {
+			bus_abort(b);
+			return (int)echoed;
+		}
+		off = (size_t)echoed;
+		int r = bus_consume(b, chunk + off, (size_t)got - off, now, reply);
+		if (r != BUS_PENDING)
+			outcome = r;
+	}
+	if (outcome != BUS_PENDING)
+		return outcome;
+	if (now >= b->deadline_us && b->reply_held) {
+		/* nothing followed the packet that looked like our echo: it was the
+		 * reply (bus_match clears the hold, so copy it out first) */
+		struct dxl_packet held = b->reply;
+		return bus_match(b, &held, now, reply);
+	}
+	if (now >= b->deadline_us) {
+		b->servo[b->req_id].timeouts++;
+		bus_abort(b);
+		return DXL_E_TIMEOUT;
+	}
+	return BUS_PENDING;
+}
+
+uint64_t bus_deadline_us(const struct bus *b)
+{
+	return b->deadline_us;
+}
+
+bool bus_is_pending(const struct bus *b)
+{
+	return b->pending;
+}
+
+void bus_abort(struct bus *b)
+{
+	bus_finish(b);
+	/* whatever was half-read belongs to the abandoned request */
+	bus_echo_clear(b);
+	dxl_parser_reset(&b->parser);
+}
+
+/* ---- blocking calls --------------------------------------------------------------- */
+
+static int bus_wait_reply(struct bus *b, struct dxl_packet *reply)
+{
+	for (;;) {
+		int r = bus_step(b, reply);
+		if (r != BUS_PENDING)
+			return r;
+		uint64_t now = b->io.now_us(b->io.ctx);
+		uint64_t left = b->deadline_us > now ? b->deadline_us - now : 0;
+		int w = b->io.wait(b->io.ctx, (uint32_t)left);
+		if (w < 0) {
+			b->io_errors++;
+			bus_abort(b);
+			return w;
+		}
+	}
+}
+
+/* One request, its reply (if any) and the error byte. */
+static int bus_transact(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params,
+                        size_t nparams, int reply_params, struct dxl_packet *reply,
+                        uint8_t *errbits)
+{
+	if (errbits)
+		*errbits = 0;
+	reply->code = 0;
+	reply->nparams = 0;
+	int r = bus_begin(b, id, instr, params, nparams, reply_params);
+	if (r < 0 || !b->pending)
+		return r;
+	r = bus_wait_reply(b, reply);
+	if (r == DXL_OK && errbits)
+		*errbits = reply->code;
+	return r;
+}
+
+int bus_ping(struct bus *b, uint8_t id, uint8_t *errbits)
+{
+	struct dxl_packet reply;
+	return bus_transact(b, id, DXL_INST_PING, NULL, 0, 0, &reply, errbits);
+}
+
+int bus_read(struct bus *b, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out, uint8_t *errbits)
+{
+	if (id > DXL_MAX_ID || len == 0 || len > DXL_MAX_PARAMS || out == NULL)
+		return DXL_E_ARG;
+	struct dxl_packet reply;
+	const uint8_t params[2] = { addr, len };
+	int r = bus_transact(b, id, DXL_INST_READ, params, sizeof params, len, &reply, errbits);
+	if (r == DXL_OK)
+		memcpy(out, reply.params, len);
+	return r;
+}
+
+int bus_read_u8(struct bus *b, uint8_t id, uint8_t addr, uint8_t *v, uint8_t *errbits)
+{
+	return bus_read(b, id, addr, 1, v, errbits);
+}
+
+int bus_read_u16(struct bus *b, uint8_t id, uint8_t addr, uint16_t *v, uint8_t *errbits)
+{
+	uint8_t raw[2];
+	if (v == NULL)
+		return DXL_E_ARG;
+	int r = bus_read(b, id, addr, 2, raw, errbits);
+	if (r == DXL_OK)
+		*v = dxl_get_u16(raw);
+	return r;
+}
+
+static int bus_addr_data(struct bus *b, uint8_t id, uint8_t instr, uint8_t addr,
+                         const uint8_t *data, size_t n, bool expect_reply, uint8_t *errbits)
+{
+	uint8_t params[DXL_MAX_PARAMS];
+	if (data == NULL || n == 0 || n + 1 > sizeof params)
+		return DXL_E_ARG;
+	params[0] = addr;
+	memcpy(params + 1, data, n);
+	struct dxl_packet reply;
+	return bus_transact(b, id, instr, params, n + 1, expect_reply ? 0 : -1, &reply, errbits);
+}
+
+int bus_write(struct bus *b, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
+              bool expect_reply, uint8_t *errbits)
+{
+	return bus_addr_data(b, id, DXL_INST_WRITE, addr, data, n, expect_reply, errbits);
+}
+
+int bus_write_u8(struct bus *b, uint8_t id, uint8_t addr, uint8_t v, uint8_t *errbits)
+{
+	return bus_write(b, id, addr, &v, 1, true, errbits);
+}
+
+int bus_write_u16(struct bus *b, uint8_t id, uint8_t addr, uint16_t v, uint8_t *errbits)
+{
+	uint8_t raw[2];
+	dxl_put_u16(raw, v);
+	return bus_write(b, id, addr, raw, 2, true, errbits);
+}
+
+int bus_reg_write(struct bus *b, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
+                  bool expect_reply, uint8_t *errbits)
+{
+	return bus_addr_data(b, id, DXL_INST_REG_WRITE, addr, data, n, expect_reply, errbits);
+}
+
+int bus_action(struct bus *b, uint8_t id, uint8_t *errbits)
+{
+	struct dxl_packet reply;
+	return bus_transact(b, id, DXL_INST_ACTION, NULL, 0, 0, &reply, errbits);
+}
+
+int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
+                   const uint8_t *data, size_t n)
+{
+	uint8_t pkt[DXL_MAX_PACKET];
+	int r = dxl_encode_sync_write(pkt, sizeof pkt, addr, len, ids, data, n);
+	if (r < 0)
+		return r;
+	return bus_send_raw(b, pkt, (size_t)r);
+}
+
+int bus_factory_reset(struct bus *b, uint8_t id, bool expect_reply, uint8_t *errbits)
+{
+	struct dxl_packet reply;
+	return bus_transact(b, id, DXL_INST_FACTORY_RESET, NULL, 0, expect_reply ? 0 : -1, &reply,
+	                    errbits);
+}

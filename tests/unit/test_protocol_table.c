@@ -1,0 +1,272 @@
+/*
+ * test_protocol_table.c — the AX-12 control table: lookup, write checks,
+ * unit conversions and formatting, against the manual's numbers (ax12.md).
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <math.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "dxl.h"
+#include "dxl_table.h"
+
+#define PI 3.14159265358979323846
+
+static void test_lookup(void **state)
+{
+	(void)state;
+	const struct dxl_reg *r = dxl_reg_lookup("goal_position");
+	assert_non_null(r);
+	assert_int_equal(r->addr, 30);
+	assert_int_equal(r->size, 2);
+	assert_ptr_equal(dxl_reg_lookup("Goal-Position"), r);
+	assert_ptr_equal(dxl_reg_lookup("GOAL_POSITION"), r);
+	assert_ptr_equal(dxl_reg_lookup("30"), r);
+	assert_ptr_equal(dxl_reg_lookup("0x1e"), r);
+	assert_ptr_equal(dxl_reg_lookup("0X1E"), r);
+	assert_ptr_equal(dxl_reg_lookup("goal"), r);
+	assert_ptr_equal(dxl_reg_at(30), r);
+	/* aliases */
+	assert_int_equal(dxl_reg_lookup("temperature")->addr, 43);
+	assert_int_equal(dxl_reg_lookup("position")->addr, 36);
+	assert_int_equal(dxl_reg_lookup("baud")->addr, 4);
+	assert_int_equal(dxl_reg_lookup("return-delay")->addr, 5);
+	assert_int_equal(dxl_reg_lookup("torque")->addr, 24);
+	/* a leading zero is decimal, not octal */
+	assert_int_equal(dxl_reg_lookup("030")->addr, 30);
+	/* unknowns: a word's high byte, a gap, garbage, out of range */
+	assert_null(dxl_reg_lookup("31"));
+	assert_null(dxl_reg_at(31));
+	assert_null(dxl_reg_lookup("10"));
+	assert_null(dxl_reg_lookup("45"));
+	assert_null(dxl_reg_lookup("nonsense"));
+	assert_null(dxl_reg_lookup("30x"));
+	assert_null(dxl_reg_lookup("256"));
+	assert_null(dxl_reg_lookup(""));
+	assert_null(dxl_reg_lookup(NULL));
+	assert_null(dxl_reg_lookup("goal_positio"));
+}
+
+/* The table itself: every row inside the table, sorted, non-overlapping,
+ * RAM from address 24, and every row findable by its own name. */
+static void test_table_shape(void **state)
+{
+	(void)state;
+	assert_int_equal(dxl_ax12_nregs, 32);
+	int next_free = 0;
+	for (size_t i = 0; i < dxl_ax12_nregs; i++) {
+		const struct dxl_reg *r = &dxl_ax12_regs[i];
+		assert_true(r->size == 1 || r->size == 2);
+		assert_true(r->addr >= next_free);
+		assert_true(r->addr + r->size <= DXL_AX_TABLE_SIZE);
+		next_free = r->addr + r->size;
+		assert_int_equal(r->area, r->addr < DXL_AX_EEPROM_END ? DXL_AREA_EEPROM : DXL_AREA_RAM);
+		assert_ptr_equal(dxl_reg_lookup(r->name), r);
+		assert_ptr_equal(dxl_reg_at(r->addr), r);
+		assert_non_null(r->desc);
+		assert_true(r->min <= r->max);
+		if (r->size == 1)
+			assert_true(r->max <= 255);
+		if (r->def >= 0 && r->access == DXL_ACCESS_RW)
+			assert_int_equal(dxl_reg_check_write(r, r->def), DXL_OK);
+	}
+}
+
+/* Defaults and ranges from the manual. */
+static void test_table_values(void **state)
+{
+	(void)state;
+	static const struct {
+		const char *name;
+		uint8_t addr, size;
+		enum dxl_access access;
+		int32_t def;
+	} rows[] = {
+		{ "model_number", 0, 2, DXL_ACCESS_R, 12 },
+		{ "id", 3, 1, DXL_ACCESS_RW, 1 },
+		{ "baud_rate", 4, 1, DXL_ACCESS_RW, 1 },
+		{ "return_delay_time", 5, 1, DXL_ACCESS_RW, 250 },
+		{ "cw_angle_limit", 6, 2, DXL_ACCESS_RW, 0 },
+		{ "ccw_angle_limit", 8, 2, DXL_ACCESS_RW, 1023 },
+		{ "temperature_limit", 11, 1, DXL_ACCESS_RW, 70 },
+		{ "min_voltage_limit", 12, 1, DXL_ACCESS_RW, 60 },
+		{ "max_voltage_limit", 13, 1, DXL_ACCESS_RW, 140 },
+		{ "max_torque", 14, 2, DXL_ACCESS_RW, 1023 },
+		{ "status_return_level", 16, 1, DXL_ACCESS_RW, 2 },
+		{ "alarm_led", 17, 1, DXL_ACCESS_RW, 36 },
+		{ "alarm_shutdown", 18, 1, DXL_ACCESS_RW, 36 },
+		{ "torque_enable", 24, 1, DXL_ACCESS_RW, 0 },
+		{ "cw_compliance_slope", 28, 1, DXL_ACCESS_RW, 32 },
+		{ "present_position", 36, 2, DXL_ACCESS_R, -1 },
+		{ "present_load", 40, 2, DXL_ACCESS_R, -1 },
+		{ "present_temperature", 43, 1, DXL_ACCESS_R, -1 },
+		{ "registered", 44, 1, DXL_ACCESS_R, 0 },
+		{ "lock", 47, 1, DXL_ACCESS_RW, 0 },
+		{ "punch", 48, 2, DXL_ACCESS_RW, 32 },
+	};
+	for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
+		const struct dxl_reg *r = dxl_reg_lookup(rows[i].name);
+		assert_non_null(r);
+		assert_int_equal(r->addr, rows[i].addr);
+		assert_int_equal(r->size, rows[i].size);
+		assert_int_equal(r->access, rows[i].access);
+		assert_int_equal(r->def, rows[i].def);
+	}
+}
+
+static void test_check_write(void **state)
+{
+	(void)state;
+	const struct dxl_reg *goal = dxl_reg_lookup("goal_position");
+	assert_int_equal(dxl_reg_check_write(goal, 0), DXL_OK);
+	assert_int_equal(dxl_reg_check_write(goal, 1023), DXL_OK);
+	assert_int_equal(dxl_reg_check_write(goal, 1024), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(goal, -1), DXL_E_ARG);
+	/* read-only registers refuse any value */
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("present_position"), 512), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("model_number"), 12), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("present_temperature"), 30), DXL_E_ARG);
+	/* IDs: 253 is the largest, 254 is broadcast */
+	const struct dxl_reg *id = dxl_reg_lookup("id");
+	assert_int_equal(dxl_reg_check_write(id, 253), DXL_OK);
+	assert_int_equal(dxl_reg_check_write(id, 254), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("status_return_level"), 3), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("torque_enable"), 2), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("alarm_shutdown"), 0x80), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("min_voltage_limit"), 49), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(NULL, 0), DXL_E_ARG);
+}
+
+static void test_position(void **state)
+{
+	(void)state;
+	assert_true(fabs(dxl_pos_to_rad(512)) < 1e-12);
+	/* 0..1023 spans 300°: 0 is -512 units, 1023 is +511 units */
+	assert_true(fabs(dxl_pos_to_rad(0) - (-512.0 * 300.0 / 1023.0 * PI / 180.0)) < 1e-12);
+	assert_true(fabs(dxl_pos_to_rad(1023) - (511.0 * 300.0 / 1023.0 * PI / 180.0)) < 1e-12);
+	assert_true(fabs(dxl_pos_to_rad(0) - (-2.6205)) < 1e-3);
+	assert_int_equal(dxl_rad_to_pos(0.0), 512);
+	for (unsigned raw = 0; raw <= 1023; raw++)
+		assert_int_equal(dxl_rad_to_pos(dxl_pos_to_rad((uint16_t)raw)), raw);
+	assert_int_equal(dxl_rad_to_pos(100.0), 1023);
+	assert_int_equal(dxl_rad_to_pos(-100.0), 0);
+	assert_int_equal(dxl_rad_to_pos(NAN), 512);
+	assert_int_equal(dxl_rad_to_pos(INFINITY), 512);
+	/* positive is CCW, toward larger raw values */
+	assert_true(dxl_rad_to_pos(0.1) > 512);
+}
+
+static void test_speed_and_load(void **state)
+{
+	(void)state;
+	/* bit 10 is the direction: set = CW = negative */
+	assert_int_equal(dxl_speed_to_units(100), 100);
+	assert_int_equal(dxl_speed_to_units(0x400 | 100), -100);
+	assert_int_equal(dxl_speed_to_units(0x400), 0);
+	assert_int_equal(dxl_units_to_speed(-100), 0x400 | 100);
+	assert_int_equal(dxl_units_to_speed(100), 100);
+	assert_int_equal(dxl_units_to_speed(5000), 1023);
+	assert_int_equal(dxl_units_to_speed(-5000), 0x400 | 1023);
+	assert_int_equal(dxl_units_to_speed(-2147483647 - 1), 0x400 | 1023);
+	double rpm_unit = 0.111 * 2.0 * PI / 60.0;
+	assert_true(fabs(dxl_speed_to_rad_s(1023) - 1023 * rpm_unit) < 1e-9);
+	assert_true(fabs(dxl_speed_to_rad_s(0x400 | 1023) + 1023 * rpm_unit) < 1e-9);
+	assert_int_equal(dxl_rad_s_to_speed(-100 * rpm_unit), 0x400 | 100);
+	assert_int_equal(dxl_rad_s_to_speed(NAN), 0);
+	/* moving speed: never 0 (= maximum) by rounding a slow request */
+	assert_int_equal(dxl_rad_s_to_moving_speed(0.0), 1);
+	assert_int_equal(dxl_rad_s_to_moving_speed(200 * rpm_unit), 200);
+	assert_int_equal(dxl_rad_s_to_moving_speed(-200 * rpm_unit), 200);
+	assert_int_equal(dxl_rad_s_to_moving_speed(1e9), 1023);
+	assert_int_equal(dxl_rad_s_to_moving_speed(NAN), 1);
+	/* load: 0.1 % a unit, bit 10 = CW */
+	assert_true(fabs(dxl_load_to_fraction(500) - 0.5) < 1e-12);
+	assert_true(fabs(dxl_load_to_fraction(0x400 | 500) + 0.5) < 1e-12);
+	assert_int_equal(dxl_fraction_to_load(-0.25), 0x400 | 250);
+	assert_int_equal(dxl_fraction_to_load(2.0), 1023);
+	assert_int_equal(dxl_fraction_to_load(NAN), 0);
+}
+
+static void test_voltage_baud_delay(void **state)
+{
+	(void)state;
+	assert_true(fabs(dxl_voltage_to_volts(120) - 12.0) < 1e-9);
+	assert_true(fabs(dxl_voltage_to_volts(95) - 9.5) < 1e-9);
+	assert_int_equal(dxl_baud_from_reg(1), 1000000);
+	assert_int_equal(dxl_baud_from_reg(3), 500000);
+	assert_int_equal(dxl_baud_from_reg(16), 117647);
+	assert_int_equal(dxl_baud_from_reg(34), 57143);
+	assert_int_equal(dxl_baud_from_reg(103), 19231);
+	assert_int_equal(dxl_baud_from_reg(207), 9615);
+	uint8_t v = 0;
+	assert_int_equal(dxl_baud_to_reg(1000000, &v), DXL_OK);
+	assert_int_equal(v, 1);
+	assert_int_equal(dxl_baud_to_reg(57600, &v), DXL_OK);
+	assert_int_equal(v, 34);
+	assert_int_equal(dxl_baud_to_reg(115200, &v), DXL_OK);
+	assert_int_equal(v, 16);
+	assert_int_equal(dxl_baud_to_reg(9600, &v), DXL_OK);
+	assert_int_equal(v, 207);
+	assert_int_equal(dxl_baud_to_reg(2000000, &v), DXL_OK);
+	assert_int_equal(v, 0);
+	/* no register value within 3 % */
+	assert_int_equal(dxl_baud_to_reg(750000, &v), DXL_E_ARG);
+	assert_int_equal(dxl_baud_to_reg(3000000, &v), DXL_E_ARG);
+	assert_int_equal(dxl_baud_to_reg(0, &v), DXL_E_ARG);
+	assert_int_equal(dxl_baud_to_reg(100, &v), DXL_E_ARG);
+	assert_int_equal(dxl_return_delay_us(250), 500);
+	assert_int_equal(dxl_return_delay_us(0), 0);
+	assert_true(dxl_is_wheel_mode(0, 0));
+	assert_false(dxl_is_wheel_mode(0, 1023));
+}
+
+static void test_format(void **state)
+{
+	(void)state;
+	char buf[96];
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("goal_position"), 512, buf, sizeof buf),
+	                    "512 (150.1 deg)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("baud_rate"), 34, buf, sizeof buf),
+	                    "34 (57143 bps)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("return_delay_time"), 250, buf, sizeof buf),
+	                    "250 (500 us)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("present_voltage"), 121, buf, sizeof buf),
+	                    "121 (12.1 V)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("present_speed"), 0x400 | 100, buf,
+	                                   sizeof buf), "1124 (11.1 rpm CW)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("present_load"), 250, buf, sizeof buf),
+	                    "250 (25.0 % CCW)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("moving_speed"), 0, buf, sizeof buf),
+	                    "0 (maximum)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("alarm_shutdown"), 36, buf, sizeof buf),
+	                    "36 (overheating|overload)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("status_return_level"), 1, buf, sizeof buf),
+	                    "1 (ping + read)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("torque_enable"), 1, buf, sizeof buf),
+	                    "1 (on)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("present_temperature"), 32, buf,
+	                                   sizeof buf), "32 (32 C)");
+	assert_string_equal(dxl_reg_format(dxl_reg_lookup("id"), 7, buf, sizeof buf), "7");
+	/* a short buffer stays terminated */
+	dxl_reg_format(dxl_reg_lookup("goal_position"), 512, buf, 5);
+	assert_string_equal(buf, "512 ");
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_lookup),
+		cmocka_unit_test(test_table_shape),
+		cmocka_unit_test(test_table_values),
+		cmocka_unit_test(test_check_write),
+		cmocka_unit_test(test_position),
+		cmocka_unit_test(test_speed_and_load),
+		cmocka_unit_test(test_voltage_baud_delay),
+		cmocka_unit_test(test_format),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
