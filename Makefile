@@ -38,7 +38,7 @@ WARN     := -Wall -Wextra -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
             -Wpointer-arith -Wcast-qual -Wundef -Wvla -Wformat-security -Werror
 STD      := -std=c11 -D_DEFAULT_SOURCE -D_XOPEN_SOURCE=700
 OPT      ?= -O2 -g
-CPPFLAGS += -Iprotocol -Iprotocol/io -I$(GEN) -MMD -MP
+CPPFLAGS += -I. -Iprotocol -Iprotocol/io -I$(GEN) -MMD -MP
 CFLAGS   += $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS)
 LDFLAGS  += $(SANFLAGS)
 LDLIBS   += $(PKG_LIBS) -lm
@@ -63,7 +63,9 @@ PROG_undulate-sim     := sim
 PROG_dxl              := dxl
 PROG_undulate-top     := top
 PROG_undulate-analyze := analyze
-PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze
+ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze
+# Build only programs whose main.c exists (keeps partial trees buildable).
+PROGRAMS := $(foreach p,$(ALL_PROGRAMS),$(if $(wildcard $(firstword $(DIR_$(PROG_$(p))))/main.c),$(p)))
 DEPS_daemon   := daemon protocol
 DEPS_sim      := sim protocol
 DEPS_dxl      := dxl protocol

@@ -4,8 +4,11 @@
  * OSCILLATOR (the paper's limit cycle, integrated from the *measured* state):
  *     I ẍ_j = −k (x_j + λ_j x_other) + (c − μ x_j²) ẋ_j  [+ b·sgn(ẋ_j)]
  * Each cycle takes the measured (x, ẋ) of both joints, integrates the coupled
- * equations over the horizon (one control period, RK4 sub-steps), and returns
- * the angle to command. Never integrated open-loop from its own last state:
+ * equations over the horizon (one control period plus OSC_SERVO_LEAD_S, RK4
+ * sub-steps), and returns the angle to command. "Other" is the next joint in
+ * the chain; the last joint couples to the one before it (so with two joints
+ * each couples to the other); a single joint ignores λ. sgn is smoothed:
+ * tanh(ẋ / 0.05 rad/s). Never integrated open-loop from its own last state:
  * proprioception is what lets phases slip on contact.
  *
  * SINUSOID (the paper's clock-driven baseline):
@@ -30,34 +33,62 @@ struct osc_joint_params {
 	double friction;  /* b, N·m: friction compensation (0 = off) */
 };
 
-/* Defaults giving ≈0.8 Hz and ≈0.8 rad on the simulated robot (documented in osc.c). */
+/* What the daemon should pass as `horizon`: the measured dt plus this lead.
+ * The servo tracks the goal with a lag (≈ 27 ms on an AX-12 at compliance
+ * slope 32); integrating over one period only, the servo never reaches the
+ * predicted angle, the measured speed keeps falling short and the loop decays
+ * into the position quantum. Make it configurable: the right value depends on
+ * the servo's dynamics. See CONTROL.md for the measurements. */
+#define OSC_SERVO_LEAD_S 0.025
+/* Cut-off for osc_velocity_filter (on measured positions) with which the lead
+ * was chosen: a lower cut-off lags more and slows the closed loop down. */
+#define OSC_VELOCITY_CUTOFF_HZ 20.0
+
+/* Defaults giving ≈0.8 Hz and ≈0.8 rad (CONTROL.md has the measured numbers):
+ * two joints get λ = 1.5 (even joints) and −0.5 (odd joints), one joint λ = 0. */
 void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints);
 
 /* Integrate the coupled oscillator from measured state (x[j], v[j]) over
- * `horizon` seconds (normally the measured dt), using `substeps` RK4 steps.
+ * `horizon` seconds (the daemon passes measured dt + OSC_SERVO_LEAD_S), using
+ * `substeps` RK4 steps (clamped to 1..1000).
  * Writes the predicted angles into x_next (and speeds into v_next if not NULL).
- * Non-finite inputs give x_next = x (hold). Returns false if anything was non-finite. */
+ * Non-finite inputs or parameters (or inertia <= 0, horizon < 0) give x_next = x
+ * (hold; v_next = v, 0 where non-finite) and return false; so does a state that
+ * overflows during the integration. njoints 0 or > OSC_MAX_JOINTS: false, nothing written. */
 bool osc_step(const struct osc_joint_params *p, size_t njoints, const double *x, const double *v,
               double horizon, int substeps, double *x_next, double *v_next);
 
-/* The baseline: commanded angle of joint j at time t (s). */
+/* The baseline: commanded angle of joint j at time t (s). Non-finite arguments
+ * give a non-finite result: the caller checks before commanding it. */
 double osc_sinusoid(double amplitude, double frequency, double phase, size_t joint, double t);
 
-/* Phase of an oscillation from (x, ẋ): atan2(−ẋ/ω, x), in (−π, π]. */
+/* Phase of an oscillation from (x, ẋ): atan2(−ẋ/ω, x), in (−π, π]
+ * (x = A cos φ, ẋ = −Aω sin φ; φ grows with time). 0 for bad input or ω = 0. */
 double osc_phase(double x, double v, double omega);
-/* Wrap an angle into (−π, π]. */
+/* Wrap an angle into (−π, π]. Non-finite gives 0. */
 double osc_wrap(double a);
 
 /* Running estimate of amplitude and frequency from successive samples. */
 struct osc_estimator {
-	double amplitude;      /* rad, peak of |x| over recent half-cycles (smoothed) */
-	double frequency;      /* Hz, from upward zero crossings (0 until two seen) */
+	double amplitude;      /* rad, half the peak-to-peak of recent cycles (smoothed; 0 until one cycle) */
+	double frequency;      /* Hz, from upward crossings of the centre (0 until the fourth) */
 	double last_x;
 	double last_cross_t;
-	double peak;
+	double peak;           /* largest x since the last upward crossing */
 	bool have_last, have_cross;
+	/* added: robustness to a non-zero mean and to quantization noise */
+	double trough;         /* smallest x since the last upward crossing */
+	double centre;         /* rad, mid-point of the last cycle: crossings are counted about it */
+	double last_t;
+	bool centred;          /* centre comes from a whole cycle (not the first-cycle guess) */
+	bool last_cross_centred; /* the last crossing was timed against such a centre */
+	bool high;             /* x went above centre + hysteresis since the last crossing */
+	bool armed;            /* ... and then below centre − hysteresis: next upward crossing counts */
+	unsigned long rejected;  /* samples ignored: non-finite, or time not increasing */
 };
 void osc_estimator_init(struct osc_estimator *e);
+/* t in seconds, strictly increasing. Both estimates fall back to 0 when no
+ * cycle completes for three periods (the joint stopped or moved its centre). */
 void osc_estimator_update(struct osc_estimator *e, double x, double t);
 
 /* Velocity from positions: first-order low-pass of the finite difference
@@ -67,8 +98,11 @@ struct osc_velocity_filter {
 	double last_x;
 	double v;
 	bool primed;
+	unsigned long rejected;  /* samples ignored: non-finite x, or dt <= 0 / non-finite */
 };
 void osc_velocity_filter_init(struct osc_velocity_filter *f, double cutoff_hz);
+/* dt: seconds since the previous sample. The first sample primes (returns 0);
+ * dt <= 0 or non-finite keeps the previous speed; cut-off <= 0: raw difference. */
 double osc_velocity_filter_update(struct osc_velocity_filter *f, double x, double dt);
 
 #endif

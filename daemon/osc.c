@@ -1,0 +1,356 @@
+/*
+ * osc.c — the control laws (see osc.h and CONTROL.md). Pure: no clock, no I/O,
+ * no allocation. Every function survives any double it is given.
+ */
+#include "osc.h"
+
+#include <math.h>
+
+#define OSC_PI 3.14159265358979323846
+
+/*
+ * Default oscillator parameters. Target: 0.8 Hz, 0.8 rad on both joints of the
+ * two-joint robot with the paper's coupling λ = (1.5, −0.5), and on a single
+ * joint; tuned numerically by integrating the equation itself (measured state =
+ * previous prediction). Measured: 0.7997 Hz, 0.7985 / 0.7981 rad; single joint
+ * 0.8001 Hz, 0.8003 rad. Chains of more than two joints alternate the two
+ * joints' values, untuned. CONTROL.md explains how each number moves f and A.
+ */
+#define OSC_DEF_INERTIA 2.0e-3   /* kg·m²: a control parameter, order of the real link's */
+#define OSC_DEF_K       0.0557   /* N·m/rad: √(k/I)/2π = 0.84 Hz, 0.80 Hz once coupled */
+#define OSC_DEF_C       3.0e-3   /* N·m·s/rad: c/(I·ω) = 0.28, cycle reached in a few periods */
+#define OSC_DEF_MU0     0.108    /* N·m·s/rad³, joint 0: 0.80 rad once coupled */
+#define OSC_DEF_MU1     0.054    /* joint 1: half of joint 0's, equalises the amplitudes */
+#define OSC_DEF_K_SINGLE 0.0511  /* N·m/rad, single joint: 0.80 Hz uncoupled */
+#define OSC_DEF_MU_SINGLE 0.01875 /* single joint: 2√(c/μ) = 0.80 rad */
+#define OSC_DEF_LAMBDA0 1.5      /* paper: first joint */
+#define OSC_DEF_LAMBDA1 (-0.5)   /* paper: second joint */
+
+/* Width (rad/s) of the smooth sign used for friction compensation:
+ * sgn(v) ≈ tanh(v / band). A true step would make RK4's stages straddle a
+ * discontinuity at every reversal; 0.05 rad/s is four steps of the servo's
+ * speed reading (0.0116 rad/s each), too small to change the motion visibly. */
+#define OSC_FRICTION_BAND 0.05
+
+/* Largest number of RK4 sub-steps per call: bounds the work per cycle. */
+#define OSC_MAX_SUBSTEPS 1000
+
+void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints)
+{
+	p->k = OSC_DEF_K;
+	p->c = OSC_DEF_C;
+	p->mu = OSC_DEF_MU0;
+	p->inertia = OSC_DEF_INERTIA;
+	p->friction = 0.0;
+	if (njoints < 2) {
+		p->lambda = 0.0;   /* uncoupled: a van der Pol oscillator */
+		p->mu = OSC_DEF_MU_SINGLE;
+		p->k = OSC_DEF_K_SINGLE;
+	} else if (joint % 2 == 0) {
+		p->lambda = OSC_DEF_LAMBDA0;
+	} else {
+		p->lambda = OSC_DEF_LAMBDA1;
+		p->mu = OSC_DEF_MU1;
+	}
+}
+
+/* The joint whose angle couples into joint j: the next joint in the chain,
+ * and for the last joint the previous one (so two joints couple each other). */
+static size_t osc_other(size_t j, size_t njoints)
+{
+	return (j + 1 < njoints) ? j + 1 : j - 1;
+}
+
+/* ẍ for every joint at state (x, v). */
+static void osc_accel(const struct osc_joint_params *p, size_t njoints, const double *x,
+                      const double *v, double *a)
+{
+	for (size_t j = 0; j < njoints; j++) {
+		double coupled = (njoints >= 2) ? p[j].lambda * x[osc_other(j, njoints)] : 0.0;
+		double torque = -p[j].k * (x[j] + coupled) + (p[j].c - p[j].mu * x[j] * x[j]) * v[j];
+		if (p[j].friction != 0.0)
+			torque += p[j].friction * tanh(v[j] / OSC_FRICTION_BAND);
+		a[j] = torque / p[j].inertia;
+	}
+}
+
+static bool osc_all_finite(const double *a, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		if (!isfinite(a[i]))
+			return false;
+	return true;
+}
+
+static bool osc_params_ok(const struct osc_joint_params *p, size_t njoints)
+{
+	for (size_t j = 0; j < njoints; j++) {
+		const struct osc_joint_params *q = &p[j];
+		if (!isfinite(q->k) || !isfinite(q->c) || !isfinite(q->mu) || !isfinite(q->lambda) ||
+		    !isfinite(q->friction) || !isfinite(q->inertia) || !(q->inertia > 0.0))
+			return false;
+	}
+	return true;
+}
+
+/* One classical RK4 step of size h on (x, v), in place. */
+static void osc_rk4(const struct osc_joint_params *p, size_t n, double *x, double *v, double h)
+{
+	double k1x[OSC_MAX_JOINTS], k1v[OSC_MAX_JOINTS], k2x[OSC_MAX_JOINTS], k2v[OSC_MAX_JOINTS];
+	double k3x[OSC_MAX_JOINTS], k3v[OSC_MAX_JOINTS], k4x[OSC_MAX_JOINTS], k4v[OSC_MAX_JOINTS];
+	double tx[OSC_MAX_JOINTS], tv[OSC_MAX_JOINTS];
+	size_t j;
+
+	for (j = 0; j < n; j++)
+		k1x[j] = v[j];
+	osc_accel(p, n, x, v, k1v);
+	for (j = 0; j < n; j++) {
+		tx[j] = x[j] + 0.5 * h * k1x[j];
+		tv[j] = v[j] + 0.5 * h * k1v[j];
+		k2x[j] = tv[j];
+	}
+	osc_accel(p, n, tx, tv, k2v);
+	for (j = 0; j < n; j++) {
+		tx[j] = x[j] + 0.5 * h * k2x[j];
+		tv[j] = v[j] + 0.5 * h * k2v[j];
+		k3x[j] = tv[j];
+	}
+	osc_accel(p, n, tx, tv, k3v);
+	for (j = 0; j < n; j++) {
+		tx[j] = x[j] + h * k3x[j];
+		tv[j] = v[j] + h * k3v[j];
+		k4x[j] = tv[j];
+	}
+	osc_accel(p, n, tx, tv, k4v);
+	for (j = 0; j < n; j++) {
+		x[j] += h / 6.0 * (k1x[j] + 2.0 * k2x[j] + 2.0 * k3x[j] + k4x[j]);
+		v[j] += h / 6.0 * (k1v[j] + 2.0 * k2v[j] + 2.0 * k3v[j] + k4v[j]);
+	}
+}
+
+static void osc_hold(size_t njoints, const double *x, const double *v, double *x_next,
+                     double *v_next)
+{
+	for (size_t j = 0; j < njoints; j++) {
+		x_next[j] = x[j];
+		if (v_next)
+			v_next[j] = isfinite(v[j]) ? v[j] : 0.0;
+	}
+}
+
+bool osc_step(const struct osc_joint_params *p, size_t njoints, const double *x, const double *v,
+              double horizon, int substeps, double *x_next, double *v_next)
+{
+	double xs[OSC_MAX_JOINTS], vs[OSC_MAX_JOINTS];
+
+	if (njoints == 0 || njoints > OSC_MAX_JOINTS)
+		return false;
+	if (!osc_all_finite(x, njoints) || !osc_all_finite(v, njoints) || !isfinite(horizon) ||
+	    horizon < 0.0 || !osc_params_ok(p, njoints)) {
+		osc_hold(njoints, x, v, x_next, v_next);
+		return false;
+	}
+	if (substeps < 1)
+		substeps = 1;
+	if (substeps > OSC_MAX_SUBSTEPS)
+		substeps = OSC_MAX_SUBSTEPS;
+	for (size_t j = 0; j < njoints; j++) {
+		xs[j] = x[j];
+		vs[j] = v[j];
+	}
+	double h = horizon / substeps;
+	for (int s = 0; s < substeps; s++)
+		osc_rk4(p, njoints, xs, vs, h);
+	if (!osc_all_finite(xs, njoints) || !osc_all_finite(vs, njoints)) {
+		osc_hold(njoints, x, v, x_next, v_next);
+		return false;
+	}
+	for (size_t j = 0; j < njoints; j++) {
+		x_next[j] = xs[j];
+		if (v_next)
+			v_next[j] = vs[j];
+	}
+	return true;
+}
+
+double osc_sinusoid(double amplitude, double frequency, double phase, size_t joint, double t)
+{
+	return amplitude * sin(phase + (2.0 * OSC_PI / 3.0) * (double)joint - 2.0 * OSC_PI * frequency * t);
+}
+
+double osc_wrap(double a)
+{
+	if (!isfinite(a))
+		return 0.0;
+	double w = remainder(a, 2.0 * OSC_PI);   /* [−π, π] */
+	if (w <= -OSC_PI)
+		w += 2.0 * OSC_PI;
+	return w;
+}
+
+double osc_phase(double x, double v, double omega)
+{
+	if (!isfinite(x) || !isfinite(v) || !isfinite(omega) || omega == 0.0)
+		return 0.0;
+	return osc_wrap(atan2(-v / omega, x));
+}
+
+/* Hysteresis about the centre before an upward crossing counts: at least
+ * four AX-12 position steps (0.29° each) so quantization flicker near the centre
+ * never counts twice, and a tenth of the amplitude so sensor noise does not. */
+#define OSC_EST_HYST_MIN 0.02
+#define OSC_EST_HYST_FRAC 0.1
+/* No upward crossing for this many estimated periods (or, before a period is
+ * known, for OSC_EST_MAX_PERIOD_S): the joint stopped or its centre moved
+ * beyond the swing. Report 0 and look for the new centre. */
+#define OSC_EST_STALE_PERIODS 3.0
+#define OSC_EST_MAX_PERIOD_S 10.0
+/* Before the first whole cycle the extremes seen so far set the centre; they
+ * fade towards the present angle with this time constant so that a value
+ * held while the joint was stopped does not pin the centre outside the swing. */
+#define OSC_EST_FADE_S 1.0
+/* Weight of the newest cycle in the smoothed amplitude and frequency. */
+#define OSC_EST_SMOOTH 0.5
+
+void osc_estimator_init(struct osc_estimator *e)
+{
+	e->amplitude = 0.0;
+	e->frequency = 0.0;
+	e->last_x = 0.0;
+	e->last_cross_t = 0.0;
+	e->peak = -INFINITY;
+	e->trough = INFINITY;
+	e->centre = 0.0;
+	e->last_t = 0.0;
+	e->centred = false;
+	e->last_cross_centred = false;
+	e->high = false;
+	e->armed = false;
+	e->have_last = false;
+	e->have_cross = false;
+	e->rejected = 0;
+}
+
+static double osc_smooth(double old, double fresh)
+{
+	return (old > 0.0) ? old + OSC_EST_SMOOTH * (fresh - old) : fresh;
+}
+
+/* An upward crossing of the centre at time tc closes one cycle. */
+static void osc_estimator_cross(struct osc_estimator *e, double tc)
+{
+	bool timed_ok = e->centred;
+	if (e->have_cross && tc > e->last_cross_t) {
+		/* a period from a crossing timed against the first-cycle guess of the
+		 * centre is skewed: skip it */
+		if (timed_ok && e->last_cross_centred)
+			e->frequency = osc_smooth(e->frequency, 1.0 / (tc - e->last_cross_t));
+		/* peak and trough cover a whole cycle only after the first crossing */
+		e->amplitude = osc_smooth(e->amplitude, 0.5 * (e->peak - e->trough));
+		e->centre = 0.5 * (e->peak + e->trough);
+		e->centred = true;
+	}
+	e->last_cross_t = tc;
+	e->last_cross_centred = timed_ok;
+	e->have_cross = true;
+	e->high = false;
+	e->armed = false;
+	e->peak = -INFINITY;
+	e->trough = INFINITY;
+}
+
+static void osc_estimator_restart(struct osc_estimator *e, double x)
+{
+	e->amplitude = 0.0;
+	e->frequency = 0.0;
+	e->have_cross = false;
+	e->centred = false;
+	e->last_cross_centred = false;
+	e->high = false;
+	e->armed = false;
+	e->peak = x;
+	e->trough = x;
+}
+
+void osc_estimator_update(struct osc_estimator *e, double x, double t)
+{
+	if (!isfinite(x) || !isfinite(t) || (e->have_last && !(t > e->last_t))) {
+		e->rejected++;
+		return;
+	}
+	if (e->have_cross) {
+		double stale = (e->frequency > 0.0) ? OSC_EST_STALE_PERIODS / e->frequency
+		                                    : OSC_EST_MAX_PERIOD_S;
+		if (t - e->last_cross_t > stale)
+			osc_estimator_restart(e, x);
+	}
+	double hyst = fmax(OSC_EST_HYST_MIN, OSC_EST_HYST_FRAC * e->amplitude);
+	if (x > e->peak)
+		e->peak = x;
+	if (x < e->trough)
+		e->trough = x;
+	if (!e->have_cross) {
+		if (e->have_last) {
+			double keep = exp(-(t - e->last_t) / OSC_EST_FADE_S);
+			e->peak = x + (e->peak - x) * keep;
+			e->trough = x + (e->trough - x) * keep;
+		}
+		e->centre = 0.5 * (e->peak + e->trough);   /* no whole cycle yet */
+	}
+	/* a Schmitt trigger: up through centre + hyst, down through centre − hyst,
+	 * then the next upward pass of the centre is one cycle; a centre that
+	 * moved at the last crossing cannot make a second one */
+	if (x > e->centre + hyst)
+		e->high = true;
+	if (e->high && x < e->centre - hyst)
+		e->armed = true;
+	if (e->have_last && e->armed && e->last_x < e->centre && x >= e->centre) {
+		/* interpolate the crossing instant between the two samples */
+		double tc = e->last_t + (t - e->last_t) * (e->centre - e->last_x) / (x - e->last_x);
+		osc_estimator_cross(e, tc);
+		e->peak = x;
+		e->trough = x;
+	}
+	e->last_x = x;
+	e->last_t = t;
+	e->have_last = true;
+}
+
+void osc_velocity_filter_init(struct osc_velocity_filter *f, double cutoff_hz)
+{
+	f->cutoff_hz = cutoff_hz;
+	f->last_x = 0.0;
+	f->v = 0.0;
+	f->primed = false;
+	f->rejected = 0;
+}
+
+double osc_velocity_filter_update(struct osc_velocity_filter *f, double x, double dt)
+{
+	if (!isfinite(x)) {
+		f->rejected++;
+		return f->v;
+	}
+	if (!f->primed) {
+		f->last_x = x;
+		f->v = 0.0;
+		f->primed = true;
+		return f->v;
+	}
+	if (!isfinite(dt) || dt <= 0.0) {
+		/* no usable interval: keep the speed, but the newest angle is the
+		 * best base for the next difference */
+		f->rejected++;
+		f->last_x = x;
+		return f->v;
+	}
+	double raw = (x - f->last_x) / dt;
+	/* exact discretisation of a first-order low-pass for any dt; cut-off <= 0
+	 * means no smoothing (the raw finite difference) */
+	double alpha = (isfinite(f->cutoff_hz) && f->cutoff_hz > 0.0)
+	                   ? 1.0 - exp(-2.0 * OSC_PI * f->cutoff_hz * dt)
+	                   : 1.0;
+	f->v += alpha * (raw - f->v);
+	f->last_x = x;
+	return f->v;
+}
