@@ -58,6 +58,25 @@ struct port_latency {
  * sysfs file is /sys/bus/usb-serial/devices/<tty>/latency_timer. */
 void port_latency_check(const char *path, bool lower, struct port_latency *out);
 
+/* The outcome of the latency check port_open() ran (opt->low_latency), or
+ * NULL when it was not asked for. */
+const struct port_latency *port_get_latency(const struct port *p);
+/* As port_latency_check(), with the port's open fd (-1: none) so the
+ * TIOCSSERIAL/ASYNC_LOW_LATENCY fallback can work when sysfs is not writable.
+ * The sysfs root is $UNDULATE_SYSFS_ROOT when set (tests), else /sys. */
+void port_latency_check_fd(const char *path, int fd, bool lower, struct port_latency *out);
+
+/* ---- low-level helpers (used by both backends; exposed for tests) ------------ */
+/* Put a tty fd in raw 8N1 mode, no flow control, receiver on, modem lines
+ * ignored, keeping its speed. DXL_OK or DXL_E_IO (errno kept). */
+int port_termios_raw(int fd);
+/* Set any bit rate on a tty fd: the standard Bxxx constant when there is one,
+ * else termios2/BOTHER. DXL_OK, DXL_E_ARG (rate <= 0) or DXL_E_IO. */
+int port_termios_set_baud(int fd, long baud);
+/* The termios2/BOTHER path alone (any rate; on a real UART the driver rounds
+ * to what its divisor can do). Same returns. */
+int port_termios2_set_baud(int fd, long baud);
+
 /* ---- enumeration ------------------------------------------------------------- */
 struct port_info {
 	char path[128];

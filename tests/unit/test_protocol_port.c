@@ -1,0 +1,411 @@
+/*
+ * test_protocol_port.c — the serial transport on real pseudo-terminals:
+ * raw mode byte-exactness, non-blocking reads, disconnection, baud setting,
+ * and the FTDI latency-timer logic against a fake sysfs tree.
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <termios.h>
+#include <unistd.h>
+#include <cmocka.h>
+
+#include "port.h"
+#include "ptypeer.h"
+
+struct fixture {
+	struct ptypeer peer;
+	struct port *port;
+};
+
+static int setup_pty(void **state)
+{
+	struct fixture *f = calloc(1, sizeof *f);
+	struct port_options opt = { .baud = 1000000 };
+	char err[200] = "";
+
+	assert_non_null(f);
+	assert_int_equal(ptypeer_open(&f->peer), 0);
+	f->port = port_open(f->peer.slave_path, &opt, err, sizeof err);
+	if (f->port == NULL)
+		fail_msg("port_open(%s): %s", f->peer.slave_path, err);
+	*state = f;
+	return 0;
+}
+
+static int teardown_pty(void **state)
+{
+	struct fixture *f = *state;
+
+	port_close(f->port);
+	ptypeer_close(&f->peer);
+	free(f);
+	return 0;
+}
+
+/* Read exactly n bytes from the port, waiting with port_wait. */
+static size_t port_read_all(struct port *p, uint8_t *buf, size_t n, uint32_t timeout_us)
+{
+	uint64_t end = port_now_us() + timeout_us;
+	size_t got = 0;
+
+	while (got < n && port_now_us() < end) {
+		int w = port_wait(p, (uint32_t)(end - port_now_us()));
+		if (w < 0)
+			break;
+		long r = port_read(p, buf + got, n - got);
+		if (r < 0)
+			break;
+		got += (size_t)r;
+	}
+	return got;
+}
+
+/* libserialport cannot open a pty: port_open falls back to the termios fd. */
+static void test_pty_uses_termios_backend(void **state)
+{
+	struct fixture *f = *state;
+	int flags = fcntl(port_fd(f->port), F_GETFL);
+
+	assert_int_equal(port_backend(f->port), PORT_BACKEND_TERMIOS);
+	assert_true(flags >= 0 && (flags & O_NONBLOCK));
+	assert_int_equal(port_baud(f->port), 1000000);
+	assert_string_equal(port_path(f->port), f->peer.slave_path);
+}
+
+/* The bytes a cooked tty mangles (LF, CR, ^C, XON, XOFF), then every value. */
+static void test_raw_mode_peer_to_port(void **state)
+{
+	struct fixture *f = *state;
+	const uint8_t special[] = { 0x0A, 0x0D, 0x03, 0x11, 0x13, 0x0D, 0x0A, 0x7F, 0x1A, 0x1C, 0x04, 0x16, 0xFF };
+	uint8_t all[256], got[256];
+
+	for (int i = 0; i < 256; i++)
+		all[i] = (uint8_t)i;
+	assert_int_equal(ptypeer_write(&f->peer, special, sizeof special), 0);
+	assert_int_equal(port_read_all(f->port, got, sizeof special, 1000000), sizeof special);
+	assert_memory_equal(got, special, sizeof special);
+	assert_int_equal(ptypeer_write(&f->peer, all, sizeof all), 0);
+	assert_int_equal(port_read_all(f->port, got, sizeof all, 1000000), sizeof all);
+	assert_memory_equal(got, all, sizeof all);
+	/* Nothing echoed back to the peer (ECHO off). */
+	assert_int_equal(ptypeer_read(&f->peer, got, 1, 50), 0);
+}
+
+static void test_raw_mode_port_to_peer(void **state)
+{
+	struct fixture *f = *state;
+	const uint8_t special[] = { 0x0A, 0x0D, 0x03, 0x11, 0x13, 0x09 };
+	uint8_t all[256], got[512];
+
+	for (int i = 0; i < 256; i++)
+		all[i] = (uint8_t)(255 - i);
+	assert_int_equal(port_write(f->port, special, sizeof special), DXL_OK);
+	assert_int_equal(ptypeer_read(&f->peer, got, sizeof special, 1000), sizeof special);
+	assert_memory_equal(got, special, sizeof special);
+	assert_int_equal(port_write(f->port, all, sizeof all), DXL_OK);
+	assert_int_equal(ptypeer_read(&f->peer, got, sizeof all, 1000), sizeof all);
+	assert_memory_equal(got, all, sizeof all);
+	/* No extra bytes (OPOST would have turned 0x0A into 0x0D 0x0A). */
+	assert_int_equal(ptypeer_read(&f->peer, got, 1, 50), 0);
+}
+
+static void test_nonblocking_read_and_wait_timeout(void **state)
+{
+	struct fixture *f = *state;
+	uint8_t b;
+	uint64_t t0 = port_now_us();
+
+	assert_int_equal(port_read(f->port, &b, 1), 0);
+	assert_true(port_now_us() - t0 < 5000);
+	t0 = port_now_us();
+	assert_int_equal(port_wait(f->port, 3000), 0);
+	uint64_t took = port_now_us() - t0;
+	/* The wait honours microseconds: at least what was asked, not 10× it. */
+	assert_true(took >= 3000);
+	assert_true(took < 20000);
+}
+
+static void test_flush_input_discards_stale_bytes(void **state)
+{
+	struct fixture *f = *state;
+	const uint8_t stale[] = { 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC };
+	const uint8_t fresh[] = { 0x42 };
+	uint8_t got[8];
+
+	assert_int_equal(ptypeer_write(&f->peer, stale, sizeof stale), 0);
+	assert_int_equal(port_wait(f->port, 1000000), 1);
+	port_flush_input(f->port);
+	assert_int_equal(ptypeer_write(&f->peer, fresh, sizeof fresh), 0);
+	assert_int_equal(port_read_all(f->port, got, 1, 1000000), 1);
+	assert_int_equal(got[0], 0x42);
+	assert_int_equal(port_read(f->port, got, sizeof got), 0);
+}
+
+/* The simulator exiting closes the master: that must read as an unplugged adapter. */
+static void test_peer_hangup_is_disconnected(void **state)
+{
+	struct fixture *f = *state;
+	uint8_t b[4];
+
+	close(f->peer.master);
+	f->peer.master = -1;
+	int w = port_wait(f->port, 1000000);
+	assert_true(w == 1 || w == DXL_E_DISCONNECTED);
+	assert_int_equal(port_read(f->port, b, sizeof b), DXL_E_DISCONNECTED);
+	assert_int_equal(port_write(f->port, b, 1), DXL_E_DISCONNECTED);
+}
+
+static void test_bus_io_drives_the_port(void **state)
+{
+	struct fixture *f = *state;
+	struct bus_io io;
+	const uint8_t ping[] = { 0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB };
+	const uint8_t reply[] = { 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC };
+	uint8_t got[8];
+
+	port_bus_io(f->port, &io);
+	assert_ptr_equal(io.ctx, f->port);
+	assert_non_null(io.flush_input);
+	uint64_t a = io.now_us(io.ctx);
+	assert_int_equal(io.write(io.ctx, ping, sizeof ping), DXL_OK);
+	assert_int_equal(ptypeer_read(&f->peer, got, sizeof ping, 1000), sizeof ping);
+	assert_memory_equal(got, ping, sizeof ping);
+	assert_int_equal(ptypeer_write(&f->peer, reply, sizeof reply), 0);
+	size_t n = 0;
+	while (n < sizeof reply && io.wait(io.ctx, 1000000) == 1) {
+		long r = io.read(io.ctx, got + n, sizeof got - n);
+		assert_true(r >= 0);
+		n += (size_t)r;
+	}
+	assert_int_equal(n, sizeof reply);
+	assert_memory_equal(got, reply, sizeof reply);
+	assert_true(io.now_us(io.ctx) >= a);
+}
+
+static void test_baud_rates(void **state)
+{
+	struct fixture *f = *state;
+	struct termios tio;
+
+	/* A standard rate reads back as its constant... */
+	assert_int_equal(port_set_baud(f->port, 57600), DXL_OK);
+	assert_int_equal(tcgetattr(port_fd(f->port), &tio), 0);
+	assert_int_equal(cfgetospeed(&tio), B57600);
+	/* ...and the Dynamixel rates without one (2e6 / (v + 1)) are accepted too. */
+	assert_int_equal(port_set_baud(f->port, 117647), DXL_OK);
+	assert_int_equal(port_baud(f->port), 117647);
+	assert_int_equal(port_set_baud(f->port, 1000000), DXL_OK);
+	assert_int_equal(tcgetattr(port_fd(f->port), &tio), 0);
+	assert_int_equal(cfgetospeed(&tio), B1000000);
+	assert_int_equal(port_set_baud(f->port, 0), DXL_E_ARG);
+	/* Raw mode survives a baud change. */
+	assert_int_equal(tio.c_lflag & (ICANON | ECHO | ISIG), 0);
+	assert_int_equal(tio.c_oflag & OPOST, 0);
+}
+
+static void test_open_missing_port(void **state)
+{
+	(void)state;
+	char err[200] = "";
+	struct port_options opt = { .baud = 1000000 };
+
+	assert_null(port_open("/dev/nonexistent-undulate-bus", &opt, err, sizeof err));
+	assert_non_null(strstr(err, "/dev/nonexistent-undulate-bus"));
+	assert_non_null(strstr(err, "No such file"));
+	/* A regular file is not a serial port. */
+	assert_null(port_open("/dev/null", &opt, err, sizeof err));
+	assert_non_null(strstr(err, "/dev/null"));
+}
+
+/* ---- latency timer against a fake sysfs tree ------------------------------------ */
+
+struct fake_sysfs {
+	char root[64];
+	char dev[PATH_MAX];     /* fake device node */
+	char link[PATH_MAX];    /* symlink to it, as a udev rule would make */
+	char timer[PATH_MAX];   /* .../latency_timer */
+};
+
+static void fake_write(const char *path, const char *text)
+{
+	FILE *fp = fopen(path, "w");
+	assert_non_null(fp);
+	fputs(text, fp);
+	fclose(fp);
+}
+
+static int read_int_file(const char *path)
+{
+	FILE *fp = fopen(path, "r");
+	int v = -1;
+	assert_non_null(fp);
+	if (fscanf(fp, "%d", &v) != 1)
+		v = -1;
+	fclose(fp);
+	return v;
+}
+
+static void fake_sysfs_make(struct fake_sysfs *s, const char *timer_text)
+{
+	char dir[256];
+
+	snprintf(s->root, sizeof s->root, "/tmp/undulate-sysfs.XXXXXX");
+	assert_non_null(mkdtemp(s->root));
+	snprintf(dir, sizeof dir, "%s/bus", s->root);
+	assert_int_equal(mkdir(dir, 0755), 0);
+	snprintf(dir, sizeof dir, "%s/bus/usb-serial", s->root);
+	assert_int_equal(mkdir(dir, 0755), 0);
+	snprintf(dir, sizeof dir, "%s/bus/usb-serial/devices", s->root);
+	assert_int_equal(mkdir(dir, 0755), 0);
+	snprintf(dir, sizeof dir, "%s/bus/usb-serial/devices/ttyUSB7", s->root);
+	assert_int_equal(mkdir(dir, 0755), 0);
+	snprintf(s->timer, sizeof s->timer, "%s/latency_timer", dir);
+	if (timer_text != NULL)
+		fake_write(s->timer, timer_text);
+	snprintf(s->dev, sizeof s->dev, "%s/ttyUSB7", s->root);
+	fake_write(s->dev, "");
+	snprintf(s->link, sizeof s->link, "%s/robot-bus", s->root);
+	assert_int_equal(symlink(s->dev, s->link), 0);
+	setenv("UNDULATE_SYSFS_ROOT", s->root, 1);
+}
+
+static void fake_sysfs_remove(struct fake_sysfs *s)
+{
+	char cmd[PATH_MAX + 16];
+
+	unsetenv("UNDULATE_SYSFS_ROOT");
+	snprintf(cmd, sizeof cmd, "rm -rf '%s'", s->root);
+	assert_int_equal(system(cmd), 0);
+}
+
+static void test_latency_reported_not_lowered(void **state)
+{
+	(void)state;
+	struct fake_sysfs s;
+	struct port_latency lat;
+
+	fake_sysfs_make(&s, "16\n");
+	port_latency_check(s.link, false, &lat);
+	assert_true(lat.known);
+	assert_int_equal(lat.timer_ms, 16);
+	assert_false(lat.lowered);
+	assert_non_null(strstr(lat.note, "ttyUSB7"));
+	assert_non_null(strstr(lat.note, "16 ms"));
+	assert_int_equal(read_int_file(s.timer), 16);
+	fake_sysfs_remove(&s);
+}
+
+static void test_latency_lowered_through_symlink(void **state)
+{
+	(void)state;
+	struct fake_sysfs s;
+	struct port_latency lat;
+
+	fake_sysfs_make(&s, "16\n");
+	port_latency_check(s.link, true, &lat);
+	assert_true(lat.known);
+	assert_true(lat.lowered);
+	assert_int_equal(lat.timer_ms, 1);
+	assert_int_equal(read_int_file(s.timer), 1);
+	assert_non_null(strstr(lat.note, "16 ms to 1 ms"));
+	/* Already at 1: nothing to do, nothing claimed. */
+	port_latency_check(s.link, true, &lat);
+	assert_true(lat.known);
+	assert_false(lat.lowered);
+	assert_int_equal(lat.timer_ms, 1);
+	fake_sysfs_remove(&s);
+}
+
+/* A timer that refuses the write: the kernel's read-only cap_last_cap file
+ * stands in for a latency_timer without write permission (EACCES even for root). */
+static void test_latency_cannot_lower(void **state)
+{
+	(void)state;
+	struct fake_sysfs s;
+	struct port_latency lat;
+	const char *ro = "/proc/sys/kernel/cap_last_cap";
+
+	if (access(ro, R_OK) != 0)
+		skip();
+	int expect = read_int_file(ro);
+	fake_sysfs_make(&s, NULL);
+	assert_int_equal(symlink(ro, s.timer), 0);
+	port_latency_check(s.link, true, &lat);
+	assert_true(lat.known);
+	assert_false(lat.lowered);
+	assert_int_equal(lat.timer_ms, expect);
+	assert_non_null(strstr(lat.note, "could not be lowered"));
+	assert_non_null(strstr(lat.note, "ttyUSB7"));
+	fake_sysfs_remove(&s);
+}
+
+static void test_latency_not_ftdi(void **state)
+{
+	struct fixture *f = *state;
+	struct port_latency lat;
+	struct fake_sysfs s;
+
+	fake_sysfs_make(&s, NULL); /* no latency_timer file at all */
+	port_latency_check(s.link, true, &lat);
+	assert_false(lat.known);
+	assert_false(lat.lowered);
+	assert_non_null(strstr(lat.note, "no latency timer"));
+	fake_sysfs_remove(&s);
+	/* A pty, through port_open's own check. */
+	struct port_options opt = { .baud = 1000000, .low_latency = true };
+	char err[200];
+	struct port *p = port_open(f->peer.slave_path, &opt, err, sizeof err);
+	assert_non_null(p);
+	assert_non_null(port_get_latency(p));
+	assert_false(port_get_latency(p)->known);
+	port_close(p);
+	assert_null(port_get_latency(f->port)); /* not asked for */
+}
+
+static void test_adapter_names(void **state)
+{
+	(void)state;
+	struct port_info info[16];
+
+	assert_string_equal(port_adapter_name(0x0403, 0x6014), "U2D2");
+	assert_string_equal(port_adapter_name(0x0403, 0x6001), "USB2Dynamixel");
+	assert_string_equal(port_adapter_name(0x16d0, 0x06a7), "USB2AX");
+	assert_null(port_adapter_name(0x0403, 0x6015));
+	assert_null(port_adapter_name(-1, -1));
+	int n = port_list(info, 16);
+	assert_true(n >= 0);
+	for (int i = 0; i < n && i < 16; i++) {
+		assert_true(info[i].path[0] != '\0');
+		if (info[i].usb_vid < 0)
+			assert_null(info[i].adapter);
+	}
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test_setup_teardown(test_pty_uses_termios_backend, setup_pty, teardown_pty),
+		cmocka_unit_test_setup_teardown(test_raw_mode_peer_to_port, setup_pty, teardown_pty),
+		cmocka_unit_test_setup_teardown(test_raw_mode_port_to_peer, setup_pty, teardown_pty),
+		cmocka_unit_test_setup_teardown(test_nonblocking_read_and_wait_timeout, setup_pty, teardown_pty),
+		cmocka_unit_test_setup_teardown(test_flush_input_discards_stale_bytes, setup_pty, teardown_pty),
+		cmocka_unit_test_setup_teardown(test_peer_hangup_is_disconnected, setup_pty, teardown_pty),
+		cmocka_unit_test_setup_teardown(test_bus_io_drives_the_port, setup_pty, teardown_pty),
+		cmocka_unit_test_setup_teardown(test_baud_rates, setup_pty, teardown_pty),
+		cmocka_unit_test(test_open_missing_port),
+		cmocka_unit_test(test_latency_reported_not_lowered),
+		cmocka_unit_test(test_latency_lowered_through_symlink),
+		cmocka_unit_test(test_latency_cannot_lower),
+		cmocka_unit_test_setup_teardown(test_latency_not_ftdi, setup_pty, teardown_pty),
+		cmocka_unit_test(test_adapter_names),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,238 @@
+/*
+ * args.c — `dxl` command-line parsing. Hand-written rather than getopt_long
+ * so that options may follow the command (`dxl read 1 goal --units`) and the
+ * parser holds no global state (the tests call it many times).
+ */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dxl_table.h"
+#include "dxlt.h"
+
+/* Baud register values the AX-12 manual lists; `--bauds all` tries these. */
+static const uint8_t dxlt_ax12_baud_regs[] = { 1, 3, 4, 7, 9, 16, 34, 103, 207 };
+
+int dxlt_parse_long(const char *s, long min, long max, long *out)
+{
+	char *end;
+	long v;
+
+	if (s == NULL || *s == '\0' || *s == '-' || *s == '+' || *s == ' ')
+		return -1;
+	errno = 0;
+	v = strtol(s, &end, 0);
+	if (errno != 0 || *end != '\0' || v < min || v > max)
+		return -1;
+	*out = v;
+	return 0;
+}
+
+int dxlt_parse_id(const char *s, bool allow_broadcast, uint8_t *id)
+{
+	long v;
+
+	if (dxlt_parse_long(s, 0, allow_broadcast ? DXL_BROADCAST_ID : DXL_MAX_ID, &v) != 0)
+		return -1;
+	*id = (uint8_t)v;
+	return 0;
+}
+
+int dxlt_parse_id_range(const char *s, uint8_t *lo, uint8_t *hi)
+{
+	char first[8];
+	const char *dash = s != NULL ? strchr(s, '-') : NULL;
+
+	if (s == NULL)
+		return -1;
+	if (dash == NULL) {
+		if (dxlt_parse_id(s, false, lo) != 0)
+			return -1;
+		*hi = *lo;
+		return 0;
+	}
+	if ((size_t)(dash - s) >= sizeof first || dash == s)
+		return -1;
+	memcpy(first, s, (size_t)(dash - s));
+	first[dash - s] = '\0';
+	if (dxlt_parse_id(first, false, lo) != 0 || dxlt_parse_id(dash + 1, false, hi) != 0)
+		return -1;
+	return *lo <= *hi ? 0 : -1;
+}
+
+int dxlt_parse_bauds(const char *s, long *out, size_t cap, size_t *n)
+{
+	char buf[256];
+	char *save = NULL;
+
+	*n = 0;
+	if (s == NULL || strlen(s) >= sizeof buf)
+		return -1;
+	if (strcmp(s, "all") == 0) {
+		for (size_t i = 0; i < sizeof dxlt_ax12_baud_regs && *n < cap; i++)
+			out[(*n)++] = dxl_baud_from_reg(dxlt_ax12_baud_regs[i]);
+		return 0;
+	}
+	strcpy(buf, s);
+	for (char *tok = strtok_r(buf, ",", &save); tok != NULL; tok = strtok_r(NULL, ",", &save)) {
+		long v;
+		if (*n >= cap || dxlt_parse_long(tok, 1, 4000000, &v) != 0)
+			return -1;
+		out[(*n)++] = v;
+	}
+	return *n > 0 ? 0 : -1;
+}
+
+/* ---- options ---------------------------------------------------------------- */
+
+enum dxlt_opt_kind { OPT_FLAG, OPT_VALUE };
+
+struct dxlt_opt {
+	const char *name;
+	enum dxlt_opt_kind kind;
+};
+
+static const struct dxlt_opt dxlt_opts[] = {
+	{ "--port", OPT_VALUE },       { "--baud", OPT_VALUE },    { "--echo", OPT_FLAG },
+	{ "--latency-us", OPT_VALUE }, { "--timeout-ms", OPT_VALUE }, { "--units", OPT_FLAG },
+	{ "--yes", OPT_FLAG },         { "--ids", OPT_VALUE },     { "--bauds", OPT_VALUE },
+	{ "--status-level", OPT_VALUE }, { "--help", OPT_FLAG },   { "-h", OPT_FLAG },
+};
+
+static const struct dxlt_opt *dxlt_find_opt(const char *arg, size_t len)
+{
+	for (size_t i = 0; i < sizeof dxlt_opts / sizeof dxlt_opts[0]; i++)
+		if (strlen(dxlt_opts[i].name) == len && strncmp(dxlt_opts[i].name, arg, len) == 0)
+			return &dxlt_opts[i];
+	return NULL;
+}
+
+static int dxlt_bad(FILE *err, const char *what, const char *opt, const char *val)
+{
+	fprintf(err, "dxl: %s %s '%s'\n", what, opt, val != NULL ? val : "");
+	dxlt_usage(err);
+	return DXLT_EXIT_USAGE;
+}
+
+static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val, FILE *err)
+{
+	long v;
+
+	if (strcmp(name, "--port") == 0) {
+		a->port_path = val;
+	} else if (strcmp(name, "--baud") == 0) {
+		if (dxlt_parse_long(val, 1, 4000000, &a->baud) != 0)
+			return dxlt_bad(err, "bad baud rate for", name, val);
+	} else if (strcmp(name, "--echo") == 0) {
+		a->echo = true;
+	} else if (strcmp(name, "--latency-us") == 0) {
+		if (dxlt_parse_long(val, 0, 1000000, &a->latency_us) != 0)
+			return dxlt_bad(err, "bad value for", name, val);
+	} else if (strcmp(name, "--timeout-ms") == 0) {
+		if (dxlt_parse_long(val, 1, 10000, &a->timeout_ms) != 0)
+			return dxlt_bad(err, "bad value for", name, val);
+	} else if (strcmp(name, "--units") == 0) {
+		a->units = true;
+	} else if (strcmp(name, "--yes") == 0) {
+		a->yes = true;
+	} else if (strcmp(name, "--ids") == 0) {
+		if (dxlt_parse_id_range(val, &a->id_lo, &a->id_hi) != 0)
+			return dxlt_bad(err, "bad ID range (want A-B within 0-253) for", name, val);
+	} else if (strcmp(name, "--bauds") == 0) {
+		if (dxlt_parse_bauds(val, a->bauds, DXLT_MAX_BAUDS, &a->nbauds) != 0)
+			return dxlt_bad(err, "bad baud list (want N,N,... or all) for", name, val);
+	} else if (strcmp(name, "--status-level") == 0) {
+		if (dxlt_parse_long(val, 0, 2, &v) != 0)
+			return dxlt_bad(err, "bad value (0, 1 or 2) for", name, val);
+		a->status_level = (int)v;
+	} else {
+		a->help = true;
+	}
+	return DXLT_EXIT_OK;
+}
+
+static void dxlt_defaults(struct dxlt_args *a)
+{
+	memset(a, 0, sizeof *a);
+	a->baud = DXLT_DEFAULT_BAUD;
+	a->latency_us = -1;
+	a->timeout_ms = -1;
+	a->status_level = -1;
+	a->id_lo = 0;
+	a->id_hi = DXL_MAX_ID;
+}
+
+int dxlt_parse_args(int argc, char **argv, struct dxlt_args *a, FILE *err)
+{
+	bool options_done = false;
+
+	dxlt_defaults(a);
+	/* Positionals are compacted to the front of argv[1..]: pos points there. */
+	a->pos = argv + 1;
+	for (int i = 1; i < argc; i++) {
+		const char *arg = argv[i];
+		if (!options_done && strcmp(arg, "--") == 0) {
+			options_done = true;
+			continue;
+		}
+		if (options_done || arg[0] != '-' || arg[1] == '\0') {
+			if (a->command == NULL)
+				a->command = arg;
+			else
+				a->pos[a->npos++] = argv[i];
+			continue;
+		}
+		const char *eq = strchr(arg, '=');
+		size_t len = eq != NULL ? (size_t)(eq - arg) : strlen(arg);
+		const struct dxlt_opt *opt = dxlt_find_opt(arg, len);
+		if (opt == NULL)
+			return dxlt_bad(err, "unknown option", "", arg);
+		const char *val = NULL;
+		if (opt->kind == OPT_VALUE) {
+			if (eq != NULL)
+				val = eq + 1;
+			else if (i + 1 < argc)
+				val = argv[++i];
+			else
+				return dxlt_bad(err, "missing value for", opt->name, "");
+		} else if (eq != NULL) {
+			return dxlt_bad(err, "option takes no value:", opt->name, eq + 1);
+		}
+		int r = dxlt_apply_opt(a, opt->name, val, err);
+		if (r != DXLT_EXIT_OK)
+			return r;
+	}
+	return DXLT_EXIT_OK;
+}
+
+void dxlt_usage(FILE *f)
+{
+	fputs("usage: dxl --port PATH [--baud N] [--echo] [--latency-us N] [--timeout-ms N] COMMAND "
+	      "[ARGS]   (dxl --help for commands)\n", f);
+}
+
+void dxlt_help(FILE *f)
+{
+	fputs("dxl — talk to Dynamixel AX-12 servos (Protocol 1.0) on a serial bus\n\n", f);
+	dxlt_usage(f);
+	fputs("\ncommands:\n"
+	      "  ports                      list serial ports with USB IDs, marking Dynamixel adapters\n"
+	      "  scan [--ids A-B] [--bauds LIST|all]   ping every ID (at every baud) and list servos\n"
+	      "  ping ID                    ping one servo: model, firmware, round-trip time\n"
+	      "  read ID REG [--units]      print a register's raw value (REG: name or address)\n"
+	      "  write ID REG VALUE         write a register (checked against the table first)\n"
+	      "  dump ID                    the whole control table, named, with units\n"
+	      "  set-id OLD NEW             change a servo's ID (refused if NEW answers)\n"
+	      "  set-baud ID BAUD           change a servo's baud rate (bps) and verify it\n"
+	      "  torque ID on|off           switch the motor torque\n"
+	      "  reset ID --yes             factory reset (ID becomes 1, baud 1 Mbps)\n"
+	      "  setup ID... [--status-level N]   prepare servos and adapter for a 100 Hz loop\n"
+	      "\noptions:\n"
+	      "  --port PATH        serial device or pty (e.g. /dev/ttyUSB0, /dev/serial/by-id/...)\n"
+	      "  --baud N           bus baud rate in bps (default 1000000)\n"
+	      "  --echo             single-wire wiring: discard our own bytes read back\n"
+	      "  --latency-us N     adapter latency to allow for (default: read the FTDI timer)\n"
+	      "  --timeout-ms N     wait about N ms per reply instead of the derived timeout\n"
+	      "\nexit codes: 0 ok, 2 usage, 3 port, 4 no reply / bus error, 5 servo error bits,\n"
+	      "            6 refused (ID taken, torque on, ...)\n", f);
+}

@@ -1,0 +1,687 @@
+/*
+ * commands.c — the `dxl` commands over one bus.
+ *
+ * Output contract: results go to `out` (a read prints the value alone so
+ * scripts can use it), every failure is one line on `err` naming what to do
+ * next, and the exit code tells the kind (dxlt.h). Nothing is written to a
+ * servo before its arguments were checked against the control table.
+ */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "dxl_table.h"
+#include "dxlt.h"
+
+struct dxlt {
+	struct dxlt_args a;
+	FILE *out, *err;
+	struct port *port;
+	struct port_latency latency;
+	struct bus bus;
+};
+
+/* ---- helpers ------------------------------------------------------------------ */
+
+static void dxlt_sleep_us(long us)
+{
+	struct timespec ts = { us / 1000000L, (us % 1000000L) * 1000L };
+
+	while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
+	}
+}
+
+static const char *dxlt_model_name(uint16_t model)
+{
+	switch (model) {
+	case 12: return "AX-12";
+	case 18: return "AX-18";
+	case 300: return "AX-12W";
+	default: return "not an AX-12";
+	}
+}
+
+/* Reply timeout parts for the current baud (dxlt.h: the defaults' reasons). */
+static void dxlt_apply_timing(struct dxlt *t)
+{
+	struct bus_timing timing = { .baud = port_baud(t->port) };
+
+	if (t->a.timeout_ms > 0) {
+		timing.margin_us = (uint32_t)(t->a.timeout_ms * 1000);
+	} else {
+		/* The servo's return delay is unknown until read: allow the largest
+		 * (254 × 2 µs). */
+		timing.return_delay_us = 254u * 2u;
+		timing.margin_us = DXLT_DEFAULT_SLACK_MS * 1000u;
+		if (t->a.latency_us >= 0)
+			timing.adapter_latency_us = (uint32_t)t->a.latency_us;
+		else if (t->latency.known)
+			timing.adapter_latency_us = (uint32_t)t->latency.timer_ms * 1000u;
+	}
+	bus_set_timing(&t->bus, &timing);
+}
+
+static int dxlt_set_baud(struct dxlt *t, long baud)
+{
+	if (port_set_baud(t->port, baud) != DXL_OK) {
+		fprintf(t->err, "dxl: cannot set %s to %ld bps\n", port_path(t->port), baud);
+		return DXLT_EXIT_PORT;
+	}
+	dxlt_apply_timing(t);
+	return DXLT_EXIT_OK;
+}
+
+/* One line for a failed transaction, and its exit code. */
+static int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
+{
+	switch (status) {
+	case DXL_E_TIMEOUT:
+		fprintf(t->err,
+		        "dxl: no reply from ID %u at %ld bps; wrong baud or ID? try: dxl --port %s "
+		        "scan --bauds all\n", id, port_baud(t->port), port_path(t->port));
+		return DXLT_EXIT_BUS;
+	case DXL_E_DISCONNECTED:
+		fprintf(t->err, "dxl: %s went away (adapter unplugged or simulator stopped)\n",
+		        port_path(t->port));
+		return DXLT_EXIT_PORT;
+	case DXL_E_IO:
+		fprintf(t->err, "dxl: I/O error on %s: %s\n", port_path(t->port), strerror(errno));
+		return DXLT_EXIT_PORT;
+	case DXL_E_ECHO:
+		fprintf(t->err, "dxl: bytes read back differ from those sent (is --echo right for "
+		        "this wiring?)\n");
+		return DXLT_EXIT_BUS;
+	case DXL_E_WRONG_LENGTH:
+		fprintf(t->err, "dxl: bad reply from ID %u: %s%s\n", id, dxl_strerror(status),
+		        t->a.echo ? "" : " (single-wire wiring? try --echo)");
+		return DXLT_EXIT_BUS;
+	default:
+		fprintf(t->err, "dxl: bad reply from ID %u: %s\n", id, dxl_strerror(status));
+		return DXLT_EXIT_BUS;
+	}
+}
+
+/* Error bits in a good reply are the servo's news, not ours: report them. */
+static int dxlt_errbits(struct dxlt *t, uint8_t id, uint8_t errbits)
+{
+	char names[128];
+
+	if (errbits == 0)
+		return DXLT_EXIT_OK;
+	fprintf(t->err, "dxl: ID %u reports error bits 0x%02X: %s\n", id, errbits,
+	        dxl_errbits_format(errbits, names, sizeof names));
+	return DXLT_EXIT_SERVO;
+}
+
+/* Finish a transaction: status and error bits folded into an exit code. */
+static int dxlt_check(struct dxlt *t, uint8_t id, int status, uint8_t errbits)
+{
+	if (status != DXL_OK)
+		return dxlt_bus_fail(t, id, status);
+	return dxlt_errbits(t, id, errbits);
+}
+
+static int dxlt_need_args(struct dxlt *t, int n, const char *form)
+{
+	if (t->a.npos == n)
+		return DXLT_EXIT_OK;
+	fprintf(t->err, "dxl: usage: dxl --port PATH %s\n", form);
+	return DXLT_EXIT_USAGE;
+}
+
+static int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id)
+{
+	if (dxlt_parse_id(s, allow_broadcast, id) == 0)
+		return DXLT_EXIT_OK;
+	fprintf(t->err, "dxl: bad ID '%s' (0-253%s)\n", s, allow_broadcast ? ", 254 broadcast" : "");
+	return DXLT_EXIT_USAGE;
+}
+
+static int dxlt_arg_reg(struct dxlt *t, const char *s, const struct dxl_reg **reg)
+{
+	*reg = dxl_reg_lookup(s);
+	if (*reg != NULL)
+		return DXLT_EXIT_OK;
+	fprintf(t->err, "dxl: unknown register '%s' (names and addresses: dxl dump ID)\n", s);
+	return DXLT_EXIT_USAGE;
+}
+
+static int dxlt_read_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t *v,
+                         uint8_t *errbits)
+{
+	uint8_t raw[2] = { 0, 0 };
+	int r = bus_read(&t->bus, id, reg->addr, reg->size, raw, errbits);
+
+	*v = reg->size == 2 ? dxl_get_u16(raw) : raw[0];
+	return r;
+}
+
+static int dxlt_write_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t v,
+                          bool expect_reply, uint8_t *errbits)
+{
+	uint8_t raw[2];
+
+	/* 16-bit values go in one packet: the servo must never act on half. */
+	if (reg->size == 2)
+		dxl_put_u16(raw, v);
+	else
+		raw[0] = (uint8_t)v;
+	return bus_write(&t->bus, id, reg->addr, raw, reg->size, expect_reply, errbits);
+}
+
+/* ---- ports -------------------------------------------------------------------- */
+
+/* Enumeration beyond this many ports is truncated (a robot has one or two). */
+#define DXLT_MAX_PORTS 64
+
+static int dxlt_cmd_ports(struct dxlt *t)
+{
+	static struct port_info info[DXLT_MAX_PORTS];
+	int n = port_list(info, DXLT_MAX_PORTS);
+
+	if (n < 0) {
+		fprintf(t->err, "dxl: cannot list serial ports: %s\n", dxl_strerror(n));
+		return DXLT_EXIT_PORT;
+	}
+	if (n == 0)
+		fprintf(t->err, "dxl: no serial ports found\n");
+	for (int i = 0; i < n && i < DXLT_MAX_PORTS; i++) {
+		const struct port_info *p = &info[i];
+		fprintf(t->out, "%s", p->path);
+		if (p->usb_vid >= 0)
+			fprintf(t->out, "  %04x:%04x", p->usb_vid, p->usb_pid);
+		if (p->serial[0] != '\0')
+			fprintf(t->out, "  serial %s", p->serial);
+		if (p->description[0] != '\0')
+			fprintf(t->out, "  \"%s\"", p->description);
+		if (p->adapter != NULL)
+			fprintf(t->out, "  [Dynamixel adapter: %s]", p->adapter);
+		fputc('\n', t->out);
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* ---- scan / ping -------------------------------------------------------------- */
+
+static void dxlt_print_identity(struct dxlt *t, uint8_t id, long baud)
+{
+	uint16_t model = 0;
+	uint8_t fw = 0, errbits = 0;
+	bool have_model = bus_read_u16(&t->bus, id, DXL_AX_MODEL_NUMBER, &model, &errbits) == DXL_OK;
+	bool have_fw = bus_read_u8(&t->bus, id, DXL_AX_FIRMWARE_VERSION, &fw, &errbits) == DXL_OK;
+
+	/* Status return level 0 answers PING only: the ID is real, the rest unknown. */
+	fprintf(t->out, "%-4u ", id);
+	if (have_model)
+		fprintf(t->out, "%-6u %-13s ", model, dxlt_model_name(model));
+	else
+		fprintf(t->out, "%-6s %-13s ", "?", "?");
+	if (have_fw)
+		fprintf(t->out, "%-9u ", fw);
+	else
+		fprintf(t->out, "%-9s ", "?");
+	fprintf(t->out, "%ld\n", baud);
+}
+
+static int dxlt_cmd_scan(struct dxlt *t)
+{
+	long own = t->a.baud;
+	const long *bauds = t->a.nbauds > 0 ? t->a.bauds : &own;
+	size_t nbauds = t->a.nbauds > 0 ? t->a.nbauds : 1;
+	unsigned found = 0;
+	int rc = DXLT_EXIT_OK;
+
+	if (t->a.npos != 0)
+		return dxlt_need_args(t, 0, "scan [--ids A-B] [--bauds LIST|all]");
+	fprintf(t->out, "%-4s %-6s %-13s %-9s %s\n", "ID", "MODEL", "NAME", "FIRMWARE", "BAUD");
+	for (size_t b = 0; b < nbauds; b++) {
+		if ((rc = dxlt_set_baud(t, bauds[b])) != DXLT_EXIT_OK)
+			return rc;
+		/* Unicast PING: a broadcast PING makes every servo answer at once. */
+		for (unsigned id = t->a.id_lo; id <= t->a.id_hi; id++) {
+			uint8_t errbits = 0;
+			int r = bus_ping(&t->bus, (uint8_t)id, &errbits);
+			if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
+				return dxlt_bus_fail(t, (uint8_t)id, r);
+			if (r != DXL_OK)
+				continue;
+			found++;
+			dxlt_print_identity(t, (uint8_t)id, bauds[b]);
+			if (dxlt_errbits(t, (uint8_t)id, errbits) != DXLT_EXIT_OK)
+				rc = DXLT_EXIT_SERVO;
+		}
+		fflush(t->out);
+	}
+	if (found == 0) {
+		fprintf(t->err, "dxl: no servo answered on %s (IDs %u-%u at %zu baud rate%s)%s\n",
+		        port_path(t->port), t->a.id_lo, t->a.id_hi, nbauds, nbauds == 1 ? "" : "s",
+		        t->a.nbauds == 0 ? "; try --bauds all" : "");
+		return DXLT_EXIT_BUS;
+	}
+	return rc;
+}
+
+static int dxlt_cmd_ping(struct dxlt *t)
+{
+	uint8_t id, errbits = 0;
+	uint16_t model = 0;
+	uint8_t fw = 0, e2;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 1, "ping ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
+		return rc;
+	int r = bus_ping(&t->bus, id, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	uint32_t rtt = t->bus.servo[id].rtt_last_us;
+	fprintf(t->out, "ID %u answered in %u us", id, (unsigned)rtt);
+	if (bus_read_u16(&t->bus, id, DXL_AX_MODEL_NUMBER, &model, &e2) == DXL_OK)
+		fprintf(t->out, ": model %u (%s)", model, dxlt_model_name(model));
+	if (bus_read_u8(&t->bus, id, DXL_AX_FIRMWARE_VERSION, &fw, &e2) == DXL_OK)
+		fprintf(t->out, ", firmware %u", fw);
+	fputc('\n', t->out);
+	return dxlt_errbits(t, id, errbits);
+}
+
+/* ---- read / write / dump ------------------------------------------------------ */
+
+static int dxlt_cmd_read(struct dxlt *t)
+{
+	const struct dxl_reg *reg;
+	uint8_t id, errbits = 0;
+	uint16_t v;
+	char text[96];
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 2, "read ID REG [--units]")) ||
+	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)) || (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)))
+		return rc;
+	int r = dxlt_read_reg(t, id, reg, &v, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (t->a.units)
+		fprintf(t->out, "%s\n", dxl_reg_format(reg, v, text, sizeof text));
+	else
+		fprintf(t->out, "%u\n", v);
+	return dxlt_errbits(t, id, errbits);
+}
+
+static int dxlt_check_value(struct dxlt *t, const struct dxl_reg *reg, const char *s, uint16_t *v)
+{
+	long value;
+
+	if (reg->access != DXL_ACCESS_RW) {
+		fprintf(t->err, "dxl: %s (address %u) is read-only\n", reg->name, reg->addr);
+		return DXLT_EXIT_USAGE;
+	}
+	if (dxlt_parse_long(s, 0, 65535, &value) != 0 || dxl_reg_check_write(reg, value) != DXL_OK) {
+		fprintf(t->err, "dxl: value '%s' out of range for %s (%u-%u)\n", s, reg->name, reg->min,
+		        reg->max);
+		return DXLT_EXIT_USAGE;
+	}
+	*v = (uint16_t)value;
+	return DXLT_EXIT_OK;
+}
+
+static int dxlt_cmd_write(struct dxlt *t)
+{
+	const struct dxl_reg *reg;
+	uint8_t id, errbits = 0;
+	uint16_t v;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 3, "write ID REG VALUE")) ||
+	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)) ||
+	    (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)) || (rc = dxlt_check_value(t, reg, t->a.pos[2], &v)))
+		return rc;
+	return dxlt_check(t, id, dxlt_write_reg(t, id, reg, v, true, &errbits), errbits);
+}
+
+static int dxlt_cmd_dump(struct dxlt *t)
+{
+	uint8_t id, errbits = 0;
+	uint8_t mem[DXL_AX_TABLE_SIZE];
+	char text[96];
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 1, "dump ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
+		return rc;
+	int r = bus_read(&t->bus, id, 0, DXL_AX_TABLE_SIZE, mem, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	fprintf(t->out, "%-4s %-22s %-24s %s\n", "ADDR", "NAME", "VALUE", "DESCRIPTION");
+	for (size_t i = 0; i < dxl_ax12_nregs; i++) {
+		const struct dxl_reg *reg = &dxl_ax12_regs[i];
+		uint16_t v = reg->size == 2 ? dxl_get_u16(&mem[reg->addr]) : mem[reg->addr];
+		fprintf(t->out, "%-4u %-22s %-24s %s%s\n", reg->addr, reg->name,
+		        dxl_reg_format(reg, v, text, sizeof text), reg->desc,
+		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
+	}
+	return dxlt_errbits(t, id, errbits);
+}
+
+/* ---- set-id / set-baud / torque / reset --------------------------------------- */
+
+/* After an EEPROM write whose reply we did not wait for (a new ID or baud
+ * makes the reply's sender ambiguous), give the servo time, then ask. */
+static int dxlt_verify_ping(struct dxlt *t, uint8_t id)
+{
+	uint8_t errbits;
+	int r = DXL_E_TIMEOUT;
+
+	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
+	for (int attempt = 0; attempt < 3 && r == DXL_E_TIMEOUT; attempt++)
+		r = bus_ping(&t->bus, id, &errbits);
+	return r;
+}
+
+static int dxlt_cmd_set_id(struct dxlt *t)
+{
+	uint8_t old_id, new_id, errbits = 0;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 2, "set-id OLD NEW")) ||
+	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &old_id)) ||
+	    (rc = dxlt_arg_id(t, t->a.pos[1], false, &new_id)))
+		return rc;
+	if (old_id == new_id) {
+		fprintf(t->out, "ID %u unchanged\n", old_id);
+		return DXLT_EXIT_OK;
+	}
+	int r = bus_ping(&t->bus, old_id, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, old_id, r);
+	/* Two servos with one ID answer at once and garble each other. */
+	if (bus_ping(&t->bus, new_id, &errbits) == DXL_OK) {
+		fprintf(t->err, "dxl: ID %u is already taken on this bus; pick another\n", new_id);
+		return DXLT_EXIT_REFUSED;
+	}
+	r = dxlt_write_reg(t, old_id, dxl_reg_at(DXL_AX_ID), new_id, false, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, old_id, r);
+	r = dxlt_verify_ping(t, new_id);
+	if (r != DXL_OK) {
+		fprintf(t->err, "dxl: wrote ID %u to servo %u but ID %u does not answer (%s)\n", new_id,
+		        old_id, new_id, dxl_strerror(r));
+		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u is now ID %u\n", old_id, new_id);
+	return DXLT_EXIT_OK;
+}
+
+static int dxlt_cmd_set_baud(struct dxlt *t)
+{
+	uint8_t id, reg_value, errbits = 0;
+	long bps;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 2, "set-baud ID BAUD")) ||
+	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
+		return rc;
+	if (dxlt_parse_long(t->a.pos[1], 1, 4000000, &bps) != 0 ||
+	    dxl_baud_to_reg(bps, &reg_value) != DXL_OK) {
+		fprintf(t->err, "dxl: an AX-12 cannot run at '%s' bps (rates are 2000000/(n+1), "
+		        "e.g. 1000000, 500000, 117647, 57143)\n", t->a.pos[1]);
+		return DXLT_EXIT_USAGE;
+	}
+	int r = bus_ping(&t->bus, id, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	r = dxlt_write_reg(t, id, dxl_reg_at(DXL_AX_BAUD_RATE), reg_value, false, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	long exact = dxl_baud_from_reg(reg_value);
+	/* Let the servo take the old-rate packet before the line changes rate. */
+	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
+	if ((rc = dxlt_set_baud(t, exact)) != DXLT_EXIT_OK)
+		return rc;
+	r = dxlt_verify_ping(t, id);
+	if (r != DXL_OK) {
+		fprintf(t->err, "dxl: ID %u does not answer at %ld bps after the change (%s); try: dxl "
+		        "--port %s scan --bauds all\n", id, exact, dxl_strerror(r), port_path(t->port));
+		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u now at %ld bps (register value %u)\n", id, exact, reg_value);
+	return DXLT_EXIT_OK;
+}
+
+static int dxlt_cmd_torque(struct dxlt *t)
+{
+	uint8_t id, errbits = 0;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 2, "torque ID on|off")) ||
+	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)))
+		return rc;
+	const char *s = t->a.pos[1];
+	bool on = strcmp(s, "on") == 0 || strcmp(s, "1") == 0;
+	if (!on && strcmp(s, "off") != 0 && strcmp(s, "0") != 0) {
+		fprintf(t->err, "dxl: torque takes on or off, not '%s'\n", s);
+		return DXLT_EXIT_USAGE;
+	}
+	int r = bus_write_u8(&t->bus, id, DXL_AX_TORQUE_ENABLE, on ? 1 : 0, &errbits);
+	return dxlt_check(t, id, r, errbits);
+}
+
+static int dxlt_cmd_reset(struct dxlt *t)
+{
+	uint8_t id, errbits = 0;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 1, "reset ID --yes")) ||
+	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
+		return rc;
+	if (!t->a.yes) {
+		fprintf(t->err, "dxl: a factory reset sets ID 1, 1000000 bps and every default "
+		        "(including angle limits); add --yes to do it\n");
+		return DXLT_EXIT_USAGE;
+	}
+	int r = bus_ping(&t->bus, id, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	r = bus_factory_reset(&t->bus, id, false, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
+	if ((rc = dxlt_set_baud(t, DXLT_DEFAULT_BAUD)) != DXLT_EXIT_OK)
+		return rc;
+	r = dxlt_verify_ping(t, 1);
+	if (r != DXL_OK) {
+		fprintf(t->err, "dxl: reset sent to ID %u but ID 1 does not answer at 1000000 bps (%s)\n",
+		        id, dxl_strerror(r));
+		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u reset to factory defaults: now ID 1 at 1000000 bps\n", id);
+	return DXLT_EXIT_OK;
+}
+
+/* ---- setup -------------------------------------------------------------------- */
+
+/* Write one EEPROM byte if it differs, then read it back. */
+static int dxlt_setup_byte(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t want, bool replies)
+{
+	const struct dxl_reg *reg = dxl_reg_at(addr);
+	uint8_t have = 0, errbits = 0;
+	int r = bus_read_u8(&t->bus, id, addr, &have, &errbits);
+
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (have == want) {
+		fprintf(t->out, "ID %u: %s already %u\n", id, reg->name, want);
+		return DXLT_EXIT_OK;
+	}
+	r = bus_write(&t->bus, id, addr, &want, 1, replies, &errbits);
+	if (r != DXL_OK || errbits != 0)
+		return dxlt_check(t, id, r, errbits);
+	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
+	r = bus_read_u8(&t->bus, id, addr, &have, &errbits);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (have != want) {
+		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u): EEPROM locked? (lock register; "
+		        "power-cycle)\n", id, reg->name, have, want);
+		return DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u: %s set to %u\n", id, reg->name, want);
+	return DXLT_EXIT_OK;
+}
+
+static int dxlt_setup_one(struct dxlt *t, uint8_t id)
+{
+	uint8_t torque = 0, level = 0, errbits = 0;
+	int r, rc;
+
+	if ((r = bus_ping(&t->bus, id, &errbits)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	/* The loop READs every cycle, so level 0 (PING only) cannot work; level
+	 * 2 costs nothing per cycle (goals go by SYNC_WRITE, never answered) and
+	 * lets start-up and tools verify their writes. */
+	int want_level = t->a.status_level >= 0 ? t->a.status_level : 2;
+	r = bus_read_u8(&t->bus, id, DXL_AX_STATUS_RETURN_LEVEL, &level, &errbits);
+	if (r != DXL_OK) {
+		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? "
+		        "(dxl write %u status_return_level 2 cannot be verified either)\n", id, id);
+		return DXLT_EXIT_BUS;
+	}
+	if ((r = bus_read_u8(&t->bus, id, DXL_AX_TORQUE_ENABLE, &torque, &errbits)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (torque) {
+		fprintf(t->err, "dxl: ID %u has torque on; the AX-12A ignores EEPROM writes then: "
+		        "dxl --port %s torque %u off\n", id, port_path(t->port), id);
+		return DXLT_EXIT_REFUSED;
+	}
+	/* 0: the reply follows the request after ≈22 µs instead of 500 µs. */
+	if ((rc = dxlt_setup_byte(t, id, DXL_AX_RETURN_DELAY_TIME, 0, level >= 2)) != DXLT_EXIT_OK)
+		return rc;
+	return dxlt_setup_byte(t, id, DXL_AX_STATUS_RETURN_LEVEL, (uint8_t)want_level, level >= 2);
+}
+
+/* Bus time of one 100 Hz cycle: one READ(36, 6) per servo and one SYNC_WRITE
+ * of goal + speed for all, plus the adapter's hold time per READ. */
+static void dxlt_setup_budget(struct dxlt *t, unsigned nservos, int latency_ms)
+{
+	double byte_us = 10.0 * 1e6 / (double)port_baud(t->port);
+	double wire_ms = (nservos * 20.0 + 5.0 * nservos + 8.0) * byte_us / 1000.0;
+	double total_ms = wire_ms + nservos * (double)latency_ms;
+
+	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire + %d ms "
+	        "adapter latency per read = %.2f ms of the 10 ms period%s\n", nservos,
+	        nservos == 1 ? "" : "s", port_baud(t->port), wire_ms, latency_ms, total_ms,
+	        total_ms > 5.0 ? " (too much for 100 Hz)" : "");
+}
+
+static int dxlt_cmd_setup(struct dxlt *t)
+{
+	uint8_t ids[DXLT_MAX_IDS];
+	int worst = DXLT_EXIT_OK;
+
+	if (t->a.npos < 1 || t->a.npos > DXLT_MAX_IDS)
+		return dxlt_need_args(t, -1, "setup ID... [--status-level N]");
+	for (int i = 0; i < t->a.npos; i++) {
+		int rc = dxlt_arg_id(t, t->a.pos[i], false, &ids[i]);
+		if (rc != DXLT_EXIT_OK)
+			return rc;
+	}
+	for (int i = 0; i < t->a.npos; i++) {
+		int rc = dxlt_setup_one(t, ids[i]);
+		if (rc == DXLT_EXIT_PORT)
+			return rc;
+		if (rc > worst)
+			worst = rc;
+	}
+	/* The adapter: lower the FTDI latency timer now that the servos are done. */
+	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
+	fprintf(t->out, "adapter: %s\n", t->latency.note);
+	int latency_ms = t->latency.known ? t->latency.timer_ms : 0;
+	dxlt_setup_budget(t, (unsigned)t->a.npos, latency_ms);
+	if (t->latency.known && t->latency.timer_ms > 1) {
+		fprintf(t->err, "dxl: %s\n", t->latency.note);
+		if (worst == DXLT_EXIT_OK)
+			worst = DXLT_EXIT_PORT;
+	}
+	return worst;
+}
+
+/* ---- main --------------------------------------------------------------------- */
+
+struct dxlt_command {
+	const char *name;
+	int (*run)(struct dxlt *t);
+};
+
+static const struct dxlt_command dxlt_commands[] = {
+	{ "scan", dxlt_cmd_scan },       { "ping", dxlt_cmd_ping },       { "read", dxlt_cmd_read },
+	{ "write", dxlt_cmd_write },     { "dump", dxlt_cmd_dump },       { "set-id", dxlt_cmd_set_id },
+	{ "set-baud", dxlt_cmd_set_baud }, { "torque", dxlt_cmd_torque }, { "reset", dxlt_cmd_reset },
+	{ "setup", dxlt_cmd_setup },
+};
+
+static int dxlt_open(struct dxlt *t)
+{
+	struct port_options opt = { .baud = t->a.baud };
+	struct bus_io io;
+	char why[256];
+
+	t->port = port_open(t->a.port_path, &opt, why, sizeof why);
+	if (t->port == NULL) {
+		fprintf(t->err, "dxl: %s\n", why);
+		return DXLT_EXIT_PORT;
+	}
+	/* Look, do not touch: only `setup` changes the adapter. */
+	port_latency_check_fd(t->a.port_path, port_fd(t->port), false, &t->latency);
+	port_bus_io(t->port, &io);
+	bus_init(&t->bus, &io, NULL, t->a.echo);
+	dxlt_apply_timing(t);
+	return DXLT_EXIT_OK;
+}
+
+static int dxlt_dispatch(struct dxlt *t)
+{
+	if (t->a.help) {
+		dxlt_help(t->out);
+		return DXLT_EXIT_OK;
+	}
+	if (t->a.command == NULL) {
+		fprintf(t->err, "dxl: no command given\n");
+		dxlt_usage(t->err);
+		return DXLT_EXIT_USAGE;
+	}
+	if (strcmp(t->a.command, "ports") == 0)
+		return t->a.npos == 0 ? dxlt_cmd_ports(t) : dxlt_need_args(t, 0, "ports");
+	for (size_t i = 0; i < sizeof dxlt_commands / sizeof dxlt_commands[0]; i++) {
+		if (strcmp(t->a.command, dxlt_commands[i].name) != 0)
+			continue;
+		if (t->a.port_path == NULL) {
+			fprintf(t->err, "dxl: %s needs --port PATH (see dxl ports)\n", t->a.command);
+			return DXLT_EXIT_USAGE;
+		}
+		int rc = dxlt_open(t);
+		if (rc != DXLT_EXIT_OK)
+			return rc;
+		return dxlt_commands[i].run(t);
+	}
+	fprintf(t->err, "dxl: unknown command '%s'\n", t->a.command);
+	dxlt_usage(t->err);
+	return DXLT_EXIT_USAGE;
+}
+
+int dxlt_main(int argc, char **argv, FILE *out, FILE *err)
+{
+	struct dxlt *t = calloc(1, sizeof *t);
+	int rc;
+
+	if (t == NULL) {
+		fprintf(err, "dxl: out of memory\n");
+		return 1;
+	}
+	t->out = out;
+	t->err = err;
+	rc = dxlt_parse_args(argc, argv, &t->a, err);
+	if (rc == DXLT_EXIT_OK)
+		rc = dxlt_dispatch(t);
+	fflush(out);
+	port_close(t->port);
+	free(t);
+	return rc;
+}

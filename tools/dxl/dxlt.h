@@ -1,0 +1,72 @@
+/*
+ * dxlt.h — the `dxl` bus tool as a library, so its tests can run every
+ * command in-process against a fake servo and read what it printed.
+ */
+#ifndef UNDULATE_DXLT_H
+#define UNDULATE_DXLT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "bus.h"
+#include "port.h"
+
+/* Exit codes (documented in tools/dxl/README.md). */
+enum dxlt_exit {
+	DXLT_EXIT_OK = 0,
+	DXLT_EXIT_USAGE = 2,     /* bad arguments: unknown register, value out of range ... */
+	DXLT_EXIT_PORT = 3,      /* cannot open/configure the port, it went away, latency too high */
+	DXLT_EXIT_BUS = 4,       /* no reply, bad reply, verification after a write failed */
+	DXLT_EXIT_SERVO = 5,     /* the servo answered with error bits set */
+	DXLT_EXIT_REFUSED = 6,   /* refused to act: ID taken, torque on during an EEPROM write */
+};
+
+/* Most IDs/bauds a command takes on its command line. */
+#define DXLT_MAX_IDS   (DXL_MAX_ID + 1)
+#define DXLT_MAX_BAUDS 16
+/* The AX-12 factory rate. */
+#define DXLT_DEFAULT_BAUD 1000000L
+/* Scheduling slack on top of the derived reply timeout (ms): the tool is
+ * interactive, a few ms more per missing servo cost nothing, a false "no
+ * reply" on a loaded machine costs the user's trust. */
+#define DXLT_DEFAULT_SLACK_MS 5
+/* Settling time after an EEPROM write before talking to the servo again: the
+ * AX-12 is busy ≈6 ms per EEPROM byte. */
+#define DXLT_EEPROM_SETTLE_US 15000
+
+struct dxlt_args {
+	const char *port_path;
+	long baud;               /* --baud, bps */
+	bool echo;               /* --echo: single-wire wiring, our bytes come back */
+	long latency_us;         /* --latency-us; -1: from the adapter's latency timer */
+	long timeout_ms;         /* --timeout-ms; -1: derived + DXLT_DEFAULT_SLACK_MS */
+	bool units;              /* --units */
+	bool yes;                /* --yes */
+	int status_level;        /* --status-level for setup; -1: default */
+	uint8_t id_lo, id_hi;    /* --ids A-B */
+	long bauds[DXLT_MAX_BAUDS];
+	size_t nbauds;           /* --bauds LIST; 0: just --baud */
+	bool help;
+	const char *command;
+	char **pos;              /* the command's positional arguments */
+	int npos;
+};
+
+/* Parsers for command-line values; each returns 0 or -1 (bad input). */
+int dxlt_parse_long(const char *s, long min, long max, long *out);
+int dxlt_parse_id(const char *s, bool allow_broadcast, uint8_t *id);
+int dxlt_parse_id_range(const char *s, uint8_t *lo, uint8_t *hi);
+/* "1000000,57600", or "all" for every AX-12 rate the register can name. */
+int dxlt_parse_bauds(const char *s, long *out, size_t cap, size_t *n);
+
+/* Parse argv (options may come before or after the command). On failure
+ * writes one line to err and returns DXLT_EXIT_USAGE. */
+int dxlt_parse_args(int argc, char **argv, struct dxlt_args *a, FILE *err);
+void dxlt_usage(FILE *f);
+void dxlt_help(FILE *f);
+
+/* The whole program: what main() calls. Returns the exit code. */
+int dxlt_main(int argc, char **argv, FILE *out, FILE *err);
+
+#endif
