@@ -4,7 +4,8 @@
  * friction, and a thermal model. Pure: stepped with dt by the caller (>= 1 kHz).
  *
  * Angles here are radians relative to the servo centre (raw 512), positive
- * towards larger raw positions (CCW); speeds rad/s.
+ * towards larger raw positions (CCW); speeds rad/s. The models, defaults and
+ * where the numbers come from: sim-bridge/PHYSICS.md.
  */
 #ifndef UNDULATE_SIM_MOTOR_H
 #define UNDULATE_SIM_MOTOR_H
@@ -14,16 +15,20 @@
 
 /* Physical parameters of one joint (defaults: sim_motor_default_params()). */
 struct sim_motor_params {
-	double inertia;            /* kg·m², joint + link about the axis (18.65 cm link) */
-	double viscous;            /* N·m·s/rad, joint viscous friction */
-	double coulomb;            /* N·m, dry friction */
+	double inertia;            /* kg·m², link + rotor through the gearbox (18.65 cm link) */
+	double viscous;            /* N·m·s/rad, what the link adds (gearbox losses are in the motor line) */
+	double coulomb;            /* N·m, dry friction the link adds */
 	double stall_torque_12v;   /* 1.5 N·m at 12 V */
 	double no_load_speed_12v;  /* 59 rpm at 12 V = 6.18 rad/s */
 	double supply_voltage;     /* V; torque and speed scale linearly with it */
-	/* thermal: dT/dt = (heat_per_torque2 · τ² − (T − ambient)/tau) */
+	/* thermal: dT/dt = heat_gain · (τ / stall_torque_12v)² − (T − ambient_c) / thermal_tau_s */
 	double ambient_c;
 	double thermal_tau_s;      /* s, cooling time constant */
-	double heat_gain;          /* °C/s per (τ/τ_stall)² at full stall */
+	double heat_gain;          /* °C/s at full 12 V stall torque */
+	/* no drive (torque off, torque limit 0, no supply): back-driving the motor
+	 * through the 254:1 gearbox */
+	double backdrive_viscous;  /* N·m·s/rad, added to viscous while there is no drive */
+	double backdrive_coulomb;  /* N·m, added to coulomb while there is no drive */
 };
 
 /* The servo registers the controller acts on (decoded from its RAM/EEPROM). */
@@ -42,9 +47,12 @@ struct sim_motor_cmd {
 struct sim_motor {
 	double angle;              /* rad, true */
 	double speed;              /* rad/s, true */
-	double motor_torque;       /* N·m the motor delivered in the last step */
+	double motor_torque;       /* N·m the motor delivered in the last step (at its start speed) */
 	double temperature;        /* °C */
 	double ext_torque;         /* N·m applied from outside during the last step (contact) */
+	double drive;              /* signed PWM duty the controller commanded, -1..1 */
+	unsigned long bad_input;   /* steps refused or repaired: non-finite dt/torque/state */
+	double setpoint;           /* position units: the firmware's moving target (moving-speed profile) */
 };
 
 void sim_motor_default_params(struct sim_motor_params *p);
@@ -52,6 +60,9 @@ void sim_motor_init(struct sim_motor *m, const struct sim_motor_params *p, doubl
 /* Advance dt seconds under cmd with an external torque (N·m) acting on the joint. */
 void sim_motor_step(struct sim_motor *m, const struct sim_motor_params *p,
                     const struct sim_motor_cmd *cmd, double ext_torque, double dt);
+/* Supply-scaled motor line: stall torque (N·m) and no-load speed (rad/s). */
+double sim_motor_stall_torque(const struct sim_motor_params *p);
+double sim_motor_no_load_speed(const struct sim_motor_params *p);
 /* Present load as the servo reports it: signed fraction of max torque in [-1, 1]. */
 double sim_motor_load_fraction(const struct sim_motor *m, const struct sim_motor_params *p);
 /* Whether the delivered torque has reached the torque limit (the overload bit's cause). */

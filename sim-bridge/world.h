@@ -17,6 +17,7 @@
 #ifndef UNDULATE_SIM_WORLD_H
 #define UNDULATE_SIM_WORLD_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "motor.h"
@@ -45,6 +46,11 @@ struct sim_collision {
 	int left, right;           /* body indices; -1 = wall */
 	double pre_left, pre_right, post_left, post_right;  /* m/s lateral */
 	double impulse;            /* N·s = effective_mass · |Δv| */
+	/* Resting contact, not an impact: the pair was already touching and closed
+	 * only by what the motors did during this step (persistent push). Such a
+	 * contact is perfectly inelastic and repeats every step while the push
+	 * lasts; its impulses still sum to the contact force × time. */
+	bool resting;
 };
 
 struct sim_world {
@@ -54,16 +60,26 @@ struct sim_world {
 	double time;
 	unsigned long long total_collisions;
 	double total_impulse;
+	/* additive diagnostics (PHYSICS.md): */
+	unsigned long long unresolved_steps;  /* contact sweeps hit their cap; finished next step */
+	unsigned long long infeasible_steps;  /* the row is wider than the space between the walls */
+	unsigned long long bad_input;         /* rejected bodies/params, repaired non-finite state */
+	unsigned long long resting_contacts;  /* of total_collisions, those with resting set */
+	/* contact memory between steps (for resting contact; see PHYSICS.md) */
+	unsigned char in_contact[SIM_MAX_BODIES + 1];  /* pair k touched (or was within a step of it) */
+	double prev_speed[SIM_MAX_BODIES];            /* lateral speed at the end of the last step */
 };
 
 void sim_world_init(struct sim_world *w, const struct sim_world_params *p);
-/* Append a body (left to right). Returns its index or -1 when full. */
+/* Append a body (left to right). Returns its index, or -1 when full or when the
+ * body is invalid (no motor, lever 0 or non-finite, negative half-width or mass). */
 int sim_world_add_body(struct sim_world *w, const struct sim_body *b);
 double sim_world_lateral(const struct sim_world *w, size_t i);          /* X_i */
 double sim_world_lateral_speed(const struct sim_world *w, size_t i);    /* lever · angular speed */
 /* After the motors moved by dt: detect and resolve every contact, write up to
- * cap collisions into out and return how many happened (all are counted in the
- * totals even when out is full). */
+ * cap collisions into out (one per touching pair and step, merged over the
+ * pair's impulses) and return how many were written, <= cap (all are counted
+ * in the totals even when out is full or NULL). */
 size_t sim_world_resolve(struct sim_world *w, double dt, struct sim_collision *out, size_t cap);
 
 #endif
