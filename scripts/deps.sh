@@ -3,10 +3,11 @@
 # As root: runs apt-get. Otherwise: prints the exact command and stops.
 set -eu
 # build + runtime: compiler, LCM (pkg-config lcm needs glib's .pc), serial
-# ports, config parsing (inih), unit tests (cmocka); tests and tools: socat,
+# ports, config parsing (inih), unit tests (cmocka); tests and tools: jq and
+# python3 (test peers and JSON checks),
 # gnuplot for plots, cyclictest for the jitter benchmark, tmux for the demo.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
-      libinih-dev libcmocka-dev gnuplot-nox rt-tests procps)
+      libinih-dev libcmocka-dev gnuplot-nox rt-tests procps jq python3)
 [ -n "${DEPS_EXTRA:-}" ] && need+=($DEPS_EXTRA)
 missing=()
 for p in "${need[@]}"; do

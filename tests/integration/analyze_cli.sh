@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# undulate-analyze from the command line: a log recorded by the real
+# lcm-logger from replayed synthetic traffic (known phases and collisions),
+# plots, and the exit codes for missing, foreign and truncated logs.
+. "$(dirname "$0")/../lib.sh"
+port=7752
+url=$(lcm_url $port)
+A="$B/undulate-analyze"
+
+tap_check "--synth writes a log" bash -c "'$A' --synth '$T/s.log' --duration 13 >/dev/null"
+# record it as a lab would: lcm-logger on the network, lcm-logplayer at 4x speed
+spawn logger lcm-logger --lcm-url="$url" --flush-interval=10 -q "$T/rec.log"
+hexport=$(printf '%04X' $port)
+# ready once its multicast socket is bound (LCM binds it when subscribing)
+wait_for 5 grep -q ":$hexport " /proc/net/udp || tap_fail "lcm-logger did not bind port $port"
+lcm-logplayer --lcm-url="$url" --speed=4 "$T/s.log" >"$T/player.log" 2>&1
+stop logger INT >/dev/null
+tap_check "lcm-logger recorded something" test -s "$T/rec.log"
+
+"$A" "$T/rec.log" --out "$T/out" --window 5 --plots >"$T/summary.out" 2>"$T/err.out"
+rc=$?
+if [ "$rc" = 0 ]; then tap_ok "analysis of an lcm-logger log exits 0"
+else tap_fail "analysis of an lcm-logger log exits 0" "rc=$rc: $(cat "$T/err.out")"; fi
+for f in states collisions bus events params phase_diff return_map collision_rate; do
+	tap_check "$f.csv written with a header and rows" test "$(wc -l <"$T/out/$f.csv")" -gt 1
+done
+tap_check "summary: r1:r2 compatible" grep -qE '^r1:r2 +compatible' "$T/out/summary.txt"
+tap_check "summary: r2:r3 anti-phase" grep -qE '^r2:r3 +anti-phase' "$T/out/summary.txt"
+tap_check "summary printed on stdout too" grep -q 'end state' "$T/summary.out"
+# r3:r4 collides at 4, 8, 12 s: two return-map points on the d~ = 0 closed form
+# delta_n = 2 atan((-r)^n tan(delta0/2)), delta0 = 2, r = 0.67
+tap_check "return map r3:r4 follows the closed form" awk -F, '
+	$1 == "\"r3:r4\"" { n = $2; e0 = 2 * atan2((-0.67)^n * sin(1) / cos(1), 1);
+		e1 = 2 * atan2((-0.67)^(n + 1) * sin(1) / cos(1), 1);
+		if (($5 - e0)^2 > 1e-6 || ($6 - e1)^2 > 1e-6) bad = 1; pts++ }
+	END { exit !(pts == 2 && !bad) }' "$T/out/return_map.csv"
+
+png_ok() { [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] && [ "$(stat -c %s "$1")" -gt 1000 ]; }
+if command -v gnuplot >/dev/null; then
+	for p in angles portraits phase_diff collision_rate return_map_1 return_map_2; do
+		tap_check "$p.png is a PNG" png_ok "$T/out/$p.png"
+	done
+else
+	tap_fail "gnuplot not installed (gnuplot-nox): plots untested"
+fi
+
+# errors: missing, foreign, truncated, bad options
+"$A" "$T/nope.log" --out "$T/e1" 2>"$T/e1.err"; rc=$?
+tap_check "missing log: exit 2 and a message" bash -c "[ $rc = 2 ] && grep -q 'No such file' '$T/e1.err'"
+printf 'not a log at all\n' >"$T/foreign.log"
+"$A" "$T/foreign.log" --out "$T/e2" 2>"$T/e2.err"; rc=$?
+tap_check "foreign file: exit 2, 'not an LCM log', nothing written" \
+	bash -c "[ $rc = 2 ] && grep -q 'not an LCM log' '$T/e2.err' && [ ! -e '$T/e2/states.csv' ]"
+head -c 300000 "$T/s.log" >"$T/cut.log"
+"$A" "$T/cut.log" --out "$T/e3" --quiet 2>"$T/e3.err"; rc=$?
+tap_check "truncated log: exit 3 with a warning saying where it stopped" \
+	bash -c "[ $rc = 3 ] && grep -q 'truncated or damaged at byte' '$T/e3.err'"
+tap_check "truncated log: everything before the damage is written" test "$(wc -l <"$T/e3/states.csv")" -gt 100
+"$A" "$T/s.log" --window -1 2>/dev/null; rc=$?
+tap_check "bad option: exit 1" [ "$rc" = 1 ]
+tap_done

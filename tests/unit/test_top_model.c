@@ -1,0 +1,275 @@
+/* test_top_model.c — undulate-top's model, keys, commands and screen,
+ * without a terminal or a network. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../tools/top/keys.h"
+#include "../../tools/top/model.h"
+#include "../../tools/top/render.h"
+
+#define T_SCREEN (256 * 1024)
+
+static struct top_model model;
+static char screen[T_SCREEN];
+
+/* A STATE from robot NAME at time NOW with joint phases PH0, PH1. */
+static void feed_state(const char *name, double now, double ph0, double ph1, double jitter, int mode)
+{
+	char n[32], reason[] = "test";
+	snprintf(n, sizeof(n), "%s", name);
+	undulate_joint_state_t j[2] = {
+		{ .servo_id = 1, .angle = 0.8 * cos(ph0), .phase = ph0, .amplitude = 0.8, .frequency = 0.8 },
+		{ .servo_id = 2, .angle = 0.8 * cos(ph1), .phase = ph1, .amplitude = 0.8, .frequency = 0.8,
+		  .error_bits = 0 },
+	};
+	undulate_robot_state_t s = { .utime = (int64_t)(now * 1e6), .robot = n, .mode = (int8_t)mode,
+		.mode_reason = reason, .period_us = 10000.0, .jitter_us = jitter, .njoints = 2, .joints = j };
+	top_on_state(&model, &s, now);
+}
+
+static int setup(void **state)
+{
+	(void)state;
+	top_model_init(&model);
+	return 0;
+}
+
+static void test_rate_jitter_stale(void **state)
+{
+	(void)state;
+	for (int i = 0; i < 100; i++)
+		feed_state("a", i * 0.01, 0, 0, i == 50 ? 900.0 : i == 60 ? 800.0 : 30.0 + (i % 10), 3);
+	const struct top_robot *r = &model.robots[0];
+	assert_true(fabs(top_robot_rate_hz(r) - 100.0) < 1e-9);
+	/* p99 of 100 samples (nearest rank): the second largest */
+	assert_true(top_robot_jitter_p99(r) == 800.0);
+	assert_true(top_robot_jitter_max(r) == 900.0);
+	assert_false(top_robot_stale(r, 1.5));
+	assert_true(top_robot_stale(r, 2.1));
+	assert_int_equal(model.nrobots, 1); /* stale robots are kept */
+	assert_true(fabs(top_robot_rx_hz(r, 0.99) - 100.0) < 1.5);
+}
+
+static void test_order_and_phases(void **state)
+{
+	(void)state;
+	feed_state("c", 0, 0.0, -2.0, 10, 3);
+	feed_state("a", 0, 0.5, -1.5, 10, 3);
+	feed_state("b", 0, 3.0, 1.0, 10, 3);
+	assert_string_equal(model.robots[model.order[0]].name, "a");
+	assert_string_equal(model.robots[model.order[2]].name, "c");
+	assert_true(fabs(top_neighbour_dphase(&model, 0) - 2.5) < 1e-12);             /* b - a */
+	assert_true(fabs(top_neighbour_dphase(&model, 1) - (0.0 - 3.0)) < 1e-12);      /* c - b */
+	assert_true(isnan(top_neighbour_dphase(&model, 2)));
+	assert_true(fabs(top_robot_dphase_joints(&model.robots[0]) + 2.0) < 1e-12);
+	/* the simulator puts c leftmost: order follows lateral position */
+	char ra[] = "a", rb[] = "b", rc[] = "c";
+	undulate_sim_body_t bodies[3] = { { .robot = ra, .servo_id = 2, .neutral = 0.2 },
+					  { .robot = rb, .servo_id = 1, .neutral = 0.3 },
+					  { .robot = rc, .servo_id = 1, .neutral = 0.1 } };
+	undulate_sim_truth_t t = { .nbodies = 3, .bodies = bodies, .total_collisions = 4, .total_impulse = 0.5 };
+	top_on_truth(&model, &t, 0.5);
+	assert_true(model.order_lateral);
+	assert_string_equal(model.robots[model.order[0]].name, "c");
+	assert_string_equal(model.robots[model.order[1]].name, "a");
+	/* a's contact body is on its joint 1 (servo 2): a.j1 - c.j0 = -1.5 - 0 */
+	assert_true(fabs(top_neighbour_dphase(&model, 0) + 1.5) < 1e-12);
+	/* wrapped: b.j0 - a.j1 = 3.0 + 1.5 -> 4.5 - 2 pi */
+	assert_true(fabs(top_neighbour_dphase(&model, 1) - (4.5 - 2 * M_PI)) < 1e-12);
+}
+
+static void test_collisions(void **state)
+{
+	(void)state;
+	char l[] = "a", r[] = "b";
+	undulate_sim_collision_t c = { .utime = 100, .left = 0, .right = 1, .left_robot = l, .right_robot = r,
+				       .impulse = 0.25 };
+	top_on_sim_collision(&model, &c, 1.0);
+	/* the same collision again inside SIM.TRUTH, stamped with the truth's
+	 * own time: counted once */
+	undulate_sim_collision_t copy = c;
+	copy.utime = 107;
+	undulate_sim_truth_t t = { .ncollisions = 1, .collisions = &copy, .total_collisions = 1, .total_impulse = 0.25 };
+	top_on_truth(&model, &t, 1.01);
+	c.utime = 200;
+	top_on_sim_collision(&model, &c, 5.0);
+	double imp = 0;
+	assert_int_equal(top_collisions_window(&model, 5.0, &imp), 2);
+	assert_true(fabs(imp - 0.5) < 1e-12);
+	assert_int_equal(top_collisions_window(&model, 12.0, &imp), 1); /* the first left the 10 s window */
+	assert_true(model.collisions_heard == 2);
+	assert_true(top_sim_present(&model, 6.0));
+	assert_false(top_sim_present(&model, 9.0));
+	/* without SIM.COLLISION (an older simulator), SIM.TRUTH's copies count */
+	top_model_init(&model);
+	top_on_truth(&model, &t, 1.0);
+	assert_int_equal(top_collisions_window(&model, 1.0, NULL), 1);
+}
+
+static void test_keys(void **state)
+{
+	(void)state;
+	struct top_keyparser kp = { 0 };
+	int ch = 0;
+	const unsigned char up[] = "\033[A", pgdn[] = "\033[6~", ss3down[] = "\033OB";
+	enum top_key k = TOP_KEY_NONE;
+	for (size_t i = 0; i < 3; i++)
+		k = top_key_feed(&kp, up[i], &ch);
+	assert_int_equal(k, TOP_KEY_UP);
+	for (size_t i = 0; i < 4; i++)
+		k = top_key_feed(&kp, pgdn[i], &ch);
+	assert_int_equal(k, TOP_KEY_PGDN);
+	for (size_t i = 0; i < 3; i++)
+		k = top_key_feed(&kp, ss3down[i], &ch);
+	assert_int_equal(k, TOP_KEY_DOWN);
+	assert_int_equal(top_key_feed(&kp, 'q', &ch), TOP_KEY_CHAR);
+	assert_int_equal(ch, 'q');
+	/* an unknown sequence is swallowed, the next key is intact */
+	const unsigned char junk[] = "\033[99Z";
+	for (size_t i = 0; i < 5; i++)
+		top_key_feed(&kp, junk[i], &ch);
+	assert_int_equal(top_key_feed(&kp, 'o', &ch), TOP_KEY_CHAR);
+	assert_int_equal(ch, 'o');
+}
+
+static void test_commands(void **state)
+{
+	(void)state;
+	struct top_command c[TOP_MAX_JOINTS];
+	assert_int_equal(top_command_mode(&c[0], "*", UNDULATE_ROBOT_STATE_T_MODE_HOLD, 42, "me"), 0);
+	assert_string_equal(c[0].channel, "UNDULATE.CMD");
+	assert_string_equal(c[0].msg.robot, "*");
+	assert_int_equal(c[0].msg.kind, UNDULATE_COMMAND_T_KIND_MODE);
+	assert_int_equal(c[0].msg.mode, 1);
+	assert_true(c[0].msg.seq == 42);
+	assert_int_equal(top_command_mode(&c[0], "r2", UNDULATE_ROBOT_STATE_T_MODE_SINUSOID, 43, "me"), 0);
+	assert_string_equal(c[0].channel, "r2.CMD");
+	assert_int_equal(top_command_mode(&c[0], "r2", 9, 44, "me"), -1);
+
+	feed_state("r2", 0, 0, 0, 10, UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR);
+	struct top_robot *r = &model.robots[0];
+	char why[160];
+	assert_int_equal(top_command_nudge(c, r, 1, 50, "me", why, sizeof(why)), -1);
+	assert_non_null(strstr(why, "PARAMS"));
+	char name[] = "r2";
+	double k[2] = { 1, 1 }, cc[2] = { 0.02, 0.04 }, mu[2] = { 1, 1 }, z[2] = { 0, 0 };
+	undulate_osc_params_t p = { .robot = name, .njoints = 2, .k = k, .c = cc, .mu = mu, .lambda = z, .inertia = z,
+				    .friction = z, .neutral = z, .limit_min = z, .limit_max = z, .amplitude = 0.8 };
+	top_on_params(&model, &p);
+	assert_int_equal(top_command_nudge(c, r, 1, 50, "me", why, sizeof(why)), 2);
+	assert_string_equal(c[1].channel, "r2.CMD");
+	assert_string_equal(c[1].msg.param, "c");
+	assert_int_equal(c[1].msg.joint, 1);
+	assert_true(fabs(c[1].msg.value - 0.044) < 1e-12);
+	assert_true(c[1].msg.seq == 51);
+	assert_non_null(strstr(why, "0.04->0.044"));
+	/* SINUSOID: the amplitude, bounded */
+	feed_state("r2", 0.01, 0, 0, 10, UNDULATE_ROBOT_STATE_T_MODE_SINUSOID);
+	assert_int_equal(top_command_nudge(c, r, -1, 60, "me", why, sizeof(why)), 1);
+	assert_string_equal(c[0].msg.param, "amplitude");
+	assert_true(fabs(c[0].msg.value - 0.75) < 1e-12);
+	r->sin_amplitude = TOP_AMPLITUDE_MAX;
+	assert_int_equal(top_command_nudge(c, r, 1, 61, "me", why, sizeof(why)), -1);
+	feed_state("r2", 0.02, 0, 0, 10, UNDULATE_ROBOT_STATE_T_MODE_LIMP);
+	assert_int_equal(top_command_nudge(c, r, 1, 62, "me", why, sizeof(why)), -1);
+}
+
+static int max_line_width(const char *s)
+{
+	int w = 0, mx = 0;
+	for (; *s; s++) {
+		if (*s == '\n') {
+			mx = w > mx ? w : mx;
+			w = 0;
+		} else if (*s == '\033') {
+			while (*s && !((*s >= 'A' && *s <= 'Z') || (*s >= 'a' && *s <= 'z')))
+				s++; /* skip the escape sequence */
+		} else if (*s != '\r') {
+			w++;
+		}
+	}
+	return w > mx ? w : mx;
+}
+
+/* Twenty robots on 80x24: all visible (compact), no line wider than 80,
+ * exactly 24 lines; the selection scrolls into view in the detail view. */
+static void test_render_twenty(void **state)
+{
+	(void)state;
+	for (int i = 0; i < 20; i++) {
+		char name[16];
+		snprintf(name, sizeof(name), "robot%02d", i + 1);
+		feed_state(name, 0, 0.1 * i, 0.1 * i - 2, 10, 3);
+	}
+	struct top_view v = { 0 };
+	top_render(&model, &v, 0.5, 24, 80, true, screen, sizeof(screen));
+	assert_true(max_line_width(screen) <= 80);
+	for (int i = 0; i < 20; i++) {
+		char name[16];
+		snprintf(name, sizeof(name), "robot%02d", i + 1);
+		assert_non_null(strstr(screen, name));
+	}
+	int lines = 1;
+	for (const char *p = screen; *p; p++)
+		lines += *p == '\n';
+	assert_int_equal(lines, 24);
+	/* detail view: robot 20 selected must be on screen, robot 1 scrolled off */
+	v.kind = TOP_VIEW_DETAIL;
+	v.selected = 19;
+	top_render(&model, &v, 0.5, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "robot20"));
+	assert_null(strstr(screen, "robot01"));
+	assert_true(max_line_width(screen) <= 80);
+	/* stale robots are marked, not dropped */
+	v.kind = TOP_VIEW_COMPACT;
+	v.selected = 0;
+	top_render(&model, &v, 5.0, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "(20 stale)"));
+	assert_non_null(strstr(screen, "robot20"));
+	/* --once text: every robot in detail, no escapes */
+	top_render(&model, &v, 5.0, 0, 0, false, screen, sizeof(screen));
+	assert_null(strchr(screen, '\033'));
+	assert_non_null(strstr(screen, "STALE"));
+	assert_non_null(strstr(screen, "robot01"));
+	assert_non_null(strstr(screen, "robot20"));
+}
+
+static void test_json(void **state)
+{
+	(void)state;
+	feed_state("r\"1", 0, 0.25, -1.0, 10, 2);
+	feed_state("r2", 0, 0.75, -1.0, 10, 3);
+	static char buf[65536];
+	FILE *f = fmemopen(buf, sizeof(buf), "w");
+	top_json(&model, 0.1, 1234, f);
+	fclose(f);
+	assert_non_null(strstr(buf, "\"name\":\"r\\\"1\""));
+	assert_non_null(strstr(buf, "\"mode\":\"SINUSOID\""));
+	assert_non_null(strstr(buf, "\"dphase\":0.5"));
+	assert_non_null(strstr(buf, "\"rate_hz\":100"));
+	assert_non_null(strstr(buf, "\"stale\":false"));
+	assert_non_null(strstr(buf, "\"sim\":{\"present\":false"));
+	assert_int_equal(strchr(buf, '\n') - buf, (long)strlen(buf) - 1); /* one line */
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test_setup(test_rate_jitter_stale, setup),
+		cmocka_unit_test_setup(test_order_and_phases, setup),
+		cmocka_unit_test_setup(test_collisions, setup),
+		cmocka_unit_test_setup(test_keys, setup),
+		cmocka_unit_test_setup(test_commands, setup),
+		cmocka_unit_test_setup(test_render_twenty, setup),
+		cmocka_unit_test_setup(test_json, setup),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,315 @@
+/* test_top_terminal.c — the real undulate-top binary on a pseudo-terminal:
+ * it switches the terminal to raw mode and the alternate screen, and gives
+ * the terminal back as it found it on q, Ctrl-C and SIGTERM; its keys send
+ * the documented commands and the robot's answer shows up. Needs
+ * $BUILD/bin/undulate-top (tests/run.sh exports BUILD). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/ioctl.h>
+#include <sys/wait.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <lcm/lcm.h>
+#include "undulate_command_t.h"
+#include "undulate_event_t.h"
+#include "undulate_osc_params_t.h"
+#include "undulate_robot_state_t.h"
+
+/* Output kept from the program (a few screens). */
+#define T_OUT (256 * 1024)
+/* How long the program may take to draw or to exit (ms). */
+#define T_TIMEOUT_MS 5000
+/* This test's own multicast port (tools range 7750-7799). */
+#define T_LCM_URL "udpm://239.255.76.67:7751?ttl=0"
+
+struct child {
+	pid_t pid;
+	int master;
+	char out[T_OUT];
+	size_t len;
+};
+
+static char binary[512];
+
+static int setup(void **state)
+{
+	(void)state;
+	const char *b = getenv("BUILD");
+	snprintf(binary, sizeof(binary), "%s/bin/undulate-top", b && *b ? b : "build");
+	if (access(binary, X_OK) != 0) {
+		fprintf(stderr, "# %s not built (set BUILD)\n", binary);
+		return -1;
+	}
+	return 0;
+}
+
+static void start(struct child *c, const char *extra)
+{
+	memset(c, 0, sizeof(*c));
+	c->master = posix_openpt(O_RDWR | O_NOCTTY);
+	assert_true(c->master >= 0);
+	assert_int_equal(grantpt(c->master), 0);
+	assert_int_equal(unlockpt(c->master), 0);
+	char *slave = ptsname(c->master);
+	assert_non_null(slave);
+	c->pid = fork();
+	assert_true(c->pid >= 0);
+	if (c->pid == 0) {
+		setsid();
+		int s = open(slave, O_RDWR); /* becomes the controlling terminal */
+		struct winsize ws = { .ws_row = 24, .ws_col = 80 };
+		ioctl(s, TIOCSWINSZ, &ws);
+		dup2(s, 0);
+		dup2(s, 1);
+		dup2(s, 2);
+		execl(binary, binary, "--lcm-url", T_LCM_URL, extra, (char *)NULL);
+		_exit(127);
+	}
+}
+
+/* Reads output until NEEDLE appears or TIMEOUT_MS passed; returns whether it did. */
+static int read_until_ms(struct child *c, const char *needle, long timeout_ms)
+{
+	struct timespec t0, t;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	for (;;) {
+		c->out[c->len] = '\0';
+		if (strstr(c->out, needle))
+			return 1;
+		clock_gettime(CLOCK_MONOTONIC, &t);
+		long ms = (t.tv_sec - t0.tv_sec) * 1000 + (t.tv_nsec - t0.tv_nsec) / 1000000;
+		if (ms > timeout_ms)
+			return 0;
+		struct pollfd p = { .fd = c->master, .events = POLLIN };
+		if (poll(&p, 1, 50) > 0) {
+			ssize_t n = read(c->master, c->out + c->len, T_OUT - 1 - c->len);
+			if (n > 0)
+				c->len += (size_t)n;
+			else if (n < 0 && errno == EIO)
+				return 0; /* the program closed the terminal */
+			if (c->len >= T_OUT - 1)
+				c->len = 0; /* keep the newest output */
+		}
+	}
+}
+
+static int read_until(struct child *c, const char *needle)
+{
+	return read_until_ms(c, needle, T_TIMEOUT_MS);
+}
+
+/* Waits for the child; returns its exit status, -1 on timeout (killed). */
+static int wait_exit(struct child *c)
+{
+	for (int i = 0; i < T_TIMEOUT_MS / 10; i++) {
+		int st;
+		/* drain output so the program never blocks on a full pty */
+		char sink[4096];
+		while (read(c->master, sink, sizeof(sink)) > 0)
+			;
+		if (waitpid(c->pid, &st, WNOHANG) == c->pid)
+			return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+		usleep(10000);
+	}
+	kill(c->pid, SIGKILL);
+	waitpid(c->pid, NULL, 0);
+	return -1;
+}
+
+static void check_session(const char *key, int sig)
+{
+	struct child *c = calloc(1, sizeof(*c));
+	start(c, "--read-only");
+	fcntl(c->master, F_SETFL, O_NONBLOCK);
+	assert_true(read_until(c, "undulate-top"));
+	assert_true(read_until(c, "READ-ONLY"));
+	/* while running: raw (no canonical input, no echo, no signals from keys) */
+	struct termios during;
+	assert_int_equal(tcgetattr(c->master, &during), 0);
+	assert_false(during.c_lflag & (ICANON | ECHO | ISIG));
+	assert_non_null(strstr(c->out, "\033[?1049h"));
+	if (key)
+		assert_int_equal(write(c->master, key, strlen(key)), (ssize_t)strlen(key));
+	else
+		kill(c->pid, sig);
+	assert_true(read_until(c, "\033[?1049l")); /* alternate screen left */
+	assert_int_equal(wait_exit(c), 0);
+	/* the terminal is back in cooked mode, as a fresh pty starts */
+	struct termios after;
+	assert_int_equal(tcgetattr(c->master, &after), 0);
+	assert_true((after.c_lflag & (ICANON | ECHO | ISIG)) == (ICANON | ECHO | ISIG));
+	assert_non_null(strstr(c->out, "\033[?25h")); /* cursor shown again */
+	close(c->master);
+	free(c);
+}
+
+static void test_quit_key(void **state)
+{
+	(void)state;
+	check_session("q", 0);
+}
+
+static void test_ctrl_c(void **state)
+{
+	(void)state;
+	check_session("\003", 0);
+}
+
+static void test_sigterm(void **state)
+{
+	(void)state;
+	check_session(NULL, SIGTERM);
+}
+
+/* ---- keys send commands, answers are shown ----------------------------------- */
+
+/* Commands received by the test, in order. */
+#define T_MAX_CMDS 16
+static undulate_command_t got[T_MAX_CMDS];
+static char got_channel[T_MAX_CMDS][32], got_robot[T_MAX_CMDS][32], got_param[T_MAX_CMDS][32];
+static int ngot;
+
+static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, const undulate_command_t *m, void *user)
+{
+	(void)rbuf;
+	(void)user;
+	if (ngot >= T_MAX_CMDS)
+		return;
+	got[ngot] = *m;
+	snprintf(got_channel[ngot], 32, "%s", channel);
+	snprintf(got_robot[ngot], 32, "%s", m->robot);
+	snprintf(got_param[ngot], 32, "%s", m->param);
+	ngot++;
+}
+
+/* What robot "r1" publishes: a STATE in OSCILLATOR and its PARAMS. */
+static void publish_robot(lcm_t *lcm)
+{
+	char name[] = "r1", reason[] = "test";
+	undulate_joint_state_t j[2] = { { .servo_id = 1 }, { .servo_id = 2 } };
+	undulate_robot_state_t s = { .robot = name, .mode = UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR,
+		.mode_reason = reason, .period_us = 10000, .njoints = 2, .joints = j };
+	undulate_robot_state_t_publish(lcm, "r1.STATE", &s);
+	double k[2] = { 1, 1 }, c[2] = { 0.02, 0.04 }, z[2] = { 0, 0 };
+	undulate_osc_params_t p = { .robot = name, .njoints = 2, .k = k, .c = c, .mu = k, .lambda = z,
+		.inertia = z, .friction = z, .neutral = z, .limit_min = z, .limit_max = z, .amplitude = 0.8 };
+	undulate_osc_params_t_publish(lcm, "r1.PARAMS", &p);
+}
+
+/* Lets undulate-top hear r1 until its screen shows it, then collects the
+ * commands that arrive within a short while after KEYS. */
+static int press(struct child *c, lcm_t *lcm, const char *keys, int want)
+{
+	int before = ngot;
+	assert_int_equal(write(c->master, keys, strlen(keys)), (ssize_t)strlen(keys));
+	for (int i = 0; i < T_TIMEOUT_MS / 20 && ngot < before + want; i++)
+		lcm_handle_timeout(lcm, 20);
+	return ngot - before;
+}
+
+static void test_commands_and_answer(void **state)
+{
+	(void)state;
+	lcm_t *lcm = lcm_create(T_LCM_URL);
+	assert_non_null(lcm);
+	undulate_command_t_subscription_t *sub =
+		undulate_command_t_subscribe(lcm, "r1\\.CMD|UNDULATE\\.CMD", on_command, NULL);
+	ngot = 0;
+	struct child *c = calloc(1, sizeof(*c));
+	start(c, NULL);
+	fcntl(c->master, F_SETFL, O_NONBLOCK);
+	assert_true(read_until(c, "undulate-top"));
+	int seen = 0;
+	for (int i = 0; i < 100 && !seen; i++) {
+		publish_robot(lcm);
+		seen = read_until_ms(c, "r1 ", 50);
+	}
+	assert_true(seen);
+	/* o: OSCILLATOR for the selected robot, on r1.CMD */
+	assert_int_equal(press(c, lcm, "o", 1), 1);
+	assert_string_equal(got_channel[0], "r1.CMD");
+	assert_string_equal(got_robot[0], "r1");
+	assert_int_equal(got[0].kind, UNDULATE_COMMAND_T_KIND_MODE);
+	assert_int_equal(got[0].mode, UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR);
+	/* L: LIMP for all robots, on UNDULATE.CMD */
+	assert_int_equal(press(c, lcm, "L", 1), 1);
+	assert_string_equal(got_channel[1], "UNDULATE.CMD");
+	assert_string_equal(got_robot[1], "*");
+	assert_int_equal(got[1].mode, UNDULATE_ROBOT_STATE_T_MODE_LIMP);
+	assert_true(got[1].seq > got[0].seq);
+	/* +: c of each joint up 10 % */
+	assert_int_equal(press(c, lcm, "+", 2), 2);
+	assert_string_equal(got_param[2], "c");
+	assert_int_equal(got[2].kind, UNDULATE_COMMAND_T_KIND_PARAM);
+	assert_int_equal(got[3].joint, 1);
+	assert_true(got[2].value > 0.02199 && got[2].value < 0.02201);
+	assert_true(got[3].value > 0.04399 && got[3].value < 0.04401);
+	/* the robot's answer to the first command appears in the status line */
+	char name[] = "r1", kind[] = "command-rejected", text[] = "mode OSCILLATOR refused: torque off";
+	undulate_event_t e = { .robot = name, .seq = got[0].seq, .level = 1, .kind = kind, .text = text };
+	c->len = 0;
+	undulate_event_t_publish(lcm, "r1.EVENT", &e);
+	assert_true(read_until(c, "command-rejected: mode OSCILLATOR refused"));
+	assert_int_equal(write(c->master, "q", 1), 1);
+	assert_int_equal(wait_exit(c), 0);
+	close(c->master);
+	free(c);
+	undulate_command_t_unsubscribe(lcm, sub);
+	lcm_destroy(lcm);
+}
+
+/* --read-only: the same keys send nothing and say so. */
+static void test_read_only_sends_nothing(void **state)
+{
+	(void)state;
+	lcm_t *lcm = lcm_create(T_LCM_URL);
+	assert_non_null(lcm);
+	undulate_command_t_subscription_t *sub = undulate_command_t_subscribe(lcm, ".*CMD", on_command, NULL);
+	ngot = 0;
+	struct child *c = calloc(1, sizeof(*c));
+	start(c, "--read-only");
+	fcntl(c->master, F_SETFL, O_NONBLOCK);
+	int seen = 0;
+	for (int i = 0; i < 100 && !seen; i++) {
+		publish_robot(lcm);
+		seen = read_until_ms(c, "r1 ", 50);
+	}
+	assert_true(seen);
+	c->len = 0;
+	assert_int_equal(write(c->master, "oL+", 3), 3);
+	assert_true(read_until(c, "read-only: commands are disabled"));
+	for (int i = 0; i < 10; i++)
+		lcm_handle_timeout(lcm, 20);
+	assert_int_equal(ngot, 0);
+	assert_int_equal(write(c->master, "q", 1), 1);
+	assert_int_equal(wait_exit(c), 0);
+	close(c->master);
+	free(c);
+	undulate_command_t_unsubscribe(lcm, sub);
+	lcm_destroy(lcm);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_quit_key),
+		cmocka_unit_test(test_ctrl_c),
+		cmocka_unit_test(test_sigterm),
+		cmocka_unit_test(test_commands_and_answer),
+		cmocka_unit_test(test_read_only_sends_nothing),
+	};
+	return cmocka_run_group_tests(tests, setup, NULL);
+}

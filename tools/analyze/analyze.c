@@ -1,0 +1,1167 @@
+/* analyze.c — undulate-analyze's pipeline (see analyze.h and README.md).
+ *
+ * Two passes over the logs. The first learns who is there: robots, their
+ * joints, the simulator's contact bodies (neutral positions, lever), the time
+ * span; from that the pairs to follow are fixed. The second streams every
+ * event into the CSV files, estimating each joint's phase on the way, so a
+ * long log never has to fit in memory. Only per-pair collision phase
+ * differences (the return map) and the collision-rate bins are kept. */
+#include "analyze.h"
+#include "alog.h"
+#include "phase.h"
+#include "plot.h"
+
+#include "undulate_bus_stats_t.h"
+#include "undulate_event_t.h"
+#include "undulate_osc_params_t.h"
+#include "undulate_robot_state_t.h"
+#include "undulate_sim_collision_t.h"
+#include "undulate_sim_truth_t.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* Samples kept per joint to find the state just before a collision: 160 ms
+ * at 100 Hz, more than a collision message can lag the states around it. */
+#define AN_HISTORY 16
+/* Two robots' samples further apart than this (s) are not paired: one of
+ * them has stopped publishing. 5 cycles at 100 Hz. */
+#define AN_PAIR_FRESH_S 0.05
+/* Recently seen collisions: the simulator reports each one on SIM.COLLISION
+ * and again inside SIM.TRUTH; it is counted once. */
+#define AN_COLL_DEDUP 64
+/* Collision-rate bin (s). */
+#define AN_RATE_BIN_S 1.0
+/* Classification thresholds (rad). The mean phase difference of a pair
+ * in step stays within a few degrees; in anti-phase within ~0.3 rad of pi in
+ * the paper's runs; a spread above AN_SPREAD_MAX means "not locked". */
+#define AN_INPHASE_TOL 0.25
+#define AN_ANTI_TOL 0.5
+#define AN_SPREAD_MAX 0.5
+/* Margin on 2 asin(d~) for sensor noise and the amplitude estimate. */
+#define AN_COMPAT_TOL 0.1
+/* Bins allowed for the collision rate (one per second): ten days. */
+#define AN_MAX_BINS (10 * 24 * 3600)
+/* Warnings of one kind printed before going quiet (the count is reported). */
+#define AN_WARN_LIMIT 5
+
+struct an_sample {
+	int64_t utime;
+	double t, phase, omega;
+};
+
+struct an_joint {
+	int16_t servo_id;
+	struct phase_tracker tr;
+	struct an_sample hist[AN_HISTORY];
+	int hn, hnext;
+	int64_t samples;
+	double reported_freq;
+};
+
+struct an_robot {
+	char name[AN_NAME_MAX];
+	int njoints;
+	struct an_joint j[AN_MAX_JOINTS];
+	int64_t states;
+	/* from SIM.TRUTH */
+	bool have_body;
+	int16_t body_servo;
+	double neutral;     /* m, last seen */
+	double lever;       /* m/rad, NAN until estimated */
+	int contact_joint;  /* joint the contact body is on; 0 without a simulator */
+};
+
+enum an_pair_kind { AN_PAIR_NEIGHBOUR, AN_PAIR_USER, AN_PAIR_JOINTS };
+
+struct an_pair {
+	enum an_pair_kind kind;
+	int a, b, ja, jb;
+	char name[2 * AN_NAME_MAX + 8];
+	struct phase_circ win;
+	int64_t rows, collisions, win_collisions, contacts;
+	double impulse;
+	double last_coll_t;   /* s, NAN before the first */
+	double *deltas;       /* phase difference just before each collision */
+	int64_t *delta_utime;
+	size_t ndeltas, cap;
+	double dsep, amp_lateral, distance;
+	const char *cls;
+};
+
+struct an_seen {
+	int64_t utime;
+	int32_t left, right;
+};
+
+struct an_ctx {
+	const struct an_options *o;
+	struct an_robot robots[AN_MAX_ROBOTS];
+	int nrobots, dropped_robots;
+	int order[AN_MAX_ROBOTS];
+	bool order_lateral;
+	struct an_pair pairs[AN_MAX_PAIRS];
+	int npairs;
+	/* time */
+	bool have_origin;
+	int64_t origin_ts;          /* first event's log timestamp (for --from/--to) */
+	int64_t t_origin;           /* t = 0: the earlier of that and the first state's utime */
+	int64_t from_ts, to_ts;     /* selected range in log timestamps */
+	int64_t last_state_utime;   /* end of the data, for the final window */
+	bool have_state;
+	int64_t last_utime;
+	double window_start_t;
+	/* counts */
+	int64_t events, decode_errors, unknown_channels, truth_msgs, collision_msgs;
+	int64_t collisions, wall_collisions, log_events[AN_MAX_LOGS];
+	double impulse;
+	int warned_decode;
+	bool truncated;
+	char trunc_note[AN_MAX_LOGS][160];
+	/* outputs */
+	FILE *states, *coll, *bus, *evt, *pdiff, *params;
+	struct an_seen seen[AN_COLL_DEDUP];
+	int seen_next;
+	int64_t *bins;
+	double *bin_impulse;
+	int64_t nbins;
+};
+
+void an_options_default(struct an_options *o)
+{
+	memset(o, 0, sizeof(*o));
+	o->out_dir = ".";
+	o->from_s = NAN;
+	o->to_s = NAN;
+	o->window_s = 10.0;
+	o->separation = NAN;
+	o->restitution = 0.67;
+	o->merge_s = 0.1;
+	o->msg = stderr;
+}
+
+static void an_warn(struct an_ctx *c, const char *fmt, ...)
+{
+	va_list ap;
+	fputs("undulate-analyze: warning: ", c->o->msg);
+	va_start(ap, fmt);
+	vfprintf(c->o->msg, fmt, ap);
+	va_end(ap);
+	fputc('\n', c->o->msg);
+}
+
+/* ---- robots and channels ---------------------------------------------------- */
+
+static int an_robot_find(struct an_ctx *c, const char *name, bool add)
+{
+	for (int i = 0; i < c->nrobots; i++)
+		if (strcmp(c->robots[i].name, name) == 0)
+			return i;
+	if (!add || !name[0])
+		return -1;
+	if (c->nrobots >= AN_MAX_ROBOTS || strlen(name) >= AN_NAME_MAX) {
+		if (c->dropped_robots++ == 0)
+			an_warn(c, "robot \"%s\" ignored (more than %d robots or name longer than %d)",
+				name, AN_MAX_ROBOTS, AN_NAME_MAX - 1);
+		return -1;
+	}
+	struct an_robot *r = &c->robots[c->nrobots];
+	memset(r, 0, sizeof(*r));
+	snprintf(r->name, sizeof(r->name), "%s", name);
+	r->lever = NAN;
+	for (int j = 0; j < AN_MAX_JOINTS; j++)
+		phase_tracker_init(&r->j[j].tr);
+	return c->nrobots++;
+}
+
+enum an_chan { CH_UNKNOWN, CH_STATE, CH_BUS, CH_EVENT, CH_PARAMS, CH_CMD, CH_TRUTH, CH_COLLISION, CH_SIMCMD };
+
+static bool an_ends_with(const char *s, const char *suffix)
+{
+	size_t n = strlen(s), m = strlen(suffix);
+	return n > m && strcmp(s + n - m, suffix) == 0;
+}
+
+static enum an_chan an_channel(const char *ch)
+{
+	if (strcmp(ch, "SIM.TRUTH") == 0)
+		return CH_TRUTH;
+	if (strcmp(ch, "SIM.COLLISION") == 0)
+		return CH_COLLISION;
+	if (strcmp(ch, "SIM.CMD") == 0)
+		return CH_SIMCMD;
+	if (an_ends_with(ch, ".STATE"))
+		return CH_STATE;
+	if (an_ends_with(ch, ".BUS"))
+		return CH_BUS;
+	if (an_ends_with(ch, ".EVENT"))
+		return CH_EVENT;
+	if (an_ends_with(ch, ".PARAMS"))
+		return CH_PARAMS;
+	if (an_ends_with(ch, ".CMD"))
+		return CH_CMD;
+	return CH_UNKNOWN;
+}
+
+static void an_decode_failed(struct an_ctx *c, const char *channel)
+{
+	c->decode_errors++;
+	if (c->warned_decode++ < AN_WARN_LIMIT)
+		an_warn(c, "message on %s does not decode as its type (skipped)", channel);
+}
+
+static double an_t(const struct an_ctx *c, int64_t utime)
+{
+	return (double)(utime - c->t_origin) * 1e-6;
+}
+
+/* ---- log iteration ------------------------------------------------------------ */
+
+typedef void (*an_event_fn)(struct an_ctx *c, const lcm_eventlog_event_t *ev);
+
+/* Runs FN on every event of every log inside the selected range. Returns
+ * AN_EXIT_OK, AN_EXIT_BADLOG or AN_EXIT_TRUNCATED; notes truncations once. */
+static int an_each_event(struct an_ctx *c, an_event_fn fn, bool first_pass)
+{
+	int rc = AN_EXIT_OK;
+	for (int i = 0; i < c->o->nlogs; i++) {
+		struct alog_reader rd;
+		char err[512];
+		if (alog_open(&rd, c->o->logs[i], err, sizeof(err)) != 0) {
+			fprintf(c->o->msg, "undulate-analyze: %s\n", err);
+			return AN_EXIT_BADLOG;
+		}
+		lcm_eventlog_event_t *ev;
+		while ((ev = alog_next(&rd)) != NULL) {
+			if (!c->have_origin) {
+				c->have_origin = true;
+				c->origin_ts = ev->timestamp;
+				if (first_pass)
+					c->t_origin = ev->timestamp;
+				c->from_ts = isnan(c->o->from_s) ? INT64_MIN
+					: ev->timestamp + (int64_t)(c->o->from_s * 1e6);
+				c->to_ts = isnan(c->o->to_s) ? INT64_MAX
+					: ev->timestamp + (int64_t)(c->o->to_s * 1e6);
+			}
+			if (ev->timestamp >= c->from_ts && ev->timestamp <= c->to_ts)
+				fn(c, ev);
+			lcm_eventlog_free_event(ev);
+		}
+		if (first_pass)
+			c->log_events[i] = rd.events;
+		if (alog_damaged(&rd)) {
+			rc = AN_EXIT_TRUNCATED;
+			if (first_pass) {
+				snprintf(c->trunc_note[i], sizeof(c->trunc_note[i]),
+					 "truncated or damaged at byte %lld of %lld; %lld complete events before it were used",
+					 (long long)rd.good_end, (long long)rd.file_size, (long long)rd.events);
+				an_warn(c, "%s: %s", c->o->logs[i], c->trunc_note[i]);
+			}
+		}
+		if (rd.events == 0 && first_pass) {
+			fprintf(c->o->msg, "undulate-analyze: %s: no complete event in the log\n", c->o->logs[i]);
+			alog_close(&rd);
+			return AN_EXIT_BADLOG;
+		}
+		alog_close(&rd);
+	}
+	return rc;
+}
+
+/* ---- pass 1: who is there ---------------------------------------------------- */
+
+static void an_scan_state(struct an_ctx *c, const undulate_robot_state_t *m)
+{
+	int ri = an_robot_find(c, m->robot, true);
+	if (ri < 0)
+		return;
+	struct an_robot *r = &c->robots[ri];
+	int nj = m->njoints < AN_MAX_JOINTS ? m->njoints : AN_MAX_JOINTS;
+	if (nj > r->njoints) {
+		for (int j = r->njoints; j < nj; j++)
+			r->j[j].servo_id = m->joints[j].servo_id;
+		r->njoints = nj;
+	}
+	r->states++;
+	if (m->utime < c->t_origin)
+		c->t_origin = m->utime;
+	if (!c->have_state || m->utime > c->last_state_utime)
+		c->last_state_utime = m->utime;
+	c->have_state = true;
+}
+
+static void an_scan_truth(struct an_ctx *c, const undulate_sim_truth_t *m)
+{
+	c->truth_msgs++;
+	for (int i = 0; i < m->nbodies; i++) {
+		const undulate_sim_body_t *b = &m->bodies[i];
+		int ri = an_robot_find(c, b->robot, true);
+		if (ri < 0)
+			continue;
+		struct an_robot *r = &c->robots[ri];
+		/* A robot has one contact body; with several, the first is used. */
+		if (r->have_body && r->body_servo != b->servo_id)
+			continue;
+		r->have_body = true;
+		r->body_servo = b->servo_id;
+		r->neutral = b->neutral;
+		/* The lever is the body's lateral travel per radian; only
+		 * measurable away from the neutral angle. */
+		if (fabs(b->angle) > 0.1)
+			r->lever = (b->lateral - b->neutral) / b->angle;
+	}
+}
+
+static void an_scan_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
+{
+	c->events++;
+	if (ev->timestamp > c->last_utime)
+		c->last_utime = ev->timestamp;
+	switch (an_channel(ev->channel)) {
+	case CH_STATE: {
+		undulate_robot_state_t m;
+		if (undulate_robot_state_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
+			an_decode_failed(c, ev->channel);
+			return;
+		}
+		if (m.utime > c->last_utime)
+			c->last_utime = m.utime;
+		an_scan_state(c, &m);
+		undulate_robot_state_t_decode_cleanup(&m);
+		break;
+	}
+	case CH_TRUTH: {
+		undulate_sim_truth_t m;
+		if (undulate_sim_truth_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
+			an_decode_failed(c, ev->channel);
+			return;
+		}
+		an_scan_truth(c, &m);
+		undulate_sim_truth_t_decode_cleanup(&m);
+		break;
+	}
+	case CH_COLLISION:
+		c->collision_msgs++;
+		break;
+	case CH_UNKNOWN:
+		c->unknown_channels++;
+		break;
+	default:
+		break;
+	}
+}
+
+/* ---- pairs ------------------------------------------------------------------ */
+
+static bool an_robot_before(const struct an_ctx *c, int i, int k)
+{
+	const struct an_robot *a = &c->robots[i], *b = &c->robots[k];
+	if (c->order_lateral && a->neutral != b->neutral)
+		return a->neutral < b->neutral;
+	return strcmp(a->name, b->name) < 0;
+}
+
+/* Neighbours are robots next to each other by neutral position when the
+ * simulator tells where everyone is, by name otherwise. */
+static void an_order_robots(struct an_ctx *c)
+{
+	c->order_lateral = c->truth_msgs > 0;
+	for (int i = 0; i < c->nrobots; i++) {
+		struct an_robot *r = &c->robots[i];
+		if (r->njoints > 0 && !r->have_body)
+			c->order_lateral = false;
+		for (int j = 0; j < r->njoints; j++)
+			if (r->have_body && r->j[j].servo_id == r->body_servo)
+				r->contact_joint = j;
+	}
+	/* insertion sort: at most AN_MAX_ROBOTS, done once */
+	for (int i = 0; i < c->nrobots; i++) {
+		int k = i;
+		while (k > 0 && an_robot_before(c, i, c->order[k - 1])) {
+			c->order[k] = c->order[k - 1];
+			k--;
+		}
+		c->order[k] = i;
+	}
+}
+
+static struct an_pair *an_pair_add(struct an_ctx *c, enum an_pair_kind kind, int a, int ja, int b, int jb)
+{
+	if (c->npairs >= AN_MAX_PAIRS) {
+		an_warn(c, "more than %d pairs; the rest are not followed", AN_MAX_PAIRS);
+		return NULL;
+	}
+	struct an_pair *p = &c->pairs[c->npairs++];
+	memset(p, 0, sizeof(*p));
+	p->kind = kind;
+	p->a = a;
+	p->b = b;
+	p->ja = ja;
+	p->jb = jb;
+	p->dsep = NAN;
+	p->last_coll_t = NAN;
+	p->amp_lateral = NAN;
+	p->distance = NAN;
+	char name[sizeof(p->name)];
+	if (kind == AN_PAIR_JOINTS)
+		snprintf(name, sizeof(name), "%s/%d:%d", c->robots[a].name, ja, jb);
+	else
+		snprintf(name, sizeof(name), "%s:%s", c->robots[a].name, c->robots[b].name);
+	memcpy(p->name, name, sizeof(name));
+	return p;
+}
+
+static int an_parse_pairs(struct an_ctx *c, const char *spec)
+{
+	char buf[4096];
+	snprintf(buf, sizeof(buf), "%s", spec);
+	char *save = NULL;
+	for (char *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+		char *colon = strchr(tok, ':');
+		if (!colon) {
+			fprintf(c->o->msg, "undulate-analyze: --pairs: \"%s\" is not robot:robot\n", tok);
+			return -1;
+		}
+		*colon = '\0';
+		int a = an_robot_find(c, tok, false), b = an_robot_find(c, colon + 1, false);
+		if (a < 0 || b < 0 || c->robots[a].njoints == 0 || c->robots[b].njoints == 0) {
+			fprintf(c->o->msg, "undulate-analyze: --pairs: no robot state for \"%s\" in the log\n",
+				a < 0 || c->robots[a].njoints == 0 ? tok : colon + 1);
+			return -1;
+		}
+		an_pair_add(c, AN_PAIR_USER, a, c->robots[a].contact_joint, b, c->robots[b].contact_joint);
+	}
+	return 0;
+}
+
+static int an_make_pairs(struct an_ctx *c)
+{
+	an_order_robots(c);
+	if (c->o->pairs) {
+		if (an_parse_pairs(c, c->o->pairs) != 0)
+			return -1;
+	} else {
+		int prev = -1;
+		for (int k = 0; k < c->nrobots; k++) {
+			int i = c->order[k];
+			if (c->robots[i].njoints == 0)
+				continue;
+			if (prev >= 0)
+				an_pair_add(c, AN_PAIR_NEIGHBOUR, prev, c->robots[prev].contact_joint,
+					    i, c->robots[i].contact_joint);
+			prev = i;
+		}
+	}
+	for (int k = 0; k < c->nrobots; k++) {
+		int i = c->order[k];
+		if (c->robots[i].njoints >= 2)
+			an_pair_add(c, AN_PAIR_JOINTS, i, 0, i, 1);
+	}
+	return 0;
+}
+
+/* ---- pass 2: CSV output ------------------------------------------------------- */
+
+/* A CSV field: quoted, inner quotes doubled (names and event text are free text). */
+static void an_csv_str(FILE *f, const char *s)
+{
+	fputc('"', f);
+	for (; s && *s; s++) {
+		if (*s == '"')
+			fputc('"', f);
+		fputc(*s == '\n' || *s == '\r' ? ' ' : *s, f);
+	}
+	fputc('"', f);
+}
+
+/* %.9g keeps full double-ish precision for the numbers people trust. */
+static void an_csv_num(FILE *f, double v)
+{
+	if (isfinite(v))
+		fprintf(f, ",%.9g", v);
+	else
+		fputs(",", f);
+}
+
+static void an_hist_push(struct an_joint *j, int64_t utime, double t, double phase, double omega)
+{
+	j->hist[j->hnext] = (struct an_sample){ .utime = utime, .t = t, .phase = phase, .omega = omega };
+	j->hnext = (j->hnext + 1) % AN_HISTORY;
+	if (j->hn < AN_HISTORY)
+		j->hn++;
+}
+
+/* The joint's latest sample strictly before UTIME (or the latest of all if
+ * UTIME is INT64_MAX). NULL if none. */
+static const struct an_sample *an_hist_before(const struct an_joint *j, int64_t utime)
+{
+	for (int k = 1; k <= j->hn; k++) {
+		const struct an_sample *s = &j->hist[(j->hnext - k + AN_HISTORY) % AN_HISTORY];
+		if (s->utime < utime)
+			return s;
+	}
+	return NULL;
+}
+
+/* Phase of a sample carried forward to time T at its own frequency. */
+static double an_phase_at(const struct an_sample *s, double t)
+{
+	double w = isfinite(s->omega) ? s->omega : 0.0;
+	return phase_wrap(s->phase + w * (t - s->t));
+}
+
+static void an_pair_row(struct an_ctx *c, struct an_pair *p, int64_t utime, double t, double delta)
+{
+	fprintf(c->pdiff, "%lld,%.6f,", (long long)utime, t);
+	an_csv_str(c->pdiff, p->name);
+	fprintf(c->pdiff, ",%s,", p->kind == AN_PAIR_JOINTS ? "joints" : p->kind == AN_PAIR_USER ? "user" : "neighbour");
+	an_csv_str(c->pdiff, c->robots[p->a].name);
+	fprintf(c->pdiff, ",%d,", p->ja);
+	an_csv_str(c->pdiff, c->robots[p->b].name);
+	fprintf(c->pdiff, ",%d", p->jb);
+	an_csv_num(c->pdiff, delta);
+	fputc('\n', c->pdiff);
+	p->rows++;
+	if (t >= c->window_start_t)
+		phase_circ_add(&p->win, delta);
+}
+
+/* After robot RI got a sample: the phase difference of each pair it leads. */
+static void an_update_pairs(struct an_ctx *c, int ri, int64_t utime, double t)
+{
+	for (int k = 0; k < c->npairs; k++) {
+		struct an_pair *p = &c->pairs[k];
+		if (p->a != ri)
+			continue;
+		const struct an_sample *sa = an_hist_before(&c->robots[p->a].j[p->ja], INT64_MAX);
+		const struct an_sample *sb = an_hist_before(&c->robots[p->b].j[p->jb], INT64_MAX);
+		if (!sa || !sb || !isfinite(sa->phase) || !isfinite(sb->phase))
+			continue;
+		if (fabs(sa->t - sb->t) > AN_PAIR_FRESH_S)
+			continue;
+		an_pair_row(c, p, utime, t, phase_wrap(an_phase_at(sb, t) - an_phase_at(sa, t)));
+	}
+}
+
+static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
+{
+	int ri = an_robot_find(c, m->robot, false);
+	if (ri < 0)
+		return;
+	struct an_robot *r = &c->robots[ri];
+	double t = an_t(c, m->utime);
+	int nj = m->njoints < r->njoints ? m->njoints : r->njoints;
+	for (int j = 0; j < nj; j++) {
+		const undulate_joint_state_t *js = &m->joints[j];
+		struct an_joint *aj = &r->j[j];
+		phase_tracker_feed(&aj->tr, t, js->angle);
+		/* The daemon's running frequency estimate when it has one (it
+		 * sees every cycle, and its phase is then ours); else our own
+		 * from zero crossings; else the phase is left empty. */
+		double omega_zc = phase_tracker_omega(&aj->tr);
+		double omega = js->frequency > 0.0 && !c->o->zero_crossings ? 2.0 * M_PI * js->frequency : omega_zc;
+		double phase = phase_from_state(js->angle, js->speed, omega);
+		an_hist_push(aj, m->utime, t, phase, omega);
+		aj->samples++;
+		aj->reported_freq = js->frequency;
+
+		FILE *f = c->states;
+		fprintf(f, "%lld,%.6f,", (long long)m->utime, t);
+		an_csv_str(f, r->name);
+		fprintf(f, ",%d,%d", j, js->servo_id);
+		an_csv_num(f, js->angle);
+		an_csv_num(f, js->speed);
+		an_csv_num(f, js->goal);
+		an_csv_num(f, js->load);
+		fprintf(f, ",%d", m->mode);
+		an_csv_num(f, phase);
+		an_csv_num(f, js->amplitude);
+		an_csv_num(f, js->frequency);
+		fprintf(f, ",%d", js->error_bits);
+		an_csv_num(f, js->phase);
+		an_csv_num(f, omega_zc / (2.0 * M_PI));
+		fputc('\n', f);
+	}
+	an_update_pairs(c, ri, m->utime, t);
+}
+
+static struct an_pair *an_pair_of(struct an_ctx *c, const char *left, const char *right)
+{
+	int l = an_robot_find(c, left, false), r = an_robot_find(c, right, false);
+	if (l < 0 || r < 0)
+		return NULL;
+	for (int k = 0; k < c->npairs; k++) {
+		struct an_pair *p = &c->pairs[k];
+		if (p->kind != AN_PAIR_JOINTS && ((p->a == l && p->b == r) || (p->a == r && p->b == l)))
+			return p;
+	}
+	return NULL;
+}
+
+static bool an_seen_before(struct an_ctx *c, const undulate_sim_collision_t *m)
+{
+	for (int i = 0; i < AN_COLL_DEDUP; i++) {
+		const struct an_seen *s = &c->seen[i];
+		if (s->utime == m->utime && s->left == m->left && s->right == m->right)
+			return true;
+	}
+	c->seen[c->seen_next] = (struct an_seen){ m->utime, m->left, m->right };
+	c->seen_next = (c->seen_next + 1) % AN_COLL_DEDUP;
+	return false;
+}
+
+static void an_pair_store_delta(struct an_pair *p, int64_t utime, double delta)
+{
+	if (p->ndeltas == p->cap) {
+		size_t cap = p->cap ? p->cap * 2 : 64;
+		double *d = realloc(p->deltas, cap * sizeof(*d));
+		int64_t *u = realloc(p->delta_utime, cap * sizeof(*u));
+		if (d)
+			p->deltas = d;
+		if (u)
+			p->delta_utime = u;
+		if (!d || !u)
+			return; /* out of memory: the return map loses points, nothing else */
+		p->cap = cap;
+	}
+	p->deltas[p->ndeltas] = delta;
+	p->delta_utime[p->ndeltas] = utime;
+	p->ndeltas++;
+}
+
+static void an_on_collision(struct an_ctx *c, const undulate_sim_collision_t *m)
+{
+	if (an_seen_before(c, m))
+		return;
+	double t = an_t(c, m->utime);
+	bool wall = m->left < 0 || m->right < 0;
+	c->collisions++;
+	c->impulse += m->impulse;
+	if (wall)
+		c->wall_collisions++;
+	int64_t bin = (int64_t)floor(t / AN_RATE_BIN_S);
+	if (bin >= 0 && bin < c->nbins) {
+		c->bins[bin]++;
+		c->bin_impulse[bin] += m->impulse;
+	}
+	struct an_pair *p = wall ? NULL : an_pair_of(c, m->left_robot, m->right_robot);
+	double delta = NAN;
+	bool new_contact = false;
+	if (p) {
+		const struct an_sample *sa = an_hist_before(&c->robots[p->a].j[p->ja], m->utime);
+		const struct an_sample *sb = an_hist_before(&c->robots[p->b].j[p->jb], m->utime);
+		if (sa && sb && isfinite(sa->phase) && isfinite(sb->phase))
+			delta = phase_wrap(an_phase_at(sb, t) - an_phase_at(sa, t));
+		p->collisions++;
+		p->impulse += m->impulse;
+		if (t >= c->window_start_t)
+			p->win_collisions++;
+		/* A contact can be reported as a burst of collisions (one per
+		 * physics step while the bodies touch); the return map wants
+		 * one point per contact: the first of the burst. */
+		new_contact = !(t - p->last_coll_t <= c->o->merge_s);
+		p->last_coll_t = t;
+		if (new_contact) {
+			p->contacts++;
+			if (isfinite(delta))
+				an_pair_store_delta(p, m->utime, delta);
+		}
+	}
+	FILE *f = c->coll;
+	fprintf(f, "%lld,%.6f,%d,%d,", (long long)m->utime, t, m->left, m->right);
+	an_csv_str(f, m->left_robot);
+	fputc(',', f);
+	an_csv_str(f, m->right_robot);
+	an_csv_num(f, m->pre_left);
+	an_csv_num(f, m->pre_right);
+	an_csv_num(f, m->post_left);
+	an_csv_num(f, m->post_right);
+	an_csv_num(f, m->impulse);
+	fputc(',', f);
+	if (p)
+		an_csv_str(f, p->name);
+	an_csv_num(f, delta);
+	fprintf(f, ",%d\n", new_contact ? 1 : 0);
+}
+
+static void an_on_bus(struct an_ctx *c, const undulate_bus_stats_t *m)
+{
+	int64_t timeouts = 0, checksum = 0, errrep = 0;
+	for (int i = 0; i < m->nservos; i++) {
+		timeouts += m->servos[i].timeouts;
+		checksum += m->servos[i].checksum_errors;
+		errrep += m->servos[i].error_replies;
+	}
+	FILE *f = c->bus;
+	fprintf(f, "%lld,%.6f,", (long long)m->utime, an_t(c, m->utime));
+	an_csv_str(f, m->robot);
+	fputc(',', f);
+	an_csv_str(f, m->port);
+	fprintf(f, ",%d,%d,%lld", m->baud, m->connected ? 1 : 0, (long long)m->reconnects);
+	an_csv_num(f, m->adapter_latency_ms);
+	fprintf(f, ",%d", m->return_delay_us);
+	an_csv_num(f, m->period_p50_us);
+	an_csv_num(f, m->period_p99_us);
+	an_csv_num(f, m->period_max_us);
+	an_csv_num(f, m->jitter_p99_us);
+	an_csv_num(f, m->bus_p99_us);
+	an_csv_num(f, m->cpu_percent);
+	fprintf(f, ",%lld,%lld,%lld,%lld,%lld,%lld\n", (long long)m->overruns, (long long)m->stray_packets,
+		(long long)m->io_errors, (long long)timeouts, (long long)checksum, (long long)errrep);
+}
+
+static void an_on_event(struct an_ctx *c, const undulate_event_t *m)
+{
+	FILE *f = c->evt;
+	fprintf(f, "%lld,%.6f,", (long long)m->utime, an_t(c, m->utime));
+	an_csv_str(f, m->robot);
+	fprintf(f, ",%lld,%d,", (long long)m->seq, m->level);
+	an_csv_str(f, m->kind);
+	fputc(',', f);
+	an_csv_str(f, m->text);
+	fputc('\n', f);
+}
+
+static void an_on_params(struct an_ctx *c, const undulate_osc_params_t *m)
+{
+	FILE *f = c->params;
+	for (int j = 0; j < m->njoints; j++) {
+		fprintf(f, "%lld,%.6f,", (long long)m->utime, an_t(c, m->utime));
+		an_csv_str(f, m->robot);
+		fprintf(f, ",%d", j);
+		an_csv_num(f, m->k[j]);
+		an_csv_num(f, m->c[j]);
+		an_csv_num(f, m->mu[j]);
+		an_csv_num(f, m->lambda[j]);
+		an_csv_num(f, m->inertia[j]);
+		an_csv_num(f, m->friction[j]);
+		an_csv_num(f, m->neutral[j]);
+		an_csv_num(f, m->limit_min[j]);
+		an_csv_num(f, m->limit_max[j]);
+		an_csv_num(f, m->amplitude);
+		an_csv_num(f, m->frequency);
+		an_csv_num(f, m->phase);
+		fputc('\n', f);
+	}
+}
+
+/* Decodes EV as T and calls HANDLER; a message that does not decode is counted. */
+#define AN_DISPATCH(T, handler)                                                   \
+	do {                                                                      \
+		undulate_##T m;                                                   \
+		if (undulate_##T##_decode(ev->data, 0, ev->datalen, &m) < 0) {   \
+			an_decode_failed(c, ev->channel);                         \
+			return;                                                   \
+		}                                                                 \
+		handler(c, &m);                                                   \
+		undulate_##T##_decode_cleanup(&m);                                \
+	} while (0)
+
+/* SIM.COLLISION is the per-collision channel; the copies inside SIM.TRUTH are
+ * used only for logs without it (the simulator stamps those copies with the
+ * truth message's time, so they cannot be matched to the originals). */
+static void an_truth_collisions(struct an_ctx *c, const undulate_sim_truth_t *m)
+{
+	if (c->collision_msgs > 0)
+		return;
+	for (int i = 0; i < m->ncollisions; i++)
+		an_on_collision(c, &m->collisions[i]);
+}
+
+static void an_process_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
+{
+	switch (an_channel(ev->channel)) {
+	case CH_STATE:
+		AN_DISPATCH(robot_state_t, an_on_state);
+		break;
+	case CH_COLLISION:
+		AN_DISPATCH(sim_collision_t, an_on_collision);
+		break;
+	case CH_TRUTH:
+		AN_DISPATCH(sim_truth_t, an_truth_collisions);
+		break;
+	case CH_BUS:
+		AN_DISPATCH(bus_stats_t, an_on_bus);
+		break;
+	case CH_EVENT:
+		AN_DISPATCH(event_t, an_on_event);
+		break;
+	case CH_PARAMS:
+		AN_DISPATCH(osc_params_t, an_on_params);
+		break;
+	default:
+		break;
+	}
+}
+
+/* ---- output files ------------------------------------------------------------- */
+
+static FILE *an_open_out(struct an_ctx *c, const char *name, const char *header)
+{
+	char path[4096];
+	snprintf(path, sizeof(path), "%s/%s", c->o->out_dir, name);
+	FILE *f = fopen(path, "w");
+	if (!f) {
+		fprintf(c->o->msg, "undulate-analyze: %s: %s\n", path, strerror(errno));
+		return NULL;
+	}
+	fprintf(f, "%s\n", header);
+	return f;
+}
+
+static int an_close_out(struct an_ctx *c, FILE **f, const char *name)
+{
+	if (!*f)
+		return 0;
+	int bad = ferror(*f) | fclose(*f);
+	*f = NULL;
+	if (bad) {
+		fprintf(c->o->msg, "undulate-analyze: writing %s/%s failed\n", c->o->out_dir, name);
+		return -1;
+	}
+	return 0;
+}
+
+static int an_open_outputs(struct an_ctx *c)
+{
+	if (mkdir(c->o->out_dir, 0777) != 0 && errno != EEXIST) {
+		fprintf(c->o->msg, "undulate-analyze: %s: %s\n", c->o->out_dir, strerror(errno));
+		return -1;
+	}
+	c->states = an_open_out(c, "states.csv",
+		"utime,t,robot,joint,servo_id,angle,speed,goal,load,mode,phase,amplitude,frequency,error_bits,phase_daemon,frequency_est");
+	c->coll = an_open_out(c, "collisions.csv",
+		"utime,t,left,right,left_robot,right_robot,pre_left,pre_right,post_left,post_right,impulse,pair,delta_before,"
+		"new_contact");
+	c->bus = an_open_out(c, "bus.csv",
+		"utime,t,robot,port,baud,connected,reconnects,adapter_latency_ms,return_delay_us,period_p50_us,"
+		"period_p99_us,period_max_us,jitter_p99_us,bus_p99_us,cpu_percent,overruns,stray_packets,io_errors,"
+		"timeouts,checksum_errors,error_replies");
+	c->evt = an_open_out(c, "events.csv", "utime,t,robot,seq,level,kind,text");
+	c->pdiff = an_open_out(c, "phase_diff.csv", "utime,t,pair,kind,robot_a,joint_a,robot_b,joint_b,delta");
+	c->params = an_open_out(c, "params.csv",
+		"utime,t,robot,joint,k,c,mu,lambda,inertia,friction,neutral,limit_min,limit_max,"
+		"sin_amplitude,sin_frequency,sin_phase");
+	return c->states && c->coll && c->bus && c->evt && c->pdiff && c->params ? 0 : -1;
+}
+
+static int an_close_outputs(struct an_ctx *c)
+{
+	int rc = 0;
+	rc |= an_close_out(c, &c->states, "states.csv");
+	rc |= an_close_out(c, &c->coll, "collisions.csv");
+	rc |= an_close_out(c, &c->bus, "bus.csv");
+	rc |= an_close_out(c, &c->evt, "events.csv");
+	rc |= an_close_out(c, &c->pdiff, "phase_diff.csv");
+	rc |= an_close_out(c, &c->params, "params.csv");
+	return rc;
+}
+
+static int an_write_return_map(struct an_ctx *c)
+{
+	FILE *f = an_open_out(c, "return_map.csv", "pair,n,utime,t,delta_n,delta_next,theory_next,dsep");
+	if (!f)
+		return -1;
+	for (int k = 0; k < c->npairs; k++) {
+		struct an_pair *p = &c->pairs[k];
+		for (size_t n = 0; n + 1 < p->ndeltas; n++) {
+			an_csv_str(f, p->name);
+			double dsep = isfinite(p->dsep) ? p->dsep : 0.0;
+			fprintf(f, ",%zu,%lld,%.6f", n, (long long)p->delta_utime[n], an_t(c, p->delta_utime[n]));
+			an_csv_num(f, p->deltas[n]);
+			an_csv_num(f, p->deltas[n + 1]);
+			an_csv_num(f, phase_return_map(p->deltas[n], dsep, c->o->restitution));
+			an_csv_num(f, p->dsep);
+			fputc('\n', f);
+		}
+	}
+	FILE *g = an_open_out(c, "collision_rate.csv", "t,collisions,impulse");
+	if (!g) {
+		fclose(f);
+		return -1;
+	}
+	for (int64_t b = 0; b < c->nbins; b++)
+		fprintf(g, "%.3f,%lld,%.9g\n", (double)b * AN_RATE_BIN_S, (long long)c->bins[b], c->bin_impulse[b]);
+	return an_close_out(c, &f, "return_map.csv") | an_close_out(c, &g, "collision_rate.csv");
+}
+
+/* ---- classification ----------------------------------------------------------- */
+
+static void an_pair_separation(struct an_ctx *c, struct an_pair *p)
+{
+	if (isfinite(c->o->separation)) {
+		p->dsep = c->o->separation;
+		return;
+	}
+	const struct an_robot *a = &c->robots[p->a], *b = &c->robots[p->b];
+	if (!a->have_body || !b->have_body)
+		return;
+	double amp = 0.5 * (a->j[p->ja].tr.amplitude + b->j[p->jb].tr.amplitude);
+	double lever = isfinite(a->lever) && isfinite(b->lever) ? 0.5 * (fabs(a->lever) + fabs(b->lever))
+		: isfinite(a->lever) ? fabs(a->lever) : fabs(b->lever);
+	p->distance = fabs(b->neutral - a->neutral);
+	p->amp_lateral = lever * amp;
+	if (isfinite(p->amp_lateral) && p->amp_lateral > 0.0)
+		p->dsep = p->distance / (2.0 * p->amp_lateral);
+}
+
+/* The end state of a pair from the final window (see README.md for the rules). */
+static const char *an_classify(const struct an_pair *p, bool have_sim)
+{
+	if (p->win.n == 0)
+		return "no-data";
+	double mean = fabs(phase_circ_mean(&p->win));
+	double spread = phase_circ_spread(&p->win);
+	bool locked = spread <= AN_SPREAD_MAX;
+	if (locked && mean >= M_PI - AN_ANTI_TOL)
+		return "anti-phase";
+	if (p->win_collisions > 0)
+		return "still-colliding";
+	if (locked && mean <= AN_INPHASE_TOL)
+		return "in-phase";
+	if (locked && isfinite(p->dsep) && mean <= phase_compat_limit(p->dsep) + AN_COMPAT_TOL)
+		return "compatible";
+	if (!have_sim && locked)
+		return "locked-no-contact-data";
+	return locked ? "locked-beyond-compatibility" : "unlocked";
+}
+
+/* ---- summary ------------------------------------------------------------------ */
+
+static void an_json_str(FILE *f, const char *s)
+{
+	fputc('"', f);
+	for (; *s; s++) {
+		unsigned char ch = (unsigned char)*s;
+		if (ch == '"' || ch == '\\')
+			fprintf(f, "\\%c", ch);
+		else if (ch < 0x20)
+			fprintf(f, "\\u%04x", ch);
+		else
+			fputc(ch, f);
+	}
+	fputc('"', f);
+}
+
+static void an_json_num(FILE *f, const char *key, double v, bool comma)
+{
+	fprintf(f, "\"%s\":", key);
+	if (isfinite(v))
+		fprintf(f, "%.9g", v);
+	else
+		fputs("null", f);
+	if (comma)
+		fputc(',', f);
+}
+
+static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
+{
+	fprintf(f, "undulate-analyze summary\n");
+	for (int i = 0; i < c->o->nlogs; i++)
+		fprintf(f, "log: %s (%lld events)%s%s\n", c->o->logs[i], (long long)c->log_events[i],
+			c->trunc_note[i][0] ? " WARNING: " : "", c->trunc_note[i]);
+	double t_end = c->have_state ? an_t(c, c->last_state_utime) : 0.0;
+	fprintf(f, "span: %.2f s of robot state; final window %.2f .. %.2f s (%.1f s)\n", t_end,
+		c->window_start_t > 0 ? c->window_start_t : 0.0, t_end, c->o->window_s);
+	fprintf(f, "robots: %d, order: %s\n", c->nrobots,
+		c->order_lateral ? "lateral neutral position (SIM.TRUTH)" : "name");
+	for (int k = 0; k < c->nrobots; k++) {
+		const struct an_robot *r = &c->robots[c->order[k]];
+		fprintf(f, "  %-16s joints %d  states %lld", r->name, r->njoints, (long long)r->states);
+		for (int j = 0; j < r->njoints; j++) {
+			double w = phase_tracker_omega(&r->j[j].tr);
+			fprintf(f, "  j%d %.3f Hz %.3f rad", j, w / (2.0 * M_PI), r->j[j].tr.amplitude);
+		}
+		if (r->have_body)
+			fprintf(f, "  neutral %.4f m lever %.4f m/rad", r->neutral, r->lever);
+		fputc('\n', f);
+	}
+	fprintf(f, "collisions: %lld (%lld with walls), total impulse %.6g N*s\n", (long long)c->collisions,
+		(long long)c->wall_collisions, c->impulse);
+	fprintf(f, "restitution for theory: %.3f; collisions less than %.3f s apart are one contact\n",
+		c->o->restitution, c->o->merge_s);
+	fprintf(f, "%-24s %-28s %8s %8s %8s %6s %6s %7s %9s %5s\n", "pair", "end state", "mean|D|", "meanD",
+		"spread", "coll", "c.win", "d~", "2asin(d~)", "map");
+	for (int k = 0; k < c->npairs; k++) {
+		const struct an_pair *p = &c->pairs[k];
+		fprintf(f, "%-24s %-28s %8.4f %8.4f %8.4f %6lld %6lld %7.4f %9.4f %5zu\n", p->name, p->cls,
+			phase_circ_mean_abs(&p->win), phase_circ_mean(&p->win), phase_circ_spread(&p->win),
+			(long long)p->collisions, (long long)p->win_collisions, p->dsep,
+			phase_compat_limit(p->dsep), p->ndeltas > 0 ? p->ndeltas - 1 : 0);
+	}
+	if (c->decode_errors)
+		fprintf(f, "undecodable messages: %lld\n", (long long)c->decode_errors);
+	if (rc == AN_EXIT_TRUNCATED)
+		fprintf(f, "WARNING: a log was truncated; results cover the events before the damage\n");
+}
+
+static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
+{
+	fputs("{\"logs\":[", f);
+	for (int i = 0; i < c->o->nlogs; i++) {
+		fputs(i ? ",{\"path\":" : "{\"path\":", f);
+		an_json_str(f, c->o->logs[i]);
+		fprintf(f, ",\"events\":%lld,\"truncated\":%s}", (long long)c->log_events[i],
+			c->trunc_note[i][0] ? "true" : "false");
+	}
+	fprintf(f, "],\"truncated\":%s,", rc == AN_EXIT_TRUNCATED ? "true" : "false");
+	an_json_num(f, "t_end", c->have_state ? an_t(c, c->last_state_utime) : NAN, true);
+	an_json_num(f, "window_s", c->o->window_s, true);
+	an_json_num(f, "restitution", c->o->restitution, true);
+	fprintf(f, "\"order\":\"%s\",\"collisions\":%lld,\"wall_collisions\":%lld,", c->order_lateral ? "lateral" : "name",
+		(long long)c->collisions, (long long)c->wall_collisions);
+	an_json_num(f, "impulse", c->impulse, true);
+	fprintf(f, "\"decode_errors\":%lld,\"robots\":[", (long long)c->decode_errors);
+	for (int k = 0; k < c->nrobots; k++) {
+		const struct an_robot *r = &c->robots[c->order[k]];
+		fputs(k ? ",{\"name\":" : "{\"name\":", f);
+		an_json_str(f, r->name);
+		fprintf(f, ",\"states\":%lld,\"joints\":[", (long long)r->states);
+		for (int j = 0; j < r->njoints; j++) {
+			fputs(j ? ",{" : "{", f);
+			an_json_num(f, "frequency_hz", phase_tracker_omega(&r->j[j].tr) / (2.0 * M_PI), true);
+			an_json_num(f, "amplitude_rad", r->j[j].tr.amplitude, false);
+			fputc('}', f);
+		}
+		fputs("]}", f);
+	}
+	fputs("],\"pairs\":[", f);
+	for (int k = 0; k < c->npairs; k++) {
+		const struct an_pair *p = &c->pairs[k];
+		fputs(k ? ",{\"pair\":" : "{\"pair\":", f);
+		an_json_str(f, p->name);
+		fprintf(f, ",\"kind\":\"%s\",\"class\":\"%s\",",
+			p->kind == AN_PAIR_JOINTS ? "joints" : p->kind == AN_PAIR_USER ? "user" : "neighbour", p->cls);
+		an_json_num(f, "mean_abs_delta", phase_circ_mean_abs(&p->win), true);
+		an_json_num(f, "mean_delta", phase_circ_mean(&p->win), true);
+		an_json_num(f, "spread", phase_circ_spread(&p->win), true);
+		fprintf(f, "\"window_samples\":%lld,\"collisions\":%lld,\"contacts\":%lld,\"window_collisions\":%lld,",
+			(long long)p->win.n, (long long)p->collisions, (long long)p->contacts, (long long)p->win_collisions);
+		an_json_num(f, "impulse", p->impulse, true);
+		an_json_num(f, "distance_m", p->distance, true);
+		an_json_num(f, "amplitude_m", p->amp_lateral, true);
+		an_json_num(f, "dsep", p->dsep, true);
+		an_json_num(f, "compat_limit", phase_compat_limit(p->dsep), true);
+		fprintf(f, "\"return_map_points\":%zu}", p->ndeltas > 0 ? p->ndeltas - 1 : 0);
+	}
+	fputs("]}\n", f);
+}
+
+static int an_write_summary(struct an_ctx *c, int rc)
+{
+	char path[4096];
+	snprintf(path, sizeof(path), "%s/summary.txt", c->o->out_dir);
+	FILE *f = fopen(path, "w");
+	snprintf(path, sizeof(path), "%s/summary.json", c->o->out_dir);
+	FILE *g = fopen(path, "w");
+	if (!f || !g) {
+		fprintf(c->o->msg, "undulate-analyze: cannot write the summary in %s\n", c->o->out_dir);
+		if (f)
+			fclose(f);
+		if (g)
+			fclose(g);
+		return -1;
+	}
+	an_summary_text(c, f, rc);
+	an_summary_json(c, g, rc);
+	if (!c->o->quiet)
+		an_summary_text(c, stdout, rc);
+	return an_close_out(c, &f, "summary.txt") | an_close_out(c, &g, "summary.json");
+}
+
+/* ---- plots -------------------------------------------------------------------- */
+
+static int an_plots(struct an_ctx *c)
+{
+	const char *names[AN_MAX_ROBOTS];
+	struct plot_pair pp[AN_MAX_PAIRS];
+	int n = 0, np = 0;
+	for (int k = 0; k < c->nrobots; k++)
+		if (c->robots[c->order[k]].njoints > 0)
+			names[n++] = c->robots[c->order[k]].name;
+	for (int k = 0; k < c->npairs; k++) {
+		const struct an_pair *p = &c->pairs[k];
+		if (p->kind == AN_PAIR_JOINTS)
+			continue;
+		pp[np++] = (struct plot_pair){ .name = p->name, .dsep = p->dsep,
+					       .map_points = p->ndeltas > 0 ? (int)p->ndeltas - 1 : 0 };
+	}
+	struct plot_input in = { .dir = c->o->out_dir, .robots = names, .nrobots = n, .pairs = pp,
+				 .npairs = np, .restitution = c->o->restitution,
+				 .have_collisions = c->collisions > 0 };
+	return plot_all(&in, c->o->msg);
+}
+
+/* ---- entry -------------------------------------------------------------------- */
+
+static void an_free(struct an_ctx *c)
+{
+	for (int k = 0; k < c->npairs; k++) {
+		free(c->pairs[k].deltas);
+		free(c->pairs[k].delta_utime);
+	}
+	free(c->bins);
+	free(c->bin_impulse);
+	an_close_outputs(c);
+}
+
+static int an_alloc_bins(struct an_ctx *c)
+{
+	double span = an_t(c, c->last_utime);
+	c->nbins = span > 0 ? (int64_t)floor(span / AN_RATE_BIN_S) + 1 : 1;
+	if (c->nbins > AN_MAX_BINS)
+		c->nbins = AN_MAX_BINS;
+	c->bins = calloc((size_t)c->nbins, sizeof(*c->bins));
+	c->bin_impulse = calloc((size_t)c->nbins, sizeof(*c->bin_impulse));
+	return c->bins && c->bin_impulse ? 0 : -1;
+}
+
+static int an_run_ctx(struct an_ctx *c)
+{
+	const struct an_options *o = c->o;
+	int rc = an_each_event(c, an_scan_event, true);
+	if (rc == AN_EXIT_BADLOG)
+		return rc;
+	if (!c->have_state)
+		an_warn(c, "no robot state (<robot>.STATE) in the selected part of the log");
+	if (an_make_pairs(c) != 0)
+		return AN_EXIT_USAGE;
+	if (an_alloc_bins(c) != 0 || an_open_outputs(c) != 0)
+		return AN_EXIT_OUTPUT;
+	c->window_start_t = an_t(c, c->last_state_utime) - o->window_s;
+	c->have_origin = false; /* pass 2 recomputes the same origin and range */
+	an_each_event(c, an_process_event, false);
+	for (int k = 0; k < c->npairs; k++) {
+		struct an_pair *p = &c->pairs[k];
+		if (p->kind != AN_PAIR_JOINTS)
+			an_pair_separation(c, p);
+		p->cls = p->kind == AN_PAIR_JOINTS ? "-" : an_classify(p, c->truth_msgs > 0 || c->collisions > 0);
+	}
+	if (an_close_outputs(c) != 0 || an_write_return_map(c) != 0 || an_write_summary(c, rc) != 0)
+		return AN_EXIT_OUTPUT;
+	if (o->plots && an_plots(c) != 0)
+		return rc == AN_EXIT_OK ? AN_EXIT_PLOTS : rc;
+	return rc;
+}
+
+int an_run(const struct an_options *o)
+{
+	if (o->nlogs <= 0) {
+		fprintf(o->msg, "undulate-analyze: no log given\n");
+		return AN_EXIT_USAGE;
+	}
+	struct an_ctx *c = calloc(1, sizeof(*c));
+	if (!c) {
+		fprintf(o->msg, "undulate-analyze: out of memory\n");
+		return AN_EXIT_OUTPUT;
+	}
+	c->o = o;
+	int rc = an_run_ctx(c);
+	an_free(c);
+	free(c);
+	return rc;
+}

@@ -1,0 +1,155 @@
+/* undulate-analyze — LCM logs to CSV files, phase differences, return maps,
+ * an end-state classification and plots. See tools/analyze/README.md. */
+#include "analyze.h"
+#include "synth.h"
+
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void usage(FILE *f)
+{
+	fputs("usage: undulate-analyze LOG... [--out DIR] [--pairs a:b,...] [--plots]\n"
+	      "                        [--from S] [--to S] [--window S] [--separation D]\n"
+	      "                        [--restitution R] [--merge S] [--zero-crossings] [--quiet]\n"
+	      "       undulate-analyze --synth OUT.log [--duration S]\n"
+	      "Reads lcm-logger logs and writes states.csv, collisions.csv, bus.csv, events.csv,\n"
+	      "phase_diff.csv, return_map.csv, collision_rate.csv, summary.txt, summary.json\n"
+	      "(and PNG plots with --plots) into DIR (default: current directory).\n"
+	      "  --pairs a:b,...   pairs to follow (default: neighbours by SIM.TRUTH position, else name)\n"
+	      "  --from/--to S     only events between S seconds after the log start\n"
+	      "  --window S        final window for the end-state classification (default 10)\n"
+	      "  --separation D    normalized separation d~ for every pair (default: from SIM.TRUTH)\n"
+	      "  --restitution R   r for the theory curve (default 0.67)\n"
+	      "  --merge S         collisions of a pair less than S apart are one contact (default 0.1)\n"
+	      "  --zero-crossings  phase from our own zero-crossing frequency, not the daemon's\n"
+	      "  --synth OUT.log   write a synthetic log with known phases and collisions\n"
+	      "exit: 0 ok, 1 usage, 2 bad/missing log, 3 truncated log (partial results),\n"
+	      "      4 plots failed, 5 output not writable\n",
+	      f);
+}
+
+static int parse_double(const char *opt, const char *s, double *out)
+{
+	char *end;
+	double v = strtod(s, &end);
+	if (end == s || *end || !isfinite(v)) {
+		fprintf(stderr, "undulate-analyze: %s: \"%s\" is not a number\n", opt, s);
+		return -1;
+	}
+	*out = v;
+	return 0;
+}
+
+enum { OPT_OUT = 256, OPT_PAIRS, OPT_PLOTS, OPT_FROM, OPT_TO, OPT_WINDOW, OPT_SEP, OPT_REST,
+       OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_HELP };
+
+static const struct option long_opts[] = {
+	{ "out", required_argument, NULL, OPT_OUT },       { "pairs", required_argument, NULL, OPT_PAIRS },
+	{ "plots", no_argument, NULL, OPT_PLOTS },         { "from", required_argument, NULL, OPT_FROM },
+	{ "to", required_argument, NULL, OPT_TO },         { "window", required_argument, NULL, OPT_WINDOW },
+	{ "separation", required_argument, NULL, OPT_SEP }, { "restitution", required_argument, NULL, OPT_REST },
+	{ "synth", required_argument, NULL, OPT_SYNTH },   { "duration", required_argument, NULL, OPT_DURATION },
+	{ "quiet", no_argument, NULL, OPT_QUIET },         { "zero-crossings", no_argument, NULL, OPT_ZC },
+	{ "merge", required_argument, NULL, OPT_MERGE },
+         { "help", no_argument, NULL, OPT_HELP },
+	{ NULL, 0, NULL, 0 },
+};
+
+static int parse_option(int c, struct an_options *o, const char **synth, double *duration)
+{
+	switch (c) {
+	case OPT_OUT: o->out_dir = optarg; return 0;
+	case OPT_PAIRS: o->pairs = optarg; return 0;
+	case OPT_PLOTS: o->plots = true; return 0;
+	case OPT_QUIET: o->quiet = true; return 0;
+	case OPT_ZC: o->zero_crossings = true; return 0;
+	case OPT_MERGE: return parse_double("--merge", optarg, &o->merge_s);
+	case OPT_FROM: return parse_double("--from", optarg, &o->from_s);
+	case OPT_TO: return parse_double("--to", optarg, &o->to_s);
+	case OPT_WINDOW: return parse_double("--window", optarg, &o->window_s);
+	case OPT_SEP: return parse_double("--separation", optarg, &o->separation);
+	case OPT_REST: return parse_double("--restitution", optarg, &o->restitution);
+	case OPT_SYNTH: *synth = optarg; return 0;
+	case OPT_DURATION: return parse_double("--duration", optarg, duration);
+	case OPT_HELP: usage(stdout); exit(AN_EXIT_OK);
+	default: return -1;
+	}
+}
+
+static int check_options(const struct an_options *o)
+{
+	if (!(o->window_s > 0)) {
+		fputs("undulate-analyze: --window must be > 0\n", stderr);
+		return -1;
+	}
+	if (!(o->restitution >= 0 && o->restitution <= 1)) {
+		fputs("undulate-analyze: --restitution must be in [0, 1]\n", stderr);
+		return -1;
+	}
+	if (!(o->merge_s >= 0)) {
+		fputs("undulate-analyze: --merge must be >= 0\n", stderr);
+		return -1;
+	}
+	if (isfinite(o->separation) && o->separation < 0) {
+		fputs("undulate-analyze: --separation must be >= 0\n", stderr);
+		return -1;
+	}
+	if (!isnan(o->from_s) && !isnan(o->to_s) && o->to_s <= o->from_s) {
+		fputs("undulate-analyze: --to must be after --from\n", stderr);
+		return -1;
+	}
+	return 0;
+}
+
+static int run_synth(const char *path, double duration)
+{
+	struct synth_spec s;
+	synth_default(&s);
+	if (duration > 0)
+		s.duration_s = duration;
+	int n = synth_write(&s, path);
+	if (n < 0) {
+		fprintf(stderr, "undulate-analyze: cannot write %s\n", path);
+		return AN_EXIT_OUTPUT;
+	}
+	printf("%s: %.1f s, %d robots, %d collisions\n", path, s.duration_s, SYNTH_ROBOTS, n);
+	return AN_EXIT_OK;
+}
+
+int main(int argc, char **argv)
+{
+	struct an_options o;
+	an_options_default(&o);
+	const char *synth = NULL;
+	double duration = 0;
+	int c;
+	while ((c = getopt_long(argc, argv, "ho:", long_opts, NULL)) != -1) {
+		if (c == 'h')
+			c = OPT_HELP;
+		if (c == 'o')
+			c = OPT_OUT;
+		if (parse_option(c, &o, &synth, &duration) != 0) {
+			usage(stderr);
+			return AN_EXIT_USAGE;
+		}
+	}
+	if (synth)
+		return run_synth(synth, duration);
+	for (; optind < argc; optind++) {
+		if (o.nlogs >= AN_MAX_LOGS) {
+			fprintf(stderr, "undulate-analyze: at most %d logs\n", AN_MAX_LOGS);
+			return AN_EXIT_USAGE;
+		}
+		o.logs[o.nlogs++] = argv[optind];
+	}
+	if (o.nlogs == 0) {
+		usage(stderr);
+		return AN_EXIT_USAGE;
+	}
+	if (check_options(&o) != 0)
+		return AN_EXIT_USAGE;
+	return an_run(&o);
+}

@@ -1,0 +1,51 @@
+/* synth.h — a synthetic LCM log with known content: four robots whose phases,
+ * collisions and return map are set by construction. Used by the tests and
+ * by `undulate-analyze --synth` to check an installation end to end.
+ *
+ * Robots r1..r4, two joints each (servo ids 2i-1, 2i), joint 1 lagging joint
+ * 0 by 2*pi/3; angle = A cos(phi), speed = -A w sin(phi).
+ *   r1:r2  d~ = 0.3, constant phase difference 0.4 rad, no contact (compatible).
+ *   r2:r3  d~ = 0.6, phase difference pi, one collision per period (anti-phase).
+ *   r3:r4  d~ = 0; phase difference delta0 at start, then at each of ncoll
+ *          collisions (every coll_period_s) the d~ = 0 return map
+ *          delta_n = 2 atan((-r)^n tan(delta0/2)); no contact afterwards.
+ *          Only r4's phase jumps, as if r3 were much heavier.
+ * SIM.TRUTH at every cycle carries the bodies and the collisions, which are
+ * also sent on SIM.COLLISION (the analyser must count each once); the
+ * copies in SIM.TRUTH carry the truth message's time, as the simulator's do. */
+#ifndef UNDULATE_ANALYZE_SYNTH_H
+#define UNDULATE_ANALYZE_SYNTH_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#define SYNTH_ROBOTS 4
+#define SYNTH_COMPAT_DELTA 0.4
+#define SYNTH_DSEP_12 0.3
+#define SYNTH_DSEP_23 0.6
+
+struct synth_spec {
+	double duration_s;
+	double dt_s;           /* control period */
+	double freq_hz;
+	double amplitude;      /* rad */
+	double lever;          /* m/rad: lateral = neutral + lever * angle */
+	double restitution;
+	double delta0;         /* r3:r4 phase difference before the first collision */
+	double coll_period_s;  /* between r3:r4 collisions */
+	int ncoll;             /* r3:r4 collisions */
+	int64_t start_utime;   /* µs */
+	bool truth;            /* publish SIM.TRUTH / SIM.COLLISION */
+	bool report_frequency; /* fill joint_state_t.frequency (else 0: unknown) */
+	int burst;             /* each r3:r4 contact reported as this many collisions, 1 ms apart */
+};
+
+void synth_default(struct synth_spec *s);
+/* r3:r4 phase difference in force at time T (s from the start). */
+double synth_delta34(const struct synth_spec *s, double t);
+/* The impulse (N*s) of collision number K (0-based) of the log. */
+double synth_impulse(int k);
+/* Writes the log; returns the number of collisions written, or -1. */
+int synth_write(const struct synth_spec *s, const char *path);
+
+#endif

@@ -1,0 +1,129 @@
+/* keys.c — see keys.h. */
+#include "keys.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define KEY_ESC 0x1b
+
+enum top_key top_key_feed(struct top_keyparser *kp, unsigned char byte, int *ch)
+{
+	if (kp->n == 0) {
+		if (byte == KEY_ESC) {
+			kp->seq[kp->n++] = byte;
+			return TOP_KEY_NONE;
+		}
+		*ch = byte;
+		return TOP_KEY_CHAR;
+	}
+	kp->seq[kp->n++] = byte;
+	if (kp->n == 2) {
+		if (byte == '[' || byte == 'O')
+			return TOP_KEY_NONE;
+		kp->n = 0; /* ESC + key (Alt-key): ignored */
+		return TOP_KEY_NONE;
+	}
+	/* CSI/SS3 sequences end with a byte in 0x40..0x7E */
+	if (byte < 0x40 || byte > 0x7e) {
+		if (kp->n >= TOP_KEYSEQ_MAX)
+			kp->n = 0;
+		return TOP_KEY_NONE;
+	}
+	enum top_key key = TOP_KEY_NONE;
+	if (kp->n == 3) {
+		switch (byte) {
+		case 'A': key = TOP_KEY_UP; break;
+		case 'B': key = TOP_KEY_DOWN; break;
+		case 'H': key = TOP_KEY_HOME; break;
+		case 'F': key = TOP_KEY_END; break;
+		default: break;
+		}
+	} else if (kp->n == 4 && byte == '~') {
+		switch (kp->seq[2]) {
+		case '5': key = TOP_KEY_PGUP; break;
+		case '6': key = TOP_KEY_PGDN; break;
+		case '1': case '7': key = TOP_KEY_HOME; break;
+		case '4': case '8': key = TOP_KEY_END; break;
+		default: break;
+		}
+	}
+	kp->n = 0;
+	return key;
+}
+
+static void top_command_base(struct top_command *c, const char *robot, int8_t kind, int64_t seq, const char *source)
+{
+	memset(c, 0, sizeof(*c));
+	snprintf(c->robot, sizeof(c->robot), "%s", robot);
+	snprintf(c->source, sizeof(c->source), "%s", source);
+	if (strcmp(robot, "*") == 0)
+		snprintf(c->channel, sizeof(c->channel), "UNDULATE.CMD");
+	else
+		snprintf(c->channel, sizeof(c->channel), "%s.CMD", robot);
+	c->msg.seq = seq;
+	c->msg.source = c->source;
+	c->msg.robot = c->robot;
+	c->msg.kind = kind;
+	c->msg.param = c->param;
+	c->msg.joint = -1;
+}
+
+int top_command_mode(struct top_command *c, const char *robot, int mode, int64_t seq, const char *source)
+{
+	if (mode < UNDULATE_ROBOT_STATE_T_MODE_LIMP || mode > UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR)
+		return -1;
+	if (!robot[0] || strlen(robot) >= TOP_NAME_MAX)
+		return -1;
+	top_command_base(c, robot, UNDULATE_COMMAND_T_KIND_MODE, seq, source);
+	c->msg.mode = (int8_t)mode;
+	return 0;
+}
+
+static int nudge_oscillator(struct top_command out[TOP_MAX_JOINTS], const struct top_robot *r, int dir,
+			    int64_t seq, const char *source, char *why, size_t whylen)
+{
+	int n = r->nparams < r->njoints || r->njoints == 0 ? r->nparams : r->njoints;
+	int len = snprintf(why, whylen, "%s c:", r->name);
+	for (int k = 0; k < n; k++) {
+		double v = r->c[k] * (1.0 + dir * TOP_NUDGE_FRACTION);
+		if (!isfinite(v) || v <= 0.0) {
+			snprintf(why, whylen, "%s: c[%d] = %g cannot be nudged (must stay > 0)", r->name, k, r->c[k]);
+			return -1;
+		}
+		top_command_base(&out[k], r->name, UNDULATE_COMMAND_T_KIND_PARAM, seq + k, source);
+		snprintf(out[k].param, sizeof(out[k].param), "c");
+		out[k].msg.joint = (int16_t)k;
+		out[k].msg.value = v;
+		if (len > 0 && (size_t)len < whylen)
+			len += snprintf(why + len, whylen - (size_t)len, " [%d] %.4g->%.4g", k, r->c[k], v);
+	}
+	return n;
+}
+
+int top_command_nudge(struct top_command out[TOP_MAX_JOINTS], const struct top_robot *r, int dir, int64_t seq,
+		      const char *source, char *why, size_t whylen)
+{
+	dir = dir > 0 ? 1 : -1;
+	if (!r->have_params) {
+		snprintf(why, whylen, "%s: no %s.PARAMS heard yet: nothing to nudge from", r->name, r->name);
+		return -1;
+	}
+	if (r->mode == UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR)
+		return nudge_oscillator(out, r, dir, seq, source, why, whylen);
+	if (r->mode != UNDULATE_ROBOT_STATE_T_MODE_SINUSOID) {
+		snprintf(why, whylen, "%s is in %s: +/- nudges c (OSCILLATOR) or the amplitude (SINUSOID)", r->name,
+			 top_mode_name(r->mode));
+		return -1;
+	}
+	double v = r->sin_amplitude + dir * TOP_NUDGE_AMPLITUDE;
+	if (!(v >= 0.0 && v <= TOP_AMPLITUDE_MAX)) {
+		snprintf(why, whylen, "%s: amplitude %.3f rad would leave [0, %.2f]", r->name, v, TOP_AMPLITUDE_MAX);
+		return -1;
+	}
+	top_command_base(&out[0], r->name, UNDULATE_COMMAND_T_KIND_PARAM, seq, source);
+	snprintf(out[0].param, sizeof(out[0].param), "amplitude");
+	out[0].msg.value = v;
+	snprintf(why, whylen, "%s amplitude %.3f->%.3f rad", r->name, r->sin_amplitude, v);
+	return 1;
+}

@@ -1,0 +1,132 @@
+/* model.h — undulate-top's picture of the LCM network: every robot heard,
+ * the simulator's collisions, derived rates and phase differences. No I/O:
+ * messages and the current time come in as arguments, so tests drive it. */
+#ifndef UNDULATE_TOP_MODEL_H
+#define UNDULATE_TOP_MODEL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "undulate_bus_stats_t.h"
+#include "undulate_event_t.h"
+#include "undulate_osc_params_t.h"
+#include "undulate_robot_state_t.h"
+#include "undulate_sim_collision_t.h"
+#include "undulate_sim_truth_t.h"
+
+#define TOP_MAX_ROBOTS 64      /* robots tracked; the paper's largest group is 10, ours 20 */
+#define TOP_MAX_JOINTS 4       /* joints shown per robot (ours have 2) */
+#define TOP_NAME_MAX 48        /* robot name length kept */
+#define TOP_TEXT_MAX 96        /* mode reason / event text kept */
+#define TOP_WINDOW 128         /* per-cycle samples kept for rate and jitter: > 1 s at 100 Hz */
+#define TOP_STALE_S 1.0        /* no STATE for this long: marked stale (kept) */
+#define TOP_COLL_WINDOW_S 10.0 /* collision-rate window */
+#define TOP_COLL_RING 2048     /* collision times kept: 200/s over the window */
+#define TOP_COLL_DEDUP 64      /* recent collisions: one seen on SIM.COLLISION and SIM.TRUTH counts once */
+#define TOP_SIM_STALE_S 2.0    /* simulator considered gone after this long */
+
+struct top_joint {
+	int16_t servo_id;
+	double angle, speed, goal, load, phase, amplitude, frequency;
+	int16_t error_bits;
+	int32_t stale_cycles;
+	bool torque;
+};
+
+struct top_robot {
+	char name[TOP_NAME_MAX];
+	bool have_state;
+	double rx;                 /* s (monotonic), last STATE */
+	int64_t utime, cycle;
+	int8_t mode;
+	char mode_reason[TOP_TEXT_MAX];
+	double period_us[TOP_WINDOW], jitter_us[TOP_WINDOW], rx_times[TOP_WINDOW];
+	int nwin, winnext;
+	int64_t overruns, bus_errors, bad_commands, states;
+	int njoints;
+	struct top_joint j[TOP_MAX_JOINTS];
+	/* <robot>.BUS */
+	bool have_bus, connected;
+	int64_t timeouts, checksum_errors, io_errors, reconnects;
+	double cpu_percent, adapter_latency_ms;
+	/* <robot>.PARAMS */
+	bool have_params;
+	int nparams;
+	double c[TOP_MAX_JOINTS], mu[TOP_MAX_JOINTS], k[TOP_MAX_JOINTS];
+	double sin_amplitude, sin_frequency;
+	/* SIM.TRUTH */
+	bool have_body;
+	int16_t body_servo;
+	double neutral, lateral;
+	/* <robot>.EVENT */
+	char last_event[TOP_TEXT_MAX];
+	int64_t last_event_seq;
+	int8_t last_event_level;
+};
+
+struct top_seen {
+	int64_t utime;
+	int32_t left, right;
+};
+
+struct top_model {
+	struct top_robot robots[TOP_MAX_ROBOTS];
+	int nrobots;
+	int64_t dropped_robots;
+	int order[TOP_MAX_ROBOTS];  /* display order (indices into robots) */
+	bool order_lateral;
+	/* simulator */
+	bool have_sim;
+	double sim_rx;
+	double coll_direct_rx;      /* s, last SIM.COLLISION (0 = never) */
+	int64_t sim_total_collisions;
+	double sim_total_impulse;
+	int64_t collisions_heard;   /* distinct collisions received */
+	double impulse_heard;
+	double coll_rx[TOP_COLL_RING];
+	double coll_impulse[TOP_COLL_RING];
+	int ncoll, collnext;
+	struct top_seen seen[TOP_COLL_DEDUP];
+	int seennext;
+	int64_t decode_errors;
+};
+
+void top_model_init(struct top_model *m);
+/* NOW: monotonic seconds at reception. */
+void top_on_state(struct top_model *m, const undulate_robot_state_t *s, double now);
+void top_on_bus(struct top_model *m, const undulate_bus_stats_t *b);
+void top_on_params(struct top_model *m, const undulate_osc_params_t *p);
+void top_on_event(struct top_model *m, const undulate_event_t *e);
+void top_on_truth(struct top_model *m, const undulate_sim_truth_t *t, double now);
+void top_on_collision(struct top_model *m, const undulate_sim_collision_t *c, double now);
+/* A collision received on SIM.COLLISION itself. */
+void top_on_sim_collision(struct top_model *m, const undulate_sim_collision_t *c, double now);
+
+/* Sorts the display order: by neutral position when the simulator reports
+ * every robot's body, by name otherwise. */
+void top_model_order(struct top_model *m);
+int top_robot_index(const struct top_model *m, const char *name);
+
+bool top_robot_stale(const struct top_robot *r, double now);
+double top_robot_rate_hz(const struct top_robot *r);      /* 1e6 / mean period; NAN none */
+double top_robot_rx_hz(const struct top_robot *r, double now); /* STATE messages received per second */
+double top_robot_jitter_p99(const struct top_robot *r);   /* µs; NAN none */
+double top_robot_jitter_max(const struct top_robot *r);
+int top_robot_contact_joint(const struct top_robot *r);
+/* phase(joint 1) - phase(joint 0), wrapped; NAN if fewer than two joints. */
+double top_robot_dphase_joints(const struct top_robot *r);
+/* phase(order[k+1]) - phase(order[k]) on their contact joints; NAN if unknown. */
+double top_neighbour_dphase(const struct top_model *m, int k);
+/* collisions received within the last TOP_COLL_WINDOW_S, and their impulse */
+int top_collisions_window(const struct top_model *m, double now, double *impulse);
+bool top_sim_present(const struct top_model *m, double now);
+
+const char *top_mode_name(int mode);
+const char *top_mode_short(int mode);
+double top_wrap(double a);
+
+/* One JSON object (one line) describing everything. WALL_UTIME: µs since the epoch. */
+void top_json(const struct top_model *m, double now, int64_t wall_utime, FILE *f);
+
+#endif
