@@ -1,0 +1,218 @@
+/*
+ * fault.c — fault descriptions and their effect on a status packet.
+ */
+#include "fault.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dxl.h"
+
+static const char *const fault_names[SIM_FAULT_KINDS] = {
+	[SIM_FAULT_NO_REPLY] = "no-reply",
+	[SIM_FAULT_BAD_CHECKSUM] = "bad-checksum",
+	[SIM_FAULT_TRUNCATE] = "truncate",
+	[SIM_FAULT_GARBAGE] = "garbage",
+	[SIM_FAULT_WRONG_ID] = "wrong-id",
+	[SIM_FAULT_STUCK_ERROR] = "stuck-error",
+	[SIM_FAULT_SLOW] = "slow",
+	[SIM_FAULT_TEMPERATURE] = "temperature",
+	[SIM_FAULT_VOLTAGE] = "voltage",
+};
+
+const char *sim_fault_name(enum sim_fault_kind k)
+{
+	return (unsigned)k < SIM_FAULT_KINDS ? fault_names[k] : "?";
+}
+
+uint64_t sim_rand_next(uint64_t *state)
+{
+	uint64_t x = *state ? *state : 0x9E3779B97F4A7C15ull;
+	x ^= x >> 12;
+	x ^= x << 25;
+	x ^= x >> 27;
+	*state = x;
+	return x * 0x2545F4914F6CDD1Dull;
+}
+
+double sim_rand_uniform(uint64_t *state)
+{
+	return (double)(sim_rand_next(state) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static bool parse_double(const char *s, double *out)
+{
+	char *end;
+	errno = 0;
+	double v = strtod(s, &end);
+	if (errno || end == s || *end || !isfinite(v))
+		return false;
+	*out = v;
+	return true;
+}
+
+/* One word per status error bit, 0..6 (no spaces: they go on a command line). */
+static const char *const errbit_words[7] = {
+	"voltage", "angle-limit", "overheating", "range", "checksum", "overload", "instruction",
+};
+
+int sim_fault_parse_bits(const char *text)
+{
+	char buf[128];
+	char *end;
+	long v = strtol(text, &end, 0);
+	if (end != text && *end == '\0')
+		return (v >= 0 && v <= (long)DXL_ERRBIT_MASK) ? (int)v : -1;
+	if (strlen(text) >= sizeof(buf))
+		return -1;
+	strcpy(buf, text);
+	int bits = 0;
+	for (char *save = NULL, *tok = strtok_r(buf, "|,+", &save); tok; tok = strtok_r(NULL, "|,+", &save)) {
+		int found = 0;
+		for (int b = 0; b < 7; b++) {
+			if (strcmp(errbit_words[b], tok) == 0) {
+				bits |= 1 << b;
+				found = 1;
+			}
+		}
+		if (!found)
+			return -1;
+	}
+	return bits;
+}
+
+static int fault_kind_of(const char *name)
+{
+	for (int k = 0; k < SIM_FAULT_KINDS; k++)
+		if (strcmp(name, fault_names[k]) == 0)
+			return k;
+	return -1;
+}
+
+/* The ARG of a fault: a number, or error-bit names for stuck-error. */
+static int fault_parse_arg(enum sim_fault_kind kind, const char *word, struct sim_fault *out)
+{
+	if (kind == SIM_FAULT_STUCK_ERROR) {
+		int bits = sim_fault_parse_bits(word);
+		if (bits < 0)
+			return -1;
+		out->arg = bits;
+		return 0;
+	}
+	return parse_double(word, &out->arg) && out->arg >= 0 ? 0 : -1;
+}
+
+int sim_fault_parse(int argc, char **argv, enum sim_fault_kind *kind, struct sim_fault *out,
+                    char *err, size_t errcap)
+{
+	if (argc < 1) {
+		snprintf(err, errcap, "missing fault kind");
+		return -1;
+	}
+	int k = fault_kind_of(argv[0]);
+	if (k < 0) {
+		snprintf(err, errcap, "unknown fault '%s' (no-reply, bad-checksum, truncate, garbage, wrong-id, "
+		                      "stuck-error, slow, temperature, voltage)", argv[0]);
+		return -1;
+	}
+	memset(out, 0, sizeof(*out));
+	out->active = true;
+	out->remaining = -1;
+	out->prob = 1.0;
+	for (int i = 1; i < argc; i++) {
+		double v;
+		if (strncmp(argv[i], "count=", 6) == 0 && parse_double(argv[i] + 6, &v) && v >= 1 && v <= 1e9) {
+			out->remaining = (long)v;
+		} else if (strncmp(argv[i], "prob=", 5) == 0 && parse_double(argv[i] + 5, &v) && v >= 0 && v <= 1) {
+			out->prob = v;
+		} else if (!out->has_arg && fault_parse_arg((enum sim_fault_kind)k, argv[i], out) == 0) {
+			out->has_arg = true;
+		} else {
+			snprintf(err, errcap, "bad argument '%s' for fault %s", argv[i], argv[0]);
+			return -1;
+		}
+	}
+	if ((k == SIM_FAULT_TEMPERATURE || k == SIM_FAULT_VOLTAGE) && !out->has_arg) {
+		snprintf(err, errcap, "fault %s needs a value", argv[0]);
+		return -1;
+	}
+	if (k == SIM_FAULT_STUCK_ERROR && !out->has_arg) {
+		out->arg = DXL_ERRBIT_OVERLOAD;
+		out->has_arg = true;
+	}
+	*kind = (enum sim_fault_kind)k;
+	return 0;
+}
+
+void sim_faults_clear(struct sim_faults *fs)
+{
+	memset(fs->f, 0, sizeof(fs->f));
+}
+
+uint8_t sim_faults_stuck_bits(const struct sim_faults *fs)
+{
+	const struct sim_fault *f = &fs->f[SIM_FAULT_STUCK_ERROR];
+	return f->active ? (uint8_t)((unsigned)f->arg & DXL_ERRBIT_MASK) : 0;
+}
+
+/* Whether a reply fault fires for this reply (count and probability). */
+static bool fault_fires(struct sim_fault *f, uint64_t *rng)
+{
+	if (!f->active)
+		return false;
+	if (f->prob < 1.0 && sim_rand_uniform(rng) >= f->prob)
+		return false;
+	if (f->remaining > 0 && --f->remaining == 0)
+		f->active = false;
+	return true;
+}
+
+static void fault_fix_checksum(uint8_t *pkt, size_t len)
+{
+	pkt[len - 1] = dxl_checksum(&pkt[2], len - 3);
+}
+
+bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t *len,
+                      uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns)
+{
+	struct sim_fault *f = fs->f;
+	bool changed = false;
+	*ngarbage = 0;
+	*extra_delay_ns = 0;
+	if (fault_fires(&f[SIM_FAULT_SLOW], rng)) {
+		*extra_delay_ns = (int64_t)((f[SIM_FAULT_SLOW].has_arg ? f[SIM_FAULT_SLOW].arg : 5.0) * 1e6);
+		changed = true;
+	}
+	if (fault_fires(&f[SIM_FAULT_GARBAGE], rng)) {
+		double n = f[SIM_FAULT_GARBAGE].has_arg ? f[SIM_FAULT_GARBAGE].arg : 8;
+		*ngarbage = n > SIM_FAULT_MAX_GARBAGE ? SIM_FAULT_MAX_GARBAGE : (size_t)n;
+		for (size_t i = 0; i < *ngarbage; i++)
+			garbage[i] = (uint8_t)sim_rand_next(rng);
+		changed = true;
+	}
+	if (fault_fires(&f[SIM_FAULT_NO_REPLY], rng)) {
+		*len = 0;
+		fs->applied++;
+		return true;
+	}
+	if (*len >= 6 && fault_fires(&f[SIM_FAULT_WRONG_ID], rng)) {
+		pkt[2] = f[SIM_FAULT_WRONG_ID].has_arg ? (uint8_t)f[SIM_FAULT_WRONG_ID].arg : (uint8_t)(pkt[2] + 1);
+		fault_fix_checksum(pkt, *len);
+		changed = true;
+	}
+	if (*len >= 6 && fault_fires(&f[SIM_FAULT_BAD_CHECKSUM], rng)) {
+		pkt[*len - 1] ^= 0xFF;
+		changed = true;
+	}
+	if (*len > 0 && fault_fires(&f[SIM_FAULT_TRUNCATE], rng)) {
+		size_t cut = f[SIM_FAULT_TRUNCATE].has_arg ? (size_t)f[SIM_FAULT_TRUNCATE].arg : *len / 2;
+		*len = cut >= *len ? 1 : *len - cut;
+		changed = true;
+	}
+	if (changed)
+		fs->applied++;
+	return changed;
+}

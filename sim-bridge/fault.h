@@ -1,0 +1,82 @@
+/*
+ * fault.h — per-servo fault injection: what happens to a status packet on its
+ * way to the controller, and conditions the servo reports. Pure: the random
+ * numbers come from the caller's generator state.
+ *
+ * Text form (scenario [events], control socket, SIM.CMD):
+ *   KIND [ARG] [count=N] [prob=P]
+ * KIND            ARG (default)        effect
+ * no-reply        -                    the servo executes the instruction, its reply is lost
+ * bad-checksum    -                    the reply's checksum byte is inverted
+ * truncate        bytes cut (half)     the reply loses its last ARG bytes
+ * garbage         bytes (8)            ARG random bytes go out just before the reply
+ * wrong-id        ID (id + 1)          the reply carries ID ARG (valid checksum)
+ * stuck-error     bits (overload=32)   ARG is OR-ed into every error byte
+ * slow            ms (5)               the reply leaves ARG ms late
+ * temperature     °C                   the servo measures ARG (can raise overheating)
+ * voltage         V                    the servo measures ARG (can raise the voltage bit)
+ * count=N limits a reply fault to the next N replies, prob=P applies it to a
+ * fraction P of replies.
+ */
+#ifndef UNDULATE_SIM_FAULT_H
+#define UNDULATE_SIM_FAULT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+enum sim_fault_kind {
+	SIM_FAULT_NO_REPLY,
+	SIM_FAULT_BAD_CHECKSUM,
+	SIM_FAULT_TRUNCATE,
+	SIM_FAULT_GARBAGE,
+	SIM_FAULT_WRONG_ID,
+	SIM_FAULT_STUCK_ERROR,
+	SIM_FAULT_SLOW,
+	SIM_FAULT_TEMPERATURE,
+	SIM_FAULT_VOLTAGE,
+	SIM_FAULT_KINDS
+};
+
+struct sim_fault {
+	bool active;
+	bool has_arg;
+	double arg;
+	long remaining;    /* replies left; < 0 = until cleared */
+	double prob;       /* 0..1 */
+};
+
+struct sim_faults {
+	struct sim_fault f[SIM_FAULT_KINDS];
+	uint64_t applied;  /* replies altered */
+};
+
+/* Most garbage bytes one fault may add before a reply. */
+#define SIM_FAULT_MAX_GARBAGE 64
+
+const char *sim_fault_name(enum sim_fault_kind k);
+/* Parse "KIND [ARG] [count=N] [prob=P]" (already split into words).
+ * Returns 0 or -1 with a message in err. */
+int sim_fault_parse(int argc, char **argv, enum sim_fault_kind *kind, struct sim_fault *out,
+                    char *err, size_t errcap);
+/* Parse an error-bit mask: a number or names joined by '|' or ','
+ * ("overload|overheating"). -1 if invalid. */
+int sim_fault_parse_bits(const char *text);
+void sim_faults_clear(struct sim_faults *fs);
+/* Stuck bits currently injected. */
+uint8_t sim_faults_stuck_bits(const struct sim_faults *fs);
+
+/* xorshift64* — small, seedable, deterministic across runs. */
+uint64_t sim_rand_next(uint64_t *state);
+double sim_rand_uniform(uint64_t *state);  /* [0, 1) */
+
+/*
+ * Apply the reply faults to one status packet in pkt[0..*len) (cap bytes of
+ * room). May shorten, alter or empty it, and may fill garbage[0..*ngarbage)
+ * to send first. *extra_delay_ns gets the slow fault's delay. Returns true
+ * when any fault changed something.
+ */
+bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t *len,
+                      uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns);
+
+#endif

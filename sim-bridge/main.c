@@ -1,0 +1,804 @@
+/*
+ * undulate-sim — simulated AX-12 buses on pseudo-terminals, with motor
+ * physics, a contact world, fault injection and ground truth on LCM.
+ *
+ *   undulate-sim --link PATH --ids 1,2 [options]      one bus (quick form)
+ *   undulate-sim --scenario FILE [--set sec.key=val]   robots, world, faults
+ *
+ * One single-threaded loop (ppoll) owns everything: the physics runs on an
+ * absolute schedule at rate_hz, replies leave each bus's line queue when
+ * their wire time has come, LCM and the control socket are served in
+ * between. See sim-bridge/README.md.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <lcm/lcm.h>
+#include <limits.h>
+#include <math.h>
+#include <poll.h>
+#include <sched.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
+#include <sys/select.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "sim.h"
+#include "undulate_sim_collision_t.h"
+#include "undulate_sim_command_t.h"
+#include "undulate_sim_truth_t.h"
+
+/* Physics steps run back to back after a stall before the schedule is
+ * reset (a stalled machine should not replay seconds of physics at once). */
+#define MAIN_MAX_CATCHUP 50
+/* Control-socket clients served at once; one command line's length. */
+#define MAIN_MAX_CLIENTS 8
+#define MAIN_LINE_MAX SIM_CMD_MAX
+/* Collisions buffered between two SIM.TRUTH messages (more are counted). */
+#define MAIN_TRUTH_MAX_COLLISIONS 256
+/* Encoded SIM.TRUTH: 64 bodies × ~100 B + 256 collisions × ~140 B, with room. */
+#define MAIN_TRUTH_BUF (128 * 1024)
+#define MAIN_MAX_FDS (SIM_MAX_BUSES + MAIN_MAX_CLIENTS + 2)
+/* Step lateness histogram for percentiles: 10 µs bins up to 20 ms (the last
+ * bin holds everything later). */
+#define MAIN_LATE_BIN_US 10
+#define MAIN_LATE_BINS 2000
+
+static volatile sig_atomic_t stop_signal;
+
+static void on_signal(int sig) { stop_signal = sig; }
+
+static int64_t mono_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int64_t wall_us(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
+}
+
+struct client {
+	int fd;
+	size_t have;
+	bool skipping;             /* inside an over-long line: drop up to its newline */
+	char buf[MAIN_LINE_MAX];
+};
+
+struct app {
+	struct sim *sim;
+	lcm_t *lcm;
+	int listen_fd;
+	char control_path[SIM_PATH_MAX];
+	struct client clients[MAIN_MAX_CLIENTS];
+	int64_t t0, step_ns, tx_slice_ns;
+	/* timing */
+	double worst_late_us, period_worst_late_us, late_sum_us;
+	uint64_t late_samples, overruns;
+	uint64_t late_hist[MAIN_LATE_BINS];
+	/* truth */
+	struct sim_collision pending[MAIN_TRUTH_MAX_COLLISIONS];
+	int pending_bus[MAIN_TRUTH_MAX_COLLISIONS][2];
+	size_t npending;
+	uint64_t truth_sent, truth_failed, collisions_unreported;
+	uint8_t *truth_buf;
+	bool bench, quiet;
+	/* bad input already reported, per bus (reported at most once a second) */
+	uint64_t reported_bad[SIM_MAX_BUSES];
+};
+
+/* ---- options ---------------------------------------------------------------- */
+
+struct options {
+	const char *scenario;
+	const char *link, *ids, *name;
+	const char *sets[64];
+	int nsets;
+	bool bench, quiet;
+	double tx_slice_us;
+	const char *send_cmd;   /* --cmd: publish one SIM.CMD and exit */
+	int realtime;           /* SCHED_FIFO priority, 0 = normal scheduling */
+	const char *lcm_url;
+};
+
+static void usage(FILE *f)
+{
+	fprintf(f,
+	        "usage: undulate-sim --link PATH --ids 1,2 [options]\n"
+	        "       undulate-sim --scenario FILE [--set section.key=value ...] [options]\n"
+	        "options (each is also a [sim] key; the command line wins):\n"
+	        "  --link PATH          the bus's pty appears at PATH (quick form)\n"
+	        "  --ids LIST           servo IDs on that bus, e.g. 1,2 or 1-4\n"
+	        "  --name NAME          robot name of the quick-form bus (default: the link's basename)\n"
+	        "  --scenario FILE      robots, world, motors and timed faults (README: scenario format)\n"
+	        "  --set SEC.KEY=VAL    override any scenario key, e.g. world.separation=0.4\n"
+	        "  --link-dir DIR       where scenario robots without a link appear (DIR/NAME)\n"
+	        "  --lcm-url URL        LCM provider for SIM.TRUTH/SIM.COLLISION/SIM.CMD\n"
+	        "  --control PATH       unix socket for run-time commands (one per line)\n"
+	        "  --seed N             initial angles and random faults (deterministic runs)\n"
+	        "  --duration S         exit after S seconds (0: run until SIGINT/SIGTERM)\n"
+	        "  --baud BPS           the controller's rate on every bus (default 1000000)\n"
+	        "  --return-delay US    initial return delay of every servo (default: factory 500)\n"
+	        "  --latency-ms MS      USB adapter hold time toward the controller (FTDI: 16)\n"
+	        "  --echo               single-wire adapter: requests come back before replies\n"
+	        "  --rate-hz HZ         physics steps per second (default 1000)\n"
+	        "  --truth-hz HZ        SIM.TRUTH messages per second (default 100)\n"
+	        "  --temperature C      ambient (and initial) servo temperature\n"
+	        "  --voltage V          supply voltage (default 12)\n"
+	        "  --tx-slice-us US     reply pacing granularity (default 100)\n"
+	        "  --bench              print CPU and step lateness every second\n"
+	        "  --realtime PRIO      run under SCHED_FIFO at PRIO (1-99) for steadier steps\n"
+	        "  --quiet              only the ready line, errors and the exit summary\n"
+	        "  --cmd 'VERB ARGS'    send one command to a running simulator on SIM.CMD and exit\n");
+}
+
+enum {
+	OPT_LINK = 256, OPT_IDS, OPT_NAME, OPT_SCENARIO, OPT_SET, OPT_LINK_DIR, OPT_LCM_URL, OPT_CONTROL,
+	OPT_SEED, OPT_DURATION, OPT_BAUD, OPT_RETURN_DELAY, OPT_LATENCY, OPT_ECHO, OPT_RATE, OPT_TRUTH,
+	OPT_TEMP, OPT_VOLTAGE, OPT_TX_SLICE, OPT_BENCH, OPT_QUIET, OPT_HELP, OPT_CMD, OPT_REALTIME,
+};
+
+/* Options that are [sim] keys go through the same parser as the file. */
+static const struct {
+	int opt;
+	const char *key;
+} sim_keys[] = {
+	{ OPT_LINK_DIR, "sim.link_dir" }, { OPT_LCM_URL, "sim.lcm_url" }, { OPT_CONTROL, "sim.control" },
+	{ OPT_SEED, "sim.seed" }, { OPT_DURATION, "sim.duration" }, { OPT_BAUD, "sim.baud" },
+	{ OPT_RETURN_DELAY, "sim.return_delay_us" }, { OPT_LATENCY, "sim.latency_ms" },
+	{ OPT_RATE, "sim.rate_hz" }, { OPT_TRUTH, "sim.truth_hz" }, { OPT_TEMP, "sim.temperature" },
+	{ OPT_VOLTAGE, "sim.voltage" },
+};
+
+static char set_store[64][SIM_CMD_MAX + SIM_PATH_MAX];
+
+static int parse_args(int argc, char **argv, struct options *o)
+{
+	static const struct option longopts[] = {
+		{ "link", required_argument, 0, OPT_LINK }, { "ids", required_argument, 0, OPT_IDS },
+		{ "name", required_argument, 0, OPT_NAME }, { "scenario", required_argument, 0, OPT_SCENARIO },
+		{ "set", required_argument, 0, OPT_SET }, { "link-dir", required_argument, 0, OPT_LINK_DIR },
+		{ "lcm-url", required_argument, 0, OPT_LCM_URL }, { "control", required_argument, 0, OPT_CONTROL },
+		{ "seed", required_argument, 0, OPT_SEED }, { "duration", required_argument, 0, OPT_DURATION },
+		{ "baud", required_argument, 0, OPT_BAUD }, { "return-delay", required_argument, 0, OPT_RETURN_DELAY },
+		{ "latency-ms", required_argument, 0, OPT_LATENCY }, { "echo", no_argument, 0, OPT_ECHO },
+		{ "rate-hz", required_argument, 0, OPT_RATE }, { "truth-hz", required_argument, 0, OPT_TRUTH },
+		{ "temperature", required_argument, 0, OPT_TEMP }, { "voltage", required_argument, 0, OPT_VOLTAGE },
+		{ "tx-slice-us", required_argument, 0, OPT_TX_SLICE }, { "bench", no_argument, 0, OPT_BENCH },
+		{ "quiet", no_argument, 0, OPT_QUIET }, { "help", no_argument, 0, OPT_HELP },
+		{ "cmd", required_argument, 0, OPT_CMD }, { "realtime", required_argument, 0, OPT_REALTIME },
+		{ 0, 0, 0, 0 },
+	};
+	memset(o, 0, sizeof(*o));
+	o->tx_slice_us = 100;
+	int c;
+	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+		const char *key = NULL;
+		for (size_t i = 0; i < sizeof(sim_keys) / sizeof(sim_keys[0]); i++)
+			if (sim_keys[i].opt == c)
+				key = sim_keys[i].key;
+		if (o->nsets >= 60 && (key || c == OPT_SET || c == OPT_ECHO)) {
+			fprintf(stderr, "undulate-sim: too many settings\n");
+			return -1;
+		}
+		if (c == OPT_LCM_URL)
+			o->lcm_url = optarg;
+		if (key) {
+			snprintf(set_store[o->nsets], sizeof(set_store[0]), "%s=%s", key, optarg);
+			o->sets[o->nsets] = set_store[o->nsets];
+			o->nsets++;
+			continue;
+		}
+		switch (c) {
+		case OPT_LINK: o->link = optarg; break;
+		case OPT_IDS: o->ids = optarg; break;
+		case OPT_NAME: o->name = optarg; break;
+		case OPT_SCENARIO: o->scenario = optarg; break;
+		case OPT_SET: o->sets[o->nsets++] = optarg; break;
+		case OPT_ECHO: o->sets[o->nsets++] = "sim.echo=true"; break;
+		case OPT_TX_SLICE:
+			o->tx_slice_us = strtod(optarg, NULL);
+			if (!(o->tx_slice_us >= 0 && o->tx_slice_us <= 10000)) {
+				fprintf(stderr, "undulate-sim: --tx-slice-us: 0..10000\n");
+				return -1;
+			}
+			break;
+		case OPT_BENCH: o->bench = true; break;
+		case OPT_CMD: o->send_cmd = optarg; break;
+		case OPT_REALTIME:
+			o->realtime = atoi(optarg);
+			if (o->realtime < 1 || o->realtime > 99) {
+				fprintf(stderr, "undulate-sim: --realtime: priority 1..99\n");
+				return -1;
+			}
+			break;
+		case OPT_QUIET: o->quiet = true; break;
+		case OPT_HELP: case 'h': usage(stdout); exit(0);
+		default: usage(stderr); return -1;
+		}
+	}
+	if (optind < argc) {
+		fprintf(stderr, "undulate-sim: unexpected argument '%s'\n", argv[optind]);
+		return -1;
+	}
+	if ((o->link != NULL) != (o->ids != NULL)) {
+		fprintf(stderr, "undulate-sim: --link and --ids go together\n");
+		return -1;
+	}
+	if (o->send_cmd)
+		return 0;
+	if (!o->link && !o->scenario) {
+		usage(stderr);
+		return -1;
+	}
+	return 0;
+}
+
+static int build_config(const struct options *o, struct sim_config *c)
+{
+	char err[400];
+	sim_config_defaults(c);
+	if (o->scenario && sim_config_load(c, o->scenario, err, sizeof(err)) != 0)
+		goto fail;
+	if (o->link) {
+		const char *base = strrchr(o->link, '/');
+		const char *name = o->name ? o->name : (base ? base + 1 : o->link);
+		if (sim_config_add_robot(c, name, o->link, o->ids, err, sizeof(err)) != 0)
+			goto fail;
+	}
+	for (int i = 0; i < o->nsets; i++)
+		if (sim_config_set(c, o->sets[i], err, sizeof(err)) != 0)
+			goto fail;
+	if (sim_config_finish(c, err, sizeof(err)) != 0)
+		goto fail;
+	return 0;
+fail:
+	fprintf(stderr, "undulate-sim: %s\n", err);
+	return -1;
+}
+
+/* ---- LCM ------------------------------------------------------------------- */
+
+static void on_sim_cmd(const lcm_recv_buf_t *rbuf, const char *channel, const undulate_sim_command_t *msg,
+                       void *user)
+{
+	(void)rbuf;
+	(void)channel;
+	struct app *a = user;
+	char line[SIM_CMD_MAX], reply[512];
+	if (snprintf(line, sizeof(line), "%s %s", msg->verb ? msg->verb : "", msg->args ? msg->args : "") >=
+	    (int)sizeof(line)) {
+		a->sim->bad_commands++;
+		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld: command too long\n", (long long)msg->seq);
+		return;
+	}
+	sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
+	fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", (long long)msg->seq, line, reply);
+}
+
+static void fill_collision(struct app *a, const struct sim_collision *c, int64_t utime,
+                           undulate_sim_collision_t *m)
+{
+	struct sim *s = a->sim;
+	static char wall[] = "wall";
+	m->utime = utime;
+	m->left = c->left;
+	m->right = c->right;
+	m->left_robot = c->left >= 0 ? s->buses[s->body_bus[c->left]].name : wall;
+	m->right_robot = c->right >= 0 ? s->buses[s->body_bus[c->right]].name : wall;
+	m->pre_left = c->pre_left;
+	m->pre_right = c->pre_right;
+	m->post_left = c->post_left;
+	m->post_right = c->post_right;
+	m->impulse = c->impulse;
+}
+
+/* Each collision of the last step: on SIM.COLLISION now, into SIM.TRUTH later. */
+static void report_collisions(struct app *a)
+{
+	struct sim *s = a->sim;
+	int64_t now = wall_us();
+	for (size_t i = 0; i < s->nstep_collisions; i++) {
+		const struct sim_collision *c = &s->step_collisions[i];
+		if (a->lcm) {
+			undulate_sim_collision_t m;
+			fill_collision(a, c, now, &m);
+			int n = undulate_sim_collision_t_encode(a->truth_buf, 0, MAIN_TRUTH_BUF, &m);
+			if (n > 0)
+				lcm_publish(a->lcm, "SIM.COLLISION", a->truth_buf, (unsigned)n);
+		}
+		if (a->npending < MAIN_TRUTH_MAX_COLLISIONS)
+			a->pending[a->npending++] = *c;
+		else
+			a->collisions_unreported++;
+	}
+}
+
+static void publish_truth(struct app *a)
+{
+	static undulate_sim_body_t bodies[SIM_MAX_BODIES];
+	static undulate_sim_collision_t colls[MAIN_TRUTH_MAX_COLLISIONS];
+	struct sim *s = a->sim;
+	int64_t now = wall_us();
+	undulate_sim_truth_t t = {
+		.utime = now, .step = (int64_t)s->steps, .sim_time = (double)s->steps * s->dt,
+		.wall_left = s->world.params.wall_left, .wall_right = s->world.params.wall_right,
+		.total_collisions = (int64_t)s->world.total_collisions, .total_impulse = s->world.total_impulse,
+		.worst_lateness_us = a->period_worst_late_us, .nbodies = (int32_t)s->world.nbodies, .bodies = bodies,
+		.ncollisions = (int32_t)a->npending, .collisions = colls,
+	};
+	for (size_t i = 0; i < s->world.nbodies; i++) {
+		struct sim_joint *j = &s->buses[s->body_bus[i]].joints[s->body_joint[i]];
+		bodies[i] = (undulate_sim_body_t){
+			.robot = s->buses[s->body_bus[i]].name, .servo_id = sim_servo_id(&j->servo),
+			.angle = j->motor.angle, .speed = j->motor.speed, .lateral = sim_world_lateral(&s->world, i),
+			.neutral = s->world.bodies[i].neutral, .load = sim_motor_load_fraction(&j->motor, &j->params),
+			.temperature = j->motor.temperature,
+		};
+	}
+	for (size_t i = 0; i < a->npending; i++)
+		fill_collision(a, &a->pending[i], now, &colls[i]);
+	a->npending = 0;
+	a->period_worst_late_us = 0;
+	int n = undulate_sim_truth_t_encode(a->truth_buf, 0, MAIN_TRUTH_BUF, &t);
+	if (n < 0 || lcm_publish(a->lcm, "SIM.TRUTH", a->truth_buf, (unsigned)n) != 0)
+		a->truth_failed++;
+	else
+		a->truth_sent++;
+}
+
+/* ---- control socket ---------------------------------------------------------- */
+
+static int control_open(struct app *a, const char *path)
+{
+	struct sockaddr_un addr = { .sun_family = AF_UNIX };
+	if (strlen(path) >= sizeof(addr.sun_path)) {
+		fprintf(stderr, "undulate-sim: --control %s: path too long\n", path);
+		return -1;
+	}
+	strcpy(addr.sun_path, path);
+	struct stat st;
+	if (lstat(path, &st) == 0) {
+		if (!S_ISSOCK(st.st_mode)) {
+			fprintf(stderr, "undulate-sim: --control %s exists and is not a socket: refusing to replace it\n", path);
+			return -1;
+		}
+		unlink(path);  /* a stale socket from a killed run */
+	}
+	int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+	if (fd < 0 || bind(fd, (struct sockaddr *)&addr, sizeof(addr)) != 0 || listen(fd, 4) != 0) {
+		fprintf(stderr, "undulate-sim: --control %s: %s\n", path, strerror(errno));
+		if (fd >= 0)
+			close(fd);
+		return -1;
+	}
+	a->listen_fd = fd;
+	snprintf(a->control_path, sizeof(a->control_path), "%s", path);
+	return 0;
+}
+
+static void control_accept(struct app *a)
+{
+	int fd = accept(a->listen_fd, NULL, NULL);
+	if (fd < 0)
+		return;
+	for (int i = 0; i < MAIN_MAX_CLIENTS; i++)
+		if (a->clients[i].fd < 0) {
+			a->clients[i].fd = fd;
+			a->clients[i].have = 0;
+			a->clients[i].skipping = false;
+			return;
+		}
+	static const char busy[] = "error: too many control clients\n";
+	(void)!write(fd, busy, sizeof(busy) - 1);
+	close(fd);
+}
+
+static void client_reply(struct client *c, const char *reply)
+{
+	char out[600];
+	int n = snprintf(out, sizeof(out), "%s\n", reply);
+	/* Replies are short; a client that does not read them loses them. */
+	if (n > 0)
+		(void)!write(c->fd, out, (size_t)n < sizeof(out) ? (size_t)n : sizeof(out) - 1);
+}
+
+static void control_read(struct app *a, struct client *c)
+{
+	ssize_t n = read(c->fd, c->buf + c->have, sizeof(c->buf) - 1 - c->have);
+	if (n <= 0) {
+		if (n < 0 && (errno == EAGAIN || errno == EINTR))
+			return;
+		close(c->fd);
+		c->fd = -1;
+		return;
+	}
+	c->have += (size_t)n;
+	c->buf[c->have] = '\0';
+	char *line = c->buf, *nl;
+	if (c->skipping) {
+		nl = strchr(line, '\n');
+		if (!nl) {
+			c->have = 0;
+			return;
+		}
+		c->skipping = false;
+		line = nl + 1;
+	}
+	while ((nl = strchr(line, '\n')) != NULL) {
+		char reply[512];
+		*nl = '\0';
+		if (nl > line && nl[-1] == '\r')
+			nl[-1] = '\0';
+		if (*line)
+			sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
+		else
+			snprintf(reply, sizeof(reply), "error: empty command (try help)");
+		client_reply(c, reply);
+		line = nl + 1;
+	}
+	c->have = strlen(line);
+	memmove(c->buf, line, c->have);
+	if (c->have >= sizeof(c->buf) - 1) {
+		a->sim->bad_commands++;
+		client_reply(c, "error: line too long");
+		c->have = 0;
+		c->skipping = true;
+	}
+}
+
+/* --cmd: split "VERB ARGS" into a sim_command_t and publish it once. */
+static int send_command(const struct options *o)
+{
+	char verb[64];
+	const char *args = o->send_cmd;
+	size_t n = strcspn(args, " \t");
+	if (n == 0 || n >= sizeof(verb)) {
+		fprintf(stderr, "undulate-sim: --cmd: want 'VERB ARGS'\n");
+		return 2;
+	}
+	memcpy(verb, args, n);
+	verb[n] = '\0';
+	args += n;
+	args += strspn(args, " \t");
+	lcm_t *lcm = lcm_create(o->lcm_url);
+	if (!lcm) {
+		fprintf(stderr, "undulate-sim: --cmd: LCM (%s) unavailable\n", o->lcm_url ? o->lcm_url : "default");
+		return 1;
+	}
+	char argbuf[SIM_CMD_MAX];
+	snprintf(argbuf, sizeof(argbuf), "%s", args);
+	undulate_sim_command_t m = { .utime = wall_us(), .seq = (int64_t)getpid(), .verb = verb, .args = argbuf };
+	int r = undulate_sim_command_t_publish(lcm, "SIM.CMD", &m);
+	lcm_destroy(lcm);
+	if (r != 0) {
+		fprintf(stderr, "undulate-sim: --cmd: publish failed\n");
+		return 1;
+	}
+	return 0;
+}
+
+/* ---- the loop ------------------------------------------------------------------ */
+
+static double cpu_seconds(void)
+{
+	struct rusage ru;
+	getrusage(RUSAGE_SELF, &ru);
+	return (double)ru.ru_utime.tv_sec + (double)ru.ru_stime.tv_sec +
+	       ((double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_usec) / 1e6;
+}
+
+static void physics(struct app *a, int64_t now, int64_t *next_step)
+{
+	struct sim *s = a->sim;
+	int n = 0;
+	while (now >= *next_step && n < MAIN_MAX_CATCHUP) {
+		double late = (double)(now - *next_step) / 1000.0;
+		if (late > a->worst_late_us)
+			a->worst_late_us = late;
+		if (late > a->period_worst_late_us)
+			a->period_worst_late_us = late;
+		a->late_sum_us += late;
+		a->late_samples++;
+		size_t bin = (size_t)(late / MAIN_LATE_BIN_US);
+		a->late_hist[bin < MAIN_LATE_BINS ? bin : MAIN_LATE_BINS - 1]++;
+		sim_step(s);
+		report_collisions(a);
+		sim_run_events(s, (double)s->steps * s->dt, now);
+		*next_step += a->step_ns;
+		n++;
+	}
+	if (now - *next_step > MAIN_MAX_CATCHUP * a->step_ns) {
+		a->overruns++;
+		*next_step = now + a->step_ns;
+	}
+}
+
+static int build_pollset(struct app *a, struct pollfd *fds, int *bus_of)
+{
+	int n = 0;
+	for (size_t i = 0; i < a->sim->nbuses; i++)
+		if (sim_bus_connected(&a->sim->buses[i])) {
+			bus_of[n] = (int)i;
+			fds[n++] = (struct pollfd){ .fd = a->sim->buses[i].master, .events = POLLIN };
+		}
+	if (a->lcm) {
+		bus_of[n] = -1;
+		fds[n++] = (struct pollfd){ .fd = lcm_get_fileno(a->lcm), .events = POLLIN };
+	}
+	if (a->listen_fd >= 0) {
+		bus_of[n] = -2;
+		fds[n++] = (struct pollfd){ .fd = a->listen_fd, .events = POLLIN };
+	}
+	for (int i = 0; i < MAIN_MAX_CLIENTS; i++)
+		if (a->clients[i].fd >= 0) {
+			bus_of[n] = -3 - i;
+			fds[n++] = (struct pollfd){ .fd = a->clients[i].fd, .events = POLLIN };
+		}
+	return n;
+}
+
+/* pselect(): POSIX, ns timeout, atomic signal mask (ppoll is GNU-only). The
+ * pollfd array stays the bookkeeping; fds are few and small. */
+static int wait_fds(struct pollfd *fds, int n, const struct timespec *ts, const sigset_t *mask)
+{
+	fd_set rd;
+	int maxfd = -1;
+	FD_ZERO(&rd);
+	for (int i = 0; i < n; i++) {
+		fds[i].revents = 0;
+		if (fds[i].fd >= 0 && fds[i].fd < FD_SETSIZE) {
+			FD_SET(fds[i].fd, &rd);
+			maxfd = fds[i].fd > maxfd ? fds[i].fd : maxfd;
+		}
+	}
+	int r = pselect(maxfd + 1, &rd, NULL, NULL, ts, mask);
+	if (r <= 0)
+		return r;
+	for (int i = 0; i < n; i++)
+		if (fds[i].fd >= 0 && fds[i].fd < FD_SETSIZE && FD_ISSET(fds[i].fd, &rd))
+			fds[i].revents = POLLIN;
+	return r;
+}
+
+static void serve(struct app *a, struct pollfd *fds, const int *bus_of, int n)
+{
+	for (int i = 0; i < n; i++) {
+		if (!fds[i].revents)
+			continue;
+		if (bus_of[i] >= 0)
+			sim_bus_read(&a->sim->buses[bus_of[i]], mono_ns());
+		else if (bus_of[i] == -1)
+			lcm_handle_timeout(a->lcm, 0);
+		else if (bus_of[i] == -2)
+			control_accept(a);
+		else if (a->clients[-3 - bus_of[i]].fd >= 0)
+			control_read(a, &a->clients[-3 - bus_of[i]]);
+	}
+}
+
+/* Upper edge of the bin holding the q-quantile of step lateness (µs). */
+static double late_quantile(const struct app *a, double q)
+{
+	uint64_t want = (uint64_t)ceil(q * (double)a->late_samples), seen = 0;
+	for (size_t i = 0; i < MAIN_LATE_BINS; i++) {
+		seen += a->late_hist[i];
+		if (seen >= want && seen > 0)
+			return (double)((i + 1) * MAIN_LATE_BIN_US);
+	}
+	return 0;
+}
+
+static void bench_line(struct app *a, int64_t now, double *cpu_prev, int64_t *bench_prev)
+{
+	double cpu = cpu_seconds();
+	double wall = (double)(now - *bench_prev) / 1e9;
+	fprintf(stderr, "undulate-sim: bench: t=%.1f cpu=%.1f%% worst_late_us=%.0f p99_late_us=%.0f mean_late_us=%.1f overruns=%llu\n",
+	        (double)(now - a->t0) / 1e9, 100.0 * (cpu - *cpu_prev) / wall, a->worst_late_us, late_quantile(a, 0.99),
+	        a->late_samples ? a->late_sum_us / (double)a->late_samples : 0.0, (unsigned long long)a->overruns);
+	*cpu_prev = cpu;
+	*bench_prev = now;
+}
+
+/* Bad bytes from a controller are counted by the bus; tell people about them
+ * at most once a second per bus, as a sum since the last report. */
+static void report_bad_input(struct app *a)
+{
+	for (size_t i = 0; i < a->sim->nbuses; i++) {
+		const struct sim_bus *b = &a->sim->buses[i];
+		const struct sim_bus_counters *c = &b->count;
+		uint64_t bad = c->checksum_errors + c->header_errors + c->tx_dropped;
+		if (bad == a->reported_bad[i])
+			continue;
+		fprintf(stderr, "undulate-sim: bus %s: bad input so far: %llu bad checksums, %llu bad headers "
+		                "(%llu bytes skipped); %llu reply bytes nobody read\n",
+		        b->name, (unsigned long long)c->checksum_errors, (unsigned long long)c->header_errors,
+		        (unsigned long long)b->parser.bytes_dropped, (unsigned long long)c->tx_dropped);
+		a->reported_bad[i] = bad;
+	}
+}
+
+static void run(struct app *a)
+{
+	struct sim *s = a->sim;
+	struct pollfd fds[MAIN_MAX_FDS];
+	int bus_of[MAIN_MAX_FDS];
+	int64_t truth_ns = (int64_t)llround(1e9 / s->cfg.truth_hz);
+	int64_t next_step = a->t0 + a->step_ns, next_truth = a->t0 + truth_ns, next_bench = a->t0 + 1000000000;
+	int64_t end = s->cfg.duration_s > 0 ? a->t0 + (int64_t)llround(s->cfg.duration_s * 1e9) : INT64_MAX;
+	double cpu_prev = cpu_seconds();
+	int64_t bench_prev = a->t0;
+	sigset_t unblocked;
+	sigemptyset(&unblocked);
+	sim_run_events(s, 0.0, a->t0);
+	while (!stop_signal) {
+		int64_t now = mono_ns();
+		if (now >= end)
+			break;
+		physics(a, now, &next_step);
+		if (now >= next_truth) {
+			if (a->lcm)
+				publish_truth(a);
+			next_truth += truth_ns;
+			if (next_truth <= now)
+				next_truth = now + truth_ns;
+		}
+		if (now >= next_bench) {
+			if (a->bench)
+				bench_line(a, now, &cpu_prev, &bench_prev);
+			if (!a->quiet)
+				report_bad_input(a);
+			next_bench += 1000000000;
+		}
+		int64_t deadline = next_step < next_truth ? next_step : next_truth;
+		for (size_t i = 0; i < s->nbuses; i++) {
+			sim_bus_flush(&s->buses[i], now);
+			int64_t tx = sim_bus_next_tx(&s->buses[i], a->tx_slice_ns);
+			if (tx < deadline)
+				deadline = tx;
+		}
+		if (end < deadline)
+			deadline = end;
+		int n = build_pollset(a, fds, bus_of);
+		int64_t wait = deadline - mono_ns();
+		struct timespec ts = { 0, 0 };
+		if (wait > 0)
+			ts = (struct timespec){ (time_t)(wait / 1000000000), (long)(wait % 1000000000) };
+		if (wait_fds(fds, n, &ts, &unblocked) > 0)
+			serve(a, fds, bus_of, n);
+	}
+}
+
+/* ---- start and stop ---------------------------------------------------------- */
+
+static void print_ready(const struct sim *s, const char *url)
+{
+	printf("undulate-sim: ready: %zu bus%s:", s->nbuses, s->nbuses == 1 ? "" : "es");
+	for (size_t i = 0; i < s->nbuses; i++) {
+		printf(" %s=%s[", s->buses[i].name, s->buses[i].link);
+		for (size_t k = 0; k < s->buses[i].njoints; k++)
+			printf("%s%u", k ? "," : "", sim_servo_id(&s->buses[i].joints[k].servo));
+		printf("]");
+	}
+	printf(" bodies=%zu rate=%.0fHz lcm=%s\n", s->world.nbodies, s->cfg.rate_hz, url[0] ? url : "default");
+	fflush(stdout);
+}
+
+static void print_summary(const struct app *a, int64_t now)
+{
+	const struct sim *s = a->sim;
+	double wall = (double)(now - a->t0) / 1e9;
+	printf("undulate-sim: exit: %.1f s, %llu steps, %llu collisions, total impulse %.6f N*s, "
+	       "worst step lateness %.0f us (p99 %.0f us, mean %.1f us), %llu overruns, cpu %.1f%%, "
+	       "%llu bad commands, %llu truth messages\n",
+	       wall, (unsigned long long)s->steps, s->world.total_collisions, s->world.total_impulse,
+	       a->worst_late_us, late_quantile(a, 0.99), a->late_samples ? a->late_sum_us / (double)a->late_samples : 0.0,
+	       (unsigned long long)a->overruns, wall > 0 ? 100.0 * cpu_seconds() / wall : 0.0,
+	       (unsigned long long)s->bad_commands, (unsigned long long)a->truth_sent);
+	for (size_t i = 0; i < s->nbuses && !a->quiet; i++) {
+		const struct sim_bus_counters *c = &s->buses[i].count;
+		printf("undulate-sim: bus %s: %llu packets, %llu replies, %llu bad checksums, %llu header errors, "
+		       "%llu wrong-baud, %llu bytes dropped, %llu collisions on the line\n",
+		       s->buses[i].name, (unsigned long long)c->packets, (unsigned long long)c->replies,
+		       (unsigned long long)c->checksum_errors, (unsigned long long)c->header_errors,
+		       (unsigned long long)c->wrong_baud, (unsigned long long)c->tx_dropped,
+		       (unsigned long long)s->buses[i].line.collisions);
+	}
+	fflush(stdout);
+}
+
+static void setup_signals(void)
+{
+	struct sigaction sa = { .sa_handler = on_signal };
+	sigemptyset(&sa.sa_mask);
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+	signal(SIGPIPE, SIG_IGN);
+	/* Signals arrive only inside ppoll(): no half-done step is interrupted. */
+	sigset_t block;
+	sigemptyset(&block);
+	sigaddset(&block, SIGINT);
+	sigaddset(&block, SIGTERM);
+	sigprocmask(SIG_BLOCK, &block, NULL);
+}
+
+int main(int argc, char **argv)
+{
+	static struct sim sim;      /* a few MB: static, allocated once */
+	static struct app app;
+	static struct sim_config cfg;
+	struct options opt;
+	char err[400] = "";
+	if (parse_args(argc, argv, &opt) != 0)
+		return 2;
+	if (opt.send_cmd)
+		return send_command(&opt);
+	if (build_config(&opt, &cfg) != 0)
+		return 2;
+	if (sim_init(&sim, &cfg, err, sizeof(err)) != 0) {
+		fprintf(stderr, "undulate-sim: %s\n", err);
+		return 2;
+	}
+	app.sim = &sim;
+	app.listen_fd = -1;
+	app.bench = opt.bench;
+	app.quiet = opt.quiet;
+	for (int i = 0; i < MAIN_MAX_CLIENTS; i++)
+		app.clients[i].fd = -1;
+	app.step_ns = (int64_t)llround(1e9 / cfg.rate_hz);
+	app.tx_slice_ns = (int64_t)llround(opt.tx_slice_us * 1000.0);
+	app.truth_buf = malloc(MAIN_TRUTH_BUF);
+	if (!app.truth_buf)
+		snprintf(err, sizeof(err), "out of memory");
+	setup_signals();
+	if (opt.realtime) {
+		struct sched_param sp = { .sched_priority = opt.realtime };
+		if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+			fprintf(stderr, "undulate-sim: --realtime %d: %s (running with normal scheduling)\n", opt.realtime,
+			        strerror(errno));
+	}
+	/* Default timer slack (50 µs) would smear reply times at 1 Mbps. */
+	prctl(PR_SET_TIMERSLACK, 1000UL, 0, 0, 0);
+	app.lcm = lcm_create(cfg.lcm_url[0] ? cfg.lcm_url : NULL);
+	if (!app.lcm)
+		fprintf(stderr, "undulate-sim: LCM (%s) unavailable: no ground truth, no SIM.CMD\n",
+		        cfg.lcm_url[0] ? cfg.lcm_url : "default");
+	undulate_sim_command_t_subscription_t *sub =
+	        app.lcm ? undulate_sim_command_t_subscribe(app.lcm, "SIM.CMD", on_sim_cmd, &app) : NULL;
+	if (!app.truth_buf || (cfg.control[0] && control_open(&app, cfg.control) != 0) ||
+	    sim_open(&sim, err, sizeof(err)) != 0) {
+		if (err[0])
+			fprintf(stderr, "undulate-sim: %s\n", err);
+		if (app.listen_fd >= 0)
+			unlink(app.control_path);
+		return 1;
+	}
+	app.t0 = mono_ns();
+	print_ready(&sim, cfg.lcm_url);
+	run(&app);
+	int64_t now = mono_ns();
+	sim_close(&sim);
+	if (app.listen_fd >= 0) {
+		close(app.listen_fd);
+		unlink(app.control_path);
+	}
+	print_summary(&app, now);
+	if (app.lcm) {
+		if (sub)
+			undulate_sim_command_t_unsubscribe(app.lcm, sub);
+		lcm_destroy(app.lcm);
+	}
+	free(app.truth_buf);
+	return 0;
+}

@@ -1,0 +1,395 @@
+/*
+ * scenario.c — INI scenarios, quick form and overrides (see scenario.h).
+ */
+#include "scenario.h"
+
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+void sim_config_defaults(struct sim_config *c)
+{
+	memset(c, 0, sizeof(*c));
+	c->rate_hz = 1000;
+	c->truth_hz = 100;
+	c->seed = 1;
+	snprintf(c->link_dir, sizeof(c->link_dir), "/tmp/undulate-sim");
+	c->baud = 1000000;
+	c->baud_follows_tty = true;
+	c->return_delay_us = -1;
+	c->ambient_c = 25.0;
+	c->initial_spread = 0.5;
+	c->eeprom_needs_torque_off = true;
+	c->overload_time_s = 0.5;
+	c->world.restitution = 0.67;
+	c->world.beta = 0;
+	c->world.wall_left = c->world.wall_right = 0;
+	c->world.wall_restitution = 0.67;
+	c->separation = 0.5;
+	c->amplitude = 0.8;
+	c->lever = 0.1865;
+	c->half_width = 0;
+	c->effective_mass = 0;
+	c->walls = SIM_WALLS_NONE;
+	sim_motor_default_params(&c->motor);
+}
+
+/* ---- value parsers -------------------------------------------------------------- */
+
+static bool parse_num(const char *s, double *out)
+{
+	char *end;
+	errno = 0;
+	double v = strtod(s, &end);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	if (errno || end == s || *end || !isfinite(v))
+		return false;
+	*out = v;
+	return true;
+}
+
+static bool parse_bool(const char *s, bool *out)
+{
+	if (!strcasecmp(s, "1") || !strcasecmp(s, "true") || !strcasecmp(s, "yes") || !strcasecmp(s, "on"))
+		*out = true;
+	else if (!strcasecmp(s, "0") || !strcasecmp(s, "false") || !strcasecmp(s, "no") || !strcasecmp(s, "off"))
+		*out = false;
+	else
+		return false;
+	return true;
+}
+
+int sim_parse_ids(const char *text, uint8_t *ids, size_t cap)
+{
+	size_t n = 0;
+	const char *p = text;
+	while (*p) {
+		char *end;
+		long a = strtol(p, &end, 10), b;
+		if (end == p || a < 0 || a > DXL_MAX_ID)
+			return -1;
+		b = a;
+		p = end;
+		if (*p == '-') {
+			b = strtol(p + 1, &end, 10);
+			if (end == p + 1 || b < a || b > DXL_MAX_ID)
+				return -1;
+			p = end;
+		}
+		for (long id = a; id <= b; id++) {
+			if (n >= cap)
+				return -1;
+			for (size_t k = 0; k < n; k++)
+				if (ids[k] == id)
+					return -1;  /* a duplicate ID is a wiring fault, not a config */
+			ids[n++] = (uint8_t)id;
+		}
+		if (*p == ',')
+			p++;
+		else if (*p)
+			return -1;
+	}
+	return n > 0 ? (int)n : -1;
+}
+
+/* ---- sections ------------------------------------------------------------------- */
+
+#define ERR(...) (snprintf(err, errcap, __VA_ARGS__), -1)
+
+static int set_sim(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)
+{
+	double d;
+	if (!strcmp(k, "lcm_url"))
+		return snprintf(c->lcm_url, sizeof(c->lcm_url), "%s", v) < (int)sizeof(c->lcm_url) ? 0 : ERR("too long");
+	if (!strcmp(k, "link_dir"))
+		return snprintf(c->link_dir, sizeof(c->link_dir), "%s", v) < (int)sizeof(c->link_dir) ? 0 : ERR("too long");
+	if (!strcmp(k, "control"))
+		return snprintf(c->control, sizeof(c->control), "%s", v) < (int)sizeof(c->control) ? 0 : ERR("too long");
+	if (!strcmp(k, "echo"))
+		return parse_bool(v, &c->echo) ? 0 : ERR("echo: want true/false");
+	if (!strcmp(k, "baud_follows_tty"))
+		return parse_bool(v, &c->baud_follows_tty) ? 0 : ERR("%s: want true/false", k);
+	if (!strcmp(k, "eeprom_needs_torque_off"))
+		return parse_bool(v, &c->eeprom_needs_torque_off) ? 0 : ERR("%s: want true/false", k);
+	if (!parse_num(v, &d))
+		return ERR("%s: '%s' is not a number", k, v);
+	if (!strcmp(k, "rate_hz"))
+		return d >= 100 && d <= 20000 ? (c->rate_hz = d, 0) : ERR("rate_hz: 100..20000");
+	if (!strcmp(k, "truth_hz"))
+		return d >= 1 && d <= 1000 ? (c->truth_hz = d, 0) : ERR("truth_hz: 1..1000");
+	if (!strcmp(k, "duration"))
+		return d >= 0 ? (c->duration_s = d, 0) : ERR("duration: >= 0 s");
+	if (!strcmp(k, "seed"))
+		return d >= 0 ? (c->seed = (uint64_t)d, 0) : ERR("seed: >= 0");
+	if (!strcmp(k, "baud"))
+		return d >= 1200 && d <= 4.5e6 ? (c->baud = (long)d, 0) : ERR("baud: 1200..4500000");
+	if (!strcmp(k, "latency_ms"))
+		return d >= 0 && d <= 1000 ? (c->latency_ms = d, 0) : ERR("latency_ms: 0..1000");
+	if (!strcmp(k, "return_delay_us"))
+		return d >= 0 && d <= 508 ? (c->return_delay_us = (int)d, 0) : ERR("return_delay_us: 0..508");
+	if (!strcmp(k, "temperature") || !strcmp(k, "ambient_c"))
+		return d > -40 && d < 150 ? (c->ambient_c = d, c->motor.ambient_c = d, 0) : ERR("%s: -40..150", k);
+	if (!strcmp(k, "voltage"))
+		return d >= 0 && d <= 25 ? (c->motor.supply_voltage = d, 0) : ERR("voltage: 0..25 V");
+	if (!strcmp(k, "initial_spread"))
+		return d >= 0 && d <= 2.5 ? (c->initial_spread = d, 0) : ERR("initial_spread: 0..2.5 rad");
+	if (!strcmp(k, "overload_time"))
+		return d >= 0 ? (c->overload_time_s = d, 0) : ERR("overload_time: >= 0 s");
+	return ERR("unknown key sim.%s", k);
+}
+
+static int set_walls(struct sim_config *c, const char *v, char *err, size_t errcap)
+{
+	double l, r;
+	char extra;
+	if (!strcasecmp(v, "none"))
+		c->walls = SIM_WALLS_NONE;
+	else if (!strcasecmp(v, "auto"))
+		c->walls = SIM_WALLS_AUTO;
+	else if (sscanf(v, "%lf , %lf %c", &l, &r, &extra) == 2 && l < r)
+		c->walls = SIM_WALLS_FIXED, c->world.wall_left = l, c->world.wall_right = r;
+	else
+		return ERR("walls: none, auto or LEFT,RIGHT (m, LEFT < RIGHT)");
+	return 0;
+}
+
+static int set_world(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)
+{
+	double d;
+	if (!strcmp(k, "walls"))
+		return set_walls(c, v, err, errcap);
+	if (!parse_num(v, &d))
+		return ERR("%s: '%s' is not a number", k, v);
+	if (!strcmp(k, "restitution"))
+		return d >= 0 && d <= 1 ? (c->world.restitution = d, 0) : ERR("restitution: 0..1");
+	if (!strcmp(k, "wall_restitution"))
+		return d >= 0 && d <= 1 ? (c->world.wall_restitution = d, 0) : ERR("wall_restitution: 0..1");
+	if (!strcmp(k, "beta"))
+		return d >= 0 ? (c->world.beta = d, 0) : ERR("beta: >= 0");
+	if (!strcmp(k, "separation"))
+		return d >= 0 && d <= 100 ? (c->separation = d, 0) : ERR("separation: 0..100");
+	if (!strcmp(k, "amplitude"))
+		return d > 0 && d <= 2.6 ? (c->amplitude = d, 0) : ERR("amplitude: 0..2.6 rad");
+	if (!strcmp(k, "spacing"))
+		return d >= 0 ? (c->spacing = d, 0) : ERR("spacing: >= 0 m");
+	if (!strcmp(k, "lever"))
+		return d > 0 && d <= 2 ? (c->lever = d, 0) : ERR("lever: 0..2 m/rad");
+	if (!strcmp(k, "half_width"))
+		return d >= 0 ? (c->half_width = d, 0) : ERR("half_width: >= 0 m");
+	if (!strcmp(k, "effective_mass"))
+		return d >= 0 ? (c->effective_mass = d, 0) : ERR("effective_mass: >= 0 kg");
+	return ERR("unknown key world.%s", k);
+}
+
+static int set_motor(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)
+{
+	double d;
+	struct sim_motor_params *m = &c->motor;
+	if (!parse_num(v, &d) || d < 0)
+		return ERR("motor.%s: '%s' is not a number >= 0", k, v);
+	if (!strcmp(k, "inertia") && d > 0) m->inertia = d;
+	else if (!strcmp(k, "viscous")) m->viscous = d;
+	else if (!strcmp(k, "coulomb")) m->coulomb = d;
+	else if (!strcmp(k, "stall_torque") && d > 0) m->stall_torque_12v = d;
+	else if (!strcmp(k, "no_load_speed") && d > 0) m->no_load_speed_12v = d;
+	else if (!strcmp(k, "thermal_tau") && d > 0) m->thermal_tau_s = d;
+	else if (!strcmp(k, "heat_gain")) m->heat_gain = d;
+	else return ERR("unknown or invalid key motor.%s", k);
+	return 0;
+}
+
+static struct sim_robot_config *robot_named(struct sim_config *c, const char *name, bool create)
+{
+	for (size_t i = 0; i < c->nrobots; i++)
+		if (!strcmp(c->robots[i].name, name))
+			return &c->robots[i];
+	if (!create || c->nrobots >= SIM_MAX_BUSES || !*name || strlen(name) >= SIM_NAME_MAX)
+		return NULL;
+	struct sim_robot_config *r = &c->robots[c->nrobots++];
+	memset(r, 0, sizeof(*r));
+	snprintf(r->name, sizeof(r->name), "%s", name);
+	r->contact_id = -2;
+	r->latency_ms = -1;
+	r->echo = -1;
+	r->return_delay_us = -1;
+	r->servo_baud_reg = -1;
+	return r;
+}
+
+static int set_robot(struct sim_config *c, const char *name, const char *k, const char *v, char *err, size_t errcap)
+{
+	struct sim_robot_config *r = robot_named(c, name, true);
+	double d;
+	bool b;
+	if (!r)
+		return ERR("robot '%s': too many robots (max %d) or bad name", name, SIM_MAX_BUSES);
+	if (!strcmp(k, "link"))
+		return snprintf(r->link, sizeof(r->link), "%s", v) < (int)sizeof(r->link) ? 0 : ERR("link: too long");
+	if (!strcmp(k, "ids")) {
+		int n = sim_parse_ids(v, r->ids, SIM_BUS_MAX_SERVOS);
+		return n > 0 ? (r->nids = (size_t)n, 0) : ERR("ids: want e.g. 1,2 (0..253, no duplicates, max %d)", SIM_BUS_MAX_SERVOS);
+	}
+	if (!strcmp(k, "contact")) {
+		if (!strcasecmp(v, "none"))
+			return r->contact_id = -1, 0;
+		return parse_num(v, &d) && d >= 0 && d <= DXL_MAX_ID ? (r->contact_id = (int)d, 0) : ERR("contact: an ID or none");
+	}
+	if (!strcmp(k, "echo"))
+		return parse_bool(v, &b) ? (r->echo = b, 0) : ERR("echo: true/false");
+	if (!strcmp(k, "mirror"))
+		return parse_bool(v, &r->mirror) ? 0 : ERR("mirror: true/false");
+	if (!parse_num(v, &d))
+		return ERR("robot.%s: '%s' is not a number", k, v);
+	if (!strcmp(k, "neutral"))
+		return r->neutral_set = true, r->neutral = d, 0;
+	if (!strcmp(k, "baud"))
+		return d >= 1200 && d <= 4.5e6 ? (r->baud = (long)d, 0) : ERR("baud: 1200..4500000");
+	if (!strcmp(k, "latency_ms"))
+		return d >= 0 && d <= 1000 ? (r->latency_ms = d, 0) : ERR("latency_ms: 0..1000");
+	if (!strcmp(k, "return_delay_us"))
+		return d >= 0 && d <= 508 ? (r->return_delay_us = (int)d, 0) : ERR("return_delay_us: 0..508");
+	if (!strcmp(k, "servo_baud"))
+		return d >= 0 && d <= 254 ? (r->servo_baud_reg = (int)d, 0) : ERR("servo_baud: register value 0..254");
+	return ERR("unknown key %s.%s", name, k);
+}
+
+static int set_event(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)
+{
+	double at;
+	if (!parse_num(k, &at) || at < 0)
+		return ERR("event key '%s': want a time in seconds", k);
+	if (c->nevents >= SIM_MAX_EVENTS)
+		return ERR("too many events (max %d)", SIM_MAX_EVENTS);
+	struct sim_event *e = &c->events[c->nevents];
+	if (snprintf(e->command, sizeof(e->command), "%s", v) >= (int)sizeof(e->command))
+		return ERR("event command too long");
+	e->at = at;
+	c->nevents++;
+	return 0;
+}
+
+static int config_set(struct sim_config *c, const char *section, const char *k, const char *v, char *err,
+                      size_t errcap)
+{
+	if (!strcmp(section, "sim"))
+		return set_sim(c, k, v, err, errcap);
+	if (!strcmp(section, "world"))
+		return set_world(c, k, v, err, errcap);
+	if (!strcmp(section, "motor"))
+		return set_motor(c, k, v, err, errcap);
+	if (!strcmp(section, "events") || !strcmp(section, "faults"))
+		return set_event(c, k, v, err, errcap);
+	if (!strncmp(section, "robot ", 6))
+		return set_robot(c, section + 6, k, v, err, errcap);
+	return ERR("unknown section [%s]", section);
+}
+
+struct load_ctx {
+	struct sim_config *c;
+	char *err;
+	size_t errcap;
+	int failed;
+};
+
+static int ini_cb(void *user, const char *section, const char *name, const char *value)
+{
+	struct load_ctx *x = user;
+	if (x->failed)
+		return 0;
+	if (config_set(x->c, section, name, value, x->err, x->errcap) != 0) {
+		x->failed = 1;
+		return 0;
+	}
+	return 1;
+}
+
+int sim_config_load(struct sim_config *c, const char *path, char *err, size_t errcap)
+{
+	struct load_ctx x = { c, err, errcap, 0 };
+	char why[200] = "";
+	x.err = why;
+	x.errcap = sizeof(why);
+	int r = ini_parse(path, ini_cb, &x);
+	if (r < 0)
+		return ERR("%s: cannot open", path);
+	if (r > 0)
+		return ERR("%s:%d: %s", path, r, why[0] ? why : "syntax error");
+	return 0;
+}
+
+int sim_config_set(struct sim_config *c, const char *assignment, char *err, size_t errcap)
+{
+	char buf[SIM_CMD_MAX + SIM_PATH_MAX];
+	if (strlen(assignment) >= sizeof(buf))
+		return ERR("--set: too long");
+	strcpy(buf, assignment);
+	char *eq = strchr(buf, '=');
+	if (!eq)
+		return ERR("--set '%s': want section.key=value", assignment);
+	*eq = '\0';
+	char *dot = strrchr(buf, '.');
+	if (!dot || dot == buf || !dot[1])
+		return ERR("--set '%s': want section.key=value", assignment);
+	*dot = '\0';
+	char why[200] = "";
+	if (config_set(c, buf, dot + 1, eq + 1, why, sizeof(why)) != 0)
+		return ERR("--set %s: %s", assignment, why);
+	return 0;
+}
+
+int sim_config_add_robot(struct sim_config *c, const char *name, const char *link, const char *ids, char *err,
+                         size_t errcap)
+{
+	if (robot_named(c, name, false))
+		return ERR("robot '%s' twice", name);
+	if (set_robot(c, name, "ids", ids, err, errcap) != 0)
+		return -1;
+	return set_robot(c, name, "link", link, err, errcap);
+}
+
+static int finish_robot(struct sim_config *c, struct sim_robot_config *r, char *err, size_t errcap)
+{
+	if (r->nids == 0)
+		return ERR("robot %s: no ids", r->name);
+	if (!r->link[0] && snprintf(r->link, sizeof(r->link), "%s/%s", c->link_dir, r->name) >= (int)sizeof(r->link))
+		return ERR("robot %s: link path too long", r->name);
+	if (r->contact_id == -2)
+		r->contact_id = r->ids[r->nids - 1];
+	if (r->contact_id >= 0) {
+		bool found = false;
+		for (size_t k = 0; k < r->nids; k++)
+			found |= r->ids[k] == r->contact_id;
+		if (!found)
+			return ERR("robot %s: contact %d is not one of its ids", r->name, r->contact_id);
+	}
+	for (size_t i = 0; i < c->nrobots; i++)
+		if (&c->robots[i] != r && !strcmp(c->robots[i].link, r->link))
+			return ERR("robots %s and %s share the link %s", c->robots[i].name, r->name, r->link);
+	return 0;
+}
+
+int sim_config_finish(struct sim_config *c, char *err, size_t errcap)
+{
+	if (c->nrobots == 0)
+		return ERR("no robots: give --link PATH --ids 1,2 or a scenario with [robot NAME] sections");
+	size_t bodies = 0;
+	for (size_t i = 0; i < c->nrobots; i++) {
+		if (finish_robot(c, &c->robots[i], err, errcap) != 0)
+			return -1;
+		bodies += c->robots[i].contact_id >= 0;
+	}
+	if (bodies > SIM_MAX_BODIES)
+		return ERR("too many contact bodies (max %d)", SIM_MAX_BODIES);
+	for (size_t i = 1; i < c->nevents; i++)  /* stable order by time */
+		for (size_t j = i; j > 0 && c->events[j - 1].at > c->events[j].at; j--) {
+			struct sim_event t = c->events[j];
+			c->events[j] = c->events[j - 1];
+			c->events[j - 1] = t;
+		}
+	return 0;
+}

@@ -1,0 +1,96 @@
+/*
+ * scenario.h — what undulate-sim simulates: the [sim] settings, the contact
+ * world, the motor parameters, the robots (one bus each) and timed events.
+ * Read from an INI file (sim-bridge/README.md documents every key), from the
+ * quick command-line form, and from "section.key=value" overrides (--set).
+ */
+#ifndef UNDULATE_SIM_SCENARIO_H
+#define UNDULATE_SIM_SCENARIO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "motor.h"
+#include "simbus.h"
+#include "world.h"
+
+#define SIM_MAX_BUSES 32     /* robots (one bus each); the benchmark runs 20 */
+#define SIM_MAX_EVENTS 64    /* timed commands in a scenario */
+#define SIM_CMD_MAX 256      /* one command line */
+#define SIM_URL_MAX 256
+
+struct sim_robot_config {
+	char name[SIM_NAME_MAX];
+	char link[SIM_PATH_MAX];     /* empty: <link_dir>/<name> */
+	uint8_t ids[SIM_BUS_MAX_SERVOS];
+	size_t nids;
+	int contact_id;              /* servo carrying the contact body; -1 none, -2 = last id */
+	bool neutral_set;
+	double neutral;              /* m */
+	long baud;                   /* 0: the [sim] baud */
+	double latency_ms;           /* < 0: the [sim] value */
+	int echo;                    /* -1: the [sim] value */
+	int return_delay_us;         /* < 0: the [sim] value */
+	int servo_baud_reg;          /* < 0: the register matching the bus baud */
+	bool mirror;                 /* the body moves left for a positive angle (facing rigs) */
+};
+
+struct sim_event {
+	double at;                   /* s after start */
+	char command[SIM_CMD_MAX];   /* control-socket syntax */
+};
+
+struct sim_config {
+	/* [sim] */
+	double rate_hz;              /* physics steps per second (>= 1000) */
+	double truth_hz;             /* SIM.TRUTH messages per second */
+	double duration_s;           /* 0 = until a signal */
+	uint64_t seed;
+	char lcm_url[SIM_URL_MAX];   /* empty: LCM's default */
+	char link_dir[SIM_PATH_MAX];
+	char control[SIM_PATH_MAX];  /* control socket path, empty = none */
+	long baud;                   /* the pty's initial rate */
+	bool baud_follows_tty;       /* the bus runs at the rate the controller sets */
+	double latency_ms;
+	bool echo;
+	int return_delay_us;         /* initial EEPROM value of every servo; < 0 = factory 500 µs */
+	double ambient_c;
+	double initial_spread;       /* rad: initial angles uniform in ±spread (seeded) */
+	bool eeprom_needs_torque_off;
+	double overload_time_s;
+	/* [world] */
+	struct sim_world_params world;
+	double separation;           /* d̃ between neighbours' neutral positions */
+	double amplitude;            /* rad: A in d̃ = d / (2·lever·A) */
+	double spacing;              /* m: if > 0, neighbour distance (overrides separation) */
+	double lever;                /* m per rad */
+	double half_width;           /* m */
+	double effective_mass;       /* kg; <= 0: motor inertia / lever² */
+	int walls;                   /* SIM_WALLS_* */
+	/* [motor] */
+	struct sim_motor_params motor;
+	/* robots, left to right */
+	struct sim_robot_config robots[SIM_MAX_BUSES];
+	size_t nrobots;
+	struct sim_event events[SIM_MAX_EVENTS];
+	size_t nevents;
+};
+
+enum { SIM_WALLS_NONE, SIM_WALLS_AUTO, SIM_WALLS_FIXED };
+
+void sim_config_defaults(struct sim_config *c);
+/* Read an INI file on top of c. 0, or -1 with "file:line: why" in err. */
+int sim_config_load(struct sim_config *c, const char *path, char *err, size_t errcap);
+/* Apply one "section.key=value" (e.g. world.separation=0.4,
+ * "robot left.ids=1,2"). 0 or -1 with err. */
+int sim_config_set(struct sim_config *c, const char *assignment, char *err, size_t errcap);
+/* Add one robot (the quick form): link path and an ID list "1,2". */
+int sim_config_add_robot(struct sim_config *c, const char *name, const char *link, const char *ids,
+                         char *err, size_t errcap);
+/* Fill derived values (links from link_dir) and check the whole. */
+int sim_config_finish(struct sim_config *c, char *err, size_t errcap);
+/* Parse an ID list "1,2,5-7" into ids; returns the count or -1. */
+int sim_parse_ids(const char *text, uint8_t *ids, size_t cap);
+
+#endif

@@ -1,0 +1,572 @@
+/*
+ * sim.c — the simulator's state and its command language (see sim.h and
+ * sim-bridge/README.md, "Commands").
+ */
+#include "sim.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dxl_table.h"
+
+/* Words in one command line. */
+#define SIM_CMD_MAX_WORDS 16
+
+/* ---- set-up ------------------------------------------------------------------- */
+
+static double config_spacing(const struct sim_config *c)
+{
+	return c->spacing > 0 ? c->spacing : c->separation * 2.0 * c->lever * c->amplitude;
+}
+
+static void sim_layout_world(struct sim *s)
+{
+	const struct sim_config *c = &s->cfg;
+	struct sim_world_params wp = c->world;
+	size_t n = s->world.nbodies;
+	double d = config_spacing(c);
+	if (c->walls == SIM_WALLS_NONE) {
+		wp.wall_left = wp.wall_right = 0;
+	} else if (c->walls == SIM_WALLS_AUTO && n > 0) {
+		/* A wall stands where a mirrored neighbour would touch. */
+		double lo = s->world.bodies[0].neutral, hi = s->world.bodies[n - 1].neutral;
+		double gap = d > 0 ? d / 2 : c->lever * c->amplitude;
+		wp.wall_left = lo - gap;
+		wp.wall_right = hi + gap;
+	}
+	s->world.params = wp;
+}
+
+/* Initial joint angles from the seed, then nudged so no contact body starts
+ * inside its left neighbour. */
+static void sim_initial_angles(struct sim *s)
+{
+	for (size_t i = 0; i < s->nbuses; i++)
+		for (size_t k = 0; k < s->buses[i].njoints; k++) {
+			struct sim_joint *j = &s->buses[i].joints[k];
+			double a = (2.0 * sim_rand_uniform(&s->rng) - 1.0) * s->cfg.initial_spread;
+			sim_motor_init(&j->motor, &j->params, a);
+		}
+	for (size_t b = 1; b < s->world.nbodies; b++) {
+		struct sim_body *l = &s->world.bodies[b - 1], *r = &s->world.bodies[b];
+		double min_x = sim_world_lateral(&s->world, b - 1) + l->half_width + r->half_width;
+		if (sim_world_lateral(&s->world, b) < min_x)
+			r->motor->angle = (min_x - r->neutral) / r->lever + 1e-6;
+	}
+}
+
+static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char *err, size_t errcap)
+{
+	const struct sim_config *c = &s->cfg;
+	struct sim_bus *b = &s->buses[s->nbuses];
+	long baud = rc->baud > 0 ? rc->baud : c->baud;
+	double latency_ms = rc->latency_ms >= 0 ? rc->latency_ms : c->latency_ms;
+	bool echo = rc->echo >= 0 ? rc->echo != 0 : c->echo;
+	sim_bus_init(b, rc->name, rc->link, baud, latency_ms / 1000.0, echo, c->seed * 1000003u + s->nbuses + 1);
+	b->follow_tty = c->baud_follows_tty;
+	uint8_t baud_reg;
+	if (rc->servo_baud_reg >= 0)
+		baud_reg = (uint8_t)rc->servo_baud_reg;
+	else if (dxl_baud_to_reg(baud, &baud_reg) != DXL_OK)
+		return snprintf(err, errcap, "robot %s: %ld bps is no AX-12 rate; set servo_baud", rc->name, baud), -1;
+	int delay_us = rc->return_delay_us >= 0 ? rc->return_delay_us : c->return_delay_us;
+	struct sim_servo_options so = { c->eeprom_needs_torque_off, c->overload_time_s };
+	for (size_t k = 0; k < rc->nids; k++) {
+		struct sim_joint *j = &b->joints[b->njoints++];
+		j->params = c->motor;
+		sim_servo_init(&j->servo, &so, DXL_POS_CENTER);
+		sim_servo_poke(&j->servo, DXL_AX_ID, rc->ids[k]);
+		sim_servo_poke(&j->servo, DXL_AX_BAUD_RATE, baud_reg);
+		if (delay_us >= 0)
+			sim_servo_poke(&j->servo, DXL_AX_RETURN_DELAY_TIME, (uint16_t)(delay_us / 2));
+		if (rc->ids[k] != rc->contact_id)
+			continue;
+		size_t body = s->world.nbodies;
+		struct sim_body sb = {
+			.motor = &j->motor, .lever = rc->mirror ? -c->lever : c->lever, .half_width = c->half_width, .robot = (int)s->nbuses,
+			.effective_mass = c->effective_mass > 0 ? c->effective_mass : c->motor.inertia / (c->lever * c->lever),
+			.neutral = rc->neutral_set ? rc->neutral : 0,
+		};
+		if (sim_world_add_body(&s->world, &sb) < 0)
+			return snprintf(err, errcap, "robot %s: the world refused its contact body", rc->name), -1;
+		s->body_bus[body] = (int)s->nbuses;
+		s->body_joint[body] = (int)k;
+	}
+	s->nbuses++;
+	return 0;
+}
+
+/* Robots without an explicit neutral position sit in a row centred on 0. */
+static void sim_place_bodies(struct sim *s)
+{
+	size_t n = s->world.nbodies;
+	double d = config_spacing(&s->cfg);
+	for (size_t i = 0; i < n; i++) {
+		const struct sim_robot_config *rc = &s->cfg.robots[s->body_bus[i]];
+		if (!rc->neutral_set)
+			s->world.bodies[i].neutral = ((double)i - (double)(n - 1) / 2.0) * d;
+	}
+}
+
+static void sim_sync_present(struct sim *s);
+
+int sim_init(struct sim *s, const struct sim_config *cfg, char *err, size_t errcap)
+{
+	memset(s, 0, sizeof(*s));
+	s->cfg = *cfg;
+	s->dt = 1.0 / cfg->rate_hz;
+	s->rng = cfg->seed ? cfg->seed : 1;
+	sim_world_init(&s->world, &cfg->world);
+	for (size_t i = 0; i < cfg->nrobots; i++)
+		if (sim_add_robot(s, &cfg->robots[i], err, errcap) != 0)
+			return -1;
+	sim_place_bodies(s);
+	sim_layout_world(s);
+	sim_initial_angles(s);
+	sim_sync_present(s);
+	return 0;
+}
+
+int sim_open(struct sim *s, char *err, size_t errcap)
+{
+	for (size_t i = 0; i < s->nbuses; i++)
+		if (sim_bus_open(&s->buses[i], err, errcap) != 0) {
+			sim_close(s);
+			return -1;
+		}
+	return 0;
+}
+
+void sim_close(struct sim *s)
+{
+	for (size_t i = 0; i < s->nbuses; i++)
+		sim_bus_close(&s->buses[i]);
+}
+
+/* ---- physics ------------------------------------------------------------------ */
+
+static void sim_sense_joint(struct sim_joint *j, double dt)
+{
+	struct sim_motor_cmd cmd;
+	const struct sim_fault *f = j->faults.f;
+	sim_servo_motor_cmd(&j->servo, &cmd);
+	struct sim_servo_sense in = {
+		.angle = j->motor.angle,
+		.speed = j->motor.speed,
+		.load_fraction = cmd.torque_enable ? sim_motor_load_fraction(&j->motor, &j->params) : 0,
+		.voltage = f[SIM_FAULT_VOLTAGE].active ? f[SIM_FAULT_VOLTAGE].arg : j->params.supply_voltage,
+		.temperature = f[SIM_FAULT_TEMPERATURE].active ? f[SIM_FAULT_TEMPERATURE].arg : j->motor.temperature,
+		.overloaded = cmd.torque_enable && sim_motor_overloaded(&j->motor, &j->params, &cmd),
+	};
+	j->servo.stuck_bits = sim_faults_stuck_bits(&j->faults);
+	sim_servo_sense(&j->servo, &in, dt);
+}
+
+/* Present values before the first step (and after a power-on). */
+static void sim_sync_present(struct sim *s)
+{
+	for (size_t i = 0; i < s->nbuses; i++)
+		for (size_t k = 0; k < s->buses[i].njoints; k++) {
+			struct sim_joint *j = &s->buses[i].joints[k];
+			sim_sense_joint(j, 0);
+			dxl_put_u16(&j->servo.mem[DXL_AX_GOAL_POSITION], dxl_get_u16(&j->servo.mem[DXL_AX_PRESENT_POSITION]));
+		}
+}
+
+void sim_step(struct sim *s)
+{
+	for (size_t i = 0; i < s->nbuses; i++)
+		for (size_t k = 0; k < s->buses[i].njoints; k++) {
+			struct sim_joint *j = &s->buses[i].joints[k];
+			struct sim_motor_cmd cmd;
+			sim_servo_motor_cmd(&j->servo, &cmd);
+			sim_motor_step(&j->motor, &j->params, &cmd, 0.0, s->dt);
+		}
+	s->nstep_collisions = sim_world_resolve(&s->world, s->dt, s->step_collisions, SIM_MAX_COLLISIONS_PER_STEP);
+	if (s->nstep_collisions > SIM_MAX_COLLISIONS_PER_STEP)
+		s->nstep_collisions = SIM_MAX_COLLISIONS_PER_STEP;
+	for (size_t i = 0; i < s->nbuses; i++)
+		for (size_t k = 0; k < s->buses[i].njoints; k++)
+			sim_sense_joint(&s->buses[i].joints[k], s->dt);
+	s->steps++;
+}
+
+/* ---- commands --------------------------------------------------------------- */
+
+struct sim_cmd_ctx {
+	struct sim *s;
+	int argc;
+	char **argv;
+	int64_t now;
+	char *reply;
+	size_t cap;
+};
+
+#define REPLY(x, ...) (snprintf((x)->reply, (x)->cap, __VA_ARGS__))
+#define FAIL(x, ...) (REPLY(x, "error: " __VA_ARGS__), -1)
+
+struct sim_bus *sim_find_bus(struct sim *s, const char *name_or_link)
+{
+	for (size_t i = 0; i < s->nbuses; i++)
+		if (!strcmp(s->buses[i].name, name_or_link) || !strcmp(s->buses[i].link, name_or_link))
+			return &s->buses[i];
+	return NULL;
+}
+
+struct sim_joint *sim_find_joint(struct sim_bus *b, uint8_t id)
+{
+	/* Look up by the configured wiring slot's current ID. */
+	for (size_t k = 0; k < b->njoints; k++)
+		if (sim_servo_id(&b->joints[k].servo) == id)
+			return &b->joints[k];
+	return NULL;
+}
+
+/* Every joint selected by BUS ('*' = all) and ID ('*' = all). Calls fn on each;
+ * returns how many matched, -1 on a bad selector. */
+static int sim_each_joint(struct sim_cmd_ctx *x, const char *bus, const char *id,
+                          int (*fn)(struct sim_cmd_ctx *, struct sim_bus *, struct sim_joint *, void *), void *arg)
+{
+	struct sim *s = x->s;
+	long want = -1;
+	if (strcmp(id, "*")) {
+		char *end;
+		want = strtol(id, &end, 10);
+		if (*end || end == id || want < 0 || want > DXL_MAX_ID)
+			return FAIL(x, "bad servo id '%s' (0..253 or *)", id);
+	}
+	int matched = 0;
+	for (size_t i = 0; i < s->nbuses; i++) {
+		struct sim_bus *b = &s->buses[i];
+		if (strcmp(bus, "*") && strcmp(bus, b->name) && strcmp(bus, b->link))
+			continue;
+		for (size_t k = 0; k < b->njoints; k++) {
+			/* Faults follow the wiring slot: the ID it was configured with
+			 * or has now. */
+			bool hit = want < 0 || sim_servo_id(&b->joints[k].servo) == want ||
+			           s->cfg.robots[i].ids[k] == want;
+			if (!hit)
+				continue;
+			if (fn(x, b, &b->joints[k], arg) != 0)
+				return -1;
+			matched++;
+		}
+	}
+	if (matched == 0)
+		return FAIL(x, "no servo matches '%s %s'", bus, id);
+	return matched;
+}
+
+static int do_fault_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joint *j, void *arg)
+{
+	(void)x;
+	(void)b;
+	const struct sim_fault *f = arg;
+	enum sim_fault_kind kind = (enum sim_fault_kind)f[1].remaining;
+	j->faults.f[kind] = f[0];
+	j->servo.stuck_bits = sim_faults_stuck_bits(&j->faults);
+	return 0;
+}
+
+static int cmd_fault(struct sim_cmd_ctx *x)
+{
+	char why[200];
+	struct sim_fault f[2];
+	enum sim_fault_kind kind;
+	if (x->argc < 4)
+		return FAIL(x, "usage: fault BUS ID|* KIND [ARG] [count=N] [prob=P]");
+	if (sim_fault_parse(x->argc - 3, x->argv + 3, &kind, &f[0], why, sizeof(why)) != 0)
+		return FAIL(x, "%s", why);
+	f[1].remaining = (long)kind;  /* carries the kind to the callback */
+	int n = sim_each_joint(x, x->argv[1], x->argv[2], do_fault_one, f);
+	return n < 0 ? -1 : (REPLY(x, "ok %d servo(s): %s", n, sim_fault_name(kind)), 0);
+}
+
+static int do_clear_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joint *j, void *arg)
+{
+	(void)x;
+	(void)b;
+	int kind = *(int *)arg;
+	if (kind < 0)
+		sim_faults_clear(&j->faults);
+	else
+		memset(&j->faults.f[kind], 0, sizeof(j->faults.f[kind]));
+	j->servo.stuck_bits = sim_faults_stuck_bits(&j->faults);
+	return 0;
+}
+
+static int cmd_clear(struct sim_cmd_ctx *x)
+{
+	if (x->argc < 2 || x->argc > 4)
+		return FAIL(x, "usage: clear BUS|* [ID|*] [KIND]");
+	int kind = -1;
+	if (x->argc == 4) {
+		for (int k = 0; k < SIM_FAULT_KINDS; k++)
+			if (!strcmp(x->argv[3], sim_fault_name((enum sim_fault_kind)k)))
+				kind = k;
+		if (kind < 0)
+			return FAIL(x, "unknown fault '%s'", x->argv[3]);
+	}
+	int n = sim_each_joint(x, x->argv[1], x->argc >= 3 ? x->argv[2] : "*", do_clear_one, &kind);
+	return n < 0 ? -1 : (REPLY(x, "ok %d servo(s)", n), 0);
+}
+
+static int do_power_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joint *j, void *arg)
+{
+	(void)x;
+	(void)b;
+	if (*(bool *)arg) {
+		if (!j->servo.powered) {
+			sim_servo_power_on(&j->servo);
+			sim_sense_joint(j, 0);
+			dxl_put_u16(&j->servo.mem[DXL_AX_GOAL_POSITION], dxl_get_u16(&j->servo.mem[DXL_AX_PRESENT_POSITION]));
+		}
+	} else {
+		sim_servo_power_off(&j->servo);
+	}
+	return 0;
+}
+
+static int cmd_power(struct sim_cmd_ctx *x)
+{
+	bool on;
+	if (x->argc != 4 || (strcmp(x->argv[3], "on") && strcmp(x->argv[3], "off")))
+		return FAIL(x, "usage: power BUS|* ID|* on|off");
+	on = !strcmp(x->argv[3], "on");
+	int n = sim_each_joint(x, x->argv[1], x->argv[2], do_power_one, &on);
+	return n < 0 ? -1 : (REPLY(x, "ok %d servo(s) %s", n, on ? "on" : "off"), 0);
+}
+
+static struct sim_bus *cmd_bus(struct sim_cmd_ctx *x, const char *usage)
+{
+	struct sim_bus *b = x->argc >= 2 ? sim_find_bus(x->s, x->argv[1]) : NULL;
+	if (!b) {
+		if (x->argc < 2)
+			REPLY(x, "error: usage: %s", usage);
+		else
+			REPLY(x, "error: no bus '%s'", x->argv[1]);
+	}
+	return b;
+}
+
+static int cmd_disconnect(struct sim_cmd_ctx *x)
+{
+	struct sim_bus *b = cmd_bus(x, "disconnect BUS");
+	if (!b)
+		return -1;
+	if (!sim_bus_connected(b))
+		return FAIL(x, "%s is already disconnected", b->name);
+	sim_bus_close(b);
+	b->count.disconnects++;
+	return REPLY(x, "ok %s disconnected", b->name), 0;
+}
+
+static int cmd_reconnect(struct sim_cmd_ctx *x)
+{
+	char why[300];
+	struct sim_bus *b = cmd_bus(x, "reconnect BUS");
+	if (!b)
+		return -1;
+	if (sim_bus_connected(b))
+		return FAIL(x, "%s is connected", b->name);
+	if (sim_bus_open(b, why, sizeof(why)) != 0)
+		return FAIL(x, "%s", why);
+	return REPLY(x, "ok %s -> %s", b->link, b->slave_path), 0;
+}
+
+static int cmd_garbage(struct sim_cmd_ctx *x)
+{
+	uint8_t bytes[SIM_FAULT_MAX_GARBAGE];
+	struct sim_bus *b = cmd_bus(x, "garbage BUS [N]");
+	if (!b)
+		return -1;
+	long n = x->argc >= 3 ? strtol(x->argv[2], NULL, 10) : 8;
+	if (n < 1 || n > SIM_FAULT_MAX_GARBAGE)
+		return FAIL(x, "garbage: N in 1..%d", SIM_FAULT_MAX_GARBAGE);
+	for (long i = 0; i < n; i++)
+		bytes[i] = (uint8_t)sim_rand_next(&b->rng);
+	sim_bus_inject(b, bytes, (size_t)n, x->now);
+	return REPLY(x, "ok %ld bytes", n), 0;
+}
+
+static const struct dxl_reg *cmd_reg(struct sim_cmd_ctx *x, const char *name)
+{
+	const struct dxl_reg *r = dxl_reg_lookup(name);
+	if (!r)
+		REPLY(x, "error: unknown register '%s'", name);
+	return r;
+}
+
+/* poke BUS ID REG VALUE: set a register without the write rules. */
+static int cmd_poke(struct sim_cmd_ctx *x)
+{
+	struct sim_bus *b = cmd_bus(x, "poke BUS ID REG VALUE");
+	if (!b)
+		return -1;
+	if (x->argc != 5)
+		return FAIL(x, "usage: poke BUS ID REG VALUE");
+	struct sim_joint *j = sim_find_joint(b, (uint8_t)atoi(x->argv[2]));
+	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
+	char *end;
+	long v = strtol(x->argv[4], &end, 0);
+	if (!j)
+		return FAIL(x, "no servo %s on %s", x->argv[2], b->name);
+	if (!r)
+		return -1;
+	if (*end || v < 0 || v > (r->size == 2 ? 65535 : 255))
+		return FAIL(x, "bad value '%s'", x->argv[4]);
+	sim_servo_poke(&j->servo, r->addr, (uint16_t)v);
+	return REPLY(x, "ok %s=%ld", r->name, v), 0;
+}
+
+static int cmd_peek(struct sim_cmd_ctx *x)
+{
+	struct sim_bus *b = cmd_bus(x, "peek BUS ID REG");
+	if (!b)
+		return -1;
+	if (x->argc != 4)
+		return FAIL(x, "usage: peek BUS ID REG");
+	struct sim_joint *j = sim_find_joint(b, (uint8_t)atoi(x->argv[2]));
+	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
+	if (!j)
+		return FAIL(x, "no servo %s on %s", x->argv[2], b->name);
+	if (!r)
+		return -1;
+	return REPLY(x, "ok %u", (unsigned)sim_servo_peek(&j->servo, r->addr)), 0;
+}
+
+/* servo BUS ID: one line of state, faults and counters (for people and tests). */
+static int cmd_servo(struct sim_cmd_ctx *x)
+{
+	struct sim_bus *b = cmd_bus(x, "servo BUS ID");
+	if (!b)
+		return -1;
+	if (x->argc != 3)
+		return FAIL(x, "usage: servo BUS ID");
+	struct sim_joint *j = sim_find_joint(b, (uint8_t)atoi(x->argv[2]));
+	if (!j)
+		return FAIL(x, "no servo %s on %s", x->argv[2], b->name);
+	const struct sim_servo *sv = &j->servo;
+	size_t off = (size_t)REPLY(x, "ok id=%u power=%s torque=%u errbits=0x%02x angle=%.4f speed=%.4f temp=%.1f "
+	                              "instructions=%u replies=%u range=%u angle_limit=%u instruction=%u checksum=%u "
+	                              "shutdowns=%u faults=",
+	                           sim_servo_id(sv), sv->powered ? "on" : "off", sv->mem[DXL_AX_TORQUE_ENABLE],
+	                           sim_servo_condition_bits(sv), j->motor.angle, j->motor.speed, j->motor.temperature,
+	                           sv->count.instructions, sv->count.replies, sv->count.range_errors,
+	                           sv->count.angle_limit_errors, sv->count.instruction_errors, sv->count.checksum_errors,
+	                           sv->count.shutdowns);
+	bool any = false;
+	for (int k = 0; k < SIM_FAULT_KINDS && off < x->cap; k++)
+		if (j->faults.f[k].active) {
+			off += (size_t)snprintf(x->reply + off, x->cap - off, "%s%s", any ? "," : "",
+			                        sim_fault_name((enum sim_fault_kind)k));
+			any = true;
+		}
+	if (!any && off < x->cap)
+		snprintf(x->reply + off, x->cap - off, "none");
+	return 0;
+}
+
+static int cmd_walls(struct sim_cmd_ctx *x)
+{
+	struct sim_world_params *p = &x->s->world.params;
+	if (x->argc == 2 && !strcmp(x->argv[1], "none")) {
+		p->wall_left = p->wall_right = 0;
+		return REPLY(x, "ok no walls"), 0;
+	}
+	char *e1, *e2;
+	double l = x->argc == 3 ? strtod(x->argv[1], &e1) : 0, r = x->argc == 3 ? strtod(x->argv[2], &e2) : 0;
+	if (x->argc != 3 || *e1 || *e2 || !(l < r) || !isfinite(l) || !isfinite(r))
+		return FAIL(x, "usage: walls none | walls LEFT RIGHT (m, LEFT < RIGHT)");
+	p->wall_left = l;
+	p->wall_right = r;
+	return REPLY(x, "ok walls %g %g", l, r), 0;
+}
+
+static int cmd_stats(struct sim_cmd_ctx *x)
+{
+	struct sim *s = x->s;
+	uint64_t packets = 0, replies = 0;
+	for (size_t i = 0; i < s->nbuses; i++)
+		packets += s->buses[i].count.packets, replies += s->buses[i].count.replies;
+	return REPLY(x, "ok steps=%llu time=%.3f collisions=%llu impulse=%.6f packets=%llu replies=%llu commands=%llu bad_commands=%llu",
+	             (unsigned long long)s->steps, (double)s->steps * s->dt, s->world.total_collisions,
+	             s->world.total_impulse, (unsigned long long)packets, (unsigned long long)replies,
+	             (unsigned long long)s->commands, (unsigned long long)s->bad_commands), 0;
+}
+
+static int cmd_list(struct sim_cmd_ctx *x)
+{
+	size_t off = (size_t)REPLY(x, "ok");
+	for (size_t i = 0; i < x->s->nbuses && off < x->cap; i++) {
+		const struct sim_bus *b = &x->s->buses[i];
+		off += (size_t)snprintf(x->reply + off, x->cap - off, " %s=%s%s", b->name, b->link,
+		                        sim_bus_connected(b) ? "" : "(disconnected)");
+	}
+	return 0;
+}
+
+static int cmd_help(struct sim_cmd_ctx *x)
+{
+	return REPLY(x, "ok commands: fault BUS ID KIND [ARG] [count=N] [prob=P] | clear BUS [ID] [KIND] | "
+	                "power BUS ID on|off | disconnect BUS | reconnect BUS | garbage BUS [N] | "
+	                "poke BUS ID REG VALUE | peek BUS ID REG | servo BUS ID | walls none|LEFT RIGHT | stats | list | help"), 0;
+}
+
+static const struct {
+	const char *verb;
+	int (*fn)(struct sim_cmd_ctx *);
+} sim_verbs[] = {
+	{ "fault", cmd_fault }, { "clear", cmd_clear }, { "power", cmd_power },
+	{ "disconnect", cmd_disconnect }, { "reconnect", cmd_reconnect }, { "garbage", cmd_garbage },
+	{ "poke", cmd_poke }, { "peek", cmd_peek }, { "servo", cmd_servo }, { "walls", cmd_walls }, { "stats", cmd_stats },
+	{ "list", cmd_list }, { "help", cmd_help },
+};
+
+int sim_command(struct sim *s, const char *line, int64_t now, char *reply, size_t cap)
+{
+	char buf[SIM_CMD_MAX];
+	char *argv[SIM_CMD_MAX_WORDS];
+	int argc = 0;
+	struct sim_cmd_ctx x = { s, 0, argv, now, reply, cap };
+	s->commands++;
+	if (strlen(line) >= sizeof(buf)) {
+		s->bad_commands++;
+		return FAIL(&x, "command too long (max %d bytes)", SIM_CMD_MAX - 1);
+	}
+	strcpy(buf, line);
+	for (char *save = NULL, *w = strtok_r(buf, " \t\r\n", &save); w; w = strtok_r(NULL, " \t\r\n", &save)) {
+		if (argc >= SIM_CMD_MAX_WORDS) {
+			s->bad_commands++;
+			return FAIL(&x, "too many words");
+		}
+		argv[argc++] = w;
+	}
+	x.argc = argc;
+	if (argc == 0) {
+		s->bad_commands++;
+		return FAIL(&x, "empty command (try help)");
+	}
+	for (size_t i = 0; i < sizeof(sim_verbs) / sizeof(sim_verbs[0]); i++)
+		if (!strcmp(argv[0], sim_verbs[i].verb)) {
+			int r = sim_verbs[i].fn(&x);
+			if (r != 0)
+				s->bad_commands++;
+			return r;
+		}
+	s->bad_commands++;
+	return FAIL(&x, "unknown command '%s' (try help)", argv[0]);
+}
+
+void sim_run_events(struct sim *s, double t, int64_t now)
+{
+	char reply[512];
+	while (s->next_event < s->cfg.nevents && s->cfg.events[s->next_event].at <= t) {
+		const struct sim_event *e = &s->cfg.events[s->next_event++];
+		int r = sim_command(s, e->command, now, reply, sizeof(reply));
+		fprintf(stderr, "undulate-sim: t=%.3f event '%s': %s\n", t, e->command, reply);
+		(void)r;
+	}
+}

@@ -1,0 +1,53 @@
+/*
+ * sim.h — the simulator: buses with their servos and motors, the contact
+ * world, timed events and the command language shared by the scenario's
+ * [events], the control socket and LCM SIM.CMD. No event loop here (main.c
+ * owns it): sim_step() advances the physics by one step, sim_command()
+ * executes one text command.
+ */
+#ifndef UNDULATE_SIM_SIM_H
+#define UNDULATE_SIM_SIM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "scenario.h"
+#include "simbus.h"
+#include "world.h"
+
+struct sim {
+	struct sim_config cfg;
+	struct sim_bus buses[SIM_MAX_BUSES];
+	size_t nbuses;
+	struct sim_world world;
+	/* which joint each contact body rides on */
+	int body_bus[SIM_MAX_BODIES];
+	int body_joint[SIM_MAX_BODIES];
+	double dt;
+	uint64_t steps;
+	/* collisions of the last step */
+	struct sim_collision step_collisions[SIM_MAX_COLLISIONS_PER_STEP];
+	size_t nstep_collisions;
+	size_t next_event;
+	uint64_t commands, bad_commands;
+	uint64_t rng;
+};
+
+/* Build everything from cfg (no I/O). 0 or -1 with err. */
+int sim_init(struct sim *s, const struct sim_config *cfg, char *err, size_t errcap);
+/* Open every bus's pty and link. 0 or -1 with err (opened ones are closed). */
+int sim_open(struct sim *s, char *err, size_t errcap);
+void sim_close(struct sim *s);
+/* One physics step of s->dt: motors from the servo registers, contacts,
+ * then the servos' present values and alarms. */
+void sim_step(struct sim *s);
+/* Execute one command line; the reply ("ok ..." / "error: ...") goes into
+ * reply. now is the monotonic time in ns (for injected bytes). 0 or -1. */
+int sim_command(struct sim *s, const char *line, int64_t now, char *reply, size_t cap);
+/* Run the scenario events due at sim time t (s). */
+void sim_run_events(struct sim *s, double t, int64_t now);
+struct sim_bus *sim_find_bus(struct sim *s, const char *name_or_link);
+struct sim_joint *sim_find_joint(struct sim_bus *b, uint8_t id);
+
+#endif

@@ -1,0 +1,247 @@
+/*
+ * test_sim_scenario.c — scenarios (INI, overrides, errors), the simulator's
+ * set-up (row layout, walls, seeded initial angles), the command language
+ * and physics steps that make two driven bodies collide.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "dxl_table.h"
+#include "../../sim-bridge/sim.h"
+
+static const char pair_ini[] =
+	"# a pair\n"
+	"[sim]\nseed = 5\nrate_hz = 1000\n"
+	"[world]\nrestitution = 0.67\nseparation = 0.4\namplitude = 0.8\nlever = 0.2\nwalls = auto\n"
+	"[robot left]\nids = 1\n"
+	"[robot right]\nids = 1\ncontact = 1\nlatency_ms = 16\n"
+	"[events]\n1.0 = fault right 1 no-reply\n0.5 = fault left 1 slow 2\n";
+
+static char path[64];
+
+static int write_file(const char *text)
+{
+	snprintf(path, sizeof(path), "/tmp/test_sim_scenario.XXXXXX");
+	int fd = mkstemp(path);
+	if (fd < 0)
+		return -1;
+	size_t n = strlen(text);
+	int ok = write(fd, text, n) == (ssize_t)n;
+	close(fd);
+	return ok ? 0 : -1;
+}
+
+static int load(struct sim_config *c, const char *text, char *err, size_t cap)
+{
+	sim_config_defaults(c);
+	assert_int_equal(write_file(text), 0);
+	int r = sim_config_load(c, path, err, cap);
+	unlink(path);
+	return r;
+}
+
+static struct sim_config cfg;
+static struct sim sim;
+
+static void test_load_pair(void **state)
+{
+	(void)state;
+	char err[256];
+	assert_int_equal(load(&cfg, pair_ini, err, sizeof(err)), 0);
+	assert_int_equal(sim_config_set(&cfg, "world.separation=0.25", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_set(&cfg, "sim.link_dir=/tmp/x", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_finish(&cfg, err, sizeof(err)), 0);
+	assert_int_equal(cfg.nrobots, 2);
+	assert_string_equal(cfg.robots[0].link, "/tmp/x/left");
+	assert_int_equal(cfg.robots[0].contact_id, 1);  /* default: the last ID */
+	assert_true(cfg.robots[1].latency_ms == 16);
+	assert_int_equal(cfg.seed, 5);
+	/* events come out sorted by time */
+	assert_int_equal(cfg.nevents, 2);
+	assert_true(cfg.events[0].at == 0.5);
+	assert_string_equal(cfg.events[1].command, "fault right 1 no-reply");
+
+	assert_int_equal(sim_init(&sim, &cfg, err, sizeof(err)), 0);
+	assert_int_equal(sim.world.nbodies, 2);
+	/* d = d̃ · 2 · lever · A = 0.25 · 2 · 0.2 · 0.8 = 0.08 m, centred on 0 */
+	assert_float_equal(sim.world.bodies[0].neutral, -0.04, 1e-12);
+	assert_float_equal(sim.world.bodies[1].neutral, 0.04, 1e-12);
+	/* auto walls: half a spacing beyond each end */
+	assert_float_equal(sim.world.params.wall_left, -0.08, 1e-12);
+	assert_float_equal(sim.world.params.wall_right, 0.08, 1e-12);
+	assert_float_equal(sim.world.params.restitution, 0.67, 1e-12);
+	/* no body starts inside its neighbour */
+	assert_true(sim_world_lateral(&sim.world, 0) <= sim_world_lateral(&sim.world, 1));
+	/* the servo starts with goal = present, torque off */
+	struct sim_servo *s = &sim.buses[1].joints[0].servo;
+	assert_int_equal(sim_servo_peek(s, DXL_AX_GOAL_POSITION), sim_servo_peek(s, DXL_AX_PRESENT_POSITION));
+	assert_int_equal(s->mem[DXL_AX_TORQUE_ENABLE], 0);
+}
+
+static void test_config_errors(void **state)
+{
+	(void)state;
+	char err[256];
+	assert_int_equal(load(&cfg, "[world]\nrestitution = 1.5\n", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, ":2:"));
+	assert_non_null(strstr(err, "restitution"));
+	assert_int_equal(load(&cfg, "[nonsense]\nx = 1\n", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "unknown section"));
+	assert_int_equal(load(&cfg, "[robot a]\nids = 1,1\n", err, sizeof(err)), -1);
+	assert_int_equal(load(&cfg, "[robot a]\nids = 300\n", err, sizeof(err)), -1);
+	assert_int_equal(load(&cfg, "[robot a]\nids = 1,2\ncontact = 3\n", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_finish(&cfg, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "contact 3"));
+	assert_int_equal(load(&cfg, "[events]\nsoon = help\n", err, sizeof(err)), -1);
+	sim_config_defaults(&cfg);
+	assert_int_equal(sim_config_finish(&cfg, err, sizeof(err)), -1);  /* no robots */
+	assert_int_equal(sim_config_set(&cfg, "nodot=1", err, sizeof(err)), -1);
+	assert_int_equal(sim_config_set(&cfg, "sim.rate_hz", err, sizeof(err)), -1);
+	assert_int_equal(sim_config_set(&cfg, "sim.rate_hz=abc", err, sizeof(err)), -1);
+	assert_int_equal(sim_config_set(&cfg, "world.walls=3,1", err, sizeof(err)), -1);
+	assert_int_equal(sim_config_set(&cfg, "world.walls=-1,1", err, sizeof(err)), 0);
+	assert_int_equal(cfg.walls, SIM_WALLS_FIXED);
+	uint8_t ids[8];
+	assert_int_equal(sim_parse_ids("1-3,7", ids, 8), 4);
+	assert_int_equal(ids[3], 7);
+	assert_int_equal(sim_parse_ids("", ids, 8), -1);
+	assert_int_equal(sim_parse_ids("1,,2", ids, 8), -1);
+}
+
+static void quick(struct sim_config *c, uint64_t seed)
+{
+	char err[256];
+	sim_config_defaults(c);
+	c->seed = seed;
+	assert_int_equal(sim_config_add_robot(c, "a", "/tmp/none/a", "1,2", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_add_robot(c, "b", "/tmp/none/b", "1,2", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_finish(c, err, sizeof(err)), 0);
+}
+
+static void test_seeded_start(void **state)
+{
+	(void)state;
+	static struct sim a, b;
+	char err[256];
+	quick(&cfg, 11);
+	assert_int_equal(sim_init(&a, &cfg, err, sizeof(err)), 0);
+	assert_int_equal(sim_init(&b, &cfg, err, sizeof(err)), 0);
+	for (size_t i = 0; i < 2; i++)
+		for (size_t k = 0; k < 2; k++)
+			assert_true(a.buses[i].joints[k].motor.angle == b.buses[i].joints[k].motor.angle);
+	quick(&cfg, 12);
+	assert_int_equal(sim_init(&b, &cfg, err, sizeof(err)), 0);
+	assert_true(a.buses[0].joints[0].motor.angle != b.buses[0].joints[0].motor.angle);
+}
+
+static void test_commands(void **state)
+{
+	(void)state;
+	char err[256], reply[512];
+	quick(&cfg, 1);
+	assert_int_equal(sim_init(&sim, &cfg, err, sizeof(err)), 0);
+	assert_int_equal(sim_command(&sim, "fault a 2 slow 3 count=2", 0, reply, sizeof(reply)), 0);
+	assert_string_equal(reply, "ok 1 servo(s): slow");
+	struct sim_fault *f = &sim.buses[0].joints[1].faults.f[SIM_FAULT_SLOW];
+	assert_true(f->active && f->arg == 3 && f->remaining == 2);
+	assert_int_equal(sim_command(&sim, "fault * * stuck-error overload", 0, reply, sizeof(reply)), 0);
+	assert_string_equal(reply, "ok 4 servo(s): stuck-error");
+	assert_int_equal(sim.buses[1].joints[0].servo.stuck_bits, DXL_ERRBIT_OVERLOAD);
+	assert_int_equal(sim_command(&sim, "clear * * stuck-error", 0, reply, sizeof(reply)), 0);
+	assert_int_equal(sim.buses[1].joints[0].servo.stuck_bits, 0);
+	assert_true(f->active);  /* other kinds stay */
+	assert_int_equal(sim_command(&sim, "clear a", 0, reply, sizeof(reply)), 0);
+	assert_false(f->active);
+	assert_int_equal(sim_command(&sim, "power b 1 off", 0, reply, sizeof(reply)), 0);
+	assert_false(sim.buses[1].joints[0].servo.powered);
+	assert_int_equal(sim_command(&sim, "power b 1 on", 0, reply, sizeof(reply)), 0);
+	assert_true(sim.buses[1].joints[0].servo.powered);
+	assert_int_equal(sim_command(&sim, "poke a 1 temperature_limit 40", 0, reply, sizeof(reply)), 0);
+	assert_int_equal(sim_command(&sim, "peek a 1 temperature_limit", 0, reply, sizeof(reply)), 0);
+	assert_string_equal(reply, "ok 40");
+	assert_int_equal(sim_command(&sim, "walls -0.5 0.5", 0, reply, sizeof(reply)), 0);
+	assert_float_equal(sim.world.params.wall_right, 0.5, 1e-12);
+	assert_int_equal(sim_command(&sim, "garbage a 4", 0, reply, sizeof(reply)), 0);
+	assert_int_equal(sim.buses[0].line.n, 4);
+	/* bad commands: a clear error each, counted, nothing changed */
+	uint64_t bad = sim.bad_commands;
+	const char *bads[] = {
+		"", "explode", "fault", "fault a 1", "fault a 1 melt", "fault a x no-reply", "fault zz 1 no-reply",
+		"fault a 9 no-reply", "clear a 1 melt", "power a 1 maybe", "disconnect zz", "disconnect a",
+		"reconnect", "poke a 1 nosuchreg 1", "poke a 1 goal_position 70000", "peek a 7 goal_position",
+		"walls 1 -1", "walls x y", "garbage a 1000",
+		"fault a 1 slow 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17",
+	};
+	for (size_t i = 0; i < sizeof(bads) / sizeof(bads[0]); i++) {
+		assert_int_equal(sim_command(&sim, bads[i], 0, reply, sizeof(reply)), -1);
+		assert_memory_equal(reply, "error: ", 7);
+	}
+	assert_int_equal(sim.bad_commands - bad, sizeof(bads) / sizeof(bads[0]));
+	assert_false(sim.buses[0].joints[0].faults.f[SIM_FAULT_NO_REPLY].active);
+}
+
+static void test_events_run_on_time(void **state)
+{
+	(void)state;
+	char err[256];
+	assert_int_equal(load(&cfg, pair_ini, err, sizeof(err)), 0);
+	assert_int_equal(sim_config_finish(&cfg, err, sizeof(err)), 0);
+	assert_int_equal(sim_init(&sim, &cfg, err, sizeof(err)), 0);
+	sim_run_events(&sim, 0.4, 0);
+	assert_false(sim.buses[0].joints[0].faults.f[SIM_FAULT_SLOW].active);
+	sim_run_events(&sim, 0.5, 0);
+	assert_true(sim.buses[0].joints[0].faults.f[SIM_FAULT_SLOW].active);
+	assert_false(sim.buses[1].joints[0].faults.f[SIM_FAULT_NO_REPLY].active);
+	sim_run_events(&sim, 2.0, 0);
+	assert_true(sim.buses[1].joints[0].faults.f[SIM_FAULT_NO_REPLY].active);
+}
+
+/* Drive the two bodies at each other through their registers: they collide,
+ * the collision is reported for the step, and they never pass each other. */
+static void test_driven_bodies_collide(void **state)
+{
+	(void)state;
+	char err[256];
+	assert_int_equal(load(&cfg, pair_ini, err, sizeof(err)), 0);
+	assert_int_equal(sim_config_set(&cfg, "world.walls=none", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_set(&cfg, "sim.overload_time=100", err, sizeof(err)), 0);  /* no shutdown */
+	assert_int_equal(sim_config_finish(&cfg, err, sizeof(err)), 0);
+	assert_int_equal(sim_init(&sim, &cfg, err, sizeof(err)), 0);
+	struct sim_servo *l = &sim.buses[0].joints[0].servo, *r = &sim.buses[1].joints[0].servo;
+	l->mem[DXL_AX_TORQUE_ENABLE] = r->mem[DXL_AX_TORQUE_ENABLE] = 1;
+	dxl_put_u16(&l->mem[DXL_AX_GOAL_POSITION], dxl_rad_to_pos(0.6));
+	dxl_put_u16(&r->mem[DXL_AX_GOAL_POSITION], dxl_rad_to_pos(-0.6));
+	size_t reported = 0;
+	for (int i = 0; i < 1000; i++) {
+		sim_step(&sim);
+		reported += sim.nstep_collisions;
+		assert_true(sim_world_lateral(&sim.world, 0) <= sim_world_lateral(&sim.world, 1) + 1e-9);
+	}
+	assert_true(sim.world.total_collisions >= 1);
+	assert_int_equal(reported, sim.world.total_collisions);
+	assert_true(sim.world.total_impulse > 0);
+	/* pushing against each other: the servos report load */
+	assert_true((sim_servo_peek(l, DXL_AX_PRESENT_LOAD) & 1023) > 100);
+	assert_int_equal(sim.steps, 1000);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_load_pair),
+		cmocka_unit_test(test_config_errors),
+		cmocka_unit_test(test_seeded_start),
+		cmocka_unit_test(test_commands),
+		cmocka_unit_test(test_events_run_on_time),
+		cmocka_unit_test(test_driven_bodies_collide),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
