@@ -1,0 +1,624 @@
+/* config.c — see config.h. */
+#include "config.h"
+
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#define CFG_PI 3.14159265358979323846
+/* The AX-12 turns 300°: ±150° = ±2.618 rad around its centre. */
+#define CFG_SERVO_HALF_RANGE (150.0 * CFG_PI / 180.0)
+
+static void cfg_error(struct cfg_errors *e, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void cfg_error(struct cfg_errors *e, const char *fmt, ...)
+{
+	if (e == NULL)
+		return;
+	if (e->count < CFG_MAX_ERRORS) {
+		va_list ap;
+		va_start(ap, fmt);
+		vsnprintf(e->line[e->count], CFG_ERR_MAX, fmt, ap);
+		va_end(ap);
+	}
+	e->count++;
+}
+
+/* ---- modes and enums ------------------------------------------------------------ */
+static const char *const cfg_mode_names[CFG_NMODES] = { "LIMP", "HOLD", "SINUSOID", "OSCILLATOR" };
+
+const char *cfg_mode_name(enum cfg_mode m)
+{
+	return (unsigned)m < CFG_NMODES ? cfg_mode_names[m] : "UNKNOWN";
+}
+
+bool cfg_mode_parse(const char *s, enum cfg_mode *out)
+{
+	for (int m = 0; m < CFG_NMODES; m++) {
+		if (strcasecmp(s, cfg_mode_names[m]) == 0) {
+			*out = (enum cfg_mode)m;
+			return true;
+		}
+	}
+	return false;
+}
+
+/* ---- value parsers: each writes a reason on failure ------------------------------- */
+static bool parse_double(const char *s, double *out)
+{
+	char *end;
+	errno = 0;
+	double v = strtod(s, &end);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	if (end == s || *end != '\0' || errno == ERANGE || !isfinite(v))
+		return false;
+	*out = v;
+	return true;
+}
+
+static bool parse_long(const char *s, long *out)
+{
+	char *end;
+	errno = 0;
+	long v = strtol(s, &end, 10);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	if (end == s || *end != '\0' || errno == ERANGE)
+		return false;
+	*out = v;
+	return true;
+}
+
+static bool parse_bool(const char *s, bool *out)
+{
+	static const char *const yes[] = { "on", "yes", "true", "1" };
+	static const char *const no[] = { "off", "no", "false", "0" };
+	for (size_t i = 0; i < 4; i++) {
+		if (strcasecmp(s, yes[i]) == 0) { *out = true; return true; }
+		if (strcasecmp(s, no[i]) == 0) { *out = false; return true; }
+	}
+	return false;
+}
+
+/* "1,2" or "1 2": servo IDs 0..253, no duplicates. */
+static bool parse_ids(const char *s, uint8_t *ids, size_t *n, char *why, size_t cap)
+{
+	size_t count = 0;
+	const char *p = s;
+	while (*p) {
+		while (*p == ' ' || *p == ',' || *p == '\t')
+			p++;
+		if (!*p)
+			break;
+		char *end;
+		errno = 0;
+		long v = strtol(p, &end, 10);
+		if (end == p || (*end && *end != ',' && *end != ' ' && *end != '\t')) {
+			snprintf(why, cap, "not a list of servo IDs '%s'", s);
+			return false;
+		}
+		if (v < 0 || v > 253) {
+			snprintf(why, cap, "servo ID %ld out of range 0..253", v);
+			return false;
+		}
+		if (count == CFG_MAX_JOINTS) {
+			snprintf(why, cap, "more than %d servo IDs", CFG_MAX_JOINTS);
+			return false;
+		}
+		for (size_t i = 0; i < count; i++) {
+			if (ids[i] == v) {
+				snprintf(why, cap, "servo ID %ld listed twice", v);
+				return false;
+			}
+		}
+		ids[count++] = (uint8_t)v;
+		p = end;
+	}
+	if (count == 0) {
+		snprintf(why, cap, "no servo IDs in '%s'", s);
+		return false;
+	}
+	*n = count;
+	return true;
+}
+
+/* ---- parameter ranges (documented in daemon/README.md) ------------------------------ */
+struct cfg_param_def {
+	const char *key;
+	struct cfg_range range;
+	bool joint;   /* per joint ([joint.N]) or per robot ([sinusoid]) */
+};
+static const struct cfg_param_def cfg_params[] = {
+	{ "k",         { 0.0, 1000.0, true }, true },
+	{ "c",         { -100.0, 100.0, false }, true },
+	{ "mu",        { 0.0, 1000.0, false }, true },
+	{ "lambda",    { -10.0, 10.0, false }, true },
+	{ "inertia",   { 0.0, 10.0, true }, true },
+	{ "friction",  { 0.0, 10.0, false }, true },
+	{ "neutral",   { -CFG_SERVO_HALF_RANGE, CFG_SERVO_HALF_RANGE, false }, true },
+	{ "limit_min", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true },
+	{ "limit_max", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true },
+	{ "max_step",  { 0.0, 0.5, true }, true },
+	{ "amplitude", { 0.0, CFG_SERVO_HALF_RANGE, false }, false },
+	{ "frequency", { 0.0, 5.0, false }, false },
+	{ "phase",     { -2.0 * CFG_PI, 2.0 * CFG_PI, false }, false },
+};
+#define CFG_NPARAMS (sizeof cfg_params / sizeof cfg_params[0])
+
+static const struct cfg_param_def *cfg_param_find(const char *key)
+{
+	for (size_t i = 0; i < CFG_NPARAMS; i++)
+		if (strcmp(key, cfg_params[i].key) == 0)
+			return &cfg_params[i];
+	return NULL;
+}
+
+bool cfg_param_range(const char *key, struct cfg_range *out)
+{
+	const struct cfg_param_def *d = cfg_param_find(key);
+	if (d == NULL)
+		return false;
+	*out = d->range;
+	return true;
+}
+
+bool cfg_param_is_joint(const char *key)
+{
+	const struct cfg_param_def *d = cfg_param_find(key);
+	return d != NULL && d->joint;
+}
+
+bool cfg_param_is_robot(const char *key)
+{
+	const struct cfg_param_def *d = cfg_param_find(key);
+	return d != NULL && !d->joint;
+}
+
+double *cfg_joint_param(struct cfg_joint *j, const char *key)
+{
+	if (strcmp(key, "k") == 0) return &j->osc.k;
+	if (strcmp(key, "c") == 0) return &j->osc.c;
+	if (strcmp(key, "mu") == 0) return &j->osc.mu;
+	if (strcmp(key, "lambda") == 0) return &j->osc.lambda;
+	if (strcmp(key, "inertia") == 0) return &j->osc.inertia;
+	if (strcmp(key, "friction") == 0) return &j->osc.friction;
+	if (strcmp(key, "neutral") == 0) return &j->neutral;
+	if (strcmp(key, "limit_min") == 0) return &j->limit_min;
+	if (strcmp(key, "limit_max") == 0) return &j->limit_max;
+	if (strcmp(key, "max_step") == 0) return &j->max_step;
+	return NULL;
+}
+
+static bool range_ok(const struct cfg_range *r, double v)
+{
+	if (r->min_open ? !(v > r->min) : !(v >= r->min))
+		return false;
+	return v <= r->max;
+}
+
+/* ---- defaults ----------------------------------------------------------------------- */
+void cfg_defaults(struct cfg *c)
+{
+	memset(c, 0, sizeof *c);
+	snprintf(c->name, sizeof c->name, "robot");
+	c->baud = 1000000;
+	c->mode = CFG_MODE_OSCILLATOR;
+	c->safe_stop = CFG_SAFE_HOLD;
+	c->fault_action = CFG_SAFE_HOLD;
+	c->velocity_source = CFG_VEL_FILTERED;
+	c->velocity_cutoff_hz = OSC_VELOCITY_CUTOFF_HZ;
+	c->servo_lead_s = OSC_SERVO_LEAD_S;
+	/* Replies on a loaded 2-core machine (simulator, tests) come up to ~3 ms
+	 * late; a real adapter with return delay 0 needs far less. */
+	c->bus_margin_us = 3000;
+	c->commands = true;
+	c->adapter_latency_us = -1;
+	c->period_ms = 10.0;
+	c->ramp_s = 1.5;
+	c->backoff_torque = 0.5;
+	c->fault_backoff_s = 1.0;
+	c->fault_retries = 3;
+	c->stale_limit = 10;
+	/* Joint values stay NaN until cfg_finish() knows how many joints there are:
+	 * the oscillator's defaults depend on it (coupling λ). */
+	for (size_t j = 0; j < CFG_MAX_JOINTS; j++) {
+		struct cfg_joint *jt = &c->joint[j];
+		jt->osc.k = jt->osc.c = jt->osc.mu = jt->osc.lambda = NAN;
+		jt->osc.inertia = jt->osc.friction = NAN;
+		jt->neutral = NAN;
+		jt->limit_min = NAN;
+		jt->limit_max = NAN;
+		jt->max_step = NAN;
+	}
+	/* The paper's baseline: 0.8 rad at 0.8 Hz. */
+	c->amplitude = 0.8;
+	c->frequency = 0.8;
+	c->phase = 0.0;
+}
+
+/* ---- [robot] keys --------------------------------------------------------------------- */
+enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL };
+struct cfg_key {
+	const char *key;
+	enum cfg_type type;
+	size_t offset;
+	size_t size;          /* strings: buffer size */
+	double min, max;      /* numbers */
+};
+#define K(name, type, field, min, max) \
+	{ name, type, offsetof(struct cfg, field), sizeof(((struct cfg *)0)->field), min, max }
+static const struct cfg_key cfg_robot_keys[] = {
+	K("name", T_STR, name, 0, 0),
+	K("port", T_STR, port, 0, 0),
+	K("usb_serial", T_STR, usb_serial, 0, 0),
+	K("baud", T_LONG, baud, 9600, 3000000),
+	K("ids", T_IDS, ids, 0, 0),
+	K("mode", T_MODE, mode, 0, 0),
+	K("lcm_url", T_STR, lcm_url, 0, 0),
+	K("priority", T_LONG, priority, 0, 99),
+	K("mlockall", T_BOOL, mlockall, 0, 0),
+	K("safe_stop", T_SAFE, safe_stop, 0, 0),
+	K("fault_action", T_SAFE, fault_action, 0, 0),
+	K("velocity_source", T_VEL, velocity_source, 0, 0),
+	K("velocity_cutoff_hz", T_DOUBLE, velocity_cutoff_hz, 0.5, 50),
+	K("commands", T_BOOL, commands, 0, 0),
+	K("echo", T_BOOL, echo, 0, 0),
+	K("adapter_latency_us", T_LONG, adapter_latency_us, -1, 100000),
+	K("period_ms", T_DOUBLE, period_ms, 2, 100),
+	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, 0.2),
+	K("bus_margin_us", T_LONG, bus_margin_us, 0, 100000),
+	K("ramp_s", T_DOUBLE, ramp_s, 0, 10),
+	K("backoff_torque", T_DOUBLE, backoff_torque, 0, 1),
+	K("fault_backoff_s", T_DOUBLE, fault_backoff_s, 0.05, 600),
+	K("fault_retries", T_LONG, fault_retries, 0, 100),
+	K("stale_limit", T_LONG, stale_limit, 1, 1000),
+};
+#undef K
+#define CFG_NROBOT_KEYS (sizeof cfg_robot_keys / sizeof cfg_robot_keys[0])
+
+static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, const char *value,
+                          struct cfg_errors *e)
+{
+	const struct cfg_key *k = NULL;
+	for (size_t i = 0; i < CFG_NROBOT_KEYS; i++)
+		if (strcmp(key, cfg_robot_keys[i].key) == 0)
+			k = &cfg_robot_keys[i];
+	if (k == NULL) {
+		cfg_error(e, "%s: [robot] %s: unknown key", where, key);
+		return false;
+	}
+	void *field = (char *)c + k->offset;
+	char why[128];
+	long lv;
+	double dv;
+	bool bv;
+	switch (k->type) {
+	case T_STR:
+		if (strlen(value) >= k->size) {
+			cfg_error(e, "%s: [robot] %s: longer than %zu characters", where, key, k->size - 1);
+			return false;
+		}
+		if (strcmp(key, "name") == 0 && (value[0] == '\0' || strpbrk(value, ".* \t") != NULL)) {
+			cfg_error(e, "%s: [robot] name: '%s' must be non-empty without '.', '*' or spaces "
+			          "(it prefixes LCM channels)", where, value);
+			return false;
+		}
+		memcpy(field, value, strlen(value) + 1);
+		return true;
+	case T_LONG:
+		if (!parse_long(value, &lv)) {
+			cfg_error(e, "%s: [robot] %s: not an integer '%s'", where, key, value);
+			return false;
+		}
+		if (lv < k->min || lv > k->max) {
+			cfg_error(e, "%s: [robot] %s: %ld out of range %.0f..%.0f", where, key, lv, k->min, k->max);
+			return false;
+		}
+		if (k->size == sizeof(int))
+			*(int *)field = (int)lv;
+		else
+			*(long *)field = lv;
+		return true;
+	case T_DOUBLE:
+		if (!parse_double(value, &dv)) {
+			cfg_error(e, "%s: [robot] %s: not a number '%s'", where, key, value);
+			return false;
+		}
+		if (dv < k->min || dv > k->max) {
+			cfg_error(e, "%s: [robot] %s: %g out of range %g..%g", where, key, dv, k->min, k->max);
+			return false;
+		}
+		*(double *)field = dv;
+		return true;
+	case T_BOOL:
+		if (!parse_bool(value, &bv)) {
+			cfg_error(e, "%s: [robot] %s: not on/off '%s'", where, key, value);
+			return false;
+		}
+		*(bool *)field = bv;
+		return true;
+	case T_IDS:
+		if (!parse_ids(value, c->ids, &c->njoints, why, sizeof why)) {
+			cfg_error(e, "%s: [robot] ids: %s", where, why);
+			return false;
+		}
+		return true;
+	case T_MODE:
+		if (!cfg_mode_parse(value, &c->mode)) {
+			cfg_error(e, "%s: [robot] mode: '%s' is not limp, hold, sinusoid or oscillator", where, value);
+			return false;
+		}
+		return true;
+	case T_SAFE:
+		if (strcasecmp(value, "hold") == 0)
+			*(enum cfg_safe *)field = CFG_SAFE_HOLD;
+		else if (strcasecmp(value, "limp") == 0)
+			*(enum cfg_safe *)field = CFG_SAFE_LIMP;
+		else {
+			cfg_error(e, "%s: [robot] %s: '%s' is not hold or limp", where, key, value);
+			return false;
+		}
+		return true;
+	case T_VEL:
+		if (strcasecmp(value, "servo") == 0)
+			c->velocity_source = CFG_VEL_SERVO;
+		else if (strcasecmp(value, "filtered") == 0)
+			c->velocity_source = CFG_VEL_FILTERED;
+		else {
+			cfg_error(e, "%s: [robot] velocity_source: '%s' is not servo or filtered", where, value);
+			return false;
+		}
+		return true;
+	}
+	return false;
+}
+
+static bool cfg_set_param(double *field, const char *where, const char *section, const char *key,
+                          const char *value, struct cfg_errors *e)
+{
+	const struct cfg_param_def *d = cfg_param_find(key);
+	double v;
+	if (!parse_double(value, &v)) {
+		cfg_error(e, "%s: [%s] %s: not a number '%s'", where, section, key, value);
+		return false;
+	}
+	if (!range_ok(&d->range, v)) {
+		cfg_error(e, "%s: [%s] %s: %g out of range %s%g..%g", where, section, key, v,
+		          d->range.min_open ? ">" : "", d->range.min, d->range.max);
+		return false;
+	}
+	*field = v;
+	return true;
+}
+
+bool cfg_set(struct cfg *c, const char *where, const char *section, const char *key,
+             const char *value, struct cfg_errors *e)
+{
+	if (strcmp(section, "robot") == 0)
+		return cfg_set_robot(c, where, key, value, e);
+	if (strcmp(section, "sinusoid") == 0) {
+		double *f = strcmp(key, "amplitude") == 0 ? &c->amplitude
+		          : strcmp(key, "frequency") == 0 ? &c->frequency
+		          : strcmp(key, "phase") == 0 ? &c->phase : NULL;
+		if (f == NULL) {
+			cfg_error(e, "%s: [sinusoid] %s: unknown key (amplitude, frequency, phase)", where, key);
+			return false;
+		}
+		return cfg_set_param(f, where, section, key, value, e);
+	}
+	if (strncmp(section, "joint.", 6) == 0) {
+		long n;
+		if (!parse_long(section + 6, &n) || n < 1 || n > CFG_MAX_JOINTS) {
+			cfg_error(e, "%s: [%s]: joint sections are [joint.1] .. [joint.%d]", where, section,
+			          CFG_MAX_JOINTS);
+			return false;
+		}
+		double *f = cfg_joint_param(&c->joint[n - 1], key);
+		if (f == NULL) {
+			cfg_error(e, "%s: [%s] %s: unknown key", where, section, key);
+			return false;
+		}
+		return cfg_set_param(f, where, section, key, value, e);
+	}
+	cfg_error(e, "%s: [%s]: unknown section (robot, joint.N, sinusoid)", where, section);
+	return false;
+}
+
+/* ---- INI parsing: a line-counting reader so every handler call knows its line ---------- */
+struct cfg_parse {
+	struct cfg *cfg;
+	struct cfg_errors *errors;
+	const char *name;
+	/* source: a FILE or a string */
+	FILE *file;
+	const char *text;
+	int line;
+	char last_section[64];
+	bool section_reported;
+};
+
+static char *cfg_reader(char *str, int num, void *stream)
+{
+	struct cfg_parse *p = stream;
+	if (p->file != NULL) {
+		if (fgets(str, num, p->file) == NULL)
+			return NULL;
+	} else {
+		if (*p->text == '\0')
+			return NULL;
+		int i = 0;
+		while (i < num - 1 && p->text[0] != '\0') {
+			str[i++] = *p->text++;
+			if (str[i - 1] == '\n')
+				break;
+		}
+		str[i] = '\0';
+	}
+	p->line++;
+	return str;
+}
+
+static int cfg_handler(void *user, const char *section, const char *name, const char *value)
+{
+	struct cfg_parse *p = user;
+	char where[CFG_PATH_MAX + 16];
+	snprintf(where, sizeof where, "%s:%d", p->name, p->line);
+	if (section[0] == '\0') {
+		cfg_error(p->errors, "%s: %s: key outside any section (start with [robot])", where, name);
+		return 1;
+	}
+	cfg_set(p->cfg, where, section, name, value, p->errors);
+	return 1;   /* keep going: report every error in one run */
+}
+
+static bool cfg_parse_run(struct cfg_parse *p)
+{
+	size_t before = p->errors->count;
+	int rc = ini_parse_stream(cfg_reader, p, cfg_handler, p);
+	if (rc > 0 && p->errors->count == before)
+		cfg_error(p->errors, "%s:%d: syntax error (expected [section] or key = value)", p->name, rc);
+	else if (rc < 0)
+		cfg_error(p->errors, "%s: cannot parse (out of memory)", p->name);
+	return p->errors->count == 0;
+}
+
+bool cfg_load_string(struct cfg *c, const char *name, const char *text, struct cfg_errors *errors)
+{
+	struct cfg_parse p = { .cfg = c, .errors = errors, .name = name, .text = text };
+	return cfg_parse_run(&p);
+}
+
+bool cfg_load_file(struct cfg *c, const char *path, struct cfg_errors *errors)
+{
+	FILE *f = fopen(path, "r");
+	if (f == NULL) {
+		cfg_error(errors, "%s: cannot open: %s", path, strerror(errno));
+		return false;
+	}
+	/* Messages name the file as given, without directories clutter removed:
+	 * users copy that path into their editor. */
+	struct cfg_parse p = { .cfg = c, .errors = errors, .name = path, .file = f };
+	bool ok = cfg_parse_run(&p);
+	fclose(f);
+	snprintf(c->source, sizeof c->source, "%s", path);
+	return ok;
+}
+
+bool cfg_override(struct cfg *c, const char *assignment, struct cfg_errors *errors)
+{
+	char buf[CFG_PATH_MAX + 64];
+	if (strlen(assignment) >= sizeof buf) {
+		cfg_error(errors, "command line: '%.40s...': too long", assignment);
+		return false;
+	}
+	strcpy(buf, assignment);
+	char *eq = strchr(buf, '=');
+	char *dot = eq ? memchr(buf, '.', (size_t)(eq - buf)) : NULL;
+	/* "joint.1.k=..." has its key after the last dot before '=' */
+	char *last_dot = NULL;
+	for (char *q = buf; eq && q < eq; q++)
+		if (*q == '.')
+			last_dot = q;
+	if (eq == NULL || dot == NULL || last_dot == buf) {
+		cfg_error(errors, "command line: '%s': expected section.key=value (e.g. joint.1.k=0.5)",
+		          assignment);
+		return false;
+	}
+	*eq = '\0';
+	*last_dot = '\0';
+	const char *section = buf, *key = last_dot + 1, *value = eq + 1;
+	return cfg_set(c, "command line", section, key, value, errors);
+}
+
+/* ---- whole-config checks ------------------------------------------------------------------ */
+static void cfg_fill_joint_defaults(struct cfg *c)
+{
+	for (size_t j = 0; j < c->njoints; j++) {
+		struct cfg_joint *jt = &c->joint[j];
+		struct osc_joint_params d;
+		osc_default_params(&d, j, c->njoints);
+		if (isnan(jt->osc.k)) jt->osc.k = d.k;
+		if (isnan(jt->osc.c)) jt->osc.c = d.c;
+		if (isnan(jt->osc.mu)) jt->osc.mu = d.mu;
+		if (isnan(jt->osc.lambda)) jt->osc.lambda = d.lambda;
+		if (isnan(jt->osc.inertia)) jt->osc.inertia = d.inertia;
+		if (isnan(jt->osc.friction)) jt->osc.friction = d.friction;
+		if (isnan(jt->neutral)) jt->neutral = 0.0;
+		/* ±1.3 rad: room for the 0.8 rad limit cycle and its overshoot, short
+		 * of links folding onto each other on the paper's robot. */
+		if (isnan(jt->limit_min)) jt->limit_min = -1.3;
+		if (isnan(jt->limit_max)) jt->limit_max = 1.3;
+		/* 0.1 rad a cycle = 10 rad/s: above what an AX-12 can follow (≈6 rad/s),
+		 * so it never limits a healthy gait, only jumps. */
+		if (isnan(jt->max_step)) jt->max_step = 0.1;
+	}
+}
+
+bool cfg_finish(struct cfg *c, struct cfg_errors *e)
+{
+	size_t before = e->count;
+	if (c->njoints == 0)
+		cfg_error(e, "%s: [robot] ids: no servo IDs configured (e.g. ids = 1,2 or --ids 1,2)",
+		          c->source[0] ? c->source : "config");
+	if (c->port[0] == '\0' && c->usb_serial[0] == '\0')
+		cfg_error(e, "%s: [robot] port: no port configured (port = /dev/ttyUSB0, usb_serial = ..., "
+		          "or --port PATH)", c->source[0] ? c->source : "config");
+	for (size_t j = c->njoints; j < CFG_MAX_JOINTS; j++) {
+		const struct cfg_joint *jt = &c->joint[j];
+		if (!isnan(jt->osc.k) || !isnan(jt->osc.c) || !isnan(jt->osc.mu) || !isnan(jt->osc.lambda) ||
+		    !isnan(jt->osc.inertia) || !isnan(jt->osc.friction) || !isnan(jt->neutral) ||
+		    !isnan(jt->limit_min) || !isnan(jt->limit_max) || !isnan(jt->max_step))
+			cfg_error(e, "%s: [joint.%zu]: the robot has only %zu joint(s) (ids)",
+			          c->source[0] ? c->source : "config", j + 1, c->njoints);
+	}
+	cfg_fill_joint_defaults(c);
+	for (size_t j = 0; j < c->njoints; j++) {
+		const struct cfg_joint *jt = &c->joint[j];
+		if (!(jt->limit_min < jt->limit_max))
+			cfg_error(e, "%s: [joint.%zu] limit_min: %g is not below limit_max %g",
+			          c->source[0] ? c->source : "config", j + 1, jt->limit_min, jt->limit_max);
+		else if (!(jt->limit_min <= 0.0 && jt->limit_max >= 0.0))
+			cfg_error(e, "%s: [joint.%zu] limit_min/limit_max: [%g, %g] must contain the neutral angle 0",
+			          c->source[0] ? c->source : "config", j + 1, jt->limit_min, jt->limit_max);
+		if (jt->neutral + jt->limit_min < -CFG_SERVO_HALF_RANGE - 1e-9 ||
+		    jt->neutral + jt->limit_max > CFG_SERVO_HALF_RANGE + 1e-9)
+			cfg_error(e, "%s: [joint.%zu] limit_min/limit_max: neutral %+g + [%g, %g] leaves the servo's "
+			          "±2.618 rad (300°) range", c->source[0] ? c->source : "config", j + 1,
+			          jt->neutral, jt->limit_min, jt->limit_max);
+	}
+	return e->count == before;
+}
+
+void cfg_print(const struct cfg *c, void *file)
+{
+	FILE *f = file;
+	static const char *const safe[] = { "hold", "limp" };
+	fprintf(f, "[robot]\nname = %s\nport = %s\nusb_serial = %s\nbaud = %ld\nids = ", c->name, c->port,
+	        c->usb_serial, c->baud);
+	for (size_t j = 0; j < c->njoints; j++)
+		fprintf(f, "%s%u", j ? "," : "", c->ids[j]);
+	fprintf(f, "\nmode = %s\nlcm_url = %s\npriority = %d\nmlockall = %s\nsafe_stop = %s\n"
+	        "fault_action = %s\nvelocity_source = %s\nvelocity_cutoff_hz = %g\ncommands = %s\n"
+	        "echo = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\nbus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
+	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\n",
+	        cfg_mode_name(c->mode), c->lcm_url, c->priority, c->mlockall ? "on" : "off",
+	        safe[c->safe_stop], safe[c->fault_action],
+	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
+	        c->commands ? "on" : "off", c->echo ? "on" : "off", c->adapter_latency_us, c->period_ms,
+	        c->servo_lead_s, c->bus_margin_us,
+	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit);
+	for (size_t j = 0; j < c->njoints; j++) {
+		const struct cfg_joint *jt = &c->joint[j];
+		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ninertia = %g\nfriction = %g\n"
+		        "neutral = %g\nlimit_min = %g\nlimit_max = %g\nmax_step = %g\n", j + 1, jt->osc.k,
+		        jt->osc.c, jt->osc.mu, jt->osc.lambda, jt->osc.inertia, jt->osc.friction, jt->neutral,
+		        jt->limit_min, jt->limit_max, jt->max_step);
+	}
+	fprintf(f, "\n[sinusoid]\namplitude = %g\nfrequency = %g\nphase = %g\n", c->amplitude, c->frequency,
+	        c->phase);
+}

@@ -1,0 +1,108 @@
+/*
+ * config.h — the robot's configuration: an INI file (libinih) plus command-line
+ * overrides, validated as a whole. Every error names where it came from:
+ *     robot1.conf:12: [joint.1] k: not a number 'abc'
+ * Unknown sections and keys are errors: a typo on a robot must not silently
+ * leave a default in place.
+ */
+#ifndef UNDULATE_DAEMON_CONFIG_H
+#define UNDULATE_DAEMON_CONFIG_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "osc.h"
+
+#define CFG_MAX_JOINTS   OSC_MAX_JOINTS   /* joints per robot: the oscillator's bound */
+#define CFG_NAME_MAX     48               /* robot name; channels are "<name>.STATE" */
+#define CFG_PATH_MAX     256              /* port path, LCM URL */
+#define CFG_ERR_MAX      256              /* one error line */
+#define CFG_MAX_ERRORS   16               /* errors kept for reporting (all are counted) */
+
+enum cfg_mode { CFG_MODE_LIMP = 0, CFG_MODE_HOLD = 1, CFG_MODE_SINUSOID = 2, CFG_MODE_OSCILLATOR = 3 };
+#define CFG_NMODES 4
+enum cfg_safe { CFG_SAFE_HOLD, CFG_SAFE_LIMP };
+enum cfg_velocity { CFG_VEL_SERVO, CFG_VEL_FILTERED };
+
+struct cfg_joint {
+	struct osc_joint_params osc;
+	double neutral;        /* rad from the servo centre that is x = 0 */
+	double limit_min;      /* rad relative to neutral */
+	double limit_max;
+	double max_step;       /* rad a goal may move per cycle */
+};
+
+struct cfg {
+	/* [robot] */
+	char name[CFG_NAME_MAX];
+	char port[CFG_PATH_MAX];
+	char usb_serial[64];
+	long baud;
+	uint8_t ids[CFG_MAX_JOINTS];
+	size_t njoints;
+	enum cfg_mode mode;
+	char lcm_url[CFG_PATH_MAX];
+	int priority;                  /* SCHED_FIFO priority, 0 = normal scheduling */
+	bool mlockall;
+	enum cfg_safe safe_stop;       /* what SIGTERM leaves behind */
+	enum cfg_safe fault_action;    /* what a persistent servo fault leaves behind */
+	enum cfg_velocity velocity_source;
+	double velocity_cutoff_hz;     /* low-pass of the filtered position difference */
+	bool commands;                 /* accept LCM commands */
+	bool echo;                     /* single-wire adapter echoes our bytes */
+	long adapter_latency_us;       /* -1: measure (FTDI latency timer) */
+	double period_ms;              /* control period */
+	double servo_lead_s;           /* oscillator horizon beyond the period (CONTROL.md) */
+	long bus_margin_us;            /* slack added to every bus timeout */
+	double ramp_s;                 /* blend time for start-up and mode switches */
+	double backoff_torque;         /* torque limit (fraction of max) while a joint backs off */
+	double fault_backoff_s;        /* wait before a recovery attempt */
+	int fault_retries;             /* recovery attempts before fault_action */
+	int stale_limit;               /* stale cycles before a joint is reported lost */
+	/* [joint.N], N = 1..njoints */
+	struct cfg_joint joint[CFG_MAX_JOINTS];
+	/* [sinusoid] */
+	double amplitude, frequency, phase;
+
+	/* where a config came from, for messages */
+	char source[CFG_PATH_MAX];
+};
+
+/* The result of parsing: every error, formatted. */
+struct cfg_errors {
+	size_t count;                              /* all errors seen */
+	char line[CFG_MAX_ERRORS][CFG_ERR_MAX];    /* the first CFG_MAX_ERRORS of them */
+};
+
+/* Defaults: robot "robot", no port, 1 Mbps, OSCILLATOR, safe_stop hold, ... */
+void cfg_defaults(struct cfg *c);
+/* Parse an INI file into c (on top of what is there). Returns errors->count == 0. */
+bool cfg_load_file(struct cfg *c, const char *path, struct cfg_errors *errors);
+/* Same, from a string; `name` is used in messages in place of a file name. */
+bool cfg_load_string(struct cfg *c, const char *name, const char *text, struct cfg_errors *errors);
+/* Apply one "section.key=value" override (section "joint.N" allowed). */
+bool cfg_override(struct cfg *c, const char *assignment, struct cfg_errors *errors);
+/* Set one key; `where` prefixes error messages ("file:line"). */
+bool cfg_set(struct cfg *c, const char *where, const char *section, const char *key,
+             const char *value, struct cfg_errors *errors);
+/* Fill unset joint parameters from osc_default_params() and check the whole
+ * (ids present, limits ordered, ...). Call once after all sources. */
+bool cfg_finish(struct cfg *c, struct cfg_errors *errors);
+
+/* Documented ranges of the per-joint and sinusoid parameters; shared with
+ * LCM command validation. Returns false for an unknown name. */
+struct cfg_range { double min, max; bool min_open; };
+bool cfg_param_range(const char *key, struct cfg_range *out);
+bool cfg_param_is_joint(const char *key);   /* k, c, ..., max_step */
+bool cfg_param_is_robot(const char *key);   /* amplitude, frequency, phase */
+/* Value of a per-joint parameter by name (for commands); NULL if unknown. */
+double *cfg_joint_param(struct cfg_joint *j, const char *key);
+
+const char *cfg_mode_name(enum cfg_mode m);     /* "OSCILLATOR" */
+bool cfg_mode_parse(const char *s, enum cfg_mode *out);   /* case-insensitive */
+
+/* Print every key with its current value as INI (for --check-config -v). */
+void cfg_print(const struct cfg *c, void *file);
+
+#endif

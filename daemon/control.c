@@ -1,0 +1,605 @@
+/* control.c — see control.h. */
+#include "control.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "dxl.h"
+#include "dxl_table.h"
+
+/* After a recovery write, watch the error bits this long before calling it a
+ * success: the servo needs a few control interrupts to load again. */
+#define CTL_FAULT_CHECK_S 0.3
+/* RK4 sub-steps per control period: the oscillator's fastest time scale is
+ * ~1 s, so 4 steps of 2.5 ms are far inside RK4's accuracy. */
+#define CTL_OSC_SUBSTEPS 4
+/* Starting from rest: a position servo quantizes angles to 5 mrad, so from
+ * rest the oscillator's first predicted steps round to the present angle and
+ * the robot stays still (CONTROL.md). So OSCILLATOR starts the way the paper
+ * switched: the baseline sinusoid ([sinusoid] amplitude and frequency) drives
+ * the joints for ramp_s plus one period, then the oscillator takes over from
+ * the measured, moving state. A joint counts as still below CTL_REST_V; an
+ * oscillator whose joints all stay still for CTL_STALL_CYCLES (1 s, far longer
+ * than a turning point of a running gait) is started again the same way. */
+#define CTL_REST_V 0.1
+/* A joint back after this many stale cycles is blended in again (its goal was
+ * held while the mode's target moved on). */
+#define CTL_RESUME_STALE 3
+#define CTL_STALL_CYCLES 100
+
+static void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
+	__attribute__((format(printf, 4, 5)));
+static void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
+{
+	if (c->nevents >= CTL_MAX_EVENTS)
+		return;
+	struct ctl_event *e = &c->events[c->nevents++];
+	e->level = level;
+	snprintf(e->kind, sizeof e->kind, "%s", kind);
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(e->text, sizeof e->text, fmt, ap);
+	va_end(ap);
+}
+
+static void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint16_t value)
+{
+	/* A later write to the same register in the same cycle replaces the earlier. */
+	for (size_t i = 0; i < c->nwrites; i++) {
+		if (c->writes[i].id == id && c->writes[i].addr == addr) {
+			c->writes[i].value = value;
+			return;
+		}
+	}
+	if (c->nwrites < CTL_MAX_WRITES)
+		c->writes[c->nwrites++] = (struct ctl_write){ .id = id, .addr = addr, .len = len, .value = value };
+}
+
+static void ctl_torque_write(struct ctl *c, size_t j, bool on)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (on) {
+		/* The manual's recovery: the torque limit back (an alarm shutdown set
+		 * it to 0), then torque enable. Harmless when nothing was wrong. */
+		ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, jt->servo.max_torque);
+		ctl_write(c, jt->id, DXL_AX_TORQUE_ENABLE, 1, 1);
+	} else {
+		ctl_write(c, jt->id, DXL_AX_TORQUE_ENABLE, 1, 0);
+	}
+	jt->torque = on;
+}
+
+void ctl_clear_outputs(struct ctl *c)
+{
+	c->nwrites = 0;
+	c->nevents = 0;
+}
+
+void ctl_init(struct ctl *c, struct cfg *cfg)
+{
+	memset(c, 0, sizeof *c);
+	c->cfg = cfg;
+	c->n = cfg->njoints;
+	c->mode = cfg->mode;
+	c->fade_mode = CFG_NMODES;
+	snprintf(c->reason, sizeof c->reason, "start");
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		jt->id = cfg->ids[j];
+		jt->goal = NAN;
+		jt->angle = NAN;
+		jt->speed = 0.0;
+		jt->voltage = NAN;
+		jt->temperature = NAN;
+		jt->servo.max_torque = 1023;
+		osc_velocity_filter_init(&jt->vfilter, cfg->velocity_cutoff_hz);
+		osc_estimator_init(&jt->estimator);
+		c->hold[j] = NAN;
+		c->blend_from[j] = NAN;
+	}
+}
+
+bool ctl_set_servo(struct ctl *c, size_t j, const struct ctl_servo_info *info, char *why, size_t cap)
+{
+	struct ctl_joint *jt = &c->j[j];
+	const struct cfg_joint *cj = &c->cfg->joint[j];
+	jt->servo = *info;
+	if (dxl_is_wheel_mode(info->cw_limit, info->ccw_limit)) {
+		snprintf(why, cap, "servo %u is in wheel mode (both angle limits 0): set its angle limits "
+		         "(dxl --port PATH write %u ccw_angle_limit 1023)", jt->id, jt->id);
+		return false;
+	}
+	if (!safety_limits_make(&jt->limits, cj->neutral, cj->limit_min, cj->limit_max, info->cw_limit,
+	                        info->ccw_limit, cj->max_step)) {
+		snprintf(why, cap, "joint %zu (servo %u): configured limits neutral %+.3f + [%.3f, %.3f] rad and the "
+		         "servo's angle limits %u..%u (%.3f..%.3f rad) have no angle in common", j, jt->id,
+		         cj->neutral, cj->limit_min, cj->limit_max, info->cw_limit, info->ccw_limit,
+		         dxl_pos_to_rad(info->cw_limit), dxl_pos_to_rad(info->ccw_limit));
+		return false;
+	}
+	return true;
+}
+
+/* Limits follow parameter changes (limit_min/max, neutral, max_step). */
+static void ctl_refresh_limits(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		const struct cfg_joint *cj = &c->cfg->joint[j];
+		struct safety_limits l;
+		if (safety_limits_make(&l, cj->neutral, cj->limit_min, cj->limit_max, jt->servo.cw_limit,
+		                       jt->servo.ccw_limit, cj->max_step))
+			jt->limits = l;
+	}
+}
+
+static void ctl_blend_joint(struct ctl *c, size_t j, double from)
+{
+	if (c->cfg->ramp_s <= 0.0 || !isfinite(from))
+		return;
+	c->blend_from[j] = from;
+	c->blend_t0[j] = c->t;
+}
+
+static void ctl_blend_stop(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++)
+		c->blend_from[j] = NAN;
+}
+
+static bool ctl_is_still(const struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++)
+		if (!(fabs(c->j[j].speed) < CTL_REST_V))
+			return false;
+	return true;
+}
+
+/* Drive the baseline sinusoid for ramp_s plus one period, then hand over. */
+static void ctl_starter(struct ctl *c)
+{
+	double period = c->cfg->frequency > 0.0 ? 1.0 / c->cfg->frequency : 1.0;
+	c->starter_until = c->t + c->cfg->ramp_s + period;
+	c->starter_active = true;
+	c->starts++;
+}
+
+static double ctl_present_or_goal(const struct ctl_joint *jt)
+{
+	if (jt->torque && isfinite(jt->goal))
+		return jt->goal;
+	return jt->angle;
+}
+
+void ctl_start(struct ctl *c, double t, const char *reason)
+{
+	c->t = t;
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		jt->fault = CTL_FAULT_NONE;
+		jt->retries = 0;
+		/* the ramp starts where the joint is: no jump at torque-on */
+		jt->goal = jt->angle;
+		c->hold[j] = jt->angle;
+		if (c->mode == CFG_MODE_LIMP) {
+			ctl_torque_write(c, j, false);
+			continue;
+		}
+		ctl_torque_write(c, j, true);
+		ctl_blend_joint(c, j, jt->angle);
+	}
+	if (c->mode == CFG_MODE_OSCILLATOR)
+		ctl_starter(c);
+	ctl_event(c, 0, "start", "%s: %s, ramping in over %.1f s", reason, cfg_mode_name(c->mode),
+	          c->mode == CFG_MODE_LIMP ? 0.0 : c->cfg->ramp_s);
+}
+
+void ctl_bus_lost(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		c->j[j].fresh = false;
+		c->j[j].torque = false;
+		/* the next reading after reconnecting starts a new difference */
+		osc_velocity_filter_init(&c->j[j].vfilter, c->cfg->velocity_cutoff_hz);
+	}
+	ctl_blend_stop(c);
+	c->fade_mode = CFG_NMODES;
+}
+
+void ctl_measure(struct ctl *c, size_t j, uint16_t pos_raw, uint16_t speed_raw, uint16_t load_raw,
+                 uint8_t errbits, double dt)
+{
+	struct ctl_joint *jt = &c->j[j];
+	jt->fresh = true;
+	jt->have_reading = true;
+	/* back after a gap: blend from the held goal to where the mode is now */
+	jt->resumed = jt->stale_cycles >= CTL_RESUME_STALE;
+	jt->stale_cycles = 0;
+	jt->angle = dxl_pos_to_rad(pos_raw);
+	jt->load = dxl_load_to_fraction(load_raw);
+	jt->errbits = errbits;
+	/* Keep the filter primed whichever source is configured, so switching
+	 * velocity_source at run time has no transient. */
+	double filtered = osc_velocity_filter_update(&jt->vfilter, jt->angle, dt);
+	jt->speed = c->cfg->velocity_source == CFG_VEL_SERVO ? dxl_speed_to_rad_s(speed_raw) : filtered;
+	if (!isfinite(jt->speed))
+		jt->speed = 0.0;
+}
+
+void ctl_measure_slow(struct ctl *c, size_t j, uint8_t voltage_raw, uint8_t temperature_raw, uint8_t errbits)
+{
+	c->j[j].voltage = dxl_voltage_to_volts(voltage_raw);
+	c->j[j].temperature = temperature_raw;
+	c->j[j].errbits |= errbits;
+}
+
+static void ctl_hold_at_present(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++)
+		c->hold[j] = isfinite(c->j[j].angle) ? c->j[j].angle : c->j[j].goal;
+}
+
+void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
+{
+	enum cfg_mode old = c->mode;
+	snprintf(c->reason, sizeof c->reason, "%s", reason);
+	for (size_t j = 0; j < c->n; j++) {
+		/* an explicit mode change is the operator taking over after a failure */
+		if (c->j[j].fault == CTL_FAULT_FAILED) {
+			c->j[j].fault = CTL_FAULT_NONE;
+			c->j[j].retries = 0;
+		}
+	}
+	if (mode == old)
+		return;
+	bool was_still = old == CFG_MODE_LIMP || old == CFG_MODE_HOLD || ctl_is_still(c);
+	/* an OSCILLATOR still in its starter is commanding the sinusoid */
+	enum cfg_mode commanding = old == CFG_MODE_OSCILLATOR && c->starter_active ? CFG_MODE_SINUSOID : old;
+	bool was_moving_mode = commanding == CFG_MODE_SINUSOID || commanding == CFG_MODE_OSCILLATOR;
+	bool moving = !was_still && was_moving_mode &&
+	              (mode == CFG_MODE_SINUSOID || mode == CFG_MODE_OSCILLATOR);
+	c->mode = mode;
+	c->starter_active = false;
+	c->fade_mode = moving ? (int)commanding : CFG_NMODES;
+	c->fade_t0 = c->t;
+	ctl_blend_stop(c);
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		if (mode == CFG_MODE_LIMP) {
+			ctl_torque_write(c, j, false);
+			continue;
+		}
+		double from = ctl_present_or_goal(jt);
+		if (!jt->torque) {
+			/* from LIMP: the joint may have been moved by hand; start where it is */
+			ctl_torque_write(c, j, true);
+			from = jt->angle;
+			jt->goal = jt->angle;
+			ctl_blend_joint(c, j, from);
+		}
+		c->hold[j] = from;
+		/* OSCILLATOR from a moving robot starts from the measured state:
+		 * continuous by itself. SINUSOID (and the starter of an OSCILLATOR
+		 * from rest) follows a clock: blend from where the joint is commanded. */
+		if (!moving && (mode == CFG_MODE_SINUSOID || (mode == CFG_MODE_OSCILLATOR && was_still)))
+			ctl_blend_joint(c, j, from);
+	}
+	if (mode == CFG_MODE_OSCILLATOR && was_still)
+		ctl_starter(c);
+	ctl_event(c, 0, "mode", "mode %s -> %s (%s)", cfg_mode_name(old), cfg_mode_name(mode), reason);
+}
+
+void ctl_params_changed(struct ctl *c)
+{
+	ctl_refresh_limits(c);
+	if (c->mode != CFG_MODE_SINUSOID)
+		return;
+	for (size_t j = 0; j < c->n; j++)
+		ctl_blend_joint(c, j, ctl_present_or_goal(&c->j[j]));
+}
+
+void ctl_torque(struct ctl *c, bool on)
+{
+	if (!on) {
+		ctl_set_mode(c, CFG_MODE_LIMP, "command: torque off");
+		return;
+	}
+	if (c->mode == CFG_MODE_LIMP)
+		ctl_set_mode(c, CFG_MODE_HOLD, "command: torque on");
+}
+
+/* ---- faults ------------------------------------------------------------------------------- */
+static void ctl_backoff(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	jt->fault = CTL_FAULT_BACKOFF;
+	jt->fault_since = c->t;
+	jt->fault_hold = isfinite(jt->angle) ? jt->angle : jt->goal;
+	uint16_t reduced = (uint16_t)lround(c->cfg->backoff_torque * jt->servo.max_torque);
+	ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, reduced);
+}
+
+static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what)
+{
+	struct ctl_joint *jt = &c->j[j];
+	jt->fault = CTL_FAULT_FAILED;
+	enum cfg_mode m = c->cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD;
+	char reason[96];
+	snprintf(reason, sizeof reason, "fault: servo %u %s persists", jt->id, what);
+	ctl_event(c, 2, "fault-persistent", "servo %u: %s persists after %d recovery attempts: robot %s; "
+	          "cool down / check the mechanics, then send a mode command", jt->id, what, jt->retries,
+	          cfg_mode_name(m));
+	/* hold where the joints are, not where the failing joint was told to go */
+	ctl_hold_at_present(c);
+	if (c->mode == m) {
+		snprintf(c->reason, sizeof c->reason, "%s", reason);
+		return;
+	}
+	enum cfg_mode old = c->mode;
+	c->mode = m;
+	c->fade_mode = CFG_NMODES;
+	ctl_blend_stop(c);
+	snprintf(c->reason, sizeof c->reason, "%s", reason);
+	if (m == CFG_MODE_LIMP)
+		for (size_t k = 0; k < c->n; k++)
+			ctl_torque_write(c, k, false);
+	ctl_event(c, 2, "mode", "mode %s -> %s (%s)", cfg_mode_name(old), cfg_mode_name(m), reason);
+}
+
+/* Error bits other than the fault kinds (voltage, angle limit, range,
+ * checksum, instruction) are reported once when they appear. */
+static void ctl_report_errbits(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (!jt->fresh)
+		return;
+	uint8_t other = jt->errbits & (uint8_t)~(DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT);
+	uint8_t fresh_bits = other & (uint8_t)~jt->reported_bits;
+	jt->reported_bits = other;
+	if (fresh_bits == 0)
+		return;
+	char what[96];
+	dxl_errbits_format(fresh_bits, what, sizeof what);
+	ctl_event(c, 1, "servo-error", "servo %u reports %s (error byte 0x%02x)", jt->id, what, jt->errbits);
+}
+
+static void ctl_fault_step(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	uint8_t bad = jt->fresh ? (jt->errbits & (DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT)) : 0;
+	char what[64];
+	dxl_errbits_format(bad ? bad : jt->errbits, what, sizeof what);
+	switch (jt->fault) {
+	case CTL_FAULT_NONE:
+		if (!bad)
+			return;
+		jt->faults++;
+		c->faults++;
+		jt->retries = 0;
+		ctl_backoff(c, j);
+		ctl_event(c, 1, "fault", "servo %u: %s: backing off (holding at %+.3f rad, torque limit %.0f %%)",
+		          jt->id, what, jt->fault_hold, 100.0 * c->cfg->backoff_torque);
+		return;
+	case CTL_FAULT_BACKOFF:
+		if (c->t - jt->fault_since < c->cfg->fault_backoff_s)
+			return;
+		if (c->mode != CFG_MODE_LIMP)
+			ctl_torque_write(c, j, true);
+		else
+			ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, jt->servo.max_torque);
+		jt->fault = CTL_FAULT_CHECK;
+		jt->fault_since = c->t;
+		jt->errbits = 0;
+		return;
+	case CTL_FAULT_CHECK:
+		if (bad) {
+			jt->retries++;
+			if (jt->retries > c->cfg->fault_retries) {
+				ctl_fault_persistent(c, j, what);
+				return;
+			}
+			ctl_backoff(c, j);
+			ctl_event(c, 1, "fault", "servo %u: %s persists, recovery attempt %d of %d", jt->id, what,
+			          jt->retries, c->cfg->fault_retries);
+			return;
+		}
+		if (c->t - jt->fault_since < CTL_FAULT_CHECK_S)
+			return;
+		jt->fault = CTL_FAULT_NONE;
+		ctl_event(c, 0, "recovered", "servo %u: recovered (torque limit %u, torque on)", jt->id,
+		          jt->servo.max_torque);
+		jt->goal = isfinite(jt->angle) ? jt->angle : jt->goal;
+		if (c->mode == CFG_MODE_HOLD)
+			c->hold[j] = jt->goal;
+		else
+			ctl_blend_joint(c, j, jt->goal);
+		return;
+	case CTL_FAULT_FAILED:
+		return;
+	}
+}
+
+/* ---- the step ------------------------------------------------------------------------------ */
+static void ctl_targets_oscillator(struct ctl *c, double dt, double *target)
+{
+	double x[CFG_MAX_JOINTS], v[CFG_MAX_JOINTS], xn[CFG_MAX_JOINTS];
+	struct osc_joint_params p[CFG_MAX_JOINTS];
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
+		p[j] = c->cfg->joint[j].osc;
+		x[j] = jt->angle - c->cfg->joint[j].neutral;
+		v[j] = jt->fresh ? jt->speed : 0.0;
+	}
+	/* The horizon: the measured period, bounded (after a stall the oscillator
+	 * must not leap seconds ahead), plus the servo's lead — the AX-12 lags its
+	 * goal by ~27 ms, so a goal one period ahead damps the loop out (CONTROL.md). */
+	double period = c->cfg->period_ms * 1e-3;
+	double h = fmin(fmax(dt, 0.25 * period), 3.0 * period) + c->cfg->servo_lead_s;
+	if (!osc_step(p, c->n, x, v, h, CTL_OSC_SUBSTEPS, xn, NULL)) {
+		for (size_t j = 0; j < c->n; j++)
+			target[j] = NAN;
+		return;
+	}
+	for (size_t j = 0; j < c->n; j++)
+		target[j] = c->cfg->joint[j].neutral + xn[j];
+}
+
+static void ctl_targets(struct ctl *c, enum cfg_mode mode, double dt, double t_real, double *target)
+{
+	switch (mode) {
+	case CFG_MODE_LIMP:
+		for (size_t j = 0; j < c->n; j++)
+			target[j] = NAN;
+		return;
+	case CFG_MODE_HOLD:
+		for (size_t j = 0; j < c->n; j++)
+			target[j] = c->hold[j];
+		return;
+	case CFG_MODE_OSCILLATOR:
+	case CFG_MODE_SINUSOID:
+		if (mode == CFG_MODE_OSCILLATOR && !c->starter_active) {
+			ctl_targets_oscillator(c, dt, target);
+			return;
+		}
+		/* SINUSOID, or the OSCILLATOR's starter */
+		for (size_t j = 0; j < c->n; j++)
+			target[j] = c->cfg->joint[j].neutral +
+			            osc_sinusoid(c->cfg->amplitude, c->cfg->frequency, c->cfg->phase, j, t_real);
+		return;
+	}
+}
+
+/* An oscillator that has come to rest (blocked, or parameters that damp it)
+ * is started again, and says so. */
+static void ctl_check_stall(struct ctl *c)
+{
+	bool fresh = true;
+	for (size_t j = 0; j < c->n; j++)
+		fresh = fresh && c->j[j].fresh;
+	bool running = c->mode == CFG_MODE_OSCILLATOR && !c->starter_active;
+	c->rest_cycles = running && fresh && ctl_is_still(c) ? c->rest_cycles + 1 : 0;
+	if (c->rest_cycles < CTL_STALL_CYCLES)
+		return;
+	c->rest_cycles = 0;
+	for (size_t j = 0; j < c->n; j++)
+		ctl_blend_joint(c, j, ctl_present_or_goal(&c->j[j]));
+	ctl_starter(c);
+	ctl_event(c, 1, "stall", "oscillator at rest for %.1f s: restarting it with the sinusoid starter",
+	          CTL_STALL_CYCLES * c->cfg->period_ms * 1e-3);
+}
+
+/* Between two moving modes (SINUSOID <-> OSCILLATOR) the old mode's target
+ * keeps being computed and the commanded angle fades from it to the new one
+ * over ramp_s: neither a jump nor a stop. */
+static void ctl_crossfade(struct ctl *c, double dt, double t_real, double *target)
+{
+	if (c->fade_mode == CFG_NMODES)
+		return;
+	double s = c->cfg->ramp_s > 0.0 ? (c->t - c->fade_t0) / c->cfg->ramp_s : 1.0;
+	if (s >= 1.0) {
+		c->fade_mode = CFG_NMODES;
+		return;
+	}
+	double from[CFG_MAX_JOINTS];
+	ctl_targets(c, (enum cfg_mode)c->fade_mode, dt, t_real, from);
+	double w = s <= 0.0 ? 0.0 : s * s * (3.0 - 2.0 * s);
+	for (size_t j = 0; j < c->n; j++)
+		if (isfinite(from[j]) && isfinite(target[j]))
+			target[j] = from[j] + w * (target[j] - from[j]);
+}
+
+/* Smoothstep: zero slope at both ends, so the blend adds no velocity kick. */
+static double ctl_blend_weight(const struct ctl *c, size_t j)
+{
+	if (!isfinite(c->blend_from[j]) || c->cfg->ramp_s <= 0.0)
+		return 1.0;
+	double s = (c->t - c->blend_t0[j]) / c->cfg->ramp_s;
+	if (s <= 0.0)
+		return 0.0;
+	if (s >= 1.0)
+		return 1.0;
+	return s * s * (3.0 - 2.0 * s);
+}
+
+static void ctl_finish_joint(struct ctl *c, size_t j, double desired)
+{
+	struct ctl_joint *jt = &c->j[j];
+	jt->write_goal = false;
+	jt->clamp_flags = 0;
+	if (c->mode == CFG_MODE_LIMP || !jt->torque) {
+		jt->goal = jt->angle;   /* reported only: nothing is written while limp */
+		return;
+	}
+	if (jt->fault != CTL_FAULT_NONE)
+		desired = jt->fault_hold;
+	if (!jt->fresh)
+		desired = jt->goal;     /* stale: hold the last goal */
+	if (jt->limits.max_step <= 0.0 || !jt->have_reading)
+		return;                 /* never talked to this servo: nothing safe to send */
+	unsigned flags;
+	double goal = safety_clamp(&jt->limits, desired, jt->goal, jt->angle, &flags);
+	if (flags & SAFETY_NONFINITE)
+		c->nonfinite++;
+	if (flags & (SAFETY_STEP | SAFETY_LIMIT))
+		c->clamps++;
+	jt->clamp_flags = flags;
+	jt->goal = goal;
+	jt->write_goal = true;
+}
+
+static void ctl_update_estimates(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (!jt->fresh)
+		return;
+	const struct cfg_joint *cj = &c->cfg->joint[j];
+	double x = jt->angle - cj->neutral;
+	osc_estimator_update(&jt->estimator, x, c->t);
+	double omega = jt->estimator.frequency > 0.0 ? 2.0 * 3.14159265358979323846 * jt->estimator.frequency
+	                                            : sqrt(cj->osc.k / cj->osc.inertia);
+	jt->phase = osc_phase(x, jt->speed, omega);
+}
+
+void ctl_step(struct ctl *c, double t, double dt, double t_real)
+{
+	c->t = t;
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		if (!jt->fresh) {
+			jt->stale_cycles++;
+			if (jt->stale_cycles == c->cfg->stale_limit && jt->have_reading)
+				ctl_event(c, 1, "stale", "servo %u: no valid reading for %d cycles, joint holds", jt->id,
+				          jt->stale_cycles);
+		}
+		ctl_report_errbits(c, j);
+		ctl_fault_step(c, j);
+		if (jt->fresh && jt->resumed) {
+			jt->resumed = false;
+			ctl_blend_joint(c, j, jt->goal);
+		}
+	}
+	ctl_check_stall(c);
+	if (c->starter_active && c->t >= c->starter_until) {
+		/* the starter hands over to the oscillator: cross-fade, no step */
+		c->starter_active = false;
+		if (c->mode == CFG_MODE_OSCILLATOR) {
+			c->fade_mode = CFG_MODE_SINUSOID;
+			c->fade_t0 = c->t;
+		}
+	}
+	double target[CFG_MAX_JOINTS];
+	ctl_targets(c, c->mode, dt, t_real, target);
+	ctl_crossfade(c, dt, t_real, target);
+	for (size_t j = 0; j < c->n; j++) {
+		double w = ctl_blend_weight(c, j);
+		if (w < 1.0 && isfinite(target[j]))
+			target[j] = c->blend_from[j] + w * (target[j] - c->blend_from[j]);
+		else if (w >= 1.0)
+			c->blend_from[j] = NAN;
+		ctl_finish_joint(c, j, target[j]);
+		ctl_update_estimates(c, j);
+		c->j[j].fresh = false;
+	}
+}

@@ -1,0 +1,96 @@
+/* log.c — see log.h. */
+#include "log.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <strings.h>
+
+static enum log_level log_threshold = LOG_LVL_INFO;
+
+void log_set_level(enum log_level level) { log_threshold = level; }
+enum log_level log_get_level(void) { return log_threshold; }
+
+bool log_level_parse(const char *name, enum log_level *out)
+{
+	static const struct { const char *name; enum log_level level; } names[] = {
+		{ "error", LOG_LVL_ERROR }, { "warn", LOG_LVL_WARN }, { "warning", LOG_LVL_WARN },
+		{ "info", LOG_LVL_INFO }, { "debug", LOG_LVL_DEBUG },
+	};
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+		if (strcasecmp(name, names[i].name) == 0) {
+			*out = names[i].level;
+			return true;
+		}
+	}
+	return false;
+}
+
+static const char *log_prefix(enum log_level level)
+{
+	switch (level) {
+	case LOG_LVL_ERROR: return "error";
+	case LOG_LVL_WARN: return "warning";
+	case LOG_LVL_INFO: return "info";
+	default: return "debug";
+	}
+}
+
+static void log_vmsg(enum log_level level, const char *suffix, const char *fmt, va_list ap)
+{
+	if (level > log_threshold)
+		return;
+	/* One fprintf per line: stderr is unbuffered and journald splits on writes. */
+	char line[512];
+	vsnprintf(line, sizeof line, fmt, ap);
+	fprintf(stderr, "undulated: %s: %s%s\n", log_prefix(level), line, suffix);
+}
+
+void log_msg(enum log_level level, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	log_vmsg(level, "", fmt, ap);
+	va_end(ap);
+}
+
+bool log_limit_allow(struct log_limit *lim, uint64_t now_us, uint32_t *suppressed_before)
+{
+	if (!lim->primed) {
+		lim->tokens = lim->burst;
+		lim->last_refill_us = now_us;
+		lim->primed = true;
+	}
+	if (lim->interval_us > 0 && now_us > lim->last_refill_us) {
+		uint64_t earned = (now_us - lim->last_refill_us) / lim->interval_us;
+		if (earned > 0) {
+			uint64_t t = lim->tokens + earned;
+			lim->tokens = t > lim->burst ? lim->burst : (uint32_t)t;
+			lim->last_refill_us += earned * lim->interval_us;
+		}
+	}
+	*suppressed_before = 0;
+	if (lim->tokens == 0) {
+		lim->suppressed++;
+		return false;
+	}
+	lim->tokens--;
+	*suppressed_before = lim->suppressed;
+	lim->suppressed = 0;
+	return true;
+}
+
+bool log_limited(struct log_limit *lim, uint64_t now_us, enum log_level level, const char *fmt, ...)
+{
+	uint32_t dropped;
+	if (!log_limit_allow(lim, now_us, &dropped))
+		return false;
+	char suffix[64] = "";
+	if (dropped > 0)
+		snprintf(suffix, sizeof suffix, " (%u similar messages suppressed)", (unsigned)dropped);
+	va_list ap;
+	va_start(ap, fmt);
+	log_vmsg(level, suffix, fmt, ap);
+	va_end(ap);
+	return true;
+}

@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# undulated against undulate-sim: the bus disappearing (the simulator's
+# disconnect, then the simulator killed and restarted) is survived — the loop
+# keeps its period, joints hold, the daemon reconnects with back-off, re-runs
+# its start-up checks and resumes from the present angles without a jump —
+# and SIGTERM with safe_stop = limp leaves the servos with torque off.
+. "$(dirname "$0")/../lib.sh"
+D="$B/undulated"; S="$B/undulate-sim"
+if [ ! -x "$S" ] || [ ! -x "$D" ]; then
+	echo "ok 1 # SKIP undulate-sim or undulated not built"; echo "1..1"; exit 0
+fi
+# a robot name of its own: a concurrent run of this test on the same
+# multicast port (another build directory) cannot answer for it
+R="u$$"
+URL=$(lcm_url 7702)
+ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+states() { grep "^STATE $R " "$T/watch.log"; }
+last_state() { states | tail -1; }
+cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
+count() { grep -c "^EVENT $R .*kind=$1 " "$T/watch.log"; }
+
+start_sim() {
+	spawn "$1" "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 7
+	wait_log "$1" 'ready' 10
+}
+start_sim sim || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
+spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode sinusoid --set robot.safe_stop=limp
+wait_log d "ready: $R.STATE" 10 || { tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
+wait_for 10 cycle_at_least 250
+
+# ---- the simulator drops the bus (like an unplugged adapter) and brings it back
+ctl disconnect r1 >/dev/null
+if wait_for 3 grep -q "^EVENT $R .*kind=bus-lost " "$T/watch.log"; then tap_ok "bus loss reported"; else
+	tap_fail "bus-lost event" "$(tail -3 "$T/d.log")"; fi
+c0=$(last_state | field cycle)
+wait_for 5 cycle_at_least $((c0 + 50))
+s=$(last_state)
+if [ "$(echo "$s" | field st0)" -ge 40 ] && alive d; then
+	tap_ok "loop keeps running without the bus (joints stale $(echo "$s" | field st0) cycles)"
+else tap_fail "loop runs without the bus" "$(echo "$s" | cut -c1-300)"; fi
+ctl reconnect r1 >/dev/null
+if wait_for 5 grep -q "^EVENT $R .*kind=bus-back " "$T/watch.log"; then tap_ok "reconnected after the bus came back"
+else tap_fail "bus-back event" "$(tail -5 "$T/d.log")"; fi
+
+# resumed without a jump: the first goals after the reconnect start at the
+# measured angles (the ramp), then the gait continues
+resume_check() { # NAME
+	local c1 line
+	c1=$(last_state | field cycle)
+	wait_for 5 cycle_at_least $((c1 + 30)) || true
+	line=$(states | awk -v c="$c1" '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
+		if (v["cycle"] >= c && v["st0"] == 0 && v["st1"] == 0) {
+			d0 = v["g0"] - v["a0"]; d1 = v["g1"] - v["a1"]; if (d0 < 0) d0 = -d0; if (d1 < 0) d1 = -d1
+			print d0, d1; exit } }')
+	if [ -n "$line" ] && awk -v l="$line" 'BEGIN { split(l, d, " "); exit !(d[1] < 0.03 && d[2] < 0.03) }'; then
+		tap_ok "$1: first goal after resuming = measured angle (|goal - angle| $line rad)"
+	else tap_fail "$1: resume without a jump" "|goal - angle| '$line'"; fi
+}
+resume_check "after reconnect"
+if [ "$(grep "^BUS $R " "$T/watch.log" | tail -1 | field reconnects)" -ge 1 ] ||
+	wait_for 2 sh -c "grep '^BUS $R ' '$T/watch.log' | tail -1 | grep -q ' reconnects=1 '"; then
+	tap_ok "reconnects counted in bus_stats_t"; else tap_fail "reconnects counted" "$(grep '^BUS' "$T/watch.log" | tail -1)"; fi
+
+# ---- the simulator exits (EIO on the pty) and is started again
+stop sim TERM >/dev/null
+if wait_for 3 sh -c "[ \$(grep -c '^EVENT $R .*kind=bus-lost ' '$T/watch.log') -ge 2 ]"; then
+	tap_ok "simulator exit seen as a bus loss"; else tap_fail "bus loss on sim exit" "$(tail -3 "$T/d.log")"; fi
+c0=$(last_state | field cycle)
+wait_for 5 cycle_at_least $((c0 + 100))   # a second without a simulator: back-off grows
+n_fail=$(grep -c 'reconnect failed' "$T/d.log")
+if alive d; then tap_ok "daemon alive while the simulator is gone ($n_fail failed reconnects logged)"; else
+	tap_fail "daemon alive" "$(tail -5 "$T/d.log")"; fi
+start_sim sim2 || tap_fail "simulator restarted" "$(cat "$T/sim2.log")"
+if wait_for 5 sh -c "[ \$(grep -c '^EVENT $R .*kind=bus-back ' '$T/watch.log') -ge 2 ]"; then
+	tap_ok "reconnected to the restarted simulator (start-up checks passed)"; else
+	tap_fail "reconnect after restart" "$(tail -5 "$T/d.log")"; fi
+resume_check "after simulator restart"
+c0=$(last_state | field cycle)
+wait_for 5 cycle_at_least $((c0 + 100))
+s=$(last_state)
+if [ "$(echo "$s" | field tq0)" = 1 ] && [ "$(echo "$s" | field st0)" = 0 ] && echo "$s" | grep -q ' mode=2 '; then
+	tap_ok "running again in SINUSOID with torque on"; else tap_fail "running again" "$(echo "$s" | cut -c1-300)"; fi
+p=$(states | awk '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] } if (v["period"] > m) m = v["period"] } END { print m }')
+echo "# longest period over the whole run: $p us (blocking start-up checks at reconnect)"
+
+# ---- SIGTERM with safe_stop = limp: torque off
+stop d TERM >"$T/stop.rc"; rc=$(cat "$T/stop.rc")
+[ "$rc" = 0 ] && tap_ok "SIGTERM: exit 0" || tap_fail "SIGTERM exit" "$rc"
+t1=$(ctl peek r1 1 torque_enable); t2=$(ctl peek r1 2 torque_enable)
+if [ "$t1" = "ok 0" ] && [ "$t2" = "ok 0" ]; then tap_ok "after SIGTERM (limp): torque off on both servos"
+else tap_fail "limp after SIGTERM" "servo 1 $t1, servo 2 $t2"; fi
+tap_done

@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# undulated's operation: --help, --check-config (errors name file, line and
+# key), a missing servo named with the baud tried, and the systemd
+# notification protocol (READY, STATUS, WATCHDOG, STOPPING) on a datagram
+# socket, without libsystemd.
+. "$(dirname "$0")/../lib.sh"
+D="$B/undulated"; S="$B/undulate-sim"
+if [ ! -x "$D" ]; then echo "ok 1 # SKIP undulated not built"; echo "1..1"; exit 0; fi
+# a robot name of its own: a concurrent run of this test on the same
+# multicast port (another build directory) cannot answer for it
+R="u$$"
+URL=$(lcm_url 7703)
+
+out=$("$D" --help); rc=$?
+if [ $rc -eq 0 ] && echo "$out" | grep -q -- '--check-config' && echo "$out" | grep -q -- '--command'; then
+	tap_ok "--help"; else tap_fail "--help" "rc $rc"; fi
+
+cat >"$T/good.conf" <<'CONF'
+[robot]
+name = robot7
+port = /dev/ttyUSB0
+ids = 1, 2
+mode = sinusoid
+safe_stop = limp
+
+[joint.1]
+k = 0.06
+[sinusoid]
+amplitude = 0.7
+CONF
+out=$("$D" --check-config "$T/good.conf" 2>&1); rc=$?
+if [ $rc -eq 0 ] && echo "$out" | grep -q 'ok (robot robot7, 2 joint(s), mode SINUSOID)'; then
+	tap_ok "--check-config accepts a good file"; else tap_fail "--check-config good" "rc $rc: $out"; fi
+out=$("$D" --check-config -v "$T/good.conf" --set joint.2.mu=0.2 2>&1)
+if echo "$out" | grep -q '^mu = 0.2$' && echo "$out" | grep -q '^safe_stop = limp$'; then
+	tap_ok "--check-config -v prints the merged configuration"; else tap_fail "--check-config -v" "$out"; fi
+
+out=$("$D" --check-config "$top/systemd/undulated.conf.example" 2>&1); rc=$?
+if [ $rc -eq 0 ]; then tap_ok "the example configuration is valid"; else tap_fail "example config" "$out"; fi
+
+printf '[robot]\nport = /dev/null\nids = 1\n\n[joint.1]\nk = abc\nlimt_max = 1\n' >"$T/bad.conf"
+out=$("$D" --check-config "$T/bad.conf" 2>&1); rc=$?
+if [ $rc -eq 1 ] && echo "$out" | grep -qF "$T/bad.conf:6: [joint.1] k: not a number 'abc'" &&
+	echo "$out" | grep -qF "$T/bad.conf:7: [joint.1] limt_max: unknown key"; then
+	tap_ok "--check-config names file:line, section and key of every error"
+else tap_fail "--check-config bad" "rc $rc: $out"; fi
+out=$("$D" --check-config "$T/good.conf" --set joint.1.c=x 2>&1); rc=$?
+if [ $rc -eq 1 ] && echo "$out" | grep -qF "command line: [joint.1] c: not a number 'x'"; then
+	tap_ok "command-line override errors are named"; else tap_fail "override error" "rc $rc: $out"; fi
+out=$("$D" --check-config --ids 1,2 2>&1); rc=$?
+if [ $rc -eq 1 ] && echo "$out" | grep -q 'no port configured'; then tap_ok "a missing port is an error"
+else tap_fail "missing port" "rc $rc: $out"; fi
+
+if [ ! -x "$S" ]; then echo "ok # SKIP undulate-sim not built"; tap_done; exit 0; fi
+spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 9
+wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
+
+# a servo that is not on the bus: named, with the baud, and the daemon exits 1
+out=$(timeout 10 "$D" --port "$T/bus" --ids 1,9 --robot "$R" --lcm-url "$URL" 2>&1); rc=$?
+if [ $rc -eq 1 ] && echo "$out" | grep -q "servo ID 9 did not answer a PING on $T/bus at 1000000 bps"; then
+	tap_ok "missing servo: ID and baud named, exit 1"; else tap_fail "missing servo" "rc $rc: $out"; fi
+
+# sd_notify: a datagram socket standing in for systemd
+spawn notify socat -u UNIX-RECV:"$T/notify" STDOUT
+wait_for 5 test -S "$T/notify"
+NOTIFY_SOCKET="$T/notify" WATCHDOG_USEC=200000 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode hold
+if wait_for 5 grep -q 'READY=1' "$T/notify.log"; then tap_ok "READY=1 sent"; else tap_fail "READY=1" "$(cat "$T/notify.log")"; fi
+if wait_for 5 grep -q 'STATUS=HOLD 100.0 Hz, 2 joints, bus ok, ' "$T/notify.log"; then
+	tap_ok "STATUS line: $(grep -o 'STATUS=HOLD 100.0 Hz[^W]*commands' "$T/notify.log" | tail -1)"; else tap_fail "STATUS" "$(cat "$T/notify.log")"; fi
+# socat writes the datagrams back to back: count occurrences, not lines
+wd() { grep -o 'WATCHDOG=1' "$T/notify.log" | wc -l; }
+if wait_for 3 sh -c "[ \$(grep -o 'WATCHDOG=1' '$T/notify.log' | wc -l) -ge 5 ]"; then
+	tap_ok "WATCHDOG=1 every half WATCHDOG_USEC while cycles complete"; else tap_fail "WATCHDOG" "$(wd)"; fi
+# a stalled loop stops feeding the watchdog
+kill -STOP "$pid_d"
+sleep 0.15; n1=$(wd); sleep 0.5; n2=$(wd)
+kill -CONT "$pid_d"
+if [ "$n1" = "$n2" ]; then tap_ok "no WATCHDOG=1 while the loop is stopped"; else tap_fail "watchdog while stalled" "$n1 -> $n2"; fi
+stop d TERM >"$T/rc"
+if wait_for 3 grep -q 'STOPPING=1' "$T/notify.log" && [ "$(cat "$T/rc")" = 0 ]; then tap_ok "STOPPING=1 and exit 0 on SIGTERM"
+else tap_fail "STOPPING" "rc $(cat "$T/rc"); $(tail -c 300 "$T/notify.log")"; fi
+tap_done

@@ -1,0 +1,215 @@
+/* test_daemon_command.c — LCM command validation: every rejection path, the
+ * accepted kinds, addressing, and the --command text parser. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "../../daemon/command.h"
+
+static struct cfg cfg;
+
+static int setup(void **state)
+{
+	(void)state;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&cfg);
+	cfg_override(&cfg, "robot.name=robot1", &e);
+	cfg_override(&cfg, "robot.port=/dev/null", &e);
+	cfg_override(&cfg, "robot.ids=1,2", &e);
+	return cfg_finish(&cfg, &e) ? 0 : -1;
+}
+
+static struct cmd_request base(int kind)
+{
+	return (struct cmd_request){ .seq = 7, .source = "test", .robot = "robot1", .kind = kind, .mode = 3,
+	                             .param = "k", .joint = -1, .value = 0.05, .torque = true };
+}
+
+/* Expect a rejection whose reason contains `needle`. */
+static void expect_reject(const struct cmd_request *r, bool direct, const char *needle)
+{
+	char why[256];
+	enum cmd_verdict v = cmd_check(r, &cfg, direct, why, sizeof why);
+	if (v != CMD_REJECT)
+		fail_msg("expected a rejection containing '%s', got verdict %d", needle, v);
+	if (strstr(why, needle) == NULL)
+		fail_msg("reason '%s' does not contain '%s'", why, needle);
+}
+
+static void expect_accept(const struct cmd_request *r)
+{
+	char why[256];
+	enum cmd_verdict v = cmd_check(r, &cfg, true, why, sizeof why);
+	if (v != CMD_ACCEPT)
+		fail_msg("expected acceptance, got %d: %s", v, why);
+}
+
+static void test_accepts_valid(void **state)
+{
+	(void)state;
+	for (int m = 0; m < 4; m++) {
+		struct cmd_request r = base(CMD_KIND_MODE);
+		r.mode = m;
+		expect_accept(&r);
+	}
+	struct cmd_request r = base(CMD_KIND_PARAM);
+	expect_accept(&r);
+	r.joint = 1;
+	r.param = "lambda";
+	r.value = -0.5;
+	expect_accept(&r);
+	r = base(CMD_KIND_PARAM);
+	r.param = "amplitude";
+	r.value = 0.6;
+	expect_accept(&r);
+	r = base(CMD_KIND_TORQUE);
+	expect_accept(&r);
+	r.robot = "*";
+	expect_accept(&r);
+}
+
+static void test_addressing(void **state)
+{
+	(void)state;
+	struct cmd_request r = base(CMD_KIND_MODE);
+	char why[256];
+	r.robot = "robot2";
+	/* on the shared channel another robot's command is simply not ours */
+	assert_int_equal(cmd_check(&r, &cfg, false, why, sizeof why), CMD_IGNORE);
+	/* on our own channel it is a mistake worth answering */
+	expect_reject(&r, true, "addressed to robot 'robot2'");
+	r.robot = NULL;
+	expect_reject(&r, true, "addressed to robot ''");
+}
+
+static void test_rejections(void **state)
+{
+	(void)state;
+	struct cmd_request r = base(CMD_KIND_MODE);
+	r.mode = 4;
+	expect_reject(&r, true, "unknown mode 4");
+	r.mode = -1;
+	expect_reject(&r, true, "unknown mode -1");
+
+	r = base(9);
+	expect_reject(&r, true, "unknown command kind 9");
+	r = base(0);
+	expect_reject(&r, true, "unknown command kind 0");
+
+	r = base(CMD_KIND_PARAM);
+	r.param = "kk";
+	expect_reject(&r, true, "unknown parameter 'kk'");
+	r.param = NULL;
+	expect_reject(&r, true, "unknown parameter ''");
+	r = base(CMD_KIND_PARAM);
+	r.value = NAN;
+	expect_reject(&r, true, "not finite");
+	r.value = INFINITY;
+	expect_reject(&r, true, "not finite");
+	r.value = -INFINITY;
+	expect_reject(&r, true, "not finite");
+	r = base(CMD_KIND_PARAM);
+	r.joint = 2;
+	expect_reject(&r, true, "joint 2 does not exist");
+	r.joint = -2;
+	expect_reject(&r, true, "joint -2 does not exist");
+	r = base(CMD_KIND_PARAM);
+	r.value = 0.0;   /* k > 0 */
+	expect_reject(&r, true, "out of range");
+	r.value = 5000;
+	expect_reject(&r, true, "out of range");
+	r = base(CMD_KIND_PARAM);
+	r.param = "max_step";
+	r.value = 0.9;
+	expect_reject(&r, true, "out of range");
+	r = base(CMD_KIND_PARAM);
+	r.param = "frequency";
+	r.joint = 0;
+	expect_reject(&r, true, "per robot: joint must be -1");
+	r = base(CMD_KIND_PARAM);
+	r.param = "limit_min";
+	r.value = 0.2;   /* must stay <= 0 */
+	expect_reject(&r, true, "must contain 0");
+	r = base(CMD_KIND_PARAM);
+	r.param = "neutral";
+	r.value = 2.0;   /* 2.0 + 1.3 leaves ±2.618 */
+	expect_reject(&r, true, "servo's");
+}
+
+static void test_disabled(void **state)
+{
+	(void)state;
+	cfg.commands = false;
+	struct cmd_request r = base(CMD_KIND_MODE);
+	expect_reject(&r, true, "commands are disabled");
+	r.robot = "*";
+	expect_reject(&r, false, "commands are disabled");
+	cfg.commands = true;
+}
+
+static void test_apply(void **state)
+{
+	(void)state;
+	struct cfg c = cfg;
+	struct cmd_request r = base(CMD_KIND_PARAM);
+	r.param = "c";
+	r.value = 0.004;
+	cmd_apply_param(&c, &r);
+	assert_true(c.joint[0].osc.c == 0.004 && c.joint[1].osc.c == 0.004);
+	r.joint = 1;
+	r.value = 0.005;
+	cmd_apply_param(&c, &r);
+	assert_true(c.joint[0].osc.c == 0.004 && c.joint[1].osc.c == 0.005);
+	r = base(CMD_KIND_PARAM);
+	r.param = "phase";
+	r.value = 1.25;
+	cmd_apply_param(&c, &r);
+	assert_true(c.phase == 1.25);
+}
+
+static void test_parse_text(void **state)
+{
+	(void)state;
+	struct cmd_request r;
+	char p[32], why[128];
+	memset(&r, 0, sizeof r);
+	assert_true(cmd_parse_text("mode oscillator", &r, p, sizeof p, why, sizeof why));
+	assert_int_equal(r.kind, CMD_KIND_MODE);
+	assert_int_equal(r.mode, CFG_MODE_OSCILLATOR);
+	assert_true(cmd_parse_text("mode 9", &r, p, sizeof p, why, sizeof why));
+	assert_int_equal(r.mode, 9);   /* passed through: the daemon validates */
+	assert_true(cmd_parse_text("param k 0.06 1", &r, p, sizeof p, why, sizeof why));
+	assert_int_equal(r.kind, CMD_KIND_PARAM);
+	assert_string_equal(r.param, "k");
+	assert_true(r.value == 0.06);
+	assert_int_equal(r.joint, 1);
+	assert_true(cmd_parse_text("param mu nan", &r, p, sizeof p, why, sizeof why));
+	assert_true(isnan(r.value));
+	assert_int_equal(r.joint, -1);
+	assert_true(cmd_parse_text("torque off", &r, p, sizeof p, why, sizeof why));
+	assert_int_equal(r.kind, CMD_KIND_TORQUE);
+	assert_false(r.torque);
+	assert_false(cmd_parse_text("torque maybe", &r, p, sizeof p, why, sizeof why));
+	assert_false(cmd_parse_text("dance", &r, p, sizeof p, why, sizeof why));
+	assert_false(cmd_parse_text("param k fast", &r, p, sizeof p, why, sizeof why));
+	assert_false(cmd_parse_text("mode walk", &r, p, sizeof p, why, sizeof why));
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_accepts_valid),
+		cmocka_unit_test(test_addressing),
+		cmocka_unit_test(test_rejections),
+		cmocka_unit_test(test_disabled),
+		cmocka_unit_test(test_apply),
+		cmocka_unit_test(test_parse_text),
+	};
+	return cmocka_run_group_tests(tests, setup, NULL);
+}

@@ -1,0 +1,301 @@
+/* test_daemon_config.c — the robot configuration: a good file, every kind of
+ * error with file:line and key, command-line overrides, defaults. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../../daemon/config.h"
+
+/* cmocka 1.1.5 has no assert_double_equal */
+#define assert_double_equal(a, b, eps)                                                    \
+	do {                                                                              \
+		double a_ = (a), b_ = (b);                                                \
+		if (!(fabs(a_ - b_) <= (eps)))                                            \
+			fail_msg("%s = %.9g, expected %.9g", #a, a_, b_);                  \
+	} while (0)
+
+static const char good[] =
+	"; robot one\n"
+	"[robot]\n"
+	"name = robot1\n"
+	"port = /dev/ttyUSB0\n"
+	"baud = 1000000\n"
+	"ids = 3, 4\n"
+	"mode = sinusoid\n"
+	"lcm_url = udpm://239.255.76.67:7667?ttl=0\n"
+	"priority = 50\n"
+	"mlockall = on\n"
+	"safe_stop = limp\n"
+	"velocity_source = servo\n"
+	"commands = off\n"
+	"echo = no\n"
+	"adapter_latency_us = 1000\n"
+	"\n"
+	"[joint.1]\n"
+	"k = 0.06\n"
+	"lambda = 1.5\n"
+	"neutral = 0.1\n"
+	"limit_min = -1.0\n"
+	"limit_max = 1.2\n"
+	"max_step = 0.05\n"
+	"[joint.2]\n"
+	"mu = 0.2   ; inline comment\n"
+	"[sinusoid]\n"
+	"amplitude = 0.7\n"
+	"frequency = 0.9\n"
+	"phase = 1.0\n";
+
+static void load_ok(struct cfg *c, const char *text)
+{
+	struct cfg_errors e = { 0 };
+	cfg_defaults(c);
+	bool ok = cfg_load_string(c, "robot1.conf", text, &e) && cfg_finish(c, &e);
+	if (!ok)
+		fail_msg("unexpected error: %s", e.line[0]);
+}
+
+/* Loads text, expects exactly one error, returns it. */
+static const char *load_error(const char *text, char *buf, size_t cap)
+{
+	static struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	if (cfg_load_string(&c, "robot1.conf", text, &e))
+		cfg_finish(&c, &e);
+	assert_int_equal(e.count, 1);
+	snprintf(buf, cap, "%s", e.line[0]);
+	return buf;
+}
+
+static void test_good_file(void **state)
+{
+	(void)state;
+	struct cfg c;
+	load_ok(&c, good);
+	assert_string_equal(c.name, "robot1");
+	assert_string_equal(c.port, "/dev/ttyUSB0");
+	assert_int_equal(c.baud, 1000000);
+	assert_int_equal(c.njoints, 2);
+	assert_int_equal(c.ids[0], 3);
+	assert_int_equal(c.ids[1], 4);
+	assert_int_equal(c.mode, CFG_MODE_SINUSOID);
+	assert_string_equal(c.lcm_url, "udpm://239.255.76.67:7667?ttl=0");
+	assert_int_equal(c.priority, 50);
+	assert_true(c.mlockall);
+	assert_int_equal(c.safe_stop, CFG_SAFE_LIMP);
+	assert_int_equal(c.velocity_source, CFG_VEL_SERVO);
+	assert_false(c.commands);
+	assert_false(c.echo);
+	assert_int_equal(c.adapter_latency_us, 1000);
+	assert_double_equal(c.joint[0].osc.k, 0.06, 1e-12);
+	assert_double_equal(c.joint[0].neutral, 0.1, 1e-12);
+	assert_double_equal(c.joint[0].limit_min, -1.0, 1e-12);
+	assert_double_equal(c.joint[0].max_step, 0.05, 1e-12);
+	assert_double_equal(c.joint[1].osc.mu, 0.2, 1e-12);
+	assert_double_equal(c.amplitude, 0.7, 1e-12);
+	assert_double_equal(c.frequency, 0.9, 1e-12);
+	assert_double_equal(c.phase, 1.0, 1e-12);
+}
+
+static void test_defaults_from_osc(void **state)
+{
+	(void)state;
+	struct cfg c;
+	load_ok(&c, "[robot]\nport=/dev/null\nids=1,2\n[joint.1]\nk=0.07\n");
+	struct osc_joint_params d0, d1;
+	osc_default_params(&d0, 0, 2);
+	osc_default_params(&d1, 1, 2);
+	assert_double_equal(c.joint[0].osc.k, 0.07, 1e-12);       /* explicit wins */
+	assert_double_equal(c.joint[0].osc.c, d0.c, 1e-12);       /* the rest: oscillator defaults */
+	assert_double_equal(c.joint[0].osc.lambda, d0.lambda, 1e-12);
+	assert_double_equal(c.joint[1].osc.lambda, d1.lambda, 1e-12);
+	assert_double_equal(c.joint[1].osc.mu, d1.mu, 1e-12);
+	assert_int_equal(c.mode, CFG_MODE_OSCILLATOR);
+	assert_int_equal(c.safe_stop, CFG_SAFE_HOLD);
+	assert_true(c.commands);
+	assert_true(c.joint[0].limit_min < 0 && c.joint[0].limit_max > 0);
+	assert_true(c.joint[0].max_step > 0);
+	assert_string_equal(c.name, "robot");
+}
+
+static void test_errors_name_file_line_key(void **state)
+{
+	(void)state;
+	char b[CFG_ERR_MAX];
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n\n[joint.1]\nk = abc\n", b, sizeof b),
+	                    "robot1.conf:6: [joint.1] k: not a number 'abc'");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nbuad = 9600\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] buad: unknown key");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nkk = 1\n", b, sizeof b),
+	                    "robot1.conf:5: [joint.1] kk: unknown key");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[jiont.1]\nk = 1\n", b, sizeof b),
+	                    "robot1.conf:5: [jiont.1]: unknown section (robot, joint.N, sinusoid)");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.9]\nk = 1\n", b, sizeof b),
+	                    "robot1.conf:5: [joint.9]: joint sections are [joint.1] .. [joint.8]");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nmode = walk\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] mode: 'walk' is not limp, hold, sinusoid or oscillator");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,1\n", b, sizeof b),
+	                    "robot1.conf:3: [robot] ids: servo ID 1 listed twice");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,300\n", b, sizeof b),
+	                    "robot1.conf:3: [robot] ids: servo ID 300 out of range 0..253");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nbaud=fast\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] baud: not an integer 'fast'");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\npriority=120\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] priority: 120 out of range 0..99");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nmlockall=maybe\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] mlockall: not on/off 'maybe'");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nsafe_stop=drop\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] safe_stop: 'drop' is not hold or limp");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nvelocity_source=gps\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] velocity_source: 'gps' is not servo or filtered");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nname=a.b\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] name: 'a.b' must be non-empty without '.', '*' or spaces "
+	                    "(it prefixes LCM channels)");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nk = 0\n", b, sizeof b),
+	                    "robot1.conf:5: [joint.1] k: 0 out of range >0..1000");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nmax_step = nan\n", b, sizeof b),
+	                    "robot1.conf:5: [joint.1] max_step: not a number 'nan'");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\nfrequency = 9\n", b, sizeof b),
+	                    "robot1.conf:5: [sinusoid] frequency: 9 out of range 0..5");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\nperiod = 1\n", b, sizeof b),
+	                    "robot1.conf:5: [sinusoid] period: unknown key (amplitude, frequency, phase)");
+	assert_string_equal(load_error("k = 1\n[robot]\nport=/dev/null\nids=1\n", b, sizeof b),
+	                    "robot1.conf:1: k: key outside any section (start with [robot])");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nthis line has no equals\n", b, sizeof b),
+	                    "robot1.conf:4: syntax error (expected [section] or key = value)");
+}
+
+static void test_whole_config_errors(void **state)
+{
+	(void)state;
+	char b[CFG_ERR_MAX];
+	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\n", b, sizeof b), "ids: no servo IDs"));
+	assert_non_null(strstr(load_error("[robot]\nids=1\n", b, sizeof b), "port: no port configured"));
+	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.2]\nk=1\n", b, sizeof b),
+	                       "[joint.2]: the robot has only 1 joint(s)"));
+	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nlimit_min=0.5\n"
+	                                  "limit_max=0.2\n", b, sizeof b), "limit_min: 0.5 is not below limit_max"));
+	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nneutral=2\nlimit_max=1\n",
+	                                  b, sizeof b), "leaves the servo's"));
+}
+
+static void test_every_error_reported(void **state)
+{
+	(void)state;
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_false(cfg_load_string(&c, "r.conf", "[robot]\nbaud=x\nids=1\n[joint.1]\nk=y\nc=z\n", &e));
+	assert_int_equal(e.count, 3);
+	assert_string_equal(e.line[0], "r.conf:2: [robot] baud: not an integer 'x'");
+	assert_string_equal(e.line[1], "r.conf:5: [joint.1] k: not a number 'y'");
+	assert_string_equal(e.line[2], "r.conf:6: [joint.1] c: not a number 'z'");
+}
+
+static void test_file_and_missing_file(void **state)
+{
+	(void)state;
+	char path[] = "/tmp/undulate-cfg-XXXXXX";
+	int fd = mkstemp(path);
+	assert_true(fd >= 0);
+	const char *text = "[robot]\nport = /dev/null\nids = 1\n[joint.1]\nc = oops\n";
+	assert_int_equal(write(fd, text, strlen(text)), (int)strlen(text));
+	close(fd);
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_false(cfg_load_file(&c, path, &e));
+	char want[128];
+	snprintf(want, sizeof want, "%s:5: [joint.1] c: not a number 'oops'", path);
+	assert_string_equal(e.line[0], want);
+	unlink(path);
+	e.count = 0;
+	assert_false(cfg_load_file(&c, path, &e));
+	assert_non_null(strstr(e.line[0], "cannot open"));
+}
+
+static void test_overrides(void **state)
+{
+	(void)state;
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "r.conf", good, &e));
+	assert_true(cfg_override(&c, "robot.port=/tmp/bus", &e));
+	assert_true(cfg_override(&c, "robot.ids=7,8", &e));
+	assert_true(cfg_override(&c, "joint.1.k=0.09", &e));
+	assert_true(cfg_override(&c, "sinusoid.amplitude=0.5", &e));
+	assert_true(cfg_override(&c, "robot.mode=HOLD", &e));
+	assert_true(cfg_finish(&c, &e));
+	assert_string_equal(c.port, "/tmp/bus");
+	assert_int_equal(c.njoints, 2);
+	assert_int_equal(c.ids[0], 7);
+	assert_double_equal(c.joint[0].osc.k, 0.09, 1e-12);
+	assert_double_equal(c.amplitude, 0.5, 1e-12);
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+	assert_int_equal(e.count, 0);
+
+	assert_false(cfg_override(&c, "joint.1.k=abc", &e));
+	assert_string_equal(e.line[0], "command line: [joint.1] k: not a number 'abc'");
+	assert_false(cfg_override(&c, "robotport=/x", &e));
+	assert_non_null(strstr(e.line[1], "expected section.key=value"));
+	assert_false(cfg_override(&c, "robot.prot=/x", &e));
+	assert_string_equal(e.line[2], "command line: [robot] prot: unknown key");
+}
+
+static void test_command_line_only(void **state)
+{
+	(void)state;
+	/* undulated --port PATH --ids 1,2: one robot, defaults, OSCILLATOR */
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.port=/dev/pts/9", &e));
+	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
+	assert_true(cfg_finish(&c, &e));
+	assert_int_equal(c.mode, CFG_MODE_OSCILLATOR);
+	assert_int_equal(c.njoints, 2);
+}
+
+static void test_param_ranges(void **state)
+{
+	(void)state;
+	struct cfg_range r;
+	assert_true(cfg_param_range("k", &r));
+	assert_true(r.min_open);
+	assert_false(cfg_param_range("kk", &r));
+	assert_true(cfg_param_is_joint("lambda"));
+	assert_false(cfg_param_is_joint("amplitude"));
+	assert_true(cfg_param_is_robot("amplitude"));
+	struct cfg_joint j;
+	assert_ptr_equal(cfg_joint_param(&j, "friction"), &j.osc.friction);
+	assert_null(cfg_joint_param(&j, "amplitude"));
+	enum cfg_mode m;
+	assert_true(cfg_mode_parse("Oscillator", &m));
+	assert_int_equal(m, CFG_MODE_OSCILLATOR);
+	assert_false(cfg_mode_parse("run", &m));
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_good_file),
+		cmocka_unit_test(test_defaults_from_osc),
+		cmocka_unit_test(test_errors_name_file_line_key),
+		cmocka_unit_test(test_whole_config_errors),
+		cmocka_unit_test(test_every_error_reported),
+		cmocka_unit_test(test_file_and_missing_file),
+		cmocka_unit_test(test_overrides),
+		cmocka_unit_test(test_command_line_only),
+		cmocka_unit_test(test_param_ranges),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}

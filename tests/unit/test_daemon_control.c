@@ -1,0 +1,378 @@
+/* test_daemon_control.c — the controller between bus and control laws, with a
+ * small servo model in the loop: start-up ramp, mode switches without jumps,
+ * stale readings hold, fault back-off / recovery / persistent failure, LIMP,
+ * and non-finite numbers never reaching a goal. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <string.h>
+
+#include "../../daemon/control.h"
+#include "dxl.h"
+#include "dxl_table.h"
+
+#define DT 0.01
+
+static struct cfg cfg;
+static struct ctl c;
+/* the servo model: a first-order lag of 27 ms (the AX-12's, CONTROL.md) toward
+ * its goal, at most 6 rad/s, quantized like an AX-12 */
+#define SERVO_TAU 0.027
+static double servo_angle[2];
+static uint8_t servo_err[2];
+static bool servo_answers[2];
+static double t;
+
+static void setup_robot(enum cfg_mode mode)
+{
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&cfg);
+	cfg_override(&cfg, "robot.port=/dev/null", &e);
+	cfg_override(&cfg, "robot.ids=1,2", &e);
+	cfg.mode = mode;
+	cfg.fault_backoff_s = 0.2;
+	cfg.fault_retries = 2;
+	assert_true(cfg_finish(&cfg, &e));
+	ctl_init(&c, &cfg);
+	char why[256];
+	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
+	for (size_t j = 0; j < 2; j++) {
+		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
+		servo_err[j] = 0;
+		servo_answers[j] = true;
+	}
+	servo_angle[0] = 0.3;
+	servo_angle[1] = -0.2;
+	t = 0.0;
+	for (size_t j = 0; j < 2; j++)
+		ctl_measure(&c, j, dxl_rad_to_pos(servo_angle[j]), 0, 0, 0, DT);
+	ctl_start(&c, t, "test");
+}
+
+static bool has_write(uint8_t id, uint8_t addr, uint16_t value)
+{
+	for (size_t i = 0; i < c.nwrites; i++)
+		if (c.writes[i].id == id && c.writes[i].addr == addr && c.writes[i].value == value)
+			return true;
+	return false;
+}
+
+static const struct ctl_event *find_event(const char *kind)
+{
+	for (size_t i = 0; i < c.nevents; i++)
+		if (strcmp(c.events[i].kind, kind) == 0)
+			return &c.events[i];
+	return NULL;
+}
+
+/* One cycle; returns the largest goal change of the cycle. */
+static double cycle(void)
+{
+	double before[2] = { c.j[0].goal, c.j[1].goal };
+	t += DT;
+	for (size_t j = 0; j < 2; j++) {
+		if (c.j[j].torque && isfinite(c.j[j].goal)) {
+			double d = (c.j[j].goal - servo_angle[j]) * (DT / SERVO_TAU);
+			if (DT > SERVO_TAU)
+				d = c.j[j].goal - servo_angle[j];
+			double lim = 6.0 * DT;
+			servo_angle[j] += d > lim ? lim : d < -lim ? -lim : d;
+		}
+		if (servo_answers[j])
+			ctl_measure(&c, j, dxl_rad_to_pos(servo_angle[j]), 0, 0, servo_err[j], DT);
+	}
+	ctl_clear_outputs(&c);
+	ctl_step(&c, t, DT, t);
+	double m = 0.0;
+	for (size_t j = 0; j < 2; j++) {
+		assert_true(isfinite(c.j[j].goal));
+		if (isfinite(before[j]) && c.j[j].write_goal)
+			m = fmax(m, fabs(c.j[j].goal - before[j]));
+	}
+	return m;
+}
+
+static double run(int n)
+{
+	double m = 0.0;
+	for (int i = 0; i < n; i++)
+		m = fmax(m, cycle());
+	return m;
+}
+
+static void test_start_hold(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_HOLD);
+	/* start: torque limit back and torque on, per servo */
+	assert_true(has_write(1, DXL_AX_TORQUE_LIMIT, 1023) && has_write(1, DXL_AX_TORQUE_ENABLE, 1));
+	assert_true(has_write(2, DXL_AX_TORQUE_LIMIT, 1023) && has_write(2, DXL_AX_TORQUE_ENABLE, 1));
+	assert_non_null(find_event("start"));
+	double a0 = servo_angle[0];
+	run(50);
+	/* HOLD where it was: the goal is the present angle, no jump */
+	assert_true(fabs(c.j[0].goal - a0) < 0.003);
+	assert_true(c.j[0].write_goal);
+}
+
+static void test_switches_without_jumps(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_SINUSOID);
+	/* the start ramp blends from the present angle into the sinusoid */
+	double m = run(400);
+	assert_true(m < 0.05);
+	/* the sinusoid itself: amplitude 0.8 rad at 0.8 Hz is at most 0.04 rad a cycle */
+	ctl_set_mode(&c, CFG_MODE_HOLD, "test");
+	assert_true(cycle() < 0.05);
+	double held = c.j[0].goal;
+	run(20);
+	assert_true(fabs(c.j[0].goal - held) < 1e-12);
+	ctl_set_mode(&c, CFG_MODE_SINUSOID, "test");
+	assert_true(run(300) < 0.05);
+	/* between moving modes: no change larger than the motion going on before */
+	double before = run(20);
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	double first = run(3);
+	if (!(first <= before + 0.01))
+		fail_msg("goal jumped %.4f rad at the switch to OSCILLATOR (moving %.4f a cycle)", first, before);
+	assert_true(run(300) <= cfg.joint[0].max_step + 1e-12);
+	assert_false(c.starter_active);
+	before = run(20);
+	ctl_set_mode(&c, CFG_MODE_SINUSOID, "test");
+	first = run(3);
+	if (!(first <= before + 0.01))
+		fail_msg("goal jumped %.4f rad at the switch to SINUSOID (moving %.4f a cycle)", first, before);
+	run(300);
+	const double a = c.cfg->amplitude;
+	/* once blended, the commanded angle is the sinusoid itself */
+	assert_true(fabs(c.j[0].goal - osc_sinusoid(a, cfg.frequency, cfg.phase, 0, t)) < 1e-9);
+}
+
+static void test_oscillator_starts_from_rest(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_HOLD);
+	run(20);
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	/* from rest the starter (the sinusoid) runs first, then the oscillator */
+	assert_true(c.starter_active && c.starter_until > c.t);
+	/* through the starter and its hand-over: no change beyond the motion itself */
+	double m = 0.0, prev_step = 0.0;
+	int handover = -1;
+	for (int i = 0; i < 400; i++) {
+		bool was_starting = c.starter_active;
+		double step = cycle();
+		if (was_starting && !c.starter_active)
+			handover = i;
+		bool near = handover >= 0 && i - handover <= 5;
+		if (i > 0 && (c.starter_active || near) && !(step <= prev_step + 0.02))
+			fail_msg("cycle %d: goal changed %.4f after %.4f (starter %s)", i, step, prev_step,
+			         c.starter_active ? "on" : "off");
+		prev_step = step;
+		m = fmax(m, step);
+	}
+	assert_true(m <= cfg.joint[0].max_step + 1e-12);
+	assert_true(handover > 0);
+	assert_false(c.starter_active);
+	double lo = 1e9, hi = -1e9;
+	for (int i = 0; i < 300; i++) {
+		cycle();
+		lo = fmin(lo, servo_angle[0]);
+		hi = fmax(hi, servo_angle[0]);
+	}
+	assert_true(hi - lo > 0.5);   /* it keeps moving on its own */
+}
+
+static void test_stale_joint_holds(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_SINUSOID);
+	run(200);
+	servo_answers[1] = false;
+	double g = c.j[1].goal;
+	run(5);
+	assert_true(c.j[1].goal == g);            /* holds its last goal */
+	assert_int_equal(c.j[1].stale_cycles, 5);
+	assert_true(c.j[0].goal != g);            /* the other joint goes on */
+	ctl_clear_outputs(&c);
+	bool seen = false;
+	for (int i = 0; i < cfg.stale_limit; i++) {
+		cycle();
+		seen = seen || find_event("stale") != NULL;
+	}
+	assert_true(seen);
+	servo_answers[1] = true;
+	assert_true(run(5) < 0.05);
+	assert_int_equal(c.j[1].stale_cycles, 0);
+}
+
+static void test_fault_recovery(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_HOLD);
+	run(10);
+	servo_err[1] = DXL_ERRBIT_OVERLOAD;
+	cycle();
+	assert_non_null(find_event("fault"));
+	assert_true(has_write(2, DXL_AX_TORQUE_LIMIT, 512));   /* backs off: half torque */
+	assert_int_equal(c.j[1].fault, CTL_FAULT_BACKOFF);
+	assert_int_equal(c.faults, 1);
+	assert_true(fabs(c.j[1].goal - servo_angle[1]) < 0.003);  /* holds where it is */
+	servo_err[1] = 0;
+	bool wrote = false, recovered = false;
+	for (int i = 0; i < 60; i++) {
+		cycle();
+		wrote = wrote || (has_write(2, DXL_AX_TORQUE_LIMIT, 1023) && has_write(2, DXL_AX_TORQUE_ENABLE, 1));
+		recovered = recovered || find_event("recovered") != NULL;
+	}
+	assert_true(wrote);
+	assert_true(recovered);
+	assert_int_equal(c.j[1].fault, CTL_FAULT_NONE);
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+}
+
+static void test_fault_persistent(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_SINUSOID);
+	cfg.fault_action = CFG_SAFE_LIMP;
+	run(100);
+	servo_err[0] = DXL_ERRBIT_OVERHEAT;
+	int fault_events = 0;
+	const struct ctl_event *persistent = NULL;
+	static struct ctl_event kept;
+	for (int i = 0; i < 300 && persistent == NULL; i++) {
+		cycle();
+		for (size_t k = 0; k < c.nevents; k++)
+			if (strcmp(c.events[k].kind, "fault") == 0)
+				fault_events++;
+		if (find_event("fault-persistent") != NULL) {
+			kept = *find_event("fault-persistent");
+			persistent = &kept;
+			assert_true(has_write(1, DXL_AX_TORQUE_ENABLE, 0) && has_write(2, DXL_AX_TORQUE_ENABLE, 0));
+		}
+	}
+	assert_non_null(persistent);
+	assert_int_equal(fault_events, 1 + cfg.fault_retries);   /* first report + each retry */
+	assert_non_null(strstr(persistent->text, "overheating persists"));
+	assert_int_equal(c.mode, CFG_MODE_LIMP);
+	assert_non_null(strstr(c.reason, "fault: servo 1 overheating persists"));
+	/* LIMP: nothing is written to the goals */
+	cycle();
+	assert_false(c.j[0].write_goal || c.j[1].write_goal);
+	/* the operator takes over */
+	servo_err[0] = 0;
+	ctl_set_mode(&c, CFG_MODE_HOLD, "command");
+	assert_true(has_write(1, DXL_AX_TORQUE_ENABLE, 1));
+	assert_int_equal(c.j[0].fault, CTL_FAULT_NONE);
+	assert_true(run(20) < 0.01);
+}
+
+static void test_other_error_bits_reported_once(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_HOLD);
+	run(5);
+	servo_err[0] = DXL_ERRBIT_VOLTAGE;
+	cycle();
+	const struct ctl_event *e = find_event("servo-error");
+	assert_non_null(e);
+	assert_non_null(strstr(e->text, "servo 1 reports input voltage"));
+	int again = 0;
+	for (int i = 0; i < 20; i++) {
+		cycle();
+		again += find_event("servo-error") != NULL;
+	}
+	assert_int_equal(again, 0);            /* once, not every cycle */
+	assert_int_equal(c.j[0].fault, CTL_FAULT_NONE);   /* not a fault: no back-off */
+	servo_err[0] = 0;
+	run(2);
+	servo_err[0] = DXL_ERRBIT_VOLTAGE;
+	cycle();
+	assert_non_null(find_event("servo-error"));   /* a new occurrence is reported again */
+}
+
+static void test_torque_commands(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_OSCILLATOR);
+	run(50);
+	ctl_clear_outputs(&c);
+	ctl_torque(&c, false);
+	assert_int_equal(c.mode, CFG_MODE_LIMP);
+	assert_true(has_write(1, DXL_AX_TORQUE_ENABLE, 0));
+	servo_angle[0] = 0.9;   /* moved by hand while limp */
+	run(5);
+	ctl_clear_outputs(&c);
+	ctl_torque(&c, true);
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+	assert_true(has_write(1, DXL_AX_TORQUE_ENABLE, 1));
+	assert_true(run(5) < 0.01);
+	assert_true(fabs(c.j[0].goal - 0.9) < 0.003);   /* holds where the hand left it */
+}
+
+static void test_nonfinite_never_reaches_goal(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_SINUSOID);
+	run(200);
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	cfg.joint[0].osc.k = NAN;      /* a corrupted parameter */
+	cfg.joint[1].osc.inertia = INFINITY;
+	long long before = c.nonfinite;
+	double m = run(50);
+	assert_true(c.nonfinite > before);
+	assert_true(m <= cfg.joint[0].max_step + 1e-12);
+	for (size_t j = 0; j < 2; j++) {
+		assert_true(isfinite(c.j[j].goal));
+		assert_true(c.j[j].goal >= c.j[j].limits.lo && c.j[j].goal <= c.j[j].limits.hi);
+	}
+}
+
+static void test_limits_respected(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_SINUSOID);
+	cfg.amplitude = 2.5;   /* asks beyond ±1.3 */
+	char why[512];
+	struct ctl_servo_info info = { .cw_limit = 400, .ccw_limit = 1023, .max_torque = 1023 };
+	assert_true(ctl_set_servo(&c, 0, &info, why, sizeof why));
+	ctl_params_changed(&c);
+	for (int i = 0; i < 400; i++) {
+		cycle();
+		assert_true(c.j[0].goal >= dxl_pos_to_rad(400) - 1e-12 && c.j[0].goal <= 1.3 + 1e-12);
+		assert_true(c.j[1].goal >= -1.3 - 1e-12 && c.j[1].goal <= 1.3 + 1e-12);
+		assert_true(dxl_rad_to_pos(c.j[0].goal) >= 400);
+	}
+	/* wheel mode and disjoint limits are refused with a reason */
+	info.cw_limit = info.ccw_limit = 0;
+	assert_false(ctl_set_servo(&c, 0, &info, why, sizeof why));
+	assert_non_null(strstr(why, "wheel mode"));
+	info.cw_limit = 1000;
+	info.ccw_limit = 1023;
+	assert_false(ctl_set_servo(&c, 0, &info, why, sizeof why));
+	if (strstr(why, "no angle in common") == NULL)
+		fail_msg("why: %s", why);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_start_hold),
+		cmocka_unit_test(test_switches_without_jumps),
+		cmocka_unit_test(test_oscillator_starts_from_rest),
+		cmocka_unit_test(test_stale_joint_holds),
+		cmocka_unit_test(test_fault_recovery),
+		cmocka_unit_test(test_fault_persistent),
+		cmocka_unit_test(test_other_error_bits_reported_once),
+		cmocka_unit_test(test_torque_commands),
+		cmocka_unit_test(test_nonfinite_never_reaches_goal),
+		cmocka_unit_test(test_limits_respected),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
