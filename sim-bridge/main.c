@@ -89,6 +89,7 @@ struct app {
 	uint64_t late_hist[MAIN_LATE_BINS];
 	/* truth */
 	struct sim_collision pending[MAIN_TRUTH_MAX_COLLISIONS];
+	int64_t pending_utime[MAIN_TRUTH_MAX_COLLISIONS];   /* when each impact was seen */
 	int pending_bus[MAIN_TRUTH_MAX_COLLISIONS][2];
 	size_t npending;
 	uint64_t truth_sent, truth_failed, collisions_unreported;
@@ -304,13 +305,17 @@ static void fill_collision(struct app *a, const struct sim_collision *c, int64_t
 	m->impulse = c->impulse;
 }
 
-/* Each collision of the last step: on SIM.COLLISION now, into SIM.TRUTH later. */
+/* Each impact of the last step: on SIM.COLLISION now, into SIM.TRUTH later.
+ * Resting contact is resolved every step while bodies stay pressed together
+ * (1000 a second per pair): it is a force, not an event, so it is only summed. */
 static void report_collisions(struct app *a)
 {
 	struct sim *s = a->sim;
 	int64_t now = wall_us();
 	for (size_t i = 0; i < s->nstep_collisions; i++) {
 		const struct sim_collision *c = &s->step_collisions[i];
+		if (c->resting)
+			continue;
 		if (a->lcm) {
 			undulate_sim_collision_t m;
 			fill_collision(a, c, now, &m);
@@ -318,8 +323,10 @@ static void report_collisions(struct app *a)
 			if (n > 0)
 				lcm_publish(a->lcm, "SIM.COLLISION", a->truth_buf, (unsigned)n);
 		}
-		if (a->npending < MAIN_TRUTH_MAX_COLLISIONS)
+		if (a->npending < MAIN_TRUTH_MAX_COLLISIONS) {
+			a->pending_utime[a->npending] = now;
 			a->pending[a->npending++] = *c;
+		}
 		else
 			a->collisions_unreported++;
 	}
@@ -334,7 +341,10 @@ static void publish_truth(struct app *a)
 	undulate_sim_truth_t t = {
 		.utime = now, .step = (int64_t)s->steps, .sim_time = (double)s->steps * s->dt,
 		.wall_left = s->world.params.wall_left, .wall_right = s->world.params.wall_right,
-		.total_collisions = (int64_t)s->world.total_collisions, .total_impulse = s->world.total_impulse,
+		.total_collisions = (int64_t)(s->world.total_collisions - s->world.resting_contacts),
+		.total_impulse = s->world.total_impulse,
+		.total_resting_steps = (int64_t)s->world.resting_contacts,
+		.total_resting_impulse = s->world.resting_impulse,
 		.worst_lateness_us = a->period_worst_late_us, .nbodies = (int32_t)s->world.nbodies, .bodies = bodies,
 		.ncollisions = (int32_t)a->npending, .collisions = colls,
 	};
@@ -348,7 +358,7 @@ static void publish_truth(struct app *a)
 		};
 	}
 	for (size_t i = 0; i < a->npending; i++)
-		fill_collision(a, &a->pending[i], now, &colls[i]);
+		fill_collision(a, &a->pending[i], a->pending_utime[i], &colls[i]);
 	a->npending = 0;
 	a->period_worst_late_us = 0;
 	int n = undulate_sim_truth_t_encode(a->truth_buf, 0, MAIN_TRUTH_BUF, &t);
@@ -699,10 +709,12 @@ static void print_summary(const struct app *a, int64_t now)
 {
 	const struct sim *s = a->sim;
 	double wall = (double)(now - a->t0) / 1e9;
-	printf("undulate-sim: exit: %.1f s, %llu steps, %llu collisions, total impulse %.6f N*s, "
+	printf("undulate-sim: exit: %.1f s, %llu steps, %llu collisions, total impulse %.6f N*s "
+	       "(resting contact %.6f N*s over %llu pair-steps), "
 	       "worst step lateness %.0f us (p99 %.0f us, mean %.1f us), %llu overruns, cpu %.1f%%, "
 	       "%llu bad commands, %llu truth messages\n",
-	       wall, (unsigned long long)s->steps, s->world.total_collisions, s->world.total_impulse,
+	       wall, (unsigned long long)s->steps, s->world.total_collisions - s->world.resting_contacts,
+	       s->world.total_impulse, s->world.resting_impulse, s->world.resting_contacts,
 	       a->worst_late_us, late_quantile(a, 0.99), a->late_samples ? a->late_sum_us / (double)a->late_samples : 0.0,
 	       (unsigned long long)a->overruns, wall > 0 ? 100.0 * cpu_seconds() / wall : 0.0,
 	       (unsigned long long)s->bad_commands, (unsigned long long)a->truth_sent);

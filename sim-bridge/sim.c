@@ -491,9 +491,10 @@ static int cmd_stats(struct sim_cmd_ctx *x)
 	uint64_t packets = 0, replies = 0;
 	for (size_t i = 0; i < s->nbuses; i++)
 		packets += s->buses[i].count.packets, replies += s->buses[i].count.replies;
-	return REPLY(x, "ok steps=%llu time=%.3f collisions=%llu impulse=%.6f packets=%llu replies=%llu commands=%llu bad_commands=%llu",
-	             (unsigned long long)s->steps, (double)s->steps * s->dt, s->world.total_collisions,
-	             s->world.total_impulse, (unsigned long long)packets, (unsigned long long)replies,
+	return REPLY(x, "ok steps=%llu time=%.3f collisions=%llu impulse=%.6f resting_impulse=%.6f packets=%llu replies=%llu commands=%llu bad_commands=%llu",
+	             (unsigned long long)s->steps, (double)s->steps * s->dt,
+	             s->world.total_collisions - s->world.resting_contacts,
+	             s->world.total_impulse, s->world.resting_impulse, (unsigned long long)packets, (unsigned long long)replies,
 	             (unsigned long long)s->commands, (unsigned long long)s->bad_commands), 0;
 }
 

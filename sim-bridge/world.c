@@ -86,6 +86,7 @@ void sim_world_init(struct sim_world *w, const struct sim_world_params *p)
 	w->infeasible_steps = 0;
 	w->bad_input = 0;
 	w->resting_contacts = 0;
+	w->resting_impulse = 0;
 	for (size_t k = 0; k <= SIM_MAX_BODIES; k++)
 		w->in_contact[k] = 0;
 	for (size_t i = 0; i < SIM_MAX_BODIES; i++)
@@ -506,8 +507,10 @@ static size_t world_report(struct sim_world *w, const struct world_scratch *s,
 			continue;
 		w->total_collisions++;
 		w->total_impulse += s->impulse[k];
-		if (!s->impact[k])
+		if (!s->impact[k]) {
 			w->resting_contacts++;
+			w->resting_impulse += s->impulse[k];
+		}
 		if (!out || count >= cap)
 			continue;   /* counted in the totals only */
 		struct sim_collision *c = &out[count++];

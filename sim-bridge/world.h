@@ -65,6 +65,7 @@ struct sim_world {
 	unsigned long long infeasible_steps;  /* the row is wider than the space between the walls */
 	unsigned long long bad_input;         /* rejected bodies/params, repaired non-finite state */
 	unsigned long long resting_contacts;  /* of total_collisions, those with resting set */
+	double resting_impulse;               /* of total_impulse, N·s carried by resting contact */
 	/* contact memory between steps (for resting contact; see PHYSICS.md) */
 	unsigned char in_contact[SIM_MAX_BODIES + 1];  /* pair k touched (or was within a step of it) */
 	double prev_speed[SIM_MAX_BODIES];            /* lateral speed at the end of the last step */

@@ -50,14 +50,17 @@ spawn() {
 	_pids+=("$pid")
 	eval "pid_${name//[^A-Za-z0-9_]/_}=$pid"
 }
-# stop NAME [SIGNAL]: signal a spawned process and wait for it; prints its exit status.
+# stop NAME [SIGNAL]: signal a spawned process and wait for it. Its exit status
+# is left in $stop_rc and printed. Call it in this shell (`stop d >file` is fine):
+# inside $(...) the process is not a child of the subshell and cannot be waited.
+stop_rc=
 stop() {
 	local var="pid_${1//[^A-Za-z0-9_]/_}" sig=${2:-TERM}
 	local pid=${!var}
 	kill -"$sig" "$pid" 2>/dev/null
-	local rc=0
-	wait "$pid" 2>/dev/null || rc=$?
-	echo "$rc"
+	stop_rc=0
+	wait "$pid" 2>/dev/null || stop_rc=$?
+	echo "$stop_rc"
 }
 alive() { local var="pid_${1//[^A-Za-z0-9_]/_}"; kill -0 "${!var}" 2>/dev/null; }
 

@@ -79,7 +79,10 @@ def ctl(path, command):
 
 def truth_bodies(payload):
     """Decode the bodies of one SIM.TRUTH payload (LCM encoding, big-endian)."""
-    off = 8 + 8 * 8  # fingerprint, utime .. worst_lateness_us
+    # fingerprint, then utime .. worst_lateness_us: ten 8-byte fields
+    # (utime, step, sim_time, wall_left, wall_right, total_collisions,
+    #  total_impulse, total_resting_steps, total_resting_impulse, worst_lateness_us)
+    off = 8 + 10 * 8
     (n,) = struct.unpack(">i", payload[off:off + 4])
     off += 4
     bodies = []

@@ -17,7 +17,7 @@ spawn toptext "$B/undulate-top" --once --wait 4.5 --lcm-url "$url" -v
 wait_log topjson 'listening' && wait_log toptext 'listening' || tap_fail "undulate-top did not start"
 lcm-logplayer --lcm-url="$url" "$T/t.log" >"$T/player.log" 2>&1
 wait_for 10 bash -c "! kill -0 $pid_topjson 2>/dev/null && ! kill -0 $pid_toptext 2>/dev/null"
-rc=$(stop topjson)
+stop topjson >/dev/null; rc=$stop_rc
 tap_check "--once exits 0" [ "$rc" = 0 ]
 
 json=$(grep '^{' "$T/topjson.log")
