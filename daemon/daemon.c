@@ -404,8 +404,15 @@ static void dmn_latency(struct dmn *d)
 	long us = d->cfg->adapter_latency_us;
 	d->adapter_latency_ms = -1.0;
 	if (us < 0) {
-		struct port_latency lat;
-		port_latency_check(d->port_path, true, &lat);
+		/* port_open() already checked (and tried to lower) the latency timer on
+		 * the fd it holds; opening the device again would fail with EBUSY on an
+		 * exclusively held real port and lose the ASYNC_LOW_LATENCY fallback. */
+		struct port_latency lat = { 0 };
+		const struct port_latency *opened = d->port ? port_get_latency(d->port) : NULL;
+		if (opened)
+			lat = *opened;
+		else
+			port_latency_check_fd(d->port_path, d->port ? port_fd(d->port) : -1, true, &lat);
 		if (lat.known) {
 			us = 1000L * lat.timer_ms;
 			d->adapter_latency_ms = lat.timer_ms;
