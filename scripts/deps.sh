@@ -5,9 +5,10 @@ set -eu
 # build + runtime: compiler, LCM (pkg-config lcm needs glib's .pc), serial
 # ports, config parsing (inih), unit tests (cmocka); tests and tools: jq and
 # python3 (test peers and JSON checks),
-# gnuplot for plots, cyclictest for the jitter benchmark, tmux for the demo.
+# gnuplot for plots, cyclictest for the jitter benchmark; systemd and man-db
+# for checking the units (systemd-analyze verify) and the man pages.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
-      libinih-dev libcmocka-dev gnuplot-nox rt-tests procps jq python3)
+      libinih-dev libcmocka-dev gnuplot-nox rt-tests procps jq python3 systemd man-db)
 [ -n "${DEPS_EXTRA:-}" ] && need+=($DEPS_EXTRA)
 missing=()
 for p in "${need[@]}"; do
