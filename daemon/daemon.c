@@ -100,6 +100,7 @@ struct dmn {
 	double cpu_percent;
 	/* LCM */
 	lcm_t *lcm;
+	int64_t cmd_fingerprint;   /* command_t's, for cmd_decode() */
 	char ch_state[DMN_CHANNEL_MAX], ch_bus[DMN_CHANNEL_MAX], ch_params[DMN_CHANNEL_MAX],
 	     ch_event[DMN_CHANNEL_MAX], ch_cmd[DMN_CHANNEL_MAX];
 	uint8_t *encode_buf;
@@ -332,11 +333,26 @@ static bool dmn_find_servos(struct dmn *d, char *err, size_t cap)
 	return false;
 }
 
+/* A start-up read that meets a lost or damaged reply is tried again: one
+ * timeout on a loaded machine must not abort the start (a cycle read simply
+ * holds the joint for a period, but start-up has no next period). The port
+ * going away is not retried. */
+static int dmn_read_retry(struct dmn *d, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out, uint8_t *eb)
+{
+	int r = DXL_E_TIMEOUT;
+	for (int t = 0; t < DMN_PING_TRIES; t++) {
+		r = bus_read(&d->bus, id, addr, len, out, eb);
+		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
+			break;
+	}
+	return r;
+}
+
 static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 {
 	uint8_t id = d->ctl.j[j].id, eb = 0;
 	uint8_t t[DXL_AX_STATUS_RETURN_LEVEL + 1];
-	int r = bus_read(&d->bus, id, 0, sizeof t, t, &eb);
+	int r = dmn_read_retry(d, id, 0, sizeof t, t, &eb);
 	if (r != DXL_OK) {
 		snprintf(err, cap, "servo %u: reading its settings failed: %s", id, dxl_strerror(r));
 		return false;
@@ -369,8 +385,11 @@ static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 		d->max_return_delay_us = (int)delay_us;
 	/* A moving speed left by another program would make every goal a slow
 	 * ramp and the oscillator sluggish: 0 is "as fast as possible". */
+	uint8_t ms[2];
 	uint16_t moving_speed = 0;
-	if (bus_read_u16(&d->bus, id, DXL_AX_MOVING_SPEED, &moving_speed, &eb) == DXL_OK && moving_speed != 0) {
+	if (dmn_read_retry(d, id, DXL_AX_MOVING_SPEED, 2, ms, &eb) == DXL_OK)
+		moving_speed = dxl_get_u16(ms);
+	if (moving_speed != 0) {
 		log_warn("servo %u: moving speed was %u (%.2f rad/s); setting 0 (maximum)", id, moving_speed,
 		         moving_speed * DXL_SPEED_RAD_S_PER_UNIT);
 		int wr = bus_write(&d->bus, id, DXL_AX_MOVING_SPEED, (const uint8_t[2]){ 0, 0 }, 2,
@@ -387,7 +406,7 @@ static bool dmn_read_present(struct dmn *d, char *err, size_t cap)
 {
 	for (size_t j = 0; j < d->ctl.n; j++) {
 		uint8_t id = d->ctl.j[j].id, eb = 0, p[6];
-		int r = bus_read(&d->bus, id, DXL_AX_PRESENT_POSITION, 6, p, &eb);
+		int r = dmn_read_retry(d, id, DXL_AX_PRESENT_POSITION, 6, p, &eb);
 		if (r != DXL_OK) {
 			snprintf(err, cap, "servo %u: reading its position failed: %s", id, dxl_strerror(r));
 			return false;
@@ -826,28 +845,25 @@ static void dmn_on_command(const lcm_recv_buf_t *rbuf, const char *channel, void
 {
 	struct dmn *d = user;
 	bool direct = strcmp(channel, d->ch_cmd) == 0;
-	undulate_command_t m;
-	if (undulate_command_t_decode(rbuf->data, 0, rbuf->data_size, &m) < 0) {
-		char why[128];
-		snprintf(why, sizeof why, "undecodable command_t on %s (%u bytes)", channel, rbuf->data_size);
-		dmn_reject(d, 0, why);
+	/* our own decoder: no allocation, and no trust in string lengths (command.h) */
+	static struct cmd_wire w;
+	char why[256];
+	if (!cmd_decode(rbuf->data, rbuf->data_size, d->cmd_fingerprint, &w, why, sizeof why)) {
+		char text[320];
+		snprintf(text, sizeof text, "undecodable command_t on %s (%u bytes): %s", channel, rbuf->data_size, why);
+		dmn_reject(d, 0, text);
 		return;
 	}
-	struct cmd_request r = {
-		.seq = m.seq, .source = m.source, .robot = m.robot, .kind = m.kind, .mode = m.mode,
-		.param = m.param, .joint = m.joint, .value = m.value, .torque = m.torque,
-	};
-	char why[256];
-	enum cmd_verdict v = cmd_check(&r, d->cfg, direct, why, sizeof why);
+	const struct cmd_request *r = &w.req;
+	enum cmd_verdict v = cmd_check(r, d->cfg, direct, why, sizeof why);
 	if (v == CMD_REJECT) {
-		dmn_reject(d, m.seq, why);
+		dmn_reject(d, r->seq, why);
 	} else if (v == CMD_ACCEPT) {
 		char text[160];
-		dmn_apply(d, &r, text, sizeof text);
-		dmn_event_quiet(d, m.seq, 0, "command-accepted", text);
-		log_info("command %" PRId64 " from %s: %s", m.seq, m.source ? m.source : "?", text);
+		dmn_apply(d, r, text, sizeof text);
+		dmn_event_quiet(d, r->seq, 0, "command-accepted", text);
+		log_info("command %" PRId64 " from %s: %s", r->seq, r->source, text);
 	}
-	undulate_command_t_decode_cleanup(&m);
 }
 
 /* ---- set-up and the loop ----------------------------------------------------------------------- */
@@ -909,6 +925,7 @@ static bool dmn_lcm(struct dmn *d)
 	snprintf(d->ch_params, sizeof d->ch_params, "%s.PARAMS", d->cfg->name);
 	snprintf(d->ch_event, sizeof d->ch_event, "%s.EVENT", d->cfg->name);
 	snprintf(d->ch_cmd, sizeof d->ch_cmd, "%s.CMD", d->cfg->name);
+	d->cmd_fingerprint = __undulate_command_t_get_hash();
 	lcm_subscribe(d->lcm, d->ch_cmd, dmn_on_command, d);
 	lcm_subscribe(d->lcm, "UNDULATE.CMD", dmn_on_command, d);
 	return true;

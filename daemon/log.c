@@ -3,8 +3,10 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 static enum log_level log_threshold = LOG_LVL_INFO;
 
@@ -36,6 +38,33 @@ static const char *log_prefix(enum log_level level)
 	}
 }
 
+/* Under systemd, stderr goes to the journal when JOURNAL_STREAM names its
+ * device:inode; a "<N>" syslog priority prefix then lets `journalctl -p
+ * warning` select our warnings (sd-daemon(3)). Decided once, at the first line. */
+static int log_journal = -1;
+
+static bool log_to_journal(void)
+{
+	if (log_journal < 0) {
+		const char *js = getenv("JOURNAL_STREAM");
+		unsigned long long dev = 0, ino = 0;
+		struct stat st;
+		log_journal = js && sscanf(js, "%llu:%llu", &dev, &ino) == 2 && fstat(2, &st) == 0 &&
+		              (unsigned long long)st.st_dev == dev && (unsigned long long)st.st_ino == ino;
+	}
+	return log_journal == 1;
+}
+
+static int log_syslog_priority(enum log_level level)
+{
+	switch (level) {
+	case LOG_LVL_ERROR: return 3;
+	case LOG_LVL_WARN: return 4;
+	case LOG_LVL_INFO: return 6;
+	default: return 7;
+	}
+}
+
 static void log_vmsg(enum log_level level, const char *suffix, const char *fmt, va_list ap)
 {
 	if (level > log_threshold)
@@ -43,7 +72,10 @@ static void log_vmsg(enum log_level level, const char *suffix, const char *fmt, 
 	/* One fprintf per line: stderr is unbuffered and journald splits on writes. */
 	char line[512];
 	vsnprintf(line, sizeof line, fmt, ap);
-	fprintf(stderr, "undulated: %s: %s%s\n", log_prefix(level), line, suffix);
+	if (log_to_journal())
+		fprintf(stderr, "<%d>undulated: %s: %s%s\n", log_syslog_priority(level), log_prefix(level), line, suffix);
+	else
+		fprintf(stderr, "undulated: %s: %s%s\n", log_prefix(level), line, suffix);
 }
 
 void log_msg(enum log_level level, const char *fmt, ...)
