@@ -1,0 +1,758 @@
+#!/usr/bin/env bash
+# bench/run.sh — the benchmark suite behind `make bench`.
+#
+# Runs the real programs (undulate-sim, undulated, lcm-logger, cyclictest) and
+# small measuring helpers built here from bench/*.c, prints one markdown report
+# and writes it to $BUILD/bench.md. Figures are printed next to the budgets in
+# DESIGN.md; nothing is asserted: the exit status says only whether the suite
+# could run. See bench/README.md for what each figure means.
+#
+# Knobs (environment): BENCH_LOOP_S (loop timing window per policy, 20),
+# BENCH_WINDOW_S (daemon bus-time windows, 5), BENCH_CYCLES (protocol-level
+# bus cycles per configuration, 300), BENCH_CAP_S (simulator-only capacity
+# runs, 8), BENCH_FLEET_S (20 robots with 20 daemons, 15), BENCH_CG_S (the
+# daemon under callgrind, 3), BENCH_ONLY (a list of sections to run, e.g.
+# "loop bus"; default all: loop bus missing cap codec cg),
+# KEEP_BENCH_DIR=1 keeps the logs.
+set -u
+top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$top" || exit 1
+BUILD=${BUILD:-build}
+case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
+BIN=$BUILD/bin
+HB=$BUILD/bench
+SIM=$BIN/undulate-sim
+DMN=$BIN/undulated
+OUT=$BUILD/bench.md
+
+LOOP_S=${BENCH_LOOP_S:-20}
+WINDOW_S=${BENCH_WINDOW_S:-5}
+CYCLES=${BENCH_CYCLES:-300}
+CAP_S=${BENCH_CAP_S:-8}
+CG_S=${BENCH_CG_S:-3}
+FLEET_S=${BENCH_FLEET_S:-15}
+ONLY=${BENCH_ONLY:-loop bus missing cap codec cg}
+# The daemon ramps into its mode over 1.5 s after start: measure after it.
+RAMP_S=2
+# Multicast ports of the benchmark (7900-7949): one per run, so runs never
+# hear each other's messages.
+PORT_LOOP_OTHER=7900 PORT_LOOP_FIFO=7901 PORT_BUS=7902 PORT_MISSING=7903 PORT_CAP=7904 PORT_FLEET=7905 PORT_CG=7906
+FIFO_PRIORITY=80
+# The simulator's own real-time option (below the daemons' priority above).
+SIM_RT_PRIORITY=10
+# Start attempts per daemon (see start_daemon).
+START_TRIES=3
+
+T=$(mktemp -d "${TMPDIR:-/tmp}/undulate-bench.XXXXXX")
+CLK_TCK=$(getconf CLK_TCK)
+
+# ---- processes: started here, stopped by PID --------------------------------------
+declare -A PID
+start() {
+	local name=$1
+	shift
+	"$@" >"$T/$name.log" 2>&1 &
+	PID[$name]=$!
+}
+stop() {
+	local pid=${PID[$1]:-}
+	[ -n "$pid" ] || return 0
+	kill -TERM "$pid" 2>/dev/null
+	for _ in $(seq 150); do kill -0 "$pid" 2>/dev/null || break; sleep 0.02; done
+	kill -KILL "$pid" 2>/dev/null
+	wait "$pid" 2>/dev/null
+	unset "PID[$1]"
+}
+cleanup() {
+	local n
+	for n in "${!PID[@]}"; do stop "$n"; done
+	if [ -n "${KEEP_BENCH_DIR:-}" ]; then echo "bench: logs kept in $T" >&2; else rm -rf "$T"; fi
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+# wait_ready NAME REGEX TIMEOUT_S: poll NAME's log; fail early if NAME died.
+wait_ready() {
+	local name=$1 re=$2 deadline=$(($(date +%s%N) + ${3:-10} * 1000000000))
+	until grep -qE "$re" "$T/$name.log" 2>/dev/null; do
+		kill -0 "${PID[$name]}" 2>/dev/null || return 1
+		[ "$(date +%s%N)" -lt "$deadline" ] || return 1
+		sleep 0.02
+	done
+}
+wait_file() {
+	local deadline=$(($(date +%s%N) + ${2:-10} * 1000000000))
+	until [ -e "$1" ]; do
+		[ "$(date +%s%N)" -lt "$deadline" ] || return 1
+		sleep 0.02
+	done
+}
+# Why a process did not come up: the last line it printed.
+why() { tail -n 1 "$T/$1.log" 2>/dev/null | tr '|' '/' | cut -c1-240; }
+
+# start_daemon NAME CMD...: start an undulated and wait for its ready line. Its
+# start-up scan gives up when servos stay silent for a few timeouts, which a
+# stall of the loaded machine can cause: it is started again (as systemd's
+# Restart=on-failure would), up to START_TRIES times. RETRIES says how often.
+start_daemon() {
+	local name=$1 try
+	shift
+	RETRIES=0
+	for try in $(seq 1 "$START_TRIES"); do
+		start "$name" "$@"
+		wait_ready "$name" 'ready:' 30 && return 0
+		cp "$T/$name.log" "$T/$name.try$try.log"
+		stop "$name"
+		[ "$try" -lt "$START_TRIES" ] && RETRIES=$((RETRIES + 1))
+	done
+	return 1
+}
+# retried: " (N start-up retried)" or nothing
+retried() { [ "${1:-0}" != nan ] && [ "${1:-0}" -gt 0 ] && echo "; $1 start-up retried"; }
+
+url() { echo "udpm://239.255.76.67:$1?ttl=0"; }
+now_us() { echo $(($(date +%s%N) / 1000)); }
+# utime + stime of a process, in clock ticks (fields 14 and 15 of stat; the
+# name field may hold spaces, so count from after its closing parenthesis).
+cpu_ticks() { sed 's/.*) //' "/proc/$1/stat" 2>/dev/null | awk '{ print $12 + $13 }'; }
+hwm_kb() { awk '/^VmHWM:/ { print $2 }' "/proc/$1/status" 2>/dev/null; }
+# cpu_pct TICKS0 TICKS1 US0 US1 -> percent of one core
+cpu_pct() { awk -v a="$1" -v b="$2" -v t0="$3" -v t1="$4" -v hz="$CLK_TCK" \
+	'BEGIN { if (a == "" || b == "" || t1 <= t0) print "nan"; else printf "%.2f", 100 * (b - a) / hz / ((t1 - t0) / 1e6) }'; }
+policy_of() { chrt -p "$1" 2>/dev/null | awk -F': ' '/policy/ { p = $2 } /priority/ { q = $2 } END { print p (q > 0 ? " " q : "") }'; }
+
+# v FILE KEY: a "key value" figure from a helper's output ("nan" if absent)
+v() { awk -v k="$2" '$1 == k { print $2; found = 1; exit } END { if (!found) print "nan" }' "$1" 2>/dev/null || echo nan; }
+# p50/p99/max (nearest rank) of the numbers in a file, one a line
+pctl() {
+	sort -n "$1" | awk '{ x[NR] = $1 }
+		function rank(p,  r) { r = int(p * NR); if (r < p * NR) r++; return r < 1 ? 1 : r }
+		END { if (NR == 0) print "nan nan nan"; else print x[rank(0.5)], x[rank(0.99)], x[NR] }'
+}
+# fmt VALUE [DECIMALS]: a number for the table ("–" when missing)
+fmt() { awk -v x="$1" -v d="${2:-0}" 'BEGIN { if (x == "nan" || x == "" || x == "-nan") print "–"; else printf "%.*f", d, x }'; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a == "nan" || b == "nan" || a == "" || b == "" || b + 0 == 0) print "–"; else printf "%.2f×", a / b }'; }
+ids_upto() { seq -s, 1 "$1"; }
+progress() { echo "bench: $*" >&2; }
+wants() { [[ " $ONLY " == *" $1 "* ]]; }
+
+# ---- the helpers ------------------------------------------------------------------
+build_helpers() {
+	local cflags="-std=c11 -D_DEFAULT_SOURCE -D_XOPEN_SOURCE=700 -O2 -g -Wall -Wextra -Wshadow
+	              -Wmissing-prototypes -Wstrict-prototypes -Wpointer-arith -Wcast-qual -Wundef -Wvla
+	              -Wformat-security -Werror"
+	local inc libs
+	inc="-Iprotocol -Iprotocol/io -I$BUILD/lcmgen $(pkg-config --cflags lcm 2>/dev/null)"
+	libs="$BUILD/lib/libprotocol.a $BUILD/lib/liblcmtypes.a $(pkg-config --libs lcm libserialport inih 2>/dev/null) -lm"
+	mkdir -p "$HB"
+	local p
+	for p in logstat buscycle codec simctl; do
+		# shellcheck disable=SC2086 # word splitting of the flag lists is wanted
+		${CC:-cc} $cflags $inc "bench/$p.c" -o "$HB/$p" $libs || return 1
+	done
+}
+
+# ---- report -----------------------------------------------------------------------
+# The details, section by section; the summary collects one row per budget
+# of DESIGN.md and goes first.
+REPORT=$T/report.md
+SUMMARY=$T/summary.md
+say() { printf '%s\n' "$*" >>"$REPORT"; }
+sum() { printf '| %s | %s | %s |\n' "$1" "$2" "$3" >>"$SUMMARY"; }
+
+# ---- 1 + 4: loop timing against cyclictest, daemon CPU and memory ------------------
+# loop_run POLICY MCAST_PORT: one robot (2 servos, return delay 0) on the simulated
+# bus, its daemon at POLICY, cyclictest at the same policy for LOOP_S seconds
+# meanwhile. Leaves $T/loop-POLICY/{stat,cyclictest,info}.
+loop_run() {
+	local pol=$1 d=$T/loop-$1 u
+	u=$(url "$2")
+	mkdir -p "$d"
+	echo "status ok" >"$d/info"
+	start "sim-$pol" "$SIM" --link "$d/r1" --ids 1,2 --return-delay 0 --lcm-url "$u" --quiet
+	if ! wait_ready "sim-$pol" 'ready:' 10; then
+		echo "status not measured: undulate-sim did not start ($(why "sim-$pol"))" >"$d/info"
+		stop "sim-$pol"
+		return 1
+	fi
+	start "log-$pol" lcm-logger --lcm-url="$u" -f "$d/run.lcm"
+	wait_file "$d/run.lcm" 10
+	local extra=()
+	[ "$pol" = fifo ] && extra=(--set "robot.priority=$FIFO_PRIORITY" --set robot.mlockall=true)
+	if ! start_daemon "dmn-$pol" "$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u" "${extra[@]}"; then
+		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$pol"))" >"$d/info"
+		stop "log-$pol"; stop "sim-$pol"
+		return 1
+	fi
+	echo "start_retries $RETRIES" >>"$d/info"
+	sleep "$RAMP_S"  # the ramp-in: a fixed wait, not a readiness guess
+	local dpid=${PID[dmn-$pol]} ct=(--policy=other)
+	[ "$pol" = fifo ] && ct=(--policy=fifo -p "$FIFO_PRIORITY")
+	echo "policy $(policy_of "$dpid" | tr ' ' '/')" >>"$d/info"
+	local t0 c0 t1 c1
+	t0=$(now_us) c0=$(cpu_ticks "$dpid")
+	start "ct-$pol" cyclictest -q -v -m -i 10000 -l $((LOOP_S * 100)) "${ct[@]}"
+	local ctrc=0
+	wait "${PID[ct-$pol]}" || ctrc=$?
+	unset "PID[ct-$pol]"
+	t1=$(now_us) c1=$(cpu_ticks "$dpid")
+	{
+		echo "cpu_pct $(cpu_pct "$c0" "$c1" "$t0" "$t1")"
+		echo "hwm_kb $(hwm_kb "$dpid")"
+		echo "cyclictest_rc $ctrc"
+	} >>"$d/info"
+	stop "dmn-$pol"; stop "log-$pol"; stop "sim-$pol"
+	"$HB/logstat" --from-us "$t0" --to-us "$t1" "$d/run.lcm" >"$d/stat"
+	# cyclictest -v: "thread: loop: latency_us"; loop 0 is before the first period
+	awk '$1 == "0:" && $2 + 0 > 0 { print $3 }' "$T/ct-$pol.log" >"$d/ct-lat"
+	echo "ct $(pctl "$d/ct-lat") $(wc -l <"$d/ct-lat")" >>"$d/info"
+}
+
+section_loop() {
+	progress "1/5 loop timing at 100 Hz: SCHED_OTHER, ${LOOP_S} s (undulated and cyclictest side by side)"
+	loop_run other $PORT_LOOP_OTHER
+	if chrt -f 1 true 2>/dev/null; then
+		progress "1/5 loop timing at 100 Hz: SCHED_FIFO $FIFO_PRIORITY, ${LOOP_S} s"
+		loop_run fifo $PORT_LOOP_FIFO
+	else
+		mkdir -p "$T/loop-fifo"
+		echo "status not measured: SCHED_FIFO not permitted for this user (CAP_SYS_NICE / RLIMIT_RTPRIO)" \
+			>"$T/loop-fifo/info"
+	fi
+	say "## 1. Control loop timing at 100 Hz"
+	say ""
+	say "Wake-up lateness = how late a cycle starts after its deadline; period = time between cycle starts (µs)."
+	say "Both programs run at the same time on the same machine, ${LOOP_S} s each, with the same policy."
+	say "Budget: undulated's p99 lateness within 2× of cyclictest's."
+	say ""
+	say "| policy | program | samples | lateness p50 | p99 | max | period p50 | p99 | max | overruns | p99 vs cyclictest |"
+	say "|---|---|---|---|---|---|---|---|---|---|---|"
+	local pol d st
+	for pol in other fifo; do
+		d=$T/loop-$pol
+		st=$(v "$d/info" status)
+		local label="SCHED_${pol^^}"
+		[ "$pol" = fifo ] && label="SCHED_FIFO $FIFO_PRIORITY"
+		if [ "$st" != ok ]; then
+			say "| $label | – | – | – | – | – | – | – | – | – | $(sed -n 's/^status //p' "$d/info") |"
+			sum "loop wake-up lateness p99, $label" "≤ 2× cyclictest" "$(sed -n 's/^status //p' "$d/info")"
+			continue
+		fi
+		local ct50 ct99 ctmax ctn dpol
+		read -r _ ct50 ct99 ctmax ctn < <(grep '^ct ' "$d/info")
+		dpol="$(v "$d/info" policy | tr '/' ' ')$(retried "$(v "$d/info" start_retries)")"
+		say "| $label | undulated ($dpol) | $(v "$d/stat" all.n) | $(fmt "$(v "$d/stat" all.jitter_p50)") |" \
+			"$(fmt "$(v "$d/stat" all.jitter_p99)") | $(fmt "$(v "$d/stat" all.jitter_max)") |" \
+			"$(fmt "$(v "$d/stat" all.period_p50)") | $(fmt "$(v "$d/stat" all.period_p99)") |" \
+			"$(fmt "$(v "$d/stat" all.period_max)") | $(v "$d/stat" all.overruns) |" \
+			"$(ratio "$(v "$d/stat" all.jitter_p99)" "$ct99") |"
+		if [ "$ctn" -gt 0 ]; then
+			say "| $label | cyclictest | $ctn | $(fmt "$ct50") | $(fmt "$ct99") | $(fmt "$ctmax") | – | – | – | – | 1× |"
+		else
+			say "| $label | cyclictest | – | – | – | – | – | – | – | – | not measured: cyclictest exited" \
+				"$(v "$d/info" cyclictest_rc) ($(why "ct-$pol")) |"
+		fi
+		sum "loop wake-up lateness p99, $label" "≤ 2× cyclictest" \
+			"$(fmt "$(v "$d/stat" all.jitter_p99)") µs vs $(fmt "$ct99") µs: $(ratio "$(v "$d/stat" all.jitter_p99)" "$ct99"); $(v "$d/stat" all.overruns) overruns in $(v "$d/stat" all.n) cycles"
+	done
+	say ""
+}
+
+section_resources() {
+	say "## 4. Daemon CPU and memory at 100 Hz (2 servos)"
+	say ""
+	say "CPU = utime + stime from /proc over the measurement window, in % of one core; the daemon's own"
+	say "figure (bus_stats_t.cpu_percent, mean of its 1 s reports) beside it. Peak RSS = VmHWM."
+	say "Budget: < 2 % of one core; no allocation after start-up."
+	say ""
+	say "| policy | CPU % (/proc) | CPU % (self-reported) | peak RSS (KiB) | control step p50 (µs) |"
+	say "|---|---|---|---|---|"
+	local pol d
+	for pol in other fifo; do
+		d=$T/loop-$pol
+		if [ "$(v "$d/info" status)" != ok ]; then
+			say "| SCHED_${pol^^} | $(sed -n 's/^status //p' "$d/info") | – | – | – |"
+			[ "$pol" = other ] && sum "daemon CPU at 100 Hz" "< 2 % of one core" "$(sed -n 's/^status //p' "$d/info")"
+			continue
+		fi
+		[ "$pol" = other ] && sum "daemon CPU at 100 Hz (SCHED_OTHER, 2 servos)" "< 2 % of one core" \
+			"$(fmt "$(v "$d/info" cpu_pct)" 2) % (self-reported $(fmt "$(v "$d/stat" all.cpu_mean)" 2) %); peak RSS $(v "$d/info" hwm_kb) KiB"
+		say "| SCHED_${pol^^} | $(fmt "$(v "$d/info" cpu_pct)" 2) | $(fmt "$(v "$d/stat" all.cpu_mean)" 2) |" \
+			"$(v "$d/info" hwm_kb) | $(fmt "$(v "$d/stat" all.control_p50)") |"
+	done
+	say ""
+}
+
+# ---- 2: bus time per cycle against the wire-time floor -----------------------------
+# buscycle_run N RD_US: the protocol-level cycle alone against a fresh sim bus.
+buscycle_run() {
+	local n=$1 rd=$2 name="bc-$1-$2" d=$T/bus
+	local out=$d/$name.txt link=$d/$name.pty
+	mkdir -p "$d"
+	start "sim-$name" "$SIM" --link "$link" --ids "$(ids_upto "$n")" --return-delay "$rd" --quiet
+	if ! wait_ready "sim-$name" 'ready:' 10; then
+		echo "status not measured: the simulator refused $n servos on one bus ($(why "sim-$name"))" >"$out"
+		stop "sim-$name"
+		return 1
+	fi
+	if ! "$HB/buscycle" --port "$link" --ids "$(ids_upto "$n")" --cycles "$CYCLES" --margin-us "$MARGIN_US" \
+		>"$out" 2>"$d/$name.err"; then
+		echo "status not measured: buscycle failed ($(tail -n1 "$d/$name.err"))" >"$out"
+	fi
+	stop "sim-$name"
+}
+
+# daemon_bus_run N RD_US: undulated's own bus_us over WINDOW_S seconds.
+daemon_bus_run() {
+	local n=$1 rd=$2 name="db-$1-$2" d=$T/bus u
+	u=$(url $PORT_BUS)
+	mkdir -p "$d"
+	start "sim-$name" "$SIM" --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay "$rd" --lcm-url "$u" --quiet
+	if ! wait_ready "sim-$name" 'ready:' 10; then
+		echo "status not measured: the simulator refused $n servos on one bus ($(why "sim-$name"))" >"$d/$name"
+		stop "sim-$name"
+		return 1
+	fi
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$d/$name.lcm"
+	wait_file "$d/$name.lcm" 10
+	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --robot "r$n" --lcm-url "$u"; then
+		sleep "$RAMP_S"
+		local t0 t1
+		t0=$(now_us)
+		sleep "$WINDOW_S"
+		t1=$(now_us)
+		stop "dmn-$name"; stop "log-$name"
+		"$HB/logstat" --from-us "$t0" --to-us "$t1" "$d/$name.lcm" >"$d/$name"
+		echo "start_retries $RETRIES" >>"$d/$name"
+	else
+		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$name"))" >"$d/$name"
+		stop "log-$name"
+	fi
+	stop "sim-$name"
+}
+
+section_bus() {
+	local n rd
+	progress "2/5 bus time per cycle: protocol-level cycle, 2/6/18 servos x return delay 0/500 us, $CYCLES cycles each"
+	for n in 2 6 18; do
+		for rd in 0 500; do buscycle_run $n $rd; done
+	done
+	progress "2/5 bus time per cycle: undulated, ${WINDOW_S} s per configuration"
+	for n in 2 6 18; do
+		for rd in 0 500; do
+			local why_not
+			if why_not=$("$DMN" --port /dev/null --ids "$(ids_upto "$n")" --check-config 2>&1); then
+				daemon_bus_run $n $rd
+			else
+				echo "status not measured: $(echo "$why_not" | head -n1 | cut -c1-120)" >"$T/bus/db-$n-$rd"
+			fi
+		done
+	done
+	say "## 2. Bus time per cycle at 1 Mbps (simulated bus)"
+	say ""
+	say "One cycle = READ(36,6) of every servo (8 + 12 bytes each, plus the return delay) and one"
+	say "SYNC_WRITE of the goal positions (LEN = 3N + 4). Floor = wire time at 10 bits a byte + N × return"
+	say "delay. Measured bus time ends when the SYNC_WRITE is handed to the port (it has no reply)."
+	say "\`buscycle\` is that cycle alone over the protocol library; undulated's figure is its own bus_us."
+	say "Budget: 2 servos, return delay 0: within 1.5× of the floor."
+	say ""
+	say "| servos | return delay (µs, register) | floor (µs) | buscycle p50 | p99 | max | p50/floor | undulated p50 | p99 | max | p50/floor | undulated overruns |"
+	say "|---|---|---|---|---|---|---|---|---|---|---|---|"
+	local f b db floor
+	for n in 2 6 18; do
+		for rd in 0 500; do
+			b=$T/bus/bc-$n-$rd.txt db=$T/bus/db-$n-$rd
+			floor=$(v "$b" floor_us)
+			local bcells dcells
+			if [ "$(v "$b" status)" = not ]; then
+				bcells="$(sed -n 's/^status //p' "$b") | – | – | –"
+			else
+				bcells="$(v "$b" bus_p50) | $(v "$b" bus_p99) | $(v "$b" bus_max) | $(ratio "$(v "$b" bus_p50)" "$floor")"
+			fi
+			if [ "$(v "$db" status)" = not ]; then
+				dcells="$(sed -n 's/^status //p' "$db") | – | – | – | –"
+			else
+				dcells="$(fmt "$(v "$db" all.bus_p50)") | $(fmt "$(v "$db" all.bus_p99)") | $(fmt "$(v "$db" all.bus_max)") |"
+				dcells="$dcells $(ratio "$(v "$db" all.bus_p50)" "$floor") | $(v "$db" all.overruns)$(retried "$(v "$db" start_retries)")"
+			fi
+			# the floor needs no servo: compute it here when the sim could not run
+			[ "$floor" = nan ] && floor=$(awk -v n="$n" -v rd="$rd" 'BEGIN { print n * (200 + rd) + (3 * n + 8) * 10 }')
+			say "| $n | $rd ($((rd / 2))) | $floor | $bcells | $dcells |"
+			if [ "$n" = 2 ] && [ "$rd" = 0 ]; then
+				local what
+				if [ "$(v "$db" status)" = not ]; then
+					what="undulated: $(sed -n 's/^status //p' "$db")"
+				else
+					what="undulated p50 $(fmt "$(v "$db" all.bus_p50)") µs: $(ratio "$(v "$db" all.bus_p50)" "$floor") (p99 $(fmt "$(v "$db" all.bus_p99)") µs)"
+				fi
+				[ "$(v "$b" status)" = not ] || what="$what; the protocol cycle alone $(ratio "$(v "$b" bus_p50)" "$floor")"
+				sum "bus time per cycle, 2 servos, return delay 0, 1 Mbps (simulated bus)" "≤ 1.5× the wire floor ($floor µs)" "$what"
+			fi
+		done
+	done
+	say ""
+}
+
+# ---- 3: a missing servo ------------------------------------------------------------
+section_missing() {
+	progress "3/5 a missing servo: 3 servos, the third stops answering; ${WINDOW_S} s before and after"
+	local d=$T/missing u
+	u=$(url $PORT_MISSING)
+	mkdir -p "$d"
+	# protocol level: IDs 1,2,3 against a bus with 1,2 only
+	start sim-miss-bc "$SIM" --link "$d/bc.pty" --ids 1,2 --return-delay 0 --quiet
+	if wait_ready sim-miss-bc 'ready:' 10; then
+		"$HB/buscycle" --port "$d/bc.pty" --ids 1,2,3 --cycles "$CYCLES" --margin-us "$MARGIN_US" >"$d/bc.txt" 2>"$d/bc.err"
+	else
+		echo "status not measured: undulate-sim did not start ($(why sim-miss-bc))" >"$d/bc.txt"
+	fi
+	stop sim-miss-bc
+	# the daemon: all three present at start, then servo 3 goes silent
+	echo "status ok" >"$d/info"
+	start sim-miss "$SIM" --link "$d/r1" --ids 1,2,3 --return-delay 0 --lcm-url "$u" --control "$d/sim.sock" --quiet
+	if ! wait_ready sim-miss 'ready:' 10; then
+		echo "status not measured: undulate-sim did not start ($(why sim-miss))" >"$d/info"
+	else
+		start log-miss lcm-logger --lcm-url="$u" -f "$d/run.lcm"
+		wait_file "$d/run.lcm" 10
+		if start_daemon dmn-miss "$DMN" --port "$d/r1" --ids 1,2,3 --robot r1 --lcm-url "$u"; then
+			echo "start_retries $RETRIES" >>"$d/info"
+			sleep "$RAMP_S"
+			local t0 t1 t2
+			t0=$(now_us)
+			sleep "$WINDOW_S"
+			t1=$(now_us)
+			"$HB/simctl" "$d/sim.sock" "fault r1 3 no-reply" >"$d/fault.out" 2>&1 ||
+				echo "status not measured: fault injection failed ($(head -n1 "$d/fault.out"))" >"$d/info"
+			sleep "$WINDOW_S"
+			t2=$(now_us)
+			"$HB/logstat" --from-us "$t0" --to-us "$t2" --missing-id 3 "$d/run.lcm" >"$d/stat"
+			"$HB/logstat" --from-us "$t1" --to-us "$t2" "$d/run.lcm" >"$d/stat-after"
+		else
+			echo "status not measured: undulated did not start in $START_TRIES tries ($(why dmn-miss))" >"$d/info"
+		fi
+		stop dmn-miss; stop log-miss
+	fi
+	stop sim-miss
+	say "## 3. Cost of a missing servo (3 servos, return delay 0)"
+	say ""
+	say "Derived READ timeout = wire time of request + reply + return delay + adapter latency (0 on a pty)"
+	say "+ $MARGIN_SAY."
+	say "Budget: a missing servo costs at most its timeout, never the loop (the period and overrun columns)."
+	say ""
+	say "| measured by | derived timeout (µs) | a READ to the missing servo (µs) | bus time p50: healthy → missing (µs) | bus p99 missing | period p99 missing | overruns while missing |"
+	say "|---|---|---|---|---|---|---|"
+	local b=$d/bc.txt
+	if [ "$(v "$b" status)" = not ]; then
+		say "| buscycle (IDs 1,2,3; the bus has 1,2) | – | $(sed -n 's/^status //p' "$b") | – | – | – | – |"
+	else
+		say "| buscycle (IDs 1,2,3; the bus has 1,2) | $(v "$b" timeout_us) |" \
+			"$(v "$b" absent_read_mean_us) mean, $(v "$b" absent_read_max_us) max (a reply: $(v "$b" read_mean_us)) |" \
+			"– → $(v "$b" bus_p50) | $(v "$b" bus_p99) | – | $(v "$b" overruns) |"
+	fi
+	if [ "$(v "$d/info" status)" != ok ]; then
+		say "| undulated (servo 3 stops answering) | – | $(sed -n 's/^status //p' "$d/info") | – | – | – | – |"
+		sum "a missing servo" "at most its timeout, never the loop" "$(sed -n 's/^status //p' "$d/info")"
+	else
+		local s=$d/stat h50 m50
+		h50=$(v "$s" r1.healthy_bus_p50) m50=$(v "$s" r1.missing_bus_p50)
+		say "| undulated (servo 3 stops answering; $(v "$s" r1.missing_n) cycles without it$(retried "$(v "$d/info" start_retries)")) | $(v "$b" timeout_us) |" \
+			"$(awk -v a="$m50" -v b="$h50" 'BEGIN { if (a == "nan" || b == "nan") print "–"; else printf "%.0f more than a reply (p50 difference)", a - b }') |" \
+			"$(fmt "$h50") → $(fmt "$m50") | $(fmt "$(v "$s" r1.missing_bus_p99)") | $(fmt "$(v "$s" r1.missing_period_p99)") |" \
+			"$(v "$s" r1.missing_overruns) |"
+		sum "a missing servo (3 servos, return delay 0)" "at most its timeout ($(v "$b" timeout_us) µs), never the loop" \
+			"$(awk -v a="$m50" -v b="$h50" 'BEGIN { if (a == "nan" || b == "nan") print "–"; else printf "+%.0f µs", a - b }') a cycle (p50); period p99 $(fmt "$(v "$s" r1.missing_period_p99)") µs, $(v "$s" r1.missing_overruns) overruns in $(v "$s" r1.missing_n) cycles"
+	fi
+	say ""
+}
+
+# ---- 5: simulator capacity ---------------------------------------------------------
+# scenario FILE N DIR: N two-servo robots in a row, links in DIR, servos
+# set up as the docs recommend (return delay 0), the world's defaults.
+scenario() {
+	local f=$1 n=$2 dir=$3 i
+	{
+		echo "[sim]"
+		echo "link_dir = $dir"
+		echo "return_delay_us = 0"
+		for i in $(seq 1 "$n"); do
+			printf '[robot r%d]\nids = 1,2\n' "$i"
+		done
+	} >"$f"
+}
+
+# cap_run N: the sim alone with N robots for CAP_S seconds (its own --duration).
+cap_run() {
+	local n=$1 d=$T/cap u
+	u=$(url $PORT_CAP)
+	mkdir -p "$d/links-$n"
+	scenario "$d/scen-$n.ini" "$n" "$d/links-$n"
+	start "log-cap-$n" lcm-logger --lcm-url="$u" -f "$d/cap-$n.lcm"
+	wait_file "$d/cap-$n.lcm" 10
+	start "sim-cap-$n" "$SIM" --scenario "$d/scen-$n.ini" --lcm-url "$u" --duration "$CAP_S" --quiet
+	wait "${PID[sim-cap-$n]}"
+	unset "PID[sim-cap-$n]"
+	cp "$T/sim-cap-$n.log" "$d/sim-$n.out"
+	stop "log-cap-$n"
+	"$HB/logstat" --skip 1 "$d/cap-$n.lcm" >"$d/stat-$n"
+}
+
+# fleet_run N TAG [SIM ARGS...]: the sim with N robots and one undulated per robot.
+fleet_run() {
+	local n=$1 d=$T/fleet-$2 u i
+	shift 2
+	u=$(url $PORT_FLEET)
+	mkdir -p "$d/links"
+	echo "status ok" >"$d/info"
+	scenario "$d/scen.ini" "$n" "$d/links"
+	start sim-fleet "$SIM" --scenario "$d/scen.ini" --lcm-url "$u" --quiet "$@"
+	if ! wait_ready sim-fleet 'ready:' 10; then
+		echo "status not measured: undulate-sim did not start ($(why sim-fleet))" >"$d/info"
+		stop sim-fleet
+		return 1
+	fi
+	start log-fleet lcm-logger --lcm-url="$u" -f "$d/run.lcm"
+	wait_file "$d/run.lcm" 10
+	# One after another, each once ready: twenty blocking start-up scans at
+	# once on two cores measure the start-up, not the running fleet.
+	local retries=0
+	for i in $(seq 1 "$n"); do
+		if ! start_daemon "dmn-fleet-$i" "$DMN" --port "$d/links/r$i" --ids 1,2 --robot "r$i" --lcm-url "$u"; then
+			echo "status not measured: undulated r$i did not start in $START_TRIES tries ($(why "dmn-fleet-$i"))" >"$d/info"
+			break
+		fi
+		retries=$((retries + RETRIES))
+	done
+	echo "start_retries $retries" >>"$d/info"
+	if [ "$(v "$d/info" status)" = ok ]; then
+		sleep "$RAMP_S"
+		local t0 t1 s0 s1 dc0=0 dc1=0 c
+		t0=$(now_us) s0=$(cpu_ticks "${PID[sim-fleet]}")
+		for i in $(seq 1 "$n"); do c=$(cpu_ticks "${PID[dmn-fleet-$i]}"); dc0=$((dc0 + ${c:-0})); done
+		sleep "$FLEET_S"
+		t1=$(now_us) s1=$(cpu_ticks "${PID[sim-fleet]}")
+		for i in $(seq 1 "$n"); do c=$(cpu_ticks "${PID[dmn-fleet-$i]}"); dc1=$((dc1 + ${c:-0})); done
+		{
+			echo "sim_cpu $(cpu_pct "$s0" "$s1" "$t0" "$t1")"
+			echo "daemons_cpu $(cpu_pct "$dc0" "$dc1" "$t0" "$t1")"
+		} >>"$d/info"
+		for i in $(seq 1 "$n"); do stop "dmn-fleet-$i"; done
+		stop log-fleet
+		"$HB/logstat" --from-us "$t0" --to-us "$t1" "$d/run.lcm" >"$d/stat"
+	else
+		for i in $(seq 1 "$n"); do stop "dmn-fleet-$i"; done
+		stop log-fleet
+	fi
+	stop sim-fleet
+	cp "$T/sim-fleet.log" "$d/sim.out"
+}
+
+# exit_field FILE REGEX: a number from the sim's exit summary line
+exit_field() { sed -n "s/.*exit:.*$2.*/\\1/p" "$1" | head -n1; }
+
+# realtime LATE_MAX OVERRUNS: the physics kept pace with the wall clock if it
+# never fell so far behind that the schedule was reset (an overrun: more than
+# 50 steps behind) and no step ran a whole control period (10 ms) late, i.e.
+# no daemon could have read a state older than one of its own cycles.
+realtime() { awk -v l="$1" -v o="$2" 'BEGIN { if (l == "nan" || o == "") print "–"; else print (o == 0 && l < 10000 ? "yes" : "no") }'; }
+
+section_cap() {
+	local n
+	progress "4/5 simulator capacity: 5/10/20/30 robots alone (${CAP_S} s each), then 20 robots with 20 daemons (${FLEET_S} s)"
+	for n in 5 10 20 30; do cap_run $n; done
+	fleet_run 20 other
+	if chrt -f 1 true 2>/dev/null && "$SIM" --help 2>&1 | grep -q -- '--realtime'; then
+		progress "4/5 again with the simulator under SCHED_FIFO $SIM_RT_PRIORITY (--realtime)"
+		fleet_run 20 fifo --realtime "$SIM_RT_PRIORITY"
+	fi
+	say "## 5. Simulator capacity (2 servos a robot, physics at 1 kHz)"
+	say ""
+	say "Step lateness = how late a physics step ran after its scheduled time: p99 over all steps from the"
+	say "simulator's exit summary; p99 and max of the worst step of each 10 ms SIM.TRUTH message over the"
+	say "window. Late steps are caught up, so lateness is not lost time. Real time = no overrun (the"
+	say "schedule was never reset) and no step ran a whole control period (10 ms) late."
+	say "Budget: 20 robots (40 servos) in real time on this machine while their 20 daemons run."
+	say ""
+	say "| robots | daemons | sim CPU % | step lateness p99, all steps (µs) | p99 of the 10 ms worst | max | overruns | real time | daemons' CPU % (sum) | daemons' lateness p99 (worst robot) | daemon overruns |"
+	say "|---|---|---|---|---|---|---|---|---|---|---|"
+	local d=$T/cap f cpu ovr late
+	for n in 5 10 20 30; do
+		f=$d/sim-$n.out
+		if ! grep -q 'exit:' "$f" 2>/dev/null; then
+			say "| $n | 0 | not measured: $(tail -n1 "$f" | cut -c1-120) | – | – | – | – | – | – | – | – |"
+			continue
+		fi
+		cpu=$(exit_field "$f" 'cpu \([0-9.]*\)%')
+		ovr=$(exit_field "$f" ' \([0-9]*\) overruns')
+		late=$(v "$d/stat-$n" truth.late_p99)
+		say "| $n | 0 | $(fmt "$cpu" 1) | $(fmt "$(exit_field "$f" '(p99 \([0-9.]*\) us')") | $(fmt "$late") |" \
+			"$(fmt "$(v "$d/stat-$n" truth.late_max)") | $ovr |" \
+			"$(realtime "$(v "$d/stat-$n" truth.late_max)" "$ovr") | – | – | – |"
+	done
+	local tag label
+	for tag in other fifo; do
+		d=$T/fleet-$tag
+		[ -d "$d" ] || continue
+		label="20 | 20"
+		[ "$tag" = fifo ] && label="20 | 20 (sim SCHED_FIFO $SIM_RT_PRIORITY)"
+		local sumwhat="simulator: 20 robots (40 servos) + 20 daemons"
+		[ "$tag" = fifo ] && sumwhat="$sumwhat, sim SCHED_FIFO $SIM_RT_PRIORITY"
+		if [ "$(v "$d/info" status)" != ok ]; then
+			say "| $label | $(sed -n 's/^status //p' "$d/info") | – | – | – | – | – | – | – | – |"
+			sum "$sumwhat" "real time on 2 cores" "$(sed -n 's/^status //p' "$d/info")"
+			continue
+		fi
+		label="$label$(retried "$(v "$d/info" start_retries)")"
+		ovr=$(exit_field "$d/sim.out" ' \([0-9]*\) overruns')
+		late=$(v "$d/stat" truth.late_p99)
+		say "| $label | $(fmt "$(v "$d/info" sim_cpu)" 1) | $(fmt "$(exit_field "$d/sim.out" '(p99 \([0-9.]*\) us')") (whole run) | $(fmt "$late") |" \
+			"$(fmt "$(v "$d/stat" truth.late_max)") | $ovr | $(realtime "$(v "$d/stat" truth.late_max)" "$ovr") |" \
+			"$(fmt "$(v "$d/info" daemons_cpu)" 1) ($(awk -v c="$(v "$d/info" daemons_cpu)" -v n="$(v "$d/stat" robots)" 'BEGIN { if (c == "nan" || n + 0 == 0) print "–"; else printf "%.1f", c / n }') each) |" \
+			"$(fmt "$(v "$d/stat" worst.jitter_p99)") | $(v "$d/stat" all.overruns) |"
+		sum "$sumwhat" "real time on 2 cores" \
+			"$(realtime "$(v "$d/stat" truth.late_max)" "$ovr"): step lateness p99 $(fmt "$late") µs, max $(fmt "$(v "$d/stat" truth.late_max)") µs, $ovr overruns; sim $(fmt "$(v "$d/info" sim_cpu)" 1) % + daemons $(fmt "$(v "$d/info" daemons_cpu)" 1) % of one core; daemons' lateness p99 $(fmt "$(v "$d/stat" worst.jitter_p99)") µs (worst robot), $(v "$d/stat" all.overruns) overruns"
+	done
+	say ""
+}
+
+# ---- 6: the framing code alone -----------------------------------------------------
+section_codec() {
+	progress "5/5 protocol framing throughput (1 s)"
+	"$HB/codec" --seconds 1 >"$T/codec" 2>&1
+	say "## 6. Protocol framing (no I/O)"
+	say ""
+	say "One READ(36,6) round trip = encode request, parse it (servo side), encode the 12-byte status,"
+	say "parse it (controller side)."
+	say ""
+	say "| round trips / s | ns per round trip | packets / s (encoded and parsed) |"
+	say "|---|---|---|"
+	say "| $(fmt "$(v "$T/codec" round_trips_per_s)") | $(fmt "$(v "$T/codec" ns_per_round_trip)" 1) |" \
+		"$(awk -v r="$(v "$T/codec" round_trips_per_s)" 'BEGIN { if (r == "nan") print "–"; else printf "%.0f", 2 * r }') |"
+	say ""
+}
+
+# ---- 7: instructions per control cycle (optional: valgrind) -------------------------
+section_cg() {
+	say "## 7. Instructions per control cycle (callgrind)"
+	say ""
+	if ! command -v valgrind >/dev/null || ! command -v callgrind_control >/dev/null; then
+		say "not measured: valgrind is not installed"
+		say ""
+		return 0
+	fi
+	progress "extra: callgrind instruction count of the control cycle (${CG_S} s under valgrind)"
+	local d=$T/cg u
+	u=$(url $PORT_CG)
+	mkdir -p "$d"
+	start sim-cg "$SIM" --link "$d/r1" --ids 1,2 --return-delay 0 --lcm-url "$u" --quiet
+	if ! wait_ready sim-cg 'ready:' 10; then
+		say "not measured: undulate-sim did not start ($(why sim-cg))"
+		say ""
+		stop sim-cg
+		return 0
+	fi
+	# valgrind runs the daemon in the same process: its PID is the daemon's
+	start dmn-cg valgrind --tool=callgrind --callgrind-out-file="$d/cg.out" \
+		"$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u"
+	local ok=1
+	if wait_ready dmn-cg 'ready:' 60; then
+		sleep "$RAMP_S"
+		callgrind_control --zero "${PID[dmn-cg]}" >/dev/null 2>&1 || ok=0
+		sleep "$CG_S"
+		callgrind_control --dump=window "${PID[dmn-cg]}" >/dev/null 2>&1 || ok=0
+	else
+		ok=0
+	fi
+	stop dmn-cg
+	stop sim-cg
+	local dump total cycles
+	dump=$(find "$d" -name 'cg.out.*' | sort | head -n1)
+	if [ "$ok" = 0 ] || [ -z "$dump" ]; then
+		say "not measured: undulated under valgrind did not run or could not be dumped ($(why dmn-cg))"
+		say ""
+		return 0
+	fi
+	total=$(awk '/^summary:/ { print $2 }' "$dump")
+	# cycles in the window = calls of the state encoder (once per cycle),
+	# summed from the dump's call arcs (names are compressed: "(id) name"
+	# the first time, "(id)" after)
+	cycles=$(awk '
+		/^c?fn=\(/ {
+			s = $0; sub(/^c?fn=/, "", s); id = s; sub(/\).*/, "", id); sub(/^\(/, "", id)
+			nm = s; if (sub(/^\([0-9]+\) /, "", nm)) names[id] = nm
+			if ($0 ~ /^cfn=/) cur = id
+		}
+		/^calls=/ { c = $0; sub(/^calls=/, "", c); split(c, f, " "); if (names[cur] == "undulate_robot_state_t_encode") n += f[1] }
+		END { print n + 0 }' "$dump")
+	say "All threads (the loop and LCM's receive thread), user space, over a ${CG_S} s window at 100 Hz;"
+	say "cycles counted as calls of the per-cycle state encoder. Self cost of the busiest functions:"
+	say ""
+	say "| cycles | instructions | per cycle | busiest functions (self, % of all) |"
+	say "|---|---|---|---|"
+	local top
+	top=$(callgrind_annotate --inclusive=no --threshold=100 "$dump" 2>/dev/null | sed -n '/file:function/,$p' |
+		grep -vE 'below main|libc-start|libc_start_call_main|main\.c:main|clone\.S|start_thread|\?\?\?:0x|^-|file:function|^ *$' |
+		head -n 6 | awk '{ pct = $2 $3; gsub(/[()]/, "", pct); f = $NF == "" ? $4 : $4; sub(/.*:/, "", f); printf "%s%s %s", (NR > 1 ? ", " : ""), f, pct }')
+	say "| ${cycles:-–} | $(fmt "$total") | $(awk -v t="$total" -v c="${cycles:-0}" 'BEGIN { if (c + 0 == 0) print "–"; else printf "%.0f", t / c }') | $top |"
+	say ""
+}
+
+# ---- main -------------------------------------------------------------------------
+main() {
+	local missing=()
+	for p in "$SIM" "$DMN"; do [ -x "$p" ] || missing+=("$p"); done
+	command -v lcm-logger >/dev/null || missing+=(lcm-logger)
+	command -v cyclictest >/dev/null || missing+=("cyclictest (apt-get install rt-tests)")
+	if [ ${#missing[@]} -gt 0 ]; then
+		echo "bench: missing: ${missing[*]} (run \`make bench\`, which builds everything first)" >&2
+		return 1
+	fi
+	if ! build_helpers; then
+		echo "bench: the helpers in bench/ did not compile" >&2
+		return 1
+	fi
+	# The slack the daemon adds to every bus timeout, as its configuration
+	# says: the derived timeout printed here is then the one it uses.
+	MARGIN_US=$("$DMN" --port /dev/null --ids 1,2 --check-config -v 2>/dev/null |
+		awk -F' *= *' '$1 == "bus_margin_us" { print $2 }')
+	MARGIN_SAY="the daemon's scheduling margin (robot.bus_margin_us = $MARGIN_US µs)"
+	if [ -z "$MARGIN_US" ]; then
+		MARGIN_US=0
+		MARGIN_SAY="the daemon's scheduling margin (unknown: \`undulated --check-config -v\` did not say; 0 used)"
+	fi
+
+	local started head
+	started=$(date +%s)
+	head="$(date -u '+%Y-%m-%d %H:%M UTC'); $(grep -m1 'model name' /proc/cpuinfo | sed 's/.*: //'), $(nproc) cores,"
+	head="$head Linux $(uname -r); $(cyclictest --help 2>&1 | head -n1); load average at start $(cut -d' ' -f1-3 /proc/loadavg)."
+	: >"$REPORT"
+	: >"$SUMMARY"
+	wants loop && section_loop
+	wants bus && section_bus
+	wants missing && section_missing
+	wants loop && section_resources
+	wants cap && section_cap
+	wants codec && section_codec
+	wants cg && section_cg
+	{
+		echo "# undulate benchmarks"
+		echo
+		echo "$head"
+		echo "Suite time: $(($(date +%s) - started)) s; load average at the end $(cut -d' ' -f1-3 /proc/loadavg)" \
+			"(other work on the machine shows in every timing figure: compare runs at similar load)."
+		echo "Figures, not pass/fail: see bench/README.md for how to read them."
+		echo
+		echo "## Summary against the budgets (DESIGN.md)"
+		echo
+		echo "| what | budget | measured |"
+		echo "|---|---|---|"
+		cat "$SUMMARY"
+		echo
+		cat "$REPORT"
+	} >"$OUT"
+	echo
+	cat "$OUT"
+	echo "bench: written to $OUT" >&2
+}
+
+main
