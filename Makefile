@@ -48,11 +48,11 @@ GEN_WARN := -w
 
 # ---- components -------------------------------------------------------------
 # name : directory
-COMPONENTS := protocol daemon sim bench dxl top analyze
+# bench/ holds standalone programs compiled by bench/run.sh, not a library.
+COMPONENTS := protocol daemon sim dxl top analyze
 DIR_protocol := protocol protocol/io
 DIR_daemon   := daemon
 DIR_sim      := sim-bridge
-DIR_bench    := bench
 DIR_dxl      := tools/dxl
 DIR_top      := tools/top
 DIR_analyze  := tools/analyze
@@ -71,7 +71,6 @@ DEPS_sim      := sim protocol
 DEPS_dxl      := dxl protocol
 DEPS_top      := top protocol
 DEPS_analyze  := analyze protocol
-DEPS_bench    := bench protocol
 DEPS_protocol := protocol
 
 srcs_of   = $(foreach d,$(DIR_$(1)),$(wildcard $(d)/*.c))

@@ -9,20 +9,26 @@
 #define OSC_PI 3.14159265358979323846
 
 /*
- * Default oscillator parameters. Target: 0.8 Hz, 0.8 rad on both joints of the
- * two-joint robot with the paper's coupling λ = (1.5, −0.5), and on a single
- * joint; tuned numerically by integrating the equation itself (measured state =
- * previous prediction). Measured: 0.7997 Hz, 0.7985 / 0.7981 rad; single joint
- * 0.8001 Hz, 0.8003 rad. Chains of more than two joints alternate the two
- * joints' values, untuned. CONTROL.md explains how each number moves f and A.
+ * Default oscillator parameters. Target: 0.8 Hz, 0.8 rad on the simulated AX-12A
+ * robot through the real daemon (factory compliance margin 1 / slope 32 /
+ * punch 32, speed from the 20 Hz filter, horizon = dt + OSC_SERVO_LEAD_S), on
+ * both joints of the two-joint robot with the paper's coupling λ = (1.5, −0.5),
+ * and on a single joint. The servo loop moves both numbers away from what the
+ * bare equation gives (CONTROL.md, "Through the servo"):
+ * - the speed estimate lags the angle (≈ 13 ms); predicting with it acts like a
+ *   softer spring, so the loop runs at 0.82–0.84 of the equation's frequency
+ *   and k is set for 0.95 (two joints) / 0.99 Hz (one) in the bare equation;
+ * - the lead puts the horizon ≈ 3.5 ms past the loop's own lag; that surplus
+ *   feeds energy like extra negative damping, so μ is larger than A ≈ 2√(c/μ)
+ *   would ask for (the bare equation: 0.65 / 0.58 rad, single joint 0.38 rad).
  */
 #define OSC_DEF_INERTIA 2.0e-3   /* kg·m²: a control parameter, order of the real link's */
-#define OSC_DEF_K       0.0557   /* N·m/rad: √(k/I)/2π = 0.84 Hz, 0.80 Hz once coupled */
-#define OSC_DEF_C       3.0e-3   /* N·m·s/rad: c/(I·ω) = 0.28, cycle reached in a few periods */
-#define OSC_DEF_MU0     0.108    /* N·m·s/rad³, joint 0: 0.80 rad once coupled */
-#define OSC_DEF_MU1     0.054    /* joint 1: half of joint 0's, equalises the amplitudes */
-#define OSC_DEF_K_SINGLE 0.0511  /* N·m/rad, single joint: 0.80 Hz uncoupled */
-#define OSC_DEF_MU_SINGLE 0.01875 /* single joint: 2√(c/μ) = 0.80 rad */
+#define OSC_DEF_K       0.078    /* N·m/rad: 0.80 Hz through the servo loop (bare: 0.947 Hz) */
+#define OSC_DEF_C       3.0e-3   /* N·m·s/rad: c/(I·ω) = 0.24; the lead's surplus adds more */
+#define OSC_DEF_MU0     0.175    /* N·m·s/rad³, joint 0: 0.80 rad through the servo loop */
+#define OSC_DEF_MU1     0.125    /* joint 1: smaller natural swing, smaller μ equalises */
+#define OSC_DEF_K_SINGLE 0.078   /* N·m/rad, single joint: 0.80 Hz through the servo loop */
+#define OSC_DEF_MU_SINGLE 0.082  /* single joint: 0.80 rad through the servo loop */
 #define OSC_DEF_LAMBDA0 1.5      /* paper: first joint */
 #define OSC_DEF_LAMBDA1 (-0.5)   /* paper: second joint */
 
@@ -175,7 +181,12 @@ bool osc_step(const struct osc_joint_params *p, size_t njoints, const double *x,
 
 double osc_sinusoid(double amplitude, double frequency, double phase, size_t joint, double t)
 {
-	return amplitude * sin(phase + (2.0 * OSC_PI / 3.0) * (double)joint - 2.0 * OSC_PI * frequency * t);
+	/* t is wall-clock time (robots on different computers share it), so f·t is
+	 * ~1e9 cycles: keep only its fraction. sin() of a ~1e10 rad argument takes
+	 * the slow argument-reduction path, and the fraction keeps ~1e-7 cycle. */
+	double cycles = frequency * t;
+	cycles -= floor(cycles);
+	return amplitude * sin(phase + (2.0 * OSC_PI / 3.0) * (double)joint - 2.0 * OSC_PI * cycles);
 }
 
 double osc_wrap(double a)

@@ -22,7 +22,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#define OSC_MAX_JOINTS 8   /* a robot has 2; a rig may have 1 */
+#define OSC_MAX_JOINTS 24  /* a robot has 2, a rig 1; up to 24 so one daemon can drive a long bus (benchmarks) */
 
 struct osc_joint_params {
 	double k;         /* N·m/rad: stiffness -> frequency ≈ √(k/I)/2π */
@@ -34,17 +34,29 @@ struct osc_joint_params {
 };
 
 /* What the daemon should pass as `horizon`: the measured dt plus this lead.
- * The servo tracks the goal with a lag (≈ 27 ms on an AX-12 at compliance
- * slope 32); integrating over one period only, the servo never reaches the
- * predicted angle, the measured speed keeps falling short and the loop decays
- * into the position quantum. Make it configurable: the right value depends on
- * the servo's dynamics. See CONTROL.md for the measurements. */
-#define OSC_SERVO_LEAD_S 0.025
+ * The servo reaches a goal late: its position loop trails by ≈ 27 ms at
+ * compliance slope 32 (slope / no-load speed), plus half a control period of
+ * goal hold, the bus time and the dead band. Measured on the simulated AX-12A
+ * (factory margin 1), the loop neither gains nor loses energy with a lead of
+ * ≈ 0.0245 s; less and it dies into the position quantum, more and it feeds
+ * energy. 0.028 s keeps a margin above that edge, so that a joint stopped
+ * 0.3 rad from neutral starts again by itself. The defaults of
+ * osc_default_params() are tuned for this value: change one, retune the other
+ * (CONTROL.md has the tables). Configurable in the daemon: it depends on the
+ * servo (compliance, inertia, bus). */
+#define OSC_SERVO_LEAD_S 0.028
+/* The same for a servo whose compliance margin was set to 0 (less dead band,
+ * less lag): with this lead the same defaults give 0.81–0.82 Hz, 0.81–0.85 rad,
+ * and a joint resting 0.1 rad from neutral starts by itself (CONTROL.md). */
+#define OSC_SERVO_LEAD_MARGIN0_S 0.026
 /* Cut-off for osc_velocity_filter (on measured positions) with which the lead
- * was chosen: a lower cut-off lags more and slows the closed loop down. */
+ * and the defaults were tuned: a lower cut-off lags more and slows the closed
+ * loop down (10 Hz: −10 % in frequency), a higher one speeds it up. */
 #define OSC_VELOCITY_CUTOFF_HZ 20.0
 
-/* Defaults giving ≈0.8 Hz and ≈0.8 rad (CONTROL.md has the measured numbers):
+/* Defaults giving ≈0.8 Hz and ≈0.8 rad on the simulated AX-12A through the
+ * daemon with OSC_SERVO_LEAD_S and OSC_VELOCITY_CUTOFF_HZ (not in the bare
+ * equation, which runs faster and smaller; CONTROL.md has the measured numbers):
  * two joints get λ = 1.5 (even joints) and −0.5 (odd joints), one joint λ = 0. */
 void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints);
 

@@ -20,7 +20,7 @@
 #include "servo.h"
 
 /* Servos on one bus: robots have two; test rigs and ID scans use a few more. */
-#define SIM_BUS_MAX_SERVOS 16
+#define SIM_BUS_MAX_SERVOS 32
 #define SIM_NAME_MAX 32        /* robot / bus names */
 #define SIM_PATH_MAX 256       /* link paths */
 
