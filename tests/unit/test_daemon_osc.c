@@ -1,6 +1,7 @@
 /*
  * test_daemon_osc.c — the control laws: limit cycle, coupling, integration
- * accuracy, reaction to a collision, a closed loop through a crude servo,
+ * accuracy, reaction to a collision, the closed loop through a model of the
+ * simulated AX-12A (the defaults give 0.8 Hz, 0.8 rad there),
  * the baseline sinusoid, phase helpers, estimator and velocity filter.
  */
 #include <math.h>
@@ -126,9 +127,13 @@ static void test_limit_cycle_same_from_any_start(void **state)
 		struct cycle r = run_ideal(p, TWO_JOINTS, starts[i], starts[i] + 2, 0.01, 4, 30.0, 45.0);
 		print_message("start %zu: A0 %.4f A1 %.4f rad, f %.4f Hz, lag %.1f deg\n", i, r.amp[0],
 		              r.amp[1], r.freq, r.lag_deg);
-		assert_in_range(lround(r.freq * 1000), 780, 820);
-		assert_in_range(lround(r.amp[0] * 1000), 770, 830);
-		assert_in_range(lround(r.amp[1] * 1000), 770, 830);
+		/* the bare equation (no servo) with the defaults: the coupling
+		 * lowers the frequency to 0.95 × √(k/I)/2π; the defaults' 0.8 Hz,
+		 * 0.8 rad come from the servo loop (test_closed_loop_through_servo) */
+		double f0 = sqrt(p[0].k / p[0].inertia) / (2.0 * PI);
+		assert_true(fabs(r.freq / f0 - 0.952) < 0.01);
+		assert_in_range(lround(r.amp[0] * 1000), 600, 700);
+		assert_in_range(lround(r.amp[1] * 1000), 530, 630);
 		if (i == 0) {
 			ref = r;
 			continue;
@@ -150,8 +155,11 @@ static void test_single_joint_limit_cycle(void **state)
 	for (size_t i = 0; i < 3; i++) {
 		struct cycle r = run_ideal(&p, 1, &x0[i][0], &x0[i][1], 0.01, 4, 30.0, 45.0);
 		print_message("single start %zu: A %.4f rad, f %.4f Hz\n", i, r.amp[0], r.freq);
-		assert_in_range(lround(r.freq * 1000), 785, 815);
-		assert_in_range(lround(r.amp[0] * 1000), 780, 820);
+		/* van der Pol with weak nonlinearity (c/(Iω) = 0.24): f ≈ √(k/I)/2π,
+		 * A ≈ 2√(c/μ), each within 1 % */
+		double f0 = sqrt(p.k / p.inertia) / (2.0 * PI), a0 = 2.0 * sqrt(p.c / p.mu);
+		assert_true(fabs(r.freq / f0 - 1.0) < 0.01);
+		assert_true(fabs(r.amp[0] / a0 - 1.0) < 0.01);
 	}
 	/* one joint: λ is ignored whatever it holds */
 	struct osc_joint_params q = p;
@@ -382,85 +390,178 @@ static void test_friction_term_is_smooth_sign(void **state)
 
 /* ---- the real loop: a servo between goal and measurement ------------------- */
 
-/* A crude AX-12: torque ramps with the position error over the compliance
- * slope (32 units = 0.164 rad) up to the stall torque, minus the motor's
- * back-EMF (the torque–speed line: 1.5 N·m at stall, 6.18 rad/s no-load at
- * 12 V, so the speed limit comes out by itself), driving the link's inertia.
- * As a lag it is ≈ slope / no-load speed ≈ 27 ms, plus the inertia's 8 ms. */
-#define SERVO_SLOPE_RAD (32.0 * AX12_POS_STEP)
+/* An AX-12A as the simulator models it (sim-bridge/motor.c, PHYSICS.md): a
+ * proportional controller on the servo's own whole-unit reading, shaped by the
+ * compliance registers (no drive within the margin, punch just outside it,
+ * ramping to full duty over the slope), the motor's torque–speed line
+ * (τ = 1.5 N·m·(duty − w/6.18 rad/s), the back-EMF braking also inside the dead
+ * band), the joint's inertia with the link's viscous and dry friction, stepped
+ * at 1 kHz with semi-implicit Euler. Factory registers: margin 1, slope 32,
+ * punch 32, full torque limit, moving speed 0. */
+#define SERVO_SLOPE_UNITS 32.0
+#define SERVO_PUNCH (32.0 / 1023.0)
 #define SERVO_STALL_NM 1.5
-#define SERVO_NO_LOAD_RAD_S 6.18
-#define SERVO_INERTIA 2e-3          /* kg·m², the order of an 18.65 cm link's */
-#define SERVO_SUBSTEPS 100          /* 0.1 ms physics inside one 10 ms period */
-#define SERVO_WRITE_DELAY 10        /* substeps between the read and the goal write */
+#define SERVO_NO_LOAD_RAD_S 6.178
+#define SERVO_INERTIA 4.39e-3       /* kg·m²: link + rotor through the gearbox */
+#define SERVO_VISCOUS 0.002         /* N·m·s/rad, link bearing */
+#define SERVO_COULOMB 0.005         /* N·m, link bearing */
+#define SERVO_SUBSTEPS 10           /* 1 ms physics inside one 10 ms period */
+#define SERVO_WRITE_DELAY 1         /* substeps between the read and the goal write (bus time) */
 
-static void servo_physics(double *x, double *speed, double goal, double h)
+struct servo_joint {
+	double angle, speed;   /* true, rad and rad/s */
+	double goal_units;     /* position units from the centre */
+};
+
+static double servo_duty(double error_units, double margin_units)
 {
-	double drive = fmax(-1.0, fmin(1.0, (goal - *x) / SERVO_SLOPE_RAD));
-	double torque = SERVO_STALL_NM * (drive - *speed / SERVO_NO_LOAD_RAD_S);
-	*speed += h * torque / SERVO_INERTIA;
-	*x += h * *speed;
+	double mag = fabs(error_units);
+	if (mag <= margin_units)
+		return 0.0;
+	double ramp = fmin(1.0, (mag - margin_units) / SERVO_SLOPE_UNITS);
+	double u = SERVO_PUNCH + (1.0 - SERVO_PUNCH) * ramp;
+	return error_units > 0.0 ? u : -u;
 }
+
+static void servo_physics(struct servo_joint *s, double margin_units, double h)
+{
+	double present = round(s->angle / AX12_POS_STEP);
+	double duty = servo_duty(s->goal_units - present, margin_units);
+	double torque = SERVO_STALL_NM * (duty - s->speed / SERVO_NO_LOAD_RAD_S);
+	torque = fmax(-SERVO_STALL_NM, fmin(SERVO_STALL_NM, torque));
+	double impulse = SERVO_INERTIA * s->speed + h * (torque - SERVO_VISCOUS * s->speed);
+	double stick = h * SERVO_COULOMB;
+	if (fabs(impulse) <= stick)
+		impulse = 0.0;
+	else
+		impulse -= impulse > 0.0 ? stick : -stick;
+	s->speed = impulse / SERVO_INERTIA;
+	s->angle += h * s->speed;
+}
+
+struct servo_run {
+	size_t njoints;
+	double lead;           /* s, added to dt for the horizon */
+	double margin;         /* compliance margin, position units */
+	double x0[TWO_JOINTS]; /* start angles, at rest, goals there */
+	double starter_s;      /* s of the baseline sinusoid first (the daemon's starter), 0 = none */
+	double t_to;           /* s; measured over the last 15 s */
+};
 
 /* The daemon's loop: read quantized angles, speed from the filtered
  * difference, integrate dt + lead ahead, write the (quantized) goal. */
-static struct cycle run_servo(double lead, double x0, double x1, double t_to)
+static struct cycle run_servo(const struct servo_run *run)
 {
 	struct osc_joint_params p[TWO_JOINTS];
-	defaults(p, TWO_JOINTS);
+	defaults(p, run->njoints);
 	struct osc_velocity_filter vf[TWO_JOINTS];
+	struct servo_joint sj[TWO_JOINTS];
 	const double dt = 0.01, hs = dt / SERVO_SUBSTEPS;
-	double x[2] = { x0, x1 }, speed[2] = { 0.0, 0.0 }, goal[2] = { x0, x1 };
 	struct crossings c;
 	cross_init(&c);
-	for (size_t j = 0; j < TWO_JOINTS; j++)
+	for (size_t j = 0; j < run->njoints; j++) {
 		osc_velocity_filter_init(&vf[j], OSC_VELOCITY_CUTOFF_HZ);
-	long steps = lround(t_to / dt);
+		sj[j] = (struct servo_joint){ .angle = run->x0[j], .speed = 0.0,
+		                              .goal_units = round(run->x0[j] / AX12_POS_STEP) };
+	}
+	long steps = lround(run->t_to / dt);
 	for (long s = 0; s < steps; s++) {
-		double xm[2], vm[2], xn[2];
-		for (size_t j = 0; j < TWO_JOINTS; j++) {
-			xm[j] = AX12_POS_STEP * round(x[j] / AX12_POS_STEP);
+		double xm[TWO_JOINTS], vm[TWO_JOINTS], xn[TWO_JOINTS];
+		for (size_t j = 0; j < run->njoints; j++) {
+			xm[j] = AX12_POS_STEP * round(sj[j].angle / AX12_POS_STEP);
 			vm[j] = osc_velocity_filter_update(&vf[j], xm[j], dt);
 		}
-		assert_true(osc_step(p, TWO_JOINTS, xm, vm, dt + lead, 4, xn, NULL));
+		if (s * dt < run->starter_s) {
+			for (size_t j = 0; j < run->njoints; j++)
+				xn[j] = osc_sinusoid(0.8, 0.8, 0.0, j, s * dt);
+		} else {
+			assert_true(osc_step(p, run->njoints, xm, vm, dt + run->lead, 4, xn, NULL));
+		}
 		for (int k = 0; k < SERVO_SUBSTEPS; k++) {
-			if (k == SERVO_WRITE_DELAY) {
-				goal[0] = AX12_POS_STEP * round(xn[0] / AX12_POS_STEP);
-				goal[1] = AX12_POS_STEP * round(xn[1] / AX12_POS_STEP);
-			}
-			for (size_t j = 0; j < TWO_JOINTS; j++) {
-				double before = x[j];
-				servo_physics(&x[j], &speed[j], goal[j], hs);
+			for (size_t j = 0; j < run->njoints; j++) {
+				if (k == SERVO_WRITE_DELAY)
+					sj[j].goal_units = round(xn[j] / AX12_POS_STEP);
+				double before = sj[j].angle;
+				servo_physics(&sj[j], run->margin, hs);
 				double t = s * dt + (k + 1) * hs;
-				if (t >= t_to - 15.0)
-					cross_sample(&c, j, t - hs, before, t, x[j]);
+				if (t >= run->t_to - 15.0)
+					cross_sample(&c, j, t - hs, before, t, sj[j].angle);
 			}
 		}
 	}
-	return cross_result(&c, TWO_JOINTS);
+	return cross_result(&c, run->njoints);
 }
 
 static void test_closed_loop_through_servo(void **state)
 {
 	(void)state;
-	struct cycle r = run_servo(OSC_SERVO_LEAD_S, 0.3, -0.1, 45.0);
+	/* as the daemon starts: two seconds of the baseline sinusoid, then the oscillator */
+	struct servo_run run = { .njoints = 2, .lead = OSC_SERVO_LEAD_S, .margin = 1.0,
+	                         .x0 = { 0.0, 0.0 }, .starter_s = 2.0, .t_to = 40.0 };
+	struct cycle r = run_servo(&run);
 	print_message("servo loop, horizon dt+%.3f s: A0 %.3f A1 %.3f rad, f %.3f Hz, lag %.1f deg\n",
 	              OSC_SERVO_LEAD_S, r.amp[0], r.amp[1], r.freq, r.lag_deg);
-	assert_in_range(lround(r.freq * 100), 70, 90);
-	assert_in_range(lround(r.amp[0] * 100), 70, 100);
-	assert_in_range(lround(r.amp[1] * 100), 70, 100);
+	/* the defaults' purpose: the paper's 0.8 Hz, 0.8 rad on the servo */
+	assert_in_range(lround(r.freq * 100), 74, 86);
+	assert_in_range(lround(r.amp[0] * 100), 72, 88);
+	assert_in_range(lround(r.amp[1] * 100), 72, 88);
 	assert_true(r.lag_deg > 60.0 && r.lag_deg < 120.0);
-	/* from rest, one joint bent by 0.4 rad: the same cycle (from rest below
-	 * ≈0.3 rad the first goals round to the present angle: see CONTROL.md) */
-	struct cycle rest = run_servo(OSC_SERVO_LEAD_S, 0.4, 0.0, 45.0);
-	print_message("servo loop from rest at 0.4 rad: A0 %.3f A1 %.3f rad, f %.3f Hz\n",
-	              rest.amp[0], rest.amp[1], rest.freq);
-	assert_true(fabs(rest.freq - r.freq) < 0.01 * r.freq);
-	assert_true(fabs(rest.amp[0] - r.amp[0]) < 0.03 && fabs(rest.amp[1] - r.amp[1]) < 0.03);
+	/* from rest without the starter, one joint bent by 0.4 rad, either joint:
+	 * the same cycle (the lead's surplus over the loop's lag gets it moving) */
+	for (size_t j = 0; j < TWO_JOINTS; j++) {
+		struct servo_run rest = run;
+		rest.starter_s = 0.0;
+		rest.x0[j] = 0.4;
+		rest.x0[1 - j] = 0.0;
+		struct cycle q = run_servo(&rest);
+		print_message("servo loop from rest, joint %zu at 0.4 rad: A0 %.3f A1 %.3f rad, f %.3f Hz\n",
+		              j, q.amp[0], q.amp[1], q.freq);
+		assert_true(fabs(q.freq - r.freq) < 0.03 * r.freq);
+		assert_true(fabs(q.amp[0] - r.amp[0]) < 0.03 && fabs(q.amp[1] - r.amp[1]) < 0.03);
+	}
+	/* compliance margin 0 (less dead band, less lag): faster, still near */
+	struct servo_run m0 = run;
+	m0.margin = 0.0;
+	struct cycle z = run_servo(&m0);
+	print_message("servo loop, margin 0: A0 %.3f A1 %.3f rad, f %.3f Hz\n", z.amp[0], z.amp[1], z.freq);
+	assert_true(z.freq > r.freq && z.freq < 0.90);
+	assert_true(z.amp[0] > 0.72 && z.amp[0] < 0.95 && z.amp[1] > 0.72 && z.amp[1] < 0.95);
+	/* ... and with the lead meant for margin 0, back at 0.8 Hz, 0.8 rad, and a
+	 * joint resting only 0.1 rad from neutral starts by itself */
+	m0.lead = OSC_SERVO_LEAD_MARGIN0_S;
+	struct cycle z0 = run_servo(&m0);
+	m0.starter_s = 0.0;
+	m0.x0[0] = 0.1;
+	m0.x0[1] = 0.0;
+	struct cycle z1 = run_servo(&m0);
+	print_message("servo loop, margin 0, lead %.3f s: A0 %.3f A1 %.3f rad, f %.3f Hz; from 0.1 rad: "
+	              "A0 %.3f, f %.3f Hz\n", OSC_SERVO_LEAD_MARGIN0_S, z0.amp[0], z0.amp[1], z0.freq,
+	              z1.amp[0], z1.freq);
+	assert_in_range(lround(z0.freq * 100), 74, 86);
+	assert_in_range(lround(z0.amp[0] * 100), 72, 88);
+	assert_in_range(lround(z0.amp[1] * 100), 72, 88);
+	assert_true(fabs(z1.freq - z0.freq) < 0.03 * z0.freq && fabs(z1.amp[0] - z0.amp[0]) < 0.03);
 	/* without the lead the servo never reaches the goal and the loop dies */
-	struct cycle none = run_servo(0.0, 0.3, -0.1, 30.0);
-	print_message("servo loop, horizon dt only: A0 %.3f A1 %.3f rad\n", none.amp[0], none.amp[1]);
-	assert_true(none.amp[0] < 0.2 && none.amp[1] < 0.2);
+	struct servo_run none = run;
+	none.lead = 0.0;
+	none.starter_s = 0.0;
+	none.x0[0] = 0.3;
+	none.x0[1] = -0.1;
+	none.t_to = 30.0;
+	struct cycle d = run_servo(&none);
+	print_message("servo loop, horizon dt only: A0 %.3f A1 %.3f rad\n", d.amp[0], d.amp[1]);
+	assert_true(d.amp[0] < 0.2 && d.amp[1] < 0.2);
+}
+
+static void test_single_joint_through_servo(void **state)
+{
+	(void)state;
+	struct servo_run run = { .njoints = 1, .lead = OSC_SERVO_LEAD_S, .margin = 1.0,
+	                         .x0 = { 0.3, 0.0 }, .t_to = 40.0 };
+	struct cycle r = run_servo(&run);
+	print_message("single joint through the servo: A %.3f rad, f %.3f Hz\n", r.amp[0], r.freq);
+	assert_in_range(lround(r.freq * 100), 74, 86);
+	assert_in_range(lround(r.amp[0] * 100), 72, 88);
 }
 
 /* ---- baseline sinusoid, phase helpers ------------------------------------- */
@@ -690,6 +791,7 @@ int main(void)
 		cmocka_unit_test(test_non_finite_input_holds),
 		cmocka_unit_test(test_friction_term_is_smooth_sign),
 		cmocka_unit_test(test_closed_loop_through_servo),
+		cmocka_unit_test(test_single_joint_through_servo),
 		cmocka_unit_test(test_sinusoid_values),
 		cmocka_unit_test(test_phase_and_wrap),
 		cmocka_unit_test(test_estimator_clean_sine),
