@@ -212,7 +212,11 @@ void cfg_defaults(struct cfg *c)
 	c->fault_action = CFG_SAFE_HOLD;
 	c->velocity_source = CFG_VEL_FILTERED;
 	c->velocity_cutoff_hz = OSC_VELOCITY_CUTOFF_HZ;
-	c->servo_lead_s = OSC_SERVO_LEAD_S;
+	/* Margin 0: with the factory dead band of 1 unit (5 mrad), a joint that
+	 * comes to rest near neutral stays there, each predicted step being inside
+	 * the dead band (CONTROL.md). The lead then follows the margin. */
+	c->compliance_margin = 0;
+	c->servo_lead_s = NAN;
 	/* Replies on a loaded 2-core machine (simulator, tests) come up to ~3 ms
 	 * late; a real adapter with return delay 0 needs far less. */
 	c->bus_margin_us = 3000;
@@ -271,6 +275,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("adapter_latency_us", T_LONG, adapter_latency_us, -1, 100000),
 	K("period_ms", T_DOUBLE, period_ms, 2, 100),
 	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, 0.2),
+	K("compliance_margin", T_LONG, compliance_margin, -1, 255),
 	K("bus_margin_us", T_LONG, bus_margin_us, 0, 100000),
 	K("ramp_s", T_DOUBLE, ramp_s, 0, 10),
 	K("backoff_torque", T_DOUBLE, backoff_torque, 0, 1),
@@ -438,9 +443,26 @@ struct cfg_parse {
 	FILE *file;
 	const char *text;
 	int line;
+	int long_line;   /* first physical line too long for inih, 0 if none */
+	int line_cap;    /* the longest line inih reads (its buffer less the NUL) */
 	char last_section[64];
 	bool section_reported;
 };
+
+/* Drops the rest of a physical line that did not fit inih's buffer, so that
+ * inih sees one line per physical line (its own line numbers stay right) and
+ * the tail of a long line is never parsed as a key of its own. */
+static void cfg_skip_rest_of_line(struct cfg_parse *p)
+{
+	if (p->file != NULL) {
+		int ch;
+		while ((ch = fgetc(p->file)) != EOF && ch != '\n')
+			;
+	} else {
+		while (*p->text != '\0' && *p->text++ != '\n')
+			;
+	}
+}
 
 static char *cfg_reader(char *str, int num, void *stream)
 {
@@ -460,6 +482,16 @@ static char *cfg_reader(char *str, int num, void *stream)
 		str[i] = '\0';
 	}
 	p->line++;
+	/* a read that fills the buffer without a newline is a line too long for
+	 * inih (a NUL byte inside a line only makes it look shorter) */
+	size_t len = strlen(str);
+	if (len > 0 && len + 1 >= (size_t)num && str[len - 1] != '\n') {
+		cfg_skip_rest_of_line(p);
+		if (p->long_line == 0) {
+			p->long_line = p->line;
+			p->line_cap = num - 1;
+		}
+	}
 	return str;
 }
 
@@ -478,9 +510,15 @@ static int cfg_handler(void *user, const char *section, const char *name, const 
 
 static bool cfg_parse_run(struct cfg_parse *p)
 {
-	size_t before = p->errors->count;
 	int rc = ini_parse_stream(cfg_reader, p, cfg_handler, p);
-	if (rc > 0 && p->errors->count == before)
+	if (p->long_line > 0)
+		cfg_error(p->errors, "%s:%d: line too long (the parser reads at most %d characters of a line)",
+		          p->name, p->long_line, p->line_cap);
+	/* our handler never stops the parser, so rc > 0 is inih's own first syntax
+	 * error: name it even when the keys after it gave errors of their own
+	 * (a "[robot" header makes every key below it "outside any section");
+	 * a long line is reported above, with a better reason */
+	if (rc > 0 && rc != p->long_line)
 		cfg_error(p->errors, "%s:%d: syntax error (expected [section] or key = value)", p->name, rc);
 	else if (rc < 0)
 		cfg_error(p->errors, "%s: cannot parse (out of memory)", p->name);
@@ -577,6 +615,8 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 			          c->source[0] ? c->source : "config", j + 1, c->njoints);
 	}
 	cfg_fill_joint_defaults(c);
+	if (isnan(c->servo_lead_s))
+		c->servo_lead_s = c->compliance_margin == 0 ? OSC_SERVO_LEAD_MARGIN0_S : OSC_SERVO_LEAD_S;
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		if (!(jt->limit_min < jt->limit_max))
@@ -604,13 +644,13 @@ void cfg_print(const struct cfg *c, void *file)
 		fprintf(f, "%s%u", j ? "," : "", c->ids[j]);
 	fprintf(f, "\nmode = %s\nlcm_url = %s\npriority = %d\nmlockall = %s\nsafe_stop = %s\n"
 	        "fault_action = %s\nvelocity_source = %s\nvelocity_cutoff_hz = %g\ncommands = %s\n"
-	        "echo = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\nbus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
+	        "echo = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\nbus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
 	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\n",
 	        cfg_mode_name(c->mode), c->lcm_url, c->priority, c->mlockall ? "on" : "off",
 	        safe[c->safe_stop], safe[c->fault_action],
 	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
 	        c->commands ? "on" : "off", c->echo ? "on" : "off", c->adapter_latency_us, c->period_ms,
-	        c->servo_lead_s, c->bus_margin_us,
+	        c->servo_lead_s, c->compliance_margin, c->bus_margin_us,
 	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit);
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];

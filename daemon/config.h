@@ -53,7 +53,9 @@ struct cfg {
 	bool echo;                     /* single-wire adapter echoes our bytes */
 	long adapter_latency_us;       /* -1: measure (FTDI latency timer) */
 	double period_ms;              /* control period */
-	double servo_lead_s;           /* oscillator horizon beyond the period (CONTROL.md) */
+	double servo_lead_s;           /* oscillator horizon beyond the period (CONTROL.md);
+	                                  NaN until cfg_finish(): then chosen by compliance_margin */
+	long compliance_margin;        /* written to both margins at start-up; -1: leave the servo's */
 	long bus_margin_us;            /* slack added to every bus timeout */
 	double ramp_s;                 /* blend time for start-up and mode switches */
 	double backoff_torque;         /* torque limit (fraction of max) while a joint backs off */

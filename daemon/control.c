@@ -21,8 +21,8 @@
  * switched: the baseline sinusoid ([sinusoid] amplitude and frequency) drives
  * the joints for ramp_s plus one period, then the oscillator takes over from
  * the measured, moving state. A joint counts as still below CTL_REST_V; an
- * oscillator whose joints all stay still for CTL_STALL_CYCLES (1 s, far longer
- * than a turning point of a running gait) is started again the same way. */
+ * oscillator with a joint still for CTL_STALL_CYCLES (1 s, far longer than a
+ * turning point of a running gait) is started again the same way. */
 #define CTL_REST_V 0.1
 /* A joint back after this many stale cycles is blended in again (its goal was
  * held while the mode's target moved on). */
@@ -155,6 +155,17 @@ static bool ctl_is_still(const struct ctl *c)
 		if (!(fabs(c->j[j].speed) < CTL_REST_V))
 			return false;
 	return true;
+}
+
+/* A single joint at rest is enough to call the oscillator stalled: a contact
+ * joint pushed to rest near neutral stays there (its first predicted steps
+ * round to the present angle) while its neighbour keeps moving. */
+static bool ctl_any_still(const struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++)
+		if (fabs(c->j[j].speed) < CTL_REST_V)
+			return true;
+	return false;
 }
 
 /* Drive the baseline sinusoid for ramp_s plus one period, then hand over. */
@@ -479,7 +490,7 @@ static void ctl_check_stall(struct ctl *c)
 	for (size_t j = 0; j < c->n; j++)
 		fresh = fresh && c->j[j].fresh;
 	bool running = c->mode == CFG_MODE_OSCILLATOR && !c->starter_active;
-	c->rest_cycles = running && fresh && ctl_is_still(c) ? c->rest_cycles + 1 : 0;
+	c->rest_cycles = running && fresh && ctl_any_still(c) ? c->rest_cycles + 1 : 0;
 	if (c->rest_cycles < CTL_STALL_CYCLES)
 		return;
 	c->rest_cycles = 0;

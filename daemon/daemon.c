@@ -383,6 +383,17 @@ static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 		         "`dxl --port %s setup %u`", id, delay_us, 1e-3 * delay_us, d->port_path, id);
 	if ((int)delay_us > d->max_return_delay_us)
 		d->max_return_delay_us = (int)delay_us;
+	/* Compliance margins are RAM: written again at every (re)connect, since
+	 * a power loss resets them to the factory value. */
+	if (d->cfg->compliance_margin >= 0) {
+		uint8_t m = (uint8_t)d->cfg->compliance_margin;
+		int wr = bus_write(&d->bus, id, DXL_AX_CW_COMPLIANCE_MARGIN, (const uint8_t[2]){ m, m }, 2,
+		                   info.status_return_level >= 2, &eb);
+		if (wr != DXL_OK) {
+			snprintf(err, cap, "servo %u: setting compliance margin %u failed: %s", id, m, dxl_strerror(wr));
+			return false;
+		}
+	}
 	/* A moving speed left by another program would make every goal a slow
 	 * ramp and the oscillator sluggish: 0 is "as fast as possible". */
 	uint8_t ms[2];

@@ -8,7 +8,7 @@ set -eu
 # gnuplot for plots, cyclictest for the jitter benchmark; systemd and man-db
 # for checking the units (systemd-analyze verify) and the man pages.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
-      libinih-dev libcmocka-dev gnuplot-nox rt-tests procps jq python3 systemd man-db)
+      libinih-dev libcmocka-dev gnuplot-nox rt-tests procps jq python3 socat systemd man-db)
 [ -n "${DEPS_EXTRA:-}" ] && need+=($DEPS_EXTRA)
 missing=()
 for p in "${need[@]}"; do

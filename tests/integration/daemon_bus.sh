@@ -29,6 +29,11 @@ spawn watch "$D" --watch "$R" --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode sinusoid --set robot.safe_stop=limp
 wait_log d "ready: $R.STATE" 10 || { tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
 wait_for 10 cycle_at_least 250
+# start-up writes compliance margin 0 (the factory value is 1: a dead band in
+# which a joint resting near neutral would stay)
+margins() { echo "$(ctl peek r1 1 cw_compliance_margin) $(ctl peek r1 2 ccw_compliance_margin)"; }
+m=$(margins)
+if [ "$m" = "ok 0 ok 0" ]; then tap_ok "start-up set compliance margin 0"; else tap_fail "compliance margin at start-up" "$m"; fi
 
 # ---- the simulator drops the bus (like an unplugged adapter) and brings it back
 ctl disconnect r1 >/dev/null
@@ -77,6 +82,9 @@ if wait_for 5 sh -c "[ \$(grep -c '^EVENT $R .*kind=bus-back ' '$T/watch.log') -
 	tap_ok "reconnected to the restarted simulator (start-up checks passed)"; else
 	tap_fail "reconnect after restart" "$(tail -5 "$T/d.log")"; fi
 resume_check "after simulator restart"
+m=$(margins)
+if [ "$m" = "ok 0 ok 0" ]; then tap_ok "compliance margin written again on the restarted (factory-fresh) servos"
+else tap_fail "compliance margin after restart" "$m"; fi
 c0=$(last_state | field cycle)
 wait_for 5 cycle_at_least $((c0 + 100))
 s=$(last_state)
