@@ -90,6 +90,73 @@ enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, b
 	}
 }
 
+/* ---- decoding command_t ---------------------------------------------------------------- */
+struct cmd_reader {
+	const uint8_t *p;
+	size_t left;
+	bool bad;
+};
+
+static uint64_t cmd_take(struct cmd_reader *rd, size_t n)
+{
+	uint64_t v = 0;
+	if (rd->bad || rd->left < n) {
+		rd->bad = true;
+		return 0;
+	}
+	for (size_t i = 0; i < n; i++)
+		v = v << 8 | rd->p[i];
+	rd->p += n;
+	rd->left -= n;
+	return v;
+}
+
+/* An LCM string: int32 length counting the NUL, the bytes, the NUL. */
+static void cmd_take_string(struct cmd_reader *rd, char *dst, size_t cap)
+{
+	int32_t n = (int32_t)(uint32_t)cmd_take(rd, 4);
+	dst[0] = '\0';
+	if (rd->bad || n < 1 || (size_t)n > rd->left || rd->p[n - 1] != '\0') {
+		rd->bad = true;
+		return;
+	}
+	size_t keep = (size_t)n - 1 < cap - 1 ? (size_t)n - 1 : cap - 1;
+	memcpy(dst, rd->p, keep);
+	dst[keep] = '\0';
+	rd->p += n;
+	rd->left -= (size_t)n;
+}
+
+bool cmd_decode(const void *data, size_t len, int64_t fingerprint, struct cmd_wire *w, char *why, size_t cap)
+{
+	struct cmd_reader rd = { .p = data, .left = len };
+	memset(w, 0, sizeof *w);
+	if ((int64_t)cmd_take(&rd, 8) != fingerprint && !rd.bad) {
+		snprintf(why, cap, "not a command_t (fingerprint differs)");
+		return false;
+	}
+	struct cmd_request *r = &w->req;
+	(void)cmd_take(&rd, 8);   /* utime: not used */
+	r->seq = (int64_t)cmd_take(&rd, 8);
+	cmd_take_string(&rd, w->source, sizeof w->source);
+	cmd_take_string(&rd, w->robot, sizeof w->robot);
+	r->kind = (int8_t)cmd_take(&rd, 1);
+	r->mode = (int8_t)cmd_take(&rd, 1);
+	cmd_take_string(&rd, w->param, sizeof w->param);
+	r->joint = (int16_t)cmd_take(&rd, 2);
+	uint64_t bits = cmd_take(&rd, 8);
+	memcpy(&r->value, &bits, sizeof r->value);
+	r->torque = cmd_take(&rd, 1) != 0;
+	if (rd.bad) {
+		snprintf(why, cap, "malformed command_t (%zu bytes: short, or a bad string length)", len);
+		return false;
+	}
+	r->source = w->source;
+	r->robot = w->robot;
+	r->param = w->param;
+	return true;
+}
+
 void cmd_apply_param(struct cfg *cfg, const struct cmd_request *r)
 {
 	const char *name = nz(r->param);

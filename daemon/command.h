@@ -35,6 +35,28 @@ enum cmd_verdict {
 	CMD_IGNORE,   /* addressed to another robot on the shared channel: not ours to answer */
 };
 
+/* A command_t decoded without allocation (the daemon's loop allocates nothing
+ * after start-up) and without trusting the message: LCM 1.3.1's generated
+ * decoder mallocs whatever length a string claims (a negative one yields a
+ * NULL or unterminated string, a huge one a leaked gigabyte). Strings longer
+ * than CMD_STR_MAX - 1 are cut: a cut robot name is longer than any robot's
+ * name (CFG_NAME_MAX) and a cut parameter name is no parameter, so a cut never
+ * turns a command into one for us. */
+#define CMD_STR_MAX (CFG_NAME_MAX + 16)
+struct cmd_wire {
+	struct cmd_request req;   /* its strings point into the arrays below */
+	char source[CMD_STR_MAX];
+	char robot[CMD_STR_MAX];
+	char param[CMD_STR_MAX];
+};
+
+/* Decodes one encoded command_t (fingerprint first, big-endian fields in the
+ * order of command_t.lcm, as lcm-gen encodes them) into w. fingerprint is
+ * __undulate_command_t_get_hash(). False with a reason when the message is
+ * short, has another fingerprint, or a string length that is not 1.. the bytes
+ * left or a string without its terminating NUL. */
+bool cmd_decode(const void *data, size_t len, int64_t fingerprint, struct cmd_wire *w, char *why, size_t cap);
+
 /* `direct` is true when the command came on "<robot>.CMD" (so another robot
  * name there is a mistake worth answering), false for "UNDULATE.CMD". */
 enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, bool direct,

@@ -2,6 +2,7 @@
  * main.c — undulated: command line, configuration, then the loop (daemon.c).
  */
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -79,6 +80,22 @@ static bool main_add(struct main_args *a, const char *key, const char *value)
 	return true;
 }
 
+/* --timeout S: a finite number of seconds, 0 .. one day (0: --watch runs until
+ * a signal, --command waits its default). */
+#define MAIN_TIMEOUT_MAX_S 86400.0
+static bool main_timeout(const char *text, double *s)
+{
+	char *end;
+	double v = strtod(text, &end);
+	if (end == text || *end != '\0' || !isfinite(v) || v < 0 || v > MAIN_TIMEOUT_MAX_S) {
+		fprintf(stderr, "undulated: --timeout: '%s' is not a number of seconds (0..%.0f)\n", text,
+		        MAIN_TIMEOUT_MAX_S);
+		return false;
+	}
+	*s = v;
+	return true;
+}
+
 /* Returns -1 to continue, else an exit status. */
 static int main_parse(int argc, char **argv, struct main_args *a)
 {
@@ -118,7 +135,11 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 			log_set_level(lv);
 			break;
 		case OPT_COMMAND: a->command = optarg; break;
-		case OPT_TIMEOUT: a->timeout_s = strtod(optarg, NULL); a->timeout_set = true; break;
+		case OPT_TIMEOUT:
+			if (!main_timeout(optarg, &a->timeout_s))
+				return 2;
+			a->timeout_set = true;
+			break;
 		case OPT_WATCH: a->watch = optarg; break;
 		case 'h': main_usage(stdout); return 0;
 		default: main_usage(stderr); return 2;

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "../../daemon/command.h"
+#include "undulate_command_t.h"
 
 static struct cfg cfg;
 
@@ -201,6 +202,77 @@ static void test_parse_text(void **state)
 	assert_false(cmd_parse_text("mode walk", &r, p, sizeof p, why, sizeof why));
 }
 
+/* cmd_decode reads what lcm-gen's encoder writes (catches a command_t.lcm that
+ * changed under it), cuts long strings, and refuses every malformed message
+ * that LCM 1.3.1's generated decoder would malloc garbage for. */
+static int encode(const undulate_command_t *m, uint8_t *buf, int cap)
+{
+	int n = undulate_command_t_encoded_size(m);
+	assert_true(n > 0 && n <= cap);
+	assert_int_equal(undulate_command_t_encode(buf, 0, cap, m), n);
+	return n;
+}
+
+static void test_decode(void **state)
+{
+	(void)state;
+	static uint8_t buf[4096];
+	char why[160], longname[300];
+	memset(longname, 'x', sizeof longname - 1);
+	longname[sizeof longname - 1] = '\0';
+	int64_t fp = __undulate_command_t_get_hash();
+	undulate_command_t m = { .utime = 1, .seq = -77, .source = "qa", .robot = "robot1", .kind = 2, .mode = -3,
+	                         .param = "limit_max", .joint = -32768, .value = -0.25, .torque = 1 };
+	static struct cmd_wire w;
+	int n = encode(&m, buf, sizeof buf);
+	assert_true(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+	assert_int_equal(w.req.seq, -77);
+	assert_string_equal(w.req.source, "qa");
+	assert_string_equal(w.req.robot, "robot1");
+	assert_int_equal(w.req.kind, 2);
+	assert_int_equal(w.req.mode, -3);
+	assert_string_equal(w.req.param, "limit_max");
+	assert_int_equal(w.req.joint, -32768);
+	assert_true(w.req.value == -0.25);
+	assert_true(w.req.torque);
+	/* every prefix is refused */
+	for (int k = 0; k < n; k++)
+		assert_false(cmd_decode(buf, (size_t)k, fp, &w, why, sizeof why));
+	assert_false(cmd_decode(buf, (size_t)n, fp + 1, &w, why, sizeof why));
+	assert_non_null(strstr(why, "fingerprint"));
+	/* a string length that lies: negative, zero, past the end; a missing NUL */
+	const int32_t lies[] = { -1, INT32_MIN, 0, INT32_MAX, 1000 };
+	for (size_t i = 0; i < sizeof lies / sizeof lies[0]; i++) {
+		n = encode(&m, buf, sizeof buf);
+		uint32_t v = (uint32_t)lies[i];
+		buf[24] = (uint8_t)(v >> 24); buf[25] = (uint8_t)(v >> 16); buf[26] = (uint8_t)(v >> 8); buf[27] = (uint8_t)v;
+		assert_false(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+		assert_non_null(strstr(why, "malformed"));
+	}
+	n = encode(&m, buf, sizeof buf);
+	buf[8 + 16 + 4 + 2] = 'y';   /* the NUL of source "qa" */
+	assert_false(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+	/* long strings are cut to CMD_STR_MAX - 1, which no robot name reaches */
+	m.robot = longname;
+	m.param = longname;
+	m.source = longname;
+	n = encode(&m, buf, sizeof buf);
+	assert_true(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+	assert_int_equal(strlen(w.req.robot), CMD_STR_MAX - 1);
+	assert_true(CMD_STR_MAX - 1 > CFG_NAME_MAX - 1);
+	assert_int_equal(cmd_check(&w.req, &cfg, true, why, sizeof why), CMD_REJECT);
+	assert_int_equal(cmd_check(&w.req, &cfg, false, why, sizeof why), CMD_IGNORE);
+	/* NaN survives decoding bit for bit, for cmd_check to refuse */
+	m.robot = "robot1";
+	m.param = "k";
+	m.joint = 0;
+	m.value = NAN;
+	n = encode(&m, buf, sizeof buf);
+	assert_true(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+	assert_true(isnan(w.req.value));
+	assert_int_equal(cmd_check(&w.req, &cfg, true, why, sizeof why), CMD_REJECT);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -210,6 +282,7 @@ int main(void)
 		cmocka_unit_test(test_disabled),
 		cmocka_unit_test(test_apply),
 		cmocka_unit_test(test_parse_text),
+		cmocka_unit_test(test_decode),
 	};
 	return cmocka_run_group_tests(tests, setup, NULL);
 }
