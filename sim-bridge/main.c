@@ -111,6 +111,7 @@ struct options {
 	const char *send_cmd;   /* --cmd: publish one SIM.CMD and exit */
 	int realtime;           /* SCHED_FIFO priority, 0 = normal scheduling */
 	const char *lcm_url;
+	int nsim_opts;          /* options other than --cmd/--lcm-url (--cmd takes none) */
 };
 
 static void usage(FILE *f)
@@ -184,6 +185,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 	memset(o, 0, sizeof(*o));
 	o->tx_slice_us = 100;
 	int c;
+	char *end;
+	long prio;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
 		const char *key = NULL;
 		for (size_t i = 0; i < sizeof(sim_keys) / sizeof(sim_keys[0]); i++)
@@ -195,6 +198,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 		}
 		if (c == OPT_LCM_URL)
 			o->lcm_url = optarg;
+		else if (c != OPT_CMD && c != OPT_HELP && c != 'h')
+			o->nsim_opts++;
 		if (key) {
 			snprintf(set_store[o->nsets], sizeof(set_store[0]), "%s=%s", key, optarg);
 			o->sets[o->nsets] = set_store[o->nsets];
@@ -209,8 +214,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 		case OPT_SET: o->sets[o->nsets++] = optarg; break;
 		case OPT_ECHO: o->sets[o->nsets++] = "sim.echo=true"; break;
 		case OPT_TX_SLICE:
-			o->tx_slice_us = strtod(optarg, NULL);
-			if (!(o->tx_slice_us >= 0 && o->tx_slice_us <= 10000)) {
+			o->tx_slice_us = strtod(optarg, &end);
+			if (end == optarg || *end != '\0' || !(o->tx_slice_us >= 0 && o->tx_slice_us <= 10000)) {
 				fprintf(stderr, "undulate-sim: --tx-slice-us: 0..10000\n");
 				return -1;
 			}
@@ -218,8 +223,9 @@ static int parse_args(int argc, char **argv, struct options *o)
 		case OPT_BENCH: o->bench = true; break;
 		case OPT_CMD: o->send_cmd = optarg; break;
 		case OPT_REALTIME:
-			o->realtime = atoi(optarg);
-			if (o->realtime < 1 || o->realtime > 99) {
+			prio = strtol(optarg, &end, 10);
+			o->realtime = prio >= 1 && prio <= 99 ? (int)prio : 0;
+			if (end == optarg || *end != '\0' || o->realtime == 0) {
 				fprintf(stderr, "undulate-sim: --realtime: priority 1..99\n");
 				return -1;
 			}
@@ -235,6 +241,11 @@ static int parse_args(int argc, char **argv, struct options *o)
 	}
 	if ((o->link != NULL) != (o->ids != NULL)) {
 		fprintf(stderr, "undulate-sim: --link and --ids go together\n");
+		return -1;
+	}
+	if (o->send_cmd && o->nsim_opts > 0) {
+		/* client mode runs no simulator: its options would be silently ignored */
+		fprintf(stderr, "undulate-sim: --cmd takes only --lcm-url\n");
 		return -1;
 	}
 	if (o->send_cmd)
@@ -271,21 +282,67 @@ fail:
 
 /* ---- LCM ------------------------------------------------------------------- */
 
-static void on_sim_cmd(const lcm_recv_buf_t *rbuf, const char *channel, const undulate_sim_command_t *msg,
-                       void *user)
+/* SIM.CMD is decoded here, not by the generated code: LCM 1.3.1's decoder
+ * mallocs whatever length a string claims (a zero length leaves it without its
+ * NUL, a huge one allocates gigabytes). sim_command_t is the fingerprint, utime
+ * and seq (int64), verb and args (int32 length counting the NUL, the bytes, the
+ * NUL), big-endian, as lcm-gen encodes it. */
+struct wire {
+	const uint8_t *p;
+	size_t left;
+	bool bad;
+};
+
+static uint64_t wire_take(struct wire *w, size_t n)
 {
-	(void)rbuf;
+	uint64_t v = 0;
+	if (w->bad || w->left < n) {
+		w->bad = true;
+		return 0;
+	}
+	for (size_t i = 0; i < n; i++)
+		v = v << 8 | w->p[i];
+	w->p += n;
+	w->left -= n;
+	return v;
+}
+
+/* The string's bytes (NUL-terminated in the message), or NULL if malformed. */
+static const char *wire_string(struct wire *w)
+{
+	int32_t n = (int32_t)(uint32_t)wire_take(w, 4);
+	if (w->bad || n < 1 || (size_t)n > w->left || w->p[n - 1] != '\0') {
+		w->bad = true;
+		return NULL;
+	}
+	const char *s = (const char *)w->p;
+	w->p += n;
+	w->left -= (size_t)n;
+	return s;
+}
+
+static void on_sim_cmd(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
 	(void)channel;
 	struct app *a = user;
-	char line[SIM_CMD_MAX], reply[512];
-	if (snprintf(line, sizeof(line), "%s %s", msg->verb ? msg->verb : "", msg->args ? msg->args : "") >=
-	    (int)sizeof(line)) {
+	struct wire w = { .p = rbuf->data, .left = rbuf->data_size };
+	bool ours = (int64_t)wire_take(&w, 8) == __undulate_sim_command_t_get_hash();
+	(void)wire_take(&w, 8);
+	long long seq = (long long)wire_take(&w, 8);
+	const char *verb = wire_string(&w), *args = wire_string(&w);
+	if (!ours || w.bad) {
 		a->sim->bad_commands++;
-		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld: command too long\n", (long long)msg->seq);
+		fprintf(stderr, "undulate-sim: SIM.CMD: not a well-formed sim_command_t (%u bytes)\n", rbuf->data_size);
+		return;
+	}
+	char line[SIM_CMD_MAX], reply[512];
+	if (snprintf(line, sizeof(line), "%s %s", verb, args) >= (int)sizeof(line)) {
+		a->sim->bad_commands++;
+		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld: command too long\n", seq);
 		return;
 	}
 	sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
-	fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", (long long)msg->seq, line, reply);
+	fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", seq, line, reply);
 }
 
 static void fill_collision(struct app *a, const struct sim_collision *c, int64_t utime,
@@ -786,8 +843,7 @@ int main(int argc, char **argv)
 	if (!app.lcm)
 		fprintf(stderr, "undulate-sim: LCM (%s) unavailable: no ground truth, no SIM.CMD\n",
 		        cfg.lcm_url[0] ? cfg.lcm_url : "default");
-	undulate_sim_command_t_subscription_t *sub =
-	        app.lcm ? undulate_sim_command_t_subscribe(app.lcm, "SIM.CMD", on_sim_cmd, &app) : NULL;
+	lcm_subscription_t *sub = app.lcm ? lcm_subscribe(app.lcm, "SIM.CMD", on_sim_cmd, &app) : NULL;
 	if (!app.truth_buf || (cfg.control[0] && control_open(&app, cfg.control) != 0) ||
 	    sim_open(&sim, err, sizeof(err)) != 0) {
 		if (err[0])
@@ -808,7 +864,7 @@ int main(int argc, char **argv)
 	print_summary(&app, now);
 	if (app.lcm) {
 		if (sub)
-			undulate_sim_command_t_unsubscribe(app.lcm, sub);
+			lcm_unsubscribe(app.lcm, sub);
 		lcm_destroy(app.lcm);
 	}
 	free(app.truth_buf);

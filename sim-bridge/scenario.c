@@ -308,15 +308,49 @@ static int ini_cb(void *user, const char *section, const char *name, const char 
 	return 1;
 }
 
+/* Reads one line for inih and drops the rest of a line longer than inih's
+ * buffer: inih would parse that rest as lines of its own (the tail of a long
+ * comment becomes a key) and number every line after it wrong. */
+struct line_reader {
+	FILE *f;
+	int line;
+	int long_line;   /* first line too long, 0 if none */
+	int cap;         /* the longest line inih reads */
+};
+
+static char *read_line(char *str, int num, void *stream)
+{
+	struct line_reader *r = stream;
+	if (fgets(str, num, r->f) == NULL)
+		return NULL;
+	r->line++;
+	size_t len = strlen(str);
+	if (len > 0 && len + 1 >= (size_t)num && str[len - 1] != '\n') {
+		int ch;
+		while ((ch = fgetc(r->f)) != EOF && ch != '\n')
+			;
+		if (r->long_line == 0) {
+			r->long_line = r->line;
+			r->cap = num - 1;
+		}
+	}
+	return str;
+}
+
 int sim_config_load(struct sim_config *c, const char *path, char *err, size_t errcap)
 {
 	struct load_ctx x = { c, err, errcap, 0 };
 	char why[200] = "";
 	x.err = why;
 	x.errcap = sizeof(why);
-	int r = ini_parse(path, ini_cb, &x);
-	if (r < 0)
+	struct line_reader rd = { .f = fopen(path, "r") };
+	if (rd.f == NULL)
 		return ERR("%s: cannot open", path);
+	int r = ini_parse_stream(read_line, &rd, ini_cb, &x);
+	fclose(rd.f);
+	/* the first problem wins: a long line, or an error before it */
+	if (rd.long_line > 0 && (r <= 0 || r >= rd.long_line))
+		return ERR("%s:%d: line too long (at most %d characters)", path, rd.long_line, rd.cap);
 	if (r > 0)
 		return ERR("%s:%d: %s", path, r, why[0] ? why : "syntax error");
 	return 0;

@@ -157,6 +157,23 @@ static double world_gap(const struct sim_world *w, const struct world_scratch *s
 	return (s->x[k] - w->bodies[k].half_width) - (s->x[k - 1] + w->bodies[k - 1].half_width);
 }
 
+/* One step of pool-adjacent-violators (isotonic regression, equal weights):
+ * append value y as a block of one to the nb blocks in s, merge while a block's
+ * mean exceeds the next one's, and return the new block count. */
+static size_t world_pool_push(struct world_scratch *s, size_t nb, double y)
+{
+	s->block_sum[nb] = y;
+	s->block_len[nb] = 1;
+	nb++;
+	while (nb > 1 && s->block_sum[nb - 2] * (double)s->block_len[nb - 1]
+	                 > s->block_sum[nb - 1] * (double)s->block_len[nb - 2]) {
+		s->block_sum[nb - 2] += s->block_sum[nb - 1];
+		s->block_len[nb - 2] += s->block_len[nb - 1];
+		nb--;
+	}
+	return nb;
+}
+
 /* ---- positions: projection onto the ordered row ----------------------------------
  * With c_0 = 0, c_i = c_{i-1} + h_{i-1} + h_i and Y_i = X_i - c_i the constraints
  * are Y nondecreasing and lo <= Y <= hi (walls): the closest such Y is the
@@ -169,16 +186,7 @@ static void world_project(struct sim_world *w, struct world_scratch *s)
 	for (size_t i = 0; i < n; i++) {
 		if (i > 0)
 			c += w->bodies[i - 1].half_width + w->bodies[i].half_width;
-		double y = s->x[i] - c;
-		s->block_sum[nb] = y;
-		s->block_len[nb] = 1;
-		nb++;
-		while (nb > 1 && s->block_sum[nb - 2] * (double)s->block_len[nb - 1]
-		                 > s->block_sum[nb - 1] * (double)s->block_len[nb - 2]) {
-			s->block_sum[nb - 2] += s->block_sum[nb - 1];
-			s->block_len[nb - 2] += s->block_len[nb - 1];
-			nb--;
-		}
+		nb = world_pool_push(s, nb, s->x[i] - c);
 	}
 	double lo = -INFINITY, hi = INFINITY;
 	if (world_has_walls(w)) {
@@ -327,15 +335,7 @@ static void world_plastic_cluster(struct sim_world *w, struct world_scratch *s,
 	size_t nb = 0;
 	for (size_t i = a; i <= b; i++) {
 		before[i] = s->v[i];
-		s->block_sum[nb] = s->v[i];
-		s->block_len[nb] = 1;
-		nb++;
-		while (nb > 1 && s->block_sum[nb - 2] * (double)s->block_len[nb - 1]
-		                 > s->block_sum[nb - 1] * (double)s->block_len[nb - 2]) {
-			s->block_sum[nb - 2] += s->block_sum[nb - 1];
-			s->block_len[nb - 2] += s->block_len[nb - 1];
-			nb--;
-		}
+		nb = world_pool_push(s, nb, s->v[i]);
 	}
 	double lo = wall_a ? 0.0 : -INFINITY, hi = wall_b ? 0.0 : INFINITY;
 	size_t i = a;
@@ -354,6 +354,7 @@ static void world_plastic_cluster(struct sim_world *w, struct world_scratch *s,
 	 * body j gains m_j Δv_j = J_j - J_{j+1}. Start from a free end. */
 	double total = 0;
 	for (size_t j = a; j <= b; j++)
+		// cppcheck-suppress uninitvar ; before[a..b] was filled by the loop above over the same range
 		total += w->bodies[j].effective_mass * (s->v[j] - before[j]);
 	double J = 0;
 	if (wall_a)

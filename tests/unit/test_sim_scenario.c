@@ -126,6 +126,26 @@ static void quick(struct sim_config *c, uint64_t seed)
 	assert_int_equal(sim_config_finish(c, err, sizeof(err)), 0);
 }
 
+/* A line longer than the INI parser reads is an error of its own line; the
+ * tail of a long comment is never parsed as a key, and lines before it keep
+ * their numbers. */
+static void test_long_line(void **state)
+{
+	(void)state;
+	static char text[2048];
+	char pad[600];
+	memset(pad, 'x', sizeof(pad) - 1);
+	pad[sizeof(pad) - 1] = '\0';
+	char err[256];
+	snprintf(text, sizeof(text), "[sim]\nrate_hz = 1000 ; %s = 5\n[world]\nrestitution = 0.5\n", pad);
+	assert_int_equal(load(&cfg, text, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, ":2: line too long"));
+	snprintf(text, sizeof(text), "[world]\nrestitution = 7\n; %s\n", pad);
+	assert_int_equal(load(&cfg, text, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, ":2:"));
+	assert_non_null(strstr(err, "restitution"));
+}
+
 static void test_seeded_start(void **state)
 {
 	(void)state;
@@ -238,6 +258,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_load_pair),
 		cmocka_unit_test(test_config_errors),
+		cmocka_unit_test(test_long_line),
 		cmocka_unit_test(test_seeded_start),
 		cmocka_unit_test(test_commands),
 		cmocka_unit_test(test_events_run_on_time),

@@ -104,6 +104,8 @@ static int check_options(const struct an_options *o)
 	return 0;
 }
 
+#define AN_SYNTH_MAX_S 3600.0   /* longest synthetic log, s */
+
 static int run_synth(const char *path, double duration)
 {
 	struct synth_spec s;
@@ -135,6 +137,12 @@ int main(int argc, char **argv)
 			usage(stderr);
 			return AN_EXIT_USAGE;
 		}
+	}
+	/* 0: not given (the synthetic default); a log of hours would only fill a disk */
+	if (synth && !(duration >= 0 && duration <= AN_SYNTH_MAX_S)) {
+		fprintf(stderr, "undulate-analyze: --duration: %g is not 0 < S <= %.0f seconds\n", duration,
+		        AN_SYNTH_MAX_S);
+		return AN_EXIT_USAGE;
 	}
 	if (synth)
 		return run_synth(synth, duration);

@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""qa_lcm.py — raw LCM (udpm) traffic for the robustness tests, no LCM binding.
+
+  qa_lcm.py capture PORT CHANNEL TIMEOUT_S    print the hex payload of the first
+                                              message on CHANNEL (e.g. a command_t)
+  qa_lcm.py hostile PORT ROBOT TEMPLATE_HEX SEED N SECONDS
+        publish N messages over SECONDS on ROBOT.CMD and UNDULATE.CMD, built from a
+        captured command_t (TEMPLATE_HEX gives its fingerprint and layout): random
+        bytes, truncated and bit-flipped commands, lying string lengths, and
+        well-formed commands with hostile values (NaN, inf, huge, joint -32768,
+        unknown kind/mode/param, empty or wrong robot, empty or 8 kB strings).
+                Prints "sent N undecodable U invalid I" — U + I commands must be rejected.
+  qa_lcm.py garbage PORT CHANNEL TEMPLATE_HEX SEED N SECONDS
+        publish N malformed messages on CHANNEL: random bytes, the template cut
+        short, and the template with its first string's length (after the
+        fingerprint, utime and seq) replaced by a lie (negative, zero, huge).
+
+A udpm message is one datagram: magic "LC02", a sequence number, the channel
+name and a NUL, then the payload (lcm_udpm.c, short messages). command_t is
+encoded as lcm-gen does: the 8-byte fingerprint, then utime, seq (int64),
+source, robot (string: int32 length with the NUL, bytes, NUL), kind, mode
+(int8), param (string), joint (int16), value (double), torque (boolean, int8),
+all big-endian.
+"""
+import math, random, socket, struct, sys, time
+
+GROUP = '239.255.76.67'
+
+
+def sender():
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+    s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+    s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+    return s
+
+
+def datagram(seq, channel, payload):
+    return b'LC02' + struct.pack('>I', seq) + channel.encode() + b'\0' + payload
+
+
+def capture(port, channel, timeout):
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    if hasattr(socket, 'SO_REUSEPORT'):
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+    s.bind(('', port))
+    mreq = struct.pack('4s4s', socket.inet_aton(GROUP), socket.inet_aton('0.0.0.0'))
+    s.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, mreq)
+    s.settimeout(0.1)
+    print('listening', flush=True)
+    end = time.time() + timeout
+    while time.time() < end:
+        try:
+            d = s.recv(65536)
+        except socket.timeout:
+            continue
+        if d[:4] != b'LC02':
+            continue
+        ch, _, payload = d[8:].partition(b'\0')
+        if ch.decode(errors='replace') == channel:
+            print(payload.hex(), flush=True)
+            return 0
+    return 1
+
+
+def string(v):
+    b = v.encode('utf-8', 'surrogateescape') if isinstance(v, str) else v
+    return struct.pack('>i', len(b) + 1) + b + b'\0'
+
+
+def command(fp, utime, seq, source, robot, kind, mode, param, joint, value, torque):
+    return (fp + struct.pack('>qq', utime, seq) + string(source) + string(robot) + struct.pack('>bb', kind, mode)
+            + string(param) + struct.pack('>hd', joint, value) + struct.pack('>B', torque))
+
+
+def parse_template(raw):
+    """The captured command back into its fields: proves our encoding is lcm-gen's."""
+    fp, pos = raw[:8], 8
+    utime, seq = struct.unpack_from('>qq', raw, pos); pos += 16
+    def s(pos):
+        n = struct.unpack_from('>i', raw, pos)[0]
+        return raw[pos + 4:pos + 4 + n - 1], pos + 4 + n
+    source, pos = s(pos)
+    robot, pos = s(pos)
+    kind, mode = struct.unpack_from('>bb', raw, pos); pos += 2
+    param, pos = s(pos)
+    joint, value = struct.unpack_from('>hd', raw, pos); pos += 10
+    torque = raw[pos]
+    again = command(fp, utime, seq, source, robot, kind, mode, param, joint, value, torque)
+    if again != raw:
+        sys.exit('qa_lcm.py: the captured command_t does not re-encode the same way')
+    return fp
+
+
+def hostile(port, robot, template_hex, seed, n, seconds):
+    rng = random.Random(seed)
+    raw = bytes.fromhex(template_hex)
+    fp = parse_template(raw)
+    out = sender()
+    params = ['k', 'c', 'mu', 'lambda', 'inertia', 'friction', 'neutral', 'limit_min', 'limit_max', 'max_step',
+              'amplitude', 'frequency', 'phase']
+    bad_values = [math.nan, math.inf, -math.inf, 1e308, -1e308, 1e30, -1e30]
+    undecodable = invalid = 0
+    seq = 1000
+    for i in range(n):
+        seq += 1
+        channel = rng.choice([robot + '.CMD', 'UNDULATE.CMD'])
+        r = rng.random()
+        if r < 0.25:    # random bytes (a fingerprint match is 2^-64)
+            payload = bytes(rng.randrange(256) for _ in range(rng.randrange(0, 200)))
+            undecodable += 1
+        elif r < 0.35:  # a real command cut short
+            payload = raw[:rng.randrange(0, len(raw) - 1)]
+            undecodable += 1
+        elif r < 0.45:  # lying string length (negative or past the end)
+            payload = fp + struct.pack('>qq', 0, seq) + struct.pack('>i', rng.choice([-1, -2**31, 2**31 - 1, 0, 10**6]))
+            payload += bytes(rng.randrange(256) for _ in range(rng.randrange(0, 40)))
+            undecodable += 1
+        else:           # well-formed, hostile values: each one must be rejected
+            which = rng.choice(['value', 'joint', 'kind', 'mode', 'param', 'robot', 'limits'])
+            src = rng.choice(['', 'qa', 'x' * 8000, '\x01\x1b[2J%s%n'])
+            kind, mode, param, joint, value, torque, tgt = 2, 0, rng.choice(params), -1, 0.5, 0, robot
+            if which == 'value':
+                value = rng.choice(bad_values)
+                joint = rng.choice([-1, 0, 1])
+                if param in ('amplitude', 'frequency', 'phase'):
+                    joint = -1
+            elif which == 'joint':
+                joint = rng.choice([-32768, -2, 2, 3, 16, 32767])
+                param, value = 'k', 0.05
+            elif which == 'kind':
+                kind = rng.choice([0, 4, 5, -1, 127, -128])
+            elif which == 'mode':
+                kind, mode = 1, rng.choice([-1, 4, 5, 127, -128])
+            elif which == 'param':
+                param = rng.choice(['', 'K', 'kk', 'x' * 300, 'limit', 'name', 'ids', 'port', 'k ', '\xff'])
+                value = 0.05
+            elif which == 'robot':
+                # on <robot>.CMD naming another robot: rejected (on UNDULATE.CMD
+                # it is ignored, so send it on the robot's own channel)
+                channel = robot + '.CMD'
+                tgt = rng.choice(['', robot + 'x', robot[:-1], 'x' * 200, ' ' + robot])
+                kind, mode = 1, 0
+            elif which == 'limits':
+                # limits that do not contain 0 or leave the servo's range
+                joint = rng.choice([-1, 0, 1])
+                param, value = rng.choice([('limit_min', 0.2), ('limit_max', -0.2), ('limit_min', -6.0),
+                                           ('limit_max', 6.0), ('max_step', 0.0), ('max_step', -0.1),
+                                           ('max_step', 2.0)])
+            payload = command(fp, int(time.time() * 1e6), seq, src, tgt, kind, mode, param, joint, value, torque)
+            invalid += 1
+        out.sendto(datagram(i, channel, payload), (GROUP, port))
+        time.sleep(seconds / n)
+    print('sent %d undecodable %d invalid %d' % (n, undecodable, invalid))
+    return 0
+
+
+def garbage(port, channel, template_hex, seed, n, seconds):
+    rng = random.Random(seed)
+    raw = bytes.fromhex(template_hex)
+    out = sender()
+    for i in range(n):
+        r = rng.random()
+        if r < 0.3:
+            payload = bytes(rng.randrange(256) for _ in range(rng.randrange(0, 200)))
+        elif r < 0.5:
+            payload = raw[:rng.randrange(0, len(raw) - 1)]
+        else:
+            lie = rng.choice([-1, -2**31, 0, 2**31 - 1, 10**6, len(raw)])
+            payload = raw[:24] + struct.pack('>i', lie) + raw[28:]
+        out.sendto(datagram(i, channel, payload), (GROUP, port))
+        time.sleep(seconds / n)
+    print('sent %d' % n)
+    return 0
+
+
+def main(argv):
+    if len(argv) >= 4 and argv[1] == 'capture':
+        return capture(int(argv[2]), argv[3], float(argv[4]) if len(argv) > 4 else 5)
+    if len(argv) == 8 and argv[1] == 'hostile':
+        return hostile(int(argv[2]), argv[3], argv[4], int(argv[5]), int(argv[6]), float(argv[7]))
+    if len(argv) == 8 and argv[1] == 'garbage':
+        return garbage(int(argv[2]), argv[3], argv[4], int(argv[5]), int(argv[6]), float(argv[7]))
+    sys.stderr.write(__doc__)
+    return 2
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv))
