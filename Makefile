@@ -43,7 +43,8 @@ CFLAGS   += $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS)
 LDFLAGS  += $(SANFLAGS)
 LDLIBS   += $(PKG_LIBS) -lm
 
-# lcm-gen output is not ours: compile it without our warning set.
+# lcm-gen output is not ours: compile it without our warning set, and with
+# compat/ first on its include path (a string decoder that checks lengths).
 GEN_WARN := -w
 
 # ---- components -------------------------------------------------------------
@@ -96,7 +97,8 @@ lcmtypes: $(LCM_STAMP)
 
 # The generated file list is only known after lcm-gen ran: build the library
 # through a recursive step so the wildcard is evaluated afterwards.
-$(LIB)/liblcmtypes.a: $(LCM_STAMP)
+LCM_COMPAT := compat/lcm/lcm_coretypes.h
+$(LIB)/liblcmtypes.a: $(LCM_STAMP) $(LCM_COMPAT)
 	@$(MAKE) --no-print-directory lcmtypes-lib
 
 .PHONY: lcmtypes-lib
@@ -104,9 +106,9 @@ lcmtypes-lib:
 	@mkdir -p $(OBJ)/lcmgen $(LIB)
 	@set -e; for c in $(GEN)/*.c; do \
 	  o=$(OBJ)/lcmgen/$$(basename $$c .c).o; \
-	  if [ ! -f $$o ] || [ $$c -nt $$o ]; then \
+	  if [ ! -f $$o ] || [ $$c -nt $$o ] || [ $(LCM_COMPAT) -nt $$o ]; then \
 	    echo "CC (lcm-gen) $$c"; \
-	    $(CC) $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS) -I$(GEN) $(GEN_WARN) -c $$c -o $$o; \
+	    $(CC) $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS) -Icompat -I$(GEN) $(GEN_WARN) -c $$c -o $$o; \
 	  fi; \
 	done; \
 	rm -f $(LIB)/liblcmtypes.a; ar rcs $(LIB)/liblcmtypes.a $(OBJ)/lcmgen/*.o

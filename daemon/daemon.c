@@ -348,6 +348,19 @@ static int dmn_read_retry(struct dmn *d, uint8_t id, uint8_t addr, uint8_t len, 
 	return r;
 }
 
+/* The same for a start-up write (writing the same bytes twice is harmless). */
+static int dmn_write_retry(struct dmn *d, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
+                           bool expect_reply, uint8_t *eb)
+{
+	int r = DXL_E_TIMEOUT;
+	for (int t = 0; t < DMN_PING_TRIES; t++) {
+		r = bus_write(&d->bus, id, addr, data, n, expect_reply, eb);
+		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
+			break;
+	}
+	return r;
+}
+
 static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 {
 	uint8_t id = d->ctl.j[j].id, eb = 0;
@@ -387,8 +400,8 @@ static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 	 * a power loss resets them to the factory value. */
 	if (d->cfg->compliance_margin >= 0) {
 		uint8_t m = (uint8_t)d->cfg->compliance_margin;
-		int wr = bus_write(&d->bus, id, DXL_AX_CW_COMPLIANCE_MARGIN, (const uint8_t[2]){ m, m }, 2,
-		                   info.status_return_level >= 2, &eb);
+		int wr = dmn_write_retry(d, id, DXL_AX_CW_COMPLIANCE_MARGIN, (const uint8_t[2]){ m, m }, 2,
+		                         info.status_return_level >= 2, &eb);
 		if (wr != DXL_OK) {
 			snprintf(err, cap, "servo %u: setting compliance margin %u failed: %s", id, m, dxl_strerror(wr));
 			return false;
@@ -403,8 +416,8 @@ static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 	if (moving_speed != 0) {
 		log_warn("servo %u: moving speed was %u (%.2f rad/s); setting 0 (maximum)", id, moving_speed,
 		         moving_speed * DXL_SPEED_RAD_S_PER_UNIT);
-		int wr = bus_write(&d->bus, id, DXL_AX_MOVING_SPEED, (const uint8_t[2]){ 0, 0 }, 2,
-		                   info.status_return_level >= 2, &eb);
+		int wr = dmn_write_retry(d, id, DXL_AX_MOVING_SPEED, (const uint8_t[2]){ 0, 0 }, 2,
+		                         info.status_return_level >= 2, &eb);
 		if (wr != DXL_OK) {
 			snprintf(err, cap, "servo %u: setting moving speed 0 failed: %s", id, dxl_strerror(wr));
 			return false;
@@ -959,16 +972,17 @@ static void dmn_safe_stop(struct dmn *d)
 		if (limp) {
 			bool reply = jt->servo.status_return_level >= 2;
 			const uint8_t off = 0;
-			int r = bus_write(&d->bus, jt->id, DXL_AX_TORQUE_ENABLE, &off, 1, reply, &eb);
+			int r = dmn_write_retry(d, jt->id, DXL_AX_TORQUE_ENABLE, &off, 1, reply, &eb);
 			if (r != DXL_OK)
 				log_error("safe stop: servo %u torque off failed: %s", jt->id, dxl_strerror(r));
 			continue;
 		}
-		uint16_t pos;
-		if (bus_read_u16(&d->bus, jt->id, DXL_AX_PRESENT_POSITION, &pos, &eb) != DXL_OK) {
+		uint8_t raw[2];
+		if (dmn_read_retry(d, jt->id, DXL_AX_PRESENT_POSITION, 2, raw, &eb) != DXL_OK) {
 			log_error("safe stop: servo %u did not answer; it keeps its last goal", jt->id);
 			continue;
 		}
+		uint16_t pos = dxl_get_u16(raw);
 		double hold = isfinite(jt->limits.lo) && jt->limits.max_step > 0
 		            ? safety_clamp(&jt->limits, dxl_pos_to_rad(pos), NAN, NAN, NULL) : dxl_pos_to_rad(pos);
 		ids[n] = jt->id;
