@@ -190,7 +190,7 @@ fuzz:
 LCM_JAR ?= /usr/share/java/lcm.jar
 spy-jar: $(BUILD)/undulate-types.jar
 $(BUILD)/undulate-types.jar: $(LCM_SRC)
-	@command -v javac >/dev/null || { echo "spy-jar: javac not found (apt-get install default-jdk-headless)"; exit 1; }
+	@scripts/deps.sh default-jdk-headless liblcm-java libjchart2d-java
 	@rm -rf $(BUILD)/java && mkdir -p $(BUILD)/java/src $(BUILD)/java/classes
 	lcm-gen -j --jpath $(BUILD)/java/src $(LCM_SRC)
 	javac -nowarn -cp $(LCM_JAR) -d $(BUILD)/java/classes $$(find $(BUILD)/java/src -name '*.java')

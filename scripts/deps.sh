@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian packages undulate needs, when they are missing.
+# scripts/deps.sh [PACKAGE...] — installs the Debian packages undulate needs
+# (or the ones named), when they are missing.
 # As root: runs apt-get. Otherwise: prints the exact command and stops.
 set -eu
 # build + runtime: compiler, LCM (pkg-config lcm needs glib's .pc), serial
@@ -9,7 +10,7 @@ set -eu
 # for checking the units (systemd-analyze verify) and the man pages.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
       libinih-dev libcmocka-dev gnuplot-nox rt-tests procps jq python3 socat systemd man-db)
-[ -n "${DEPS_EXTRA:-}" ] && need+=($DEPS_EXTRA)
+[ $# -gt 0 ] && need=("$@")
 missing=()
 for p in "${need[@]}"; do
 	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q '^install ok installed' || missing+=("$p")

@@ -14,27 +14,7 @@ share=/usr/share/java
 
 # Packages: a JRE (default-jdk-headless also brings javac for `make spy-jar`),
 # lcm.jar (liblcm-java), the charts (libjchart2d-java).
-need=(default-jdk-headless liblcm-java libjchart2d-java)
-missing=()
-for p in "${need[@]}"; do
-	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q '^install ok installed' || missing+=("$p")
-done
-# A JDK installed some other way is fine too.
-if [ ${#missing[@]} -gt 0 ] && [ "${missing[0]}" = default-jdk-headless ] && command -v java >/dev/null; then
-	missing=("${missing[@]:1}")
-fi
-if [ ${#missing[@]} -gt 0 ]; then
-	cmd="apt-get install -y --no-install-recommends ${missing[*]}"
-	if [ "$(id -u)" -ne 0 ]; then
-		echo "lcm-spy needs these Debian packages: ${missing[*]}" >&2
-		echo "run:  sudo apt-get update && sudo $cmd" >&2
-		exit 1
-	fi
-	echo "installing: ${missing[*]}"
-	export DEBIAN_FRONTEND=noninteractive
-	apt-get update -qq
-	apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+"$(dirname "$0")/deps.sh" default-jdk-headless liblcm-java libjchart2d-java
 
 [ -f "$jar" ] || { echo "spy.sh: $jar not found (make spy-jar builds it)" >&2; exit 1; }
 for j in "$share/lcm.jar" "$share/jchart2d.jar"; do
