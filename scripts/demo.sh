@@ -1,3 +1,407 @@
 #!/usr/bin/env bash
-echo "make demo: not yet — the daemon and the simulator are being built." >&2
-exit 1
+# scripts/demo.sh — robots on the simulated bus, one undulated per robot.
+#
+#   make demo                       four robots in a channel, watched live in undulate-top
+#   make demo DEMO_SECONDS=60       headless for 60 s, LCM log recorded, summary printed
+#
+# Used directly it runs any scenario the same way (the experiments in
+# docs/EXPERIMENTS.md and the end-to-end tests are built on it):
+#
+#   scripts/demo.sh [--scenario FILE] [--seconds S] [--set SEC.KEY=VAL]...
+#                   [--daemon-set SEC.KEY=VAL]... [--start-mode MODE]
+#                   [--switch-at S|never] [--switch-to MODE] [--phases random|LIST]
+#                   [--seed N] [--window S] [--out DIR] [--lcm-url URL]
+#
+# The robots start in --start-mode (default SINUSOID, each with its own phase:
+# random, or the comma-separated radians of --phases in scenario order) and are
+# switched to --switch-to (default OSCILLATOR) by one LCM command to every
+# robot --switch-at seconds after they are all running (default 3). Starting
+# from the clock-driven sinusoid is how the paper starts its runs, and it is
+# what gives every robot a chosen phase: a robot started in OSCILLATOR from
+# rest begins at phase 0 or π only.
+#
+# Everything runs in a private temporary directory on a private LCM port
+# (printed at start), so two demos, or a demo and the tests, never hear each
+# other. Ctrl-C (or SIGTERM) stops the daemons, the simulator and the logger by
+# PID, waits for them, and removes the pty links and the directory.
+set -u
+
+top=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${BUILD:-build}
+case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
+B="$BUILD/bin"
+
+scenario="$top/sim-bridge/scenarios/channel4.scenario"
+seconds=${DEMO_SECONDS:-}
+sim_sets=()
+daemon_sets=()
+start_mode=sinusoid
+switch_at=3
+switch_to=oscillator
+phases=random
+seed=""
+window=10
+out=""
+url=${DEMO_LCM_URL:-}
+# How long a program may take to say it is ready (s).
+READY_TIMEOUT_S=10
+
+usage() {
+	sed -n '2,/^set -u/p' "$0" | sed -e '/^set -u/d' -e 's/^# \{0,1\}//' >&2
+	exit 2
+}
+
+while [ $# -gt 0 ]; do
+	case "$1" in
+	--scenario) scenario=$2; shift 2 ;;
+	--seconds) seconds=$2; shift 2 ;;
+	--set) sim_sets+=(--set "$2"); shift 2 ;;
+	--daemon-set) daemon_sets+=(--set "$2"); shift 2 ;;
+	--start-mode) start_mode=$2; shift 2 ;;
+	--switch-at) switch_at=$2; shift 2 ;;
+	--switch-to) switch_to=$2; shift 2 ;;
+	--phases) phases=$2; shift 2 ;;
+	--seed) seed=$2; shift 2 ;;
+	--window) window=$2; shift 2 ;;
+	--out) out=$2; shift 2 ;;
+	--lcm-url) url=$2; shift 2 ;;
+	-h|--help) usage ;;
+	*) echo "demo: unknown argument '$1' (--help)" >&2; exit 2 ;;
+	esac
+done
+
+die() { echo "demo: $*" >&2; exit 1; }
+is_number() { [[ "$1" =~ ^-?[0-9]+([.][0-9]+)?$ ]]; }
+
+[ -f "$scenario" ] || die "no scenario file '$scenario'"
+for p in undulate-sim undulated undulate-analyze undulate-top; do
+	[ -x "$B/$p" ] || die "$B/$p is not built (run: make BUILD=$BUILD)"
+done
+[ -z "$seconds" ] || { is_number "$seconds" && [ "${seconds%.*}" -gt 0 ]; } || die "--seconds/DEMO_SECONDS: want a positive number, got '$seconds'"
+[ "$switch_at" = never ] || is_number "$switch_at" || die "--switch-at: seconds or 'never'"
+is_number "$window" || die "--window: seconds"
+interactive=0
+[ -z "$seconds" ] && [ -t 1 ] && interactive=1
+if [ -z "$seconds" ] && [ "$interactive" -eq 0 ]; then
+	seconds=60  # not a terminal: nobody could watch or press Ctrl-C
+fi
+if [ -n "$seconds" ]; then
+	command -v lcm-logger >/dev/null || die "lcm-logger not found (Debian package liblcm-bin)"
+fi
+
+# A private multicast port (udpm, ttl=0: nothing leaves this host). The tests
+# use 7600-7949; the demo picks one of 10000 ports above them from its PID.
+[ -n "$url" ] || url="udpm://239.255.76.67:$((17600 + $$ % 10000))?ttl=0"
+[ -n "$seed" ] || seed=$(( (RANDOM << 15 | RANDOM) % 1000000 + 1 ))
+
+run=$(mktemp -d "${TMPDIR:-/tmp}/undulate-demo.XXXXXX") || die "cannot make a temporary directory"
+links="$run/links"
+mkdir -p "$links"
+
+pids=()       # everything we started, in start order
+names=()
+cleaning=0
+# stop_group PID...: SIGTERM to all at once, wait up to 3 s, then SIGKILL.
+stop_group() {
+	local pid i
+	[ $# -gt 0 ] || return 0
+	kill -TERM "$@" 2>/dev/null
+	for _ in $(seq 150); do
+		for pid in "$@"; do kill -0 "$pid" 2>/dev/null && break; pid=""; done
+		[ -z "$pid" ] && break
+		sleep 0.02
+	done
+	for pid in "$@"; do
+		if kill -0 "$pid" 2>/dev/null; then
+			for i in "${!pids[@]}"; do [ "${pids[$i]}" = "$pid" ] && echo "demo: ${names[$i]} (pid $pid) ignored SIGTERM for 3 s; killing it" >&2; done
+			kill -KILL "$pid" 2>/dev/null
+		fi
+		wait "$pid" 2>/dev/null
+	done
+}
+# stop_children: the daemons first (they leave the robots in their safe state
+# while the simulated bus still answers), then the simulator and the logger.
+stop_children() {
+	local i first=() rest=()
+	for i in "${!pids[@]}"; do
+		case "${names[$i]}" in sim|logger) rest+=("${pids[$i]}") ;; *) first+=("${pids[$i]}") ;; esac
+	done
+	stop_group ${first[@]+"${first[@]}"}
+	stop_group ${rest[@]+"${rest[@]}"}
+	pids=() names=()
+}
+cleanup() {
+	[ "$cleaning" -eq 1 ] && return
+	cleaning=1
+	trap '' INT TERM
+	[ -n "${sleep_pid:-}" ] && kill "$sleep_pid" 2>/dev/null
+	stop_children
+	rm -rf "$run"
+}
+trap cleanup EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
+
+start() {
+	local name=$1; shift
+	"$@" >"$run/$name.log" 2>&1 &
+	pids+=("$!")
+	names+=("$name")
+}
+
+# pid_of NAME: the PID of a process we started.
+pid_of() { local i; for i in "${!names[@]}"; do [ "${names[$i]}" = "$1" ] && echo "${pids[$i]}"; done; }
+# wait_ready NAME REGEX: poll NAME's log until REGEX appears; 1 (with its log's
+# tail) if it exits or takes longer than READY_TIMEOUT_S.
+wait_ready() {
+	local name=$1 re=$2 pid
+	pid=$(pid_of "$name")
+	local deadline=$(( $(date +%s%N) + READY_TIMEOUT_S * 1000000000 ))
+	until grep -qE "$re" "$run/$name.log" 2>/dev/null; do
+		if ! kill -0 "$pid" 2>/dev/null || [ "$(date +%s%N)" -ge "$deadline" ]; then
+			echo "demo: $name did not become ready; its log:" >&2
+			tail -n 15 "$run/$name.log" | sed 's/^/    /' >&2
+			return 1
+		fi
+		sleep 0.02
+	done
+}
+
+# ---- logger -------------------------------------------------------------------
+log=""
+if [ -n "$seconds" ]; then
+	log="$run/demo.lcmlog"
+	# lcm-logger's -l option is broken in LCM 1.3.1: only --lcm-url= works.
+	start logger lcm-logger --lcm-url="$url" --force "$log"
+	wait_ready logger '^Opening log file' || exit 1
+fi
+
+# ---- simulator --------------------------------------------------------------
+start sim "$B/undulate-sim" --scenario "$scenario" --link-dir "$links" --lcm-url "$url" \
+	--seed "$seed" ${sim_sets[@]+"${sim_sets[@]}"}
+wait_ready sim '^undulate-sim: ready:' || exit 1
+# "ready: 4 buses: r1=/path/r1[1,2] r2=... bodies=..." names every robot, its
+# pty and its servo IDs, in scenario (left to right) order.
+ready_line=$(grep -m1 '^undulate-sim: ready:' "$run/sim.log")
+robots=() ports=() ids=()
+for word in $ready_line; do
+	[[ "$word" =~ ^([A-Za-z0-9_-]+)=(/[^[]+)\[([0-9,]+)\]$ ]] || continue
+	robots+=("${BASH_REMATCH[1]}"); ports+=("${BASH_REMATCH[2]}"); ids+=("${BASH_REMATCH[3]}")
+done
+[ ${#robots[@]} -gt 0 ] || die "cannot read the robots from the simulator's ready line: $ready_line"
+
+# ---- phases -------------------------------------------------------------------
+robot_phase=()
+if [ "$phases" = random ]; then
+	RANDOM=$seed
+	for _ in "${robots[@]}"; do
+		robot_phase+=("$(awk -v r="$RANDOM" 'BEGIN { printf "%.3f", (r / 32768.0) * 6.283185 - 3.141593 }')")
+	done
+else
+	IFS=, read -r -a robot_phase <<<"$phases"
+	[ ${#robot_phase[@]} -eq ${#robots[@]} ] || die "--phases: ${#robots[@]} robots, ${#robot_phase[@]} phases"
+	for p in "${robot_phase[@]}"; do is_number "$p" || die "--phases: '$p' is not a number (radians)"; done
+fi
+
+# ---- one daemon per robot -----------------------------------------------------
+start_daemon() {
+	local i=$1
+	start "undulated-${robots[$i]}" "$B/undulated" --port "${ports[$i]}" --ids "${ids[$i]}" \
+		--robot "${robots[$i]}" --lcm-url "$url" --mode "$start_mode" \
+		--set "sinusoid.phase=${robot_phase[$i]}" ${daemon_sets[@]+"${daemon_sets[@]}"}
+}
+# Start-up attempts per daemon (see below).
+START_ATTEMPTS=3
+# One after the other: start-up is the busiest moment on the simulated buses
+# (every daemon pings, reads and configures its servos), and the robots need
+# not start together (SINUSOID runs on the wall clock, and the switch comes
+# when all are up).
+for i in "${!robots[@]}"; do
+	name="undulated-${robots[$i]}"
+	start_daemon "$i"
+	for attempt in $(seq "$START_ATTEMPTS"); do
+		wait_ready "$name" 'ready:' && continue 2
+		# A start-up transaction that fails for good (a reply lost or
+		# garbled more often than undulated retries it: "... failed: no
+		# reply / bad checksum / unexpected length") ends undulated's start;
+		# on a heavily loaded machine the simulated bus can answer late. Say
+		# so and try again; anything else (e.g. a bad setting) is fatal.
+		kill -0 "$(pid_of "$name")" 2>/dev/null && break
+		grep -qE 'failed: |did not answer a PING' "$run/$name.log" || break
+		[ "$attempt" -lt "$START_ATTEMPTS" ] || break
+		echo "demo: $name: the simulated bus answered too late during start-up; starting it again" >&2
+		# forget the failed process (it has exited) so it is not taken for a crash later
+		for k in "${!names[@]}"; do
+			[ "${names[$k]}" = "$name" ] || continue
+			wait "${pids[$k]}" 2>/dev/null
+			unset 'names[k]' 'pids[k]'
+		done
+		names=("${names[@]}") pids=("${pids[@]}")
+		mv "$run/$name.log" "$run/$name.$attempt.log"
+		start_daemon "$i"
+	done
+	exit 1
+done
+t_ready=$(date +%s%N)
+
+say() { [ "$interactive" -eq 1 ] || echo "demo: $*"; }
+say "scenario $(basename "$scenario"), ${#robots[@]} robots (${robots[*]}), seed $seed, LCM $url"
+say "phases at start (rad): ${robot_phase[*]}; $start_mode until +${switch_at} s, then $switch_to"
+
+# switch_modes: one command to every robot (UNDULATE.CMD).
+switch_modes() {
+	if "$B/undulated" --command "mode $switch_to" --robot '*' --lcm-url "$url" --timeout 2 \
+		>"$run/switch.log" 2>&1; then
+		echo "$(date +%s%N)" >"$run/switch.time"
+	else
+		echo "demo: the switch to $switch_to was not accepted by every robot:" >&2
+		sed 's/^/    /' "$run/switch.log" >&2
+	fi
+}
+
+# sleep_until T_NS: sleep until the monotonic-enough wall time T_NS.
+sleep_until() {
+	local now left
+	now=$(date +%s%N)
+	left=$(( $1 - now ))
+	[ "$left" -gt 0 ] || return 0
+	# In the background and waited for: a trapped SIGTERM/SIGINT interrupts
+	# `wait` at once, where a foreground sleep would delay it to its end.
+	sleep "$(awk -v n="$left" 'BEGIN { printf "%.3f", n / 1e9 }')" &
+	sleep_pid=$!
+	wait "$sleep_pid"
+	sleep_pid=""
+	return 0
+}
+secs_ns() { awk -v s="$1" 'BEGIN { printf "%.0f", s * 1e9 }'; }
+
+# ---- interactive: undulate-top in the foreground ------------------------------
+if [ "$interactive" -eq 1 ]; then
+	if [ "$switch_at" != never ]; then
+		( trap '[ -n "${sleep_pid:-}" ] && kill "$sleep_pid" 2>/dev/null; exit 143' TERM
+		  sleep_until $(( t_ready + $(secs_ns "$switch_at") )); switch_modes ) &
+		pids+=("$!"); names+=("switch timer")
+	fi
+	# Ctrl-C reaches undulate-top (it restores the terminal and exits) and this
+	# script, whose EXIT trap then stops everything else.
+	"$B/undulate-top" --lcm-url "$url"
+	exit 0
+fi
+
+# ---- headless -------------------------------------------------------------------
+# sample_contact: ask the simulator for its running totals (SIM.CMD "stats");
+# the reply, with the simulated time, lands in its log. The rate of its total
+# impulse (impacts + resting contact) is the mean contact force: ground truth
+# that the collision messages (impacts only) do not carry.
+sample_contact() { "$B/undulate-sim" --cmd stats --lcm-url "$url" >/dev/null 2>&1; }
+# Seconds between samples.
+CONTACT_SAMPLE_S=5
+sample_contact
+next_sample=$CONTACT_SAMPLE_S
+switch_pending=0
+[ "$switch_at" != never ] && [ "$(secs_ns "$switch_at")" -lt "$(secs_ns "$seconds")" ] && switch_pending=1
+while :; do
+	# the next event: a sample, the switch, or the end
+	next=$next_sample what=sample
+	if [ "$switch_pending" -eq 1 ] && awk -v a="$switch_at" -v b="$next" 'BEGIN { exit !(a <= b) }'; then
+		next=$switch_at what=switch
+	fi
+	if awk -v a="$seconds" -v b="$next" 'BEGIN { exit !(a <= b) }'; then
+		next=$seconds what=end
+	fi
+	sleep_until $(( t_ready + $(secs_ns "$next") ))
+	case $what in
+	switch) sample_contact; switch_modes; switch_pending=0 ;;
+	sample) sample_contact; next_sample=$(awk -v a="$next_sample" -v d=$CONTACT_SAMPLE_S 'BEGIN { print a + d }') ;;
+	end) sample_contact; break ;;
+	esac
+done
+for i in "${!pids[@]}"; do
+	kill -0 "${pids[$i]}" 2>/dev/null || die "${names[$i]} stopped during the run; its log:
+$(tail -n 15 "$run/${names[$i]}.log")"
+done
+
+# Stop the robots and the simulator, then the logger, so the log is complete.
+stop_children
+
+analysis="$run/analysis"
+mkdir -p "$analysis"
+"$B/undulate-analyze" "$log" --out "$analysis" --window "$window" --quiet >"$run/analyze.log" 2>&1
+rc=$?
+# 3 = truncated log (the logger was stopped mid-message): partial results are still written.
+[ "$rc" -eq 0 ] || [ "$rc" -eq 3 ] || die "undulate-analyze failed (exit $rc): $(tail -n 5 "$run/analyze.log")"
+
+# Seconds from the start of the log to the switch: the daemons' "mode" events.
+switch_t=""
+if [ -f "$run/switch.time" ]; then
+	switch_t=$(awk -F, -v to="-> $(echo "$switch_to" | tr a-z A-Z)" \
+		'$6 == "\"mode\"" && index($0, to) { printf "%.1f", $2; exit }' "$analysis/events.csv")
+fi
+
+# ---- summary --------------------------------------------------------------------
+echo
+echo "=== undulate demo summary: ${#robots[@]} robots, $seconds s, $(basename "$scenario") ==="
+[ -n "$switch_t" ] && echo "switched $start_mode -> $switch_to at t = $switch_t s"
+echo "final window: the last $window s"
+# summary.txt has one row per pair under a header line starting with "pair";
+# columns are found by name so a new column does not break this.
+awk -v OFS='' '
+	$1 == "pair" && !hdr {
+		# "end state" is one column of the rows but two words of the header
+		for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { col["end"] = ++j; i++ } else col[$i] = ++j }
+		hdr = 1;
+		printf "%-20s %-16s %10s %8s %10s %8s\n", "pair", "state", "final D", "d~", "2asin(d~)", "coll.";
+		next }
+	hdr && NF == 0 { hdr = 2 }
+	hdr == 1 && NF > 5 && $col["end"] != "-" {
+		printf "%-20s %-16s %10s %8s %10s %8s\n", $col["pair"], $col["end"], $col["meanD"], $col["d~"], $col["2asin(d~)"], $col["c.win"] }
+' "$analysis/summary.txt"
+echo "(final D: mean phase difference in the final window, rad; d~: normalized separation"
+echo " from the measured amplitude; coll.: collisions in the final window)"
+echo
+echo "collisions per 10 s window:"
+awk -F, 'NR > 1 { b = int($1 / 10); n[b] += $2; imp[b] += $3; if (b > last) last = b; end = $1 + 1 }
+	END { for (b = 0; b <= last; b++) {
+		e = b * 10 + 10 < end ? b * 10 + 10 : end
+		printf "  %4d-%-4d s  %6d collisions  %9.4f N*s\n", b * 10, e, n[b], imp[b] } }' \
+	"$analysis/collision_rate.csv"
+
+# Contact force from the simulator's samples: "t,impacts,impulse,resting_impulse"
+# (simulated seconds since its start, running totals).
+sed -n "s/^undulate-sim: SIM.CMD seq [0-9]* 'stats *': ok steps=[0-9]* time=\([0-9.]*\) collisions=\([0-9]*\) impulse=\([0-9.]*\) resting_impulse=\([0-9.]*\).*/\1,\2,\3,\4/p" \
+	"$run/sim.log" | sort -t, -k1,1n | { echo "t,impacts,impulse,resting_impulse"; cat; } >"$analysis/contact.csv"
+if [ "$(wc -l <"$analysis/contact.csv")" -gt 2 ]; then
+	echo
+	echo "mean contact force between samples (simulator ground truth: impacts + resting contact):"
+	awk -F, 'NR > 2 && $1 > t0 { printf "  %6.1f-%-6.1f s  %9.4f N  (%d impacts)\n", t0, $1, ($3 - i0) / ($1 - t0), $2 - n0 }
+		NR > 1 { t0 = $1; n0 = $2; i0 = $3 }' "$analysis/contact.csv"
+	[ -f "$run/switch.time" ] && echo "  (simulated time; one sample is taken just before the switch)"
+fi
+
+# One daemon publishes 100 STATE messages a second: many more means another
+# program publishes on this LCM URL (e.g. the same test run twice at once),
+# and the analysis mixes two runs.
+crosstalk=$(awk '/^span:/ { span = $2 } $2 == "joints" && $4 == "states" && span > 0 && $5 > 1.15 * 100 * span { print $1 }' \
+	"$analysis/summary.txt" | tr '\n' ' ')
+if [ -n "$crosstalk" ]; then
+	echo
+	echo "WARNING: more STATE messages from ${crosstalk}than one daemon sends: another program uses $url; these results mix two runs"
+	echo "$crosstalk" >"$analysis/crosstalk"
+fi
+
+# The simulator's own count over the whole run (ground truth, SIM.TRUTH).
+truth=$(grep -m1 '^undulate-sim: exit:' "$run/sim.log" | sed 's/^undulate-sim: exit: //')
+[ -n "$truth" ] && echo "simulator: $truth"
+
+if [ -n "$out" ]; then
+	mkdir -p "$out" || die "cannot create --out $out"
+	cp "$log" "$out/demo.lcmlog"
+	cp -r "$analysis"/. "$out/"
+	mkdir -p "$out/logs"
+	cp "$run"/*.log "$out/logs/" 2>/dev/null
+	[ -n "$switch_t" ] && echo "$switch_t" >"$out/switch_t"
+	echo "$seed" >"$out/seed"
+	echo
+	echo "log and analysis (CSV, summary.json) kept in $out"
+fi
+exit 0

@@ -17,8 +17,9 @@ mkdir -p "$logs"
 per_test_timeout=${TEST_TIMEOUT:-300}
 filter=${TEST_FILTER:-}
 
-passed=0 failed=0
+passed=0 failed=0 todo=0
 failures=()
+todos=()
 
 run_one() {
 	local name=$1; shift
@@ -27,9 +28,11 @@ run_one() {
 	local start=$(date +%s%N)
 	CMOCKA_MESSAGE_OUTPUT=TAP timeout --kill-after=10 "$per_test_timeout" "$@" >"$log" 2>&1
 	local rc=$?
-	local p f
+	local p f t
 	p=$(grep -c '^ok ' "$log")
-	f=$(grep -c '^not ok ' "$log")
+	# TAP "# TODO": a known unmet claim, counted apart (not a pass, not a failure)
+	t=$(grep -c '^not ok .*# TODO' "$log")
+	f=$(( $(grep -c '^not ok ' "$log") - t ))
 	if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
 		f=1
 		echo "not ok - $name exited with status $rc" >>"$log"
@@ -38,7 +41,8 @@ run_one() {
 		f=1
 		echo "not ok - $name ran no test" >>"$log"
 	fi
-	passed=$((passed + p)); failed=$((failed + f))
+	passed=$((passed + p)); failed=$((failed + f)); todo=$((todo + t))
+	[ "$t" -gt 0 ] && todos+=("$(grep '^not ok .*# TODO' "$log" | sed "s/^not ok [0-9]* - /$name: /; s/ # TODO.*//")")
 	local ms=$(( ($(date +%s%N) - start) / 1000000 ))
 	local secs="$((ms / 1000)).$(( (ms % 1000) / 100 ))"
 	if [ "$f" -gt 0 ]; then
@@ -47,7 +51,7 @@ run_one() {
 		grep -E '^not ok|^#' "$log" | head -20 | sed 's/^/    /'
 		echo "    (full log: $log)"
 	else
-		printf '%-40s %3d passed  (%ss)\n' "$name" "$p" "$secs"
+		printf '%-40s %3d passed%s  (%ss)\n' "$name" "$p" "$([ "$t" -gt 0 ] && echo ", $t todo")" "$secs"
 	fi
 }
 
@@ -67,5 +71,9 @@ if [ -n "${TEST_LONG:-}" ]; then
 fi
 
 echo
+if [ "$todo" -gt 0 ]; then
+	echo "$todo known unmet claim(s) (TAP TODO, not counted; see docs/EXPERIMENTS.md):"
+	printf '  %s\n' "${todos[@]}"
+fi
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

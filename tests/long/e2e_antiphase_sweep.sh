@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# e2e_antiphase_sweep.sh (make test-long) — where does anti-phase appear as the
+# pair rig's separation grows? The pair rig (tests/scenarios/pair-rig.scenario,
+# r = 0.67, immobile) through the real daemons, started from a phase
+# difference of pi at d~ = 0.1 .. 0.9, each run analysed with undulate-analyze.
+# Theory (theory.md): anti-phase is a stable fixed point of the return map
+# above d~_c = sqrt(r(r - 1) / (r^2 - r - 2)) = 0.316 for r = 0.67, unstable
+# below it. Asserted, as the paper reports it: every run well above d~_c
+# (d~ >= d~_c + 0.15) ends in anti-phase (|D| within 0.5 of pi, still
+# colliding), and no run well below it (d~ <= d~_c - 0.1) does.
+# Prints the whole table (d~ set, d~ measured, final D, state, collisions)
+# for docs/EXPERIMENTS.md.
+source "$(dirname "$0")/../lib.sh"
+
+# keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
+# test directory is removed on exit) in $BUILD/test-logs/<test>.d/.
+keep_runs() {
+	[ "$_tap_failed" -gt 0 ] || return 0
+	local d="$BUILD/test-logs/$(basename "$0" .sh).d" x
+	rm -rf "$d" && mkdir -p "$d"
+	for x in "$@"; do [ -d "$T/$x" ] && cp -r "$T/$x" "$d/"; done
+	echo "# runs kept in $d"
+}
+
+seconds=${E2E_SWEEP_SECONDS:-40}
+seps=(${E2E_SWEEP_SEPARATIONS:-0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.9})
+rig=(${E2E_DAEMON_SETS:-})  # extra settings for every daemon, e.g. "--daemon-set joint.1.c=0.006"
+# Runs at once (each is a simulator and two daemons, a few % of a core).
+parallel=3
+r=0.67
+dc=$(awk -v r=$r 'BEGIN { printf "%.3f", sqrt(r * (r - 1) / (r * r - r - 2)) }')
+
+col() {
+	awk -v want="$2" '
+		$1 == "pair" && !hdr { for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { c["state"] = ++j; i++ } else c[$i] = ++j }; hdr = 1; next }
+		hdr && $1 == "left:right" { print $c[want]; exit }' "$T/$1/summary.txt"
+}
+last_collisions() {
+	awk -F, 'NR > 1 { t[NR] = $1; n[NR] = $2; end = $1 + 1 } END { for (k in t) if (t[k] >= end - 10) s += n[k]; print s + 0 }' \
+		"$T/$1/collision_rate.csv"
+}
+
+# swing NAME: the smallest peak-to-peak angle (rad) of either robot over the
+# last 10 s (a stopped pair would read as "in phase" and never collide).
+swing() {
+	awk -F, 'NR > 1 { t[NR] = $2; k[NR] = $3 "/" $4; a[NR] = $6; if ($2 > end) end = $2 }
+		END { for (i in t) if (t[i] >= end - 10) { j = k[i]
+			if (!(j in lo) || a[i] < lo[j]) lo[j] = a[i]; if (!(j in hi) || a[i] > hi[j]) hi[j] = a[i] }
+		m = -1; for (j in lo) if (m < 0 || hi[j] - lo[j] < m) m = hi[j] - lo[j]; printf "%.2f", m }' "$T/$1/states.csv"
+}
+
+# Three LCM ports (one run each at a time), one of five blocks in 7885-7899.
+port=$((7885 + 3 * ($$ % 5)))
+names=()
+k=0
+for sep in "${seps[@]}"; do
+	name="sep$sep"
+	names+=("$name")
+	spawn "$name" env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --scenario "$top/tests/scenarios/pair-rig.scenario" \
+		--seconds "$seconds" --switch-at 3 --seed 5 --phases 0,3.1416 --set "world.separation=$sep" \
+		--lcm-url "$(lcm_url $((port + k % parallel)))" --out "$T/$name" ${rig[@]+"${rig[@]}"}
+	wait_log "$name" '^demo: phases' 20 || true
+	k=$((k + 1))
+	# A batch of $parallel runs, then wait for all of them (they share the ports).
+	if [ $((k % parallel)) -eq 0 ] || [ "$k" -eq "${#seps[@]}" ]; then
+		for n in "${names[@]: -$(( (k - 1) % parallel + 1 ))}"; do
+			var="pid_${n//[^A-Za-z0-9_]/_}"  # spawn's variable name
+			wait_for $((seconds + 60)) bash -c "! kill -0 ${!var}"
+			kill -TERM "${!var}" 2>/dev/null  # only if it overran
+			wait "${!var}"
+		done
+	fi
+done
+
+echo "# pair rig from D0 = pi, r = $r, critical d~_c = $dc"
+printf '# %-8s %-10s %-9s %-10s %-16s %-6s %s\n' "d~ set" "d~ meas." "final D" "2asin(d~)" "state" "coll." "swing (rad p-p, last 10 s)"
+for name in "${names[@]}"; do
+	if [ -f "$T/$name/crosstalk" ]; then
+		tap_fail "$name: nobody else on its LCM port" "another program published on the run's LCM URL"
+		continue
+	fi
+	if [ ! -f "$T/$name/summary.txt" ]; then
+		tap_fail "$name ran and was analysed" "$(tail -n 10 "$T/$name.log")"
+		continue
+	fi
+	d=$(col "$name" d~); D=$(col "$name" meanD); st=$(col "$name" state); n=$(last_collisions "$name")
+	sw=$(swing "$name")
+	printf '# %-8s %-10s %-9s %-10s %-16s %-6s %s\n' "${name#sep}" "$d" "$D" "$(col "$name" "2asin(d~)")" "$st" "$n" "$sw"
+	if awk -v s="$sw" 'BEGIN { exit !(s < 0.8) }'; then
+		tap_fail "d~ = $d: both robots still swing" "smallest peak-to-peak $sw rad over the last 10 s"
+		continue
+	fi
+	anti=0
+	awk -v D="$D" 'BEGIN { D = D < 0 ? -D : D; exit !(D > 3.14159 - 0.5) }' && [ "$n" -gt 0 ] && anti=1
+	if awk -v d="$d" -v c="$dc" 'BEGIN { exit !(d >= c + 0.15 && d < 1) }'; then
+		if [ "$anti" -eq 1 ]; then
+			tap_ok "d~ = $d (above d~_c = $dc): anti-phase, as the theory predicts"
+		else
+			tap_fail "d~ = $d (above d~_c = $dc): anti-phase" "final D $D, state $st, collisions in the last 10 s $n"
+		fi
+	elif awk -v d="$d" -v c="$dc" 'BEGIN { exit !(d <= c - 0.1) }'; then
+		if [ "$anti" -eq 0 ]; then
+			tap_ok "d~ = $d (below d~_c = $dc): no anti-phase, as the theory predicts"
+		else
+			tap_fail "d~ = $d (below d~_c = $dc): no anti-phase" "final D $D, state $st"
+		fi
+	else
+		echo "# d~ = $d is within the margin around d~_c = $dc: recorded, not asserted"
+	fi
+done
+keep_runs "${names[@]}"
+tap_done
