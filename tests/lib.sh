@@ -85,3 +85,13 @@ wait_for() {
 wait_log() { wait_for "${3:-10}" grep -qE "$2" "$T/$1.log"; }
 
 lcm_url() { echo "udpm://239.255.76.67:$1?ttl=0"; }
+
+# keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
+# test directory is removed on exit) in $BUILD/test-logs/<test>.d/.
+keep_runs() {
+	[ "$_tap_failed" -gt 0 ] || return 0
+	local d="$BUILD/test-logs/$(basename "$0" .sh).d" x
+	rm -rf "$d" && mkdir -p "$d"
+	for x in "$@"; do [ -d "$T/$x" ] && cp -r "$T/$x" "$d/"; done
+	echo "# runs kept in $d"
+}

@@ -42,7 +42,9 @@ run_one() {
 		echo "not ok - $name ran no test" >>"$log"
 	fi
 	passed=$((passed + p)); failed=$((failed + f)); todo=$((todo + t))
-	[ "$t" -gt 0 ] && todos+=("$(grep '^not ok .*# TODO' "$log" | sed "s/^not ok [0-9]* - /$name: /; s/ # TODO.*//")")
+	local line
+	while IFS= read -r line; do todos+=("$line"); done \
+		< <(grep '^not ok .*# TODO' "$log" | sed "s/^not ok [0-9]* - /$name: /; s/ # TODO.*//")
 	local ms=$(( ($(date +%s%N) - start) / 1000000 ))
 	local secs="$((ms / 1000)).$(( (ms % 1000) / 100 ))"
 	if [ "$f" -gt 0 ]; then

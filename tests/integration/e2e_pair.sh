@@ -14,16 +14,6 @@
 # each run first checks that it landed in the regime it is meant to test.
 source "$(dirname "$0")/../lib.sh"
 
-# keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
-# test directory is removed on exit) in $BUILD/test-logs/<test>.d/.
-keep_runs() {
-	[ "$_tap_failed" -gt 0 ] || return 0
-	local d="$BUILD/test-logs/$(basename "$0" .sh).d" x
-	rm -rf "$d" && mkdir -p "$d"
-	for x in "$@"; do [ -d "$T/$x" ] && cp -r "$T/$x" "$d/"; done
-	echo "# runs kept in $d"
-}
-
 scenario="$top/tests/scenarios/pair-rig.scenario"
 seconds=${E2E_PAIR_SECONDS:-40}
 # Extra daemon settings for every run (none: the daemon's single-joint

@@ -9,16 +9,6 @@
 #                                 last 10 s, every pair |D| <= 2 asin(d~) + 0.1
 source "$(dirname "$0")/../lib.sh"
 
-# keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
-# test directory is removed on exit) in $BUILD/test-logs/<test>.d/.
-keep_runs() {
-	[ "$_tap_failed" -gt 0 ] || return 0
-	local d="$BUILD/test-logs/$(basename "$0" .sh).d" x
-	rm -rf "$d" && mkdir -p "$d"
-	for x in "$@"; do [ -d "$T/$x" ] && cp -r "$T/$x" "$d/"; done
-	echo "# runs kept in $d"
-}
-
 seconds=${E2E_ROW_SECONDS:-45}
 # Extra daemon settings for every run (none: the daemon's defaults give the
 # paper's ~0.8 rad at ~0.8 Hz on the simulated AX-12); e.g.

@@ -12,16 +12,6 @@
 # for docs/EXPERIMENTS.md.
 source "$(dirname "$0")/../lib.sh"
 
-# keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
-# test directory is removed on exit) in $BUILD/test-logs/<test>.d/.
-keep_runs() {
-	[ "$_tap_failed" -gt 0 ] || return 0
-	local d="$BUILD/test-logs/$(basename "$0" .sh).d" x
-	rm -rf "$d" && mkdir -p "$d"
-	for x in "$@"; do [ -d "$T/$x" ] && cp -r "$T/$x" "$d/"; done
-	echo "# runs kept in $d"
-}
-
 seconds=${E2E_SWEEP_SECONDS:-40}
 seps=(${E2E_SWEEP_SEPARATIONS:-0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.9})
 rig=(${E2E_DAEMON_SETS:-})  # extra settings for every daemon, e.g. "--daemon-set joint.1.c=0.006"
