@@ -44,6 +44,33 @@ else
 	tap_fail "gnuplot not installed (gnuplot-nox): plots untested"
 fi
 
+# A pair whose joints stopped is not-oscillating, whatever its phases say:
+# r3 and r4 stand still from 8 s on (r3:r4 at rest on the same side would
+# otherwise be "in-phase"); the swings are in the last two columns.
+tap_check "--synth-stop-after writes a log" bash -c "'$A' --synth '$T/stop.log' --duration 20 --synth-stop-after 8 >/dev/null"
+"$A" "$T/stop.log" --out "$T/stop" --quiet 2>"$T/stop.err"; rc=$?
+tap_check "analysis of a log with stopped robots exits 0" [ "$rc" = 0 ]
+# col DIR PAIR COLUMN: a column of a pair's row in summary.txt, found by header name.
+col() {
+	awk -v pair="$2" -v want="$3" '
+		$1 == "pair" && !hdr { for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { c["state"] = ++j; i++ } else c[$i] = ++j }; hdr = 1; next }
+		hdr && $1 == pair { print $c[want]; exit }' "$1/summary.txt"
+}
+tap_check "stopped: r1:r2 still compatible" [ "$(col "$T/stop" r1:r2 state)" = compatible ]
+tap_check "stopped: r2:r3 (one robot at rest) not-oscillating" [ "$(col "$T/stop" r2:r3 state)" = not-oscillating ]
+tap_check "stopped: r3:r4 (both at rest) not-oscillating" [ "$(col "$T/stop" r3:r4 state)" = not-oscillating ]
+tap_check "stopped: swing_a of r2:r3 is 1.6 rad p-p, swing_b 0" \
+	awk -v a="$(col "$T/stop" r2:r3 swing_a)" -v b="$(col "$T/stop" r2:r3 swing_b)" \
+	'BEGIN { exit !(a > 1.59 && a < 1.61 && b == 0) }'
+tap_check "stopped: summary.json has the swings and the class" \
+	grep -qE '"pair":"r3:r4"[^}]*"class":"not-oscillating"[^}]*"swing_a":0,"swing_b":0}' "$T/stop/summary.json"
+"$A" "$T/stop.log" --out "$T/stop0" --quiet --min-swing 0 2>/dev/null
+tap_check "--min-swing 0: the phases decide again (r3:r4 in-phase)" [ "$(col "$T/stop0" r3:r4 state)" = in-phase ]
+"$A" "$T/stop.log" --out "$T/stop1" --quiet --min-swing -1 2>/dev/null; rc=$?
+tap_check "--min-swing -1: exit 1" [ "$rc" = 1 ]
+"$A" "$T/stop.log" --synth-stop-after 3 --out "$T/stop2" 2>/dev/null; rc=$?
+tap_check "--synth-stop-after without --synth: exit 1" [ "$rc" = 1 ]
+
 # errors: missing, foreign, truncated, bad options
 "$A" "$T/nope.log" --out "$T/e1" 2>"$T/e1.err"; rc=$?
 tap_check "missing log: exit 2 and a message" bash -c "[ $rc = 2 ] && grep -q 'No such file' '$T/e1.err'"

@@ -149,6 +149,9 @@ static void test_synthetic_classes(void **state)
 	/* the final r3:r4 difference is the closed form after ncoll collisions */
 	double final = phase_return_map_d0(s.delta0, s.restitution, s.ncoll);
 	assert_true(fabs(pair_num(js, "r3:r4", "mean_delta") - final) < 1e-6);
+	/* every joint swings 2A in the final window */
+	assert_true(fabs(pair_num(js, "r2:r3", "swing_a") - 2 * s.amplitude) < 1e-3);
+	assert_true(fabs(pair_num(js, "r3:r4", "swing_b") - 2 * s.amplitude) < 1e-3);
 	/* joints of one robot: joint 1 lags by 2 pi / 3 */
 	assert_true(fabs(pair_num(js, "r2/0:1", "mean_delta") + 2 * M_PI / 3) < 1e-6);
 	free(js);
@@ -278,6 +281,34 @@ static void test_pairs_and_range(void **state)
 	assert_true(count_lines("pr", "states.csv") < 1 + 8 * 1002);
 }
 
+/* --synth-stop-after: r3 and r4 stand still; the pairs with a stopped robot
+ * are not oscillating (r3:r4 would otherwise pass for in-phase), r1:r2 is
+ * untouched, and the swings say why. */
+static void test_synth_stop(void **state)
+{
+	(void)state;
+	struct synth_spec s;
+	synth_default(&s);
+	s.duration_s = 25.0;
+	s.stop_after_s = 12.0;
+	write_synth("stop.log", &s);
+	assert_int_equal(run("stop.log", "stop", NULL), AN_EXIT_OK);
+	char *js = slurp("stop", "summary.json");
+	assert_non_null(js);
+	assert_true(pair_has(js, "r1:r2", "\"class\":\"compatible\""));
+	assert_true(pair_has(js, "r2:r3", "\"class\":\"not-oscillating\""));
+	assert_true(pair_has(js, "r3:r4", "\"class\":\"not-oscillating\""));
+	double pp = 2 * s.amplitude;
+	assert_true(fabs(pair_num(js, "r1:r2", "swing_a") - pp) < 1e-3);
+	assert_true(fabs(pair_num(js, "r2:r3", "swing_a") - pp) < 1e-3);
+	assert_true(pair_num(js, "r2:r3", "swing_b") < 1e-9);
+	assert_true(pair_num(js, "r3:r4", "swing_a") < 1e-9 && pair_num(js, "r3:r4", "swing_b") < 1e-9);
+	assert_true(pair_num(js, "r3/0:1", "swing_b") < 1e-9);
+	/* no contact with a robot at rest after the stop */
+	assert_int_equal((int)pair_num(js, "r2:r3", "window_collisions"), 0);
+	free(js);
+}
+
 static void test_missing_and_foreign(void **state)
 {
 	(void)state;
@@ -398,6 +429,7 @@ int main(void)
 		cmocka_unit_test(test_zero_crossings),
 		cmocka_unit_test(test_bursts),
 		cmocka_unit_test(test_pairs_and_range),
+		cmocka_unit_test(test_synth_stop),
 		cmocka_unit_test(test_missing_and_foreign),
 		cmocka_unit_test(test_truncated),
 		cmocka_unit_test(test_damaged_middle),

@@ -89,6 +89,29 @@ static void test_circ(void **state)
 }
 
 /* d~ = 0: the map iterated n times equals the closed form, and -> 0. */
+/* Peak-to-peak of the angle: empty is NAN, bad samples do not count. */
+static void test_swing(void **state)
+{
+	(void)state;
+	struct phase_swing s;
+	phase_swing_init(&s);
+	assert_true(isnan(phase_swing_pp(&s)));
+	phase_swing_add(&s, NAN);
+	phase_swing_add(&s, INFINITY);
+	assert_true(isnan(phase_swing_pp(&s)));
+	phase_swing_add(&s, 0.3);
+	assert_true(phase_swing_pp(&s) == 0.0); /* one sample: no swing */
+	for (double t = 0; t < 5.0; t += 0.01)
+		phase_swing_add(&s, 0.3 + 0.8 * sin(2 * M_PI * 0.8 * t));
+	phase_swing_add(&s, -INFINITY);
+	assert_true(fabs(phase_swing_pp(&s) - 1.6) < 1e-3);
+	/* all negative: the extremes are not anchored at 0 */
+	phase_swing_init(&s);
+	phase_swing_add(&s, -0.5);
+	phase_swing_add(&s, -0.7);
+	assert_true(fabs(phase_swing_pp(&s) - 0.2) < 1e-12);
+}
+
 static void test_return_map_d0(void **state)
 {
 	(void)state;
@@ -139,6 +162,7 @@ int main(void)
 		cmocka_unit_test(test_tracker_frequency),
 		cmocka_unit_test(test_tracker_jump),
 		cmocka_unit_test(test_circ),
+		cmocka_unit_test(test_swing),
 		cmocka_unit_test(test_return_map_d0),
 		cmocka_unit_test(test_return_map_fixed_points),
 	};

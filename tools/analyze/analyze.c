@@ -61,6 +61,7 @@ struct an_joint {
 	int hn, hnext;
 	int64_t samples;
 	double reported_freq;
+	struct phase_swing win_swing;  /* measured angle over the final window */
 };
 
 struct an_robot {
@@ -90,6 +91,7 @@ struct an_pair {
 	int64_t *delta_utime;
 	size_t ndeltas, cap;
 	double dsep, amp_lateral, distance;
+	double swing_a, swing_b;  /* rad p-p of joints a/ja and b/jb in the final window */
 	const char *cls;
 };
 
@@ -141,6 +143,7 @@ void an_options_default(struct an_options *o)
 	o->separation = NAN;
 	o->restitution = 0.67;
 	o->merge_s = 0.1;
+	o->min_swing = AN_MIN_SWING_DEFAULT;
 	o->msg = stderr;
 }
 
@@ -173,8 +176,10 @@ static int an_robot_find(struct an_ctx *c, const char *name, bool add)
 	memset(r, 0, sizeof(*r));
 	snprintf(r->name, sizeof(r->name), "%s", name);
 	r->lever = NAN;
-	for (int j = 0; j < AN_MAX_JOINTS; j++)
+	for (int j = 0; j < AN_MAX_JOINTS; j++) {
 		phase_tracker_init(&r->j[j].tr);
+		phase_swing_init(&r->j[j].win_swing);
+	}
 	return c->nrobots++;
 }
 
@@ -559,6 +564,8 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 		const undulate_joint_state_t *js = &m->joints[j];
 		struct an_joint *aj = &r->j[j];
 		phase_tracker_feed(&aj->tr, t, js->angle);
+		if (t >= c->window_start_t)
+			phase_swing_add(&aj->win_swing, js->angle);
 		/* The daemon's running frequency estimate when it has one (it
 		 * sees every cycle, and its phase is then ours); else our own
 		 * from zero crossings; else the phase is left empty. */
@@ -910,10 +917,16 @@ static void an_pair_separation(struct an_ctx *c, struct an_pair *p)
 }
 
 /* The end state of a pair from the final window (see README.md for the rules). */
-static const char *an_classify(const struct an_pair *p, bool have_sim)
+static const char *an_classify(const struct an_pair *p, bool have_sim, double min_swing)
 {
 	if (p->win.n == 0)
 		return "no-data";
+	/* A joint at rest still has a phase (0 or pi from its sign, at the
+	 * daemon's last frequency): two stopped robots would pass for in-phase
+	 * or anti-phase. No phase relation means anything unless both swing.
+	 * NAN (no finite angle in the window) counts as not swinging. */
+	if (!(p->swing_a >= min_swing) || !(p->swing_b >= min_swing))
+		return "not-oscillating";
 	double mean = fabs(phase_circ_mean(&p->win));
 	double spread = phase_circ_spread(&p->win);
 	bool locked = spread <= AN_SPREAD_MAX;
@@ -978,20 +991,28 @@ static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 		}
 		if (r->have_body)
 			fprintf(f, "  neutral %.4f m lever %.4f m/rad", r->neutral, r->lever);
+		if (r->njoints > 0)
+			fputs("  swing", f);
+		for (int j = 0; j < r->njoints; j++)
+			fprintf(f, " j%d %.3f", j, phase_swing_pp(&r->j[j].win_swing));
+		if (r->njoints > 0)
+			fputs(" rad p-p", f);
 		fputc('\n', f);
 	}
 	fprintf(f, "collisions: %lld (%lld with walls), total impulse %.6g N*s\n", (long long)c->collisions,
 		(long long)c->wall_collisions, c->impulse);
 	fprintf(f, "restitution for theory: %.3f; collisions less than %.3f s apart are one contact\n",
 		c->o->restitution, c->o->merge_s);
-	fprintf(f, "%-24s %-28s %8s %8s %8s %6s %6s %7s %9s %5s\n", "pair", "end state", "mean|D|", "meanD",
-		"spread", "coll", "c.win", "d~", "2asin(d~)", "map");
+	fprintf(f, "not oscillating: a joint of the pair swings less than %.3f rad peak-to-peak in the final window\n",
+		c->o->min_swing);
+	fprintf(f, "%-24s %-28s %8s %8s %8s %6s %6s %7s %9s %5s %8s %8s\n", "pair", "end state", "mean|D|", "meanD",
+		"spread", "coll", "c.win", "d~", "2asin(d~)", "map", "swing_a", "swing_b");
 	for (int k = 0; k < c->npairs; k++) {
 		const struct an_pair *p = &c->pairs[k];
-		fprintf(f, "%-24s %-28s %8.4f %8.4f %8.4f %6lld %6lld %7.4f %9.4f %5zu\n", p->name, p->cls,
-			phase_circ_mean_abs(&p->win), phase_circ_mean(&p->win), phase_circ_spread(&p->win),
+		fprintf(f, "%-24s %-28s %8.4f %8.4f %8.4f %6lld %6lld %7.4f %9.4f %5zu %8.4f %8.4f\n", p->name,
+			p->cls, phase_circ_mean_abs(&p->win), phase_circ_mean(&p->win), phase_circ_spread(&p->win),
 			(long long)p->collisions, (long long)p->win_collisions, p->dsep,
-			phase_compat_limit(p->dsep), p->ndeltas > 0 ? p->ndeltas - 1 : 0);
+			phase_compat_limit(p->dsep), p->ndeltas > 0 ? p->ndeltas - 1 : 0, p->swing_a, p->swing_b);
 	}
 	if (c->decode_errors)
 		fprintf(f, "undecodable messages: %lld\n", (long long)c->decode_errors);
@@ -1024,7 +1045,8 @@ static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 		for (int j = 0; j < r->njoints; j++) {
 			fputs(j ? ",{" : "{", f);
 			an_json_num(f, "frequency_hz", phase_tracker_omega(&r->j[j].tr) / (2.0 * M_PI), true);
-			an_json_num(f, "amplitude_rad", r->j[j].tr.amplitude, false);
+			an_json_num(f, "amplitude_rad", r->j[j].tr.amplitude, true);
+			an_json_num(f, "swing_rad", phase_swing_pp(&r->j[j].win_swing), false);
 			fputc('}', f);
 		}
 		fputs("]}", f);
@@ -1046,9 +1068,14 @@ static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 		an_json_num(f, "amplitude_m", p->amp_lateral, true);
 		an_json_num(f, "dsep", p->dsep, true);
 		an_json_num(f, "compat_limit", phase_compat_limit(p->dsep), true);
-		fprintf(f, "\"return_map_points\":%zu}", p->ndeltas > 0 ? p->ndeltas - 1 : 0);
+		fprintf(f, "\"return_map_points\":%zu,", p->ndeltas > 0 ? p->ndeltas - 1 : 0);
+		an_json_num(f, "swing_a", p->swing_a, true);
+		an_json_num(f, "swing_b", p->swing_b, false);
+		fputc('}', f);
 	}
-	fputs("]}\n", f);
+	fputs("],", f);
+	an_json_num(f, "min_swing", c->o->min_swing, false);
+	fputs("}\n", f);
 }
 
 static int an_write_summary(struct an_ctx *c, int rc)
@@ -1137,9 +1164,12 @@ static int an_run_ctx(struct an_ctx *c)
 	an_each_event(c, an_process_event, false);
 	for (int k = 0; k < c->npairs; k++) {
 		struct an_pair *p = &c->pairs[k];
+		p->swing_a = phase_swing_pp(&c->robots[p->a].j[p->ja].win_swing);
+		p->swing_b = phase_swing_pp(&c->robots[p->b].j[p->jb].win_swing);
 		if (p->kind != AN_PAIR_JOINTS)
 			an_pair_separation(c, p);
-		p->cls = p->kind == AN_PAIR_JOINTS ? "-" : an_classify(p, c->truth_msgs > 0 || c->collisions > 0);
+		p->cls = p->kind == AN_PAIR_JOINTS ? "-"
+			: an_classify(p, c->truth_msgs > 0 || c->collisions > 0, o->min_swing);
 	}
 	if (an_close_outputs(c) != 0 || an_write_return_map(c) != 0 || an_write_summary(c, rc) != 0)
 		return AN_EXIT_OUTPUT;

@@ -38,7 +38,13 @@ struct an_options {
 	FILE *msg;             /* warnings and the summary go here (stderr/stdout) */
 	bool quiet;            /* do not print the summary to msg */
 	bool zero_crossings;   /* phase from our zero-crossing frequency, never the daemon's */
+	double min_swing;      /* rad p-p: a pair with a joint swinging less in the final
+				  window is "not-oscillating", whatever its phases say */
 };
+
+/* Default of min_swing (rad peak-to-peak): the robots swing about 1.6 rad
+ * p-p; a stopped AX-12 reads within a few 0.005 rad steps of one angle. */
+#define AN_MIN_SWING_DEFAULT 0.2
 
 void an_options_default(struct an_options *o);
 /* Runs the whole analysis; returns an enum an_exit. */

@@ -13,8 +13,9 @@ static void usage(FILE *f)
 {
 	fputs("usage: undulate-analyze LOG... [--out DIR] [--pairs a:b,...] [--plots]\n"
 	      "                        [--from S] [--to S] [--window S] [--separation D]\n"
-	      "                        [--restitution R] [--merge S] [--zero-crossings] [--quiet]\n"
-	      "       undulate-analyze --synth OUT.log [--duration S]\n"
+	      "                        [--restitution R] [--merge S] [--min-swing RAD] [--zero-crossings]\n"
+	      "                        [--quiet]\n"
+	      "       undulate-analyze --synth OUT.log [--duration S] [--synth-stop-after S]\n"
 	      "Reads lcm-logger logs and writes states.csv, collisions.csv, bus.csv, events.csv,\n"
 	      "phase_diff.csv, return_map.csv, collision_rate.csv, summary.txt, summary.json\n"
 	      "(and PNG plots with --plots) into DIR (default: current directory).\n"
@@ -24,8 +25,12 @@ static void usage(FILE *f)
 	      "  --separation D    normalized separation d~ for every pair (default: from SIM.TRUTH)\n"
 	      "  --restitution R   r for the theory curve (default 0.67)\n"
 	      "  --merge S         collisions of a pair less than S apart are one contact (default 0.1)\n"
+	      "  --min-swing RAD   a pair with a joint swinging less than RAD peak-to-peak in the final\n"
+	      "                    window is not-oscillating, whatever its phases (default 0.2)\n"
 	      "  --zero-crossings  phase from our own zero-crossing frequency, not the daemon's\n"
 	      "  --synth OUT.log   write a synthetic log with known phases and collisions\n"
+	      "  --duration S      length of the synthetic log (default 45)\n"
+	      "  --synth-stop-after S  in the synthetic log, r3 and r4 stand still from S seconds on\n"
 	      "exit: 0 ok, 1 usage, 2 bad/missing log, 3 truncated log (partial results),\n"
 	      "      4 plots failed, 5 output not writable\n",
 	      f);
@@ -44,7 +49,7 @@ static int parse_double(const char *opt, const char *s, double *out)
 }
 
 enum { OPT_OUT = 256, OPT_PAIRS, OPT_PLOTS, OPT_FROM, OPT_TO, OPT_WINDOW, OPT_SEP, OPT_REST,
-       OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_HELP };
+       OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_MIN_SWING, OPT_STOP_AFTER, OPT_HELP };
 
 static const struct option long_opts[] = {
 	{ "out", required_argument, NULL, OPT_OUT },       { "pairs", required_argument, NULL, OPT_PAIRS },
@@ -53,12 +58,20 @@ static const struct option long_opts[] = {
 	{ "separation", required_argument, NULL, OPT_SEP }, { "restitution", required_argument, NULL, OPT_REST },
 	{ "synth", required_argument, NULL, OPT_SYNTH },   { "duration", required_argument, NULL, OPT_DURATION },
 	{ "quiet", no_argument, NULL, OPT_QUIET },         { "zero-crossings", no_argument, NULL, OPT_ZC },
-	{ "merge", required_argument, NULL, OPT_MERGE },
-         { "help", no_argument, NULL, OPT_HELP },
+	{ "merge", required_argument, NULL, OPT_MERGE },   { "min-swing", required_argument, NULL, OPT_MIN_SWING },
+	{ "synth-stop-after", required_argument, NULL, OPT_STOP_AFTER },
+	{ "help", no_argument, NULL, OPT_HELP },
 	{ NULL, 0, NULL, 0 },
 };
 
-static int parse_option(int c, struct an_options *o, const char **synth, double *duration)
+/* What --synth takes besides the output path; 0 / NAN: not given. */
+struct synth_args {
+	const char *path;
+	double duration;
+	double stop_after;
+};
+
+static int parse_option(int c, struct an_options *o, struct synth_args *sa)
 {
 	switch (c) {
 	case OPT_OUT: o->out_dir = optarg; return 0;
@@ -72,8 +85,10 @@ static int parse_option(int c, struct an_options *o, const char **synth, double 
 	case OPT_WINDOW: return parse_double("--window", optarg, &o->window_s);
 	case OPT_SEP: return parse_double("--separation", optarg, &o->separation);
 	case OPT_REST: return parse_double("--restitution", optarg, &o->restitution);
-	case OPT_SYNTH: *synth = optarg; return 0;
-	case OPT_DURATION: return parse_double("--duration", optarg, duration);
+	case OPT_MIN_SWING: return parse_double("--min-swing", optarg, &o->min_swing);
+	case OPT_SYNTH: sa->path = optarg; return 0;
+	case OPT_DURATION: return parse_double("--duration", optarg, &sa->duration);
+	case OPT_STOP_AFTER: return parse_double("--synth-stop-after", optarg, &sa->stop_after);
 	case OPT_HELP: usage(stdout); exit(AN_EXIT_OK);
 	default: return -1;
 	}
@@ -93,6 +108,10 @@ static int check_options(const struct an_options *o)
 		fputs("undulate-analyze: --merge must be >= 0\n", stderr);
 		return -1;
 	}
+	if (!(o->min_swing >= 0)) {
+		fputs("undulate-analyze: --min-swing must be >= 0\n", stderr);
+		return -1;
+	}
 	if (isfinite(o->separation) && o->separation < 0) {
 		fputs("undulate-analyze: --separation must be >= 0\n", stderr);
 		return -1;
@@ -106,46 +125,64 @@ static int check_options(const struct an_options *o)
 
 #define AN_SYNTH_MAX_S 3600.0   /* longest synthetic log, s */
 
-static int run_synth(const char *path, double duration)
+static int run_synth(const struct synth_args *sa)
 {
 	struct synth_spec s;
 	synth_default(&s);
-	if (duration > 0)
-		s.duration_s = duration;
-	int n = synth_write(&s, path);
+	if (sa->duration > 0)
+		s.duration_s = sa->duration;
+	if (!isnan(sa->stop_after))
+		s.stop_after_s = sa->stop_after;
+	int n = synth_write(&s, sa->path);
 	if (n < 0) {
-		fprintf(stderr, "undulate-analyze: cannot write %s\n", path);
+		fprintf(stderr, "undulate-analyze: cannot write %s\n", sa->path);
 		return AN_EXIT_OUTPUT;
 	}
-	printf("%s: %.1f s, %d robots, %d collisions\n", path, s.duration_s, SYNTH_ROBOTS, n);
+	printf("%s: %.1f s, %d robots, %d collisions", sa->path, s.duration_s, SYNTH_ROBOTS, n);
+	if (s.stop_after_s >= 0)
+		printf(", r3 and r4 still from %.1f s", s.stop_after_s);
+	putchar('\n');
 	return AN_EXIT_OK;
+}
+
+/* The --synth options; returns 0 or -1 after saying what is wrong. */
+static int check_synth(const struct synth_args *sa)
+{
+	/* 0: not given (the synthetic default); a log of hours would only fill a disk */
+	if (!(sa->duration >= 0 && sa->duration <= AN_SYNTH_MAX_S)) {
+		fprintf(stderr, "undulate-analyze: --duration: %g is not 0 < S <= %.0f seconds\n", sa->duration,
+		        AN_SYNTH_MAX_S);
+		return -1;
+	}
+	if (!isnan(sa->stop_after) && !(sa->stop_after >= 0)) {
+		fprintf(stderr, "undulate-analyze: --synth-stop-after: %g is not >= 0 seconds\n", sa->stop_after);
+		return -1;
+	}
+	return 0;
 }
 
 int main(int argc, char **argv)
 {
 	struct an_options o;
 	an_options_default(&o);
-	const char *synth = NULL;
-	double duration = 0;
+	struct synth_args sa = { .path = NULL, .duration = 0, .stop_after = NAN };
 	int c;
 	while ((c = getopt_long(argc, argv, "ho:", long_opts, NULL)) != -1) {
 		if (c == 'h')
 			c = OPT_HELP;
 		if (c == 'o')
 			c = OPT_OUT;
-		if (parse_option(c, &o, &synth, &duration) != 0) {
+		if (parse_option(c, &o, &sa) != 0) {
 			usage(stderr);
 			return AN_EXIT_USAGE;
 		}
 	}
-	/* 0: not given (the synthetic default); a log of hours would only fill a disk */
-	if (synth && !(duration >= 0 && duration <= AN_SYNTH_MAX_S)) {
-		fprintf(stderr, "undulate-analyze: --duration: %g is not 0 < S <= %.0f seconds\n", duration,
-		        AN_SYNTH_MAX_S);
+	if (sa.path)
+		return check_synth(&sa) != 0 ? AN_EXIT_USAGE : run_synth(&sa);
+	if (!isnan(sa.stop_after)) {
+		fputs("undulate-analyze: --synth-stop-after only goes with --synth\n", stderr);
 		return AN_EXIT_USAGE;
 	}
-	if (synth)
-		return run_synth(synth, duration);
 	for (; optind < argc; optind++) {
 		if (o.nlogs >= AN_MAX_LOGS) {
 			fprintf(stderr, "undulate-analyze: at most %d logs\n", AN_MAX_LOGS);

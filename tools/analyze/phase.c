@@ -51,6 +51,27 @@ void phase_tracker_feed(struct phase_tracker *tr, double t, double angle)
 	tr->prev_x = angle;
 }
 
+void phase_swing_init(struct phase_swing *s)
+{
+	*s = (struct phase_swing){ .lo = 0.0, .hi = 0.0, .n = 0 };
+}
+
+void phase_swing_add(struct phase_swing *s, double angle)
+{
+	if (!isfinite(angle))
+		return;
+	if (s->n == 0 || angle < s->lo)
+		s->lo = angle;
+	if (s->n == 0 || angle > s->hi)
+		s->hi = angle;
+	s->n++;
+}
+
+double phase_swing_pp(const struct phase_swing *s)
+{
+	return s->n > 0 ? s->hi - s->lo : NAN;
+}
+
 static int cmp_double(const void *a, const void *b)
 {
 	double x = *(const double *)a, y = *(const double *)b;

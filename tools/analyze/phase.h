@@ -38,6 +38,19 @@ void phase_tracker_feed(struct phase_tracker *tr, double t, double angle);
 /* Angular frequency (rad/s) from the median measured period; 0 if none yet. */
 double phase_tracker_omega(const struct phase_tracker *tr);
 
+/* Peak-to-peak of a joint's measured angle over a span of samples (the final
+ * window): a joint that does not swing has no phase worth comparing. */
+struct phase_swing {
+	double lo, hi;   /* rad, extremes seen */
+	int64_t n;       /* finite samples seen */
+};
+
+void phase_swing_init(struct phase_swing *s);
+/* Adds one angle (rad); a non-finite angle is not a measurement and is ignored. */
+void phase_swing_add(struct phase_swing *s, double angle);
+/* hi - lo (rad); NAN before the first finite sample. */
+double phase_swing_pp(const struct phase_swing *s);
+
 /* atan2(-speed/omega, angle): phase read clockwise in the (x, x') plane, in
  * (-pi, pi]. NAN if omega <= 0. */
 double phase_from_state(double angle, double speed, double omega);

@@ -36,6 +36,7 @@ void synth_default(struct synth_spec *s)
 		.duration_s = 45.0, .dt_s = 0.01, .freq_hz = 0.8, .amplitude = 0.8, .lever = 0.1,
 		.restitution = 0.67, .delta0 = 2.0, .coll_period_s = 4.0, .ncoll = 8,
 		.start_utime = 1700000000000000LL, .truth = true, .report_frequency = true, .burst = 1,
+		.stop_after_s = -1.0, .stop_mask = SYNTH_STOP_DEFAULT_MASK,
 	};
 }
 
@@ -54,12 +55,29 @@ double synth_impulse(int k)
 	return 0.001 * (double)(k % 7 + 1);
 }
 
-static void synth_phases(const struct synth_spec *s, double t, double phi[SYNTH_ROBOTS])
+/* Robot I stands still at time T. */
+static bool synth_stopped(const struct synth_spec *s, int i, double t)
+{
+	return s->stop_after_s >= 0 && t > s->stop_after_s && (s->stop_mask >> i & 1u);
+}
+
+static void synth_phases_at(const struct synth_spec *s, double t, double phi[SYNTH_ROBOTS])
 {
 	phi[0] = 2.0 * M_PI * s->freq_hz * t;
 	phi[1] = phi[0] + SYNTH_COMPAT_DELTA;
 	phi[2] = phi[1] + M_PI;
 	phi[3] = phi[2] + synth_delta34(s, t);
+}
+
+/* Phases at T; a stopped robot keeps the phase it had when it stopped. */
+static void synth_phases(const struct synth_spec *s, double t, double phi[SYNTH_ROBOTS])
+{
+	synth_phases_at(s, t, phi);
+	double held[SYNTH_ROBOTS];
+	synth_phases_at(s, s->stop_after_s, held);
+	for (int i = 0; i < SYNTH_ROBOTS; i++)
+		if (synth_stopped(s, i, t))
+			phi[i] = held[i];
 }
 
 static double synth_neutral(const struct synth_spec *s, int i)
@@ -71,9 +89,10 @@ static double synth_neutral(const struct synth_spec *s, int i)
 }
 
 static int synth_state(const struct synth_spec *s, struct alog_writer *w, int i, int64_t cycle,
-		       int64_t utime, double phi)
+		       int64_t utime, double phi, bool stopped)
 {
-	double omega = 2.0 * M_PI * s->freq_hz;
+	/* a stopped joint has speed 0 and its goal where it stands */
+	double omega = stopped ? 0.0 : 2.0 * M_PI * s->freq_hz;
 	undulate_joint_state_t j[2];
 	memset(j, 0, sizeof(j));
 	for (int k = 0; k < 2; k++) {
@@ -112,7 +131,7 @@ static int synth_collisions(const struct synth_spec *s, double t, int64_t utime,
 	int n = 0;
 	double per = 1.0 / s->freq_hz;
 	double tq = t - 0.25 * per;
-	if (tq >= 0 && fmod(tq, per) < s->dt_s - 1e-9) {
+	if (tq >= 0 && fmod(tq, per) < s->dt_s - 1e-9 && !synth_stopped(s, 1, t) && !synth_stopped(s, 2, t)) {
 		out[n] = (undulate_sim_collision_t){ .utime = utime, .left = 1, .right = 2, .pre_left = 0.2,
 			.pre_right = -0.2, .post_left = -0.134, .post_right = 0.134, .impulse = synth_impulse(*count) };
 		snprintf(names[n][0], 8, "r2");
@@ -121,7 +140,8 @@ static int synth_collisions(const struct synth_spec *s, double t, int64_t utime,
 		n++;
 	}
 	int k = (int)floor(t / s->coll_period_s + 1e-9);
-	if (k >= 1 && k <= s->ncoll && t - k * s->coll_period_s < s->dt_s - 1e-9) {
+	if (k >= 1 && k <= s->ncoll && t - k * s->coll_period_s < s->dt_s - 1e-9 && !synth_stopped(s, 2, t) &&
+	    !synth_stopped(s, 3, t)) {
 		out[n] = (undulate_sim_collision_t){ .utime = utime, .left = 2, .right = 3, .pre_left = 0.1,
 			.pre_right = -0.1, .post_left = -0.067, .post_right = 0.067, .impulse = synth_impulse(*count) };
 		snprintf(names[n][0], 8, "r3");
@@ -145,8 +165,9 @@ static int synth_truth(const struct synth_spec *s, struct alog_writer *w, int64_
 	for (int i = 0; i < SYNTH_ROBOTS; i++) {
 		snprintf(bnames[i], sizeof(bnames[i]), "%s", synth_names[i]);
 		double angle = s->amplitude * cos(phi[i]);
+		double speed = synth_stopped(s, i, t) ? 0.0 : -s->amplitude * omega * sin(phi[i]);
 		bodies[i] = (undulate_sim_body_t){ .robot = bnames[i], .servo_id = (int16_t)(2 * i + 1),
-			.angle = angle, .speed = -s->amplitude * omega * sin(phi[i]),
+			.angle = angle, .speed = speed,
 			.neutral = synth_neutral(s, i), .lateral = synth_neutral(s, i) + s->lever * angle,
 			.load = 0.1, .temperature = 35.0 };
 	}
@@ -230,7 +251,7 @@ int synth_write(const struct synth_spec *s, const char *path)
 		double phi[SYNTH_ROBOTS];
 		synth_phases(s, t, phi);
 		for (int i = 0; i < SYNTH_ROBOTS && rc == 0; i++) {
-			rc = synth_state(s, &w, i, cyc, utime, phi[i]);
+			rc = synth_state(s, &w, i, cyc, utime, phi[i], synth_stopped(s, i, t));
 			if (rc == 0 && cyc % per_second == 0)
 				rc = synth_bus_and_event(&w, i, utime, cyc / per_second);
 		}

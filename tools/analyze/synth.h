@@ -10,6 +10,10 @@
  *          collisions (every coll_period_s) the d~ = 0 return map
  *          delta_n = 2 atan((-r)^n tan(delta0/2)); no contact afterwards.
  *          Only r4's phase jumps, as if r3 were much heavier.
+ * With stop_after_s >= 0 the robots in stop_mask (default r3 and r4) stand
+ * still from that time on: angle held at its value then, speed 0, the daemon's
+ * frequency still reported (as a daemon whose joints stalled would), and no
+ * collision involving them. r2:r3 then has one stopped robot, r3:r4 two.
  * SIM.TRUTH at every cycle carries the bodies and the collisions, which are
  * also sent on SIM.COLLISION (the analyser must count each once); the
  * copies in SIM.TRUTH carry the truth message's time, as the simulator's do. */
@@ -38,7 +42,12 @@ struct synth_spec {
 	bool truth;            /* publish SIM.TRUTH / SIM.COLLISION */
 	bool report_frequency; /* fill joint_state_t.frequency (else 0: unknown) */
 	int burst;             /* each r3:r4 contact reported as this many collisions, 1 ms apart */
+	double stop_after_s;   /* robots in stop_mask stand still from here on; < 0: never */
+	unsigned stop_mask;    /* bit i: robot i (r1 = bit 0) */
 };
+
+/* Robots that stop by default: r3 and r4. */
+#define SYNTH_STOP_DEFAULT_MASK 0xCu
 
 void synth_default(struct synth_spec *s);
 /* r3:r4 phase difference in force at time T (s from the start). */
