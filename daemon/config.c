@@ -217,6 +217,11 @@ void cfg_defaults(struct cfg *c)
 	 * the dead band (CONTROL.md). The lead then follows the margin. */
 	c->compliance_margin = 0;
 	c->servo_lead_s = NAN;
+	c->actuation = CFG_ACT_POSITION;
+	c->torque_drive = CFG_DRIVE_PWM;
+	/* The AX-12A's datasheet line at 12 V. */
+	c->stall_torque = 1.5;
+	c->no_load_speed = 59.0 * 2.0 * 3.14159265358979323846 / 60.0;
 	/* Replies on a loaded 2-core machine (simulator, tests) come up to ~3 ms
 	 * late; a real adapter with return delay 0 needs far less. */
 	c->bus_margin_us = 3000;
@@ -246,7 +251,7 @@ void cfg_defaults(struct cfg *c)
 }
 
 /* ---- [robot] keys --------------------------------------------------------------------- */
-enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL };
+enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL, T_ACT, T_DRIVE };
 struct cfg_key {
 	const char *key;
 	enum cfg_type type;
@@ -276,6 +281,10 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("period_ms", T_DOUBLE, period_ms, 2, 100),
 	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, 0.2),
 	K("compliance_margin", T_LONG, compliance_margin, -1, 255),
+	K("actuation", T_ACT, actuation, 0, 0),
+	K("torque_drive", T_DRIVE, torque_drive, 0, 0),
+	K("stall_torque", T_DOUBLE, stall_torque, 0.01, 100),
+	K("no_load_speed", T_DOUBLE, no_load_speed, 0.01, 1000),
 	K("bus_margin_us", T_LONG, bus_margin_us, 0, 100000),
 	K("ramp_s", T_DOUBLE, ramp_s, 0, 10),
 	K("backoff_torque", T_DOUBLE, backoff_torque, 0, 1),
@@ -376,6 +385,26 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			c->velocity_source = CFG_VEL_FILTERED;
 		else {
 			cfg_error(e, "%s: [robot] velocity_source: '%s' is not servo or filtered", where, value);
+			return false;
+		}
+		return true;
+	case T_ACT:
+		if (strcasecmp(value, "position") == 0)
+			c->actuation = CFG_ACT_POSITION;
+		else if (strcasecmp(value, "torque") == 0)
+			c->actuation = CFG_ACT_TORQUE;
+		else {
+			cfg_error(e, "%s: [robot] actuation: '%s' is not position or torque", where, value);
+			return false;
+		}
+		return true;
+	case T_DRIVE:
+		if (strcasecmp(value, "pwm") == 0)
+			c->torque_drive = CFG_DRIVE_PWM;
+		else if (strcasecmp(value, "current") == 0)
+			c->torque_drive = CFG_DRIVE_CURRENT;
+		else {
+			cfg_error(e, "%s: [robot] torque_drive: '%s' is not pwm or current", where, value);
 			return false;
 		}
 		return true;
@@ -579,7 +608,10 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 	for (size_t j = 0; j < c->njoints; j++) {
 		struct cfg_joint *jt = &c->joint[j];
 		struct osc_joint_params d;
-		osc_default_params(&d, j, c->njoints);
+		if (c->actuation == CFG_ACT_TORQUE)
+			osc_default_torque_params(&d, j, c->njoints);
+		else
+			osc_default_params(&d, j, c->njoints);
 		if (isnan(jt->osc.k)) jt->osc.k = d.k;
 		if (isnan(jt->osc.c)) jt->osc.c = d.c;
 		if (isnan(jt->osc.mu)) jt->osc.mu = d.mu;
@@ -644,13 +676,17 @@ void cfg_print(const struct cfg *c, void *file)
 		fprintf(f, "%s%u", j ? "," : "", c->ids[j]);
 	fprintf(f, "\nmode = %s\nlcm_url = %s\npriority = %d\nmlockall = %s\nsafe_stop = %s\n"
 	        "fault_action = %s\nvelocity_source = %s\nvelocity_cutoff_hz = %g\ncommands = %s\n"
-	        "echo = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\nbus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
+	        "echo = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\n"
+	        "actuation = %s\ntorque_drive = %s\nstall_torque = %g\nno_load_speed = %g\n"
+	        "bus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
 	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\n",
 	        cfg_mode_name(c->mode), c->lcm_url, c->priority, c->mlockall ? "on" : "off",
 	        safe[c->safe_stop], safe[c->fault_action],
 	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
 	        c->commands ? "on" : "off", c->echo ? "on" : "off", c->adapter_latency_us, c->period_ms,
-	        c->servo_lead_s, c->compliance_margin, c->bus_margin_us,
+	        c->servo_lead_s, c->compliance_margin, c->actuation == CFG_ACT_TORQUE ? "torque" : "position",
+	        c->torque_drive == CFG_DRIVE_CURRENT ? "current" : "pwm", c->stall_torque, c->no_load_speed,
+	        c->bus_margin_us,
 	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit);
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];

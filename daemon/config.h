@@ -24,6 +24,13 @@ enum cfg_mode { CFG_MODE_LIMP = 0, CFG_MODE_HOLD = 1, CFG_MODE_SINUSOID = 2, CFG
 #define CFG_NMODES 4
 enum cfg_safe { CFG_SAFE_HOLD, CFG_SAFE_LIMP };
 enum cfg_velocity { CFG_VEL_SERVO, CFG_VEL_FILTERED };
+/* How OSCILLATOR drives a joint: position goals integrated from the measured
+ * state (the paper's robots), or the law's torque itself through the servo's
+ * wheel mode (the paper's torque-controlled pair rig; CONTROL.md). */
+enum cfg_actuation { CFG_ACT_POSITION, CFG_ACT_TORQUE };
+/* What the wheel-mode register drives: the AX-12's PWM duty (the controller
+ * adds the back-EMF it loses) or a current-controlled drive's torque. */
+enum cfg_drive { CFG_DRIVE_PWM, CFG_DRIVE_CURRENT };
 
 struct cfg_joint {
 	struct osc_joint_params osc;
@@ -56,6 +63,10 @@ struct cfg {
 	double servo_lead_s;           /* oscillator horizon beyond the period (CONTROL.md);
 	                                  NaN until cfg_finish(): then chosen by compliance_margin */
 	long compliance_margin;        /* written to both margins at start-up; -1: leave the servo's */
+	enum cfg_actuation actuation;  /* OSCILLATOR through goals or through torque (wheel mode) */
+	enum cfg_drive torque_drive;   /* torque actuation: pwm (AX-12) or current */
+	double stall_torque;           /* N·m at 12 V and full output (AX-12A: 1.5) */
+	double no_load_speed;          /* rad/s at 12 V and full output (AX-12A: 59 rpm = 6.18) */
 	long bus_margin_us;            /* slack added to every bus timeout */
 	double ramp_s;                 /* blend time for start-up and mode switches */
 	double backoff_torque;         /* torque limit (fraction of max) while a joint backs off */

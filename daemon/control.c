@@ -28,6 +28,14 @@
  * held while the mode's target moved on). */
 #define CTL_RESUME_STALE 3
 #define CTL_STALL_CYCLES 100
+/* Torque actuation: a virtual spring pushes a joint back from CTL_WALL_MARGIN
+ * inside either limit, reaching the stall torque at the limit itself, with
+ * CTL_WALL_DAMPING against moving outwards; past the limit the robot falls
+ * back to fault_action in joint mode, where the servo enforces its limits. */
+#define CTL_WALL_MARGIN 0.15
+#define CTL_WALL_DAMPING 0.1
+/* Supply assumed for the PWM drive until the servo's voltage is read (V). */
+#define CTL_NOMINAL_VOLTAGE 12.0
 
 static void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
@@ -44,7 +52,7 @@ static void ctl_event(struct ctl *c, int level, const char *kind, const char *fm
 	va_end(ap);
 }
 
-static void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint16_t value)
+static void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
 {
 	/* A later write to the same register in the same cycle replaces the earlier. */
 	for (size_t i = 0; i < c->nwrites; i++) {
@@ -53,6 +61,14 @@ static void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint
 			return;
 		}
 	}
+	if (c->nwrites < CTL_MAX_WRITES)
+		c->writes[c->nwrites++] = (struct ctl_write){ .id = id, .addr = addr, .len = len, .value = value };
+}
+
+/* Appended as they are, in order: a sequence that writes one register twice
+ * (torque off, EEPROM write, torque on) must not be merged. */
+static void ctl_write_seq(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
+{
 	if (c->nwrites < CTL_MAX_WRITES)
 		c->writes[c->nwrites++] = (struct ctl_write){ .id = id, .addr = addr, .len = len, .value = value };
 }
@@ -93,6 +109,8 @@ void ctl_init(struct ctl *c, struct cfg *cfg)
 		jt->speed = 0.0;
 		jt->voltage = NAN;
 		jt->temperature = NAN;
+		jt->duty = NAN;
+		jt->torque_cmd = NAN;
 		jt->servo.max_torque = 1023;
 		osc_velocity_filter_init(&jt->vfilter, cfg->velocity_cutoff_hz);
 		osc_estimator_init(&jt->estimator);
@@ -120,6 +138,11 @@ bool ctl_set_servo(struct ctl *c, size_t j, const struct ctl_servo_info *info, c
 		return false;
 	}
 	return true;
+}
+
+uint32_t ctl_joint_mode_limits(const struct ctl *c, size_t j)
+{
+	return (uint32_t)c->j[j].servo.cw_limit | (uint32_t)c->j[j].servo.ccw_limit << 16;
 }
 
 /* Limits follow parameter changes (limit_min/max, neutral, max_step). */
@@ -187,6 +210,8 @@ static double ctl_present_or_goal(const struct ctl_joint *jt)
 void ctl_start(struct ctl *c, double t, const char *reason)
 {
 	c->t = t;
+	/* the daemon's start-up checks leave every servo in joint mode */
+	c->wheel = false;
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
 		jt->fault = CTL_FAULT_NONE;
@@ -273,6 +298,9 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 	              (mode == CFG_MODE_SINUSOID || mode == CFG_MODE_OSCILLATOR);
 	c->mode = mode;
 	c->starter_active = false;
+	/* into a torque-actuated OSCILLATOR: the law takes the moving state as it is */
+	if (mode == CFG_MODE_OSCILLATOR && c->cfg->actuation == CFG_ACT_TORQUE)
+		moving = false;
 	c->fade_mode = moving ? (int)commanding : CFG_NMODES;
 	c->fade_t0 = c->t;
 	ctl_blend_stop(c);
@@ -470,6 +498,14 @@ static void ctl_targets(struct ctl *c, enum cfg_mode mode, double dt, double t_r
 		return;
 	case CFG_MODE_OSCILLATOR:
 	case CFG_MODE_SINUSOID:
+		if (mode == CFG_MODE_OSCILLATOR && !c->starter_active && c->cfg->actuation == CFG_ACT_TORQUE) {
+			/* torque actuation drives through duties (ctl_duties); as a
+			 * position it stands for where the joint is (the cycles that
+			 * switch servo modes, fades out of it) */
+			for (size_t j = 0; j < c->n; j++)
+				target[j] = c->j[j].angle;
+			return;
+		}
 		if (mode == CFG_MODE_OSCILLATOR && !c->starter_active) {
 			ctl_targets_oscillator(c, dt, target);
 			return;
@@ -573,6 +609,166 @@ static void ctl_update_estimates(struct ctl *c, size_t j)
 	jt->phase = osc_phase(x, jt->speed, omega);
 }
 
+/* ---- torque actuation (wheel mode) ------------------------------------------------------------ */
+/* The servos go into wheel mode only for a running OSCILLATOR whose joints are
+ * all healthy, torqued and measured; everything else (starter, HOLD, SINUSOID,
+ * faults, LIMP) runs in joint mode, where the servo itself holds positions and
+ * enforces its angle limits. */
+static bool ctl_want_wheel(const struct ctl *c)
+{
+	if (c->cfg->actuation != CFG_ACT_TORQUE || c->mode != CFG_MODE_OSCILLATOR || c->starter_active)
+		return false;
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
+		if (jt->fault != CTL_FAULT_NONE || !jt->torque || !jt->have_reading || jt->limits.max_step <= 0.0)
+			return false;
+	}
+	return true;
+}
+
+/* A joint past its limits under torque: fall back to fault_action (joint
+ * mode), holding inside the limits. */
+static void ctl_check_limits(struct ctl *c)
+{
+	if (!c->wheel)
+		return;
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
+		if (!jt->fresh || (jt->angle >= jt->limits.lo && jt->angle <= jt->limits.hi))
+			continue;
+		c->limit_trips++;
+		enum cfg_mode m = c->cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD;
+		double neutral = c->cfg->joint[j].neutral;
+		ctl_event(c, 2, "limit", "servo %u at %+.3f rad left its limits [%+.3f, %+.3f] under torque "
+		          "actuation: robot %s in joint mode; send a mode command to go on", jt->id,
+		          jt->angle - neutral, jt->limits.lo - neutral, jt->limits.hi - neutral, cfg_mode_name(m));
+		char reason[96];
+		snprintf(reason, sizeof reason, "limit: servo %u left its limits", jt->id);
+		ctl_set_mode(c, m, reason);
+		/* HOLD where it is: the safety clamp puts the goal inside the limits */
+		ctl_hold_at_present(c);
+		return;
+	}
+}
+
+/* The virtual spring near a limit (N·m), on top of the law's torque. */
+static double ctl_wall(const struct ctl_joint *jt, double stall)
+{
+	double k = stall / CTL_WALL_MARGIN;
+	double over_hi = jt->angle - (jt->limits.hi - CTL_WALL_MARGIN);
+	double over_lo = (jt->limits.lo + CTL_WALL_MARGIN) - jt->angle;
+	if (over_hi > 0.0)
+		return -k * over_hi - CTL_WALL_DAMPING * fmax(jt->speed, 0.0);
+	if (over_lo > 0.0)
+		return k * over_lo - CTL_WALL_DAMPING * fmin(jt->speed, 0.0);
+	return 0.0;
+}
+
+/* Output ratio that makes the drive deliver `tau` at speed v: a PWM drive
+ * loses tau_stall(V)/w0(V) per rad/s to back-EMF (voltage-independent), so
+ * that is added back; a current drive delivers duty × stall torque. Capped by
+ * the servo's max torque, as the torque limit caps it in the servo. */
+static double ctl_duty(const struct ctl *c, const struct ctl_joint *jt, double tau)
+{
+	const struct cfg *cfg = c->cfg;
+	double cap = jt->servo.max_torque / 1023.0;
+	double u;
+	if (cfg->torque_drive == CFG_DRIVE_CURRENT) {
+		u = tau / cfg->stall_torque;
+	} else {
+		double volts = isfinite(jt->voltage) && jt->voltage > 1.0 ? jt->voltage : CTL_NOMINAL_VOLTAGE;
+		double stall = cfg->stall_torque * volts / CTL_NOMINAL_VOLTAGE;
+		double w0 = cfg->no_load_speed * volts / CTL_NOMINAL_VOLTAGE;
+		u = tau / stall + jt->speed / w0;
+	}
+	return isfinite(u) ? fmax(-cap, fmin(cap, u)) : 0.0;
+}
+
+static void ctl_duties(struct ctl *c)
+{
+	double x[CFG_MAX_JOINTS], v[CFG_MAX_JOINTS], tau[CFG_MAX_JOINTS];
+	struct osc_joint_params p[CFG_MAX_JOINTS];
+	for (size_t j = 0; j < c->n; j++) {
+		p[j] = c->cfg->joint[j].osc;
+		x[j] = c->j[j].angle - c->cfg->joint[j].neutral;
+		v[j] = c->j[j].fresh ? c->j[j].speed : 0.0;
+	}
+	if (!osc_torque(p, c->n, x, v, tau))
+		c->nonfinite++;
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		jt->write_goal = false;
+		jt->clamp_flags = 0;
+		jt->goal = NAN;
+		if (!jt->fresh) {
+			/* no reading, no law: the joint coasts until it answers again */
+			jt->torque_cmd = 0.0;
+			jt->duty = 0.0;
+			continue;
+		}
+		double wall = ctl_wall(jt, c->cfg->stall_torque);
+		if (wall != 0.0) {
+			jt->clamp_flags = SAFETY_LIMIT;
+			c->clamps++;
+		}
+		jt->torque_cmd = tau[j] + wall;
+		jt->duty = ctl_duty(c, jt, jt->torque_cmd);
+	}
+}
+
+/* Wheel-mode switches, queued after this cycle's SYNC_WRITE. The angle
+ * limits are EEPROM, which the AX-12A writes only with torque off: torque off,
+ * both limits in one 4-byte write (the servo never sees a half-set pair),
+ * torque on again. The joint coasts for the ~1 ms this takes on the bus (a
+ * real servo is then busy ~6 ms per EEPROM byte: its next replies may be
+ * missed, which the loop takes as stale cycles). */
+static void ctl_switch_limits(struct ctl *c, size_t j, uint32_t limits, bool torque_after)
+{
+	uint8_t id = c->j[j].id;
+	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 0);
+	ctl_write_seq(c, id, DXL_AX_CW_ANGLE_LIMIT, 4, limits);
+	if (torque_after)
+		ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
+}
+
+static void ctl_enter_wheel(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++)
+		ctl_switch_limits(c, j, 0, true);
+	c->wheel = true;
+	ctl_event(c, 0, "actuation", "torque actuation: servos in wheel mode, the law drives their torque");
+}
+
+static void ctl_leave_wheel(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		ctl_switch_limits(c, j, ctl_joint_mode_limits(c, j), jt->torque && c->mode != CFG_MODE_LIMP);
+		/* position modes start where the joint is, with no step bound from a
+		 * goal it never had */
+		jt->goal = NAN;
+		ctl_blend_joint(c, j, jt->angle);
+	}
+	c->wheel = false;
+	c->sync = CTL_SYNC_GOAL_STOP;
+	ctl_event(c, 0, "actuation", "torque actuation: servos back in joint mode (%s)", cfg_mode_name(c->mode));
+}
+
+/* Leaving wheel mode, the SYNC_WRITE stops every drive and leaves a goal the
+ * joint mode can hold: joints without a goal this cycle hold where they are. */
+static void ctl_stop_goals(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		jt->duty = NAN;
+		jt->torque_cmd = NAN;
+		if (jt->write_goal || !jt->have_reading || jt->limits.max_step <= 0.0)
+			continue;
+		jt->goal = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
+		jt->write_goal = true;
+	}
+}
+
 void ctl_step(struct ctl *c, double t, double dt, double t_real)
 {
 	c->t = t;
@@ -595,11 +791,26 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 	if (c->starter_active && c->t >= c->starter_until) {
 		/* the starter hands over to the oscillator: cross-fade, no step */
 		c->starter_active = false;
-		if (c->mode == CFG_MODE_OSCILLATOR) {
+		/* under torque actuation the law takes the moving state as it is */
+		if (c->mode == CFG_MODE_OSCILLATOR && c->cfg->actuation != CFG_ACT_TORQUE) {
 			c->fade_mode = CFG_MODE_SINUSOID;
 			c->fade_t0 = c->t;
 		}
 	}
+	ctl_check_limits(c);
+	c->sync = CTL_SYNC_GOAL;
+	bool want = ctl_want_wheel(c);
+	if (want && c->wheel) {
+		c->sync = CTL_SYNC_DUTY;
+		ctl_duties(c);
+		for (size_t j = 0; j < c->n; j++) {
+			ctl_update_estimates(c, j);
+			c->j[j].fresh = false;
+		}
+		return;
+	}
+	if (!want && c->wheel)
+		ctl_leave_wheel(c);
 	double target[CFG_MAX_JOINTS];
 	ctl_targets(c, c->mode, dt, t_real, target);
 	ctl_crossfade(c, dt, t_real, target);
@@ -610,6 +821,16 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 		else if (w >= 1.0)
 			c->blend_from[j] = NAN;
 		ctl_finish_joint(c, j, target[j]);
+		c->j[j].duty = NAN;
+		c->j[j].torque_cmd = NAN;
+	}
+	if (c->sync == CTL_SYNC_GOAL_STOP)
+		ctl_stop_goals(c);
+	/* into wheel mode after this cycle's goals: the joint is held where it
+	 * is for the half millisecond until the limits are written */
+	if (want)
+		ctl_enter_wheel(c);
+	for (size_t j = 0; j < c->n; j++) {
 		ctl_update_estimates(c, j);
 		c->j[j].fresh = false;
 	}

@@ -21,19 +21,27 @@
 #include "safety.h"
 
 /* Register writes the controller may queue in one cycle: per joint at most a
- * torque limit and a torque enable, plus slack. */
-#define CTL_MAX_WRITES (2 * CFG_MAX_JOINTS + 4)
+ * torque limit, a torque enable and the angle limits, plus slack. */
+#define CTL_MAX_WRITES (3 * CFG_MAX_JOINTS + 4)
 /* Events (faults, recoveries, mode changes) queued per cycle for LCM. */
 #define CTL_MAX_EVENTS 8
 #define CTL_EVENT_TEXT 160
 
 enum ctl_fault { CTL_FAULT_NONE, CTL_FAULT_BACKOFF, CTL_FAULT_CHECK, CTL_FAULT_FAILED };
 
+/* What this cycle's SYNC_WRITE carries. */
+enum ctl_sync {
+	CTL_SYNC_GOAL,       /* goal position (30) of the joints with write_goal */
+	CTL_SYNC_DUTY,       /* torque actuation, wheel mode: moving speed (32) = duty of every joint */
+	CTL_SYNC_GOAL_STOP,  /* leaving wheel mode: goal (30) and moving speed 0 (32) of every joint
+	                        with a reading; the angle-limit writes that follow restore joint mode */
+};
+
 struct ctl_write {
 	uint8_t id;
 	uint8_t addr;
-	uint8_t len;         /* 1 or 2 */
-	uint16_t value;
+	uint8_t len;         /* 1, 2 or 4 (little-endian, as the registers) */
+	uint32_t value;
 };
 
 struct ctl_event {
@@ -71,6 +79,8 @@ struct ctl_joint {
 	/* command */
 	double goal;                /* rad absolute, last sent (NaN: none yet) */
 	bool write_goal;            /* include in this cycle's SYNC_WRITE */
+	double duty;                /* torque actuation: signed output ratio sent this cycle (NaN: none) */
+	double torque_cmd;          /* N·m the duty stands for (NaN: none) */
 	bool torque;                /* torque enabled as far as we know */
 	unsigned clamp_flags;       /* SAFETY_* of this cycle */
 	/* faults */
@@ -102,10 +112,15 @@ struct ctl {
 	struct ctl_event events[CTL_MAX_EVENTS];
 	size_t nevents;
 	int rest_cycles;                /* cycles a running oscillator has been still */
+	/* torque actuation: the servos are in wheel mode (as far as our writes
+	 * went), and what this cycle's SYNC_WRITE carries */
+	bool wheel;
+	enum ctl_sync sync;
 	bool starter_active;            /* OSCILLATOR runs the sinusoid starter ... */
 	double starter_until;           /* ... until then */
 	/* counters */
 	long long faults, clamps, nonfinite, starts;
+	long long limit_trips;          /* torque actuation: a joint left its limits */
 };
 
 void ctl_init(struct ctl *c, struct cfg *cfg);
@@ -113,6 +128,10 @@ void ctl_init(struct ctl *c, struct cfg *cfg);
  * settings. False (with *why) if the configured limits and the servo's have
  * no angle in common or the servo is in wheel mode. */
 bool ctl_set_servo(struct ctl *c, size_t joint, const struct ctl_servo_info *info, char *why, size_t cap);
+/* The servo angle limits that put a joint back in joint mode after wheel mode
+ * (torque actuation): the servo's own, or the configured joint limits if the
+ * servo was found in wheel mode. Packed as the 4 bytes at register 6. */
+uint32_t ctl_joint_mode_limits(const struct ctl *c, size_t joint);
 /* Called once the bus is (re)connected and every joint has a reading: enable
  * torque (unless LIMP) and ramp in from the present positions. */
 void ctl_start(struct ctl *c, double t, const char *reason);

@@ -175,6 +175,7 @@ static void dmn_publish_state(struct dmn *d)
 		s->speed = jt->speed;
 		s->load = jt->load;
 		s->goal = jt->goal - neutral;
+		s->drive = jt->duty;
 		s->phase = jt->phase;
 		s->amplitude = jt->estimator.amplitude;
 		s->frequency = jt->estimator.frequency;
@@ -361,6 +362,46 @@ static int dmn_write_retry(struct dmn *d, uint8_t id, uint8_t addr, const uint8_
 	return r;
 }
 
+/* Torque actuation found a servo in wheel mode (the daemon was stopped
+ * without its safe stop, or the bus went away while the law drove it): stop
+ * the drive, make the present position the goal, and give it angle limits
+ * again — the configured joint limits — so joint mode holds it. */
+static bool dmn_restore_joint_mode(struct dmn *d, size_t j, struct ctl_servo_info *info, char *err, size_t cap)
+{
+	const struct cfg_joint *cj = &d->cfg->joint[j];
+	uint8_t id = d->ctl.j[j].id, eb = 0, raw[2];
+	bool reply = info->status_return_level >= 2;
+	int r = dmn_read_retry(d, id, DXL_AX_PRESENT_POSITION, 2, raw, &eb);
+	uint8_t stop[4] = { raw[0], raw[1], 0, 0 }, off = 0;
+	if (r == DXL_OK)
+		r = dmn_write_retry(d, id, DXL_AX_GOAL_POSITION, stop, 4, reply, &eb);
+	/* EEPROM: the AX-12A takes it only with torque off; ctl_start() turns
+	 * torque on again */
+	if (r == DXL_OK)
+		r = dmn_write_retry(d, id, DXL_AX_TORQUE_ENABLE, &off, 1, reply, &eb);
+	uint16_t cw = dxl_rad_to_pos(cj->neutral + cj->limit_min);
+	uint16_t ccw = dxl_rad_to_pos(cj->neutral + cj->limit_max);
+	/* whole units inside the configured limits */
+	if (dxl_pos_to_rad(cw) < cj->neutral + cj->limit_min && cw < DXL_POS_MAX)
+		cw++;
+	if (dxl_pos_to_rad(ccw) > cj->neutral + cj->limit_max && ccw > 0)
+		ccw--;
+	uint8_t limits[4];
+	dxl_put_u16(limits, cw);
+	dxl_put_u16(limits + 2, ccw);
+	if (r == DXL_OK)
+		r = dmn_write_retry(d, id, DXL_AX_CW_ANGLE_LIMIT, limits, 4, reply, &eb);
+	if (r != DXL_OK) {
+		snprintf(err, cap, "servo %u: in wheel mode, and putting it back in joint mode failed: %s", id,
+		         dxl_strerror(r));
+		return false;
+	}
+	log_warn("servo %u was in wheel mode: drive stopped, angle limits set to the joint's %u..%u", id, cw, ccw);
+	info->cw_limit = cw;
+	info->ccw_limit = ccw;
+	return true;
+}
+
 static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 {
 	uint8_t id = d->ctl.j[j].id, eb = 0;
@@ -386,6 +427,9 @@ static bool dmn_read_servo(struct dmn *d, size_t j, char *err, size_t cap)
 		         "(`dxl --port %s write %u status_return_level 2`)", id, d->port_path, id);
 		return false;
 	}
+	if (d->cfg->actuation == CFG_ACT_TORQUE && dxl_is_wheel_mode(info.cw_limit, info.ccw_limit) &&
+	    !dmn_restore_joint_mode(d, j, &info, err, cap))
+		return false;
 	if (info.max_torque == 0) {
 		log_warn("servo %u: max torque (EEPROM) is 0: it cannot move; using 1023 as torque limit", id);
 		info.max_torque = 1023;
@@ -595,7 +639,8 @@ static int dmn_begin_read(struct dmn *d, size_t j, uint8_t addr, uint8_t len)
 
 static int dmn_begin_write(struct dmn *d, const struct ctl_write *w)
 {
-	uint8_t params[3] = { w->addr, (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8) };
+	uint8_t params[5] = { w->addr, (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8),
+	                      (uint8_t)(w->value >> 16), (uint8_t)(w->value >> 24) };
 	int reply = -1;
 	for (size_t j = 0; j < d->ctl.n; j++)
 		if (d->ctl.j[j].id == w->id && d->ctl.j[j].servo.status_return_level >= 2)
@@ -603,24 +648,39 @@ static int dmn_begin_write(struct dmn *d, const struct ctl_write *w)
 	return bus_begin(&d->bus, w->id, DXL_INST_WRITE, params, (size_t)w->len + 1, reply);
 }
 
+/* The cycle's SYNC_WRITE: goals, wheel-mode duties, or (leaving wheel mode)
+ * goals with moving speed 0, which stops the drive and is joint mode's
+ * "as fast as possible" again. */
 static int dmn_send_goals(struct dmn *d)
 {
-	uint8_t ids[CFG_MAX_JOINTS], data[2 * CFG_MAX_JOINTS];
+	uint8_t ids[CFG_MAX_JOINTS], data[4 * CFG_MAX_JOINTS];
 	uint8_t pkt[DXL_MAX_PACKET];
 	size_t n = 0;
+	enum ctl_sync sync = d->ctl.sync;
+	size_t width = sync == CTL_SYNC_GOAL_STOP ? 4 : 2;
 	for (size_t j = 0; j < d->ctl.n; j++) {
 		const struct ctl_joint *jt = &d->ctl.j[j];
+		if (sync == CTL_SYNC_DUTY) {
+			/* the conversion clamps and turns a non-finite duty into 0 */
+			ids[n] = jt->id;
+			dxl_put_u16(&data[2 * n], dxl_duty_to_wheel(jt->duty));
+			n++;
+			continue;
+		}
 		/* safety_clamp() made goal finite and inside the limits; the
 		 * conversion clamps to 0..1023 as a last line. */
 		if (!jt->write_goal || !isfinite(jt->goal))
 			continue;
 		ids[n] = jt->id;
-		dxl_put_u16(&data[2 * n], dxl_rad_to_pos(jt->goal));
+		dxl_put_u16(&data[width * n], dxl_rad_to_pos(jt->goal));
+		if (width == 4)
+			dxl_put_u16(&data[width * n + 2], 0);
 		n++;
 	}
 	if (n == 0)
 		return DXL_OK;
-	int len = dxl_encode_sync_write(pkt, sizeof pkt, DXL_AX_GOAL_POSITION, 2, ids, data, n);
+	uint8_t addr = sync == CTL_SYNC_DUTY ? DXL_AX_MOVING_SPEED : DXL_AX_GOAL_POSITION;
+	int len = dxl_encode_sync_write(pkt, sizeof pkt, addr, (uint8_t)width, ids, data, n);
 	if (len < 0)
 		return len;
 	return bus_send_raw(&d->bus, pkt, (size_t)len);
@@ -955,6 +1015,44 @@ static bool dmn_lcm(struct dmn *d)
 	return true;
 }
 
+/* Torque actuation at exit: no servo may be left driving in wheel mode. Stop
+ * every drive first (one packet), then goals at the present positions, then
+ * the angle limits back; the safe state below then holds or goes limp. */
+static void dmn_stop_wheel(struct dmn *d, bool limp)
+{
+	uint8_t ids[CFG_MAX_JOINTS], zero[2 * CFG_MAX_JOINTS] = { 0 };
+	for (size_t j = 0; j < d->ctl.n; j++)
+		ids[j] = d->ctl.j[j].id;
+	bus_sync_write(&d->bus, DXL_AX_MOVING_SPEED, 2, ids, zero, d->ctl.n);
+	for (size_t j = 0; j < d->ctl.n; j++) {
+		struct ctl_joint *jt = &d->ctl.j[j];
+		bool reply = jt->servo.status_return_level >= 2;
+		uint8_t eb, raw[2], limits[4];
+		const uint8_t off = 0, on = 1;
+		int r = dmn_read_retry(d, jt->id, DXL_AX_PRESENT_POSITION, 2, raw, &eb);
+		if (r == DXL_OK) {
+			double hold = safety_clamp(&jt->limits, dxl_pos_to_rad(dxl_get_u16(raw)), NAN, NAN, NULL);
+			dxl_put_u16(raw, dxl_rad_to_pos(hold));
+			r = dmn_write_retry(d, jt->id, DXL_AX_GOAL_POSITION, raw, 2, reply, &eb);
+		}
+		uint32_t lim = ctl_joint_mode_limits(&d->ctl, j);
+		dxl_put_u16(limits, (uint16_t)(lim & 0xFFFF));
+		dxl_put_u16(limits + 2, (uint16_t)(lim >> 16));
+		/* EEPROM: written with torque off (AX-12A) */
+		if (r == DXL_OK)
+			r = dmn_write_retry(d, jt->id, DXL_AX_TORQUE_ENABLE, &off, 1, reply, &eb);
+		if (r == DXL_OK)
+			r = dmn_write_retry(d, jt->id, DXL_AX_CW_ANGLE_LIMIT, limits, 4, reply, &eb);
+		if (r == DXL_OK && !limp)
+			r = dmn_write_retry(d, jt->id, DXL_AX_TORQUE_ENABLE, &on, 1, reply, &eb);
+		if (r != DXL_OK)
+			log_error("safe stop: servo %u: back to joint mode failed (%s); its drive was stopped",
+			          jt->id, dxl_strerror(r));
+	}
+	d->ctl.wheel = false;
+	log_info("safe stop: torque actuation ended, servos back in joint mode");
+}
+
 /* Leave the configured safe state on the bus (blocking: we are exiting). */
 static void dmn_safe_stop(struct dmn *d)
 {
@@ -964,6 +1062,8 @@ static void dmn_safe_stop(struct dmn *d)
 	d->phase = PH_IDLE;
 	/* a robot that is limp stays limp: writing goals could bring torque back */
 	bool limp = d->cfg->safe_stop == CFG_SAFE_LIMP || d->ctl.mode == CFG_MODE_LIMP;
+	if (d->ctl.wheel)
+		dmn_stop_wheel(d, limp);
 	uint8_t ids[CFG_MAX_JOINTS], data[2 * CFG_MAX_JOINTS];
 	size_t n = 0;
 	for (size_t j = 0; j < d->ctl.n; j++) {

@@ -32,6 +32,26 @@
 #define OSC_DEF_LAMBDA0 1.5      /* paper: first joint */
 #define OSC_DEF_LAMBDA1 (-0.5)   /* paper: second joint */
 
+/*
+ * Torque actuation (the joint driven by a torque, as on the paper's pair rig):
+ * the law's torque is applied to the joint itself, so k, c, μ are physical and
+ * `inertia` is the joint's own (the simulated AX-12A joint with its 18.65 cm
+ * link: 4.39e-3 kg·m², sim-bridge/PHYSICS.md). Target 0.8 Hz, 0.8 rad through
+ * the daemon on the simulated bus, one joint; measured in CONTROL.md.
+ * - k = I·(2π·0.8 Hz)² = 0.111 N·m/rad;
+ * - c = 0.3·I·ω = 6.6e-3 N·m·s/rad: van der Pol ε = 0.3, a few periods to
+ *   recover the amplitude after a collision, little distortion;
+ * - μ below 4c/A² = 0.041: the 10 ms hold of each command and the lag of the
+ *   speed estimate take energy out, so the loop settles lower than A = 2√(c/μ);
+ * - friction 5 mN·m: the link's dry friction (PHYSICS.md), so the joint
+ *   starts from a turning point without a dead zone.
+ */
+#define OSC_TQ_INERTIA 4.39e-3
+#define OSC_TQ_K        0.111
+#define OSC_TQ_C        6.6e-3
+#define OSC_TQ_MU       0.032
+#define OSC_TQ_FRICTION 0.005
+
 /* Width (rad/s) of the smooth sign used for friction compensation:
  * sgn(v) ≈ tanh(v / band). A true step would make RK4's stages straddle a
  * discontinuity at every reversal; 0.05 rad/s is four steps of the servo's
@@ -60,6 +80,16 @@ void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints
 	}
 }
 
+void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t njoints)
+{
+	p->k = OSC_TQ_K;
+	p->c = OSC_TQ_C;
+	p->mu = OSC_TQ_MU;
+	p->inertia = OSC_TQ_INERTIA;
+	p->friction = OSC_TQ_FRICTION;
+	p->lambda = njoints < 2 ? 0.0 : (joint % 2 == 0 ? OSC_DEF_LAMBDA0 : OSC_DEF_LAMBDA1);
+}
+
 /* The joint whose angle couples into joint j: the next joint in the chain,
  * and for the last joint the previous one (so two joints couple each other). */
 static size_t osc_other(size_t j, size_t njoints)
@@ -67,17 +97,23 @@ static size_t osc_other(size_t j, size_t njoints)
 	return (j + 1 < njoints) ? j + 1 : j - 1;
 }
 
+/* The right-hand side of the law for joint j at state (x, v). */
+static double osc_law(const struct osc_joint_params *p, size_t njoints, const double *x,
+                      const double *v, size_t j)
+{
+	double coupled = (njoints >= 2) ? p[j].lambda * x[osc_other(j, njoints)] : 0.0;
+	double torque = -p[j].k * (x[j] + coupled) + (p[j].c - p[j].mu * x[j] * x[j]) * v[j];
+	if (p[j].friction != 0.0)
+		torque += p[j].friction * tanh(v[j] / OSC_FRICTION_BAND);
+	return torque;
+}
+
 /* ẍ for every joint at state (x, v). */
 static void osc_accel(const struct osc_joint_params *p, size_t njoints, const double *x,
                       const double *v, double *a)
 {
-	for (size_t j = 0; j < njoints; j++) {
-		double coupled = (njoints >= 2) ? p[j].lambda * x[osc_other(j, njoints)] : 0.0;
-		double torque = -p[j].k * (x[j] + coupled) + (p[j].c - p[j].mu * x[j] * x[j]) * v[j];
-		if (p[j].friction != 0.0)
-			torque += p[j].friction * tanh(v[j] / OSC_FRICTION_BAND);
-		a[j] = torque / p[j].inertia;
-	}
+	for (size_t j = 0; j < njoints; j++)
+		a[j] = osc_law(p, njoints, x, v, j) / p[j].inertia;
 }
 
 static bool osc_all_finite(const double *a, size_t n)
@@ -177,6 +213,25 @@ bool osc_step(const struct osc_joint_params *p, size_t njoints, const double *x,
 			v_next[j] = vs[j];
 	}
 	return true;
+}
+
+bool osc_torque(const struct osc_joint_params *p, size_t njoints, const double *x, const double *v,
+                double *torque)
+{
+	if (njoints == 0 || njoints > OSC_MAX_JOINTS)
+		return false;
+	bool ok = osc_all_finite(x, njoints) && osc_all_finite(v, njoints);
+	for (size_t j = 0; ok && j < njoints; j++)
+		ok = isfinite(p[j].k) && isfinite(p[j].c) && isfinite(p[j].mu) && isfinite(p[j].lambda) &&
+		     isfinite(p[j].friction);
+	for (size_t j = 0; j < njoints; j++)
+		torque[j] = ok ? osc_law(p, njoints, x, v, j) : 0.0;
+	for (size_t j = 0; ok && j < njoints; j++)
+		ok = isfinite(torque[j]);
+	if (!ok)
+		for (size_t j = 0; j < njoints; j++)
+			torque[j] = 0.0;
+	return ok;
 }
 
 double osc_sinusoid(double amplitude, double frequency, double phase, size_t joint, double t)

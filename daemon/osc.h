@@ -60,6 +60,18 @@ struct osc_joint_params {
  * two joints get λ = 1.5 (even joints) and −0.5 (odd joints), one joint λ = 0. */
 void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints);
 
+/* Defaults for torque actuation (CONTROL.md, "Torque actuation"): the law's
+ * torque drives the joint directly, so the parameters are physical; tuned for
+ * ≈0.8 Hz, ≈0.8 rad on one simulated AX-12A joint with an 18.65 cm link. */
+void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t njoints);
+
+/* Torque actuation: the law's right-hand side at the measured state,
+ *     τ_j = −k (x_j + λ_j x_other) + (c − μ x_j²) ẋ_j + b·sgn(ẋ_j)   (N·m).
+ * Non-finite state or parameters give 0 for every joint (no drive) and false;
+ * njoints 0 or > OSC_MAX_JOINTS: false, nothing written. */
+bool osc_torque(const struct osc_joint_params *p, size_t njoints, const double *x, const double *v,
+                double *torque);
+
 /* Integrate the coupled oscillator from measured state (x[j], v[j]) over
  * `horizon` seconds (the daemon passes measured dt + OSC_SERVO_LEAD_S), using
  * `substeps` RK4 steps (clamped to 1..1000).

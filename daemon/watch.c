@@ -34,9 +34,9 @@ static void watch_state(const lcm_recv_buf_t *rb, const char *ch, const undulate
 	for (int j = 0; j < m->njoints; j++) {
 		const undulate_joint_state_t *s = &m->joints[j];
 		printf(" a%d=%.4f s%d=%.4f g%d=%.4f amp%d=%.4f f%d=%.4f ph%d=%.3f ld%d=%.3f e%d=%d st%d=%d tq%d=%d "
-		       "v%d=%.1f T%d=%.0f", j, s->angle, j, s->speed, j, s->goal, j, s->amplitude, j, s->frequency,
-		       j, s->phase, j, s->load, j, s->error_bits, j, s->stale_cycles, j, s->torque, j, s->voltage,
-		       j, s->temperature);
+		       "v%d=%.1f T%d=%.0f dr%d=%.4f", j, s->angle, j, s->speed, j, s->goal, j, s->amplitude, j,
+		       s->frequency, j, s->phase, j, s->load, j, s->error_bits, j, s->stale_cycles, j, s->torque, j,
+		       s->voltage, j, s->temperature, j, s->drive);
 	}
 	printf("\n");
 }

@@ -292,6 +292,13 @@ uint16_t dxl_rad_s_to_speed(double rad_s)
 	return dxl_units_to_speed((int)lround(units));
 }
 
+uint16_t dxl_duty_to_wheel(double duty)
+{
+	if (!isfinite(duty))
+		return 0;
+	return dxl_units_to_speed((int)lround(fmax(-1.0, fmin(1.0, duty)) * 1023.0));
+}
+
 uint16_t dxl_rad_s_to_moving_speed(double rad_s)
 {
 	/* 0 would mean "as fast as possible" — never produce it by rounding a slow

@@ -116,6 +116,9 @@ double dxl_speed_to_rad_s(uint16_t raw);
 uint16_t dxl_rad_s_to_speed(double rad_s);
 /* Goal moving speed (joint mode): rad/s magnitude -> 1..1023, 0 means "maximum". */
 uint16_t dxl_rad_s_to_moving_speed(double rad_s);
+/* Wheel mode's moving speed: signed output ratio in [-1, 1] (positive CCW)
+ * -> 0..1023 with bit 10 for CW. Clamped; non-finite gives 0 (no drive). */
+uint16_t dxl_duty_to_wheel(double duty);
 /* Present load: signed fraction of max torque in [-1, 1], positive CCW. */
 double dxl_load_to_fraction(uint16_t raw);
 uint16_t dxl_fraction_to_load(double fraction);

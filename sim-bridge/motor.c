@@ -54,6 +54,7 @@ void sim_motor_default_params(struct sim_motor_params *p)
 	p->heat_gain = 0.6;
 	p->backdrive_viscous = 0.2;
 	p->backdrive_coulomb = 0.05;
+	p->current_drive = false;   /* the AX-12A's PWM */
 }
 
 double sim_motor_stall_torque(const struct sim_motor_params *p)
@@ -118,15 +119,23 @@ static double motor_limit_fraction(const struct sim_motor_cmd *cmd)
 	return motor_clamp(cmd->torque_limit / MOTOR_RAW_FULL, 0.0, 1.0);
 }
 
-/* Wheel mode: moving speed is the PWM output ratio, bit 10 = CW. */
-static void motor_wheel(const struct sim_motor_cmd *cmd, double stall, double c_emf,
-                        double limit, struct motor_line *ln)
+/* Wheel mode: moving speed is the PWM output ratio, bit 10 = CW; with a
+ * current drive it is the torque ratio (no back-EMF term). */
+static void motor_wheel(const struct sim_motor_cmd *cmd, const struct sim_motor_params *p, double stall,
+                        double c_emf, double limit, struct motor_line *ln)
 {
 	double u = (cmd->moving_speed & MOTOR_SPEED_MASK) / MOTOR_RAW_FULL;
 	double dir = (cmd->moving_speed & DXL_DIRECTION_BIT) ? -1.0 : 1.0;
 	if (u > limit)
 		u = limit;
 	ln->duty = dir * u;
+	if (p->current_drive) {
+		/* a current loop holds the torque whatever the speed and supply */
+		ln->a = ln->duty * p->stall_torque_12v;
+		ln->c = 0.0;
+		ln->cap = limit * p->stall_torque_12v;
+		return;
+	}
 	ln->a = ln->duty * stall;
 	ln->c = c_emf;
 }
@@ -200,7 +209,7 @@ static void motor_line_for(struct sim_motor *m, const struct sim_motor_params *p
 	double limit = motor_limit_fraction(cmd);
 	ln->cap = limit * stall;
 	if (wheel)
-		motor_wheel(cmd, stall, c_emf, limit, ln);
+		motor_wheel(cmd, p, stall, c_emf, limit, ln);
 	else
 		motor_joint(m, cmd, stall, c_emf, limit, dt, ln);
 }

@@ -29,6 +29,12 @@ struct sim_motor_params {
 	 * through the 254:1 gearbox */
 	double backdrive_viscous;  /* N·m·s/rad, added to viscous while there is no drive */
 	double backdrive_coulomb;  /* N·m, added to coulomb while there is no drive */
+	/* Wheel mode's drive. false: the AX-12A's H-bridge, the moving-speed
+	 * register is a PWM duty and the motor loses tau_stall/w0 per rad/s to
+	 * back-EMF. true: a current-controlled drive (not an AX-12A: the paper's
+	 * torque-controlled pair rig), the register commands torque,
+	 * duty × stall torque, with no back-EMF loss. Joint mode is unchanged. */
+	bool current_drive;
 };
 
 /* The servo registers the controller acts on (decoded from its RAM/EEPROM). */

@@ -190,6 +190,13 @@ static int set_motor(struct sim_config *c, const char *k, const char *v, char *e
 {
 	double d;
 	struct sim_motor_params *m = &c->motor;
+	if (!strcmp(k, "drive")) {
+		if (!strcmp(v, "pwm") || !strcmp(v, "current")) {
+			m->current_drive = !strcmp(v, "current");
+			return 0;
+		}
+		return ERR("motor.drive: '%s' is not pwm or current", v);
+	}
 	if (!parse_num(v, &d) || d < 0)
 		return ERR("motor.%s: '%s' is not a number >= 0", k, v);
 	if (!strcmp(k, "inertia") && d > 0) m->inertia = d;

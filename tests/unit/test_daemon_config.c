@@ -124,6 +124,18 @@ static void test_defaults_from_osc(void **state)
 	assert_true(c.joint[0].limit_min < 0 && c.joint[0].limit_max > 0);
 	assert_true(c.joint[0].max_step > 0);
 	assert_string_equal(c.name, "robot");
+	assert_int_equal(c.actuation, CFG_ACT_POSITION);
+	/* torque actuation takes the physical defaults, wherever the key comes */
+	load_ok(&c, "[robot]\nport=/dev/null\nids=1\n[joint.1]\nmu=0.05\n[robot]\nactuation = torque\n"
+	        "torque_drive = current\n");
+	struct osc_joint_params t0;
+	osc_default_torque_params(&t0, 0, 1);
+	assert_int_equal(c.actuation, CFG_ACT_TORQUE);
+	assert_int_equal(c.torque_drive, CFG_DRIVE_CURRENT);
+	assert_double_equal(c.joint[0].osc.k, t0.k, 1e-12);
+	assert_double_equal(c.joint[0].osc.inertia, t0.inertia, 1e-12);
+	assert_double_equal(c.joint[0].osc.mu, 0.05, 1e-12);
+	assert_double_equal(c.stall_torque, 1.5, 1e-12);
 }
 
 static void test_errors_name_file_line_key(void **state)
@@ -156,6 +168,12 @@ static void test_errors_name_file_line_key(void **state)
 	                    "robot1.conf:4: [robot] safe_stop: 'drop' is not hold or limp");
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nvelocity_source=gps\n", b, sizeof b),
 	                    "robot1.conf:4: [robot] velocity_source: 'gps' is not servo or filtered");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nactuation=force\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] actuation: 'force' is not position or torque");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\ntorque_drive=hydraulic\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] torque_drive: 'hydraulic' is not pwm or current");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nstall_torque=0\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] stall_torque: 0 out of range 0.01..100");
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nname=a.b\n", b, sizeof b),
 	                    "robot1.conf:4: [robot] name: 'a.b' must be non-empty without '.', '*' or spaces "
 	                    "(it prefixes LCM channels)");

@@ -183,6 +183,13 @@ static void test_speed_and_load(void **state)
 	assert_int_equal(dxl_rad_s_to_moving_speed(-200 * rpm_unit), 200);
 	assert_int_equal(dxl_rad_s_to_moving_speed(1e9), 1023);
 	assert_int_equal(dxl_rad_s_to_moving_speed(NAN), 1);
+	/* wheel mode output ratio: bit 10 = CW = negative, clamped, NaN = no drive */
+	assert_int_equal(dxl_duty_to_wheel(0.5), 512);
+	assert_int_equal(dxl_duty_to_wheel(-0.5), 0x400 | 512);
+	assert_int_equal(dxl_duty_to_wheel(3.0), 1023);
+	assert_int_equal(dxl_duty_to_wheel(-3.0), 0x400 | 1023);
+	assert_int_equal(dxl_duty_to_wheel(NAN), 0);
+	assert_int_equal(dxl_duty_to_wheel(-INFINITY), 0);
 	/* load: 0.1 % a unit, bit 10 = CW */
 	assert_true(fabs(dxl_load_to_fraction(500) - 0.5) < 1e-12);
 	assert_true(fabs(dxl_load_to_fraction(0x400 | 500) + 0.5) < 1e-12);

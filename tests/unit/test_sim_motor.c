@@ -319,6 +319,49 @@ static void test_wheel_mode(void **state)
 	assert_true(m.speed < 256.0 / 1023 * w0 && m.speed > 0.9 * 256.0 / 1023 * w0);
 }
 
+/* A current-controlled drive (motor.drive = current, not an AX-12A): the
+ * wheel-mode register is a torque, with no back-EMF loss. */
+static void test_current_drive(void **state)
+{
+	(void)state;
+	struct sim_motor_params p = params();
+	p.current_drive = true;
+	p.viscous = 0;
+	p.coulomb = 0;
+	struct sim_motor_cmd c = cmd_default();
+	c.cw_limit = c.ccw_limit = 0;
+	c.moving_speed = 1024 + 102;   /* 10 % of 1.5 N·m, CW */
+	struct sim_motor m;
+	sim_motor_init(&m, &p, 0);
+	m.speed = 3.0;                 /* no back-EMF: the speed does not change the torque */
+	sim_motor_step(&m, &p, &c, 0, 1e-3);
+	assert_true(fabs(m.motor_torque + 102.0 / 1023 * 1.5) < 1e-9);
+	/* the acceleration is the commanded torque over the inertia */
+	double w = m.speed;
+	sim_motor_step(&m, &p, &c, 0, 1e-3);
+	assert_true(fabs((m.speed - w) / 1e-3 + 102.0 / 1023 * 1.5 / p.inertia) < 1e-6);
+	/* independent of the supply; capped by the torque limit */
+	p.supply_voltage = 9.0;
+	c.moving_speed = 1023;
+	c.torque_limit = 512;
+	sim_motor_step(&m, &p, &c, 0, 1e-3);
+	assert_true(fabs(m.motor_torque - 512.0 / 1023 * 1.5) < 1e-9);
+	/* joint mode is unchanged by the option */
+	struct sim_motor_params q = params();
+	struct sim_motor a, b;
+	struct sim_motor_cmd j = cmd_default();
+	sim_motor_init(&a, &q, 0);
+	q.current_drive = true;
+	sim_motor_init(&b, &q, 0);
+	for (int k = 0; k < 200; k++) {
+		q.current_drive = false;
+		sim_motor_step(&a, &q, &j, 0, DT);
+		q.current_drive = true;
+		sim_motor_step(&b, &q, &j, 0, DT);
+	}
+	assert_true(a.angle == b.angle && a.speed == b.speed);
+}
+
 static void test_torque_off(void **state)
 {
 	(void)state;
@@ -473,6 +516,7 @@ int main(void)
 		cmocka_unit_test(test_compliance_slope),
 		cmocka_unit_test(test_torque_limit_blocked_joint),
 		cmocka_unit_test(test_wheel_mode),
+		cmocka_unit_test(test_current_drive),
 		cmocka_unit_test(test_torque_off),
 		cmocka_unit_test(test_voltage_scaling),
 		cmocka_unit_test(test_heating_and_cooling),

@@ -108,6 +108,15 @@ static void test_config_errors(void **state)
 	assert_int_equal(sim_config_set(&cfg, "sim.rate_hz=abc", err, sizeof(err)), -1);
 	assert_int_equal(sim_config_set(&cfg, "world.walls=3,1", err, sizeof(err)), -1);
 	assert_int_equal(sim_config_set(&cfg, "world.walls=-1,1", err, sizeof(err)), 0);
+	/* wheel-mode drive: pwm (AX-12A) or current, nothing else */
+	assert_false(cfg.motor.current_drive);
+	assert_int_equal(sim_config_set(&cfg, "motor.drive=current", err, sizeof(err)), 0);
+	assert_true(cfg.motor.current_drive);
+	assert_int_equal(sim_config_set(&cfg, "motor.drive=torque", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "pwm or current"));
+	assert_true(cfg.motor.current_drive);
+	assert_int_equal(sim_config_set(&cfg, "motor.drive=pwm", err, sizeof(err)), 0);
+	assert_false(cfg.motor.current_drive);
 	assert_int_equal(cfg.walls, SIM_WALLS_FIXED);
 	uint8_t ids[8];
 	assert_int_equal(sim_parse_ids("1-3,7", ids, 8), 4);

@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# undulated with torque actuation against undulate-sim (daemon/README.md,
+# "Torque actuation"): OSCILLATOR puts the servos in wheel mode and drives their
+# output; the register traffic is read back from the simulator. Checked: a
+# servo found in wheel mode is refused in position actuation and repaired in
+# torque actuation; the starter runs in joint mode, then wheel mode with the
+# law's duty (published as `drive`, goals NaN) and a limit cycle; HOLD goes
+# back to joint mode holding where the joint is; the safe stop leaves no servo
+# driving in wheel mode.
+. "$(dirname "$0")/../lib.sh"
+D="$B/undulated"; S="$B/undulate-sim"
+if [ ! -x "$S" ] || [ ! -x "$D" ]; then
+	echo "ok 1 # SKIP undulate-sim or undulated not built"; echo "1..1"; exit 0
+fi
+R="t$$"
+URL=$(lcm_url 7704)
+ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+last_state() { grep "^STATE $R " "$T/watch.log" | tail -1; }
+event() { wait_for "${2:-5}" grep -qE "^EVENT $R .*$1" "$T/watch.log"; }
+peek() { local v; v=$(ctl peek r1 "$1" "$2"); echo "${v#ok }"; }
+num() { awk "BEGIN { exit !($*) }"; }
+
+spawn sim "$S" --link "$T/bus" --ids 1 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 3
+wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
+spawn watch "$D" --watch "$R" --lcm-url "$URL"
+
+# ---- a servo left in wheel mode, spinning
+ctl poke r1 1 torque_enable 0 >/dev/null
+ctl poke r1 1 cw_angle_limit 0 >/dev/null
+ctl poke r1 1 ccw_angle_limit 0 >/dev/null
+ctl poke r1 1 torque_enable 1 >/dev/null
+ctl poke r1 1 moving_speed 200 >/dev/null
+spawn pos "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL"
+wait_for 10 bash -c "! kill -0 $pid_pos" && stop pos
+if [ "$stop_rc" != 0 ] && grep -q 'servo 1 is in wheel mode' "$T/pos.log"; then
+	tap_ok "position actuation refuses a servo in wheel mode, saying so (exit $stop_rc)"
+else tap_fail "position actuation refuses wheel mode" "exit $stop_rc: $(tail -3 "$T/pos.log")"; fi
+
+spawn d "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold \
+	--set robot.actuation=torque --set robot.torque_drive=pwm \
+	--set joint.1.limit_min=-1.2 --set joint.1.limit_max=1.2
+wait_log d "ready: $R.STATE" 10 || { tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
+cw=$(peek 1 cw_angle_limit); ccw=$(peek 1 ccw_angle_limit); ms=$(peek 1 moving_speed)
+# the configured limits +-1.2 rad in whole units inside: 512 -+ 234
+if [ "$cw" = 278 ] && [ "$ccw" = 746 ] && [ "$ms" = 0 ] && grep -q 'servo 1 was in wheel mode: drive stopped' "$T/d.log"; then
+	tap_ok "torque actuation repairs it: drive stopped, joint limits as angle limits ($cw..$ccw)"
+else tap_fail "wheel mode repaired at start-up" "limits $cw..$ccw, moving speed $ms: $(grep -i wheel "$T/d.log")"; fi
+
+# ---- OSCILLATOR: starter in joint mode, then wheel mode driven by the law
+wait_for 5 sh -c "grep -q '^STATE $R ' '$T/watch.log'"
+"$D" --command 'mode oscillator' --robot "$R" --lcm-url "$URL" >/dev/null
+if event 'kind=actuation text="torque actuation: servos in wheel mode' 10; then
+	tap_ok "after the starter the servos go into wheel mode (event)"
+else tap_fail "into wheel mode" "$(grep "EVENT $R" "$T/watch.log" | tail -3)"; fi
+if [ "$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)" = 0/0 ] && [ "$(peek 1 torque_enable)" = 1 ]; then
+	tap_ok "angle limits 0/0 on the servo, torque on"; else tap_fail "wheel mode on the servo" "$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)"; fi
+# 12 s of the law driving the joint: it swings, goals are NaN, drive is published
+sleep_until() { local t0=$SECONDS; wait_for "$1" bash -c "[ \$((SECONDS - $t0)) -ge $1 ]"; }
+sleep_until 12
+lo=$(grep "^STATE $R " "$T/watch.log" | tail -500 | field a0 | sort -g | head -1)
+hi=$(grep "^STATE $R " "$T/watch.log" | tail -500 | field a0 | sort -g | tail -1)
+s=$(last_state); g=$(echo "$s" | field g0); dr=$(echo "$s" | field dr0)
+if num "$hi - $lo > 1.0"; then tap_ok "the law swings the joint through torque: $lo .. $hi rad over 5 s"
+else tap_fail "joint swings under torque actuation" "angle $lo .. $hi"; fi
+if [ "$g" = nan ] || [ "$g" = -nan ]; then tap_ok "no goal published in wheel mode (goal NaN)"; else tap_fail "goal NaN in wheel mode" "g0=$g"; fi
+if num "$dr == $dr && $dr >= -1 && $dr <= 1 && $dr != 0"; then tap_ok "drive published: $dr of full output"
+else tap_fail "drive published" "dr0=$dr"; fi
+if ! grep -q "kind=stall" "$T/watch.log"; then tap_ok "no stall restart"; else tap_fail "no stall restart" "$(grep kind=stall "$T/watch.log" | head -2)"; fi
+
+# ---- HOLD: back to joint mode where the joint is
+"$D" --command 'mode hold' --robot "$R" --lcm-url "$URL" >/dev/null
+if event 'kind=actuation text="torque actuation: servos back in joint mode' 5; then
+	tap_ok "HOLD: servos back in joint mode (event)"; else tap_fail "back to joint mode" "$(grep "EVENT $R" "$T/watch.log" | tail -3)"; fi
+wait_for 3 bash -c "[ \"\$(echo 'peek r1 1 cw_angle_limit' | socat -t 2 - UNIX-CONNECT:$T/ctl)\" = 'ok 278' ]"
+pos=$(peek 1 present_position); goal=$(peek 1 goal_position); ms=$(peek 1 moving_speed)
+if [ "$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)" = 278/746 ] && [ "$ms" = 0 ] && [ "$(peek 1 torque_enable)" = 1 ] &&
+	num "$pos - $goal < 25 && $goal - $pos < 25"; then
+	tap_ok "joint mode again: limits 278..746, moving speed 0, holding (present $pos, goal $goal)"
+else tap_fail "joint mode holds" "limits $(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit) speed $ms present $pos goal $goal"; fi
+
+# ---- the safe stop from wheel mode
+"$D" --command 'mode oscillator' --robot "$R" --lcm-url "$URL" >/dev/null
+n=$(grep -c 'servos in wheel mode' "$T/watch.log")
+wait_for 10 bash -c "[ \$(grep -c 'servos in wheel mode' '$T/watch.log') -gt $n ]"
+if [ "$(peek 1 ccw_angle_limit)" = 0 ]; then
+	stop d
+	lim="$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)"; ms=$(peek 1 moving_speed); te=$(peek 1 torque_enable)
+	if [ "$stop_rc" = 0 ] && [ "$lim" = 278/746 ] && [ "$ms" = 0 ] && [ "$te" = 1 ] &&
+		grep -q 'safe stop: torque actuation ended' "$T/d.log"; then
+		tap_ok "SIGTERM in wheel mode: drive stopped, joint mode back, holding (exit 0)"
+	else tap_fail "safe stop from wheel mode" "exit $stop_rc, limits $lim, speed $ms, torque $te"; fi
+else
+	tap_fail "back in wheel mode before the stop" "ccw limit $(peek 1 ccw_angle_limit)"
+fi
+tap_done

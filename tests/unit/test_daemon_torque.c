@@ -1,0 +1,406 @@
+/* test_daemon_torque.c — torque actuation in the controller, with a joint model
+ * in the loop that obeys the servo's registers as the controller writes them:
+ * joint mode follows the goal (27 ms lag), wheel mode takes the duty as a
+ * torque (a current drive) or as a PWM duty (with back-EMF), EEPROM limits
+ * change only with torque off (AX-12A). Checked: the switch into and out of
+ * wheel mode and its register sequence, the limit cycle driven through torque,
+ * the walls near the limits, a limit breach falling back to joint mode, stale
+ * joints and non-finite parameters giving no drive, the back-EMF added back. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "../../daemon/control.h"
+#include "dxl.h"
+#include "dxl_table.h"
+
+#define DT 0.01
+#define SUBSTEPS 20
+#define NJ_MAX 2
+/* the simulated AX-12A joint with its link (sim-bridge/PHYSICS.md) */
+#define INERTIA 4.39e-3
+#define STALL 1.5
+#define W0 6.18
+#define SERVO_TAU 0.027
+
+static struct cfg cfg;
+static struct ctl c;
+static size_t nj;
+static double t;
+
+/* what the servos hold, as the controller's writes left them */
+struct servo {
+	double angle, speed;
+	bool torque;
+	uint16_t cw, ccw;
+	double goal;         /* rad */
+	uint16_t speed_reg;  /* moving speed register (wheel: duty) */
+	bool answers;
+	int eeprom_refused;  /* EEPROM writes refused for torque on */
+	int wheel_entries, wheel_exits;
+};
+static struct servo sv[NJ_MAX];
+
+static bool wheel(const struct servo *s) { return s->cw == 0 && s->ccw == 0; }
+
+static void apply_write(const struct ctl_write *w)
+{
+	for (size_t j = 0; j < nj; j++) {
+		struct servo *s = &sv[j];
+		if (c.j[j].id != w->id)
+			continue;
+		switch (w->addr) {
+		case DXL_AX_TORQUE_ENABLE:
+			s->torque = w->value != 0;
+			break;
+		case DXL_AX_CW_ANGLE_LIMIT:
+			assert_int_equal(w->len, 4);   /* both limits in one write */
+			if (s->torque) {
+				s->eeprom_refused++;
+				break;
+			}
+			bool was = wheel(s);
+			s->cw = (uint16_t)(w->value & 0xFFFF);
+			s->ccw = (uint16_t)(w->value >> 16);
+			s->wheel_entries += !was && wheel(s);
+			s->wheel_exits += was && !wheel(s);
+			break;
+		default:
+			break;
+		}
+	}
+}
+
+/* The cycle's SYNC_WRITE, as the daemon encodes it. */
+static void apply_sync(void)
+{
+	for (size_t j = 0; j < nj; j++) {
+		const struct ctl_joint *jt = &c.j[j];
+		struct servo *s = &sv[j];
+		switch (c.sync) {
+		case CTL_SYNC_DUTY:
+			s->speed_reg = dxl_duty_to_wheel(jt->duty);
+			break;
+		case CTL_SYNC_GOAL_STOP:
+			if (jt->write_goal) {
+				s->goal = dxl_pos_to_rad(dxl_rad_to_pos(jt->goal));
+				s->speed_reg = 0;
+			}
+			break;
+		case CTL_SYNC_GOAL:
+			if (jt->write_goal)
+				s->goal = dxl_pos_to_rad(dxl_rad_to_pos(jt->goal));
+			break;
+		}
+	}
+}
+
+static void physics(bool pwm)
+{
+	double h = DT / SUBSTEPS;
+	for (size_t j = 0; j < nj; j++) {
+		struct servo *s = &sv[j];
+		for (int k = 0; k < SUBSTEPS; k++) {
+			if (!s->torque) {
+				s->speed *= 0.9;   /* back-driven gearbox */
+			} else if (wheel(s)) {
+				double u = (s->speed_reg & 0x3FF) / 1023.0 * ((s->speed_reg & 0x400) ? -1.0 : 1.0);
+				double tau = pwm ? STALL * (u - s->speed / W0) : STALL * u;
+				s->speed += h * tau / INERTIA;
+			} else {
+				double target = fmin(fmax(s->goal, dxl_pos_to_rad(s->cw)), dxl_pos_to_rad(s->ccw));
+				s->speed = (target - s->angle) / SERVO_TAU;
+			}
+			s->angle += h * s->speed;
+		}
+	}
+}
+
+/* The queue is sent after the SYNC_WRITE and emptied, as in the daemon (so
+ * writes queued between cycles by commands go out with the next cycle); a
+ * copy of the last cycle's is kept for the tests. */
+static struct ctl_write sent[CTL_MAX_WRITES];
+static size_t nsent;
+
+static void cycle_pwm(bool pwm)
+{
+	c.nevents = 0;
+	physics(pwm);
+	t += DT;
+	for (size_t j = 0; j < nj; j++)
+		if (sv[j].answers)
+			ctl_measure(&c, j, dxl_rad_to_pos(sv[j].angle), dxl_rad_s_to_speed(sv[j].speed), 0, 0, DT);
+	ctl_step(&c, t, DT, t);
+	apply_sync();
+	for (size_t i = 0; i < c.nwrites; i++)
+		apply_write(&c.writes[i]);
+	memcpy(sent, c.writes, c.nwrites * sizeof sent[0]);
+	nsent = c.nwrites;
+	c.nwrites = 0;
+}
+
+static void cycle(void) { cycle_pwm(false); }
+
+static void run(int n)
+{
+	for (int i = 0; i < n; i++)
+		cycle();
+}
+
+static void setup(const char *ids, const char *drive, enum cfg_mode mode)
+{
+	struct cfg_errors e = { 0 };
+	char a[64], b[64];
+	cfg_defaults(&cfg);
+	cfg_override(&cfg, "robot.port=/dev/null", &e);
+	snprintf(a, sizeof a, "robot.ids=%s", ids);
+	cfg_override(&cfg, a, &e);
+	cfg_override(&cfg, "robot.actuation=torque", &e);
+	snprintf(b, sizeof b, "robot.torque_drive=%s", drive);
+	cfg_override(&cfg, b, &e);
+	cfg.mode = mode;
+	assert_int_equal(e.count, 0);
+	assert_true(cfg_finish(&cfg, &e));
+	nj = cfg.njoints;
+	ctl_init(&c, &cfg);
+	char why[256];
+	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
+	memset(sv, 0, sizeof sv);
+	for (size_t j = 0; j < nj; j++) {
+		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
+		sv[j] = (struct servo){ .angle = 0.2 - 0.3 * (double)j, .cw = 0, .ccw = 1023, .answers = true };
+		sv[j].goal = sv[j].angle;
+		ctl_measure(&c, j, dxl_rad_to_pos(sv[j].angle), 0, 0, 0, DT);
+	}
+	t = 0.0;
+	ctl_clear_outputs(&c);
+	ctl_start(&c, t, "test");
+	for (size_t i = 0; i < c.nwrites; i++)
+		apply_write(&c.writes[i]);
+	c.nwrites = 0;
+}
+
+static const struct ctl_event *find_event(const char *kind)
+{
+	for (size_t i = 0; i < c.nevents; i++)
+		if (strcmp(c.events[i].kind, kind) == 0)
+			return &c.events[i];
+	return NULL;
+}
+
+/* Run until the controller has put the servos in wheel mode. */
+static void run_into_wheel(void)
+{
+	for (int i = 0; i < 1000 && !c.wheel; i++)
+		cycle();
+	assert_true(c.wheel);
+	cycle();
+	assert_int_equal(c.sync, CTL_SYNC_DUTY);
+}
+
+static void test_switch_sequence(void **state)
+{
+	(void)state;
+	setup("1,2", "current", CFG_MODE_OSCILLATOR);
+	/* the starter runs in joint mode: goals, no wheel mode yet */
+	assert_true(c.starter_active);
+	cycle();
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL);
+	/* at the hand-over: torque off, limits 0 in one write, torque on, per servo, in that order */
+	for (int i = 0; i < 1000 && !c.wheel; i++)
+		cycle();
+	assert_true(c.wheel);
+	assert_non_null(find_event("actuation"));
+	for (size_t j = 0; j < nj; j++) {
+		int seen = 0;
+		for (size_t i = 0; i < nsent; i++) {
+			const struct ctl_write *w = &sent[i];
+			if (w->id != c.j[j].id)
+				continue;
+			if (seen == 0 && w->addr == DXL_AX_TORQUE_ENABLE && w->value == 0)
+				seen = 1;
+			else if (seen == 1 && w->addr == DXL_AX_CW_ANGLE_LIMIT && w->len == 4 && w->value == 0)
+				seen = 2;
+			else if (seen == 2 && w->addr == DXL_AX_TORQUE_ENABLE && w->value == 1)
+				seen = 3;
+		}
+		assert_int_equal(seen, 3);
+		assert_true(wheel(&sv[j]) && sv[j].torque);
+		assert_int_equal(sv[j].eeprom_refused, 0);
+	}
+	/* from then on duties, no goals */
+	cycle();
+	assert_int_equal(c.sync, CTL_SYNC_DUTY);
+	for (size_t j = 0; j < nj; j++) {
+		assert_true(isfinite(c.j[j].duty) && fabs(c.j[j].duty) <= 1.0);
+		assert_false(c.j[j].write_goal);
+		assert_true(isnan(c.j[j].goal));
+	}
+	/* out again on a mode change: drive stopped with goals where the joints
+	 * are, then the limits back with torque off and on */
+	ctl_set_mode(&c, CFG_MODE_HOLD, "test");
+	cycle();
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);
+	for (size_t j = 0; j < nj; j++) {
+		assert_true(c.j[j].write_goal && isfinite(c.j[j].goal));
+		assert_true(fabs(c.j[j].goal - sv[j].angle) < 0.1);
+		assert_true(isnan(c.j[j].duty));
+		assert_int_equal(sv[j].cw, 0);
+		assert_int_equal(sv[j].ccw, 1023);
+		assert_true(sv[j].torque);
+		assert_int_equal(sv[j].speed_reg, 0);
+		assert_int_equal(sv[j].wheel_exits, 1);
+		assert_int_equal(sv[j].eeprom_refused, 0);
+	}
+	run(100);
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL);
+}
+
+static void test_limit_cycle_through_torque(void **state)
+{
+	(void)state;
+	setup("1", "current", CFG_MODE_OSCILLATOR);
+	run_into_wheel();
+	run(1500);   /* 15 s to settle */
+	double lo = 1e9, hi = -1e9;
+	int ups = 0;
+	double first_up = -1, last_up = -1, prev = sv[0].angle;
+	for (int i = 0; i < 1000; i++) {
+		cycle();
+		assert_true(c.wheel);
+		lo = fmin(lo, sv[0].angle);
+		hi = fmax(hi, sv[0].angle);
+		if (prev < 0.0 && sv[0].angle >= 0.0) {
+			if (first_up < 0)
+				first_up = t;
+			last_up = t;
+			ups++;
+		}
+		prev = sv[0].angle;
+	}
+	double amp = 0.5 * (hi - lo);
+	double f = ups > 1 ? (ups - 1) / (last_up - first_up) : 0;
+	/* the law itself with the defaults: a van der Pol cycle near 0.8 Hz and
+	 * ~0.8 rad (the loop's delay shifts both a little) */
+	if (!(amp > 0.6 && amp < 1.05 && f > 0.65 && f < 0.9))
+		fail_msg("limit cycle through torque: amplitude %.3f rad, %.3f Hz", amp, f);
+	assert_int_equal(c.starts, 1);   /* never stalled and restarted */
+}
+
+static void test_walls_and_limit_breach(void **state)
+{
+	(void)state;
+	setup("1", "current", CFG_MODE_OSCILLATOR);
+	cfg.joint[0].limit_min = -1.0;
+	cfg.joint[0].limit_max = 1.0;
+	ctl_params_changed(&c);
+	run_into_wheel();
+	/* near the upper limit and moving out: the wall pushes back whatever
+	 * the law says */
+	double hi = c.j[0].limits.hi;
+	sv[0].angle = hi - 0.05;
+	sv[0].speed = 2.0;
+	cycle();
+	assert_true(c.wheel);
+	assert_true(c.j[0].torque_cmd < 0.0);
+	assert_true(c.j[0].clamp_flags & SAFETY_LIMIT);
+	/* past it: back to joint mode, fault_action (HOLD), the goal inside the limits */
+	long long trips = c.limit_trips;
+	sv[0].angle = hi + 0.05;
+	sv[0].speed = 0.0;
+	cycle();
+	assert_int_equal(c.limit_trips, trips + 1);
+	assert_non_null(find_event("limit"));
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);
+	assert_true(c.j[0].write_goal && c.j[0].goal <= hi + 1e-9);
+	assert_false(wheel(&sv[0]));
+	run(50);
+	assert_true(sv[0].angle <= hi + 0.01);   /* the servo brought it back */
+}
+
+static void test_limp_leaves_torque_off(void **state)
+{
+	(void)state;
+	setup("1,2", "current", CFG_MODE_OSCILLATOR);
+	run_into_wheel();
+	ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+	cycle();
+	assert_false(c.wheel);
+	for (size_t j = 0; j < nj; j++) {
+		assert_false(wheel(&sv[j]));
+		assert_false(sv[j].torque);
+		assert_int_equal(sv[j].speed_reg, 0);
+		assert_int_equal(sv[j].eeprom_refused, 0);
+	}
+	/* and torque on later starts where the joint is, in joint mode */
+	ctl_torque(&c, true);
+	cycle();
+	assert_false(c.wheel);
+	assert_true(sv[0].torque);
+	assert_true(fabs(sv[0].goal - sv[0].angle) < 0.05);
+}
+
+static void test_stale_and_nonfinite_give_no_drive(void **state)
+{
+	(void)state;
+	setup("1,2", "current", CFG_MODE_OSCILLATOR);
+	run_into_wheel();
+	sv[1].answers = false;
+	cycle();
+	assert_true(c.wheel);
+	assert_true(c.j[1].duty == 0.0);
+	sv[1].answers = true;
+	run(5);
+	long long nonfinite = c.nonfinite;
+	cfg.joint[0].osc.k = NAN;
+	cycle();
+	assert_true(c.nonfinite > nonfinite);
+	for (size_t j = 0; j < nj; j++)
+		assert_true(c.j[j].duty == 0.0);
+}
+
+static void test_pwm_adds_back_emf(void **state)
+{
+	(void)state;
+	setup("1", "pwm", CFG_MODE_OSCILLATOR);
+	for (int i = 0; i < 1000 && !c.wheel; i++)
+		cycle_pwm(true);
+	assert_true(c.wheel);
+	for (int i = 0; i < 300; i++)
+		cycle_pwm(true);
+	/* duty = tau / stall + speed / w0 (at the nominal 12 V, no voltage read yet) */
+	const struct ctl_joint *jt = &c.j[0];
+	double expect = jt->torque_cmd / cfg.stall_torque + jt->speed / cfg.no_load_speed;
+	assert_true(fabs(jt->duty - fmax(-1.0, fmin(1.0, expect))) < 1e-12);
+	assert_true(fabs(jt->speed) > 0.1);
+	/* a lower supply asks for more duty for the same torque */
+	ctl_measure_slow(&c, 0, 90, 40, 0);   /* 9.0 V */
+	cycle_pwm(true);
+	double volts = 9.0;
+	expect = jt->torque_cmd / (cfg.stall_torque * volts / 12.0) + jt->speed / (cfg.no_load_speed * volts / 12.0);
+	assert_true(fabs(jt->duty - fmax(-1.0, fmin(1.0, expect))) < 1e-12);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_switch_sequence),
+		cmocka_unit_test(test_limit_cycle_through_torque),
+		cmocka_unit_test(test_walls_and_limit_breach),
+		cmocka_unit_test(test_limp_leaves_torque_off),
+		cmocka_unit_test(test_stale_and_nonfinite_give_no_drive),
+		cmocka_unit_test(test_pwm_adds_back_emf),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
