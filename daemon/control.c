@@ -172,12 +172,25 @@ static void ctl_blend_stop(struct ctl *c)
 		c->blend_from[j] = NAN;
 }
 
+/* Still: every joint below CTL_REST_V for CTL_STILL_CYCLES cycles in a row.
+ * One reading would call a swinging robot still at its turning points, where
+ * the quantized position stands for tens of milliseconds: a mode switch landing
+ * there restarted it with the starter (seen: one robot of a pair on the clock
+ * for 2.7 s while the other ran the oscillator, which scrambled their phase
+ * difference). 0.25 s is far longer than a turning point, far shorter than a
+ * stop anyone would switch modes after. */
+#define CTL_STILL_CYCLES 25
 static bool ctl_is_still(const struct ctl *c)
 {
+	return c->still_cycles >= CTL_STILL_CYCLES;
+}
+
+static void ctl_count_still(struct ctl *c)
+{
+	bool still = true;
 	for (size_t j = 0; j < c->n; j++)
-		if (!(fabs(c->j[j].speed) < CTL_REST_V))
-			return false;
-	return true;
+		still = still && c->j[j].fresh && fabs(c->j[j].speed) < CTL_REST_V;
+	c->still_cycles = still ? c->still_cycles + 1 : 0;
 }
 
 /* A single joint at rest is enough to call the oscillator stalled: a contact
@@ -194,10 +207,27 @@ static bool ctl_any_still(const struct ctl *c)
 /* Drive the baseline sinusoid for ramp_s plus one period, then hand over. */
 static void ctl_starter(struct ctl *c)
 {
+	c->starter_offset = 0.0;
 	double period = c->cfg->frequency > 0.0 ? 1.0 / c->cfg->frequency : 1.0;
 	c->starter_until = c->t + c->cfg->ramp_s + period;
 	c->starter_active = true;
 	c->starts++;
+}
+
+/* A position servo needs the starter from any rest (its first predicted
+ * steps round to nothing). Under torque actuation the law's own torque, −k·x,
+ * starts a joint resting away from neutral, and from rest at chosen angles the
+ * phases are exactly 0 or π; only a robot resting at neutral, where the law
+ * gives no torque, needs the starter. */
+#define CTL_TORQUE_START_X 0.1
+static bool ctl_needs_starter(const struct ctl *c)
+{
+	if (c->cfg->actuation != CFG_ACT_TORQUE)
+		return true;
+	for (size_t j = 0; j < c->n; j++)
+		if (!(fabs(c->j[j].angle - c->cfg->joint[j].neutral) < CTL_TORQUE_START_X))
+			return false;
+	return true;
 }
 
 static double ctl_present_or_goal(const struct ctl_joint *jt)
@@ -226,7 +256,7 @@ void ctl_start(struct ctl *c, double t, const char *reason)
 		ctl_torque_write(c, j, true);
 		ctl_blend_joint(c, j, jt->angle);
 	}
-	if (c->mode == CFG_MODE_OSCILLATOR)
+	if (c->mode == CFG_MODE_OSCILLATOR && ctl_needs_starter(c))
 		ctl_starter(c);
 	ctl_event(c, 0, "start", "%s: %s, ramping in over %.1f s", reason, cfg_mode_name(c->mode),
 	          c->mode == CFG_MODE_LIMP ? 0.0 : c->cfg->ramp_s);
@@ -296,6 +326,11 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 	bool was_moving_mode = commanding == CFG_MODE_SINUSOID || commanding == CFG_MODE_OSCILLATOR;
 	bool moving = !was_still && was_moving_mode &&
 	              (mode == CFG_MODE_SINUSOID || mode == CFG_MODE_OSCILLATOR);
+	/* a restart's starter runs at its own phase offset, which the new mode's
+	 * computation cannot reproduce: blend from the last goal instead */
+	if (commanding == CFG_MODE_SINUSOID && old == CFG_MODE_OSCILLATOR && c->starter_offset != 0.0)
+		moving = false;
+	c->starter_offset = 0.0;
 	c->mode = mode;
 	c->starter_active = false;
 	/* into a torque-actuated OSCILLATOR: the law takes the moving state as it is */
@@ -325,7 +360,7 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 		if (!moving && (mode == CFG_MODE_SINUSOID || (mode == CFG_MODE_OSCILLATOR && was_still)))
 			ctl_blend_joint(c, j, from);
 	}
-	if (mode == CFG_MODE_OSCILLATOR && was_still)
+	if (mode == CFG_MODE_OSCILLATOR && was_still && ctl_needs_starter(c))
 		ctl_starter(c);
 	ctl_event(c, 0, "mode", "mode %s -> %s (%s)", cfg_mode_name(old), cfg_mode_name(mode), reason);
 }
@@ -510,12 +545,33 @@ static void ctl_targets(struct ctl *c, enum cfg_mode mode, double dt, double t_r
 			ctl_targets_oscillator(c, dt, target);
 			return;
 		}
-		/* SINUSOID, or the OSCILLATOR's starter */
+		/* SINUSOID, or the OSCILLATOR's starter (also while it fades out),
+		 * which after a stall runs at its own offset */
 		for (size_t j = 0; j < c->n; j++)
 			target[j] = c->cfg->joint[j].neutral +
-			            osc_sinusoid(c->cfg->amplitude, c->cfg->frequency, c->cfg->phase, j, t_real);
+			            osc_sinusoid(c->cfg->amplitude, c->cfg->frequency,
+			                         c->cfg->phase + (c->mode == CFG_MODE_OSCILLATOR ? c->starter_offset : 0.0),
+			                         j, t_real);
 		return;
 	}
+}
+
+/* The phase offset of a restart after a stall, in [-pi, pi): a pseudo-random
+ * number from the robot's name and its count of starts. Two robots jammed
+ * against each other (started in exact anti-phase at a small separation,
+ * docs/EXPERIMENTS.md) would otherwise restart on the same clock-driven
+ * sinusoids and jam again the same way; different names draw different
+ * offsets, and every restart draws again. Deterministic, so tests repeat. */
+static double ctl_restart_offset(const struct ctl *c)
+{
+	uint64_t h = 1469598103934665603ULL;   /* FNV-1a of the name, then the count */
+	for (const char *p = c->cfg->name; *p; p++)
+		h = (h ^ (uint8_t)*p) * 1099511628211ULL;
+	h = (h ^ (uint64_t)c->starts) * 1099511628211ULL;
+	h ^= h >> 33;                          /* a murmur finalizer to spread the bits */
+	h *= 0xff51afd7ed558ccdULL;
+	h ^= h >> 33;
+	return ((double)(h >> 11) / 9007199254740992.0 - 0.5) * 2.0 * 3.14159265358979323846;
 }
 
 /* An oscillator that has come to rest (blocked, or parameters that damp it)
@@ -533,8 +589,9 @@ static void ctl_check_stall(struct ctl *c)
 	for (size_t j = 0; j < c->n; j++)
 		ctl_blend_joint(c, j, ctl_present_or_goal(&c->j[j]));
 	ctl_starter(c);
-	ctl_event(c, 1, "stall", "oscillator at rest for %.1f s: restarting it with the sinusoid starter",
-	          CTL_STALL_CYCLES * c->cfg->period_ms * 1e-3);
+	c->starter_offset = ctl_restart_offset(c);
+	ctl_event(c, 1, "stall", "oscillator at rest for %.1f s: restarting it with the sinusoid starter, "
+	          "phase %+.2f rad from its own", CTL_STALL_CYCLES * c->cfg->period_ms * 1e-3, c->starter_offset);
 }
 
 /* Between two moving modes (SINUSOID <-> OSCILLATOR) the old mode's target
@@ -727,8 +784,17 @@ static void ctl_switch_limits(struct ctl *c, size_t j, uint32_t limits, bool tor
 	uint8_t id = c->j[j].id;
 	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 0);
 	ctl_write_seq(c, id, DXL_AX_CW_ANGLE_LIMIT, 4, limits);
-	if (torque_after)
-		ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
+	if (!torque_after)
+		return;
+	/* Torque on the manual's way, the torque limit first: enabling torque
+	 * clears a latched overload bit, so an alarm shutdown that zeroed the
+	 * torque limit since the last reading would otherwise never be seen, and
+	 * the joint would stay without drive. */
+	const struct ctl_joint *jt = &c->j[j];
+	uint16_t limit = jt->fault == CTL_FAULT_NONE ? jt->servo.max_torque
+	                                              : (uint16_t)lround(c->cfg->backoff_torque * jt->servo.max_torque);
+	ctl_write_seq(c, id, DXL_AX_TORQUE_LIMIT, 2, limit);
+	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
 }
 
 static void ctl_enter_wheel(struct ctl *c)
@@ -787,6 +853,7 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 			ctl_blend_joint(c, j, jt->goal);
 		}
 	}
+	ctl_count_still(c);
 	ctl_check_stall(c);
 	if (c->starter_active && c->t >= c->starter_until) {
 		/* the starter hands over to the oscillator: cross-fade, no step */

@@ -112,11 +112,13 @@ struct ctl {
 	struct ctl_event events[CTL_MAX_EVENTS];
 	size_t nevents;
 	int rest_cycles;                /* cycles a running oscillator has been still */
+	int still_cycles;               /* cycles every joint has been still (any mode) */
 	/* torque actuation: the servos are in wheel mode (as far as our writes
 	 * went), and what this cycle's SYNC_WRITE carries */
 	bool wheel;
 	enum ctl_sync sync;
 	bool starter_active;            /* OSCILLATOR runs the sinusoid starter ... */
+	double starter_offset;          /* rad added to its phase after a stall (ctl_check_stall) */
 	double starter_until;           /* ... until then */
 	/* counters */
 	long long faults, clamps, nonfinite, starts;

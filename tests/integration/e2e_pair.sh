@@ -21,7 +21,12 @@ scenario="$top/tests/scenarios/pair-rig.scenario"
 seconds=${E2E_PAIR_SECONDS:-40}
 # Daemon settings for every run: torque actuation on the rig's current drive;
 # the daemon's single-joint torque defaults give ~0.8 rad at 0.80 Hz there.
-rig=(${E2E_DAEMON_SETS---daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current})
+# The robots start on a small sinusoid (0.25 rad) at the chosen phases, so the
+# phase difference is set before any contact (at 0.8 rad the pair would already
+# press into each other under the clock, and the moment of the switch would
+# scramble it); the oscillators then grow to their limit cycle within a few
+# periods, both alike, and the contact starts from the chosen difference.
+rig=(${E2E_DAEMON_SETS---daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current --daemon-set sinusoid.amplitude=0.25})
 
 # run NAME PORT SEPARATION PHASES: one rig run in the background, output in $T/NAME/.
 run() {

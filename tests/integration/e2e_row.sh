@@ -2,18 +2,20 @@
 # e2e_row.sh — a row of five single-joint robots at large separation
 # (d~ = 0.7 at 0.8 rad), restitution 0.67, each end closed by a wall where a
 # mirrored neighbour would stand (the paper's lattice has fixed ends), through
-# the real daemons. The paper's claims (theory.md, lattice):
+# the real daemons, each joint driven by the oscillator's torque (daemon torque
+# actuation on the simulator's current drive). The paper's claims (theory.md, lattice):
 #   immobile bases (beta = 0)  -> neighbours keep colliding
 #   mobile bases (beta > 0)    -> always relax to a collision-free compatible
 #                                 state: no collision (pairs or walls) in the
 #                                 last 10 s, every pair |D| <= 2 asin(d~) + 0.1
 source "$(dirname "$0")/../lib.sh"
 
-seconds=${E2E_ROW_SECONDS:-45}
-# Extra daemon settings for every run (none: the daemon's defaults give the
-# paper's ~0.8 rad at ~0.8 Hz on the simulated AX-12); e.g.
-# E2E_DAEMON_SETS="--daemon-set joint.1.c=0.006".
-rig=(${E2E_DAEMON_SETS:-})
+seconds=${E2E_ROW_SECONDS:-60}
+# Daemon settings for every run: the lattice's oscillators driven by torque, on
+# the scenarios' current drive (as the pair rig; ~0.8 rad at 0.80 Hz).
+# E2E_DAEMON_SETS="" runs them as position servos instead: there the mobile
+# row's claim does not reproduce reliably and is reported as TODO.
+rig=(${E2E_DAEMON_SETS---daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current})
 
 run() {
 	local name=$1 port=$2
@@ -90,7 +92,9 @@ if [ -f "$T/mobile/summary.txt" ]; then
 	if [ "$last" -eq 0 ] && [ -z "$bad" ]; then
 		tap_ok "mobile row reaches a collision-free compatible state (no collision in the last 10 s, every |D| <= 2 asin(d~) + 0.1)"
 	else
-		tap_todo "mobile row reaches a collision-free compatible state" "collisions (pairs and walls) in the last 10 s: $last; pairs outside 2 asin(d~) + 0.1: ${bad:-none}"
+		report=tap_fail
+		[ ${#rig[@]} -eq 0 ] && report=tap_todo
+		$report "mobile row reaches a collision-free compatible state" "collisions (pairs and walls) in the last 10 s: $last; pairs outside 2 asin(d~) + 0.1: ${bad:-none}"
 	fi
 fi
 keep_runs immobile mobile

@@ -39,8 +39,9 @@ progs = {
     'undulate-top': (['--lcm-url', '--wait', '--interval'], ['--wait', '--interval'],
                      ['--read-only', '--json', '-v'], []),
     'undulate-analyze': (['--out', '--pairs', '--from', '--to', '--window', '--separation', '--restitution',
-                          '--merge', '--synth', '--duration'],
-                         ['--from', '--to', '--window', '--separation', '--restitution', '--merge', '--duration'],
+                          '--merge', '--synth', '--duration', '--min-swing', '--synth-stop-after'],
+                         ['--from', '--to', '--window', '--separation', '--restitution', '--merge', '--duration',
+                          '--min-swing', '--synth-stop-after'],
                          ['--plots', '--zero-crossings', '--quiet'], []),
 }
 

@@ -1,20 +1,28 @@
 #!/usr/bin/env bash
 # e2e_antiphase_sweep.sh (make test-long) — where does anti-phase appear as the
 # pair rig's separation grows? The pair rig (tests/scenarios/pair-rig.scenario,
-# r = 0.67, immobile) through the real daemons, started from a phase
-# difference of pi at d~ = 0.1 .. 0.9, each run analysed with undulate-analyze.
+# r = 0.67, immobile, joints driven by torque as on the paper's rig) through
+# the real daemons, started from a phase difference of pi at d~ = 0.1 .. 0.9,
+# each run analysed with undulate-analyze.
 # Theory (theory.md): anti-phase is a stable fixed point of the return map
 # above d~_c = sqrt(r(r - 1) / (r^2 - r - 2)) = 0.316 for r = 0.67, unstable
 # below it. Asserted, as the paper reports it: every run well above d~_c
 # (d~ >= d~_c + 0.15) ends in anti-phase (|D| within 0.5 of pi, still
-# colliding), and no run well below it (d~ <= d~_c - 0.1) does.
-# Prints the whole table (d~ set, d~ measured, final D, state, collisions)
-# for docs/EXPERIMENTS.md.
+# colliding), and no run well below it (d~ <= d~_c - 0.1) does. d~ here is
+# the separation set for the amplitude the joints reach without contact
+# (0.8 rad; measured 0.80-0.85): an anti-phase lock lowers the amplitude, so
+# the analyser's d~ of the final window reads higher; both are printed.
+# Prints the whole table for docs/EXPERIMENTS.md.
+# E2E_DAEMON_SETS="" runs the daemons as position servos instead; there the
+# runs above d~_c are reported as TODO (it does not reproduce).
 source "$(dirname "$0")/../lib.sh"
 
 seconds=${E2E_SWEEP_SECONDS:-40}
-seps=(${E2E_SWEEP_SEPARATIONS:-0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.9})
-rig=(${E2E_DAEMON_SETS:-})  # extra settings for every daemon, e.g. "--daemon-set joint.1.c=0.006"
+seps=(${E2E_SWEEP_SEPARATIONS:-0.1 0.2 0.3 0.35 0.4 0.45 0.5 0.6 0.7 0.8 0.9})
+# settings for every run: torque actuation on the rig's current drive, the
+# start on a small sinusoid (the phase difference set before any contact, as
+# in tests/integration/e2e_pair.sh)
+rig=(${E2E_DAEMON_SETS---daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current --daemon-set sinusoid.amplitude=0.25})
 # Runs at once (each is a simulator and two daemons, a few % of a core).
 parallel=3
 r=0.67
@@ -62,7 +70,10 @@ for sep in "${seps[@]}"; do
 	fi
 done
 
-echo "# pair rig from D0 = pi, r = $r, critical d~_c = $dc"
+# Above d~_c: a failure through torque-driven joints, TODO through position servos.
+report=tap_fail
+[ ${#rig[@]} -eq 0 ] && report=tap_todo
+echo "# pair rig from D0 = pi, r = $r, critical d~_c = $dc; daemons: ${rig[*]:-position actuation}"
 printf '# %-8s %-10s %-9s %-10s %-16s %-6s %s\n' "d~ set" "d~ meas." "final D" "2asin(d~)" "state" "coll." "swing (rad p-p, last 10 s)"
 for name in "${names[@]}"; do
 	if [ -f "$T/$name/crosstalk" ]; then
@@ -82,20 +93,21 @@ for name in "${names[@]}"; do
 	fi
 	anti=0
 	awk -v D="$D" 'BEGIN { D = D < 0 ? -D : D; exit !(D > 3.14159 - 0.5) }' && [ "$n" -gt 0 ] && anti=1
-	if awk -v d="$d" -v c="$dc" 'BEGIN { exit !(d >= c + 0.15 && d < 1) }'; then
+	set_d=${name#sep}
+	if awk -v d="$set_d" -v c="$dc" 'BEGIN { exit !(d >= c + 0.15 && d < 1) }'; then
 		if [ "$anti" -eq 1 ]; then
-			tap_ok "d~ = $d (above d~_c = $dc): anti-phase, as the theory predicts"
+			tap_ok "d~ = $set_d (above d~_c = $dc): anti-phase, as the theory predicts"
 		else
-			tap_todo "d~ = $d (above d~_c = $dc): anti-phase" "final D $D, state $st, collisions in the last 10 s $n"
+			$report "d~ = $set_d (above d~_c = $dc): anti-phase" "final D $D, state $st, collisions in the last 10 s $n"
 		fi
-	elif awk -v d="$d" -v c="$dc" 'BEGIN { exit !(d <= c - 0.1) }'; then
+	elif awk -v d="$set_d" -v c="$dc" 'BEGIN { exit !(d <= c - 0.1) }'; then
 		if [ "$anti" -eq 0 ]; then
-			tap_ok "d~ = $d (below d~_c = $dc): no anti-phase, as the theory predicts"
+			tap_ok "d~ = $set_d (below d~_c = $dc): no anti-phase, as the theory predicts"
 		else
-			tap_fail "d~ = $d (below d~_c = $dc): no anti-phase" "final D $D, state $st"
+			tap_fail "d~ = $set_d (below d~_c = $dc): no anti-phase" "final D $D, state $st"
 		fi
 	else
-		echo "# d~ = $d is within the margin around d~_c = $dc: recorded, not asserted"
+		echo "# d~ = $set_d is within the margin around d~_c = $dc: recorded, not asserted"
 	fi
 done
 keep_runs "${names[@]}"

@@ -9,6 +9,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "../../daemon/control.h"
@@ -25,6 +26,7 @@ static struct ctl c;
 static double servo_angle[2];
 static uint8_t servo_err[2];
 static bool servo_answers[2];
+static bool servo_blocked;   /* held in place from outside (a jam) */
 static double t;
 
 static void setup_robot(enum cfg_mode mode)
@@ -45,6 +47,7 @@ static void setup_robot(enum cfg_mode mode)
 		servo_err[j] = 0;
 		servo_answers[j] = true;
 	}
+	servo_blocked = false;
 	servo_angle[0] = 0.3;
 	servo_angle[1] = -0.2;
 	t = 0.0;
@@ -75,7 +78,7 @@ static double cycle(void)
 	double before[2] = { c.j[0].goal, c.j[1].goal };
 	t += DT;
 	for (size_t j = 0; j < 2; j++) {
-		if (c.j[j].torque && isfinite(c.j[j].goal)) {
+		if (c.j[j].torque && isfinite(c.j[j].goal) && !servo_blocked) {
 			double d = (c.j[j].goal - servo_angle[j]) * (DT / SERVO_TAU);
 			if (DT > SERVO_TAU)
 				d = c.j[j].goal - servo_angle[j];
@@ -186,6 +189,46 @@ static void test_oscillator_starts_from_rest(void **state)
 		hi = fmax(hi, servo_angle[0]);
 	}
 	assert_true(hi - lo > 0.5);   /* it keeps moving on its own */
+}
+
+/* Run OSCILLATOR, block the joints until the stall restart, return its offset. */
+static double stall_offset(const char *name)
+{
+	setup_robot(CFG_MODE_OSCILLATOR);
+	snprintf(cfg.name, sizeof cfg.name, "%s", name);
+	run(400);
+	assert_false(c.starter_active);
+	long long starts = c.starts;
+	servo_blocked = true;
+	const struct ctl_event *stall = NULL;
+	for (int i = 0; i < 300 && stall == NULL; i++) {
+		cycle();
+		stall = find_event("stall");
+	}
+	assert_non_null(stall);
+	assert_true(c.starter_active && c.starts == starts + 1);
+	assert_non_null(strstr(stall->text, "phase"));
+	servo_blocked = false;
+	/* the starter drives the sinusoid at the offset phase once blended in */
+	run((int)(cfg.ramp_s / DT) + 2);
+	assert_true(c.starter_active);
+	double want = cfg.joint[0].neutral + osc_sinusoid(cfg.amplitude, cfg.frequency, cfg.phase + c.starter_offset, 0, t);
+	assert_true(fabs(c.j[0].goal - want) < 1e-9);
+	/* and hands over without a jump */
+	double m = run(300);
+	assert_true(m <= cfg.joint[0].max_step + 1e-12);
+	return c.starter_offset;
+}
+
+/* A stall restart draws a phase offset from the robot's name: two robots
+ * jammed in exact anti-phase do not restart into the same jam. */
+static void test_stall_restart_offset(void **state)
+{
+	(void)state;
+	double a = stall_offset("left"), b = stall_offset("right"), a2 = stall_offset("left");
+	assert_true(fabs(a) <= 3.14159266 && fabs(b) <= 3.14159266);
+	assert_true(fabs(a - b) > 1e-3);
+	assert_true(a == a2);   /* deterministic */
 }
 
 static void test_stale_joint_holds(void **state)
@@ -366,6 +409,7 @@ int main(void)
 		cmocka_unit_test(test_start_hold),
 		cmocka_unit_test(test_switches_without_jumps),
 		cmocka_unit_test(test_oscillator_starts_from_rest),
+		cmocka_unit_test(test_stall_restart_offset),
 		cmocka_unit_test(test_stale_joint_holds),
 		cmocka_unit_test(test_fault_recovery),
 		cmocka_unit_test(test_fault_persistent),

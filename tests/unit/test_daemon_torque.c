@@ -153,6 +153,9 @@ static void run(int n)
 		cycle();
 }
 
+/* where the joints rest before the start (rad from neutral) */
+static double start_angle[NJ_MAX] = { 0.2, -0.1 };
+
 static void setup(const char *ids, const char *drive, enum cfg_mode mode)
 {
 	struct cfg_errors e = { 0 };
@@ -174,7 +177,7 @@ static void setup(const char *ids, const char *drive, enum cfg_mode mode)
 	memset(sv, 0, sizeof sv);
 	for (size_t j = 0; j < nj; j++) {
 		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
-		sv[j] = (struct servo){ .angle = 0.2 - 0.3 * (double)j, .cw = 0, .ccw = 1023, .answers = true };
+		sv[j] = (struct servo){ .angle = start_angle[j], .cw = 0, .ccw = 1023, .answers = true };
 		sv[j].goal = sv[j].angle;
 		ctl_measure(&c, j, dxl_rad_to_pos(sv[j].angle), 0, 0, 0, DT);
 	}
@@ -207,13 +210,18 @@ static void run_into_wheel(void)
 static void test_switch_sequence(void **state)
 {
 	(void)state;
+	/* at rest at neutral, where the law gives no torque: the starter runs
+	 * first, in joint mode (goals, no wheel mode yet) */
+	start_angle[0] = 0.03;
+	start_angle[1] = -0.02;
 	setup("1,2", "current", CFG_MODE_OSCILLATOR);
-	/* the starter runs in joint mode: goals, no wheel mode yet */
+	start_angle[0] = 0.2;
+	start_angle[1] = -0.1;
 	assert_true(c.starter_active);
 	cycle();
 	assert_false(c.wheel);
 	assert_int_equal(c.sync, CTL_SYNC_GOAL);
-	/* at the hand-over: torque off, limits 0 in one write, torque on, per servo, in that order */
+	/* at the hand-over: torque off, limits 0 in one write, torque limit, torque on, per servo, in that order */
 	for (int i = 0; i < 1000 && !c.wheel; i++)
 		cycle();
 	assert_true(c.wheel);
@@ -228,10 +236,12 @@ static void test_switch_sequence(void **state)
 				seen = 1;
 			else if (seen == 1 && w->addr == DXL_AX_CW_ANGLE_LIMIT && w->len == 4 && w->value == 0)
 				seen = 2;
-			else if (seen == 2 && w->addr == DXL_AX_TORQUE_ENABLE && w->value == 1)
-				seen = 3;
+			else if (seen == 2 && w->addr == DXL_AX_TORQUE_LIMIT && w->value == 1023)
+				seen = 3;   /* the torque limit back before torque on (an alarm may have zeroed it) */
+			else if (seen == 3 && w->addr == DXL_AX_TORQUE_ENABLE && w->value == 1)
+				seen = 4;
 		}
-		assert_int_equal(seen, 3);
+		assert_int_equal(seen, 4);
 		assert_true(wheel(&sv[j]) && sv[j].torque);
 		assert_int_equal(sv[j].eeprom_refused, 0);
 	}
@@ -293,7 +303,31 @@ static void test_limit_cycle_through_torque(void **state)
 	 * ~0.8 rad (the loop's delay shifts both a little) */
 	if (!(amp > 0.6 && amp < 1.05 && f > 0.65 && f < 0.9))
 		fail_msg("limit cycle through torque: amplitude %.3f rad, %.3f Hz", amp, f);
-	assert_int_equal(c.starts, 1);   /* never stalled and restarted */
+	/* from rest at 0.2 rad the law started it by itself: no starter, no stall restart */
+	assert_int_equal(c.starts, 0);
+}
+
+/* From rest at chosen angles the law starts at once, at phases 0 and pi:
+ * joints held apart in anti-phase stay exactly in anti-phase. */
+static void test_start_from_rest_displaced(void **state)
+{
+	(void)state;
+	start_angle[0] = 0.5;
+	start_angle[1] = -0.5;
+	setup("1,2", "current", CFG_MODE_HOLD);
+	cfg.joint[0].osc.lambda = cfg.joint[1].osc.lambda = 0.0;   /* two independent oscillators */
+	run(50);
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	start_angle[0] = 0.2;
+	start_angle[1] = -0.1;
+	assert_false(c.starter_active);
+	cycle();
+	assert_true(c.wheel);
+	run(500);
+	assert_int_equal(c.starts, 0);
+	/* mirror images: x0 = -x1 all along */
+	assert_true(fabs(sv[0].angle + sv[1].angle) < 0.02);
+	assert_true(fabs(sv[0].angle) > 0.3 || fabs(sv[0].speed) > 1.0);
 }
 
 static void test_walls_and_limit_breach(void **state)
@@ -392,6 +426,23 @@ static void test_pwm_adds_back_emf(void **state)
 	assert_true(fabs(jt->duty - fmax(-1.0, fmin(1.0, expect))) < 1e-12);
 }
 
+/* A switch from SINUSOID that lands on a turning point (speed ~0) is still a
+ * switch from a moving robot: the law takes over at once, no starter. */
+static void test_switch_at_turning_point(void **state)
+{
+	(void)state;
+	setup("1", "current", CFG_MODE_SINUSOID);
+	run(400);
+	int i = 0;
+	for (; i < 200 && !(fabs(c.j[0].speed) < 0.05); i++)
+		cycle();
+	assert_true(fabs(c.j[0].speed) < 0.05);
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	assert_false(c.starter_active);
+	cycle();
+	assert_true(c.wheel);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -401,6 +452,8 @@ int main(void)
 		cmocka_unit_test(test_limp_leaves_torque_off),
 		cmocka_unit_test(test_stale_and_nonfinite_give_no_drive),
 		cmocka_unit_test(test_pwm_adds_back_emf),
+		cmocka_unit_test(test_switch_at_turning_point),
+		cmocka_unit_test(test_start_from_rest_displaced),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
