@@ -70,6 +70,8 @@ tap_check "--min-swing 0: the phases decide again (r3:r4 in-phase)" [ "$(col "$T
 tap_check "--min-swing -1: exit 1" [ "$rc" = 1 ]
 "$A" "$T/stop.log" --synth-stop-after 3 --out "$T/stop2" 2>/dev/null; rc=$?
 tap_check "--synth-stop-after without --synth: exit 1" [ "$rc" = 1 ]
+"$A" --synth "$T/s3.log" "$T/s.log" 2>"$T/s3.err"; rc=$?
+tap_check "--synth with a log to read: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'reads none' '$T/s3.err'"
 
 # errors: missing, foreign, truncated, bad options
 "$A" "$T/nope.log" --out "$T/e1" 2>"$T/e1.err"; rc=$?

@@ -260,10 +260,34 @@ static void test_json(void **state)
 	assert_int_equal(strchr(buf, '\n') - buf, (long)strlen(buf) - 1); /* one line */
 }
 
+/* Torque actuation publishes no goal (NaN) but the drive sent: the goal
+ * column shows the drive, marked d, and JSON carries both. */
+static void test_drive_column(void **state)
+{
+	(void)state;
+	char n[] = "rig", reason[] = "test";
+	undulate_joint_state_t j[1] = {
+		{ .servo_id = 1, .angle = 0.5, .goal = NAN, .drive = 0.124, .amplitude = 0.8, .frequency = 0.8 },
+	};
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason,
+		.period_us = 10000.0, .njoints = 1, .joints = j };
+	top_on_state(&model, &s, 0.0);
+	struct top_view v = { .kind = TOP_VIEW_DETAIL };
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "d+0.124"));
+	assert_null(strstr(screen, "nan"));
+	static char buf[65536];
+	FILE *f = fmemopen(buf, sizeof(buf), "w");
+	top_json(&model, 0.1, 1234, f);
+	fclose(f);
+	assert_non_null(strstr(buf, "\"goal\":null,\"drive\":0.124"));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test_setup(test_rate_jitter_stale, setup),
+		cmocka_unit_test_setup(test_drive_column, setup),
 		cmocka_unit_test_setup(test_order_and_phases, setup),
 		cmocka_unit_test_setup(test_collisions, setup),
 		cmocka_unit_test_setup(test_keys, setup),

@@ -177,6 +177,11 @@ int main(int argc, char **argv)
 			return AN_EXIT_USAGE;
 		}
 	}
+	if (sa.path && optind < argc) {
+		/* a log named here would silently not be read */
+		fprintf(stderr, "undulate-analyze: --synth writes a log and reads none: unexpected '%s'\n", argv[optind]);
+		return AN_EXIT_USAGE;
+	}
 	if (sa.path)
 		return check_synth(&sa) != 0 ? AN_EXIT_USAGE : run_synth(&sa);
 	if (!isnan(sa.stop_after)) {

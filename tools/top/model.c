@@ -102,7 +102,7 @@ void top_on_state(struct top_model *m, const undulate_robot_state_t *s, double n
 	for (int k = 0; k < r->njoints; k++) {
 		const undulate_joint_state_t *js = &s->joints[k];
 		r->j[k] = (struct top_joint){
-			.servo_id = js->servo_id, .angle = js->angle, .speed = js->speed, .goal = js->goal,
+			.servo_id = js->servo_id, .angle = js->angle, .speed = js->speed, .goal = js->goal, .drive = js->drive,
 			.load = js->load, .phase = js->phase, .amplitude = js->amplitude,
 			.frequency = js->frequency, .error_bits = js->error_bits,
 			.stale_cycles = js->stale_cycles, .torque = js->torque,
@@ -371,6 +371,7 @@ static void top_json_joint(FILE *f, const struct top_joint *j)
 	top_json_num(f, "angle", j->angle, false);
 	top_json_num(f, "speed", j->speed, false);
 	top_json_num(f, "goal", j->goal, false);
+	top_json_num(f, "drive", j->drive, false);
 	top_json_num(f, "load", j->load, false);
 	top_json_num(f, "phase", j->phase, false);
 	top_json_num(f, "amplitude", j->amplitude, false);

@@ -29,6 +29,7 @@
 struct top_joint {
 	int16_t servo_id;
 	double angle, speed, goal, load, phase, amplitude, frequency;
+	double drive;          /* torque actuation: output ratio sent (NaN with goals) */
 	int16_t error_bits;
 	int32_t stale_cycles;
 	bool torque;

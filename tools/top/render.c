@@ -137,8 +137,14 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 		num(dn, sizeof(dn), "%+8.2f", top_neighbour_dphase(m, pos), 8), flags);
 	for (int k = 0; k < r->njoints; k++) {
 		const struct top_joint *j = &r->j[k];
-		rb_line(b, false, "     j%d id%-3d %+7.3f %+7.3f %+7.3f %+6.2f %+6.2f %5.2f %5.2f %02X", k, j->servo_id,
-			j->angle, j->speed, j->goal, j->load, j->phase, j->amplitude, j->frequency,
+		/* torque actuation has no goal: the column shows the drive, marked d */
+		char goal[16];
+		if (!isfinite(j->goal) && isfinite(j->drive))
+			snprintf(goal, sizeof goal, "d%+6.3f", j->drive);
+		else
+			num(goal, sizeof goal, "%+7.3f", j->goal, 7);
+		rb_line(b, false, "     j%d id%-3d %+7.3f %+7.3f %7s %+6.2f %+6.2f %5.2f %5.2f %02X", k, j->servo_id,
+			j->angle, j->speed, goal, j->load, j->phase, j->amplitude, j->frequency,
 			j->error_bits & 0xFF);
 	}
 }
