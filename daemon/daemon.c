@@ -689,6 +689,29 @@ static int dmn_send_goals(struct dmn *d)
 static void dmn_cycle_done(struct dmn *d);
 static void dmn_advance(struct dmn *d);
 
+/* Register writes are queued commands (torque on, recovery, mode switches):
+ * one that was sent is done. Those not sent yet move to the front of the
+ * queue for the next cycle, where ctl_step() may add to them. Without this a
+ * queue longer than what fits after the reads (torque on for 16+ servos at
+ * start-up) was sent again from its start every cycle and never finished. */
+static void dmn_defer_writes(struct dmn *d)
+{
+	struct ctl *c = &d->ctl;
+	size_t sent = d->idx < c->nwrites ? d->idx : c->nwrites;
+	memmove(c->writes, c->writes + sent, (c->nwrites - sent) * sizeof c->writes[0]);
+	c->nwrites -= sent;
+	d->idx = 0;
+}
+
+/* Past this share of the period no new write is begun: a transaction cut off
+ * by the next tick leaves its reply on the line to collide with the next
+ * cycle's first READ. */
+#define DMN_WRITES_UNTIL 0.7
+static bool dmn_late_in_cycle(const struct dmn *d)
+{
+	return (double)(now_us() - d->cycle_start_us) > DMN_WRITES_UNTIL * (double)d->period_us;
+}
+
 static void dmn_control(struct dmn *d)
 {
 	uint64_t t0 = now_us();
@@ -726,6 +749,12 @@ static void dmn_advance(struct dmn *d)
 				break;
 			continue;
 		case PH_WRITES:
+			if (d->idx < d->ctl.nwrites && dmn_late_in_cycle(d)) {
+				/* the rest waits for the next cycle: the reads come first */
+				dmn_defer_writes(d);
+				dmn_cycle_done(d);
+				return;
+			}
 			if (d->idx < d->ctl.nwrites) {
 				r = dmn_begin_write(d, &d->ctl.writes[d->idx]);
 				break;
@@ -850,7 +879,10 @@ static void dmn_tick(struct dmn *d)
 	}
 	uint64_t scheduled = d->first_tick_us + (d->ticks - 1) * d->period_us;
 	if (d->phase != PH_IDLE) {
-		/* the previous cycle's bus work is still going: give it up */
+		/* the previous cycle's bus work is still going: give it up (a write
+		 * cut off is sent again next cycle) */
+		if (d->phase == PH_WRITES)
+			dmn_defer_writes(d);
 		bus_abort(&d->bus);
 		d->bus_errors++;
 		d->overruns++;
