@@ -609,7 +609,7 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 		struct cfg_joint *jt = &c->joint[j];
 		struct osc_joint_params d;
 		if (c->actuation == CFG_ACT_TORQUE)
-			osc_default_torque_params(&d, j, c->njoints);
+			osc_default_torque_params(&d, j, c->njoints, c->torque_drive == CFG_DRIVE_PWM);
 		else
 			osc_default_params(&d, j, c->njoints);
 		if (isnan(jt->osc.k)) jt->osc.k = d.k;

@@ -45,9 +45,14 @@
  *   speed estimate take energy out, so the loop settles lower than A = 2√(c/μ);
  * - friction 5 mN·m: the link's dry friction (PHYSICS.md), so the joint
  *   starts from a turning point without a dead zone.
+ * On a PWM drive (the AX-12's wheel mode) the daemon adds the back-EMF back
+ * from a speed estimate a few ms late: the error goes with the acceleration,
+ * i.e. with −x, and softens the spring (0.61 Hz with k = 0.111); k = 0.19
+ * gives 0.79–0.80 Hz, 0.77 rad there (measured, CONTROL.md).
  */
 #define OSC_TQ_INERTIA 4.39e-3
 #define OSC_TQ_K        0.111
+#define OSC_TQ_K_PWM    0.19
 #define OSC_TQ_C        6.6e-3
 #define OSC_TQ_MU       0.032
 #define OSC_TQ_FRICTION 0.005
@@ -80,9 +85,9 @@ void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints
 	}
 }
 
-void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t njoints)
+void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t njoints, bool pwm)
 {
-	p->k = OSC_TQ_K;
+	p->k = pwm ? OSC_TQ_K_PWM : OSC_TQ_K;
 	p->c = OSC_TQ_C;
 	p->mu = OSC_TQ_MU;
 	p->inertia = OSC_TQ_INERTIA;

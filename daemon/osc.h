@@ -62,8 +62,9 @@ void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints
 
 /* Defaults for torque actuation (CONTROL.md, "Torque actuation"): the law's
  * torque drives the joint directly, so the parameters are physical; tuned for
- * ≈0.8 Hz, ≈0.8 rad on one simulated AX-12A joint with an 18.65 cm link. */
-void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t njoints);
+ * ≈0.8 Hz, ≈0.8 rad on one simulated AX-12A joint with an 18.65 cm link, on a
+ * current drive, or on the AX-12's PWM drive (`pwm`: a stiffer k). */
+void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t njoints, bool pwm);
 
 /* Torque actuation: the law's right-hand side at the measured state,
  *     τ_j = −k (x_j + λ_j x_other) + (c − μ x_j²) ẋ_j + b·sgn(ẋ_j)   (N·m).

@@ -129,7 +129,10 @@ static void test_defaults_from_osc(void **state)
 	load_ok(&c, "[robot]\nport=/dev/null\nids=1\n[joint.1]\nmu=0.05\n[robot]\nactuation = torque\n"
 	        "torque_drive = current\n");
 	struct osc_joint_params t0;
-	osc_default_torque_params(&t0, 0, 1);
+	osc_default_torque_params(&t0, 0, 1, false);
+	struct osc_joint_params tp;
+	osc_default_torque_params(&tp, 0, 1, true);
+	assert_true(tp.k > t0.k);   /* the PWM drive's softer loop needs a stiffer spring */
 	assert_int_equal(c.actuation, CFG_ACT_TORQUE);
 	assert_int_equal(c.torque_drive, CFG_DRIVE_CURRENT);
 	assert_double_equal(c.joint[0].osc.k, t0.k, 1e-12);
