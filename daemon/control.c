@@ -65,6 +65,15 @@ static void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint
 		c->writes[c->nwrites++] = (struct ctl_write){ .id = id, .addr = addr, .len = len, .value = value };
 }
 
+/* The torque limit a joint should have: the servo's max torque, reduced to
+ * backoff_torque while it backs off from a fault. */
+static uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt)
+{
+	if (jt->fault == CTL_FAULT_NONE)
+		return jt->servo.max_torque;
+	return (uint16_t)lround(c->cfg->backoff_torque * jt->servo.max_torque);
+}
+
 /* Appended as they are, in order: a sequence that writes one register twice
  * (torque off, EEPROM write, torque on) must not be merged. */
 static void ctl_write_seq(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
@@ -391,8 +400,7 @@ static void ctl_backoff(struct ctl *c, size_t j)
 	jt->fault = CTL_FAULT_BACKOFF;
 	jt->fault_since = c->t;
 	jt->fault_hold = isfinite(jt->angle) ? jt->angle : jt->goal;
-	uint16_t reduced = (uint16_t)lround(c->cfg->backoff_torque * jt->servo.max_torque);
-	ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, reduced);
+	ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, jt));
 }
 
 static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what)
@@ -790,10 +798,7 @@ static void ctl_switch_limits(struct ctl *c, size_t j, uint32_t limits, bool tor
 	 * clears a latched overload bit, so an alarm shutdown that zeroed the
 	 * torque limit since the last reading would otherwise never be seen, and
 	 * the joint would stay without drive. */
-	const struct ctl_joint *jt = &c->j[j];
-	uint16_t limit = jt->fault == CTL_FAULT_NONE ? jt->servo.max_torque
-	                                              : (uint16_t)lround(c->cfg->backoff_torque * jt->servo.max_torque);
-	ctl_write_seq(c, id, DXL_AX_TORQUE_LIMIT, 2, limit);
+	ctl_write_seq(c, id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, &c->j[j]));
 	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
 }
 

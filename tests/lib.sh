@@ -86,6 +86,31 @@ wait_log() { wait_for "${3:-10}" grep -qE "$2" "$T/$1.log"; }
 
 lcm_url() { echo "udpm://239.255.76.67:$1?ttl=0"; }
 
+# ---- reading an experiment's analysis (scripts/demo.sh --out DIR) -------------------
+# min_swing DIR: the smallest peak-to-peak angle (rad) of any robot's joint
+# over the last 10 s of DIR/states.csv, and whose: "0.812 (\"r3\"/1)" (the
+# number is ${x%% *}). Robots that stopped moving never collide either: no
+# claim about phases or collisions means anything unless they all still swing.
+min_swing() {
+	awk -F, 'NR > 1 { t[NR] = $2; k[NR] = $3 "/" $4; a[NR] = $6; if ($2 > end) end = $2 }
+		END { for (i in t) if (t[i] >= end - 10) { j = k[i]
+			if (!(j in lo) || a[i] < lo[j]) lo[j] = a[i]; if (!(j in hi) || a[i] > hi[j]) hi[j] = a[i] }
+		m = -1; for (j in lo) if (m < 0 || hi[j] - lo[j] < m) { m = hi[j] - lo[j]; w = j }
+		printf "%.3f (%s)", m, w }' "$1/states.csv"
+}
+# summary_col DIR PAIR COLUMN: a column of PAIR's row in DIR/summary.txt, by
+# its header name ("end state" is one column, named "state").
+summary_col() {
+	awk -v pair="$2" -v want="$3" '
+		$1 == "pair" && !hdr { for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { c["state"] = ++j; i++ } else c[$i] = ++j }; hdr = 1; next }
+		hdr && $1 == pair { print $c[want]; exit }' "$1/summary.txt"
+}
+# last_collisions DIR: collisions (pairs and walls) in the last 10 s of DIR/collision_rate.csv.
+last_collisions() {
+	awk -F, 'NR > 1 { t[NR] = $1; n[NR] = $2; end = $1 + 1 } END { for (k in t) if (t[k] >= end - 10) s += n[k]; print s + 0 }' \
+		"$1/collision_rate.csv"
+}
+
 # keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
 # test directory is removed on exit) in $BUILD/test-logs/<test>.d/.
 keep_runs() {

@@ -49,16 +49,6 @@ else
 	tap_fail "all ten robots report the switch to OSCILLATOR" "$nmode mode events"
 fi
 
-# swing DIR: the smallest peak-to-peak angle (rad) of any robot's joint over
-# the last 10 s of the log. Robots that stopped moving never collide either:
-# no claim about collisions means anything unless they all still swing.
-swing() {
-	awk -F, 'NR > 1 { t[NR] = $2; k[NR] = $3 "/" $4; a[NR] = $6; if ($2 > end) end = $2 }
-		END { for (i in t) if (t[i] >= end - 10) { j = k[i]
-			if (!(j in lo) || a[i] < lo[j]) lo[j] = a[i]; if (!(j in hi) || a[i] > hi[j]) hi[j] = a[i] }
-		m = -1; for (j in lo) if (m < 0 || hi[j] - lo[j] < m) { m = hi[j] - lo[j]; w = j }
-		printf "%.3f (%s)", m, w }' "$1/states.csv"
-}
 # The simulator's samples (contact.csv: simulated time, running impact count,
 # total impulse), taken by demo.sh every 5 s from the start, just before the
 # switch and at the end.
@@ -86,7 +76,7 @@ echo "# impacts only (collision messages): SINUSOID $ib N*s/s, OSCILLATOR $ia N*
 
 # Robots that stopped would also stop colliding: every joint must still swing
 # at least 0.6 rad peak-to-peak (a crowded end robot's free joint swings least).
-sg=$(swing "$T/out")
+sg=$(min_swing "$T/out")
 if awk -v s="${sg%% *}" 'BEGIN { exit !(s >= 0.6) }'; then
 	tap_ok "OSCILLATOR: every robot still undulates at the end (smallest peak-to-peak $sg rad)"
 else

@@ -38,27 +38,14 @@ run() {
 	# busiest moment for the simulated buses).
 	wait_log "$name" '^demo: phases' 20 || true
 }
-# col NAME COLUMN: a column of the pair's row in summary.txt ("end state" is one column).
-col() {
-	awk -v want="$2" '
-		$1 == "pair" && !hdr { for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { c["state"] = ++j; i++ } else c[$i] = ++j }; hdr = 1; next }
-		hdr && $1 == "left:right" { print $c[want]; exit }' "$T/$1/summary.txt"
-}
+# col NAME COLUMN: a column of the pair's row in the run's summary.txt.
+col() { summary_col "$T/$1" left:right "$2"; }
 # collisions NAME FROM TO: collisions (pairs and walls) between FROM and TO s of the log.
 collisions() {
 	awk -F, -v a="$2" -v b="$3" 'NR > 1 && $1 >= a && $1 < b { n += $2 } END { print n + 0 }' "$T/$1/collision_rate.csv"
 }
 span() { awk -F, 'NR > 1 { t = $1 } END { print t + 1 }' "$T/$1/collision_rate.csv"; }
 num() { awk "BEGIN { exit !($*) }"; }
-# swing NAME: the smallest peak-to-peak angle (rad) of any robot's joint over
-# the last 10 s of the log. A pair that stopped moving never collides either:
-# no claim about phases or collisions means anything unless both still swing.
-swing() {
-	awk -F, 'NR > 1 { t[NR] = $2; k[NR] = $3 "/" $4; a[NR] = $6; if ($2 > end) end = $2 }
-		END { for (i in t) if (t[i] >= end - 10) { j = k[i]
-			if (!(j in lo) || a[i] < lo[j]) lo[j] = a[i]; if (!(j in hi) || a[i] > hi[j]) hi[j] = a[i] }
-		m = -1; for (j in lo) if (m < 0 || hi[j] - lo[j] < m) m = hi[j] - lo[j]; printf "%.3f", m }' "$T/$1/states.csv"
-}
 # Peak-to-peak (rad) both robots must keep: half the rig's 2 x 0.8 rad.
 MIN_SWING=0.8
 
@@ -78,8 +65,8 @@ for name in inphase compat anti; do
 		tap_fail "$name: nobody else on its LCM port" "another program published on the run's LCM URL; its results mix two runs"
 	elif [ "$rc" = 0 ] && [ -f "$T/$name/summary.txt" ]; then
 		tap_ok "$name: rig ran ${seconds} s through sim + 2 daemons, log analysed"
-		sw=$(swing "$name")
-		if num "$sw >= $MIN_SWING"; then
+		sw=$(min_swing "$T/$name")
+		if num "${sw%% *} >= $MIN_SWING"; then
 			tap_ok "$name: both robots still swing at the end (smallest peak-to-peak $sw rad)"
 		else
 			tap_fail "$name: both robots still swing at the end" "smallest peak-to-peak over the last 10 s: $sw rad (< $MIN_SWING): a stopped pair proves nothing"

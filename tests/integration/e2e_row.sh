@@ -30,22 +30,8 @@ rows() {
 		$1 == "pair" && !hdr { for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { c["state"] = ++j; i++ } else c[$i] = ++j }; hdr = 1; next }
 		hdr && $1 ~ /^r[0-9]:r[0-9]$/ { print $1, $c["state"], $c["meanD"], $c["d~"], $c["2asin(d~)"], $c["c.win"] }' "$T/$1/summary.txt"
 }
-# swing DIR: the smallest peak-to-peak angle (rad) of any robot's joint over
-# the last 10 s of the log. Robots that stopped moving never collide either:
-# no claim about collisions means anything unless they all still swing.
-swing() {
-	awk -F, 'NR > 1 { t[NR] = $2; k[NR] = $3 "/" $4; a[NR] = $6; if ($2 > end) end = $2 }
-		END { for (i in t) if (t[i] >= end - 10) { j = k[i]
-			if (!(j in lo) || a[i] < lo[j]) lo[j] = a[i]; if (!(j in hi) || a[i] > hi[j]) hi[j] = a[i] }
-		m = -1; for (j in lo) if (m < 0 || hi[j] - lo[j] < m) { m = hi[j] - lo[j]; w = j }
-		printf "%.3f (%s)", m, w }' "$1/states.csv"
-}
 # Peak-to-peak (rad) every robot must keep: half of 2 x 0.8 rad.
 MIN_SWING=0.8
-last_collisions() {
-	awk -F, 'NR > 1 { t[NR] = $1; n[NR] = $2; end = $1 + 1 } END { for (k in t) if (t[k] >= end - 10) s += n[k]; print s + 0 }' \
-		"$T/$1/collision_rate.csv"
-}
 
 # Two LCM ports, one of five blocks in 7870-7879.
 port=$((7870 + 2 * ($$ % 5)))
@@ -61,7 +47,7 @@ for name in immobile mobile; do
 		tap_fail "$name row: nobody else on its LCM port" "another program published on the run's LCM URL; its results mix two runs"
 	elif [ "$rc" = 0 ] && [ -f "$T/$name/summary.txt" ]; then
 		tap_ok "$name row: ${seconds} s through sim + 5 daemons, log analysed"
-		sw=$(swing "$T/$name")
+		sw=$(min_swing "$T/$name")
 		if awk -v s="${sw%% *}" -v m=$MIN_SWING 'BEGIN { exit !(s >= m) }'; then
 			tap_ok "$name row: every robot still swings at the end (smallest peak-to-peak $sw rad)"
 		else
@@ -87,7 +73,7 @@ fi
 if [ -f "$T/mobile/summary.txt" ]; then
 	r=$(rows mobile)
 	echo "$r" | sed 's/^/# mobile: /'
-	last=$(last_collisions mobile)
+	last=$(last_collisions "$T/mobile")
 	bad=$(echo "$r" | awk '{ D = $3 < 0 ? -$3 : $3 } D > $5 + 0.1 { print $1 }' | tr '\n' ' ')
 	if [ "$last" -eq 0 ] && [ -z "$bad" ]; then
 		tap_ok "mobile row reaches a collision-free compatible state (no collision in the last 10 s, every |D| <= 2 asin(d~) + 0.1)"

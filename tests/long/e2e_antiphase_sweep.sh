@@ -28,24 +28,7 @@ parallel=3
 r=0.67
 dc=$(awk -v r=$r 'BEGIN { printf "%.3f", sqrt(r * (r - 1) / (r * r - r - 2)) }')
 
-col() {
-	awk -v want="$2" '
-		$1 == "pair" && !hdr { for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { c["state"] = ++j; i++ } else c[$i] = ++j }; hdr = 1; next }
-		hdr && $1 == "left:right" { print $c[want]; exit }' "$T/$1/summary.txt"
-}
-last_collisions() {
-	awk -F, 'NR > 1 { t[NR] = $1; n[NR] = $2; end = $1 + 1 } END { for (k in t) if (t[k] >= end - 10) s += n[k]; print s + 0 }' \
-		"$T/$1/collision_rate.csv"
-}
-
-# swing NAME: the smallest peak-to-peak angle (rad) of either robot over the
-# last 10 s (a stopped pair would read as "in phase" and never collide).
-swing() {
-	awk -F, 'NR > 1 { t[NR] = $2; k[NR] = $3 "/" $4; a[NR] = $6; if ($2 > end) end = $2 }
-		END { for (i in t) if (t[i] >= end - 10) { j = k[i]
-			if (!(j in lo) || a[i] < lo[j]) lo[j] = a[i]; if (!(j in hi) || a[i] > hi[j]) hi[j] = a[i] }
-		m = -1; for (j in lo) if (m < 0 || hi[j] - lo[j] < m) m = hi[j] - lo[j]; printf "%.2f", m }' "$T/$1/states.csv"
-}
+col() { summary_col "$T/$1" left:right "$2"; }
 
 # Three LCM ports (one run each at a time), one of five blocks in 7885-7899.
 port=$((7885 + 3 * ($$ % 5)))
@@ -84,8 +67,8 @@ for name in "${names[@]}"; do
 		tap_fail "$name ran and was analysed" "$(tail -n 10 "$T/$name.log")"
 		continue
 	fi
-	d=$(col "$name" d~); D=$(col "$name" meanD); st=$(col "$name" state); n=$(last_collisions "$name")
-	sw=$(swing "$name")
+	d=$(col "$name" d~); D=$(col "$name" meanD); st=$(col "$name" state); n=$(last_collisions "$T/$name")
+	sw=$(min_swing "$T/$name"); sw=${sw%% *}
 	printf '# %-8s %-10s %-9s %-10s %-16s %-6s %s\n' "${name#sep}" "$d" "$D" "$(col "$name" "2asin(d~)")" "$st" "$n" "$sw"
 	if awk -v s="$sw" 'BEGIN { exit !(s < 0.8) }'; then
 		tap_fail "d~ = $d: both robots still swing" "smallest peak-to-peak $sw rad over the last 10 s"

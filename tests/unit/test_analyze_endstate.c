@@ -18,6 +18,7 @@
 
 #include "../../tools/analyze/alog.h"
 #include "../../tools/analyze/analyze.h"
+#include "scratch.h"
 
 #include "undulate_robot_state_t.h"
 
@@ -34,7 +35,6 @@ ALOG_DEFINE_WRITER(robot_state_t)
  * flickers by this much. */
 #define T_AX12_STEP (300.0 / 1023.0 * M_PI / 180.0)
 
-static char tmpdir[256];
 
 /* One joint's motion: A cos(2 pi f t + phase) + offset until stop_s (< 0:
  * never), then held where it was, flickering by one position step. */
@@ -45,16 +45,13 @@ struct motion {
 static int setup(void **state)
 {
 	(void)state;
-	snprintf(tmpdir, sizeof(tmpdir), "%s/undulate-endstate-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
-	return mkdtemp(tmpdir) ? 0 : -1;
+	return scratch_make("endstate");
 }
 
 static int teardown(void **state)
 {
 	(void)state;
-	char cmd[512];
-	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", tmpdir);
-	return system(cmd) == 0 ? 0 : -1;
+	return scratch_remove();
 }
 
 static void motion_at(const struct motion *m, int64_t cycle, double *angle, double *speed)
@@ -92,7 +89,7 @@ static int write_state(struct alog_writer *w, const char *robot, int64_t cycle, 
 static void write_log(const char *name, const struct motion *a, const struct motion *b)
 {
 	char p[512];
-	snprintf(p, sizeof(p), "%s/%s.log", tmpdir, name);
+	snprintf(p, sizeof(p), "%s/%s.log", scratch_dir, name);
 	struct alog_writer w;
 	assert_int_equal(alog_writer_open(&w, p), 0);
 	int64_t cycles = (int64_t)llround(T_SECONDS / T_DT);
@@ -107,8 +104,8 @@ static void write_log(const char *name, const struct motion *a, const struct mot
 static void analyse(const char *name, double min_swing)
 {
 	char logp[512], outp[512];
-	snprintf(logp, sizeof(logp), "%s/%s.log", tmpdir, name);
-	snprintf(outp, sizeof(outp), "%s/%s", tmpdir, name);
+	snprintf(logp, sizeof(logp), "%s/%s.log", scratch_dir, name);
+	snprintf(outp, sizeof(outp), "%s/%s", scratch_dir, name);
 	struct an_options o;
 	an_options_default(&o);
 	o.logs[0] = logp;
@@ -122,14 +119,10 @@ static void analyse(const char *name, double min_swing)
 
 static char *slurp(const char *dir, const char *file)
 {
-	char p[512];
-	snprintf(p, sizeof(p), "%s/%s/%s", tmpdir, dir, file);
-	FILE *f = fopen(p, "rb");
-	assert_non_null(f);
-	char *buf = calloc(1, T_FILE_MAX + 1);
-	size_t n = fread(buf, 1, T_FILE_MAX, f);
-	buf[n] = '\0';
-	fclose(f);
+	char rel[256];
+	snprintf(rel, sizeof(rel), "%s/%s", dir, file);
+	char *buf = scratch_slurp(rel, T_FILE_MAX);
+	assert_non_null(buf);
 	return buf;
 }
 

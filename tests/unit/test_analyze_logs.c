@@ -17,44 +17,33 @@
 #include "../../tools/analyze/analyze.h"
 #include "../../tools/analyze/phase.h"
 #include "../../tools/analyze/synth.h"
+#include "scratch.h"
 
 /* Largest file the tests read whole (summary.json, return_map.csv). */
 #define T_FILE_MAX (1 << 20)
 
-static char tmpdir[256];
-
 static int setup(void **state)
 {
 	(void)state;
-	snprintf(tmpdir, sizeof(tmpdir), "%s/undulate-analyze-XXXXXX", getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
-	return mkdtemp(tmpdir) ? 0 : -1;
+	return scratch_make("analyze");
 }
 
 static int teardown(void **state)
 {
 	(void)state;
-	char cmd[512];
-	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", tmpdir);
-	return system(cmd) == 0 ? 0 : -1;
+	return scratch_remove();
 }
 
 static void path_of(char *out, size_t n, const char *a, const char *b)
 {
-	snprintf(out, n, "%s/%s%s%s", tmpdir, a, b ? "/" : "", b ? b : "");
+	snprintf(out, n, "%s/%s%s%s", scratch_dir, a, b ? "/" : "", b ? b : "");
 }
 
 static char *slurp(const char *dir, const char *name)
 {
-	char p[512];
-	path_of(p, sizeof(p), dir, name);
-	FILE *f = fopen(p, "rb");
-	if (!f)
-		return NULL;
-	char *buf = calloc(1, T_FILE_MAX + 1);
-	size_t n = fread(buf, 1, T_FILE_MAX, f);
-	buf[n] = '\0';
-	fclose(f);
-	return buf;
+	char rel[256];
+	snprintf(rel, sizeof(rel), "%s/%s", dir, name);
+	return scratch_slurp(rel, T_FILE_MAX);
 }
 
 static long count_lines(const char *dir, const char *name)

@@ -1,0 +1,44 @@
+/* scratch.c — see scratch.h. */
+#include "scratch.h"
+
+#include <ftw.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+char scratch_dir[256];
+
+int scratch_make(const char *tag)
+{
+	const char *base = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+	snprintf(scratch_dir, sizeof scratch_dir, "%s/undulate-%s-XXXXXX", base, tag);
+	return mkdtemp(scratch_dir) ? 0 : -1;
+}
+
+static int scratch_unlink(const char *path, const struct stat *st, int type, struct FTW *ftw)
+{
+	(void)st; (void)type; (void)ftw;
+	return remove(path);
+}
+
+int scratch_remove(void)
+{
+	if (scratch_dir[0] == '\0')
+		return 0;
+	/* depth first, no symlinks followed: only what the test wrote goes */
+	return nftw(scratch_dir, scratch_unlink, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+char *scratch_slurp(const char *rel, size_t cap)
+{
+	char p[512];
+	snprintf(p, sizeof p, "%s/%s", scratch_dir, rel);
+	FILE *f = fopen(p, "rb");
+	if (!f)
+		return NULL;
+	char *buf = calloc(1, cap + 1);
+	size_t n = buf ? fread(buf, 1, cap, f) : 0;
+	if (buf)
+		buf[n] = '\0';
+	fclose(f);
+	return buf;
+}

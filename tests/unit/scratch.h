@@ -1,0 +1,23 @@
+/*
+ * scratch.h — a private scratch directory for a unit test that writes files
+ * (logs, analyser output), and reading a file back whole. Linked into every
+ * unit test, like ptypeer.c.
+ */
+#ifndef UNDULATE_SCRATCH_H
+#define UNDULATE_SCRATCH_H
+
+#include <stddef.h>
+
+/* The directory made by scratch_make(), "" before. */
+extern char scratch_dir[256];
+
+/* Make $TMPDIR/undulate-TAG-XXXXXX (or under /tmp). 0, or -1 on failure:
+ * usable as a cmocka group setup through a one-line wrapper. */
+int scratch_make(const char *tag);
+/* Remove the directory and everything in it. 0, or -1. */
+int scratch_remove(void);
+/* A file under the scratch directory, NUL-terminated, at most cap bytes read
+ * (free() it); NULL if it cannot be opened. `rel` is relative to scratch_dir. */
+char *scratch_slurp(const char *rel, size_t cap);
+
+#endif
