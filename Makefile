@@ -30,7 +30,7 @@ OBJ      := $(BUILD)/obj
 LIB      := $(BUILD)/lib
 GEN      := $(BUILD)/lcmgen
 
-PKGS     := lcm libserialport inih
+PKGS     := lcm libserialport inih libsodium
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 
@@ -38,7 +38,7 @@ WARN     := -Wall -Wextra -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
             -Wpointer-arith -Wcast-qual -Wundef -Wvla -Wformat-security -Werror
 STD      := -std=c11 -D_DEFAULT_SOURCE -D_XOPEN_SOURCE=700
 OPT      ?= -O2 -g
-CPPFLAGS += -I. -Iprotocol -Iprotocol/io -I$(GEN) -MMD -MP
+CPPFLAGS += -I. -Icommon -Iprotocol -Iprotocol/io -I$(GEN) -MMD -MP
 CFLAGS   += $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS)
 LDFLAGS  += $(SANFLAGS)
 LDLIBS   += $(PKG_LIBS) -lm
@@ -50,7 +50,8 @@ GEN_WARN := -w
 # ---- components -------------------------------------------------------------
 # name : directory
 # bench/ holds standalone programs compiled by bench/run.sh, not a library.
-COMPONENTS := protocol daemon sim dxl top analyze
+COMPONENTS := common protocol daemon sim dxl top analyze
+DIR_common   := common
 DIR_protocol := protocol protocol/io
 DIR_daemon   := daemon
 DIR_sim      := sim-bridge
@@ -67,12 +68,13 @@ PROG_undulate-analyze := analyze
 ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze
 # Build only programs whose main.c exists (keeps partial trees buildable).
 PROGRAMS := $(foreach p,$(ALL_PROGRAMS),$(if $(wildcard $(firstword $(DIR_$(PROG_$(p))))/main.c),$(p)))
-DEPS_daemon   := daemon protocol
-DEPS_sim      := sim protocol
-DEPS_dxl      := dxl protocol
-DEPS_top      := top protocol
-DEPS_analyze  := analyze protocol
-DEPS_protocol := protocol
+DEPS_daemon   := daemon protocol common
+DEPS_sim      := sim protocol common
+DEPS_dxl      := dxl protocol common
+DEPS_top      := top protocol common
+DEPS_analyze  := analyze protocol common
+DEPS_protocol := protocol common
+DEPS_common   := common
 
 srcs_of   = $(foreach d,$(DIR_$(1)),$(wildcard $(d)/*.c))
 libsrcs_of = $(filter-out %/main.c,$(call srcs_of,$(1)))
@@ -157,6 +159,15 @@ $(BUILD)/tests/$(1): $(OBJ)/tests/unit/$(1).o $(TEST_HELPERS) $(call libs_of,$(c
 endef
 $(foreach t,$(patsubst tests/unit/%.c,%,$(UNIT_SRC)),$(eval $(call unit_test,$(t))))
 
+# tests/tools/*.c: programs the integration tests drive (peers, forgers),
+# linked against the daemon's libraries; never installed.
+TOOL_SRC  := $(wildcard tests/tools/*.c)
+TOOL_BINS := $(patsubst tests/tools/%.c,$(BUILD)/tests/tools/%,$(TOOL_SRC))
+$(BUILD)/tests/tools/%: $(OBJ)/tests/tools/%.o $(call libs_of,daemon) $(LIB)/liblcmtypes.a
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $< $(call libs_of,daemon) $(LIB)/liblcmtypes.a $(LDLIBS)
+unit-tests: $(TOOL_BINS)
+
 # ---- entry points -----------------------------------------------------------
 deps:
 	@scripts/deps.sh
@@ -178,13 +189,26 @@ demo: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) scripts/demo.sh
 
-# libFuzzer: clang only, its own build directory.
-fuzz:
-	@$(MAKE) --no-print-directory lcmtypes
-	@mkdir -p $(BUILD)/fuzz
-	clang $(STD) -g -O1 -fsanitize=fuzzer,address,undefined $(CPPFLAGS) -MF /dev/null \
-	  tests/fuzz/fuzz_parser.c protocol/*.c -o $(BUILD)/fuzz/fuzz_parser -lm
-	@echo "run: $(BUILD)/fuzz/fuzz_parser -max_total_time=60"
+# libFuzzer targets: tests/fuzz/fuzz_<component>_<what>.c, built with clang
+# from the sources of that component's libraries (instrumented, unlike the
+# gcc-built archives) and run by scripts/fuzz.sh for a fixed number of inputs.
+FUZZ_SRC   := $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_BINS  := $(patsubst tests/fuzz/%.c,$(BUILD)/fuzz/%,$(FUZZ_SRC))
+FUZZ_FLAGS := $(STD) -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+fuzz_component = $(word 2,$(subst _, ,$(1)))
+define fuzz_target
+$(BUILD)/fuzz/$(1): tests/fuzz/$(1).c $(foreach c,$(DEPS_$(call fuzz_component,$(1))),$(call libsrcs_of,$(c))) $(LCM_STAMP) $(LCM_COMPAT)
+	@mkdir -p $$(dir $$@)
+	clang $(FUZZ_FLAGS) -I. -Icommon -Iprotocol -Iprotocol/io -Icompat -I$(GEN) $(PKG_CFLAGS) -w \
+	  $$(filter %.c,$$^) $(GEN)/*.c -o $$@ $(PKG_LIBS) -lm
+endef
+$(foreach t,$(patsubst tests/fuzz/%.c,%,$(FUZZ_SRC)),$(eval $(call fuzz_target,$(t))))
+.PHONY: fuzz-build
+fuzz-build: $(LCM_STAMP) $(FUZZ_BINS)
+fuzz: deps
+	@scripts/deps.sh clang
+	@$(MAKE) --no-print-directory fuzz-build
+	@BUILD=$(BUILD) scripts/fuzz.sh
 
 # lcm-spy needs our types in a jar: javac + lcm.jar (liblcm-java).
 LCM_JAR ?= /usr/share/java/lcm.jar

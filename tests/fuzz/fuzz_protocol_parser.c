@@ -1,5 +1,5 @@
 /*
- * fuzz_parser.c — libFuzzer target for the Dynamixel 1.0 parser (both kinds)
+ * fuzz_protocol_parser.c — libFuzzer target for the Dynamixel 1.0 parser (both kinds)
  * and for a bus transaction fed with arbitrary reply bytes.
  *
  * The first input byte seeds the chunk sizes, so the fuzzer also explores how
@@ -8,7 +8,7 @@
  * obey the header rules, and a decoded frame re-encodes to a packet that parses
  * back to itself.
  *
- *   make fuzz && build/fuzz/fuzz_parser -max_total_time=60
+ *   make fuzz && build/fuzz/fuzz_protocol_parser -max_total_time=60
  */
 #include <stdint.h>
 #include <stdlib.h>
