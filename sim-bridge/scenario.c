@@ -4,12 +4,15 @@
 #include "scenario.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <ini.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 void sim_config_defaults(struct sim_config *c)
 {
@@ -315,11 +318,12 @@ static int ini_cb(void *user, const char *section, const char *name, const char 
 	return 1;
 }
 
-/* Reads one line for inih and drops the rest of a line longer than inih's
- * buffer: inih would parse that rest as lines of its own (the tail of a long
- * comment becomes a key) and number every line after it wrong. */
+/* Hands inih one line at a time from the scenario text in memory, and drops
+ * the rest of a line longer than inih's buffer: inih would parse that rest as
+ * lines of its own (the tail of a long comment becomes a key) and number
+ * every line after it wrong. */
 struct line_reader {
-	FILE *f;
+	const char *p, *end;
 	int line;
 	int long_line;   /* first line too long, 0 if none */
 	int cap;         /* the longest line inih reads */
@@ -328,39 +332,116 @@ struct line_reader {
 static char *read_line(char *str, int num, void *stream)
 {
 	struct line_reader *r = stream;
-	if (fgets(str, num, r->f) == NULL)
+	if (r->p >= r->end || num < 2)
 		return NULL;
+	const char *nl = memchr(r->p, '\n', (size_t)(r->end - r->p));
+	const char *eol = nl ? nl + 1 : r->end;   /* the line with its newline */
+	size_t len = (size_t)(eol - r->p);
 	r->line++;
-	size_t len = strlen(str);
-	if (len > 0 && len + 1 >= (size_t)num && str[len - 1] != '\n') {
-		int ch;
-		while ((ch = fgetc(r->f)) != EOF && ch != '\n')
-			;
+	if (len > (size_t)num - 1) {
+		len = (size_t)num - 1;
 		if (r->long_line == 0) {
 			r->long_line = r->line;
 			r->cap = num - 1;
 		}
 	}
+	memcpy(str, r->p, len);
+	str[len] = '\0';
+	r->p = eol;
 	return str;
 }
 
-int sim_config_load(struct sim_config *c, const char *path, char *err, size_t errcap)
+int sim_config_load_text(struct sim_config *c, const char *name, const char *text, size_t len, char *err,
+                         size_t errcap)
 {
 	struct load_ctx x = { c, err, errcap, 0 };
 	char why[200] = "";
 	x.err = why;
 	x.errcap = sizeof(why);
-	struct line_reader rd = { .f = fopen(path, "r") };
-	if (rd.f == NULL)
-		return ERR("%s: cannot open", path);
+	/* inih sees C strings: a NUL would silently end a line early. */
+	const char *nul = memchr(text, '\0', len);
+	if (nul) {
+		int line = 1;
+		for (const char *q = text; q < nul; q++)
+			line += *q == '\n';
+		return ERR("%s:%d: a NUL byte: a scenario is a text file", name, line);
+	}
+	struct line_reader rd = { .p = text, .end = text + len };
 	int r = ini_parse_stream(read_line, &rd, ini_cb, &x);
-	fclose(rd.f);
 	/* the first problem wins: a long line, or an error before it */
 	if (rd.long_line > 0 && (r <= 0 || r >= rd.long_line))
-		return ERR("%s:%d: line too long (at most %d characters)", path, rd.long_line, rd.cap);
+		return ERR("%s:%d: line too long (at most %d characters)", name, rd.long_line, rd.cap);
 	if (r > 0)
-		return ERR("%s:%d: %s", path, r, why[0] ? why : "syntax error");
+		return ERR("%s:%d: %s", name, r, why[0] ? why : "syntax error");
+	if (r < 0)
+		return ERR("%s: cannot parse (out of memory)", name);
 	return 0;
+}
+
+static const char *file_kind(mode_t m)
+{
+	if (S_ISDIR(m))
+		return "a directory";
+	if (S_ISFIFO(m))
+		return "a FIFO";
+	if (S_ISCHR(m))
+		return "a character device";
+	if (S_ISBLK(m))
+		return "a block device";
+	if (S_ISSOCK(m))
+		return "a socket";
+	return "not a plain file";
+}
+
+/* A scenario is a regular file of bounded size. The type is checked with
+ * stat() before open(): opening a FIFO blocks until a writer comes, and
+ * opening a device can have effects of its own (a serial port raises DTR).
+ * open() then uses O_NONBLOCK and fstat() checks the same again, in case the
+ * path was replaced in between; reading stops one byte past the limit, in
+ * case the file grew. */
+int sim_config_load(struct sim_config *c, const char *path, char *err, size_t errcap)
+{
+	struct stat st;
+	if (stat(path, &st) != 0)
+		return ERR("%s: cannot open: %s", path, strerror(errno));
+	if (!S_ISREG(st.st_mode))
+		return ERR("%s: not a regular file (%s): a scenario is a text file", path, file_kind(st.st_mode));
+	if (st.st_size > SIM_SCENARIO_MAX_BYTES)
+		return ERR("%s: larger than 1 MiB (%lld bytes): not a scenario", path, (long long)st.st_size);
+	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+	if (fd < 0)
+		return ERR("%s: cannot open: %s", path, strerror(errno));
+	if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+		close(fd);
+		return ERR("%s: not a regular file: a scenario is a text file", path);
+	}
+	char *text = malloc(SIM_SCENARIO_MAX_BYTES + 1);
+	if (!text) {
+		close(fd);
+		return ERR("%s: out of memory", path);
+	}
+	size_t len = 0;
+	int rerr = 0;
+	while (len <= SIM_SCENARIO_MAX_BYTES) {
+		ssize_t n = read(fd, text + len, SIM_SCENARIO_MAX_BYTES + 1 - len);
+		if (n < 0 && errno == EINTR)
+			continue;
+		if (n < 0)
+			rerr = errno;
+		if (n <= 0)
+			break;
+		len += (size_t)n;
+	}
+	close(fd);
+	int r;
+	if (rerr)
+		r = ERR("%s: cannot read: %s", path, strerror(rerr));
+	else if (len > SIM_SCENARIO_MAX_BYTES)
+		r = ERR("%s: larger than 1 MiB: not a scenario", path);
+	else
+		r = sim_config_load_text(c, path, text, len, err, errcap);
+	free(text);
+	return r;
 }
 
 int sim_config_set(struct sim_config *c, const char *assignment, char *err, size_t errcap)

@@ -19,6 +19,8 @@
 #define SIM_MAX_EVENTS 64    /* timed commands in a scenario */
 #define SIM_CMD_MAX 256      /* one command line */
 #define SIM_URL_MAX 256
+/* A scenario file larger than this is refused (the presets are ~1 kB). */
+#define SIM_SCENARIO_MAX_BYTES (1024 * 1024)
 
 struct sim_robot_config {
 	char name[SIM_NAME_MAX];
@@ -80,8 +82,14 @@ struct sim_config {
 enum { SIM_WALLS_NONE, SIM_WALLS_AUTO, SIM_WALLS_FIXED };
 
 void sim_config_defaults(struct sim_config *c);
-/* Read an INI file on top of c. 0, or -1 with "file:line: why" in err. */
+/* Read an INI file on top of c. Only a regular file of at most
+ * SIM_SCENARIO_MAX_BYTES is read (a FIFO, a device, a directory is refused
+ * without blocking). 0, or -1 with "file:line: why" or "file: why" in err. */
 int sim_config_load(struct sim_config *c, const char *path, char *err, size_t errcap);
+/* The same from len bytes of text (no NUL needed; a NUL byte is an error);
+ * name is the file name used in messages. */
+int sim_config_load_text(struct sim_config *c, const char *name, const char *text, size_t len, char *err,
+                         size_t errcap);
 /* Apply one "section.key=value" (e.g. world.separation=0.4,
  * "robot left.ids=1,2"). 0 or -1 with err. */
 int sim_config_set(struct sim_config *c, const char *assignment, char *err, size_t errcap);

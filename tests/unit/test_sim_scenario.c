@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -155,6 +156,53 @@ static void test_long_line(void **state)
 	assert_non_null(strstr(err, "restitution"));
 }
 
+/* Only a regular file of at most 1 MiB is a scenario: a directory, a device,
+ * a FIFO, a huge file or NUL bytes get "PATH: why" and load nothing. (A FIFO
+ * with no writer would block open() without O_NONBLOCK; it is checked here
+ * before opening, and end to end in sim_scenario_file.sh under a timeout.) */
+static void test_scenario_files(void **state)
+{
+	(void)state;
+	char err[256];
+	sim_config_defaults(&cfg);
+	assert_int_equal(sim_config_load(&cfg, "/tmp", err, sizeof(err)), -1);
+	assert_string_equal(err, "/tmp: not a regular file (a directory): a scenario is a text file");
+	assert_int_equal(sim_config_load(&cfg, "/dev/null", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "/dev/null: not a regular file (a character device)"));
+	assert_int_equal(sim_config_load(&cfg, "/dev/zero", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "/dev/zero: not a regular file"));
+	char fifo[] = "/tmp/test_sim_scenario.fifo.XXXXXX";
+	int tfd = mkstemp(fifo);
+	assert_true(tfd >= 0);
+	close(tfd);
+	unlink(fifo);
+	assert_int_equal(mkfifo(fifo, 0600), 0);
+	assert_int_equal(sim_config_load(&cfg, fifo, err, sizeof(err)), -1);
+	unlink(fifo);
+	assert_non_null(strstr(err, "(a FIFO)"));
+	assert_int_equal(sim_config_load(&cfg, "/nonexistent/x.scenario", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "/nonexistent/x.scenario: cannot open: No such file"));
+	/* one byte over 1 MiB (a sparse file: nothing is written) */
+	assert_int_equal(write_file("[robot a]\nids = 1\n"), 0);
+	assert_int_equal(truncate(path, SIM_SCENARIO_MAX_BYTES + 1), 0);
+	assert_int_equal(sim_config_load(&cfg, path, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "larger than 1 MiB"));
+	/* exactly 1 MiB: the NUL padding is refused, with its line */
+	assert_int_equal(truncate(path, SIM_SCENARIO_MAX_BYTES), 0);
+	assert_int_equal(sim_config_load(&cfg, path, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, ":3: a NUL byte"));
+	unlink(path);
+	assert_int_equal(cfg.nrobots, 0);  /* nothing was loaded by any of these */
+	/* the same text from memory, without a terminating NUL */
+	static const char text[] = "[robot a]\nids = 1,2\n[sim]\nseed = 9";
+	assert_int_equal(sim_config_load_text(&cfg, "mem", text, sizeof(text) - 1, err, sizeof(err)), 0);
+	assert_int_equal(cfg.nrobots, 1);
+	assert_int_equal(cfg.robots[0].nids, 2);
+	assert_int_equal(cfg.seed, 9);
+	assert_int_equal(sim_config_load_text(&cfg, "mem", "[world]\nbeta = -1\n", 18, err, sizeof(err)), -1);
+	assert_string_equal(err, "mem:2: beta: >= 0");
+}
+
 static void test_seeded_start(void **state)
 {
 	(void)state;
@@ -268,6 +316,7 @@ int main(void)
 		cmocka_unit_test(test_load_pair),
 		cmocka_unit_test(test_config_errors),
 		cmocka_unit_test(test_long_line),
+		cmocka_unit_test(test_scenario_files),
 		cmocka_unit_test(test_seeded_start),
 		cmocka_unit_test(test_commands),
 		cmocka_unit_test(test_events_run_on_time),
