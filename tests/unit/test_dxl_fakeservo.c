@@ -499,10 +499,20 @@ static void test_dxl_write_validates_first(void **state)
 	assert_int_equal(run_dxl(f, "write", "1", "warp_drive", "1", NULL), DXLT_EXIT_USAGE);
 	assert_non_null(strstr(f->err, "unknown register 'warp_drive'"));
 	assert_int_equal(run_dxl(f, "write", "1", "led", "-1", NULL), DXLT_EXIT_USAGE);
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "5x", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(strstr(f->err, "value '5x' for goal_position is not a number"));
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "1e3", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(strstr(f->err, "is not a number"));
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "", NULL), DXLT_EXIT_USAGE);
 	assert_int_equal(run_dxl(f, "read", "1", "nonsense", NULL), DXLT_EXIT_USAGE);
 	assert_int_equal(atomic_load(&f->bus.writes), writes);
 	assert_int_equal(atomic_load(&f->bus.packets), packets);
 	assert_int_equal(dxl_get_u16(&servo_by_id(f, 1)->mem[DXL_AX_GOAL_POSITION]), 700);
+	/* padded values are decimal: 0500 is 500, not octal 320 */
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "0500", NULL), 0);
+	assert_int_equal(dxl_get_u16(&servo_by_id(f, 1)->mem[DXL_AX_GOAL_POSITION]), 500);
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "0x1f4", NULL), 0);
+	assert_int_equal(dxl_get_u16(&servo_by_id(f, 1)->mem[DXL_AX_GOAL_POSITION]), 500);
 }
 
 static void test_dxl_no_reply_suggests_baud(void **state)
@@ -711,6 +721,14 @@ static void test_arg_parsers(void **state)
 	assert_int_equal(dxlt_parse_id("0x10", false, &id), 0);
 	assert_int_equal(id, 16);
 	assert_int_equal(dxlt_parse_id("1x", false, &id), -1);
+	/* a leading zero is decimal (num.h), not octal as strtol's base 0 had it */
+	assert_int_equal(dxlt_parse_id("010", false, &id), 0);
+	assert_int_equal(id, 10);
+	assert_int_equal(dxlt_parse_id(" 1", false, &id), -1);
+	assert_int_equal(dxlt_parse_id("1 ", false, &id), -1);
+	assert_int_equal(dxlt_parse_id("", false, &id), -1);
+	assert_int_equal(dxlt_parse_id_range("", &lo, &hi), -1);
+	assert_int_equal(dxlt_parse_id_range("3-", &lo, &hi), -1);
 	assert_int_equal(dxlt_parse_bauds("1000000,57143", bauds, DXLT_MAX_BAUDS, &n), 0);
 	assert_int_equal(n, 2);
 	assert_int_equal(bauds[1], 57143);

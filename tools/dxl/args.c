@@ -3,36 +3,20 @@
  * so that options may follow the command (`dxl read 1 goal --units`) and the
  * parser holds no global state (the tests call it many times).
  */
-#include <errno.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "dxl_table.h"
 #include "dxlt.h"
+#include "num.h"
 
 /* Baud register values the AX-12 manual lists; `--bauds all` tries these. */
 static const uint8_t dxlt_ax12_baud_regs[] = { 1, 3, 4, 7, 9, 16, 34, 103, 207 };
-
-int dxlt_parse_long(const char *s, long min, long max, long *out)
-{
-	char *end;
-	long v;
-
-	if (s == NULL || *s == '\0' || *s == '-' || *s == '+' || *s == ' ')
-		return -1;
-	errno = 0;
-	v = strtol(s, &end, 0);
-	if (errno != 0 || *end != '\0' || v < min || v > max)
-		return -1;
-	*out = v;
-	return 0;
-}
 
 int dxlt_parse_id(const char *s, bool allow_broadcast, uint8_t *id)
 {
 	long v;
 
-	if (dxlt_parse_long(s, 0, allow_broadcast ? DXL_BROADCAST_ID : DXL_MAX_ID, &v) != 0)
+	if (num_parse_long(s, 0, allow_broadcast ? DXL_BROADCAST_ID : DXL_MAX_ID, &v) != NUM_OK)
 		return -1;
 	*id = (uint8_t)v;
 	return 0;
@@ -76,7 +60,7 @@ int dxlt_parse_bauds(const char *s, long *out, size_t cap, size_t *n)
 	strcpy(buf, s);
 	for (char *tok = strtok_r(buf, ",", &save); tok != NULL; tok = strtok_r(NULL, ",", &save)) {
 		long v;
-		if (*n >= cap || dxlt_parse_long(tok, 1, 4000000, &v) != 0)
+		if (*n >= cap || num_parse_long(tok, 1, DXLT_MAX_BAUD, &v) != NUM_OK)
 			return -1;
 		out[(*n)++] = v;
 	}
@@ -114,23 +98,32 @@ static int dxlt_bad(FILE *err, const char *what, const char *opt, const char *va
 	return DXLT_EXIT_USAGE;
 }
 
+/* An option's number in [min, max]; on failure says which and why. */
+static int dxlt_opt_long(FILE *err, const char *opt, const char *val, long min, long max, long *out)
+{
+	enum num_status st = num_parse_long(val, min, max, out);
+	if (st == NUM_OK)
+		return DXLT_EXIT_OK;
+	fprintf(err, "dxl: %s '%s' is %s (%ld-%ld)\n", opt, val != NULL ? val : "", num_strerror(st), min, max);
+	dxlt_usage(err);
+	return DXLT_EXIT_USAGE;
+}
+
 static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val, FILE *err)
 {
 	long v;
+	int rc = DXLT_EXIT_OK;
 
 	if (strcmp(name, "--port") == 0) {
 		a->port_path = val;
 	} else if (strcmp(name, "--baud") == 0) {
-		if (dxlt_parse_long(val, 1, 4000000, &a->baud) != 0)
-			return dxlt_bad(err, "bad baud rate for", name, val);
+		rc = dxlt_opt_long(err, name, val, 1, DXLT_MAX_BAUD, &a->baud);
 	} else if (strcmp(name, "--echo") == 0) {
 		a->echo = true;
 	} else if (strcmp(name, "--latency-us") == 0) {
-		if (dxlt_parse_long(val, 0, 1000000, &a->latency_us) != 0)
-			return dxlt_bad(err, "bad value for", name, val);
+		rc = dxlt_opt_long(err, name, val, 0, 1000000, &a->latency_us);
 	} else if (strcmp(name, "--timeout-ms") == 0) {
-		if (dxlt_parse_long(val, 1, 10000, &a->timeout_ms) != 0)
-			return dxlt_bad(err, "bad value for", name, val);
+		rc = dxlt_opt_long(err, name, val, 1, 10000, &a->timeout_ms);
 	} else if (strcmp(name, "--units") == 0) {
 		a->units = true;
 	} else if (strcmp(name, "--yes") == 0) {
@@ -142,13 +135,12 @@ static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val
 		if (dxlt_parse_bauds(val, a->bauds, DXLT_MAX_BAUDS, &a->nbauds) != 0)
 			return dxlt_bad(err, "bad baud list (want N,N,... or all) for", name, val);
 	} else if (strcmp(name, "--status-level") == 0) {
-		if (dxlt_parse_long(val, 0, 2, &v) != 0)
-			return dxlt_bad(err, "bad value (0, 1 or 2) for", name, val);
-		a->status_level = (int)v;
+		rc = dxlt_opt_long(err, name, val, 0, 2, &v);
+		a->status_level = rc == DXLT_EXIT_OK ? (int)v : a->status_level;
 	} else {
 		a->help = true;
 	}
-	return DXLT_EXIT_OK;
+	return rc;
 }
 
 static void dxlt_defaults(struct dxlt_args *a)

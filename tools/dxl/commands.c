@@ -7,12 +7,14 @@
  * servo before its arguments were checked against the control table.
  */
 #include <errno.h>
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "dxl_table.h"
 #include "dxlt.h"
+#include "num.h"
 
 struct dxlt {
 	struct dxlt_args a;
@@ -315,7 +317,12 @@ static int dxlt_check_value(struct dxlt *t, const struct dxl_reg *reg, const cha
 		fprintf(t->err, "dxl: %s (address %u) is read-only\n", reg->name, reg->addr);
 		return DXLT_EXIT_USAGE;
 	}
-	if (dxlt_parse_long(s, 0, 65535, &value) != 0 || dxl_reg_check_write(reg, value) != DXL_OK) {
+	enum num_status st = num_parse_long(s, LONG_MIN, LONG_MAX, &value);
+	if (st != NUM_OK && st != NUM_RANGE) {
+		fprintf(t->err, "dxl: value '%s' for %s is %s\n", s, reg->name, num_strerror(st));
+		return DXLT_EXIT_USAGE;
+	}
+	if (st != NUM_OK || dxl_reg_check_write(reg, value) != DXL_OK) {
 		fprintf(t->err, "dxl: value '%s' out of range for %s (%u-%u)\n", s, reg->name, reg->min,
 		        reg->max);
 		return DXLT_EXIT_USAGE;
@@ -419,7 +426,7 @@ static int dxlt_cmd_set_baud(struct dxlt *t)
 	if ((rc = dxlt_need_args(t, 2, "set-baud ID BAUD")) ||
 	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
 		return rc;
-	if (dxlt_parse_long(t->a.pos[1], 1, 4000000, &bps) != 0 ||
+	if (num_parse_long(t->a.pos[1], 1, DXLT_MAX_BAUD, &bps) != NUM_OK ||
 	    dxl_baud_to_reg(bps, &reg_value) != DXL_OK) {
 		fprintf(t->err, "dxl: an AX-12 cannot run at '%s' bps (rates are 2000000/(n+1), "
 		        "e.g. 1000000, 500000, 117647, 57143)\n", t->a.pos[1]);

@@ -25,6 +25,9 @@ enum dxlt_exit {
 /* Most IDs/bauds a command takes on its command line. */
 #define DXLT_MAX_IDS   (DXL_MAX_ID + 1)
 #define DXLT_MAX_BAUDS 16
+/* Largest rate a command line may name, bps: twice the AX-12's own top rate
+ * (2 Mbps, baud register 0), so a typo's extra digit is caught here. */
+#define DXLT_MAX_BAUD 4000000L
 /* The AX-12 factory rate. */
 #define DXLT_DEFAULT_BAUD 1000000L
 /* Scheduling slack on top of the derived reply timeout (ms): the tool is
@@ -53,8 +56,8 @@ struct dxlt_args {
 	int npos;
 };
 
-/* Parsers for command-line values; each returns 0 or -1 (bad input). */
-int dxlt_parse_long(const char *s, long min, long max, long *out);
+/* Parsers for command-line values; each returns 0 or -1 (bad input). Numbers
+ * are read by num_parse_long (common/num.h): decimal or 0x hex, never octal. */
 int dxlt_parse_id(const char *s, bool allow_broadcast, uint8_t *id);
 int dxlt_parse_id_range(const char *s, uint8_t *lo, uint8_t *hi);
 /* "1000000,57600", or "all" for every AX-12 rate the register can name. */
