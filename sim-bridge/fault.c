@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "dxl.h"
+#include "num.h"
 
 static const char *const fault_names[SIM_FAULT_KINDS] = {
 	[SIM_FAULT_NO_REPLY] = "no-reply",
@@ -45,13 +46,7 @@ double sim_rand_uniform(uint64_t *state)
 
 static bool parse_double(const char *s, double *out)
 {
-	char *end;
-	errno = 0;
-	double v = strtod(s, &end);
-	if (errno || end == s || *end || !isfinite(v))
-		return false;
-	*out = v;
-	return true;
+	return num_parse_double(s, out) == NUM_OK;
 }
 
 /* One word per status error bit, 0..6 (no spaces: they go on a command line). */
@@ -92,6 +87,21 @@ static int fault_kind_of(const char *name)
 	return -1;
 }
 
+/* What ARG may be for each kind: sim_faults_apply() turns the byte counts,
+ * the ID and the delay into integers, so each is bounded here (a cast of
+ * 1e300 to size_t or uint8_t is undefined behaviour). */
+static const struct {
+	bool whole;        /* a whole number */
+	double lo, hi;
+} fault_arg_range[SIM_FAULT_KINDS] = {
+	[SIM_FAULT_TRUNCATE] = { true, 0, DXL_MAX_PACKET },        /* bytes cut */
+	[SIM_FAULT_GARBAGE] = { true, 0, SIM_FAULT_MAX_GARBAGE },   /* bytes added */
+	[SIM_FAULT_WRONG_ID] = { true, 0, DXL_MAX_ID },
+	[SIM_FAULT_SLOW] = { false, 0, SIM_FAULT_MAX_SLOW_MS },
+	[SIM_FAULT_TEMPERATURE] = { false, -40, 255 },             /* °C; the register holds 0..255 */
+	[SIM_FAULT_VOLTAGE] = { false, 0, 25.5 },                  /* V; the register holds 0..25.5 */
+};
+
 /* The ARG of a fault: a number, or error-bit names for stuck-error. */
 static int fault_parse_arg(enum sim_fault_kind kind, const char *word, struct sim_fault *out)
 {
@@ -102,7 +112,19 @@ static int fault_parse_arg(enum sim_fault_kind kind, const char *word, struct si
 		out->arg = bits;
 		return 0;
 	}
-	return parse_double(word, &out->arg) && out->arg >= 0 ? 0 : -1;
+	if (kind == SIM_FAULT_NO_REPLY || kind == SIM_FAULT_BAD_CHECKSUM)
+		return -1;   /* no ARG */
+	double v;
+	if (fault_arg_range[kind].whole) {
+		long n;
+		if (num_parse_long(word, (long)fault_arg_range[kind].lo, (long)fault_arg_range[kind].hi, &n) != NUM_OK)
+			return -1;
+		v = (double)n;
+	} else if (num_parse_double_in(word, fault_arg_range[kind].lo, fault_arg_range[kind].hi, &v) != NUM_OK) {
+		return -1;
+	}
+	out->arg = v;
+	return 0;
 }
 
 int sim_fault_parse(int argc, char **argv, enum sim_fault_kind *kind, struct sim_fault *out,
@@ -124,8 +146,9 @@ int sim_fault_parse(int argc, char **argv, enum sim_fault_kind *kind, struct sim
 	out->prob = 1.0;
 	for (int i = 1; i < argc; i++) {
 		double v;
-		if (strncmp(argv[i], "count=", 6) == 0 && parse_double(argv[i] + 6, &v) && v >= 1 && v <= 1e9) {
-			out->remaining = (long)v;
+		long n;
+		if (strncmp(argv[i], "count=", 6) == 0 && num_parse_long(argv[i] + 6, 1, SIM_FAULT_MAX_COUNT, &n) == NUM_OK) {
+			out->remaining = n;
 		} else if (strncmp(argv[i], "prob=", 5) == 0 && parse_double(argv[i] + 5, &v) && v >= 0 && v <= 1) {
 			out->prob = v;
 		} else if (!out->has_arg && fault_parse_arg((enum sim_fault_kind)k, argv[i], out) == 0) {
@@ -183,12 +206,18 @@ bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t
 	*ngarbage = 0;
 	*extra_delay_ns = 0;
 	if (fault_fires(&f[SIM_FAULT_SLOW], rng)) {
-		*extra_delay_ns = (int64_t)((f[SIM_FAULT_SLOW].has_arg ? f[SIM_FAULT_SLOW].arg : 5.0) * 1e6);
+		double ms = f[SIM_FAULT_SLOW].has_arg ? f[SIM_FAULT_SLOW].arg : 5.0;
+		/* parsed within range; a caller's own struct is clamped (no cast of a huge double) */
+		if (!(ms > 0))
+			ms = 0;
+		else if (ms > SIM_FAULT_MAX_SLOW_MS)
+			ms = SIM_FAULT_MAX_SLOW_MS;
+		*extra_delay_ns = (int64_t)(ms * 1e6);
 		changed = true;
 	}
 	if (fault_fires(&f[SIM_FAULT_GARBAGE], rng)) {
 		double n = f[SIM_FAULT_GARBAGE].has_arg ? f[SIM_FAULT_GARBAGE].arg : 8;
-		*ngarbage = n > SIM_FAULT_MAX_GARBAGE ? SIM_FAULT_MAX_GARBAGE : (size_t)n;
+		*ngarbage = n > SIM_FAULT_MAX_GARBAGE ? SIM_FAULT_MAX_GARBAGE : (n > 0 ? (size_t)n : 0);
 		for (size_t i = 0; i < *ngarbage; i++)
 			garbage[i] = (uint8_t)sim_rand_next(rng);
 		changed = true;
@@ -199,7 +228,8 @@ bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t
 		return true;
 	}
 	if (*len >= 6 && fault_fires(&f[SIM_FAULT_WRONG_ID], rng)) {
-		pkt[2] = f[SIM_FAULT_WRONG_ID].has_arg ? (uint8_t)f[SIM_FAULT_WRONG_ID].arg : (uint8_t)(pkt[2] + 1);
+		double id = f[SIM_FAULT_WRONG_ID].arg;
+		pkt[2] = f[SIM_FAULT_WRONG_ID].has_arg && id >= 0 && id <= DXL_MAX_ID ? (uint8_t)id : (uint8_t)(pkt[2] + 1);
 		fault_fix_checksum(pkt, *len);
 		changed = true;
 	}
@@ -208,7 +238,8 @@ bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t
 		changed = true;
 	}
 	if (*len > 0 && fault_fires(&f[SIM_FAULT_TRUNCATE], rng)) {
-		size_t cut = f[SIM_FAULT_TRUNCATE].has_arg ? (size_t)f[SIM_FAULT_TRUNCATE].arg : *len / 2;
+		double a = f[SIM_FAULT_TRUNCATE].arg;
+		size_t cut = !f[SIM_FAULT_TRUNCATE].has_arg ? *len / 2 : (a >= (double)*len ? *len : (a > 0 ? (size_t)a : 0));
 		*len = cut >= *len ? 1 : *len - cut;
 		changed = true;
 	}

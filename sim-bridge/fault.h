@@ -53,6 +53,9 @@ struct sim_faults {
 
 /* Most garbage bytes one fault may add before a reply. */
 #define SIM_FAULT_MAX_GARBAGE 64
+/* Longest slow-reply delay (ms) and count=N. */
+#define SIM_FAULT_MAX_SLOW_MS 60000
+#define SIM_FAULT_MAX_COUNT 1000000000L
 
 const char *sim_fault_name(enum sim_fault_kind k);
 /* Parse "KIND [ARG] [count=N] [prob=P]" (already split into words).

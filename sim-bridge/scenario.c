@@ -3,6 +3,8 @@
  */
 #include "scenario.h"
 
+#include "num.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <ini.h>
@@ -43,17 +45,36 @@ void sim_config_defaults(struct sim_config *c)
 
 /* ---- value parsers -------------------------------------------------------------- */
 
+/* Values as inih hands them over may carry spaces (a --set value too);
+ * common/num.h parses only the bare number. */
+static const char *trim(const char *s, char *buf, size_t cap)
+{
+	while (*s == ' ' || *s == '\t')
+		s++;
+	size_t n = strlen(s);
+	while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\t'))
+		n--;
+	if (n >= cap)
+		return "";   /* longer than any number: refused as empty */
+	memcpy(buf, s, n);
+	buf[n] = '\0';
+	return buf;
+}
+
+/* A finite double (no inf, nan, hex floats). */
 static bool parse_num(const char *s, double *out)
 {
-	char *end;
-	errno = 0;
-	double v = strtod(s, &end);
-	while (*end == ' ' || *end == '\t')
-		end++;
-	if (errno || end == s || *end || !isfinite(v))
-		return false;
-	*out = v;
-	return true;
+	char buf[64];
+	return num_parse_double(trim(s, buf, sizeof(buf)), out) == NUM_OK;
+}
+
+/* A whole number in [lo, hi]: values stored in integers are parsed as
+ * integers, never as a double cast afterwards (1e98 into a uint64 is
+ * undefined behaviour, and 1.5 would silently become 1). */
+static bool parse_long(const char *s, long lo, long hi, long *out)
+{
+	char buf[64];
+	return num_parse_long(trim(s, buf, sizeof(buf)), lo, hi, out) == NUM_OK;
 }
 
 static bool parse_bool(const char *s, bool *out)
@@ -119,22 +140,31 @@ static int set_sim(struct sim_config *c, const char *k, const char *v, char *err
 		return parse_bool(v, &c->baud_follows_tty) ? 0 : ERR("%s: want true/false", k);
 	if (!strcmp(k, "eeprom_needs_torque_off"))
 		return parse_bool(v, &c->eeprom_needs_torque_off) ? 0 : ERR("%s: want true/false", k);
+	if (!strcmp(k, "seed")) {
+		char buf[64];
+		uint64_t seed;
+		if (num_parse_u64(trim(v, buf, sizeof(buf)), 0, UINT64_MAX, &seed) != NUM_OK)
+			return ERR("seed: '%s' is not a whole number 0..18446744073709551615", v);
+		c->seed = seed;
+		return 0;
+	}
+	long n;
+	if (!strcmp(k, "baud"))
+		return parse_long(v, 1200, 4500000, &n) ? (c->baud = n, 0) : ERR("baud: '%s' is not a whole number 1200..4500000", v);
+	if (!strcmp(k, "return_delay_us"))
+		return parse_long(v, 0, 508, &n) ? (c->return_delay_us = (int)n, 0)
+		                                 : ERR("return_delay_us: '%s' is not a whole number 0..508", v);
 	if (!parse_num(v, &d))
 		return ERR("%s: '%s' is not a number", k, v);
 	if (!strcmp(k, "rate_hz"))
 		return d >= 100 && d <= 20000 ? (c->rate_hz = d, 0) : ERR("rate_hz: 100..20000");
 	if (!strcmp(k, "truth_hz"))
 		return d >= 1 && d <= 1000 ? (c->truth_hz = d, 0) : ERR("truth_hz: 1..1000");
+	/* main.c turns it into int64 nanoseconds: bounded well inside */
 	if (!strcmp(k, "duration"))
-		return d >= 0 ? (c->duration_s = d, 0) : ERR("duration: >= 0 s");
-	if (!strcmp(k, "seed"))
-		return d >= 0 ? (c->seed = (uint64_t)d, 0) : ERR("seed: >= 0");
-	if (!strcmp(k, "baud"))
-		return d >= 1200 && d <= 4.5e6 ? (c->baud = (long)d, 0) : ERR("baud: 1200..4500000");
+		return d >= 0 && d <= SIM_MAX_DURATION_S ? (c->duration_s = d, 0) : ERR("duration: 0..%.0f s", SIM_MAX_DURATION_S);
 	if (!strcmp(k, "latency_ms"))
 		return d >= 0 && d <= 1000 ? (c->latency_ms = d, 0) : ERR("latency_ms: 0..1000");
-	if (!strcmp(k, "return_delay_us"))
-		return d >= 0 && d <= 508 ? (c->return_delay_us = (int)d, 0) : ERR("return_delay_us: 0..508");
 	if (!strcmp(k, "temperature") || !strcmp(k, "ambient_c"))
 		return d > -40 && d < 150 ? (c->ambient_c = d, c->motor.ambient_c = d, 0) : ERR("%s: -40..150", k);
 	if (!strcmp(k, "voltage"))
@@ -148,16 +178,28 @@ static int set_sim(struct sim_config *c, const char *k, const char *v, char *err
 
 static int set_walls(struct sim_config *c, const char *v, char *err, size_t errcap)
 {
-	double l, r;
-	char extra;
-	if (!strcasecmp(v, "none"))
+	if (!strcasecmp(v, "none")) {
 		c->walls = SIM_WALLS_NONE;
-	else if (!strcasecmp(v, "auto"))
+		return 0;
+	}
+	if (!strcasecmp(v, "auto")) {
 		c->walls = SIM_WALLS_AUTO;
-	else if (sscanf(v, "%lf , %lf %c", &l, &r, &extra) == 2 && l < r)
-		c->walls = SIM_WALLS_FIXED, c->world.wall_left = l, c->world.wall_right = r;
-	else
+		return 0;
+	}
+	/* LEFT,RIGHT: both finite (sscanf's %lf used to take "-inf") */
+	double l, r;
+	char left[64];
+	const char *comma = strchr(v, ',');
+	size_t n = comma ? (size_t)(comma - v) : sizeof(left);
+	if (n < sizeof(left)) {
+		memcpy(left, v, n);
+		left[n] = '\0';
+	}
+	if (n >= sizeof(left) || !parse_num(left, &l) || !parse_num(comma + 1, &r) || !(l < r))
 		return ERR("walls: none, auto or LEFT,RIGHT (m, LEFT < RIGHT)");
+	c->walls = SIM_WALLS_FIXED;
+	c->world.wall_left = l;
+	c->world.wall_right = r;
 	return 0;
 }
 
@@ -244,27 +286,30 @@ static int set_robot(struct sim_config *c, const char *name, const char *k, cons
 		int n = sim_parse_ids(v, r->ids, SIM_BUS_MAX_SERVOS);
 		return n > 0 ? (r->nids = (size_t)n, 0) : ERR("ids: want e.g. 1,2 (0..253, no duplicates, max %d)", SIM_BUS_MAX_SERVOS);
 	}
+	long n;
 	if (!strcmp(k, "contact")) {
 		if (!strcasecmp(v, "none"))
 			return r->contact_id = -1, 0;
-		return parse_num(v, &d) && d >= 0 && d <= DXL_MAX_ID ? (r->contact_id = (int)d, 0) : ERR("contact: an ID or none");
+		return parse_long(v, 0, DXL_MAX_ID, &n) ? (r->contact_id = (int)n, 0) : ERR("contact: '%s' is not an ID 0..253 or none", v);
 	}
 	if (!strcmp(k, "echo"))
 		return parse_bool(v, &b) ? (r->echo = b, 0) : ERR("echo: true/false");
 	if (!strcmp(k, "mirror"))
 		return parse_bool(v, &r->mirror) ? 0 : ERR("mirror: true/false");
+	if (!strcmp(k, "baud"))
+		return parse_long(v, 1200, 4500000, &n) ? (r->baud = n, 0) : ERR("baud: '%s' is not a whole number 1200..4500000", v);
+	if (!strcmp(k, "return_delay_us"))
+		return parse_long(v, 0, 508, &n) ? (r->return_delay_us = (int)n, 0)
+		                                 : ERR("return_delay_us: '%s' is not a whole number 0..508", v);
+	if (!strcmp(k, "servo_baud"))
+		return parse_long(v, 0, 254, &n) ? (r->servo_baud_reg = (int)n, 0)
+		                                 : ERR("servo_baud: '%s' is not a register value 0..254", v);
 	if (!parse_num(v, &d))
 		return ERR("robot.%s: '%s' is not a number", k, v);
 	if (!strcmp(k, "neutral"))
 		return r->neutral_set = true, r->neutral = d, 0;
-	if (!strcmp(k, "baud"))
-		return d >= 1200 && d <= 4.5e6 ? (r->baud = (long)d, 0) : ERR("baud: 1200..4500000");
 	if (!strcmp(k, "latency_ms"))
 		return d >= 0 && d <= 1000 ? (r->latency_ms = d, 0) : ERR("latency_ms: 0..1000");
-	if (!strcmp(k, "return_delay_us"))
-		return d >= 0 && d <= 508 ? (r->return_delay_us = (int)d, 0) : ERR("return_delay_us: 0..508");
-	if (!strcmp(k, "servo_baud"))
-		return d >= 0 && d <= 254 ? (r->servo_baud_reg = (int)d, 0) : ERR("servo_baud: register value 0..254");
 	return ERR("unknown key %s.%s", name, k);
 }
 

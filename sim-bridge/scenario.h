@@ -19,6 +19,8 @@
 #define SIM_MAX_EVENTS 64    /* timed commands in a scenario */
 #define SIM_CMD_MAX 256      /* one command line */
 #define SIM_URL_MAX 256
+/* Longest --duration: about 31 years (as int64 ns it stays far from overflow). */
+#define SIM_MAX_DURATION_S 1e9
 /* A scenario file larger than this is refused (the presets are ~1 kB). */
 #define SIM_SCENARIO_MAX_BYTES (1024 * 1024)
 

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "dxl_table.h"
+#include "num.h"
 
 /* Words in one command line. */
 #define SIM_CMD_MAX_WORDS 16
@@ -231,12 +232,8 @@ static int sim_each_joint(struct sim_cmd_ctx *x, const char *bus, const char *id
 {
 	struct sim *s = x->s;
 	long want = -1;
-	if (strcmp(id, "*")) {
-		char *end;
-		want = strtol(id, &end, 10);
-		if (*end || end == id || want < 0 || want > DXL_MAX_ID)
-			return FAIL(x, "bad servo id '%s' (0..253 or *)", id);
-	}
+	if (strcmp(id, "*") && num_parse_long(id, 0, DXL_MAX_ID, &want) != NUM_OK)
+		return FAIL(x, "bad servo id '%s' (0..253 or *)", id);
 	int matched = 0;
 	for (size_t i = 0; i < s->nbuses; i++) {
 		struct sim_bus *b = &s->buses[i];
@@ -382,13 +379,28 @@ static int cmd_garbage(struct sim_cmd_ctx *x)
 	struct sim_bus *b = cmd_bus(x, "garbage BUS [N]");
 	if (!b)
 		return -1;
-	long n = x->argc >= 3 ? strtol(x->argv[2], NULL, 10) : 8;
-	if (n < 1 || n > SIM_FAULT_MAX_GARBAGE)
+	long n = 8;
+	if (x->argc > 3 || (x->argc == 3 && num_parse_long(x->argv[2], 1, SIM_FAULT_MAX_GARBAGE, &n) != NUM_OK))
 		return FAIL(x, "garbage: N in 1..%d", SIM_FAULT_MAX_GARBAGE);
 	for (long i = 0; i < n; i++)
 		bytes[i] = (uint8_t)sim_rand_next(&b->rng);
 	sim_bus_inject(b, bytes, (size_t)n, x->now);
 	return REPLY(x, "ok %ld bytes", n), 0;
+}
+
+/* The servo with ID text on b; NULL with the reply set. (atoi() wrapped
+ * "257" onto servo 1.) */
+static struct sim_joint *cmd_joint(struct sim_cmd_ctx *x, struct sim_bus *b, const char *text)
+{
+	int id;
+	if (num_parse_int(text, 0, DXL_MAX_ID, &id) != NUM_OK) {
+		REPLY(x, "error: bad servo id '%s' (0..253)", text);
+		return NULL;
+	}
+	struct sim_joint *j = sim_find_joint(b, (uint8_t)id);
+	if (!j)
+		REPLY(x, "error: no servo %d on %s", id, b->name);
+	return j;
 }
 
 static const struct dxl_reg *cmd_reg(struct sim_cmd_ctx *x, const char *name)
@@ -407,16 +419,15 @@ static int cmd_poke(struct sim_cmd_ctx *x)
 		return -1;
 	if (x->argc != 5)
 		return FAIL(x, "usage: poke BUS ID REG VALUE");
-	struct sim_joint *j = sim_find_joint(b, (uint8_t)atoi(x->argv[2]));
-	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
-	char *end;
-	long v = strtol(x->argv[4], &end, 0);
+	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
 	if (!j)
-		return FAIL(x, "no servo %s on %s", x->argv[2], b->name);
+		return -1;
+	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
 	if (!r)
 		return -1;
-	if (*end || v < 0 || v > (r->size == 2 ? 65535 : 255))
-		return FAIL(x, "bad value '%s'", x->argv[4]);
+	long v;
+	if (num_parse_long(x->argv[4], 0, r->size == 2 ? 65535 : 255, &v) != NUM_OK)
+		return FAIL(x, "bad value '%s' (0..%d)", x->argv[4], r->size == 2 ? 65535 : 255);
 	sim_servo_poke(&j->servo, r->addr, (uint16_t)v);
 	return REPLY(x, "ok %s=%ld", r->name, v), 0;
 }
@@ -428,10 +439,10 @@ static int cmd_peek(struct sim_cmd_ctx *x)
 		return -1;
 	if (x->argc != 4)
 		return FAIL(x, "usage: peek BUS ID REG");
-	struct sim_joint *j = sim_find_joint(b, (uint8_t)atoi(x->argv[2]));
-	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
+	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
 	if (!j)
-		return FAIL(x, "no servo %s on %s", x->argv[2], b->name);
+		return -1;
+	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
 	if (!r)
 		return -1;
 	return REPLY(x, "ok %u", (unsigned)sim_servo_peek(&j->servo, r->addr)), 0;
@@ -445,9 +456,9 @@ static int cmd_servo(struct sim_cmd_ctx *x)
 		return -1;
 	if (x->argc != 3)
 		return FAIL(x, "usage: servo BUS ID");
-	struct sim_joint *j = sim_find_joint(b, (uint8_t)atoi(x->argv[2]));
+	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
 	if (!j)
-		return FAIL(x, "no servo %s on %s", x->argv[2], b->name);
+		return -1;
 	const struct sim_servo *sv = &j->servo;
 	size_t off = (size_t)REPLY(x, "ok id=%u power=%s torque=%u errbits=0x%02x angle=%.4f speed=%.4f temp=%.1f "
 	                              "instructions=%u replies=%u range=%u angle_limit=%u instruction=%u checksum=%u "
@@ -476,9 +487,9 @@ static int cmd_walls(struct sim_cmd_ctx *x)
 		p->wall_left = p->wall_right = 0;
 		return REPLY(x, "ok no walls"), 0;
 	}
-	char *e1, *e2;
-	double l = x->argc == 3 ? strtod(x->argv[1], &e1) : 0, r = x->argc == 3 ? strtod(x->argv[2], &e2) : 0;
-	if (x->argc != 3 || *e1 || *e2 || !(l < r) || !isfinite(l) || !isfinite(r))
+	double l = 0, r = 0;
+	if (x->argc != 3 || num_parse_double(x->argv[1], &l) != NUM_OK || num_parse_double(x->argv[2], &r) != NUM_OK ||
+	    !(l < r))
 		return FAIL(x, "usage: walls none | walls LEFT RIGHT (m, LEFT < RIGHT)");
 	p->wall_left = l;
 	p->wall_right = r;

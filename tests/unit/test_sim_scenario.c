@@ -203,6 +203,70 @@ static void test_scenario_files(void **state)
 	assert_string_equal(err, "mem:2: beta: >= 0");
 }
 
+/* Numbers that end up in integers are parsed as integers, in range: a double
+ * like 1e98 cast to the seed's uint64 was undefined behaviour (found by UBSan
+ * fuzzing), and 1.5 was silently cut to 1. */
+static void test_integer_values(void **state)
+{
+	(void)state;
+	char err[256];
+	sim_config_defaults(&cfg);
+	const char *bad[] = {
+		"sim.seed=1e98", "sim.seed=-1", "sim.seed=1.5", "sim.seed=nan", "sim.seed=inf",
+		"sim.seed=18446744073709551616", "sim.seed=", "sim.seed=0x", "sim.seed=5x",
+		"sim.baud=1e300", "sim.baud=57600.5", "sim.return_delay_us=3.5", "sim.return_delay_us=1e300",
+		"sim.duration=1e300", "robot a.contact=1.5", "robot a.contact=1e300", "robot a.baud=1e98",
+		"robot a.return_delay_us=-1", "robot a.servo_baud=3.5", "robot a.servo_baud=1e300",
+	};
+	for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+		err[0] = '\0';
+		if (sim_config_set(&cfg, bad[i], err, sizeof(err)) != -1)
+			fail_msg("'%s' accepted", bad[i]);
+		assert_non_null(strstr(err, bad[i]));  /* the message quotes it */
+	}
+	assert_int_equal(cfg.seed, 1);  /* unchanged by all of these */
+	assert_int_equal(sim_config_set(&cfg, "sim.seed=18446744073709551615", err, sizeof(err)), 0);
+	assert_true(cfg.seed == UINT64_MAX);
+	assert_int_equal(sim_config_set(&cfg, "sim.seed=0x10", err, sizeof(err)), 0);
+	assert_int_equal(cfg.seed, 16);
+	assert_int_equal(sim_config_set(&cfg, "sim.seed=9007199254740993", err, sizeof(err)), 0);
+	assert_true(cfg.seed == 9007199254740993ull);  /* exact, beyond a double's 2^53 */
+	assert_int_equal(sim_config_set(&cfg, "sim.seed= 7 ", err, sizeof(err)), 0);  /* spaces as in a file */
+	assert_int_equal(cfg.seed, 7);
+	assert_int_equal(sim_config_set(&cfg, "sim.baud=57600", err, sizeof(err)), 0);
+	assert_int_equal(cfg.baud, 57600);
+	assert_int_equal(sim_config_set(&cfg, "sim.duration=3600.5", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_set(&cfg, "robot a.contact=none", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_set(&cfg, "robot a.contact=2", err, sizeof(err)), 0);
+	assert_int_equal(cfg.robots[0].contact_id, 2);
+	/* in a file: the line of the bad value */
+	assert_int_equal(load(&cfg, "[sim]\nrate_hz = 1000\nseed = 1e98\n", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, ":3: seed"));
+
+	/* command arguments that become integers or times */
+	char reply[512];
+	quick(&cfg, 1);
+	assert_int_equal(sim_init(&sim, &cfg, err, sizeof(err)), 0);
+	const char *bads[] = {
+		"fault a 1 truncate 1e300", "fault a 1 truncate 2.5", "fault a 1 slow 1e300", "fault a 1 wrong-id 1e300",
+		"fault a 1 wrong-id 254", "fault a 1 garbage 1e300", "fault a 1 garbage 65", "fault a 1 no-reply count=1.5",
+		"fault a 1 no-reply count=1e300", "fault a 1 temperature 1e300", "fault a 1 voltage 1e300",
+		"peek a 257 goal_position", "peek a 1x goal_position", "poke a 257 led 1", "servo a 257", "servo a -255",
+		"poke a 1 led 1x", "garbage a 5x", "garbage a 1e1",
+	};
+	for (size_t i = 0; i < sizeof(bads) / sizeof(bads[0]); i++)
+		if (sim_command(&sim, bads[i], 0, reply, sizeof(reply)) != -1)
+			fail_msg("'%s' accepted: %s", bads[i], reply);
+	for (size_t k = 0; k < SIM_FAULT_KINDS; k++)
+		assert_false(sim.buses[0].joints[0].faults.f[k].active);
+	/* register values are decimal or 0x, never octal */
+	assert_int_equal(sim_command(&sim, "poke a 1 temperature_limit 010", 0, reply, sizeof(reply)), 0);
+	assert_int_equal(sim_command(&sim, "peek a 1 temperature_limit", 0, reply, sizeof(reply)), 0);
+	assert_string_equal(reply, "ok 10");
+	assert_int_equal(sim_command(&sim, "fault a 1 slow 2.5 count=3", 0, reply, sizeof(reply)), 0);
+	assert_int_equal(sim_command(&sim, "fault a 1 wrong-id 253", 0, reply, sizeof(reply)), 0);
+}
+
 static void test_seeded_start(void **state)
 {
 	(void)state;
@@ -317,6 +381,7 @@ int main(void)
 		cmocka_unit_test(test_config_errors),
 		cmocka_unit_test(test_long_line),
 		cmocka_unit_test(test_scenario_files),
+		cmocka_unit_test(test_integer_values),
 		cmocka_unit_test(test_seeded_start),
 		cmocka_unit_test(test_commands),
 		cmocka_unit_test(test_events_run_on_time),
