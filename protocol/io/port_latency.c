@@ -21,6 +21,7 @@
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include "num.h"
 #include "port.h"
 
 /* Range the ftdi_sio driver accepts for latency_timer, in ms. */
@@ -69,12 +70,13 @@ static int port_tty_name(const char *path, char *name, size_t cap, char *shown, 
 	return 0;
 }
 
-/* Read the timer in ms; -1 when the file cannot be read or holds no valid value. */
+/* Read the timer in ms; -1 when the file cannot be read or holds no valid value.
+ * The kernel writes "%d\n": one trailing newline is the format, anything
+ * else around the number means a file we do not understand. */
 static int port_read_timer(const char *file)
 {
 	char text[16];
-	char *end;
-	long v;
+	int v;
 	ssize_t n;
 	int fd = open(file, O_RDONLY | O_CLOEXEC);
 
@@ -85,11 +87,11 @@ static int port_read_timer(const char *file)
 	if (n <= 0)
 		return -1;
 	text[n] = '\0';
-	errno = 0;
-	v = strtol(text, &end, 10);
-	if (errno != 0 || end == text || v < PORT_LATENCY_MIN_MS || v > PORT_LATENCY_MAX_MS)
+	if (text[n - 1] == '\n')
+		text[n - 1] = '\0';
+	if (num_parse_int(text, PORT_LATENCY_MIN_MS, PORT_LATENCY_MAX_MS, &v) != NUM_OK)
 		return -1;
-	return (int)v;
+	return v;
 }
 
 /* 0, or the errno of the failed write. */

@@ -303,6 +303,31 @@ static void test_latency_reported_not_lowered(void **state)
 	fake_sysfs_remove(&s);
 }
 
+/* The kernel writes "%d\n"; anything else is no timer we understand. */
+static void test_latency_timer_text(void **state)
+{
+	(void)state;
+	static const struct { const char *text; bool known; int ms; } rows[] = {
+		{ "16", true, 16 },       /* no newline: still the number */
+		{ "2\n", true, 2 },
+		{ "16x\n", false, 0 },    /* trailing garbage: not half-read as 16 */
+		{ " 16\n", false, 0 },
+		{ "\n", false, 0 },
+		{ "0\n", false, 0 },      /* outside the timer's 1..255 ms */
+		{ "256\n", false, 0 },
+		{ "16\n\n", false, 0 },
+	};
+	for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
+		struct fake_sysfs s;
+		struct port_latency lat;
+		fake_sysfs_make(&s, rows[i].text);
+		port_latency_check(s.link, false, &lat);
+		if (lat.known != rows[i].known || lat.timer_ms != rows[i].ms)
+			fail_msg("timer text %zu: known %d ms %d", i, lat.known, lat.timer_ms);
+		fake_sysfs_remove(&s);
+	}
+}
+
 static void test_latency_lowered_through_symlink(void **state)
 {
 	(void)state;
@@ -402,6 +427,7 @@ int main(void)
 		cmocka_unit_test_setup_teardown(test_baud_rates, setup_pty, teardown_pty),
 		cmocka_unit_test(test_open_missing_port),
 		cmocka_unit_test(test_latency_reported_not_lowered),
+		cmocka_unit_test(test_latency_timer_text),
 		cmocka_unit_test(test_latency_lowered_through_symlink),
 		cmocka_unit_test(test_latency_cannot_lower),
 		cmocka_unit_test_setup_teardown(test_latency_not_ftdi, setup_pty, teardown_pty),

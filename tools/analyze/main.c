@@ -1,6 +1,7 @@
 /* undulate-analyze — LCM logs to CSV files, phase differences, return maps,
  * an end-state classification and plots. See tools/analyze/README.md. */
 #include "analyze.h"
+#include "num.h"
 #include "synth.h"
 
 #include <getopt.h>
@@ -38,13 +39,11 @@ static void usage(FILE *f)
 
 static int parse_double(const char *opt, const char *s, double *out)
 {
-	char *end;
-	double v = strtod(s, &end);
-	if (end == s || *end || !isfinite(v)) {
-		fprintf(stderr, "undulate-analyze: %s: \"%s\" is not a number\n", opt, s);
+	enum num_status st = num_parse_double(s, out);
+	if (st != NUM_OK) {
+		fprintf(stderr, "undulate-analyze: %s: \"%s\" is %s\n", opt, s, num_strerror(st));
 		return -1;
 	}
-	*out = v;
 	return 0;
 }
 

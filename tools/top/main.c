@@ -2,6 +2,7 @@
  * See tools/top/README.md. */
 #include "keys.h"
 #include "model.h"
+#include "num.h"
 #include "render.h"
 #include "term.h"
 
@@ -348,9 +349,8 @@ static void usage(FILE *f)
 
 static int parse_seconds(const char *opt, const char *s, double *out)
 {
-	char *end;
-	double v = strtod(s, &end);
-	if (end == s || *end || !(v > 0) || !isfinite(v)) {
+	double v;
+	if (num_parse_double(s, &v) != NUM_OK || !(v > 0)) {
 		fprintf(stderr, "undulate-top: %s: \"%s\" is not a positive number of seconds\n", opt, s);
 		return -1;
 	}
