@@ -175,12 +175,6 @@ void sim_faults_clear(struct sim_faults *fs)
 	memset(fs->f, 0, sizeof(fs->f));
 }
 
-uint8_t sim_faults_stuck_bits(const struct sim_faults *fs)
-{
-	const struct sim_fault *f = &fs->f[SIM_FAULT_STUCK_ERROR];
-	return f->active ? (uint8_t)((unsigned)f->arg & DXL_ERRBIT_MASK) : 0;
-}
-
 /* Whether a reply fault fires for this reply (count and probability). */
 static bool fault_fires(struct sim_fault *f, uint64_t *rng)
 {
@@ -205,6 +199,15 @@ bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t
 	bool changed = false;
 	*ngarbage = 0;
 	*extra_delay_ns = 0;
+	/* First what the servo says (its error byte), then what the line does
+	 * to it: a bad-checksum fault inverts the checksum of the packet with
+	 * the stuck bits in. */
+	if (*len >= 6 && fault_fires(&f[SIM_FAULT_STUCK_ERROR], rng)) {
+		double bits = f[SIM_FAULT_STUCK_ERROR].arg;
+		pkt[4] |= bits > 0 && bits <= DXL_ERRBIT_MASK ? (uint8_t)bits : 0;
+		fault_fix_checksum(pkt, *len);
+		changed = true;
+	}
 	if (fault_fires(&f[SIM_FAULT_SLOW], rng)) {
 		double ms = f[SIM_FAULT_SLOW].has_arg ? f[SIM_FAULT_SLOW].arg : 5.0;
 		/* parsed within range; a caller's own struct is clamped (no cast of a huge double) */

@@ -11,12 +11,14 @@
  * truncate        bytes cut (half)     the reply loses its last ARG bytes
  * garbage         bytes (8)            ARG random bytes go out just before the reply
  * wrong-id        ID (id + 1)          the reply carries ID ARG (valid checksum)
- * stuck-error     bits (overload=32)   ARG is OR-ed into every error byte
+ * stuck-error     bits (overload=32)   ARG is OR-ed into the reply's error byte (report
+ *                                      only: the servo itself does not act on them)
  * slow            ms (5)               the reply leaves ARG ms late
  * temperature     °C                   the servo measures ARG (can raise overheating)
  * voltage         V                    the servo measures ARG (can raise the voltage bit)
- * count=N limits a reply fault to the next N replies, prob=P applies it to a
- * fraction P of replies.
+ * count=N limits a reply fault (all but temperature and voltage, which are
+ * measurements) to the next N replies, prob=P applies it to a fraction P of
+ * replies.
  */
 #ifndef UNDULATE_SIM_FAULT_H
 #define UNDULATE_SIM_FAULT_H
@@ -66,8 +68,6 @@ int sim_fault_parse(int argc, char **argv, enum sim_fault_kind *kind, struct sim
  * ("overload|overheating"). -1 if invalid. */
 int sim_fault_parse_bits(const char *text);
 void sim_faults_clear(struct sim_faults *fs);
-/* Stuck bits currently injected. */
-uint8_t sim_faults_stuck_bits(const struct sim_faults *fs);
 
 /* xorshift64* — small, seedable, deterministic across runs. */
 uint64_t sim_rand_next(uint64_t *state);

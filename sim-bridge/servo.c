@@ -123,7 +123,7 @@ void sim_servo_power_on(struct sim_servo *s)
 
 uint8_t sim_servo_condition_bits(const struct sim_servo *s)
 {
-	return (uint8_t)((s->conditions | s->stuck_bits) & DXL_ERRBIT_MASK);
+	return (uint8_t)(s->conditions & DXL_ERRBIT_MASK);
 }
 
 /* ---- replies ----------------------------------------------------------------- */
@@ -419,8 +419,9 @@ static void servo_update_conditions(struct sim_servo *s, const struct sim_servo_
 }
 
 /* Alarm shutdown: the manual's reaction is torque off with torque limit 0.
- * Injected stuck bits are reported only: they model a servo that *says* it
- * is overloaded, which the controller must handle without the sim acting. */
+ * Injected stuck-error bits never get here (fault.c adds them to replies):
+ * they model a servo that *says* it is overloaded, which the controller must
+ * handle without the sim acting. */
 static void servo_alarm(struct sim_servo *s)
 {
 	uint8_t active = s->conditions;

@@ -53,7 +53,6 @@ struct sim_servo {
 	uint8_t mem[DXL_AX_TABLE_SIZE];  /* the control table, as on the wire */
 	bool powered;
 	uint8_t conditions;        /* voltage/overheat/overload bits while they last */
-	uint8_t stuck_bits;        /* injected: OR-ed into every status error byte (report only: no shutdown) */
 	bool alarm_led;            /* an alarm-LED-mask condition is active */
 	double overload_s;         /* time spent at the torque limit */
 	/* REG_WRITE waiting for ACTION */
@@ -108,7 +107,8 @@ struct sim_servo_sense {
 /* Update present position/speed/load/voltage/temperature/moving, the error
  * conditions and the alarm shutdown. */
 void sim_servo_sense(struct sim_servo *s, const struct sim_servo_sense *in, double dt);
-/* Error byte a status packet would carry now (conditions | stuck bits). */
+/* Error conditions a status packet carries now (voltage, overheating,
+ * overload). Injected stuck-error bits are added on the way out (fault.c). */
 uint8_t sim_servo_condition_bits(const struct sim_servo *s);
 
 #endif

@@ -161,7 +161,6 @@ static void sim_sense_joint(struct sim_joint *j, double dt)
 		.temperature = f[SIM_FAULT_TEMPERATURE].active ? f[SIM_FAULT_TEMPERATURE].arg : j->motor.temperature,
 		.overloaded = cmd.torque_enable && sim_motor_overloaded(&j->motor, &j->params, &cmd),
 	};
-	j->servo.stuck_bits = sim_faults_stuck_bits(&j->faults);
 	sim_servo_sense(&j->servo, &in, dt);
 }
 
@@ -263,7 +262,6 @@ static int do_fault_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joi
 	const struct sim_fault *f = arg;
 	enum sim_fault_kind kind = (enum sim_fault_kind)f[1].remaining;
 	j->faults.f[kind] = f[0];
-	j->servo.stuck_bits = sim_faults_stuck_bits(&j->faults);
 	return 0;
 }
 
@@ -290,7 +288,6 @@ static int do_clear_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joi
 		sim_faults_clear(&j->faults);
 	else
 		memset(&j->faults.f[kind], 0, sizeof(j->faults.f[kind]));
-	j->servo.stuck_bits = sim_faults_stuck_bits(&j->faults);
 	return 0;
 }
 

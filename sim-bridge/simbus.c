@@ -104,7 +104,6 @@ static void bus_dispatch(struct sim_bus *b, const struct dxl_packet *pkt, int64_
 			b->count.wrong_baud++;
 			continue;  /* at another rate the servo sees only framing noise */
 		}
-		j->servo.stuck_bits = sim_faults_stuck_bits(&j->faults);
 		uint8_t reply[DXL_MAX_PACKET];
 		int len = sim_servo_handle(&j->servo, pkt, reply, sizeof(reply));
 		if (len > 0)

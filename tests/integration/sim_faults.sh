@@ -64,6 +64,23 @@ xfer $PING1 300 6; tap_check "stuck-error: overload|overheating in every reply" 
 xfer "$(pkt 1 2 43 1)" 300 7
 tap_check "stuck-error: in READ replies too" test "${reply:8:2}" = 24
 ctl "clear r1" >/dev/null
+# count=N and prob=P, as for every other fault
+ctl_ok "stuck-error count=2 accepted" "fault r1 1 stuck-error overload count=2"
+got=""; for _ in 1 2 3; do xfer $PING1 300 6; got+="$reply "; done
+tap_check "stuck-error count=2: the bit in the next 2 replies only ($got)" \
+	test "$got" = "FFFF010220DC FFFF010220DC $OK1 "
+r=$(ctl "servo r1 1")
+tap_check "stuck-error count=2: used up, no fault left" test "${r##*faults=}" = none
+ctl_ok "stuck-error prob=0.5 accepted" "fault r1 1 stuck-error overload prob=0.5"
+with=0 without=0 other=""
+for _ in $(seq 12); do
+	xfer "$(pkt 1 2 43 1)" 300 7
+	case "${reply:8:2}" in 20) with=$((with + 1));; 00) without=$((without + 1));; *) other+="$reply ";; esac
+done
+if [ "$with" -gt 0 ] && [ "$without" -gt 0 ] && [ -z "$other" ]; then
+	tap_ok "stuck-error prob=0.5: the bit in some READ replies ($with of 12), not all"
+else tap_fail "stuck-error prob=0.5" "with $with, without $without, other: $other"; fi
+ctl "clear r1" >/dev/null
 
 ctl "fault r1 1 slow 30" >/dev/null
 xfer $PING1 200 6

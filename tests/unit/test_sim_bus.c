@@ -261,20 +261,99 @@ static void test_reply_faults(void **state)
 	n = ping_with_fault(&b, "slow 3", out, &first);
 	assert_int_equal(first, 3 * MS + 70 * US);
 	n = ping_with_fault(&b, "stuck-error overload|overheating", out, &first);
-	b.joints[0].servo.stuck_bits = sim_faults_stuck_bits(&b.joints[0].faults);
-	static const uint8_t ping[] = { 0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB };
-	int64_t last;
-	sim_bus_feed(&b, ping, sizeof(ping), 0);
-	n = drain(&b, out, sizeof(out), &first, &last);
 	static const uint8_t want[] = { 0xFF, 0xFF, 0x01, 0x02, 0x24, 0xD8 };  /* the manual's example */
+	assert_int_equal(n, sizeof(want));
 	assert_memory_equal(out, want, sizeof(want));
 	/* count=N: only the next N replies. */
-	sim_bus_feed(&b, ping, sizeof(ping), MS);  /* flush the stuck state */
-	drain(&b, out, sizeof(out), &first, &last);
+	static const uint8_t ping[] = { 0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB };
+	int64_t last;
 	n = ping_with_fault(&b, "no-reply count=1", out, &first);
 	assert_int_equal(n, 0);
 	sim_bus_feed(&b, ping, sizeof(ping), 2 * MS);
 	assert_int_equal(drain(&b, out, sizeof(out), &first, &last), 6);
+}
+
+/* One PING to servo 1 at time t; its reply (6 bytes, or what the faults made
+ * of it) in out. */
+static size_t ping1(struct sim_bus *b, int64_t t, uint8_t *out)
+{
+	static const uint8_t ping[] = { 0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB };
+	int64_t first, last;
+	sim_bus_feed(b, ping, sizeof(ping), t);
+	return drain(b, out, 128, &first, &last);
+}
+
+static void set_fault(struct sim_bus *b, const char *text)
+{
+	char buf[128], err[128], *argv[8];
+	int argc = 0;
+	enum sim_fault_kind kind;
+	struct sim_fault f;
+	snprintf(buf, sizeof(buf), "%s", text);
+	for (char *save = NULL, *w = strtok_r(buf, " ", &save); w && argc < 8; w = strtok_r(NULL, " ", &save))
+		argv[argc++] = w;
+	assert_int_equal(sim_fault_parse(argc, argv, &kind, &f, err, sizeof(err)), 0);
+	b->joints[0].faults.f[kind] = f;
+}
+
+/* stuck-error honours count=N and prob=P like every other fault: the bits
+ * are in the next N replies only, or in a fraction P of them (the bus's
+ * seeded generator), and each reply carrying them has a valid checksum. */
+static void test_stuck_error_count_and_prob(void **state)
+{
+	(void)state;
+	struct sim_bus b;
+	uint8_t out[128];
+	struct dxl_packet pkt;
+	int64_t t = 0;
+	bus_two(&b, 0, false);
+	set_fault(&b, "stuck-error overload count=2");
+	for (int i = 0; i < 4; i++) {
+		assert_int_equal(ping1(&b, t += MS, out), 6);
+		assert_int_equal(parse_status(out, 6, &pkt), DXL_FRAME);
+		assert_int_equal(pkt.code, i < 2 ? DXL_ERRBIT_OVERLOAD : 0);
+	}
+	assert_false(b.joints[0].faults.f[SIM_FAULT_STUCK_ERROR].active);  /* used up */
+
+	set_fault(&b, "stuck-error overload|overheating prob=0.5");
+	int with = 0;
+	for (int i = 0; i < 400; i++) {
+		assert_int_equal(ping1(&b, t += MS, out), 6);
+		assert_int_equal(parse_status(out, 6, &pkt), DXL_FRAME);
+		assert_true(pkt.code == 0 || pkt.code == (DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT));
+		with += pkt.code != 0;
+	}
+	assert_in_range(with, 140, 260);   /* 200 ± 6 sigma */
+	set_fault(&b, "stuck-error prob=0");
+	for (int i = 0; i < 50; i++) {
+		ping1(&b, t += MS, out);
+		assert_int_equal(out[4], 0);
+	}
+	/* the same seed gives the same replies */
+	struct sim_bus c;
+	int pattern_b = 0, pattern_c = 0;
+	bus_two(&b, 0, false);
+	bus_two(&c, 0, false);
+	set_fault(&b, "stuck-error prob=0.5");
+	set_fault(&c, "stuck-error prob=0.5");
+	for (int i = 0; i < 20; i++) {
+		ping1(&b, t += MS, out);
+		pattern_b = pattern_b << 1 | (out[4] != 0);
+		ping1(&c, t, out);
+		pattern_c = pattern_c << 1 | (out[4] != 0);
+	}
+	assert_int_equal(pattern_b, pattern_c);
+	assert_true(pattern_b != 0 && pattern_b != (1 << 20) - 1);
+	/* together with bad-checksum: the bits are in, and the checksum (of the
+	 * packet with the bits) is inverted */
+	bus_two(&b, 0, false);
+	set_fault(&b, "stuck-error range");
+	set_fault(&b, "bad-checksum");
+	ping1(&b, t += MS, out);
+	assert_int_equal(out[4], DXL_ERRBIT_RANGE);
+	assert_int_equal(out[5], (uint8_t)~dxl_checksum(&out[2], 3));
+	/* the bits never reach the servo's own state: report only, no shutdown */
+	assert_int_equal(b.joints[0].servo.conditions, 0);
 }
 
 static void test_fault_parse_errors(void **state)
@@ -339,6 +418,7 @@ int main(void)
 		cmocka_unit_test(test_conformance_through_library),
 		cmocka_unit_test(test_bad_checksum_gets_checksum_bit),
 		cmocka_unit_test(test_reply_faults),
+		cmocka_unit_test(test_stuck_error_count_and_prob),
 		cmocka_unit_test(test_fault_parse_errors),
 		cmocka_unit_test(test_line_queue),
 	};

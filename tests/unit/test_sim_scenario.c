@@ -295,9 +295,10 @@ static void test_commands(void **state)
 	assert_true(f->active && f->arg == 3 && f->remaining == 2);
 	assert_int_equal(sim_command(&sim, "fault * * stuck-error overload", 0, reply, sizeof(reply)), 0);
 	assert_string_equal(reply, "ok 4 servo(s): stuck-error");
-	assert_int_equal(sim.buses[1].joints[0].servo.stuck_bits, DXL_ERRBIT_OVERLOAD);
+	const struct sim_fault *stuck = &sim.buses[1].joints[0].faults.f[SIM_FAULT_STUCK_ERROR];
+	assert_true(stuck->active && stuck->arg == DXL_ERRBIT_OVERLOAD && stuck->remaining < 0);
 	assert_int_equal(sim_command(&sim, "clear * * stuck-error", 0, reply, sizeof(reply)), 0);
-	assert_int_equal(sim.buses[1].joints[0].servo.stuck_bits, 0);
+	assert_false(stuck->active);
 	assert_true(f->active);  /* other kinds stay */
 	assert_int_equal(sim_command(&sim, "clear a", 0, reply, sizeof(reply)), 0);
 	assert_false(f->active);
