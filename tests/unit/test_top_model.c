@@ -260,6 +260,32 @@ static void test_json(void **state)
 	assert_int_equal(strchr(buf, '\n') - buf, (long)strlen(buf) - 1); /* one line */
 }
 
+/* Texts from the network reach JSON as valid JSON: a newline and a stray
+ * byte in an event, and a reason cut by TOP_TEXT_MAX inside a UTF-8 character. */
+static void test_json_hostile_text(void **state)
+{
+	(void)state;
+	char n[] = "r1", reason[200];
+	memset(reason, 'a', sizeof reason);
+	memcpy(reason + TOP_TEXT_MAX - 3, "\xe2\x82\xac", 3);   /* U+20AC across the cut: 2 bytes kept */
+	reason[sizeof reason - 1] = '\0';
+	undulate_joint_state_t j[1] = { { .servo_id = 1, .angle = NAN, .speed = INFINITY } };
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 1, .mode_reason = reason,
+		.period_us = 10000.0, .njoints = 1, .joints = j };
+	top_on_state(&model, &s, 0.0);
+	char kind[] = "fault", text[] = "line1\nline2 \xff end";
+	undulate_event_t e = { .utime = 1, .robot = n, .seq = 1, .level = 1, .kind = kind, .text = text };
+	top_on_event(&model, &e);
+	static char buf[65536];
+	FILE *f = fmemopen(buf, sizeof(buf), "w");
+	top_json(&model, 0.1, 1234, f);
+	fclose(f);
+	assert_non_null(strstr(buf, "\"last_event\":\"fault: line1\\u000aline2 \\ufffd end\""));
+	assert_non_null(strstr(buf, "aaa\\ufffd\\ufffd\",\"utime\""));
+	assert_non_null(strstr(buf, "\"angle\":null,\"speed\":null"));
+	assert_int_equal(strchr(buf, '\n') - buf, (long)strlen(buf) - 1); /* still one line */
+}
+
 /* Torque actuation publishes no goal (NaN) but the drive sent: the goal
  * column shows the drive, marked d, and JSON carries both. */
 static void test_drive_column(void **state)
@@ -294,6 +320,7 @@ int main(void)
 		cmocka_unit_test_setup(test_commands, setup),
 		cmocka_unit_test_setup(test_render_twenty, setup),
 		cmocka_unit_test_setup(test_json, setup),
+		cmocka_unit_test_setup(test_json_hostile_text, setup),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,6 @@
 /* model.c — see model.h. */
 #include "model.h"
+#include "json.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -340,124 +341,138 @@ bool top_sim_present(const struct top_model *m, double now)
 
 /* ---- JSON --------------------------------------------------------------------- */
 
-static void top_json_str(FILE *f, const char *s)
+static void top_json_joint(struct json *j, const struct top_joint *jt)
 {
-	fputc('"', f);
-	for (; s && *s; s++) {
-		unsigned char ch = (unsigned char)*s;
-		if (ch == '"' || ch == '\\')
-			fprintf(f, "\\%c", ch);
-		else if (ch < 0x20)
-			fprintf(f, "\\u%04x", ch);
-		else
-			fputc(ch, f);
-	}
-	fputc('"', f);
+	json_object_begin(j);
+	json_field_int(j, "servo_id", jt->servo_id);
+	json_field_number(j, "angle", jt->angle);
+	json_field_number(j, "speed", jt->speed);
+	json_field_number(j, "goal", jt->goal);
+	json_field_number(j, "drive", jt->drive);
+	json_field_number(j, "load", jt->load);
+	json_field_number(j, "phase", jt->phase);
+	json_field_number(j, "amplitude", jt->amplitude);
+	json_field_number(j, "frequency", jt->frequency);
+	json_field_int(j, "error_bits", jt->error_bits);
+	json_field_int(j, "stale_cycles", jt->stale_cycles);
+	json_field_bool(j, "torque", jt->torque);
+	json_object_end(j);
 }
 
-/* "key":number (null when not finite), with a leading comma unless FIRST. */
-static void top_json_num(FILE *f, const char *key, double v, bool first)
+static void top_json_bus(struct json *j, const struct top_robot *r)
 {
-	fprintf(f, "%s\"%s\":", first ? "" : ",", key);
-	if (isfinite(v))
-		fprintf(f, "%.12g", v);
-	else
-		fputs("null", f);
+	json_key(j, "bus");
+	if (!r->have_bus) {
+		json_null(j);
+		return;
+	}
+	json_object_begin(j);
+	json_field_bool(j, "connected", r->connected);
+	json_field_int(j, "reconnects", r->reconnects);
+	json_field_int(j, "timeouts", r->timeouts);
+	json_field_int(j, "checksum_errors", r->checksum_errors);
+	json_field_int(j, "io_errors", r->io_errors);
+	json_field_number(j, "cpu_percent", r->cpu_percent);
+	json_object_end(j);
 }
 
-static void top_json_joint(FILE *f, const struct top_joint *j)
+static void top_json_params(struct json *j, const struct top_robot *r)
 {
-	fprintf(f, "{\"servo_id\":%d", j->servo_id);
-	top_json_num(f, "angle", j->angle, false);
-	top_json_num(f, "speed", j->speed, false);
-	top_json_num(f, "goal", j->goal, false);
-	top_json_num(f, "drive", j->drive, false);
-	top_json_num(f, "load", j->load, false);
-	top_json_num(f, "phase", j->phase, false);
-	top_json_num(f, "amplitude", j->amplitude, false);
-	top_json_num(f, "frequency", j->frequency, false);
-	fprintf(f, ",\"error_bits\":%d,\"stale_cycles\":%d,\"torque\":%s}", j->error_bits, j->stale_cycles,
-		j->torque ? "true" : "false");
+	json_key(j, "params");
+	if (!r->have_params) {
+		json_null(j);
+		return;
+	}
+	json_object_begin(j);
+	json_key(j, "c");
+	json_array_begin(j);
+	for (int k = 0; k < r->nparams; k++)
+		json_number(j, r->c[k]);
+	json_array_end(j);
+	json_field_number(j, "amplitude", r->sin_amplitude);
+	json_field_number(j, "frequency", r->sin_frequency);
+	json_object_end(j);
 }
 
-static void top_json_robot(FILE *f, const struct top_robot *r, double now)
+static void top_json_robot(struct json *j, const struct top_robot *r, double now)
 {
-	fputs("{\"name\":", f);
-	top_json_str(f, r->name);
-	fprintf(f, ",\"stale\":%s", top_robot_stale(r, now) ? "true" : "false");
-	top_json_num(f, "age_s", r->have_state ? now - r->rx : NAN, false);
-	fprintf(f, ",\"mode\":\"%s\",\"mode_id\":%d,\"mode_reason\":", top_mode_name(r->mode), r->mode);
-	top_json_str(f, r->mode_reason);
-	fprintf(f, ",\"utime\":%lld,\"cycle\":%lld,\"states\":%lld", (long long)r->utime, (long long)r->cycle,
-		(long long)r->states);
-	top_json_num(f, "rate_hz", top_robot_rate_hz(r), false);
-	top_json_num(f, "rx_hz", top_robot_rx_hz(r, now), false);
-	top_json_num(f, "jitter_p99_us", top_robot_jitter_p99(r), false);
-	top_json_num(f, "jitter_max_us", top_robot_jitter_max(r), false);
-	fprintf(f, ",\"overruns\":%lld,\"bus_errors\":%lld,\"bad_commands\":%lld", (long long)r->overruns,
-		(long long)r->bus_errors, (long long)r->bad_commands);
-	top_json_num(f, "dphase_joints", top_robot_dphase_joints(r), false);
-	top_json_num(f, "neutral", r->have_body ? r->neutral : NAN, false);
-	fputs(",\"joints\":[", f);
-	for (int k = 0; k < r->njoints; k++) {
-		if (k)
-			fputc(',', f);
-		top_json_joint(f, &r->j[k]);
-	}
-	fputc(']', f);
-	if (r->have_bus)
-		fprintf(f, ",\"bus\":{\"connected\":%s,\"reconnects\":%lld,\"timeouts\":%lld,\"checksum_errors\":%lld,"
-			   "\"io_errors\":%lld,\"cpu_percent\":%.3f}",
-			r->connected ? "true" : "false", (long long)r->reconnects, (long long)r->timeouts,
-			(long long)r->checksum_errors, (long long)r->io_errors, r->cpu_percent);
-	else
-		fputs(",\"bus\":null", f);
-	if (r->have_params) {
-		fputs(",\"params\":{\"c\":[", f);
-		for (int k = 0; k < r->nparams; k++)
-			fprintf(f, "%s%.12g", k ? "," : "", r->c[k]);
-		fputs("]", f);
-		top_json_num(f, "amplitude", r->sin_amplitude, false);
-		top_json_num(f, "frequency", r->sin_frequency, false);
-		fputc('}', f);
-	} else {
-		fputs(",\"params\":null", f);
-	}
-	fputs(",\"last_event\":", f);
-	top_json_str(f, r->last_event);
-	fputc('}', f);
+	json_object_begin(j);
+	json_field_string(j, "name", r->name);
+	json_field_bool(j, "stale", top_robot_stale(r, now));
+	json_field_number(j, "age_s", r->have_state ? now - r->rx : NAN);
+	json_field_string(j, "mode", top_mode_name(r->mode));
+	json_field_int(j, "mode_id", r->mode);
+	json_field_string(j, "mode_reason", r->mode_reason);
+	json_field_int(j, "utime", r->utime);
+	json_field_int(j, "cycle", r->cycle);
+	json_field_int(j, "states", r->states);
+	json_field_number(j, "rate_hz", top_robot_rate_hz(r));
+	json_field_number(j, "rx_hz", top_robot_rx_hz(r, now));
+	json_field_number(j, "jitter_p99_us", top_robot_jitter_p99(r));
+	json_field_number(j, "jitter_max_us", top_robot_jitter_max(r));
+	json_field_int(j, "overruns", r->overruns);
+	json_field_int(j, "bus_errors", r->bus_errors);
+	json_field_int(j, "bad_commands", r->bad_commands);
+	json_field_number(j, "dphase_joints", top_robot_dphase_joints(r));
+	json_field_number(j, "neutral", r->have_body ? r->neutral : NAN);
+	json_key(j, "joints");
+	json_array_begin(j);
+	for (int k = 0; k < r->njoints; k++)
+		top_json_joint(j, &r->j[k]);
+	json_array_end(j);
+	top_json_bus(j, r);
+	top_json_params(j, r);
+	json_field_string(j, "last_event", r->last_event);
+	json_object_end(j);
+}
+
+static void top_json_sim(struct json *j, const struct top_model *m, double now)
+{
+	double imp = 0;
+	int n = top_collisions_window(m, now, &imp);
+	json_key(j, "sim");
+	json_object_begin(j);
+	json_field_bool(j, "present", top_sim_present(m, now));
+	json_field_bool(j, "heard", m->have_sim);
+	json_field_int(j, "collisions_10s", n);
+	json_field_number(j, "impulse_10s", imp);
+	json_field_int(j, "collisions_heard", m->collisions_heard);
+	json_field_number(j, "impulse_heard", m->impulse_heard);
+	json_field_int(j, "total_collisions", m->sim_total_collisions);
+	json_field_number(j, "total_impulse", m->sim_total_impulse);
+	json_object_end(j);
 }
 
 void top_json(const struct top_model *m, double now, int64_t wall_utime, FILE *f)
 {
+	struct json j;
 	int stale = 0;
 	for (int i = 0; i < m->nrobots; i++)
 		stale += top_robot_stale(&m->robots[i], now);
-	fprintf(f, "{\"utime\":%lld,\"nrobots\":%d,\"stale\":%d,\"order\":\"%s\",\"robots\":[", (long long)wall_utime,
-		m->nrobots, stale, m->order_lateral ? "lateral" : "name");
-	for (int k = 0; k < m->nrobots; k++) {
-		if (k)
-			fputc(',', f);
-		top_json_robot(f, &m->robots[m->order[k]], now);
-	}
-	fputs("],\"neighbours\":[", f);
+	json_init(&j, f, TOP_JSON_DIGITS);
+	json_object_begin(&j);
+	json_field_int(&j, "utime", wall_utime);
+	json_field_int(&j, "nrobots", m->nrobots);
+	json_field_int(&j, "stale", stale);
+	json_field_string(&j, "order", m->order_lateral ? "lateral" : "name");
+	json_key(&j, "robots");
+	json_array_begin(&j);
+	for (int k = 0; k < m->nrobots; k++)
+		top_json_robot(&j, &m->robots[m->order[k]], now);
+	json_array_end(&j);
+	json_key(&j, "neighbours");
+	json_array_begin(&j);
 	for (int k = 0; k + 1 < m->nrobots; k++) {
-		fprintf(f, "%s{\"a\":", k ? "," : "");
-		top_json_str(f, m->robots[m->order[k]].name);
-		fputs(",\"b\":", f);
-		top_json_str(f, m->robots[m->order[k + 1]].name);
-		top_json_num(f, "dphase", top_neighbour_dphase(m, k), false);
-		fputc('}', f);
+		json_object_begin(&j);
+		json_field_string(&j, "a", m->robots[m->order[k]].name);
+		json_field_string(&j, "b", m->robots[m->order[k + 1]].name);
+		json_field_number(&j, "dphase", top_neighbour_dphase(m, k));
+		json_object_end(&j);
 	}
-	double imp = 0;
-	int n = top_collisions_window(m, now, &imp);
-	fprintf(f, "],\"sim\":{\"present\":%s,\"heard\":%s,\"collisions_10s\":%d", top_sim_present(m, now) ? "true" : "false",
-		m->have_sim ? "true" : "false", n);
-	top_json_num(f, "impulse_10s", imp, false);
-	fprintf(f, ",\"collisions_heard\":%lld", (long long)m->collisions_heard);
-	top_json_num(f, "impulse_heard", m->impulse_heard, false);
-	fprintf(f, ",\"total_collisions\":%lld", (long long)m->sim_total_collisions);
-	top_json_num(f, "total_impulse", m->sim_total_impulse, false);
-	fprintf(f, "},\"dropped_robots\":%lld,\"decode_errors\":%lld}\n", (long long)m->dropped_robots,
-		(long long)m->decode_errors);
+	json_array_end(&j);
+	top_json_sim(&j, m, now);
+	json_field_int(&j, "dropped_robots", m->dropped_robots);
+	json_field_int(&j, "decode_errors", m->decode_errors);
+	json_object_end(&j);
+	fputc('\n', f);
 }

@@ -25,6 +25,7 @@
 #define TOP_COLL_RING 2048     /* collision times kept: 200/s over the window */
 #define TOP_COLL_DEDUP 64      /* recent collisions: one seen on SIM.COLLISION and SIM.TRUTH counts once */
 #define TOP_SIM_STALE_S 2.0    /* simulator considered gone after this long */
+#define TOP_JSON_DIGITS 12     /* significant digits of --json numbers */
 
 struct top_joint {
 	int16_t servo_id;
@@ -127,7 +128,9 @@ const char *top_mode_name(int mode);
 const char *top_mode_short(int mode);
 double top_wrap(double a);
 
-/* One JSON object (one line) describing everything. WALL_UTIME: µs since the epoch. */
+/* One JSON object (one line) describing everything, written with common/json.h
+ * (non-finite numbers as null, names from the network escaped to valid UTF-8).
+ * WALL_UTIME: µs since the epoch. */
 void top_json(const struct top_model *m, double now, int64_t wall_utime, FILE *f);
 
 #endif
