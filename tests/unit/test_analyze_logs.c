@@ -342,6 +342,23 @@ static void test_truncated(void **state)
 	free(js);
 }
 
+/* A log path is text from outside: summary.json escapes it (quote, newline,
+ * a byte that is not UTF-8) and stays valid JSON. */
+static void test_json_path_escaped(void **state)
+{
+	(void)state;
+	struct synth_spec s;
+	synth_default(&s);
+	s.duration_s = 2.0;
+	write_synth("we\"ird\n\xff.log", &s);
+	assert_int_equal(run("we\"ird\n\xff.log", "esc", NULL), AN_EXIT_OK);
+	char *js = slurp("esc", "summary.json");
+	assert_non_null(js);
+	assert_non_null(strstr(js, "/we\\\"ird\\u000a\\ufffd.log\",\"events\":"));
+	assert_int_equal(strchr(js, '\n') - js, (long)strlen(js) - 1); /* one line */
+	free(js);
+}
+
 /* Garbage in the middle: everything before it is used, and it is reported. */
 static void test_damaged_middle(void **state)
 {
@@ -421,6 +438,7 @@ int main(void)
 		cmocka_unit_test(test_synth_stop),
 		cmocka_unit_test(test_missing_and_foreign),
 		cmocka_unit_test(test_truncated),
+		cmocka_unit_test(test_json_path_escaped),
 		cmocka_unit_test(test_damaged_middle),
 		cmocka_unit_test(test_plots),
 	};

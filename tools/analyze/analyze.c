@@ -8,6 +8,7 @@
  * differences (the return map) and the collision-rate bins are kept. */
 #include "analyze.h"
 #include "alog.h"
+#include "json.h"
 #include "phase.h"
 #include "plot.h"
 
@@ -48,6 +49,8 @@
 #define AN_MAX_BINS (10 * 24 * 3600)
 /* Warnings of one kind printed before going quiet (the count is reported). */
 #define AN_WARN_LIMIT 5
+/* Significant digits of summary.json numbers: finer than any estimate here. */
+#define AN_JSON_DIGITS 9
 
 struct an_sample {
 	int64_t utime;
@@ -394,6 +397,11 @@ static void an_order_robots(struct an_ctx *c)
 	}
 }
 
+static const char *an_pair_kind_name(enum an_pair_kind kind)
+{
+	return kind == AN_PAIR_JOINTS ? "joints" : kind == AN_PAIR_USER ? "user" : "neighbour";
+}
+
 static struct an_pair *an_pair_add(struct an_ctx *c, enum an_pair_kind kind, int a, int ja, int b, int jb)
 {
 	if (c->npairs >= AN_MAX_PAIRS) {
@@ -523,7 +531,7 @@ static void an_pair_row(struct an_ctx *c, struct an_pair *p, int64_t utime, doub
 {
 	fprintf(c->pdiff, "%lld,%.6f,", (long long)utime, t);
 	an_csv_str(c->pdiff, p->name);
-	fprintf(c->pdiff, ",%s,", p->kind == AN_PAIR_JOINTS ? "joints" : p->kind == AN_PAIR_USER ? "user" : "neighbour");
+	fprintf(c->pdiff, ",%s,", an_pair_kind_name(p->kind));
 	an_csv_str(c->pdiff, c->robots[p->a].name);
 	fprintf(c->pdiff, ",%d,", p->ja);
 	an_csv_str(c->pdiff, c->robots[p->b].name);
@@ -945,32 +953,6 @@ static const char *an_classify(const struct an_pair *p, bool have_sim, double mi
 
 /* ---- summary ------------------------------------------------------------------ */
 
-static void an_json_str(FILE *f, const char *s)
-{
-	fputc('"', f);
-	for (; *s; s++) {
-		unsigned char ch = (unsigned char)*s;
-		if (ch == '"' || ch == '\\')
-			fprintf(f, "\\%c", ch);
-		else if (ch < 0x20)
-			fprintf(f, "\\u%04x", ch);
-		else
-			fputc(ch, f);
-	}
-	fputc('"', f);
-}
-
-static void an_json_num(FILE *f, const char *key, double v, bool comma)
-{
-	fprintf(f, "\"%s\":", key);
-	if (isfinite(v))
-		fprintf(f, "%.9g", v);
-	else
-		fputs("null", f);
-	if (comma)
-		fputc(',', f);
-}
-
 static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 {
 	fprintf(f, "undulate-analyze summary\n");
@@ -1020,62 +1002,85 @@ static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 		fprintf(f, "WARNING: a log was truncated; results cover the events before the damage\n");
 }
 
+static void an_json_robot(struct json *j, const struct an_robot *r)
+{
+	json_object_begin(j);
+	json_field_string(j, "name", r->name);
+	json_field_int(j, "states", r->states);
+	json_key(j, "joints");
+	json_array_begin(j);
+	for (int k = 0; k < r->njoints; k++) {
+		json_object_begin(j);
+		json_field_number(j, "frequency_hz", phase_tracker_omega(&r->j[k].tr) / (2.0 * M_PI));
+		json_field_number(j, "amplitude_rad", r->j[k].tr.amplitude);
+		json_field_number(j, "swing_rad", phase_swing_pp(&r->j[k].win_swing));
+		json_object_end(j);
+	}
+	json_array_end(j);
+	json_object_end(j);
+}
+
+static void an_json_pair(struct json *j, const struct an_pair *p)
+{
+	json_object_begin(j);
+	json_field_string(j, "pair", p->name);
+	json_field_string(j, "kind", an_pair_kind_name(p->kind));
+	json_field_string(j, "class", p->cls);
+	json_field_number(j, "mean_abs_delta", phase_circ_mean_abs(&p->win));
+	json_field_number(j, "mean_delta", phase_circ_mean(&p->win));
+	json_field_number(j, "spread", phase_circ_spread(&p->win));
+	json_field_int(j, "window_samples", p->win.n);
+	json_field_int(j, "collisions", p->collisions);
+	json_field_int(j, "contacts", p->contacts);
+	json_field_int(j, "window_collisions", p->win_collisions);
+	json_field_number(j, "impulse", p->impulse);
+	json_field_number(j, "distance_m", p->distance);
+	json_field_number(j, "amplitude_m", p->amp_lateral);
+	json_field_number(j, "dsep", p->dsep);
+	json_field_number(j, "compat_limit", phase_compat_limit(p->dsep));
+	json_field_int(j, "return_map_points", p->ndeltas > 0 ? (long long)p->ndeltas - 1 : 0);
+	json_field_number(j, "swing_a", p->swing_a);
+	json_field_number(j, "swing_b", p->swing_b);
+	json_object_end(j);
+}
+
 static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 {
-	fputs("{\"logs\":[", f);
+	struct json j;
+	json_init(&j, f, AN_JSON_DIGITS);
+	json_object_begin(&j);
+	json_key(&j, "logs");
+	json_array_begin(&j);
 	for (int i = 0; i < c->o->nlogs; i++) {
-		fputs(i ? ",{\"path\":" : "{\"path\":", f);
-		an_json_str(f, c->o->logs[i]);
-		fprintf(f, ",\"events\":%lld,\"truncated\":%s}", (long long)c->log_events[i],
-			c->trunc_note[i][0] ? "true" : "false");
+		json_object_begin(&j);
+		json_field_string(&j, "path", c->o->logs[i]);
+		json_field_int(&j, "events", c->log_events[i]);
+		json_field_bool(&j, "truncated", c->trunc_note[i][0] != '\0');
+		json_object_end(&j);
 	}
-	fprintf(f, "],\"truncated\":%s,", rc == AN_EXIT_TRUNCATED ? "true" : "false");
-	an_json_num(f, "t_end", c->have_state ? an_t(c, c->last_state_utime) : NAN, true);
-	an_json_num(f, "window_s", c->o->window_s, true);
-	an_json_num(f, "restitution", c->o->restitution, true);
-	fprintf(f, "\"order\":\"%s\",\"collisions\":%lld,\"wall_collisions\":%lld,", c->order_lateral ? "lateral" : "name",
-		(long long)c->collisions, (long long)c->wall_collisions);
-	an_json_num(f, "impulse", c->impulse, true);
-	fprintf(f, "\"decode_errors\":%lld,\"robots\":[", (long long)c->decode_errors);
-	for (int k = 0; k < c->nrobots; k++) {
-		const struct an_robot *r = &c->robots[c->order[k]];
-		fputs(k ? ",{\"name\":" : "{\"name\":", f);
-		an_json_str(f, r->name);
-		fprintf(f, ",\"states\":%lld,\"joints\":[", (long long)r->states);
-		for (int j = 0; j < r->njoints; j++) {
-			fputs(j ? ",{" : "{", f);
-			an_json_num(f, "frequency_hz", phase_tracker_omega(&r->j[j].tr) / (2.0 * M_PI), true);
-			an_json_num(f, "amplitude_rad", r->j[j].tr.amplitude, true);
-			an_json_num(f, "swing_rad", phase_swing_pp(&r->j[j].win_swing), false);
-			fputc('}', f);
-		}
-		fputs("]}", f);
-	}
-	fputs("],\"pairs\":[", f);
-	for (int k = 0; k < c->npairs; k++) {
-		const struct an_pair *p = &c->pairs[k];
-		fputs(k ? ",{\"pair\":" : "{\"pair\":", f);
-		an_json_str(f, p->name);
-		fprintf(f, ",\"kind\":\"%s\",\"class\":\"%s\",",
-			p->kind == AN_PAIR_JOINTS ? "joints" : p->kind == AN_PAIR_USER ? "user" : "neighbour", p->cls);
-		an_json_num(f, "mean_abs_delta", phase_circ_mean_abs(&p->win), true);
-		an_json_num(f, "mean_delta", phase_circ_mean(&p->win), true);
-		an_json_num(f, "spread", phase_circ_spread(&p->win), true);
-		fprintf(f, "\"window_samples\":%lld,\"collisions\":%lld,\"contacts\":%lld,\"window_collisions\":%lld,",
-			(long long)p->win.n, (long long)p->collisions, (long long)p->contacts, (long long)p->win_collisions);
-		an_json_num(f, "impulse", p->impulse, true);
-		an_json_num(f, "distance_m", p->distance, true);
-		an_json_num(f, "amplitude_m", p->amp_lateral, true);
-		an_json_num(f, "dsep", p->dsep, true);
-		an_json_num(f, "compat_limit", phase_compat_limit(p->dsep), true);
-		fprintf(f, "\"return_map_points\":%zu,", p->ndeltas > 0 ? p->ndeltas - 1 : 0);
-		an_json_num(f, "swing_a", p->swing_a, true);
-		an_json_num(f, "swing_b", p->swing_b, false);
-		fputc('}', f);
-	}
-	fputs("],", f);
-	an_json_num(f, "min_swing", c->o->min_swing, false);
-	fputs("}\n", f);
+	json_array_end(&j);
+	json_field_bool(&j, "truncated", rc == AN_EXIT_TRUNCATED);
+	json_field_number(&j, "t_end", c->have_state ? an_t(c, c->last_state_utime) : NAN);
+	json_field_number(&j, "window_s", c->o->window_s);
+	json_field_number(&j, "restitution", c->o->restitution);
+	json_field_string(&j, "order", c->order_lateral ? "lateral" : "name");
+	json_field_int(&j, "collisions", c->collisions);
+	json_field_int(&j, "wall_collisions", c->wall_collisions);
+	json_field_number(&j, "impulse", c->impulse);
+	json_field_int(&j, "decode_errors", c->decode_errors);
+	json_key(&j, "robots");
+	json_array_begin(&j);
+	for (int k = 0; k < c->nrobots; k++)
+		an_json_robot(&j, &c->robots[c->order[k]]);
+	json_array_end(&j);
+	json_key(&j, "pairs");
+	json_array_begin(&j);
+	for (int k = 0; k < c->npairs; k++)
+		an_json_pair(&j, &c->pairs[k]);
+	json_array_end(&j);
+	json_field_number(&j, "min_swing", c->o->min_swing);
+	json_object_end(&j);
+	fputc('\n', f);
 }
 
 static int an_write_summary(struct an_ctx *c, int rc)
