@@ -15,7 +15,7 @@
 #include <unistd.h>
 
 #include "dxl_table.h"
-#include "ttyspeed.h"
+#include "port.h"
 
 /* Bytes read from the pty per read() call. */
 #define BUS_READ_CHUNK 512
@@ -242,8 +242,9 @@ int sim_bus_open(struct sim_bus *b, char *err, size_t errcap)
 			close(s);
 		return -1;
 	}
-	/* Clients that never set a rate talk at the configured one. */
-	sim_tty_set_speed(s, b->initial_baud);
+	/* Clients that never set a rate talk at the configured one (any rate:
+	 * termios2, protocol/io/port_baud.c). */
+	port_termios2_set_baud(s, b->initial_baud);
 	sim_bus_set_baud(b, b->initial_baud);
 	fcntl(m, F_SETFD, FD_CLOEXEC);
 	fcntl(s, F_SETFD, FD_CLOEXEC);
@@ -285,7 +286,7 @@ void sim_bus_read(struct sim_bus *b, int64_t now)
 	if (b->master < 0)
 		return;
 	if (b->follow_tty) {
-		long bps = sim_tty_speed(b->slave);
+		long bps = port_termios2_get_baud(b->slave);
 		if (bps > 0 && bps != b->baud)
 			sim_bus_set_baud(b, bps);
 	}

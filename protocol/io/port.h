@@ -76,6 +76,9 @@ int port_termios_set_baud(int fd, long baud);
 /* The termios2/BOTHER path alone (any rate; on a real UART the driver rounds
  * to what its divisor can do). Same returns. */
 int port_termios2_set_baud(int fd, long baud);
+/* The output rate of a tty fd in bps, however it was set (a Bxxx constant or
+ * BOTHER; for a pty, also by the process at its other end), or DXL_E_IO. */
+long port_termios2_get_baud(int fd);
 
 /* ---- enumeration ------------------------------------------------------------- */
 struct port_info {

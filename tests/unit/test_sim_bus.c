@@ -8,13 +8,18 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <fcntl.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <termios.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
 #include "dxl.h"
 #include "dxl_table.h"
+#include "port.h"
 #include "../../sim-bridge/fault.h"
 #include "../../sim-bridge/line.h"
 #include "../../sim-bridge/simbus.h"
@@ -356,6 +361,43 @@ static void test_stuck_error_count_and_prob(void **state)
 	assert_int_equal(b.joints[0].servo.conditions, 0);
 }
 
+/* The bus follows the rate its controller set on the pty, standard or not
+ * (read back with protocol/io's termios2 helpers, the one home of that code). */
+static void test_bus_follows_pty_rate(void **state)
+{
+	(void)state;
+	char dir[] = "/tmp/test_sim_bus.XXXXXX", link[64];
+	assert_non_null(mkdtemp(dir));
+	snprintf(link, sizeof(link), "%s/bus", dir);
+	static struct sim_bus b;
+	char err[256];
+	sim_bus_init(&b, "t", link, 57600, 0, false, 1);
+	assert_int_equal(sim_bus_open(&b, err, sizeof(err)), 0);
+	/* a new pty starts at the configured rate */
+	assert_int_equal(port_termios2_get_baud(b.slave), 57600);
+	assert_int_equal(b.baud, 57600);
+	int fd = open(link, O_RDWR | O_NOCTTY | O_NONBLOCK);
+	assert_true(fd >= 0);
+	/* a standard rate through POSIX termios ... */
+	struct termios t;
+	assert_int_equal(tcgetattr(fd, &t), 0);
+	cfsetspeed(&t, B500000);
+	assert_int_equal(tcsetattr(fd, TCSANOW, &t), 0);
+	assert_int_equal(port_termios2_get_baud(fd), 500000);
+	sim_bus_read(&b, 0);
+	assert_int_equal(b.baud, 500000);
+	assert_int_equal(b.byte_ns, 20000);
+	/* ... and a Dynamixel rate without a constant (BOTHER) */
+	assert_int_equal(port_termios2_set_baud(fd, 117647), DXL_OK);
+	assert_int_equal(port_termios2_get_baud(b.slave), 117647);
+	sim_bus_read(&b, 0);
+	assert_int_equal(b.baud, 117647);
+	close(fd);
+	sim_bus_close(&b);
+	assert_int_equal(port_termios2_get_baud(-1), DXL_E_IO);
+	assert_int_equal(rmdir(dir), 0);  /* the link went with the bus */
+}
+
 static void test_fault_parse_errors(void **state)
 {
 	(void)state;
@@ -419,6 +461,7 @@ int main(void)
 		cmocka_unit_test(test_bad_checksum_gets_checksum_bit),
 		cmocka_unit_test(test_reply_faults),
 		cmocka_unit_test(test_stuck_error_count_and_prob),
+		cmocka_unit_test(test_bus_follows_pty_rate),
 		cmocka_unit_test(test_fault_parse_errors),
 		cmocka_unit_test(test_line_queue),
 	};
