@@ -85,8 +85,14 @@ static void phase_estimator_cross(struct phase_estimator *e, double tc)
 		}
 		/* peak and trough cover a whole cycle only after the first crossing */
 		phase_ring_add(e->halves, &e->nhalves, &e->next_half, 0.5 * (e->peak - e->trough));
+		e->mids[e->next_mid] = 0.5 * (e->peak + e->trough);
+		e->next_mid = (e->next_mid + 1) % PHASE_CENTRE_CYCLES;
+		if (e->nmids < PHASE_CENTRE_CYCLES)
+			e->nmids++;
 		e->amplitude = phase_median(e->halves, e->nhalves);
-		e->centre = 0.5 * (e->peak + e->trough);
+		/* the centre too: a cycle bent by a collision would otherwise time
+		 * the next crossing wrong and disturb a second period */
+		e->centre = phase_median(e->mids, e->nmids);
 		e->centred = true;
 	}
 	e->last_cross_t = tc;
@@ -100,7 +106,7 @@ static void phase_estimator_restart(struct phase_estimator *e, double x)
 {
 	e->frequency = 0.0;
 	e->amplitude = 0.0;
-	e->nperiods = e->next_period = e->nhalves = e->next_half = 0;
+	e->nperiods = e->next_period = e->nhalves = e->next_half = e->nmids = e->next_mid = 0;
 	e->have_cross = false;
 	e->centred = false;
 	e->last_cross_centred = false;

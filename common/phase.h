@@ -24,26 +24,33 @@
 /* Cycles the estimates are the median of: odd, and large enough that the one
  * or two cycles a collision's phase jump disturbs are outvoted. */
 #define PHASE_CYCLES 5
+/* Cycles the centre is the median of: three outvote one bent cycle and lag a
+ * drifting centre by one cycle only (five would lag two, and the periods
+ * measured while the lag builds up would outvote the good ones for longer). */
+#define PHASE_CENTRE_CYCLES 3
 
 /* Wrap an angle into (−π, π] (−π becomes π). Non-finite stays NAN. */
 double phase_wrap(double a);
 
-/* atan2(−v/omega, x) wrapped into (−π, π]; NAN if omega is not finite and
- * > 0, or x or v is not finite. */
+/* atan2(−v/omega, x) wrapped into (−π, π]; NAN unless x, v and omega are
+ * finite and omega > 0. */
 double phase_from_state(double x, double v, double omega);
 
 /*
  * Running frequency and amplitude of one joint, sample by sample:
- * - cycles are counted at upward crossings of a centre (the mid-point of the
- *   last whole cycle's extremes), not of zero, so a swing about a non-zero
- *   mean is measured too;
+ * - cycles are counted at upward crossings of a centre (the median of the
+ *   last PHASE_CENTRE_CYCLES cycles' mid-points between their extremes), not
+ *   of zero, so a swing about a non-zero mean is measured too;
  * - a Schmitt trigger: up through centre + h, down through centre − h, then
  *   up through the centre is one cycle, h = max(0.02 rad, 0.1·amplitude)
  *   (four AX-12 position steps: quantization flicker never counts);
  * - crossing instants are interpolated between samples (at 100 Hz the grid
  *   alone would put ±5 ms on every period);
  * - frequency = 1 / the median of the last PHASE_CYCLES periods, amplitude =
- *   the median of their half peak-to-peaks. The first two crossings are timed
+ *   the median of their half peak-to-peaks: a collision's phase jump shortens
+ *   or lengthens one period (two if it falls on a crossing); daemon/osc.c's
+ *   running mean (newest cycle weighs 0.5) lets one jump move the frequency
+ *   by 16 % for cycles, the median not at all (test_common_phase). The first two crossings are timed
  *   against a guessed centre and give no period, so a frequency appears from
  *   the fourth crossing; a period shorter than PHASE_PERIOD_MIN_S is noise;
  * - stale: no crossing for three estimated periods (PHASE_MAX_PERIOD_S before
@@ -61,7 +68,8 @@ struct phase_estimator {
 	/* the rest is the estimator's own */
 	double periods[PHASE_CYCLES];   /* s, ring of the last periods */
 	double halves[PHASE_CYCLES];    /* rad, ring of the last half peak-to-peaks */
-	int nperiods, next_period, nhalves, next_half;
+	double mids[PHASE_CENTRE_CYCLES]; /* rad, ring of the last cycles' mid-points */
+	int nperiods, next_period, nhalves, next_half, nmids, next_mid;
 	double last_x, last_t;
 	double last_cross_t;
 	double peak, trough;    /* extremes since the last upward crossing */
