@@ -11,6 +11,8 @@
 #include "json.h"
 #include "phase.h"
 #include "plot.h"
+#include "theory.h"
+#include "window.h"
 
 #include "undulate_bus_stats_t.h"
 #include "undulate_event_t.h"
@@ -59,12 +61,12 @@ struct an_sample {
 
 struct an_joint {
 	int16_t servo_id;
-	struct phase_tracker tr;
+	struct phase_estimator est;
 	struct an_sample hist[AN_HISTORY];
 	int hn, hnext;
 	int64_t samples;
 	double reported_freq;
-	struct phase_swing win_swing;  /* measured angle over the final window */
+	struct win_swing win_swing;  /* measured angle over the final window */
 };
 
 struct an_robot {
@@ -86,7 +88,7 @@ struct an_pair {
 	enum an_pair_kind kind;
 	int a, b, ja, jb;
 	char name[2 * AN_NAME_MAX + 8];
-	struct phase_circ win;
+	struct win_circ win;
 	int64_t rows, collisions, win_collisions, contacts;
 	double impulse;
 	double last_coll_t;   /* s, NAN before the first */
@@ -180,8 +182,8 @@ static int an_robot_find(struct an_ctx *c, const char *name, bool add)
 	snprintf(r->name, sizeof(r->name), "%s", name);
 	r->lever = NAN;
 	for (int j = 0; j < AN_MAX_JOINTS; j++) {
-		phase_tracker_init(&r->j[j].tr);
-		phase_swing_init(&r->j[j].win_swing);
+		phase_estimator_init(&r->j[j].est);
+		win_swing_init(&r->j[j].win_swing);
 	}
 	return c->nrobots++;
 }
@@ -540,7 +542,7 @@ static void an_pair_row(struct an_ctx *c, struct an_pair *p, int64_t utime, doub
 	fputc('\n', c->pdiff);
 	p->rows++;
 	if (t >= c->window_start_t)
-		phase_circ_add(&p->win, delta);
+		win_circ_add(&p->win, delta);
 }
 
 /* After robot RI got a sample: the phase difference of each pair it leads. */
@@ -571,14 +573,14 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 	for (int j = 0; j < nj; j++) {
 		const undulate_joint_state_t *js = &m->joints[j];
 		struct an_joint *aj = &r->j[j];
-		phase_tracker_feed(&aj->tr, t, js->angle);
+		phase_estimator_update(&aj->est, js->angle, t);
 		if (t >= c->window_start_t)
-			phase_swing_add(&aj->win_swing, js->angle);
+			win_swing_add(&aj->win_swing, js->angle);
 		/* The daemon's running frequency estimate when it has one (it
-		 * sees every cycle, and its phase is then ours); else our own
-		 * from zero crossings; else the phase is left empty. */
-		double omega_zc = phase_tracker_omega(&aj->tr);
-		double omega = js->frequency > 0.0 && !c->o->zero_crossings ? 2.0 * M_PI * js->frequency : omega_zc;
+		 * sees every cycle, and its phase is then ours); else our own,
+		 * by the same rules (common/phase.h); else the phase is left empty. */
+		double omega = js->frequency > 0.0 && !c->o->zero_crossings ? 2.0 * M_PI * js->frequency
+		                                                            : phase_estimator_omega(&aj->est);
 		double phase = phase_from_state(js->angle, js->speed, omega);
 		an_hist_push(aj, m->utime, t, phase, omega);
 		aj->samples++;
@@ -598,7 +600,7 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 		an_csv_num(f, js->frequency);
 		fprintf(f, ",%d", js->error_bits);
 		an_csv_num(f, js->phase);
-		an_csv_num(f, omega_zc / (2.0 * M_PI));
+		an_csv_num(f, aj->est.frequency);
 		fputc('\n', f);
 	}
 	an_update_pairs(c, ri, m->utime, t);
@@ -889,7 +891,7 @@ static int an_write_return_map(struct an_ctx *c)
 			fprintf(f, ",%zu,%lld,%.6f", n, (long long)p->delta_utime[n], an_t(c, p->delta_utime[n]));
 			an_csv_num(f, p->deltas[n]);
 			an_csv_num(f, p->deltas[n + 1]);
-			an_csv_num(f, phase_return_map(p->deltas[n], dsep, c->o->restitution));
+			an_csv_num(f, theory_return_map(p->deltas[n], dsep, c->o->restitution));
 			an_csv_num(f, p->dsep);
 			fputc('\n', f);
 		}
@@ -915,7 +917,7 @@ static void an_pair_separation(struct an_ctx *c, struct an_pair *p)
 	const struct an_robot *a = &c->robots[p->a], *b = &c->robots[p->b];
 	if (!a->have_body || !b->have_body)
 		return;
-	double amp = 0.5 * (a->j[p->ja].tr.amplitude + b->j[p->jb].tr.amplitude);
+	double amp = 0.5 * (a->j[p->ja].est.amplitude + b->j[p->jb].est.amplitude);
 	double lever = isfinite(a->lever) && isfinite(b->lever) ? 0.5 * (fabs(a->lever) + fabs(b->lever))
 		: isfinite(a->lever) ? fabs(a->lever) : fabs(b->lever);
 	p->distance = fabs(b->neutral - a->neutral);
@@ -935,8 +937,8 @@ static const char *an_classify(const struct an_pair *p, bool have_sim, double mi
 	 * NAN (no finite angle in the window) counts as not swinging. */
 	if (!(p->swing_a >= min_swing) || !(p->swing_b >= min_swing))
 		return "not-oscillating";
-	double mean = fabs(phase_circ_mean(&p->win));
-	double spread = phase_circ_spread(&p->win);
+	double mean = fabs(win_circ_mean(&p->win));
+	double spread = win_circ_spread(&p->win);
 	bool locked = spread <= AN_SPREAD_MAX;
 	if (locked && mean >= M_PI - AN_ANTI_TOL)
 		return "anti-phase";
@@ -944,7 +946,7 @@ static const char *an_classify(const struct an_pair *p, bool have_sim, double mi
 		return "still-colliding";
 	if (locked && mean <= AN_INPHASE_TOL)
 		return "in-phase";
-	if (locked && isfinite(p->dsep) && mean <= phase_compat_limit(p->dsep) + AN_COMPAT_TOL)
+	if (locked && isfinite(p->dsep) && mean <= theory_compat_limit(p->dsep) + AN_COMPAT_TOL)
 		return "compatible";
 	if (!have_sim && locked)
 		return "locked-no-contact-data";
@@ -967,16 +969,14 @@ static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 	for (int k = 0; k < c->nrobots; k++) {
 		const struct an_robot *r = &c->robots[c->order[k]];
 		fprintf(f, "  %-16s joints %d  states %lld", r->name, r->njoints, (long long)r->states);
-		for (int j = 0; j < r->njoints; j++) {
-			double w = phase_tracker_omega(&r->j[j].tr);
-			fprintf(f, "  j%d %.3f Hz %.3f rad", j, w / (2.0 * M_PI), r->j[j].tr.amplitude);
-		}
+		for (int j = 0; j < r->njoints; j++)
+			fprintf(f, "  j%d %.3f Hz %.3f rad", j, r->j[j].est.frequency, r->j[j].est.amplitude);
 		if (r->have_body)
 			fprintf(f, "  neutral %.4f m lever %.4f m/rad", r->neutral, r->lever);
 		if (r->njoints > 0)
 			fputs("  swing", f);
 		for (int j = 0; j < r->njoints; j++)
-			fprintf(f, " j%d %.3f", j, phase_swing_pp(&r->j[j].win_swing));
+			fprintf(f, " j%d %.3f", j, win_swing_pp(&r->j[j].win_swing));
 		if (r->njoints > 0)
 			fputs(" rad p-p", f);
 		fputc('\n', f);
@@ -992,9 +992,9 @@ static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 	for (int k = 0; k < c->npairs; k++) {
 		const struct an_pair *p = &c->pairs[k];
 		fprintf(f, "%-24s %-28s %8.4f %8.4f %8.4f %6lld %6lld %7.4f %9.4f %5zu %8.4f %8.4f\n", p->name,
-			p->cls, phase_circ_mean_abs(&p->win), phase_circ_mean(&p->win), phase_circ_spread(&p->win),
+			p->cls, win_circ_mean_abs(&p->win), win_circ_mean(&p->win), win_circ_spread(&p->win),
 			(long long)p->collisions, (long long)p->win_collisions, p->dsep,
-			phase_compat_limit(p->dsep), p->ndeltas > 0 ? p->ndeltas - 1 : 0, p->swing_a, p->swing_b);
+			theory_compat_limit(p->dsep), p->ndeltas > 0 ? p->ndeltas - 1 : 0, p->swing_a, p->swing_b);
 	}
 	if (c->decode_errors)
 		fprintf(f, "undecodable messages: %lld\n", (long long)c->decode_errors);
@@ -1011,9 +1011,9 @@ static void an_json_robot(struct json *j, const struct an_robot *r)
 	json_array_begin(j);
 	for (int k = 0; k < r->njoints; k++) {
 		json_object_begin(j);
-		json_field_number(j, "frequency_hz", phase_tracker_omega(&r->j[k].tr) / (2.0 * M_PI));
-		json_field_number(j, "amplitude_rad", r->j[k].tr.amplitude);
-		json_field_number(j, "swing_rad", phase_swing_pp(&r->j[k].win_swing));
+		json_field_number(j, "frequency_hz", r->j[k].est.frequency);
+		json_field_number(j, "amplitude_rad", r->j[k].est.amplitude);
+		json_field_number(j, "swing_rad", win_swing_pp(&r->j[k].win_swing));
 		json_object_end(j);
 	}
 	json_array_end(j);
@@ -1026,9 +1026,9 @@ static void an_json_pair(struct json *j, const struct an_pair *p)
 	json_field_string(j, "pair", p->name);
 	json_field_string(j, "kind", an_pair_kind_name(p->kind));
 	json_field_string(j, "class", p->cls);
-	json_field_number(j, "mean_abs_delta", phase_circ_mean_abs(&p->win));
-	json_field_number(j, "mean_delta", phase_circ_mean(&p->win));
-	json_field_number(j, "spread", phase_circ_spread(&p->win));
+	json_field_number(j, "mean_abs_delta", win_circ_mean_abs(&p->win));
+	json_field_number(j, "mean_delta", win_circ_mean(&p->win));
+	json_field_number(j, "spread", win_circ_spread(&p->win));
 	json_field_int(j, "window_samples", p->win.n);
 	json_field_int(j, "collisions", p->collisions);
 	json_field_int(j, "contacts", p->contacts);
@@ -1037,7 +1037,7 @@ static void an_json_pair(struct json *j, const struct an_pair *p)
 	json_field_number(j, "distance_m", p->distance);
 	json_field_number(j, "amplitude_m", p->amp_lateral);
 	json_field_number(j, "dsep", p->dsep);
-	json_field_number(j, "compat_limit", phase_compat_limit(p->dsep));
+	json_field_number(j, "compat_limit", theory_compat_limit(p->dsep));
 	json_field_int(j, "return_map_points", p->ndeltas > 0 ? (long long)p->ndeltas - 1 : 0);
 	json_field_number(j, "swing_a", p->swing_a);
 	json_field_number(j, "swing_b", p->swing_b);
@@ -1169,8 +1169,8 @@ static int an_run_ctx(struct an_ctx *c)
 	an_each_event(c, an_process_event, false);
 	for (int k = 0; k < c->npairs; k++) {
 		struct an_pair *p = &c->pairs[k];
-		p->swing_a = phase_swing_pp(&c->robots[p->a].j[p->ja].win_swing);
-		p->swing_b = phase_swing_pp(&c->robots[p->b].j[p->jb].win_swing);
+		p->swing_a = win_swing_pp(&c->robots[p->a].j[p->ja].win_swing);
+		p->swing_b = win_swing_pp(&c->robots[p->b].j[p->jb].win_swing);
 		if (p->kind != AN_PAIR_JOINTS)
 			an_pair_separation(c, p);
 		p->cls = p->kind == AN_PAIR_JOINTS ? "-"

@@ -28,7 +28,7 @@ static void usage(FILE *f)
 	      "  --merge S         collisions of a pair less than S apart are one contact (default 0.1)\n"
 	      "  --min-swing RAD   a pair with a joint swinging less than RAD peak-to-peak in the final\n"
 	      "                    window is not-oscillating, whatever its phases (default 0.2)\n"
-	      "  --zero-crossings  phase from our own zero-crossing frequency, not the daemon's\n"
+	      "  --zero-crossings  phase from our own frequency estimate (centre crossings), not the daemon's\n"
 	      "  --synth OUT.log   write a synthetic log with known phases and collisions\n"
 	      "  --duration S      length of the synthetic log (default 45)\n"
 	      "  --synth-stop-after S  in the synthetic log, r3 and r4 stand still from S seconds on\n"

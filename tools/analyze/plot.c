@@ -2,7 +2,7 @@
  * One script, plots.gp, is left in the output directory so a user can tweak
  * and re-run it (`gnuplot plots.gp` in that directory). */
 #include "plot.h"
-#include "phase.h"
+#include "theory.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -102,7 +102,7 @@ static int plot_theory_file(const struct plot_input *in, int k, double dsep)
 	double prev = NAN;
 	for (int i = 0; i < PLOT_THEORY_POINTS; i++) {
 		double x = -M_PI + 2.0 * M_PI * (i + 0.5) / PLOT_THEORY_POINTS;
-		double y = phase_return_map(x, dsep, in->restitution);
+		double y = theory_return_map(x, dsep, in->restitution);
 		/* A blank line breaks the curve where no contact is possible
 		 * and where it wraps from pi to -pi. */
 		if (!isfinite(y) || (isfinite(prev) && fabs(y - prev) > M_PI))

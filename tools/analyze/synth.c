@@ -2,6 +2,7 @@
 #include "synth.h"
 #include "alog.h"
 #include "phase.h"
+#include "theory.h"
 
 #include "undulate_bus_stats_t.h"
 #include "undulate_event_t.h"
@@ -47,7 +48,7 @@ double synth_delta34(const struct synth_spec *s, double t)
 		n = s->ncoll;
 	if (n < 0)
 		n = 0;
-	return phase_return_map_d0(s->delta0, s->restitution, n);
+	return theory_return_map_d0(s->delta0, s->restitution, n);
 }
 
 double synth_impulse(int k)
