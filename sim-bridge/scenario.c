@@ -125,15 +125,26 @@ int sim_parse_ids(const char *text, uint8_t *ids, size_t cap)
 
 #define ERR(...) (snprintf(err, errcap, __VA_ARGS__), -1)
 
+/* Copy a text value whole or not at all: a refused value must leave the
+ * setting as it was, not cut short. */
+static bool set_text(char *dst, size_t cap, const char *v)
+{
+	size_t n = strlen(v);
+	if (n >= cap)
+		return false;
+	memcpy(dst, v, n + 1);
+	return true;
+}
+
 static int set_sim(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)
 {
 	double d;
 	if (!strcmp(k, "lcm_url"))
-		return snprintf(c->lcm_url, sizeof(c->lcm_url), "%s", v) < (int)sizeof(c->lcm_url) ? 0 : ERR("too long");
+		return set_text(c->lcm_url, sizeof(c->lcm_url), v) ? 0 : ERR("lcm_url: too long");
 	if (!strcmp(k, "link_dir"))
-		return snprintf(c->link_dir, sizeof(c->link_dir), "%s", v) < (int)sizeof(c->link_dir) ? 0 : ERR("too long");
+		return set_text(c->link_dir, sizeof(c->link_dir), v) ? 0 : ERR("link_dir: too long");
 	if (!strcmp(k, "control"))
-		return snprintf(c->control, sizeof(c->control), "%s", v) < (int)sizeof(c->control) ? 0 : ERR("too long");
+		return set_text(c->control, sizeof(c->control), v) ? 0 : ERR("control: too long");
 	if (!strcmp(k, "echo"))
 		return parse_bool(v, &c->echo) ? 0 : ERR("echo: want true/false");
 	if (!strcmp(k, "baud_follows_tty"))
@@ -273,18 +284,21 @@ static struct sim_robot_config *robot_named(struct sim_config *c, const char *na
 	return r;
 }
 
-static int set_robot(struct sim_config *c, const char *name, const char *k, const char *v, char *err, size_t errcap)
+static int robot_key(struct sim_robot_config *r, const char *name, const char *k, const char *v, char *err,
+                     size_t errcap)
 {
-	struct sim_robot_config *r = robot_named(c, name, true);
 	double d;
 	bool b;
-	if (!r)
-		return ERR("robot '%s': too many robots (max %d) or bad name", name, SIM_MAX_BUSES);
 	if (!strcmp(k, "link"))
-		return snprintf(r->link, sizeof(r->link), "%s", v) < (int)sizeof(r->link) ? 0 : ERR("link: too long");
+		return set_text(r->link, sizeof(r->link), v) ? 0 : ERR("link: too long");
 	if (!strcmp(k, "ids")) {
-		int n = sim_parse_ids(v, r->ids, SIM_BUS_MAX_SERVOS);
-		return n > 0 ? (r->nids = (size_t)n, 0) : ERR("ids: want e.g. 1,2 (0..253, no duplicates, max %d)", SIM_BUS_MAX_SERVOS);
+		uint8_t ids[SIM_BUS_MAX_SERVOS];   /* the old list stays if the new one is bad */
+		int n = sim_parse_ids(v, ids, SIM_BUS_MAX_SERVOS);
+		if (n <= 0)
+			return ERR("ids: want e.g. 1,2 (0..253, no duplicates, max %d)", SIM_BUS_MAX_SERVOS);
+		memcpy(r->ids, ids, (size_t)n);
+		r->nids = (size_t)n;
+		return 0;
 	}
 	long n;
 	if (!strcmp(k, "contact")) {
@@ -311,6 +325,22 @@ static int set_robot(struct sim_config *c, const char *name, const char *k, cons
 	if (!strcmp(k, "latency_ms"))
 		return d >= 0 && d <= 1000 ? (r->latency_ms = d, 0) : ERR("latency_ms: 0..1000");
 	return ERR("unknown key %s.%s", name, k);
+}
+
+static int set_robot(struct sim_config *c, const char *name, const char *k, const char *v, char *err, size_t errcap)
+{
+	size_t had = c->nrobots;
+	struct sim_robot_config *r = robot_named(c, name, true);
+	if (!r)
+		return ERR("robot '%s': too many robots (max %d) or bad name", name, SIM_MAX_BUSES);
+	if (robot_key(r, name, k, v, err, errcap) == 0)
+		return 0;
+	/* a robot the bad assignment would have created is not kept */
+	if (c->nrobots > had) {
+		memset(r, 0, sizeof(*r));
+		c->nrobots = had;
+	}
+	return -1;
 }
 
 static int set_event(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)

@@ -267,6 +267,38 @@ static void test_integer_values(void **state)
 	assert_int_equal(sim_command(&sim, "fault a 1 wrong-id 253", 0, reply, sizeof(reply)), 0);
 }
 
+/* A refused --set leaves the configuration exactly as it was (found by
+ * fuzz_sim_scenario: a bad ID list half-overwrote the robot's IDs, leaving
+ * duplicates; a too-long URL or link was stored cut short; a bad key of a
+ * new robot left that robot behind). */
+static void test_failed_set_changes_nothing(void **state)
+{
+	(void)state;
+	static struct sim_config before;
+	char err[256], longv[SIM_PATH_MAX + 40], assign[SIM_PATH_MAX + 80];
+	memset(longv, 'x', sizeof(longv) - 1);
+	longv[sizeof(longv) - 1] = '\0';
+	sim_config_defaults(&cfg);
+	assert_int_equal(sim_config_set(&cfg, "robot a.ids=1-3", err, sizeof(err)), 0);
+	assert_int_equal(sim_config_set(&cfg, "sim.lcm_url=udpm://239.255.76.67:7667", err, sizeof(err)), 0);
+	memcpy(&before, &cfg, sizeof(cfg));
+	const char *bad[] = { "robot a.ids=2,x", "robot a.ids=3,3", "robot zz.bogus=1", "robot zz.ids=", NULL };
+	for (size_t i = 0; bad[i]; i++) {
+		assert_int_equal(sim_config_set(&cfg, bad[i], err, sizeof(err)), -1);
+		if (memcmp(&before, &cfg, sizeof(cfg)) != 0)
+			fail_msg("'%s' changed the configuration", bad[i]);
+	}
+	const char *keys[] = { "sim.lcm_url", "sim.link_dir", "sim.control", "robot a.link", "robot b.link", NULL };
+	for (size_t i = 0; keys[i]; i++) {
+		snprintf(assign, sizeof(assign), "%s=%s", keys[i], longv);
+		assert_int_equal(sim_config_set(&cfg, assign, err, sizeof(err)), -1);
+		if (memcmp(&before, &cfg, sizeof(cfg)) != 0)
+			fail_msg("'%s=xxx...' changed the configuration", keys[i]);
+	}
+	assert_int_equal(cfg.robots[0].nids, 3);
+	assert_int_equal(cfg.robots[0].ids[0], 1);
+}
+
 static void test_seeded_start(void **state)
 {
 	(void)state;
@@ -383,6 +415,7 @@ int main(void)
 		cmocka_unit_test(test_long_line),
 		cmocka_unit_test(test_scenario_files),
 		cmocka_unit_test(test_integer_values),
+		cmocka_unit_test(test_failed_set_changes_nothing),
 		cmocka_unit_test(test_seeded_start),
 		cmocka_unit_test(test_commands),
 		cmocka_unit_test(test_events_run_on_time),
