@@ -148,8 +148,11 @@ void sim_bus_feed(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now)
 	if (b->echo)
 		sim_line_put(&b->line, start + b->byte_ns + b->latency_ns, b->byte_ns, data, n);
 	size_t off = 0;
-	/* Each round consumes bytes or drops one buffered byte: bounded. */
-	for (size_t rounds = 0; off < n && rounds < n + DXL_MAX_PACKET + 1; rounds++) {
+	/* Until the parser needs more input, even when all of it is consumed:
+	 * after an error the bytes it still holds may be a whole packet (one
+	 * inside a damaged packet), due now, not at the controller's next byte.
+	 * Each round consumes bytes or drops one buffered byte: bounded. */
+	for (size_t rounds = 0; rounds < n + DXL_MAX_PACKET + 1; rounds++) {
 		size_t used = 0;
 		struct dxl_packet pkt;
 		int r = dxl_parser_feed(&b->parser, data + off, n - off, &used, &pkt);
@@ -162,8 +165,8 @@ void sim_bus_feed(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now)
 			bus_bad_checksum(b, end);
 		else if (r < 0)
 			b->count.header_errors++;
-		else if (used == 0)
-			break;
+		else
+			break;   /* DXL_NEED_MORE: everything given was consumed */
 	}
 }
 

@@ -398,6 +398,43 @@ static void test_bus_follows_pty_rate(void **state)
 	assert_int_equal(rmdir(dir), 0);  /* the link went with the bus */
 }
 
+/* A whole packet inside a damaged one (here in the parameters of a WRITE
+ * with a bad checksum) is found by the parser's resync when the damaged one
+ * ends, and answered then, in whatever reads the bytes came: the bus asks
+ * the parser for more until it needs input, as its contract says. (Found by
+ * fuzz_sim_serial: in one read, the PING stayed buffered, unanswered, until
+ * the controller's next byte.) */
+static void test_packet_inside_a_bad_packet(void **state)
+{
+	(void)state;
+	static struct sim_bus b;
+	uint8_t out[128];
+	int64_t first, last;
+	struct dxl_packet pkt;
+	/* WRITE to 1 at address 6 of the bytes FF FF 02 02 01 FA (a PING to 2) */
+	uint8_t outer[] = { 0xFF, 0xFF, 0x01, 0x09, 0x03, 0x06, 0xFF, 0xFF, 0x02, 0x02, 0x01, 0xFA, 0x00 };
+	outer[sizeof(outer) - 1] = (uint8_t)(dxl_checksum(&outer[2], sizeof(outer) - 3) ^ 0x55);  /* bad */
+	for (size_t cut = 1; cut <= sizeof(outer); cut++) {
+		bus_two(&b, 0, false);
+		/* servo 2 answers 100 µs later: the two replies do not collide */
+		sim_servo_poke(&b.joints[1].servo, DXL_AX_RETURN_DELAY_TIME, 50);
+		sim_bus_feed(&b, outer, cut, 0);
+		sim_bus_feed(&b, outer + cut, sizeof(outer) - cut, 0);
+		assert_int_equal(b.count.checksum_errors, 1);
+		assert_int_equal(b.count.packets, 1);
+		assert_int_equal(b.joints[0].servo.count.checksum_errors, 1);   /* servo 1: the checksum bit */
+		assert_int_equal(b.joints[1].servo.count.instructions, 1);      /* servo 2: the PING */
+		size_t n = drain(&b, out, sizeof(out), &first, &last);
+		assert_int_equal(n, 12);
+		assert_int_equal(parse_status(out, 6, &pkt), DXL_FRAME);
+		assert_int_equal(pkt.id, 1);
+		assert_int_equal(pkt.code, DXL_ERRBIT_CHECKSUM);
+		assert_int_equal(parse_status(out + 6, 6, &pkt), DXL_FRAME);
+		assert_int_equal(pkt.id, 2);
+		assert_int_equal(pkt.code, 0);
+	}
+}
+
 static void test_fault_parse_errors(void **state)
 {
 	(void)state;
@@ -462,6 +499,7 @@ int main(void)
 		cmocka_unit_test(test_reply_faults),
 		cmocka_unit_test(test_stuck_error_count_and_prob),
 		cmocka_unit_test(test_bus_follows_pty_rate),
+		cmocka_unit_test(test_packet_inside_a_bad_packet),
 		cmocka_unit_test(test_fault_parse_errors),
 		cmocka_unit_test(test_line_queue),
 	};
