@@ -286,6 +286,30 @@ static void test_json_hostile_text(void **state)
 	assert_int_equal(strchr(buf, '\n') - buf, (long)strlen(buf) - 1); /* still one line */
 }
 
+/* A joint without a known phase (no frequency yet, a stale reading) publishes
+ * NAN there (common/phase.h): both views show dashes, never "nan". */
+static void test_unknown_phase(void **state)
+{
+	(void)state;
+	char n[] = "r1", reason[] = "test";
+	undulate_joint_state_t j[2] = {
+		{ .servo_id = 1, .angle = 0.5, .phase = NAN, .amplitude = 0.0, .frequency = 0.0 },
+		{ .servo_id = 2, .angle = NAN, .speed = NAN, .phase = NAN, .load = NAN, .amplitude = NAN,
+		  .frequency = NAN },
+	};
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason,
+		.period_us = 10000.0, .njoints = 2, .joints = j };
+	top_on_state(&model, &s, 0.0);
+	struct top_view v = { .kind = TOP_VIEW_DETAIL };
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_null(strstr(screen, "nan"));
+	assert_non_null(strstr(screen, "+0.500"));
+	v.kind = TOP_VIEW_COMPACT;
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_null(strstr(screen, "nan"));
+	assert_non_null(strstr(screen, "+0.50"));
+}
+
 /* Torque actuation publishes no goal (NaN) but the drive sent: the goal
  * column shows the drive, marked d, and JSON carries both. */
 static void test_drive_column(void **state)
@@ -314,6 +338,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test_setup(test_rate_jitter_stale, setup),
 		cmocka_unit_test_setup(test_drive_column, setup),
+		cmocka_unit_test_setup(test_unknown_phase, setup),
 		cmocka_unit_test_setup(test_order_and_phases, setup),
 		cmocka_unit_test_setup(test_collisions, setup),
 		cmocka_unit_test_setup(test_keys, setup),

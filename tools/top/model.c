@@ -1,6 +1,7 @@
 /* model.c — see model.h. */
 #include "model.h"
 #include "json.h"
+#include "phase.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -9,18 +10,6 @@
 void top_model_init(struct top_model *m)
 {
 	memset(m, 0, sizeof(*m));
-}
-
-double top_wrap(double a)
-{
-	if (!isfinite(a))
-		return a;
-	a = fmod(a, 2.0 * M_PI);
-	if (a <= -M_PI)
-		a += 2.0 * M_PI;
-	else if (a > M_PI)
-		a -= 2.0 * M_PI;
-	return a;
 }
 
 const char *top_mode_name(int mode)
@@ -307,7 +296,7 @@ double top_robot_dphase_joints(const struct top_robot *r)
 {
 	if (!r->have_state || r->njoints < 2)
 		return NAN;
-	return top_wrap(r->j[1].phase - r->j[0].phase);
+	return phase_wrap(r->j[1].phase - r->j[0].phase);
 }
 
 double top_neighbour_dphase(const struct top_model *m, int k)
@@ -317,7 +306,7 @@ double top_neighbour_dphase(const struct top_model *m, int k)
 	const struct top_robot *a = &m->robots[m->order[k]], *b = &m->robots[m->order[k + 1]];
 	if (!a->have_state || !b->have_state || a->njoints == 0 || b->njoints == 0)
 		return NAN;
-	return top_wrap(b->j[top_robot_contact_joint(b)].phase - a->j[top_robot_contact_joint(a)].phase);
+	return phase_wrap(b->j[top_robot_contact_joint(b)].phase - a->j[top_robot_contact_joint(a)].phase);
 }
 
 int top_collisions_window(const struct top_model *m, double now, double *impulse)

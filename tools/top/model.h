@@ -126,7 +126,6 @@ bool top_sim_present(const struct top_model *m, double now);
 
 const char *top_mode_name(int mode);
 const char *top_mode_short(int mode);
-double top_wrap(double a);
 
 /* One JSON object (one line) describing everything, written with common/json.h
  * (non-finite numbers as null, names from the network escaped to valid UTF-8).

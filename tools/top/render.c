@@ -138,13 +138,15 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 	for (int k = 0; k < r->njoints; k++) {
 		const struct top_joint *j = &r->j[k];
 		/* torque actuation has no goal: the column shows the drive, marked d */
-		char goal[16];
+		char goal[16], ang[16], spd[16], load[16], ph[16], amp[16], freq[16];
 		if (!isfinite(j->goal) && isfinite(j->drive))
 			snprintf(goal, sizeof goal, "d%+6.3f", j->drive);
 		else
 			num(goal, sizeof goal, "%+7.3f", j->goal, 7);
-		rb_line(b, false, "     j%d id%-3d %+7.3f %+7.3f %7s %+6.2f %+6.2f %5.2f %5.2f %02X", k, j->servo_id,
-			j->angle, j->speed, goal, j->load, j->phase, j->amplitude, j->frequency,
+		rb_line(b, false, "     j%d id%-3d %s %s %7s %s %s %s %s %02X", k, j->servo_id,
+			num(ang, sizeof ang, "%+7.3f", j->angle, 7), num(spd, sizeof spd, "%+7.3f", j->speed, 7), goal,
+			num(load, sizeof load, "%+6.2f", j->load, 6), num(ph, sizeof ph, "%+6.2f", j->phase, 6),
+			num(amp, sizeof amp, "%5.2f", j->amplitude, 5), num(freq, sizeof freq, "%5.2f", j->frequency, 5),
 			j->error_bits & 0xFF);
 	}
 }
@@ -154,8 +156,10 @@ static void robot_compact(struct rbuf *b, const struct top_model *m, const struc
 	const struct top_robot *r = &m->robots[m->order[pos]];
 	char rate[16], jit[16], dj[16], dn[16], jt[2][32];
 	for (int k = 0; k < 2; k++) {
+		char ang[16], ph[16];
 		if (k < r->njoints)
-			snprintf(jt[k], sizeof(jt[k]), "%+6.2f %+6.2f", r->j[k].angle, r->j[k].phase);
+			snprintf(jt[k], sizeof(jt[k]), "%s %s", num(ang, sizeof ang, "%+6.2f", r->j[k].angle, 6),
+			         num(ph, sizeof ph, "%+6.2f", r->j[k].phase, 6));
 		else
 			snprintf(jt[k], sizeof(jt[k]), "%13s", "");
 	}
