@@ -1,6 +1,7 @@
 /* synth.c — see synth.h. */
 #include "synth.h"
 #include "alog.h"
+#include "modes.h"
 #include "phase.h"
 #include "theory.h"
 
@@ -115,7 +116,7 @@ static int synth_state(const struct synth_spec *s, struct alog_writer *w, int i,
 	snprintf(chan, sizeof(chan), "%s.STATE", synth_names[i]);
 	char reason[] = "command";
 	undulate_robot_state_t m = {
-		.utime = utime, .robot = name, .cycle = cycle, .mode = UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR,
+		.utime = utime, .robot = name, .cycle = cycle, .mode = MODE_OSCILLATOR,
 		.mode_reason = reason, .period_us = s->dt_s * 1e6,
 		/* jitter 50..140 µs in a known pattern: its maximum is 140 */
 		.jitter_us = 50.0 + 10.0 * (double)(cycle % 10), .bus_us = 600.0, .control_us = 20.0,
@@ -231,7 +232,7 @@ static int synth_bus_and_event(struct alog_writer *w, int i, int64_t utime, int6
 		return -1;
 	if (second != 0)
 		return 0;
-	snprintf(text, sizeof(text), "mode OSCILLATOR, \"start\"");
+	snprintf(text, sizeof(text), "mode %s, \"start\"", mode_name(MODE_OSCILLATOR));
 	undulate_event_t e = { .utime = utime, .robot = name, .seq = 0, .level = 0, .kind = kind, .text = text };
 	snprintf(chan, sizeof(chan), "%s.EVENT", name);
 	return alog_write_event_t(w, chan, utime + SYNTH_LOG_LAG_US, &e);

@@ -1,5 +1,6 @@
 /* keys.c — see keys.h. */
 #include "keys.h"
+#include "modes.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -71,7 +72,7 @@ static void top_command_base(struct top_command *c, const char *robot, int8_t ki
 
 int top_command_mode(struct top_command *c, const char *robot, int mode, int64_t seq, const char *source)
 {
-	if (mode < UNDULATE_ROBOT_STATE_T_MODE_LIMP || mode > UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR)
+	if (!mode_is_valid(mode))
 		return -1;
 	if (!robot[0] || strlen(robot) >= TOP_NAME_MAX)
 		return -1;
@@ -109,11 +110,11 @@ int top_command_nudge(struct top_command out[TOP_MAX_JOINTS], const struct top_r
 		snprintf(why, whylen, "%s: no %s.PARAMS heard yet: nothing to nudge from", r->name, r->name);
 		return -1;
 	}
-	if (r->mode == UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR)
+	if (r->mode == MODE_OSCILLATOR)
 		return nudge_oscillator(out, r, dir, seq, source, why, whylen);
-	if (r->mode != UNDULATE_ROBOT_STATE_T_MODE_SINUSOID) {
-		snprintf(why, whylen, "%s is in %s: +/- nudges c (OSCILLATOR) or the amplitude (SINUSOID)", r->name,
-			 top_mode_name(r->mode));
+	if (r->mode != MODE_SINUSOID) {
+		snprintf(why, whylen, "%s is in %s: +/- nudges c (%s) or the amplitude (%s)", r->name,
+			 mode_name(r->mode), mode_name(MODE_OSCILLATOR), mode_name(MODE_SINUSOID));
 		return -1;
 	}
 	double v = r->sin_amplitude + dir * TOP_NUDGE_AMPLITUDE;

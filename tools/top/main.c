@@ -2,6 +2,7 @@
  * See tools/top/README.md. */
 #include "keys.h"
 #include "model.h"
+#include "modes.h"
 #include "num.h"
 #include "render.h"
 #include "term.h"
@@ -152,7 +153,7 @@ static void send_mode(struct top_app *a, int mode, bool all)
 		return;
 	publish(a, &c);
 	set_status(a, "#%lld sent %s mode %s on %s, waiting for the answer",
-		 (long long)a->next_seq, all ? "all robots" : robot, top_mode_name(mode), c.channel);
+		 (long long)a->next_seq, all ? "all robots" : robot, mode_name(mode), c.channel);
 	a->next_seq++;
 }
 
@@ -180,10 +181,10 @@ static void send_nudge(struct top_app *a, int dir)
 static int mode_of_key(int ch)
 {
 	switch (ch | 0x20) { /* lower case */
-	case 'l': return UNDULATE_ROBOT_STATE_T_MODE_LIMP;
-	case 'h': return UNDULATE_ROBOT_STATE_T_MODE_HOLD;
-	case 's': return UNDULATE_ROBOT_STATE_T_MODE_SINUSOID;
-	case 'o': return UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR;
+	case 'l': return MODE_LIMP;
+	case 'h': return MODE_HOLD;
+	case 's': return MODE_SINUSOID;
+	case 'o': return MODE_OSCILLATOR;
 	default: return -1;
 	}
 }

@@ -1,6 +1,7 @@
 /* model.c — see model.h. */
 #include "model.h"
 #include "json.h"
+#include "modes.h"
 #include "phase.h"
 
 #include <math.h>
@@ -10,28 +11,6 @@
 void top_model_init(struct top_model *m)
 {
 	memset(m, 0, sizeof(*m));
-}
-
-const char *top_mode_name(int mode)
-{
-	switch (mode) {
-	case UNDULATE_ROBOT_STATE_T_MODE_LIMP: return "LIMP";
-	case UNDULATE_ROBOT_STATE_T_MODE_HOLD: return "HOLD";
-	case UNDULATE_ROBOT_STATE_T_MODE_SINUSOID: return "SINUSOID";
-	case UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR: return "OSCILLATOR";
-	default: return "UNKNOWN";
-	}
-}
-
-const char *top_mode_short(int mode)
-{
-	switch (mode) {
-	case UNDULATE_ROBOT_STATE_T_MODE_LIMP: return "LIMP";
-	case UNDULATE_ROBOT_STATE_T_MODE_HOLD: return "HOLD";
-	case UNDULATE_ROBOT_STATE_T_MODE_SINUSOID: return "SIN";
-	case UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR: return "OSC";
-	default: return "?";
-	}
 }
 
 int top_robot_index(const struct top_model *m, const char *name)
@@ -389,7 +368,7 @@ static void top_json_robot(struct json *j, const struct top_robot *r, double now
 	json_field_string(j, "name", r->name);
 	json_field_bool(j, "stale", top_robot_stale(r, now));
 	json_field_number(j, "age_s", r->have_state ? now - r->rx : NAN);
-	json_field_string(j, "mode", top_mode_name(r->mode));
+	json_field_string(j, "mode", mode_name(r->mode));
 	json_field_int(j, "mode_id", r->mode);
 	json_field_string(j, "mode_reason", r->mode_reason);
 	json_field_int(j, "utime", r->utime);

@@ -124,8 +124,6 @@ double top_neighbour_dphase(const struct top_model *m, int k);
 int top_collisions_window(const struct top_model *m, double now, double *impulse);
 bool top_sim_present(const struct top_model *m, double now);
 
-const char *top_mode_name(int mode);
-const char *top_mode_short(int mode);
 
 /* One JSON object (one line) describing everything, written with common/json.h
  * (non-finite numbers as null, names from the network escaped to valid UTF-8).

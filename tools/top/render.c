@@ -1,5 +1,6 @@
 /* render.c — see render.h. */
 #include "render.h"
+#include "modes.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -130,7 +131,7 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 	char rate[16], jit[16], dj[16], dn[16], flags[32];
 	flags_text(flags, sizeof(flags), r, now);
 	rb_line(b, pos == v->selected, "%c%2d %-14.14s %-4s %s %s %5lld %s %s %s", pos == v->selected ? '>' : ' ',
-		pos + 1, r->name, r->have_state ? top_mode_short(r->mode) : "-",
+		pos + 1, r->name, r->have_state ? mode_short(r->mode) : "-",
 		num(rate, sizeof(rate), "%6.1f", top_robot_rate_hz(r), 6),
 		num(jit, sizeof(jit), "%6.0f", top_robot_jitter_p99(r), 6), (long long)r->bus_errors,
 		num(dj, sizeof(dj), "%+8.2f", top_robot_dphase_joints(r), 8),
@@ -168,7 +169,7 @@ static void robot_compact(struct rbuf *b, const struct top_model *m, const struc
 		err |= r->j[k].error_bits;
 	char mark = top_robot_stale(r, now) ? 'x' : err ? '!' : ' ';
 	rb_line(b, pos == v->selected, "%c%c%2d %-10.10s %-4s %s %s %4lld %s %s %s %s", pos == v->selected ? '>' : ' ',
-		mark, pos + 1, r->name, r->have_state ? top_mode_short(r->mode) : "-",
+		mark, pos + 1, r->name, r->have_state ? mode_short(r->mode) : "-",
 		num(rate, sizeof(rate), "%5.1f", top_robot_rate_hz(r), 5),
 		num(jit, sizeof(jit), "%5.0f", top_robot_jitter_p99(r), 5), (long long)r->bus_errors, jt[0], jt[1],
 		num(dj, sizeof(dj), "%+6.2f", top_robot_dphase_joints(r), 6),
