@@ -37,9 +37,10 @@ ALOG_DEFINE_WRITER(robot_state_t)
 
 
 /* One joint's motion: A cos(2 pi f t + phase) + offset until stop_s (< 0:
- * never), then held where it was, flickering by one position step. */
+ * never), then held where it was, flickering by one position step. The
+ * reported frequency is T_FREQ_HZ, and 0 from freq_zero_s on (> 0 only). */
 struct motion {
-	double amplitude, phase, offset, stop_s;
+	double amplitude, phase, offset, stop_s, freq_zero_s;
 };
 
 static int setup(void **state)
@@ -73,7 +74,8 @@ static int write_state(struct alog_writer *w, const char *robot, int64_t cycle, 
 	motion_at(m, cycle, &j.angle, &j.speed);
 	j.goal = j.angle;
 	j.amplitude = m->amplitude;
-	j.frequency = T_FREQ_HZ; /* kept after a stop, as a stalled daemon's is */
+	/* kept after a stop, as a stalled daemon's is, unless told otherwise */
+	j.frequency = m->freq_zero_s > 0 && (double)cycle * T_DT >= m->freq_zero_s ? 0.0 : T_FREQ_HZ;
 	j.torque = true;
 	char name[16], chan[32], reason[] = "test";
 	snprintf(name, sizeof(name), "%s", robot);
@@ -222,6 +224,19 @@ static void test_both_stopped_opposite(void **state)
 	free(js);
 }
 
+/* Both stopped, and the daemon says so: its estimator reports 0 Hz three
+ * periods after the last crossing (common/phase.h), so no phase is known in
+ * the final window. Still not-oscillating, not no-data: the swing decides. */
+static void test_both_stopped_no_frequency(void **state)
+{
+	(void)state;
+	struct motion a = { .amplitude = 0.8, .phase = 0.0, .offset = 0.0, .stop_s = 5.0, .freq_zero_s = 8.8 };
+	struct motion b = { .amplitude = 0.8, .phase = 1.0, .offset = 0.0, .stop_s = 5.0, .freq_zero_s = 8.8 };
+	write_log("nofreq", &a, &b);
+	analyse("nofreq", NAN);
+	expect_pair("nofreq", "not-oscillating", 2 * T_AX12_STEP, 2 * T_AX12_STEP);
+}
+
 /* Both swinging in anti-phase: classified by their phases as before. */
 static void test_both_anti_phase(void **state)
 {
@@ -270,6 +285,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_one_stopped),
 		cmocka_unit_test(test_both_stopped_opposite),
+		cmocka_unit_test(test_both_stopped_no_frequency),
 		cmocka_unit_test(test_both_anti_phase),
 		cmocka_unit_test(test_min_swing_option),
 		cmocka_unit_test(test_stop_inside_window),

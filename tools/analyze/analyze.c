@@ -929,12 +929,17 @@ static void an_pair_separation(struct an_ctx *c, struct an_pair *p)
 /* The end state of a pair from the final window (see README.md for the rules). */
 static const char *an_classify(const struct an_pair *p, bool have_sim, double min_swing)
 {
-	if (p->win.n == 0)
-		return "no-data";
 	/* A joint at rest still has a phase (0 or pi from its sign, at the
 	 * daemon's last frequency): two stopped robots would pass for in-phase
 	 * or anti-phase. No phase relation means anything unless both swing.
-	 * NAN (no finite angle in the window) counts as not swinging. */
+	 * A stopped joint whose frequency went to 0 has no phase at all: the
+	 * swing still says why, so it is asked first. */
+	bool have_angles = isfinite(p->swing_a) && isfinite(p->swing_b);
+	if (have_angles && (p->swing_a < min_swing || p->swing_b < min_swing))
+		return "not-oscillating";
+	if (p->win.n == 0)
+		return "no-data";
+	/* NAN (no finite angle in the window) counts as not swinging */
 	if (!(p->swing_a >= min_swing) || !(p->swing_b >= min_swing))
 		return "not-oscillating";
 	double mean = fabs(win_circ_mean(&p->win));
