@@ -1,0 +1,306 @@
+/*
+ * fuzz_sim_serial.c — libFuzzer target for undulate-sim's serial side: the
+ * bytes a controller writes, fed into a simulated bus with three servos
+ * through the pure cores (sim_bus_feed() of simbus.c, the parser of
+ * protocol/dxl.c, the instruction semantics of servo.c, the reply faults of
+ * fault.c, the wire queue of line.c). No pty, no clock: time is a number the
+ * input advances.
+ *
+ * Input: 4 header bytes, then the byte stream.
+ *   [0] flags: bit 0 echo, bit 1 a 16 ms adapter latency, bit 2 EEPROM
+ *       writable with torque on (the original AX-12), bit 3 reply faults on
+ *   [1] [2] [3] the fault of servo 1 when bit 3 is set: kind, ARG, count/prob
+ *   the rest: the stream, cut into reads of 1..16 bytes with gaps between
+ *   them (now and then over 100 ms: the servo drops a half-read packet), by
+ *   a small generator seeded from the header.
+ *
+ * The same stream also goes, one byte at a time, through a model: our own
+ * instruction parser (called until it needs more, as its contract says) and
+ * three more servos the frames are handed to directly. Invariants, checked
+ * with abort():
+ *  - the bus sees exactly the model's frames, checksum and header errors, and
+ *    its servos' control tables equal the model's after every read, however
+ *    the stream is cut (nothing lost or delayed by the bus's loop);
+ *  - a read that completes no frame changes no control table: a packet with
+ *    a bad checksum, a broken header or half a packet writes nothing;
+ *  - every servo's table stays in its documented ranges (protocol/
+ *    dxl_table.c), read-only and reserved bytes keep their values, a refused
+ *    write (range, angle-limit or instruction error) writes nothing, lock
+ *    and torque-on protect the EEPROM, lock stays on until a reset;
+ *  - every reply is one well-formed status packet from the servo's ID (the
+ *    one before the instruction), only where the manual allows one (a
+ *    broadcast gets none but PING; the status return level), and a READ
+ *    reply carries the requested bytes of the table;
+ *  - the wire queue stays ordered by time, within its capacity.
+ *
+ *   make fuzz-build && build/fuzz/fuzz_sim_serial tests/fuzz/seeds/fuzz_sim_serial
+ */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dxl.h"
+#include "dxl_table.h"
+#include "../../sim-bridge/fault.h"
+#include "../../sim-bridge/line.h"
+#include "../../sim-bridge/servo.h"
+#include "../../sim-bridge/simbus.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+#define CHECK(cond) do { if (!(cond)) abort(); } while (0)
+
+#define NSERVOS 3
+#define HEADER 4
+#define MS 1000000LL
+/* the bus's rule (simbus.c): a gap this long drops a half-read packet */
+#define GAP_NS (100 * MS)
+
+static struct sim_bus bus;
+static struct sim_servo model[NSERVOS];
+static uint8_t table0[NSERVOS][DXL_AX_TABLE_SIZE];  /* each table after set-up */
+
+static uint32_t next_rand(uint32_t *s)
+{
+	*s = *s * 1103515245u + 12345u;
+	return *s >> 16;
+}
+
+static uint16_t reg_value(const uint8_t *mem, const struct dxl_reg *r)
+{
+	return r->size == 2 ? dxl_get_u16(&mem[r->addr]) : mem[r->addr];
+}
+
+/* Bytes no register covers (10, 19-23, 45; 49 is punch's high byte), found once. */
+static bool is_reserved[DXL_AX_TABLE_SIZE];
+
+static void find_reserved(void)
+{
+	for (size_t a = 0; a < DXL_AX_TABLE_SIZE; a++) {
+		is_reserved[a] = true;
+		for (size_t i = 0; i < dxl_ax12_nregs; i++)
+			if (a >= dxl_ax12_regs[i].addr && a < (size_t)dxl_ax12_regs[i].addr + dxl_ax12_regs[i].size)
+				is_reserved[a] = false;
+	}
+	CHECK(is_reserved[10] && is_reserved[19] && is_reserved[23] && is_reserved[45] && !is_reserved[49]);
+}
+
+/* The table of one servo is within its documented ranges. */
+static void check_table(const struct sim_servo *s, int k)
+{
+	const uint8_t *m = s->mem;
+	for (size_t i = 0; i < dxl_ax12_nregs; i++) {
+		const struct dxl_reg *r = &dxl_ax12_regs[i];
+		if (r->access == DXL_ACCESS_RW)
+			CHECK(reg_value(m, r) >= r->min && reg_value(m, r) <= r->max);
+	}
+	CHECK(dxl_get_u16(&m[DXL_AX_MODEL_NUMBER]) == DXL_AX12_MODEL);
+	CHECK(m[DXL_AX_FIRMWARE_VERSION] == SIM_SERVO_FIRMWARE);
+	CHECK(m[DXL_AX_REGISTERED] == (s->reg_pending ? 1 : 0));
+	CHECK(s->reg_len <= DXL_MAX_PARAMS);
+	/* no physics here: the measured values keep what set-up put there */
+	for (size_t a = DXL_AX_PRESENT_POSITION; a <= DXL_AX_PRESENT_TEMPERATURE; a++)
+		CHECK(m[a] == table0[k][a]);
+	CHECK(m[DXL_AX_MOVING] == table0[k][DXL_AX_MOVING]);
+	for (size_t a = 0; a < DXL_AX_TABLE_SIZE; a++)
+		if (is_reserved[a])
+			CHECK(m[a] == table0[k][a]);
+}
+
+/* One well-formed status packet of len bytes from id; its parameters. */
+static void check_reply(const uint8_t *out, int len, uint8_t id, struct dxl_packet *pkt)
+{
+	struct dxl_parser p;
+	size_t used = 0;
+	dxl_parser_init(&p, DXL_PARSE_STATUS);
+	CHECK(len >= 6 && len <= DXL_MAX_PACKET);
+	CHECK(dxl_parser_feed(&p, out, (size_t)len, &used, pkt) == DXL_FRAME);
+	CHECK(used == (size_t)len);
+	CHECK(pkt->id == id);
+	CHECK(pkt->code <= DXL_ERRBIT_MASK);
+}
+
+/* Hand one frame to a model servo and check what it did. */
+static void model_handle(int k, const struct dxl_packet *req)
+{
+	struct sim_servo *s = &model[k];
+	struct sim_servo before;
+	memcpy(&before, s, sizeof(before));   /* bytewise: compared with memcmp below */
+	uint8_t out[DXL_MAX_PACKET];
+	if (!sim_bus_baud_matches(&bus, s->mem[DXL_AX_BAUD_RATE]))
+		return;   /* at another rate it hears nothing (as bus_dispatch) */
+	int len = sim_servo_handle(s, req, out, sizeof(out));
+	CHECK(len >= 0);
+	bool addressed = sim_servo_addressed(&before, req);
+	uint8_t id = sim_servo_id(&before), level = before.mem[DXL_AX_STATUS_RETURN_LEVEL];
+	bool broadcast = req->id == DXL_BROADCAST_ID;
+	if (!addressed) {
+		CHECK(len == 0);
+		CHECK(memcmp(&before, s, sizeof(*s)) == 0);
+		return;
+	}
+	check_table(s, k);
+	/* replies: where the manual gives one, and only there */
+	if (req->code == DXL_INST_PING)
+		CHECK(len > 0);
+	else if (broadcast)
+		CHECK(len == 0);
+	else
+		CHECK((len > 0) == (req->code == DXL_INST_READ ? level >= 1 : level >= 2));
+	struct dxl_packet reply;
+	if (len > 0) {
+		check_reply(out, len, id, &reply);
+		if (req->code == DXL_INST_PING)
+			CHECK(reply.nparams == 0 && reply.code == sim_servo_condition_bits(&before));
+		if (req->code == DXL_INST_READ && reply.code == 0) {
+			CHECK(req->nparams == 2 && reply.nparams == req->params[1]);
+			CHECK(memcmp(reply.params, &s->mem[req->params[0]], reply.nparams) == 0);
+		}
+	}
+	if (req->code == DXL_INST_FACTORY_RESET)
+		return;   /* EEPROM and RAM back to the factory: any change is right */
+	/* a refused write writes nothing (ACTION has cleared `registered` first) */
+	uint32_t errs = s->count.range_errors + s->count.angle_limit_errors + s->count.instruction_errors;
+	uint32_t errs0 = before.count.range_errors + before.count.angle_limit_errors + before.count.instruction_errors;
+	if (errs != errs0) {
+		uint8_t a[DXL_AX_TABLE_SIZE], b[DXL_AX_TABLE_SIZE];
+		memcpy(a, before.mem, sizeof(a));
+		memcpy(b, s->mem, sizeof(b));
+		if (req->code == DXL_INST_ACTION)
+			a[DXL_AX_REGISTERED] = b[DXL_AX_REGISTERED] = 0;
+		CHECK(memcmp(a, b, sizeof(a)) == 0);
+	}
+	/* the EEPROM is locked, or (AX-12A) writable only with torque off */
+	if (before.mem[DXL_AX_LOCK] || (before.opt.eeprom_needs_torque_off && before.mem[DXL_AX_TORQUE_ENABLE]))
+		CHECK(memcmp(before.mem, s->mem, DXL_AX_EEPROM_END) == 0);
+	if (before.mem[DXL_AX_LOCK])
+		CHECK(s->mem[DXL_AX_LOCK] == 1);
+}
+
+/* The model's side of one read: the parser called until it needs more. */
+struct model_counts {
+	uint64_t frames, checksum_errors, header_errors;
+};
+
+static void model_feed(struct dxl_parser *p, const uint8_t *d, size_t n, struct model_counts *mc)
+{
+	size_t off = 0;
+	for (;;) {
+		size_t used = 0;
+		struct dxl_packet pkt;
+		int r = dxl_parser_feed(p, d + off, n - off, &used, &pkt);
+		CHECK(used <= n - off);
+		off += used;
+		if (r == DXL_FRAME) {
+			mc->frames++;
+			for (int k = 0; k < NSERVOS; k++)
+				model_handle(k, &pkt);
+		} else if (r == DXL_E_CHECKSUM) {
+			mc->checksum_errors++;
+		} else if (r < 0) {
+			mc->header_errors++;
+		} else {
+			CHECK(off == n);
+			return;
+		}
+	}
+}
+
+static void check_line(const struct sim_line *l)
+{
+	CHECK(l->n <= SIM_LINE_CAP && l->head + l->n <= SIM_LINE_CAP);
+	for (size_t i = l->head + 1; i < l->head + l->n; i++)
+		CHECK(l->q[i - 1].t <= l->q[i].t);
+}
+
+static void setup(uint8_t flags, const uint8_t *fault)
+{
+	struct sim_servo_options o;
+	sim_servo_default_options(&o);
+	o.eeprom_needs_torque_off = !(flags & 4);
+	sim_bus_init(&bus, "fuzz", "/nonexistent/fuzz", 1000000, (flags & 2) ? 0.016 : 0, (flags & 1) != 0, 7);
+	for (int k = 0; k < NSERVOS; k++) {
+		struct sim_joint *j = &bus.joints[bus.njoints++];
+		memset(j, 0, sizeof(*j));
+		sim_servo_init(&j->servo, &o, (uint16_t)(DXL_POS_CENTER + 100 * k));
+		sim_servo_poke(&j->servo, DXL_AX_ID, (uint16_t)(k + 1));
+		/* different return delays: fewer collisions on the line */
+		sim_servo_poke(&j->servo, DXL_AX_RETURN_DELAY_TIME, (uint16_t)(k * 20));
+		if (k == 2)
+			sim_servo_poke(&j->servo, DXL_AX_STATUS_RETURN_LEVEL, 1);
+		model[k] = j->servo;
+		memcpy(table0[k], j->servo.mem, DXL_AX_TABLE_SIZE);
+	}
+	if (flags & 8) {
+		/* A fault set directly, ARG unchecked: fault.c must cope with any. */
+		struct sim_fault *f = &bus.joints[0].faults.f[fault[0] % SIM_FAULT_KINDS];
+		f->active = true;
+		f->has_arg = fault[1] & 1;
+		f->arg = (double)(int8_t)fault[1] * 3.0;
+		f->remaining = (fault[2] & 3) ? (long)(fault[2] & 3) : -1;
+		f->prob = (double)(fault[2] >> 2) / 63.0;
+	}
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+	static struct dxl_parser mp;
+	static bool once;
+	if (!once) {
+		find_reserved();
+		once = true;
+	}
+	if (size < HEADER)
+		return 0;
+	setup(data[0], data + 1);
+	dxl_parser_init(&mp, DXL_PARSE_INSTRUCTION);
+	struct model_counts mc = { 0, 0, 0 };
+	uint32_t seed = (uint32_t)data[0] << 24 | (uint32_t)data[1] << 16 | (uint32_t)data[2] << 8 | data[3];
+	int64_t now = MS, last_rx = 0;
+	uint8_t drained[SIM_LINE_CAP];
+	size_t off = HEADER;
+	unsigned reads = 0;
+	while (off < size) {
+		uint32_t r = next_rand(&seed);
+		size_t n = 1 + r % 16;
+		if (n > size - off)
+			n = size - off;
+		/* mostly back to back, sometimes a pause, now and then a long one */
+		r = next_rand(&seed);
+		now += (r & 7) == 0 ? 150 * MS : (r & 7) == 1 ? 2 * MS : 20000;
+		/* the model drops a half-read packet after a long gap, as the bus does */
+		if (mp.have > 0 && now - last_rx > GAP_NS)
+			dxl_parser_reset(&mp);
+		last_rx = now;
+		uint8_t mem_before[NSERVOS][DXL_AX_TABLE_SIZE];
+		for (int k = 0; k < NSERVOS; k++)
+			memcpy(mem_before[k], bus.joints[k].servo.mem, DXL_AX_TABLE_SIZE);
+		uint64_t packets = bus.count.packets;
+		sim_bus_feed(&bus, data + off, n, now);
+		for (size_t i = 0; i < n; i++)
+			model_feed(&mp, data + off + i, 1, &mc);
+		off += n;
+		/* the bus saw what the model saw, and its servos agree */
+		CHECK(bus.count.packets == mc.frames);
+		CHECK(bus.count.checksum_errors == mc.checksum_errors);
+		CHECK(bus.count.header_errors == mc.header_errors);
+		CHECK(bus.parser.have == mp.have);
+		for (int k = 0; k < NSERVOS; k++) {
+			const struct sim_servo *s = &bus.joints[k].servo;
+			CHECK(memcmp(s->mem, model[k].mem, DXL_AX_TABLE_SIZE) == 0);
+			CHECK(s->reg_pending == model[k].reg_pending);
+			if (bus.count.packets == packets)
+				CHECK(memcmp(s->mem, mem_before[k], DXL_AX_TABLE_SIZE) == 0);
+		}
+		/* the whole queue now and then (it holds up to 4096 bytes: every
+		 * read would make long inputs slow), its bounds always */
+		CHECK(bus.line.n <= SIM_LINE_CAP && bus.line.head + bus.line.n <= SIM_LINE_CAP);
+		if ((++reads & 7) == 0)
+			check_line(&bus.line);
+		/* what is due goes to the controller */
+		sim_line_take(&bus.line, now, drained, sizeof(drained));
+	}
+	check_line(&bus.line);
+	CHECK(bus.count.rx_bytes == size - HEADER);
+	return 0;
+}
