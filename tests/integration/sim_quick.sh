@@ -101,7 +101,7 @@ if grep -qE 'undulate-sim: exit: .* collisions, total impulse .* worst step late
 # ---- --duration and a servo at another baud ----------------------------------------------
 link2="$T/bus/slow"
 spawn sim2 "$B/undulate-sim" --link "$link2" --ids 1 --name slow --set "robot slow.servo_baud=3" \
-	--duration 1.5 --lcm-url "$URL"
+	--duration 4 --lcm-url "$URL"   # long enough for three exchanges on a loaded machine (SAN build)
 wait_log sim2 'ready:' 5
 xfer() { read -r reply rtt < <($C xfer "$link2" "$@"); }
 expect_silence "servo at 500 kbps ignores a 1 Mbps PING" FFFF010201FB
@@ -110,7 +110,7 @@ xfer FFFF010201FB 300 6
 tap_check "...and answers when the controller sets the pty to 500 kbps" test "$reply" = FFFF010200FC
 unset SIM_CLIENT_BAUD
 t0=$(date +%s%N)
-wait_for 5 bash -c "! kill -0 $pid_sim2 2>/dev/null"
+wait_for 10 bash -c "! kill -0 $pid_sim2 2>/dev/null"
 stop sim2 >"$T/rc"; rc=$(cat "$T/rc")
 ms=$(( ($(date +%s%N) - t0) / 1000000 ))
 tap_check "--duration exits by itself with 0" test "$rc" = 0
