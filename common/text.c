@@ -42,6 +42,17 @@ char *text_sanitize(char *dst, size_t cap, const char *src)
 	return dst;
 }
 
+char *text_line(char *dst, size_t cap, const char *src)
+{
+	size_t o = 0;
+	if (cap == 0)
+		return dst;
+	for (const unsigned char *p = (const unsigned char *)(src != NULL ? src : ""); *p && o + 1 < cap; p++)
+		dst[o++] = *p >= 0x20 && *p <= 0x7e ? (char)*p : '?';
+	dst[o] = '\0';
+	return dst;
+}
+
 bool text_is_name(const char *s, size_t max)
 {
 	size_t n = 0;

@@ -15,6 +15,11 @@
  * fit is cut at a character boundary and ends with "...". Returns dst. */
 char *text_sanitize(char *dst, size_t cap, const char *src);
 
+/* One printable line for a text that is ours but may quote text from outside
+ * (already sanitized, or not): bytes outside 0x20..0x7e become '?', nothing
+ * is escaped a second time; cut to cap - 1 bytes. Returns dst. */
+char *text_line(char *dst, size_t cap, const char *src);
+
 /* True when s is non-empty, at most max bytes, and only [A-Za-z0-9_-]: the
  * names that may become file names and LCM channel prefixes. */
 bool text_is_name(const char *s, size_t max);

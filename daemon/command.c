@@ -1,13 +1,19 @@
 /* command.c — see command.h. */
 #include "command.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+
+#include "num.h"
+#include "text.h"
+#include "wire.h"
+
+/* A name from outside, quoted in a message: one safe line. */
+#define CMD_QUOTE_MAX 48
 
 static const char *nz(const char *s) { return s != NULL ? s : ""; }
 
@@ -25,10 +31,14 @@ static enum cmd_verdict cmd_check_param(const struct cmd_request *r, const struc
                                         size_t cap)
 {
 	const char *name = nz(r->param);
+	char quoted[CMD_QUOTE_MAX];
+	text_sanitize(quoted, sizeof quoted, name);
 	struct cfg_range range;
 	if (!cfg_param_range(name, &range))
-		return reject(why, cap, "unknown parameter '%.40s' (k, c, mu, lambda, inertia, friction, neutral, "
-		              "limit_min, limit_max, max_step, amplitude, frequency, phase)", name);
+		return reject(why, cap, "unknown parameter '%s' (%s)", quoted, cfg_param_commandable_list());
+	if (!cfg_param_commandable(name))
+		return reject(why, cap, "parameter %s bounds where a joint may go: only the configuration file sets it "
+		              "(commands may set %s)", name, cfg_param_commandable_list());
 	if (!isfinite(r->value))
 		return reject(why, cap, "parameter %s: value is not finite", name);
 	if (cfg_param_is_robot(name)) {
@@ -44,22 +54,15 @@ static enum cmd_verdict cmd_check_param(const struct cmd_request *r, const struc
 		              range.min_open ? ">" : "", range.min, range.max);
 	if (cfg_param_is_robot(name))
 		return CMD_ACCEPT;
-	/* Cross-checks the range table cannot express: limits stay ordered around 0
-	 * and inside the servo's travel. */
+	/* what the range table cannot express: the joint's parameters together */
 	size_t first = r->joint < 0 ? 0 : (size_t)r->joint;
 	size_t last = r->joint < 0 ? cfg->njoints : first + 1;
 	for (size_t j = first; j < last; j++) {
 		struct cfg_joint jt = cfg->joint[j];
 		*cfg_joint_param(&jt, name) = r->value;
-		if (strcmp(name, "limit_min") == 0 || strcmp(name, "limit_max") == 0 ||
-		    strcmp(name, "neutral") == 0) {
-			if (!(jt.limit_min <= 0.0 && 0.0 <= jt.limit_max && jt.limit_min < jt.limit_max))
-				return reject(why, cap, "parameter %s: joint %zu limits [%g, %g] must contain 0", name, j,
-				              jt.limit_min, jt.limit_max);
-			if (fabs(jt.neutral + jt.limit_min) > 2.618 || fabs(jt.neutral + jt.limit_max) > 2.618)
-				return reject(why, cap, "parameter %s: joint %zu would leave the servo's ±2.618 rad range",
-				              name, j);
-		}
+		char inner[160];
+		if (!cfg_joint_check(&jt, inner, sizeof inner))
+			return reject(why, cap, "parameter %s: joint %zu: %s", name, j, inner);
 	}
 	return CMD_ACCEPT;
 }
@@ -72,10 +75,10 @@ enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, b
 	if (strcmp(robot, "*") != 0 && strcmp(robot, cfg->name) != 0) {
 		if (!direct)
 			return CMD_IGNORE;
-		return reject(why, cap, "addressed to robot '%.40s', this is '%s'", robot, cfg->name);
+		char quoted[CMD_QUOTE_MAX];
+		return reject(why, cap, "addressed to robot '%s', this is '%s'", text_sanitize(quoted, sizeof quoted, robot),
+		              cfg->name);
 	}
-	if (!cfg->commands)
-		return reject(why, cap, "commands are disabled in this robot's configuration (commands = off)");
 	switch (r->kind) {
 	case CMD_KIND_MODE:
 		if (r->mode < 0 || r->mode >= CFG_NMODES)
@@ -84,82 +87,98 @@ enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, b
 	case CMD_KIND_PARAM:
 		return cmd_check_param(r, cfg, why, cap);
 	case CMD_KIND_TORQUE:
+	case CMD_KIND_CLEAR:
 		return CMD_ACCEPT;
 	default:
-		return reject(why, cap, "unknown command kind %d (1 mode, 2 param, 3 torque)", r->kind);
+		return reject(why, cap, "unknown command kind %d (1 mode, 2 param, 3 torque, 4 clear)", r->kind);
 	}
 }
 
-/* ---- decoding command_t ---------------------------------------------------------------- */
-struct cmd_reader {
-	const uint8_t *p;
-	size_t left;
-	bool bad;
-};
-
-static uint64_t cmd_take(struct cmd_reader *rd, size_t n)
+/* ---- command_t on the wire ---------------------------------------------------------------- */
+static void cmd_take_name(struct wire_reader *rd, char *dst, size_t cap, bool *cut_any)
 {
-	uint64_t v = 0;
-	if (rd->bad || rd->left < n) {
-		rd->bad = true;
-		return 0;
-	}
-	for (size_t i = 0; i < n; i++)
-		v = v << 8 | rd->p[i];
-	rd->p += n;
-	rd->left -= n;
-	return v;
-}
-
-/* An LCM string: int32 length counting the NUL, the bytes, the NUL. */
-static void cmd_take_string(struct cmd_reader *rd, char *dst, size_t cap)
-{
-	int32_t n = (int32_t)(uint32_t)cmd_take(rd, 4);
-	dst[0] = '\0';
-	if (rd->bad || n < 1 || (size_t)n > rd->left || rd->p[n - 1] != '\0') {
-		rd->bad = true;
-		return;
-	}
-	size_t keep = (size_t)n - 1 < cap - 1 ? (size_t)n - 1 : cap - 1;
-	memcpy(dst, rd->p, keep);
-	dst[keep] = '\0';
-	rd->p += n;
-	rd->left -= (size_t)n;
+	bool cut = false;
+	wire_take_string(rd, dst, cap, &cut);
+	*cut_any = *cut_any || cut;
 }
 
 bool cmd_decode(const void *data, size_t len, int64_t fingerprint, struct cmd_wire *w, char *why, size_t cap)
 {
-	struct cmd_reader rd = { .p = data, .left = len };
+	struct wire_reader rd;
+	wire_reader_init(&rd, data, len);
 	memset(w, 0, sizeof *w);
-	if ((int64_t)cmd_take(&rd, 8) != fingerprint && !rd.bad) {
+	if ((int64_t)wire_take(&rd, 8) != fingerprint && !rd.bad) {
 		snprintf(why, cap, "not a command_t (fingerprint differs)");
 		return false;
 	}
 	struct cmd_request *r = &w->req;
-	(void)cmd_take(&rd, 8);   /* utime: not used */
-	r->seq = (int64_t)cmd_take(&rd, 8);
-	cmd_take_string(&rd, w->source, sizeof w->source);
-	cmd_take_string(&rd, w->robot, sizeof w->robot);
-	r->kind = (int8_t)cmd_take(&rd, 1);
-	r->mode = (int8_t)cmd_take(&rd, 1);
-	cmd_take_string(&rd, w->param, sizeof w->param);
-	r->joint = (int16_t)cmd_take(&rd, 2);
-	uint64_t bits = cmd_take(&rd, 8);
-	memcpy(&r->value, &bits, sizeof r->value);
-	r->torque = cmd_take(&rd, 1) != 0;
+	bool cut = false;
+	r->utime = (int64_t)wire_take(&rd, 8);
+	r->seq = (int64_t)wire_take(&rd, 8);
+	cmd_take_name(&rd, w->source, sizeof w->source, &cut);
+	cmd_take_name(&rd, w->robot, sizeof w->robot, &cut);
+	r->kind = (int8_t)wire_take(&rd, 1);
+	r->mode = (int8_t)wire_take(&rd, 1);
+	cmd_take_name(&rd, w->param, sizeof w->param, &cut);
+	r->joint = (int16_t)wire_take(&rd, 2);
+	r->value = wire_take_double(&rd);
+	r->torque = wire_take(&rd, 1) != 0;
+	w->signed_len = len - rd.left;
+	wire_take_bytes(&rd, w->mac, sizeof w->mac);
 	if (rd.bad) {
 		snprintf(why, cap, "malformed command_t (%zu bytes: short, or a bad string length)", len);
 		return false;
 	}
-	r->source = w->source;
-	r->robot = w->robot;
-	r->param = w->param;
+	if (rd.left != 0) {
+		snprintf(why, cap, "malformed command_t (%zu bytes after its end)", rd.left);
+		return false;
+	}
+	if (cut) {
+		/* a name cut at an embedded NUL or at CMD_STR_MAX would say less than
+		 * the sender wrote (and the MAC covers) */
+		snprintf(why, cap, "malformed command_t (a name with a NUL inside, or longer than %d bytes)",
+		         CMD_STR_MAX - 1);
+		return false;
+	}
+	cmd_wire_rebase(w);
 	return true;
+}
+
+void cmd_wire_rebase(struct cmd_wire *w)
+{
+	w->req.source = w->source;
+	w->req.robot = w->robot;
+	w->req.param = w->param;
+}
+
+size_t cmd_encode(const struct cmd_request *r, int64_t fingerprint, const uint8_t *mac, void *buf, size_t cap,
+                  size_t *signed_len)
+{
+	static const uint8_t zeros[CMD_MAC_BYTES];
+	struct wire_writer wr;
+	wire_writer_init(&wr, buf, cap);
+	wire_put(&wr, (uint64_t)fingerprint, 8);
+	wire_put(&wr, (uint64_t)r->utime, 8);
+	wire_put(&wr, (uint64_t)r->seq, 8);
+	wire_put_string(&wr, nz(r->source));
+	wire_put_string(&wr, nz(r->robot));
+	wire_put(&wr, (uint8_t)(int8_t)r->kind, 1);
+	wire_put(&wr, (uint8_t)(int8_t)r->mode, 1);
+	wire_put_string(&wr, nz(r->param));
+	wire_put(&wr, (uint16_t)(int16_t)r->joint, 2);
+	wire_put_double(&wr, r->value);
+	wire_put(&wr, r->torque ? 1 : 0, 1);
+	if (signed_len != NULL)
+		*signed_len = wr.len;
+	wire_put_bytes(&wr, mac != NULL ? mac : zeros, CMD_MAC_BYTES);
+	return wr.bad ? 0 : wr.len;
 }
 
 void cmd_apply_param(struct cfg *cfg, const struct cmd_request *r)
 {
 	const char *name = nz(r->param);
+	if (!cfg_param_commandable(name))
+		return;   /* cmd_check() refused it; a caller that skipped it changes nothing */
 	if (strcmp(name, "amplitude") == 0) { cfg->amplitude = r->value; return; }
 	if (strcmp(name, "frequency") == 0) { cfg->frequency = r->value; return; }
 	if (strcmp(name, "phase") == 0) { cfg->phase = r->value; return; }
@@ -172,17 +191,31 @@ void cmd_apply_param(struct cfg *cfg, const struct cmd_request *r)
 	}
 }
 
-static bool parse_int(const char *s, long *out)
+void cmd_describe(const struct cmd_request *r, char *out, size_t cap)
 {
-	char *end;
-	errno = 0;
-	long v = strtol(s, &end, 10);
-	if (end == s || *end != '\0' || errno != 0)
-		return false;
-	*out = v;
-	return true;
+	char param[CMD_QUOTE_MAX];
+	switch (r->kind) {
+	case CMD_KIND_MODE:
+		snprintf(out, cap, "mode %s", r->mode >= 0 && r->mode < CFG_NMODES ? cfg_mode_name((enum cfg_mode)r->mode)
+		                                                                    : "?");
+		return;
+	case CMD_KIND_PARAM:
+		text_sanitize(param, sizeof param, r->param);
+		snprintf(out, cap, "param %s = %g (joint %d)", param, r->value, r->joint);
+		return;
+	case CMD_KIND_TORQUE:
+		snprintf(out, cap, "torque %s", r->torque ? "on" : "off");
+		return;
+	case CMD_KIND_CLEAR:
+		snprintf(out, cap, "clear");
+		return;
+	default:
+		snprintf(out, cap, "kind %d", r->kind);
+		return;
+	}
 }
 
+/* ---- the text form ------------------------------------------------------------------------ */
 bool cmd_parse_text(const char *text, struct cmd_request *r, char *param_buf, size_t param_cap,
                     char *why, size_t cap)
 {
@@ -194,14 +227,14 @@ bool cmd_parse_text(const char *text, struct cmd_request *r, char *param_buf, si
 	     t = strtok_r(NULL, " \t", &save))
 		word[n++] = t;
 	r->joint = -1;
-	long v;
+	int v;
 	if (n == 2 && strcasecmp(word[0], "mode") == 0) {
 		enum cfg_mode m;
 		r->kind = CMD_KIND_MODE;
 		if (cfg_mode_parse(word[1], &m))
 			r->mode = (int)m;
-		else if (parse_int(word[1], &v) && v >= -128 && v <= 127)
-			r->mode = (int)v;
+		else if (num_parse_int(word[1], -128, 127, &v) == NUM_OK)
+			r->mode = v;
 		else {
 			snprintf(why, cap, "mode: '%s' is not limp, hold, sinusoid, oscillator or a number", word[1]);
 			return false;
@@ -212,6 +245,7 @@ bool cmd_parse_text(const char *text, struct cmd_request *r, char *param_buf, si
 		r->kind = CMD_KIND_PARAM;
 		snprintf(param_buf, param_cap, "%s", word[1]);
 		r->param = param_buf;
+		/* any number, even out of range or not finite: the daemon judges */
 		char *end;
 		r->value = strtod(word[2], &end);
 		if (end == word[2] || *end != '\0') {
@@ -219,11 +253,11 @@ bool cmd_parse_text(const char *text, struct cmd_request *r, char *param_buf, si
 			return false;
 		}
 		if (n == 4) {
-			if (!parse_int(word[3], &v) || v < -32768 || v > 32767) {
+			if (num_parse_int(word[3], -32768, 32767, &v) != NUM_OK) {
 				snprintf(why, cap, "param: joint '%s' is not an integer", word[3]);
 				return false;
 			}
-			r->joint = (int)v;
+			r->joint = v;
 		}
 		return true;
 	}
@@ -239,11 +273,15 @@ bool cmd_parse_text(const char *text, struct cmd_request *r, char *param_buf, si
 		}
 		return true;
 	}
-	if (n == 2 && strcasecmp(word[0], "kind") == 0 && parse_int(word[1], &v)) {
-		/* raw kind, for testing the daemon's own validation */
-		r->kind = (int)v;
+	if (n == 1 && strcasecmp(word[0], "clear") == 0) {
+		r->kind = CMD_KIND_CLEAR;
 		return true;
 	}
-	snprintf(why, cap, "'%s': expected 'mode NAME', 'param NAME VALUE [JOINT]' or 'torque on|off'", text);
+	if (n == 2 && strcasecmp(word[0], "kind") == 0 && num_parse_int(word[1], -128, 127, &v) == NUM_OK) {
+		/* raw kind, for testing the daemon's own validation */
+		r->kind = v;
+		return true;
+	}
+	snprintf(why, cap, "'%s': expected 'mode NAME', 'param NAME VALUE [JOINT]', 'torque on|off' or 'clear'", text);
 	return false;
 }

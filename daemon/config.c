@@ -10,6 +10,8 @@
 #include <string.h>
 #include <strings.h>
 
+#include "udpm.h"
+
 #define CFG_PI 3.14159265358979323846
 /* The AX-12 turns 300°: ±150° = ±2.618 rad around its centre. */
 #define CFG_SERVO_HALF_RANGE (150.0 * CFG_PI / 180.0)
@@ -30,6 +32,11 @@ static void cfg_error(struct cfg_errors *e, const char *fmt, ...)
 
 /* ---- modes and enums ------------------------------------------------------------ */
 static const char *const cfg_mode_names[CFG_NMODES] = { "LIMP", "HOLD", "SINUSOID", "OSCILLATOR" };
+
+const char *cfg_commands_name(enum cfg_commands c)
+{
+	return c == CFG_CMD_OFF ? "off" : c == CFG_CMD_NETWORK ? "network" : "local";
+}
 
 const char *cfg_mode_name(enum cfg_mode m)
 {
@@ -131,22 +138,28 @@ static bool parse_ids(const char *s, uint8_t *ids, size_t *n, char *why, size_t 
 struct cfg_param_def {
 	const char *key;
 	struct cfg_range range;
-	bool joint;   /* per joint ([joint.N]) or per robot ([sinusoid]) */
+	bool joint;        /* per joint ([joint.N]) or per robot ([sinusoid]) */
+	bool commandable;  /* a command may change it (never what bounds a joint) */
 };
+/* The ranges are physical: an AX-12 joint's link has an inertia of order
+ * 1e-3 kg·m² and a stall torque of 1.5 N·m, so a law's spring of more than
+ * 10 N·m/rad or an inertia below 1e-5 (the oscillator then asks for
+ * accelerations the servo cannot give and one control period cannot
+ * integrate) is a typo, not a tuning. */
 static const struct cfg_param_def cfg_params[] = {
-	{ "k",         { 0.0, 1000.0, true }, true },
-	{ "c",         { -100.0, 100.0, false }, true },
-	{ "mu",        { 0.0, 1000.0, false }, true },
-	{ "lambda",    { -10.0, 10.0, false }, true },
-	{ "inertia",   { 0.0, 10.0, true }, true },
-	{ "friction",  { 0.0, 10.0, false }, true },
-	{ "neutral",   { -CFG_SERVO_HALF_RANGE, CFG_SERVO_HALF_RANGE, false }, true },
-	{ "limit_min", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true },
-	{ "limit_max", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true },
-	{ "max_step",  { 0.0, 0.5, true }, true },
-	{ "amplitude", { 0.0, CFG_SERVO_HALF_RANGE, false }, false },
-	{ "frequency", { 0.0, 5.0, false }, false },
-	{ "phase",     { -2.0 * CFG_PI, 2.0 * CFG_PI, false }, false },
+	{ "k",         { 1e-4, 10.0, false }, true, true },
+	{ "c",         { -1.0, 1.0, false }, true, true },
+	{ "mu",        { 0.0, 100.0, false }, true, true },
+	{ "lambda",    { -10.0, 10.0, false }, true, true },
+	{ "inertia",   { 1e-5, 1.0, false }, true, true },
+	{ "friction",  { 0.0, 1.0, false }, true, true },
+	{ "neutral",   { -CFG_SERVO_HALF_RANGE, CFG_SERVO_HALF_RANGE, false }, true, false },
+	{ "limit_min", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
+	{ "limit_max", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
+	{ "max_step",  { 0.0, 0.5, true }, true, false },
+	{ "amplitude", { 0.0, CFG_SERVO_HALF_RANGE, false }, false, true },
+	{ "frequency", { 0.0, 5.0, false }, false, true },
+	{ "phase",     { -2.0 * CFG_PI, 2.0 * CFG_PI, false }, false, true },
 };
 #define CFG_NPARAMS (sizeof cfg_params / sizeof cfg_params[0])
 
@@ -164,6 +177,28 @@ bool cfg_param_range(const char *key, struct cfg_range *out)
 	if (d == NULL)
 		return false;
 	*out = d->range;
+	return true;
+}
+
+bool cfg_param_commandable(const char *key)
+{
+	const struct cfg_param_def *d = cfg_param_find(key);
+	return d != NULL && d->commandable;
+}
+
+const char *cfg_param_commandable_list(void)
+{
+	return "k, c, mu, lambda, inertia, friction (per joint), amplitude, frequency, phase (sinusoid)";
+}
+
+bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap)
+{
+	double hz = sqrt(j->osc.k / j->osc.inertia) / (2.0 * CFG_PI);
+	if (!(hz <= CFG_MAX_NATURAL_HZ)) {
+		snprintf(why, cap, "k %g and inertia %g give a natural frequency of %.3g Hz, above %g Hz", j->osc.k,
+		         j->osc.inertia, hz, CFG_MAX_NATURAL_HZ);
+		return false;
+	}
 	return true;
 }
 
@@ -225,7 +260,11 @@ void cfg_defaults(struct cfg *c)
 	/* Replies on a loaded 2-core machine (simulator, tests) come up to ~3 ms
 	 * late; a real adapter with return delay 0 needs far less. */
 	c->bus_margin_us = 3000;
-	c->commands = true;
+	c->commands = CFG_CMD_LOCAL;
+	c->command_window_s = 2.0;
+	/* Five periods of 10 ms stale are a hold; half a second is a servo gone
+	 * (a bus reconnect takes 0.01-0.15 s, DESIGN.md). */
+	c->silent_s = 0.5;
 	c->adapter_latency_us = -1;
 	c->period_ms = 10.0;
 	c->ramp_s = 1.5;
@@ -251,7 +290,7 @@ void cfg_defaults(struct cfg *c)
 }
 
 /* ---- [robot] keys --------------------------------------------------------------------- */
-enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL, T_ACT, T_DRIVE };
+enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL, T_ACT, T_DRIVE, T_CMDS };
 struct cfg_key {
 	const char *key;
 	enum cfg_type type;
@@ -275,7 +314,10 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("fault_action", T_SAFE, fault_action, 0, 0),
 	K("velocity_source", T_VEL, velocity_source, 0, 0),
 	K("velocity_cutoff_hz", T_DOUBLE, velocity_cutoff_hz, 0.5, 50),
-	K("commands", T_BOOL, commands, 0, 0),
+	K("commands", T_CMDS, commands, 0, 0),
+	K("command_key", T_STR, command_key, 0, 0),
+	K("command_window_s", T_DOUBLE, command_window_s, 0.05, 60),
+	K("run_dir", T_STR, run_dir, 0, 0),
 	K("echo", T_BOOL, echo, 0, 0),
 	K("adapter_latency_us", T_LONG, adapter_latency_us, -1, 100000),
 	K("period_ms", T_DOUBLE, period_ms, 2, 100),
@@ -291,6 +333,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("fault_backoff_s", T_DOUBLE, fault_backoff_s, 0.05, 600),
 	K("fault_retries", T_LONG, fault_retries, 0, 100),
 	K("stale_limit", T_LONG, stale_limit, 1, 1000),
+	K("silent_s", T_DOUBLE, silent_s, 0.05, 60),
 };
 #undef K
 #define CFG_NROBOT_KEYS (sizeof cfg_robot_keys / sizeof cfg_robot_keys[0])
@@ -395,6 +438,19 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			c->actuation = CFG_ACT_TORQUE;
 		else {
 			cfg_error(e, "%s: [robot] actuation: '%s' is not position or torque", where, value);
+			return false;
+		}
+		return true;
+	case T_CMDS:
+		/* "on" is what this key took before commands left the network */
+		if (strcasecmp(value, "local") == 0 || strcasecmp(value, "on") == 0)
+			c->commands = CFG_CMD_LOCAL;
+		else if (strcasecmp(value, "network") == 0)
+			c->commands = CFG_CMD_NETWORK;
+		else if (strcasecmp(value, "off") == 0)
+			c->commands = CFG_CMD_OFF;
+		else {
+			cfg_error(e, "%s: [robot] commands: '%s' is not off, local or network", where, value);
 			return false;
 		}
 		return true;
@@ -662,7 +718,17 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 			cfg_error(e, "%s: [joint.%zu] limit_min/limit_max: neutral %+g + [%g, %g] leaves the servo's "
 			          "±2.618 rad (300°) range", c->source[0] ? c->source : "config", j + 1,
 			          jt->neutral, jt->limit_min, jt->limit_max);
+		char jwhy[160];
+		if (!cfg_joint_check(jt, jwhy, sizeof jwhy))
+			cfg_error(e, "%s: [joint.%zu] k/inertia: %s", c->source[0] ? c->source : "config", j + 1, jwhy);
 	}
+	struct udpm_url url;
+	char why[200];
+	if (c->lcm_url[0] != '\0' && !udpm_parse_url(c->lcm_url, &url, why, sizeof why))
+		cfg_error(e, "%s: [robot] lcm_url: %s", c->source[0] ? c->source : "config", why);
+	if (c->commands == CFG_CMD_NETWORK && c->command_key[0] == '\0')
+		cfg_error(e, "%s: [robot] commands = network needs command_key = FILE (the shared key: "
+		          "`undulated --gen-key FILE` makes one)", c->source[0] ? c->source : "config");
 	return e->count == before;
 }
 
@@ -679,15 +745,17 @@ void cfg_print(const struct cfg *c, void *file)
 	        "echo = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\n"
 	        "actuation = %s\ntorque_drive = %s\nstall_torque = %g\nno_load_speed = %g\n"
 	        "bus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
-	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\n",
+	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\nsilent_s = %g\n"
+	        "command_key = %s\ncommand_window_s = %g\nrun_dir = %s\n",
 	        cfg_mode_name(c->mode), c->lcm_url, c->priority, c->mlockall ? "on" : "off",
 	        safe[c->safe_stop], safe[c->fault_action],
 	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
-	        c->commands ? "on" : "off", c->echo ? "on" : "off", c->adapter_latency_us, c->period_ms,
+	        cfg_commands_name(c->commands), c->echo ? "on" : "off", c->adapter_latency_us, c->period_ms,
 	        c->servo_lead_s, c->compliance_margin, c->actuation == CFG_ACT_TORQUE ? "torque" : "position",
 	        c->torque_drive == CFG_DRIVE_CURRENT ? "current" : "pwm", c->stall_torque, c->no_load_speed,
 	        c->bus_margin_us,
-	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit);
+	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit, c->silent_s,
+	        c->command_key, c->command_window_s, c->run_dir);
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ninertia = %g\nfriction = %g\n"

@@ -31,6 +31,10 @@ enum cfg_actuation { CFG_ACT_POSITION, CFG_ACT_TORQUE };
 /* What the wheel-mode register drives: the AX-12's PWM duty (the controller
  * adds the back-EMF it loses) or a current-controlled drive's torque. */
 enum cfg_drive { CFG_DRIVE_PWM, CFG_DRIVE_CURRENT };
+/* Where commands may come from (README, "Safety"): nowhere; this computer
+ * only (the local command socket, whose file permissions decide who); or
+ * also the LCM network, each command signed with the shared key. */
+enum cfg_commands { CFG_CMD_OFF, CFG_CMD_LOCAL, CFG_CMD_NETWORK };
 
 struct cfg_joint {
 	struct osc_joint_params osc;
@@ -56,7 +60,10 @@ struct cfg {
 	enum cfg_safe fault_action;    /* what a persistent servo fault leaves behind */
 	enum cfg_velocity velocity_source;
 	double velocity_cutoff_hz;     /* low-pass of the filtered position difference */
-	bool commands;                 /* accept LCM commands */
+	enum cfg_commands commands;    /* where commands are accepted from */
+	char command_key[CFG_PATH_MAX];/* commands = network: the shared key's file (root-only) */
+	double command_window_s;       /* commands = network: a signed command's time must be this close */
+	char run_dir[CFG_PATH_MAX];    /* the local command socket's directory ("": the default) */
 	bool echo;                     /* single-wire adapter echoes our bytes */
 	long adapter_latency_us;       /* -1: measure (FTDI latency timer) */
 	double period_ms;              /* control period */
@@ -73,6 +80,7 @@ struct cfg {
 	double fault_backoff_s;        /* wait before a recovery attempt */
 	int fault_retries;             /* recovery attempts before fault_action */
 	int stale_limit;               /* stale cycles before a joint is reported lost */
+	double silent_s;               /* a joint without a valid reading this long latches the fault action */
 	/* [joint.N], N = 1..njoints */
 	struct cfg_joint joint[CFG_MAX_JOINTS];
 	/* [sinusoid] */
@@ -104,9 +112,20 @@ bool cfg_set(struct cfg *c, const char *where, const char *section, const char *
 bool cfg_finish(struct cfg *c, struct cfg_errors *errors);
 
 /* Documented ranges of the per-joint and sinusoid parameters; shared with
- * LCM command validation. Returns false for an unknown name. */
+ * command validation. Returns false for an unknown name. */
 struct cfg_range { double min, max; bool min_open; };
 bool cfg_param_range(const char *key, struct cfg_range *out);
+/* May a command change it? Only the configuration decides where a joint may
+ * go: neutral, the limits and max_step are not commandable. */
+bool cfg_param_commandable(const char *key);
+/* The commandable parameters' names, for messages ("k, c, mu, ..."). */
+const char *cfg_param_commandable_list(void);
+/* Cross-checks a joint's oscillator parameters as a whole (the range table
+ * cannot): its natural frequency sqrt(k/I)/2π at most CFG_MAX_NATURAL_HZ, so
+ * that one control period integrates it accurately. False with *why. */
+#define CFG_MAX_NATURAL_HZ 5.0
+bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap);
+const char *cfg_commands_name(enum cfg_commands c);
 bool cfg_param_is_joint(const char *key);   /* k, c, ..., max_step */
 bool cfg_param_is_robot(const char *key);   /* amplitude, frequency, phase */
 /* Value of a per-joint parameter by name (for commands); NULL if unknown. */

@@ -1,4 +1,4 @@
-/* control.c — see control.h. */
+/* control.c — see control.h. Torque actuation is in torque.c. */
 #include "control.h"
 
 #include <math.h>
@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "control_priv.h"
 #include "dxl.h"
 #include "dxl_table.h"
 
@@ -28,21 +29,14 @@
  * held while the mode's target moved on). */
 #define CTL_RESUME_STALE 3
 #define CTL_STALL_CYCLES 100
-/* Torque actuation: a virtual spring pushes a joint back from CTL_WALL_MARGIN
- * inside either limit, reaching the stall torque at the limit itself, with
- * CTL_WALL_DAMPING against moving outwards; past the limit the robot falls
- * back to fault_action in joint mode, where the servo enforces its limits. */
-#define CTL_WALL_MARGIN 0.15
-#define CTL_WALL_DAMPING 0.1
-/* Supply assumed for the PWM drive until the servo's voltage is read (V). */
-#define CTL_NOMINAL_VOLTAGE 12.0
 
-static void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
-	__attribute__((format(printf, 4, 5)));
-static void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
+/* ---- events and writes ------------------------------------------------------------------ */
+void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
 {
-	if (c->nevents >= CTL_MAX_EVENTS)
+	if (c->nevents >= CTL_MAX_EVENTS) {
+		c->events_dropped++;
 		return;
+	}
 	struct ctl_event *e = &c->events[c->nevents++];
 	e->level = level;
 	snprintf(e->kind, sizeof e->kind, "%s", kind);
@@ -52,34 +46,40 @@ static void ctl_event(struct ctl *c, int level, const char *kind, const char *fm
 	va_end(ap);
 }
 
-static void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
+bool ctl_next_event(struct ctl *c, struct ctl_event *out)
 {
-	/* A later write to the same register in the same cycle replaces the earlier. */
-	for (size_t i = 0; i < c->nwrites; i++) {
-		if (c->writes[i].id == id && c->writes[i].addr == addr) {
-			c->writes[i].value = value;
-			return;
-		}
-	}
-	if (c->nwrites < CTL_MAX_WRITES)
-		c->writes[c->nwrites++] = (struct ctl_write){ .id = id, .addr = addr, .len = len, .value = value };
+	if (c->nevents == 0)
+		return false;
+	*out = c->events[0];
+	memmove(c->events, c->events + 1, (c->nevents - 1) * sizeof c->events[0]);
+	c->nevents--;
+	return true;
 }
 
-/* The torque limit a joint should have: the servo's max torque, reduced to
- * backoff_torque while it backs off from a fault. */
-static uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt)
+static void ctl_queue_full(struct ctl *c, uint8_t id, uint8_t addr)
 {
-	if (jt->fault == CTL_FAULT_NONE)
+	ctl_event(c, 2, "write-failed", "servo %u: register %u not written: the write queue is full (%d)", id, addr,
+	          WQ_CAP);
+}
+
+void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
+{
+	if (!wq_put(&c->wq, id, addr, len, value))
+		ctl_queue_full(c, id, addr);
+}
+
+void ctl_write_seq(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
+{
+	if (!wq_put_seq(&c->wq, id, addr, len, value))
+		ctl_queue_full(c, id, addr);
+}
+
+uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt)
+{
+	/* a recovery attempt (CHECK) is with the full limit back */
+	if (jt->fault == CTL_FAULT_NONE || jt->fault == CTL_FAULT_CHECK)
 		return jt->servo.max_torque;
 	return (uint16_t)lround(c->cfg->backoff_torque * jt->servo.max_torque);
-}
-
-/* Appended as they are, in order: a sequence that writes one register twice
- * (torque off, EEPROM write, torque on) must not be merged. */
-static void ctl_write_seq(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
-{
-	if (c->nwrites < CTL_MAX_WRITES)
-		c->writes[c->nwrites++] = (struct ctl_write){ .id = id, .addr = addr, .len = len, .value = value };
 }
 
 static void ctl_torque_write(struct ctl *c, size_t j, bool on)
@@ -88,7 +88,7 @@ static void ctl_torque_write(struct ctl *c, size_t j, bool on)
 	if (on) {
 		/* The manual's recovery: the torque limit back (an alarm shutdown set
 		 * it to 0), then torque enable. Harmless when nothing was wrong. */
-		ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, jt->servo.max_torque);
+		ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, jt));
 		ctl_write(c, jt->id, DXL_AX_TORQUE_ENABLE, 1, 1);
 	} else {
 		ctl_write(c, jt->id, DXL_AX_TORQUE_ENABLE, 1, 0);
@@ -96,12 +96,62 @@ static void ctl_torque_write(struct ctl *c, size_t j, bool on)
 	jt->torque = on;
 }
 
-void ctl_clear_outputs(struct ctl *c)
+const struct wq_write *ctl_take_write(struct ctl *c)
 {
-	c->nwrites = 0;
-	c->nevents = 0;
+	return wq_take(&c->wq);
 }
 
+static const char *ctl_register_name(uint8_t addr)
+{
+	switch (addr) {
+	case DXL_AX_TORQUE_ENABLE: return "torque enable";
+	case DXL_AX_TORQUE_LIMIT: return "torque limit";
+	case DXL_AX_CW_ANGLE_LIMIT: return "angle limits";
+	case DXL_AX_CW_COMPLIANCE_MARGIN: return "compliance margins";
+	case DXL_AX_MOVING_SPEED: return "moving speed";
+	default: return "register";
+	}
+}
+
+void ctl_write_result(struct ctl *c, bool ok)
+{
+	struct wq_write w;
+	if (wq_done(&c->wq, ok, &w) != WQ_FAILED)
+		return;
+	c->write_failures++;
+	ctl_event(c, 2, "write-failed", "servo %u: %s (%u) = %u not acknowledged after %d sends: given up; "
+	          "the read-back will tell what the servo holds", w.id, ctl_register_name(w.addr), w.addr,
+	          (unsigned)w.value, WQ_TRIES);
+}
+
+size_t ctl_sync(const struct ctl *c, uint8_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data)
+{
+	size_t n = 0;
+	*width = c->sync == CTL_SYNC_GOAL_STOP ? 4 : 2;
+	*addr = c->sync == CTL_SYNC_DUTY ? DXL_AX_MOVING_SPEED : DXL_AX_GOAL_POSITION;
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
+		if (c->sync == CTL_SYNC_DUTY) {
+			/* the conversion clamps and turns a non-finite duty into 0 */
+			ids[n] = jt->id;
+			dxl_put_u16(&data[2 * n], dxl_duty_to_wheel(jt->duty));
+			n++;
+			continue;
+		}
+		/* safety_clamp() made goal finite and inside the limits; the
+		 * conversion clamps to 0..1023 as a last line */
+		if (!jt->write_goal || !isfinite(jt->goal))
+			continue;
+		ids[n] = jt->id;
+		dxl_put_u16(&data[*width * n], dxl_rad_to_pos(jt->goal));
+		if (*width == 4)
+			dxl_put_u16(&data[*width * n + 2], 0);   /* moving speed 0: joint mode's "fastest" */
+		n++;
+	}
+	return n;
+}
+
+/* ---- set-up --------------------------------------------------------------------------------- */
 void ctl_init(struct ctl *c, struct cfg *cfg)
 {
 	memset(c, 0, sizeof *c);
@@ -109,6 +159,7 @@ void ctl_init(struct ctl *c, struct cfg *cfg)
 	c->n = cfg->njoints;
 	c->mode = cfg->mode;
 	c->fade_mode = CFG_NMODES;
+	wq_init(&c->wq);
 	snprintf(c->reason, sizeof c->reason, "start");
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
@@ -120,6 +171,8 @@ void ctl_init(struct ctl *c, struct cfg *cfg)
 		jt->temperature = NAN;
 		jt->duty = NAN;
 		jt->torque_cmd = NAN;
+		jt->torque_read = -1;
+		jt->torque_limit_read = -1;
 		jt->servo.max_torque = 1023;
 		osc_velocity_filter_init(&jt->vfilter, cfg->velocity_cutoff_hz);
 		osc_estimator_init(&jt->estimator);
@@ -154,20 +207,7 @@ uint32_t ctl_joint_mode_limits(const struct ctl *c, size_t j)
 	return (uint32_t)c->j[j].servo.cw_limit | (uint32_t)c->j[j].servo.ccw_limit << 16;
 }
 
-/* Limits follow parameter changes (limit_min/max, neutral, max_step). */
-static void ctl_refresh_limits(struct ctl *c)
-{
-	for (size_t j = 0; j < c->n; j++) {
-		struct ctl_joint *jt = &c->j[j];
-		const struct cfg_joint *cj = &c->cfg->joint[j];
-		struct safety_limits l;
-		if (safety_limits_make(&l, cj->neutral, cj->limit_min, cj->limit_max, jt->servo.cw_limit,
-		                       jt->servo.ccw_limit, cj->max_step))
-			jt->limits = l;
-	}
-}
-
-static void ctl_blend_joint(struct ctl *c, size_t j, double from)
+void ctl_blend_joint(struct ctl *c, size_t j, double from)
 {
 	if (c->cfg->ramp_s <= 0.0 || !isfinite(from))
 		return;
@@ -246,14 +286,32 @@ static double ctl_present_or_goal(const struct ctl_joint *jt)
 	return jt->angle;
 }
 
+/* The writes that make a servo what the controller expects, after a start
+ * or a reset: its compliance margins (RAM: a power loss resets them to the
+ * factory value), moving speed 0 ("as fast as possible") in joint mode, and
+ * torque as the mode wants it. */
+static void ctl_servo_setup(struct ctl *c, size_t j, bool torque)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (c->cfg->compliance_margin >= 0) {
+		uint32_t m = (uint32_t)c->cfg->compliance_margin;
+		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_MARGIN, 2, m | m << 8);
+	}
+	if (!c->wheel)
+		ctl_write(c, jt->id, DXL_AX_MOVING_SPEED, 2, 0);
+	ctl_torque_write(c, j, torque);
+}
+
 void ctl_start(struct ctl *c, double t, const char *reason)
 {
 	c->t = t;
-	/* the daemon's start-up checks leave every servo in joint mode */
+	/* the daemon's start-up checks leave every servo in joint mode, with its
+	 * margins and moving speed set */
 	c->wheel = false;
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
-		jt->fault = CTL_FAULT_NONE;
+		if (jt->fault != CTL_FAULT_FAILED)
+			jt->fault = CTL_FAULT_NONE;
 		jt->retries = 0;
 		/* the ramp starts where the joint is: no jump at torque-on */
 		jt->goal = jt->angle;
@@ -267,22 +325,26 @@ void ctl_start(struct ctl *c, double t, const char *reason)
 	}
 	if (c->mode == CFG_MODE_OSCILLATOR && ctl_needs_starter(c))
 		ctl_starter(c);
-	ctl_event(c, 0, "start", "%s: %s, ramping in over %.1f s", reason, cfg_mode_name(c->mode),
-	          c->mode == CFG_MODE_LIMP ? 0.0 : c->cfg->ramp_s);
+	ctl_event(c, 0, "start", "%s: %s, ramping in over %.1f s%s%s", reason, cfg_mode_name(c->mode),
+	          c->mode == CFG_MODE_LIMP ? 0.0 : c->cfg->ramp_s, c->latched ? "; fault latched: " : "",
+	          c->latched ? c->latch : "");
 }
 
 void ctl_bus_lost(struct ctl *c)
 {
 	for (size_t j = 0; j < c->n; j++) {
 		c->j[j].fresh = false;
-		c->j[j].torque = false;
+		c->j[j].torque_read = -1;
+		c->j[j].torque_limit_read = -1;
 		/* the next reading after reconnecting starts a new difference */
 		osc_velocity_filter_init(&c->j[j].vfilter, c->cfg->velocity_cutoff_hz);
 	}
+	wq_clear(&c->wq);
 	ctl_blend_stop(c);
 	c->fade_mode = CFG_NMODES;
 }
 
+/* ---- inputs ----------------------------------------------------------------------------------- */
 void ctl_measure(struct ctl *c, size_t j, uint16_t pos_raw, uint16_t speed_raw, uint16_t load_raw,
                  uint8_t errbits, double dt)
 {
@@ -310,23 +372,126 @@ void ctl_measure_slow(struct ctl *c, size_t j, uint8_t voltage_raw, uint8_t temp
 	c->j[j].errbits |= errbits;
 }
 
-static void ctl_hold_at_present(struct ctl *c)
+void ctl_hold_at_present(struct ctl *c)
 {
 	for (size_t j = 0; j < c->n; j++)
 		c->hold[j] = isfinite(c->j[j].angle) ? c->j[j].angle : c->j[j].goal;
+}
+
+/* A servo found with torque off that should be on: it lost power (or browned
+ * out) and came back with its RAM at the factory values. It is set up again
+ * and ramps in from where it is now; one that keeps resetting latches. */
+static void ctl_servo_reset(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	jt->resets++;
+	c->resets++;
+	if (jt->resets > c->cfg->fault_retries) {
+		char what[CTL_LATCH_TEXT];
+		snprintf(what, sizeof what, "servo %u reset %lld times (power?)", jt->id, jt->resets);
+		ctl_event(c, 2, "servo-reset", "servo %u found with torque off again (reset %lld): giving up", jt->id,
+		          jt->resets);
+		ctl_latch(c, what);
+		if (c->mode == CFG_MODE_LIMP)
+			return;
+	} else {
+		ctl_event(c, 2, "servo-reset", "servo %u found with torque off while %s wanted it on (power loss or "
+		          "brown-out: its RAM is back at the factory values): setting it up again, reset %lld of %d",
+		          jt->id, cfg_mode_name(c->mode), jt->resets, c->cfg->fault_retries);
+	}
+	wq_drop_id(&c->wq, jt->id);
+	ctl_servo_setup(c, j, true);
+	/* it may have been moved while limp: start where it is */
+	jt->goal = jt->angle;
+	c->hold[j] = jt->angle;
+	if (jt->fault == CTL_FAULT_NONE)
+		ctl_blend_joint(c, j, jt->angle);
+}
+
+static void ctl_mismatch(struct ctl *c, size_t j, const char *what, unsigned read, unsigned want)
+{
+	c->readback_mismatches++;
+	ctl_event(c, 1, "readback", "servo %u: %s read back %u, expected %u: written again", c->j[j].id, what, read,
+	          want);
+}
+
+void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits)
+{
+	struct ctl_joint *jt = &c->j[j];
+#define REG(addr) ram[(addr) - CTL_READBACK_ADDR]
+	unsigned torque = REG(DXL_AX_TORQUE_ENABLE);
+	unsigned limit = dxl_get_u16(&REG(DXL_AX_TORQUE_LIMIT));
+	unsigned margin_cw = REG(DXL_AX_CW_COMPLIANCE_MARGIN), margin_ccw = REG(DXL_AX_CCW_COMPLIANCE_MARGIN);
+	jt->torque_read = (int)torque;
+	jt->torque_limit_read = (int)limit;
+	ctl_measure_slow(c, j, REG(DXL_AX_PRESENT_VOLTAGE), REG(DXL_AX_PRESENT_TEMPERATURE), errbits);
+#undef REG
+	/* a write to this servo is queued or on the wire: its registers are
+	 * about to change; judge them at the next read-back. A joint in a fault's
+	 * back-off, recovery or latched failure is the fault machinery's. */
+	if (wq_has_id(&c->wq, jt->id) || !jt->have_reading || jt->fault != CTL_FAULT_NONE)
+		return;
+	if (jt->torque && torque == 0 && limit == 0) {
+		/* the manual's alarm shutdown (torque off, torque limit 0), though no
+		 * reply showed its bit: a fault, backed off and recovered as one */
+		jt->faults++;
+		c->faults++;
+		jt->retries = 0;
+		ctl_event(c, 1, "fault", "servo %u found shut down (torque off, torque limit 0: an alarm): backing "
+		          "off", jt->id);
+		jt->fault = CTL_FAULT_BACKOFF;
+		jt->fault_since = c->t;
+		jt->fault_hold = jt->angle;
+		return;
+	}
+	if (jt->torque && torque == 0) {
+		ctl_servo_reset(c, j);
+		return;
+	}
+	if (!jt->torque && torque != 0) {
+		ctl_mismatch(c, j, "torque enable", torque, 0);
+		ctl_torque_write(c, j, false);
+		return;
+	}
+	if (!jt->torque)
+		return;
+	unsigned want_limit = ctl_torque_limit(c, jt);
+	if (limit != want_limit && jt->fault != CTL_FAULT_CHECK) {
+		/* 0 is an alarm shutdown the error bits did not show (they clear
+		 * when torque is enabled again) */
+		ctl_mismatch(c, j, limit == 0 ? "torque limit (alarm shutdown)" : "torque limit", limit, want_limit);
+		ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, want_limit);
+	}
+	long want_margin = c->cfg->compliance_margin;
+	if (want_margin >= 0 && (margin_cw != (unsigned)want_margin || margin_ccw != (unsigned)want_margin)) {
+		ctl_mismatch(c, j, "compliance margin", margin_cw != (unsigned)want_margin ? margin_cw : margin_ccw,
+		             (unsigned)want_margin);
+		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_MARGIN, 2, (uint32_t)want_margin | (uint32_t)want_margin << 8);
+	}
+}
+
+/* ---- modes ------------------------------------------------------------------------------------ */
+static enum cfg_mode ctl_fault_mode(const struct ctl *c)
+{
+	return c->cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD;
+}
+
+bool ctl_mode_allowed(const struct ctl *c, enum cfg_mode mode, char *why, size_t cap)
+{
+	if (!c->latched || mode == CFG_MODE_LIMP || mode == ctl_fault_mode(c))
+		return true;
+	if (ctl_fault_mode(c) == CFG_MODE_LIMP)
+		snprintf(why, cap, "fault latched (%s): only LIMP until 'clear'", c->latch);
+	else
+		snprintf(why, cap, "fault latched (%s): only LIMP or %s until 'clear'", c->latch,
+		         cfg_mode_name(ctl_fault_mode(c)));
+	return false;
 }
 
 void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 {
 	enum cfg_mode old = c->mode;
 	snprintf(c->reason, sizeof c->reason, "%s", reason);
-	for (size_t j = 0; j < c->n; j++) {
-		/* an explicit mode change is the operator taking over after a failure */
-		if (c->j[j].fault == CTL_FAULT_FAILED) {
-			c->j[j].fault = CTL_FAULT_NONE;
-			c->j[j].retries = 0;
-		}
-	}
 	if (mode == old)
 		return;
 	bool was_still = old == CFG_MODE_LIMP || old == CFG_MODE_HOLD || ctl_is_still(c);
@@ -371,12 +536,13 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 	}
 	if (mode == CFG_MODE_OSCILLATOR && was_still && ctl_needs_starter(c))
 		ctl_starter(c);
-	ctl_event(c, 0, "mode", "mode %s -> %s (%s)", cfg_mode_name(old), cfg_mode_name(mode), reason);
+	/* a fault's switch is an error; the operator's is news */
+	ctl_event(c, c->latched && mode == ctl_fault_mode(c) ? 2 : 0, "mode", "mode %s -> %s (%s)",
+	          cfg_mode_name(old), cfg_mode_name(mode), reason);
 }
 
 void ctl_params_changed(struct ctl *c)
 {
-	ctl_refresh_limits(c);
 	if (c->mode != CFG_MODE_SINUSOID)
 		return;
 	for (size_t j = 0; j < c->n; j++)
@@ -393,7 +559,69 @@ void ctl_torque(struct ctl *c, bool on)
 		ctl_set_mode(c, CFG_MODE_HOLD, "command: torque on");
 }
 
-/* ---- faults ------------------------------------------------------------------------------- */
+void ctl_latch(struct ctl *c, const char *what)
+{
+	enum cfg_mode m = ctl_fault_mode(c);
+	if (c->latched) {
+		/* the first cause stays the one reported; a second one is said */
+		ctl_event(c, 2, "fault", "%s (latched already: %s)", what, c->latch);
+		if (c->mode == m || c->mode == CFG_MODE_LIMP)
+			return;
+	} else {
+		c->latched = true;
+		snprintf(c->latch, sizeof c->latch, "%s", what);
+		ctl_event(c, 2, "fault-latched", "%s: robot %s until 'clear'", what, cfg_mode_name(m));
+	}
+	char reason[sizeof c->reason];
+	snprintf(reason, sizeof reason, "fault: %.80s", what);
+	/* hold where the joints are, not where a failing joint was told to go */
+	ctl_hold_at_present(c);
+	if (c->mode == m) {
+		snprintf(c->reason, sizeof c->reason, "%s", reason);
+		return;
+	}
+	c->fade_mode = CFG_NMODES;
+	c->starter_active = false;
+	ctl_set_mode(c, m, reason);
+	/* HOLD from a moving mode: where the joints are, no blend from elsewhere */
+	ctl_blend_stop(c);
+	ctl_hold_at_present(c);
+}
+
+bool ctl_clear_faults(struct ctl *c, char *why, size_t cap)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
+		if (jt->have_reading && jt->stale_cycles > 0 && jt->stale_cycles * c->cfg->period_ms * 1e-3 >= c->cfg->silent_s) {
+			snprintf(why, cap, "servo %u is still silent (%.1f s): fix the cause first", jt->id,
+			         jt->stale_cycles * c->cfg->period_ms * 1e-3);
+			return false;
+		}
+	}
+	bool was = c->latched;
+	c->latched = false;
+	c->latch[0] = '\0';
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		if (jt->fault == CTL_FAULT_FAILED) {
+			jt->fault = CTL_FAULT_NONE;
+			jt->goal = isfinite(jt->angle) ? jt->angle : jt->goal;
+			c->hold[j] = jt->goal;
+		}
+		jt->retries = 0;
+		jt->resets = 0;
+		/* the manual's recovery, whatever happened while latched (an alarm
+		 * shutdown zeroes the torque limit and turns torque off) */
+		if (jt->torque)
+			ctl_torque_write(c, j, true);
+	}
+	snprintf(c->reason, sizeof c->reason, "fault cleared");
+	ctl_event(c, 0, "fault-cleared", "%s", was ? "latched fault cleared: send a mode command to go on"
+	                                           : "no fault was latched");
+	return true;
+}
+
+/* ---- faults -------------------------------------------------------------------------------- */
 static void ctl_backoff(struct ctl *c, size_t j)
 {
 	struct ctl_joint *jt = &c->j[j];
@@ -407,27 +635,12 @@ static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what)
 {
 	struct ctl_joint *jt = &c->j[j];
 	jt->fault = CTL_FAULT_FAILED;
-	enum cfg_mode m = c->cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD;
-	char reason[96];
-	snprintf(reason, sizeof reason, "fault: servo %u %s persists", jt->id, what);
+	char text[CTL_LATCH_TEXT];
+	snprintf(text, sizeof text, "servo %u %s persists", jt->id, what);
 	ctl_event(c, 2, "fault-persistent", "servo %u: %s persists after %d recovery attempts: robot %s; "
-	          "cool down / check the mechanics, then send a mode command", jt->id, what, jt->retries,
-	          cfg_mode_name(m));
-	/* hold where the joints are, not where the failing joint was told to go */
-	ctl_hold_at_present(c);
-	if (c->mode == m) {
-		snprintf(c->reason, sizeof c->reason, "%s", reason);
-		return;
-	}
-	enum cfg_mode old = c->mode;
-	c->mode = m;
-	c->fade_mode = CFG_NMODES;
-	ctl_blend_stop(c);
-	snprintf(c->reason, sizeof c->reason, "%s", reason);
-	if (m == CFG_MODE_LIMP)
-		for (size_t k = 0; k < c->n; k++)
-			ctl_torque_write(c, k, false);
-	ctl_event(c, 2, "mode", "mode %s -> %s (%s)", cfg_mode_name(old), cfg_mode_name(m), reason);
+	          "cool down / check the mechanics, then 'clear'", jt->id, what, jt->retries,
+	          cfg_mode_name(ctl_fault_mode(c)));
+	ctl_latch(c, text);
 }
 
 /* Error bits other than the fault kinds (voltage, angle limit, range,
@@ -467,13 +680,13 @@ static void ctl_fault_step(struct ctl *c, size_t j)
 	case CTL_FAULT_BACKOFF:
 		if (c->t - jt->fault_since < c->cfg->fault_backoff_s)
 			return;
+		jt->fault = CTL_FAULT_CHECK;
+		jt->fault_since = c->t;
+		jt->errbits = 0;
 		if (c->mode != CFG_MODE_LIMP)
 			ctl_torque_write(c, j, true);
 		else
 			ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, jt->servo.max_torque);
-		jt->fault = CTL_FAULT_CHECK;
-		jt->fault_since = c->t;
-		jt->errbits = 0;
 		return;
 	case CTL_FAULT_CHECK:
 		if (bad) {
@@ -500,6 +713,28 @@ static void ctl_fault_step(struct ctl *c, size_t j)
 		return;
 	case CTL_FAULT_FAILED:
 		return;
+	}
+}
+
+/* Stale: no valid reading this cycle. The joint holds its last goal; after
+ * stale_limit cycles an event says so; silent for silent_s latches the
+ * robot's fault action: the other joints must not go on against a frozen
+ * reading. */
+static void ctl_check_stale(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (jt->fresh || !jt->have_reading)
+		return;
+	jt->stale_cycles++;
+	if (jt->stale_cycles == c->cfg->stale_limit)
+		ctl_event(c, 1, "stale", "servo %u: no valid reading for %d cycles, joint holds", jt->id,
+		          jt->stale_cycles);
+	double silent = jt->stale_cycles * c->cfg->period_ms * 1e-3;
+	double previous = (jt->stale_cycles - 1) * c->cfg->period_ms * 1e-3;
+	if (silent >= c->cfg->silent_s && previous < c->cfg->silent_s) {
+		char what[CTL_LATCH_TEXT];
+		snprintf(what, sizeof what, "servo %u silent for %.2f s", jt->id, silent);
+		ctl_latch(c, what);
 	}
 }
 
@@ -542,7 +777,7 @@ static void ctl_targets(struct ctl *c, enum cfg_mode mode, double dt, double t_r
 	case CFG_MODE_OSCILLATOR:
 	case CFG_MODE_SINUSOID:
 		if (mode == CFG_MODE_OSCILLATOR && !c->starter_active && c->cfg->actuation == CFG_ACT_TORQUE) {
-			/* torque actuation drives through duties (ctl_duties); as a
+			/* torque actuation drives through duties (torque.c); as a
 			 * position it stands for where the joint is (the cycles that
 			 * switch servo modes, fades out of it) */
 			for (size_t j = 0; j < c->n; j++)
@@ -674,183 +909,12 @@ static void ctl_update_estimates(struct ctl *c, size_t j)
 	jt->phase = osc_phase(x, jt->speed, omega);
 }
 
-/* ---- torque actuation (wheel mode) ------------------------------------------------------------ */
-/* The servos go into wheel mode only for a running OSCILLATOR whose joints are
- * all healthy, torqued and measured; everything else (starter, HOLD, SINUSOID,
- * faults, LIMP) runs in joint mode, where the servo itself holds positions and
- * enforces its angle limits. */
-static bool ctl_want_wheel(const struct ctl *c)
-{
-	if (c->cfg->actuation != CFG_ACT_TORQUE || c->mode != CFG_MODE_OSCILLATOR || c->starter_active)
-		return false;
-	for (size_t j = 0; j < c->n; j++) {
-		const struct ctl_joint *jt = &c->j[j];
-		if (jt->fault != CTL_FAULT_NONE || !jt->torque || !jt->have_reading || jt->limits.max_step <= 0.0)
-			return false;
-	}
-	return true;
-}
-
-/* A joint past its limits under torque: fall back to fault_action (joint
- * mode), holding inside the limits. */
-static void ctl_check_limits(struct ctl *c)
-{
-	if (!c->wheel)
-		return;
-	for (size_t j = 0; j < c->n; j++) {
-		const struct ctl_joint *jt = &c->j[j];
-		if (!jt->fresh || (jt->angle >= jt->limits.lo && jt->angle <= jt->limits.hi))
-			continue;
-		c->limit_trips++;
-		enum cfg_mode m = c->cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD;
-		double neutral = c->cfg->joint[j].neutral;
-		ctl_event(c, 2, "limit", "servo %u at %+.3f rad left its limits [%+.3f, %+.3f] under torque "
-		          "actuation: robot %s in joint mode; send a mode command to go on", jt->id,
-		          jt->angle - neutral, jt->limits.lo - neutral, jt->limits.hi - neutral, cfg_mode_name(m));
-		char reason[96];
-		snprintf(reason, sizeof reason, "limit: servo %u left its limits", jt->id);
-		ctl_set_mode(c, m, reason);
-		/* HOLD where it is: the safety clamp puts the goal inside the limits */
-		ctl_hold_at_present(c);
-		return;
-	}
-}
-
-/* The virtual spring near a limit (N·m), on top of the law's torque. */
-static double ctl_wall(const struct ctl_joint *jt, double stall)
-{
-	double k = stall / CTL_WALL_MARGIN;
-	double over_hi = jt->angle - (jt->limits.hi - CTL_WALL_MARGIN);
-	double over_lo = (jt->limits.lo + CTL_WALL_MARGIN) - jt->angle;
-	if (over_hi > 0.0)
-		return -k * over_hi - CTL_WALL_DAMPING * fmax(jt->speed, 0.0);
-	if (over_lo > 0.0)
-		return k * over_lo - CTL_WALL_DAMPING * fmin(jt->speed, 0.0);
-	return 0.0;
-}
-
-/* Output ratio that makes the drive deliver `tau` at speed v: a PWM drive
- * loses tau_stall(V)/w0(V) per rad/s to back-EMF (voltage-independent), so
- * that is added back; a current drive delivers duty × stall torque. Capped by
- * the servo's max torque, as the torque limit caps it in the servo. */
-static double ctl_duty(const struct ctl *c, const struct ctl_joint *jt, double tau)
-{
-	const struct cfg *cfg = c->cfg;
-	double cap = jt->servo.max_torque / 1023.0;
-	double u;
-	if (cfg->torque_drive == CFG_DRIVE_CURRENT) {
-		u = tau / cfg->stall_torque;
-	} else {
-		double volts = isfinite(jt->voltage) && jt->voltage > 1.0 ? jt->voltage : CTL_NOMINAL_VOLTAGE;
-		double stall = cfg->stall_torque * volts / CTL_NOMINAL_VOLTAGE;
-		double w0 = cfg->no_load_speed * volts / CTL_NOMINAL_VOLTAGE;
-		u = tau / stall + jt->speed / w0;
-	}
-	return isfinite(u) ? fmax(-cap, fmin(cap, u)) : 0.0;
-}
-
-static void ctl_duties(struct ctl *c)
-{
-	double x[CFG_MAX_JOINTS], v[CFG_MAX_JOINTS], tau[CFG_MAX_JOINTS];
-	struct osc_joint_params p[CFG_MAX_JOINTS];
-	for (size_t j = 0; j < c->n; j++) {
-		p[j] = c->cfg->joint[j].osc;
-		x[j] = c->j[j].angle - c->cfg->joint[j].neutral;
-		v[j] = c->j[j].fresh ? c->j[j].speed : 0.0;
-	}
-	if (!osc_torque(p, c->n, x, v, tau))
-		c->nonfinite++;
-	for (size_t j = 0; j < c->n; j++) {
-		struct ctl_joint *jt = &c->j[j];
-		jt->write_goal = false;
-		jt->clamp_flags = 0;
-		jt->goal = NAN;
-		if (!jt->fresh) {
-			/* no reading, no law: the joint coasts until it answers again */
-			jt->torque_cmd = 0.0;
-			jt->duty = 0.0;
-			continue;
-		}
-		double wall = ctl_wall(jt, c->cfg->stall_torque);
-		if (wall != 0.0) {
-			jt->clamp_flags = SAFETY_LIMIT;
-			c->clamps++;
-		}
-		jt->torque_cmd = tau[j] + wall;
-		jt->duty = ctl_duty(c, jt, jt->torque_cmd);
-	}
-}
-
-/* Wheel-mode switches, queued after this cycle's SYNC_WRITE. The angle
- * limits are EEPROM, which the AX-12A writes only with torque off: torque off,
- * both limits in one 4-byte write (the servo never sees a half-set pair),
- * torque on again. The joint coasts for the ~1 ms this takes on the bus (a
- * real servo is then busy ~6 ms per EEPROM byte: its next replies may be
- * missed, which the loop takes as stale cycles). */
-static void ctl_switch_limits(struct ctl *c, size_t j, uint32_t limits, bool torque_after)
-{
-	uint8_t id = c->j[j].id;
-	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 0);
-	ctl_write_seq(c, id, DXL_AX_CW_ANGLE_LIMIT, 4, limits);
-	if (!torque_after)
-		return;
-	/* Torque on the manual's way, the torque limit first: enabling torque
-	 * clears a latched overload bit, so an alarm shutdown that zeroed the
-	 * torque limit since the last reading would otherwise never be seen, and
-	 * the joint would stay without drive. */
-	ctl_write_seq(c, id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, &c->j[j]));
-	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
-}
-
-static void ctl_enter_wheel(struct ctl *c)
-{
-	for (size_t j = 0; j < c->n; j++)
-		ctl_switch_limits(c, j, 0, true);
-	c->wheel = true;
-	ctl_event(c, 0, "actuation", "torque actuation: servos in wheel mode, the law drives their torque");
-}
-
-static void ctl_leave_wheel(struct ctl *c)
-{
-	for (size_t j = 0; j < c->n; j++) {
-		struct ctl_joint *jt = &c->j[j];
-		ctl_switch_limits(c, j, ctl_joint_mode_limits(c, j), jt->torque && c->mode != CFG_MODE_LIMP);
-		/* position modes start where the joint is, with no step bound from a
-		 * goal it never had */
-		jt->goal = NAN;
-		ctl_blend_joint(c, j, jt->angle);
-	}
-	c->wheel = false;
-	c->sync = CTL_SYNC_GOAL_STOP;
-	ctl_event(c, 0, "actuation", "torque actuation: servos back in joint mode (%s)", cfg_mode_name(c->mode));
-}
-
-/* Leaving wheel mode, the SYNC_WRITE stops every drive and leaves a goal the
- * joint mode can hold: joints without a goal this cycle hold where they are. */
-static void ctl_stop_goals(struct ctl *c)
-{
-	for (size_t j = 0; j < c->n; j++) {
-		struct ctl_joint *jt = &c->j[j];
-		jt->duty = NAN;
-		jt->torque_cmd = NAN;
-		if (jt->write_goal || !jt->have_reading || jt->limits.max_step <= 0.0)
-			continue;
-		jt->goal = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
-		jt->write_goal = true;
-	}
-}
-
 void ctl_step(struct ctl *c, double t, double dt, double t_real)
 {
 	c->t = t;
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
-		if (!jt->fresh) {
-			jt->stale_cycles++;
-			if (jt->stale_cycles == c->cfg->stale_limit && jt->have_reading)
-				ctl_event(c, 1, "stale", "servo %u: no valid reading for %d cycles, joint holds", jt->id,
-				          jt->stale_cycles);
-		}
+		ctl_check_stale(c, j);
 		ctl_report_errbits(c, j);
 		ctl_fault_step(c, j);
 		if (jt->fresh && jt->resumed) {
@@ -869,12 +933,12 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 			c->fade_t0 = c->t;
 		}
 	}
-	ctl_check_limits(c);
+	tq_check_limits(c);
 	c->sync = CTL_SYNC_GOAL;
-	bool want = ctl_want_wheel(c);
+	bool want = tq_want_wheel(c);
 	if (want && c->wheel) {
 		c->sync = CTL_SYNC_DUTY;
-		ctl_duties(c);
+		tq_duties(c);
 		for (size_t j = 0; j < c->n; j++) {
 			ctl_update_estimates(c, j);
 			c->j[j].fresh = false;
@@ -882,7 +946,7 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 		return;
 	}
 	if (!want && c->wheel)
-		ctl_leave_wheel(c);
+		tq_leave_wheel(c);
 	double target[CFG_MAX_JOINTS];
 	ctl_targets(c, c->mode, dt, t_real, target);
 	ctl_crossfade(c, dt, t_real, target);
@@ -897,11 +961,11 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 		c->j[j].torque_cmd = NAN;
 	}
 	if (c->sync == CTL_SYNC_GOAL_STOP)
-		ctl_stop_goals(c);
+		tq_stop_goals(c);
 	/* into wheel mode after this cycle's goals: the joint is held where it
 	 * is for the half millisecond until the limits are written */
 	if (want)
-		ctl_enter_wheel(c);
+		tq_enter_wheel(c);
 	for (size_t j = 0; j < c->n; j++) {
 		ctl_update_estimates(c, j);
 		c->j[j].fresh = false;

@@ -1,13 +1,22 @@
 /*
- * control.h — one robot's control state between the bus and the control laws:
- * modes and their transitions, blending, stale readings, servo faults and their
- * recovery, and the safety clamp. No I/O and no clock: the daemon hands in
- * measurements and times, and takes out goals and the register writes the
- * controller wants (torque on/off, torque limit). That keeps mode switches and
- * fault handling unit-testable.
+ * control.h — one robot's controller between the bus and the control laws:
+ * modes and their transitions, blending, stale and silent joints, servo
+ * faults and their recovery, what the servos report about themselves (read
+ * back), latched faults, and the safety clamp. No I/O and no clock: the
+ * cycle (cycle.h) hands in measurements and times and takes out goals and
+ * register writes through the calls below; nothing else touches the queue of
+ * writes or the events. That keeps mode switches, faults and the write
+ * rules unit-testable.
  *
  * Angles: `angle`/`goal` are absolute servo radians (0 = raw 512); the
  * oscillator works in x = angle − neutral.
+ *
+ * Faults latch (as a CiA 402 drive's do): a joint silent for longer than
+ * silent_s, a servo fault that persists through its recovery attempts, a
+ * servo that keeps resetting, and a joint that left its limits under torque
+ * actuation put the robot in its fault action (HOLD or LIMP) and keep it
+ * there. Only LIMP, HOLD and `clear` are accepted then; `clear` succeeds only
+ * once the cause is gone.
  */
 #ifndef UNDULATE_DAEMON_CONTROL_H
 #define UNDULATE_DAEMON_CONTROL_H
@@ -19,13 +28,18 @@
 #include "config.h"
 #include "osc.h"
 #include "safety.h"
+#include "writeq.h"
 
-/* Register writes the controller may queue in one cycle: per joint at most a
- * torque limit, a torque enable and the angle limits, plus slack. */
-#define CTL_MAX_WRITES (3 * CFG_MAX_JOINTS + 4)
-/* Events (faults, recoveries, mode changes) queued per cycle for LCM. */
-#define CTL_MAX_EVENTS 8
+/* Events (faults, recoveries, mode changes) queued per cycle for LCM; more
+ * in one cycle are counted in events_dropped. */
+#define CTL_MAX_EVENTS 16
 #define CTL_EVENT_TEXT 160
+#define CTL_LATCH_TEXT 128
+
+/* The RAM block read back in the slow round-robin: torque enable (24)
+ * through present temperature (43). */
+#define CTL_READBACK_ADDR 24
+#define CTL_READBACK_LEN 20
 
 enum ctl_fault { CTL_FAULT_NONE, CTL_FAULT_BACKOFF, CTL_FAULT_CHECK, CTL_FAULT_FAILED };
 
@@ -35,13 +49,6 @@ enum ctl_sync {
 	CTL_SYNC_DUTY,       /* torque actuation, wheel mode: moving speed (32) = duty of every joint */
 	CTL_SYNC_GOAL_STOP,  /* leaving wheel mode: goal (30) and moving speed 0 (32) of every joint
 	                        with a reading; the angle-limit writes that follow restore joint mode */
-};
-
-struct ctl_write {
-	uint8_t id;
-	uint8_t addr;
-	uint8_t len;         /* 1, 2 or 4 (little-endian, as the registers) */
-	uint32_t value;
 };
 
 struct ctl_event {
@@ -76,12 +83,16 @@ struct ctl_joint {
 	struct osc_velocity_filter vfilter;
 	struct osc_estimator estimator;
 	double phase;
+	/* read back (slow round-robin); -1 until read */
+	int torque_read;            /* torque enable (24) */
+	int torque_limit_read;      /* torque limit (34) */
+	long long resets;           /* found reset (torque off, RAM at its defaults) since the last clear */
 	/* command */
 	double goal;                /* rad absolute, last sent (NaN: none yet) */
 	bool write_goal;            /* include in this cycle's SYNC_WRITE */
 	double duty;                /* torque actuation: signed output ratio sent this cycle (NaN: none) */
 	double torque_cmd;          /* N·m the duty stands for (NaN: none) */
-	bool torque;                /* torque enabled as far as we know */
+	bool torque;                /* torque wanted on (what the writes make it) */
 	unsigned clamp_flags;       /* SAFETY_* of this cycle */
 	/* faults */
 	enum ctl_fault fault;
@@ -92,12 +103,15 @@ struct ctl_joint {
 };
 
 struct ctl {
-	struct cfg *cfg;            /* parameters (commands change them) */
+	struct cfg *cfg;            /* parameters (accepted commands change the documented ones) */
 	size_t n;
 	struct ctl_joint j[CFG_MAX_JOINTS];
 	enum cfg_mode mode;
 	char reason[96];
 	double t;                   /* s, monotonic controller time of this cycle */
+	/* a latched fault: the robot stays in its fault action until cleared */
+	bool latched;
+	char latch[CTL_LATCH_TEXT];
 	/* per joint: blend from `blend_from` (NaN: not blending) to the mode's
 	 * target over cfg->ramp_s, starting at blend_t0 */
 	double blend_t0[CFG_MAX_JOINTS];
@@ -106,23 +120,27 @@ struct ctl {
 	int fade_mode;
 	double fade_t0;
 	double hold[CFG_MAX_JOINTS];    /* HOLD targets, rad absolute */
-	/* outputs of the current cycle */
-	struct ctl_write writes[CTL_MAX_WRITES];
-	size_t nwrites;
+	/* outputs: register writes (owned here; the cycle takes them one at a
+	 * time) and events */
+	struct wq wq;
 	struct ctl_event events[CTL_MAX_EVENTS];
 	size_t nevents;
+	long long events_dropped;
 	int rest_cycles;                /* cycles a running oscillator has been still */
 	int still_cycles;               /* cycles every joint has been still (any mode) */
-	/* torque actuation: the servos are in wheel mode (as far as our writes
-	 * went), and what this cycle's SYNC_WRITE carries */
+	/* torque actuation (torque.c): the servos are in wheel mode (as far as our
+	 * writes went), and what this cycle's SYNC_WRITE carries */
 	bool wheel;
 	enum ctl_sync sync;
 	bool starter_active;            /* OSCILLATOR runs the sinusoid starter ... */
-	double starter_offset;          /* rad added to its phase after a stall (ctl_check_stall) */
+	double starter_offset;          /* rad added to its phase after a stall */
 	double starter_until;           /* ... until then */
 	/* counters */
 	long long faults, clamps, nonfinite, starts;
 	long long limit_trips;          /* torque actuation: a joint left its limits */
+	long long write_failures;       /* register writes given up after WQ_TRIES sends */
+	long long readback_mismatches;  /* a register read back differed from what we wrote */
+	long long resets;               /* servos found reset */
 };
 
 void ctl_init(struct ctl *c, struct cfg *cfg);
@@ -131,26 +149,37 @@ void ctl_init(struct ctl *c, struct cfg *cfg);
  * no angle in common or the servo is in wheel mode. */
 bool ctl_set_servo(struct ctl *c, size_t joint, const struct ctl_servo_info *info, char *why, size_t cap);
 /* The servo angle limits that put a joint back in joint mode after wheel mode
- * (torque actuation): the servo's own, or the configured joint limits if the
- * servo was found in wheel mode. Packed as the 4 bytes at register 6. */
+ * (torque actuation): the servo's own. Packed as the 4 bytes at register 6. */
 uint32_t ctl_joint_mode_limits(const struct ctl *c, size_t joint);
 /* Called once the bus is (re)connected and every joint has a reading: enable
- * torque (unless LIMP) and ramp in from the present positions. */
+ * torque (unless LIMP or a LIMP fault action is latched) and ramp in from the
+ * present positions. */
 void ctl_start(struct ctl *c, double t, const char *reason);
-/* The bus went away: every joint is stale, torque state unknown. */
+/* The bus went away: every joint is stale, torque state unknown, queued
+ * writes forgotten (the start-up sequence rewrites what matters). */
 void ctl_bus_lost(struct ctl *c);
 
-/* Feed this cycle's reading of joint j (raw registers 36..41 and the error byte). */
+/* ---- inputs ------------------------------------------------------------------------- */
+/* This cycle's reading of joint j (raw registers 36..41 and the error byte). */
 void ctl_measure(struct ctl *c, size_t j, uint16_t pos_raw, uint16_t speed_raw, uint16_t load_raw,
                  uint8_t errbits, double dt);
-/* Feed a voltage/temperature reading (registers 42, 43). */
+/* A voltage/temperature reading (registers 42, 43). */
 void ctl_measure_slow(struct ctl *c, size_t j, uint8_t voltage_raw, uint8_t temperature_raw, uint8_t errbits);
+/* The RAM block CTL_READBACK_ADDR.. (CTL_READBACK_LEN bytes) of joint j as the
+ * servo reports it: torque enable, margins, torque limit, voltage,
+ * temperature. Compared with what the controller wrote; a servo found reset
+ * or shut down is reported and brought back (or the fault latches). */
+void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits);
 
 /* One control step at controller time t (s) with measured period dt (s) and
  * wall-clock time t_real (s, for SINUSOID's shared clock). Fills goals,
  * writes and events. Call after ctl_measure() for every joint that answered. */
 void ctl_step(struct ctl *c, double t, double dt, double t_real);
 
+/* ---- commands (applied by the daemon at the cycle boundary) ------------------------- */
+/* May the robot go to `mode` now? False with *why while a fault is latched
+ * and `mode` is neither LIMP nor the fault action. */
+bool ctl_mode_allowed(const struct ctl *c, enum cfg_mode mode, char *why, size_t cap);
 /* Mode change (commands, faults, signals). Continuous in commanded angle. */
 void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason);
 /* Parameters changed (a command): SINUSOID re-blends so its new phase/frequency
@@ -158,8 +187,22 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason);
 void ctl_params_changed(struct ctl *c);
 /* Torque on/off command: off = LIMP; on = HOLD where the joints are. */
 void ctl_torque(struct ctl *c, bool on);
+/* Clear latched faults. False (with *why) if the cause is still there: a
+ * joint still silent. The robot stays in its mode; the operator chooses the
+ * next one. */
+bool ctl_clear_faults(struct ctl *c, char *why, size_t cap);
 
-/* Consume this cycle's outputs. */
-void ctl_clear_outputs(struct ctl *c);
+/* ---- outputs (taken by the cycle) ---------------------------------------------------- */
+/* The next register write to send, NULL when none. It is on the wire until
+ * ctl_write_result() says how it went; nothing changes it meanwhile. */
+const struct wq_write *ctl_take_write(struct ctl *c);
+/* ok: the servo acknowledged it (or no reply was due). A failed write is
+ * sent again, up to WQ_TRIES times; then it is reported as an event. */
+void ctl_write_result(struct ctl *c, bool ok);
+/* This cycle's SYNC_WRITE: register, bytes per servo, and per servo its ID
+ * and data (little-endian). Returns the number of servos (0: nothing to send). */
+size_t ctl_sync(const struct ctl *c, uint8_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data);
+/* The next queued event; false when none is left. */
+bool ctl_next_event(struct ctl *c, struct ctl_event *out);
 
 #endif

@@ -1,7 +1,9 @@
 /*
  * daemon.h — undulated's event loop: one thread, one poll() over the control
- * timer, the bus, the bus-deadline timer, LCM and signals. Owns the port, the
- * bus state machine of each cycle, reconnecting, LCM publishing and commands.
+ * timer, the bus and its deadline timer, the command sockets and signals.
+ * Owns the port and reconnecting; the cycle's bus work is cycle.h's, the
+ * control the controller's (control.h), commands cmdin.h's, publishing
+ * publish.h's, start-up and the safe stop setup.h's.
  */
 #ifndef UNDULATE_DAEMON_DAEMON_H
 #define UNDULATE_DAEMON_DAEMON_H
@@ -9,13 +11,22 @@
 #include "config.h"
 
 /* Run the robot until SIGTERM/SIGINT. Returns the process exit status:
- * 0 after a clean safe stop, 1 when start-up failed. */
+ * 0 after a clean safe stop, 1 when start-up failed (the bus, a servo: worth
+ * a retry), 2 when the configuration cannot work (not worth one). */
 int dmn_run(struct cfg *cfg);
 
-/* `undulated --command TEXT`: publish one command_t to robot (or "*") and
- * print the answering events within timeout_s. 0 if accepted (by every robot
- * that answered), 1 if rejected or unanswered, 2 on a usage error. */
-int dmn_send_command(const char *lcm_url, const char *robot, const char *text, double timeout_s);
+/* `undulated --command TEXT`: send one command to robot (or "*") and print
+ * the answers within timeout_s. 0 if accepted (by every robot that
+ * answered), 1 if rejected or unanswered, 2 on a usage error. */
+struct send_opts {
+	const char *lcm_url;      /* NULL: LCM's default */
+	const char *robot;
+	const char *text;
+	double timeout_s;
+	const char *key_file;     /* NULL: the local command socket; else signed, over LCM */
+	const char *source;       /* NULL: "undulated@HOST:PID" */
+};
+int dmn_send_command(const struct send_opts *o);
 
 /* `undulated --watch ROBOT`: print the robot's STATE/EVENT/BUS/PARAMS
  * messages as text lines (robot "*": every robot) until a signal or for

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "auth.h"
 #include "config.h"
 #include "daemon.h"
 #include "log.h"
@@ -19,6 +20,8 @@ static void main_usage(FILE *f)
 	fprintf(f,
 	        "usage: undulated [CONFIG.conf] [options]\n"
 	        "       undulated --command 'TEXT' --robot NAME|'*' [--lcm-url URL] [--timeout S]\n"
+	        "                 [--key FILE] [--source NAME]\n"
+	        "       undulated --gen-key FILE\n"
 	        "       undulated --watch NAME|'*' [--lcm-url URL] [--timeout S]\n"
 	        "\n"
 	        "Runs one robot: reads its joints at 100 Hz over the Dynamixel bus, integrates\n"
@@ -38,7 +41,13 @@ static void main_usage(FILE *f)
 	        "  -q, --quiet            warnings and errors only\n"
 	        "      --log-level L      error|warn|info|debug\n"
 	        "      --command TEXT     send one command and print the answer: 'mode oscillator',\n"
-	        "                         'param k 0.06 [joint]', 'torque on|off'; exit 0 if accepted\n"
+	        "                         'param k 0.06 [joint]', 'torque on|off', 'clear'; exit 0 if\n"
+	        "                         accepted. Goes to the robot's local command socket; with\n"
+	        "                         --key FILE it is signed and sent over LCM instead (robots\n"
+	        "                         with commands = network)\n"
+	        "      --key FILE         the robot's shared command key (64 hex digits, mode 600)\n"
+	        "      --source NAME      who sends, as the robot logs it (default undulated@HOST:PID)\n"
+	        "      --gen-key FILE     write a new random command key (mode 600) and exit\n"
 	        "      --timeout S        how long --command waits for answers (default 1)\n"
 	        "      --watch NAME|'*'   print a robot's STATE/EVENT/BUS/PARAMS messages as text\n"
 	        "                         lines (with --timeout S: for S seconds)\n"
@@ -47,7 +56,7 @@ static void main_usage(FILE *f)
 
 enum {
 	OPT_SET = 256, OPT_PORT, OPT_IDS, OPT_BAUD, OPT_ROBOT, OPT_MODE, OPT_LCM, OPT_CHECK, OPT_LOGLEVEL,
-	OPT_COMMAND, OPT_TIMEOUT, OPT_WATCH,
+	OPT_COMMAND, OPT_TIMEOUT, OPT_WATCH, OPT_KEY, OPT_SOURCE, OPT_GENKEY,
 };
 
 struct main_args {
@@ -62,6 +71,9 @@ struct main_args {
 	const char *robot;
 	const char *lcm_url;
 	double timeout_s;
+	const char *key_file;
+	const char *source;
+	const char *gen_key;
 };
 
 static bool main_add(struct main_args *a, const char *key, const char *value)
@@ -107,7 +119,8 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		{ "check-config", no_argument, NULL, OPT_CHECK }, { "verbose", no_argument, NULL, 'v' },
 		{ "quiet", no_argument, NULL, 'q' }, { "log-level", required_argument, NULL, OPT_LOGLEVEL },
 		{ "command", required_argument, NULL, OPT_COMMAND }, { "timeout", required_argument, NULL, OPT_TIMEOUT },
-		{ "watch", required_argument, NULL, OPT_WATCH },
+		{ "watch", required_argument, NULL, OPT_WATCH }, { "key", required_argument, NULL, OPT_KEY },
+		{ "source", required_argument, NULL, OPT_SOURCE }, { "gen-key", required_argument, NULL, OPT_GENKEY },
 		{ "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 },
 	};
 	int o;
@@ -141,6 +154,9 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 			a->timeout_set = true;
 			break;
 		case OPT_WATCH: a->watch = optarg; break;
+		case OPT_KEY: a->key_file = optarg; break;
+		case OPT_SOURCE: a->source = optarg; break;
+		case OPT_GENKEY: a->gen_key = optarg; break;
 		case 'h': main_usage(stdout); return 0;
 		default: main_usage(stderr); return 2;
 		}
@@ -171,6 +187,16 @@ int main(int argc, char **argv)
 	int rc = main_parse(argc, argv, &a);
 	if (rc >= 0)
 		return rc;
+	if (a.gen_key != NULL) {
+		char why[256];
+		if (!auth_key_generate(a.gen_key, why, sizeof why)) {
+			fprintf(stderr, "undulated --gen-key: %s\n", why);
+			return 1;
+		}
+		printf("%s: a new command key (mode 600); give it to the robot (command_key = %s) and to whoever "
+		       "commands it over the network (--key)\n", a.gen_key, a.gen_key);
+		return 0;
+	}
 	if (a.watch != NULL)
 		return dmn_watch(a.lcm_url, a.watch, a.timeout_set ? a.timeout_s : 0.0);
 	if (a.command != NULL) {
@@ -178,7 +204,11 @@ int main(int argc, char **argv)
 			fprintf(stderr, "undulated: --command needs --robot NAME (or '*' for every robot)\n");
 			return 2;
 		}
-		return dmn_send_command(a.lcm_url, a.robot, a.command, a.timeout_s > 0 ? a.timeout_s : 1.0);
+		struct send_opts o = {
+			.lcm_url = a.lcm_url, .robot = a.robot, .text = a.command,
+			.timeout_s = a.timeout_s > 0 ? a.timeout_s : 1.0, .key_file = a.key_file, .source = a.source,
+		};
+		return dmn_send_command(&o);
 	}
 	static struct cfg cfg;
 	struct cfg_errors errors = { 0 };

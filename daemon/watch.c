@@ -17,6 +17,7 @@
 
 #include "daemon.h"
 #include "undulate_bus_stats_t.h"
+#include "text.h"
 #include "undulate_event_t.h"
 #include "undulate_osc_params_t.h"
 #include "undulate_robot_state_t.h"
@@ -27,16 +28,19 @@ static void watch_on_signal(int sig) { (void)sig; watch_stop = 1; }
 static void watch_state(const lcm_recv_buf_t *rb, const char *ch, const undulate_robot_state_t *m, void *u)
 {
 	(void)rb; (void)ch; (void)u;
-	printf("STATE %s cycle=%" PRId64 " mode=%d reason=\"%s\" period=%.0f jitter=%.0f bus=%.0f control=%.0f "
-	       "overruns=%" PRId64 " bus_errors=%" PRId64 " bad_commands=%" PRId64, m->robot, m->cycle, m->mode,
-	       m->mode_reason, m->period_us, m->jitter_us, m->bus_us, m->control_us, m->overruns, m->bus_errors,
-	       m->bad_commands);
+	/* whatever is on the network may say anything: one printable line each */
+	char robot[64], reason[128], fault[160];
+	printf("STATE %s cycle=%" PRId64 " mode=%d reason=\"%s\" fault=\"%s\" period=%.0f jitter=%.0f bus=%.0f "
+	       "control=%.0f overruns=%" PRId64 " bus_errors=%" PRId64 " bad_commands=%" PRId64,
+	       text_line(robot, sizeof robot, m->robot), m->cycle, m->mode,
+	       text_line(reason, sizeof reason, m->mode_reason), text_line(fault, sizeof fault, m->fault),
+	       m->period_us, m->jitter_us, m->bus_us, m->control_us, m->overruns, m->bus_errors, m->bad_commands);
 	for (int j = 0; j < m->njoints; j++) {
 		const undulate_joint_state_t *s = &m->joints[j];
 		printf(" a%d=%.4f s%d=%.4f g%d=%.4f amp%d=%.4f f%d=%.4f ph%d=%.3f ld%d=%.3f e%d=%d st%d=%d tq%d=%d "
-		       "v%d=%.1f T%d=%.0f dr%d=%.4f", j, s->angle, j, s->speed, j, s->goal, j, s->amplitude, j,
+		       "tr%d=%d tl%d=%d v%d=%.1f T%d=%.0f dr%d=%.4f", j, s->angle, j, s->speed, j, s->goal, j, s->amplitude, j,
 		       s->frequency, j, s->phase, j, s->load, j, s->error_bits, j, s->stale_cycles, j, s->torque, j,
-		       s->voltage, j, s->temperature, j, s->drive);
+		       s->torque_read, j, s->torque_limit, j, s->voltage, j, s->temperature, j, s->drive);
 	}
 	printf("\n");
 }
@@ -44,8 +48,9 @@ static void watch_state(const lcm_recv_buf_t *rb, const char *ch, const undulate
 static void watch_event(const lcm_recv_buf_t *rb, const char *ch, const undulate_event_t *m, void *u)
 {
 	(void)rb; (void)ch; (void)u;
-	printf("EVENT %s seq=%" PRId64 " level=%d kind=%s text=\"%s\"\n", m->robot, m->seq, m->level, m->kind,
-	       m->text);
+	char robot[64], kind[48], text[600];
+	printf("EVENT %s seq=%" PRId64 " level=%d kind=%s text=\"%s\"\n", text_line(robot, sizeof robot, m->robot),
+	       m->seq, m->level, text_line(kind, sizeof kind, m->kind), text_line(text, sizeof text, m->text));
 }
 
 static void watch_bus(const lcm_recv_buf_t *rb, const char *ch, const undulate_bus_stats_t *m, void *u)

@@ -16,6 +16,9 @@ BUILD=${BUILD:-$top/build}
 case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
 B="$BUILD/bin"
 T=$(mktemp -d "${TMPDIR:-/tmp}/undulate-test.XXXXXX")
+# Each test's daemons put their local command sockets here, and
+# `undulated --command` looks for them here: tests never command each other.
+export UNDULATE_RUN_DIR="$T"
 _pids=()
 _tap_n=0
 _tap_failed=0

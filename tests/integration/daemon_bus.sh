@@ -2,8 +2,9 @@
 # undulated against undulate-sim: the bus disappearing (the simulator's
 # disconnect, then the simulator killed and restarted) is survived — the loop
 # keeps its period, joints hold, the daemon reconnects with back-off, re-runs
-# its start-up checks and resumes from the present angles without a jump —
-# and SIGTERM with safe_stop = limp leaves the servos with torque off.
+# its start-up checks and resumes from the present angles without a jump; a
+# bus gone for longer than silent_s latches the fault action (HOLD) until
+# 'clear' — and SIGTERM with safe_stop = limp leaves the servos with torque off.
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
@@ -26,7 +27,9 @@ start_sim() {
 }
 start_sim sim || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
-spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode sinusoid --set robot.safe_stop=limp
+# silent_s 2: the short outage below resumes by itself, the long one latches
+spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode sinusoid --set robot.safe_stop=limp \
+	--set robot.silent_s=2
 wait_log d "ready: $R.STATE" 10 || { tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
 wait_for 10 cycle_at_least 250
 # start-up writes compliance margin 0 (the factory value is 1: a dead band in
@@ -73,7 +76,7 @@ stop sim TERM >/dev/null
 if wait_for 3 sh -c "[ \$(grep -c '^EVENT $R .*kind=bus-lost ' '$T/watch.log') -ge 2 ]"; then
 	tap_ok "simulator exit seen as a bus loss"; else tap_fail "bus loss on sim exit" "$(tail -3 "$T/d.log")"; fi
 c0=$(last_state | field cycle)
-wait_for 5 cycle_at_least $((c0 + 100))   # a second without a simulator: back-off grows
+wait_for 8 cycle_at_least $((c0 + 250))   # 2.5 s without a simulator: back-off grows, silent_s passes
 n_fail=$(grep -c 'reconnect failed' "$T/d.log")
 if alive d; then tap_ok "daemon alive while the simulator is gone ($n_fail failed reconnects logged)"; else
 	tap_fail "daemon alive" "$(tail -5 "$T/d.log")"; fi
@@ -88,8 +91,22 @@ else tap_fail "compliance margin after restart" "$m"; fi
 c0=$(last_state | field cycle)
 wait_for 5 cycle_at_least $((c0 + 100))
 s=$(last_state)
-if [ "$(echo "$s" | field tq0)" = 1 ] && [ "$(echo "$s" | field st0)" = 0 ] && echo "$s" | grep -q ' mode=2 '; then
-	tap_ok "running again in SINUSOID with torque on"; else tap_fail "running again" "$(echo "$s" | cut -c1-300)"; fi
+if echo "$s" | grep -q ' mode=1 reason="fault: servo [12] silent for 2.00 s" fault="servo [12] silent for 2.00 s" ' &&
+	[ "$(echo "$s" | field tq0)" = 1 ] && [ "$(echo "$s" | field tr0)" = 1 ]; then
+	tap_ok "a bus gone longer than silent_s: fault latched, robot holds (torque on, read back)"
+else tap_fail "latched after the long outage" "$(echo "$s" | cut -c1-300)"; fi
+out=$("$D" --command 'mode sinusoid' --robot "$R" --lcm-url "$URL" --timeout 2); rc=$?
+if [ $rc -eq 1 ] && echo "$out" | grep -q "fault latched (servo [12] silent for 2.00 s): only LIMP or HOLD until 'clear'"; then
+	tap_ok "SINUSOID refused while the fault is latched"; else tap_fail "SINUSOID refused while latched" "rc $rc: $out"; fi
+"$D" --command clear --robot "$R" --lcm-url "$URL" --timeout 2 >"$T/clear.out" 2>&1; rc1=$?
+"$D" --command 'mode sinusoid' --robot "$R" --lcm-url "$URL" --timeout 2 >>"$T/clear.out" 2>&1; rc2=$?
+c0=$(last_state | field cycle)
+wait_for 5 cycle_at_least $((c0 + 100))
+s=$(last_state)
+if [ $rc1 -eq 0 ] && [ $rc2 -eq 0 ] && [ "$(echo "$s" | field tq0)" = 1 ] && [ "$(echo "$s" | field st0)" = 0 ] &&
+	echo "$s" | grep -q ' mode=2 .* fault="" '; then
+	tap_ok "cleared, then running again in SINUSOID with torque on"
+else tap_fail "running again after clear" "rc $rc1 $rc2 $(cat "$T/clear.out"); $(echo "$s" | cut -c1-300)"; fi
 p=$(states | awk '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] } if (v["period"] > m) m = v["period"] } END { print m }')
 echo "# longest period over the whole run: $p us (blocking start-up checks at reconnect)"
 

@@ -63,8 +63,13 @@ if [ "$t1" = "ok 0" ] && [ "$t2" = "ok 0" ]; then tap_ok "torque off on both ser
 n=$(grep -c 'kind=fault text="servo 1' "$T/watch.log")
 if [ "$n" -eq 3 ]; then tap_ok "3 fault events (first report + 2 retries)"; else tap_fail "fault events" "$n"; fi
 
-# ---- the operator takes over: clear, then a mode command
+# ---- the operator takes over: the cause cleared, then 'clear', then a mode command
 ctl clear r1 >/dev/null
+# latched: HOLD is refused until the operator clears the fault (fault_action is LIMP)
+out=$("$D" --command "mode hold" --robot "$R" --lcm-url "$URL" --timeout 2); rc=$?
+if [ $rc -eq 1 ] && echo "$out" | grep -q "fault latched (servo 1 overheating persists): only LIMP until 'clear'"; then
+	tap_ok "HOLD refused while the fault is latched"; else tap_fail "HOLD refused while latched" "rc $rc $out"; fi
+"$D" --command clear --robot "$R" --lcm-url "$URL" --timeout 2 >/dev/null
 out=$("$D" --command "mode hold" --robot "$R" --lcm-url "$URL" --timeout 2); rc=$?
 if [ $rc -eq 0 ] && wait_for 3 sh -c "grep '^STATE $R ' '$T/watch.log' | tail -1 | grep -q ' mode=1 .* tq0=1 .* tq1=1 '"; then
 	tap_ok "HOLD by command after the fault: torque back on"; else tap_fail "HOLD after fault" "rc $rc $out; $(last_state | cut -c1-200)"; fi

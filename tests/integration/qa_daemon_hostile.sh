@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # undulated against undulate-sim under attack from both sides at once:
-#  - LCM: random bytes, truncated commands, lying string lengths and well-formed
-#    commands with hostile values (NaN, inf, huge, joint -32768, unknown kind,
-#    mode and parameter, empty/wrong robot, 8 kB strings) on <robot>.CMD and
-#    UNDULATE.CMD (qa_lcm.py, ~100 a second);
+#  - LCM, on a robot that takes signed commands from the network
+#    (commands = network): random bytes, truncated commands, lying string
+#    lengths and well-formed commands with hostile values (NaN, inf, huge,
+#    joint -32768, unknown kind, mode and parameter, limits, empty/wrong
+#    robot, 8 kB strings) on <robot>.CMD and UNDULATE.CMD (qa_lcm.py, ~100 a
+#    second), half of the well-formed ones signed with the robot's key (they
+#    reach the validation), the rest unsigned (refused unauthenticated);
 #  - the bus: random bytes on the line and corrupted replies (garbage,
 #    bad-checksum, truncate, wrong-id faults of the simulator).
 # The daemon keeps its 100 Hz loop and keeps publishing, counts every bad
@@ -25,10 +28,12 @@ states() { grep -a "^STATE $R " "$T/watch.log"; }
 last_state() { states | tail -1; }
 cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
 
+KEY="$T/command.key"
+"$D" --gen-key "$KEY" >/dev/null || { tap_fail "command key made" "undulated --gen-key failed"; tap_done; exit 1; }
 # a command_t as lcm-gen encodes it, for its fingerprint (sent to nobody)
 spawn cap python3 "$Q" capture $PORT "nobody$$.CMD" 10
 wait_log cap listening 10
-"$D" --command 'mode hold' --robot "nobody$$" --lcm-url "$URL" --timeout 0.3 >/dev/null 2>&1
+"$D" --command 'mode hold' --robot "nobody$$" --lcm-url "$URL" --key "$KEY" --timeout 0.3 >/dev/null 2>&1
 wait_for 5 grep -qE '^[0-9a-f]{40,}$' "$T/cap.log"
 TEMPLATE=$(grep -E '^[0-9a-f]{40,}$' "$T/cap.log" | head -1)
 [ -n "$TEMPLATE" ] || { tap_fail "capture a command_t" "$(cat "$T/cap.log")"; tap_done; exit 1; }
@@ -37,6 +42,7 @@ spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" \
+	--set robot.commands=network --set robot.command_key="$KEY" \
 	--set joint.1.limit_min=-$LIM --set joint.1.limit_max=$LIM \
 	--set joint.2.limit_min=-$LIM --set joint.2.limit_max=$LIM
 if wait_log d "ready: $R.STATE" 10 && wait_for 10 cycle_at_least 150; then
@@ -55,7 +61,7 @@ for f in "fault r1 1 garbage 16 prob=0.2" "fault r1 2 bad-checksum prob=0.2" \
 done
 spawn garbage bash -c "for i in \$(seq 40); do python3 '$top/tests/integration/sim_client.py' ctl '$T/ctl' 'garbage r1 64' >/dev/null; sleep 0.1; done"
 # LCM: 400 hostile messages over 4 s
-python3 "$Q" hostile $PORT "$R" "$TEMPLATE" "${QA_SEED:-11}" 400 4 >"$T/hostile.out" 2>&1
+python3 "$Q" hostile $PORT "$R" "$TEMPLATE" "${QA_SEED:-11}" 400 4 "$KEY" >"$T/hostile.out" 2>&1
 echo "# $(cat "$T/hostile.out")"
 t1=$(date +%s%N)
 ctl "clear r1" >/dev/null
@@ -116,8 +122,10 @@ if [ "$np" -ge 2 ] && [ "$nb" -eq 0 ]; then tap_ok "limits unchanged in all $np 
 	tap_fail "limits unchanged" "$nb of $np PARAMS differ"; fi
 
 # still obeys a good command afterwards, and stops cleanly
-if "$D" --command 'mode sinusoid' --robot "$R" --lcm-url "$URL" --timeout 2 >"$T/cmd.out" 2>&1; then
-	tap_ok "a valid command is still accepted"; else tap_fail "valid command accepted" "$(cat "$T/cmd.out")"; fi
+if "$D" --command 'mode sinusoid' --robot "$R" --lcm-url "$URL" --timeout 2 >"$T/cmd.out" 2>&1 &&
+	"$D" --command 'mode hold' --robot "$R" --lcm-url "$URL" --key "$KEY" --timeout 2 >>"$T/cmd.out" 2>&1; then
+	tap_ok "valid commands are still accepted (local, and signed over LCM)"
+else tap_fail "valid commands accepted" "$(cat "$T/cmd.out")"; fi
 stop d >/dev/null; rc=$stop_rc
 if [ "$rc" = 0 ]; then tap_ok "SIGTERM: clean stop"; else tap_fail "SIGTERM: clean stop" "exit $rc: $(tail -5 "$T/d.log")"; fi
 if grep -aqE "Sanitizer|runtime error" "$T/d.log" "$T/sim.log" "$T/watch.log"; then

@@ -3,13 +3,30 @@
 
   qa_lcm.py capture PORT CHANNEL TIMEOUT_S    print the hex payload of the first
                                               message on CHANNEL (e.g. a command_t)
-  qa_lcm.py hostile PORT ROBOT TEMPLATE_HEX SEED N SECONDS
+  qa_lcm.py hostile PORT ROBOT TEMPLATE_HEX SEED N SECONDS [KEYFILE]
         publish N messages over SECONDS on ROBOT.CMD and UNDULATE.CMD, built from a
         captured command_t (TEMPLATE_HEX gives its fingerprint and layout): random
         bytes, truncated and bit-flipped commands, lying string lengths, and
         well-formed commands with hostile values (NaN, inf, huge, joint -32768,
-        unknown kind/mode/param, empty or wrong robot, empty or 8 kB strings).
-                Prints "sent N undecodable U invalid I" — U + I commands must be rejected.
+        unknown kind/mode/param, limits, empty or wrong robot, empty or 8 kB
+        strings). With KEYFILE half of the well-formed ones are signed with the
+        robot's key (a key holder's buggy client: they reach the validation), the
+        rest carry a zero MAC (an attacker's: refused as unauthenticated).
+                Prints "sent N undecodable U invalid I signed S" — U + I must be rejected.
+  qa_lcm.py forge TEMPLATE_HEX ROBOT KIND MODE PARAM JOINT VALUE [key=FILE] [age=S] [source=S]
+        print the hex of one command_t (fingerprint from the template), signed
+        with FILE's key if given, its utime S seconds in the past (negative: the
+        future), from source S (default "qa")
+  qa_lcm.py send PORT CHANNEL HEX [to=ADDR] [times=N]
+        publish the command_t HEX on CHANNEL (N times: a replay), to the group,
+        or as a unicast datagram to ADDR:PORT (this host's own address: what
+        LCM's sockets, bound to every address, take too). Prints "sent N".
+  qa_lcm.py flood SOCKET HEX N
+        send the command_t HEX N times to a robot's local command socket, as
+        fast as it takes them. Prints "sent N".
+  qa_lcm.py names PORT PREFIX N
+        publish N small messages, each on a channel name never used before
+        (PREFIX + a number), as fast as the socket takes them. Prints "sent N".
   qa_lcm.py garbage PORT CHANNEL TEMPLATE_HEX SEED N SECONDS
         publish N malformed messages on CHANNEL: random bytes, the template cut
         short, and the template with its first string's length (after the
@@ -20,9 +37,10 @@ name and a NUL, then the payload (lcm_udpm.c, short messages). command_t is
 encoded as lcm-gen does: the 8-byte fingerprint, then utime, seq (int64),
 source, robot (string: int32 length with the NUL, bytes, NUL), kind, mode
 (int8), param (string), joint (int16), value (double), torque (boolean, int8),
+then mac (32 bytes: HMAC-SHA256 of everything before it, zeros when unsigned),
 all big-endian.
 """
-import math, random, socket, struct, sys, time
+import hashlib, hmac, math, random, socket, struct, sys, time
 
 GROUP = '239.255.76.67'
 
@@ -68,9 +86,15 @@ def string(v):
     return struct.pack('>i', len(b) + 1) + b + b'\0'
 
 
-def command(fp, utime, seq, source, robot, kind, mode, param, joint, value, torque):
-    return (fp + struct.pack('>qq', utime, seq) + string(source) + string(robot) + struct.pack('>bb', kind, mode)
+def command(fp, utime, seq, source, robot, kind, mode, param, joint, value, torque, key=None):
+    body = (fp + struct.pack('>qq', utime, seq) + string(source) + string(robot) + struct.pack('>bb', kind, mode)
             + string(param) + struct.pack('>hd', joint, value) + struct.pack('>B', torque))
+    mac = hmac.new(key, body, hashlib.sha256).digest() if key is not None else bytes(32)
+    return body + mac
+
+
+def read_key(path):
+    return bytes.fromhex(open(path).read().strip())
 
 
 def parse_template(raw):
@@ -87,12 +111,14 @@ def parse_template(raw):
     joint, value = struct.unpack_from('>hd', raw, pos); pos += 10
     torque = raw[pos]
     again = command(fp, utime, seq, source, robot, kind, mode, param, joint, value, torque)
-    if again != raw:
+    if again[:-32] != raw[:-32] or len(again) != len(raw):
         sys.exit('qa_lcm.py: the captured command_t does not re-encode the same way')
     return fp
 
 
-def hostile(port, robot, template_hex, seed, n, seconds):
+def hostile(port, robot, template_hex, seed, n, seconds, keyfile=None):
+    key = read_key(keyfile) if keyfile else None
+    signed = 0
     rng = random.Random(seed)
     raw = bytes.fromhex(template_hex)
     fp = parse_template(raw)
@@ -129,7 +155,7 @@ def hostile(port, robot, template_hex, seed, n, seconds):
                 joint = rng.choice([-32768, -2, 2, 3, 16, 32767])
                 param, value = 'k', 0.05
             elif which == 'kind':
-                kind = rng.choice([0, 4, 5, -1, 127, -128])
+                kind = rng.choice([0, 5, 6, -1, 127, -128])   # 1..4 are mode, param, torque, clear
             elif which == 'mode':
                 kind, mode = 1, rng.choice([-1, 4, 5, 127, -128])
             elif which == 'param':
@@ -147,11 +173,14 @@ def hostile(port, robot, template_hex, seed, n, seconds):
                 param, value = rng.choice([('limit_min', 0.2), ('limit_max', -0.2), ('limit_min', -6.0),
                                            ('limit_max', 6.0), ('max_step', 0.0), ('max_step', -0.1),
                                            ('max_step', 2.0)])
-            payload = command(fp, int(time.time() * 1e6), seq, src, tgt, kind, mode, param, joint, value, torque)
+            sign = key is not None and rng.random() < 0.5
+            payload = command(fp, int(time.time() * 1e6), seq, src, tgt, kind, mode, param, joint, value, torque,
+                              key if sign else None)
+            signed += sign
             invalid += 1
         out.sendto(datagram(i, channel, payload), (GROUP, port))
         time.sleep(seconds / n)
-    print('sent %d undecodable %d invalid %d' % (n, undecodable, invalid))
+    print('sent %d undecodable %d invalid %d signed %d' % (n, undecodable, invalid, signed))
     return 0
 
 
@@ -174,11 +203,65 @@ def garbage(port, channel, template_hex, seed, n, seconds):
     return 0
 
 
+def forge(template_hex, robot, kind, mode, param, joint, value, opts):
+    fp = parse_template(bytes.fromhex(template_hex))
+    key = read_key(opts['key']) if 'key' in opts else None
+    utime = int((time.time() - float(opts.get('age', 0))) * 1e6)
+    payload = command(fp, utime, utime, opts.get('source', 'qa'), robot, kind, mode, param, joint, value, 0, key)
+    print(payload.hex())
+    return 0
+
+
+def send(port, channel, payload_hex, opts):
+    out = sender()
+    payload = bytes.fromhex(payload_hex)
+    n = int(opts.get('times', 1))
+    to = opts.get('to', GROUP)
+    for i in range(n):
+        out.sendto(datagram(i, channel, payload), (to, port))
+    print('sent %d' % n)
+    return 0
+
+
+def flood(path, payload_hex, n):
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    payload = bytes.fromhex(payload_hex)
+    for i in range(n):
+        s.sendto(payload, path)
+    print('sent %d' % n)
+    return 0
+
+
+def names(port, prefix, n):
+    out = sender()
+    payload = bytes(16)
+    for i in range(n):
+        while True:
+            try:
+                out.sendto(datagram(i, '%s%d' % (prefix, i), payload), (GROUP, port))
+                break
+            except BlockingIOError:
+                time.sleep(0.001)
+    print('sent %d' % n)
+    return 0
+
+
 def main(argv):
     if len(argv) >= 4 and argv[1] == 'capture':
         return capture(int(argv[2]), argv[3], float(argv[4]) if len(argv) > 4 else 5)
-    if len(argv) == 8 and argv[1] == 'hostile':
-        return hostile(int(argv[2]), argv[3], argv[4], int(argv[5]), int(argv[6]), float(argv[7]))
+    if len(argv) in (8, 9) and argv[1] == 'hostile':
+        return hostile(int(argv[2]), argv[3], argv[4], int(argv[5]), int(argv[6]), float(argv[7]),
+                       argv[8] if len(argv) == 9 else None)
+    kv = lambda args: dict(a.split('=', 1) for a in args)
+    if len(argv) >= 9 and argv[1] == 'forge':
+        return forge(argv[2], argv[3], int(argv[4]), int(argv[5]), argv[6], int(argv[7]), float(argv[8]),
+                     kv(argv[9:]))
+    if len(argv) >= 5 and argv[1] == 'send':
+        return send(int(argv[2]), argv[3], argv[4], kv(argv[5:]))
+    if len(argv) == 5 and argv[1] == 'flood':
+        return flood(argv[2], argv[3], int(argv[4]))
+    if len(argv) == 5 and argv[1] == 'names':
+        return names(int(argv[2]), argv[3], int(argv[4]))
     if len(argv) == 8 and argv[1] == 'garbage':
         return garbage(int(argv[2]), argv[3], argv[4], int(argv[5]), int(argv[6]), float(argv[7]))
     sys.stderr.write(__doc__)

@@ -82,7 +82,7 @@ static int write_state(struct alog_writer *w, const char *robot, int64_t cycle, 
 	snprintf(chan, sizeof(chan), "%s.STATE", robot);
 	int64_t utime = T_START_UTIME + cycle * (int64_t)llround(T_DT * 1e6);
 	undulate_robot_state_t msg = { .utime = utime, .robot = name, .cycle = cycle,
-		.mode = UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR, .mode_reason = reason, .period_us = T_DT * 1e6,
+		.mode = UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR, .mode_reason = reason, .fault = "", .period_us = T_DT * 1e6,
 		.njoints = 1, .joints = &j };
 	return alog_write_robot_state_t(w, chan, utime + 100, &msg);
 }

@@ -1,5 +1,6 @@
-/* test_daemon_command.c — LCM command validation: every rejection path, the
- * accepted kinds, addressing, and the --command text parser. */
+/* test_daemon_command.c — command validation: every rejection path (limits
+ * are the configuration's alone), the accepted kinds, addressing, decoding
+ * and encoding command_t, and the --command text parser. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -121,37 +122,49 @@ static void test_rejections(void **state)
 	r.joint = -2;
 	expect_reject(&r, true, "joint -2 does not exist");
 	r = base(CMD_KIND_PARAM);
-	r.value = 0.0;   /* k > 0 */
+	r.value = 0.0;   /* k >= 1e-4 */
 	expect_reject(&r, true, "out of range");
 	r.value = 5000;
 	expect_reject(&r, true, "out of range");
 	r = base(CMD_KIND_PARAM);
-	r.param = "max_step";
-	r.value = 0.9;
+	r.param = "inertia";
+	r.value = 1e-300;   /* a typo, not a tuning: the law would ask for the impossible */
 	expect_reject(&r, true, "out of range");
+	r.value = 1e-5;     /* in range, but with k 0.078 a 10 Hz oscillator */
+	expect_reject(&r, true, "natural frequency");
 	r = base(CMD_KIND_PARAM);
 	r.param = "frequency";
 	r.joint = 0;
 	expect_reject(&r, true, "per robot: joint must be -1");
-	r = base(CMD_KIND_PARAM);
-	r.param = "limit_min";
-	r.value = 0.2;   /* must stay <= 0 */
-	expect_reject(&r, true, "must contain 0");
-	r = base(CMD_KIND_PARAM);
-	r.param = "neutral";
-	r.value = 2.0;   /* 2.0 + 1.3 leaves ±2.618 */
-	expect_reject(&r, true, "servo's");
 }
 
-static void test_disabled(void **state)
+/* Nothing that bounds where a joint may go can be commanded, whatever the
+ * value, the joint or the robot it is addressed to. */
+static void test_limits_not_commandable(void **state)
 {
 	(void)state;
-	cfg.commands = false;
-	struct cmd_request r = base(CMD_KIND_MODE);
-	expect_reject(&r, true, "commands are disabled");
-	r.robot = "*";
-	expect_reject(&r, false, "commands are disabled");
-	cfg.commands = true;
+	const char *names[] = { "limit_min", "limit_max", "neutral", "max_step" };
+	const double values[] = { -2.6, 2.6, 0.0, 0.01, -0.1, 0.5 };
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+		for (size_t k = 0; k < sizeof values / sizeof values[0]; k++) {
+			for (int joint = -1; joint < 2; joint++) {
+				struct cmd_request r = base(CMD_KIND_PARAM);
+				r.param = names[i];
+				r.value = values[k];
+				r.joint = joint;
+				expect_reject(&r, true, "only the configuration file");
+				r.robot = "*";
+				expect_reject(&r, false, "only the configuration file");
+			}
+		}
+		/* and applied anyway (a caller that skipped the check), nothing changes */
+		struct cfg c = cfg;
+		struct cmd_request r = base(CMD_KIND_PARAM);
+		r.param = names[i];
+		r.value = 0.25;
+		cmd_apply_param(&c, &r);
+		assert_memory_equal(&c, &cfg, sizeof c);
+	}
 }
 
 static void test_apply(void **state)
@@ -197,6 +210,9 @@ static void test_parse_text(void **state)
 	assert_int_equal(r.kind, CMD_KIND_TORQUE);
 	assert_false(r.torque);
 	assert_false(cmd_parse_text("torque maybe", &r, p, sizeof p, why, sizeof why));
+	assert_true(cmd_parse_text("clear", &r, p, sizeof p, why, sizeof why));
+	assert_int_equal(r.kind, CMD_KIND_CLEAR);
+	assert_false(cmd_parse_text("clear all", &r, p, sizeof p, why, sizeof why));
 	assert_false(cmd_parse_text("dance", &r, p, sizeof p, why, sizeof why));
 	assert_false(cmd_parse_text("param k fast", &r, p, sizeof p, why, sizeof why));
 	assert_false(cmd_parse_text("mode walk", &r, p, sizeof p, why, sizeof why));
@@ -252,16 +268,25 @@ static void test_decode(void **state)
 	n = encode(&m, buf, sizeof buf);
 	buf[8 + 16 + 4 + 2] = 'y';   /* the NUL of source "qa" */
 	assert_false(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
-	/* long strings are cut to CMD_STR_MAX - 1, which no robot name reaches */
+	/* a name longer than CMD_STR_MAX - 1 (which no robot name reaches), or
+	 * with a NUL inside, would say less than the sender wrote: refused */
 	m.robot = longname;
 	m.param = longname;
 	m.source = longname;
 	n = encode(&m, buf, sizeof buf);
-	assert_true(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
-	assert_int_equal(strlen(w.req.robot), CMD_STR_MAX - 1);
+	assert_false(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+	assert_non_null(strstr(why, "longer than"));
 	assert_true(CMD_STR_MAX - 1 > CFG_NAME_MAX - 1);
-	assert_int_equal(cmd_check(&w.req, &cfg, true, why, sizeof why), CMD_REJECT);
-	assert_int_equal(cmd_check(&w.req, &cfg, false, why, sizeof why), CMD_IGNORE);
+	m.source = m.param = "k";
+	m.robot = "robot1\0";   /* lcm-gen writes up to the first NUL: build one by hand */
+	n = encode(&m, buf, sizeof buf);
+	buf[8 + 16 + 4 + 2] = 0;   /* source "k": its NUL stays, fine */
+	assert_true(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+	buf[8 + 16 + 4 + 2 + 4 + 2] = 0;   /* "robot1" -> "ro\0ot1": a NUL inside */
+	assert_false(cmd_decode(buf, (size_t)n, fp, &w, why, sizeof why));
+	/* bytes after the end are no command_t either */
+	n = encode(&m, buf, sizeof buf);
+	assert_false(cmd_decode(buf, (size_t)n + 1, fp, &w, why, sizeof why));
 	/* NaN survives decoding bit for bit, for cmd_check to refuse */
 	m.robot = "robot1";
 	m.param = "k";
@@ -273,13 +298,46 @@ static void test_decode(void **state)
 	assert_int_equal(cmd_check(&w.req, &cfg, true, why, sizeof why), CMD_REJECT);
 }
 
+/* cmd_encode writes what lcm-gen's encoder writes, byte for byte, and says
+ * where the MAC starts: the MAC covers every byte before it. */
+static void test_encode(void **state)
+{
+	(void)state;
+	static uint8_t ours[1024], theirs[1024];
+	int64_t fp = __undulate_command_t_get_hash();
+	struct cmd_request r = { .utime = 1700000000123456, .seq = 42, .source = "a@b", .robot = "robot1",
+	                         .kind = CMD_KIND_PARAM, .mode = 2, .param = "mu", .joint = 1, .value = -0.125,
+	                         .torque = true };
+	uint8_t mac[CMD_MAC_BYTES];
+	for (size_t i = 0; i < sizeof mac; i++)
+		mac[i] = (uint8_t)(0xA0 + i);
+	size_t signed_len = 0;
+	size_t n = cmd_encode(&r, fp, mac, ours, sizeof ours, &signed_len);
+	undulate_command_t m = { .utime = r.utime, .seq = r.seq, .source = "a@b", .robot = "robot1", .kind = 2,
+	                         .mode = 2, .param = "mu", .joint = 1, .value = -0.125, .torque = 1 };
+	memcpy(m.mac, mac, sizeof mac);
+	int k = encode(&m, theirs, sizeof theirs);
+	assert_int_equal(n, (size_t)k);
+	assert_memory_equal(ours, theirs, n);
+	assert_int_equal(signed_len, n - CMD_MAC_BYTES);
+	static struct cmd_wire w;
+	char why[128];
+	assert_true(cmd_decode(ours, n, fp, &w, why, sizeof why));
+	assert_int_equal(w.signed_len, signed_len);
+	assert_memory_equal(w.mac, mac, sizeof mac);
+	assert_true(w.req.utime == r.utime);
+	/* a buffer too small: 0, nothing claimed */
+	assert_int_equal(cmd_encode(&r, fp, NULL, ours, n - 1, NULL), 0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_accepts_valid),
 		cmocka_unit_test(test_addressing),
 		cmocka_unit_test(test_rejections),
-		cmocka_unit_test(test_disabled),
+		cmocka_unit_test(test_limits_not_commandable),
+		cmocka_unit_test(test_encode),
 		cmocka_unit_test(test_apply),
 		cmocka_unit_test(test_parse_text),
 		cmocka_unit_test(test_decode),

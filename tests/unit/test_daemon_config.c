@@ -92,7 +92,7 @@ static void test_good_file(void **state)
 	assert_true(c.mlockall);
 	assert_int_equal(c.safe_stop, CFG_SAFE_LIMP);
 	assert_int_equal(c.velocity_source, CFG_VEL_SERVO);
-	assert_false(c.commands);
+	assert_int_equal(c.commands, CFG_CMD_OFF);
 	assert_false(c.echo);
 	assert_int_equal(c.adapter_latency_us, 1000);
 	assert_double_equal(c.joint[0].osc.k, 0.06, 1e-12);
@@ -120,7 +120,7 @@ static void test_defaults_from_osc(void **state)
 	assert_double_equal(c.joint[1].osc.mu, d1.mu, 1e-12);
 	assert_int_equal(c.mode, CFG_MODE_OSCILLATOR);
 	assert_int_equal(c.safe_stop, CFG_SAFE_HOLD);
-	assert_true(c.commands);
+	assert_int_equal(c.commands, CFG_CMD_LOCAL);
 	assert_true(c.joint[0].limit_min < 0 && c.joint[0].limit_max > 0);
 	assert_true(c.joint[0].max_step > 0);
 	assert_string_equal(c.name, "robot");
@@ -181,7 +181,11 @@ static void test_errors_name_file_line_key(void **state)
 	                    "robot1.conf:4: [robot] name: 'a.b' must be non-empty without '.', '*' or spaces "
 	                    "(it prefixes LCM channels)");
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nk = 0\n", b, sizeof b),
-	                    "robot1.conf:5: [joint.1] k: 0 out of range >0..1000");
+	                    "robot1.conf:5: [joint.1] k: 0 out of range 0.0001..10");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\ninertia = 1e-300\n", b, sizeof b),
+	                    "robot1.conf:5: [joint.1] inertia: 1e-300 out of range 1e-05..1");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\ncommands=maybe\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] commands: 'maybe' is not off, local or network");
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nmax_step = nan\n", b, sizeof b),
 	                    "robot1.conf:5: [joint.1] max_step: not a number 'nan'");
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\nfrequency = 9\n", b, sizeof b),
@@ -310,7 +314,15 @@ static void test_param_ranges(void **state)
 	(void)state;
 	struct cfg_range r;
 	assert_true(cfg_param_range("k", &r));
-	assert_true(r.min_open);
+	assert_false(r.min_open);
+	assert_true(r.min > 0.0);
+	assert_true(cfg_param_range("inertia", &r));
+	assert_true(r.min >= 1e-5);
+	/* what bounds a joint is the configuration's alone */
+	assert_true(cfg_param_commandable("k") && cfg_param_commandable("amplitude"));
+	assert_false(cfg_param_commandable("limit_min") || cfg_param_commandable("limit_max") ||
+	             cfg_param_commandable("neutral") || cfg_param_commandable("max_step") ||
+	             cfg_param_commandable("kk"));
 	assert_false(cfg_param_range("kk", &r));
 	assert_true(cfg_param_is_joint("lambda"));
 	assert_false(cfg_param_is_joint("amplitude"));

@@ -56,10 +56,22 @@ static void setup_robot(enum cfg_mode mode)
 	ctl_start(&c, t, "test");
 }
 
+/* The cycle's side of the controller's outputs: every queued write sent and
+ * acknowledged, every event taken. What a step queues is then what the
+ * controller's queue and event list hold until the next drain. */
+static void drain_outputs(void)
+{
+	while (ctl_take_write(&c) != NULL)
+		ctl_write_result(&c, true);
+	struct ctl_event e;
+	while (ctl_next_event(&c, &e))
+		;
+}
+
 static bool has_write(uint8_t id, uint8_t addr, uint16_t value)
 {
-	for (size_t i = 0; i < c.nwrites; i++)
-		if (c.writes[i].id == id && c.writes[i].addr == addr && c.writes[i].value == value)
+	for (size_t i = 0; i < c.wq.n; i++)
+		if (c.wq.w[i].id == id && c.wq.w[i].addr == addr && c.wq.w[i].value == value)
 			return true;
 	return false;
 }
@@ -88,7 +100,7 @@ static double cycle(void)
 		if (servo_answers[j])
 			ctl_measure(&c, j, dxl_rad_to_pos(servo_angle[j]), 0, 0, servo_err[j], DT);
 	}
-	ctl_clear_outputs(&c);
+	drain_outputs();
 	ctl_step(&c, t, DT, t);
 	double m = 0.0;
 	for (size_t j = 0; j < 2; j++) {
@@ -242,7 +254,7 @@ static void test_stale_joint_holds(void **state)
 	assert_true(c.j[1].goal == g);            /* holds its last goal */
 	assert_int_equal(c.j[1].stale_cycles, 5);
 	assert_true(c.j[0].goal != g);            /* the other joint goes on */
-	ctl_clear_outputs(&c);
+	drain_outputs();
 	bool seen = false;
 	for (int i = 0; i < cfg.stale_limit; i++) {
 		cycle();
@@ -308,11 +320,21 @@ static void test_fault_persistent(void **state)
 	/* LIMP: nothing is written to the goals */
 	cycle();
 	assert_false(c.j[0].write_goal || c.j[1].write_goal);
-	/* the operator takes over */
+	/* latched: only LIMP (the fault action here) until cleared */
+	char why[256];
+	assert_true(c.latched);
+	assert_false(ctl_mode_allowed(&c, CFG_MODE_HOLD, why, sizeof why));
+	assert_non_null(strstr(why, "fault latched"));
+	assert_false(ctl_mode_allowed(&c, CFG_MODE_OSCILLATOR, why, sizeof why));
+	assert_true(ctl_mode_allowed(&c, CFG_MODE_LIMP, why, sizeof why));
+	/* the operator clears it, then takes over */
 	servo_err[0] = 0;
+	assert_true(ctl_clear_faults(&c, why, sizeof why));
+	assert_false(c.latched);
+	assert_int_equal(c.j[0].fault, CTL_FAULT_NONE);
+	assert_int_equal(c.mode, CFG_MODE_LIMP);   /* clearing changes no mode */
 	ctl_set_mode(&c, CFG_MODE_HOLD, "command");
 	assert_true(has_write(1, DXL_AX_TORQUE_ENABLE, 1));
-	assert_int_equal(c.j[0].fault, CTL_FAULT_NONE);
 	assert_true(run(20) < 0.01);
 }
 
@@ -345,13 +367,13 @@ static void test_torque_commands(void **state)
 	(void)state;
 	setup_robot(CFG_MODE_OSCILLATOR);
 	run(50);
-	ctl_clear_outputs(&c);
+	drain_outputs();
 	ctl_torque(&c, false);
 	assert_int_equal(c.mode, CFG_MODE_LIMP);
 	assert_true(has_write(1, DXL_AX_TORQUE_ENABLE, 0));
 	servo_angle[0] = 0.9;   /* moved by hand while limp */
 	run(5);
-	ctl_clear_outputs(&c);
+	drain_outputs();
 	ctl_torque(&c, true);
 	assert_int_equal(c.mode, CFG_MODE_HOLD);
 	assert_true(has_write(1, DXL_AX_TORQUE_ENABLE, 1));

@@ -49,7 +49,7 @@ static struct servo sv[NJ_MAX];
 
 static bool wheel(const struct servo *s) { return s->cw == 0 && s->ccw == 0; }
 
-static void apply_write(const struct ctl_write *w)
+static void apply_write(const struct wq_write *w)
 {
 	for (size_t j = 0; j < nj; j++) {
 		struct servo *s = &sv[j];
@@ -122,15 +122,33 @@ static void physics(bool pwm)
 	}
 }
 
-/* The queue is sent after the SYNC_WRITE and emptied, as in the daemon (so
- * writes queued between cycles by commands go out with the next cycle); a
- * copy of the last cycle's is kept for the tests. */
-static struct ctl_write sent[CTL_MAX_WRITES];
+/* The queue is sent after the SYNC_WRITE, each write acknowledged, as in the
+ * daemon's cycle (so writes queued between cycles by commands go out with the
+ * next cycle); a copy of the last cycle's is kept for the tests. */
+static struct wq_write sent[WQ_CAP];
 static size_t nsent;
+
+static void send_writes(void)
+{
+	const struct wq_write *w;
+	nsent = 0;
+	while ((w = ctl_take_write(&c)) != NULL) {
+		apply_write(w);
+		sent[nsent++] = *w;
+		ctl_write_result(&c, true);
+	}
+}
+
+static void take_events(void)
+{
+	struct ctl_event e;
+	while (ctl_next_event(&c, &e))
+		;
+}
 
 static void cycle_pwm(bool pwm)
 {
-	c.nevents = 0;
+	take_events();
 	physics(pwm);
 	t += DT;
 	for (size_t j = 0; j < nj; j++)
@@ -138,11 +156,7 @@ static void cycle_pwm(bool pwm)
 			ctl_measure(&c, j, dxl_rad_to_pos(sv[j].angle), dxl_rad_s_to_speed(sv[j].speed), 0, 0, DT);
 	ctl_step(&c, t, DT, t);
 	apply_sync();
-	for (size_t i = 0; i < c.nwrites; i++)
-		apply_write(&c.writes[i]);
-	memcpy(sent, c.writes, c.nwrites * sizeof sent[0]);
-	nsent = c.nwrites;
-	c.nwrites = 0;
+	send_writes();
 }
 
 static void cycle(void) { cycle_pwm(false); }
@@ -182,11 +196,9 @@ static void setup(const char *ids, const char *drive, enum cfg_mode mode)
 		ctl_measure(&c, j, dxl_rad_to_pos(sv[j].angle), 0, 0, 0, DT);
 	}
 	t = 0.0;
-	ctl_clear_outputs(&c);
+	take_events();
 	ctl_start(&c, t, "test");
-	for (size_t i = 0; i < c.nwrites; i++)
-		apply_write(&c.writes[i]);
-	c.nwrites = 0;
+	send_writes();
 }
 
 static const struct ctl_event *find_event(const char *kind)
@@ -229,7 +241,7 @@ static void test_switch_sequence(void **state)
 	for (size_t j = 0; j < nj; j++) {
 		int seen = 0;
 		for (size_t i = 0; i < nsent; i++) {
-			const struct ctl_write *w = &sent[i];
+			const struct wq_write *w = &sent[i];
 			if (w->id != c.j[j].id)
 				continue;
 			if (seen == 0 && w->addr == DXL_AX_TORQUE_ENABLE && w->value == 0)

@@ -31,7 +31,7 @@ static void feed_state(const char *name, double now, double ph0, double ph1, dou
 		  .error_bits = 0 },
 	};
 	undulate_robot_state_t s = { .utime = (int64_t)(now * 1e6), .robot = n, .mode = (int8_t)mode,
-		.mode_reason = reason, .period_us = 10000.0, .jitter_us = jitter, .njoints = 2, .joints = j };
+		.mode_reason = reason, .fault = "", .period_us = 10000.0, .jitter_us = jitter, .njoints = 2, .joints = j };
 	top_on_state(&model, &s, now);
 }
 
@@ -270,7 +270,7 @@ static void test_json_hostile_text(void **state)
 	memcpy(reason + TOP_TEXT_MAX - 3, "\xe2\x82\xac", 3);   /* U+20AC across the cut: 2 bytes kept */
 	reason[sizeof reason - 1] = '\0';
 	undulate_joint_state_t j[1] = { { .servo_id = 1, .angle = NAN, .speed = INFINITY } };
-	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 1, .mode_reason = reason,
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 1, .mode_reason = reason, .fault = "",
 		.period_us = 10000.0, .njoints = 1, .joints = j };
 	top_on_state(&model, &s, 0.0);
 	char kind[] = "fault", text[] = "line1\nline2 \xff end";
@@ -281,7 +281,7 @@ static void test_json_hostile_text(void **state)
 	top_json(&model, 0.1, 1234, f);
 	fclose(f);
 	assert_non_null(strstr(buf, "\"last_event\":\"fault: line1\\u000aline2 \\ufffd end\""));
-	assert_non_null(strstr(buf, "aaa\\ufffd\\ufffd\",\"utime\""));
+	assert_non_null(strstr(buf, "aaa\\ufffd\\ufffd\",\"fault\":\"\",\"utime\""));
 	assert_non_null(strstr(buf, "\"angle\":null,\"speed\":null"));
 	assert_int_equal(strchr(buf, '\n') - buf, (long)strlen(buf) - 1); /* still one line */
 }
@@ -297,7 +297,7 @@ static void test_unknown_phase(void **state)
 		{ .servo_id = 2, .angle = NAN, .speed = NAN, .phase = NAN, .load = NAN, .amplitude = NAN,
 		  .frequency = NAN },
 	};
-	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason,
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason, .fault = "",
 		.period_us = 10000.0, .njoints = 2, .joints = j };
 	top_on_state(&model, &s, 0.0);
 	struct top_view v = { .kind = TOP_VIEW_DETAIL };
@@ -319,7 +319,7 @@ static void test_drive_column(void **state)
 	undulate_joint_state_t j[1] = {
 		{ .servo_id = 1, .angle = 0.5, .goal = NAN, .drive = 0.124, .amplitude = 0.8, .frequency = 0.8 },
 	};
-	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason,
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason, .fault = "",
 		.period_us = 10000.0, .njoints = 1, .joints = j };
 	top_on_state(&model, &s, 0.0);
 	struct top_view v = { .kind = TOP_VIEW_DETAIL };

@@ -201,7 +201,7 @@ static void publish_robot(lcm_t *lcm)
 	char name[] = "r1", reason[] = "test";
 	undulate_joint_state_t j[2] = { { .servo_id = 1 }, { .servo_id = 2 } };
 	undulate_robot_state_t s = { .robot = name, .mode = UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR,
-		.mode_reason = reason, .period_us = 10000, .njoints = 2, .joints = j };
+		.mode_reason = reason, .fault = "", .period_us = 10000, .njoints = 2, .joints = j };
 	undulate_robot_state_t_publish(lcm, "r1.STATE", &s);
 	double k[2] = { 1, 1 }, c[2] = { 0.02, 0.04 }, z[2] = { 0, 0 };
 	undulate_osc_params_t p = { .robot = name, .njoints = 2, .k = k, .c = c, .mu = k, .lambda = z,

@@ -72,7 +72,7 @@ static void test_robot_state(void **state)
 	fill_joint(&j[0], 0);
 	fill_joint(&j[1], 1);
 	undulate_robot_state_t m = { .utime = 1700000000123456LL, .robot = s_robot, .cycle = 123456789012LL,
-		.mode = UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR, .mode_reason = s_reason, .period_us = 10001.5,
+		.mode = UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR, .mode_reason = s_reason, .fault = "", .period_us = 10001.5,
 		.jitter_us = 42.25, .bus_us = 612.0, .control_us = 18.5, .overruns = 7, .bus_errors = 11,
 		.bad_commands = 2, .njoints = 2, .joints = j };
 	undulate_robot_state_t d;

@@ -117,7 +117,7 @@ static int synth_state(const struct synth_spec *s, struct alog_writer *w, int i,
 	char reason[] = "command";
 	undulate_robot_state_t m = {
 		.utime = utime, .robot = name, .cycle = cycle, .mode = MODE_OSCILLATOR,
-		.mode_reason = reason, .period_us = s->dt_s * 1e6,
+		.mode_reason = reason, .fault = "", .period_us = s->dt_s * 1e6,
 		/* jitter 50..140 µs in a known pattern: its maximum is 140 */
 		.jitter_us = 50.0 + 10.0 * (double)(cycle % 10), .bus_us = 600.0, .control_us = 20.0,
 		.overruns = 0, .bus_errors = 3 * i, .bad_commands = 0, .njoints = 2, .joints = j,

@@ -1,5 +1,6 @@
 /* undulate-top — live monitor of every robot on the LCM network.
  * See tools/top/README.md. */
+#include "csock.h"
 #include "keys.h"
 #include "model.h"
 #include "modes.h"
@@ -17,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <sys/time.h>
 #include <time.h>
 #include <unistd.h>
@@ -28,6 +30,7 @@
 
 struct top_app {
 	lcm_t *lcm;
+	int cmd_fd;                 /* our end of the robots' local command sockets (-1: none) */
 	struct top_model model;
 	struct top_view view;
 	bool once, json, read_only, verbose;
@@ -136,10 +139,50 @@ static int top_subscribe(struct top_app *a)
 
 /* ---- commands ------------------------------------------------------------------- */
 
-static void publish(struct top_app *a, const struct top_command *c)
+/* Commands go to the robots' local command sockets on this computer (never
+ * over the network: a robot takes those only signed); the answers come back
+ * on ours and show in the status line. */
+#define TOP_MAX_SOCKETS 64
+static bool publish(struct top_app *a, const struct top_command *c)
 {
-	if (undulate_command_t_publish(a->lcm, c->channel, &c->msg) != 0)
-		set_status(a, "publishing on %s failed", c->channel);
+	static char paths[TOP_MAX_SOCKETS][CSOCK_PATH_MAX];
+	uint8_t buf[1024];
+	char why[256];
+	int n = undulate_command_t_encoded_size(&c->msg);
+	if (a->cmd_fd < 0 || n <= 0 || n > (int)sizeof(buf) || undulate_command_t_encode(buf, 0, n, &c->msg) != n) {
+		set_status(a, "cannot send commands (%s)", a->cmd_fd < 0 ? "no local socket" : "encoding failed");
+		return false;
+	}
+	size_t np = csock_find(c->msg.robot, a->url, paths, TOP_MAX_SOCKETS);
+	if (np == 0) {
+		set_status(a, "no robot %s runs on this computer: commands go to local robots only",
+			   strcmp(c->msg.robot, "*") == 0 ? "at all" : c->msg.robot);
+		return false;
+	}
+	size_t sent = 0;
+	for (size_t i = 0; i < np; i++) {
+		if (csock_send(a->cmd_fd, paths[i], buf, (size_t)n, why, sizeof(why)))
+			sent++;
+		else
+			set_status(a, "%s", why);
+	}
+	return sent > 0;
+}
+
+static void read_answers(struct top_app *a)
+{
+	uint8_t buf[2048];
+	for (int i = 0; i < 64; i++) {
+		ssize_t n = recv(a->cmd_fd, buf, sizeof(buf), MSG_DONTWAIT);
+		if (n <= 0)
+			return;
+		undulate_event_t e;
+		if (undulate_event_t_decode(buf, 0, (int)n, &e) != (int)n)
+			continue;
+		top_on_event(&a->model, &e);
+		show_event(a, &e);
+		undulate_event_t_decode_cleanup(&e);
+	}
 }
 
 static void send_mode(struct top_app *a, int mode, bool all)
@@ -151,9 +194,9 @@ static void send_mode(struct top_app *a, int mode, bool all)
 	struct top_command c;
 	if (top_command_mode(&c, robot, mode, a->next_seq, a->source) != 0)
 		return;
-	publish(a, &c);
-	set_status(a, "#%lld sent %s mode %s on %s, waiting for the answer",
-		 (long long)a->next_seq, all ? "all robots" : robot, mode_name(mode), c.channel);
+	if (publish(a, &c))
+		set_status(a, "#%lld sent %s mode %s, waiting for the answer", (long long)a->next_seq,
+			   all ? "all robots" : robot, mode_name(mode));
 	a->next_seq++;
 }
 
@@ -170,9 +213,11 @@ static void send_nudge(struct top_app *a, int dir)
 		set_status(a, "%s", what);
 		return;
 	}
+	bool ok = true;
 	for (int i = 0; i < n; i++)
-		publish(a, &c[i]);
-	set_status(a, "#%lld sent %s", (long long)a->next_seq, what);
+		ok = publish(a, &c[i]) && ok;
+	if (ok)
+		set_status(a, "#%lld sent %s", (long long)a->next_seq, what);
 	a->next_seq += n;
 }
 
@@ -269,15 +314,18 @@ static int print_snapshot(struct top_app *a, double now)
 /* Waits for LCM traffic and keys until TIMEOUT_S has passed. */
 static void pump(struct top_app *a, double timeout_s, bool keys)
 {
-	struct pollfd fds[2] = { { .fd = lcm_get_fileno(a->lcm), .events = POLLIN },
+	struct pollfd fds[3] = { { .fd = lcm_get_fileno(a->lcm), .events = POLLIN },
+				 { .fd = a->cmd_fd, .events = POLLIN },
 				 { .fd = STDIN_FILENO, .events = POLLIN } };
 	int ms = timeout_s > 0 ? (int)ceil(timeout_s * 1000.0) : 0;
-	int n = poll(fds, keys ? 2 : 1, ms);
+	int n = poll(fds, keys ? 3 : 2, ms);
 	if (n <= 0)
 		return; /* timeout, or EINTR from a signal checked by the caller */
 	if (fds[0].revents & POLLIN)
 		lcm_handle(a->lcm);
-	if (keys && (fds[1].revents & (POLLIN | POLLHUP)))
+	if (fds[1].revents & POLLIN)
+		read_answers(a);
+	if (keys && (fds[2].revents & (POLLIN | POLLHUP)))
 		read_keys(a);
 }
 
@@ -415,7 +463,8 @@ int main(int argc, char **argv)
 	a->view.read_only = a->read_only;
 	char host[64] = "?";
 	gethostname(host, sizeof(host) - 1);
-	snprintf(a->source, sizeof(a->source), "undulate-top@%s:%ld", host, (long)getpid());
+	/* short enough for any robot to take (command.h's CMD_STR_MAX) */
+	snprintf(a->source, sizeof(a->source), "undulate-top@%.24s:%ld", host, (long)getpid());
 	/* Sequence numbers from the clock: two monitors on one network rarely
 	 * pick the same ones, so each shows only answers to its own commands. */
 	a->first_seq = a->next_seq = wall_utime();
@@ -429,11 +478,20 @@ int main(int argc, char **argv)
 		fputs("undulate-top: LCM subscription failed\n", stderr);
 		return 1;
 	}
+	a->cmd_fd = -1;
+	if (!a->read_only && !a->once && !a->json) {
+		char why[256];
+		a->cmd_fd = csock_client_open(why, sizeof(why));
+		if (a->cmd_fd < 0)
+			fprintf(stderr, "undulate-top: commands disabled: %s\n", why);
+	}
 	install_signals();
 	if (a->verbose)
 		fprintf(stderr, "undulate-top: listening on %s\n", a->url ? a->url : "the default LCM URL");
 	int rc = a->once ? run_once(a) : a->json ? run_stream(a) : run_interactive(a);
 	lcm_destroy(a->lcm);
+	if (a->cmd_fd >= 0)
+		close(a->cmd_fd);
 	free(a->screen);
 	return rc;
 }

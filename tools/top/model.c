@@ -57,6 +57,7 @@ void top_on_state(struct top_model *m, const undulate_robot_state_t *s, double n
 	r->cycle = s->cycle;
 	r->mode = s->mode;
 	top_copy_text(r->mode_reason, s->mode_reason);
+	top_copy_text(r->fault, s->fault);
 	r->period_us[r->winnext] = s->period_us;
 	r->jitter_us[r->winnext] = s->jitter_us;
 	r->rx_times[r->winnext] = now;
@@ -371,6 +372,7 @@ static void top_json_robot(struct json *j, const struct top_robot *r, double now
 	json_field_string(j, "mode", mode_name(r->mode));
 	json_field_int(j, "mode_id", r->mode);
 	json_field_string(j, "mode_reason", r->mode_reason);
+	json_field_string(j, "fault", r->fault);
 	json_field_int(j, "utime", r->utime);
 	json_field_int(j, "cycle", r->cycle);
 	json_field_int(j, "states", r->states);

@@ -43,6 +43,7 @@ struct top_robot {
 	int64_t utime, cycle;
 	int8_t mode;
 	char mode_reason[TOP_TEXT_MAX];
+	char fault[TOP_TEXT_MAX];          /* a latched fault ("" when none) */
 	double period_us[TOP_WINDOW], jitter_us[TOP_WINDOW], rx_times[TOP_WINDOW];
 	int nwin, winnext;
 	int64_t overruns, bus_errors, bad_commands, states;

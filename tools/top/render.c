@@ -136,6 +136,8 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 		num(jit, sizeof(jit), "%6.0f", top_robot_jitter_p99(r), 6), (long long)r->bus_errors,
 		num(dj, sizeof(dj), "%+8.2f", top_robot_dphase_joints(r), 8),
 		num(dn, sizeof(dn), "%+8.2f", top_neighbour_dphase(m, pos), 8), flags);
+	if (r->fault[0] != '\0')
+		rb_line(b, false, "     FAULT LATCHED: %s (send 'clear' once fixed)", r->fault);
 	for (int k = 0; k < r->njoints; k++) {
 		const struct top_joint *j = &r->j[k];
 		/* torque actuation has no goal: the column shows the drive, marked d */

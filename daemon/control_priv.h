@@ -1,0 +1,44 @@
+/*
+ * control_priv.h — the controller's internals shared by its two files:
+ * control.c (modes, faults, read-back, the position laws) and torque.c
+ * (torque actuation through wheel mode). Nothing outside the controller
+ * includes this.
+ */
+#ifndef UNDULATE_DAEMON_CONTROL_PRIV_H
+#define UNDULATE_DAEMON_CONTROL_PRIV_H
+
+#include "control.h"
+
+/* ---- control.c ------------------------------------------------------------------------ */
+void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
+	__attribute__((format(printf, 4, 5)));
+/* A register's new value (writeq.h's merge rules). */
+void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value);
+/* Appended as it is, in order: a sequence that writes one register twice
+ * (torque off, EEPROM write, torque on) must not be merged. */
+void ctl_write_seq(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value);
+/* The torque limit a joint should have: the servo's max torque, reduced to
+ * backoff_torque while it backs off from a fault or holds after one that
+ * persisted. */
+uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt);
+void ctl_blend_joint(struct ctl *c, size_t j, double from);
+void ctl_hold_at_present(struct ctl *c);
+/* Put the robot in its fault action and keep it there until cleared. */
+void ctl_latch(struct ctl *c, const char *what);
+
+/* ---- torque.c ------------------------------------------------------------------------- */
+/* The servos go into wheel mode only for a running OSCILLATOR whose joints are
+ * all healthy, torqued and measured. */
+bool tq_want_wheel(const struct ctl *c);
+/* A joint past its limits under torque: the fault action, latched. */
+void tq_check_limits(struct ctl *c);
+/* This cycle's duties from the law's torque (wheel mode). */
+void tq_duties(struct ctl *c);
+/* Wheel-mode switches, queued after this cycle's SYNC_WRITE. */
+void tq_enter_wheel(struct ctl *c);
+void tq_leave_wheel(struct ctl *c);
+/* Leaving wheel mode, the SYNC_WRITE stops every drive and leaves a goal the
+ * joint mode can hold. */
+void tq_stop_goals(struct ctl *c);
+
+#endif

@@ -1,0 +1,261 @@
+/* cycle.c — see cycle.h. */
+#include "cycle.h"
+
+#include <stddef.h>
+
+#include "dxl.h"
+#include "dxl_table.h"
+
+/* Error bits in a write's acknowledgement that mean the servo did not take
+ * it: a refused EEPROM write (range), an instruction it rejected, or a
+ * packet it received damaged. */
+#define CYC_WRITE_REFUSED (DXL_ERRBIT_RANGE | DXL_ERRBIT_INSTRUCTION | DXL_ERRBIT_CHECKSUM)
+
+void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks)
+{
+	*y = (struct cyc){ .bus = bus, .ctl = ctl, .period_us = period_us, .phase = CYC_IDLE };
+	if (hooks != NULL)
+		y->hooks = *hooks;
+}
+
+static uint64_t cyc_now(const struct cyc *y)
+{
+	return y->bus->io.now_us(y->bus->io.ctx);
+}
+
+bool cyc_busy(const struct cyc *y)
+{
+	return y->phase != CYC_IDLE;
+}
+
+uint64_t cyc_deadline_us(const struct cyc *y)
+{
+	return bus_is_pending(y->bus) ? bus_deadline_us(y->bus) : 0;
+}
+
+static void cyc_error(struct cyc *y, uint8_t id, const char *what, int status)
+{
+	y->errors++;
+	if (y->hooks.bus_error != NULL)
+		y->hooks.bus_error(y->hooks.ctx, id, what, status);
+}
+
+static bool cyc_late(const struct cyc *y)
+{
+	return (double)(cyc_now(y) - y->start_us) > CYC_LATE_SHARE * (double)y->period_us;
+}
+
+static bool cyc_port_gone(int r)
+{
+	return r == DXL_E_DISCONNECTED || r == DXL_E_IO;
+}
+
+static enum cyc_status cyc_finish(struct cyc *y, enum cyc_status st)
+{
+	y->bus_us = (double)(cyc_now(y) - y->start_us) - y->control_us;
+	y->phase = CYC_IDLE;
+	return st;
+}
+
+static void cyc_drop_write(struct cyc *y)
+{
+	if (!y->write_on_wire)
+		return;
+	y->write_on_wire = false;
+	/* it may or may not have reached the servo: sent again (writes are
+	 * idempotent), up to the controller's limit */
+	ctl_write_result(y->ctl, false);
+}
+
+static enum cyc_status cyc_lost(struct cyc *y, int r)
+{
+	cyc_drop_write(y);
+	bus_abort(y->bus);
+	y->lost = r;
+	return cyc_finish(y, CYC_LOST);
+}
+
+void cyc_cut(struct cyc *y)
+{
+	if (y->phase == CYC_IDLE)
+		return;
+	cyc_drop_write(y);
+	if (bus_is_pending(y->bus))
+		y->errors++;
+	bus_abort(y->bus);
+	y->cut_off++;
+	(void)cyc_finish(y, CYC_DONE);
+}
+
+static int cyc_begin_read(struct cyc *y, uint8_t id, uint8_t addr, uint8_t len)
+{
+	uint8_t params[2] = { addr, len };
+	return bus_begin(y->bus, id, DXL_INST_READ, params, 2, len);
+}
+
+static int cyc_begin_write(struct cyc *y, const struct wq_write *w)
+{
+	uint8_t params[5] = { w->addr, (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8),
+	                      (uint8_t)(w->value >> 16), (uint8_t)(w->value >> 24) };
+	int reply = -1;
+	for (size_t j = 0; j < y->ctl->n; j++)
+		if (y->ctl->j[j].id == w->id && y->ctl->j[j].servo.status_return_level >= 2)
+			reply = 0;
+	return bus_begin(y->bus, w->id, DXL_INST_WRITE, params, (size_t)w->len + 1, reply);
+}
+
+/* Start the next transaction, skipping steps with nothing to do. */
+static enum cyc_status cyc_advance(struct cyc *y)
+{
+	for (;;) {
+		int r;
+		switch (y->phase) {
+		case CYC_IDLE:
+			return CYC_DONE;
+		case CYC_CONTROL_STEP:
+			return CYC_CONTROL;
+		case CYC_READ:
+			if (y->idx >= y->ctl->n) {
+				y->phase = CYC_CONTROL_STEP;
+				y->control_start_us = cyc_now(y);
+				return CYC_CONTROL;
+			}
+			r = cyc_begin_read(y, y->ctl->j[y->idx].id, DXL_AX_PRESENT_POSITION, y->read_len);
+			if (cyc_port_gone(r))
+				return cyc_lost(y, r);
+			if (r == DXL_OK && bus_is_pending(y->bus))
+				return CYC_PENDING;
+			cyc_error(y, y->ctl->j[y->idx].id, "READ", r);
+			y->idx++;
+			continue;
+		case CYC_WRITES: {
+			if (cyc_late(y)) {
+				/* the rest waits for the next cycle: the reads come first */
+				if (wq_pending(&y->ctl->wq) > 0)
+					y->deferred++;
+				return cyc_finish(y, CYC_DONE);
+			}
+			const struct wq_write *w = ctl_take_write(y->ctl);
+			if (w == NULL) {
+				y->phase = CYC_READBACK;
+				continue;
+			}
+			uint8_t id = w->id;
+			y->write_on_wire = true;
+			r = cyc_begin_write(y, w);
+			if (cyc_port_gone(r))
+				return cyc_lost(y, r);
+			if (r == DXL_OK && bus_is_pending(y->bus))
+				return CYC_PENDING;
+			y->write_on_wire = false;
+			if (r != DXL_OK)
+				cyc_error(y, id, "WRITE", r);
+			/* sent with no reply due (status return level < 2), or not sent */
+			ctl_write_result(y->ctl, r == DXL_OK);
+			continue;
+		}
+		case CYC_READBACK:
+			if (y->count % CYC_READBACK_EVERY != 0 || y->ctl->n == 0 || cyc_late(y))
+				return cyc_finish(y, CYC_DONE);
+			y->readback_joint = (y->readback_joint + 1) % y->ctl->n;
+			r = cyc_begin_read(y, y->ctl->j[y->readback_joint].id, CTL_READBACK_ADDR, CTL_READBACK_LEN);
+			if (cyc_port_gone(r))
+				return cyc_lost(y, r);
+			if (r == DXL_OK && bus_is_pending(y->bus))
+				return CYC_PENDING;
+			cyc_error(y, y->ctl->j[y->readback_joint].id, "READ(24)", r);
+			return cyc_finish(y, CYC_DONE);
+		}
+	}
+}
+
+enum cyc_status cyc_start(struct cyc *y)
+{
+	if (y->phase != CYC_IDLE)
+		cyc_cut(y);
+	y->count++;
+	y->phase = CYC_READ;
+	y->idx = 0;
+	y->start_us = cyc_now(y);
+	y->control_us = 0.0;
+	y->bus_us = 0.0;
+	y->read_len = (y->count & 1) ? 8 : 6;
+	return cyc_advance(y);
+}
+
+static void cyc_reading(struct cyc *y, const struct dxl_packet *p)
+{
+	size_t j = y->idx;
+	/* the position difference is over the time between this joint's own
+	 * replies: a timeout earlier in the cycle shifts them */
+	uint64_t now = cyc_now(y), last = y->read_at_us[j];
+	double dt = last != 0 && now > last ? 1e-6 * (double)(now - last) : 1e-6 * (double)y->period_us;
+	y->read_at_us[j] = now;
+	ctl_measure(y->ctl, j, dxl_get_u16(p->params), dxl_get_u16(p->params + 2), dxl_get_u16(p->params + 4),
+	            p->code, dt);
+	if (p->nparams == 8)
+		ctl_measure_slow(y->ctl, j, p->params[6], p->params[7], p->code);
+}
+
+enum cyc_status cyc_step(struct cyc *y)
+{
+	if (!bus_is_pending(y->bus))
+		return y->phase == CYC_IDLE ? CYC_DONE : y->phase == CYC_CONTROL_STEP ? CYC_CONTROL : CYC_PENDING;
+	struct dxl_packet reply;
+	int r = bus_step(y->bus, &reply);
+	if (r == BUS_PENDING)
+		return CYC_PENDING;
+	if (cyc_port_gone(r))
+		return cyc_lost(y, r);
+	switch (y->phase) {
+	case CYC_READ:
+		if (r == DXL_OK)
+			cyc_reading(y, &reply);
+		else
+			cyc_error(y, y->ctl->j[y->idx].id, "READ", r);
+		y->idx++;
+		break;
+	case CYC_WRITES: {
+		uint8_t id = y->bus->req_id;
+		bool ok = r == DXL_OK && (reply.code & CYC_WRITE_REFUSED) == 0;
+		if (r != DXL_OK)
+			cyc_error(y, id, "WRITE", r);
+		else if (!ok)
+			cyc_error(y, id, "WRITE refused by the servo (error byte with range, instruction or checksum)",
+			          DXL_OK);
+		y->write_on_wire = false;
+		ctl_write_result(y->ctl, ok);
+		break;
+	}
+	case CYC_READBACK:
+		if (r == DXL_OK) {
+			y->readbacks++;
+			ctl_readback(y->ctl, y->readback_joint, reply.params, reply.code);
+		} else {
+			cyc_error(y, y->ctl->j[y->readback_joint].id, "READ(24)", r);
+		}
+		return cyc_finish(y, CYC_DONE);
+	default:
+		break;
+	}
+	return cyc_advance(y);
+}
+
+enum cyc_status cyc_resume(struct cyc *y)
+{
+	if (y->phase != CYC_CONTROL_STEP)
+		return y->phase == CYC_IDLE ? CYC_DONE : CYC_PENDING;
+	y->control_us = (double)(cyc_now(y) - y->control_start_us);
+	y->phase = CYC_WRITES;
+	uint8_t addr, width, ids[CFG_MAX_JOINTS], data[4 * CFG_MAX_JOINTS], pkt[DXL_MAX_PACKET];
+	size_t n = ctl_sync(y->ctl, &addr, &width, ids, data);
+	if (n > 0) {
+		int len = dxl_encode_sync_write(pkt, sizeof pkt, addr, width, ids, data, n);
+		int r = len < 0 ? len : bus_send_raw(y->bus, pkt, (size_t)len);
+		if (cyc_port_gone(r))
+			return cyc_lost(y, r);
+		if (r != DXL_OK)
+			cyc_error(y, DXL_BROADCAST_ID, "SYNC_WRITE", r);
+	}
+	return cyc_advance(y);
+}

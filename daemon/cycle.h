@@ -1,0 +1,96 @@
+/*
+ * cycle.h — one control cycle's bus work, a state machine the daemon's
+ * poll() loop drives without ever blocking on the bus:
+ *
+ *   READ(36, n) of every joint ─→ CYC_CONTROL: the daemon applies commands
+ *   and runs the control step ─→ SYNC_WRITE of the goals (or duties) ─→ the
+ *   controller's register writes, one at a time, while the period allows ─→
+ *   every CYC_READBACK_EVERY cycles, while the period allows, one joint's
+ *   RAM block read back (ctl_readback) ─→ CYC_DONE.
+ *
+ * It owns only its progress through those steps. Readings go to the
+ * controller (ctl_measure, ctl_readback); writes come from it, one at a time
+ * (ctl_take_write), and every one taken is reported back (ctl_write_result):
+ * acknowledged, or failed — which includes a write cut off by the next tick,
+ * as it may or may not have reached the servo. Time comes only from the
+ * bus's clock seam (bus_io.now_us), so tests drive it with a fake transport
+ * and a fake clock (tests/unit/test_daemon_cycle.c).
+ *
+ * Late replies: each cycle asks for n = 6 or 8 bytes, alternately (8 adds
+ * voltage and temperature). A reply that arrives a whole period late — its
+ * request cut off by the tick — finds the next cycle asking the same servo
+ * for the other length and is refused as the wrong length, instead of being
+ * taken for this cycle's reading.
+ */
+#ifndef UNDULATE_DAEMON_CYCLE_H
+#define UNDULATE_DAEMON_CYCLE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "bus.h"
+#include "control.h"
+
+/* Read-back of one joint every CYC_READBACK_EVERY cycles, round-robin: each
+ * of two joints every 0.1 s at 100 Hz (a servo reset is found within that),
+ * for 340 µs of bus time at 1 Mbps. */
+#define CYC_READBACK_EVERY 5
+/* Past this share of the period no new write or read-back is begun: a
+ * transaction cut off by the next tick leaves its reply on the line. */
+#define CYC_LATE_SHARE 0.7
+
+enum cyc_status {
+	CYC_PENDING,    /* waiting for the bus: poll its fd until cyc_deadline_us() */
+	CYC_CONTROL,    /* the readings are in: run the control step, then cyc_resume() */
+	CYC_DONE,       /* the cycle's bus work is over */
+	CYC_LOST,       /* the port failed (cyc.lost says how): the cycle is over */
+};
+
+enum cyc_phase { CYC_IDLE, CYC_READ, CYC_CONTROL_STEP, CYC_WRITES, CYC_READBACK };
+
+struct cyc_hooks {
+	void *ctx;
+	/* a failed transaction (counted here too); the daemon logs it, rate-limited.
+	 * status is DXL_OK when the servo answered but refused (`what` says so). */
+	void (*bus_error)(void *ctx, uint8_t id, const char *what, int status);
+};
+
+struct cyc {
+	struct bus *bus;
+	struct ctl *ctl;
+	struct cyc_hooks hooks;
+	uint64_t period_us;
+	enum cyc_phase phase;
+	size_t idx;                   /* joint being read */
+	bool write_on_wire;           /* a write taken from the controller is pending */
+	size_t readback_joint;
+	uint64_t count;               /* cycles started */
+	uint8_t read_len;             /* this cycle's READ length, 6 or 8 */
+	uint64_t start_us;            /* this cycle's start (the tick) */
+	uint64_t control_start_us;
+	uint64_t read_at_us[CFG_MAX_JOINTS];   /* when each joint's last reply arrived */
+	int lost;                     /* dxl_status of CYC_LOST */
+	/* this cycle's figures (valid at CYC_DONE / CYC_LOST) */
+	double bus_us, control_us;
+	/* counters */
+	long long errors, cut_off, deferred, readbacks;
+};
+
+void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks);
+/* Start a cycle (the timer ticked). The previous cycle must be over (see
+ * cyc_cut). Returns PENDING, CONTROL, DONE or LOST. */
+enum cyc_status cyc_start(struct cyc *y);
+/* The bus fd is readable, or its deadline passed: drive the pending
+ * transaction and whatever follows it. */
+enum cyc_status cyc_step(struct cyc *y);
+/* After CYC_CONTROL, once the control step ran: send its outputs. */
+enum cyc_status cyc_resume(struct cyc *y);
+/* A cycle is under way (not idle). */
+bool cyc_busy(const struct cyc *y);
+/* End the cycle under way now: the next tick came first, or the daemon stops
+ * or lost the port. A write on the wire is reported failed (sent again). */
+void cyc_cut(struct cyc *y);
+/* The deadline of the pending transaction (monotonic µs), 0 if none. */
+uint64_t cyc_deadline_us(const struct cyc *y);
+
+#endif

@@ -1,0 +1,65 @@
+/*
+ * publish.h — what a robot tells the LCM network: <robot>.STATE every cycle,
+ * .BUS once a second, .PARAMS when they change (and once a second), .EVENT
+ * when something happens. Publish only: the daemon never subscribes, so LCM
+ * opens no receive socket in it (commands come in through cmdin.h).
+ * Messages are encoded into one buffer allocated at start-up (lcm-gen's
+ * _publish helpers allocate per message). Text that reaches an event is
+ * sanitized here, whatever produced it.
+ */
+#ifndef UNDULATE_DAEMON_PUBLISH_H
+#define UNDULATE_DAEMON_PUBLISH_H
+
+#include <lcm/lcm.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "bus.h"
+#include "config.h"
+#include "control.h"
+#include "log.h"
+#include "undulate_joint_state_t.h"
+#include "undulate_servo_stats_t.h"
+
+/* Encode buffer: a robot_state_t of 24 joints is ~2.4 kB, a bus_stats_t ~2 kB. */
+#define PUB_ENCODE_CAP 16384
+#define PUB_CHANNEL_MAX (CFG_NAME_MAX + 16)
+
+/* One cycle's figures for the state message. */
+struct pub_cycle {
+	int64_t cycle;
+	double period_us, jitter_us, bus_us, control_us;
+	long long overruns, bus_errors, bad_commands;
+};
+
+/* Once a second, for the bus message. */
+struct pub_bus {
+	const char *port;
+	bool connected;
+	long long reconnects, overruns;
+	double adapter_latency_ms;
+	int return_delay_us;
+	double period_p50_us, period_p99_us, period_max_us, jitter_p99_us, bus_p99_us, cpu_percent;
+};
+
+struct pub {
+	lcm_t *lcm;
+	const struct cfg *cfg;
+	uint8_t *buf;
+	char ch_state[PUB_CHANNEL_MAX], ch_bus[PUB_CHANNEL_MAX], ch_params[PUB_CHANNEL_MAX],
+	     ch_event[PUB_CHANNEL_MAX];
+	undulate_joint_state_t js[CFG_MAX_JOINTS];
+	undulate_servo_stats_t ss[CFG_MAX_JOINTS];
+	struct log_limit lim_encode;
+	long long events, encode_failures;
+};
+
+/* False with *why (LCM could not be created for the URL). */
+bool pub_open(struct pub *p, const struct cfg *cfg, char *why, size_t cap);
+void pub_close(struct pub *p);
+void pub_event(struct pub *p, int64_t seq, int level, const char *kind, const char *text);
+void pub_state(struct pub *p, const struct ctl *c, const struct pub_cycle *f);
+void pub_params(struct pub *p);
+void pub_bus(struct pub *p, const struct pub_bus *f, const struct bus *bus, const struct ctl *c);
+
+#endif

@@ -1,0 +1,42 @@
+/*
+ * setup.h — the blocking bus work around the loop: start-up checks at every
+ * (re)connect, and the safe stop at exit. Blocking is right here: start-up
+ * has no cycle to keep yet, and the stop is the last thing the daemon does.
+ *
+ * Start-up: every servo answers a PING (a missing one is named), its
+ * settings are read (model, angle limits, max torque, return delay, status
+ * return level) and handed to the controller (ctl_set_servo), a servo left in
+ * wheel mode by a torque-actuated run is put back in joint mode, the
+ * compliance margins and moving speed (RAM: a power loss resets them) are
+ * written, and every joint's present position is read. Lost replies are
+ * retried (a loaded machine); a port that goes away is not.
+ *
+ * Safe stop: any wheel-mode drive is stopped and joint mode restored, then
+ * the robot is left as configured (safe_stop: holding where it is, or limp),
+ * and what matters is read back: a torque-off that did not take is said.
+ */
+#ifndef UNDULATE_DAEMON_SETUP_H
+#define UNDULATE_DAEMON_SETUP_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "bus.h"
+#include "control.h"
+
+/* Tries of a start-up transaction before a servo is called missing. */
+#define SETUP_TRIES 3
+
+/* Every start-up check; *max_return_delay_us gets the largest return delay
+ * found (for the bus timeouts). False with *err (one line, with the command
+ * that fixes it where there is one). */
+bool setup_servos(struct bus *bus, struct ctl *ctl, const struct cfg *cfg, const char *port_path,
+                  int *max_return_delay_us, char *err, size_t cap);
+/* Reads every joint's present position, speed and load into the controller. */
+bool setup_read_present(struct bus *bus, struct ctl *ctl, double dt, char *err, size_t cap);
+/* Leaves the configured safe state on the bus (LIMP when the robot is limp
+ * already: writing goals could bring torque back). Logs what it did and
+ * what failed. */
+void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg);
+
+#endif

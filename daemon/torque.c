@@ -1,0 +1,181 @@
+/*
+ * torque.c — torque actuation: OSCILLATOR drives the law's torque itself
+ * through the servo's wheel mode (the paper's torque-controlled pair rig;
+ * CONTROL.md), on the AX-12's PWM drive (back-EMF added back) or on a
+ * current-controlled drive. Part of the controller (control_priv.h).
+ *
+ * The servos go into wheel mode only for a running OSCILLATOR whose joints are
+ * all healthy, torqued and measured; everything else (starter, HOLD, SINUSOID,
+ * faults, LIMP) runs in joint mode, where the servo itself holds positions and
+ * enforces its angle limits.
+ */
+#include <math.h>
+#include <stdio.h>
+
+#include "control_priv.h"
+#include "dxl.h"
+#include "dxl_table.h"
+
+/* A virtual spring pushes a joint back from TQ_WALL_MARGIN inside either
+ * limit, reaching the stall torque at the limit itself, with TQ_WALL_DAMPING
+ * against moving outwards; past the limit the robot falls back to
+ * fault_action in joint mode, where the servo enforces its limits. */
+#define TQ_WALL_MARGIN 0.15
+#define TQ_WALL_DAMPING 0.1
+/* Supply assumed for the PWM drive until the servo's voltage is read (V). */
+#define TQ_NOMINAL_VOLTAGE 12.0
+
+bool tq_want_wheel(const struct ctl *c)
+{
+	if (c->cfg->actuation != CFG_ACT_TORQUE || c->mode != CFG_MODE_OSCILLATOR || c->starter_active ||
+	    c->latched)
+		return false;
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
+		if (jt->fault != CTL_FAULT_NONE || !jt->torque || !jt->have_reading || jt->limits.max_step <= 0.0)
+			return false;
+	}
+	return true;
+}
+
+void tq_check_limits(struct ctl *c)
+{
+	if (!c->wheel)
+		return;
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
+		if (!jt->fresh || (jt->angle >= jt->limits.lo && jt->angle <= jt->limits.hi))
+			continue;
+		c->limit_trips++;
+		double neutral = c->cfg->joint[j].neutral;
+		char what[CTL_LATCH_TEXT];
+		snprintf(what, sizeof what, "servo %u at %+.3f rad left its limits [%+.3f, %+.3f] under torque actuation",
+		         jt->id, jt->angle - neutral, jt->limits.lo - neutral, jt->limits.hi - neutral);
+		ctl_event(c, 2, "limit", "%s: robot %s in joint mode", what,
+		          cfg_mode_name(c->cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD));
+		/* HOLD where it is: the safety clamp puts the goal inside the limits */
+		ctl_latch(c, what);
+		return;
+	}
+}
+
+/* The virtual spring near a limit (N·m), on top of the law's torque. */
+static double tq_wall(const struct ctl_joint *jt, double stall)
+{
+	double k = stall / TQ_WALL_MARGIN;
+	double over_hi = jt->angle - (jt->limits.hi - TQ_WALL_MARGIN);
+	double over_lo = (jt->limits.lo + TQ_WALL_MARGIN) - jt->angle;
+	if (over_hi > 0.0)
+		return -k * over_hi - TQ_WALL_DAMPING * fmax(jt->speed, 0.0);
+	if (over_lo > 0.0)
+		return k * over_lo - TQ_WALL_DAMPING * fmin(jt->speed, 0.0);
+	return 0.0;
+}
+
+/* Output ratio that makes the drive deliver `tau` at speed v: a PWM drive
+ * loses tau_stall(V)/w0(V) per rad/s to back-EMF (voltage-independent), so
+ * that is added back; a current drive delivers duty × stall torque. Capped by
+ * the servo's max torque, as the torque limit caps it in the servo. */
+static double tq_duty(const struct ctl *c, const struct ctl_joint *jt, double tau)
+{
+	const struct cfg *cfg = c->cfg;
+	double cap = jt->servo.max_torque / 1023.0;
+	double u;
+	if (cfg->torque_drive == CFG_DRIVE_CURRENT) {
+		u = tau / cfg->stall_torque;
+	} else {
+		double volts = isfinite(jt->voltage) && jt->voltage > 1.0 ? jt->voltage : TQ_NOMINAL_VOLTAGE;
+		double stall = cfg->stall_torque * volts / TQ_NOMINAL_VOLTAGE;
+		double w0 = cfg->no_load_speed * volts / TQ_NOMINAL_VOLTAGE;
+		u = tau / stall + jt->speed / w0;
+	}
+	return isfinite(u) ? fmax(-cap, fmin(cap, u)) : 0.0;
+}
+
+void tq_duties(struct ctl *c)
+{
+	double x[CFG_MAX_JOINTS], v[CFG_MAX_JOINTS], tau[CFG_MAX_JOINTS];
+	struct osc_joint_params p[CFG_MAX_JOINTS];
+	for (size_t j = 0; j < c->n; j++) {
+		p[j] = c->cfg->joint[j].osc;
+		x[j] = c->j[j].angle - c->cfg->joint[j].neutral;
+		v[j] = c->j[j].fresh ? c->j[j].speed : 0.0;
+	}
+	if (!osc_torque(p, c->n, x, v, tau))
+		c->nonfinite++;
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		jt->write_goal = false;
+		jt->clamp_flags = 0;
+		jt->goal = NAN;
+		if (!jt->fresh) {
+			/* no reading, no law: the joint coasts until it answers again */
+			jt->torque_cmd = 0.0;
+			jt->duty = 0.0;
+			continue;
+		}
+		double wall = tq_wall(jt, c->cfg->stall_torque);
+		if (wall != 0.0) {
+			jt->clamp_flags = SAFETY_LIMIT;
+			c->clamps++;
+		}
+		jt->torque_cmd = tau[j] + wall;
+		jt->duty = tq_duty(c, jt, jt->torque_cmd);
+	}
+}
+
+/* The angle limits are EEPROM, which the AX-12A writes only with torque off:
+ * torque off, both limits in one 4-byte write (the servo never sees a
+ * half-set pair), torque on again. The joint coasts for the ~1 ms this takes
+ * on the bus (a real servo is then busy ~6 ms per EEPROM byte: its next
+ * replies may be missed, which the loop takes as stale cycles). */
+static void tq_switch_limits(struct ctl *c, size_t j, uint32_t limits, bool torque_after)
+{
+	uint8_t id = c->j[j].id;
+	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 0);
+	ctl_write_seq(c, id, DXL_AX_CW_ANGLE_LIMIT, 4, limits);
+	if (!torque_after)
+		return;
+	/* Torque on the manual's way, the torque limit first: enabling torque
+	 * clears a latched overload bit, so an alarm shutdown that zeroed the
+	 * torque limit since the last reading would otherwise never be seen, and
+	 * the joint would stay without drive. */
+	ctl_write_seq(c, id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, &c->j[j]));
+	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
+}
+
+void tq_enter_wheel(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++)
+		tq_switch_limits(c, j, 0, true);
+	c->wheel = true;
+	ctl_event(c, 0, "actuation", "torque actuation: servos in wheel mode, the law drives their torque");
+}
+
+void tq_leave_wheel(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		tq_switch_limits(c, j, ctl_joint_mode_limits(c, j), jt->torque && c->mode != CFG_MODE_LIMP);
+		/* position modes start where the joint is, with no step bound from a
+		 * goal it never had */
+		jt->goal = NAN;
+		ctl_blend_joint(c, j, jt->angle);
+	}
+	c->wheel = false;
+	c->sync = CTL_SYNC_GOAL_STOP;
+	ctl_event(c, 0, "actuation", "torque actuation: servos back in joint mode (%s)", cfg_mode_name(c->mode));
+}
+
+void tq_stop_goals(struct ctl *c)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		jt->duty = NAN;
+		jt->torque_cmd = NAN;
+		if (jt->write_goal || !jt->have_reading || jt->limits.max_step <= 0.0)
+			continue;
+		jt->goal = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
+		jt->write_goal = true;
+	}
+}
