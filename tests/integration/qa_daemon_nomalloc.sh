@@ -17,8 +17,8 @@ if ldd "$D" | grep -q 'libasan\|libtsan'; then
 	echo "ok 1 # SKIP sanitizer build: the malloc shim needs the C library's allocator"; echo "1..1"; exit 0
 fi
 command -v cc >/dev/null || { echo "ok 1 # SKIP no C compiler"; echo "1..1"; exit 0; }
-PORT=7953
-URL=$(lcm_url $PORT)
+PORT=$(lcm_port 7953)   # the UDP port itself: qa_lcm.py talks to it raw
+URL=$(lcm_url 7953)
 R="qa$$"
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 last_state() { grep -a "^STATE $R " "$T/watch.log" | tail -1; }
