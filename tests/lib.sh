@@ -1,6 +1,9 @@
 # tests/lib.sh — shared by the integration tests (source it).
 #
 #   tap_ok NAME / tap_fail NAME [WHY] / tap_check NAME CMD...   -> TAP lines
+#   tap_skip NAME WHY      a check that cannot run here ("ok N - NAME # SKIP WHY")
+#   tap_skip_all WHY       the whole script cannot run here: skip, plan, exit 0
+#   tap_done               the plan (1..N); fails the script if a check failed
 #   spawn NAME CMD...      start a background process; its PID is remembered
 #                          and killed by the EXIT trap; stdout+stderr -> $T/NAME.log
 #   wait_for TIMEOUT_S CMD...   poll (every 20 ms) until CMD succeeds
@@ -66,6 +69,15 @@ tap_todo() {
 	[ $# -gt 1 ] && echo "# ${2//$'\n'/$'\n'# }"
 	return 0
 }
+# tap_skip NAME WHY: a check that cannot run on this machine (a program not
+# built, a tool not installed): counted as a skip by tests/run.sh, never as a pass.
+tap_skip() {
+	_tap_n=$((_tap_n + 1))
+	echo "ok $_tap_n - $1 # SKIP${2:+ $2}"
+}
+# tap_skip_all WHY: the whole script cannot run here: one skip named after
+# the script, its plan, exit 0.
+tap_skip_all() { tap_skip "$(basename "$0" .sh)" "$1"; tap_done; exit 0; }
 tap_check() { local name=$1; shift; if "$@"; then tap_ok "$name"; else tap_fail "$name" "command failed: $*"; fi; }
 tap_done() { echo "1..$_tap_n"; [ "$_tap_failed" -eq 0 ]; }
 

@@ -9,7 +9,7 @@
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; TOP="$B/undulate-top"; A="$B/undulate-analyze"; Q="$top/tests/integration/qa_lcm.py"
 for p in "$D" "$TOP" "$A"; do
-	[ -x "$p" ] || { echo "ok 1 # SKIP $(basename "$p") not built"; echo "1..1"; exit 0; }
+	[ -x "$p" ] || tap_skip_all "$(basename "$p") not built"
 done
 PORT=$(lcm_port 7955)   # the UDP port itself: the sender below talks to it raw
 URL=$(lcm_url 7955)
