@@ -1,20 +1,39 @@
 # tests/lib.sh — shared by the integration tests (source it).
 #
 #   tap_ok NAME / tap_fail NAME [WHY] / tap_check NAME CMD...   -> TAP lines
+#   tap_skip NAME WHY      a check that cannot run here ("ok N - NAME # SKIP WHY")
+#   tap_skip_all WHY       the whole script cannot run here: skip, plan, exit 0
+#   tap_done               the plan (1..N); fails the script if a check failed
 #   spawn NAME CMD...      start a background process; its PID is remembered
 #                          and killed by the EXIT trap; stdout+stderr -> $T/NAME.log
 #   wait_for TIMEOUT_S CMD...   poll (every 20 ms) until CMD succeeds
 #   wait_log NAME REGEX [TIMEOUT_S]  poll a spawned process's log for a line
-#   lcm_url PORT           udpm URL on its own multicast port, ttl=0
+#   lcm_url PORT           udpm URL on multicast port PORT + $TEST_PORT_OFFSET, ttl=0
+#   lcm_port PORT          that port number alone (for raw sockets, /proc/net/udp)
 #
 # Every test uses its own multicast port so tests never hear each other.
 # Port ranges: protocol 7600-7649, sim 7650-7699, daemon 7700-7749,
-# tools 7750-7799, systemd 7800-7849, end-to-end 7850-7899, bench 7900-7949.
+# tools 7750-7799, systemd 7800-7849, end-to-end 7850-7899, bench 7900-7949,
+# hostile-input QA 7950-7999. Tests name the port in these ranges and take it
+# through lcm_url / lcm_port, never "udpm://..." by hand.
+#
+# TEST_PORT_OFFSET (default 0) is added to every port, so two copies of the
+# suite can run on one machine without hearing each other: give each copy its
+# own offset, 400 or more apart (the ranges above span 7600-7999), e.g.
+# TEST_PORT_OFFSET=400 make test. The unit tests that use LCM read it too.
 set -u
 top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BUILD=${BUILD:-$top/build}
 case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
 B="$BUILD/bin"
+TEST_PORT_OFFSET=${TEST_PORT_OFFSET:-0}
+# Checked here, once: a bad offset inside $(lcm_url ...) could not stop the test.
+if ! [[ "$TEST_PORT_OFFSET" =~ ^[0-9]{1,5}$ ]] || [ $((10#$TEST_PORT_OFFSET)) -gt 57000 ]; then
+	echo "lib.sh: TEST_PORT_OFFSET must be a whole number from 0 to 57000 (ports reach 7999 + offset), not '$TEST_PORT_OFFSET'" >&2
+	exit 2
+fi
+TEST_PORT_OFFSET=$((10#$TEST_PORT_OFFSET))
+export TEST_PORT_OFFSET
 T=$(mktemp -d "${TMPDIR:-/tmp}/undulate-test.XXXXXX")
 # Each test's daemons put their local command sockets here, and
 # `undulated --command` looks for them here: tests never command each other.
@@ -53,6 +72,15 @@ tap_todo() {
 	[ $# -gt 1 ] && echo "# ${2//$'\n'/$'\n'# }"
 	return 0
 }
+# tap_skip NAME WHY: a check that cannot run on this machine (a program not
+# built, a tool not installed): counted as a skip by tests/run.sh, never as a pass.
+tap_skip() {
+	_tap_n=$((_tap_n + 1))
+	echo "ok $_tap_n - $1 # SKIP${2:+ $2}"
+}
+# tap_skip_all WHY: the whole script cannot run here: one skip named after
+# the script, its plan, exit 0.
+tap_skip_all() { tap_skip "$(basename "$0" .sh)" "$1"; tap_done; exit 0; }
 tap_check() { local name=$1; shift; if "$@"; then tap_ok "$name"; else tap_fail "$name" "command failed: $*"; fi; }
 tap_done() { echo "1..$_tap_n"; [ "$_tap_failed" -eq 0 ]; }
 
@@ -87,7 +115,8 @@ wait_for() {
 }
 wait_log() { wait_for "${3:-10}" grep -qE "$2" "$T/$1.log"; }
 
-lcm_url() { echo "udpm://239.255.76.67:$1?ttl=0"; }
+lcm_port() { echo $(( $1 + TEST_PORT_OFFSET )); }
+lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }
 
 # ---- reading an experiment's analysis (scripts/demo.sh --out DIR) -------------------
 # min_swing DIR: the smallest peak-to-peak angle (rad) of any robot's joint

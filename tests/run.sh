@@ -1,72 +1,165 @@
 #!/usr/bin/env bash
-# Runs every test and ends with one line: "N passed, N failed".
-#  - unit tests: $BUILD/tests/test_* (cmocka, TAP output)
-#  - integration tests: tests/integration/*.sh (TAP lines: "ok ..." / "not ok ...")
-#  - with TEST_LONG=1: tests/long/*.sh as well
-# A test program that crashes or exits non-zero without printing "not ok" counts
-# as one failure, so nothing can fail silently.
+# Runs every test and ends with one line: "N passed, N failed, N skipped".
+#  - unit tests: $UNIT_TESTS_DIR/test_* (default $BUILD/tests; cmocka, TAP output)
+#  - integration tests: $INTEGRATION_TESTS_DIR/*.sh (default tests/integration;
+#    TAP lines: "ok ..." / "not ok ...", and a plan "1..N")
+#  - with TEST_LONG=1: $LONG_TESTS_DIR/*.sh (default tests/long) as well
+# Environment: TEST_FILTER (run the programs whose name contains it),
+# TEST_TIMEOUT (seconds one program may run, default 300; a hang is a failure).
+# Logs: $BUILD/test-logs/<program>.log.
+#
+# What counts (TAP):
+#  - "ok N - name" passes; "not ok N - name" fails.
+#  - "# SKIP" after a result, "ok" or "not ok" (cmocka 1.1 writes a skip() as
+#    "not ok N # SKIP name"), is a skip; a plan "1..0 # SKIP why" with no
+#    result skips the whole program.
+#  - "not ok ... # TODO" is a known unmet claim, counted apart (not a pass,
+#    not a failure).
+# On top of what a program prints, the runner counts one failure for a program
+# that exits non-zero without a "not ok", prints no result, prints results but
+# no plan, or whose plans (a plan at its start or end; cmocka prints one per
+# group, and they add up) disagree with the number of results it printed.
+# So nothing can fail, stop early or run half its tests silently.
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/.." && pwd)
 BUILD=${BUILD:-build}
 case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
 export BUILD
+unit_dir=${UNIT_TESTS_DIR:-$BUILD/tests}
+integration_dir=${INTEGRATION_TESTS_DIR:-$top/tests/integration}
+long_dir=${LONG_TESTS_DIR:-$top/tests/long}
 logs="$BUILD/test-logs"
 mkdir -p "$logs"
 # One test may not run longer than this (seconds); a hang is a failure.
 per_test_timeout=${TEST_TIMEOUT:-300}
 filter=${TEST_FILTER:-}
 
-passed=0 failed=0 todo=0
+passed=0 failed=0 skipped=0 todo=0 programs=0
 failures=()
 todos=()
+skips=()
+
+# tap_counts LOG: "passed failed skipped todo plans planned plan_skip" of a TAP log.
+tap_counts() {
+	awk '
+		function directive(word) { return tolower($0) ~ ("#[ \t]*" word) }
+		/^(not )?ok([ \t]|$)/ {
+			if (directive("skip")) s++
+			else if (/^not ok/ && directive("todo")) t++
+			else if (/^not ok/) f++
+			else p++
+			next
+		}
+		/^1\.\.[0-9]+/ {
+			plans++
+			planned += substr($1, 4)
+			if (substr($1, 4) + 0 == 0 && directive("skip")) plan_skip = 1
+		}
+		END { printf "%d %d %d %d %d %d %d\n", p, f, s, t, plans, planned, plan_skip }
+	' "$1"
+}
+
+# exit_reason RC SECONDS: what a non-zero exit status means, in words.
+exit_reason() {
+	local rc=$1 secs=$2
+	if [ "$rc" -eq 124 ] || { [ "$rc" -eq 137 ] && [ "$secs" -ge "$per_test_timeout" ]; }; then
+		echo "timed out after ${per_test_timeout}s (TEST_TIMEOUT)"
+	elif [ "$rc" -gt 128 ]; then
+		echo "killed by signal $((rc - 128)) (exit status $rc)"
+	else
+		echo "exited with status $rc"
+	fi
+}
+
+# tap_lines LOG NAME PATTERN: the log's result lines matching PATTERN, as
+# "NAME: description" (the "ok N - " in front dropped).
+tap_lines() {
+	grep -E "$3" "$1" | sed -E "s/^(not )?ok[[:space:]]*[0-9]*[[:space:]]*(- )?/$2: /"
+}
+
+# faults RC SECONDS FAILED RESULTS PLANS PLANNED PLAN_SKIP: what the runner
+# finds wrong with a program beyond its own "not ok" lines, as "a; b", or "".
+faults() {
+	local rc=$1 secs=$2 f=$3 results=$4 plans=$5 planned=$6 plan_skip=$7
+	local why=()
+	if [ "$rc" -ne 0 ]; then
+		# a "not ok" explains a non-zero exit; nothing explains a crash without one
+		[ "$f" -eq 0 ] && why+=("$(exit_reason "$rc" "$secs")")
+	elif [ "$results" -eq 0 ] && [ "$plan_skip" -eq 0 ]; then
+		why+=("ran no test")
+	fi
+	if [ "$results" -gt 0 ] && [ "$plans" -eq 0 ]; then
+		why+=("printed $results result(s) but no plan (1..N)")
+	elif [ "$plans" -gt 0 ] && [ "$planned" -ne "$results" ]; then
+		why+=("plan says $planned test(s), printed $results result(s)")
+	fi
+	# a program that stopped early shows it in its plan: say why it stopped
+	[ "${#why[@]}" -gt 0 ] && [ "$rc" -ne 0 ] && [ "$f" -gt 0 ] && why+=("$(exit_reason "$rc" "$secs")")
+	local out="" w
+	for w in "${why[@]}"; do out+="${out:+; }$w"; done
+	echo "$out"
+}
 
 run_one() {
 	local name=$1; shift
 	local log="$logs/$name.log"
 	[ -n "$filter" ] && [[ "$name" != *$filter* ]] && return
+	programs=$((programs + 1))
 	local start=$(date +%s%N)
 	CMOCKA_MESSAGE_OUTPUT=TAP timeout --kill-after=10 "$per_test_timeout" "$@" >"$log" 2>&1
 	local rc=$?
-	local p f t
-	p=$(grep -c '^ok ' "$log")
-	# TAP "# TODO": a known unmet claim, counted apart (not a pass, not a failure)
-	t=$(grep -c '^not ok .*# TODO' "$log")
-	f=$(( $(grep -c '^not ok ' "$log") - t ))
-	if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
-		f=1
-		echo "not ok - $name exited with status $rc" >>"$log"
-	fi
-	if [ "$rc" -eq 0 ] && [ "$p" -eq 0 ] && [ "$f" -eq 0 ]; then
-		f=1
-		echo "not ok - $name ran no test" >>"$log"
-	fi
-	passed=$((passed + p)); failed=$((failed + f)); todo=$((todo + t))
-	local line
-	while IFS= read -r line; do todos+=("$line"); done \
-		< <(grep '^not ok .*# TODO' "$log" | sed "s/^not ok [0-9]* - /$name: /; s/ # TODO.*//")
 	local ms=$(( ($(date +%s%N) - start) / 1000000 ))
+	local p f s t plans planned plan_skip
+	read -r p f s t plans planned plan_skip < <(tap_counts "$log")
+	local results=$((p + f + s + t))
+	if [ "$results" -eq 0 ] && [ "$plan_skip" -eq 1 ]; then
+		s=1
+		skips+=("$name: $(grep -m1 -E '^1\.\.0' "$log" | sed -E 's/^1\.\.0[[:space:]]*#[[:space:]]*[Ss][Kk][Ii][Pp][[:alpha:]]*[[:space:]]*//')")
+	fi
+	local reason
+	reason=$(faults "$rc" "$((ms / 1000))" "$f" "$results" "$plans" "$planned" "$plan_skip")
+	if [ -n "$reason" ]; then
+		f=$((f + 1))
+		echo "not ok - $name: $reason" >>"$log"
+	fi
+
+	passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + s)); todo=$((todo + t))
+	local line
+	while IFS= read -r line; do todos+=("${line% # [Tt][Oo][Dd][Oo]*}"); done \
+		< <(tap_lines "$log" "$name" '^not ok.*#[[:space:]]*[Tt][Oo][Dd][Oo]' | grep -viE '#[[:space:]]*skip')
+	while IFS= read -r line; do skips+=("$line"); done \
+		< <(tap_lines "$log" "$name" '^(not )?ok([[:space:]]|$).*#[[:space:]]*[Ss][Kk][Ii][Pp]')
+	[ "$f" -gt 0 ] && failures+=("$name${reason:+: $reason}")
+	show "$name" "$log" "$ms" "$p" "$f" "$s" "$t"
+}
+
+# show NAME LOG MS PASSED FAILED SKIPPED TODO: the program's line, and on a
+# failure its "not ok" and comment lines.
+show() {
+	local name=$1 log=$2 ms=$3 p=$4 f=$5 s=$6 t=$7 extra=""
 	local secs="$((ms / 1000)).$(( (ms % 1000) / 100 ))"
+	[ "$s" -gt 0 ] && extra+=", $s skipped"
+	[ "$t" -gt 0 ] && extra+=", $t todo"
 	if [ "$f" -gt 0 ]; then
-		failures+=("$name")
-		printf '%-40s %3d passed, %3d FAILED  (%ss)\n' "$name" "$p" "$f" "$secs"
-		grep -E '^not ok|^#' "$log" | head -20 | sed 's/^/    /'
+		printf '%-40s %3d passed, %3d FAILED%s  (%ss)\n' "$name" "$p" "$f" "$extra" "$secs"
+		grep -E '^not ok|^#' "$log" | grep -viE '^(not )?ok.*#[[:space:]]*(skip|todo)' | head -20 | sed 's/^/    /'
 		echo "    (full log: $log)"
 	else
-		printf '%-40s %3d passed%s  (%ss)\n' "$name" "$p" "$([ "$t" -gt 0 ] && echo ", $t todo")" "$secs"
+		printf '%-40s %3d passed%s  (%ss)\n' "$name" "$p" "$extra" "$secs"
 	fi
 }
 
-for t in "$BUILD"/tests/test_*; do
-	[ -x "$t" ] || continue
+for t in "$unit_dir"/test_*; do
+	[ -f "$t" ] && [ -x "$t" ] || continue
 	run_one "$(basename "$t")" "$t"
 done
-for t in "$top"/tests/integration/*.sh; do
+for t in "$integration_dir"/*.sh; do
 	[ -f "$t" ] || continue
 	run_one "$(basename "$t" .sh)" bash "$t"
 done
 if [ -n "${TEST_LONG:-}" ]; then
-	for t in "$top"/tests/long/*.sh; do
+	for t in "$long_dir"/*.sh; do
 		[ -f "$t" ] || continue
 		run_one "$(basename "$t" .sh)" bash "$t"
 	done
@@ -77,5 +170,16 @@ if [ "$todo" -gt 0 ]; then
 	echo "$todo known unmet claim(s) (TAP TODO, not counted; see docs/EXPERIMENTS.md):"
 	printf '  %s\n' "${todos[@]}"
 fi
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+if [ "${#skips[@]}" -gt 0 ]; then
+	echo "$skipped skipped:"
+	printf '  %s\n' "${skips[@]}"
+fi
+if [ "${#failures[@]}" -gt 0 ]; then
+	echo "failed in ${#failures[@]} program(s):"
+	printf '  %s\n' "${failures[@]}"
+fi
+if [ "$programs" -eq 0 ]; then
+	echo "no test program ran (TEST_FILTER='$filter'; unit tests from $unit_dir, integration tests from $integration_dir)"
+fi
+echo "$passed passed, $failed failed, $skipped skipped"
+[ "$failed" -eq 0 ] && [ "$programs" -gt 0 ]

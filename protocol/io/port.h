@@ -67,6 +67,8 @@ const struct port_latency *port_get_latency(const struct port *p);
 void port_latency_check_fd(const char *path, int fd, bool lower, struct port_latency *out);
 
 /* ---- low-level helpers (used by both backends; exposed for tests) ------------ */
+/* Where sysfs is: $UNDULATE_SYSFS_ROOT when set (tests), else "/sys". */
+const char *port_sysfs_root(void);
 /* Put a tty fd in raw 8N1 mode, no flow control, receiver on, modem lines
  * ignored, keeping its speed. DXL_OK or DXL_E_IO (errno kept). */
 int port_termios_raw(int fd);
@@ -89,7 +91,10 @@ struct port_info {
 	const char *adapter;        /* "U2D2", "USB2Dynamixel", "USB2AX" or NULL */
 };
 /* Fill up to cap entries; returns the number of ports found (may exceed cap),
- * or a negative dxl_status. */
+ * or a negative dxl_status. Linux lists ttys in sysfs (<sysfs root>/class/tty):
+ * without it (a container with no /sys) there is nothing to enumerate and
+ * the answer is 0 ports, not an error. libserialport itself always reads /sys;
+ * the root only decides whether there is a sysfs to list from. */
 int port_list(struct port_info *out, size_t cap);
 /* Name of a known Dynamixel adapter for a VID:PID, or NULL. */
 const char *port_adapter_name(int vid, int pid);

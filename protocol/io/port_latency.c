@@ -42,7 +42,7 @@ static void port_note(struct port_latency *out, const char *fmt, ...)
 	va_end(ap);
 }
 
-static const char *port_sysfs_root(void)
+const char *port_sysfs_root(void)
 {
 	const char *root = getenv("UNDULATE_SYSFS_ROOT");
 

@@ -3,8 +3,10 @@
  * Dynamixel USB adapters named so a user can tell which port is the bus.
  */
 #include <libserialport.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "port.h"
 
@@ -49,11 +51,29 @@ static void port_info_fill(struct sp_port *sp, struct port_info *info)
 	snprintf(info->serial, sizeof info->serial, "%s", serial != NULL ? serial : "");
 }
 
+/* Room for "<root>/class/tty". */
+#define PORT_TTY_CLASS_PATH_MAX 512
+
+/* libserialport fails the whole listing when it cannot open /sys/class/tty;
+ * a system without that directory has no tty the kernel could name to us. */
+static bool port_have_tty_class(void)
+{
+	char dir[PORT_TTY_CLASS_PATH_MAX];
+	struct stat st;
+	int len = snprintf(dir, sizeof dir, "%s/class/tty", port_sysfs_root());
+
+	if (len < 0 || (size_t)len >= sizeof dir)
+		return true; /* a root we cannot name: let libserialport report */
+	return stat(dir, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
 int port_list(struct port_info *out, size_t cap)
 {
 	struct sp_port **ports = NULL;
 	int n = 0;
 
+	if (!port_have_tty_class())
+		return 0;
 	if (sp_list_ports(&ports) != SP_OK)
 		return DXL_E_IO;
 	for (; ports[n] != NULL; n++)

@@ -3,8 +3,8 @@
 # lcm-logger from replayed synthetic traffic (known phases and collisions),
 # plots, and the exit codes for missing, foreign and truncated logs.
 . "$(dirname "$0")/../lib.sh"
-port=7752
-url=$(lcm_url $port)
+port=$(lcm_port 7752)   # the UDP port itself, to find in /proc/net/udp
+url=$(lcm_url 7752)
 A="$B/undulate-analyze"
 
 tap_check "--synth writes a log" bash -c "'$A' --synth '$T/s.log' --duration 13 >/dev/null"

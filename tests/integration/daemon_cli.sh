@@ -5,7 +5,7 @@
 # socket, without libsystemd.
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
-if [ ! -x "$D" ]; then echo "ok 1 # SKIP undulated not built"; echo "1..1"; exit 0; fi
+if [ ! -x "$D" ]; then tap_skip_all "undulated not built"; fi
 # a robot name of its own: a concurrent run of this test on the same
 # multicast port (another build directory) cannot answer for it
 R="u$$"
@@ -51,7 +51,7 @@ out=$("$D" --check-config --ids 1,2 2>&1); rc=$?
 if [ $rc -eq 1 ] && echo "$out" | grep -q 'no port configured'; then tap_ok "a missing port is an error"
 else tap_fail "missing port" "rc $rc: $out"; fi
 
-if [ ! -x "$S" ]; then echo "ok # SKIP undulate-sim not built"; tap_done; exit 0; fi
+if [ ! -x "$S" ]; then tap_skip "commands to a running daemon" "undulate-sim not built"; tap_done; exit 0; fi
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 9
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 

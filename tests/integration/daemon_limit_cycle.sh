@@ -11,7 +11,7 @@
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
-	echo "ok 1 # SKIP undulate-sim or undulated not built"; echo "1..1"; exit 0
+	tap_skip_all "undulate-sim or undulated not built"
 fi
 URL2=$(lcm_url 7740)
 URL1=$(lcm_url 7741)

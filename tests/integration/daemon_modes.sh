@@ -5,7 +5,7 @@
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
-	echo "ok 1 # SKIP undulate-sim or undulated not built"; echo "1..1"; exit 0
+	tap_skip_all "undulate-sim or undulated not built"
 fi
 # a robot name of its own: a concurrent run of this test on the same
 # multicast port (another build directory) cannot answer for it

@@ -10,7 +10,7 @@
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
-	echo "ok 1 # SKIP undulate-sim or undulated not built"; echo "1..1"; exit 0
+	tap_skip_all "undulate-sim or undulated not built"
 fi
 R="t$$"
 URL=$(lcm_url 7704)

@@ -6,9 +6,9 @@
 # explained, and a mutation that breaks one line is named as FILE:LINE.
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"
-[ -x "$D" ] || { echo "ok 1 # SKIP undulated not built"; echo "1..1"; exit 0; }
+[ -x "$D" ] || tap_skip_all "undulated not built"
 EX="$top/systemd/undulated.conf.example"
-[ -f "$EX" ] || { echo "ok 1 # SKIP no example configuration"; echo "1..1"; exit 0; }
+[ -f "$EX" ] || tap_skip_all "no example configuration"
 N=${QA_CONFIG_MUTATIONS:-300}
 SEED=${QA_SEED:-20261122}
 

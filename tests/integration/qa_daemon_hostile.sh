@@ -16,10 +16,10 @@
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"; Q="$top/tests/integration/qa_lcm.py"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
-	echo "ok 1 # SKIP undulate-sim or undulated not built"; echo "1..1"; exit 0
+	tap_skip_all "undulate-sim or undulated not built"
 fi
-PORT=7952
-URL=$(lcm_url $PORT)
+PORT=$(lcm_port 7952)   # the UDP port itself: qa_lcm.py talks to it raw
+URL=$(lcm_url 7952)
 R="qa$$"
 LIM=0.5
 ctl() { python3 "$top/tests/integration/sim_client.py" ctl "$T/ctl" "$1"; }

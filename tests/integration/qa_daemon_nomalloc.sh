@@ -10,15 +10,15 @@
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"; Q="$top/tests/integration/qa_lcm.py"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
-	echo "ok 1 # SKIP undulate-sim or undulated not built"; echo "1..1"; exit 0
+	tap_skip_all "undulate-sim or undulated not built"
 fi
 # a sanitizer build brings its own allocator, which must come first
 if ldd "$D" | grep -q 'libasan\|libtsan'; then
-	echo "ok 1 # SKIP sanitizer build: the malloc shim needs the C library's allocator"; echo "1..1"; exit 0
+	tap_skip_all "sanitizer build: the malloc shim needs the C library's allocator"
 fi
-command -v cc >/dev/null || { echo "ok 1 # SKIP no C compiler"; echo "1..1"; exit 0; }
-PORT=7953
-URL=$(lcm_url $PORT)
+command -v cc >/dev/null || tap_skip_all "no C compiler"
+PORT=$(lcm_port 7953)   # the UDP port itself: qa_lcm.py talks to it raw
+URL=$(lcm_url 7953)
 R="qa$$"
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 last_state() { grep -a "^STATE $R " "$T/watch.log" | tail -1; }

@@ -9,10 +9,10 @@
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; TOP="$B/undulate-top"; A="$B/undulate-analyze"; Q="$top/tests/integration/qa_lcm.py"
 for p in "$D" "$TOP" "$A"; do
-	[ -x "$p" ] || { echo "ok 1 # SKIP $(basename "$p") not built"; echo "1..1"; exit 0; }
+	[ -x "$p" ] || tap_skip_all "$(basename "$p") not built"
 done
-PORT=7955
-URL=$(lcm_url $PORT)
+PORT=$(lcm_port 7955)   # the UDP port itself: the sender below talks to it raw
+URL=$(lcm_url 7955)
 
 # a synthetic log: its STATE messages are the template, and a copy of it with
 # 60 of them corrupted is the bad log

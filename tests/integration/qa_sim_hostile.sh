@@ -8,9 +8,9 @@
 #    (qa_lcm.py garbage): each is counted in bad_commands, none crashes it.
 . "$(dirname "$0")/../lib.sh"
 S="$B/undulate-sim"; Q="$top/tests/integration/qa_lcm.py"
-[ -x "$S" ] || { echo "ok 1 # SKIP undulate-sim not built"; echo "1..1"; exit 0; }
-PORT=7954
-URL=$(lcm_url $PORT)
+[ -x "$S" ] || tap_skip_all "undulate-sim not built"
+PORT=$(lcm_port 7954)   # the UDP port itself: qa_lcm.py talks to it raw
+URL=$(lcm_url 7954)
 ctl() { python3 "$top/tests/integration/sim_client.py" ctl "$T/ctl" "$1"; }
 
 # a sim_command_t as lcm-gen encodes it, for its fingerprint

@@ -11,6 +11,9 @@
                                              the last SIM.TRUTH's total_collisions (and
                                              its bodies: robot id angle speed lateral
                                              neutral load temperature)
+  sim_client.py rate FILE CHANNEL            CHANNEL's rate in an LCM log over the log's own
+                                             time span: "COUNT SPAN_S HZ" (HZ = (COUNT - 1) /
+                                             SPAN_S, from the logger's event timestamps)
   sim_client.py check HEX                    print "valid" if HEX is one well-formed status packet
   sim_client.py eio LINK                     print "eio" once reads on LINK fail (bus gone)
 Bytes are written in hex, e.g. FFFF010201FB; exits non-zero on usage errors.
@@ -97,23 +100,34 @@ def truth_bodies(payload):
     return bodies
 
 
-def lcmlog(path, show_bodies=False):
-    counts, last_total, last_payload = {}, None, None
+def log_events(path):
+    """(utime, channel, payload) of each whole event of an LCM log; stops at
+    the first bad sync word or an event the logger has not finished writing."""
     with open(path, "rb") as f:
         data = f.read()
     off = 0
     while off + 28 <= len(data):
-        sync, _num, _ts, clen, dlen = struct.unpack(">IqqII", data[off:off + 28])
-        if sync != 0xEDA1DA01:
+        sync, _num, utime, clen, dlen = struct.unpack(">IqqII", data[off:off + 28])
+        if sync != 0xEDA1DA01 or off + 28 + clen + dlen > len(data):
             break
-        chan = data[off + 28:off + 28 + clen].decode()
-        payload = data[off + 28 + clen:off + 28 + clen + dlen]
+        yield utime, data[off + 28:off + 28 + clen].decode(), data[off + 28 + clen:off + 28 + clen + dlen]
+        off += 28 + clen + dlen
+
+
+def rate(path, channel):
+    times = [t for t, chan, _ in log_events(path) if chan == channel]
+    span = (times[-1] - times[0]) / 1e6 if len(times) > 1 else 0.0
+    print("%d %.3f %.1f" % (len(times), span, (len(times) - 1) / span if span > 0 else 0.0))
+
+
+def lcmlog(path, show_bodies=False):
+    counts, last_total, last_payload = {}, None, None
+    for _utime, chan, payload in log_events(path):
         counts[chan] = counts.get(chan, 0) + 1
         if chan == "SIM.TRUTH" and len(payload) >= 8 + 8 * 6:
             # fingerprint, utime, step, sim_time, wall_left, wall_right, total_collisions
             last_total = struct.unpack(">q", payload[8 + 40:8 + 48])[0]
             last_payload = payload
-        off += 28 + clen + dlen
     for chan in sorted(counts):
         print(chan, counts[chan])
     print("total_collisions", last_total if last_total is not None else -1)
@@ -160,6 +174,8 @@ def main(argv):
         ctl(argv[2], argv[3])
     elif len(argv) in (3, 4) and argv[1] == "lcmlog":
         lcmlog(argv[2], len(argv) == 4 and argv[3] == "--bodies")
+    elif len(argv) == 4 and argv[1] == "rate":
+        rate(argv[2], argv[3])
     elif len(argv) == 3 and argv[1] == "check":
         check(argv[2])
     elif len(argv) >= 3 and argv[1] == "eio":

@@ -15,11 +15,11 @@ SCENARIO="$top/sim-bridge/scenarios/channel4.scenario"
 
 for p in undulated undulate-sim dxl undulate-top undulate-analyze; do
 	if [ ! -x "$B/$p" ]; then
-		tap_ok "bench set-up from the installed units # SKIP $p not built"
+		tap_skip "bench set-up from the installed units" "$p not built"
 		tap_done; exit
 	fi
 done
-command -v python3 >/dev/null || { tap_ok "bench set-up # SKIP python3 not installed"; tap_done; exit; }
+command -v python3 >/dev/null || { tap_skip "bench set-up" "python3 not installed"; tap_done; exit; }
 [ -f "$SCENARIO" ] || { tap_fail "preset scenario $SCENARIO exists"; tap_done; exit; }
 
 R="$T/root"

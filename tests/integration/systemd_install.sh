@@ -122,7 +122,7 @@ verify_units() { # DIR UNIT... -> output of systemd-analyze verify
 		systemd-analyze verify --generators=no "$man_check" "${@/#/./}" 2>&1)
 }
 if ! command -v systemd-analyze >/dev/null; then
-	tap_ok "systemd-analyze verify # SKIP systemd-analyze not installed"
+	tap_skip "systemd-analyze verify" "systemd-analyze not installed"
 else
 	mkdir -p "$T/units"
 	for u in "${units[@]}"; do

@@ -16,7 +16,7 @@ long_opts() { grep -oE -- '(^|[^A-Za-z0-9-])--[a-z][a-z0-9-]*' | grep -oE -- '--
 iface_sections() { awk '/^[A-Z][A-Z ]*$/ { keep = ($0 ~ /^(SYNOPSIS|OPTIONS|COMMANDS)$/) } keep'; }
 
 if ! command -v man >/dev/null; then
-	tap_ok "man pages # SKIP man not installed"
+	tap_skip "man pages" "man not installed"
 	tap_done; exit
 fi
 
@@ -33,7 +33,7 @@ for page in "${pages[@]}"; do
 	else tap_fail "$page renders without warnings" "$warn"; fi
 
 	if [ ! -x "$B/$prog" ]; then
-		tap_ok "$page matches $prog --help # SKIP $prog not built"
+		tap_skip "$page matches $prog --help" "$prog not built"
 		continue
 	fi
 	# --help itself works (exit 0) even where the text does not list it.

@@ -25,12 +25,12 @@ WD_USEC=1000000         # pings expected every 500 ms
 
 for p in undulated undulate-sim; do
 	if [ ! -x "$B/$p" ]; then
-		tap_ok "sd_notify READY/WATCHDOG/STATUS/STOPPING # SKIP daemon not built ($B/$p missing)"
+		tap_skip "sd_notify READY/WATCHDOG/STATUS/STOPPING" "daemon not built ($B/$p missing)"
 		tap_done; exit
 	fi
 done
 if ! command -v python3 >/dev/null; then
-	tap_ok "sd_notify READY/WATCHDOG/STATUS/STOPPING # SKIP python3 not installed"
+	tap_skip "sd_notify READY/WATCHDOG/STATUS/STOPPING" "python3 not installed"
 	tap_done; exit
 fi
 

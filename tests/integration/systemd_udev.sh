@@ -15,7 +15,7 @@
 rules="$top/systemd/99-undulate.rules"
 
 if ! command -v python3 >/dev/null; then
-	tap_ok "udev rules checked # SKIP python3 not installed"
+	tap_skip "udev rules checked" "python3 not installed"
 	tap_done; exit
 fi
 

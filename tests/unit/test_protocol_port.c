@@ -414,6 +414,36 @@ static void test_adapter_names(void **state)
 	}
 }
 
+/* A system without sysfs (a container with no /sys) has no ports to list:
+ * 0 of them, not an I/O error, and nothing written. */
+static void test_list_without_sysfs(void **state)
+{
+	(void)state;
+	char root[64] = "/tmp/undulate-nosysfs.XXXXXX";
+	char dir[128];
+	struct port_info info[2];
+
+	assert_non_null(mkdtemp(root));
+	setenv("UNDULATE_SYSFS_ROOT", root, 1);
+	memset(info, 0x5a, sizeof info);
+	assert_int_equal(port_list(info, 2), 0);
+	assert_int_equal(((unsigned char *)info)[0], 0x5a);
+	/* A sysfs without the tty class says the same. */
+	snprintf(dir, sizeof dir, "%s/class", root);
+	assert_int_equal(mkdir(dir, 0755), 0);
+	assert_int_equal(port_list(info, 2), 0);
+	/* "tty" that is no directory is no tty class either. */
+	snprintf(dir, sizeof dir, "%s/class/tty", root);
+	fake_write(dir, "");
+	assert_int_equal(port_list(info, 2), 0);
+	assert_int_equal(port_list(NULL, 0), 0);
+	unsetenv("UNDULATE_SYSFS_ROOT");
+	assert_int_equal(unlink(dir), 0);
+	snprintf(dir, sizeof dir, "%s/class", root);
+	assert_int_equal(rmdir(dir), 0);
+	assert_int_equal(rmdir(root), 0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -432,6 +462,7 @@ int main(void)
 		cmocka_unit_test(test_latency_cannot_lower),
 		cmocka_unit_test_setup_teardown(test_latency_not_ftdi, setup_pty, teardown_pty),
 		cmocka_unit_test(test_adapter_names),
+		cmocka_unit_test(test_list_without_sysfs),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -32,8 +32,11 @@
 #define T_OUT (256 * 1024)
 /* How long the program may take to draw or to exit (ms). */
 #define T_TIMEOUT_MS 5000
-/* This test's own multicast port (tools range 7750-7799). */
-#define T_LCM_URL "udpm://239.255.76.67:7751?ttl=0"
+/* This test's own multicast port (tools range 7750-7799), moved by
+ * $TEST_PORT_OFFSET as tests/lib.sh moves every integration test's port. */
+#define T_LCM_PORT 7751
+/* Offsets tests/lib.sh accepts: the highest port, 7999 + offset, stays < 65536. */
+#define T_PORT_OFFSET_MAX 57000
 
 struct child {
 	pid_t pid;
@@ -43,10 +46,23 @@ struct child {
 };
 
 static char binary[512];
+static char lcm_url[64];
 
 static int setup(void **state)
 {
 	(void)state;
+	const char *offset_text = getenv("TEST_PORT_OFFSET");
+	long offset = 0;
+	if (offset_text != NULL && *offset_text != '\0') {
+		char *end;
+		errno = 0;
+		offset = strtol(offset_text, &end, 10);
+		if (errno != 0 || *end != '\0' || offset < 0 || offset > T_PORT_OFFSET_MAX) {
+			fprintf(stderr, "# TEST_PORT_OFFSET must be 0..%d, not '%s'\n", T_PORT_OFFSET_MAX, offset_text);
+			return -1;
+		}
+	}
+	snprintf(lcm_url, sizeof(lcm_url), "udpm://239.255.76.67:%ld?ttl=0", T_LCM_PORT + offset);
 	const char *b = getenv("BUILD");
 	snprintf(binary, sizeof(binary), "%s/bin/undulate-top", b && *b ? b : "build");
 	if (access(binary, X_OK) != 0) {
@@ -75,7 +91,7 @@ static void start(struct child *c, const char *extra)
 		dup2(s, 0);
 		dup2(s, 1);
 		dup2(s, 2);
-		execl(binary, binary, "--lcm-url", T_LCM_URL, extra, (char *)NULL);
+		execl(binary, binary, "--lcm-url", lcm_url, extra, (char *)NULL);
 		_exit(127);
 	}
 }
@@ -223,7 +239,7 @@ static int press(struct child *c, lcm_t *lcm, const char *keys, int want)
 static void test_commands_and_answer(void **state)
 {
 	(void)state;
-	lcm_t *lcm = lcm_create(T_LCM_URL);
+	lcm_t *lcm = lcm_create(lcm_url);
 	assert_non_null(lcm);
 	undulate_command_t_subscription_t *sub =
 		undulate_command_t_subscribe(lcm, "r1\\.CMD|UNDULATE\\.CMD", on_command, NULL);
@@ -275,7 +291,7 @@ static void test_commands_and_answer(void **state)
 static void test_read_only_sends_nothing(void **state)
 {
 	(void)state;
-	lcm_t *lcm = lcm_create(T_LCM_URL);
+	lcm_t *lcm = lcm_create(lcm_url);
 	assert_non_null(lcm);
 	undulate_command_t_subscription_t *sub = undulate_command_t_subscribe(lcm, ".*CMD", on_command, NULL);
 	ngot = 0;
