@@ -31,10 +31,12 @@ bool cin_open(struct cin *in, const struct cfg *cfg, const struct cin_hooks *hoo
 	/* rejected: a line and an event for the first few, then one a second
 	 * (with the count of those left out); accepted: more, as an operator's
 	 * script may send bursts */
-	in->lim_log_reject = (struct log_limit)LOG_LIMIT_INIT(5, 1000000);
-	in->lim_event_reject = (struct log_limit)LOG_LIMIT_INIT(5, 1000000);
+	in->lim_log_reject = (struct log_limit)LOG_LIMIT_INIT(10, 200000);
+	in->lim_event_reject = (struct log_limit)LOG_LIMIT_INIT(20, 100000);
 	in->lim_log_accept = (struct log_limit)LOG_LIMIT_INIT(20, 200000);
 	in->lim_event_accept = (struct log_limit)LOG_LIMIT_INIT(50, 20000);
+	in->lim_log_unauth = (struct log_limit)LOG_LIMIT_INIT(5, 1000000);
+	in->lim_event_unauth = (struct log_limit)LOG_LIMIT_INIT(5, 1000000);
 	snprintf(in->ch_cmd, sizeof in->ch_cmd, "%s.CMD", cfg->name);
 	auth_replay_init(&in->replay, (int64_t)(cfg->command_window_s * 1e6), cin_wall(in));
 
@@ -109,14 +111,14 @@ static void cin_reply_local(struct cin *in, const struct cin_cmd *c, int level, 
 /* A refusal: counted, answered to a local sender, logged and published
  * within the rate limits (a flood of bad commands must not become a flood
  * of lines and multicast events). */
-static void cin_refuse(struct cin *in, const struct cin_cmd *c, const char *why)
+static void cin_refuse_as(struct cin *in, const struct cin_cmd *c, const char *why, bool authentic)
 {
 	uint64_t now = cin_mono(in);
 	cin_reply_local(in, c, 1, "command-rejected", why);
-	log_limited(&in->lim_log_reject, now, LOG_LVL_WARN, "command %" PRId64 " from %s rejected: %s", c->w.req.seq,
-	            c->who, why);
+	log_limited(authentic ? &in->lim_log_reject : &in->lim_log_unauth, now, LOG_LVL_WARN,
+	            "command %" PRId64 " from %s rejected: %s", c->w.req.seq, c->who, why);
 	uint32_t dropped;
-	if (log_limit_allow(&in->lim_event_reject, now, &dropped)) {
+	if (log_limit_allow(authentic ? &in->lim_event_reject : &in->lim_event_unauth, now, &dropped)) {
 		char text[400];
 		if (dropped > 0)
 			snprintf(text, sizeof text, "%s (and %u more refused since)", why, dropped);
@@ -124,6 +126,19 @@ static void cin_refuse(struct cin *in, const struct cin_cmd *c, const char *why)
 			snprintf(text, sizeof text, "%s", why);
 		in->hooks.event(in->hooks.ctx, c->w.req.seq, 1, "command-rejected", text);
 	}
+}
+
+/* From a sender whose identity is known (the local socket, a valid signature). */
+static void cin_refuse(struct cin *in, const struct cin_cmd *c, const char *why)
+{
+	cin_refuse_as(in, c, why, true);
+}
+
+/* From the network, not (yet) authenticated. */
+static void cin_refuse_unauth(struct cin *in, const struct cin_cmd *c, const char *why)
+{
+	in->unauthenticated++;
+	cin_refuse_as(in, c, why, false);
 }
 
 static void cin_reject(struct cin *in, const struct cin_cmd *c, const char *why)
@@ -236,8 +251,7 @@ void cin_network_datagram(struct cin *in, const uint8_t *d, size_t n, bool trunc
 	char why[256];
 	if (truncated) {
 		snprintf(c.who, sizeof c.who, "the network");
-		in->unauthenticated++;
-		cin_refuse(in, &c, "a datagram on a command channel longer than any command_t: not read");
+		cin_refuse_unauth(in, &c, "a datagram on a command channel longer than any command_t: not read");
 		return;
 	}
 	if (!cmd_decode(m.payload, m.payload_len, in->fingerprint, &c.w, why, sizeof why)) {
@@ -245,8 +259,7 @@ void cin_network_datagram(struct cin *in, const uint8_t *d, size_t n, bool trunc
 		char text[400];
 		snprintf(text, sizeof text, "undecodable command_t on %s (%zu bytes): %s", direct ? in->ch_cmd
 		         : CIN_SHARED_CHANNEL, m.payload_len, why);
-		in->unauthenticated++;
-		cin_refuse(in, &c, text);
+		cin_refuse_unauth(in, &c, text);
 		return;
 	}
 	char source[48];
@@ -256,8 +269,7 @@ void cin_network_datagram(struct cin *in, const uint8_t *d, size_t n, bool trunc
 	if (!direct && strcmp(c.w.req.robot, "*") != 0 && strcmp(c.w.req.robot, in->cfg->name) != 0)
 		return;
 	if (!cin_authentic(in, &c, m.payload, why, sizeof why)) {
-		in->unauthenticated++;
-		cin_refuse(in, &c, why);
+		cin_refuse_unauth(in, &c, why);
 		return;
 	}
 	cin_take(in, &c);

@@ -76,7 +76,12 @@ struct cin {
 	uint8_t buf[CIN_DGRAM_MAX];
 	/* counters */
 	long long received, accepted, rejected, unauthenticated, busy;
+	/* what may reach the log and the event channel: the answers to
+	 * authentic senders (local, or signed) apart from the refusals of
+	 * unauthenticated network traffic, so a flood of the latter cannot
+	 * silence the former */
 	struct log_limit lim_log_reject, lim_log_accept, lim_event_reject, lim_event_accept;
+	struct log_limit lim_log_unauth, lim_event_unauth;
 };
 
 /* Opens the doors the configuration asks for. cfg is read each time (its
