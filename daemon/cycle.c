@@ -54,6 +54,7 @@ static enum cyc_status cyc_finish(struct cyc *y, enum cyc_status st)
 {
 	y->bus_us = (double)(cyc_now(y) - y->start_us) - y->control_us;
 	y->phase = CYC_IDLE;
+	y->starved = wq_pending(&y->ctl->wq) > 0 ? y->starved + 1 : 0;
 	return st;
 }
 
@@ -128,8 +129,9 @@ static enum cyc_status cyc_advance(struct cyc *y)
 			cyc_error(y, y->ctl->j[y->idx].id, "READ", r);
 			y->idx++;
 			continue;
+		case CYC_WRITE_FIRST:
 		case CYC_WRITES: {
-			if (cyc_late(y)) {
+			if (y->phase == CYC_WRITES && cyc_late(y)) {
 				/* the rest waits for the next cycle: the reads come first */
 				if (wq_pending(&y->ctl->wq) > 0)
 					y->deferred++;
@@ -137,7 +139,7 @@ static enum cyc_status cyc_advance(struct cyc *y)
 			}
 			const struct wq_write *w = ctl_take_write(y->ctl);
 			if (w == NULL) {
-				y->phase = CYC_READBACK;
+				y->phase = y->phase == CYC_WRITE_FIRST ? CYC_READ : CYC_READBACK;
 				continue;
 			}
 			uint8_t id = w->id;
@@ -152,6 +154,8 @@ static enum cyc_status cyc_advance(struct cyc *y)
 				cyc_error(y, id, "WRITE", r);
 			/* sent with no reply due (status return level < 2), or not sent */
 			ctl_write_result(y->ctl, r == DXL_OK);
+			if (y->phase == CYC_WRITE_FIRST)
+				y->phase = CYC_READ;
 			continue;
 		}
 		case CYC_READBACK:
@@ -180,6 +184,10 @@ enum cyc_status cyc_start(struct cyc *y)
 	y->control_us = 0.0;
 	y->bus_us = 0.0;
 	y->read_len = (y->count & 1) ? 8 : 6;
+	if (y->starved >= CYC_STARVED_CYCLES && wq_pending(&y->ctl->wq) > 0) {
+		y->phase = CYC_WRITE_FIRST;
+		y->writes_first++;
+	}
 	return cyc_advance(y);
 }
 
@@ -215,6 +223,7 @@ enum cyc_status cyc_step(struct cyc *y)
 			cyc_error(y, y->ctl->j[y->idx].id, "READ", r);
 		y->idx++;
 		break;
+	case CYC_WRITE_FIRST:
 	case CYC_WRITES: {
 		uint8_t id = y->bus->req_id;
 		bool ok = r == DXL_OK && (reply.code & CYC_WRITE_REFUSED) == 0;
@@ -225,6 +234,8 @@ enum cyc_status cyc_step(struct cyc *y)
 			          DXL_OK);
 		y->write_on_wire = false;
 		ctl_write_result(y->ctl, ok);
+		if (y->phase == CYC_WRITE_FIRST)
+			y->phase = CYC_READ;
 		break;
 	}
 	case CYC_READBACK:

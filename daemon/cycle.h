@@ -6,7 +6,9 @@
  *   and runs the control step ─→ SYNC_WRITE of the goals (or duties) ─→ the
  *   controller's register writes, one at a time, while the period allows ─→
  *   every CYC_READBACK_EVERY cycles, while the period allows, one joint's
- *   RAM block read back (ctl_readback) ─→ CYC_DONE.
+ *   RAM block read back (ctl_readback) ─→ CYC_DONE. Writes never starve:
+ *   when the reads leave no room for them cycle after cycle, one is sent
+ *   before the reads (CYC_STARVED_CYCLES).
  *
  * It owns only its progress through those steps. Readings go to the
  * controller (ctl_measure, ctl_readback); writes come from it, one at a time
@@ -46,7 +48,13 @@ enum cyc_status {
 	CYC_LOST,       /* the port failed (cyc.lost says how): the cycle is over */
 };
 
-enum cyc_phase { CYC_IDLE, CYC_READ, CYC_CONTROL_STEP, CYC_WRITES, CYC_READBACK };
+enum cyc_phase { CYC_IDLE, CYC_WRITE_FIRST, CYC_READ, CYC_CONTROL_STEP, CYC_WRITES, CYC_READBACK };
+
+/* A bus so slow that the reads fill CYC_LATE_SHARE of every period would
+ * starve the writes (a LIMP's torque-off among them): after this many cycles
+ * in a row ended with writes waiting, the next cycle sends one write before
+ * its reads. */
+#define CYC_STARVED_CYCLES 2
 
 struct cyc_hooks {
 	void *ctx;
@@ -72,8 +80,9 @@ struct cyc {
 	int lost;                     /* dxl_status of CYC_LOST */
 	/* this cycle's figures (valid at CYC_DONE / CYC_LOST) */
 	double bus_us, control_us;
+	int starved;                  /* cycles in a row that ended with writes waiting */
 	/* counters */
-	long long errors, cut_off, deferred, readbacks;
+	long long errors, cut_off, deferred, readbacks, writes_first;
 };
 
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks);

@@ -445,6 +445,26 @@ static void test_overrun_cut_off(void **state)
 	assert_int_equal(wq_pending(&c.wq), 0);
 }
 
+/* A bus so slow that the reads alone take past 70 % of every period: the
+ * writes would wait forever behind them; a LIMP's torque-off must still get
+ * out, one write before the reads once they have waited two cycles. */
+static void test_writes_never_starve(void **state)
+{
+	(void)state;
+	setup_n(2, CFG_MODE_HOLD, 6000);
+	run(10);
+	for (size_t i = 0; i < nsv; i++)
+		sv[i].slow_us = 3500;   /* two READs: 7.4 ms */
+	run(5);
+	ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+	run(12);
+	for (size_t i = 0; i < nsv; i++)
+		assert_int_equal(sv[i].mem[DXL_AX_TORQUE_ENABLE], 0);
+	assert_true(y.writes_first >= 2);
+	assert_int_equal(c.write_failures, 0);
+	assert_int_equal(wq_pending(&c.wq), 0);
+}
+
 /* LIMP applied while HOLD's torque-on is on the wire (as a command applied
  * mid-cycle once could be): the torque-off is queued behind it, never
  * merged into it and dropped. */
@@ -536,6 +556,7 @@ int main(void)
 		cmocka_unit_test(test_reply_one_period_late),
 		cmocka_unit_test(test_writes_that_do_not_fit),
 		cmocka_unit_test(test_overrun_cut_off),
+		cmocka_unit_test(test_writes_never_starve),
 		cmocka_unit_test(test_torque_off_never_lost),
 		cmocka_unit_test(test_servo_reset_found),
 		cmocka_unit_test(test_write_given_up),
