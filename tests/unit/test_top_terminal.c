@@ -1,8 +1,9 @@
 /* test_top_terminal.c — the real undulate-top binary on a pseudo-terminal:
  * it switches the terminal to raw mode and the alternate screen, and gives
  * the terminal back as it found it on q, Ctrl-C and SIGTERM; its keys send
- * the documented commands and the robot's answer shows up. Needs
- * $BUILD/bin/undulate-top (tests/run.sh exports BUILD). */
+ * the documented commands to the robot's local command socket (a fake robot
+ * here, in a directory of the test's own) and the robot's answer shows up.
+ * Needs $BUILD/bin/undulate-top (tests/run.sh exports BUILD). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -23,6 +24,8 @@
 #include <unistd.h>
 
 #include <lcm/lcm.h>
+#include "csock.h"
+#include "scratch.h"
 #include "undulate_command_t.h"
 #include "undulate_event_t.h"
 #include "undulate_osc_params_t.h"
@@ -198,17 +201,67 @@ static undulate_command_t got[T_MAX_CMDS];
 static char got_channel[T_MAX_CMDS][32], got_robot[T_MAX_CMDS][32], got_param[T_MAX_CMDS][32];
 static int ngot;
 
+/* Anything that still publishes commands on LCM (nothing should). */
+static int nlcm;
 static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, const undulate_command_t *m, void *user)
 {
 	(void)rbuf;
+	(void)channel;
+	(void)m;
 	(void)user;
-	if (ngot >= T_MAX_CMDS)
-		return;
-	got[ngot] = *m;
-	snprintf(got_channel[ngot], 32, "%s", channel);
-	snprintf(got_robot[ngot], 32, "%s", m->robot);
-	snprintf(got_param[ngot], 32, "%s", m->param);
-	ngot++;
+	nlcm++;
+}
+
+/* The fake robot "r1": its local command socket, where top's commands arrive. */
+static int robot_fd = -1;
+static char robot_path[CSOCK_PATH_MAX];
+static struct csock_peer last_peer;
+
+static void robot_open(void)
+{
+	char why[256];
+	if (scratch_dir[0] == '\0')
+		assert_int_equal(scratch_make("top-terminal"), 0);
+	setenv("UNDULATE_RUN_DIR", scratch_dir, 1);   /* top (the child) looks there */
+	assert_true(csock_path(robot_path, sizeof robot_path, scratch_dir, "r1", lcm_url));
+	robot_fd = csock_listen(robot_path, why, sizeof why);
+	if (robot_fd < 0)
+		fail_msg("%s", why);
+}
+
+static void robot_close(void)
+{
+	csock_close(robot_fd, robot_path);
+	robot_fd = -1;
+}
+
+/* Collects what arrives on the robot's socket within T_TIMEOUT_MS (or until want). */
+static void robot_receive(int want)
+{
+	struct timespec t0, t;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	while (ngot < want) {
+		clock_gettime(CLOCK_MONOTONIC, &t);
+		if ((t.tv_sec - t0.tv_sec) * 1000 + (t.tv_nsec - t0.tv_nsec) / 1000000 > T_TIMEOUT_MS)
+			return;
+		struct pollfd p = { .fd = robot_fd, .events = POLLIN };
+		if (poll(&p, 1, 20) <= 0)
+			continue;
+		uint8_t buf[2048];
+		bool truncated = false;
+		ssize_t n = csock_recv(robot_fd, buf, sizeof buf, &last_peer, &truncated);
+		if (n <= 0 || ngot >= T_MAX_CMDS)
+			continue;
+		undulate_command_t m;
+		assert_int_equal(undulate_command_t_decode(buf, 0, (int)n, &m), (int)n);
+		got[ngot] = m;
+		snprintf(got_channel[ngot], 32, "socket");
+		snprintf(got_robot[ngot], 32, "%s", m.robot);
+		snprintf(got_param[ngot], 32, "%s", m.param);
+		got[ngot].source = got[ngot].robot = got[ngot].param = NULL;
+		undulate_command_t_decode_cleanup(&m);
+		ngot++;
+	}
 }
 
 /* What robot "r1" publishes: a STATE in OSCILLATOR and its PARAMS. */
@@ -225,14 +278,12 @@ static void publish_robot(lcm_t *lcm)
 	undulate_osc_params_t_publish(lcm, "r1.PARAMS", &p);
 }
 
-/* Lets undulate-top hear r1 until its screen shows it, then collects the
- * commands that arrive within a short while after KEYS. */
-static int press(struct child *c, lcm_t *lcm, const char *keys, int want)
+/* Presses KEYS, then collects the commands that arrive at the robot's socket. */
+static int press(struct child *c, const char *keys, int want)
 {
 	int before = ngot;
 	assert_int_equal(write(c->master, keys, strlen(keys)), (ssize_t)strlen(keys));
-	for (int i = 0; i < T_TIMEOUT_MS / 20 && ngot < before + want; i++)
-		lcm_handle_timeout(lcm, 20);
+	robot_receive(before + want);
 	return ngot - before;
 }
 
@@ -241,9 +292,10 @@ static void test_commands_and_answer(void **state)
 	(void)state;
 	lcm_t *lcm = lcm_create(lcm_url);
 	assert_non_null(lcm);
-	undulate_command_t_subscription_t *sub =
-		undulate_command_t_subscribe(lcm, "r1\\.CMD|UNDULATE\\.CMD", on_command, NULL);
+	undulate_command_t_subscription_t *sub = undulate_command_t_subscribe(lcm, ".*CMD", on_command, NULL);
 	ngot = 0;
+	nlcm = 0;
+	robot_open();
 	struct child *c = calloc(1, sizeof(*c));
 	start(c, NULL);
 	fcntl(c->master, F_SETFL, O_NONBLOCK);
@@ -254,31 +306,34 @@ static void test_commands_and_answer(void **state)
 		seen = read_until_ms(c, "r1 ", 50);
 	}
 	assert_true(seen);
-	/* o: OSCILLATOR for the selected robot, on r1.CMD */
-	assert_int_equal(press(c, lcm, "o", 1), 1);
-	assert_string_equal(got_channel[0], "r1.CMD");
+	/* o: OSCILLATOR for the selected robot, to its local socket */
+	assert_int_equal(press(c, "o", 1), 1);
 	assert_string_equal(got_robot[0], "r1");
 	assert_int_equal(got[0].kind, UNDULATE_COMMAND_T_KIND_MODE);
 	assert_int_equal(got[0].mode, UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR);
-	/* L: LIMP for all robots, on UNDULATE.CMD */
-	assert_int_equal(press(c, lcm, "L", 1), 1);
-	assert_string_equal(got_channel[1], "UNDULATE.CMD");
+	/* L: LIMP for all robots: every robot's socket on this LCM network */
+	assert_int_equal(press(c, "L", 1), 1);
 	assert_string_equal(got_robot[1], "*");
 	assert_int_equal(got[1].mode, UNDULATE_ROBOT_STATE_T_MODE_LIMP);
 	assert_true(got[1].seq > got[0].seq);
 	/* +: c of each joint up 10 % */
-	assert_int_equal(press(c, lcm, "+", 2), 2);
+	assert_int_equal(press(c, "+", 2), 2);
 	assert_string_equal(got_param[2], "c");
 	assert_int_equal(got[2].kind, UNDULATE_COMMAND_T_KIND_PARAM);
 	assert_int_equal(got[3].joint, 1);
 	assert_true(got[2].value > 0.02199 && got[2].value < 0.02201);
 	assert_true(got[3].value > 0.04399 && got[3].value < 0.04401);
-	/* the robot's answer to the first command appears in the status line */
+	/* the robot's answer, on the socket back to the sender, appears in the status line */
 	char name[] = "r1", kind[] = "command-rejected", text[] = "mode OSCILLATOR refused: torque off";
-	undulate_event_t e = { .robot = name, .seq = got[0].seq, .level = 1, .kind = kind, .text = text };
+	undulate_event_t e = { .robot = name, .seq = got[3].seq, .level = 1, .kind = kind, .text = text };
+	uint8_t ev[512];
+	int n = undulate_event_t_encode(ev, 0, sizeof ev, &e);
+	assert_true(n > 0);
 	c->len = 0;
-	undulate_event_t_publish(lcm, "r1.EVENT", &e);
+	assert_true(csock_reply(robot_fd, &last_peer, ev, (size_t)n));
 	assert_true(read_until(c, "command-rejected: mode OSCILLATOR refused"));
+	assert_int_equal(nlcm, 0);   /* and nothing went out on LCM */
+	robot_close();
 	assert_int_equal(write(c->master, "q", 1), 1);
 	assert_int_equal(wait_exit(c), 0);
 	close(c->master);
@@ -295,6 +350,8 @@ static void test_read_only_sends_nothing(void **state)
 	assert_non_null(lcm);
 	undulate_command_t_subscription_t *sub = undulate_command_t_subscribe(lcm, ".*CMD", on_command, NULL);
 	ngot = 0;
+	nlcm = 0;
+	robot_open();
 	struct child *c = calloc(1, sizeof(*c));
 	start(c, "--read-only");
 	fcntl(c->master, F_SETFL, O_NONBLOCK);
@@ -309,7 +366,10 @@ static void test_read_only_sends_nothing(void **state)
 	assert_true(read_until(c, "read-only: commands are disabled"));
 	for (int i = 0; i < 10; i++)
 		lcm_handle_timeout(lcm, 20);
+	robot_receive(1);
 	assert_int_equal(ngot, 0);
+	assert_int_equal(nlcm, 0);
+	robot_close();
 	assert_int_equal(write(c->master, "q", 1), 1);
 	assert_int_equal(wait_exit(c), 0);
 	close(c->master);
@@ -327,5 +387,8 @@ int main(void)
 		cmocka_unit_test(test_commands_and_answer),
 		cmocka_unit_test(test_read_only_sends_nothing),
 	};
-	return cmocka_run_group_tests(tests, setup, NULL);
+	int rc = cmocka_run_group_tests(tests, setup, NULL);
+	if (scratch_dir[0] != '\0')
+		scratch_remove();
+	return rc;
 }
