@@ -118,6 +118,23 @@ wait_log() { wait_for "${3:-10}" grep -qE "$2" "$T/$1.log"; }
 lcm_port() { echo $(( $1 + TEST_PORT_OFFSET )); }
 lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }
 
+# ---- a robot under test ---------------------------------------------------------------
+# For scripts that run `undulated --watch $R` into $T/watch.log and a simulator
+# with its control socket at $T/ctl (a script may define its own to replace one):
+#   ctl CMD...            one command to the simulator; prints its answer line
+#   field NAME            the value of NAME=... in the line on stdin
+#   states / last_state   robot $R's STATE lines / the last one
+#   cycle_at_least N      its last published cycle is >= N
+#   wait_cycles N         wait (up to 10 s) until N more cycles were published
+#   events                robot $R's EVENT lines
+ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+states() { grep -a "^STATE $R " "$T/watch.log"; }
+last_state() { states | tail -1; }
+cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
+wait_cycles() { local c; c=$(last_state | field cycle); wait_for 10 cycle_at_least $((${c:-0} + $1)); }
+events() { grep -a "^EVENT $R " "$T/watch.log"; }
+
 # ---- reading an experiment's analysis (scripts/demo.sh --out DIR) -------------------
 # min_swing DIR: the smallest peak-to-peak angle (rad) of any robot's joint
 # over the last 10 s of DIR/states.csv, and whose: "0.812 (\"r3\"/1)" (the

@@ -14,11 +14,6 @@ fi
 # multicast port (another build directory) cannot answer for it
 R="u$$"
 URL=$(lcm_url 7702)
-ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-states() { grep "^STATE $R " "$T/watch.log"; }
-last_state() { states | tail -1; }
-cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
 count() { grep -c "^EVENT $R .*kind=$1 " "$T/watch.log"; }
 
 start_sim() {

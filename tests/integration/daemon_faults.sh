@@ -12,9 +12,6 @@ fi
 # multicast port (another build directory) cannot answer for it
 R="u$$"
 URL=$(lcm_url 7701)
-ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-last_state() { grep "^STATE $R " "$T/watch.log" | tail -1; }
 event() { wait_for "${2:-5}" grep -qE "^EVENT $R .*$1" "$T/watch.log"; }
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5

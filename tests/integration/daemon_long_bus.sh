@@ -17,10 +17,6 @@ fi
 R="b$$"
 URL=$(lcm_url 7705)
 ids=$(seq -s, 1 18)
-ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-states() { grep "^STATE $R " "$T/watch.log"; }
-cycle_at_least() { [ "$(states | tail -1 | field cycle)" -ge "$1" ] 2>/dev/null; }
 
 spawn sim "$S" --link "$T/bus" --ids "$ids" --name r1 --return-delay 0 --lcm-url "$URL" --control "$T/ctl"
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }

@@ -11,12 +11,7 @@ fi
 # multicast port (another build directory) cannot answer for it
 R="u$$"
 URL=$(lcm_url 7700)
-ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
 # value of key=... in a watch line
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-states() { grep "^STATE $R " "$T/watch.log"; }
-last_state() { states | tail -1; }
-cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 3
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }

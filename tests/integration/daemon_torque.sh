@@ -14,9 +14,6 @@ if [ ! -x "$S" ] || [ ! -x "$D" ]; then
 fi
 R="t$$"
 URL=$(lcm_url 7704)
-ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-last_state() { grep "^STATE $R " "$T/watch.log" | tail -1; }
 event() { wait_for "${2:-5}" grep -qE "^EVENT $R .*$1" "$T/watch.log"; }
 peek() { local v; v=$(ctl peek r1 "$1" "$2"); echo "${v#ok }"; }
 num() { awk "BEGIN { exit !($*) }"; }

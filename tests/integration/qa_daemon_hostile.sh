@@ -23,10 +23,6 @@ URL=$(lcm_url 7952)
 R="qa$$"
 LIM=0.5
 ctl() { python3 "$top/tests/integration/sim_client.py" ctl "$T/ctl" "$1"; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-states() { grep -a "^STATE $R " "$T/watch.log"; }
-last_state() { states | tail -1; }
-cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
 
 KEY="$T/command.key"
 "$D" --gen-key "$KEY" >/dev/null || { tap_fail "command key made" "undulated --gen-key failed"; tap_done; exit 1; }

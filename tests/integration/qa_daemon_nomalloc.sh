@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# "No allocation after start-up" (DESIGN.md budgets), measured: an LD_PRELOAD
+# "No allocation after start-up" (the budgets in bench/README.md), measured: an LD_PRELOAD
 # shim, built here, counts every malloc/calloc/realloc/memalign of the daemon
 # (all threads, LCM's included) between SIGUSR1 and SIGUSR2 and writes the
 # count with the first call sites. The daemon runs OSCILLATOR against the
@@ -20,9 +20,6 @@ command -v cc >/dev/null || tap_skip_all "no C compiler"
 PORT=$(lcm_port 7953)   # the UDP port itself: qa_lcm.py talks to it raw
 URL=$(lcm_url 7953)
 R="qa$$"
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-last_state() { grep -a "^STATE $R " "$T/watch.log" | tail -1; }
-cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
 
 cat >"$T/shim.c" <<'EOF'
 #define _GNU_SOURCE

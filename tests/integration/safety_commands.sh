@@ -17,13 +17,6 @@ PORT=$(lcm_port 7710)
 URL=$(lcm_url 7710)
 R="sc$$"
 LIM=1.3
-ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-states() { grep -a "^STATE $R " "$T/watch.log"; }
-last_state() { states | tail -1; }
-cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
-wait_cycles() { local c; c=$(last_state | field cycle); wait_for 10 cycle_at_least $((c + $1)); }
-events() { grep -a "^EVENT $R " "$T/watch.log"; }
 cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2 "${@:2}"; }
 
 KEY="$T/command.key"

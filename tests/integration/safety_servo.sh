@@ -17,13 +17,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; exit 0; fi
 URL=$(lcm_url 7711)
 R="ss$$"
-ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
-states() { grep -a "^STATE $R " "$T/watch.log"; }
-last_state() { states | tail -1; }
-cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
-wait_cycles() { local c; c=$(last_state | field cycle); wait_for 10 cycle_at_least $((c + $1)); }
-events() { grep -a "^EVENT $R " "$T/watch.log"; }
 event() { wait_for "${2:-5}" sh -c "grep -a '^EVENT $R ' '$T/watch.log' | grep -qE '$1'"; }
 state_is() { wait_for "${2:-5}" sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -qE '$1'"; }
 cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2; }
