@@ -128,7 +128,7 @@ $(LIB)/lib$(1).a: $(call objs,$(call libsrcs_of,$(1)))
 endef
 $(foreach c,$(COMPONENTS),$(eval $(call component_lib,$(c))))
 
-# The protocol framing must stay pure: no I/O, no clock (STYLE.md).
+# The protocol framing must stay pure: no I/O, no clock (protocol/README.md).
 .PHONY: check-pure
 check-pure:
 	@! grep -nE '#include <(unistd|libserialport|time|poll|fcntl|termios)\.h>|clock_gettime' protocol/*.c protocol/*.h \

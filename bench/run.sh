@@ -4,7 +4,7 @@
 # Runs the real programs (undulate-sim, undulated, lcm-logger, cyclictest) and
 # small measuring helpers built here from bench/*.c, prints one markdown report
 # and writes it to $BUILD/bench.md. Figures are printed next to the budgets in
-# DESIGN.md; nothing is asserted: the exit status says only whether the suite
+# bench/README.md; nothing is asserted: the exit status says only whether the suite
 # could run. See bench/README.md for what each figure means.
 #
 # Knobs (environment): BENCH_LOOP_S (loop timing window per policy, 20),
@@ -154,7 +154,7 @@ build_helpers() {
 
 # ---- report -----------------------------------------------------------------------
 # The details, section by section; the summary collects one row per budget
-# of DESIGN.md and goes first.
+# of bench/README.md and goes first.
 REPORT=$T/report.md
 SUMMARY=$T/summary.md
 say() { printf '%s\n' "$*" >>"$REPORT"; }
@@ -742,7 +742,7 @@ main() {
 			"(other work on the machine shows in every timing figure: compare runs at similar load)."
 		echo "Figures, not pass/fail: see bench/README.md for how to read them."
 		echo
-		echo "## Summary against the budgets (DESIGN.md)"
+		echo "## Summary against the budgets (bench/README.md)"
 		echo
 		echo "| what | budget | measured |"
 		echo "|---|---|---|"

@@ -10,6 +10,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "dxl_table.h"
 #include "udpm.h"
 
 #define CFG_PI 3.14159265358979323846
@@ -255,15 +256,15 @@ void cfg_defaults(struct cfg *c)
 	c->actuation = CFG_ACT_POSITION;
 	c->torque_drive = CFG_DRIVE_PWM;
 	/* The AX-12A's datasheet line at 12 V. */
-	c->stall_torque = 1.5;
-	c->no_load_speed = 59.0 * 2.0 * 3.14159265358979323846 / 60.0;
+	c->stall_torque = DXL_AX12_STALL_TORQUE_NM;
+	c->no_load_speed = DXL_AX12_NO_LOAD_SPEED_RAD_S;
 	/* Replies on a loaded 2-core machine (simulator, tests) come up to ~3 ms
 	 * late; a real adapter with return delay 0 needs far less. */
 	c->bus_margin_us = 3000;
 	c->commands = CFG_CMD_LOCAL;
 	c->command_window_s = 2.0;
 	/* Five periods of 10 ms stale are a hold; half a second is a servo gone
-	 * (a bus reconnect takes 0.01-0.15 s, DESIGN.md). */
+	 * (a bus reconnect takes 0.01-0.15 s, tests/integration/daemon_bus.sh). */
 	c->silent_s = 0.5;
 	c->adapter_latency_us = -1;
 	c->period_ms = 10.0;

@@ -22,8 +22,9 @@
  * fault_action in joint mode, where the servo enforces its limits. */
 #define TQ_WALL_MARGIN 0.15
 #define TQ_WALL_DAMPING 0.1
-/* Supply assumed for the PWM drive until the servo's voltage is read (V). */
-#define TQ_NOMINAL_VOLTAGE 12.0
+/* Supply assumed for the PWM drive until the servo's voltage is read: the
+ * datasheet's reference, which stall_torque and no_load_speed are given at. */
+#define TQ_NOMINAL_VOLTAGE DXL_AX12_REF_VOLTAGE
 
 bool tq_want_wheel(const struct ctl *c)
 {

@@ -49,6 +49,13 @@ enum dxl_ax12_addr {
 #define DXL_AX_TABLE_SIZE   50   /* bytes 0..49 */
 #define DXL_AX_EEPROM_END   24   /* addresses below are EEPROM */
 #define DXL_AX12_MODEL      12   /* model number of AX-12/AX-12+/AX-12A */
+/* The AX-12A's datasheet line at its reference supply (torque and speed scale
+ * about linearly with the supply voltage): the daemon's torque actuation
+ * defaults and the simulator's motor model start from the same numbers. */
+#define DXL_AX12_REF_VOLTAGE        12.0   /* V */
+#define DXL_AX12_STALL_TORQUE_NM    1.5    /* N·m at 12 V, 1.5 A */
+#define DXL_AX12_NO_LOAD_SPEED_RPM  59.0   /* at 12 V */
+#define DXL_AX12_NO_LOAD_SPEED_RAD_S (DXL_AX12_NO_LOAD_SPEED_RPM * 2.0 * 3.14159265358979323846 / 60.0)
 
 enum dxl_access { DXL_ACCESS_R, DXL_ACCESS_RW };
 enum dxl_area { DXL_AREA_EEPROM, DXL_AREA_RAM };

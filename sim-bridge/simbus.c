@@ -178,7 +178,9 @@ void sim_bus_inject(struct sim_bus *b, const uint8_t *data, size_t n, int64_t no
 /* ---- pty ------------------------------------------------------------------------ */
 
 /* Raw 8N1 without any processing: pty line disciplines otherwise eat or
- * rewrite 0x03, 0x0A, 0x0D, 0x11, 0x13 (DESIGN.md, "Pseudo-terminals"). */
+ * rewrite 0x03, 0x0A, 0x0D, 0x11, 0x13 (both ends must be raw: the
+ * controller's end is set so by protocol/io/port.c, whose comments say which
+ * flag does what). */
 static int bus_raw(int fd)
 {
 	struct termios t;

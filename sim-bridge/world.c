@@ -8,7 +8,7 @@
  *     index, so a body that went through its neighbour in one step (any speed,
  *     any dt) comes back to its own side — there is no tunnelling;
  *  3. every touching pair approaching faster than a resting contact collides
- *     (DESIGN.md's law, walls with their own restitution), swept until none
+ *     (PHYSICS.md 2.2's law, walls with their own restitution), swept until none
  *     does (chains, Newton's cradle); mobility moves the neutral positions;
  *  4. resting contacts (a persistent push) are made plastic all at once per
  *     touching row: the speeds' monotone regression, O(N), no jitter;

@@ -4,7 +4,7 @@
  * the body's lateral coordinate is X = n + lever · angle (n its neutral
  * position). Neighbours collide when X_i reaches X_{i+1} while approaching:
  * an instantaneous inelastic collision with restitution r, equal effective
- * inertia, momentum conserved (DESIGN.md):
+ * inertia, momentum conserved (PHYSICS.md, section 2):
  *     v_i+ = ½[(1 − r) v_i + (1 + r) v_j],  v_j+ = ½[(1 − r) v_j + (1 + r) v_i]
  * Mobility: right after a collision each body's neutral position moves by
  * δ_i = β (v_j − v_i) (pre-collision speeds). Walls bound the row; bodies
