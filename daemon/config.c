@@ -691,17 +691,17 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 	size_t before = e->count;
 	if (c->njoints == 0)
 		cfg_error(e, "%s: [robot] ids: no servo IDs configured (e.g. ids = 1,2 or --ids 1,2)",
-		          c->source[0] ? c->source : "config");
+		          c->source[0] ? c->source : "command line");
 	if (c->port[0] == '\0' && c->usb_serial[0] == '\0')
 		cfg_error(e, "%s: [robot] port: no port configured (port = /dev/ttyUSB0, usb_serial = ..., "
-		          "or --port PATH)", c->source[0] ? c->source : "config");
+		          "or --port PATH)", c->source[0] ? c->source : "command line");
 	for (size_t j = c->njoints; j < CFG_MAX_JOINTS; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		if (!isnan(jt->osc.k) || !isnan(jt->osc.c) || !isnan(jt->osc.mu) || !isnan(jt->osc.lambda) ||
 		    !isnan(jt->osc.inertia) || !isnan(jt->osc.friction) || !isnan(jt->neutral) ||
 		    !isnan(jt->limit_min) || !isnan(jt->limit_max) || !isnan(jt->max_step))
 			cfg_error(e, "%s: [joint.%zu]: the robot has only %zu joint(s) (ids)",
-			          c->source[0] ? c->source : "config", j + 1, c->njoints);
+			          c->source[0] ? c->source : "command line", j + 1, c->njoints);
 	}
 	cfg_fill_joint_defaults(c);
 	if (isnan(c->servo_lead_s))
@@ -710,26 +710,26 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 		const struct cfg_joint *jt = &c->joint[j];
 		if (!(jt->limit_min < jt->limit_max))
 			cfg_error(e, "%s: [joint.%zu] limit_min: %g is not below limit_max %g",
-			          c->source[0] ? c->source : "config", j + 1, jt->limit_min, jt->limit_max);
+			          c->source[0] ? c->source : "command line", j + 1, jt->limit_min, jt->limit_max);
 		else if (!(jt->limit_min <= 0.0 && jt->limit_max >= 0.0))
 			cfg_error(e, "%s: [joint.%zu] limit_min/limit_max: [%g, %g] must contain the neutral angle 0",
-			          c->source[0] ? c->source : "config", j + 1, jt->limit_min, jt->limit_max);
+			          c->source[0] ? c->source : "command line", j + 1, jt->limit_min, jt->limit_max);
 		if (jt->neutral + jt->limit_min < -CFG_SERVO_HALF_RANGE - 1e-9 ||
 		    jt->neutral + jt->limit_max > CFG_SERVO_HALF_RANGE + 1e-9)
 			cfg_error(e, "%s: [joint.%zu] limit_min/limit_max: neutral %+g + [%g, %g] leaves the servo's "
-			          "±2.618 rad (300°) range", c->source[0] ? c->source : "config", j + 1,
+			          "±2.618 rad (300°) range", c->source[0] ? c->source : "command line", j + 1,
 			          jt->neutral, jt->limit_min, jt->limit_max);
 		char jwhy[160];
 		if (!cfg_joint_check(jt, jwhy, sizeof jwhy))
-			cfg_error(e, "%s: [joint.%zu] k/inertia: %s", c->source[0] ? c->source : "config", j + 1, jwhy);
+			cfg_error(e, "%s: [joint.%zu] k/inertia: %s", c->source[0] ? c->source : "command line", j + 1, jwhy);
 	}
 	struct udpm_url url;
 	char why[200];
 	if (c->lcm_url[0] != '\0' && !udpm_parse_url(c->lcm_url, &url, why, sizeof why))
-		cfg_error(e, "%s: [robot] lcm_url: %s", c->source[0] ? c->source : "config", why);
+		cfg_error(e, "%s: [robot] lcm_url: %s", c->source[0] ? c->source : "command line", why);
 	if (c->commands == CFG_CMD_NETWORK && c->command_key[0] == '\0')
 		cfg_error(e, "%s: [robot] commands = network needs command_key = FILE (the shared key: "
-		          "`undulated --gen-key FILE` makes one)", c->source[0] ? c->source : "config");
+		          "`undulated --gen-key FILE` makes one)", c->source[0] ? c->source : "command line");
 	return e->count == before;
 }
 

@@ -51,6 +51,25 @@ out=$("$D" --check-config --ids 1,2 2>&1); rc=$?
 if [ $rc -eq 1 ] && echo "$out" | grep -q 'no port configured'; then tap_ok "a missing port is an error"
 else tap_fail "missing port" "rc $rc: $out"; fi
 
+# configuration errors exit 2 (systemd's RestartPreventExitStatus=2: no point
+# restarting); a bad LCM URL is one, found before anything starts
+for u in 'udpm://1.2.3.4:7667' 'udpm://239.255.76.67:99999' 'udpm://239.255.76.67:7667?ttl=999' 'carrier-pigeon://x'; do
+	out=$(timeout 10 "$D" --port /dev/null --ids 1 --lcm-url "$u" 2>&1); rc=$?
+	if [ $rc -eq 2 ] && echo "$out" | grep -q "lcm_url: "; then tap_ok "bad LCM URL '$u': exit 2, $(echo "$out" | head -1 | cut -c1-100)"
+	else tap_fail "bad LCM URL '$u' is a config error" "rc $rc: $out"; fi
+done
+out=$(timeout 10 "$D" --port /dev/null --ids 1 --set robot.commands=network 2>&1); rc=$?
+if [ $rc -eq 2 ] && echo "$out" | grep -q "commands = network needs command_key"; then tap_ok "commands = network without a key: exit 2"
+else tap_fail "network commands need a key" "rc $rc: $out"; fi
+printf 'not a key\n' >"$T/bad.key"; chmod 600 "$T/bad.key"
+out=$(timeout 10 "$D" --port /dev/null --ids 1 --set robot.commands=network --set robot.command_key="$T/bad.key" 2>&1); rc=$?
+if [ $rc -eq 2 ] && echo "$out" | grep -q "command_key: $T/bad.key"; then tap_ok "an unreadable command key: exit 2 (config), not 1 (retry)"
+else tap_fail "bad key is a config error" "rc $rc: $out"; fi
+"$D" --gen-key "$T/good.key" >/dev/null; chmod 644 "$T/good.key"
+out=$(timeout 10 "$D" --port /dev/null --ids 1 --set robot.commands=network --set robot.command_key="$T/good.key" 2>&1); rc=$?
+if [ $rc -eq 2 ] && echo "$out" | grep -q "lets others read the key"; then tap_ok "a key others can read is refused"
+else tap_fail "world-readable key refused" "rc $rc: $out"; fi
+
 if [ ! -x "$S" ]; then tap_skip "commands to a running daemon" "undulate-sim not built"; tap_done; exit 0; fi
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 9
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
