@@ -100,11 +100,33 @@ static void test_dirs(void **state)
 	/* the configured run_dir first */
 	assert_true(csock_daemon_dir(d, sizeof d, "/srv/robots", why, sizeof why));
 	assert_string_equal(d, "/srv/robots");
+	/* a directory too long for any socket in it: refused with a reason */
+	char longdir[200];
+	memset(longdir, 'd', sizeof longdir);
+	longdir[0] = '/';
+	longdir[150] = '\0';
+	snprintf(why, sizeof why, "unset");
+	assert_false(csock_daemon_dir(d, sizeof d, longdir, why, sizeof why));
+	if (strstr(why, "too long") == NULL)
+		fail_msg("why '%s'", why);
+	setenv("UNDULATE_RUN_DIR", longdir, 1);
+	snprintf(why, sizeof why, "unset");
+	assert_false(csock_daemon_dir(d, sizeof d, "", why, sizeof why));
+	assert_non_null(strstr(why, "too long"));
 	/* systemd's RUNTIME_DIRECTORY: the first of a list */
 	unsetenv("UNDULATE_RUN_DIR");
 	setenv("RUNTIME_DIRECTORY", "/run/undulate-a:/run/undulate-b", 1);
 	assert_true(csock_daemon_dir(d, sizeof d, NULL, why, sizeof why));
 	assert_string_equal(d, "/run/undulate-a");
+	/* ... not cut short when it is too long */
+	longdir[150] = ':';
+	memcpy(longdir + 151, "/run/b", 7);
+	setenv("RUNTIME_DIRECTORY", longdir, 1);
+	snprintf(why, sizeof why, "unset");
+	bool ok = csock_daemon_dir(d, sizeof d, NULL, why, sizeof why);
+	if (ok)
+		fail_msg("RUNTIME_DIRECTORY's 150-byte first entry gave '%s'", d);
+	assert_non_null(strstr(why, "RUNTIME_DIRECTORY"));
 	unsetenv("RUNTIME_DIRECTORY");
 	/* $XDG_RUNTIME_DIR/undulate, made private */
 	char xdg[sizeof scratch_dir + 8];
