@@ -85,10 +85,15 @@ static size_t count_kind(const char *kind)
 	return n;
 }
 
-/* The last event, which must be of `kind` and contain `needle`. */
+/* The last event, which must be new since the previous call (or the test's
+ * start), of `kind` and contain `needle`. */
+static size_t ev_checked;
+
 static const struct ev *expect_last_event(const char *kind, const char *needle)
 {
-	assert_true(nev > 0);
+	if (nev <= ev_checked)
+		fail_msg("no new event (want %s with '%s')", kind, needle);
+	ev_checked = nev;
 	const struct ev *e = &evs[nev - 1];
 	if (strcmp(e->kind, kind) != 0 || strstr(e->text, needle) == NULL)
 		fail_msg("last event %s '%s', want %s with '%s'", e->kind, e->text, kind, needle);
@@ -132,7 +137,7 @@ static int setup(void **state)
 	make_cfg(&cfg);
 	fake_wall = T0;
 	fake_mono = 5000000;
-	nev = 0;
+	nev = ev_checked = 0;
 	char why[300];
 	if (!cin_open(&in, &cfg, &hooks, fp, why, sizeof why)) {
 		print_error("cin_open: %s\n", why);
@@ -204,6 +209,20 @@ static void send_net(const struct cmd_request *r, const struct auth_key *k, cons
 	uint8_t d[CIN_DGRAM_MAX];
 	size_t n = net_datagram(r, k, channel, d, sizeof d);
 	cin_network_datagram(&in, d, n, false);
+}
+
+/* The same, a second after the last datagram: each refusal's event then
+ * passes the limiter of unauthenticated traffic (one a second). */
+static void send_net_later(const struct cmd_request *r, const struct auth_key *k, const char *channel)
+{
+	fake_mono += 1000000;
+	send_net(r, k, channel);
+}
+
+static void dgram_later(const uint8_t *d, size_t n, bool truncated)
+{
+	fake_mono += 1000000;
+	cin_network_datagram(&in, d, n, truncated);
 }
 
 /* Reuses the stack below the caller, as the daemon's loop does between a
@@ -423,72 +442,59 @@ static void test_network_refused(void **state)
 {
 	(void)state;
 	go_network();
-	/* a second apart, so that each refusal's event passes the limiter of
-	 * unauthenticated traffic (test_rate_limits) */
 	struct auth_key wrong = key;
 	wrong.bytes[31] ^= 1;
 	struct cmd_request r = base_cmd(CMD_KIND_MODE, 41);
 	/* unsigned */
-	fake_mono += 1000000;
-	send_net(&r, NULL, "robot1.CMD");
+	send_net_later(&r, NULL, "robot1.CMD");
 	expect_last_event("command-rejected", "not signed");
 	/* another key */
 	r.seq = 42;
-	fake_mono += 1000000;
-	send_net(&r, &wrong, "robot1.CMD");
+	send_net_later(&r, &wrong, "robot1.CMD");
 	expect_last_event("command-rejected", "not signed");
 	/* signed, then changed on the way */
 	uint8_t d[CIN_DGRAM_MAX];
 	r.seq = 43;
 	size_t n = net_datagram(&r, &key, "robot1.CMD", d, sizeof d);
 	d[n - CMD_MAC_BYTES - 1] ^= 1;   /* torque flag */
-	fake_mono += 1000000;
-	cin_network_datagram(&in, d, n, false);
+	dgram_later(d, n, false);
 	expect_last_event("command-rejected", "not signed");
 	assert_int_equal(in.unauthenticated, 3);
 	/* a good one, then the same datagram again */
 	r.seq = 44;
 	n = net_datagram(&r, &key, "robot1.CMD", d, sizeof d);
-	fake_mono += 1000000;
-	cin_network_datagram(&in, d, n, false);
+	dgram_later(d, n, false);
 	assert_int_equal(cin_pending(&in), 1);
-	fake_mono += 1000000;
-	cin_network_datagram(&in, d, n, false);
+	dgram_later(d, n, false);
 	expect_last_event("command-rejected", "replayed");
 	assert_int_equal(cin_pending(&in), 1);
 	/* ... or an older sequence number at the same time */
 	r.seq = 43;
-	fake_mono += 1000000;
-	send_net(&r, &key, "robot1.CMD");
+	send_net_later(&r, &key, "robot1.CMD");
 	expect_last_event("command-rejected", "replayed");
 	/* outside the window (command_window_s), either way */
 	int64_t win = (int64_t)(cfg.command_window_s * 1e6);
 	fake_wall = T0 + 10 * win;
 	r = base_cmd(CMD_KIND_MODE, 50);
 	r.utime = fake_wall - win - 1;
-	fake_mono += 1000000;
-	send_net(&r, &key, "robot1.CMD");
+	send_net_later(&r, &key, "robot1.CMD");
 	expect_last_event("command-rejected", "too old");
 	r.utime = fake_wall + win + 1;
-	fake_mono += 1000000;
-	send_net(&r, &key, "robot1.CMD");
+	send_net_later(&r, &key, "robot1.CMD");
 	expect_last_event("command-rejected", "from the future");
 	/* signed before the robot started (a recording from an earlier run) */
 	fake_wall = T0 + win / 4;
 	r.utime = T0 - 1;
 	r.source = "operator-2";
-	fake_mono += 1000000;
-	send_net(&r, &key, "robot1.CMD");
+	send_net_later(&r, &key, "robot1.CMD");
 	expect_last_event("command-rejected", "too old");
 	/* undecodable, and longer than any command, on a command channel */
 	uint8_t junk[64];
 	memset(junk, 0xab, sizeof junk);
 	n = wire_udpm_build(d, sizeof d, 1, "robot1.CMD", junk, sizeof junk);
-	fake_mono += 1000000;
-	cin_network_datagram(&in, d, n, false);
+	dgram_later(d, n, false);
 	expect_last_event("command-rejected", "undecodable");
-	fake_mono += 1000000;
-	cin_network_datagram(&in, d, n, true);
+	dgram_later(d, n, true);
 	expect_last_event("command-rejected", "longer than any command_t");
 	assert_int_equal(in.unauthenticated, 10);
 	assert_int_equal(in.rejected, 0);
