@@ -157,9 +157,10 @@ static ptrdiff_t auth_find(const struct auth_replay *g, const char *source)
 enum auth_fresh auth_replay_check(const struct auth_replay *g, const char *source, int64_t utime, int64_t seq,
                                   int64_t now_us)
 {
-	if (utime <= g->floor_us || utime < now_us - g->window_us)
+	/* |utime - now_us| < window_us (auth.h): the window's edge is outside */
+	if (utime <= g->floor_us || utime <= now_us - g->window_us)
 		return AUTH_TOO_OLD;
-	if (utime > now_us + g->window_us)
+	if (utime >= now_us + g->window_us)
 		return AUTH_TOO_NEW;
 	ptrdiff_t i = auth_find(g, source);
 	const struct auth_seen *s = i >= 0 ? &g->seen[i] : NULL;

@@ -47,22 +47,37 @@ static bool csock_private_dir(const char *dir, char *why, size_t cap)
 	return true;
 }
 
+/* out = a b, or false with *why. */
+static bool csock_set_dir(char *out, size_t cap, const char *a, const char *b, char *why, size_t why_cap)
+{
+	if (csock_set(out, cap, a, b))
+		return true;
+	snprintf(why, why_cap, "'%.200s%s': too long for the socket's directory (%zu bytes at most)", a, b, cap - 1);
+	return false;
+}
+
 bool csock_daemon_dir(char *out, size_t cap, const char *configured, char *why, size_t why_cap)
 {
 	const char *env;
 	if (configured != NULL && configured[0] != '\0')
-		return csock_set(out, cap, configured, "");
+		return csock_set_dir(out, cap, configured, "", why, why_cap);
 	if ((env = getenv("UNDULATE_RUN_DIR")) != NULL && env[0] != '\0')
-		return csock_set(out, cap, env, "");
+		return csock_set_dir(out, cap, env, "", why, why_cap);
 	if ((env = getenv("RUNTIME_DIRECTORY")) != NULL && env[0] != '\0') {
 		/* systemd may list several, separated by ':' — the first is ours */
 		char first[CSOCK_PATH_MAX];
-		snprintf(first, sizeof first, "%s", env);
-		first[strcspn(first, ":")] = '\0';
-		return csock_set(out, cap, first, "");
+		size_t n = strcspn(env, ":");
+		if (n >= sizeof first) {
+			snprintf(why, why_cap, "RUNTIME_DIRECTORY: its first directory is longer than %zu bytes",
+			         sizeof first - 1);
+			return false;
+		}
+		memcpy(first, env, n);
+		first[n] = '\0';
+		return csock_set_dir(out, cap, first, "", why, why_cap);
 	}
 	if ((env = getenv("XDG_RUNTIME_DIR")) != NULL && env[0] != '\0') {
-		if (!csock_set(out, cap, env, "/undulate"))
+		if (!csock_set_dir(out, cap, env, "/undulate", why, why_cap))
 			return false;
 		if (mkdir(out, 0700) != 0 && errno != EEXIST) {
 			snprintf(why, why_cap, "%s: %s", out, strerror(errno));
@@ -71,7 +86,7 @@ bool csock_daemon_dir(char *out, size_t cap, const char *configured, char *why, 
 		return true;
 	}
 	if (geteuid() == 0) {
-		if (!csock_set(out, cap, "/run/undulate", ""))
+		if (!csock_set_dir(out, cap, "/run/undulate", "", why, why_cap))
 			return false;
 		if (mkdir(out, 0750) != 0 && errno != EEXIST) {
 			snprintf(why, why_cap, "%s: %s", out, strerror(errno));

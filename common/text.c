@@ -4,19 +4,30 @@
 #include <stdio.h>
 #include <string.h>
 
+static bool text_printable(unsigned char b)
+{
+	return b >= 0x20 && b <= 0x7e && b != '\\';
+}
+
 char *text_sanitize(char *dst, size_t cap, const char *src)
 {
 	static const char hex[] = "0123456789abcdef";
-	const char *ellipsis = "...";
-	size_t o = 0;
+	static const char ellipsis[] = "...";
+	const size_t elen = sizeof ellipsis - 1;
+	size_t o = 0, need = 0;
 	if (cap == 0)
 		return dst;
 	if (src == NULL)
 		src = "";
+	for (const unsigned char *p = (const unsigned char *)src; *p; p++)
+		need += text_printable(*p) ? 1 : 4;
+	/* only a text that does not fit is cut, and then room is kept for the ellipsis */
+	bool cut = need > cap - 1;
+	size_t room = !cut ? cap - 1 : cap - 1 > elen ? cap - 1 - elen : 0;
 	for (const unsigned char *p = (const unsigned char *)src; *p; p++) {
-		char piece[5];
+		char piece[4];
 		size_t n;
-		if (*p >= 0x20 && *p <= 0x7e && *p != '\\') {
+		if (text_printable(*p)) {
 			piece[0] = (char)*p;
 			n = 1;
 		} else {
@@ -26,17 +37,14 @@ char *text_sanitize(char *dst, size_t cap, const char *src)
 			piece[3] = hex[*p & 15];
 			n = 4;
 		}
-		/* keep room for the ellipsis unless this is the last byte */
-		size_t room = p[1] ? cap - 1 - strlen(ellipsis) : cap - 1;
-		if (cap <= strlen(ellipsis) + 1 || o + n > room) {
-			if (cap > strlen(ellipsis) + 1) {
-				memcpy(dst + o, ellipsis, strlen(ellipsis));
-				o += strlen(ellipsis);
-			}
+		if (o + n > room)
 			break;
-		}
 		memcpy(dst + o, piece, n);
 		o += n;
+	}
+	if (cut && o + elen < cap) {
+		memcpy(dst + o, ellipsis, elen);
+		o += elen;
 	}
 	dst[o] = '\0';
 	return dst;

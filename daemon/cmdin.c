@@ -28,9 +28,11 @@ bool cin_open(struct cin *in, const struct cfg *cfg, const struct cin_hooks *hoo
 	in->hooks = *hooks;
 	in->fingerprint = fingerprint;
 	in->local_fd = in->net_fd = -1;
-	/* rejected: a line and an event for the first few, then one a second
-	 * (with the count of those left out); accepted: more, as an operator's
-	 * script may send bursts */
+	/* refused, from an authentic sender (local, or signed): 10 lines and 20
+	 * events, then a line per 0.2 s and an event per 0.1 s, each with the
+	 * count of those left out; refused unauthenticated network traffic: 5 of
+	 * each, then one a second; accepted: more, as an operator's script may
+	 * send bursts */
 	in->lim_log_reject = (struct log_limit)LOG_LIMIT_INIT(10, 200000);
 	in->lim_event_reject = (struct log_limit)LOG_LIMIT_INIT(20, 100000);
 	in->lim_log_accept = (struct log_limit)LOG_LIMIT_INIT(20, 200000);
