@@ -10,11 +10,15 @@
 # undulate-analyze. The three regimes the theory predicts, asserted as the
 # paper states them:
 #   small d~  (0.05)            -> in phase: final |D| < 0.3 rad
-#   intermediate d~ (0.3)       -> compatible: no collision in the last 10 s and
-#                                  |D| <= 2 asin(d~) + 0.1
+#   intermediate d~ (0.3)       -> compatible: |D| <= 2 asin(d~) + 0.1, the contact
+#                                  impulse down tenfold, and no collision in the
+#                                  last 10 s (a TODO when one graze remains:
+#                                  docs/EXPERIMENTS.md)
 #   large d~ (0.7), D0 = pi     -> anti-phase: |D| within 0.5 of pi, collisions go on
 # d~ is the analyser's, from the amplitude the daemons actually reach, and
-# each run first checks that it landed in the regime it is meant to test.
+# each run first checks that it landed in the regime it is meant to test. A
+# pair that stopped swinging proves nothing: its regime checks are skipped (the
+# stop is a failure of its own).
 source "$(dirname "$0")/../lib.sh"
 
 scenario="$top/tests/scenarios/pair-rig.scenario"
@@ -68,6 +72,7 @@ for name in inphase compat anti; do
 		sw=$(min_swing "$T/$name")
 		if num "${sw%% *} >= $MIN_SWING"; then
 			tap_ok "$name: both robots still swing at the end (smallest peak-to-peak $sw rad)"
+			: >"$T/$name/moving"
 		else
 			tap_fail "$name: both robots still swing at the end" "smallest peak-to-peak over the last 10 s: $sw rad (< $MIN_SWING): a stopped pair proves nothing"
 		fi
@@ -76,9 +81,17 @@ for name in inphase compat anti; do
 	fi
 done
 
+# regime NAME: the run's regime can be judged (it ran, and both robots still swing)
+regime() {
+	[ -f "$T/$1/summary.txt" ] || return 1
+	[ -f "$T/$1/moving" ] && return 0
+	tap_skip "$1: the regime's checks" "the robots stopped swinging: nothing to judge"
+	return 1
+}
+
 # ---- small separation: in phase --------------------------------------------------
 n=inphase
-if [ -f "$T/$n/summary.txt" ]; then
+if regime $n; then
 	d=$(col $n d~); D=$(col $n meanD); sw=$(cat "$T/$n/switch_t")
 	after=$(collisions $n "$sw" "$(awk "BEGIN { print $sw + 10 }")")
 	echo "# in phase: d~ $d, final D $D, collisions in the 10 s after the switch $after"
@@ -96,7 +109,7 @@ fi
 
 # ---- intermediate separation: compatible ----------------------------------------
 n=compat
-if [ -f "$T/$n/summary.txt" ]; then
+if regime $n; then
 	d=$(col $n d~); D=$(col $n meanD); lim=$(col $n "2asin(d~)"); end=$(span $n)
 	sw=$(cat "$T/$n/switch_t")
 	after=$(collisions $n "$sw" "$(awk "BEGIN { print $sw + 10 }")")
@@ -119,24 +132,24 @@ if [ -f "$T/$n/summary.txt" ]; then
 	imp() { awk -F, -v a="$2" -v b="$3" 'NR > 1 && $1 >= a && $1 < b { s += $3 } END { printf "%.4f", s }' "$T/$1/collision_rate.csv"; }
 	imp_after=$(imp $n "$sw" "$(awk "BEGIN { print $sw + 10 }")")
 	imp_last=$(imp $n "$(awk "BEGIN { print $end - 10 }")" "$end")
+	per10=$(awk -F, 'NR > 1 { b = int($1 / 10); s[b] += $3; if (b > m) m = b } END { for (b = 0; b <= m; b++) printf "%.3f ", s[b] }' "$T/$n/collision_rate.csv")
+	if num "$imp_after > 0 && $imp_last <= 0.1 * $imp_after"; then
+		tap_ok "compatible: contact impulse down at least tenfold ($imp_after -> $imp_last N*s per 10 s)"
+	else
+		tap_fail "compatible: contact impulse down at least tenfold" "$imp_after -> $imp_last N*s per 10 s; per 10 s: ${per10}N*s"
+	fi
 	if [ "$last" -eq 0 ]; then
 		tap_ok "compatible: no collision in the last 10 s"
-	elif num "${D#-} >= $lim - 0.1 && ${D#-} <= $lim + 0.1 && $imp_last <= 0.1 * $imp_after"; then
-		# theory.md: 2 asin(d~) is the map's fixed point, "the largest phase
-		# difference at which they only graze" — a pair that settles exactly
-		# there touches once a cycle with a small impulse. Accepted only at
-		# that fixed point and with the contact impulse down tenfold.
-		tap_ok "compatible: settled at the grazing fixed point |D| = ${D#-} ~ 2 asin(d~) = $lim; impulse $imp_after -> $imp_last N*s per 10 s ($last grazes)"
 	else
-		# In about 1 run of 4 the pair keeps touching inside the compatible set
-		# (docs/EXPERIMENTS.md): not reproduced reliably yet, reported with the numbers.
-		tap_todo "compatible: no collision in the last 10 s" "$last collisions in the last 10 s at final D $D (2 asin(d~) $lim, state $(col $n state)); impulse per 10 s: $(awk -F, 'NR > 1 { b = int($1 / 10); s[b] += $3; if (b > m) m = b } END { for (b = 0; b <= m; b++) printf "%.3f ", s[b] }' "$T/$n/collision_rate.csv")N*s"
+		# The paper's "contact stops": in some runs one graze in 10 s remains at
+		# |D| near 2 asin(d~) (docs/EXPERIMENTS.md says so): reported with the numbers.
+		tap_todo "compatible: no collision in the last 10 s" "$last collisions in the last 10 s at final D $D (2 asin(d~) $lim, state $(col $n state)); impulse per 10 s: ${per10}N*s"
 	fi
 fi
 
 # ---- large separation from a large phase difference: anti-phase ------------------
 n=anti
-if [ -f "$T/$n/summary.txt" ]; then
+if regime $n; then
 	d=$(col $n d~); D=$(col $n meanD); end=$(span $n)
 	last=$(collisions $n "$(awk "BEGIN { print $end - 10 }")" "$end")
 	# d~_c = sqrt(r(r - 1) / (r^2 - r - 2)) for r = 0.67 (theory.md)
