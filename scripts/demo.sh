@@ -11,6 +11,7 @@
 #                   [--daemon-set SEC.KEY=VAL]... [--start-mode MODE]
 #                   [--switch-at S|never] [--switch-to MODE] [--phases random|LIST]
 #                   [--seed N] [--window S] [--out DIR] [--lcm-url URL]
+#                   [--no-realtime]
 #
 # The robots start in --start-mode (default SINUSOID, each with its own phase:
 # random, or the comma-separated radians of --phases in scenario order) and are
@@ -19,6 +20,12 @@
 # from the clock-driven sinusoid is how the paper starts its runs, and it is
 # what gives every robot a chosen phase: a robot started in OSCILLATOR from
 # rest begins at phase 0 or π only.
+#
+# The simulator and the daemons run under SCHED_FIFO where the machine allows
+# it (root, or LimitRTPRIO/an rtprio limit), the simulator above the daemons:
+# servos do not slow down when their computer is busy, and a robot's unit runs
+# its daemon at real-time priority (systemd/). Where it is not allowed each says
+# so once and runs with normal scheduling; --no-realtime never asks.
 #
 # Everything runs in a private temporary directory on a private LCM port
 # (printed at start), so two demos, or a demo and the tests, never hear each
@@ -43,6 +50,10 @@ seed=""
 window=10
 out=""
 url=${DEMO_LCM_URL:-}
+# SCHED_FIFO priorities: the simulated servos first, then the control loops
+RT_SIM=30
+RT_DAEMON=20
+realtime=${DEMO_REALTIME:-1}
 # How long a program may take to say it is ready (s).
 READY_TIMEOUT_S=10
 
@@ -65,6 +76,7 @@ while [ $# -gt 0 ]; do
 	--window) window=$2; shift 2 ;;
 	--out) out=$2; shift 2 ;;
 	--lcm-url) url=$2; shift 2 ;;
+	--no-realtime) realtime=0; shift ;;
 	-h|--help) usage ;;
 	*) echo "demo: unknown argument '$1' (--help)" >&2; exit 2 ;;
 	esac
@@ -177,8 +189,10 @@ if [ -n "$seconds" ]; then
 fi
 
 # ---- simulator --------------------------------------------------------------
+rt_sim=() rt_daemon=()
+if [ "$realtime" = 1 ]; then rt_sim=(--realtime "$RT_SIM"); rt_daemon=(--set "robot.priority=$RT_DAEMON"); fi
 start sim "$B/undulate-sim" --scenario "$scenario" --link-dir "$links" --lcm-url "$url" \
-	--seed "$seed" ${sim_sets[@]+"${sim_sets[@]}"}
+	--seed "$seed" ${rt_sim[@]+"${rt_sim[@]}"} ${sim_sets[@]+"${sim_sets[@]}"}
 wait_ready sim '^undulate-sim: ready:' || exit 1
 # "ready: 4 buses: r1=/path/r1[1,2] r2=... bodies=..." names every robot, its
 # pty and its servo IDs, in scenario (left to right) order.
@@ -208,7 +222,8 @@ start_daemon() {
 	local i=$1
 	start "undulated-${robots[$i]}" "$B/undulated" --port "${ports[$i]}" --ids "${ids[$i]}" \
 		--robot "${robots[$i]}" --lcm-url "$url" --mode "$start_mode" \
-		--set "sinusoid.phase=${robot_phase[$i]}" ${daemon_sets[@]+"${daemon_sets[@]}"}
+		--set "sinusoid.phase=${robot_phase[$i]}" ${rt_daemon[@]+"${rt_daemon[@]}"} \
+		${daemon_sets[@]+"${daemon_sets[@]}"}
 }
 # Start-up attempts per daemon (see below).
 START_ATTEMPTS=3
