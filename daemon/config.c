@@ -10,6 +10,8 @@
 #include <string.h>
 #include <strings.h>
 
+#include "textfile.h"
+
 #define CFG_PI 3.14159265358979323846
 /* The AX-12 turns 300°: ±150° = ±2.618 rad around its centre. */
 #define CFG_SERVO_HALF_RANGE (150.0 * CFG_PI / 180.0)
@@ -468,9 +470,7 @@ struct cfg_parse {
 	struct cfg *cfg;
 	struct cfg_errors *errors;
 	const char *name;
-	/* source: a FILE or a string */
-	FILE *file;
-	const char *text;
+	const char *text;   /* what is left to read */
 	int line;
 	int long_line;   /* first physical line too long for inih, 0 if none */
 	int line_cap;    /* the longest line inih reads (its buffer less the NUL) */
@@ -483,36 +483,24 @@ struct cfg_parse {
  * the tail of a long line is never parsed as a key of its own. */
 static void cfg_skip_rest_of_line(struct cfg_parse *p)
 {
-	if (p->file != NULL) {
-		int ch;
-		while ((ch = fgetc(p->file)) != EOF && ch != '\n')
-			;
-	} else {
-		while (*p->text != '\0' && *p->text++ != '\n')
-			;
-	}
+	while (*p->text != '\0' && *p->text++ != '\n')
+		;
 }
 
 static char *cfg_reader(char *str, int num, void *stream)
 {
 	struct cfg_parse *p = stream;
-	if (p->file != NULL) {
-		if (fgets(str, num, p->file) == NULL)
-			return NULL;
-	} else {
-		if (*p->text == '\0')
-			return NULL;
-		int i = 0;
-		while (i < num - 1 && p->text[0] != '\0') {
-			str[i++] = *p->text++;
-			if (str[i - 1] == '\n')
-				break;
-		}
-		str[i] = '\0';
+	if (*p->text == '\0')
+		return NULL;
+	int i = 0;
+	while (i < num - 1 && p->text[0] != '\0') {
+		str[i++] = *p->text++;
+		if (str[i - 1] == '\n')
+			break;
 	}
+	str[i] = '\0';
 	p->line++;
-	/* a read that fills the buffer without a newline is a line too long for
-	 * inih (a NUL byte inside a line only makes it look shorter) */
+	/* a read that fills the buffer without a newline is a line too long for inih */
 	size_t len = strlen(str);
 	if (len > 0 && len + 1 >= (size_t)num && str[len - 1] != '\n') {
 		cfg_skip_rest_of_line(p);
@@ -562,16 +550,20 @@ bool cfg_load_string(struct cfg *c, const char *name, const char *text, struct c
 
 bool cfg_load_file(struct cfg *c, const char *path, struct cfg_errors *errors)
 {
-	FILE *f = fopen(path, "r");
-	if (f == NULL) {
-		cfg_error(errors, "%s: cannot open: %s", path, strerror(errno));
+	/* only a regular file, read whole: a FIFO blocked here, /dev/zero never ended */
+	char why[CFG_ERR_MAX];
+	size_t len;
+	char *text = textfile_read(path, "a configuration", &len, why, sizeof why);
+	if (text == NULL) {
+		cfg_error(errors, "%s", why);
+		errors->file_refused = true;
 		return false;
 	}
 	/* Messages name the file as given, without directories clutter removed:
 	 * users copy that path into their editor. */
-	struct cfg_parse p = { .cfg = c, .errors = errors, .name = path, .file = f };
+	struct cfg_parse p = { .cfg = c, .errors = errors, .name = path, .text = text };
 	bool ok = cfg_parse_run(&p);
-	fclose(f);
+	free(text);
 	snprintf(c->source, sizeof c->source, "%s", path);
 	return ok;
 }
