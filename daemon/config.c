@@ -500,9 +500,13 @@ static char *cfg_reader(char *str, int num, void *stream)
 	}
 	str[i] = '\0';
 	p->line++;
-	/* a read that fills the buffer without a newline is a line too long for inih */
-	size_t len = strlen(str);
-	if (len > 0 && len + 1 >= (size_t)num && str[len - 1] != '\n') {
+	/* a read that fills the buffer without a newline is a line too long for
+	 * inih, unless the line ends right there: num - 1 characters fit (the
+	 * README's 199), handed over without their newline */
+	bool full = i > 0 && i == num - 1 && str[i - 1] != '\n';
+	if (full && (*p->text == '\n' || *p->text == '\0')) {
+		p->text += *p->text == '\n';
+	} else if (full) {
 		cfg_skip_rest_of_line(p);
 		if (p->long_line == 0) {
 			p->long_line = p->line;

@@ -241,6 +241,43 @@ static void test_long_line(void **state)
 	assert_non_null(strstr(e.line[1], "r.conf:2: line too long"));
 }
 
+/* README: "A line may hold at most 199 characters". A line of exactly 199
+ * filled the parser's buffer and was reported too long, whether a newline
+ * or the end of the text followed it; 200 is too long. */
+static void test_line_of_199_characters(void **state)
+{
+	(void)state;
+	static char text[1024];
+	char line[201];
+	memset(line, 'x', sizeof line);
+	memcpy(line, "name = r ; ", 11);
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	line[199] = '\0';
+	snprintf(text, sizeof text, "[robot]\nport = /dev/null\n%s\nids = 1\nbaud = x\n", line);
+	cfg_defaults(&c);
+	assert_false(cfg_load_string(&c, "r.conf", text, &e));
+	assert_int_equal(e.count, 1);
+	assert_string_equal(e.line[0], "r.conf:5: [robot] baud: not an integer 'x'");
+	assert_string_equal(c.name, "r");
+	/* at the end of the text, without a newline */
+	snprintf(text, sizeof text, "[robot]\nport = /dev/null\nids = 1\n%s", line);
+	e.count = 0;
+	cfg_defaults(&c);
+	if (!cfg_load_string(&c, "r.conf", text, &e))
+		fail_msg("unexpected error: %s", e.line[0]);
+	/* one more is too long, and the line after it keeps its number */
+	line[199] = 'x';
+	line[200] = '\0';
+	snprintf(text, sizeof text, "[robot]\nport = /dev/null\n%s\nids = 1\nbaud = x\n", line);
+	e.count = 0;
+	cfg_defaults(&c);
+	assert_false(cfg_load_string(&c, "r.conf", text, &e));
+	assert_int_equal(e.count, 2);
+	assert_string_equal(e.line[0], "r.conf:5: [robot] baud: not an integer 'x'");
+	assert_string_equal(e.line[1], "r.conf:3: line too long (the parser reads at most 199 characters of a line)");
+}
+
 static void test_file_and_missing_file(void **state)
 {
 	(void)state;
@@ -394,6 +431,7 @@ int main(void)
 		cmocka_unit_test(test_whole_config_errors),
 		cmocka_unit_test(test_every_error_reported),
 		cmocka_unit_test(test_long_line),
+		cmocka_unit_test(test_line_of_199_characters),
 		cmocka_unit_test(test_file_and_missing_file),
 		cmocka_unit_test(test_only_regular_files),
 		cmocka_unit_test(test_overrides),
