@@ -319,7 +319,7 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			cfg_error(e, "%s: [robot] %s: longer than %zu characters", where, key, k->size - 1);
 			return false;
 		}
-		if (strcmp(key, "name") == 0 && (value[0] == '\0' || strpbrk(value, ".* \t") != NULL)) {
+		if (strcmp(key, "name") == 0 && (value[0] == '\0' || strpbrk(value, ".* \t\r\n\v\f") != NULL)) {
 			cfg_error(e, "%s: [robot] name: '%s' must be non-empty without '.', '*' or spaces "
 			          "(it prefixes LCM channels)", where, value);
 			return false;

@@ -278,6 +278,35 @@ static void test_line_of_199_characters(void **state)
 	assert_string_equal(e.line[1], "r.conf:3: line too long (the parser reads at most 199 characters of a line)");
 }
 
+/* README: a robot name has no '.', '*' or spaces (it prefixes LCM channels).
+ * A vertical tab or form feed inside a line, or a CR or newline from the
+ * command line (--robot), was accepted: only ' ' and '\t' were refused. */
+static void test_name_without_spaces(void **state)
+{
+	(void)state;
+	static const char *const bad[] = { "a b", "a\tb", "a\vb", "a\fb", "a\rb", "a\nb", "a.b", "a*", "" };
+	struct cfg c;
+	char assignment[64], want[CFG_ERR_MAX];
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+		struct cfg_errors e = { 0 };
+		cfg_defaults(&c);
+		snprintf(assignment, sizeof assignment, "robot.name=%s", bad[i]);
+		assert_false(cfg_override(&c, assignment, &e));
+		snprintf(want, sizeof want, "command line: [robot] name: '%s' must be non-empty without '.', '*' or "
+		         "spaces (it prefixes LCM channels)", bad[i]);
+		assert_string_equal(e.line[0], want);
+		assert_string_equal(c.name, "robot");
+	}
+	char b[CFG_ERR_MAX];
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nname = r\v1\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] name: 'r\v1' must be non-empty without '.', '*' or spaces "
+	                    "(it prefixes LCM channels)");
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.name=robot_1-b", &e));
+	assert_string_equal(c.name, "robot_1-b");
+}
+
 static void test_file_and_missing_file(void **state)
 {
 	(void)state;
@@ -432,6 +461,7 @@ int main(void)
 		cmocka_unit_test(test_every_error_reported),
 		cmocka_unit_test(test_long_line),
 		cmocka_unit_test(test_line_of_199_characters),
+		cmocka_unit_test(test_name_without_spaces),
 		cmocka_unit_test(test_file_and_missing_file),
 		cmocka_unit_test(test_only_regular_files),
 		cmocka_unit_test(test_overrides),
