@@ -11,6 +11,7 @@
 #include <strings.h>
 
 #include "dxl_table.h"
+#include "textfile.h"
 #include "udpm.h"
 
 #define CFG_PI 3.14159265358979323846
@@ -361,7 +362,7 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			cfg_error(e, "%s: [robot] %s: longer than %zu characters", where, key, k->size - 1);
 			return false;
 		}
-		if (strcmp(key, "name") == 0 && (value[0] == '\0' || strpbrk(value, ".* \t") != NULL)) {
+		if (strcmp(key, "name") == 0 && (value[0] == '\0' || strpbrk(value, ".* \t\r\n\v\f") != NULL)) {
 			cfg_error(e, "%s: [robot] name: '%s' must be non-empty without '.', '*' or spaces "
 			          "(it prefixes LCM channels)", where, value);
 			return false;
@@ -525,9 +526,7 @@ struct cfg_parse {
 	struct cfg *cfg;
 	struct cfg_errors *errors;
 	const char *name;
-	/* source: a FILE or a string */
-	FILE *file;
-	const char *text;
+	const char *text;   /* what is left to read */
 	int line;
 	int long_line;   /* first physical line too long for inih, 0 if none */
 	int line_cap;    /* the longest line inih reads (its buffer less the NUL) */
@@ -540,38 +539,30 @@ struct cfg_parse {
  * the tail of a long line is never parsed as a key of its own. */
 static void cfg_skip_rest_of_line(struct cfg_parse *p)
 {
-	if (p->file != NULL) {
-		int ch;
-		while ((ch = fgetc(p->file)) != EOF && ch != '\n')
-			;
-	} else {
-		while (*p->text != '\0' && *p->text++ != '\n')
-			;
-	}
+	while (*p->text != '\0' && *p->text++ != '\n')
+		;
 }
 
 static char *cfg_reader(char *str, int num, void *stream)
 {
 	struct cfg_parse *p = stream;
-	if (p->file != NULL) {
-		if (fgets(str, num, p->file) == NULL)
-			return NULL;
-	} else {
-		if (*p->text == '\0')
-			return NULL;
-		int i = 0;
-		while (i < num - 1 && p->text[0] != '\0') {
-			str[i++] = *p->text++;
-			if (str[i - 1] == '\n')
-				break;
-		}
-		str[i] = '\0';
+	if (*p->text == '\0')
+		return NULL;
+	int i = 0;
+	while (i < num - 1 && p->text[0] != '\0') {
+		str[i++] = *p->text++;
+		if (str[i - 1] == '\n')
+			break;
 	}
+	str[i] = '\0';
 	p->line++;
 	/* a read that fills the buffer without a newline is a line too long for
-	 * inih (a NUL byte inside a line only makes it look shorter) */
-	size_t len = strlen(str);
-	if (len > 0 && len + 1 >= (size_t)num && str[len - 1] != '\n') {
+	 * inih, unless the line ends right there: num - 1 characters fit (the
+	 * README's 199), handed over without their newline */
+	bool full = i > 0 && i == num - 1 && str[i - 1] != '\n';
+	if (full && (*p->text == '\n' || *p->text == '\0')) {
+		p->text += *p->text == '\n';
+	} else if (full) {
 		cfg_skip_rest_of_line(p);
 		if (p->long_line == 0) {
 			p->long_line = p->line;
@@ -619,16 +610,20 @@ bool cfg_load_string(struct cfg *c, const char *name, const char *text, struct c
 
 bool cfg_load_file(struct cfg *c, const char *path, struct cfg_errors *errors)
 {
-	FILE *f = fopen(path, "r");
-	if (f == NULL) {
-		cfg_error(errors, "%s: cannot open: %s", path, strerror(errno));
+	/* only a regular file, read whole: a FIFO blocked here, /dev/zero never ended */
+	char why[CFG_ERR_MAX];
+	size_t len;
+	char *text = textfile_read(path, "a configuration", &len, why, sizeof why);
+	if (text == NULL) {
+		cfg_error(errors, "%s", why);
+		errors->file_refused = true;
 		return false;
 	}
 	/* Messages name the file as given, without directories clutter removed:
 	 * users copy that path into their editor. */
-	struct cfg_parse p = { .cfg = c, .errors = errors, .name = path, .file = f };
+	struct cfg_parse p = { .cfg = c, .errors = errors, .name = path, .text = text };
 	bool ok = cfg_parse_run(&p);
-	fclose(f);
+	free(text);
 	snprintf(c->source, sizeof c->source, "%s", path);
 	return ok;
 }

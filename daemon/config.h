@@ -94,11 +94,15 @@ struct cfg {
 struct cfg_errors {
 	size_t count;                              /* all errors seen */
 	char line[CFG_MAX_ERRORS][CFG_ERR_MAX];    /* the first CFG_MAX_ERRORS of them */
+	bool file_refused;                         /* cfg_load_file() read nothing: not a config file */
 };
 
 /* Defaults: robot "robot", no port, 1 Mbps, OSCILLATOR, safe_stop hold, ... */
 void cfg_defaults(struct cfg *c);
-/* Parse an INI file into c (on top of what is there). Returns errors->count == 0. */
+/* Parse an INI file into c (on top of what is there). Returns errors->count == 0.
+ * Only a regular file of at most 1 MiB with no NUL byte is read (common/textfile.h);
+ * anything else (a FIFO, a device, a directory, a missing path) is one error
+ * "PATH: why", at once, sets errors->file_refused and leaves c as it was. */
 bool cfg_load_file(struct cfg *c, const char *path, struct cfg_errors *errors);
 /* Same, from a string; `name` is used in messages in place of a file name. */
 bool cfg_load_string(struct cfg *c, const char *name, const char *text, struct cfg_errors *errors);

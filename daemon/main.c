@@ -221,7 +221,9 @@ int main(int argc, char **argv)
 		cfg_finish(&cfg, &errors);
 	if (errors.count > 0) {
 		main_print_errors(&errors);
-		return a.check ? 1 : 2;
+		/* a path that is no configuration file at all is a usage error, even
+		 * for --check-config (which otherwise reports a config's errors with 1) */
+		return a.check && !errors.file_refused ? 1 : 2;
 	}
 	if (a.check) {
 		if (log_get_level() > LOG_LVL_INFO)

@@ -4,17 +4,14 @@
 #include "scenario.h"
 
 #include "num.h"
+#include "textfile.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <ini.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 void sim_config_defaults(struct sim_config *c)
 {
@@ -453,68 +450,14 @@ int sim_config_load_text(struct sim_config *c, const char *name, const char *tex
 	return 0;
 }
 
-static const char *file_kind(mode_t m)
-{
-	if (S_ISDIR(m))
-		return "a directory";
-	if (S_ISFIFO(m))
-		return "a FIFO";
-	if (S_ISCHR(m))
-		return "a character device";
-	if (S_ISBLK(m))
-		return "a block device";
-	if (S_ISSOCK(m))
-		return "a socket";
-	return "not a plain file";
-}
-
-/* A scenario is a regular file of bounded size. The type is checked with
- * stat() before open(): opening a FIFO blocks until a writer comes, and
- * opening a device can have effects of its own (a serial port raises DTR).
- * open() then uses O_NONBLOCK and fstat() checks the same again, in case the
- * path was replaced in between; reading stops one byte past the limit, in
- * case the file grew. */
+/* A scenario is a regular file of bounded size, read whole (common/textfile.h). */
 int sim_config_load(struct sim_config *c, const char *path, char *err, size_t errcap)
 {
-	struct stat st;
-	if (stat(path, &st) != 0)
-		return ERR("%s: cannot open: %s", path, strerror(errno));
-	if (!S_ISREG(st.st_mode))
-		return ERR("%s: not a regular file (%s): a scenario is a text file", path, file_kind(st.st_mode));
-	if (st.st_size > SIM_SCENARIO_MAX_BYTES)
-		return ERR("%s: larger than 1 MiB (%lld bytes): not a scenario", path, (long long)st.st_size);
-	int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-	if (fd < 0)
-		return ERR("%s: cannot open: %s", path, strerror(errno));
-	if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-		close(fd);
-		return ERR("%s: not a regular file: a scenario is a text file", path);
-	}
-	char *text = malloc(SIM_SCENARIO_MAX_BYTES + 1);
-	if (!text) {
-		close(fd);
-		return ERR("%s: out of memory", path);
-	}
-	size_t len = 0;
-	int rerr = 0;
-	while (len <= SIM_SCENARIO_MAX_BYTES) {
-		ssize_t n = read(fd, text + len, SIM_SCENARIO_MAX_BYTES + 1 - len);
-		if (n < 0 && errno == EINTR)
-			continue;
-		if (n < 0)
-			rerr = errno;
-		if (n <= 0)
-			break;
-		len += (size_t)n;
-	}
-	close(fd);
-	int r;
-	if (rerr)
-		r = ERR("%s: cannot read: %s", path, strerror(rerr));
-	else if (len > SIM_SCENARIO_MAX_BYTES)
-		r = ERR("%s: larger than 1 MiB: not a scenario", path);
-	else
-		r = sim_config_load_text(c, path, text, len, err, errcap);
+	size_t len;
+	char *text = textfile_read(path, "a scenario", &len, err, errcap);
+	if (text == NULL)
+		return -1;
+	int r = sim_config_load_text(c, path, text, len, err, errcap);
 	free(text);
 	return r;
 }

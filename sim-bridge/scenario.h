@@ -13,6 +13,7 @@
 
 #include "motor.h"
 #include "simbus.h"
+#include "textfile.h"
 #include "world.h"
 
 #define SIM_MAX_BUSES 32     /* robots (one bus each); the benchmark runs 20 */
@@ -22,7 +23,7 @@
 /* Longest --duration: about 31 years (as int64 ns it stays far from overflow). */
 #define SIM_MAX_DURATION_S 1e9
 /* A scenario file larger than this is refused (the presets are ~1 kB). */
-#define SIM_SCENARIO_MAX_BYTES (1024 * 1024)
+#define SIM_SCENARIO_MAX_BYTES TEXTFILE_MAX_BYTES
 
 struct sim_robot_config {
 	char name[SIM_NAME_MAX];

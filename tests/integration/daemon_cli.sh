@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # undulated's operation: --help, --check-config (errors name file, line and
-# key), a missing servo named with the baud tried, and the systemd
-# notification protocol (READY, STATUS, WATCHDOG, STOPPING) on a datagram
-# socket, without libsystemd.
+# key; a FIFO or /dev/zero refused at once), a missing servo named with the
+# baud tried, and the systemd notification protocol (READY, STATUS, WATCHDOG,
+# STOPPING) on a datagram socket, without libsystemd.
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$D" ]; then tap_skip_all "undulated not built"; fi
@@ -69,6 +69,25 @@ else tap_fail "bad key is a config error" "rc $rc: $out"; fi
 out=$(timeout 10 "$D" --port /dev/null --ids 1 --set robot.commands=network --set robot.command_key="$T/good.key" 2>&1); rc=$?
 if [ $rc -eq 2 ] && echo "$out" | grep -q "lets others read the key"; then tap_ok "a key others can read is refused"
 else tap_fail "world-readable key refused" "rc $rc: $out"; fi
+
+# a configuration path that is no file to read is refused at once with exit 2,
+# also by --check-config (a FIFO with no writer blocked open() for ever, and
+# /dev/zero was read for ever); every run is under `timeout`, so a regression
+# fails here instead of hanging the suite
+refused() {
+	local name=$1 want=$2 rc out; shift 2
+	out=$(timeout -k 2 5 "$D" "$@" 2>&1); rc=$?
+	if [ "$rc" = 124 ] || [ "$rc" = 137 ]; then tap_fail "$name" "still running after 5 s (blocked)"; return; fi
+	if [ "$rc" = 2 ] && [ "$out" = "undulated: config: $want" ]; then tap_ok "$name: exit 2, '$out'"
+	else tap_fail "$name" "rc $rc: $out"; fi
+}
+refused "--check-config /dev/zero" \
+	"/dev/zero: not a regular file (a character device): a configuration is a text file" --check-config /dev/zero
+mkfifo "$T/fifo"
+refused "--check-config on a FIFO with no writer" \
+	"$T/fifo: not a regular file (a FIFO): a configuration is a text file" --check-config "$T/fifo"
+refused "a FIFO as the configuration to run" \
+	"$T/fifo: not a regular file (a FIFO): a configuration is a text file" "$T/fifo"
 
 if [ ! -x "$S" ]; then tap_skip "commands to a running daemon" "undulate-sim not built"; tap_done; exit 0; fi
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 9

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "../../daemon/config.h"
@@ -244,6 +245,72 @@ static void test_long_line(void **state)
 	assert_non_null(strstr(e.line[1], "r.conf:2: line too long"));
 }
 
+/* README: "A line may hold at most 199 characters". A line of exactly 199
+ * filled the parser's buffer and was reported too long, whether a newline
+ * or the end of the text followed it; 200 is too long. */
+static void test_line_of_199_characters(void **state)
+{
+	(void)state;
+	static char text[1024];
+	char line[201];
+	memset(line, 'x', sizeof line);
+	memcpy(line, "name = r ; ", 11);
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	line[199] = '\0';
+	snprintf(text, sizeof text, "[robot]\nport = /dev/null\n%s\nids = 1\nbaud = x\n", line);
+	cfg_defaults(&c);
+	assert_false(cfg_load_string(&c, "r.conf", text, &e));
+	assert_int_equal(e.count, 1);
+	assert_string_equal(e.line[0], "r.conf:5: [robot] baud: not an integer 'x'");
+	assert_string_equal(c.name, "r");
+	/* at the end of the text, without a newline */
+	snprintf(text, sizeof text, "[robot]\nport = /dev/null\nids = 1\n%s", line);
+	e.count = 0;
+	cfg_defaults(&c);
+	if (!cfg_load_string(&c, "r.conf", text, &e))
+		fail_msg("unexpected error: %s", e.line[0]);
+	/* one more is too long, and the line after it keeps its number */
+	line[199] = 'x';
+	line[200] = '\0';
+	snprintf(text, sizeof text, "[robot]\nport = /dev/null\n%s\nids = 1\nbaud = x\n", line);
+	e.count = 0;
+	cfg_defaults(&c);
+	assert_false(cfg_load_string(&c, "r.conf", text, &e));
+	assert_int_equal(e.count, 2);
+	assert_string_equal(e.line[0], "r.conf:5: [robot] baud: not an integer 'x'");
+	assert_string_equal(e.line[1], "r.conf:3: line too long (the parser reads at most 199 characters of a line)");
+}
+
+/* README: a robot name has no '.', '*' or spaces (it prefixes LCM channels).
+ * A vertical tab or form feed inside a line, or a CR or newline from the
+ * command line (--robot), was accepted: only ' ' and '\t' were refused. */
+static void test_name_without_spaces(void **state)
+{
+	(void)state;
+	static const char *const bad[] = { "a b", "a\tb", "a\vb", "a\fb", "a\rb", "a\nb", "a.b", "a*", "" };
+	struct cfg c;
+	char assignment[64], want[CFG_ERR_MAX];
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+		struct cfg_errors e = { 0 };
+		cfg_defaults(&c);
+		snprintf(assignment, sizeof assignment, "robot.name=%s", bad[i]);
+		assert_false(cfg_override(&c, assignment, &e));
+		snprintf(want, sizeof want, "command line: [robot] name: '%s' must be non-empty without '.', '*' or "
+		         "spaces (it prefixes LCM channels)", bad[i]);
+		assert_string_equal(e.line[0], want);
+		assert_string_equal(c.name, "robot");
+	}
+	char b[CFG_ERR_MAX];
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nname = r\v1\n", b, sizeof b),
+	                    "robot1.conf:4: [robot] name: 'r\v1' must be non-empty without '.', '*' or spaces "
+	                    "(it prefixes LCM channels)");
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.name=robot_1-b", &e));
+	assert_string_equal(c.name, "robot_1-b");
+}
+
 static void test_file_and_missing_file(void **state)
 {
 	(void)state;
@@ -260,10 +327,70 @@ static void test_file_and_missing_file(void **state)
 	char want[128];
 	snprintf(want, sizeof want, "%s:5: [joint.1] c: not a number 'oops'", path);
 	assert_string_equal(e.line[0], want);
+	assert_false(e.file_refused);   /* read, with errors of its own */
 	unlink(path);
 	e.count = 0;
 	assert_false(cfg_load_file(&c, path, &e));
 	assert_non_null(strstr(e.line[0], "cannot open"));
+}
+
+/* Loads path; expects it refused unread: one error, exactly want (or
+ * containing it), file_refused set, the configuration as it was. */
+static void expect_file_refused(const char *path, const char *want, bool partial)
+{
+	static struct cfg c, before;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
+	memcpy(&before, &c, sizeof c);
+	assert_false(cfg_load_file(&c, path, &e));
+	assert_int_equal(e.count, 1);
+	assert_true(e.file_refused);
+	if (partial ? strstr(e.line[0], want) == NULL : strcmp(e.line[0], want) != 0)
+		fail_msg("%s: got '%s', want '%s'", path, e.line[0], want);
+	assert_memory_equal(&c, &before, sizeof c);
+}
+
+/* The configuration is a regular file of at most 1 MiB with no NUL byte:
+ * anything else is refused at once, unread, with "PATH: why". A FIFO with no
+ * writer blocked fopen() for ever, and /dev/zero was read for ever (a line
+ * of NULs is an empty line to inih); a directory gave no error at all. */
+static void test_only_regular_files(void **state)
+{
+	(void)state;
+	/* a regression hangs: end this program instead of the suite's timeout */
+	alarm(20);
+	char dir[] = "/tmp/undulate-cfg-dir-XXXXXX";
+	assert_non_null(mkdtemp(dir));
+	char path[128], want[256];
+	snprintf(want, sizeof want, "%s: not a regular file (a directory): a configuration is a text file", dir);
+	expect_file_refused(dir, want, false);
+	expect_file_refused("/dev/zero", "/dev/zero: not a regular file (a character device): "
+	                    "a configuration is a text file", false);
+	snprintf(path, sizeof path, "%s/fifo", dir);
+	assert_int_equal(mkfifo(path, 0600), 0);
+	snprintf(want, sizeof want, "%s: not a regular file (a FIFO): a configuration is a text file", path);
+	expect_file_refused(path, want, false);
+	unlink(path);
+	/* 2 MiB (sparse: nothing is written) */
+	snprintf(path, sizeof path, "%s/huge.conf", dir);
+	FILE *f = fopen(path, "w");
+	assert_non_null(f);
+	fputs("[robot]\nport = /dev/null\nids = 1\n", f);
+	fclose(f);
+	assert_int_equal(truncate(path, 2 * 1024 * 1024), 0);
+	snprintf(want, sizeof want, "%s: larger than 1 MiB (2097152 bytes): not a configuration", path);
+	expect_file_refused(path, want, false);
+	/* NUL bytes, named with their line */
+	assert_int_equal(truncate(path, 40), 0);
+	snprintf(want, sizeof want, "%s:4: a NUL byte: a configuration is a text file", path);
+	expect_file_refused(path, want, false);
+	unlink(path);
+	snprintf(path, sizeof path, "%s/missing.conf", dir);
+	snprintf(want, sizeof want, "%s: cannot open: No such file or directory", path);
+	expect_file_refused(path, want, false);
+	rmdir(dir);
+	alarm(0);
 }
 
 static void test_overrides(void **state)
@@ -345,7 +472,10 @@ int main(void)
 		cmocka_unit_test(test_whole_config_errors),
 		cmocka_unit_test(test_every_error_reported),
 		cmocka_unit_test(test_long_line),
+		cmocka_unit_test(test_line_of_199_characters),
+		cmocka_unit_test(test_name_without_spaces),
 		cmocka_unit_test(test_file_and_missing_file),
+		cmocka_unit_test(test_only_regular_files),
 		cmocka_unit_test(test_overrides),
 		cmocka_unit_test(test_command_line_only),
 		cmocka_unit_test(test_param_ranges),
