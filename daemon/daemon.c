@@ -11,6 +11,7 @@
  * (setup.c) block; nothing else does. Nothing here writes the controller's
  * state: it calls the controller.
  */
+#include "clock.h"
 #include "daemon.h"
 
 #include <errno.h>
@@ -88,12 +89,6 @@ struct dmn {
 
 static uint64_t now_us(void) { return port_now_us(); }
 
-static int64_t wall_us(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_REALTIME, &ts);
-	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
 
 /* ---- events ---------------------------------------------------------------------------------- */
 static void dmn_event(struct dmn *d, int64_t seq, int level, const char *kind, const char *text)
@@ -127,7 +122,7 @@ static void cin_event_hook(void *ctx, int64_t seq, int level, const char *kind, 
 {
 	pub_event(&((struct dmn *)ctx)->pub, seq, level, kind, text);
 }
-static int64_t cin_wall_hook(void *ctx) { (void)ctx; return wall_us(); }
+static int64_t cin_wall_hook(void *ctx) { (void)ctx; return clock_wall_us(); }
 static uint64_t cin_mono_hook(void *ctx) { (void)ctx; return now_us(); }
 
 static void dmn_bus_error_hook(void *ctx, uint8_t id, const char *what, int status)
@@ -376,7 +371,7 @@ static void dmn_control(struct dmn *d)
 		d->params_dirty = true;
 	}
 	double dt = 1e-6 * (double)(d->cycle_start_us - d->last_cycle_start_us);
-	ctl_step(&d->ctl, dmn_ctl_time(d, d->cycle_start_us), dt, 1e-6 * (double)wall_us());
+	ctl_step(&d->ctl, dmn_ctl_time(d, d->cycle_start_us), dt, 1e-6 * (double)clock_wall_us());
 }
 
 static void dmn_cycle_done(struct dmn *d)

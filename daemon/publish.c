@@ -1,10 +1,10 @@
 /* publish.c — see publish.h. */
+#include "clock.h"
 #include "publish.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "port.h"
 #include "text.h"
@@ -12,13 +12,6 @@
 #include "undulate_event_t.h"
 #include "undulate_osc_params_t.h"
 #include "undulate_robot_state_t.h"
-
-static int64_t pub_wall_us(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_REALTIME, &ts);
-	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
 
 #define PUB_SEND(p, type, channel, msg)                                                          \
 	do {                                                                                     \
@@ -75,7 +68,7 @@ void pub_event(struct pub *p, int64_t seq, int level, const char *kind, const ch
 	text_line(kind_buf, sizeof kind_buf, kind);
 	text_line(text_buf, sizeof text_buf, text);
 	undulate_event_t e = {
-		.utime = pub_wall_us(), .robot = robot, .seq = seq, .level = (int8_t)level,
+		.utime = clock_wall_us(), .robot = robot, .seq = seq, .level = (int8_t)level,
 		.kind = kind_buf, .text = text_buf,
 	};
 	p->events++;
@@ -101,7 +94,7 @@ void pub_state(struct pub *p, const struct ctl *c, const struct pub_cycle *f)
 	snprintf(reason, sizeof reason, "%s", c->reason);
 	snprintf(fault, sizeof fault, "%s", c->latched ? c->latch : "");
 	undulate_robot_state_t m = {
-		.utime = pub_wall_us(), .robot = robot, .cycle = f->cycle, .mode = (int8_t)c->mode,
+		.utime = clock_wall_us(), .robot = robot, .cycle = f->cycle, .mode = (int8_t)c->mode,
 		.mode_reason = reason, .fault = fault, .period_us = f->period_us, .jitter_us = f->jitter_us,
 		.bus_us = f->bus_us, .control_us = f->control_us, .overruns = f->overruns, .bus_errors = f->bus_errors,
 		.bad_commands = f->bad_commands, .njoints = (int32_t)c->n, .joints = p->js,
@@ -128,7 +121,7 @@ void pub_params(struct pub *p)
 	char robot[CFG_NAME_MAX];
 	snprintf(robot, sizeof robot, "%s", c->name);
 	undulate_osc_params_t m = {
-		.utime = pub_wall_us(), .robot = robot, .njoints = (int32_t)c->njoints,
+		.utime = clock_wall_us(), .robot = robot, .njoints = (int32_t)c->njoints,
 		.k = v[0], .c = v[1], .mu = v[2], .lambda = v[3], .inertia = v[4], .friction = v[5],
 		.neutral = v[6], .limit_min = v[7], .limit_max = v[8],
 		.amplitude = c->amplitude, .frequency = c->frequency, .phase = c->phase,
@@ -153,7 +146,7 @@ void pub_bus(struct pub *p, const struct pub_bus *f, const struct bus *bus, cons
 	snprintf(robot, sizeof robot, "%s", p->cfg->name);
 	snprintf(port, sizeof port, "%s", f->port);
 	undulate_bus_stats_t m = {
-		.utime = pub_wall_us(), .robot = robot, .port = port, .baud = (int32_t)p->cfg->baud,
+		.utime = clock_wall_us(), .robot = robot, .port = port, .baud = (int32_t)p->cfg->baud,
 		.connected = f->connected, .reconnects = f->reconnects, .adapter_latency_ms = f->adapter_latency_ms,
 		.return_delay_us = f->return_delay_us, .period_p50_us = f->period_p50_us,
 		.period_p99_us = f->period_p99_us, .period_max_us = f->period_max_us, .jitter_p99_us = f->jitter_p99_us,

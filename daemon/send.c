@@ -13,9 +13,9 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/socket.h>
-#include <time.h>
 #include <unistd.h>
 
+#include "clock.h"
 #include "auth.h"
 #include "command.h"
 #include "csock.h"
@@ -33,20 +33,6 @@ struct send_state {
 	int accepted, rejected;
 	size_t expected;      /* answers to wait for (0: as many as come) */
 };
-
-static double send_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int64_t send_wall_us(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_REALTIME, &ts);
-	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
 
 static void send_answer(struct send_state *s, const undulate_event_t *e)
 {
@@ -108,10 +94,10 @@ static int send_local(const struct send_opts *o, const uint8_t *msg, size_t len,
 	}
 	st->expected = sent;
 	uint8_t buf[SEND_BUF];
-	double deadline = send_now() + o->timeout_s;
-	while ((size_t)(st->accepted + st->rejected) < st->expected && send_now() < deadline) {
+	double deadline = clock_mono_s() + o->timeout_s;
+	while ((size_t)(st->accepted + st->rejected) < st->expected && clock_mono_s() < deadline) {
 		struct pollfd p = { .fd = fd, .events = POLLIN };
-		int left_ms = (int)((deadline - send_now()) * 1000.0) + 1;
+		int left_ms = (int)((deadline - clock_mono_s()) * 1000.0) + 1;
 		if (poll(&p, 1, left_ms) <= 0)
 			continue;
 		ssize_t got = recv(fd, buf, sizeof buf, MSG_DONTWAIT);
@@ -153,11 +139,11 @@ static int send_network(const struct send_opts *o, const uint8_t *msg, size_t le
 	undulate_event_t_subscription_t *sub = undulate_event_t_subscribe(lcm, events, send_on_event, st);
 	st->expected = single ? 1 : 0;
 	lcm_publish(lcm, chan, msg, (unsigned)len);
-	double deadline = send_now() + o->timeout_s;
-	while (send_now() < deadline) {
+	double deadline = clock_mono_s() + o->timeout_s;
+	while (clock_mono_s() < deadline) {
 		if (st->expected > 0 && (size_t)(st->accepted + st->rejected) >= st->expected)
 			break;
-		int left_ms = (int)((deadline - send_now()) * 1000.0) + 1;
+		int left_ms = (int)((deadline - clock_mono_s()) * 1000.0) + 1;
 		lcm_handle_timeout(lcm, left_ms);
 	}
 	/* the generated wrapper is not freed by lcm_destroy() */
@@ -188,7 +174,7 @@ int dmn_send_command(const struct send_opts *o)
 		snprintf(source, sizeof source, "%s", o->source);
 	else
 		snprintf(source, sizeof source, "undulated@%.24s:%d", host, (int)getpid());
-	struct send_state st = { .seq = send_wall_us() };
+	struct send_state st = { .seq = clock_wall_us() };
 	r.utime = st.seq;
 	r.seq = st.seq;
 	r.source = source;

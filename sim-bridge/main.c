@@ -30,6 +30,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "clock.h"
 #include "sim.h"
 #include "undulate_sim_collision_t.h"
 #include "undulate_sim_command_t.h"
@@ -62,12 +63,6 @@ static int64_t mono_ns(void)
 	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
 
-static int64_t wall_us(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_REALTIME, &ts);
-	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
 
 struct client {
 	int fd;
@@ -368,7 +363,7 @@ static void fill_collision(struct app *a, const struct sim_collision *c, int64_t
 static void report_collisions(struct app *a)
 {
 	struct sim *s = a->sim;
-	int64_t now = wall_us();
+	int64_t now = clock_wall_us();
 	for (size_t i = 0; i < s->nstep_collisions; i++) {
 		const struct sim_collision *c = &s->step_collisions[i];
 		if (c->resting)
@@ -394,7 +389,7 @@ static void publish_truth(struct app *a)
 	static undulate_sim_body_t bodies[SIM_MAX_BODIES];
 	static undulate_sim_collision_t colls[MAIN_TRUTH_MAX_COLLISIONS];
 	struct sim *s = a->sim;
-	int64_t now = wall_us();
+	int64_t now = clock_wall_us();
 	undulate_sim_truth_t t = {
 		.utime = now, .step = (int64_t)s->steps, .sim_time = (double)s->steps * s->dt,
 		.wall_left = s->world.params.wall_left, .wall_right = s->world.params.wall_right,
@@ -546,7 +541,7 @@ static int send_command(const struct options *o)
 	}
 	char argbuf[SIM_CMD_MAX];
 	snprintf(argbuf, sizeof(argbuf), "%s", args);
-	undulate_sim_command_t m = { .utime = wall_us(), .seq = (int64_t)getpid(), .verb = verb, .args = argbuf };
+	undulate_sim_command_t m = { .utime = clock_wall_us(), .seq = (int64_t)getpid(), .verb = verb, .args = argbuf };
 	int r = undulate_sim_command_t_publish(lcm, "SIM.CMD", &m);
 	lcm_destroy(lcm);
 	if (r != 0) {

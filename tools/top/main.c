@@ -1,5 +1,6 @@
 /* undulate-top — live monitor of every robot on the LCM network.
  * See tools/top/README.md. */
+#include "clock.h"
 #include "csock.h"
 #include "keys.h"
 #include "model.h"
@@ -58,19 +59,6 @@ static void on_winch(int sig)
 	top_winch = 1;
 }
 
-static double mono_now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int64_t wall_utime(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_REALTIME, &ts);
-	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
 
 /* The status line (answers to commands, what was sent, why not). Long
  * texts are cut: the line is as wide as the screen anyway. */
@@ -112,7 +100,7 @@ static void show_event(struct top_app *a, const undulate_event_t *e)
 static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
 	struct top_app *a = user;
-	double now = mono_now();
+	double now = clock_mono_s();
 	if (strcmp(channel, "SIM.TRUTH") == 0)
 		TOP_DECODE(sim_truth_t, top_on_truth(&a->model, &msg, now));
 	else if (strcmp(channel, "SIM.COLLISION") == 0)
@@ -300,7 +288,7 @@ static void draw(struct top_app *a, double now)
 static int print_snapshot(struct top_app *a, double now)
 {
 	if (a->json) {
-		top_json(&a->model, now, wall_utime(), stdout);
+		top_json(&a->model, now, clock_wall_us(), stdout);
 	} else {
 		a->view.clock[0] = '\0';
 		top_render(&a->model, &a->view, now, 0, 0, false, a->screen, TOP_SCREEN_MAX);
@@ -331,17 +319,17 @@ static void pump(struct top_app *a, double timeout_s, bool keys)
 
 static int run_once(struct top_app *a)
 {
-	double end = mono_now() + a->wait_s;
-	for (double now = mono_now(); now < end && !top_signal; now = mono_now())
+	double end = clock_mono_s() + a->wait_s;
+	for (double now = clock_mono_s(); now < end && !top_signal; now = clock_mono_s())
 		pump(a, end - now, false);
-	return print_snapshot(a, mono_now()) == 0 ? 0 : 1;
+	return print_snapshot(a, clock_mono_s()) == 0 ? 0 : 1;
 }
 
 static int run_stream(struct top_app *a)
 {
-	double next = mono_now() + a->interval_s;
+	double next = clock_mono_s() + a->interval_s;
 	while (!top_signal) {
-		double now = mono_now();
+		double now = clock_mono_s();
 		if (now >= next) {
 			if (print_snapshot(a, now) != 0)
 				break;
@@ -361,14 +349,14 @@ static int run_interactive(struct top_app *a)
 	}
 	atexit(term_leave);
 	term_size(&a->rows, &a->cols);
-	double next = mono_now();
+	double next = clock_mono_s();
 	while (!a->quit && !top_signal) {
 		if (top_winch) {
 			top_winch = 0;
 			term_size(&a->rows, &a->cols);
 			next = 0;
 		}
-		double now = mono_now();
+		double now = clock_mono_s();
 		if (now >= next) {
 			draw(a, now);
 			next = now + TOP_FRAME_S;
@@ -467,7 +455,7 @@ int main(int argc, char **argv)
 	snprintf(a->source, sizeof(a->source), "undulate-top@%.24s:%ld", host, (long)getpid());
 	/* Sequence numbers from the clock: two monitors on one network rarely
 	 * pick the same ones, so each shows only answers to its own commands. */
-	a->first_seq = a->next_seq = wall_utime();
+	a->first_seq = a->next_seq = clock_wall_us();
 	a->screen = malloc(TOP_SCREEN_MAX);
 	a->lcm = lcm_create(a->url);
 	if (!a->screen || !a->lcm) {
