@@ -7,16 +7,17 @@
 # magnitude once the oscillators synchronize. Asserted: the contact impulse
 # per second — the simulator's ground truth (SIM.TRUTH total_impulse: impacts
 # and resting contact, i.e. the mean contact force), sampled by demo.sh — in
-# the last 10 s of the OSCILLATOR phase is at least 10 times lower than in the
-# last 10 s of the SINUSOID phase. The impulse of the impacts alone (the
-# collision messages, through undulate-analyze) is reported beside it.
+# the last 10 s of the OSCILLATOR phase is at least 3 times lower than in the
+# last 10 s of the SINUSOID phase; the paper's 10 times is checked too and
+# reported as a TODO when a run falls short. The impulse of the impacts alone
+# (the collision messages, through undulate-analyze) is printed beside it.
 source "$(dirname "$0")/../lib.sh"
 
 switch_at=${E2E_FORCE_SWITCH_AT:-15}
 seconds=${E2E_FORCE_SECONDS:-45}
 # The paper's figure is "orders of magnitude"; one order is checked (TODO when short).
 min_ratio=10   # the paper: an order of magnitude or more
-min_fall=3     # what every run here has shown
+min_fall=3     # the least fall docs/EXPERIMENTS.md records is 3.8x (2026-11-25)
 
 spawn force env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" \
 	--scenario "$top/tests/scenarios/force10.scenario" --seconds "$seconds" --switch-at "$switch_at" \
@@ -87,7 +88,7 @@ if awk -v a="$before" 'BEGIN { exit !(a > 0.1) }'; then
 else
 	tap_fail "SINUSOID: the crowded robots push each other" "mean contact force $before N"
 fi
-# The fall itself is always seen (6x to 44x over the runs in docs/EXPERIMENTS.md);
+# The fall itself was seen in every run docs/EXPERIMENTS.md records (3.8x to 55x);
 # the paper's order of magnitude in most runs but not all: reported as TODO
 # with the numbers when a run falls short, never lowered.
 at_least() { [ "$ratio" = inf ] || awk -v r="$ratio" -v m="$1" 'BEGIN { exit !(r >= m) }'; }
