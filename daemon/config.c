@@ -95,8 +95,11 @@ static bool parse_bool(const char *s, bool *out)
 }
 
 /* "1,2" or "1 2": servo IDs 0..253, no duplicates. */
-static bool parse_ids(const char *s, uint8_t *ids, size_t *n, char *why, size_t cap)
+/* Parses into a list of its own and copies it out only when the whole list is
+ * good: a refused value leaves the configured IDs as they were. */
+static bool parse_ids(const char *s, uint8_t *out, size_t *n, char *why, size_t cap)
 {
+	uint8_t ids[CFG_MAX_JOINTS];
 	size_t count = 0;
 	const char *p = s;
 	while (*p) {
@@ -132,6 +135,7 @@ static bool parse_ids(const char *s, uint8_t *ids, size_t *n, char *why, size_t 
 		snprintf(why, cap, "no servo IDs in '%s'", s);
 		return false;
 	}
+	memcpy(out, ids, count);
 	*n = count;
 	return true;
 }

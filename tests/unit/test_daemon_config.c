@@ -436,6 +436,23 @@ static void test_command_line_only(void **state)
 	assert_int_equal(c.njoints, 2);
 }
 
+/* A refused ID list leaves the configured one as it was (it was half
+ * overwritten once: "5,j" wrote the 5 before failing). */
+static void test_refused_ids_change_nothing(void **state)
+{
+	(void)state;
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
+	assert_false(cfg_override(&c, "robot.ids=5,j", &e));
+	assert_false(cfg_override(&c, "robot.ids=7,7", &e));
+	assert_false(cfg_override(&c, "robot.ids=9,300", &e));
+	assert_int_equal(c.njoints, 2);
+	assert_int_equal(c.ids[0], 1);
+	assert_int_equal(c.ids[1], 2);
+}
+
 static void test_param_ranges(void **state)
 {
 	(void)state;
@@ -467,6 +484,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_good_file),
+		cmocka_unit_test(test_refused_ids_change_nothing),
 		cmocka_unit_test(test_defaults_from_osc),
 		cmocka_unit_test(test_errors_name_file_line_key),
 		cmocka_unit_test(test_whole_config_errors),
