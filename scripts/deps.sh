@@ -5,11 +5,12 @@
 set -eu
 # build + runtime: compiler, LCM (pkg-config lcm needs glib's .pc), serial
 # ports, config parsing (inih), command authentication (libsodium), unit tests (cmocka); tests and tools: jq and
-# python3 (test peers and JSON checks),
+# python3 (test peers and JSON checks), iproute2 (`ss`: the sockets a daemon
+# holds, safety_commands),
 # gnuplot for plots, cyclictest for the jitter benchmark; systemd and man-db
 # for checking the units (systemd-analyze verify) and the man pages.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
-      libinih-dev libsodium-dev libcmocka-dev gnuplot-nox rt-tests procps jq python3 socat systemd man-db)
+      libinih-dev libsodium-dev libcmocka-dev gnuplot-nox rt-tests procps iproute2 jq python3 socat systemd man-db)
 [ $# -gt 0 ] && need=("$@")
 missing=()
 for p in "${need[@]}"; do
