@@ -63,19 +63,23 @@ switch() { # MODE: send it, wait for the answer, return the switch's cycle
 	out=$("$D" --command "mode $1" --robot "$R" --lcm-url "$URL" --timeout 2) || { echo "# $out"; return 1; }
 	echo "# $out"
 }
-jump_around() { # CYCLE: max |goal change| over joints in cycles CYCLE-3 .. CYCLE+30
+# The goal change per cycle between two published states, divided by the
+# cycles between them: a state the watcher missed, or a skipped period on a
+# loaded machine, must not count as a jump.
+jump_around() { # CYCLE: max |goal change| per cycle over joints in cycles CYCLE-3 .. CYCLE+30
 	states | awk -v c="$1" '{
 		for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
 		cy = v["cycle"]
-		if (cy >= c - 3 && cy <= c + 30 && have) {
-			for (j = 0; j < 2; j++) { d = v["g" j] - prev[j]; if (d < 0) d = -d; if (d > m) m = d }
+		if (cy >= c - 3 && cy <= c + 30 && have && cy > pc) {
+			for (j = 0; j < 2; j++) { d = (v["g" j] - prev[j]) / (cy - pc); if (d < 0) d = -d; if (d > m) m = d }
 		}
-		for (j = 0; j < 2; j++) prev[j] = v["g" j]; have = 1
+		for (j = 0; j < 2; j++) prev[j] = v["g" j]; pc = cy; have = 1
 	} END { printf "%.4f\n", m }'
 }
 baseline=$(states | awk '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
-	if (have) for (j = 0; j < 2; j++) { d = v["g" j] - prev[j]; if (d < 0) d = -d; if (d > m) m = d }
-	for (j = 0; j < 2; j++) prev[j] = v["g" j]; have = 1 } END { printf "%.4f\n", m }')
+	cy = v["cycle"]
+	if (have && cy > pc) for (j = 0; j < 2; j++) { d = (v["g" j] - prev[j]) / (cy - pc); if (d < 0) d = -d; if (d > m) m = d }
+	for (j = 0; j < 2; j++) prev[j] = v["g" j]; pc = cy; have = 1 } END { printf "%.4f\n", m }')
 echo "# largest goal change per cycle while oscillating: $baseline rad"
 for m in sinusoid oscillator hold sinusoid hold oscillator; do
 	c=$(last_state | field cycle)
