@@ -28,6 +28,7 @@ void bus_init(struct bus *b, const struct bus_io *io, const struct bus_timing *t
 		b->timing = *timing;
 	b->echo = echo;
 	b->expect_params = -1;
+	b->line_dirty = true;   /* whatever was on the line before us */
 	dxl_parser_init(&b->parser, DXL_PARSE_STATUS);
 }
 
@@ -130,6 +131,15 @@ static int bus_echo_drain(struct bus *b)
 
 /* ---- sending ------------------------------------------------------------------ */
 
+/* Is there input to throw away before a request? Without a way to ask the
+ * transport, assume so. */
+static bool bus_needs_flush(const struct bus *b)
+{
+	if (b->line_dirty || b->io.pending_input == NULL)
+		return true;
+	return b->io.pending_input(b->io.ctx) != 0;
+}
+
 /* Stale input goes before a request; kept only while an echo is still due. */
 static int bus_prepare(struct bus *b)
 {
@@ -140,8 +150,10 @@ static int bus_prepare(struct bus *b)
 		b->io.flush_input(b->io.ctx);
 	if (r < 0)
 		return r;
-	if (b->echo_left == 0 && b->io.flush_input)
+	if (b->echo_left == 0 && b->io.flush_input && bus_needs_flush(b)) {
 		b->io.flush_input(b->io.ctx);
+		b->line_dirty = false;
+	}
 	dxl_parser_reset(&b->parser);
 	return DXL_OK;
 }
@@ -229,10 +241,13 @@ static int bus_match(struct bus *b, const struct dxl_packet *pkt, uint64_t now,
 	bus_finish(b);
 	if (pkt->id != b->req_id) {
 		st->wrong_id++;
+		b->line_dirty = true;
 		return DXL_E_WRONG_ID;
 	}
 	if (pkt->nparams != expect_params) {
 		st->wrong_length++;
+		/* a late reply to an earlier request: this one's may follow */
+		b->line_dirty = true;
 		return DXL_E_WRONG_LENGTH;
 	}
 	uint32_t rtt = (uint32_t)(now - b->started_us);
@@ -268,6 +283,7 @@ static int bus_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t no
 		if (r == DXL_FRAME) {
 			if (!b->pending) {
 				b->stray_packets++;
+				b->line_dirty = true;
 			} else if (!b->echo && !b->reply_held && bus_is_own_request(b, &pkt)) {
 				b->reply_held = true;
 				b->reply = pkt;
@@ -282,6 +298,7 @@ static int bus_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t no
 				/* the reply is damaged; waiting longer cannot repair it */
 				st->checksum_errors++;
 				bus_finish(b);
+				b->line_dirty = true;
 				outcome = DXL_E_CHECKSUM;
 			} else {
 				st->resyncs++;
@@ -318,6 +335,11 @@ int bus_step(struct bus *b, struct dxl_packet *reply)
 		int r = bus_consume(b, chunk + off, (size_t)got - off, now, reply);
 		if (r != BUS_PENDING)
 			outcome = r;
+		/* A short read took what there was. Reading again only to be told
+		 * "nothing" makes a tty wait for the kernel's buffer worker, which a
+		 * busy machine schedules late: the next poll() says when more came. */
+		if ((size_t)got < sizeof chunk)
+			break;
 	}
 	if (outcome != BUS_PENDING)
 		return outcome;
@@ -347,6 +369,8 @@ bool bus_is_pending(const struct bus *b)
 
 void bus_abort(struct bus *b)
 {
+	if (b->pending)
+		b->line_dirty = true;   /* its reply may still come */
 	bus_finish(b);
 	/* whatever was half-read belongs to the abandoned request */
 	bus_echo_clear(b);

@@ -41,6 +41,12 @@ struct bus_io {
 	uint64_t (*now_us)(void *ctx);
 	/* Optional: discard unread input (stale bytes before a new request). */
 	void (*flush_input)(void *ctx);
+	/* Optional: bytes readable now without waiting (FIONREAD), -1 if unknown.
+	 * With it, a request flushes the input only when there is something to
+	 * flush or the line is dirty (a transaction that did not end cleanly):
+	 * on a tty each flush may wait for the kernel's buffer worker, which a
+	 * busy machine schedules late. */
+	long (*pending_input)(void *ctx);
 };
 
 /* What the timeout is derived from. */
@@ -92,6 +98,10 @@ struct bus {
 	uint8_t echo_buf[BUS_ECHO_QUEUE];
 	size_t echo_len;           /* bytes in echo_buf; the first echo_len - echo_left matched */
 	uint64_t started_us, deadline_us;
+	/* Stale bytes may be on their way: a transaction ended without its
+	 * reply, with a damaged one or one from elsewhere. The next request
+	 * flushes the input first. */
+	bool line_dirty;
 	struct dxl_packet reply;
 	/* The request as written. With echo off, a packet identical to it may be
 	 * an unexpected echo — or a genuine reply (a PING answered with the

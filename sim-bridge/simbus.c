@@ -300,6 +300,12 @@ void sim_bus_read(struct sim_bus *b, int64_t now)
 		if (n <= 0)
 			return;  /* EAGAIN; EIO cannot happen while we hold the slave open */
 		sim_bus_feed(b, buf, (size_t)n, now);
+		/* A short read took what there was: reading again only to hear
+		 * EAGAIN makes the pty wait for the kernel's buffer worker, which a
+		 * busy machine schedules late (tens of ms seen), and that would
+		 * stall the whole simulation. poll() says when more came. */
+		if ((size_t)n < sizeof(buf))
+			return;
 	}
 }
 

@@ -360,6 +360,16 @@ void port_flush_input(struct port *p)
 		(void)tcflush(p->fd, TCIFLUSH);
 }
 
+long port_pending_input(struct port *p)
+{
+	int n = 0;
+	/* FIONREAD on a tty counts what its line discipline holds, without
+	 * waiting for the kernel's buffer worker (libserialport asks the same) */
+	if (ioctl(p->fd, FIONREAD, &n) != 0)
+		return -1;
+	return n;
+}
+
 uint64_t port_now_us(void)
 {
 	struct timespec ts;
@@ -374,6 +384,7 @@ static int port_io_write(void *ctx, const uint8_t *buf, size_t n) { return port_
 static long port_io_read(void *ctx, uint8_t *buf, size_t cap) { return port_read(ctx, buf, cap); }
 static int port_io_wait(void *ctx, uint32_t timeout_us) { return port_wait(ctx, timeout_us); }
 static void port_io_flush(void *ctx) { port_flush_input(ctx); }
+static long port_io_pending(void *ctx) { return port_pending_input(ctx); }
 
 static uint64_t port_io_now(void *ctx)
 {
@@ -390,4 +401,5 @@ void port_bus_io(struct port *p, struct bus_io *io)
 	io->wait = port_io_wait;
 	io->now_us = port_io_now;
 	io->flush_input = port_io_flush;
+	io->pending_input = port_io_pending;
 }

@@ -43,6 +43,8 @@ int port_write(struct port *p, const uint8_t *buf, size_t n);
 /* Wait up to timeout_us for input: 1 readable, 0 timeout, negative error. */
 int port_wait(struct port *p, uint32_t timeout_us);
 void port_flush_input(struct port *p);
+/* Bytes readable now, without waiting (FIONREAD); -1 if it cannot say. */
+long port_pending_input(struct port *p);
 /* Fill a bus_io that drives this port (clock: CLOCK_MONOTONIC). */
 void port_bus_io(struct port *p, struct bus_io *io);
 uint64_t port_now_us(void);

@@ -137,7 +137,7 @@ static void run_bus(const uint8_t *data, size_t size, uint32_t seed, bool echo)
 {
 	static struct bus b; /* large: keep it off the stack */
 	struct fuzz_io f = { data, size, 0, seed, 0 };
-	const struct bus_io io = { &f, fio_write, fio_read, fio_wait, fio_now, NULL };
+	const struct bus_io io = { &f, fio_write, fio_read, fio_wait, fio_now, NULL, NULL };
 	const struct bus_timing t = { 1000000, 0, 1000, 500 };
 	bus_init(&b, &io, &t, echo);
 	uint8_t out[8], err = 0;

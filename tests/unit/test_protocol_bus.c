@@ -138,7 +138,7 @@ static void setup_bus(bool echo)
 	memset(&fk, 0, sizeof fk);
 	fk.now = 1000000;
 	fk.echo = echo;
-	const struct bus_io io = { &fk, fake_write, fake_read, fake_wait, fake_now, fake_flush };
+	const struct bus_io io = { &fk, fake_write, fake_read, fake_wait, fake_now, fake_flush, NULL };
 	bus_init(&bus, &io, &timing, echo);
 }
 
@@ -162,6 +162,40 @@ static const uint8_t sync_golden[] = { 0xFF, 0xFF, 0xFE, 0x0E, 0x83, 0x1E, 0x04,
                                        0x50, 0x01, 0x01, 0x20, 0x02, 0x60, 0x03, 0x67 };
 static const uint8_t goal512_golden[] = { 0xFF, 0xFF, 0x01, 0x05, 0x03, 0x1E, 0x00, 0x02, 0xD6 };
 static const uint8_t bc_id1_golden[] = { 0xFF, 0xFF, 0xFE, 0x04, 0x03, 0x03, 0x01, 0xF6 };
+
+/* The transport can say what is waiting: a request flushes the input only
+ * when there is something, or the line is dirty (a timeout, a damaged or
+ * stray reply) — on a tty every flush may wait for the kernel's worker. */
+static long fake_pending(void *ctx)
+{
+	struct fake *f = ctx;
+	return (long)fake_ready(f);
+}
+
+static void test_flush_only_when_needed(void **state)
+{
+	(void)state;
+	setup_bus(false);
+	bus.io.pending_input = fake_pending;
+	script(ping1_reply, sizeof ping1_reply, 80);
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_OK);
+	assert_int_equal(fk.flushes, 1);           /* the first request: the line is unknown */
+	for (int i = 0; i < 5; i++) {
+		script(ping1_reply, sizeof ping1_reply, 80);
+		assert_int_equal(bus_ping(&bus, 1, NULL), DXL_OK);
+	}
+	assert_int_equal(fk.flushes, 1);           /* clean transactions: never again */
+	assert_int_equal(bus_ping(&bus, 7, NULL), DXL_E_TIMEOUT);
+	script(ping1_reply, sizeof ping1_reply, 80);
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_OK);
+	assert_int_equal(fk.flushes, 2);           /* after the timeout: flushed */
+	/* bytes waiting (a servo answering late, unasked) are flushed too */
+	fake_push(&fk, ping2_reply, sizeof ping2_reply, fk.now);
+	script(ping1_reply, sizeof ping1_reply, 80);
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_OK);
+	assert_int_equal(fk.flushes, 3);
+	assert_int_equal(bus.stray_packets, 0);
+}
 
 static void test_timeout_formula(void **state)
 {
@@ -505,6 +539,7 @@ static void test_io_errors_and_args(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_flush_only_when_needed),
 		cmocka_unit_test(test_timeout_formula),
 		cmocka_unit_test(test_ping_ok),
 		cmocka_unit_test(test_read_returns_data),
