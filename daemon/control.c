@@ -604,9 +604,10 @@ bool ctl_clear_faults(struct ctl *c, char *why, size_t cap)
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
 		if (jt->fault == CTL_FAULT_FAILED) {
+			/* hold where it is; the goal itself moves there within max_step
+			 * a cycle, like every goal (it is the clamp's reference) */
 			jt->fault = CTL_FAULT_NONE;
-			jt->goal = isfinite(jt->angle) ? jt->angle : jt->goal;
-			c->hold[j] = jt->goal;
+			c->hold[j] = isfinite(jt->angle) ? jt->angle : jt->goal;
 		}
 		jt->retries = 0;
 		jt->resets = 0;
@@ -705,11 +706,15 @@ static void ctl_fault_step(struct ctl *c, size_t j)
 		jt->fault = CTL_FAULT_NONE;
 		ctl_event(c, 0, "recovered", "servo %u: recovered (torque limit %u, torque on)", jt->id,
 		          jt->servo.max_torque);
-		jt->goal = isfinite(jt->angle) ? jt->angle : jt->goal;
-		if (c->mode == CFG_MODE_HOLD)
-			c->hold[j] = jt->goal;
-		else
-			ctl_blend_joint(c, j, jt->goal);
+		{
+			/* from where it is now; the goal (the clamp's reference) follows
+			 * within max_step a cycle */
+			double from = isfinite(jt->angle) ? jt->angle : jt->goal;
+			if (c->mode == CFG_MODE_HOLD)
+				c->hold[j] = from;
+			else
+				ctl_blend_joint(c, j, from);
+		}
 		return;
 	case CTL_FAULT_FAILED:
 		return;

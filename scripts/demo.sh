@@ -25,7 +25,8 @@
 # it (root, or LimitRTPRIO/an rtprio limit), the simulator above the daemons:
 # servos do not slow down when their computer is busy, and a robot's unit runs
 # its daemon at real-time priority (systemd/). Where it is not allowed each says
-# so once and runs with normal scheduling; --no-realtime never asks.
+# so once and runs with normal scheduling; --no-realtime (or DEMO_REALTIME=0)
+# never asks.
 #
 # Everything runs in a private temporary directory on a private LCM port
 # (printed at start), so two demos, or a demo and the tests, never hear each

@@ -17,7 +17,8 @@
  * Invariants (abort() on violation):
  *  - the configuration's limits, neutral angles and max_step never change;
  *  - every goal the controller would send is finite and inside the joint's
- *    limits, and moves at most max_step a cycle;
+ *    limits, and moves at most max_step a cycle (or, once torque was off,
+ *    starts within max_step of where the joint is);
  *  - the queue never holds more than CIN_QUEUE commands;
  *  - every datagram on a command channel or the local socket is counted:
  *    received = accepted + refused + still queued + ignored (another robot's
@@ -123,8 +124,11 @@ static void step(void)
 		CHECK(isfinite(jt->goal));
 		CHECK(jt->goal >= cfg0.joint[j].neutral + cfg0.joint[j].limit_min - 1e-9);
 		CHECK(jt->goal <= cfg0.joint[j].neutral + cfg0.joint[j].limit_max + 1e-9);
+		/* a goal moves at most max_step from the last one, or starts where
+		 * the joint is (after torque was off: it may have been moved) */
 		if (isfinite(before[j]))
-			CHECK(fabs(jt->goal - before[j]) <= cfg0.joint[j].max_step + 1e-9);
+			CHECK(fabs(jt->goal - before[j]) <= cfg0.joint[j].max_step + 1e-9 ||
+			      fabs(jt->goal - jt->angle) <= cfg0.joint[j].max_step + 1e-9);
 	}
 	while (ctl_take_write(&ctl) != NULL)
 		ctl_write_result(&ctl, true);
