@@ -32,6 +32,8 @@
 
 #include "clock.h"
 #include "sim.h"
+#include "text.h"
+#include "wire.h"
 #include "undulate_sim_collision_t.h"
 #include "undulate_sim_command_t.h"
 #include "undulate_sim_truth_t.h"
@@ -277,67 +279,38 @@ fail:
 
 /* ---- LCM ------------------------------------------------------------------- */
 
-/* SIM.CMD is decoded here, not by the generated code: LCM 1.3.1's decoder
- * mallocs whatever length a string claims (a zero length leaves it without its
- * NUL, a huge one allocates gigabytes). sim_command_t is the fingerprint, utime
- * and seq (int64), verb and args (int32 length counting the NUL, the bytes, the
- * NUL), big-endian, as lcm-gen encodes it. */
-struct wire {
-	const uint8_t *p;
-	size_t left;
-	bool bad;
-};
-
-static uint64_t wire_take(struct wire *w, size_t n)
-{
-	uint64_t v = 0;
-	if (w->bad || w->left < n) {
-		w->bad = true;
-		return 0;
-	}
-	for (size_t i = 0; i < n; i++)
-		v = v << 8 | w->p[i];
-	w->p += n;
-	w->left -= n;
-	return v;
-}
-
-/* The string's bytes (NUL-terminated in the message), or NULL if malformed. */
-static const char *wire_string(struct wire *w)
-{
-	int32_t n = (int32_t)(uint32_t)wire_take(w, 4);
-	if (w->bad || n < 1 || (size_t)n > w->left || w->p[n - 1] != '\0') {
-		w->bad = true;
-		return NULL;
-	}
-	const char *s = (const char *)w->p;
-	w->p += n;
-	w->left -= (size_t)n;
-	return s;
-}
-
+/* SIM.CMD is decoded here (common/wire.h), not by the generated code: LCM
+ * 1.3.1's decoder mallocs whatever length a string claims (a zero length
+ * leaves it without its NUL, a huge one allocates gigabytes). sim_command_t is
+ * the fingerprint, utime and seq (int64), verb and args (LCM strings). */
 static void on_sim_cmd(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
 	(void)channel;
 	struct app *a = user;
-	struct wire w = { .p = rbuf->data, .left = rbuf->data_size };
+	struct wire_reader w;
+	char verb[SIM_CMD_MAX], args[SIM_CMD_MAX];
+	bool cut_verb = false, cut_args = false;
+	wire_reader_init(&w, rbuf->data, rbuf->data_size);
 	bool ours = (int64_t)wire_take(&w, 8) == __undulate_sim_command_t_get_hash();
 	(void)wire_take(&w, 8);
 	long long seq = (long long)wire_take(&w, 8);
-	const char *verb = wire_string(&w), *args = wire_string(&w);
+	wire_take_string(&w, verb, sizeof verb, &cut_verb);
+	wire_take_string(&w, args, sizeof args, &cut_args);
 	if (!ours || w.bad) {
 		a->sim->bad_commands++;
 		fprintf(stderr, "undulate-sim: SIM.CMD: not a well-formed sim_command_t (%u bytes)\n", rbuf->data_size);
 		return;
 	}
-	char line[SIM_CMD_MAX], reply[512];
-	if (snprintf(line, sizeof(line), "%s %s", verb, args) >= (int)sizeof(line)) {
+	char line[SIM_CMD_MAX], reply[512], shown[SIM_CMD_MAX + 64], shown_reply[600];
+	if (cut_verb || cut_args || snprintf(line, sizeof(line), "%s %s", verb, args) >= (int)sizeof(line)) {
 		a->sim->bad_commands++;
-		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld: command too long\n", seq);
+		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld: command too long (or a NUL inside)\n", seq);
 		return;
 	}
 	sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
-	fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", seq, line, reply);
+	/* whatever came from the network is one printable line in the log */
+	fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", seq, text_sanitize(shown, sizeof shown, line),
+	        text_sanitize(shown_reply, sizeof shown_reply, reply));
 }
 
 static void fill_collision(struct app *a, const struct sim_collision *c, int64_t utime,
