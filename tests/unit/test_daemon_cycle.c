@@ -247,45 +247,38 @@ static void drive(enum cyc_status st)
 	}
 }
 
-static enum cyc_status last_status;
+/* One tick: a cycle still on the bus is cut off, the events taken (true if
+ * one of kind `kind` was among them or comes out of this cycle), a cycle run. */
+static bool tick(const char *kind)
+{
+	bool seen = false;
+	f.now = next_tick;
+	next_tick += PERIOD_US;
+	if (cyc_busy(&y)) {
+		cyc_cut(&y);
+		cuts++;
+	}
+	struct ctl_event e;
+	while (ctl_next_event(&c, &e))
+		seen = seen || (kind != NULL && strcmp(e.kind, kind) == 0);
+	drive(cyc_start(&y));
+	for (size_t k = 0; k < c.nevents && kind != NULL; k++)
+		seen = seen || strcmp(c.events[k].kind, kind) == 0;
+	return seen;
+}
+
 static void run(int cycles)
 {
-	for (int i = 0; i < cycles; i++) {
-		f.now = next_tick;
-		next_tick += PERIOD_US;
-		if (cyc_busy(&y)) {
-			cyc_cut(&y);
-			cuts++;
-		}
-		struct ctl_event e;
-		while (ctl_next_event(&c, &e))
-			;
-		enum cyc_status st = cyc_start(&y);
-		drive(st);
-		last_status = st;
-	}
+	for (int i = 0; i < cycles; i++)
+		(void)tick(NULL);
 }
 
 static bool saw_event;
-static char event_kind[32];
 static void run_watching(int cycles, const char *kind)
 {
 	saw_event = false;
-	snprintf(event_kind, sizeof event_kind, "%s", kind);
-	for (int i = 0; i < cycles && !saw_event; i++) {
-		f.now = next_tick;
-		next_tick += PERIOD_US;
-		if (cyc_busy(&y)) {
-			cyc_cut(&y);
-			cuts++;
-		}
-		struct ctl_event e;
-		while (ctl_next_event(&c, &e))
-			saw_event = saw_event || strcmp(e.kind, event_kind) == 0;
-		drive(cyc_start(&y));
-		for (size_t k = 0; k < c.nevents; k++)
-			saw_event = saw_event || strcmp(c.events[k].kind, event_kind) == 0;
-	}
+	for (int i = 0; i < cycles && !saw_event; i++)
+		saw_event = tick(kind);
 }
 
 static void setup_n(size_t n, enum cfg_mode mode, uint32_t margin_us)
