@@ -75,6 +75,10 @@ static int setup(void **state)
 	return 0;
 }
 
+/* The program under test, while it runs: a check that fails jumps out of
+ * the test before wait_exit(), and the teardown must not leave it behind. */
+static pid_t live_child = -1;
+
 static void start(struct child *c, const char *extra)
 {
 	memset(c, 0, sizeof(*c));
@@ -97,6 +101,7 @@ static void start(struct child *c, const char *extra)
 		execl(binary, binary, "--lcm-url", lcm_url, extra, (char *)NULL);
 		_exit(127);
 	}
+	live_child = c->pid;
 }
 
 /* Reads output until NEEDLE appears or TIMEOUT_MS passed; returns whether it did. */
@@ -139,12 +144,15 @@ static int wait_exit(struct child *c)
 		char sink[4096];
 		while (read(c->master, sink, sizeof(sink)) > 0)
 			;
-		if (waitpid(c->pid, &st, WNOHANG) == c->pid)
+		if (waitpid(c->pid, &st, WNOHANG) == c->pid) {
+			live_child = -1;
 			return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+		}
 		usleep(10000);
 	}
 	kill(c->pid, SIGKILL);
 	waitpid(c->pid, NULL, 0);
+	live_child = -1;
 	return -1;
 }
 
@@ -378,14 +386,28 @@ static void test_read_only_sends_nothing(void **state)
 	lcm_destroy(lcm);
 }
 
+/* After every test, passed or not: no program and no socket left behind. */
+static int kill_live_child(void **state)
+{
+	(void)state;
+	if (live_child > 0) {
+		kill(live_child, SIGKILL);
+		waitpid(live_child, NULL, 0);
+	}
+	live_child = -1;
+	if (robot_fd >= 0)
+		robot_close();
+	return 0;
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_quit_key),
-		cmocka_unit_test(test_ctrl_c),
-		cmocka_unit_test(test_sigterm),
-		cmocka_unit_test(test_commands_and_answer),
-		cmocka_unit_test(test_read_only_sends_nothing),
+		cmocka_unit_test_teardown(test_quit_key, kill_live_child),
+		cmocka_unit_test_teardown(test_ctrl_c, kill_live_child),
+		cmocka_unit_test_teardown(test_sigterm, kill_live_child),
+		cmocka_unit_test_teardown(test_commands_and_answer, kill_live_child),
+		cmocka_unit_test_teardown(test_read_only_sends_nothing, kill_live_child),
 	};
 	int rc = cmocka_run_group_tests(tests, setup, NULL);
 	if (scratch_dir[0] != '\0')
