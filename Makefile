@@ -8,6 +8,7 @@
 #   make            build everything into $(BUILD)/
 #   make test       install missing packages, build, run every test
 #   make test-long  the long sweeps (paper experiments over many separations)
+#   make test-busy  make test with one CPU-bound process per core beside it
 #   make bench      benchmarks; figures printed, written to $(BUILD)/bench.md
 #   make demo       robots on the simulated bus, watched live
 #   make SAN=1 test the same tests under AddressSanitizer + UBSan (build-san/)
@@ -87,7 +88,7 @@ LCM_STAMP := $(GEN)/.stamp
 # lcm-gen names files <package>_<type>.c; the package is `undulate`.
 LCM_GEN_C = $(wildcard $(GEN)/*.c)
 
-.PHONY: all deps test test-long bench demo fuzz spy-jar spy install uninstall clean lcmtypes
+.PHONY: all deps test test-long test-busy bench demo fuzz spy-jar spy install uninstall clean lcmtypes
 all: $(foreach p,$(PROGRAMS),$(BIN)/$(p)) unit-tests
 
 $(LCM_STAMP): $(LCM_SRC)
@@ -179,6 +180,10 @@ test: deps
 test-long: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) TEST_LONG=1 tests/run.sh
+
+test-busy: deps
+	@$(MAKE) --no-print-directory check-pure all
+	@scripts/busy.sh env BUILD=$(BUILD) tests/run.sh
 
 bench: deps
 	@$(MAKE) --no-print-directory all

@@ -155,9 +155,18 @@ trap cleanup EXIT
 trap 'exit 130' INT
 trap 'exit 143' TERM
 
+# Each program runs in a session of its own (setsid), as a robot's service runs
+# in a cgroup of its own. With the kernel's autogroups everything started from
+# one session shares one scheduling group: started from a shell that also runs
+# CPU-bound work, the kernel worker that carries the simulated buses' bytes was
+# seen waiting over half a second to run (README: Known limits). A background
+# job of a script is not a process group leader, so setsid execs and the PID
+# kept below is the program's; stopping by PID does not depend on the session.
+own_session=()
+command -v setsid >/dev/null 2>&1 && own_session=(setsid)
 start() {
 	local name=$1; shift
-	"$@" >"$run/$name.log" 2>&1 &
+	${own_session[@]+"${own_session[@]}"} "$@" >"$run/$name.log" 2>&1 &
 	pids+=("$!")
 	names+=("$name")
 }

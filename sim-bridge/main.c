@@ -84,6 +84,9 @@ struct app {
 	double worst_late_us, period_worst_late_us, late_sum_us;
 	uint64_t late_samples, overruns;
 	uint64_t late_hist[MAIN_LATE_BINS];
+	/* real time the physics gave up (overruns), said at most once a second */
+	int64_t lost_ns, lost_said_ns, last_said;
+	uint64_t overruns_said;
 	/* truth */
 	struct sim_collision pending[MAIN_TRUTH_MAX_COLLISIONS];
 	int64_t pending_utime[MAIN_TRUTH_MAX_COLLISIONS];   /* when each impact was seen */
@@ -555,8 +558,22 @@ static void physics(struct app *a, int64_t now, int64_t *next_step)
 		n++;
 	}
 	if (now - *next_step > MAIN_MAX_CATCHUP * a->step_ns) {
+		/* Too far behind to catch up step by step: the simulated time
+		 * stops for what was lost, and the servos with it. A controller
+		 * then sees slow servos; say so, so that nobody takes it for
+		 * the controller's doing. */
 		a->overruns++;
+		a->lost_ns += now - *next_step + a->step_ns;
 		*next_step = now + a->step_ns;
+		if (now - a->last_said >= 1000000000) {
+			fprintf(stderr, "undulate-sim: warning: fell behind real time: simulated time stopped for %.1f ms "
+			        "(%llu time(s) since the last warning; %.1f ms in all): the machine is too busy for "
+			        "the simulated servos to keep up\n", (double)(a->lost_ns - a->lost_said_ns) / 1e6,
+			        (unsigned long long)(a->overruns - a->overruns_said), (double)a->lost_ns / 1e6);
+			a->last_said = now;
+			a->lost_said_ns = a->lost_ns;
+			a->overruns_said = a->overruns;
+		}
 	}
 }
 
@@ -736,12 +753,12 @@ static void print_summary(const struct app *a, int64_t now)
 	double wall = (double)(now - a->t0) / 1e9;
 	printf("undulate-sim: exit: %.1f s, %llu steps, %llu collisions, total impulse %.6f N*s "
 	       "(resting contact %.6f N*s over %llu pair-steps), "
-	       "worst step lateness %.0f us (p99 %.0f us, mean %.1f us), %llu overruns, cpu %.1f%%, "
+	       "worst step lateness %.0f us (p99 %.0f us, mean %.1f us), %llu overruns (simulated time stopped %.1f ms), cpu %.1f%%, "
 	       "%llu bad commands, %llu truth messages\n",
 	       wall, (unsigned long long)s->steps, s->world.total_collisions - s->world.resting_contacts,
 	       s->world.total_impulse, s->world.resting_impulse, s->world.resting_contacts,
 	       a->worst_late_us, late_quantile(a, 0.99), a->late_samples ? a->late_sum_us / (double)a->late_samples : 0.0,
-	       (unsigned long long)a->overruns, wall > 0 ? 100.0 * cpu_seconds() / wall : 0.0,
+	       (unsigned long long)a->overruns, (double)a->lost_ns / 1e6, wall > 0 ? 100.0 * cpu_seconds() / wall : 0.0,
 	       (unsigned long long)s->bad_commands, (unsigned long long)a->truth_sent);
 	for (size_t i = 0; i < s->nbuses && !a->quiet; i++) {
 		const struct sim_bus_counters *c = &s->buses[i].count;

@@ -84,9 +84,20 @@ tap_skip_all() { tap_skip "$(basename "$0" .sh)" "$1"; tap_done; exit 0; }
 tap_check() { local name=$1; shift; if "$@"; then tap_ok "$name"; else tap_fail "$name" "command failed: $*"; fi; }
 tap_done() { echo "1..$_tap_n"; [ "$_tap_failed" -eq 0 ]; }
 
+# Each spawned program runs in a session of its own (setsid), as a service runs
+# in a cgroup of its own: with the kernel's autogroups, programs in the session
+# of `make test` share one scheduling group with whatever CPU-bound work was
+# started beside it, and then the kernel worker that carries a pseudo-terminal's
+# bytes was traced runnable but waiting 577 ms (2 cores, one busy loop per core
+# in that session; 2.4 ms with the programs in sessions of their own), so
+# simulated servos answered half a second late. The PID stays the program's:
+# a background job of a script is not a process group leader, so setsid execs.
+# The kill-by-PID cleanup below does not depend on the session.
+_own_session=()
+command -v setsid >/dev/null 2>&1 && _own_session=(setsid)
 spawn() {
 	local name=$1; shift
-	"$@" >"$T/$name.log" 2>&1 &
+	${_own_session[@]+"${_own_session[@]}"} "$@" >"$T/$name.log" 2>&1 &
 	local pid=$!
 	_pids+=("$pid")
 	eval "pid_${name//[^A-Za-z0-9_]/_}=$pid"

@@ -136,6 +136,20 @@ tap_check "echo: the request comes back before the reply" test "$reply" = FFFF01
 if [ "$rtt" -ge 16000 ]; then tap_ok "adapter latency: nothing before 16 ms ($rtt us)"; else tap_fail "adapter latency" "first byte after $rtt us"; fi
 stop sim3 >"$T/rc"
 
+# ---- a stall: the simulator says that its servos stopped with it -----------------------------
+# (a machine too busy for the physics: stopped here with SIGSTOP for 0.4 s)
+spawn sim4 "$B/undulate-sim" --link "$T/bus/stall" --ids 1 --lcm-url "$URL"
+wait_log sim4 'ready:' 5
+kill -STOP "$pid_sim4"; sleep 0.4; kill -CONT "$pid_sim4"
+if wait_log sim4 'fell behind real time: simulated time stopped for [0-9.]+ ms' 5; then
+	tap_ok "a stall is said: $(grep -o 'stopped for [0-9.]* ms' "$T/sim4.log" | head -1)"
+else tap_fail "a stall of 0.4 s is said" "$(cat "$T/sim4.log")"; fi
+stop sim4 >"$T/rc"
+lost=$(sed -n 's/.*overruns (simulated time stopped \([0-9.]*\) ms).*/\1/p' "$T/sim4.log")
+if awk -v l="${lost:-0}" 'BEGIN { exit !(l >= 300 && l <= 1000) }'; then
+	tap_ok "the summary counts the simulated time lost: $lost ms (0.4 s stopped, 50 steps caught up)"
+else tap_fail "summary: simulated time lost 300..1000 ms" "$(grep exit: "$T/sim4.log")"; fi
+
 # ---- bad configuration: a clear message, exit 2 -----------------------------------------------
 "$B/undulate-sim" --link "$T/x" --ids 1,1 >"$T/bad.log" 2>&1; rc=$?
 if [ "$rc" = 2 ] && grep -q 'ids' "$T/bad.log"; then tap_ok "duplicate IDs refused"; else tap_fail "duplicate IDs refused" "rc $rc: $(cat "$T/bad.log")"; fi
