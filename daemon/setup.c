@@ -9,6 +9,19 @@
 #include "dxl_table.h"
 #include "log.h"
 
+/* Before try t (t > 0) of a transaction: wait for the line to go quiet, a
+ * little longer each time. A reply that was late (a busy machine, a slow
+ * adapter) lands in the wait; sent at once, the next request would collide
+ * with it on the half-duplex line and lose both, as often as it is tried. */
+static void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, int last)
+{
+	if (t == 0)
+		return;
+	int dropped = bus_settle(bus, (uint32_t)t * SETUP_QUIET_US, SETUP_SETTLE_MAX_US);
+	log_warn("servo %u: %s: %s; try %d of %d after %u ms of quiet line%s", id, what, dxl_strerror(last), t + 1,
+	         SETUP_TRIES, t * SETUP_QUIET_US / 1000, dropped > 0 ? " (a late reply came meanwhile)" : "");
+}
+
 /* A start-up read that meets a lost or damaged reply is tried again: one
  * timeout on a loaded machine must not abort the start (a cycle read simply
  * holds the joint for a period, but start-up has no next period). The port
@@ -17,6 +30,7 @@ static int setup_read(struct bus *bus, uint8_t id, uint8_t addr, uint8_t len, ui
 {
 	int r = DXL_E_TIMEOUT;
 	for (int t = 0; t < SETUP_TRIES; t++) {
+		setup_pause(bus, t, id, "READ", r);
 		r = bus_read(bus, id, addr, len, out, eb);
 		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 			break;
@@ -30,6 +44,7 @@ static int setup_write(struct bus *bus, uint8_t id, uint8_t addr, const uint8_t 
 {
 	int r = DXL_E_TIMEOUT;
 	for (int t = 0; t < SETUP_TRIES; t++) {
+		setup_pause(bus, t, id, "WRITE", r);
 		r = bus_write(bus, id, addr, data, n, expect_reply, eb);
 		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 			break;
@@ -46,6 +61,7 @@ static bool setup_find(struct bus *bus, const struct ctl *ctl, const struct cfg 
 		uint8_t id = ctl->j[j].id, eb = 0;
 		int r = DXL_E_TIMEOUT;
 		for (int t = 0; t < SETUP_TRIES && r != DXL_OK; t++) {
+			setup_pause(bus, t, id, "PING", r);
 			r = bus_ping(bus, id, &eb);
 			if (r == DXL_E_DISCONNECTED || r == DXL_E_IO) {
 				snprintf(err, cap, "%s: %s while pinging servo %u", port_path, dxl_strerror(r), id);

@@ -24,8 +24,12 @@
 #include "bus.h"
 #include "control.h"
 
-/* Tries of a start-up transaction before a servo is called missing. */
-#define SETUP_TRIES 3
+/* Tries of a start-up (or safe-stop) transaction before a servo is called
+ * missing, and the quiet line waited for before each new try: 10, 20, 30 ms
+ * (a missing servo costs about 70 ms), at most 100 ms of a talking line. */
+#define SETUP_TRIES 4
+#define SETUP_QUIET_US 10000u
+#define SETUP_SETTLE_MAX_US 100000u
 
 /* Every start-up check; *max_return_delay_us gets the largest return delay
  * found (for the bus timeouts). False with *err (one line, with the command

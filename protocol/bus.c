@@ -396,6 +396,45 @@ static int bus_wait_reply(struct bus *b, struct dxl_packet *reply)
 	}
 }
 
+int bus_settle(struct bus *b, uint32_t quiet_us, uint32_t max_us)
+{
+	if (b->pending)
+		return DXL_E_BUSY;
+	uint64_t start = b->io.now_us(b->io.ctx), last = start;
+	long dropped = 0;
+	for (;;) {
+		uint8_t chunk[64];
+		long got;
+		while ((got = b->io.read(b->io.ctx, chunk, sizeof chunk)) > 0) {
+			dropped += got;
+			b->bytes_in += (uint64_t)got;
+			last = b->io.now_us(b->io.ctx);
+		}
+		if (got < 0) {
+			b->io_errors++;
+			return (int)got;
+		}
+		uint64_t now = b->io.now_us(b->io.ctx);
+		if (now - last >= quiet_us) {
+			b->line_dirty = false;
+			break;
+		}
+		if (now - start >= max_us) {
+			b->line_dirty = true;   /* still talking: the next request flushes */
+			break;
+		}
+		uint64_t until_quiet = last + quiet_us - now, until_max = start + max_us - now;
+		int w = b->io.wait(b->io.ctx, (uint32_t)(until_quiet < until_max ? until_quiet : until_max));
+		if (w < 0) {
+			b->io_errors++;
+			return w;
+		}
+	}
+	bus_echo_clear(b);
+	dxl_parser_reset(&b->parser);
+	return dropped > INT32_MAX ? INT32_MAX : (int)dropped;
+}
+
 /* One request, its reply (if any) and the error byte. */
 static int bus_transact(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params,
                         size_t nparams, int reply_params, struct dxl_packet *reply,

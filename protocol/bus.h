@@ -164,5 +164,11 @@ int bus_action(struct bus *b, uint8_t id, uint8_t *errbits); /* broadcast: no re
 int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
                    const uint8_t *data, size_t n);
 int bus_factory_reset(struct bus *b, uint8_t id, bool expect_reply, uint8_t *errbits);
+/* Before trying a failed transaction again: read and discard input until the
+ * line has been quiet for quiet_us, or max_us have passed. A reply that was
+ * only late lands here instead of colliding with the next request. Returns
+ * the bytes discarded (>= 0; the line is clean if it went quiet), DXL_E_BUSY
+ * while a transaction is pending, or an I/O error. */
+int bus_settle(struct bus *b, uint32_t quiet_us, uint32_t max_us);
 
 #endif

@@ -515,6 +515,46 @@ static void test_stale_input_and_strays(void **state)
 	assert_int_equal(bus.servo[1].wrong_id, 0);
 }
 
+/* After a failed transaction, a blocking caller that will try again waits
+ * for the line to go quiet: a reply that was only late lands in the wait,
+ * not on top of the next request (on a half-duplex bus the two would
+ * collide). */
+static void test_settle(void **state)
+{
+	(void)state;
+	setup_bus(false);
+	bus.io.pending_input = fake_pending;
+	/* nothing comes: quiet at once, after quiet_us */
+	uint64_t start = fk.now;
+	assert_int_equal(bus_settle(&bus, 5000, 50000), 0);
+	assert_int_equal(fk.now - start, 5000);
+
+	/* a ping whose reply comes 2 ms after the deadline */
+	script(ping1_reply, sizeof ping1_reply, 1620 + 2000);
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_E_TIMEOUT);
+	start = fk.now;
+	assert_int_equal(bus_settle(&bus, 5000, 50000), (int)sizeof ping1_reply);
+	assert_int_equal(fk.now - start, 2000 + 5000);   /* the late reply, then 5 ms of quiet */
+	unsigned flushes = fk.flushes;
+	script(ping1_reply, sizeof ping1_reply, 80);
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_OK);
+	assert_int_equal(fk.flushes, flushes);            /* the line is known clean */
+	assert_int_equal(bus.stray_packets, 0);
+
+	/* a line that never goes quiet: given up after max_us, still dirty */
+	for (int i = 0; i < 40; i++)
+		fake_push(&fk, ping2_reply, sizeof ping2_reply, fk.now + 1000u * (unsigned)i);
+	start = fk.now;
+	assert_true(bus_settle(&bus, 5000, 20000) > 0);
+	assert_true(fk.now - start >= 20000 && fk.now - start < 21000);
+	assert_true(bus.line_dirty);
+
+	/* not while a transaction is pending */
+	assert_int_equal(bus_begin(&bus, 1, DXL_INST_PING, NULL, 0, 0), DXL_OK);
+	assert_int_equal(bus_settle(&bus, 5000, 50000), DXL_E_BUSY);
+	bus_abort(&bus);
+}
+
 static void test_io_errors_and_args(void **state)
 {
 	(void)state;
@@ -553,6 +593,7 @@ int main(void)
 		cmocka_unit_test(test_echo),
 		cmocka_unit_test(test_reply_like_request),
 		cmocka_unit_test(test_stale_input_and_strays),
+		cmocka_unit_test(test_settle),
 		cmocka_unit_test(test_io_errors_and_args),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
