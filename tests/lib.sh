@@ -137,6 +137,10 @@ lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }
 #   states / last_state   robot $R's STATE lines / the last one
 #   cycle_at_least N      its last published cycle is >= N
 #   wait_cycles N         wait (up to 10 s) until N more cycles were published
+#   mark_states           after stopping $R's daemon: what it published is old
+#   wait_restarted N      wait (up to 10 s) until the daemon started since has
+#                         published N cycles (its counter starts at 0 again, and
+#                         the watcher may still print the old one's last states)
 #   events                robot $R's EVENT lines
 ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
@@ -145,6 +149,13 @@ last_state() { states | tail -1; }
 cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
 wait_cycles() { local c; c=$(last_state | field cycle); wait_for 10 cycle_at_least $((${c:-0} + $1)); }
 events() { grep -a "^EVENT $R " "$T/watch.log"; }
+_mark=0
+mark_states() { _mark=$(states | wc -l); }
+restarted_at_least() {
+	states | tail -n +$((_mark + 1)) | awk -v n="$1" '{ c = $3; sub("cycle=", "", c); c += 0; if (c < n) low = 1; last = c }
+		END { exit !(low && last >= n) }'
+}
+wait_restarted() { wait_for 10 restarted_at_least "$1"; }
 
 # ---- reading an experiment's analysis (scripts/demo.sh --out DIR) -------------------
 # min_swing DIR: the smallest peak-to-peak angle (rad) of any robot's joint

@@ -39,8 +39,9 @@ wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; t
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
 start_daemon() { # NAME ARGS...: the robot, default limits +-1.3 rad, in HOLD
 	local name=$1; shift
+	mark_states   # the daemon before it (stopped) published under the same name
 	spawn "$name" "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode hold "$@"
-	wait_log "$name" "ready: $R.STATE" 10 && wait_for 10 cycle_at_least 100
+	wait_log "$name" "ready: $R.STATE" 10 && wait_restarted 100
 }
 start_daemon d || { tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
 

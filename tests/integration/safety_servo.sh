@@ -59,9 +59,10 @@ if [ "$t" = "0 0" ] && [ "$(echo "$s" | field tq0)$(echo "$s" | field tr0)$(echo
 # ---- a servo loses power: found, reported, set up again -------------------------------------------
 # silent_s 5: long enough that a 2 s outage does not latch, so the reset itself is seen
 stop d >/dev/null
+mark_states
 spawn d2 "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator \
 	--set robot.fault_action=hold --set robot.silent_s=5
-wait_log d2 "ready: $R.STATE" 10 && wait_cycles 300 || { tap_fail "daemon restarts" "$(cat "$T/d2.log")"; tap_done; exit 1; }
+wait_log d2 "ready: $R.STATE" 10 && wait_restarted 300 || { tap_fail "daemon restarts" "$(cat "$T/d2.log")"; tap_done; exit 1; }
 ctl power r1 2 off >/dev/null
 wait_cycles 200
 ctl power r1 2 on >/dev/null
@@ -78,8 +79,9 @@ if state_is ' mode=3 ' 1 && awk -v s="$lo" 'BEGIN { exit !(s > 0.5) }'; then
 
 # ---- a joint falls silent: the fault action latches --------------------------------------------
 stop d2 >/dev/null
+mark_states
 spawn d3 "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator --set robot.fault_action=hold
-wait_log d3 "ready: $R.STATE" 10 && wait_cycles 300 || { tap_fail "daemon restarts" "$(cat "$T/d3.log")"; tap_done; exit 1; }
+wait_log d3 "ready: $R.STATE" 10 && wait_restarted 300 || { tap_fail "daemon restarts" "$(cat "$T/d3.log")"; tap_done; exit 1; }
 ctl fault r1 2 no-reply >/dev/null
 if event 'kind=fault-latched text="servo 2 silent for 0.50 s: robot HOLD until .clear.' 3 &&
 	state_is ' mode=1 reason="fault: servo 2 silent for 0.50 s" fault="servo 2 silent for 0.50 s" ' 2; then
