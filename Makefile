@@ -167,6 +167,8 @@ TOOL_BINS := $(patsubst tests/tools/%.c,$(BUILD)/tests/tools/%,$(TOOL_SRC))
 $(BUILD)/tests/tools/%: $(OBJ)/tests/tools/%.o $(call libs_of,daemon) $(LIB)/liblcmtypes.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $< $(call libs_of,daemon) $(LIB)/liblcmtypes.a $(LDLIBS)
+# pngdata reads the plots' PNGs (libpng, from Debian's libpng-dev).
+$(BUILD)/tests/tools/pngdata: LDLIBS += -lpng
 unit-tests: $(TOOL_BINS)
 
 # ---- entry points -----------------------------------------------------------
@@ -190,9 +192,10 @@ bench: deps
 	@BUILD=$(BUILD) bench/run.sh
 
 DEMO_SECONDS ?=
+DEMO_OUT ?=
 demo: deps
 	@$(MAKE) --no-print-directory all
-	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) scripts/demo.sh
+	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) DEMO_OUT=$(DEMO_OUT) scripts/demo.sh
 
 # libFuzzer targets: tests/fuzz/fuzz_<component>_<what>.c, built with clang
 # from the sources of that component's libraries (instrumented, unlike the

@@ -180,7 +180,7 @@ loop_run() {
 	wait_file "$d/run.lcm" 10
 	local extra=()
 	[ "$pol" = fifo ] && extra=(--set "robot.priority=$FIFO_PRIORITY" --set robot.mlockall=true)
-	if ! start_daemon "dmn-$pol" "$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u" "${extra[@]}"; then
+	if ! start_daemon "dmn-$pol" "$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u" --mode oscillator "${extra[@]}"; then
 		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$pol"))" >"$d/info"
 		stop "log-$pol"; stop "sim-$pol"
 		return 1
@@ -316,7 +316,7 @@ daemon_bus_run() {
 	fi
 	start "log-$name" lcm-logger --lcm-url="$u" -f "$d/$name.lcm"
 	wait_file "$d/$name.lcm" 10
-	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --robot "r$n" --lcm-url "$u"; then
+	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --robot "r$n" --lcm-url "$u" --mode oscillator; then
 		sleep "$RAMP_S"
 		local t0 t1
 		t0=$(now_us)
@@ -416,7 +416,7 @@ section_missing() {
 	else
 		start log-miss lcm-logger --lcm-url="$u" -f "$d/run.lcm"
 		wait_file "$d/run.lcm" 10
-		if start_daemon dmn-miss "$DMN" --port "$d/r1" --ids 1,2,3 --robot r1 --lcm-url "$u"; then
+		if start_daemon dmn-miss "$DMN" --port "$d/r1" --ids 1,2,3 --robot r1 --lcm-url "$u" --mode oscillator; then
 			echo "start_retries $RETRIES" >>"$d/info"
 			sleep "$RAMP_S"
 			local t0 t1 t2
@@ -518,7 +518,7 @@ fleet_run() {
 	# once on two cores measure the start-up, not the running fleet.
 	local retries=0
 	for i in $(seq 1 "$n"); do
-		if ! start_daemon "dmn-fleet-$i" "$DMN" --port "$d/links/r$i" --ids 1,2 --robot "r$i" --lcm-url "$u"; then
+		if ! start_daemon "dmn-fleet-$i" "$DMN" --port "$d/links/r$i" --ids 1,2 --robot "r$i" --lcm-url "$u" --mode oscillator; then
 			echo "status not measured: undulated r$i did not start in $START_TRIES tries ($(why "dmn-fleet-$i"))" >"$d/info"
 			break
 		fi
@@ -654,7 +654,7 @@ section_cg() {
 	fi
 	# valgrind runs the daemon in the same process: its PID is the daemon's
 	start dmn-cg valgrind --tool=callgrind --callgrind-out-file="$d/cg.out" \
-		"$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u"
+		"$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u" --mode oscillator
 	local ok=1
 	if wait_ready dmn-cg 'ready:' 60; then
 		sleep "$RAMP_S"

@@ -248,7 +248,10 @@ void cfg_defaults(struct cfg *c)
 	memset(c, 0, sizeof *c);
 	snprintf(c->name, sizeof c->name, "robot");
 	c->baud = 1000000;
-	c->mode = CFG_MODE_OSCILLATOR;
+	/* A robot started without a mode (the first `undulated --port ... --ids
+	 * ...` on new hardware) holds where it stands: nothing swings before the
+	 * person at the robot has seen it answer and asked for it. */
+	c->mode = CFG_MODE_HOLD;
 	c->safe_stop = CFG_SAFE_HOLD;
 	c->fault_action = CFG_SAFE_HOLD;
 	c->velocity_source = CFG_VEL_FILTERED;
@@ -416,6 +419,7 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			cfg_error(e, "%s: [robot] mode: '%s' is not limp, hold, sinusoid or oscillator", where, value);
 			return false;
 		}
+		c->mode_given = true;
 		return true;
 	case T_SAFE:
 		if (strcasecmp(value, "hold") == 0)

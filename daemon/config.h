@@ -52,7 +52,8 @@ struct cfg {
 	long baud;
 	uint8_t ids[CFG_MAX_JOINTS];
 	size_t njoints;
-	enum cfg_mode mode;
+	enum cfg_mode mode;            /* the start mode; HOLD when none is given (mode_given) */
+	bool mode_given;               /* `mode` in the file or --mode/--set: else the first-run default */
 	char lcm_url[CFG_PATH_MAX];
 	int priority;                  /* SCHED_FIFO priority, 0 = normal scheduling */
 	bool mlockall;

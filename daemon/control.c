@@ -325,9 +325,12 @@ void ctl_start(struct ctl *c, double t, const char *reason)
 	}
 	if (c->mode == CFG_MODE_OSCILLATOR && ctl_needs_starter(c))
 		ctl_starter(c);
-	ctl_event(c, 0, "start", "%s: %s, ramping in over %.1f s%s%s", reason, cfg_mode_name(c->mode),
-	          c->mode == CFG_MODE_LIMP ? 0.0 : c->cfg->ramp_s, c->latched ? "; fault latched: " : "",
-	          c->latched ? c->latch : "");
+	/* The event's kind is already "start": name the reason only when it says
+	 * more (a reconnection), or the log reads "start: start: ...". */
+	bool plain = strcmp(reason, "start") == 0;
+	ctl_event(c, 0, "start", "%s%s%s, ramping in over %.1f s%s%s", plain ? "" : reason, plain ? "" : ": ",
+	          cfg_mode_name(c->mode), c->mode == CFG_MODE_LIMP ? 0.0 : c->cfg->ramp_s,
+	          c->latched ? "; fault latched: " : "", c->latched ? c->latch : "");
 }
 
 void ctl_bus_lost(struct ctl *c)
@@ -537,7 +540,7 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 	if (mode == CFG_MODE_OSCILLATOR && was_still && ctl_needs_starter(c))
 		ctl_starter(c);
 	/* a fault's switch is an error; the operator's is news */
-	ctl_event(c, c->latched && mode == ctl_fault_mode(c) ? 2 : 0, "mode", "mode %s -> %s (%s)",
+	ctl_event(c, c->latched && mode == ctl_fault_mode(c) ? 2 : 0, "mode", "%s -> %s (%s)",
 	          cfg_mode_name(old), cfg_mode_name(mode), reason);
 }
 

@@ -645,6 +645,11 @@ int dmn_run(struct cfg *cfg)
 	         cfg->baud, cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");
 	log_info("commands: %s (local socket %s%s)", cfg_commands_name(cfg->commands), cin_local_path(&d->cin),
 	         cfg->commands == CFG_CMD_NETWORK ? "; signed commands from the LCM group" : "");
+	if (!cfg->mode_given)
+		log_info("no mode given: holding where it stands (the first-run default). Once the robot answers as "
+		         "it should, swing the joints with: undulated --command 'mode oscillator' --robot %s%s%s "
+		         "(or start with --mode oscillator, or mode = oscillator in the configuration)", cfg->name,
+		         cfg->lcm_url[0] ? " --lcm-url " : "", cfg->lcm_url[0] ? cfg->lcm_url : "");
 	dmn_realtime(cfg);
 	dmn_start_timer(d);
 	dmn_flush_ctl_events(d);
@@ -660,8 +665,9 @@ int dmn_run(struct cfg *cfg)
 	if (d->connected)
 		setup_safe_stop(&d->bus, &d->ctl, cfg);
 	char text[96];
-	snprintf(text, sizeof text, "stopped: %s",
-	         cfg->safe_stop == CFG_SAFE_LIMP || d->ctl.mode == CFG_MODE_LIMP ? "limp" : "holding");
+	snprintf(text, sizeof text, "%s",
+	         cfg->safe_stop == CFG_SAFE_LIMP || d->ctl.mode == CFG_MODE_LIMP ? "joints limp (torque off)"
+	                                                                         : "joints holding (torque on)");
 	dmn_event(d, 0, 0, "stop", text);
 	dmn_close_port(d);
 	cin_close(&d->cin);

@@ -11,6 +11,7 @@
 #include <inttypes.h>
 #include <lcm/lcm.h>
 #include <signal.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -22,12 +23,17 @@
 #include "undulate_osc_params_t.h"
 #include "undulate_robot_state_t.h"
 
+/* Silence after which --watch says it hears nobody (seconds). */
+#define WATCH_QUIET_S 3.0
+
 static volatile sig_atomic_t watch_stop;
+static unsigned long watch_heard; /* messages printed: none at the end is a failure */
 static void watch_on_signal(int sig) { (void)sig; watch_stop = 1; }
 
 static void watch_state(const lcm_recv_buf_t *rb, const char *ch, const undulate_robot_state_t *m, void *u)
 {
 	(void)rb; (void)ch; (void)u;
+	watch_heard++;
 	/* whatever is on the network may say anything: one printable line each */
 	char robot[64], reason[128], fault[160];
 	printf("STATE %s cycle=%" PRId64 " mode=%d reason=\"%s\" fault=\"%s\" period=%.0f jitter=%.0f bus=%.0f "
@@ -48,6 +54,7 @@ static void watch_state(const lcm_recv_buf_t *rb, const char *ch, const undulate
 static void watch_event(const lcm_recv_buf_t *rb, const char *ch, const undulate_event_t *m, void *u)
 {
 	(void)rb; (void)ch; (void)u;
+	watch_heard++;
 	char robot[64], kind[48], text[600];
 	printf("EVENT %s seq=%" PRId64 " level=%d kind=%s text=\"%s\"\n", text_line(robot, sizeof robot, m->robot),
 	       m->seq, m->level, text_line(kind, sizeof kind, m->kind), text_line(text, sizeof text, m->text));
@@ -56,6 +63,7 @@ static void watch_event(const lcm_recv_buf_t *rb, const char *ch, const undulate
 static void watch_bus(const lcm_recv_buf_t *rb, const char *ch, const undulate_bus_stats_t *m, void *u)
 {
 	(void)rb; (void)ch; (void)u;
+	watch_heard++;
 	printf("BUS %s connected=%d reconnects=%" PRId64 " p50=%.0f p99=%.0f max=%.0f jitter99=%.0f bus99=%.0f "
 	       "cpu=%.2f overruns=%" PRId64 " stray=%" PRId64 " io_errors=%" PRId64, m->robot, m->connected,
 	       m->reconnects, m->period_p50_us, m->period_p99_us, m->period_max_us, m->jitter_p99_us,
@@ -69,6 +77,7 @@ static void watch_bus(const lcm_recv_buf_t *rb, const char *ch, const undulate_b
 static void watch_params(const lcm_recv_buf_t *rb, const char *ch, const undulate_osc_params_t *m, void *u)
 {
 	(void)rb; (void)ch; (void)u;
+	watch_heard++;
 	printf("PARAMS %s", m->robot);
 	for (int j = 0; j < m->njoints; j++)
 		printf(" k%d=%g c%d=%g mu%d=%g lambda%d=%g inertia%d=%g friction%d=%g neutral%d=%g min%d=%g max%d=%g",
@@ -97,12 +106,23 @@ int dmn_watch(const char *lcm_url, const char *robot, double duration_s)
 	signal(SIGINT, watch_on_signal);
 	signal(SIGTERM, watch_on_signal);
 	setvbuf(stdout, NULL, _IOLBF, 0);
+	const char *url = lcm_url && lcm_url[0] ? lcm_url : "LCM's default URL";
 	struct timespec t0, t;
+	double waited = 0;
+	bool told = false;
 	clock_gettime(CLOCK_MONOTONIC, &t0);
 	while (!watch_stop) {
 		lcm_handle_timeout(lcm, 100);
 		clock_gettime(CLOCK_MONOTONIC, &t);
-		if (duration_s > 0 && (double)(t.tv_sec - t0.tv_sec) + 1e-9 * (double)(t.tv_nsec - t0.tv_nsec) >= duration_s)
+		waited = (double)(t.tv_sec - t0.tv_sec) + 1e-9 * (double)(t.tv_nsec - t0.tv_nsec);
+		/* A robot publishes its state at 100 Hz: seconds of silence mean a
+		 * wrong name or URL, or no daemon. Say so once, keep listening. */
+		if (!told && watch_heard == 0 && waited >= WATCH_QUIET_S && (duration_s <= 0 || duration_s > WATCH_QUIET_S)) {
+			fprintf(stderr, "undulated --watch: nothing heard from '%s' on %s for %.0f s yet (is its daemon "
+			        "running, with this --lcm-url?)\n", robot, url, WATCH_QUIET_S);
+			told = true;
+		}
+		if (duration_s > 0 && waited >= duration_s)
 			break;
 	}
 	/* the generated wrappers are not freed by lcm_destroy() */
@@ -111,5 +131,9 @@ int dmn_watch(const char *lcm_url, const char *robot, double duration_s)
 	undulate_bus_stats_t_unsubscribe(lcm, s2);
 	undulate_osc_params_t_unsubscribe(lcm, s3);
 	lcm_destroy(lcm);
+	if (watch_heard == 0) {
+		fprintf(stderr, "undulated --watch: nothing heard from '%s' on %s in %.1f s\n", robot, url, waited);
+		return 1;
+	}
 	return 0;
 }

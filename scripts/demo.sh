@@ -1,8 +1,17 @@
 #!/usr/bin/env bash
 # scripts/demo.sh — robots on the simulated bus, one undulated per robot.
 #
-#   make demo                       four robots in a channel, watched live in undulate-top
-#   make demo DEMO_SECONDS=60       headless for 60 s, LCM log recorded, summary printed
+#   make demo                       the paper's contact-force experiment, watched live:
+#                                   ten robots crowded in a row, 20 s on the clock
+#                                   (SINUSOID), then on the oscillator; q stops it and
+#                                   prints the summary
+#   make demo DEMO_SECONDS=60       the same headless for 60 s, then the summary
+#
+# The run is kept (the LCM log, the analysis, the programs' logs) in DEMO_OUT
+# or --out, by default demo-out/<date>-<time> in the current directory; the
+# summary says how the contact force and the collisions changed at the switch,
+# each neighbouring pair's final phase difference against its compatibility
+# bound 2 asin(d~), and the command that draws the plots.
 #
 # Used directly it runs any scenario the same way (the experiments in
 # docs/EXPERIMENTS.md and the end-to-end tests are built on it):
@@ -15,8 +24,8 @@
 #
 # The robots start in --start-mode (default SINUSOID, each with its own phase:
 # random, or the comma-separated radians of --phases in scenario order) and are
-# switched to --switch-to (default OSCILLATOR) by one LCM command to every
-# robot --switch-at seconds after they are all running (default 3). Starting
+# switched to --switch-to (default OSCILLATOR) by one command to every
+# robot --switch-at seconds after they are all running (default 20). Starting
 # from the clock-driven sinusoid is how the paper starts its runs, and it is
 # what gives every robot a chosen phase: a robot started in OSCILLATOR from
 # rest begins at phase 0 or π only.
@@ -35,21 +44,79 @@
 set -u
 
 top=$(cd "$(dirname "$0")/.." && pwd)
+
+# ---- supervisor ---------------------------------------------------------------
+# The demo runs as two processes: this one only waits, and a worker (this
+# script again, with UNDULATE_DEMO_RUN set) does the work. A signal trap in
+# bash 5.2 that fires while the shell is parsing a command substitution (the
+# worker runs many: timing, awk) is itself parsed in the middle of it and
+# fails ("trap: unexpected EOF while looking for matching `)'"); the script
+# then went on as if nothing had happened: a SIGTERM gave a summary and exit 0
+# (seen under the sanitizer build's timing). Here the traps fire while the
+# shell sits in `wait`, where nothing is being parsed: they kill the worker,
+# stop what it started (its "PID NAME" lines in $run/pids: the daemons first,
+# which leave the robots in their safe state while the simulated bus still
+# answers, then the simulator and the logger) and remove the directory.
+# stop_pids PID...: SIGTERM to all at once, up to 3 s, then SIGKILL. Watched
+# with kill -0, which works for the supervisor too (they are not its children).
+stop_pids() {
+	local pid
+	[ $# -gt 0 ] || return 0
+	kill -TERM "$@" 2>/dev/null
+	for _ in $(seq 150); do
+		for pid in "$@"; do kill -0 "$pid" 2>/dev/null && break; pid=""; done
+		[ -z "$pid" ] && return 0
+		sleep 0.02
+	done
+	for pid in "$@"; do
+		kill -0 "$pid" 2>/dev/null && echo "demo: pid $pid ignored SIGTERM for 3 s; killing it" >&2
+	done
+	kill -KILL "$@" 2>/dev/null
+}
+if [ -z "${UNDULATE_DEMO_RUN:-}" ]; then
+	sv_run=$(mktemp -d "${TMPDIR:-/tmp}/undulate-demo.XXXXXX") ||
+		{ echo "demo: cannot make a temporary directory" >&2; exit 1; }
+	# stdin stays the terminal: undulate-top reads its keys from it
+	UNDULATE_DEMO_RUN=$sv_run "$0" "$@" <&0 &
+	sv_worker=$!
+	sv_stop() {
+		trap '' INT TERM HUP
+		kill -KILL "$sv_worker" 2>/dev/null
+		wait "$sv_worker" 2>/dev/null
+		local pid name first=() rest=()
+		if [ -f "$sv_run/pids" ]; then
+			while read -r pid name; do
+				case "$name" in sim|logger) rest+=("$pid") ;; *) first+=("$pid") ;; esac
+			done <"$sv_run/pids"
+		fi
+		stop_pids ${first[@]+"${first[@]}"}
+		stop_pids ${rest[@]+"${rest[@]}"}
+		rm -rf "$sv_run"
+		exit "$1"
+	}
+	trap 'sv_stop 130' INT
+	trap 'sv_stop 143' TERM
+	trap 'sv_stop 129' HUP
+	sv_rc=0
+	wait "$sv_worker" || sv_rc=$?
+	rm -rf "$sv_run"   # normally gone already: the worker removes it
+	exit "$sv_rc"
+fi
 BUILD=${BUILD:-build}
 case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
 B="$BUILD/bin"
 
-scenario="$top/sim-bridge/scenarios/channel4.scenario"
+scenario="$top/sim-bridge/scenarios/force10.scenario"
 seconds=${DEMO_SECONDS:-}
 sim_sets=()
 daemon_sets=()
 start_mode=sinusoid
-switch_at=3
+switch_at=20
 switch_to=oscillator
 phases=random
 seed=""
 window=10
-out=""
+out=${DEMO_OUT:-}
 url=${DEMO_LCM_URL:-}
 # SCHED_FIFO priorities: the simulated servos first, then the control loops
 RT_SIM=30
@@ -98,39 +165,28 @@ interactive=0
 if [ -z "$seconds" ] && [ "$interactive" -eq 0 ]; then
 	seconds=60  # not a terminal: nobody could watch or press Ctrl-C
 fi
-if [ -n "$seconds" ]; then
-	command -v lcm-logger >/dev/null || die "lcm-logger not found (Debian package liblcm-bin)"
-fi
+command -v lcm-logger >/dev/null || die "lcm-logger not found (Debian package liblcm-bin)"
+# Where the run is kept: created at the end, when there is something to keep.
+[ -n "$out" ] || out="$PWD/demo-out/$(date +%Y%m%d-%H%M%S)"
+case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
 
 # A private multicast port (udpm, ttl=0: nothing leaves this host). The tests
 # use 7600-7949; the demo picks one of 10000 ports above them from its PID.
 [ -n "$url" ] || url="udpm://239.255.76.67:$((17600 + $$ % 10000))?ttl=0"
 [ -n "$seed" ] || seed=$(( (RANDOM << 15 | RANDOM) % 1000000 + 1 ))
 
-run=$(mktemp -d "${TMPDIR:-/tmp}/undulate-demo.XXXXXX") || die "cannot make a temporary directory"
+run=$UNDULATE_DEMO_RUN
 links="$run/links"
 mkdir -p "$links"
 
 pids=()       # everything we started, in start order
 names=()
 cleaning=0
-# stop_group PID...: SIGTERM to all at once, wait up to 3 s, then SIGKILL.
+# stop_group PID...: stop them (stop_pids) and reap them.
 stop_group() {
-	local pid i
-	[ $# -gt 0 ] || return 0
-	kill -TERM "$@" 2>/dev/null
-	for _ in $(seq 150); do
-		for pid in "$@"; do kill -0 "$pid" 2>/dev/null && break; pid=""; done
-		[ -z "$pid" ] && break
-		sleep 0.02
-	done
-	for pid in "$@"; do
-		if kill -0 "$pid" 2>/dev/null; then
-			for i in "${!pids[@]}"; do [ "${pids[$i]}" = "$pid" ] && echo "demo: ${names[$i]} (pid $pid) ignored SIGTERM for 3 s; killing it" >&2; done
-			kill -KILL "$pid" 2>/dev/null
-		fi
-		wait "$pid" 2>/dev/null
-	done
+	local pid
+	stop_pids "$@"
+	for pid in "$@"; do wait "$pid" 2>/dev/null; done
 }
 # stop_children: the daemons first (they leave the robots in their safe state
 # while the simulated bus still answers), then the simulator and the logger.
@@ -152,8 +208,8 @@ cleanup() {
 	rm -rf "$run"
 }
 trap cleanup EXIT
-trap 'exit 130' INT
-trap 'exit 143' TERM
+# No INT/TERM traps here: the supervisor (above) takes the signals, and as its
+# background job this worker ignores SIGINT anyway.
 
 # Each program runs in a session of its own (setsid), as a robot's service runs
 # in a cgroup of its own. With the kernel's autogroups everything started from
@@ -164,11 +220,16 @@ trap 'exit 143' TERM
 # kept below is the program's; stopping by PID does not depend on the session.
 own_session=()
 command -v setsid >/dev/null 2>&1 && own_session=(setsid)
+# record PID NAME: keep what was started, here and for the supervisor.
+record() {
+	pids+=("$1")
+	names+=("$2")
+	echo "$1 $2" >>"$run/pids"
+}
 start() {
 	local name=$1; shift
 	${own_session[@]+"${own_session[@]}"} "$@" >"$run/$name.log" 2>&1 &
-	pids+=("$!")
-	names+=("$name")
+	record "$!" "$name"
 }
 
 # pid_of NAME: the PID of a process we started.
@@ -190,13 +251,11 @@ wait_ready() {
 }
 
 # ---- logger -------------------------------------------------------------------
-log=""
-if [ -n "$seconds" ]; then
-	log="$run/demo.lcmlog"
-	# lcm-logger's -l option is broken in LCM 1.3.1: only --lcm-url= works.
-	start logger lcm-logger --lcm-url="$url" --force "$log"
-	wait_ready logger '^Opening log file' || exit 1
-fi
+# Always: the run is analysed and kept, watched live or not.
+log="$run/demo.lcmlog"
+# lcm-logger's -l option is broken in LCM 1.3.1: only --lcm-url= works.
+start logger lcm-logger --lcm-url="$url" --force "$log"
+wait_ready logger '^Opening log file' || exit 1
 
 # ---- simulator --------------------------------------------------------------
 rt_sim=() rt_daemon=()
@@ -301,19 +360,50 @@ sleep_until() {
 secs_ns() { awk -v s="$1" 'BEGIN { printf "%.0f", s * 1e9 }'; }
 
 # ---- interactive: undulate-top in the foreground ------------------------------
+# banner_loop: once a second, what the demo is doing and what comes next, on
+# the line undulate-top shows under its title (--banner-file).
+banner_loop() {
+	local now el left
+	trap '[ -n "${sleep_pid:-}" ] && kill "$sleep_pid" 2>/dev/null; exit 143' TERM
+	while :; do
+		now=$(date +%s%N)
+		el=$(( (now - t_ready) / 1000000000 ))
+		if [ "$switch_at" != never ] && [ ! -f "$run/switch.time" ]; then
+			left=$(awk -v s="$switch_at" -v e="$el" 'BEGIN { printf "%d", s - e }')
+			echo "DEMO ${el}s | on the CLOCK (${start_mode}) | ${switch_to} in ${left}s | ? legend  q end" >"$run/banner.new"
+		else
+			echo "DEMO ${el}s | on the ${switch_to}: watch contact force, collisions | ? legend  q end" >"$run/banner.new"
+		fi
+		mv -f "$run/banner.new" "$run/banner"
+		sleep_until $(( now + 1000000000 ))
+	done
+}
+
 if [ "$interactive" -eq 1 ]; then
 	if [ "$switch_at" != never ]; then
 		( trap '[ -n "${sleep_pid:-}" ] && kill "$sleep_pid" 2>/dev/null; exit 143' TERM
 		  sleep_until $(( t_ready + $(secs_ns "$switch_at") )); switch_modes ) &
-		pids+=("$!"); names+=("switch timer")
+		record "$!" "switch timer"
 	fi
+	banner_loop &
+	record "$!" banner
 	# Ctrl-C reaches undulate-top (it restores the terminal and exits) and this
-	# script, whose EXIT trap then stops everything else.
-	"$B/undulate-top" --lcm-url "$url"
-	exit 0
+	# script, whose EXIT trap then stops everything (nothing is kept); q ends
+	# undulate-top alone, and the run is analysed and kept below.
+	# In the background and recorded, so that a signal to the supervisor
+	# stops it too (it gives the terminal back on SIGTERM); its keys still
+	# come from the terminal.
+	"$B/undulate-top" --lcm-url "$url" --banner-file "$run/banner" <&0 &
+	record "$!" top
+	top_rc=0
+	wait "$!" || top_rc=$?
+	# 130: Ctrl-C (a key to undulate-top's raw terminal): stop, keep nothing
+	[ "$top_rc" -eq 0 ] || exit "$top_rc"
+	seconds=$(awk -v n="$(( $(date +%s%N) - t_ready ))" 'BEGIN { printf "%.0f", n / 1e9 }')
 fi
 
 # ---- headless -------------------------------------------------------------------
+if [ "$interactive" -eq 0 ]; then
 # sample_contact: ask the simulator for its running totals (SIM.CMD "stats");
 # the reply, with the simulated time, lands in its log. The rate of its total
 # impulse (impacts + resting contact) is the mean contact force: ground truth
@@ -341,7 +431,9 @@ while :; do
 	end) sample_contact; break ;;
 	esac
 done
+fi
 for i in "${!pids[@]}"; do
+	case "${names[$i]}" in "switch timer"|banner|top) continue ;; esac
 	kill -0 "${pids[$i]}" 2>/dev/null || die "${names[$i]} stopped during the run; its log:
 $(tail -n 15 "$run/${names[$i]}.log")"
 done
@@ -349,10 +441,15 @@ done
 # Stop the robots and the simulator, then the logger, so the log is complete.
 stop_children
 
-analysis="$run/analysis"
-mkdir -p "$analysis"
-"$B/undulate-analyze" "$log" --out "$analysis" --window "$window" --quiet >"$run/analyze.log" 2>&1
-rc=$?
+# The run is kept: the log first, so that the analysis names the kept file.
+mkdir -p "$out" || die "cannot create $out (DEMO_OUT / --out)"
+mv "$log" "$out/demo.lcmlog" || die "cannot move the LCM log into $out"
+log="$out/demo.lcmlog"
+analysis="$out"
+"$B/undulate-analyze" "$log" --out "$analysis" --window "$window" --quiet >"$run/analyze.log" 2>&1 &
+record "$!" analyze
+rc=0
+wait "$!" || rc=$?
 # 3 = truncated log (the logger was stopped mid-message): partial results are still written.
 [ "$rc" -eq 0 ] || [ "$rc" -eq 3 ] || die "undulate-analyze failed (exit $rc): $(tail -n 5 "$run/analyze.log")"
 
@@ -364,9 +461,52 @@ if [ -f "$run/switch.time" ]; then
 fi
 
 # ---- summary --------------------------------------------------------------------
+summary() {
 echo
 echo "=== undulate demo summary: ${#robots[@]} robots, $seconds s, $(basename "$scenario") ==="
 [ -n "$switch_t" ] && echo "switched $start_mode -> $switch_to at t = $switch_t s"
+
+# In words: the contact force and the collisions between robots in the last
+# $window s before the switch and in the last $window s of the run, from the
+# analysis (collision_rate.csv: 1 s bins; contact_force is SIM.TRUTH's total
+# impulse rate, impacts and resting contact).
+if [ -n "$switch_t" ]; then
+	awk -F, -v sw="$switch_t" -v w="$window" -v from="$start_mode" -v to="$switch_to" '
+		NR == 1 { next }
+		{ t[NR] = $1; pc[NR] = $4; wc[NR] = $5; f[NR] = $6; last = $1 }
+		END {
+			b0 = sw - w; if (b0 < 0) b0 = 0; a0 = last + 1 - w; if (a0 < sw) a0 = sw
+			for (k in t) {
+				if (t[k] >= b0 && t[k] + 1 <= sw) { bp += pc[k]; bw += wc[k]; if (f[k] != "") { bf += f[k]; bn++ }; bs++ }
+				if (t[k] >= a0) { ap += pc[k]; aw += wc[k]; if (f[k] != "") { af += f[k]; an++ }; as++ }
+			}
+			if (bn == 0 || an == 0 || bs == 0 || as == 0) { print "(no contact-force data around the switch: no words)"; exit }
+			fb = bf / bn; fa = af / an
+			printf "\nIn words:\n"
+			if (fa <= 0 && fb <= 0)
+				printf "  No contact force before the switch or after it (t = %.0f-%.0f s and %.0f-%.0f s): nothing to compare.\n", b0, sw, a0, last + 1
+			else if (fa <= 0)
+				printf "  The mean contact force fell to zero after the switch: %.3f N on the %s (t = %.0f-%.0f s) -> 0 N on the %s (t = %.0f-%.0f s).\n", fb, from, b0, sw, to, a0, last + 1
+			else if (fb / fa >= 1.5)
+				printf "  The mean contact force fell %.1fx after the switch: %.3f N on the %s (t = %.0f-%.0f s) -> %.3f N on the %s (t = %.0f-%.0f s).\n", fb / fa, fb, from, b0, sw, fa, to, a0, last + 1
+			else
+				printf "  The mean contact force did not fall: %.3f N on the %s (t = %.0f-%.0f s), %.3f N on the %s (t = %.0f-%.0f s).\n", fb, from, b0, sw, fa, to, a0, last + 1
+			printf "  Collisions between robots per 10 s: %.0f -> %.0f; against the walls: %.0f -> %.0f.\n", bp * 10 / bs, ap * 10 / as, bw * 10 / bs, aw * 10 / as
+		}' "$analysis/collision_rate.csv"
+fi
+awk '
+	$1 == "pair" && !hdr {
+		for (i = 1; i <= NF; i++) { if ($i == "end" && $(i + 1) == "state") { col["end"] = ++j; i++ } else col[$i] = ++j }
+		hdr = 1; next }
+	hdr && NF == 0 { hdr = 2 }
+	hdr == 1 && NF > 5 && $col["end"] != "-" && $col["2asin(d~)"] ~ /^[0-9.]+$/ {
+		n++; d = $col["meanD"]; if (d < 0) d = -d; b = $col["2asin(d~)"]
+		if (d <= b + 0.1) within++
+		rows = rows sprintf("    %-10s |D| %5.2f rad %s bound %4.2f: %s\n", $col["pair"], d, d <= b + 0.1 ? "<=" : "> ", b, $col["end"]) }
+	END { if (n) { printf "  Neighbours at the end (|D| against the compatibility bound 2 asin(d~)): %d of %d at or within it.\n%s", within, n, rows } }
+' "$analysis/summary.txt"
+
+echo
 echo "final window: the last $window s"
 # summary.txt has one row per pair under a header line starting with "pair";
 # columns are found by name so a new column does not break this.
@@ -398,7 +538,7 @@ sed -n "s/^undulate-sim: SIM.CMD seq [0-9]* 'stats *': ok steps=[0-9]* time=\([0
 if [ "$(wc -l <"$analysis/contact.csv")" -gt 2 ]; then
 	echo
 	echo "mean contact force between samples (simulator ground truth: impacts + resting contact):"
-	awk -F, 'NR > 2 && $1 > t0 { printf "  %6.1f-%-6.1f s  %9.4f N  (%d impacts)\n", t0, $1, ($3 - i0) / ($1 - t0), $2 - n0 }
+	awk -F, 'NR > 2 && $1 >= t0 + 1 { printf "  %6.1f-%-6.1f s  %9.4f N  (%d impacts)\n", t0, $1, ($3 - i0) / ($1 - t0), $2 - n0 }
 		NR > 1 { t0 = $1; n0 = $2; i0 = $3 }' "$analysis/contact.csv"
 	[ -f "$run/switch.time" ] && echo "  (simulated time; one sample is taken just before the switch)"
 fi
@@ -418,15 +558,14 @@ fi
 truth=$(grep -m1 '^undulate-sim: exit:' "$run/sim.log" | sed 's/^undulate-sim: exit: //')
 [ -n "$truth" ] && echo "simulator: $truth"
 
-if [ -n "$out" ]; then
-	mkdir -p "$out" || die "cannot create --out $out"
-	cp "$log" "$out/demo.lcmlog"
-	cp -r "$analysis"/. "$out/"
-	mkdir -p "$out/logs"
-	cp "$run"/*.log "$out/logs/" 2>/dev/null
-	[ -n "$switch_t" ] && echo "$switch_t" >"$out/switch_t"
-	echo "$seed" >"$out/seed"
-	echo
-	echo "log and analysis (CSV, summary.json) kept in $out"
-fi
+}
+
+summary | tee "$out/demo-summary.txt"
+mkdir -p "$out/logs"
+cp "$run"/*.log "$out/logs/" 2>/dev/null
+[ -n "$switch_t" ] && echo "$switch_t" >"$out/switch_t"
+echo "$seed" >"$out/seed"
+echo
+echo "The run is kept in $out: demo.lcmlog (the LCM log), demo-summary.txt, the analysis (summary.txt, CSV files), logs/."
+echo "Next, the plots:  $B/undulate-analyze $out/demo.lcmlog --out $out/plots --plots"
 exit 0

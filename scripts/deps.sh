@@ -10,7 +10,7 @@ set -eu
 # gnuplot for plots, cyclictest for the jitter benchmark; systemd and man-db
 # for checking the units (systemd-analyze verify) and the man pages.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
-      libinih-dev libsodium-dev libcmocka-dev gnuplot-nox rt-tests procps iproute2 jq python3 socat systemd man-db)
+      libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox rt-tests procps iproute2 jq python3 socat systemd man-db)
 [ $# -gt 0 ] && need=("$@")
 missing=()
 for p in "${need[@]}"; do

@@ -9,6 +9,7 @@
 #   BINDIR        $PREFIX/bin
 #   MANDIR        $PREFIX/share/man
 #   DATADIR       $PREFIX/share/undulate            (scenarios, install manifest)
+#   DOCDIR        $PREFIX/share/doc/undulate        (the READMEs and docs, in the source's layout)
 #   SYSCONFDIR    /etc                              (robot configs in $SYSCONFDIR/undulate)
 #   UNITDIR       systemd units: $PREFIX/lib/systemd/system for PREFIX /usr or
 #                 /usr/local (both are on systemd's search path), else /etc/systemd/system
@@ -36,6 +37,7 @@ esac
 BINDIR=${BINDIR:-$PREFIX/bin}
 MANDIR=${MANDIR:-$PREFIX/share/man}
 DATADIR=${DATADIR:-$PREFIX/share/undulate}
+DOCDIR=${DOCDIR:-$PREFIX/share/doc/undulate}
 SYSCONFDIR=${SYSCONFDIR:-/etc}
 UNITDIR=${UNITDIR:-${sys_lib:-$sys_etc}/systemd/system}
 UDEVRULESDIR=${UDEVRULESDIR:-${sys_lib:-$sys_etc}/udev/rules.d}
@@ -45,6 +47,9 @@ MANIFEST="$DATADIR/install-manifest"
 
 PROGRAMS=(undulated undulate-sim dxl undulate-top undulate-analyze)
 UNITS=(undulated@.service undulate-sim.service)
+DOCS=(README.md daemon/README.md daemon/CONTROL.md sim-bridge/README.md sim-bridge/PHYSICS.md
+      protocol/README.md lcmtypes/README.md systemd/README.md tools/dxl/README.md tools/top/README.md
+      tools/analyze/README.md docs/EXPERIMENTS.md)
 SERVICE_USER=undulate
 
 die() { echo "install.sh: $*" >&2; exit 1; }
@@ -190,7 +195,7 @@ do_install() {
 	local missing=() p
 	for p in "${PROGRAMS[@]}"; do [ -x "$BUILD/bin/$p" ] || missing+=("$BUILD/bin/$p"); done
 	[ ${#missing[@]} -eq 0 ] || die "not built: ${missing[*]} (run make first)"
-	check_writable "$BINDIR" "$UNITDIR" "$UDEVRULESDIR" "$SYSUSERSDIR" "$CONFDIR" "$MANDIR" "$DATADIR"
+	check_writable "$BINDIR" "$UNITDIR" "$UDEVRULESDIR" "$SYSUSERSDIR" "$CONFDIR" "$MANDIR" "$DATADIR" "$DOCDIR"
 
 	echo "installing undulate into ${DESTDIR:+$DESTDIR (staging) }prefix $PREFIX"
 	load_manifest
@@ -229,6 +234,12 @@ do_install() {
 	for s in "$top"/sim-bridge/scenarios/*.scenario; do
 		[ -f "$s" ] || continue
 		install_file 0644 "$s" "$DATADIR/scenarios/$(basename "$s")"
+	done
+	# The documentation, in the source's layout so its links between
+	# documents still work (the example config and man pages point here).
+	local doc
+	for doc in "${DOCS[@]}"; do
+		[ -f "$top/$doc" ] && install_file 0644 "$top/$doc" "$DOCDIR/$doc"
 	done
 
 	if live_system; then

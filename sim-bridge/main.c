@@ -36,7 +36,9 @@
 #include "wire.h"
 #include "undulate_sim_collision_t.h"
 #include "undulate_sim_command_t.h"
+#include "undulate_sim_reply_t.h"
 #include "undulate_sim_truth_t.h"
+#include "undulate_sim_world_t.h"
 
 /* Physics steps run back to back after a stall before the schedule is
  * reset (a stalled machine should not replay seconds of physics at once). */
@@ -308,12 +310,24 @@ static void on_sim_cmd(const lcm_recv_buf_t *rbuf, const char *channel, void *us
 	if (cut_verb || cut_args || snprintf(line, sizeof(line), "%s %s", verb, args) >= (int)sizeof(line)) {
 		a->sim->bad_commands++;
 		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld: command too long (or a NUL inside)\n", seq);
-		return;
+		/* still answered: the sender must not think nobody heard it */
+		char v[44];
+		snprintf(shown, sizeof shown, "%s...", text_sanitize(v, sizeof v, verb));
+		snprintf(shown_reply, sizeof shown_reply, "error: command too long (at most %d bytes) or a NUL inside",
+		         SIM_CMD_MAX - 1);
+	} else {
+		sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
+		/* whatever came from the network is one printable line in the log */
+		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", seq, text_sanitize(shown, sizeof shown, line),
+		        text_sanitize(shown_reply, sizeof shown_reply, reply));
 	}
-	sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
-	/* whatever came from the network is one printable line in the log */
-	fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", seq, text_sanitize(shown, sizeof shown, line),
-	        text_sanitize(shown_reply, sizeof shown_reply, reply));
+	/* The sender learns it was heard, and what came of it. Encoded on the
+	 * stack: commands are rare and the reply is bounded. */
+	uint8_t buf[sizeof shown + sizeof shown_reply + 64];
+	undulate_sim_reply_t m = { .utime = clock_wall_us(), .seq = seq, .command = shown, .reply = shown_reply };
+	int n = undulate_sim_reply_t_encode(buf, 0, (int)sizeof buf, &m);
+	if (n > 0)
+		lcm_publish(a->lcm, "SIM.REPLY", buf, (unsigned)n);
 }
 
 static void fill_collision(struct app *a, const struct sim_collision *c, int64_t utime,
@@ -394,6 +408,19 @@ static void publish_truth(struct app *a)
 		a->truth_failed++;
 	else
 		a->truth_sent++;
+}
+
+/* The world's constants (SIM.WORLD): rare, small, into the truth buffer. */
+static void publish_world(struct app *a)
+{
+	const struct sim_world_params *w = &a->sim->world.params;
+	undulate_sim_world_t m = {
+		.utime = clock_wall_us(), .restitution = w->restitution, .wall_restitution = w->wall_restitution,
+		.beta = w->beta, .wall_left = w->wall_left, .wall_right = w->wall_right,
+	};
+	int n = undulate_sim_world_t_encode(a->truth_buf, 0, MAIN_TRUTH_BUF, &m);
+	if (n > 0)
+		lcm_publish(a->lcm, "SIM.WORLD", a->truth_buf, (unsigned)n);
 }
 
 /* ---- control socket ---------------------------------------------------------- */
@@ -496,11 +523,44 @@ static void control_read(struct app *a, struct client *c)
 	}
 }
 
-/* --cmd: split "VERB ARGS" into a sim_command_t and publish it once. */
+/* How long --cmd waits for a simulator's answer: a busy simulator serves LCM
+ * between physics steps, within milliseconds; seconds mean nobody is there. */
+#define SEND_WAIT_MS 3000
+
+struct send_wait {
+	int64_t seq;
+	bool answered;
+	bool refused;
+};
+
+static void on_sim_reply(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+	(void)channel;
+	struct send_wait *w = user;
+	undulate_sim_reply_t m;
+	char shown[700];
+
+	/* Our own small fixed message type from a simulator; still, the decoded
+	 * text is printed sanitized and only when it answers our seq. */
+	if (w->answered || undulate_sim_reply_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0)
+		return;
+	if (m.seq == w->seq) {
+		w->answered = true;
+		w->refused = strncmp(m.reply, "ok", 2) != 0;
+		printf("%s\n", text_sanitize(shown, sizeof shown, m.reply));
+		fflush(stdout);
+	}
+	undulate_sim_reply_t_decode_cleanup(&m);
+}
+
+/* --cmd: split "VERB ARGS" into a sim_command_t, publish it, and print the
+ * simulator's answer. Exit 0: done; 1: the simulator refused it (its error
+ * is printed); 3: no simulator answered; 2: usage. */
 static int send_command(const struct options *o)
 {
 	char verb[64];
 	const char *args = o->send_cmd;
+	const char *url = o->lcm_url ? o->lcm_url : "LCM's default";
 	size_t n = strcspn(args, " \t");
 	if (n == 0 || n >= sizeof(verb)) {
 		fprintf(stderr, "undulate-sim: --cmd: want 'VERB ARGS'\n");
@@ -512,19 +572,43 @@ static int send_command(const struct options *o)
 	args += strspn(args, " \t");
 	lcm_t *lcm = lcm_create(o->lcm_url);
 	if (!lcm) {
-		fprintf(stderr, "undulate-sim: --cmd: LCM (%s) unavailable\n", o->lcm_url ? o->lcm_url : "default");
+		fprintf(stderr, "undulate-sim: --cmd: LCM (%s) unavailable\n", url);
 		return 1;
 	}
+	/* seq tells our answer from another client's: pid and time together. */
+	struct send_wait w = { .seq = ((int64_t)getpid() << 32) ^ (mono_ns() & 0xFFFFFFFF) };
+	lcm_subscription_t *sub = lcm_subscribe(lcm, "SIM.REPLY", on_sim_reply, &w);
 	char argbuf[SIM_CMD_MAX];
-	snprintf(argbuf, sizeof(argbuf), "%s", args);
-	undulate_sim_command_t m = { .utime = clock_wall_us(), .seq = (int64_t)getpid(), .verb = verb, .args = argbuf };
+	if (snprintf(argbuf, sizeof(argbuf), "%s", args) >= (int)sizeof(argbuf)) {
+		fprintf(stderr, "undulate-sim: --cmd: the command is longer than %zu bytes\n", sizeof argbuf - 1);
+		lcm_unsubscribe(lcm, sub);
+		lcm_destroy(lcm);
+		return 2;
+	}
+	undulate_sim_command_t m = { .utime = clock_wall_us(), .seq = w.seq, .verb = verb, .args = argbuf };
 	int r = undulate_sim_command_t_publish(lcm, "SIM.CMD", &m);
-	lcm_destroy(lcm);
 	if (r != 0) {
-		fprintf(stderr, "undulate-sim: --cmd: publish failed\n");
+		fprintf(stderr, "undulate-sim: --cmd: publish on %s failed\n", url);
+		lcm_unsubscribe(lcm, sub);
+		lcm_destroy(lcm);
 		return 1;
 	}
-	return 0;
+	int64_t deadline = mono_ns() + (int64_t)SEND_WAIT_MS * 1000000;
+	while (!w.answered) {
+		int64_t left_ms = (deadline - mono_ns()) / 1000000;
+		if (left_ms <= 0)
+			break;
+		if (lcm_handle_timeout(lcm, (int)left_ms) < 0)
+			break;
+	}
+	lcm_unsubscribe(lcm, sub);
+	lcm_destroy(lcm);
+	if (!w.answered) {
+		fprintf(stderr, "undulate-sim: --cmd: no simulator answered on %s within %d s (is one "
+		        "running with this --lcm-url?)\n", url, SEND_WAIT_MS / 1000);
+		return 3;
+	}
+	return w.refused ? 1 : 0;
 }
 
 /* ---- the loop ------------------------------------------------------------------ */
@@ -694,6 +778,8 @@ static void run(struct app *a)
 	sigset_t unblocked;
 	sigemptyset(&unblocked);
 	sim_run_events(s, 0.0, a->t0);
+	if (a->lcm)
+		publish_world(a);
 	while (!stop_signal) {
 		int64_t now = mono_ns();
 		if (now >= end)
@@ -707,6 +793,8 @@ static void run(struct app *a)
 				next_truth = now + truth_ns;
 		}
 		if (now >= next_bench) {
+			if (a->lcm)
+				publish_world(a);
 			if (a->bench)
 				bench_line(a, now, &cpu_prev, &bench_prev);
 			if (!a->quiet)

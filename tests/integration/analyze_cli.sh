@@ -36,10 +36,33 @@ tap_check "return map r3:r4 follows the closed form" awk -F, '
 	END { exit !(pts == 2 && !bad) }' "$T/out/return_map.csv"
 
 png_ok() { [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] && [ "$(stat -c %s "$1")" -gt 1000 ]; }
+# A plot drawn without its data still has frame, text and key samples: count
+# the pixels of the data's own colours (tests/tools/pngdata). An empty
+# angles.png (rows of several robots interleaved in states.csv, filtered
+# inside `plot with lines`) had 156 coloured pixels; the key samples of a
+# panel are about 100.
+PNGDATA="$BUILD/tests/tools/pngdata"
+# drawn NAME FILE MIN [RGB]: at least MIN data pixels (of colour RGB if given)
+drawn() {
+	local n
+	n=$("$PNGDATA" ${4:+--rgb "$4"} "$2" 2>&1 | sed -n 's/.*\(coloured\|matching\)=\([0-9]*\)$/\2/p')
+	if [ "${n:-0}" -ge "$3" ]; then tap_ok "$1 ($n data pixels)"; else tap_fail "$1" "${n:-no count}: $("$PNGDATA" "$2" 2>&1)"; fi
+}
 if command -v gnuplot >/dev/null; then
 	for p in angles portraits phase_diff collision_rate return_map_1 return_map_2; do
 		tap_check "$p.png is a PNG" png_ok "$T/out/$p.png"
 	done
+	drawn "angles.png draws every robot's joints" "$T/out/angles.png" 20000
+	drawn "angles.png: joint 1 drawn (its own colour)" "$T/out/angles.png" 2000 b3261e
+	drawn "portraits.png draws the portraits" "$T/out/portraits.png" 3000
+	drawn "phase_diff.png draws the phase differences" "$T/out/phase_diff.png" 3000 1f4e9c
+	drawn "collision_rate.png draws the contact force" "$T/out/collision_rate.png" 1000 b3261e
+	# the anti-phase pair r2:r3 is one band at pi, not two at the edges: its
+	# deltas near -pi were moved up by 2 pi (cut below -2 asin(d~))
+	tap_check "phase_diff.png: anti-phase drawn as one band" grep -q '? (\$9 <= -1.5' "$T/out/plots.gp"
+	tap_check "phase_diff.png: compatibility bounds and collisions drawn" \
+		bash -c "grep -q 'compatible bound' '$T/out/plots.gp' && grep -q \"title 'collision'\" '$T/out/plots.gp'"
+	tap_check "return maps: measured points coloured by time" grep -q "lc palette title 'measured (colour: time)'" "$T/out/plots.gp"
 else
 	tap_fail "gnuplot not installed (gnuplot-nox): plots untested"
 fi

@@ -89,6 +89,12 @@ refused "--check-config on a FIFO with no writer" \
 refused "a FIFO as the configuration to run" \
 	"$T/fifo: not a regular file (a FIFO): a configuration is a text file" "$T/fifo"
 
+# --watch with nobody publishing: says so and fails (it printed nothing, exit 0)
+out=$(timeout 10 "$D" --watch r1 --timeout 1 --lcm-url "$URL" 2>&1); rc=$?
+if [ $rc -eq 1 ] && [ "$out" = "undulated --watch: nothing heard from 'r1' on $URL in 1.0 s" ]; then
+	tap_ok "--watch with nobody publishing: exit 1, '$out'"
+else tap_fail "--watch with nobody publishing says so" "rc $rc: $out"; fi
+
 if [ ! -x "$S" ]; then tap_skip "commands to a running daemon" "undulate-sim not built"; tap_done; exit 0; fi
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 9
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }

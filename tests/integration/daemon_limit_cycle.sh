@@ -40,7 +40,7 @@ spawn watch3 "$D" --watch "$R3" --lcm-url "$URL3"
 start_daemon() {   # NAME ROBOT BUS IDS URL [DAEMON OPTIONS...]
 	local try
 	for try in 1 2; do
-		spawn "$1" "$D" --port "$T/$3" --ids "$4" --robot "$2" --lcm-url "$5" "${@:6}"
+		spawn "$1" "$D" --port "$T/$3" --ids "$4" --robot "$2" --lcm-url "$5" --mode oscillator "${@:6}"
 		wait_log "$1" "ready: $2.STATE" 10 && return 0
 		alive "$1" && return 1
 		echo "# $1 exited at start-up (try $try): $(tail -1 "$T/$1.log")"

@@ -28,7 +28,7 @@ ctl poke r1 1 cw_angle_limit 0 >/dev/null
 ctl poke r1 1 ccw_angle_limit 0 >/dev/null
 ctl poke r1 1 torque_enable 1 >/dev/null
 ctl poke r1 1 moving_speed 200 >/dev/null
-spawn pos "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL"
+spawn pos "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode oscillator
 wait_for 10 bash -c "! kill -0 $pid_pos" && stop pos
 if [ "$stop_rc" != 0 ] && grep -q 'servo 1 is in wheel mode' "$T/pos.log"; then
 	tap_ok "position actuation refuses a servo in wheel mode, saying so (exit $stop_rc)"

@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# e2e_demo.sh — `make demo DEMO_SECONDS=...` end to end: four robots in the
-# channel, one undulated each, headless with an LCM log; the summary names
-# every neighbouring pair with its final phase difference, separation and
-# state and the collisions per 10 s window; afterwards nothing is left behind
-# (no process, no pty link, no socket, no temporary directory) — also when
-# the demo is stopped early by SIGTERM.
+# e2e_demo.sh — `make demo DEMO_SECONDS=...` end to end, as a new user runs
+# it: the paper's contact-force scene (ten robots crowded in a row, one
+# undulated each), 20 s on the clock, then the oscillator, headless; the
+# summary says in words and numbers how the contact force and the collisions
+# changed, each pair's final phase difference against its bound, where the
+# run is kept and the exact command for the plots (run here: its plots must
+# draw data); afterwards nothing is left behind (no process, no pty link, no
+# socket, no temporary directory) — also when the demo is stopped early by
+# SIGTERM, and on a terminal stopped by Ctrl-C.
 source "$(dirname "$0")/../lib.sh"
 
 demo="$top/scripts/demo.sh"
@@ -25,19 +28,19 @@ leftovers() {
 	return 1
 }
 
-# ---- a short headless run ------------------------------------------------------
-seconds=20
+# ---- a headless run, as `make demo DEMO_SECONDS=45 DEMO_OUT=...` ----------------
+seconds=45
 spawn demo env BUILD="$BUILD" DEMO_SECONDS=$seconds DEMO_LCM_URL="$url" TMPDIR="$T/tmp" \
-	"$demo" --out "$T/out"
-if wait_log demo '^demo: scenario' 15; then
-	tap_ok "demo starts the simulator and four daemons"
+	DEMO_OUT="$T/out" "$demo"
+if wait_log demo '^demo: scenario' 40; then
+	tap_ok "demo starts the simulator and ten daemons"
 else
-	tap_fail "demo starts the simulator and four daemons" "$(tail -n 20 "$T/demo.log")"
+	tap_fail "demo starts the simulator and ten daemons" "$(tail -n 20 "$T/demo.log")"
 fi
-# While it runs: four robots publish on the demo's LCM URL.
+# While it runs: ten robots publish on the demo's LCM URL.
 n=$("$B/undulate-top" --lcm-url "$url" --once --json --wait 2 2>/dev/null |
-	grep -o '"name":"r[0-9]"' | sort -u | wc -l)
-if [ "$n" -eq 4 ]; then tap_ok "undulate-top sees the four robots live"; else tap_fail "undulate-top sees the four robots live" "saw $n"; fi
+	grep -o '"name":"r[0-9]*"' | sort -u | wc -l)
+if [ "$n" -eq 10 ]; then tap_ok "undulate-top sees the ten robots live"; else tap_fail "undulate-top sees the ten robots live" "saw $n"; fi
 
 wait_for $((seconds + 40)) bash -c "! kill -0 $pid_demo"
 kill -TERM "$pid_demo" 2>/dev/null  # only if it overran
@@ -46,34 +49,72 @@ rc=$?
 if [ "$rc" = 0 ]; then tap_ok "headless demo exits 0"; else tap_fail "headless demo exits 0" "exit $rc; $(tail -n 20 "$T/demo.log")"; fi
 
 out="$T/demo.log"
-if grep -q '^=== undulate demo summary: 4 robots' "$out"; then
+if grep -q '^=== undulate demo summary: 10 robots, 45 s, force10.scenario' "$out"; then
 	tap_ok "summary printed"
 else
 	tap_fail "summary printed" "$(tail -n 30 "$out")"
 fi
 # One row per neighbouring pair: name, state, final phase difference, d~, 2 asin(d~), collisions.
-pair_rows=$(awk '$1 ~ /^r[0-9]:r[0-9]$/ && $2 ~ /^(in-phase|compatible|anti-phase|still-colliding|no-data)$/ \
+pair_rows=$(awk '$1 ~ /^r[0-9]+:r[0-9]+$/ && $2 ~ /^(in-phase|compatible|anti-phase|still-colliding|no-data|not-oscillating|unlocked|locked-[a-z-]*)$/ \
 	&& $3 ~ /^-?[0-9.]+$/ && $4 ~ /^[0-9.]+$/' "$out" | awk '{ print $1 }' | tr '\n' ' ')
-if [ "$pair_rows" = "r1:r2 r2:r3 r3:r4 " ]; then
-	tap_ok "summary has the three neighbouring pairs with phase difference, d~ and state"
+if [ "$pair_rows" = "r1:r2 r2:r3 r3:r4 r4:r5 r5:r6 r6:r7 r7:r8 r8:r9 r9:r10 " ]; then
+	tap_ok "summary has the nine neighbouring pairs with phase difference, d~ and state"
 else
-	tap_fail "summary has the three neighbouring pairs with phase difference, d~ and state" "got '$pair_rows'; $(sed -n '/=== undulate/,$p' "$out")"
+	tap_fail "summary has the nine neighbouring pairs with phase difference, d~ and state" "got '$pair_rows'; $(sed -n '/=== undulate/,$p' "$out")"
 fi
 # Every pair's final phase difference is a real angle and its d~ comes from a
-# measured amplitude (channel4: d~ = 0.55 at 0.8 rad; the bases slide a little).
-bad=$(awk '$1 ~ /^r[0-9]:r[0-9]$/ && ($3 < -3.1416 || $3 > 3.1416 || $4 <= 0.05 || $4 > 2) { print }' "$out")
+# measured amplitude (force10: d~ = 0.4 at 0.8 rad).
+bad=$(awk '$1 ~ /^r[0-9]+:r[0-9]+$/ && $2 ~ /^(in-phase|compatible|anti-phase|still-colliding|no-data|not-oscillating|unlocked|locked-[a-z-]*)$/ \
+	&& ($3 < -3.1416 || $3 > 3.1416 || $4 <= 0.05 || $4 > 2) { print }' "$out")
 if [ -z "$bad" ]; then tap_ok "phase differences within (-pi, pi], d~ plausible"; else tap_fail "phase differences within (-pi, pi], d~ plausible" "$bad"; fi
 windows=$(awk '/^collisions per 10 s window:/ { on = 1; next } on && /collisions/ { n++ } END { print n + 0 }' "$out")
-if [ "$windows" -ge 2 ]; then
+if [ "$windows" -ge 4 ]; then
 	tap_ok "collision count per 10 s window ($windows windows)"
 else
 	tap_fail "collision count per 10 s window" "$(sed -n '/collisions per 10 s/,$p' "$out")"
 fi
-# The switch to OSCILLATOR happened (by one LCM command to every robot).
-if grep -qE '^switched sinusoid -> oscillator at t = [0-9.]+ s' "$out"; then
-	tap_ok "robots switched from SINUSOID to OSCILLATOR by LCM command"
+# The switch to OSCILLATOR happened (by one command to every robot), after
+# at least 15 s on the clock.
+sw=$(sed -n 's/^switched sinusoid -> oscillator at t = \([0-9.]*\) s$/\1/p' "$out")
+if [ -n "$sw" ] && awk -v s="$sw" 'BEGIN { exit !(s >= 15) }'; then
+	tap_ok "robots switched from SINUSOID to OSCILLATOR after $sw s on the clock"
 else
-	tap_fail "robots switched from SINUSOID to OSCILLATOR by LCM command" "$(grep -i switch "$out")"
+	tap_fail "robots switched from SINUSOID to OSCILLATOR after >= 15 s" "$(grep -i switch "$out")"
+fi
+# In words: the contact force's change, as a ratio, and the collisions.
+words=$(grep -E '^  The mean contact force (fell [0-9.]+x after the switch|fell to zero after the switch|did not fall): [0-9.]+ N on the sinusoid' "$out")
+ratio=$(echo "$words" | sed -n 's/.*fell \([0-9.]*\)x after.*/\1/p')
+if [ -n "$words" ] && grep -qE '^  Collisions between robots per 10 s: [0-9]+ -> [0-9]+; against the walls' "$out"; then
+	tap_ok "summary in words: ${words#  }"
+else
+	tap_fail "summary says in words how the contact force and collisions changed" "$(sed -n '/In words/,+4p' "$out")"
+fi
+# The paper's effect, as the README promises it for the demo: the force falls
+# 5x or more (e2e_force asserts 3x over a shorter run, docs/EXPERIMENTS.md has
+# the spread); a shortfall is a TODO with its number.
+if [ -n "$ratio" ] && awk -v r="$ratio" 'BEGIN { exit !(r >= 5) }' || echo "$words" | grep -q 'fell to zero'; then
+	tap_ok "the contact force falls 5x or more after the switch (${ratio:-to zero}x)"
+else
+	tap_todo "the contact force falls 5x or more after the switch" "${words:-no words}"
+fi
+if grep -qE '^  Neighbours at the end \(\|D\| against the compatibility bound 2 asin\(d~\)\): [0-9]+ of 9 at or within it' "$out"; then
+	tap_ok "summary: each pair's final |D| against its bound ($(grep -oE '[0-9]+ of 9 at or within' "$out"))"
+else
+	tap_fail "summary: each pair's final |D| against its bound" "$(sed -n '/In words/,+14p' "$out")"
+fi
+# Where the run is kept, and the next command, which works as printed.
+next=$(sed -n 's/^Next, the plots:  //p' "$out")
+if grep -qF "The run is kept in $T/out: demo.lcmlog" "$out" && [ "$next" = "$B/undulate-analyze $T/out/demo.lcmlog --out $T/out/plots --plots" ] &&
+	grep -qF "log: $T/out/demo.lcmlog" "$T/out/summary.txt"; then
+	tap_ok "summary ends with the kept folder and the next command; summary.txt names the kept log"
+else
+	tap_fail "summary ends with the kept folder and the next command" "$(tail -n 4 "$out"; head -2 "$T/out/summary.txt")"
+fi
+if [ -n "$next" ] && $next >"$T/next.out" 2>&1 && [ -f "$T/out/plots/angles.png" ] &&
+	n=$("$BUILD/tests/tools/pngdata" "$T/out/plots/angles.png" | sed -n 's/.*coloured=//p') && [ "${n:-0}" -ge 20000 ]; then
+	tap_ok "the next command draws the plots (angles.png: $n data pixels)"
+else
+	tap_fail "the next command draws the plots" "$(tail -n 5 "$T/next.out")"
 fi
 # The summary's numbers are the analyser's: compare with the kept summary.json.
 if [ -f "$T/out/summary.json" ] && [ -s "$T/out/demo.lcmlog" ] &&
@@ -82,14 +123,23 @@ if [ -f "$T/out/summary.json" ] && [ -s "$T/out/demo.lcmlog" ] &&
 else
 	tap_fail "--out keeps the LCM log and the analysis" "$(ls -la "$T/out" 2>&1)"
 fi
+# The theory is drawn for the run's own restitution, which the log carries
+# (SIM.WORLD): the channel scenario's r = 0.67, said to come from the simulator.
+if grep -q '^restitution for theory: 0.670 (the simulator.s, SIM.WORLD)' "$T/out/summary.txt"; then
+	tap_ok "the analysis takes the restitution from the simulator's SIM.WORLD"
+else
+	tap_fail "the analysis takes the restitution from the simulator's SIM.WORLD" "$(grep -i restitution "$T/out/summary.txt")"
+fi
 if why=$(leftovers); then tap_ok "nothing left behind after a full run"; else tap_fail "nothing left behind after a full run" "$why"; fi
 
 # ---- stopped early ---------------------------------------------------------------
 # SIGTERM (what `timeout`, a service manager or a closing terminal sends)
 # must stop every child and remove the links. (Ctrl-C in a terminal goes to
 # the whole foreground process group; a background job here ignores SIGINT.)
-spawn demo2 env BUILD="$BUILD" DEMO_SECONDS=60 DEMO_LCM_URL="$url" TMPDIR="$T/tmp" "$demo"
-if wait_log demo2 '^demo: phases' 15; then
+# (the four robots of the channel: what is tested is the stopping)
+spawn demo2 env BUILD="$BUILD" DEMO_SECONDS=60 DEMO_LCM_URL="$url" TMPDIR="$T/tmp" "$demo" \
+	--scenario "$top/sim-bridge/scenarios/channel4.scenario"
+if wait_log demo2 '^demo: phases' 40; then
 	links=$(find "$T/tmp" -type l | wc -l)
 	# (not $(stop ...): a subshell cannot wait for a child of this shell)
 	kill -TERM "$pid_demo2"
@@ -98,28 +148,51 @@ if wait_log demo2 '^demo: phases' 15; then
 	if [ "$links" -eq 4 ] && [ "$rc" = 143 ]; then
 		tap_ok "SIGTERM stops the demo (exit 143) after it made 4 pty links"
 	else
-		tap_fail "SIGTERM stops the demo (exit 143) after it made 4 pty links" "links $links, exit $rc"
+		tap_fail "SIGTERM stops the demo (exit 143) after it made 4 pty links" "links $links, exit $rc; its log: $(tail -n 12 "$T/demo2.log")"
 	fi
 	if why=$(leftovers); then tap_ok "nothing left behind after SIGTERM"; else tap_fail "nothing left behind after SIGTERM" "$why"; fi
 else
 	tap_fail "second demo starts" "$(tail -n 20 "$T/demo2.log")"
 fi
 
-# ---- interactive, on a terminal, stopped by Ctrl-C --------------------------------
+# ---- interactive, on a terminal: q, then Ctrl-C ------------------------------------
 # `script` gives the demo a pseudo-terminal: undulate-top runs in the
-# foreground, and the 0x03 written to the terminal is the user's Ctrl-C (the
-# line discipline turns it into SIGINT for the foreground process group).
+# foreground. q ends it and the demo summarizes and keeps the run; the 0x03
+# written to the terminal is the user's Ctrl-C (the line discipline turns it
+# into SIGINT for the foreground process group): everything stops at once.
+# The switch comes after 3 s here, not 20, to see both phases of the banner.
+clean() { tr -d '\r' <"$1" | sed 's/\x1b\[[0-9;?]*[A-Za-z]//g'; }
 if command -v script >/dev/null; then
-	( wait_for 15 grep -q 'r4 ' "$T/tty.out"; sleep 4; printf '\003'; sleep 5 ) |
-		env BUILD="$BUILD" DEMO_LCM_URL="$url" TMPDIR="$T/tmp" \
-		timeout 40 script -qec "$demo" /dev/null >"$T/tty.out" 2>&1
+	( wait_for 40 grep -q 'on the oscillator:' "$T/tty.out"; wait_for 10 grep -q 'r10 ' "$T/tty.out"; sleep 3
+	  printf 'q'; wait_for 60 grep -q 'Next, the plots' "$T/tty.out" ) |
+		env BUILD="$BUILD" DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/iout" \
+		timeout 120 script -qec "$demo --switch-at 3" /dev/null >"$T/tty.out" 2>&1
 	rc=$?
-	screen=$(tr -d '\r' <"$T/tty.out" | sed 's/\x1b\[[0-9;?]*[A-Za-z]//g')
-	rows=$(echo "$screen" | grep -cE '^. *[1-4] r[1-4] +(SIN|OSC)')
-	if [ "$rc" -ne 124 ] && echo "$screen" | grep -q 'OSC' && [ "$rows" -ge 4 ]; then
-		tap_ok "interactive: undulate-top shows the four robots, OSCILLATOR after the switch; Ctrl-C ends it"
+	screen=$(clean "$T/tty.out")
+	rows=$(echo "$screen" | grep -cE '^. *[0-9]+ r[0-9]+ +(SIN|OSC)')
+	if [ "$rc" = 0 ] && echo "$screen" | grep -q 'DEMO [0-9]*s | on the CLOCK (sinusoid) | oscillator in [0-9]*s' &&
+		echo "$screen" | grep -q 'DEMO [0-9]*s | on the oscillator: watch' && echo "$screen" | grep -q '^contact force, N per 5 s:' &&
+		[ "$rows" -ge 10 ]; then
+		tap_ok "interactive: the banner says what happens and when, the contact trend and the robots are shown"
 	else
-		tap_fail "interactive: undulate-top shows the four robots; Ctrl-C ends it" "exit $rc, robot rows $rows; $(echo "$screen" | tail -n 15)"
+		tap_fail "interactive: banner, contact trend and robots on the screen" "exit $rc, robot rows $rows; $(echo "$screen" | tail -n 25)"
+	fi
+	if echo "$screen" | grep -q '^=== undulate demo summary: 10 robots' && [ -s "$T/iout/demo.lcmlog" ] &&
+		[ -f "$T/iout/demo-summary.txt" ]; then
+		tap_ok "interactive: q stops the run, prints the summary and keeps the run in DEMO_OUT"
+	else
+		tap_fail "interactive: q prints the summary and keeps the run" "$(echo "$screen" | tail -n 15; ls "$T/iout" 2>&1)"
+	fi
+	if why=$(leftovers); then tap_ok "nothing left behind after q"; else tap_fail "nothing left behind after q" "$why"; fi
+
+	( wait_for 40 grep -q 'r4 ' "$T/tty2.out"; sleep 2; printf '\003'; sleep 5 ) |
+		env BUILD="$BUILD" DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/iout2" \
+		timeout 60 script -qec "$demo --scenario $top/sim-bridge/scenarios/channel4.scenario" /dev/null >"$T/tty2.out" 2>&1
+	rc=$?
+	if [ "$rc" = 130 ] && clean "$T/tty2.out" | grep -qE '^. *[0-9]+ r4 +SIN' && [ ! -e "$T/iout2" ]; then
+		tap_ok "interactive: Ctrl-C ends the demo at once (exit 130, nothing kept)"
+	else
+		tap_fail "interactive: Ctrl-C ends the demo" "exit $rc; $(clean "$T/tty2.out" | tail -n 10)"
 	fi
 	if why=$(leftovers); then tap_ok "nothing left behind after Ctrl-C"; else tap_fail "nothing left behind after Ctrl-C" "$why"; fi
 fi

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # e2e_force.sh — the paper's contact-force experiment, shortened: ten
-# two-joint robots crowded in a row (tests/scenarios/force10.scenario), one
+# two-joint robots crowded in a row (sim-bridge/scenarios/force10.scenario), one
 # undulated each, driven by the clock (SINUSOID) at random phases, then
 # switched to the limit-cycle OSCILLATOR by one LCM command to every robot
 # (UNDULATE.CMD). The paper's claim: contact forces collapse by orders of
@@ -20,7 +20,7 @@ min_ratio=10   # the paper: an order of magnitude or more
 min_fall=3     # the least fall docs/EXPERIMENTS.md records is 3.8x (2026-11-25)
 
 spawn force env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" \
-	--scenario "$top/tests/scenarios/force10.scenario" --seconds "$seconds" --switch-at "$switch_at" \
+	--scenario "$top/sim-bridge/scenarios/force10.scenario" --seconds "$seconds" --switch-at "$switch_at" \
 	--seed 3 --lcm-url "$(lcm_url $((7880 + $$ % 5)))" --out "$T/out"
 wait_for $((seconds + 60)) bash -c "! kill -0 $pid_force"
 kill -TERM "$pid_force" 2>/dev/null  # only if it overran

@@ -21,7 +21,7 @@
 # stop is a failure of its own).
 source "$(dirname "$0")/../lib.sh"
 
-scenario="$top/tests/scenarios/pair-rig.scenario"
+scenario="$top/sim-bridge/scenarios/pair-rig.scenario"
 seconds=${E2E_PAIR_SECONDS:-40}
 # Daemon settings for every run: torque actuation on the rig's current drive;
 # the daemon's single-joint torque defaults give ~0.8 rad at 0.80 Hz there.

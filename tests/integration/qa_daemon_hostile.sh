@@ -37,7 +37,7 @@ TEMPLATE=$(grep -E '^[0-9a-f]{40,}$' "$T/cap.log" | head -1)
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5 --return-delay 0
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
-spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" \
+spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator \
 	--set robot.commands=network --set robot.command_key="$KEY" \
 	--set joint.1.limit_min=-$LIM --set joint.1.limit_max=$LIM \
 	--set joint.2.limit_min=-$LIM --set joint.2.limit_max=$LIM

@@ -209,7 +209,7 @@ spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --seed 2 --r
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 QA_MALLOC_OUT="$T/watch.count" LD_PRELOAD="$T/shim.so" spawn watch "$D" --watch "$R" --lcm-url "$URL"
 # a short ramp: the oscillator takes over from the starter within ~1.5 s
-QA_MALLOC_OUT="$T/d.count" LD_PRELOAD="$T/shim.so" spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" \
+QA_MALLOC_OUT="$T/d.count" LD_PRELOAD="$T/shim.so" spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --mode oscillator \
 	--lcm-url "$URL" --set robot.ramp_s=0.3 --set robot.commands=network --set robot.command_key="$KEY"
 if wait_log d "ready: $R.STATE" 10 && wait_for 10 cycle_at_least 250; then
 	tap_ok "daemon runs OSCILLATOR against the simulator (shim preloaded)"

@@ -110,10 +110,15 @@ xfer "$(pkt 1 2 24 2)" 300 8
 tap_check "power on: torque and LED back to 0" test "$reply" = "$(status 1 0 0 0)"
 
 # ---- SIM.CMD over LCM ---------------------------------------------------------------
-"$B/undulate-sim" --cmd "fault r1 2 no-reply" --lcm-url "$URL"
+# The client prints the simulator's answer (SIM.REPLY) and exits by it.
+simcmd() { rc=0; "$B/undulate-sim" --cmd "$1" --lcm-url "$URL" >"$T/cmd.out" 2>"$T/cmd.err" || rc=$?; }
+simcmd "fault r1 2 no-reply"
+[ "$rc" = 0 ] && [ "$(cat "$T/cmd.out")" = "ok 1 servo(s): no-reply" ] \
+	&& tap_ok "--cmd prints the simulator's answer, exit 0" \
+	|| tap_fail "--cmd prints the simulator's answer, exit 0" "rc=$rc $(cat "$T/cmd.out" "$T/cmd.err")"
 silent2() { xfer $PING2 30; [ "$reply" = - ]; }
 if wait_for 3 silent2; then tap_ok "SIM.CMD fault applied"; else tap_fail "SIM.CMD fault applied" "$(tail -3 "$T/sim.log")"; fi
-"$B/undulate-sim" --cmd "clear r1 2" --lcm-url "$URL"
+simcmd "clear r1 2"
 answers2() { xfer $PING2 300 6; [ "$reply" = FFFF020200FB ]; }
 if wait_for 3 answers2; then tap_ok "SIM.CMD clear applied"; else tap_fail "SIM.CMD clear applied"; fi
 
@@ -145,7 +150,21 @@ long=$(printf 'x%.0s' $(seq 600))
 r=$(ctl "fault r1 1 $long")
 if [ "$(echo "$r" | head -1)" = "error: line too long" ] && [ "$(echo "$r" | wc -l)" = 1 ]; then tap_ok "an over-long line: one error"
 else tap_fail "an over-long line: one error" "$r"; fi
-"$B/undulate-sim" --cmd "explode now" --lcm-url "$URL"
+simcmd "explode now"
+[ "$rc" = 1 ] && grep -q "^error: unknown command 'explode'" "$T/cmd.out" \
+	&& tap_ok "--cmd refused by the simulator: its error, exit 1" \
+	|| tap_fail "--cmd refused by the simulator: its error, exit 1" "rc=$rc $(cat "$T/cmd.out" "$T/cmd.err")"
+simcmd help
+[ "$rc" = 0 ] && grep -q "^ok commands: fault BUS ID KIND" "$T/cmd.out" \
+	&& tap_ok "--cmd help lists the commands" || tap_fail "--cmd help lists the commands" "rc=$rc $(cat "$T/cmd.out")"
+simcmd "stats $(printf 'x%.0s' $(seq 300))"
+[ "$rc" = 2 ] && grep -q "longer than 255 bytes" "$T/cmd.err" \
+	&& tap_ok "--cmd longer than a command may be: refused before sending, exit 2" \
+	|| tap_fail "--cmd too long: exit 2" "rc=$rc $(cat "$T/cmd.out" "$T/cmd.err")"
+rc=0; "$B/undulate-sim" --cmd stats --lcm-url "$(lcm_url 7699)" >"$T/none.out" 2>"$T/none.err" || rc=$?
+[ "$rc" = 3 ] && grep -q "no simulator answered on udpm://.*:$(lcm_port 7699)" "$T/none.err" \
+	&& tap_ok "--cmd with nobody listening: says so, exit 3" \
+	|| tap_fail "--cmd with nobody listening: says so, exit 3" "rc=$rc $(cat "$T/none.out" "$T/none.err")"
 counted() { ctl stats | grep -q 'bad_commands=9'; }
 if wait_for 3 counted; then tap_ok "bad commands counted (control socket and SIM.CMD)"; else tap_fail "bad commands counted" "$(ctl stats)"; fi
 tap_check "sim still running" alive sim

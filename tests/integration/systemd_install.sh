@@ -55,8 +55,14 @@ for s in "$top"/sim-bridge/scenarios/*.scenario; do
 	[ -f "$s" ] || continue
 	cmp -s "$s" "$R$P/share/undulate/scenarios/$(basename "$s")" || missing+=("scenario $(basename "$s")")
 done
+# the documents installed files point at (the example config: the daemon's README)
+for d in README.md daemon/README.md daemon/CONTROL.md sim-bridge/README.md docs/EXPERIMENTS.md; do
+	cmp -s "$top/$d" "$R$P/share/doc/undulate/$d" || missing+=("doc $d")
+done
+grep -q "share/doc/undulate/daemon/README.md" "$R/etc/undulate/undulated.conf.example" 2>/dev/null ||
+	missing+=("the example config's pointer to the installed daemon README")
 if [ ${#missing[@]} -eq 0 ]; then
-	tap_ok "installed tree: programs, units, udev rules, sysusers, man pages, scenarios"
+	tap_ok "installed tree: programs, units, udev rules, sysusers, man pages, scenarios, documentation"
 else
 	tap_fail "installed tree complete" "missing or different: ${missing[*]}"
 fi

@@ -77,6 +77,7 @@ cat >"$T/sysd1.conf" <<EOF
 name = sysd1
 port = $T/bus
 ids = 1,2
+mode = oscillator
 lcm_url = $URL
 EOF
 start_daemon() {

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # e2e_antiphase_sweep.sh (make test-long) — where does anti-phase appear as the
-# pair rig's separation grows? The pair rig (tests/scenarios/pair-rig.scenario,
+# pair rig's separation grows? The pair rig (sim-bridge/scenarios/pair-rig.scenario,
 # r = 0.67, immobile, joints driven by torque as on the paper's rig) through
 # the real daemons, started from a phase difference of pi at d~ = 0.1 .. 0.9,
 # each run analysed with undulate-analyze.
@@ -40,7 +40,7 @@ k=0
 for sep in "${seps[@]}"; do
 	name="sep$sep"
 	names+=("$name")
-	spawn "$name" env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --scenario "$top/tests/scenarios/pair-rig.scenario" \
+	spawn "$name" env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --scenario "$top/sim-bridge/scenarios/pair-rig.scenario" \
 		--seconds "$seconds" --switch-at 3 --seed 5 --phases 0,3.1416 --set "world.separation=$sep" \
 		--lcm-url "$(lcm_url $((port + k % parallel)))" --out "$T/$name" ${rig[@]+"${rig[@]}"}
 	wait_log "$name" '^demo: phases' 20 || true

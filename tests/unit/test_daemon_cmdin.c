@@ -126,6 +126,7 @@ static void make_cfg(struct cfg *c)
 	assert_true(cfg_override(c, "robot.name=robot1", &e));
 	assert_true(cfg_override(c, "robot.port=/dev/null", &e));
 	assert_true(cfg_override(c, "robot.ids=1,2", &e));
+	assert_true(cfg_override(c, "robot.mode=oscillator", &e)); /* running: commands change it */
 	assert_true(cfg_override(c, run_dir, &e));
 	assert_true(cfg_override(c, "robot.lcm_url=udpm://239.255.76.67:7667?ttl=0", &e));
 	assert_true(cfg_finish(c, &e));

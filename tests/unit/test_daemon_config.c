@@ -119,7 +119,7 @@ static void test_defaults_from_osc(void **state)
 	assert_double_equal(c.joint[0].osc.lambda, d0.lambda, 1e-12);
 	assert_double_equal(c.joint[1].osc.lambda, d1.lambda, 1e-12);
 	assert_double_equal(c.joint[1].osc.mu, d1.mu, 1e-12);
-	assert_int_equal(c.mode, CFG_MODE_OSCILLATOR);
+	assert_int_equal(c.mode, CFG_MODE_HOLD);                  /* no mode given: hold */
 	assert_int_equal(c.safe_stop, CFG_SAFE_HOLD);
 	assert_int_equal(c.commands, CFG_CMD_LOCAL);
 	assert_true(c.joint[0].limit_min < 0 && c.joint[0].limit_max > 0);
@@ -425,15 +425,20 @@ static void test_overrides(void **state)
 static void test_command_line_only(void **state)
 {
 	(void)state;
-	/* undulated --port PATH --ids 1,2: one robot, defaults, OSCILLATOR */
+	/* undulated --port PATH --ids 1,2: one robot, defaults; no mode given:
+	 * HOLD, the first-run default (nothing swings before it is asked to) */
 	struct cfg c;
 	struct cfg_errors e = { 0 };
 	cfg_defaults(&c);
 	assert_true(cfg_override(&c, "robot.port=/dev/pts/9", &e));
 	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
 	assert_true(cfg_finish(&c, &e));
-	assert_int_equal(c.mode, CFG_MODE_OSCILLATOR);
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+	assert_false(c.mode_given);
 	assert_int_equal(c.njoints, 2);
+	assert_true(cfg_override(&c, "robot.mode=oscillator", &e));
+	assert_int_equal(c.mode, CFG_MODE_OSCILLATOR);
+	assert_true(c.mode_given);
 }
 
 /* A refused ID list leaves the configured one as it was (it was half

@@ -528,15 +528,98 @@ static void test_dxl_no_reply_suggests_baud(void **state)
 	assert_non_null(strstr(f->err, "at 57600 bps; wrong baud"));
 }
 
+/* Every command reports a servo's error bits (names, not just a number) and
+ * exits 5, after doing its work; the write whose reply carries them too (its
+ * bits were once read before the call that filled them). */
 static void test_dxl_errbits_exit_code(void **state)
 {
 	struct fixture *f = *state;
+	struct {
+		const char *what;
+		char *argv[6];
+	} cmds[] = {
+		{ "read", { "read", "2", "present_load", NULL } },
+		{ "write", { "write", "2", "goal_position", "600", NULL } },
+		{ "ping", { "ping", "2", NULL } },
+		{ "scan", { "scan", "--ids", "1-2", NULL } },
+		{ "dump", { "dump", "2", NULL } },
+		{ "setup", { "setup", "2", NULL } },
+		{ "torque", { "torque", "2", "on", NULL } },
+		{ "set-baud", { "set-baud", "2", "1000000", NULL } },
+		{ "set-id", { "set-id", "2", "3", NULL } },
+	};
 
 	servo_by_id(f, 2)->errbits = DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT;
-	assert_int_equal(run_dxl(f, "read", "2", "present_load", NULL), DXLT_EXIT_SERVO);
+	for (size_t i = 0; i < sizeof cmds / sizeof cmds[0]; i++) {
+		char **a = cmds[i].argv;
+		int rc = run_dxl(f, a[0], a[1], a[2], a[3], a[4]);
+		if (rc != DXLT_EXIT_SERVO || strstr(f->err, "reports error bits 0x24: ") == NULL ||
+		    strstr(f->err, "overload") == NULL || strstr(f->err, "overheating") == NULL)
+			fail_msg("%s: exit %d, stderr '%s'", cmds[i].what, rc, f->err);
+	}
+	/* ...and did their work all the same */
+	assert_int_equal(dxl_get_u16(&servo_by_id(f, 3)->mem[DXL_AX_GOAL_POSITION]), 600);
+	assert_int_equal(servo_by_id(f, 3)->mem[DXL_AX_TORQUE_ENABLE], 1);
+	assert_int_equal(run_dxl(f, "read", "3", "present_load", NULL), DXLT_EXIT_SERVO);
 	assert_string_equal(f->out, "0\n"); /* the value still comes out */
-	assert_non_null(strstr(f->err, "ID 2 reports error bits 0x24"));
-	assert_non_null(strstr(f->err, "overload"));
+	assert_int_equal(run_dxl(f, "reset", "3", "--yes", NULL), DXLT_EXIT_SERVO);
+	/* the other servo is healthy: no bits, exit 0 */
+	assert_int_equal(run_dxl(f, "read", "1", "present_load", NULL), 0);
+	assert_string_equal(f->err, "");
+}
+
+/* A refused EEPROM write names the remedy, not only the bit. */
+static void test_dxl_errbits_hint(void **state)
+{
+	struct fixture *f = *state;
+
+	servo_by_id(f, 1)->errbits = DXL_ERRBIT_RANGE;
+	assert_int_equal(run_dxl(f, "write", "1", "cw_angle_limit", "100", NULL), DXLT_EXIT_SERVO);
+	assert_non_null(strstr(f->err, "error bits 0x08: range"));
+	assert_non_null(strstr(f->err, "torque 1 off"));
+	servo_by_id(f, 1)->errbits = DXL_ERRBIT_ANGLE_LIMIT;
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "1000", NULL), DXLT_EXIT_SERVO);
+	assert_non_null(strstr(f->err, "angle limits"));
+}
+
+/* The servo's status return level decides what it answers: a write that took
+ * effect is not "no reply". Level 1 is read back; level 0 is said unconfirmed. */
+static void test_dxl_follows_status_level(void **state)
+{
+	struct fixture *f = *state;
+
+	servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL] = 1;
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "700", NULL), 0);
+	assert_int_equal(dxl_get_u16(&servo_by_id(f, 1)->mem[DXL_AX_GOAL_POSITION]), 700);
+	assert_non_null(strstr(f->out, "read back"));
+	assert_int_equal(run_dxl(f, "torque", "1", "on", NULL), 0);
+	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_TORQUE_ENABLE], 1);
+
+	servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL] = 0;
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "300", NULL), 0);
+	assert_int_equal(dxl_get_u16(&servo_by_id(f, 1)->mem[DXL_AX_GOAL_POSITION]), 300);
+	assert_non_null(strstr(f->out, "not confirmed"));
+	assert_int_equal(run_dxl(f, "read", "1", "goal_position", NULL), DXLT_EXIT_BUS);
+	assert_non_null(strstr(f->err, "answers PING but not READ: status return level 0"));
+	assert_int_equal(run_dxl(f, "ping", "1", NULL), 0);
+	assert_non_null(strstr(f->out, "PING only"));
+	/* raising the level back from 0, then writing with replies again */
+	assert_int_equal(run_dxl(f, "write", "1", "status_return_level", "2", NULL), 0);
+	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL], 2);
+	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "400", NULL), 0);
+	assert_string_equal(f->out, "");
+	/* ID and baud go through set-id / set-baud, which look for the answer
+	 * where the servo went */
+	assert_int_equal(run_dxl(f, "write", "1", "id", "6", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(strstr(f->err, "set-id OLD NEW"));
+	assert_int_equal(run_dxl(f, "write", "1", "baud_rate", "34", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(servo_by_id(f, 1));
+	/* setup lowering the level: no false "no reply" (the write is read back) */
+	assert_int_equal(run_dxl(f, "setup", "1", "--status-level", "1", "--yes", NULL), 0);
+	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL], 1);
+	/* a servo absent at any level is still "no reply" */
+	assert_int_equal(run_dxl(f, "write", "4", "goal_position", "400", NULL), DXLT_EXIT_BUS);
+	assert_non_null(strstr(f->err, "no reply from ID 4"));
 }
 
 static void test_dxl_set_id(void **state)
@@ -596,11 +679,14 @@ static void test_dxl_setup(void **state)
 	servo_by_id(f, 1)->mem[DXL_AX_TORQUE_ENABLE] = 1;
 	assert_int_equal(run_dxl(f, "setup", "1", "2", NULL), DXLT_EXIT_REFUSED);
 	assert_non_null(strstr(f->err, "ID 1 has torque on"));
+	assert_non_null(strstr(f->err, "add --yes to turn it off first"));
+	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_TORQUE_ENABLE], 1);
 	assert_int_equal(servo_by_id(f, 2)->mem[DXL_AX_RETURN_DELAY_TIME], 0);
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_RETURN_DELAY_TIME], 250);
-	servo_by_id(f, 1)->mem[DXL_AX_TORQUE_ENABLE] = 0;
 	servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL] = 1;
-	assert_int_equal(run_dxl(f, "setup", "1", "2", NULL), 0);
+	assert_int_equal(run_dxl(f, "setup", "1", "2", "--yes", NULL), 0);
+	assert_non_null(strstr(f->out, "ID 1: torque turned off (--yes)"));
+	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_TORQUE_ENABLE], 0);
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_RETURN_DELAY_TIME], 0);
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL], 2);
 	assert_non_null(strstr(f->out, "adapter: "));
@@ -749,6 +835,8 @@ int main(int argc, char **argv)
 		cmocka_unit_test_setup_teardown(test_dxl_write_validates_first, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_dxl_no_reply_suggests_baud, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_dxl_errbits_exit_code, setup, teardown),
+		cmocka_unit_test_setup_teardown(test_dxl_errbits_hint, setup, teardown),
+		cmocka_unit_test_setup_teardown(test_dxl_follows_status_level, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_dxl_set_id, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_dxl_set_baud_then_scan, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_dxl_torque_reset_dump, setup, teardown),

@@ -35,6 +35,17 @@ static void feed_state(const char *name, double now, double ph0, double ph1, dou
 	top_on_state(&model, &s, now);
 }
 
+/* The model as --json prints it. */
+static const char *json_of(double now)
+{
+	static char buf[65536];
+	FILE *f = fmemopen(buf, sizeof(buf), "w");
+	assert_non_null(f);
+	top_json(&model, now, 1234, f);
+	fclose(f);
+	return buf;
+}
+
 static int setup(void **state)
 {
 	(void)state;
@@ -247,10 +258,7 @@ static void test_json(void **state)
 	(void)state;
 	feed_state("r\"1", 0, 0.25, -1.0, 10, 2);
 	feed_state("r2", 0, 0.75, -1.0, 10, 3);
-	static char buf[65536];
-	FILE *f = fmemopen(buf, sizeof(buf), "w");
-	top_json(&model, 0.1, 1234, f);
-	fclose(f);
+	const char *buf = json_of(0.1);
 	assert_non_null(strstr(buf, "\"name\":\"r\\\"1\""));
 	assert_non_null(strstr(buf, "\"mode\":\"SINUSOID\""));
 	assert_non_null(strstr(buf, "\"dphase\":0.5"));
@@ -276,10 +284,7 @@ static void test_json_hostile_text(void **state)
 	char kind[] = "fault", text[] = "line1\nline2 \xff end";
 	undulate_event_t e = { .utime = 1, .robot = n, .seq = 1, .level = 1, .kind = kind, .text = text };
 	top_on_event(&model, &e);
-	static char buf[65536];
-	FILE *f = fmemopen(buf, sizeof(buf), "w");
-	top_json(&model, 0.1, 1234, f);
-	fclose(f);
+	const char *buf = json_of(0.1);
 	assert_non_null(strstr(buf, "\"last_event\":\"fault: line1\\u000aline2 \\ufffd end\""));
 	assert_non_null(strstr(buf, "aaa\\ufffd\\ufffd\",\"fault\":\"\",\"utime\""));
 	assert_non_null(strstr(buf, "\"angle\":null,\"speed\":null"));
@@ -326,16 +331,63 @@ static void test_drive_column(void **state)
 	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
 	assert_non_null(strstr(screen, "d+0.124"));
 	assert_null(strstr(screen, "nan"));
-	static char buf[65536];
-	FILE *f = fmemopen(buf, sizeof(buf), "w");
-	top_json(&model, 0.1, 1234, f);
-	fclose(f);
-	assert_non_null(strstr(buf, "\"goal\":null,\"drive\":0.124"));
+	assert_non_null(strstr(json_of(0.1), "\"goal\":null,\"drive\":0.124"));
+}
+
+/* A dead servo is shown as such: its frozen angle and speed are not shown as
+ * live values; error bits are named; temperature and voltage are shown. */
+static void test_joint_health(void **state)
+{
+	(void)state;
+	char n[] = "r1", reason[] = "test";
+	undulate_joint_state_t j[2] = {
+		{ .servo_id = 1, .angle = 0.4321, .speed = 1.2345, .amplitude = 0.8, .frequency = 0.8,
+		  .temperature = 41, .voltage = 11.8, .error_bits = 0x24 },
+		{ .servo_id = 2, .angle = 0.6789, .speed = -2.3456, .amplitude = 0.8, .frequency = 0.8,
+		  .temperature = 33, .voltage = 11.9, .stale_cycles = 37 },
+	};
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason, .fault = "",
+		.period_us = 10000.0, .njoints = 2, .joints = j };
+	top_on_state(&model, &s, 0.0);
+	struct top_view v = { .kind = TOP_VIEW_DETAIL };
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "+0.432"));        /* joint 1 is live */
+	assert_null(strstr(screen, "+0.679"));            /* joint 2 is frozen: not shown */
+	assert_null(strstr(screen, "-2.346"));
+	assert_non_null(strstr(screen, "SILENT x37"));
+	assert_non_null(strstr(screen, "1 joint SILENT"));
+	assert_true(isnan(top_robot_dphase_joints(&model.robots[0]))); /* j1's phase is frozen */
+	assert_non_null(strstr(screen, " 41C 11.8V"));
+	/* the status column ends the line: whole on a wider terminal */
+	top_render(&model, &v, 0.1, 24, 100, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "41C 11.8V overheating|overload"));
+	const char *js = json_of(0.1);
+	assert_non_null(strstr(js, "\"status\":\"SILENT x37\""));
+	assert_non_null(strstr(js, "\"temperature\":41"));
+	/* compact view: an S marks the robot */
+	v.kind = TOP_VIEW_COMPACT;
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, ">S 1 r1"));
+}
+
+/* Nobody heard: the screen says which URL it listens on; ? shows the legend. */
+static void test_empty_and_help(void **state)
+{
+	(void)state;
+	struct top_view v = { .kind = TOP_VIEW_AUTO, .url = "udpm://239.255.76.67:7667?ttl=0" };
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "no robot heard yet on udpm://239.255.76.67:7667?ttl=0"));
+	v.help = true;
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "jit99   99th percentile"));
+	assert_non_null(strstr(screen, "m then l/h/s/o"));
 }
 
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test_setup(test_joint_health, setup),
+		cmocka_unit_test_setup(test_empty_and_help, setup),
 		cmocka_unit_test_setup(test_rate_jitter_stale, setup),
 		cmocka_unit_test_setup(test_drive_column, setup),
 		cmocka_unit_test_setup(test_unknown_phase, setup),

@@ -156,7 +156,8 @@ static int wait_exit(struct child *c)
 	return -1;
 }
 
-static void check_session(const char *key, int sig)
+/* KEY (or signal SIG) ends the session; the program exits with WANT. */
+static void check_session(const char *key, int sig, int want)
 {
 	struct child *c = calloc(1, sizeof(*c));
 	start(c, "--read-only");
@@ -173,7 +174,7 @@ static void check_session(const char *key, int sig)
 	else
 		kill(c->pid, sig);
 	assert_true(read_until(c, "\033[?1049l")); /* alternate screen left */
-	assert_int_equal(wait_exit(c), 0);
+	assert_int_equal(wait_exit(c), want);
 	/* the terminal is back in cooked mode, as a fresh pty starts */
 	struct termios after;
 	assert_int_equal(tcgetattr(c->master, &after), 0);
@@ -186,19 +187,24 @@ static void check_session(const char *key, int sig)
 static void test_quit_key(void **state)
 {
 	(void)state;
-	check_session("q", 0);
+	check_session("q", 0, 0);
 }
 
 static void test_ctrl_c(void **state)
 {
 	(void)state;
-	check_session("\003", 0);
+	/* an interrupt, not a plain quit: 130, as a shell reports SIGINT (the
+	 * terminal is raw, so Ctrl-C is a key here and the demo learns of it
+	 * only from this status) */
+	check_session("\003", 0, 130);
+	/* also from the legend (it used to close the legend only) */
+	check_session("?\003", 0, 130);
 }
 
 static void test_sigterm(void **state)
 {
 	(void)state;
-	check_session(NULL, SIGTERM);
+	check_session(NULL, SIGTERM, 0);
 }
 
 /* ---- keys send commands, answers are shown ----------------------------------- */
@@ -243,15 +249,35 @@ static void robot_close(void)
 	robot_fd = -1;
 }
 
-/* Collects what arrives on the robot's socket within T_TIMEOUT_MS (or until want). */
-static void robot_receive(int want)
+/* The program under test, whose screen output is drained while the robot
+ * waits: a program that draws ten times a second blocks in write() once the
+ * terminal's buffer is full, and then reads no key. */
+static struct child *draining;
+
+static void drain(void)
+{
+	if (draining == NULL)
+		return;
+	for (;;) {
+		ssize_t n = read(draining->master, draining->out + draining->len, T_OUT - 1 - draining->len);
+		if (n <= 0)
+			return;
+		draining->len += (size_t)n;
+		if (draining->len >= T_OUT - 1)
+			draining->len = 0;
+	}
+}
+
+/* Collects what arrives on the robot's socket within MS (or until want). */
+static void robot_receive_ms(int want, long ms)
 {
 	struct timespec t0, t;
 	clock_gettime(CLOCK_MONOTONIC, &t0);
 	while (ngot < want) {
 		clock_gettime(CLOCK_MONOTONIC, &t);
-		if ((t.tv_sec - t0.tv_sec) * 1000 + (t.tv_nsec - t0.tv_nsec) / 1000000 > T_TIMEOUT_MS)
+		if ((t.tv_sec - t0.tv_sec) * 1000 + (t.tv_nsec - t0.tv_nsec) / 1000000 > ms)
 			return;
+		drain();
 		struct pollfd p = { .fd = robot_fd, .events = POLLIN };
 		if (poll(&p, 1, 20) <= 0)
 			continue;
@@ -272,6 +298,11 @@ static void robot_receive(int want)
 	}
 }
 
+static void robot_receive(int want)
+{
+	robot_receive_ms(want, T_TIMEOUT_MS);
+}
+
 /* What robot "r1" publishes: a STATE in OSCILLATOR and its PARAMS. */
 static void publish_robot(lcm_t *lcm)
 {
@@ -286,12 +317,47 @@ static void publish_robot(lcm_t *lcm)
 	undulate_osc_params_t_publish(lcm, "r1.PARAMS", &p);
 }
 
+/* The robot's answer to command SEQ, on the socket back to the sender (and,
+ * with LCM, also on its EVENT channel, as a daemon sends it). */
+static void answer(lcm_t *lcm, int64_t seq, const char *kind_text, const char *what)
+{
+	char name[] = "r1", kind[40], text[120];
+	snprintf(kind, sizeof kind, "%s", kind_text);
+	snprintf(text, sizeof text, "%s", what);
+	undulate_event_t e = { .robot = name, .seq = seq, .level = 0, .kind = kind, .text = text };
+	uint8_t ev[512];
+	int n = undulate_event_t_encode(ev, 0, sizeof ev, &e);
+	assert_true(n > 0);
+	if (lcm != NULL)
+		undulate_event_t_publish(lcm, "r1.EVENT", &e);
+	assert_true(csock_reply(robot_fd, &last_peer, ev, (size_t)n));
+}
+
 /* Presses KEYS, then collects the commands that arrive at the robot's socket. */
 static int press(struct child *c, const char *keys, int want)
 {
 	int before = ngot;
+	draining = c;
 	assert_int_equal(write(c->master, keys, strlen(keys)), (ssize_t)strlen(keys));
 	robot_receive(before + want);
+	draining = NULL;
+	return ngot - before;
+}
+
+/* Presses KEYS that must send nothing: then three `v` (the view goes round
+ * to auto again), whose "view: auto" on the screen shows every key before
+ * was read; a command those keys sent would have been sent by then. */
+static int press_none(struct child *c, const char *keys)
+{
+	int before = ngot;
+	char buf[64];
+	snprintf(buf, sizeof buf, "%svvv", keys);
+	c->len = 0;
+	assert_int_equal(write(c->master, buf, strlen(buf)), (ssize_t)strlen(buf));
+	assert_true(read_until(c, "view: auto"));
+	draining = c;
+	robot_receive_ms(before + 1, 100); /* what was sent is queued by now */
+	draining = NULL;
 	return ngot - before;
 }
 
@@ -314,16 +380,39 @@ static void test_commands_and_answer(void **state)
 		seen = read_until_ms(c, "r1 ", 50);
 	}
 	assert_true(seen);
-	/* o: OSCILLATOR for the selected robot, to its local socket */
+	/* navigating as vi does (h j k l), and the old one-key mode letters,
+	 * send nothing: a mode change takes two keys */
+	assert_int_equal(press_none(c, "hjkllhsoLHSO"), 0);
+	/* ?: the legend, then any key back */
+	c->len = 0;
+	assert_int_equal(write(c->master, "?", 1), 1);
+	assert_true(read_until(c, "SILENT xN"));
+	assert_int_equal(press_none(c, "x"), 0);
+	/* m o: OSCILLATOR for the selected robot, to its local socket */
+	c->len = 0;
+	assert_int_equal(write(c->master, "m", 1), 1);
+	assert_true(read_until(c, "mode for the selected robot"));
 	assert_int_equal(press(c, "o", 1), 1);
 	assert_string_equal(got_robot[0], "r1");
 	assert_int_equal(got[0].kind, UNDULATE_COMMAND_T_KIND_MODE);
 	assert_int_equal(got[0].mode, UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR);
-	/* L: LIMP for all robots: every robot's socket on this LCM network */
-	assert_int_equal(press(c, "L", 1), 1);
+	/* M l: LIMP for all robots: every robot's socket on this LCM network;
+	 * the status line counts the answers */
+	c->len = 0;
+	assert_int_equal(press(c, "Ml", 1), 1);
 	assert_string_equal(got_robot[1], "*");
 	assert_int_equal(got[1].mode, UNDULATE_ROBOT_STATE_T_MODE_LIMP);
 	assert_true(got[1].seq > got[0].seq);
+	assert_true(read_until(c, "all robots mode LIMP: 0 of 1 accepted"));
+	/* a robot answers twice, on its EVENT channel and on the socket: one
+	 * robot, one answer */
+	c->len = 0;
+	answer(lcm, got[1].seq, "command-accepted", "mode LIMP");
+	assert_true(read_until(c, "all robots mode LIMP: 1 of 1 accepted"));
+	read_until_ms(c, "2 of 1", 500);
+	assert_null(strstr(c->out, "2 of 1"));
+	/* m then a key that names no mode: cancelled, nothing sent */
+	assert_int_equal(press_none(c, "mx"), 0);
 	/* +: c of each joint up 10 % */
 	assert_int_equal(press(c, "+", 2), 2);
 	assert_string_equal(got_param[2], "c");
@@ -332,13 +421,8 @@ static void test_commands_and_answer(void **state)
 	assert_true(got[2].value > 0.02199 && got[2].value < 0.02201);
 	assert_true(got[3].value > 0.04399 && got[3].value < 0.04401);
 	/* the robot's answer, on the socket back to the sender, appears in the status line */
-	char name[] = "r1", kind[] = "command-rejected", text[] = "mode OSCILLATOR refused: torque off";
-	undulate_event_t e = { .robot = name, .seq = got[3].seq, .level = 1, .kind = kind, .text = text };
-	uint8_t ev[512];
-	int n = undulate_event_t_encode(ev, 0, sizeof ev, &e);
-	assert_true(n > 0);
 	c->len = 0;
-	assert_true(csock_reply(robot_fd, &last_peer, ev, (size_t)n));
+	answer(NULL, got[3].seq, "command-rejected", "mode OSCILLATOR refused: torque off");
 	assert_true(read_until(c, "command-rejected: mode OSCILLATOR refused"));
 	assert_int_equal(nlcm, 0);   /* and nothing went out on LCM */
 	robot_close();
@@ -370,7 +454,7 @@ static void test_read_only_sends_nothing(void **state)
 	}
 	assert_true(seen);
 	c->len = 0;
-	assert_int_equal(write(c->master, "oL+", 3), 3);
+	assert_int_equal(write(c->master, "moMl+", 5), 5);
 	assert_true(read_until(c, "read-only: commands are disabled"));
 	for (int i = 0; i < 10; i++)
 		lcm_handle_timeout(lcm, 20);

@@ -10,6 +10,7 @@
 #include "alog.h"
 #include "json.h"
 #include "phase.h"
+#include "modes.h"
 #include "plot.h"
 #include "theory.h"
 #include "window.h"
@@ -20,6 +21,7 @@
 #include "undulate_robot_state_t.h"
 #include "undulate_sim_collision_t.h"
 #include "undulate_sim_truth_t.h"
+#include "undulate_sim_world_t.h"
 
 #include <errno.h>
 #include <math.h>
@@ -39,6 +41,12 @@
 #define AN_COLL_DEDUP 64
 /* Collision-rate bin (s). */
 #define AN_RATE_BIN_S 1.0
+/* Mode switches marked on the plots; switches of several robots within
+ * AN_SWITCH_MERGE_S of the first are one (a command to all robots). */
+#define AN_MAX_SWITCHES 16
+/* r of the paper's pair rig (theory.md), for logs that do not say theirs. */
+#define AN_DEFAULT_RESTITUTION 0.67
+#define AN_SWITCH_MERGE_S 0.5
 /* Classification thresholds (rad). The mean phase difference of a pair
  * in step stays within a few degrees; in anti-phase within ~0.3 rad of pi in
  * the paper's runs; a spread above AN_SPREAD_MAX means "not locked". */
@@ -80,6 +88,8 @@ struct an_robot {
 	double neutral;     /* m, last seen */
 	double lever;       /* m/rad, NAN until estimated */
 	int contact_joint;  /* joint the contact body is on; 0 without a simulator */
+	bool seen_mode;     /* mode: its last published mode, once seen */
+	int mode;
 };
 
 enum an_pair_kind { AN_PAIR_NEIGHBOUR, AN_PAIR_USER, AN_PAIR_JOINTS };
@@ -89,7 +99,7 @@ struct an_pair {
 	int a, b, ja, jb;
 	char name[2 * AN_NAME_MAX + 8];
 	struct win_circ win;
-	int64_t rows, collisions, win_collisions, contacts;
+	int64_t rows, finite_rows, collisions, win_collisions, contacts;
 	double impulse;
 	double last_coll_t;   /* s, NAN before the first */
 	double *deltas;       /* phase difference just before each collision */
@@ -133,9 +143,21 @@ struct an_ctx {
 	FILE *states, *coll, *bus, *evt, *pdiff, *params;
 	struct an_seen seen[AN_COLL_DEDUP];
 	int seen_next;
-	int64_t *bins;
+	int64_t *bins, *bin_walls;
 	double *bin_impulse;
+	/* SIM.TRUTH's running total impulse (impacts and resting contact) and
+	 * its time, last seen in each bin: its rate is the mean contact force */
+	double *bin_total, *bin_total_t;
 	int64_t nbins;
+	/* the theory's restitution, and where it came from */
+	double restitution;
+	const char *restitution_from;
+	bool have_force;            /* a contact force was written to collision_rate.csv */
+	double world_restitution;   /* from SIM.WORLD; NAN without */
+	/* mode switches (any robot's published mode changing), for the plots */
+	double switch_t[AN_MAX_SWITCHES];
+	int switch_mode[AN_MAX_SWITCHES];
+	int nswitches;
 };
 
 void an_options_default(struct an_options *o)
@@ -146,7 +168,7 @@ void an_options_default(struct an_options *o)
 	o->to_s = NAN;
 	o->window_s = 10.0;
 	o->separation = NAN;
-	o->restitution = 0.67;
+	o->restitution = NAN;
 	o->merge_s = 0.1;
 	o->min_swing = AN_MIN_SWING_DEFAULT;
 	o->msg = stderr;
@@ -188,7 +210,7 @@ static int an_robot_find(struct an_ctx *c, const char *name, bool add)
 	return c->nrobots++;
 }
 
-enum an_chan { CH_UNKNOWN, CH_STATE, CH_BUS, CH_EVENT, CH_PARAMS, CH_CMD, CH_TRUTH, CH_COLLISION, CH_SIMCMD };
+enum an_chan { CH_UNKNOWN, CH_STATE, CH_BUS, CH_EVENT, CH_PARAMS, CH_CMD, CH_TRUTH, CH_COLLISION, CH_SIMCMD, CH_WORLD };
 
 static bool an_ends_with(const char *s, const char *suffix)
 {
@@ -204,6 +226,8 @@ static enum an_chan an_channel(const char *ch)
 		return CH_COLLISION;
 	if (strcmp(ch, "SIM.CMD") == 0)
 		return CH_SIMCMD;
+	if (strcmp(ch, "SIM.WORLD") == 0)
+		return CH_WORLD;
 	if (an_ends_with(ch, ".STATE"))
 		return CH_STATE;
 	if (an_ends_with(ch, ".BUS"))
@@ -357,6 +381,17 @@ static void an_scan_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
 	case CH_COLLISION:
 		c->collision_msgs++;
 		break;
+	case CH_WORLD: {
+		undulate_sim_world_t m;
+		if (undulate_sim_world_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
+			an_decode_failed(c, ev->channel);
+			return;
+		}
+		if (m.restitution >= 0 && m.restitution <= 1)
+			c->world_restitution = m.restitution;
+		undulate_sim_world_t_decode_cleanup(&m);
+		break;
+	}
 	case CH_UNKNOWN:
 		c->unknown_channels++;
 		break;
@@ -541,6 +576,8 @@ static void an_pair_row(struct an_ctx *c, struct an_pair *p, int64_t utime, doub
 	an_csv_num(c->pdiff, delta);
 	fputc('\n', c->pdiff);
 	p->rows++;
+	if (isfinite(delta))
+		p->finite_rows++;
 	if (t >= c->window_start_t)
 		win_circ_add(&p->win, delta);
 }
@@ -562,6 +599,18 @@ static void an_update_pairs(struct an_ctx *c, int ri, int64_t utime, double t)
 	}
 }
 
+/* A robot's mode changed at t: one mark per switch of the group. */
+static void an_note_switch(struct an_ctx *c, double t, int mode)
+{
+	if (c->nswitches > 0 && c->switch_mode[c->nswitches - 1] == mode &&
+	    t - c->switch_t[c->nswitches - 1] <= AN_SWITCH_MERGE_S)
+		return;
+	if (c->nswitches == AN_MAX_SWITCHES)
+		return;
+	c->switch_t[c->nswitches] = t;
+	c->switch_mode[c->nswitches++] = mode;
+}
+
 static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 {
 	int ri = an_robot_find(c, m->robot, false);
@@ -570,6 +619,10 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 	struct an_robot *r = &c->robots[ri];
 	double t = an_t(c, m->utime);
 	int nj = m->njoints < r->njoints ? m->njoints : r->njoints;
+	if (r->seen_mode && m->mode != r->mode)
+		an_note_switch(c, t, m->mode);
+	r->seen_mode = true;
+	r->mode = m->mode;
 	for (int j = 0; j < nj; j++) {
 		const undulate_joint_state_t *js = &m->joints[j];
 		struct an_joint *aj = &r->j[j];
@@ -601,7 +654,9 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 		fprintf(f, ",%d", js->error_bits);
 		an_csv_num(f, js->phase);
 		an_csv_num(f, aj->est.frequency);
-		fputc('\n', f);
+		/* the robot as a number: plots select rows by it (a name may hold
+		 * quotes or commas that a gnuplot filter cannot match) */
+		fprintf(f, ",%d\n", ri);
 	}
 	an_update_pairs(c, ri, m->utime, t);
 }
@@ -664,6 +719,8 @@ static void an_on_collision(struct an_ctx *c, const undulate_sim_collision_t *m)
 	if (bin >= 0 && bin < c->nbins) {
 		c->bins[bin]++;
 		c->bin_impulse[bin] += m->impulse;
+		if (wall)
+			c->bin_walls[bin]++;
 	}
 	struct an_pair *p = wall ? NULL : an_pair_of(c, m->left_robot, m->right_robot);
 	double delta = NAN;
@@ -783,6 +840,12 @@ static void an_on_params(struct an_ctx *c, const undulate_osc_params_t *m)
  * truth message's time, so they cannot be matched to the originals). */
 static void an_truth_collisions(struct an_ctx *c, const undulate_sim_truth_t *m)
 {
+	double t = an_t(c, m->utime);
+	int64_t bin = (int64_t)floor(t / AN_RATE_BIN_S);
+	if (bin >= 0 && bin < c->nbins && isfinite(m->total_impulse)) {
+		c->bin_total[bin] = m->total_impulse;
+		c->bin_total_t[bin] = t;
+	}
 	if (c->collision_msgs > 0)
 		return;
 	for (int i = 0; i < m->ncollisions; i++)
@@ -850,7 +913,8 @@ static int an_open_outputs(struct an_ctx *c)
 		return -1;
 	}
 	c->states = an_open_out(c, "states.csv",
-		"utime,t,robot,joint,servo_id,angle,speed,goal,load,mode,phase,amplitude,frequency,error_bits,phase_daemon,frequency_est");
+		"utime,t,robot,joint,servo_id,angle,speed,goal,load,mode,phase,amplitude,frequency,error_bits,phase_daemon,frequency_est,"
+		"robot_index");
 	c->coll = an_open_out(c, "collisions.csv",
 		"utime,t,left,right,left_robot,right_robot,pre_left,pre_right,post_left,post_right,impulse,pair,delta_before,"
 		"new_contact");
@@ -891,18 +955,34 @@ static int an_write_return_map(struct an_ctx *c)
 			fprintf(f, ",%zu,%lld,%.6f", n, (long long)p->delta_utime[n], an_t(c, p->delta_utime[n]));
 			an_csv_num(f, p->deltas[n]);
 			an_csv_num(f, p->deltas[n + 1]);
-			an_csv_num(f, theory_return_map(p->deltas[n], dsep, c->o->restitution));
+			an_csv_num(f, theory_return_map(p->deltas[n], dsep, c->restitution));
 			an_csv_num(f, p->dsep);
 			fputc('\n', f);
 		}
 	}
-	FILE *g = an_open_out(c, "collision_rate.csv", "t,collisions,impulse");
+	FILE *g = an_open_out(c, "collision_rate.csv",
+		"t,collisions,impulse,pair_collisions,wall_collisions,contact_force");
 	if (!g) {
 		fclose(f);
 		return -1;
 	}
-	for (int64_t b = 0; b < c->nbins; b++)
-		fprintf(g, "%.3f,%lld,%.9g\n", (double)b * AN_RATE_BIN_S, (long long)c->bins[b], c->bin_impulse[b]);
+	/* contact force: the rate of SIM.TRUTH's total impulse between the last
+	 * truth of the previous bin with one and this bin's last */
+	int64_t prev = -1;
+	for (int64_t b = 0; b < c->nbins; b++) {
+		fprintf(g, "%.3f,%lld,%.9g,%lld,%lld,", (double)b * AN_RATE_BIN_S, (long long)c->bins[b],
+			c->bin_impulse[b], (long long)(c->bins[b] - c->bin_walls[b]), (long long)c->bin_walls[b]);
+		if (isfinite(c->bin_total_t[b])) {
+			if (prev >= 0 && c->bin_total_t[b] > c->bin_total_t[prev])
+			{
+				fprintf(g, "%.9g", (c->bin_total[b] - c->bin_total[prev]) /
+						   (c->bin_total_t[b] - c->bin_total_t[prev]));
+				c->have_force = true;
+			}
+			prev = b;
+		}
+		fputc('\n', g);
+	}
 	return an_close_out(c, &f, "return_map.csv") | an_close_out(c, &g, "collision_rate.csv");
 }
 
@@ -988,8 +1068,8 @@ static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 	}
 	fprintf(f, "collisions: %lld (%lld with walls), total impulse %.6g N*s\n", (long long)c->collisions,
 		(long long)c->wall_collisions, c->impulse);
-	fprintf(f, "restitution for theory: %.3f; collisions less than %.3f s apart are one contact\n",
-		c->o->restitution, c->o->merge_s);
+	fprintf(f, "restitution for theory: %.3f (%s); collisions less than %.3f s apart are one contact\n",
+		c->restitution, c->restitution_from, c->o->merge_s);
 	fprintf(f, "not oscillating: a joint of the pair swings less than %.3f rad peak-to-peak in the final window\n",
 		c->o->min_swing);
 	fprintf(f, "%-24s %-28s %8s %8s %8s %6s %6s %7s %9s %5s %8s %8s\n", "pair", "end state", "mean|D|", "meanD",
@@ -1067,7 +1147,8 @@ static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 	json_field_bool(&j, "truncated", rc == AN_EXIT_TRUNCATED);
 	json_field_number(&j, "t_end", c->have_state ? an_t(c, c->last_state_utime) : NAN);
 	json_field_number(&j, "window_s", c->o->window_s);
-	json_field_number(&j, "restitution", c->o->restitution);
+	json_field_number(&j, "restitution", c->restitution);
+	json_field_string(&j, "restitution_from", c->restitution_from);
 	json_field_string(&j, "order", c->order_lateral ? "lateral" : "name");
 	json_field_int(&j, "collisions", c->collisions);
 	json_field_int(&j, "wall_collisions", c->wall_collisions);
@@ -1115,21 +1196,41 @@ static int an_write_summary(struct an_ctx *c, int rc)
 static int an_plots(struct an_ctx *c)
 {
 	const char *names[AN_MAX_ROBOTS];
+	int njoints[AN_MAX_ROBOTS];
+	unsigned joint_mask[AN_MAX_ROBOTS];
+	int robot_index[AN_MAX_ROBOTS];
 	struct plot_pair pp[AN_MAX_PAIRS];
+	struct plot_switch sw[AN_MAX_SWITCHES];
 	int n = 0, np = 0;
-	for (int k = 0; k < c->nrobots; k++)
-		if (c->robots[c->order[k]].njoints > 0)
-			names[n++] = c->robots[c->order[k]].name;
+	for (int k = 0; k < c->nrobots; k++) {
+		const struct an_robot *r = &c->robots[c->order[k]];
+		unsigned mask = 0;
+		for (int j = 0; j < r->njoints && j < 32; j++)
+			if (r->j[j].samples > 0)
+				mask |= 1u << j;
+		if (mask != 0) {
+			names[n] = r->name;
+			robot_index[n] = c->order[k];
+			joint_mask[n] = mask;
+			njoints[n++] = r->njoints;
+		}
+	}
 	for (int k = 0; k < c->npairs; k++) {
 		const struct an_pair *p = &c->pairs[k];
 		if (p->kind == AN_PAIR_JOINTS)
 			continue;
 		pp[np++] = (struct plot_pair){ .name = p->name, .dsep = p->dsep,
-					       .map_points = p->ndeltas > 0 ? (int)p->ndeltas - 1 : 0 };
+					       .map_points = p->ndeltas > 0 ? (int)p->ndeltas - 1 : 0,
+					       .delta_points = (int)(p->finite_rows < INT32_MAX ? p->finite_rows : INT32_MAX),
+					       .collisions = (int)(p->collisions < INT32_MAX ? p->collisions : INT32_MAX) };
 	}
-	struct plot_input in = { .dir = c->o->out_dir, .robots = names, .nrobots = n, .pairs = pp,
-				 .npairs = np, .restitution = c->o->restitution,
-				 .have_collisions = c->collisions > 0 };
+	for (int i = 0; i < c->nswitches; i++)
+		sw[i] = (struct plot_switch){ .t = c->switch_t[i], .to = mode_name(c->switch_mode[i]) };
+	struct plot_input in = { .dir = c->o->out_dir, .robots = names, .njoints = njoints, .joint_mask = joint_mask, .robot_index = robot_index, .nrobots = n,
+				 .pairs = pp, .npairs = np, .switches = sw, .nswitches = c->nswitches,
+				 .window_start = c->window_start_t > 0 ? c->window_start_t : 0.0,
+				 .restitution = c->restitution, .restitution_from = c->restitution_from,
+				 .have_collisions = c->collisions > 0, .have_force = c->have_force };
 	return plot_all(&in, c->o->msg);
 }
 
@@ -1143,6 +1244,9 @@ static void an_free(struct an_ctx *c)
 	}
 	free(c->bins);
 	free(c->bin_impulse);
+	free(c->bin_walls);
+	free(c->bin_total);
+	free(c->bin_total_t);
 	an_close_outputs(c);
 }
 
@@ -1154,15 +1258,35 @@ static int an_alloc_bins(struct an_ctx *c)
 		c->nbins = AN_MAX_BINS;
 	c->bins = calloc((size_t)c->nbins, sizeof(*c->bins));
 	c->bin_impulse = calloc((size_t)c->nbins, sizeof(*c->bin_impulse));
-	return c->bins && c->bin_impulse ? 0 : -1;
+	c->bin_walls = calloc((size_t)c->nbins, sizeof(*c->bin_walls));
+	c->bin_total = calloc((size_t)c->nbins, sizeof(*c->bin_total));
+	c->bin_total_t = malloc((size_t)c->nbins * sizeof(*c->bin_total_t));
+	if (!c->bins || !c->bin_impulse || !c->bin_walls || !c->bin_total || !c->bin_total_t)
+		return -1;
+	for (int64_t b = 0; b < c->nbins; b++)
+		c->bin_total_t[b] = NAN;
+	return 0;
 }
 
 static int an_run_ctx(struct an_ctx *c)
 {
 	const struct an_options *o = c->o;
+	c->world_restitution = NAN;
 	int rc = an_each_event(c, an_scan_event, true);
 	if (rc == AN_EXIT_BADLOG)
 		return rc;
+	/* The theory for the run's own restitution: the user's word, else the
+	 * simulator's (SIM.WORLD), else the paper's rig. */
+	if (!isnan(o->restitution)) {
+		c->restitution = o->restitution;
+		c->restitution_from = "--restitution";
+	} else if (!isnan(c->world_restitution)) {
+		c->restitution = c->world_restitution;
+		c->restitution_from = "the simulator's, SIM.WORLD";
+	} else {
+		c->restitution = AN_DEFAULT_RESTITUTION;
+		c->restitution_from = "the paper's rig: no SIM.WORLD in the log";
+	}
 	if (!c->have_state)
 		an_warn(c, "no robot state (<robot>.STATE) in the selected part of the log");
 	if (an_make_pairs(c) != 0)

@@ -33,7 +33,7 @@ struct an_options {
 	double from_s, to_s;   /* seconds from the first event; NAN = open */
 	double window_s;       /* final window for the classification */
 	double separation;     /* d~ for every pair; NAN = from SIM.TRUTH */
-	double restitution;    /* r for the theory curve */
+	double restitution;    /* r for the theory curve; NAN: the log's (SIM.WORLD), else 0.67 */
 	double merge_s;        /* collisions of a pair closer than this are one contact */
 	FILE *msg;             /* warnings and the summary go here (stderr/stdout) */
 	bool quiet;            /* do not print the summary to msg */

@@ -24,7 +24,7 @@ static void usage(FILE *f)
 	      "  --from/--to S     only events between S seconds after the log start\n"
 	      "  --window S        final window for the end-state classification (default 10)\n"
 	      "  --separation D    normalized separation d~ for every pair (default: from SIM.TRUTH)\n"
-	      "  --restitution R   r for the theory curve (default 0.67)\n"
+	      "  --restitution R   r for the theory curve (default: the simulator's, from SIM.WORLD; else 0.67)\n"
 	      "  --merge S         collisions of a pair less than S apart are one contact (default 0.1)\n"
 	      "  --min-swing RAD   a pair with a joint swinging less than RAD peak-to-peak in the final\n"
 	      "                    window is not-oscillating, whatever its phases (default 0.2)\n"
@@ -99,7 +99,7 @@ static int check_options(const struct an_options *o)
 		fputs("undulate-analyze: --window must be > 0\n", stderr);
 		return -1;
 	}
-	if (!(o->restitution >= 0 && o->restitution <= 1)) {
+	if (!isnan(o->restitution) && !(o->restitution >= 0 && o->restitution <= 1)) {
 		fputs("undulate-analyze: --restitution must be in [0, 1]\n", stderr);
 		return -1;
 	}

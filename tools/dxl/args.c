@@ -218,13 +218,15 @@ void dxlt_help(FILE *f)
 	      "  set-baud ID BAUD           change a servo's baud rate (bps) and verify it\n"
 	      "  torque ID on|off           switch the motor torque\n"
 	      "  reset ID --yes             factory reset (ID becomes 1, baud 1 Mbps)\n"
-	      "  setup ID... [--status-level N]   prepare servos and adapter for a 100 Hz loop\n"
+	      "  setup ID... [--status-level N] [--yes]   prepare servos and adapter for a 100 Hz\n"
+	      "                             loop (--yes: turn torque off first; the joint goes limp)\n"
 	      "\noptions:\n"
 	      "  --port PATH        serial device or pty (e.g. /dev/ttyUSB0, /dev/serial/by-id/...)\n"
 	      "  --baud N           bus baud rate in bps (default 1000000)\n"
 	      "  --echo             single-wire wiring: discard our own bytes read back\n"
 	      "  --latency-us N     adapter latency to allow for (default: read the FTDI timer)\n"
 	      "  --timeout-ms N     wait about N ms per reply instead of the derived timeout\n"
-	      "\nexit codes: 0 ok, 2 usage, 3 port, 4 no reply / bus error, 5 servo error bits,\n"
+	      "\nexit codes: 0 ok, 2 usage, 3 port, 4 no reply / bus error, 5 servo error bits\n"
+	      "            (in any reply; the bits are named),\n"
 	      "            6 refused (ID taken, torque on, ...)\n", f);
 }

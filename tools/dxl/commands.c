@@ -22,6 +22,10 @@ struct dxlt {
 	struct port *port;
 	struct port_latency latency;
 	struct bus bus;
+	/* Error bits any reply carried, per ID: the servo's news, reported once
+	 * when the command ends (dxlt_report_errbits), whichever call saw them. */
+	uint8_t errseen[DXL_BROADCAST_ID + 1];
+	char hint[200];          /* what to do about them, when we know */
 };
 
 /* ---- helpers ------------------------------------------------------------------ */
@@ -104,24 +108,58 @@ static int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
 	}
 }
 
-/* Error bits in a good reply are the servo's news, not ours: report them. */
-static int dxlt_errbits(struct dxlt *t, uint8_t id, uint8_t errbits)
-{
-	char names[128];
+/* ---- transactions: every reply's error bits are remembered ------------------- */
 
-	if (errbits == 0)
-		return DXLT_EXIT_OK;
-	fprintf(t->err, "dxl: ID %u reports error bits 0x%02X: %s\n", id, errbits,
-	        dxl_errbits_format(errbits, names, sizeof names));
-	return DXLT_EXIT_SERVO;
+static int dxlt_ping(struct dxlt *t, uint8_t id)
+{
+	uint8_t e = 0;
+	int r = bus_ping(&t->bus, id, &e);
+
+	if (r == DXL_OK)
+		t->errseen[id] |= e;
+	return r;
 }
 
-/* Finish a transaction: status and error bits folded into an exit code. */
-static int dxlt_check(struct dxlt *t, uint8_t id, int status, uint8_t errbits)
+static int dxlt_read(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out)
 {
-	if (status != DXL_OK)
-		return dxlt_bus_fail(t, id, status);
-	return dxlt_errbits(t, id, errbits);
+	uint8_t e = 0;
+	int r = bus_read(&t->bus, id, addr, len, out, &e);
+
+	if (r == DXL_OK)
+		t->errseen[id] |= e;
+	return r;
+}
+
+static int dxlt_write(struct dxlt *t, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
+                      bool expect_reply)
+{
+	uint8_t e = 0;
+	int r = bus_write(&t->bus, id, addr, data, n, expect_reply, &e);
+
+	if (r == DXL_OK)
+		t->errseen[id] |= e;
+	return r;
+}
+
+/* One line per servo whose replies carried error bits; exit 5 unless the
+ * command already failed in a way that says more (a lost bus, bad usage). */
+static int dxlt_report_errbits(struct dxlt *t, int rc)
+{
+	char names[128];
+	bool any = false;
+
+	for (size_t id = 0; id < sizeof t->errseen; id++) {
+		if (t->errseen[id] == 0)
+			continue;
+		fprintf(t->err, "dxl: ID %zu reports error bits 0x%02X: %s\n", id, t->errseen[id],
+		        dxl_errbits_format(t->errseen[id], names, sizeof names));
+		any = true;
+	}
+	if (!any)
+		return rc;
+	if (t->hint[0] != '\0')
+		fprintf(t->err, "dxl: %s\n", t->hint);
+	return rc == DXLT_EXIT_OK ? DXLT_EXIT_SERVO : rc;
 }
 
 static int dxlt_need_args(struct dxlt *t, int n, const char *form)
@@ -149,18 +187,17 @@ static int dxlt_arg_reg(struct dxlt *t, const char *s, const struct dxl_reg **re
 	return DXLT_EXIT_USAGE;
 }
 
-static int dxlt_read_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t *v,
-                         uint8_t *errbits)
+static int dxlt_read_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t *v)
 {
 	uint8_t raw[2] = { 0, 0 };
-	int r = bus_read(&t->bus, id, reg->addr, reg->size, raw, errbits);
+	int r = dxlt_read(t, id, reg->addr, reg->size, raw);
 
 	*v = reg->size == 2 ? dxl_get_u16(raw) : raw[0];
 	return r;
 }
 
 static int dxlt_write_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t v,
-                          bool expect_reply, uint8_t *errbits)
+                          bool expect_reply)
 {
 	uint8_t raw[2];
 
@@ -169,7 +206,7 @@ static int dxlt_write_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg,
 		dxl_put_u16(raw, v);
 	else
 		raw[0] = (uint8_t)v;
-	return bus_write(&t->bus, id, reg->addr, raw, reg->size, expect_reply, errbits);
+	return dxlt_write(t, id, reg->addr, raw, reg->size, expect_reply);
 }
 
 /* ---- ports -------------------------------------------------------------------- */
@@ -208,10 +245,10 @@ static int dxlt_cmd_ports(struct dxlt *t)
 
 static void dxlt_print_identity(struct dxlt *t, uint8_t id, long baud)
 {
-	uint16_t model = 0;
-	uint8_t fw = 0, errbits = 0;
-	bool have_model = bus_read_u16(&t->bus, id, DXL_AX_MODEL_NUMBER, &model, &errbits) == DXL_OK;
-	bool have_fw = bus_read_u8(&t->bus, id, DXL_AX_FIRMWARE_VERSION, &fw, &errbits) == DXL_OK;
+	uint8_t raw[2], fw = 0;
+	bool have_model = dxlt_read(t, id, DXL_AX_MODEL_NUMBER, 2, raw) == DXL_OK;
+	bool have_fw = dxlt_read(t, id, DXL_AX_FIRMWARE_VERSION, 1, &fw) == DXL_OK;
+	uint16_t model = have_model ? dxl_get_u16(raw) : 0;
 
 	/* Status return level 0 answers PING only: the ID is real, the rest unknown. */
 	fprintf(t->out, "%-4u ", id);
@@ -232,7 +269,7 @@ static int dxlt_cmd_scan(struct dxlt *t)
 	const long *bauds = t->a.nbauds > 0 ? t->a.bauds : &own;
 	size_t nbauds = t->a.nbauds > 0 ? t->a.nbauds : 1;
 	unsigned found = 0;
-	int rc = DXLT_EXIT_OK;
+	int rc;
 
 	if (t->a.npos != 0)
 		return dxlt_need_args(t, 0, "scan [--ids A-B] [--bauds LIST|all]");
@@ -242,16 +279,13 @@ static int dxlt_cmd_scan(struct dxlt *t)
 			return rc;
 		/* Unicast PING: a broadcast PING makes every servo answer at once. */
 		for (unsigned id = t->a.id_lo; id <= t->a.id_hi; id++) {
-			uint8_t errbits = 0;
-			int r = bus_ping(&t->bus, (uint8_t)id, &errbits);
+			int r = dxlt_ping(t, (uint8_t)id);
 			if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 				return dxlt_bus_fail(t, (uint8_t)id, r);
 			if (r != DXL_OK)
 				continue;
 			found++;
 			dxlt_print_identity(t, (uint8_t)id, bauds[b]);
-			if (dxlt_errbits(t, (uint8_t)id, errbits) != DXLT_EXIT_OK)
-				rc = DXLT_EXIT_SERVO;
 		}
 		fflush(t->out);
 	}
@@ -261,29 +295,29 @@ static int dxlt_cmd_scan(struct dxlt *t)
 		        t->a.nbauds == 0 ? "; try --bauds all" : "");
 		return DXLT_EXIT_BUS;
 	}
-	return rc;
+	return DXLT_EXIT_OK;
 }
 
 static int dxlt_cmd_ping(struct dxlt *t)
 {
-	uint8_t id, errbits = 0;
-	uint16_t model = 0;
-	uint8_t fw = 0, e2;
+	uint8_t id, raw[2], fw = 0;
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 1, "ping ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
 		return rc;
-	int r = bus_ping(&t->bus, id, &errbits);
+	int r = dxlt_ping(t, id);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	uint32_t rtt = t->bus.servo[id].rtt_last_us;
 	fprintf(t->out, "ID %u answered in %u us", id, (unsigned)rtt);
-	if (bus_read_u16(&t->bus, id, DXL_AX_MODEL_NUMBER, &model, &e2) == DXL_OK)
-		fprintf(t->out, ": model %u (%s)", model, dxlt_model_name(model));
-	if (bus_read_u8(&t->bus, id, DXL_AX_FIRMWARE_VERSION, &fw, &e2) == DXL_OK)
+	if (dxlt_read(t, id, DXL_AX_MODEL_NUMBER, 2, raw) == DXL_OK)
+		fprintf(t->out, ": model %u (%s)", dxl_get_u16(raw), dxlt_model_name(dxl_get_u16(raw)));
+	else
+		fprintf(t->out, ": answers PING only (status return level 0)");
+	if (dxlt_read(t, id, DXL_AX_FIRMWARE_VERSION, 1, &fw) == DXL_OK)
 		fprintf(t->out, ", firmware %u", fw);
 	fputc('\n', t->out);
-	return dxlt_errbits(t, id, errbits);
+	return DXLT_EXIT_OK;
 }
 
 /* ---- read / write / dump ------------------------------------------------------ */
@@ -291,7 +325,7 @@ static int dxlt_cmd_ping(struct dxlt *t)
 static int dxlt_cmd_read(struct dxlt *t)
 {
 	const struct dxl_reg *reg;
-	uint8_t id, errbits = 0;
+	uint8_t id;
 	uint16_t v;
 	char text[96];
 	int rc;
@@ -299,14 +333,20 @@ static int dxlt_cmd_read(struct dxlt *t)
 	if ((rc = dxlt_need_args(t, 2, "read ID REG [--units]")) ||
 	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)) || (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)))
 		return rc;
-	int r = dxlt_read_reg(t, id, reg, &v, &errbits);
+	int r = dxlt_read_reg(t, id, reg, &v);
+	if (r == DXL_E_TIMEOUT && dxlt_ping(t, id) == DXL_OK) {
+		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0 "
+		        "(raise it: dxl --port %s write %u status_return_level 2)\n", id,
+		        port_path(t->port), id);
+		return DXLT_EXIT_BUS;
+	}
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (t->a.units)
 		fprintf(t->out, "%s\n", dxl_reg_format(reg, v, text, sizeof text));
 	else
 		fprintf(t->out, "%u\n", v);
-	return dxlt_errbits(t, id, errbits);
+	return DXLT_EXIT_OK;
 }
 
 static int dxlt_check_value(struct dxlt *t, const struct dxl_reg *reg, const char *s, uint16_t *v)
@@ -331,10 +371,98 @@ static int dxlt_check_value(struct dxlt *t, const struct dxl_reg *reg, const cha
 	return DXLT_EXIT_OK;
 }
 
+/* The servo's status return level decides which instructions it answers (0:
+ * PING only, 1: READ too, 2: everything): ask it rather than assume 2, or a
+ * write that took effect reads as "no reply". */
+static int dxlt_status_level(struct dxlt *t, uint8_t id, uint8_t *level)
+{
+	uint8_t v = 0;
+	int r = dxlt_read(t, id, DXL_AX_STATUS_RETURN_LEVEL, 1, &v);
+
+	if (r == DXL_OK) {
+		*level = v > 2 ? 2 : v;
+		return DXL_OK;
+	}
+	if (r != DXL_E_TIMEOUT)
+		return r;
+	r = dxlt_ping(t, id);
+	if (r == DXL_OK)
+		*level = 0;
+	return r;
+}
+
+/* Why the servo refused a write, when its error bits say (the bits alone
+ * name the symptom, not the remedy). */
+static void dxlt_write_hint(struct dxlt *t, uint8_t id, const struct dxl_reg *reg)
+{
+	uint8_t e = t->errseen[id];
+
+	if ((e & DXL_ERRBIT_RANGE) && reg->area == DXL_AREA_EEPROM)
+		snprintf(t->hint, sizeof t->hint, "the AX-12A refuses EEPROM writes (%s) while torque "
+		         "is on or the lock is set: dxl --port %s torque %u off", reg->name,
+		         port_path(t->port), id);
+	else if ((e & DXL_ERRBIT_ANGLE_LIMIT) && reg->addr == DXL_AX_GOAL_POSITION)
+		snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's angle limits: dxl "
+		         "--port %s read %u cw_angle_limit (and ccw_angle_limit)", port_path(t->port), id);
+}
+
+/* Write one register and know whether it took, as far as the servo's status
+ * return level lets us: level 2 answers the WRITE; level 1 answers only a
+ * READ, so read the value back; level 0 answers nothing but PING, so the
+ * write goes out unconfirmed and the output says so. A write to the status
+ * return level itself is never waited for: which level answers it is the
+ * servo's choice. */
+static int dxlt_write_checked(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t v)
+{
+	uint8_t level = 2;
+	int r;
+
+	if (id == DXL_BROADCAST_ID) {
+		r = dxlt_write_reg(t, id, reg, v, false);
+		if (r != DXL_OK)
+			return dxlt_bus_fail(t, id, r);
+		fprintf(t->out, "broadcast: %s = %u sent (servos do not answer a broadcast)\n",
+		        reg->name, v);
+		return DXLT_EXIT_OK;
+	}
+	if ((r = dxlt_status_level(t, id, &level)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	bool answered = level >= 2 && reg->addr != DXL_AX_STATUS_RETURN_LEVEL;
+	r = dxlt_write_reg(t, id, reg, v, answered);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	dxlt_write_hint(t, id, reg);
+	if (answered)
+		return DXLT_EXIT_OK;
+	uint8_t now_level = reg->addr == DXL_AX_STATUS_RETURN_LEVEL ? (uint8_t)v : level;
+	if (now_level == 0) {
+		if ((r = dxlt_ping(t, id)) != DXL_OK)
+			return dxlt_bus_fail(t, id, r);
+		fprintf(t->out, "ID %u: %s = %u sent, not confirmed: the servo answers PING only "
+		        "(status return level 0)\n", id, reg->name, v);
+		return DXLT_EXIT_OK;
+	}
+	/* A READ right after a WRITE to EEPROM may find the servo busy writing. */
+	if (reg->area == DXL_AREA_EEPROM)
+		dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
+	uint16_t have = 0;
+	if ((r = dxlt_read_reg(t, id, reg, &have)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (have != v) {
+		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u; status return level %u: the "
+		        "WRITE itself is not answered, its read-back is)\n", id, reg->name, have, v,
+		        level);
+		return t->errseen[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u: %s = %u (read back: status return level %u does not answer "
+	        "WRITE)\n", id, reg->name, v, level);
+	return DXLT_EXIT_OK;
+}
+
 static int dxlt_cmd_write(struct dxlt *t)
 {
 	const struct dxl_reg *reg;
-	uint8_t id, errbits = 0;
+	uint8_t id;
 	uint16_t v;
 	int rc;
 
@@ -342,19 +470,26 @@ static int dxlt_cmd_write(struct dxlt *t)
 	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)) ||
 	    (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)) || (rc = dxlt_check_value(t, reg, t->a.pos[2], &v)))
 		return rc;
-	return dxlt_check(t, id, dxlt_write_reg(t, id, reg, v, true, &errbits), errbits);
+	/* After a new ID or baud the servo answers elsewhere: only the commands
+	 * made for it know where to look for the answer. */
+	if (reg->addr == DXL_AX_ID || reg->addr == DXL_AX_BAUD_RATE) {
+		fprintf(t->err, "dxl: %s moves the servo away from this ID/rate: use dxl --port %s %s\n", reg->name,
+		        port_path(t->port), reg->addr == DXL_AX_ID ? "set-id OLD NEW" : "set-baud ID BAUD");
+		return DXLT_EXIT_USAGE;
+	}
+	return dxlt_write_checked(t, id, reg, v);
 }
 
 static int dxlt_cmd_dump(struct dxlt *t)
 {
-	uint8_t id, errbits = 0;
+	uint8_t id;
 	uint8_t mem[DXL_AX_TABLE_SIZE];
 	char text[96];
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 1, "dump ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
 		return rc;
-	int r = bus_read(&t->bus, id, 0, DXL_AX_TABLE_SIZE, mem, &errbits);
+	int r = dxlt_read(t, id, 0, DXL_AX_TABLE_SIZE, mem);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	fprintf(t->out, "%-4s %-22s %-24s %s\n", "ADDR", "NAME", "VALUE", "DESCRIPTION");
@@ -365,7 +500,7 @@ static int dxlt_cmd_dump(struct dxlt *t)
 		        dxl_reg_format(reg, v, text, sizeof text), reg->desc,
 		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
 	}
-	return dxlt_errbits(t, id, errbits);
+	return DXLT_EXIT_OK;
 }
 
 /* ---- set-id / set-baud / torque / reset --------------------------------------- */
@@ -374,18 +509,17 @@ static int dxlt_cmd_dump(struct dxlt *t)
  * makes the reply's sender ambiguous), give the servo time, then ask. */
 static int dxlt_verify_ping(struct dxlt *t, uint8_t id)
 {
-	uint8_t errbits;
 	int r = DXL_E_TIMEOUT;
 
 	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
 	for (int attempt = 0; attempt < 3 && r == DXL_E_TIMEOUT; attempt++)
-		r = bus_ping(&t->bus, id, &errbits);
+		r = dxlt_ping(t, id);
 	return r;
 }
 
 static int dxlt_cmd_set_id(struct dxlt *t)
 {
-	uint8_t old_id, new_id, errbits = 0;
+	uint8_t old_id, new_id;
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 2, "set-id OLD NEW")) ||
@@ -396,15 +530,15 @@ static int dxlt_cmd_set_id(struct dxlt *t)
 		fprintf(t->out, "ID %u unchanged\n", old_id);
 		return DXLT_EXIT_OK;
 	}
-	int r = bus_ping(&t->bus, old_id, &errbits);
+	int r = dxlt_ping(t, old_id);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, old_id, r);
 	/* Two servos with one ID answer at once and garble each other. */
-	if (bus_ping(&t->bus, new_id, &errbits) == DXL_OK) {
+	if (dxlt_ping(t, new_id) == DXL_OK) {
 		fprintf(t->err, "dxl: ID %u is already taken on this bus; pick another\n", new_id);
 		return DXLT_EXIT_REFUSED;
 	}
-	r = dxlt_write_reg(t, old_id, dxl_reg_at(DXL_AX_ID), new_id, false, &errbits);
+	r = dxlt_write_reg(t, old_id, dxl_reg_at(DXL_AX_ID), new_id, false);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, old_id, r);
 	r = dxlt_verify_ping(t, new_id);
@@ -419,7 +553,7 @@ static int dxlt_cmd_set_id(struct dxlt *t)
 
 static int dxlt_cmd_set_baud(struct dxlt *t)
 {
-	uint8_t id, reg_value, errbits = 0;
+	uint8_t id, reg_value;
 	long bps;
 	int rc;
 
@@ -432,10 +566,10 @@ static int dxlt_cmd_set_baud(struct dxlt *t)
 		        "e.g. 1000000, 500000, 117647, 57143)\n", t->a.pos[1]);
 		return DXLT_EXIT_USAGE;
 	}
-	int r = bus_ping(&t->bus, id, &errbits);
+	int r = dxlt_ping(t, id);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	r = dxlt_write_reg(t, id, dxl_reg_at(DXL_AX_BAUD_RATE), reg_value, false, &errbits);
+	r = dxlt_write_reg(t, id, dxl_reg_at(DXL_AX_BAUD_RATE), reg_value, false);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	long exact = dxl_baud_from_reg(reg_value);
@@ -455,7 +589,7 @@ static int dxlt_cmd_set_baud(struct dxlt *t)
 
 static int dxlt_cmd_torque(struct dxlt *t)
 {
-	uint8_t id, errbits = 0;
+	uint8_t id;
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 2, "torque ID on|off")) ||
@@ -467,13 +601,12 @@ static int dxlt_cmd_torque(struct dxlt *t)
 		fprintf(t->err, "dxl: torque takes on or off, not '%s'\n", s);
 		return DXLT_EXIT_USAGE;
 	}
-	int r = bus_write_u8(&t->bus, id, DXL_AX_TORQUE_ENABLE, on ? 1 : 0, &errbits);
-	return dxlt_check(t, id, r, errbits);
+	return dxlt_write_checked(t, id, dxl_reg_at(DXL_AX_TORQUE_ENABLE), on ? 1 : 0);
 }
 
 static int dxlt_cmd_reset(struct dxlt *t)
 {
-	uint8_t id, errbits = 0;
+	uint8_t id, e = 0;
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 1, "reset ID --yes")) ||
@@ -484,10 +617,10 @@ static int dxlt_cmd_reset(struct dxlt *t)
 		        "(including angle limits); add --yes to do it\n");
 		return DXLT_EXIT_USAGE;
 	}
-	int r = bus_ping(&t->bus, id, &errbits);
+	int r = dxlt_ping(t, id);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	r = bus_factory_reset(&t->bus, id, false, &errbits);
+	r = bus_factory_reset(&t->bus, id, false, &e);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
@@ -509,8 +642,8 @@ static int dxlt_cmd_reset(struct dxlt *t)
 static int dxlt_setup_byte(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t want, bool replies)
 {
 	const struct dxl_reg *reg = dxl_reg_at(addr);
-	uint8_t have = 0, errbits = 0;
-	int r = bus_read_u8(&t->bus, id, addr, &have, &errbits);
+	uint8_t have = 0;
+	int r = dxlt_read(t, id, addr, 1, &have);
 
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
@@ -518,11 +651,14 @@ static int dxlt_setup_byte(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t wan
 		fprintf(t->out, "ID %u: %s already %u\n", id, reg->name, want);
 		return DXLT_EXIT_OK;
 	}
-	r = bus_write(&t->bus, id, addr, &want, 1, replies, &errbits);
-	if (r != DXL_OK || errbits != 0)
-		return dxlt_check(t, id, r, errbits);
+	uint8_t before = t->errseen[id];
+	r = dxlt_write(t, id, addr, &want, 1, replies);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (t->errseen[id] & ~before)
+		return DXLT_EXIT_SERVO; /* refused: reported with the others at the end */
 	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	r = bus_read_u8(&t->bus, id, addr, &have, &errbits);
+	r = dxlt_read(t, id, addr, 1, &have);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (have != want) {
@@ -534,34 +670,62 @@ static int dxlt_setup_byte(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t wan
 	return DXLT_EXIT_OK;
 }
 
+/* The AX-12A ignores EEPROM writes while torque is on, and a robot just
+ * stopped by the daemon holds its pose. Turning torque off lets the joint
+ * fall, so it is done only when asked (--yes). */
+static int dxlt_setup_torque_off(struct dxlt *t, uint8_t id, bool replies)
+{
+	uint8_t torque = 0;
+	int r;
+
+	if ((r = dxlt_read(t, id, DXL_AX_TORQUE_ENABLE, 1, &torque)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (!torque)
+		return DXLT_EXIT_OK;
+	if (!t->a.yes) {
+		fprintf(t->err, "dxl: ID %u has torque on, and the AX-12A ignores EEPROM writes then; "
+		        "add --yes to turn it off first (the joint goes limp: support the robot), or "
+		        "dxl --port %s torque %u off\n", id, port_path(t->port), id);
+		return DXLT_EXIT_REFUSED;
+	}
+	uint8_t off = 0;
+	if ((r = dxlt_write(t, id, DXL_AX_TORQUE_ENABLE, &off, 1, replies)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if ((r = dxlt_read(t, id, DXL_AX_TORQUE_ENABLE, 1, &torque)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (torque) {
+		fprintf(t->err, "dxl: ID %u kept torque on after torque off\n", id);
+		return DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u: torque turned off (--yes)\n", id);
+	return DXLT_EXIT_OK;
+}
+
 static int dxlt_setup_one(struct dxlt *t, uint8_t id)
 {
-	uint8_t torque = 0, level = 0, errbits = 0;
+	uint8_t level = 0;
 	int r, rc;
 
-	if ((r = bus_ping(&t->bus, id, &errbits)) != DXL_OK)
+	if ((r = dxlt_ping(t, id)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	/* The loop READs every cycle, so level 0 (PING only) cannot work; level
 	 * 2 costs nothing per cycle (goals go by SYNC_WRITE, never answered) and
 	 * lets start-up and tools verify their writes. */
 	int want_level = t->a.status_level >= 0 ? t->a.status_level : 2;
-	r = bus_read_u8(&t->bus, id, DXL_AX_STATUS_RETURN_LEVEL, &level, &errbits);
+	r = dxlt_read(t, id, DXL_AX_STATUS_RETURN_LEVEL, 1, &level);
 	if (r != DXL_OK) {
 		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? "
 		        "(dxl write %u status_return_level 2 cannot be verified either)\n", id, id);
 		return DXLT_EXIT_BUS;
 	}
-	if ((r = bus_read_u8(&t->bus, id, DXL_AX_TORQUE_ENABLE, &torque, &errbits)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (torque) {
-		fprintf(t->err, "dxl: ID %u has torque on; the AX-12A ignores EEPROM writes then: "
-		        "dxl --port %s torque %u off\n", id, port_path(t->port), id);
-		return DXLT_EXIT_REFUSED;
-	}
+	if ((rc = dxlt_setup_torque_off(t, id, level >= 2)) != DXLT_EXIT_OK)
+		return rc;
 	/* 0: the reply follows the request after ≈22 µs instead of 500 µs. */
 	if ((rc = dxlt_setup_byte(t, id, DXL_AX_RETURN_DELAY_TIME, 0, level >= 2)) != DXLT_EXIT_OK)
 		return rc;
-	return dxlt_setup_byte(t, id, DXL_AX_STATUS_RETURN_LEVEL, (uint8_t)want_level, level >= 2);
+	/* Which level answers a write to the level is the servo's choice: never
+	 * wait for that reply, read the value back instead. */
+	return dxlt_setup_byte(t, id, DXL_AX_STATUS_RETURN_LEVEL, (uint8_t)want_level, false);
 }
 
 /* Bus time of one 100 Hz cycle: one READ(36, 6) per servo and one SYNC_WRITE
@@ -666,7 +830,7 @@ static int dxlt_dispatch(struct dxlt *t)
 		int rc = dxlt_open(t);
 		if (rc != DXLT_EXIT_OK)
 			return rc;
-		return dxlt_commands[i].run(t);
+		return dxlt_report_errbits(t, dxlt_commands[i].run(t));
 	}
 	fprintf(t->err, "dxl: unknown command '%s'\n", t->a.command);
 	dxlt_usage(t->err);

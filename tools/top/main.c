@@ -8,6 +8,7 @@
 #include "num.h"
 #include "render.h"
 #include "term.h"
+#include "text.h"
 
 #include <errno.h>
 #include <getopt.h>
@@ -37,11 +38,27 @@ struct top_app {
 	bool once, json, read_only, verbose;
 	double wait_s, interval_s;
 	const char *url;
+	const char *banner_file;    /* --banner-file: its first line is shown under the title */
 	int64_t first_seq, next_seq;
 	char source[64];
+	/* The last command to every robot: how many sockets it went to and how
+	 * many robots answered, so the status line says "N of M accepted". */
+	struct {
+		int64_t seq;
+		char what[64];
+		int sent, accepted, rejected;
+		/* robots already counted: each answers twice (its local socket
+		 * and its EVENT channel) */
+		char counted[TOP_MAX_ROBOTS][TOP_NAME_MAX];
+		int ncounted;
+		char first_reject[TOP_STATUS_MAX];
+		double sent_at;
+		bool showing;        /* the status line shows this count (refreshed) */
+	} all;
 	char *screen;
 	struct top_keyparser kp;
 	bool quit;
+	bool interrupted;           /* Ctrl-C (a key in raw mode): exit 130, not 0 */
 	int rows, cols;
 };
 
@@ -64,6 +81,7 @@ static void on_winch(int sig)
  * texts are cut: the line is as wide as the screen anyway. */
 static void set_status(struct top_app *a, const char *fmt, ...)
 {
+	a->all.showing = false;
 	va_list ap;
 	va_start(ap, fmt);
 	vsnprintf(a->view.status, sizeof(a->view.status), fmt, ap);
@@ -78,11 +96,51 @@ static bool ends_with(const char *s, const char *suffix)
 	return n > m && strcmp(s + n - m, suffix) == 0;
 }
 
+/* Seconds after a command to every robot before the ones that did not
+ * answer are counted as such. */
+#define TOP_ALL_ANSWER_S 2.0
+
+static void clock_text(char *out, size_t n)
+{
+	time_t t = time(NULL);
+	struct tm tm;
+	localtime_r(&t, &tm);
+	strftime(out, n, "%H:%M:%S", &tm);
+}
+
+static void show_all_status(struct top_app *a, double now)
+{
+	int silent = a->all.sent - a->all.accepted - a->all.rejected;
+	char tail[TOP_STATUS_MAX] = "";
+	if (silent > 0 && now - a->all.sent_at >= TOP_ALL_ANSWER_S)
+		snprintf(tail, sizeof tail, ", %d did not answer", silent);
+	else if (silent > 0)
+		snprintf(tail, sizeof tail, ", waiting for %d", silent);
+	set_status(a, "all robots %s: %d of %d accepted%s%s%s", a->all.what, a->all.accepted, a->all.sent, tail,
+		   a->all.rejected ? "; " : "", a->all.rejected ? a->all.first_reject : "");
+	a->all.showing = true;
+}
+
 static void show_event(struct top_app *a, const undulate_event_t *e)
 {
-	if (e->seq >= a->first_seq && e->seq < a->next_seq)
-		set_status(a, "#%lld %s: %s: %s", (long long)e->seq, e->robot,
-			 e->kind, e->text);
+	if (e->seq < a->first_seq || e->seq >= a->next_seq)
+		return;
+	if (e->seq == a->all.seq && a->all.sent > 0) {
+		for (int i = 0; i < a->all.ncounted; i++)
+			if (strcmp(a->all.counted[i], e->robot) == 0)
+				return;
+		if (a->all.ncounted < TOP_MAX_ROBOTS)
+			snprintf(a->all.counted[a->all.ncounted++], TOP_NAME_MAX, "%s", e->robot);
+		if (strcmp(e->kind, "command-accepted") == 0)
+			a->all.accepted++;
+		else if (strcmp(e->kind, "command-rejected") == 0 && a->all.rejected++ == 0)
+			snprintf(a->all.first_reject, sizeof a->all.first_reject, "%s: %s", e->robot, e->text);
+		show_all_status(a, clock_mono_s());
+		return;
+	}
+	char t[16];
+	clock_text(t, sizeof t);
+	set_status(a, "%s %s: %s: %s", t, e->robot, e->kind, e->text);
 }
 
 /* Decodes BUF as T into a local, runs STMT with `msg`, cleans up. */
@@ -131,7 +189,7 @@ static int top_subscribe(struct top_app *a)
  * over the network: a robot takes those only signed); the answers come back
  * on ours and show in the status line. */
 #define TOP_MAX_SOCKETS 64
-static bool publish(struct top_app *a, const struct top_command *c)
+static int publish(struct top_app *a, const struct top_command *c)
 {
 	static char paths[TOP_MAX_SOCKETS][CSOCK_PATH_MAX];
 	uint8_t buf[1024];
@@ -139,13 +197,14 @@ static bool publish(struct top_app *a, const struct top_command *c)
 	int n = undulate_command_t_encoded_size(&c->msg);
 	if (a->cmd_fd < 0 || n <= 0 || n > (int)sizeof(buf) || undulate_command_t_encode(buf, 0, n, &c->msg) != n) {
 		set_status(a, "cannot send commands (%s)", a->cmd_fd < 0 ? "no local socket" : "encoding failed");
-		return false;
+		return 0;
 	}
 	size_t np = csock_find(c->msg.robot, a->url, paths, TOP_MAX_SOCKETS);
 	if (np == 0) {
-		set_status(a, "no robot %s runs on this computer: commands go to local robots only",
-			   strcmp(c->msg.robot, "*") == 0 ? "at all" : c->msg.robot);
-		return false;
+		set_status(a, "nothing sent: no robot %s runs on this computer with %s (commands go to "
+			   "local robots only)", strcmp(c->msg.robot, "*") == 0 ? "at all" : c->msg.robot,
+			   a->url ? a->url : "the default LCM URL");
+		return 0;
 	}
 	size_t sent = 0;
 	for (size_t i = 0; i < np; i++) {
@@ -154,7 +213,7 @@ static bool publish(struct top_app *a, const struct top_command *c)
 		else
 			set_status(a, "%s", why);
 	}
-	return sent > 0;
+	return (int)sent;
 }
 
 static void read_answers(struct top_app *a)
@@ -176,15 +235,29 @@ static void read_answers(struct top_app *a)
 static void send_mode(struct top_app *a, int mode, bool all)
 {
 	const struct top_model *m = &a->model;
-	if (!all && m->nrobots == 0)
+	if (!all && m->nrobots == 0) {
+		set_status(a, "no robot selected: none heard yet");
 		return;
+	}
 	const char *robot = all ? "*" : m->robots[m->order[a->view.selected]].name;
 	struct top_command c;
 	if (top_command_mode(&c, robot, mode, a->next_seq, a->source) != 0)
 		return;
-	if (publish(a, &c))
-		set_status(a, "#%lld sent %s mode %s, waiting for the answer", (long long)a->next_seq,
-			   all ? "all robots" : robot, mode_name(mode));
+	int sent = publish(a, &c);
+	if (sent > 0 && all) {
+		a->all.seq = a->next_seq;
+		a->all.sent = sent;
+		a->all.accepted = a->all.rejected = 0;
+		a->all.ncounted = 0;
+		a->all.first_reject[0] = '\0';
+		a->all.sent_at = clock_mono_s();
+		snprintf(a->all.what, sizeof a->all.what, "mode %s", mode_name(mode));
+		show_all_status(a, a->all.sent_at);
+	} else if (sent > 0) {
+		char t[16];
+		clock_text(t, sizeof t);
+		set_status(a, "%s sent %s mode %s, waiting for the answer", t, robot, mode_name(mode));
+	}
 	a->next_seq++;
 }
 
@@ -203,9 +276,12 @@ static void send_nudge(struct top_app *a, int dir)
 	}
 	bool ok = true;
 	for (int i = 0; i < n; i++)
-		ok = publish(a, &c[i]) && ok;
-	if (ok)
-		set_status(a, "#%lld sent %s", (long long)a->next_seq, what);
+		ok = publish(a, &c[i]) > 0 && ok;
+	if (ok) {
+		char t[16];
+		clock_text(t, sizeof t);
+		set_status(a, "%s sent %s", t, what);
+	}
 	a->next_seq += n;
 }
 
@@ -213,7 +289,7 @@ static void send_nudge(struct top_app *a, int dir)
 
 static int mode_of_key(int ch)
 {
-	switch (ch | 0x20) { /* lower case */
+	switch (ch) {
 	case 'l': return MODE_LIMP;
 	case 'h': return MODE_HOLD;
 	case 's': return MODE_SINUSOID;
@@ -222,10 +298,35 @@ static int mode_of_key(int ch)
 	}
 }
 
+/* A mode change takes two keys, `m` (selected robot) or `M` (every robot)
+ * and then l/h/s/o: no key of navigation (vi's h j k l, the arrows) can turn
+ * a robot's torque off by itself. */
 static void on_char(struct top_app *a, int ch)
 {
+	/* Ctrl-C and Ctrl-D quit from any state (the legend, a half-typed mode) */
+	if (ch == 3 || ch == 4) {
+		a->quit = true;
+		a->interrupted = ch == 3;
+		return;
+	}
+	if (a->view.help) {
+		a->view.help = false;
+		return;
+	}
+	if (a->view.prefix) {
+		int prefix = a->view.prefix;
+		a->view.prefix = 0;
+		if (mode_of_key(ch) >= 0)
+			send_mode(a, mode_of_key(ch), prefix == 'M');
+		else
+			set_status(a, "mode change cancelled");
+		return;
+	}
 	if (ch == 'q' || ch == 'Q' || ch == 3 /* Ctrl-C */ || ch == 4 /* Ctrl-D */) {
 		a->quit = true;
+		a->interrupted = ch == 3;
+	} else if (ch == '?') {
+		a->view.help = true;
 	} else if (ch >= '1' && ch <= '9') {
 		a->view.selected = ch - '1';
 		top_view_move(&a->view, &a->model, 0);
@@ -235,11 +336,11 @@ static void on_char(struct top_app *a, int ch)
 		a->view.kind = (enum top_view_kind)((a->view.kind + 1) % 3);
 		set_status(a, "view: %s",
 			 a->view.kind == TOP_VIEW_AUTO ? "auto" : a->view.kind == TOP_VIEW_DETAIL ? "detail" : "compact");
-	} else if (mode_of_key(ch) >= 0 || ch == '+' || ch == '=' || ch == '-') {
+	} else if (ch == 'm' || ch == 'M' || ch == '+' || ch == '=' || ch == '-') {
 		if (a->read_only)
 			set_status(a, "read-only: commands are disabled");
-		else if (mode_of_key(ch) >= 0)
-			send_mode(a, mode_of_key(ch), ch >= 'A' && ch <= 'Z');
+		else if (ch == 'm' || ch == 'M')
+			a->view.prefix = ch;
 		else
 			send_nudge(a, ch == '-' ? -1 : 1);
 	}
@@ -251,7 +352,15 @@ static void read_keys(struct top_app *a)
 	ssize_t n = read(STDIN_FILENO, buf, sizeof(buf));
 	for (ssize_t i = 0; i < n; i++) {
 		int ch = 0;
-		switch (top_key_feed(&a->kp, buf[i], &ch)) {
+		enum top_key key = top_key_feed(&a->kp, buf[i], &ch);
+		/* a navigation key closes the help and cancels a half-typed mode change */
+		if (key != TOP_KEY_NONE && key != TOP_KEY_CHAR && (a->view.help || a->view.prefix)) {
+			if (a->view.prefix)
+				set_status(a, "mode change cancelled");
+			a->view.help = false;
+			a->view.prefix = 0;
+		}
+		switch (key) {
 		case TOP_KEY_UP: top_view_move(&a->view, &a->model, -1); break;
 		case TOP_KEY_DOWN: top_view_move(&a->view, &a->model, 1); break;
 		case TOP_KEY_PGUP: top_view_move(&a->view, &a->model, -TOP_PAGE_ROBOTS); break;
@@ -266,8 +375,28 @@ static void read_keys(struct top_app *a)
 
 /* ---- output --------------------------------------------------------------------- */
 
+/* The banner: the first line of --banner-file, read every frame (whoever
+ * runs the show rewrites it; a missing or empty file shows nothing). */
+static void read_banner(struct top_app *a)
+{
+	a->view.banner[0] = '\0';
+	if (a->banner_file == NULL)
+		return;
+	FILE *f = fopen(a->banner_file, "r");
+	if (f == NULL)
+		return;
+	char line[TOP_STATUS_MAX];
+	if (fgets(line, sizeof line, f) != NULL) {
+		line[strcspn(line, "\r\n")] = '\0';
+		/* printable ASCII only: the screen must not take escapes from a file */
+		text_line(a->view.banner, sizeof a->view.banner, line);
+	}
+	fclose(f);
+}
+
 static void draw(struct top_app *a, double now)
 {
+	read_banner(a);
 	time_t t = time(NULL);
 	struct tm tm;
 	localtime_r(&t, &tm);
@@ -357,6 +486,8 @@ static int run_interactive(struct top_app *a)
 			next = 0;
 		}
 		double now = clock_mono_s();
+		if (a->all.showing && now - a->all.sent_at < TOP_ALL_ANSWER_S + 2 * TOP_FRAME_S)
+			show_all_status(a, now);
 		if (now >= next) {
 			draw(a, now);
 			next = now + TOP_FRAME_S;
@@ -364,23 +495,27 @@ static int run_interactive(struct top_app *a)
 		pump(a, next - now, true);
 	}
 	term_leave();
-	return 0;
+	/* 130: interrupted, as a shell reports SIGINT; whoever started us (the
+	 * demo) stops instead of going on as after q */
+	return a->interrupted ? 130 : 0;
 }
 
 /* ---- options -------------------------------------------------------------------- */
 
 static void usage(FILE *f)
 {
-	fputs("usage: undulate-top [--lcm-url URL] [--read-only] [--once [--wait S]] [--json [--interval S]] [-v]\n"
+	fputs("usage: undulate-top [--lcm-url URL] [--read-only] [--banner-file FILE] [--once [--wait S]]\n"
+	      "                    [--json [--interval S]] [-v]\n"
 	      "Live view of every robot publishing <robot>.STATE on the LCM network.\n"
 	      "  --once        collect for --wait S (default 1.5), print one snapshot, exit\n"
 	      "  --json        JSON snapshots, one object per line (with --once exactly one)\n"
 	      "  --interval S  seconds between --json snapshots (default 1)\n"
 	      "  --read-only   no commands (keys only navigate)\n"
+	      "  --banner-file FILE  show FILE's first line under the title, re-read every frame\n"
 	      "  --lcm-url URL LCM provider (default: $LCM_DEFAULT_URL or udpm ttl=0)\n"
-	      "keys: up/down or 1-9 select; l h s o = LIMP HOLD SINUSOID OSCILLATOR for the\n"
-	      "selected robot, L H S O for all; +/- nudge c (OSCILLATOR) or the amplitude\n"
-	      "(SINUSOID); v detail/compact view; PgUp/PgDn; q or Ctrl-C quit\n",
+	      "keys: up/down j/k 1-9 select; m then l h s o = LIMP HOLD SINUSOID OSCILLATOR for\n"
+	      "the selected robot, M then l h s o for every robot; +/- nudge c (OSCILLATOR) or\n"
+	      "the amplitude (SINUSOID); v detail/compact view; ? help; q or Ctrl-C quit\n",
 	      f);
 }
 
@@ -397,12 +532,13 @@ static int parse_seconds(const char *opt, const char *s, double *out)
 
 static int parse_args(struct top_app *a, int argc, char **argv)
 {
-	enum { O_URL = 256, O_RO, O_ONCE, O_JSON, O_WAIT, O_INTERVAL };
+	enum { O_URL = 256, O_RO, O_ONCE, O_JSON, O_WAIT, O_INTERVAL, O_BANNER };
 	static const struct option opts[] = {
 		{ "lcm-url", required_argument, NULL, O_URL }, { "read-only", no_argument, NULL, O_RO },
 		{ "once", no_argument, NULL, O_ONCE },          { "json", no_argument, NULL, O_JSON },
 		{ "wait", required_argument, NULL, O_WAIT },    { "interval", required_argument, NULL, O_INTERVAL },
 		{ "help", no_argument, NULL, 'h' },             { "verbose", no_argument, NULL, 'v' },
+		{ "banner-file", required_argument, NULL, O_BANNER },
 		{ NULL, 0, NULL, 0 },
 	};
 	int c;
@@ -410,6 +546,7 @@ static int parse_args(struct top_app *a, int argc, char **argv)
 		switch (c) {
 		case O_URL: a->url = optarg; break;
 		case O_RO: a->read_only = true; break;
+		case O_BANNER: a->banner_file = optarg; break;
 		case O_ONCE: a->once = true; break;
 		case O_JSON: a->json = true; break;
 		case O_WAIT: if (parse_seconds("--wait", optarg, &a->wait_s)) return -1; break;
@@ -449,6 +586,7 @@ int main(int argc, char **argv)
 	if (parse_args(a, argc, argv) != 0)
 		return 1;
 	a->view.read_only = a->read_only;
+	a->view.url = a->url;
 	char host[64] = "?";
 	gethostname(host, sizeof(host) - 1);
 	/* short enough for any robot to take (command.h's CMD_STR_MAX) */

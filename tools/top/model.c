@@ -1,5 +1,6 @@
 /* model.c — see model.h. */
 #include "model.h"
+#include "dxl.h"
 #include "json.h"
 #include "modes.h"
 #include "phase.h"
@@ -35,6 +36,7 @@ static struct top_robot *top_robot_get(struct top_model *m, const char *name)
 	struct top_robot *r = &m->robots[m->nrobots];
 	memset(r, 0, sizeof(*r));
 	snprintf(r->name, sizeof(r->name), "%s", name);
+	r->lever = NAN;
 	m->order[m->nrobots] = m->nrobots;
 	m->nrobots++;
 	top_model_order(m);
@@ -75,6 +77,7 @@ void top_on_state(struct top_model *m, const undulate_robot_state_t *s, double n
 			.servo_id = js->servo_id, .angle = js->angle, .speed = js->speed, .goal = js->goal, .drive = js->drive,
 			.load = js->load, .phase = js->phase, .amplitude = js->amplitude,
 			.frequency = js->frequency, .error_bits = js->error_bits,
+			.temperature = js->temperature, .voltage = js->voltage,
 			.stale_cycles = js->stale_cycles, .torque = js->torque,
 		};
 	}
@@ -155,6 +158,45 @@ void top_on_sim_collision(struct top_model *m, const undulate_sim_collision_t *c
 	top_on_collision(m, c, now);
 }
 
+/* Angle (rad) a body's joint must be deflected by before its lever
+ * (lateral offset per radian) is estimated from it. */
+#define TOP_LEVER_MIN_ANGLE 0.2
+
+static void top_trend_update(struct top_model *m, const undulate_sim_truth_t *t, double now)
+{
+	if (!isfinite(t->total_impulse) || t->total_impulse < 0)
+		return; /* a broken total would poison every window after it */
+	if (m->trend_t0 <= 0 || t->total_collisions < m->trend_coll0 || t->total_impulse < m->trend_imp0) {
+		/* first message, or a restarted simulator: a new first window */
+		m->trend_t0 = now;
+		m->trend_coll0 = t->total_collisions;
+		m->trend_imp0 = t->total_impulse;
+		return;
+	}
+	double dt = now - m->trend_t0;
+	if (dt < TOP_TREND_S)
+		return;
+	m->trend_coll[m->trendnext] = t->total_collisions - m->trend_coll0;
+	m->trend_force[m->trendnext] = (t->total_impulse - m->trend_imp0) / dt;
+	m->trendnext = (m->trendnext + 1) % TOP_TREND_N;
+	if (m->ntrend < TOP_TREND_N)
+		m->ntrend++;
+	m->trend_t0 = now;
+	m->trend_coll0 = t->total_collisions;
+	m->trend_imp0 = t->total_impulse;
+}
+
+int top_trend(const struct top_model *m, int64_t *coll, double *force, int n)
+{
+	int have = m->ntrend < n ? m->ntrend : n;
+	for (int i = 0; i < have; i++) {
+		int k = (m->trendnext - have + i + TOP_TREND_N) % TOP_TREND_N;
+		coll[i] = m->trend_coll[k];
+		force[i] = m->trend_force[k];
+	}
+	return have;
+}
+
 void top_on_truth(struct top_model *m, const undulate_sim_truth_t *t, double now)
 {
 	m->have_sim = true;
@@ -172,7 +214,11 @@ void top_on_truth(struct top_model *m, const undulate_sim_truth_t *t, double now
 		r->body_servo = b->servo_id;
 		r->neutral = b->neutral;
 		r->lateral = b->lateral;
+		/* the lever from a clearly deflected joint (small angles divide noise) */
+		if (fabs(b->angle) > TOP_LEVER_MIN_ANGLE)
+			r->lever = (b->lateral - b->neutral) / b->angle;
 	}
+	top_trend_update(m, t, now);
 	/* SIM.COLLISION is the per-collision channel; the copies inside
 	 * SIM.TRUTH (stamped with the truth message's time, so not matchable)
 	 * count only while no SIM.COLLISION is heard. */
@@ -208,6 +254,30 @@ void top_model_order(struct top_model *m)
 		}
 		m->order[k] = v;
 	}
+}
+
+bool top_joint_silent(const struct top_joint *j)
+{
+	return j->stale_cycles > 0;
+}
+
+int top_robot_silent_joints(const struct top_robot *r)
+{
+	int n = 0;
+	for (int k = 0; k < r->njoints; k++)
+		n += top_joint_silent(&r->j[k]);
+	return n;
+}
+
+const char *top_joint_status(const struct top_joint *j, char *buf, size_t cap)
+{
+	if (top_joint_silent(j))
+		snprintf(buf, cap, "SILENT x%d", (int)j->stale_cycles);
+	else if (j->error_bits & 0x7F)
+		dxl_errbits_format((uint8_t)(j->error_bits & 0x7F), buf, cap);
+	else
+		snprintf(buf, cap, "ok");
+	return buf;
 }
 
 bool top_robot_stale(const struct top_robot *r, double now)
@@ -274,7 +344,8 @@ int top_robot_contact_joint(const struct top_robot *r)
 
 double top_robot_dphase_joints(const struct top_robot *r)
 {
-	if (!r->have_state || r->njoints < 2)
+	/* a silent joint's phase is frozen: no difference to show */
+	if (!r->have_state || r->njoints < 2 || top_joint_silent(&r->j[0]) || top_joint_silent(&r->j[1]))
 		return NAN;
 	return phase_wrap(r->j[1].phase - r->j[0].phase);
 }
@@ -286,7 +357,25 @@ double top_neighbour_dphase(const struct top_model *m, int k)
 	const struct top_robot *a = &m->robots[m->order[k]], *b = &m->robots[m->order[k + 1]];
 	if (!a->have_state || !b->have_state || a->njoints == 0 || b->njoints == 0)
 		return NAN;
-	return phase_wrap(b->j[top_robot_contact_joint(b)].phase - a->j[top_robot_contact_joint(a)].phase);
+	const struct top_joint *ja = &a->j[top_robot_contact_joint(a)], *jb = &b->j[top_robot_contact_joint(b)];
+	if (top_joint_silent(ja) || top_joint_silent(jb))
+		return NAN;
+	return phase_wrap(jb->phase - ja->phase);
+}
+
+double top_pair_bound(const struct top_model *m, int k)
+{
+	if (k < 0 || k + 1 >= m->nrobots)
+		return NAN;
+	const struct top_robot *a = &m->robots[m->order[k]], *b = &m->robots[m->order[k + 1]];
+	if (!a->have_body || !b->have_body || !a->have_state || !b->have_state || a->njoints == 0 || b->njoints == 0)
+		return NAN;
+	double lever = 0.5 * (a->lever + b->lever);
+	double amp = 0.5 * (a->j[top_robot_contact_joint(a)].amplitude + b->j[top_robot_contact_joint(b)].amplitude);
+	if (!(fabs(lever) > 0) || !(amp > 0))
+		return NAN;
+	double d = fabs(b->neutral - a->neutral) / (2.0 * fabs(lever) * amp);
+	return d >= 1.0 ? M_PI : 2.0 * asin(d);
 }
 
 int top_collisions_window(const struct top_model *m, double now, double *impulse)
@@ -324,6 +413,10 @@ static void top_json_joint(struct json *j, const struct top_joint *jt)
 	json_field_number(j, "frequency", jt->frequency);
 	json_field_int(j, "error_bits", jt->error_bits);
 	json_field_int(j, "stale_cycles", jt->stale_cycles);
+	json_field_number(j, "temperature", jt->temperature);
+	json_field_number(j, "voltage", jt->voltage);
+	char status[96];
+	json_field_string(j, "status", top_joint_status(jt, status, sizeof status));
 	json_field_bool(j, "torque", jt->torque);
 	json_object_end(j);
 }

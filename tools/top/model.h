@@ -26,11 +26,15 @@
 #define TOP_COLL_DEDUP 64      /* recent collisions: one seen on SIM.COLLISION and SIM.TRUTH counts once */
 #define TOP_SIM_STALE_S 2.0    /* simulator considered gone after this long */
 #define TOP_JSON_DIGITS 12     /* significant digits of --json numbers */
+#define TOP_TREND_S 5.0        /* contact trend: window length, s */
+#define TOP_TREND_N 12         /* windows kept (a minute) */
 
 struct top_joint {
 	int16_t servo_id;
 	double angle, speed, goal, load, phase, amplitude, frequency;
 	double drive;          /* torque actuation: output ratio sent (NaN with goals) */
+	double temperature;    /* °C, as the servo last reported */
+	double voltage;        /* V */
 	int16_t error_bits;
 	int32_t stale_cycles;
 	bool torque;
@@ -62,6 +66,7 @@ struct top_robot {
 	bool have_body;
 	int16_t body_servo;
 	double neutral, lateral;
+	double lever;              /* m per rad of the contact joint; NAN until seen swinging */
 	/* <robot>.EVENT */
 	char last_event[TOP_TEXT_MAX];
 	int64_t last_event_seq;
@@ -92,6 +97,14 @@ struct top_model {
 	int ncoll, collnext;
 	struct top_seen seen[TOP_COLL_DEDUP];
 	int seennext;
+	/* contact trend from SIM.TRUTH's running totals: per TOP_TREND_S window
+	 * the impacts and the mean contact force (impacts and resting contact) */
+	double trend_t0;            /* s (monotonic) the open window began; 0: none */
+	int64_t trend_coll0;
+	double trend_imp0;
+	int64_t trend_coll[TOP_TREND_N];
+	double trend_force[TOP_TREND_N];
+	int ntrend, trendnext;
 	int64_t decode_errors;
 };
 
@@ -112,6 +125,14 @@ void top_model_order(struct top_model *m);
 int top_robot_index(const struct top_model *m, const char *name);
 
 bool top_robot_stale(const struct top_robot *r, double now);
+/* A joint whose servo has not given a valid reading for a cycle or more: its
+ * angle and speed are the last good ones, frozen. */
+bool top_joint_silent(const struct top_joint *j);
+/* Joints of R that are silent. */
+int top_robot_silent_joints(const struct top_robot *r);
+/* A joint's health in words: "ok", "SILENT xN" (no valid reading for N cycles), or the
+ * servo's error bits by name ("overload|overheating"). */
+const char *top_joint_status(const struct top_joint *j, char *buf, size_t cap);
 double top_robot_rate_hz(const struct top_robot *r);      /* 1e6 / mean period; NAN none */
 double top_robot_rx_hz(const struct top_robot *r, double now); /* STATE messages received per second */
 double top_robot_jitter_p99(const struct top_robot *r);   /* µs; NAN none */
@@ -121,6 +142,14 @@ int top_robot_contact_joint(const struct top_robot *r);
 double top_robot_dphase_joints(const struct top_robot *r);
 /* phase(order[k+1]) - phase(order[k]) on their contact joints; NAN if unknown. */
 double top_neighbour_dphase(const struct top_model *m, int k);
+/* The compatibility bound 2·asin(d̃) of the pair (order[k], order[k+1]),
+ * d̃ = |n_b − n_a| / (2·lever·A) from the simulator's neutral positions, the
+ * bodies' lever and the contact joints' amplitude; π when d̃ >= 1 (they cannot
+ * touch); NAN while unknown (no simulator, or no swing seen yet). */
+double top_pair_bound(const struct top_model *m, int k);
+/* The last N closed trend windows, oldest first: impacts and mean contact
+ * force (N). Returns how many were written (<= n). */
+int top_trend(const struct top_model *m, int64_t *coll, double *force, int n);
 /* collisions received within the last TOP_COLL_WINDOW_S, and their impulse */
 int top_collisions_window(const struct top_model *m, double now, double *impulse);
 bool top_sim_present(const struct top_model *m, double now);

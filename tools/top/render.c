@@ -1,5 +1,6 @@
 /* render.c — see render.h. */
 #include "render.h"
+#include "dxl.h"
 #include "modes.h"
 
 #include <math.h>
@@ -113,12 +114,16 @@ static void title_line(struct rbuf *b, const struct top_model *m, const struct t
 static void flags_text(char *out, size_t n, const struct top_robot *r, double now)
 {
 	int16_t err = 0;
+	int silent = top_robot_silent_joints(r);
 	for (int k = 0; k < r->njoints; k++)
 		err |= r->j[k].error_bits;
+	char names[64];
 	if (top_robot_stale(r, now))
 		snprintf(out, n, r->have_state ? "STALE %.0fs" : "no state", now - r->rx);
-	else if (err)
-		snprintf(out, n, "err %02X", err & 0xFF);
+	else if (silent > 0)
+		snprintf(out, n, "%d joint%s SILENT", silent, silent == 1 ? "" : "s");
+	else if (err & 0x7F)
+		snprintf(out, n, "%s", dxl_errbits_format((uint8_t)(err & 0x7F), names, sizeof names));
 	else if (r->have_bus && !r->connected)
 		snprintf(out, n, "bus down");
 	else
@@ -128,54 +133,134 @@ static void flags_text(char *out, size_t n, const struct top_robot *r, double no
 static void robot_detail(struct rbuf *b, const struct top_model *m, const struct top_view *v, int pos, double now)
 {
 	const struct top_robot *r = &m->robots[m->order[pos]];
-	char rate[16], jit[16], dj[16], dn[16], flags[32];
+	char rate[16], jit[16], dj[16], dn[16], bd[16], flags[80];
 	flags_text(flags, sizeof(flags), r, now);
-	rb_line(b, pos == v->selected, "%c%2d %-14.14s %-4s %s %s %5lld %s %s %s", pos == v->selected ? '>' : ' ',
+	rb_line(b, pos == v->selected, "%c%2d %-14.14s %-4s %s %s %5lld %s %s %s %s", pos == v->selected ? '>' : ' ',
 		pos + 1, r->name, r->have_state ? mode_short(r->mode) : "-",
 		num(rate, sizeof(rate), "%6.1f", top_robot_rate_hz(r), 6),
 		num(jit, sizeof(jit), "%6.0f", top_robot_jitter_p99(r), 6), (long long)r->bus_errors,
-		num(dj, sizeof(dj), "%+8.2f", top_robot_dphase_joints(r), 8),
-		num(dn, sizeof(dn), "%+8.2f", top_neighbour_dphase(m, pos), 8), flags);
+		num(dj, sizeof(dj), "%+7.2f", top_robot_dphase_joints(r), 7),
+		num(dn, sizeof(dn), "%+7.2f", top_neighbour_dphase(m, pos), 7),
+		num(bd, sizeof(bd), "%5.2f", top_pair_bound(m, pos), 5), flags);
 	if (r->fault[0] != '\0')
 		rb_line(b, false, "     FAULT LATCHED: %s (send 'clear' once fixed)", r->fault);
 	for (int k = 0; k < r->njoints; k++) {
 		const struct top_joint *j = &r->j[k];
+		/* A silent servo's angle and speed are its last good reading,
+		 * frozen: shown as dashes, never as if live. */
+		bool live = !top_joint_silent(j);
+		double nan = NAN;
 		/* torque actuation has no goal: the column shows the drive, marked d */
-		char goal[16], ang[16], spd[16], load[16], ph[16], amp[16], freq[16];
+		char goal[16], ang[16], spd[16], load[16], ph[16], amp[16], freq[16], temp[16], volt[16], st[64];
 		if (!isfinite(j->goal) && isfinite(j->drive))
 			snprintf(goal, sizeof goal, "d%+6.3f", j->drive);
 		else
 			num(goal, sizeof goal, "%+7.3f", j->goal, 7);
-		rb_line(b, false, "     j%d id%-3d %s %s %7s %s %s %s %s %02X", k, j->servo_id,
-			num(ang, sizeof ang, "%+7.3f", j->angle, 7), num(spd, sizeof spd, "%+7.3f", j->speed, 7), goal,
-			num(load, sizeof load, "%+6.2f", j->load, 6), num(ph, sizeof ph, "%+6.2f", j->phase, 6),
-			num(amp, sizeof amp, "%5.2f", j->amplitude, 5), num(freq, sizeof freq, "%5.2f", j->frequency, 5),
-			j->error_bits & 0xFF);
+		rb_line(b, false, "   j%d id%-3d %s %s %7s %s %s %s %s %s %s %s", k, j->servo_id,
+			num(ang, sizeof ang, "%+7.3f", live ? j->angle : nan, 7),
+			num(spd, sizeof spd, "%+7.3f", live ? j->speed : nan, 7), goal,
+			num(load, sizeof load, "%+5.2f", live ? j->load : nan, 5),
+			num(ph, sizeof ph, "%+5.2f", live ? j->phase : nan, 5),
+			num(amp, sizeof amp, "%4.2f", j->amplitude, 4), num(freq, sizeof freq, "%4.2f", j->frequency, 4),
+			num(temp, sizeof temp, "%3.0fC", j->temperature > 0 ? j->temperature : nan, 4),
+			num(volt, sizeof volt, "%4.1fV", j->voltage > 0 ? j->voltage : nan, 5),
+			top_joint_status(j, st, sizeof st));
 	}
 }
 
 static void robot_compact(struct rbuf *b, const struct top_model *m, const struct top_view *v, int pos, double now)
 {
 	const struct top_robot *r = &m->robots[m->order[pos]];
-	char rate[16], jit[16], dj[16], dn[16], jt[2][32];
+	char rate[16], jit[16], dj[16], dn[16], bd[16], jt[2][32];
 	for (int k = 0; k < 2; k++) {
 		char ang[16], ph[16];
-		if (k < r->njoints)
+		if (k < r->njoints && k == 0)
 			snprintf(jt[k], sizeof(jt[k]), "%s %s", num(ang, sizeof ang, "%+6.2f", r->j[k].angle, 6),
 			         num(ph, sizeof ph, "%+6.2f", r->j[k].phase, 6));
+		else if (k < r->njoints)
+			snprintf(jt[k], sizeof(jt[k]), "%s", num(ph, sizeof ph, "%+6.2f", r->j[k].phase, 6));
 		else
-			snprintf(jt[k], sizeof(jt[k]), "%13s", "");
+			snprintf(jt[k], sizeof(jt[k]), "%*s", k == 0 ? 13 : 6, "");
 	}
 	int16_t err = 0;
 	for (int k = 0; k < r->njoints; k++)
 		err |= r->j[k].error_bits;
-	char mark = top_robot_stale(r, now) ? 'x' : err ? '!' : ' ';
-	rb_line(b, pos == v->selected, "%c%c%2d %-10.10s %-4s %s %s %4lld %s %s %s %s", pos == v->selected ? '>' : ' ',
+	char mark = top_robot_stale(r, now) ? 'x' : top_robot_silent_joints(r) > 0 ? 'S' : err ? '!' : ' ';
+	rb_line(b, pos == v->selected, "%c%c%2d %-10.10s %-4s %s %s %4lld %s %s %s %s %s", pos == v->selected ? '>' : ' ',
 		mark, pos + 1, r->name, r->have_state ? mode_short(r->mode) : "-",
 		num(rate, sizeof(rate), "%5.1f", top_robot_rate_hz(r), 5),
 		num(jit, sizeof(jit), "%5.0f", top_robot_jitter_p99(r), 5), (long long)r->bus_errors, jt[0], jt[1],
 		num(dj, sizeof(dj), "%+6.2f", top_robot_dphase_joints(r), 6),
-		num(dn, sizeof(dn), "%+6.2f", top_neighbour_dphase(m, pos), 6));
+		num(dn, sizeof(dn), "%+6.2f", top_neighbour_dphase(m, pos), 6),
+		num(bd, sizeof(bd), "%5.2f", top_pair_bound(m, pos), 5));
+}
+
+/* The banner (what the show is doing now) and, with a simulator, the contact
+ * trend: collisions and mean contact force per TOP_TREND_S window, oldest
+ * first. Returns the lines written. */
+#define TOP_TREND_SHOWN 8
+static int extra_count(const struct top_model *m, const struct top_view *v)
+{
+	return (v->banner[0] != '\0') + (m->have_sim && m->ntrend > 0 ? 2 : 0);
+}
+
+static int extra_lines(struct rbuf *b, const struct top_model *m, const struct top_view *v)
+{
+	int n = 0;
+	if (v->banner[0] != '\0') {
+		rb_line(b, false, "%s", v->banner);
+		n++;
+	}
+	int64_t coll[TOP_TREND_SHOWN];
+	double force[TOP_TREND_SHOWN];
+	int k = m->have_sim ? top_trend(m, coll, force, TOP_TREND_SHOWN) : 0;
+	if (k > 0) {
+		char fl[TOP_LINE_MAX] = "", cl[TOP_LINE_MAX] = "";
+		size_t fo = 0, co = 0;
+		/* %g: a force from a hostile or broken SIM.TRUTH (1e300 N) stays
+		 * one short field; the offsets never pass the buffers' ends */
+		for (int i = 0; i < k; i++) {
+			int w = snprintf(fl + fo, sizeof fl - fo, " %6.3g", force[i]);
+			fo = w > 0 && (size_t)w < sizeof fl - fo ? fo + (size_t)w : sizeof fl - 1;
+			w = snprintf(cl + co, sizeof cl - co, " %6lld", (long long)coll[i]);
+			co = w > 0 && (size_t)w < sizeof cl - co ? co + (size_t)w : sizeof cl - 1;
+		}
+		rb_line(b, false, "contact force, N per %.0f s:%s", TOP_TREND_S, fl);
+		rb_line(b, false, "collisions per %.0f s:     %s", TOP_TREND_S, cl);
+		n += 2;
+	}
+	return n;
+}
+
+/* `?`: what the columns mean and what the keys do (also in undulate-top(1)). */
+static const char *const top_help_lines[] = {
+	"Robot line:  mode LIMP | HOLD | SIN(USOID) | OSC(ILLATOR)",
+	"  rate    control loop rate, Hz (mean period over the last 128 cycles)",
+	"  jit99   99th percentile of the loop's wake-up lateness, us",
+	"  berr    bus errors since the daemon started (timeouts, bad replies)",
+	"  dJ      phase of joint 1 minus joint 0, rad",
+	"  d(next) phase of the next robot minus this one's (contact joints), rad",
+	"  bound   2 asin(d~) with the next robot: |d(next)| below it, no contact needed",
+	"  flags   STALE (no STATE > 1 s), N joints SILENT, error bits, bus down",
+	"Joint line: angle (rad), speed (rad/s), goal (rad; d+x: torque drive),",
+	"  load (of max torque), phase (rad), amp (rad), freq (Hz), temp (C), volt (V);",
+	"  status: ok | SILENT xN (no valid reading for N cycles: its angle and speed",
+	"  are frozen, shown as -) | the servo's error bits by name (overload, ...)",
+	"Keys: up/down j/k 1-9 PgUp/PgDn Home/End select; v view (auto/detail/compact)",
+	"  m then l/h/s/o  mode of the selected robot: LIMP HOLD SINUSOID OSCILLATOR",
+	"  M then l/h/s/o  the same for every robot; the status line counts answers",
+	"  + / -  OSCILLATOR: c of every joint +-10 %; SINUSOID: amplitude +-0.05 rad",
+	"  ? this help; q quit (Ctrl-C: interrupt). Commands reach local robots only.",
+};
+
+static void help_screen(struct rbuf *b, const struct top_view *v, int rows)
+{
+	(void)v;
+	for (size_t i = 0; i < sizeof top_help_lines / sizeof top_help_lines[0]; i++) {
+		if (b->lines >= rows - TOP_FOOT_LINES)
+			break;
+		rb_line(b, false, "%s", top_help_lines[i]);
+	}
 }
 
 /* Keeps the selected robot on screen; returns the last position shown. */
@@ -207,8 +292,10 @@ size_t top_render(const struct top_model *m, struct top_view *v, double now, int
 {
 	struct rbuf b = { .buf = buf, .cap = cap, .cols = cols, .ansi = ansi, .max_lines = ansi ? rows : 0 };
 	buf[0] = '\0';
-	bool detail = ansi ? top_view_detailed(m, v, rows) : true;
-	int avail = rows - (detail ? TOP_HEAD_LINES_DETAIL : TOP_HEAD_LINES_COMPACT) - TOP_FOOT_LINES;
+	/* the banner and the contact trend take lines from the list */
+	int extra = extra_count(m, v);
+	bool detail = ansi ? top_view_detailed(m, v, rows - extra) : true;
+	int avail = rows - extra - (detail ? TOP_HEAD_LINES_DETAIL : TOP_HEAD_LINES_COMPACT) - TOP_FOOT_LINES;
 	int first = 0, last = m->nrobots - 1;
 	if (ansi) {
 		rb_raw(&b, "\033[H");
@@ -216,28 +303,39 @@ size_t top_render(const struct top_model *m, struct top_view *v, double now, int
 		first = v->scroll;
 	}
 	title_line(&b, m, v, now, first, last);
-	if (detail) {
-		rb_line(&b, false, "  # robot          mode   rate  jit99  berr  dJ(1-0) d(next)");
-		rb_line(&b, false, "     joint       angle   speed    goal   load  phase   amp  freq err");
+	extra_lines(&b, m, v);
+	if (ansi && v->help) {
+		help_screen(&b, v, rows);
 	} else {
-		rb_line(&b, false, "    # robot      mode  rate jit99 berr j0 angle phase j1 angle phase    dJ dnext");
+	if (detail) {
+		rb_line(&b, false, "  # robot          mode   rate  jit99  berr dJ(1-0) d(next) bound");
+		rb_line(&b, false, "   joint     angle   speed    goal  load phase  amp freq temp  volt status");
+	} else {
+		rb_line(&b, false, "    # robot      mode  rate jit99 berr j0 angle phase j1 ph     dJ  dnext bound");
 	}
 	if (m->nrobots == 0)
-		rb_line(&b, false, "  (no robot heard yet: <robot>.STATE on this LCM URL)");
+		rb_line(&b, false, "  (no robot heard yet on %s: is a daemon running with this --lcm-url?)",
+			v->url && v->url[0] ? v->url : "LCM's default URL");
 	for (int p = first; p <= last && p < m->nrobots; p++) {
 		if (detail)
 			robot_detail(&b, m, v, p, now);
 		else
 			robot_compact(&b, m, v, p, now);
 	}
+	}
 	if (ansi) {
 		while (b.lines < rows - TOP_FOOT_LINES)
 			rb_line(&b, false, "%s", "");
 		rb_line(&b, false, "%s", v->status);
-		if (v->read_only)
-			rb_line(&b, false, "READ-ONLY  up/down 1-9 select  PgUp/PgDn  v view  q quit");
+		if (v->help)
+			rb_line(&b, false, "any key: back to the robots");
+		else if (v->read_only)
+			rb_line(&b, false, "READ-ONLY  up/dn j/k 1-9 select  v view  ? help  q quit");
+		else if (v->prefix)
+			rb_line(&b, false, "mode for %s: l LIMP  h HOLD  s SINUSOID  o OSCILLATOR  (other key: cancel)",
+				v->prefix == 'M' ? "EVERY robot" : "the selected robot");
 		else
-			rb_line(&b, false, "up/dn 1-9 select  l h s o mode (LHSO: all)  +/- nudge  v view  q quit");
+			rb_line(&b, false, "up/dn j/k 1-9 select  m mode  M mode for all  +/- nudge  v view  ? help  q quit");
 		/* no newline after the last line: the screen must not scroll */
 		if (b.len >= 2 && strcmp(b.buf + b.len - 2, "\r\n") == 0)
 			b.buf[b.len -= 2] = '\0';

@@ -21,6 +21,10 @@ struct top_view {
 	int scroll;              /* first position shown */
 	enum top_view_kind kind;
 	bool read_only;
+	bool help;               /* `?`: the legend and keys instead of the list */
+	int prefix;              /* 'm' or 'M' typed: the next key names the mode (0: none) */
+	const char *url;         /* the LCM URL listened on, said when nobody is heard */
+	char banner[TOP_STATUS_MAX]; /* a line from whoever runs the show (--banner-file), or "" */
 	char status[TOP_STATUS_MAX];
 	char clock[16];          /* HH:MM:SS shown in the title */
 };
