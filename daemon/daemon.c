@@ -40,6 +40,7 @@
 #include "publish.h"
 #include "setup.h"
 #include "stats.h"
+#include "tune.h"
 #include "undulate_command_t.h"
 
 /* Reconnect back-off: 100 ms doubling to 2 s. */
@@ -84,6 +85,9 @@ struct dmn {
 	/* systemd */
 	uint64_t watchdog_interval_us, last_watchdog_us, watchdog_cycle;
 	bool stop;
+	/* --tune: the tuner, fed every cycle (NULL in normal runs) */
+	struct tune *tune;
+	FILE *tune_out;
 	struct log_limit lim_bus, lim_overrun, lim_events;
 };
 
@@ -370,8 +374,47 @@ static void dmn_control(struct dmn *d)
 		cin_apply(&d->cin, &d->ctl, d->cfg);
 		d->params_dirty = true;
 	}
+	if (d->tune && d->tune->changed) {
+		tune_apply(d->tune, d->cfg);
+		ctl_params_changed(&d->ctl);
+		d->params_dirty = true;
+	}
 	double dt = 1e-6 * (double)(d->cycle_start_us - d->last_cycle_start_us);
 	ctl_step(&d->ctl, dmn_ctl_time(d, d->cycle_start_us), dt, 1e-6 * (double)clock_wall_us());
+}
+
+/* --tune: this cycle's measurement to the tuner. It stops the run when it
+ * is done or gives up, and when the robot left OSCILLATOR (a fault latched,
+ * a LIMP command): it only knows how to tune a running oscillator. */
+static void dmn_tune_cycle(struct dmn *d)
+{
+	struct tune *t = d->tune;
+	if (d->ctl.mode != CFG_MODE_OSCILLATOR || d->ctl.latched) {
+		snprintf(t->why, sizeof t->why, "the robot left OSCILLATOR (%s%s%s): stopped", cfg_mode_name(d->ctl.mode),
+		         d->ctl.latched ? ", fault: " : "", d->ctl.latched ? d->ctl.latch : "");
+		t->state = TUNE_FAILED;
+		d->stop = true;
+		return;
+	}
+	double x[CFG_MAX_JOINTS], v[CFG_MAX_JOINTS];
+	for (size_t j = 0; j < d->ctl.n; j++) {
+		const struct ctl_joint *jt = &d->ctl.j[j];
+		bool ok = jt->have_reading && jt->stale_cycles == 0;   /* read this cycle */
+		x[j] = ok ? jt->angle - d->cfg->joint[j].neutral : NAN;
+		v[j] = ok ? jt->speed : NAN;
+	}
+	double volts = NAN;
+	for (size_t j = 0; j < d->ctl.n; j++)
+		if (d->ctl.j[j].voltage > 0 && !(d->ctl.j[j].voltage >= volts))
+			volts = d->ctl.j[j].voltage;   /* the lowest: the weakest servo sets the pace */
+	tune_supply(t, volts);
+	tune_sample(t, d->ctl.t, x, v, d->ctl.starter_active);
+	if (t->progress[0]) {
+		fprintf(d->tune_out, "tune: %5.1f s  %s\n", d->ctl.t, t->progress);
+		fflush(d->tune_out);
+	}
+	if (t->state == TUNE_DONE || t->state == TUNE_FAILED)
+		d->stop = true;
 }
 
 static void dmn_cycle_done(struct dmn *d)
@@ -380,6 +423,8 @@ static void dmn_cycle_done(struct dmn *d)
 		stats_add(&d->w_bus, d->cyc.bus_us);
 	dmn_flush_ctl_events(d);
 	dmn_publish_state(d);
+	if (d->tune && d->connected)
+		dmn_tune_cycle(d);
 	d->cycle++;
 }
 
@@ -605,12 +650,23 @@ static bool dmn_open(struct dmn *d, int *status)
 	return true;
 }
 
-int dmn_run(struct cfg *cfg)
+static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out);
+
+int dmn_run(struct cfg *cfg) { return dmn_run_with(cfg, NULL, NULL); }
+
+int dmn_run_tune(struct cfg *cfg, struct tune *t, void *progress)
+{
+	return dmn_run_with(cfg, t, progress ? progress : stdout);
+}
+
+static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 {
 	static struct dmn dmn;   /* large (bus stats per ID): not on the stack */
 	struct dmn *d = &dmn;
 	memset(d, 0, sizeof *d);
 	d->cfg = cfg;
+	d->tune = tune;
+	d->tune_out = tune_out;
 	d->lim_bus = (struct log_limit)LOG_LIMIT_INIT(5, 2000000);
 	d->lim_overrun = (struct log_limit)LOG_LIMIT_INIT(5, 5000000);
 	d->lim_events = (struct log_limit)LOG_LIMIT_INIT(30, 100000);

@@ -15,6 +15,14 @@
  * a retry), 2 when the configuration cannot work (not worth one). */
 int dmn_run(struct cfg *cfg);
 
+/* `undulated --tune`: the same loop in OSCILLATOR, with the tuner (tune.h)
+ * fed every cycle and its parameters applied at the cycle boundary, until it
+ * is done or has given up (or a signal). Then the usual safe stop. Progress
+ * lines go to `progress` (a FILE *). Returns as dmn_run(); what the tuner
+ * found is in *t. */
+struct tune;
+int dmn_run_tune(struct cfg *cfg, struct tune *t, void *progress);
+
 /* `undulated --command TEXT`: send one command to robot (or "*") and print
  * the answers within timeout_s. 0 if accepted (by every robot that
  * answered), 1 if rejected or unanswered, 2 on a usage error. */

@@ -1,16 +1,21 @@
 /*
  * main.c — undulated: command line, configuration, then the loop (daemon.c).
  */
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "auth.h"
 #include "config.h"
 #include "daemon.h"
 #include "log.h"
+#include "tune.h"
 
 /* Command-line overrides are applied in order after the file. */
 #define MAIN_MAX_OVERRIDES 64
@@ -23,6 +28,8 @@ static void main_usage(FILE *f)
 	        "                 [--key FILE] [--source NAME]\n"
 	        "       undulated --gen-key FILE\n"
 	        "       undulated --watch NAME|'*' [--lcm-url URL] [--timeout S]\n"
+	        "       undulated --tune [CONFIG.conf] --port PATH --ids 1,2 [--robot NAME]\n"
+	        "                 [--target-freq HZ] [--target-amp RAD] [--out FILE]\n"
 	        "\n"
 	        "Runs one robot: reads its joints at 100 Hz over the Dynamixel bus, integrates\n"
 	        "the limit-cycle oscillator from the measured state, writes goal positions and\n"
@@ -51,12 +58,21 @@ static void main_usage(FILE *f)
 	        "      --timeout S        how long --command waits for answers (default 1)\n"
 	        "      --watch NAME|'*'   print a robot's STATE/EVENT/BUS/PARAMS messages as text\n"
 	        "                         lines (with --timeout S: for S seconds)\n"
+	        "      --tune             run the oscillator on the connected robot and adjust k and mu until\n"
+	        "                         every joint is within 5 %% of the target frequency and amplitude;\n"
+	        "                         then write a complete configuration (with the SINUSOID baseline\n"
+	        "                         set to the gait measured) to --out FILE (default NAME.conf)\n"
+	        "      --target-freq HZ   --tune's frequency (default 0.8)\n"
+	        "      --target-amp RAD   --tune's amplitude, each joint's half peak-to-peak (default 0.8)\n"
+	        "      --tune-time S      --tune gives up after S seconds (default 90)\n"
+	        "      --out FILE         where --tune writes the configuration ('-': standard output)\n"
 	        "  -h, --help             this text\n");
 }
 
 enum {
 	OPT_SET = 256, OPT_PORT, OPT_IDS, OPT_BAUD, OPT_ROBOT, OPT_MODE, OPT_LCM, OPT_CHECK, OPT_LOGLEVEL,
-	OPT_COMMAND, OPT_TIMEOUT, OPT_WATCH, OPT_KEY, OPT_SOURCE, OPT_GENKEY,
+	OPT_COMMAND, OPT_TIMEOUT, OPT_WATCH, OPT_KEY, OPT_SOURCE, OPT_GENKEY, OPT_TUNE, OPT_TFREQ, OPT_TAMP,
+	OPT_TTIME, OPT_OUT,
 };
 
 struct main_args {
@@ -74,6 +90,10 @@ struct main_args {
 	const char *key_file;
 	const char *source;
 	const char *gen_key;
+	/* --tune */
+	bool tune;
+	struct tune_opts tune_opts;
+	const char *out;
 };
 
 static bool main_add(struct main_args *a, const char *key, const char *value)
@@ -108,6 +128,19 @@ static bool main_timeout(const char *text, double *s)
 	return true;
 }
 
+/* NAME TEXT: a finite number in [lo, hi]. */
+static bool main_number(const char *name, const char *text, double lo, double hi, const char *unit, double *out)
+{
+	char *end;
+	double v = strtod(text, &end);
+	if (end == text || *end != '\0' || !isfinite(v) || v < lo || v > hi) {
+		fprintf(stderr, "undulated: %s: '%s' is not a number of %s from %g to %g\n", name, text, unit, lo, hi);
+		return false;
+	}
+	*out = v;
+	return true;
+}
+
 /* Returns -1 to continue, else an exit status. */
 static int main_parse(int argc, char **argv, struct main_args *a)
 {
@@ -121,12 +154,16 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		{ "command", required_argument, NULL, OPT_COMMAND }, { "timeout", required_argument, NULL, OPT_TIMEOUT },
 		{ "watch", required_argument, NULL, OPT_WATCH }, { "key", required_argument, NULL, OPT_KEY },
 		{ "source", required_argument, NULL, OPT_SOURCE }, { "gen-key", required_argument, NULL, OPT_GENKEY },
+		{ "tune", no_argument, NULL, OPT_TUNE }, { "target-freq", required_argument, NULL, OPT_TFREQ },
+		{ "target-amp", required_argument, NULL, OPT_TAMP }, { "tune-time", required_argument, NULL, OPT_TTIME },
+		{ "out", required_argument, NULL, OPT_OUT },
 		{ "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 },
 	};
 	int o;
 	enum log_level lv;
 	bool ok = true;
 	a->timeout_s = 1.0;
+	a->tune_opts = (struct tune_opts){ .target_freq = 0.8, .target_amp = 0.8, .max_s = TUNE_DEFAULT_MAX_S };
 	while ((o = getopt_long(argc, argv, "c:vqh", opts, NULL)) != -1) {
 		switch (o) {
 		case 'c': a->config = optarg; break;
@@ -157,12 +194,31 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		case OPT_KEY: a->key_file = optarg; break;
 		case OPT_SOURCE: a->source = optarg; break;
 		case OPT_GENKEY: a->gen_key = optarg; break;
+		case OPT_TUNE: a->tune = true; break;
+		case OPT_TFREQ:
+			if (!main_number("--target-freq", optarg, 0.1, 3.0, "Hz", &a->tune_opts.target_freq))
+				return 2;
+			break;
+		case OPT_TAMP:
+			if (!main_number("--target-amp", optarg, 0.05, 2.0, "rad", &a->tune_opts.target_amp))
+				return 2;
+			break;
+		case OPT_TTIME:
+			if (!main_number("--tune-time", optarg, 10.0, 600.0, "s", &a->tune_opts.max_s))
+				return 2;
+			break;
+		case OPT_OUT: a->out = optarg; break;
 		case 'h': main_usage(stdout); return 0;
 		default: main_usage(stderr); return 2;
 		}
 	}
 	if (!ok)
 		return 2;
+	if (!a->tune && (a->out || a->tune_opts.target_freq != 0.8 || a->tune_opts.target_amp != 0.8 ||
+	                 a->tune_opts.max_s != TUNE_DEFAULT_MAX_S)) {
+		fprintf(stderr, "undulated: --out, --target-freq, --target-amp and --tune-time go with --tune\n");
+		return 2;
+	}
 	if (optind < argc && a->config == NULL)
 		a->config = argv[optind++];
 	if (optind < argc) {
@@ -179,6 +235,109 @@ static void main_print_errors(const struct cfg_errors *e)
 		fprintf(stderr, "undulated: config: %s\n", e->line[i]);
 	if (e->count > shown)
 		fprintf(stderr, "undulated: config: ... and %zu more error(s)\n", e->count - shown);
+}
+
+/* mkstemp makes 0600; a configuration is read by the service user: 0644
+ * less the umask, as any file the user writes. */
+static void fchmod_default(const char *path)
+{
+	mode_t m = umask(0);
+	umask(m);
+	chmod(path, 0666 & ~m);
+}
+
+/* --tune: run the tuner on the robot, then write what it found. Exit 0 done,
+ * 1 start-up failed, 2 usage or configuration, 3 the targets were not
+ * reached (nothing written), 130 stopped by a signal (nothing written). */
+static int main_tune(const struct main_args *a, struct cfg *cfg)
+{
+	cfg->mode = CFG_MODE_OSCILLATOR;
+	cfg->mode_given = true;
+	static struct tune t;
+	char why[TUNE_TEXT];
+	if (!tune_init(&t, &a->tune_opts, cfg, why, sizeof why)) {
+		fprintf(stderr, "undulated --tune: %s\n", why);
+		return 2;
+	}
+	/* where the result goes, made before tuning: a minute on the robot is not
+	 * lost to a directory that cannot be written */
+	char def[CFG_NAME_MAX + 8], tmp[CFG_PATH_MAX + 16];
+	snprintf(def, sizeof def, "%s.conf", cfg->name);
+	const char *out = a->out ? a->out : def;
+	bool to_stdout = strcmp(out, "-") == 0;
+	if (!a->out && access(def, F_OK) == 0) {
+		fprintf(stderr, "undulated --tune: %s exists: name the file to write with --out FILE (it is replaced)\n",
+		        def);
+		return 2;
+	}
+	int fd = -1;
+	if (!to_stdout) {
+		if (snprintf(tmp, sizeof tmp, "%s.XXXXXX", out) >= (int)sizeof tmp) {
+			fprintf(stderr, "undulated --tune: --out: path too long\n");
+			return 2;
+		}
+		fd = mkstemp(tmp);
+		if (fd < 0) {
+			fprintf(stderr, "undulated --tune: cannot write next to %s: %s\n", out, strerror(errno));
+			return 2;
+		}
+	}
+	printf("tune: robot %s, joint(s) ", cfg->name);
+	for (size_t j = 0; j < cfg->njoints; j++)
+		printf("%s%u", j ? "," : "", cfg->ids[j]);
+	printf(" on %s: target %.2f Hz, %.2f rad, every joint within %.0f %%; gives up after %.0f s; Ctrl-C stops "
+	       "with the joints %s\n", cfg->port[0] ? cfg->port : cfg->usb_serial, t.opts.target_freq,
+	       t.opts.target_amp, 100.0 * TUNE_TOLERANCE, t.opts.max_s,
+	       cfg->safe_stop == CFG_SAFE_LIMP ? "limp" : "holding");
+	fflush(stdout);
+	struct timespec t0, t1;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	int rc = dmn_run_tune(cfg, &t, stdout);
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	double took = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+	if (rc != 0 || t.state != TUNE_DONE) {
+		if (fd >= 0) {
+			close(fd);
+			unlink(tmp);
+		}
+		if (rc != 0)
+			return rc;
+		if (t.state == TUNE_FAILED) {
+			printf("tune: %s; nothing written\n", t.why);
+			return 3;
+		}
+		printf("tune: stopped after %.0f s; nothing written\n", took);
+		return 130;
+	}
+	char when[32];
+	time_t now = time(NULL);
+	strftime(when, sizeof when, "%Y-%m-%d %H:%M UTC", gmtime(&now));
+	FILE *f = to_stdout ? stdout : fdopen(fd, "w");
+	if (f == NULL) {
+		fprintf(stderr, "undulated --tune: %s: %s\n", tmp, strerror(errno));
+		close(fd);
+		unlink(tmp);
+		return 1;
+	}
+	tune_write_config(&t, cfg, when, took, f);
+	if (!to_stdout) {
+		bool ok = fflush(f) == 0 && fsync(fileno(f)) == 0;
+		ok = fclose(f) == 0 && ok;
+		if (ok)
+			fchmod_default(tmp);
+		if (!ok || rename(tmp, out) != 0) {
+			fprintf(stderr, "undulated --tune: writing %s: %s\n", out, strerror(errno));
+			unlink(tmp);
+			return 1;
+		}
+	}
+	printf("tune: done in %.0f s (%d windows): k x%.3f, mu ", took, t.iterations, t.result.k);
+	for (size_t j = 0; j < cfg->njoints; j++)
+		printf("%s%.4g", j ? "/" : "", t.result.mu[j]);
+	printf(", lead %.3f s%s%s\n", t.result.lead, to_stdout ? "" : "; written to ", to_stdout ? "" : out);
+	if (!to_stdout)
+		printf("tune: run it with: undulated %s\n", out);
+	return 0;
 }
 
 int main(int argc, char **argv)
@@ -232,5 +391,7 @@ int main(int argc, char **argv)
 		       cfg.njoints, cfg_mode_name(cfg.mode));
 		return 0;
 	}
+	if (a.tune)
+		return main_tune(&a, &cfg);
 	return dmn_run(&cfg);
 }

@@ -54,57 +54,10 @@ torque3=1
 wait_log sim3 'ready' 10 && start_daemon d3 "$R3" bus3 1 "$URL3" --set robot.actuation=torque \
 	--set robot.torque_drive=current || { torque3=0; echo "# torque-driven robot did not start: not measured"; }
 
-# "t a0 [a1]" per published state, t from the cycle counter (10 ms)
-samples() { awk -v r="$1" '$1 == "STATE" && $2 == r && $4 == "mode=3" {
-		c = $3; sub("cycle=", "", c); line = c * 0.01
-		for (i = 5; i <= NF; i++) if ($i ~ /^a[0-9]=/) { v = $i; sub(/^a[0-9]=/, "", v); line = line " " v }
-		print line }' "$T/$2.log"; }
 last_cycle() { awk -v r="$1" '$1 == "STATE" && $2 == r { c = $3 } END { sub("cycle=", "", c); print c + 0 }' "$T/$2.log"; }
 past() { [ "$(last_cycle "$1" "$2")" -ge "$3" ]; }
 
-# Per joint over [from, to): upward crossings of the window's centre with
-# hysteresis (a tenth of the swing, well above the 5 mrad position step);
-# frequency from the first to the last crossing; each whole cycle's half
-# peak-to-peak; joint 2's crossing after each of joint 1's, as a lag in degrees.
-measure() {
-	awk -v from="$1" -v to="$2" '
-	function cross(j, t, x) {
-		if (x > c[j] + h[j]) hi[j] = 1
-		if (hi[j] && x < c[j] - h[j]) armed[j] = 1
-		if (armed[j] && px[j] < c[j] && x >= c[j]) {
-			tc = pt + (t - pt) * (c[j] - px[j]) / (x - px[j])
-			n[j]++; ct[j, n[j]] = tc
-			if (n[j] > 1) { amp = (mx[j] - mn[j]) / 2; if (amp < amin[j]) amin[j] = amp; if (amp > amax[j]) amax[j] = amp }
-			mx[j] = x; mn[j] = x; hi[j] = 0; armed[j] = 0
-		}
-	}
-	$1 >= from && $1 < to { ns++; for (j = 2; j <= NF; j++) { T[ns] = $1; X[ns, j - 1] = $j } nj = NF - 1 }
-	END {
-		for (j = 1; j <= nj; j++) {
-			lo = 1e9; hiv = -1e9
-			for (i = 1; i <= ns; i++) { if (X[i, j] < lo) lo = X[i, j]; if (X[i, j] > hiv) hiv = X[i, j] }
-			c[j] = (lo + hiv) / 2; h[j] = (hiv - lo) / 20; amin[j] = 1e9; amax[j] = 0; n[j] = 0
-			mx[j] = -1e9; mn[j] = 1e9
-			for (i = 1; i <= ns; i++) {
-				x = X[i, j]; if (i > 1) { pt = T[i - 1]; px[j] = X[i - 1, j]; cross(j, T[i], x) }
-				if (x > mx[j]) mx[j] = x; if (x < mn[j]) mn[j] = x
-			}
-			f[j] = n[j] > 1 ? (n[j] - 1) / (ct[j, n[j]] - ct[j, 1]) : 0
-			printf "j%d n=%d f=%.3f amin=%.3f amax=%.3f\n", j, n[j], f[j], amin[j] == 1e9 ? 0 : amin[j], amax[j]
-		}
-		if (nj >= 2 && f[1] > 0) {
-			k = 0; lmin = 1e9; lmax = -1e9
-			for (a = 1; a < n[1]; a++) for (b = 1; b <= n[2]; b++)
-				if (ct[2, b] >= ct[1, a] && ct[2, b] < ct[1, a + 1]) {
-					l = 360 * (ct[2, b] - ct[1, a]) / (ct[1, a + 1] - ct[1, a]); if (l > 180) l -= 360
-					k++; if (l < lmin) lmin = l; if (l > lmax) lmax = l; break
-				}
-			printf "lag n=%d min=%.1f max=%.1f\n", k, k ? lmin : 0, k ? lmax : 0
-		}
-	}'
-}
 field() { sed -n "s/.* $1=\([-0-9.]*\).*/\1/p" | head -1; }
-within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v >= lo && v <= hi) }'; }
 
 # bus errors + overruns the daemon counted between two cycles (from its STATE)
 upsets() {   # ROBOT LOG FROM_CYCLE TO_CYCLE
