@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# dxl_doctor — `dxl doctor`, the first-run hardware check, against the
+# simulated bus with one problem injected at a time: the factory return delay
+# (500 us), a 16 ms adapter latency, a low supply voltage, a missing servo,
+# servo angle limits narrower than the configuration. Each run must name the
+# problem on the right line (WARN or FAIL) with its fix, and a clean bus must
+# give nothing but OK lines and exit 0. Also: RS-485 mode asked for on a
+# device that cannot do it (a pty) is one clear error, never a silent start.
+. "$(dirname "$0")/../lib.sh"
+
+dxl="$B/dxl"
+sim="$B/undulate-sim"
+
+if [ ! -x "$dxl" ] || [ ! -x "$sim" ]; then
+	tap_fail "dxl and undulate-sim are built" "missing $dxl or $sim"
+	tap_done; exit
+fi
+
+# sim_up NAME PORT ARGS...: a simulator with servos 1 and 2 at $T/NAME.
+sim_up() {
+	local name=$1 port=$2; shift 2
+	spawn "$name" "$sim" --link "$T/$name.bus" --ids 1,2 --lcm-url "$(lcm_url "$port")" --quiet "$@"
+	wait_log "$name" 'ready' 10 || { tap_fail "$name: simulator ready" "$(cat "$T/$name.log")"; return 1; }
+}
+
+# robot_conf NAME IDS [EXTRA...]: the robot's configuration, as undulated reads it.
+robot_conf() {
+	local name=$1 ids=$2; shift 2
+	{ printf '[robot]\nname = %s\nport = %s\nids = %s\n' "$name" "$T/$name.bus" "$ids"; printf '%s\n' "$@"; } >"$T/$name.conf"
+}
+
+# doctor NAME ARGS...: run dxl doctor; stdout in $T/NAME.out, stderr in $T/NAME.err, status in $rc.
+doctor() {
+	local name=$1; shift
+	rc=0
+	timeout 60 "$dxl" doctor "$@" >"$T/$name.out" 2>"$T/$name.err" || rc=$?
+}
+show() { cat "$T/$1.out" "$T/$1.err"; echo "exit $rc"; }
+# line NAME LEVEL CHECK REGEX: the check's line has that level and matches REGEX.
+line() { grep -E "^$2 +$3 " "$T/$1.out" | grep -qE -- "$4"; }
+
+# ---- a clean bus: every check OK, exit 0 -------------------------------------------------
+if sim_up clean 7760 --return-delay 0; then
+	robot_conf clean 1,2
+	doctor clean --config "$T/clean.conf"
+	[ "$rc" -eq 0 ] && ! grep -qE '^(WARN|FAIL) ' "$T/clean.out" && line clean OK 'ID 1 return delay' '0 us' \
+		&& line clean OK 'ID 2 voltage' '12\.0 V' && line clean OK latency 'ms' \
+		&& tap_ok "clean bus: every line OK, exit 0" || tap_fail "clean bus: every line OK, exit 0" "$(show clean)"
+	# The budget is measured on the daemon's own cycle: three figures, the floor, the period.
+	line clean OK budget 'p50 [0-9.]+ / p99 [0-9.]+ / max [0-9.]+ ms' && line clean OK budget 'wire floor [0-9.]+ ms' \
+		&& line clean OK budget 'period 10 ms' && line clean OK budget '[0-9]+ cycles' \
+		&& tap_ok "clean bus: the budget line gives p50/p99/max, the wire floor and the period" \
+		|| tap_fail "clean bus: the budget line gives p50/p99/max, the wire floor and the period" "$(show clean)"
+	# Torque is put back as it was found: off.
+	t1=$("$dxl" --port "$T/clean.bus" --timeout-ms 100 read 1 torque_enable 2>&1)
+	[ "$t1" = 0 ] && tap_ok "clean bus: torque left off as found" || tap_fail "clean bus: torque left off as found" "torque_enable=$t1"
+	stop clean >/dev/null
+fi
+
+# ---- the factory return delay (500 us) ---------------------------------------------------
+if sim_up delay 7761; then
+	doctor delay --port "$T/delay.bus" --cycles 100 1 2
+	[ "$rc" -eq 1 ] && line delay WARN 'ID 1 return delay' '500 us' && line delay WARN 'ID 2 return delay' '500 us' \
+		&& line delay WARN 'ID 1 return delay' "fix: dxl --port $T/delay.bus setup 1 2 --yes" \
+		&& ! grep -qE '^FAIL ' "$T/delay.out" \
+		&& tap_ok "return delay 500 us: WARN on each servo with the setup command, exit 1" \
+		|| tap_fail "return delay 500 us: WARN on each servo with the setup command, exit 1" "$(show delay)"
+	stop delay >/dev/null
+fi
+
+# ---- a 16 ms adapter latency (no sysfs on a pty: measured) -------------------------------
+if sim_up latency 7762 --return-delay 0 --latency-ms 16; then
+	doctor latency --port "$T/latency.bus" --cycles 100 1 2
+	[ "$rc" -eq 7 ] && line latency FAIL latency '1[5-9]\.[0-9] ms' && line latency FAIL latency 'fix: ' \
+		&& line latency FAIL budget '' \
+		&& tap_ok "latency 16 ms: measured on the latency line, budget FAIL, exit 7" \
+		|| tap_fail "latency 16 ms: measured on the latency line, budget FAIL, exit 7" "$(show latency)"
+	stop latency >/dev/null
+fi
+
+# ---- a low supply voltage -------------------------------------------------------------------
+if sim_up volt 7763 --return-delay 0 --voltage 7; then
+	doctor volt --port "$T/volt.bus" --cycles 50 1 2
+	[ "$rc" -eq 7 ] && line volt FAIL 'ID 1 voltage' '7\.0 V' && line volt FAIL 'ID 2 voltage' 'fix: ' \
+		&& tap_ok "7 V supply: voltage FAIL on each servo with the fix, exit 7" \
+		|| tap_fail "7 V supply: voltage FAIL on each servo with the fix, exit 7" "$(show volt)"
+	stop volt >/dev/null
+fi
+
+# ---- a missing servo (the configuration asks for ID 3) -----------------------------------------
+if sim_up missing 7764 --return-delay 0; then
+	robot_conf missing 1,2,3
+	doctor missing --config "$T/missing.conf" --cycles 50
+	[ "$rc" -eq 7 ] && line missing FAIL 'ID 3' 'no reply' && line missing FAIL 'ID 3' 'scan --bauds all' \
+		&& line missing OK 'ID 1 model' '12 \(AX-12\)' && line missing OK 'ID 2 model' '12 \(AX-12\)' \
+		&& tap_ok "missing ID 3: FAIL naming it and the scan, the others checked, exit 7" \
+		|| tap_fail "missing ID 3: FAIL naming it and the scan, the others checked, exit 7" "$(show missing)"
+	stop missing >/dev/null
+fi
+
+# ---- servo angle limits narrower than the configuration -----------------------------------------
+if sim_up limits 7765 --return-delay 0; then
+	# The configuration allows neutral 0 +- 1.3 rad (raw 258..766, the daemon's own
+	# conversion); the servo is set to stop at 350..700.
+	robot_conf limits 1,2 '[joint.1]' 'limit_min = -1.3' 'limit_max = 1.3'
+	"$dxl" --port "$T/limits.bus" --timeout-ms 100 write 1 cw_angle_limit 350 >/dev/null 2>&1
+	"$dxl" --port "$T/limits.bus" --timeout-ms 100 write 1 ccw_angle_limit 700 >/dev/null 2>&1
+	doctor limits --config "$T/limits.conf" --cycles 50
+	[ "$rc" -eq 1 ] && line limits WARN 'ID 1 angle limits' '350\.\.700' \
+		&& line limits WARN 'ID 1 angle limits' 'write 1 cw_angle_limit 258' \
+		&& line limits WARN 'ID 1 angle limits' 'write 1 ccw_angle_limit 766' \
+		&& line limits OK 'ID 2 angle limits' '' \
+		&& tap_ok "narrower servo limits: WARN with both limits and the writes, exit 1" \
+		|| tap_fail "narrower servo limits: WARN with both limits and the writes, exit 1" "$(show limits)"
+	# RS-485 mode on a pty: the driver refuses TIOCSRS485; one clear error, exit 3.
+	doctor rs485 --port "$T/limits.bus" --rs485 rts-on-send 1
+	[ "$rc" -eq 3 ] && grep -q "RS-485" "$T/rs485.out" "$T/rs485.err" \
+		&& grep -q "$T/limits.bus" "$T/rs485.err" && grep -q 'Inappropriate ioctl' "$T/rs485.err" \
+		&& tap_ok "--rs485 on a pty: refused, naming the port and errno, exit 3" \
+		|| tap_fail "--rs485 on a pty: refused, naming the port and errno, exit 3" "$(show rs485)"
+	stop limits >/dev/null
+fi
+
+# ---- bad input ------------------------------------------------------------------------------------
+printf '[robot]\nids = 1,2\nbaud = fast\n' >"$T/bad.conf"
+doctor badconf --config "$T/bad.conf" --port /nonexistent
+[ "$rc" -eq 2 ] && grep -q "bad.conf:3: \[robot\] baud: not an integer 'fast'" "$T/badconf.err" \
+	&& tap_ok "a bad configuration: its line named, exit 2" || tap_fail "a bad configuration: its line named, exit 2" "$(show badconf)"
+doctor noport 1 2
+[ "$rc" -eq 2 ] && grep -q 'needs --port' "$T/noport.err" \
+	&& tap_ok "no port and no configuration: usage, exit 2" || tap_fail "no port and no configuration: usage, exit 2" "$(show noport)"
+
+tap_done
