@@ -49,6 +49,29 @@ long port_pending_input(struct port *p);
 void port_bus_io(struct port *p, struct bus_io *io);
 uint64_t port_now_us(void);
 
+/* ---- RS-485 direction control (an on-board UART with a half-duplex buffer) ---- */
+/* A single-board computer's UART drives the Dynamixel line through a tri-state
+ * buffer whose direction pin is wired to RTS. The kernel's RS-485 mode
+ * (TIOCSRS485) switches RTS around every transmission itself, at the last stop
+ * bit, which no user-space toggle can time. The level is the kernel's
+ * "logical" one: on many UARTs an asserted RTS drives the pin low, so when
+ * nothing answers in one mode, try the other. */
+enum port_rs485 {
+	PORT_RS485_OFF,             /* leave the port's RS-485 setting alone */
+	PORT_RS485_RTS_ON_SEND,     /* RTS high while sending, low after (SER_RS485_RTS_ON_SEND) */
+	PORT_RS485_RTS_AFTER_SEND,  /* RTS low while sending, high after (SER_RS485_RTS_AFTER_SEND) */
+};
+/* "off", "rts-on-send" (or "rts"), "rts-after-send"; false if none of them. */
+bool port_rs485_parse(const char *s, enum port_rs485 *out);
+const char *port_rs485_name(enum port_rs485 mode);
+/* Switch the open port to RS-485 mode (SER_RS485_ENABLED, RTS as asked, no
+ * delays before or after sending, the receiver off while sending) and read it
+ * back. PORT_RS485_OFF does nothing. DXL_OK; DXL_E_ARG when the device refuses
+ * (a pty, a USB adapter, a UART driver without RS-485: ENOTTY and kin) or
+ * changes what was asked; DXL_E_IO otherwise. On failure err gets one line
+ * naming the port and errno. port_close() puts back the setting found. */
+int port_set_rs485(struct port *p, enum port_rs485 mode, char *err, size_t errcap);
+
 /* ---- adapter latency (FTDI) -------------------------------------------------- */
 struct port_latency {
 	bool known;                 /* found a latency_timer for this tty */
