@@ -47,8 +47,6 @@
 #define DMN_BACKOFF_MAX_MS 2000
 /* Assumed until the servos are read: the AX-12's factory return delay. */
 #define DMN_DEFAULT_RETURN_DELAY_US 500
-/* Serial ports looked at when searching by USB serial number. */
-#define DMN_MAX_PORTS 32
 
 struct dmn {
 	struct cfg *cfg;
@@ -219,38 +217,22 @@ static void dmn_close_port(struct dmn *d)
 	d->connected = false;
 }
 
-/* The bus timeouts: the adapter's latency (FTDI latency timer, read and
- * lowered by port_open() on the fd it holds), the servos' return delay. */
+/* The bus timeouts: the adapter's latency (the FTDI latency timer, read and
+ * lowered by port_open() on the fd it holds, or as configured), the servos'
+ * return delay. `dxl doctor` derives them the same way (port.h). */
 static void dmn_latency(struct dmn *d)
 {
-	long us = d->cfg->adapter_latency_us;
-	d->adapter_latency_ms = -1.0;
-	if (us < 0) {
-		/* port_open() already checked (and tried to lower) the latency timer on
-		 * the fd it holds; opening the device again would fail with EBUSY on an
-		 * exclusively held real port and lose the ASYNC_LOW_LATENCY fallback. */
-		struct port_latency lat = { 0 };
-		const struct port_latency *opened = d->port ? port_get_latency(d->port) : NULL;
-		if (opened)
-			lat = *opened;
-		else
-			port_latency_check_fd(d->port_path, d->port ? port_fd(d->port) : -1, true, &lat);
-		if (lat.known) {
-			us = 1000L * lat.timer_ms;
-			d->adapter_latency_ms = lat.timer_ms;
-		}
-		if (lat.known && lat.timer_ms > 1)
-			log_warn("%s: adapter latency timer %d ms (%s): replies wait that long, 100 Hz is out of "
-			         "reach; set it to 1 ms (`dxl --port PATH setup`, or the udev rule in systemd/)", d->port_path,
-			         lat.timer_ms, lat.note);
-		if (us < 0)
-			us = 0;
-	} else {
-		d->adapter_latency_ms = 1e-3 * (double)us;
-		if (us > 1000)
-			log_warn("adapter_latency_us = %ld: replies wait that long, 100 Hz needs <= 1000 µs "
-			         "(`dxl --port PATH setup`)", us);
-	}
+	struct port_latency lat;
+	long configured = d->cfg->adapter_latency_us;
+	long us = port_adapter_latency_us(d->port, configured, &lat);
+	d->adapter_latency_ms = configured >= 0 ? 1e-3 * (double)us : lat.known ? (double)lat.timer_ms : -1.0;
+	if (lat.known && lat.timer_ms > 1)
+		log_warn("%s: adapter latency timer %d ms (%s): replies wait that long, 100 Hz is out of "
+		         "reach; set it to 1 ms (`dxl --port PATH setup`, or the udev rule in systemd/)", d->port_path,
+		         lat.timer_ms, lat.note);
+	if (configured > 1000)
+		log_warn("adapter_latency_us = %ld: replies wait that long, 100 Hz needs <= 1000 µs "
+		         "(`dxl --port PATH setup`)", configured);
 	struct bus_timing tm = {
 		.baud = d->cfg->baud, .return_delay_us = (uint32_t)d->max_return_delay_us,
 		.adapter_latency_us = (uint32_t)us, .margin_us = (uint32_t)d->cfg->bus_margin_us,
@@ -264,16 +246,11 @@ static bool dmn_find_port(struct dmn *d, char *err, size_t cap)
 {
 	if (d->cfg->usb_serial[0] == '\0')
 		return true;
-	static struct port_info ports[DMN_MAX_PORTS];
-	int n = port_list(ports, DMN_MAX_PORTS);
-	for (int i = 0; i < n && i < DMN_MAX_PORTS; i++) {
-		if (strcmp(ports[i].serial, d->cfg->usb_serial) == 0) {
-			snprintf(d->port_path, sizeof d->port_path, "%s", ports[i].path);
-			return true;
-		}
-	}
+	int n = 0;
+	if (port_find_by_serial(d->cfg->usb_serial, d->port_path, sizeof d->port_path, &n))
+		return true;
 	snprintf(err, cap, "no serial port with USB serial number '%s' (%d port(s) found; `dxl ports` lists them)",
-	         d->cfg->usb_serial, n < 0 ? 0 : n);
+	         d->cfg->usb_serial, n);
 	return false;
 }
 

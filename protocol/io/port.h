@@ -75,7 +75,8 @@ int port_set_rs485(struct port *p, enum port_rs485 mode, char *err, size_t errca
 /* ---- adapter latency (FTDI) -------------------------------------------------- */
 struct port_latency {
 	bool known;                 /* found a latency_timer for this tty */
-	int timer_ms;               /* its value (FTDI default 16) */
+	int timer_ms;               /* its value (FTDI default 16), after any lowering */
+	int found_ms;               /* its value before we touched it */
 	bool lowered;               /* we set it to 1 (or ASYNC_LOW_LATENCY) */
 	char note[160];             /* human-readable outcome, e.g. why it stays at 16 */
 };
@@ -90,6 +91,14 @@ const struct port_latency *port_get_latency(const struct port *p);
  * TIOCSSERIAL/ASYNC_LOW_LATENCY fallback can work when sysfs is not writable.
  * The sysfs root is $UNDULATE_SYSFS_ROOT when set (tests), else /sys. */
 void port_latency_check_fd(const char *path, int fd, bool lower, struct port_latency *out);
+
+/* The adapter hold time the bus timeouts must allow for, in µs, as the daemon
+ * derives it: configured_us when >= 0 (a configuration's adapter_latency_us);
+ * else the FTDI latency timer behind the open port — the check port_open() ran
+ * (opt->low_latency: lowered if it could), or one run now on the port's fd,
+ * lowering it — and 0 for a device without one. *lat (may be NULL) gets the
+ * check's outcome; known = false when configured_us decided. */
+long port_adapter_latency_us(struct port *p, long configured_us, struct port_latency *lat);
 
 /* ---- low-level helpers (used by both backends; exposed for tests) ------------ */
 /* Where sysfs is: $UNDULATE_SYSFS_ROOT when set (tests), else "/sys". */
@@ -121,6 +130,13 @@ struct port_info {
  * the answer is 0 ports, not an error. libserialport itself always reads /sys;
  * the root only decides whether there is a sysfs to list from. */
 int port_list(struct port_info *out, size_t cap);
+/* The port whose USB serial number is `serial`, wherever it is enumerated now
+ * (ttyUSB numbers change on replugging): true with its path in path[cap];
+ * false, with the number of ports looked at in *nports. */
+bool port_find_by_serial(const char *serial, char *path, size_t cap, int *nports);
+/* The listing's entry for the device behind path (symlinks resolved): its USB
+ * IDs and adapter name. False when it is not listed (a pty, a missing device). */
+bool port_info_for(const char *path, struct port_info *out);
 /* Name of a known Dynamixel adapter for a VID:PID, or NULL. */
 const char *port_adapter_name(int vid, int pid);
 
