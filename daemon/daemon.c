@@ -65,6 +65,7 @@ struct dmn {
 	long long reconnects;
 	double adapter_latency_ms;
 	int max_return_delay_us;
+	bool wiring_refused;          /* the port refused the configured rs485 mode */
 	/* timing */
 	int timer_fd, deadline_fd, signal_fd;
 	uint64_t period_us;
@@ -268,6 +269,14 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 	d->port = port_open(d->port_path, &opt, err, cap);
 	if (d->port == NULL)
 		return false;
+	/* A UART behind a half-duplex buffer: the kernel switches the direction
+	 * around every packet. A device that cannot (a USB adapter, a pty) must
+	 * not run with the wiring silently wrong: one error, and no start. */
+	if (port_set_rs485(d->port, d->cfg->rs485, err, cap) != DXL_OK) {
+		d->wiring_refused = true;
+		dmn_close_port(d);
+		return false;
+	}
 	struct bus_io io;
 	port_bus_io(d->port, &io);
 	struct bus_timing tm = {
@@ -616,7 +625,8 @@ int dmn_run(struct cfg *cfg)
 		cin_close(&d->cin);
 		pub_close(&d->pub);
 		dmn_close_fds(d);
-		return 1;
+		/* a wiring the device cannot do stays wrong: not worth a restart */
+		return d->wiring_refused ? 2 : 1;
 	}
 	log_info("robot %s: %zu joint(s) on %s at %ld bps, mode %s, LCM %s", cfg->name, cfg->njoints, d->port_path,
 	         cfg->baud, cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");
