@@ -71,7 +71,8 @@ ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze
 PROGRAMS := $(foreach p,$(ALL_PROGRAMS),$(if $(wildcard $(firstword $(DIR_$(PROG_$(p))))/main.c),$(p)))
 DEPS_daemon   := daemon protocol common
 DEPS_sim      := sim protocol common
-DEPS_dxl      := dxl protocol common
+# dxl doctor reads undulated's configuration and runs its cycle: libdaemon
+DEPS_dxl      := dxl daemon protocol common
 DEPS_top      := top protocol common
 DEPS_analyze  := analyze protocol common
 DEPS_protocol := protocol common

@@ -71,7 +71,7 @@ fi
 # ---- a 16 ms adapter latency (no sysfs on a pty: measured) -------------------------------
 if sim_up latency 7762 --return-delay 0 --latency-ms 16; then
 	doctor latency --port "$T/latency.bus" --cycles 100 1 2
-	[ "$rc" -eq 7 ] && line latency FAIL latency '1[5-9]\.[0-9] ms' && line latency FAIL latency 'fix: ' \
+	[ "$rc" -eq 7 ] && line latency FAIL latency '1[5-9]\.[0-9]+ ms' && line latency FAIL latency 'fix: ' \
 		&& line latency FAIL budget '' \
 		&& tap_ok "latency 16 ms: measured on the latency line, budget FAIL, exit 7" \
 		|| tap_fail "latency 16 ms: measured on the latency line, budget FAIL, exit 7" "$(show latency)"
@@ -100,15 +100,15 @@ fi
 
 # ---- servo angle limits narrower than the configuration -----------------------------------------
 if sim_up limits 7765 --return-delay 0; then
-	# The configuration allows neutral 0 +- 1.3 rad (raw 258..766, the daemon's own
-	# conversion); the servo is set to stop at 350..700.
+	# The configuration allows neutral 0 +- 1.3 rad (raw 259..765, the daemon's own
+	# conversion: whole units inside the limits); the servo is set to stop at 350..700.
 	robot_conf limits 1,2 '[joint.1]' 'limit_min = -1.3' 'limit_max = 1.3'
 	"$dxl" --port "$T/limits.bus" --timeout-ms 100 write 1 cw_angle_limit 350 >/dev/null 2>&1
 	"$dxl" --port "$T/limits.bus" --timeout-ms 100 write 1 ccw_angle_limit 700 >/dev/null 2>&1
 	doctor limits --config "$T/limits.conf" --cycles 50
 	[ "$rc" -eq 1 ] && line limits WARN 'ID 1 angle limits' '350\.\.700' \
-		&& line limits WARN 'ID 1 angle limits' 'write 1 cw_angle_limit 258' \
-		&& line limits WARN 'ID 1 angle limits' 'write 1 ccw_angle_limit 766' \
+		&& line limits WARN 'ID 1 angle limits' 'write 1 cw_angle_limit 259' \
+		&& line limits WARN 'ID 1 angle limits' 'write 1 ccw_angle_limit 765' \
 		&& line limits OK 'ID 2 angle limits' '' \
 		&& tap_ok "narrower servo limits: WARN with both limits and the writes, exit 1" \
 		|| tap_fail "narrower servo limits: WARN with both limits and the writes, exit 1" "$(show limits)"
