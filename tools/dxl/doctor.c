@@ -16,11 +16,13 @@
  *     Torque is put back as it was found.
  *
  * Exit status: 0 all OK, 1 warnings only, 7 a check failed; 2 usage or a bad
- * configuration, 3 the port cannot be opened or went away (nothing to check).
+ * configuration, 3 the port cannot be opened or went away (nothing to check),
+ * 130 interrupted during the timed cycles (torque put back all the same).
  */
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -65,6 +67,7 @@ struct dr {
 	bool is_pty;
 	uint32_t lateness_max_us;            /* measured, for the check reads' timeouts */
 	bool lateness_known;
+	bool interrupted;                    /* SIGINT/SIGTERM during the timed cycles */
 };
 
 static void dr_line(struct dr *d, const char *check, const struct dr_verdict *v)
@@ -508,10 +511,21 @@ static bool dr_drive(struct dr_run *r, struct bus *bus, enum cyc_status st)
 	}
 }
 
+/* A Ctrl-C while the joints are torqued for the timed cycles ends the run,
+ * and torque is still put back as found. Set by the handler, read by the
+ * loop: the one state a signal can reach. */
+static volatile sig_atomic_t dr_interrupted;
+
+static void dr_on_signal(int sig)
+{
+	(void)sig;
+	dr_interrupted = 1;
+}
+
 static void dr_sleep_until(uint64_t t_us)
 {
 	struct timespec ts = { .tv_sec = (time_t)(t_us / 1000000u), .tv_nsec = (long)(t_us % 1000000u) * 1000L };
-	while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
+	while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR && !dr_interrupted) {
 	}
 }
 
@@ -524,7 +538,7 @@ static int dr_cycles(struct dr_run *r, struct dxlt *t, unsigned n)
 	struct bus *bus = &t->bus;
 	uint64_t period = r->cyc.period_us, next = port_now_us() + period;
 
-	while (r->done < n) {
+	while (r->done < n && !dr_interrupted) {
 		uint64_t now = port_now_us();
 		if (now >= next) {
 			if (cyc_busy(&r->cyc)) {
@@ -637,14 +651,25 @@ static int dr_budget(struct dr *d)
 	ctl_start(&r->ctl, 0.0, "start");
 	dr_events(r);
 	long long before = dr_transactions(r, &d->t->bus);
+	struct sigaction stop = { .sa_handler = dr_on_signal }, old_int, old_term;
+	sigemptyset(&stop.sa_mask);
+	dr_interrupted = 0;
+	sigaction(SIGINT, &stop, &old_int);
+	sigaction(SIGTERM, &stop, &old_term);
 	int lost = dr_cycles(r, d->t, (unsigned)n);
 	b.transactions = dr_transactions(r, &d->t->bus) - before;
 	if (lost != DXL_OK) {
 		rc = dxlt_bus_fail(d->t, DXL_BROADCAST_ID, lost);
-		goto out;
+		goto restore_signals;
 	}
 	dr_summarize(r, &b);
 	dr_check_budget(&b, &v);
+	if (dr_interrupted) {
+		d->interrupted = true;
+		snprintf(why, sizeof why, "interrupted after %u of %ld cycles", r->done, n);
+		b.skipped = why;
+		dr_check_budget(&b, &v);
+	}
 	/* what the controller said while holding (a servo's error bits, a
 	 * refused write): the checks above have the detail */
 	size_t len = strlen(v.text);
@@ -655,6 +680,11 @@ static int dr_budget(struct dr *d)
 	/* back to the tool's patient timeouts to put torque back */
 	dr_timing(d, 254u * 2u, d->lateness_max_us, DR_CHECK_SLACK_US);
 	dr_restore(d, r);
+restore_signals:
+	/* only now: a second signal (timeout(1) sends its own and the group's;
+	 * a user presses Ctrl-C twice) must not cut the torque-off short */
+	sigaction(SIGINT, &old_int, NULL);
+	sigaction(SIGTERM, &old_term, NULL);
 out:
 	if (r != NULL) {
 		free(r->bus_ms);
@@ -718,6 +748,9 @@ int dxlt_cmd_doctor(struct dxlt *t)
 		if (d->count[DR_SKIP] > 0)
 			fprintf(t->out, ", %u SKIP", d->count[DR_SKIP]);
 		rc = d->count[DR_FAIL] > 0 ? DXLT_EXIT_FAIL : d->count[DR_WARN] > 0 ? DXLT_EXIT_WARN : DXLT_EXIT_OK;
+		/* the shell's convention for a command stopped by SIGINT: not a clean bill */
+		if (d->interrupted)
+			rc = DXLT_EXIT_INTERRUPTED;
 		fprintf(t->out, ": exit %d\n", rc);
 	}
 	/* every reply's error bits were on the servos' lines */

@@ -22,6 +22,7 @@ enum dxlt_exit {
 	DXLT_EXIT_SERVO = 5,     /* the servo answered with error bits set */
 	DXLT_EXIT_REFUSED = 6,   /* refused to act: ID taken, torque on during an EEPROM write */
 	DXLT_EXIT_FAIL = 7,      /* doctor: at least one check failed */
+	DXLT_EXIT_INTERRUPTED = 130, /* doctor: SIGINT/SIGTERM during the timed cycles (128 + SIGINT) */
 };
 
 /* Most IDs/bauds a command takes on its command line. */
