@@ -52,8 +52,9 @@ uint64_t port_now_us(void);
 /* ---- RS-485 direction control (an on-board UART with a half-duplex buffer) ---- */
 /* A single-board computer's UART drives the Dynamixel line through a tri-state
  * buffer whose direction pin is wired to RTS. The kernel's RS-485 mode
- * (TIOCSRS485) switches RTS around every transmission itself, at the last stop
- * bit, which no user-space toggle can time. The level is the kernel's
+ * (TIOCSRS485) switches RTS around every transmission itself, as soon as the
+ * transmitter is empty: far closer to the last stop bit than a user-space
+ * toggle gets, and a servo with return delay 0 answers 22 µs after it. The level is the kernel's
  * "logical" one: on many UARTs an asserted RTS drives the pin low, so when
  * nothing answers in one mode, try the other. */
 enum port_rs485 {
