@@ -5,7 +5,8 @@
 # servo angle limits narrower than the configuration. Each run must name the
 # problem on the right line (WARN or FAIL) with its fix, and a clean bus must
 # give nothing but OK lines and exit 0. Also: RS-485 mode asked for on a
-# device that cannot do it (a pty) is one clear error, never a silent start.
+# device that cannot do it (a pty) is one clear error, never a silent start,
+# and an echo setting that does not match the wiring is named.
 . "$(dirname "$0")/../lib.sh"
 
 dxl="$B/dxl"
@@ -145,6 +146,26 @@ if sim_up limits 7765 --return-delay 0; then
 		&& tap_ok "--rs485 on a pty: refused, naming the port and errno, exit 3" \
 		|| tap_fail "--rs485 on a pty: refused, naming the port and errno, exit 3" "$(show rs485)"
 	stop limits >/dev/null
+fi
+
+# ---- the wiring against the echo setting --------------------------------------------------------
+if sim_up echo 7766 --return-delay 0 --echo; then
+	doctor echo --port "$T/echo.bus" --cycles 0 1 2
+	[ "$rc" -eq 1 ] && line echo WARN echo 'our own request came back' && line echo WARN echo 'fix: echo = true' \
+		&& line echo OK 'ID 2 model' '12 \(AX-12\)' \
+		&& tap_ok "an echoing wiring without echo: WARN with the fix, exit 1" \
+		|| tap_fail "an echoing wiring without echo: WARN with the fix, exit 1" "$(show echo)"
+	doctor echoon --port "$T/echo.bus" --echo --cycles 0 1 2
+	[ "$rc" -eq 0 ] && ! grep -qE '^(WARN|FAIL) ' "$T/echoon.out" && line echoon OK adapter 'echo cancelling on' \
+		&& tap_ok "the same wiring with --echo: all OK, exit 0" || tap_fail "the same wiring with --echo: all OK, exit 0" "$(show echoon)"
+	stop echo >/dev/null
+fi
+if sim_up noecho 7767 --return-delay 0; then
+	doctor noecho --port "$T/noecho.bus" --echo --cycles 0 1 2
+	[ "$rc" -eq 7 ] && line noecho FAIL echo 'the wiring does not echo' && line noecho FAIL 'ID 1 ping' 'see the echo line' \
+		&& tap_ok "echo on where the wiring has none: FAIL naming it, exit 7" \
+		|| tap_fail "echo on where the wiring has none: FAIL naming it, exit 7" "$(show noecho)"
+	stop noecho >/dev/null
 fi
 
 # ---- bad input ------------------------------------------------------------------------------------

@@ -342,6 +342,19 @@ static void test_latency(void **state)
 	expect(&v, DR_SKIP, "no servo answered", NULL);
 }
 
+static void test_echo(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	assert_false(dr_check_echo(false, 0, 0, &v));
+	assert_false(dr_check_echo(true, 0, 0, &v));
+	assert_false(dr_check_echo(true, 3, 0, &v));   /* with echo on, an echo is expected */
+	assert_true(dr_check_echo(false, 15, 0, &v));
+	expect(&v, DR_WARN, "came back before the reply 15 time(s)", "fix: echo = true", "--echo", NULL);
+	assert_true(dr_check_echo(true, 0, 4, &v));
+	expect(&v, DR_FAIL, "4 time(s)", "the wiring does not echo", "fix: echo = false", NULL);
+}
+
 static void test_baud(void **state)
 {
 	(void)state;
@@ -401,7 +414,7 @@ int main(void)
 		cmocka_unit_test(test_status_level), cmocka_unit_test(test_voltage), cmocka_unit_test(test_temperature),
 		cmocka_unit_test(test_limits),       cmocka_unit_test(test_alarms),  cmocka_unit_test(test_torque),
 		cmocka_unit_test(test_errbits),      cmocka_unit_test(test_adapter), cmocka_unit_test(test_latency),
-		cmocka_unit_test(test_baud),         cmocka_unit_test(test_budget),
+		cmocka_unit_test(test_baud),         cmocka_unit_test(test_budget),  cmocka_unit_test(test_echo),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

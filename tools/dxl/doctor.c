@@ -31,12 +31,12 @@
 #include "daemon/config.h"
 #include "daemon/control.h"
 #include "daemon/cycle.h"
+#include "daemon/log.h"
+#include "daemon/setup.h"
 #include "doctor.h"
 #include "dxl.h"
 #include "dxl_table.h"
 #include "dxlt_priv.h"
-#include "daemon/log.h"
-#include "daemon/setup.h"
 
 /* The probe's wait for each PING before anything is known about the adapter:
  * longer than the largest FTDI latency timer (255 ms) and a loaded machine. */
@@ -96,24 +96,23 @@ static int dr_cfg_errors(struct dr *d, const struct cfg_errors *e)
 }
 
 /* IDs given on the command line (positional, or --ids A-B) as the config's
- * "ids" value. False when there are none. */
-static bool dr_cli_ids(const struct dxlt_args *a, char *buf, size_t cap)
+ * "ids" value: 1 with them in buf, 0 when there are none, -1 when they do not
+ * fit (far more than a robot's CFG_MAX_JOINTS: cut, they would name others). */
+static int dr_cli_ids(const struct dxlt_args *a, char *buf, size_t cap)
 {
 	size_t off = 0;
 	buf[0] = '\0';
 	for (int i = 0; i < a->npos; i++) {
 		int w = snprintf(buf + off, cap - off, "%s%s", i ? "," : "", a->pos[i]);
 		if (w < 0 || (size_t)w >= cap - off)
-			break;
+			return -1;
 		off += (size_t)w;
 	}
-	if (a->npos == 0 && a->ids_given) {
-		for (unsigned id = a->id_lo; id <= a->id_hi; id++) {
-			int w = snprintf(buf + off, cap - off, "%s%u", off ? "," : "", id);
-			if (w < 0 || (size_t)w >= cap - off)
-				break;
-			off += (size_t)w;
-		}
+	for (unsigned id = a->id_lo; a->npos == 0 && a->ids_given && id <= a->id_hi; id++) {
+		int w = snprintf(buf + off, cap - off, "%s%u", off ? "," : "", id);
+		if (w < 0 || (size_t)w >= cap - off)
+			return -1;
+		off += (size_t)w;
 	}
 	return off > 0;
 }
@@ -131,7 +130,12 @@ static int dr_configure(struct dr *d)
 	/* the command line wins over the file, as undulated's does */
 	if (t->a.port_path != NULL)
 		cfg_set(c, "command line", "robot", "port", t->a.port_path, &e);
-	if (dr_cli_ids(&t->a, ids, sizeof ids))
+	int have_ids = dr_cli_ids(&t->a, ids, sizeof ids);
+	if (have_ids < 0) {
+		fprintf(t->err, "dxl: more servo IDs on the command line than a robot has (at most %d)\n", CFG_MAX_JOINTS);
+		return DXLT_EXIT_USAGE;
+	}
+	if (have_ids > 0)
 		cfg_set(c, "command line", "robot", "ids", ids, &e);
 	if (t->a.baud_given) {
 		snprintf(baud, sizeof baud, "%ld", t->a.baud);
@@ -232,6 +236,7 @@ static int dr_find(struct dr *d, unsigned *answered)
 				return dxlt_bus_fail(d->t, s->id, r);
 		}
 		s->answered = r == DXL_OK;
+		s->ping_status = r;
 		*answered += s->answered;
 	}
 	return DXLT_EXIT_OK;
@@ -326,9 +331,14 @@ static void dr_servo_lines(struct dr *d, size_t j, int read_status)
 	struct dr_verdict v = { DR_OK, "" };
 
 	if (!s->answered) {
-		snprintf(v.text, sizeof v.text, "no reply to %d PINGs at %ld bps (%u ms each); fix: its power and cable, "
-		         "or its ID and rate: dxl --port %s scan --bauds all", DR_PING_TRIES, d->cfg.baud,
-		         DR_PROBE_MARGIN_US / 1000u, d->cfg.port);
+		if (s->ping_status == DXL_E_TIMEOUT)
+			snprintf(v.text, sizeof v.text, "no reply to %d PINGs at %ld bps (%u ms each); fix: its power and "
+			         "cable, or its ID and rate: dxl --port %s scan --bauds all", DR_PING_TRIES, d->cfg.baud,
+			         DR_PROBE_MARGIN_US / 1000u, d->cfg.port);
+		else
+			snprintf(v.text, sizeof v.text, "its PING replies are bad (%s)%s", dxl_strerror(s->ping_status),
+			         s->ping_status == DXL_E_ECHO ? ": see the echo line" : "; fix: the cable, a second master on "
+			         "the bus, or two servos with this ID (unplug all but one and scan)");
 		v.level = DR_FAIL;
 		dr_servo_line(d, s->id, "ping", &v);
 		return;
@@ -726,6 +736,8 @@ static int dr_check(struct dr *d)
 	dr_context(d);
 	for (size_t j = 0; j < d->cfg.njoints; j++)
 		dr_servo_lines(d, j, status[j]);
+	if (dr_check_echo(t->a.echo, t->bus.unexpected_echoes, t->bus.echo_errors, &v))
+		dr_line(d, "echo", &v);
 	return dr_budget(d);
 }
 

@@ -41,6 +41,7 @@ struct dr_verdict {
 struct dr_servo {
 	uint8_t id;
 	bool answered;               /* a PING */
+	int ping_status;             /* the last PING's dxl_status (DXL_OK when answered) */
 	bool read;                   /* both blocks (status return level >= 1) */
 	uint16_t model;
 	uint8_t firmware;
@@ -98,6 +99,11 @@ struct dr_latency {
  * are 6 of the 10 ms. */
 #define DR_LATE_FAIL_US 3000
 void dr_check_latency(const struct dr_latency *l, struct dr_verdict *v);
+
+/* The wiring against the echo setting: our own requests read back with echo
+ * cancelling off (a single-wire wiring taken for replies), or bytes that are
+ * not our request where an echo is expected. False (no line) when neither. */
+bool dr_check_echo(bool echo, uint32_t unexpected_echoes, uint32_t echo_errors, struct dr_verdict *v);
 
 /* The wire time of one cycle of undulated's for n servos at baud: a READ of
  * 8 bytes (answered by 14) per servo and a SYNC_WRITE of the goals, in µs. */

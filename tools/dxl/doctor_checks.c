@@ -143,6 +143,24 @@ void dr_check_latency(const struct dr_latency *l, struct dr_verdict *v)
 		       "longer period_ms", (unsigned)(ceil(1e-3 * t->max_us) * 1000.0 + 1000.0));
 }
 
+bool dr_check_echo(bool echo, uint32_t unexpected_echoes, uint32_t echo_errors, struct dr_verdict *v)
+{
+	if (!echo && unexpected_echoes > 0) {
+		/* the bus still tells echo from reply by waiting for what follows,
+		 * but a missing servo's PING then reads as answered */
+		dr_set(v, DR_WARN, "our own request came back before the reply %u time(s): a single-wire wiring (or a "
+		       "buffer whose receiver hears its transmitter); fix: echo = true in [robot] (dxl --echo)",
+		       unexpected_echoes);
+		return true;
+	}
+	if (echo && echo_errors > 0) {
+		dr_set(v, DR_FAIL, "echo cancelling is on and %u time(s) the bytes read back were not our request: the "
+		       "wiring does not echo; fix: echo = false in [robot] (no --echo)", echo_errors);
+		return true;
+	}
+	return false;
+}
+
 /* READ(36, 8) is 8 bytes out and 14 back; the SYNC_WRITE of 2-byte goals is
  * (2 + 1)·N + 8 bytes (ax12.md); 10 bits a byte. */
 double dr_cycle_wire_us(unsigned nservos, long baud)
