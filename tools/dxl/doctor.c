@@ -407,36 +407,30 @@ static double dr_pct(const double *v, size_t n, double p)
 	return n ? v[rank ? rank - 1 : 0] : 0.0;
 }
 
-/* The joints the daemon could drive: the servo answered READ and its angle
- * limits leave the joint room (ctl_set_servo, as at undulated's start). */
-static unsigned dr_pick_joints(struct dr *d, struct dr_run *r)
+/* What start-up hands the controller (setup.c's setup_servo), from the checks' reads. */
+static void dr_servo_info(const struct dr_servo *s, struct ctl_servo_info *info)
 {
+	*info = (struct ctl_servo_info){
+		.cw_limit = s->cw_limit, .ccw_limit = s->ccw_limit,
+		.max_torque = s->max_torque ? s->max_torque : 1023,   /* as setup.c does */
+		.return_delay = s->return_delay, .status_return_level = s->status_return_level,
+	};
+}
+
+/* Give the controller the joints r->from[0..n) lists; keep those it takes
+ * (ctl_set_servo: angle limits with room, not wheel mode — as at undulated's
+ * start). Returns how many were kept. */
+static size_t dr_set_servos(struct dr *d, struct dr_run *r, size_t n)
+{
+	struct ctl_servo_info info;
 	char why[256];
-	r->cfg = d->cfg;
-	/* never swing a joint in a check: hold where it stands (the daemon's first-run default) */
-	r->cfg.mode = CFG_MODE_HOLD;
-	/* the servo's own compliance margins: a check leaves them (undulated
-	 * writes the configured one at start; the cycle costs the same) */
-	r->cfg.compliance_margin = -1;
-	r->cfg.njoints = 0;
-	for (size_t j = 0; j < d->cfg.njoints; j++) {
-		const struct dr_servo *s = &d->servo[j];
-		if (!s->read || s->status_return_level == 0)
-			continue;
-		size_t k = r->cfg.njoints++;
-		r->cfg.ids[k] = s->id;
-		r->cfg.joint[k] = d->cfg.joint[j];
-		r->from[k] = j;
-	}
-	ctl_init(&r->ctl, &r->cfg);
 	size_t kept = 0;
-	for (size_t k = 0; k < r->cfg.njoints; k++) {
+
+	r->cfg.njoints = n;
+	ctl_init(&r->ctl, &r->cfg);
+	for (size_t k = 0; k < n; k++) {
 		const struct dr_servo *s = &d->servo[r->from[k]];
-		struct ctl_servo_info info = {
-			.cw_limit = s->cw_limit, .ccw_limit = s->ccw_limit,
-			.max_torque = s->max_torque ? s->max_torque : 1023,   /* as setup.c does */
-			.return_delay = s->return_delay, .status_return_level = s->status_return_level,
-		};
+		dr_servo_info(s, &info);
 		if (!ctl_set_servo(&r->ctl, k, &info, why, sizeof why))
 			continue;   /* its angle-limits line says why */
 		r->cfg.ids[kept] = r->cfg.ids[k];
@@ -445,17 +439,34 @@ static unsigned dr_pick_joints(struct dr *d, struct dr_run *r)
 		r->rd_us[kept] = dxl_return_delay_us(s->return_delay);
 		kept++;
 	}
-	r->cfg.njoints = kept;
-	/* again, with the joints kept only */
-	ctl_init(&r->ctl, &r->cfg);
-	for (size_t k = 0; k < kept; k++) {
-		const struct dr_servo *s = &d->servo[r->from[k]];
-		struct ctl_servo_info info = {
-			.cw_limit = s->cw_limit, .ccw_limit = s->ccw_limit, .max_torque = s->max_torque ? s->max_torque : 1023,
-			.return_delay = s->return_delay, .status_return_level = s->status_return_level,
-		};
-		(void)ctl_set_servo(&r->ctl, k, &info, why, sizeof why);
+	return kept;
+}
+
+/* The joints the daemon could drive: the servo answered READ at a status
+ * return level that lets it, and the controller takes its angle limits. */
+static unsigned dr_pick_joints(struct dr *d, struct dr_run *r)
+{
+	size_t n = 0;
+	r->cfg = d->cfg;
+	/* never swing a joint in a check: hold where it stands (the daemon's first-run default) */
+	r->cfg.mode = CFG_MODE_HOLD;
+	/* the servo's own compliance margins: a check leaves them (undulated
+	 * writes the configured one at start; the cycle costs the same) */
+	r->cfg.compliance_margin = -1;
+	for (size_t j = 0; j < d->cfg.njoints; j++) {
+		const struct dr_servo *s = &d->servo[j];
+		if (!s->read || s->status_return_level == 0)
+			continue;
+		r->cfg.ids[n] = s->id;
+		r->cfg.joint[n] = d->cfg.joint[j];
+		r->from[n++] = j;
 	}
+	size_t kept = dr_set_servos(d, r, n);
+	/* a second time with the kept joints alone: the controller's joints are
+	 * its configuration's, in order */
+	if (kept != n)
+		kept = dr_set_servos(d, r, kept);
+	r->cfg.njoints = kept;
 	return (unsigned)kept;
 }
 
@@ -618,6 +629,74 @@ static void dr_summarize(struct dr_run *r, struct dr_budget *b)
 	b->errors = r->cyc.errors;
 }
 
+/* Everything the timed cycles need, or why they cannot run (a static
+ * string, or one written into why). */
+static const char *dr_budget_prepare(struct dr *d, struct dr_run *r, long n, struct dr_budget *b, char *why,
+                                     size_t cap)
+{
+	char err[256];
+
+	if (n == 0)
+		return "--cycles 0";
+	if ((r->bus_ms = calloc((size_t)n, sizeof(double))) == NULL ||
+	    (r->floor_ms = calloc((size_t)n, sizeof(double))) == NULL)
+		return "out of memory";
+	if ((b->joints = dr_pick_joints(d, r)) == 0)
+		return "no servo passed what the loop needs (a PING, READ, angle limits with room)";
+	/* the controller starts from where the joints are, as after start-up */
+	if (!setup_read_present(&d->t->bus, &r->ctl, 1e-3 * d->cfg.period_ms, err, sizeof err)) {
+		snprintf(why, cap, "reading the present positions failed: %s", err);
+		return why;
+	}
+	return NULL;
+}
+
+/* The daemon's own timeouts (dmn_latency): the largest return delay, the
+ * adapter latency it derives, its margin. */
+static void dr_daemon_timing(struct dr *d, const struct dr_run *r)
+{
+	unsigned rd_max = 0;
+	for (size_t k = 0; k < r->cfg.njoints; k++)
+		rd_max = r->rd_us[k] > rd_max ? r->rd_us[k] : rd_max;
+	struct bus_timing daemon = {
+		.baud = d->cfg.baud, .return_delay_us = rd_max,
+		.adapter_latency_us = (uint32_t)port_adapter_latency_us(d->t->port, d->cfg.adapter_latency_us, NULL),
+		.margin_us = (uint32_t)d->cfg.bus_margin_us,
+	};
+	bus_set_timing(&d->t->bus, &daemon);
+}
+
+/* n cycles of HOLD, then torque back as found, with SIGINT/SIGTERM ending the
+ * cycles instead of the tool until then: a second signal (timeout(1) sends
+ * its own and the group's; a user presses Ctrl-C twice) must not cut the
+ * torque-off short. DXL_OK, or why the port went away. */
+static int dr_time(struct dr *d, struct dr_run *r, long n, struct dr_budget *b)
+{
+	struct sigaction stop = { .sa_handler = dr_on_signal }, old_int, old_term;
+
+	dr_daemon_timing(d, r);
+	cyc_init(&r->cyc, &d->t->bus, &r->ctl, (uint64_t)llround(d->cfg.period_ms * 1000.0), NULL);
+	r->epoch_us = port_now_us();
+	ctl_start(&r->ctl, 0.0, "start");
+	dr_events(r);
+	sigemptyset(&stop.sa_mask);
+	dr_interrupted = 0;
+	sigaction(SIGINT, &stop, &old_int);
+	sigaction(SIGTERM, &stop, &old_term);
+	long long before = dr_transactions(r, &d->t->bus);
+	int lost = dr_cycles(r, d->t, (unsigned)n);
+	b->transactions = dr_transactions(r, &d->t->bus) - before;
+	d->interrupted = dr_interrupted != 0;
+	if (lost == DXL_OK) {
+		/* back to the tool's patient timeouts to put torque back */
+		dr_timing(d, 254u * 2u, d->lateness_max_us, DR_CHECK_SLACK_US);
+		dr_restore(d, r);
+	}
+	sigaction(SIGINT, &old_int, NULL);
+	sigaction(SIGTERM, &old_term, NULL);
+	return lost;
+}
+
 /* The budget line. DXLT_EXIT_OK, or the port's failure. */
 static int dr_budget(struct dr *d)
 {
@@ -626,75 +705,29 @@ static int dr_budget(struct dr *d)
 	long n = d->t->a.cycles >= 0 ? d->t->a.cycles : DXLT_DOCTOR_CYCLES;
 	struct dr_run *r = calloc(1, sizeof *r);
 	int rc = DXLT_EXIT_OK;
-	char why[256];
+	char why[320];
 
-	if (r == NULL || (n > 0 && ((r->bus_ms = calloc((size_t)n, sizeof(double))) == NULL ||
-	                            (r->floor_ms = calloc((size_t)n, sizeof(double))) == NULL))) {
-		b.skipped = "out of memory";
-	} else if (n == 0) {
-		b.skipped = "--cycles 0";
-	} else if ((b.joints = dr_pick_joints(d, r)) == 0) {
-		b.skipped = "no servo passed what the loop needs (a PING, READ, angle limits with room)";
-	} else if (!setup_read_present(&d->t->bus, &r->ctl, 1e-3 * d->cfg.period_ms, why, sizeof why)) {
-		snprintf(v.text, sizeof v.text, "reading the present positions failed: %s", why);
-		b.skipped = v.text;
+	b.skipped = r == NULL ? "out of memory" : dr_budget_prepare(d, r, n, &b, why, sizeof why);
+	if (b.skipped == NULL) {
+		int lost = dr_time(d, r, n, &b);
+		if (lost != DXL_OK) {
+			rc = dxlt_bus_fail(d->t, DXL_BROADCAST_ID, lost);
+			goto out;
+		}
+		dr_summarize(r, &b);
+		if (d->interrupted) {
+			snprintf(why, sizeof why, "interrupted after %u of %ld cycles", r->done, n);
+			b.skipped = why;
+		}
 	}
-	if (b.skipped != NULL) {
-		struct dr_verdict sv;
-		dr_check_budget(&b, &sv);
-		dr_line(d, "budget", &sv);
-		goto out;
-	}
-	/* the daemon's own timeouts (dmn_latency): the largest return delay, the
-	 * adapter latency it derives, its margin */
-	unsigned rd_max = 0;
-	for (size_t k = 0; k < b.joints; k++)
-		rd_max = r->rd_us[k] > rd_max ? r->rd_us[k] : rd_max;
-	struct bus_timing daemon = {
-		.baud = d->cfg.baud, .return_delay_us = rd_max,
-		.adapter_latency_us = (uint32_t)port_adapter_latency_us(d->t->port, d->cfg.adapter_latency_us, NULL),
-		.margin_us = (uint32_t)d->cfg.bus_margin_us,
-	};
-	bus_set_timing(&d->t->bus, &daemon);
-	cyc_init(&r->cyc, &d->t->bus, &r->ctl, (uint64_t)llround(d->cfg.period_ms * 1000.0), NULL);
-	r->epoch_us = port_now_us();
-	ctl_start(&r->ctl, 0.0, "start");
-	dr_events(r);
-	long long before = dr_transactions(r, &d->t->bus);
-	struct sigaction stop = { .sa_handler = dr_on_signal }, old_int, old_term;
-	sigemptyset(&stop.sa_mask);
-	dr_interrupted = 0;
-	sigaction(SIGINT, &stop, &old_int);
-	sigaction(SIGTERM, &stop, &old_term);
-	int lost = dr_cycles(r, d->t, (unsigned)n);
-	b.transactions = dr_transactions(r, &d->t->bus) - before;
-	if (lost != DXL_OK) {
-		rc = dxlt_bus_fail(d->t, DXL_BROADCAST_ID, lost);
-		goto restore_signals;
-	}
-	dr_summarize(r, &b);
 	dr_check_budget(&b, &v);
-	if (dr_interrupted) {
-		d->interrupted = true;
-		snprintf(why, sizeof why, "interrupted after %u of %ld cycles", r->done, n);
-		b.skipped = why;
-		dr_check_budget(&b, &v);
-	}
 	/* what the controller said while holding (a servo's error bits, a
 	 * refused write): the checks above have the detail */
 	size_t len = strlen(v.text);
-	if (r->events > 0 && len < sizeof v.text)
+	if (b.skipped == NULL && r->events > 0 && len < sizeof v.text)
 		snprintf(v.text + len, sizeof v.text - len, "; %lld controller warning(s), the first: %s", r->events,
 		         r->first_event);
 	dr_line(d, "budget", &v);
-	/* back to the tool's patient timeouts to put torque back */
-	dr_timing(d, 254u * 2u, d->lateness_max_us, DR_CHECK_SLACK_US);
-	dr_restore(d, r);
-restore_signals:
-	/* only now: a second signal (timeout(1) sends its own and the group's;
-	 * a user presses Ctrl-C twice) must not cut the torque-off short */
-	sigaction(SIGINT, &old_int, NULL);
-	sigaction(SIGTERM, &old_term, NULL);
 out:
 	if (r != NULL) {
 		free(r->bus_ms);
