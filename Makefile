@@ -11,6 +11,8 @@
 #   make test-busy  make test with one CPU-bound process per core beside it
 #   make bench      benchmarks; figures printed, written to $(BUILD)/bench.md
 #   make demo       robots on the simulated bus, watched live
+#   make hwcheck PORT=/dev/ttyUSB0 [CONFIG=robot.conf] [IDS="1 2"]
+#                   the first-run hardware check on a robot (dxl doctor)
 #   make SAN=1 test the same tests under AddressSanitizer + UBSan (build-san/)
 #   make fuzz       libFuzzer target for the packet parser (needs clang)
 
@@ -71,7 +73,8 @@ ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze
 PROGRAMS := $(foreach p,$(ALL_PROGRAMS),$(if $(wildcard $(firstword $(DIR_$(PROG_$(p))))/main.c),$(p)))
 DEPS_daemon   := daemon protocol common
 DEPS_sim      := sim protocol common
-DEPS_dxl      := dxl protocol common
+# dxl doctor reads undulated's configuration and runs its cycle: libdaemon
+DEPS_dxl      := dxl daemon protocol common
 DEPS_top      := top protocol common
 DEPS_analyze  := analyze protocol common
 DEPS_protocol := protocol common
@@ -88,7 +91,7 @@ LCM_STAMP := $(GEN)/.stamp
 # lcm-gen names files <package>_<type>.c; the package is `undulate`.
 LCM_GEN_C = $(wildcard $(GEN)/*.c)
 
-.PHONY: all deps test test-long test-busy bench demo fuzz spy-jar spy install uninstall clean lcmtypes
+.PHONY: all deps test test-long test-busy bench demo hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
 all: $(foreach p,$(PROGRAMS),$(BIN)/$(p)) unit-tests
 
 $(LCM_STAMP): $(LCM_SRC)
@@ -196,6 +199,15 @@ DEMO_OUT ?=
 demo: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) DEMO_OUT=$(DEMO_OUT) scripts/demo.sh
+
+# The first command on a new robot: dxl doctor (tools/dxl/README.md). Its
+# exit status is make's: 0 all OK, 1 warnings, 7 a check failed.
+PORT   ?=
+CONFIG ?=
+IDS    ?=
+hwcheck: $(BIN)/dxl
+	@test -n "$(PORT)$(CONFIG)" || { echo "usage: make hwcheck PORT=/dev/ttyUSB0 [CONFIG=robot.conf] [IDS=\"1 2\"]" >&2; exit 2; }
+	$(BIN)/dxl doctor $(if $(PORT),--port '$(PORT)') $(if $(CONFIG),--config '$(CONFIG)') $(IDS)
 
 # libFuzzer targets: tests/fuzz/fuzz_<component>_<what>.c, built with clang
 # from the sources of that component's libraries (instrumented, unlike the

@@ -299,7 +299,7 @@ void cfg_defaults(struct cfg *c)
 }
 
 /* ---- [robot] keys --------------------------------------------------------------------- */
-enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL, T_ACT, T_DRIVE, T_CMDS };
+enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL, T_ACT, T_DRIVE, T_CMDS, T_RS485 };
 struct cfg_key {
 	const char *key;
 	enum cfg_type type;
@@ -328,6 +328,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("command_window_s", T_DOUBLE, command_window_s, 0.05, 60),
 	K("run_dir", T_STR, run_dir, 0, 0),
 	K("echo", T_BOOL, echo, 0, 0),
+	K("rs485", T_RS485, rs485, 0, 0),
 	K("adapter_latency_us", T_LONG, adapter_latency_us, -1, 100000),
 	K("period_ms", T_DOUBLE, period_ms, 2, 100),
 	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, 0.2),
@@ -461,6 +462,13 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			c->commands = CFG_CMD_OFF;
 		else {
 			cfg_error(e, "%s: [robot] commands: '%s' is not off, local or network", where, value);
+			return false;
+		}
+		return true;
+	case T_RS485:
+		if (!port_rs485_parse(value, &c->rs485)) {
+			cfg_error(e, "%s: [robot] rs485: '%s' is not off, rts-on-send (or rts) or rts-after-send", where,
+			          value);
 			return false;
 		}
 		return true;
@@ -746,7 +754,7 @@ void cfg_print(const struct cfg *c, void *file)
 		fprintf(f, "%s%u", j ? "," : "", c->ids[j]);
 	fprintf(f, "\nmode = %s\nlcm_url = %s\npriority = %d\nmlockall = %s\nsafe_stop = %s\n"
 	        "fault_action = %s\nvelocity_source = %s\nvelocity_cutoff_hz = %g\ncommands = %s\n"
-	        "echo = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\n"
+	        "echo = %s\nrs485 = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\n"
 	        "actuation = %s\ntorque_drive = %s\nstall_torque = %g\nno_load_speed = %g\n"
 	        "bus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
 	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\nsilent_s = %g\n"
@@ -754,7 +762,7 @@ void cfg_print(const struct cfg *c, void *file)
 	        cfg_mode_name(c->mode), c->lcm_url, c->priority, c->mlockall ? "on" : "off",
 	        safe[c->safe_stop], safe[c->fault_action],
 	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
-	        cfg_commands_name(c->commands), c->echo ? "on" : "off", c->adapter_latency_us, c->period_ms,
+	        cfg_commands_name(c->commands), c->echo ? "on" : "off", port_rs485_name(c->rs485), c->adapter_latency_us, c->period_ms,
 	        c->servo_lead_s, c->compliance_margin, c->actuation == CFG_ACT_TORQUE ? "torque" : "position",
 	        c->torque_drive == CFG_DRIVE_CURRENT ? "current" : "pwm", c->stall_torque, c->no_load_speed,
 	        c->bus_margin_us,

@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "osc.h"
+#include "port.h"
 
 #define CFG_MAX_JOINTS   OSC_MAX_JOINTS   /* joints per robot: the oscillator's bound */
 #define CFG_NAME_MAX     48               /* robot name; channels are "<name>.STATE" */
@@ -66,6 +67,7 @@ struct cfg {
 	double command_window_s;       /* commands = network: a signed command's time must be this close */
 	char run_dir[CFG_PATH_MAX];    /* the local command socket's directory ("": the default) */
 	bool echo;                     /* single-wire adapter echoes our bytes */
+	enum port_rs485 rs485;         /* a UART's half-duplex buffer switched by RTS (port.h) */
 	long adapter_latency_us;       /* -1: measure (FTDI latency timer) */
 	double period_ms;              /* control period */
 	double servo_lead_s;           /* oscillator horizon beyond the period (CONTROL.md);

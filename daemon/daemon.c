@@ -48,8 +48,6 @@
 #define DMN_BACKOFF_MAX_MS 2000
 /* Assumed until the servos are read: the AX-12's factory return delay. */
 #define DMN_DEFAULT_RETURN_DELAY_US 500
-/* Serial ports looked at when searching by USB serial number. */
-#define DMN_MAX_PORTS 32
 
 struct dmn {
 	struct cfg *cfg;
@@ -68,6 +66,7 @@ struct dmn {
 	long long reconnects;
 	double adapter_latency_ms;
 	int max_return_delay_us;
+	bool wiring_refused;          /* the port refused the configured rs485 mode */
 	/* timing */
 	int timer_fd, deadline_fd, signal_fd;
 	uint64_t period_us;
@@ -223,38 +222,22 @@ static void dmn_close_port(struct dmn *d)
 	d->connected = false;
 }
 
-/* The bus timeouts: the adapter's latency (FTDI latency timer, read and
- * lowered by port_open() on the fd it holds), the servos' return delay. */
+/* The bus timeouts: the adapter's latency (the FTDI latency timer, read and
+ * lowered by port_open() on the fd it holds, or as configured), the servos'
+ * return delay. `dxl doctor` derives them the same way (port.h). */
 static void dmn_latency(struct dmn *d)
 {
-	long us = d->cfg->adapter_latency_us;
-	d->adapter_latency_ms = -1.0;
-	if (us < 0) {
-		/* port_open() already checked (and tried to lower) the latency timer on
-		 * the fd it holds; opening the device again would fail with EBUSY on an
-		 * exclusively held real port and lose the ASYNC_LOW_LATENCY fallback. */
-		struct port_latency lat = { 0 };
-		const struct port_latency *opened = d->port ? port_get_latency(d->port) : NULL;
-		if (opened)
-			lat = *opened;
-		else
-			port_latency_check_fd(d->port_path, d->port ? port_fd(d->port) : -1, true, &lat);
-		if (lat.known) {
-			us = 1000L * lat.timer_ms;
-			d->adapter_latency_ms = lat.timer_ms;
-		}
-		if (lat.known && lat.timer_ms > 1)
-			log_warn("%s: adapter latency timer %d ms (%s): replies wait that long, 100 Hz is out of "
-			         "reach; set it to 1 ms (`dxl --port PATH setup`, or the udev rule in systemd/)", d->port_path,
-			         lat.timer_ms, lat.note);
-		if (us < 0)
-			us = 0;
-	} else {
-		d->adapter_latency_ms = 1e-3 * (double)us;
-		if (us > 1000)
-			log_warn("adapter_latency_us = %ld: replies wait that long, 100 Hz needs <= 1000 µs "
-			         "(`dxl --port PATH setup`)", us);
-	}
+	struct port_latency lat;
+	long configured = d->cfg->adapter_latency_us;
+	long us = port_adapter_latency_us(d->port, configured, &lat);
+	d->adapter_latency_ms = configured >= 0 ? 1e-3 * (double)us : lat.known ? (double)lat.timer_ms : -1.0;
+	if (lat.known && lat.timer_ms > 1)
+		log_warn("%s: adapter latency timer %d ms (%s): replies wait that long, 100 Hz is out of "
+		         "reach; set it to 1 ms (`dxl --port PATH setup`, or the udev rule in systemd/)", d->port_path,
+		         lat.timer_ms, lat.note);
+	if (configured > 1000)
+		log_warn("adapter_latency_us = %ld: replies wait that long, 100 Hz needs <= 1000 µs "
+		         "(`dxl --port PATH setup`)", configured);
 	struct bus_timing tm = {
 		.baud = d->cfg->baud, .return_delay_us = (uint32_t)d->max_return_delay_us,
 		.adapter_latency_us = (uint32_t)us, .margin_us = (uint32_t)d->cfg->bus_margin_us,
@@ -268,16 +251,11 @@ static bool dmn_find_port(struct dmn *d, char *err, size_t cap)
 {
 	if (d->cfg->usb_serial[0] == '\0')
 		return true;
-	static struct port_info ports[DMN_MAX_PORTS];
-	int n = port_list(ports, DMN_MAX_PORTS);
-	for (int i = 0; i < n && i < DMN_MAX_PORTS; i++) {
-		if (strcmp(ports[i].serial, d->cfg->usb_serial) == 0) {
-			snprintf(d->port_path, sizeof d->port_path, "%s", ports[i].path);
-			return true;
-		}
-	}
+	int n = 0;
+	if (port_find_by_serial(d->cfg->usb_serial, d->port_path, sizeof d->port_path, &n))
+		return true;
 	snprintf(err, cap, "no serial port with USB serial number '%s' (%d port(s) found; `dxl ports` lists them)",
-	         d->cfg->usb_serial, n < 0 ? 0 : n);
+	         d->cfg->usb_serial, n);
 	return false;
 }
 
@@ -295,6 +273,14 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 	d->port = port_open(d->port_path, &opt, err, cap);
 	if (d->port == NULL)
 		return false;
+	/* A UART behind a half-duplex buffer: the kernel switches the direction
+	 * around every packet. A device that cannot (a USB adapter, a pty) must
+	 * not run with the wiring silently wrong: one error, and no start. */
+	if (port_set_rs485(d->port, d->cfg->rs485, err, cap) != DXL_OK) {
+		d->wiring_refused = true;
+		dmn_close_port(d);
+		return false;
+	}
 	struct bus_io io;
 	port_bus_io(d->port, &io);
 	struct bus_timing tm = {
@@ -695,7 +681,8 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 		cin_close(&d->cin);
 		pub_close(&d->pub);
 		dmn_close_fds(d);
-		return 1;
+		/* a wiring the device cannot do stays wrong: not worth a restart */
+		return d->wiring_refused ? 2 : 1;
 	}
 	log_info("robot %s: %zu joint(s) on %s at %ld bps, mode %s, LCM %s", cfg->name, cfg->njoints, d->port_path,
 	         cfg->baud, cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");

@@ -12,7 +12,8 @@
 
 /* Run the robot until SIGTERM/SIGINT. Returns the process exit status:
  * 0 after a clean safe stop, 1 when start-up failed (the bus, a servo: worth
- * a retry), 2 when the configuration cannot work (not worth one). */
+ * a retry), 2 when the configuration cannot work (not worth one; also a port
+ * that refuses the configured rs485 mode). */
 int dmn_run(struct cfg *cfg);
 
 /* `undulated --tune`: the same loop in OSCILLATOR, with the tuner (tune.h)

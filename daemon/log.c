@@ -9,6 +9,11 @@
 #include <sys/stat.h>
 
 static enum log_level log_threshold = LOG_LVL_INFO;
+/* The program named in front of every line: the daemon's modules also run
+ * inside `dxl doctor`. */
+static const char *log_program = "undulated";
+
+void log_set_program(const char *name) { log_program = name != NULL ? name : "undulated"; }
 
 void log_set_level(enum log_level level) { log_threshold = level; }
 enum log_level log_get_level(void) { return log_threshold; }
@@ -73,9 +78,10 @@ static void log_vmsg(enum log_level level, const char *suffix, const char *fmt, 
 	char line[512];
 	vsnprintf(line, sizeof line, fmt, ap);
 	if (log_to_journal())
-		fprintf(stderr, "<%d>undulated: %s: %s%s\n", log_syslog_priority(level), log_prefix(level), line, suffix);
+		fprintf(stderr, "<%d>%s: %s: %s%s\n", log_syslog_priority(level), log_program, log_prefix(level), line,
+		        suffix);
 	else
-		fprintf(stderr, "undulated: %s: %s%s\n", log_prefix(level), line, suffix);
+		fprintf(stderr, "%s: %s: %s%s\n", log_program, log_prefix(level), line, suffix);
 }
 
 void log_msg(enum log_level level, const char *fmt, ...)

@@ -12,6 +12,8 @@
 enum log_level { LOG_LVL_ERROR = 0, LOG_LVL_WARN = 1, LOG_LVL_INFO = 2, LOG_LVL_DEBUG = 3 };
 
 void log_set_level(enum log_level level);
+/* The name in front of every line ("undulated" unless set; a static string). */
+void log_set_program(const char *name);
 enum log_level log_get_level(void);
 /* "error", "warn"/"warning", "info", "debug" -> level; false if unknown. */
 bool log_level_parse(const char *name, enum log_level *out);

@@ -82,9 +82,7 @@ static bool setup_find(struct bus *bus, const struct ctl *ctl, const struct cfg 
 	return false;
 }
 
-/* The configured joint limits as servo angle limits, in whole units inside
- * them. */
-static void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw)
+void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw)
 {
 	*cw = dxl_rad_to_pos(cj->neutral + cj->limit_min);
 	*ccw = dxl_rad_to_pos(cj->neutral + cj->limit_max);
@@ -270,9 +268,7 @@ static void setup_stop_wheel(struct bus *bus, const struct ctl *ctl, bool limp)
 	log_info("safe stop: torque actuation ended, servos back in joint mode");
 }
 
-/* Torque off, and read back that it is off: a lost write must not leave a
- * robot that says it is limp torqued. */
-static void setup_limp(struct bus *bus, const struct ctl_joint *jt)
+bool setup_limp(struct bus *bus, const struct ctl_joint *jt)
 {
 	bool reply = jt->servo.status_return_level >= 2;
 	const uint8_t off = 0;
@@ -289,6 +285,7 @@ static void setup_limp(struct bus *bus, const struct ctl_joint *jt)
 	if (te != 0)
 		log_error("safe stop: servo %u: torque off not confirmed (%s): check it", jt->id,
 		          r == DXL_OK ? "it reads back on" : dxl_strerror(r));
+	return te == 0;
 }
 
 void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg)

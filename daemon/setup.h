@@ -20,6 +20,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "bus.h"
 #include "control.h"
@@ -42,5 +43,14 @@ bool setup_read_present(struct bus *bus, struct ctl *ctl, double dt, char *err, 
  * already: writing goals could bring torque back). Logs what it did and
  * what failed. */
 void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg);
+/* One joint limp: torque off, read back (tried SETUP_TRIES times) — a lost
+ * write must not leave a robot that says it is limp torqued. False, logged,
+ * when it does not read back off. */
+bool setup_limp(struct bus *bus, const struct ctl_joint *jt);
+/* A joint's configured limits (neutral + [limit_min, limit_max]) as servo
+ * angle limits, in whole units inside them: what start-up writes when it
+ * puts a servo back in joint mode, and what `dxl doctor` compares the servo's
+ * own limits with. */
+void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw);
 
 #endif

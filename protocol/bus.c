@@ -539,6 +539,42 @@ int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
 	return bus_send_raw(b, pkt, (size_t)r);
 }
 
+int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsigned n, struct bus_lateness *out)
+{
+	uint32_t late[BUS_LATENESS_MAX];
+	uint32_t floor_us = bus_wire_time_us(b, 2 * BUS_PACKET_BYTES(0)) + return_delay_us;
+	int r = DXL_E_ARG;
+
+	memset(out, 0, sizeof *out);
+	if (n > BUS_LATENESS_MAX)
+		n = BUS_LATENESS_MAX;
+	for (unsigned i = 0; i < n; i++) {
+		uint8_t eb;
+		r = bus_ping(b, id, &eb);
+		out->pings++;
+		if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
+			break;
+		if (r != DXL_OK)
+			continue;
+		uint32_t rtt = b->servo[id].rtt_last_us;
+		uint32_t v = rtt > floor_us ? rtt - floor_us : 0;
+		/* insertion sort: a few dozen values */
+		size_t k = out->replies++;
+		while (k > 0 && late[k - 1] > v) {
+			late[k] = late[k - 1];
+			k--;
+		}
+		late[k] = v;
+	}
+	if (out->replies == 0)
+		return r == DXL_OK ? DXL_E_TIMEOUT : r;
+	out->min_us = late[0];
+	out->max_us = late[out->replies - 1];
+	/* the lower median: one slow wake-up in an even count does not move it */
+	out->median_us = late[(out->replies - 1) / 2];
+	return DXL_OK;
+}
+
 int bus_factory_reset(struct bus *b, uint8_t id, bool expect_reply, uint8_t *errbits)
 {
 	struct dxl_packet reply;

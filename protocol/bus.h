@@ -164,6 +164,20 @@ int bus_action(struct bus *b, uint8_t id, uint8_t *errbits); /* broadcast: no re
 int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
                    const uint8_t *data, size_t n);
 int bus_factory_reset(struct bus *b, uint8_t id, bool expect_reply, uint8_t *errbits);
+/* How late replies come: n PINGs to id (at most BUS_LATENESS_MAX), each round
+ * trip less the wire time of the PING and its reply (6 bytes each) and the
+ * servo's return delay. What is left is time the bytes were held between the
+ * line and us: an adapter's latency timer (an FTDI chip holds a short reply
+ * up to 16 ms), a USB-serial bridge, a reader scheduled late. It is measured
+ * where no setting can be read (a CDC-ACM adapter, an on-board UART, a pty).
+ * DXL_OK when at least one PING was answered; else the last PING's status. */
+#define BUS_LATENESS_MAX 32
+struct bus_lateness {
+	unsigned pings, replies;
+	uint32_t min_us, median_us, max_us;
+};
+int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsigned n, struct bus_lateness *out);
+
 /* Before trying a failed transaction again: read and discard input until the
  * line has been quiet for quiet_us, or max_us have passed. A reply that was
  * only late lands here instead of colliding with the next request. Returns

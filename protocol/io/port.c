@@ -13,6 +13,7 @@
 #include <fcntl.h>
 #include <libserialport.h>
 #include <limits.h>
+#include <linux/serial.h>
 #include <poll.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,6 +41,10 @@ struct port {
 	char path[PORT_PATH_MAX];
 	bool latency_checked;
 	struct port_latency latency;
+	/* RS-485 mode as found before port_set_rs485() changed it: put back at
+	 * close, so a later program that did not ask for it does not get it */
+	bool rs485_changed;
+	struct serial_rs485 rs485_found;
 };
 
 /* ---- raw mode ----------------------------------------------------------------- */
@@ -224,6 +229,8 @@ void port_close(struct port *p)
 {
 	if (p == NULL)
 		return;
+	if (p->rs485_changed)
+		(void)ioctl(p->fd, TIOCSRS485, &p->rs485_found);
 	if (p->sp != NULL) {
 		(void)ioctl(p->fd, TIOCNXCL);
 		sp_close(p->sp);
@@ -257,6 +264,82 @@ int port_set_baud(struct port *p, long baud)
 	if (port_termios_set_baud(p->fd, baud) != DXL_OK)
 		return DXL_E_IO;
 	p->baud = baud;
+	return DXL_OK;
+}
+
+/* ---- RS-485 direction control ---------------------------------------------------- */
+
+static const char *const port_rs485_names[] = { "off", "rts-on-send", "rts-after-send" };
+
+bool port_rs485_parse(const char *s, enum port_rs485 *out)
+{
+	if (s == NULL)
+		return false;
+	/* "rts": the common wiring, a buffer enabled while RTS is high */
+	if (strcmp(s, "rts") == 0) {
+		*out = PORT_RS485_RTS_ON_SEND;
+		return true;
+	}
+	for (size_t i = 0; i < sizeof port_rs485_names / sizeof port_rs485_names[0]; i++) {
+		if (strcmp(s, port_rs485_names[i]) == 0) {
+			*out = (enum port_rs485)i;
+			return true;
+		}
+	}
+	return false;
+}
+
+const char *port_rs485_name(enum port_rs485 mode)
+{
+	return (unsigned)mode < sizeof port_rs485_names / sizeof port_rs485_names[0] ? port_rs485_names[mode] : "?";
+}
+
+/* errno values that mean "this device cannot do RS-485", not "it failed". */
+static bool port_rs485_unsupported(int e)
+{
+	return e == ENOTTY || e == EINVAL || e == EOPNOTSUPP;
+}
+
+int port_set_rs485(struct port *p, enum port_rs485 mode, char *err, size_t errcap)
+{
+	struct serial_rs485 want, found, got;
+	const uint32_t rts = SER_RS485_RTS_ON_SEND | SER_RS485_RTS_AFTER_SEND;
+
+	if (mode == PORT_RS485_OFF)
+		return DXL_OK;
+	memset(&found, 0, sizeof found);
+	bool have_found = ioctl(p->fd, TIOCGRS485, &found) == 0;
+	memset(&want, 0, sizeof want);
+	/* No RX_DURING_TX: the buffer's receiver is off while we send (a board
+	 * whose receiver hears the transmitter anyway wants echo = true). No
+	 * delays: the servo may answer 22 us after the last stop bit. */
+	want.flags = SER_RS485_ENABLED |
+	             (mode == PORT_RS485_RTS_ON_SEND ? SER_RS485_RTS_ON_SEND : SER_RS485_RTS_AFTER_SEND);
+	if (ioctl(p->fd, TIOCSRS485, &want) != 0) {
+		int e = errno;
+		char why[200];
+		snprintf(why, sizeof why, "%s (errno %d): %s", strerror(e), e,
+		         port_rs485_unsupported(e) ? "this device has no RS-485 mode (a pty, a USB adapter, a "
+		                                     "UART driver without it)" : "the driver refused it");
+		port_errf(err, errcap, "cannot switch %s to RS-485 mode (TIOCSRS485): %s", p->path, why);
+		errno = e;
+		return port_rs485_unsupported(e) ? DXL_E_ARG : DXL_E_IO;
+	}
+	if (have_found) {
+		p->rs485_found = found;
+		p->rs485_changed = true;
+	}
+	/* Drivers adjust what they cannot do (the serial core rewrites an RTS
+	 * polarity the hardware lacks): a direction backwards would leave the
+	 * bus silent, so read it back. */
+	memset(&got, 0, sizeof got);
+	if (ioctl(p->fd, TIOCGRS485, &got) != 0 || !(got.flags & SER_RS485_ENABLED) ||
+	    (got.flags & rts) != (want.flags & rts)) {
+		char why[96];
+		snprintf(why, sizeof why, "the driver kept flags 0x%x for 0x%x", (unsigned)got.flags, (unsigned)want.flags);
+		port_errf(err, errcap, "cannot switch %s to RS-485 mode as asked: %s", p->path, why);
+		return DXL_E_ARG;
+	}
 	return DXL_OK;
 }
 

@@ -49,10 +49,35 @@ long port_pending_input(struct port *p);
 void port_bus_io(struct port *p, struct bus_io *io);
 uint64_t port_now_us(void);
 
+/* ---- RS-485 direction control (an on-board UART with a half-duplex buffer) ---- */
+/* A single-board computer's UART drives the Dynamixel line through a tri-state
+ * buffer whose direction pin is wired to RTS. The kernel's RS-485 mode
+ * (TIOCSRS485) switches RTS around every transmission itself, as soon as the
+ * transmitter is empty: far closer to the last stop bit than a user-space
+ * toggle gets, and a servo with return delay 0 answers 22 µs after it. The level is the kernel's
+ * "logical" one: on many UARTs an asserted RTS drives the pin low, so when
+ * nothing answers in one mode, try the other. */
+enum port_rs485 {
+	PORT_RS485_OFF,             /* leave the port's RS-485 setting alone */
+	PORT_RS485_RTS_ON_SEND,     /* RTS high while sending, low after (SER_RS485_RTS_ON_SEND) */
+	PORT_RS485_RTS_AFTER_SEND,  /* RTS low while sending, high after (SER_RS485_RTS_AFTER_SEND) */
+};
+/* "off", "rts-on-send" (or "rts"), "rts-after-send"; false if none of them. */
+bool port_rs485_parse(const char *s, enum port_rs485 *out);
+const char *port_rs485_name(enum port_rs485 mode);
+/* Switch the open port to RS-485 mode (SER_RS485_ENABLED, RTS as asked, no
+ * delays before or after sending, the receiver off while sending) and read it
+ * back. PORT_RS485_OFF does nothing. DXL_OK; DXL_E_ARG when the device refuses
+ * (a pty, a USB adapter, a UART driver without RS-485: ENOTTY and kin) or
+ * changes what was asked; DXL_E_IO otherwise. On failure err gets one line
+ * naming the port and errno. port_close() puts back the setting found. */
+int port_set_rs485(struct port *p, enum port_rs485 mode, char *err, size_t errcap);
+
 /* ---- adapter latency (FTDI) -------------------------------------------------- */
 struct port_latency {
 	bool known;                 /* found a latency_timer for this tty */
-	int timer_ms;               /* its value (FTDI default 16) */
+	int timer_ms;               /* its value (FTDI default 16), after any lowering */
+	int found_ms;               /* its value before we touched it */
 	bool lowered;               /* we set it to 1 (or ASYNC_LOW_LATENCY) */
 	char note[160];             /* human-readable outcome, e.g. why it stays at 16 */
 };
@@ -67,6 +92,14 @@ const struct port_latency *port_get_latency(const struct port *p);
  * TIOCSSERIAL/ASYNC_LOW_LATENCY fallback can work when sysfs is not writable.
  * The sysfs root is $UNDULATE_SYSFS_ROOT when set (tests), else /sys. */
 void port_latency_check_fd(const char *path, int fd, bool lower, struct port_latency *out);
+
+/* The adapter hold time the bus timeouts must allow for, in µs, as the daemon
+ * derives it: configured_us when >= 0 (a configuration's adapter_latency_us);
+ * else the FTDI latency timer behind the open port — the check port_open() ran
+ * (opt->low_latency: lowered if it could), or one run now on the port's fd,
+ * lowering it — and 0 for a device without one. *lat (may be NULL) gets the
+ * check's outcome; known = false when configured_us decided. */
+long port_adapter_latency_us(struct port *p, long configured_us, struct port_latency *lat);
 
 /* ---- low-level helpers (used by both backends; exposed for tests) ------------ */
 /* Where sysfs is: $UNDULATE_SYSFS_ROOT when set (tests), else "/sys". */
@@ -98,6 +131,13 @@ struct port_info {
  * the answer is 0 ports, not an error. libserialport itself always reads /sys;
  * the root only decides whether there is a sysfs to list from. */
 int port_list(struct port_info *out, size_t cap);
+/* The port whose USB serial number is `serial`, wherever it is enumerated now
+ * (ttyUSB numbers change on replugging): true with its path in path[cap];
+ * false, with the number of ports looked at in *nports. */
+bool port_find_by_serial(const char *serial, char *path, size_t cap, int *nports);
+/* The listing's entry for the device behind path (symlinks resolved): its USB
+ * IDs and adapter name. False when it is not listed (a pty, a missing device). */
+bool port_info_for(const char *path, struct port_info *out);
 /* Name of a known Dynamixel adapter for a VID:PID, or NULL. */
 const char *port_adapter_name(int vid, int pid);
 

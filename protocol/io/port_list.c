@@ -3,8 +3,10 @@
  * Dynamixel USB adapters named so a user can tell which port is the bus.
  */
 #include <libserialport.h>
+#include <limits.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
@@ -81,4 +83,58 @@ int port_list(struct port_info *out, size_t cap)
 			port_info_fill(ports[n], &out[n]);
 	sp_free_port_list(ports);
 	return n;
+}
+
+/* Ports looked at by the look-ups below: a robot's computer has a few. */
+#define PORT_LOOKUP_MAX 64
+
+/* The listing, on the heap: 64 entries are 24 KiB, too much for a stack
+ * that a daemon's start-up shares with its own buffers. NULL when out of memory. */
+static struct port_info *port_list_all(int *n)
+{
+	struct port_info *all = calloc(PORT_LOOKUP_MAX, sizeof *all);
+
+	*n = 0;
+	if (all == NULL)
+		return NULL;
+	*n = port_list(all, PORT_LOOKUP_MAX);
+	if (*n > PORT_LOOKUP_MAX)
+		*n = PORT_LOOKUP_MAX;
+	return all;
+}
+
+bool port_find_by_serial(const char *serial, char *path, size_t cap, int *nports)
+{
+	int n = 0;
+	bool found = false;
+	struct port_info *all = port_list_all(&n);
+
+	*nports = n < 0 ? 0 : n;
+	for (int i = 0; all != NULL && serial != NULL && serial[0] != '\0' && i < n && !found; i++) {
+		if (strcmp(all[i].serial, serial) == 0 && strlen(all[i].path) < cap) {
+			memcpy(path, all[i].path, strlen(all[i].path) + 1);
+			found = true;
+		}
+	}
+	free(all);
+	return found;
+}
+
+bool port_info_for(const char *path, struct port_info *out)
+{
+	char want[PATH_MAX], have[PATH_MAX];
+	int n = 0;
+	bool found = false;
+
+	if (path == NULL || realpath(path, want) == NULL)
+		return false;
+	struct port_info *all = port_list_all(&n);
+	for (int i = 0; all != NULL && i < n && !found; i++) {
+		if (realpath(all[i].path, have) != NULL && strcmp(have, want) == 0) {
+			*out = all[i];
+			found = true;
+		}
+	}
+	free(all);
+	return found;
 }

@@ -104,6 +104,18 @@ out=$(timeout 10 "$D" --port "$T/bus" --ids 1,9 --robot "$R" --lcm-url "$URL" 2>
 if [ $rc -eq 1 ] && echo "$out" | grep -q "servo ID 9 did not answer a PING on $T/bus at 1000000 bps"; then
 	tap_ok "missing servo: ID and baud named, exit 1"; else tap_fail "missing servo" "rc $rc: $out"; fi
 
+# RS-485 mode asked of a device that has none (the simulator's pty, like a USB
+# adapter): one line naming the port and errno, no start, exit 2 (a wiring the
+# device cannot do stays wrong: systemd does not restart it)
+out=$(timeout 10 "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.rs485=rts-on-send 2>&1); rc=$?
+if [ $rc -eq 2 ] && echo "$out" | grep -qF "cannot switch $T/bus to RS-485 mode (TIOCSRS485): Inappropriate ioctl for device (errno 25)" \
+	&& ! echo "$out" | grep -q 'ready'; then
+	tap_ok "rs485 on a pty: refused with port and errno, not started, exit 2"
+else tap_fail "rs485 on a pty is refused" "rc $rc: $out"; fi
+out=$("$D" --check-config "$T/good.conf" --set robot.rs485=rts-sideways 2>&1); rc=$?
+if [ $rc -eq 1 ] && echo "$out" | grep -qF "command line: [robot] rs485: 'rts-sideways' is not off, rts-on-send (or rts) or rts-after-send"; then
+	tap_ok "a bad rs485 value is named"; else tap_fail "bad rs485 value" "rc $rc: $out"; fi
+
 # sd_notify: a datagram socket standing in for systemd
 spawn notify socat -u UNIX-RECV:"$T/notify" STDOUT
 wait_for 5 test -S "$T/notify"

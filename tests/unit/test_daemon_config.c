@@ -458,6 +458,38 @@ static void test_refused_ids_change_nothing(void **state)
 	assert_int_equal(c.ids[1], 2);
 }
 
+/* rs485: the port option of an on-board UART (port.h), off by default; a
+ * refused value names itself and leaves the setting as it was. */
+static void test_rs485(void **state)
+{
+	(void)state;
+	struct cfg c;
+	char err[CFG_ERR_MAX];
+	load_ok(&c, good);
+	assert_int_equal(c.rs485, PORT_RS485_OFF);
+	load_ok(&c, "[robot]\nport=/dev/ttyAMA0\nids=1\nrs485 = rts-after-send\n");
+	assert_int_equal(c.rs485, PORT_RS485_RTS_AFTER_SEND);
+	load_ok(&c, "[robot]\nport=/dev/ttyAMA0\nids=1\nrs485 = rts\necho = on\n");
+	assert_int_equal(c.rs485, PORT_RS485_RTS_ON_SEND);
+	assert_true(c.echo);
+	struct cfg_errors e = { 0 };
+	assert_false(cfg_override(&c, "robot.rs485=yes", &e));
+	assert_string_equal(e.line[0], "command line: [robot] rs485: 'yes' is not off, rts-on-send (or rts) or "
+	                               "rts-after-send");
+	assert_int_equal(c.rs485, PORT_RS485_RTS_ON_SEND);
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nrs485=\n", err, sizeof err),
+	                    "robot1.conf:4: [robot] rs485: '' is not off, rts-on-send (or rts) or rts-after-send");
+	/* --check-config -v prints it back in a form the parser takes */
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	assert_non_null(f);
+	cfg_print(&c, f);
+	fclose(f);
+	assert_non_null(strstr(text, "\nrs485 = rts-on-send\n"));
+	free(text);
+}
+
 static void test_param_ranges(void **state)
 {
 	(void)state;
@@ -502,6 +534,7 @@ int main(void)
 		cmocka_unit_test(test_overrides),
 		cmocka_unit_test(test_command_line_only),
 		cmocka_unit_test(test_param_ranges),
+		cmocka_unit_test(test_rs485),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -786,6 +786,43 @@ static void test_dxl_usage_and_port_errors(void **state)
 	assert_int_equal(run_dxl(f, "ping", "300", NULL), DXLT_EXIT_USAGE);
 	assert_int_equal(run_dxl(f, "--bogus", "ping", "1", NULL), DXLT_EXIT_USAGE);
 	assert_int_equal(run_dxl(f, "scan", "--ids", "9-3", NULL), DXLT_EXIT_USAGE);
+	/* --rs485: a mode the kernel knows, or usage; on the fake's pty the
+	 * kernel refuses it: exit 3, the port and errno named, nothing sent */
+	assert_int_equal(run_dxl(f, "--rs485", "sideways", "ping", "1", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(strstr(f->err, "bad mode (want rts-on-send, rts or rts-after-send, or off) for --rs485 'sideways'"));
+	unsigned packets = atomic_load(&f->bus.packets);
+	assert_int_equal(run_dxl(f, "--rs485", "rts-after-send", "ping", "1", NULL), DXLT_EXIT_PORT);
+	assert_non_null(strstr(f->err, "cannot switch "));
+	assert_non_null(strstr(f->err, f->path));
+	assert_non_null(strstr(f->err, "to RS-485 mode (TIOCSRS485): Inappropriate ioctl for device (errno 25)"));
+	assert_int_equal(atomic_load(&f->bus.packets), packets);
+	assert_int_equal(run_dxl(f, "--rs485", "off", "ping", "1", NULL), 0);
+	/* doctor's own options */
+	assert_int_equal(run_dxl(f, "doctor", "1", "--cycles", "10001", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(strstr(f->err, "--cycles '10001' is"));
+	assert_int_equal(run_dxl(f, "doctor", "1", "300", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(strstr(f->err, "servo ID 300 out of range 0..253"));
+	assert_int_equal(run_dxl(f, "doctor", "--config", "/nonexistent/robot.conf", NULL), DXLT_EXIT_USAGE);
+	assert_non_null(strstr(f->err, "dxl: /nonexistent/robot.conf: "));
+}
+
+/* dxl doctor in-process on the fake bus: its servos keep the factory return
+ * delay, and servo 2 flags every reply with overload — named on its own
+ * line, once (not again as the other commands' closing error-bits line). */
+static void test_dxl_doctor(void **state)
+{
+	struct fixture *f = *state;
+
+	assert_int_equal(run_dxl(f, "doctor", "1", "2", "--cycles", "0", NULL), DXLT_EXIT_WARN);
+	assert_non_null(strstr(f->out, "\nWARN  ID 1 return delay   500 us before every reply"));
+	assert_non_null(strstr(f->out, "\nOK    ID 2 voltage        12.0 V"));
+	assert_non_null(strstr(f->out, "\nSKIP  budget              not timed: --cycles 0\n"));
+	assert_non_null(strstr(f->out, "summary: 17 OK, 2 WARN, 0 FAIL, 1 SKIP: exit 1\n"));
+	servo_by_id(f, 2)->errbits = DXL_ERRBIT_OVERLOAD;
+	assert_int_equal(run_dxl(f, "doctor", "1", "2", "--cycles", "0", NULL), DXLT_EXIT_FAIL);
+	assert_non_null(strstr(f->out, "\nFAIL  ID 2 error bits     its replies carry 0x20 (overload)"));
+	assert_null(strstr(f->out, "ID 1 error bits"));
+	assert_null(strstr(f->err, "reports error bits"));
 }
 
 static void test_arg_parsers(void **state)
@@ -844,6 +881,7 @@ int main(int argc, char **argv)
 		cmocka_unit_test_setup_teardown(test_dxl_setup_lowers_latency_timer, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_dxl_setup_latency_stuck, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_dxl_usage_and_port_errors, setup, teardown),
+		cmocka_unit_test_setup_teardown(test_dxl_doctor, setup, teardown),
 		cmocka_unit_test(test_arg_parsers),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

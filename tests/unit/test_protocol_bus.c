@@ -40,6 +40,11 @@ struct fake {
 	bool echo;
 	uint64_t echo_delay_us;
 	size_t echo_corrupt_at;
+	/* answer every write (not only the next one), after delays[i] for the
+	 * i-th write when delays is set; UINT64_MAX: no answer to that one */
+	bool reply_every;
+	const uint64_t *delays;
+	size_t ndelays, delay_i;
 	/* transport faults and fragmentation */
 	int write_error;
 	size_t max_chunk;
@@ -80,8 +85,11 @@ static int fake_write(void *ctx, const uint8_t *buf, size_t n)
 		fake_push(f, copy, n, f->now + f->echo_delay_us);
 	}
 	if (f->reply) {
-		fake_push(f, f->reply, f->reply_len, f->now + f->reply_delay_us);
-		f->reply = NULL;
+		uint64_t delay = f->delays != NULL ? f->delays[f->delay_i++ % f->ndelays] : f->reply_delay_us;
+		if (delay != UINT64_MAX)
+			fake_push(f, f->reply, f->reply_len, f->now + delay);
+		if (!f->reply_every)
+			f->reply = NULL;
 	}
 	return DXL_OK;
 }
@@ -576,6 +584,68 @@ static void test_io_errors_and_args(void **state)
 	assert_int_equal(bus.bytes_out, 0);
 }
 
+/* Reply lateness: round trip less the PING's and reply's wire time (12 bytes,
+ * 120 µs at 1 Mbps) and the return delay; the lower median, the extremes;
+ * lost PINGs counted apart. */
+static void test_reply_lateness(void **state)
+{
+	(void)state;
+	struct bus_lateness lt;
+	/* an FTDI adapter at its 16 ms default, once a bit less, once a reader late */
+	static const uint64_t held[] = { 16620, 16620, 12620, 16620, 21620, 16620 };
+	/* the probe's timeout must outlast the hold it measures */
+	static const struct bus_timing patient = { 1000000, 500, 0, 30000 };
+	setup_bus(false);
+	bus_set_timing(&bus, &patient);
+	script(ping1_reply, sizeof ping1_reply, 0);
+	fk.reply_every = true;
+	fk.delays = held;
+	fk.ndelays = 6;
+	assert_int_equal(bus_reply_lateness(&bus, 1, 500, 6, &lt), DXL_OK);
+	assert_int_equal(lt.pings, 6);
+	assert_int_equal(lt.replies, 6);
+	assert_int_equal(lt.min_us, 12000);
+	assert_int_equal(lt.median_us, 16000);
+	assert_int_equal(lt.max_us, 21000);
+	assert_int_equal(fk.writes, 6);
+
+	/* no hold at all: the floor itself, never below 0 */
+	static const uint64_t prompt[] = { 100, 120, 130 };
+	setup_bus(false);
+	script(ping1_reply, sizeof ping1_reply, 0);
+	fk.reply_every = true;
+	fk.delays = prompt;
+	fk.ndelays = 3;
+	assert_int_equal(bus_reply_lateness(&bus, 1, 0, 3, &lt), DXL_OK);
+	assert_int_equal(lt.min_us, 0);
+	assert_int_equal(lt.median_us, 0);
+	assert_int_equal(lt.max_us, 10);
+
+	/* lost PINGs: counted, not taken as late replies */
+	static const uint64_t lossy[] = { 1120, UINT64_MAX };
+	setup_bus(false);
+	script(ping1_reply, sizeof ping1_reply, 0);
+	fk.reply_every = true;
+	fk.delays = lossy;
+	fk.ndelays = 2;
+	assert_int_equal(bus_reply_lateness(&bus, 1, 0, 4, &lt), DXL_OK);
+	assert_int_equal(lt.pings, 4);
+	assert_int_equal(lt.replies, 2);
+	assert_int_equal(lt.median_us, 1000);
+
+	/* nobody there: the PING's own status; more than BUS_LATENESS_MAX asked is capped */
+	setup_bus(false);
+	assert_int_equal(bus_reply_lateness(&bus, 9, 0, 1000, &lt), DXL_E_TIMEOUT);
+	assert_int_equal(lt.pings, BUS_LATENESS_MAX);
+	assert_int_equal(lt.replies, 0);
+	assert_int_equal(bus_reply_lateness(&bus, 9, 0, 0, &lt), DXL_E_ARG);
+	/* the port gone: stop at once */
+	setup_bus(false);
+	fk.write_error = DXL_E_DISCONNECTED;
+	assert_int_equal(bus_reply_lateness(&bus, 1, 0, 8, &lt), DXL_E_DISCONNECTED);
+	assert_int_equal(lt.pings, 1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -595,6 +665,7 @@ int main(void)
 		cmocka_unit_test(test_stale_input_and_strays),
 		cmocka_unit_test(test_settle),
 		cmocka_unit_test(test_io_errors_and_args),
+		cmocka_unit_test(test_reply_lateness),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

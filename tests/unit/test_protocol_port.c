@@ -444,6 +444,62 @@ static void test_list_without_sysfs(void **state)
 	assert_int_equal(rmdir(root), 0);
 }
 
+/* RS-485 mode names, as a configuration or `dxl --rs485` spells them. */
+static void test_rs485_names(void **state)
+{
+	(void)state;
+	enum port_rs485 m = PORT_RS485_OFF;
+
+	assert_true(port_rs485_parse("rts-on-send", &m));
+	assert_int_equal(m, PORT_RS485_RTS_ON_SEND);
+	assert_true(port_rs485_parse("rts-after-send", &m));
+	assert_int_equal(m, PORT_RS485_RTS_AFTER_SEND);
+	assert_true(port_rs485_parse("off", &m));
+	assert_int_equal(m, PORT_RS485_OFF);
+	/* "rts" is the common wiring: transmitter enabled while RTS is high */
+	assert_true(port_rs485_parse("rts", &m));
+	assert_int_equal(m, PORT_RS485_RTS_ON_SEND);
+	m = PORT_RS485_RTS_AFTER_SEND;
+	assert_false(port_rs485_parse("RTS", &m));
+	assert_false(port_rs485_parse("", &m));
+	assert_false(port_rs485_parse("rts-on-send ", &m));
+	assert_false(port_rs485_parse("on", &m));
+	assert_false(port_rs485_parse(NULL, &m));
+	assert_int_equal(m, PORT_RS485_RTS_AFTER_SEND);   /* untouched by a refusal */
+	for (int i = PORT_RS485_OFF; i <= PORT_RS485_RTS_AFTER_SEND; i++) {
+		assert_true(port_rs485_parse(port_rs485_name((enum port_rs485)i), &m));
+		assert_int_equal(m, i);
+	}
+}
+
+/* A pty has no RS-485 mode: the kernel refuses TIOCSRS485 (ENOTTY). One line
+ * names the port and errno; the port stays usable; "off" asks nothing. */
+static void test_rs485_refused_on_pty(void **state)
+{
+	struct fixture *f = *state;
+	char err[512] = "", want[64];
+	uint8_t b = 0;
+
+	assert_int_equal(port_set_rs485(f->port, PORT_RS485_OFF, err, sizeof err), DXL_OK);
+	assert_string_equal(err, "");
+	assert_int_equal(port_set_rs485(f->port, PORT_RS485_RTS_ON_SEND, err, sizeof err), DXL_E_ARG);
+	assert_non_null(strstr(err, f->peer.slave_path));
+	assert_non_null(strstr(err, "RS-485"));
+	assert_non_null(strstr(err, strerror(ENOTTY)));
+	snprintf(want, sizeof want, "errno %d", ENOTTY);
+	assert_non_null(strstr(err, want));
+	assert_null(strchr(err, '\n'));
+	assert_int_equal(port_set_rs485(f->port, PORT_RS485_RTS_AFTER_SEND, err, sizeof err), DXL_E_ARG);
+	/* a short buffer gets a cut line, never an overflow */
+	char tiny[8];
+	memset(tiny, 'x', sizeof tiny);
+	assert_int_equal(port_set_rs485(f->port, PORT_RS485_RTS_ON_SEND, tiny, sizeof tiny), DXL_E_ARG);
+	assert_int_equal(tiny[7], '\0');
+	assert_int_equal(port_write(f->port, (const uint8_t *)"\x55", 1), DXL_OK);
+	assert_int_equal(ptypeer_read(&f->peer, &b, 1, 1000), 1);
+	assert_int_equal(b, 0x55);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -463,6 +519,8 @@ int main(void)
 		cmocka_unit_test_setup_teardown(test_latency_not_ftdi, setup_pty, teardown_pty),
 		cmocka_unit_test(test_adapter_names),
 		cmocka_unit_test(test_list_without_sysfs),
+		cmocka_unit_test(test_rs485_names),
+		cmocka_unit_test_setup_teardown(test_rs485_refused_on_pty, setup_pty, teardown_pty),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -81,6 +81,7 @@ static const struct dxlt_opt dxlt_opts[] = {
 	{ "--latency-us", OPT_VALUE }, { "--timeout-ms", OPT_VALUE }, { "--units", OPT_FLAG },
 	{ "--yes", OPT_FLAG },         { "--ids", OPT_VALUE },     { "--bauds", OPT_VALUE },
 	{ "--status-level", OPT_VALUE }, { "--help", OPT_FLAG },   { "-h", OPT_FLAG },
+	{ "--rs485", OPT_VALUE },      { "--config", OPT_VALUE },  { "--cycles", OPT_VALUE },
 };
 
 static const struct dxlt_opt *dxlt_find_opt(const char *arg, size_t len)
@@ -118,6 +119,7 @@ static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val
 		a->port_path = val;
 	} else if (strcmp(name, "--baud") == 0) {
 		rc = dxlt_opt_long(err, name, val, 1, DXLT_MAX_BAUD, &a->baud);
+		a->baud_given = true;
 	} else if (strcmp(name, "--echo") == 0) {
 		a->echo = true;
 	} else if (strcmp(name, "--latency-us") == 0) {
@@ -131,9 +133,18 @@ static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val
 	} else if (strcmp(name, "--ids") == 0) {
 		if (dxlt_parse_id_range(val, &a->id_lo, &a->id_hi) != 0)
 			return dxlt_bad(err, "bad ID range (want A-B within 0-253) for", name, val);
+		a->ids_given = true;
 	} else if (strcmp(name, "--bauds") == 0) {
 		if (dxlt_parse_bauds(val, a->bauds, DXLT_MAX_BAUDS, &a->nbauds) != 0)
 			return dxlt_bad(err, "bad baud list (want N,N,... or all) for", name, val);
+	} else if (strcmp(name, "--rs485") == 0) {
+		if (!port_rs485_parse(val, &a->rs485))
+			return dxlt_bad(err, "bad mode (want rts-on-send, rts or rts-after-send, or off) for", name, val);
+		a->rs485_given = true;
+	} else if (strcmp(name, "--config") == 0) {
+		a->config_path = val;
+	} else if (strcmp(name, "--cycles") == 0) {
+		rc = dxlt_opt_long(err, name, val, 0, DXLT_DOCTOR_MAX_CYCLES, &a->cycles);
 	} else if (strcmp(name, "--status-level") == 0) {
 		rc = dxlt_opt_long(err, name, val, 0, 2, &v);
 		a->status_level = rc == DXLT_EXIT_OK ? (int)v : a->status_level;
@@ -150,6 +161,7 @@ static void dxlt_defaults(struct dxlt_args *a)
 	a->latency_us = -1;
 	a->timeout_ms = -1;
 	a->status_level = -1;
+	a->cycles = -1;
 	a->id_lo = 0;
 	a->id_hi = DXL_MAX_ID;
 }
@@ -199,8 +211,8 @@ int dxlt_parse_args(int argc, char **argv, struct dxlt_args *a, FILE *err)
 
 void dxlt_usage(FILE *f)
 {
-	fputs("usage: dxl --port PATH [--baud N] [--echo] [--latency-us N] [--timeout-ms N] COMMAND "
-	      "[ARGS]   (dxl --help for commands)\n", f);
+	fputs("usage: dxl --port PATH [--baud N] [--echo] [--rs485 MODE] [--latency-us N] [--timeout-ms N] "
+	      "COMMAND [ARGS]   (dxl --help for commands)\n", f);
 }
 
 void dxlt_help(FILE *f)
@@ -220,13 +232,21 @@ void dxlt_help(FILE *f)
 	      "  reset ID --yes             factory reset (ID becomes 1, baud 1 Mbps)\n"
 	      "  setup ID... [--status-level N] [--yes]   prepare servos and adapter for a 100 Hz\n"
 	      "                             loop (--yes: turn torque off first; the joint goes limp)\n"
+	      "  doctor [ID...] [--config FILE] [--cycles N]   the first-run hardware check: adapter,\n"
+	      "                             latency, baud, every servo's settings against the\n"
+	      "                             configuration, then N (300) of undulated's own cycles timed,\n"
+	      "                             holding each joint where it stands; one line per check\n"
+	      "                             (OK/WARN/FAIL) with its fix\n"
 	      "\noptions:\n"
 	      "  --port PATH        serial device or pty (e.g. /dev/ttyUSB0, /dev/serial/by-id/...)\n"
 	      "  --baud N           bus baud rate in bps (default 1000000)\n"
 	      "  --echo             single-wire wiring: discard our own bytes read back\n"
+	      "  --rs485 MODE       on-board UART with a half-duplex buffer on RTS: the kernel's RS-485\n"
+	      "                     mode, rts-on-send (or rts) or rts-after-send\n"
 	      "  --latency-us N     adapter latency to allow for (default: read the FTDI timer)\n"
 	      "  --timeout-ms N     wait about N ms per reply instead of the derived timeout\n"
 	      "\nexit codes: 0 ok, 2 usage, 3 port, 4 no reply / bus error, 5 servo error bits\n"
 	      "            (in any reply; the bits are named),\n"
-	      "            6 refused (ID taken, torque on, ...)\n", f);
+	      "            6 refused (ID taken, torque on, ...);\n"
+	      "            doctor: 0 all OK, 1 warnings only, 7 a check failed\n", f);
 }

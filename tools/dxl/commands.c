@@ -13,20 +13,8 @@
 #include <time.h>
 
 #include "dxl_table.h"
-#include "dxlt.h"
+#include "dxlt_priv.h"
 #include "num.h"
-
-struct dxlt {
-	struct dxlt_args a;
-	FILE *out, *err;
-	struct port *port;
-	struct port_latency latency;
-	struct bus bus;
-	/* Error bits any reply carried, per ID: the servo's news, reported once
-	 * when the command ends (dxlt_report_errbits), whichever call saw them. */
-	uint8_t errseen[DXL_BROADCAST_ID + 1];
-	char hint[200];          /* what to do about them, when we know */
-};
 
 /* ---- helpers ------------------------------------------------------------------ */
 
@@ -38,7 +26,7 @@ static void dxlt_sleep_us(long us)
 	}
 }
 
-static const char *dxlt_model_name(uint16_t model)
+const char *dxlt_model_name(uint16_t model)
 {
 	switch (model) {
 	case 12: return "AX-12";
@@ -48,8 +36,7 @@ static const char *dxlt_model_name(uint16_t model)
 	}
 }
 
-/* Reply timeout parts for the current baud (dxlt.h: the defaults' reasons). */
-static void dxlt_apply_timing(struct dxlt *t)
+void dxlt_apply_timing(struct dxlt *t)
 {
 	struct bus_timing timing = { .baud = port_baud(t->port) };
 
@@ -78,8 +65,7 @@ static int dxlt_set_baud(struct dxlt *t, long baud)
 	return DXLT_EXIT_OK;
 }
 
-/* One line for a failed transaction, and its exit code. */
-static int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
+int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
 {
 	switch (status) {
 	case DXL_E_TIMEOUT:
@@ -110,7 +96,7 @@ static int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
 
 /* ---- transactions: every reply's error bits are remembered ------------------- */
 
-static int dxlt_ping(struct dxlt *t, uint8_t id)
+int dxlt_ping(struct dxlt *t, uint8_t id)
 {
 	uint8_t e = 0;
 	int r = bus_ping(&t->bus, id, &e);
@@ -120,7 +106,7 @@ static int dxlt_ping(struct dxlt *t, uint8_t id)
 	return r;
 }
 
-static int dxlt_read(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out)
+int dxlt_read(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out)
 {
 	uint8_t e = 0;
 	int r = bus_read(&t->bus, id, addr, len, out, &e);
@@ -788,19 +774,29 @@ static const struct dxlt_command dxlt_commands[] = {
 	{ "setup", dxlt_cmd_setup },
 };
 
-static int dxlt_open(struct dxlt *t)
+int dxlt_open(struct dxlt *t, const char *path, bool low_latency)
 {
-	struct port_options opt = { .baud = t->a.baud };
+	struct port_options opt = { .baud = t->a.baud, .low_latency = low_latency };
 	struct bus_io io;
-	char why[256];
+	char why[512];
 
-	t->port = port_open(t->a.port_path, &opt, why, sizeof why);
+	t->port = port_open(path, &opt, why, sizeof why);
 	if (t->port == NULL) {
 		fprintf(t->err, "dxl: %s\n", why);
 		return DXLT_EXIT_PORT;
 	}
-	/* Look, do not touch: only `setup` changes the adapter. */
-	port_latency_check_fd(t->a.port_path, port_fd(t->port), false, &t->latency);
+	/* A UART behind a half-duplex buffer: the kernel switches the direction
+	 * around every packet, or nothing we send reaches a servo. */
+	if (port_set_rs485(t->port, t->a.rs485, why, sizeof why) != DXL_OK) {
+		fprintf(t->err, "dxl: %s\n", why);
+		return DXLT_EXIT_PORT;
+	}
+	/* Look, do not touch (unless asked): only setup and doctor change the adapter. */
+	const struct port_latency *checked = port_get_latency(t->port);
+	if (checked != NULL)
+		t->latency = *checked;
+	else
+		port_latency_check_fd(path, port_fd(t->port), false, &t->latency);
 	port_bus_io(t->port, &io);
 	bus_init(&t->bus, &io, NULL, t->a.echo);
 	dxlt_apply_timing(t);
@@ -820,6 +816,8 @@ static int dxlt_dispatch(struct dxlt *t)
 	}
 	if (strcmp(t->a.command, "ports") == 0)
 		return t->a.npos == 0 ? dxlt_cmd_ports(t) : dxlt_need_args(t, 0, "ports");
+	if (strcmp(t->a.command, "doctor") == 0)
+		return dxlt_cmd_doctor(t);
 	for (size_t i = 0; i < sizeof dxlt_commands / sizeof dxlt_commands[0]; i++) {
 		if (strcmp(t->a.command, dxlt_commands[i].name) != 0)
 			continue;
@@ -827,7 +825,7 @@ static int dxlt_dispatch(struct dxlt *t)
 			fprintf(t->err, "dxl: %s needs --port PATH (see dxl ports)\n", t->a.command);
 			return DXLT_EXIT_USAGE;
 		}
-		int rc = dxlt_open(t);
+		int rc = dxlt_open(t, t->a.port_path, false);
 		if (rc != DXLT_EXIT_OK)
 			return rc;
 		return dxlt_report_errbits(t, dxlt_commands[i].run(t));

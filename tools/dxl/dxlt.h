@@ -15,11 +15,14 @@
 /* Exit codes (documented in tools/dxl/README.md). */
 enum dxlt_exit {
 	DXLT_EXIT_OK = 0,
+	DXLT_EXIT_WARN = 1,      /* doctor: warnings, no failure (100 Hz works, with a cost) */
 	DXLT_EXIT_USAGE = 2,     /* bad arguments: unknown register, value out of range ... */
 	DXLT_EXIT_PORT = 3,      /* cannot open/configure the port, it went away, latency too high */
 	DXLT_EXIT_BUS = 4,       /* no reply, bad reply, verification after a write failed */
 	DXLT_EXIT_SERVO = 5,     /* the servo answered with error bits set */
 	DXLT_EXIT_REFUSED = 6,   /* refused to act: ID taken, torque on during an EEPROM write */
+	DXLT_EXIT_FAIL = 7,      /* doctor: at least one check failed */
+	DXLT_EXIT_INTERRUPTED = 130, /* doctor: SIGINT/SIGTERM during the timed cycles (128 + SIGINT) */
 };
 
 /* Most IDs/bauds a command takes on its command line. */
@@ -34,6 +37,11 @@ enum dxlt_exit {
  * interactive, a few ms more per missing servo cost nothing, a false "no
  * reply" on a loaded machine costs the user's trust. */
 #define DXLT_DEFAULT_SLACK_MS 5
+/* Cycles `dxl doctor` times by default: 300 at 10 ms are 3 s, enough for a
+ * p99 that means something (3 cycles above it). */
+#define DXLT_DOCTOR_CYCLES 300
+/* At most: 10 000 cycles are 100 s, and their figures are kept in memory. */
+#define DXLT_DOCTOR_MAX_CYCLES 10000
 /* Settling time after an EEPROM write before talking to the servo again: the
  * AX-12 is busy ≈6 ms per EEPROM byte. */
 #define DXLT_EEPROM_SETTLE_US 15000
@@ -41,13 +49,19 @@ enum dxlt_exit {
 struct dxlt_args {
 	const char *port_path;
 	long baud;               /* --baud, bps */
+	bool baud_given;         /* --baud was on the command line (doctor: over the configuration's) */
 	bool echo;               /* --echo: single-wire wiring, our bytes come back */
+	enum port_rs485 rs485;   /* --rs485: a UART's half-duplex buffer on RTS (port.h) */
+	bool rs485_given;
 	long latency_us;         /* --latency-us; -1: from the adapter's latency timer */
 	long timeout_ms;         /* --timeout-ms; -1: derived + DXLT_DEFAULT_SLACK_MS */
 	bool units;              /* --units */
 	bool yes;                /* --yes */
 	int status_level;        /* --status-level for setup; -1: default */
 	uint8_t id_lo, id_hi;    /* --ids A-B */
+	bool ids_given;
+	const char *config_path; /* --config FILE: undulated's configuration (doctor) */
+	long cycles;             /* --cycles N (doctor); -1: DXLT_DOCTOR_CYCLES */
 	long bauds[DXLT_MAX_BAUDS];
 	size_t nbauds;           /* --bauds LIST; 0: just --baud */
 	bool help;

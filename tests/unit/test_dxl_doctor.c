@@ -1,0 +1,420 @@
+/*
+ * test_dxl_doctor.c — the verdicts of `dxl doctor` (tools/dxl/doctor.h): each
+ * check's thresholds on both sides, the level, the value shown and the fix
+ * named. The bus work around them is tests/integration/dxl_doctor.sh's, on
+ * the simulator.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "../../tools/dxl/doctor.h"
+#include "dxl.h"
+
+#define PORT "/dev/ttyUSB0"
+
+static const struct dr_context ctx = { .port = PORT, .ids = "1 2", .baud = 1000000, .period_ms = 10.0 };
+
+/* The line has level lv and contains every string given (NULL-terminated). */
+static void expect(const struct dr_verdict *v, enum dr_level lv, ...)
+{
+	va_list ap;
+	if (v->level != lv)
+		fail_msg("level %s, expected %s: %s", dr_level_name(v->level), dr_level_name(lv), v->text);
+	va_start(ap, lv);
+	for (const char *want = va_arg(ap, const char *); want != NULL; want = va_arg(ap, const char *))
+		if (strstr(v->text, want) == NULL)
+			fail_msg("'%s' not in: %s", want, v->text);
+	va_end(ap);
+}
+
+static void lacks(const struct dr_verdict *v, const char *what)
+{
+	if (strstr(v->text, what) != NULL)
+		fail_msg("'%s' should not be in: %s", what, v->text);
+}
+
+/* An AX-12A as it leaves the factory, set up for 100 Hz (return delay 0). */
+static struct dr_servo factory(uint8_t id)
+{
+	struct dr_servo s = {
+		.id = id, .answered = true, .read = true, .model = 12, .firmware = 24, .return_delay = 0,
+		.cw_limit = 0, .ccw_limit = 1023, .temperature_limit = 70, .min_voltage = 60, .max_voltage = 140,
+		.max_torque = 1023, .status_return_level = 2, .alarm_led = 36, .alarm_shutdown = 36, .torque_enable = 0,
+		.torque_limit = 1023, .voltage = 120, .temperature = 32,
+	};
+	return s;
+}
+
+/* The two blocks as the manual lays them out (ax12.md), not through our own
+ * encoder: EEPROM 0..18 and RAM 24..43 of a factory AX-12A at 12 V, 32 °C. */
+static void test_decode(void **state)
+{
+	(void)state;
+	const uint8_t eeprom[DR_EEPROM_LEN] = { 12, 0, 24, 1, 1, 250, 0, 0, 0xFF, 0x03, 0, 70, 60, 140, 0xFF, 0x03, 2, 36, 4 };
+	uint8_t ram[DR_RAM_LEN] = { 0 };
+	ram[0] = 1;                    /* 24 torque enable */
+	ram[10] = 0x00, ram[11] = 0x02; /* 34 torque limit 512 */
+	ram[18] = 111;                 /* 42 present voltage */
+	ram[19] = 32;                  /* 43 present temperature */
+	struct dr_servo s = { 0 };
+	dr_servo_decode(&s, eeprom, ram);
+	assert_int_equal(s.model, 12);
+	assert_int_equal(s.firmware, 24);
+	assert_int_equal(s.return_delay, 250);
+	assert_int_equal(s.cw_limit, 0);
+	assert_int_equal(s.ccw_limit, 1023);
+	assert_int_equal(s.temperature_limit, 70);
+	assert_int_equal(s.min_voltage, 60);
+	assert_int_equal(s.max_voltage, 140);
+	assert_int_equal(s.max_torque, 1023);
+	assert_int_equal(s.status_return_level, 2);
+	assert_int_equal(s.alarm_led, 36);
+	assert_int_equal(s.alarm_shutdown, 4);
+	assert_int_equal(s.torque_enable, 1);
+	assert_int_equal(s.torque_limit, 512);
+	assert_int_equal(s.voltage, 111);
+	assert_int_equal(s.temperature, 32);
+}
+
+static void test_model(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(1);
+	dr_check_model(&s, &ctx, &v);
+	expect(&v, DR_OK, "12 (AX-12)", "firmware 24", NULL);
+	s.model = 18;
+	dr_check_model(&s, &ctx, &v);
+	expect(&v, DR_WARN, "18 (AX-18)", "dxl --port " PORT " dump 1", NULL);
+}
+
+static void test_return_delay(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(1);
+	dr_check_return_delay(&s, &ctx, &v);
+	expect(&v, DR_OK, "0 us", NULL);
+	lacks(&v, "fix");
+	s.return_delay = 250;    /* the factory's 500 µs */
+	dr_check_return_delay(&s, &ctx, &v);
+	expect(&v, DR_WARN, "500 us", "0.50 ms of every 10 ms cycle", "fix: dxl --port " PORT " setup 1 2 --yes "
+	       "(writes return delay 0)", NULL);
+	lacks(&v, "support the robot");
+	s.return_delay = 1;      /* even 2 µs is said: it is one write away */
+	struct dr_context held = ctx;
+	held.any_torque_on = true;
+	dr_check_return_delay(&s, &held, &v);
+	expect(&v, DR_WARN, "2 us", "--yes turns torque off first: support the robot", NULL);
+}
+
+static void test_status_level(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(4);
+	dr_check_status_level(&s, &ctx, &v);
+	expect(&v, DR_OK, "2", NULL);
+	s.status_return_level = 1;
+	dr_check_status_level(&s, &ctx, &v);
+	expect(&v, DR_WARN, "1: WRITEs are not answered", "setup 1 2 --yes (writes status return level 2)", NULL);
+	s.status_return_level = 0;
+	dr_check_status_level(&s, &ctx, &v);
+	expect(&v, DR_FAIL, "answers PING only", "fix: dxl --port " PORT " write 4 status_return_level 2", NULL);
+}
+
+static void test_voltage(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(1);
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_OK, "12.0 V", "(servo's limits 6.0..14.0 V)", NULL);
+	s.voltage = 100;         /* 10.0 V: the lowest that is not a warning */
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_OK, "10.0 V", NULL);
+	s.voltage = 99;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_WARN, "9.9 V", "fix: charge the battery", NULL);
+	s.voltage = 96;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_WARN, "9.6 V", "80% of the 12 V torque", NULL);
+	s.voltage = 90;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_WARN, "9.0 V", NULL);
+	s.voltage = 89;          /* below the AX-12A's 9 V, inside the servo's own limits */
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_FAIL, "8.9 V", "below the AX-12A's 9..12 V", "fix: charge or replace the battery", NULL);
+	s.voltage = 70;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_FAIL, "7.0 V", "58% of its 12 V torque", NULL);
+	s.voltage = 55;          /* outside the servo's own limits: its replies say so */
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_FAIL, "5.5 V", "voltage error", NULL);
+	s.voltage = 126;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_OK, "12.6 V", NULL);
+	s.voltage = 127;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_WARN, "12.7 V", "above the AX-12A's 12 V", NULL);
+	s.voltage = 141;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_FAIL, "14.1 V", "voltage error", NULL);
+}
+
+static void test_temperature(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(1);
+	s.temperature = 59;
+	dr_check_temperature(&s, &v);
+	expect(&v, DR_OK, "59 C (limit 70 C)", NULL);
+	s.temperature = 60;
+	dr_check_temperature(&s, &v);
+	expect(&v, DR_WARN, "60 C, within 10 C of its limit 70 C", "fix: let it cool", NULL);
+	s.temperature = 70;
+	dr_check_temperature(&s, &v);
+	expect(&v, DR_FAIL, "70 C, at or above its limit", "the alarm switches its torque off", "20 minutes", NULL);
+	s.alarm_shutdown = DXL_ERRBIT_OVERLOAD;
+	dr_check_temperature(&s, &v);
+	expect(&v, DR_FAIL, "no alarm switches its torque off", NULL);
+}
+
+/* The configured joint: neutral 0, ±1.3 rad, i.e. raw 259..765 (whole units
+ * inside the limits, setup_joint_limits). */
+static struct cfg robot(void)
+{
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "t.conf", "[robot]\nport=/dev/null\nids=1,2\n", &e) && cfg_finish(&c, &e));
+	return c;
+}
+
+static void test_limits(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct cfg c = robot();
+	struct dr_servo s = factory(1);
+	dr_check_limits(&s, &c, 0, &ctx, &v);
+	expect(&v, DR_OK, "0..1023", "259..765", "joint 1", NULL);
+	s.cw_limit = 259, s.ccw_limit = 765;     /* exactly the configuration's */
+	dr_check_limits(&s, &c, 0, &ctx, &v);
+	expect(&v, DR_OK, "259..765", NULL);
+	s.cw_limit = 350, s.ccw_limit = 700;
+	dr_check_limits(&s, &c, 0, &ctx, &v);
+	expect(&v, DR_WARN, "350..700, narrower than the configuration's 259..765", "write 1 cw_angle_limit 259",
+	       "write 1 ccw_angle_limit 765", NULL);
+	lacks(&v, "torque 1 off");
+	s.ccw_limit = 1023;                      /* one side only: one write */
+	s.torque_enable = 1;
+	dr_check_limits(&s, &c, 1, &ctx, &v);
+	expect(&v, DR_WARN, "350..1023", "joint 2", "dxl --port " PORT " torque 1 off; dxl --port " PORT
+	       " write 1 cw_angle_limit 259", NULL);
+	lacks(&v, "ccw_angle_limit");
+	s.cw_limit = 800, s.ccw_limit = 1023;    /* no angle in common */
+	dr_check_limits(&s, &c, 0, &ctx, &v);
+	expect(&v, DR_FAIL, "800..1023 have no angle in common", "refuses to start", NULL);
+	s.cw_limit = 0, s.ccw_limit = 0;         /* wheel mode */
+	s.torque_enable = 0;
+	dr_check_limits(&s, &c, 0, &ctx, &v);
+	expect(&v, DR_FAIL, "wheel mode", "write 1 cw_angle_limit 259; dxl --port " PORT " write 1 ccw_angle_limit 765",
+	       NULL);
+	c.actuation = CFG_ACT_TORQUE;            /* the daemon restores joint mode itself */
+	dr_check_limits(&s, &c, 0, &ctx, &v);
+	expect(&v, DR_WARN, "wheel mode", "puts", NULL);
+}
+
+static void test_alarms(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(2);
+	dr_check_alarms(&s, &ctx, &v);
+	expect(&v, DR_OK, "shutdown 36 (overheating|overload)", "LED 36", NULL);
+	s.alarm_shutdown = DXL_ERRBIT_OVERHEAT;  /* the old manual's default 4 */
+	dr_check_alarms(&s, &ctx, &v);
+	expect(&v, DR_WARN, "overload does not switch torque off", "fix: dxl --port " PORT " write 2 alarm_shutdown 36",
+	       NULL);
+	s.alarm_shutdown = 36 | DXL_ERRBIT_CHECKSUM;
+	dr_check_alarms(&s, &ctx, &v);
+	expect(&v, DR_WARN, "checksum switches torque off", "one damaged packet", NULL);
+	lacks(&v, "does not switch");
+	s.torque_enable = 1;
+	dr_check_alarms(&s, &ctx, &v);
+	expect(&v, DR_WARN, "(torque off first)", NULL);
+}
+
+static void test_torque(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(1);
+	dr_check_torque(&s, &ctx, &v);
+	expect(&v, DR_OK, "off", "turns it on at start", NULL);
+	s.torque_enable = 1;
+	dr_check_torque(&s, &ctx, &v);
+	expect(&v, DR_OK, "on, torque limit 1023", NULL);
+	s.torque_limit = 0;
+	dr_check_torque(&s, &ctx, &v);
+	expect(&v, DR_WARN, "torque limit 0: an alarm shut it down", "write 1 torque_limit 1023", NULL);
+	s.max_torque = 0;
+	dr_check_torque(&s, &ctx, &v);
+	expect(&v, DR_WARN, "max torque 0", "write 1 max_torque 1023", NULL);
+}
+
+static void test_errbits(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_servo s = factory(1);
+	assert_false(dr_check_errbits(&s, &ctx, &v));
+	s.errbits = DXL_ERRBIT_OVERLOAD;
+	assert_true(dr_check_errbits(&s, &ctx, &v));
+	expect(&v, DR_FAIL, "0x20 (overload)", "free the joint", NULL);
+	s.errbits = DXL_ERRBIT_CHECKSUM;
+	assert_true(dr_check_errbits(&s, &ctx, &v));
+	expect(&v, DR_WARN, "0x10 (checksum)", "a damaged line", NULL);
+	assert_int_equal(v.text[strlen(v.text) - 1] == ' ', 0);
+}
+
+static void test_adapter(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_adapter a = { .tty = "pts/3", .is_pty = true, .sysfs_root = "/sys" };
+	dr_check_adapter(&a, &v);
+	expect(&v, DR_OK, "pts/3: a pseudo-terminal", "no latency timer", NULL);
+	/* a U2D2 whose timer was 16 ms: lowered for this run, as undulated does */
+	struct dr_adapter u = { .tty = "ttyUSB0", .listed = true, .sysfs_root = "/sys" };
+	u.info.usb_vid = 0x0403, u.info.usb_pid = 0x6014, u.info.adapter = "U2D2";
+	u.lat.known = true, u.lat.found_ms = 16, u.lat.timer_ms = 1, u.lat.lowered = true;
+	dr_check_adapter(&u, &v);
+	expect(&v, DR_WARN, "ttyUSB0: U2D2 0403:6014", "was 16 ms, lowered to 1 ms", "99-undulate.rules",
+	       "echo 1 > /sys/bus/usb-serial/devices/ttyUSB0/latency_timer", NULL);
+	u.lat.timer_ms = 16, u.lat.lowered = false;
+	snprintf(u.lat.note, sizeof u.lat.note, "Permission denied");
+	dr_check_adapter(&u, &v);
+	expect(&v, DR_FAIL, "latency timer 16 ms and it could not be lowered (Permission denied)", "as root", NULL);
+	u.lat.found_ms = 1, u.lat.timer_ms = 1;
+	dr_check_adapter(&u, &v);
+	expect(&v, DR_OK, "latency timer 1 ms", NULL);
+	/* an on-board UART in RS-485 mode, echoing */
+	struct dr_adapter r = { .tty = "ttyAMA0", .sysfs_root = "/sys", .rs485 = PORT_RS485_RTS_ON_SEND, .echo = true };
+	dr_check_adapter(&r, &v);
+	expect(&v, DR_OK, "ttyAMA0: a serial port", "RS-485 mode rts-on-send", "echo cancelling on", NULL);
+}
+
+static void test_latency(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_latency l = { .measured = true, .id = 1, .allowed_us = 3000, .njoints = 2 };
+	l.late = (struct bus_lateness){ .pings = 8, .replies = 8, .min_us = 40, .median_us = 80, .max_us = 140 };
+	dr_check_latency(&l, &v);
+	expect(&v, DR_OK, "0.08 ms after their wire time", "median of 8 PINGs to ID 1", NULL);
+	l.late.median_us = DR_LATE_WARN_US;
+	dr_check_latency(&l, &v);
+	expect(&v, DR_OK, "1.50 ms", NULL);
+	l.late.median_us = DR_LATE_WARN_US + 1;
+	dr_check_latency(&l, &v);
+	expect(&v, DR_WARN, "3.0 ms a cycle for 2 joint(s)", "fix: an adapter that passes replies on at once", NULL);
+	l.allowed_us = 20000;
+	l.late.median_us = DR_LATE_FAIL_US + 1;
+	l.ftdi = true;
+	dr_check_latency(&l, &v);
+	expect(&v, DR_FAIL, "every READ waits that long", "fix: the latency timer to 1 ms", NULL);
+	/* beyond what the daemon's timeouts allow: its READs would all time out */
+	l.ftdi = false;
+	l.allowed_us = 3000;
+	l.late.median_us = 16150, l.late.max_us = 18610;
+	dr_check_latency(&l, &v);
+	expect(&v, DR_FAIL, "16.15 ms", "every READ of its cycle would time out", "adapter_latency_us = 20000", NULL);
+	l.measured = false;
+	dr_check_latency(&l, &v);
+	expect(&v, DR_SKIP, "no servo answered", NULL);
+}
+
+static void test_echo(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	assert_false(dr_check_echo(false, 0, 0, &v));
+	assert_false(dr_check_echo(true, 0, 0, &v));
+	assert_false(dr_check_echo(true, 3, 0, &v));   /* with echo on, an echo is expected */
+	assert_true(dr_check_echo(false, 15, 0, &v));
+	expect(&v, DR_WARN, "came back before the reply 15 time(s)", "fix: echo = true", "--echo", NULL);
+	assert_true(dr_check_echo(true, 0, 4, &v));
+	expect(&v, DR_FAIL, "4 time(s)", "the wiring does not echo", "fix: echo = false", NULL);
+}
+
+static void test_baud(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	/* ax12.md's budget table: 2 servos 0.58 ms, 6 servos 1.58 ms at 1 Mbps */
+	assert_true(dr_cycle_wire_us(2, 1000000) > 579.9 && dr_cycle_wire_us(2, 1000000) < 580.1);
+	assert_true(dr_cycle_wire_us(6, 1000000) > 1579.9 && dr_cycle_wire_us(6, 1000000) < 1580.1);
+	assert_true(dr_cycle_wire_us(0, 1000000) == 0.0);
+	dr_check_baud(&ctx, 2, 2, &v);
+	expect(&v, DR_OK, "1000000 bps: 2 of 2", "0.58 ms on the wire", NULL);
+	dr_check_baud(&ctx, 3, 0, &v);
+	expect(&v, DR_FAIL, "none of the 3 servo(s) answered", "dxl --port " PORT " scan --bauds all", NULL);
+	struct dr_context slow = ctx;
+	slow.baud = 57143;
+	dr_check_baud(&slow, 6, 6, &v);   /* 158 bytes: 27.6 ms */
+	expect(&v, DR_WARN, "57143 bps", "more than half", "set-baud ID 1000000", NULL);
+}
+
+static void test_budget(void **state)
+{
+	(void)state;
+	struct dr_verdict v;
+	struct dr_budget b = { .cycles = 300, .joints = 2, .p50_ms = 0.65, .p99_ms = 3.84, .max_ms = 4.57,
+	                       .floor_ms = 0.58, .period_ms = 10.0, .errors = 2, .transactions = 666 };
+	dr_check_budget(&b, &v);
+	expect(&v, DR_OK, "p50 0.65 / p99 3.84 / max 4.57 ms", "wire floor 0.58 ms (p50 1.1x it)", "period 10 ms",
+	       "300 cycles", "2 of 666 transactions failed", NULL);
+	lacks(&v, "fix");
+	b.errors = 7;            /* 1.05 % */
+	dr_check_budget(&b, &v);
+	expect(&v, DR_WARN, "fix: the failed transactions", NULL);
+	b.errors = 67;           /* 10.06 % */
+	dr_check_budget(&b, &v);
+	expect(&v, DR_FAIL, NULL);
+	b.errors = 0;
+	b.p99_ms = 7.1;          /* writes and read-backs start to wait (CYC_LATE_SHARE) */
+	dr_check_budget(&b, &v);
+	expect(&v, DR_WARN, NULL);
+	b.p99_ms = 6.0, b.p50_ms = 5.1;
+	dr_check_budget(&b, &v);
+	expect(&v, DR_WARN, "too much bus time", NULL);
+	b.p50_ms = 7.1, b.p99_ms = 9.9;
+	dr_check_budget(&b, &v);
+	expect(&v, DR_FAIL, NULL);
+	b.p50_ms = 1.0, b.p99_ms = 2.0, b.cut_off = 4;
+	dr_check_budget(&b, &v);
+	expect(&v, DR_WARN, "4 cycle(s) cut off", NULL);
+	b.skipped = "--cycles 0";
+	dr_check_budget(&b, &v);
+	expect(&v, DR_SKIP, "not timed: --cycles 0", NULL);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_decode),       cmocka_unit_test(test_model),   cmocka_unit_test(test_return_delay),
+		cmocka_unit_test(test_status_level), cmocka_unit_test(test_voltage), cmocka_unit_test(test_temperature),
+		cmocka_unit_test(test_limits),       cmocka_unit_test(test_alarms),  cmocka_unit_test(test_torque),
+		cmocka_unit_test(test_errbits),      cmocka_unit_test(test_adapter), cmocka_unit_test(test_latency),
+		cmocka_unit_test(test_baud),         cmocka_unit_test(test_budget),  cmocka_unit_test(test_echo),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
