@@ -11,7 +11,8 @@
  * Invariants (abort() on violation):
  *  - every error kept is one NUL-terminated line, non-empty, naming where it
  *    came from ("fuzz:..." for the text, "command line: ..." for an
- *    override, "config: ..." for the whole-config checks; config.h);
+ *    override, "<source>: ..." for the whole-config checks — the file's
+ *    name, or "command line" when none was loaded; config.h);
  *  - the count of errors matches what each call returned: a load succeeds
  *    only with no error, an override fails with exactly one, finish() fails
  *    only with new ones;
@@ -218,7 +219,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	size_t before = e.count;
 	bool finished = cfg_finish(&c, &e);
 	CHECK(finished == (e.count == before));
-	check_messages(&e, before, e.count, "config: ");
+	/* the whole-config checks name the configuration's source: the file's
+	 * name when one was loaded, else the command line */
+	char whole[CFG_PATH_MAX + 3];
+	snprintf(whole, sizeof whole, "%s: ", c.source[0] ? c.source : "command line");
+	check_messages(&e, before, e.count, whole);
 	if (before == 0 && finished) {
 		check_config(&c);
 		cfg_print(&c, sink);
