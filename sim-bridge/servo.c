@@ -175,18 +175,18 @@ static bool servo_byte_writable(const struct sim_servo *s, const struct dxl_reg 
 	return true;
 }
 
-/* Range check of one register's new value against the new table image. */
+/* Check of one register's new value against the new table image: its range
+ * from the one table of protocol/dxl_table.c (the e-manual's, per mode),
+ * then the two rules that depend on the servo's state. */
 static uint8_t servo_value_error(const struct sim_servo *s, const uint8_t *img, const struct dxl_reg *r)
 {
 	uint16_t v = mem_get(img, r);
 	bool wheel = dxl_is_wheel_mode(dxl_get_u16(&img[DXL_AX_CW_ANGLE_LIMIT]),
 	                               dxl_get_u16(&img[DXL_AX_CCW_ANGLE_LIMIT]));
-	if (r->addr == DXL_AX_MOVING_SPEED)
-		return v > (wheel ? 2047 : 1023) ? DXL_ERRBIT_RANGE : 0;
+	if (dxl_reg_check_write_mode(r, v, wheel) != DXL_OK)
+		return DXL_ERRBIT_RANGE;
 	if (r->addr == DXL_AX_LOCK && s->mem[DXL_AX_LOCK] && v == 0)
 		return DXL_ERRBIT_RANGE;  /* only a power cycle unlocks */
-	if (dxl_reg_check_write(r, v) != DXL_OK)
-		return DXL_ERRBIT_RANGE;
 	if (r->addr == DXL_AX_GOAL_POSITION && !wheel) {
 		uint16_t cw = dxl_get_u16(&img[DXL_AX_CW_ANGLE_LIMIT]);
 		uint16_t ccw = dxl_get_u16(&img[DXL_AX_CCW_ANGLE_LIMIT]);

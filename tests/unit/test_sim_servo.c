@@ -103,11 +103,13 @@ static void test_golden_write(void **state)
 	struct sim_servo s;
 	uint8_t out[DXL_MAX_PACKET];
 	servo_at_32c(&s);
-	/* WRITE id 1, addr 12 (min voltage), 0x64 0xAA: 100 -> 10.0 V, 0xAA -> max 17.0 V. */
+	/* The e-manual's checksum example: WRITE id 1, addr 12 (min voltage),
+	 * 0x64 0xAA: 10.0 V and 17.0 V. The same manual's range is 50-160: 170
+	 * gets the range bit and neither byte is stored. */
 	int n = SEND(&s, out, 0xFF, 0xFF, 0x01, 0x05, 0x03, 0x0C, 0x64, 0xAA, 0xDC);
-	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC);
-	assert_int_equal(s.mem[12], 0x64);
-	assert_int_equal(s.mem[13], 0xAA);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x08, 0xF4);
+	assert_int_equal(s.mem[12], 60);
+	assert_int_equal(s.mem[13], 140);
 	/* WRITE id 1 goal position 512. */
 	n = SEND(&s, out, 0xFF, 0xFF, 0x01, 0x05, 0x03, 0x1E, 0x00, 0x02, 0xD6);
 	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC);
@@ -189,6 +191,63 @@ static void test_range_error_not_written(void **state)
 	n = req(&s, 1, DXL_INST_WRITE, q, 5, out);
 	assert_int_equal(out[4], DXL_ERRBIT_RANGE);
 	assert_int_equal(sim_servo_peek(&s, DXL_AX_GOAL_POSITION), DXL_POS_CENTER);
+}
+
+/* The AX-12A e-manual's write ranges, written out here (not read from
+ * protocol/dxl_table.c, which the servo enforces): the last value inside is
+ * stored, the first outside gets the range bit and changes nothing. */
+static void test_emanual_ranges(void **state)
+{
+	(void)state;
+	static const struct {
+		uint8_t addr;
+		uint16_t inside, outside;
+	} rows[] = {
+		{ DXL_AX_ID, 253, 254 },
+		{ DXL_AX_BAUD_RATE, 254, 255 },
+		{ DXL_AX_RETURN_DELAY_TIME, 254, 255 },
+		{ DXL_AX_CW_ANGLE_LIMIT, 1023, 1024 },
+		{ DXL_AX_TEMPERATURE_LIMIT, 100, 101 },   /* e-manual 0-100 (old manual 0-150) */
+		{ DXL_AX_MIN_VOLTAGE_LIMIT, 50, 49 },     /* 50-160 (old manual 50-250) */
+		{ DXL_AX_MIN_VOLTAGE_LIMIT, 160, 161 },
+		{ DXL_AX_MAX_VOLTAGE_LIMIT, 160, 161 },
+		{ DXL_AX_MAX_TORQUE, 1023, 1024 },
+		{ DXL_AX_STATUS_RETURN_LEVEL, 2, 3 },
+		{ DXL_AX_ALARM_LED, 0x7F, 0x80 },
+		{ DXL_AX_ALARM_SHUTDOWN, 0x7F, 0x80 },
+		{ DXL_AX_TORQUE_ENABLE, 1, 2 },
+		{ DXL_AX_LED, 1, 2 },
+		{ DXL_AX_CW_COMPLIANCE_SLOPE, 254, 255 },  /* 0-254, in 7 steps */
+		{ DXL_AX_CCW_COMPLIANCE_SLOPE, 0, 255 },
+		{ DXL_AX_GOAL_POSITION, 1023, 1024 },
+		{ DXL_AX_MOVING_SPEED, 1023, 1024 },       /* joint mode */
+		{ DXL_AX_TORQUE_LIMIT, 1023, 1024 },
+		{ DXL_AX_PUNCH, 0x20, 0x1F },              /* 0x20-0x3FF (old manual 0-1023) */
+		{ DXL_AX_PUNCH, 0x3FF, 0x400 },
+	};
+	for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
+		struct sim_servo s;
+		uint8_t out[DXL_MAX_PACKET];
+		servo_at_32c(&s);
+		const struct dxl_reg *r = dxl_reg_at(rows[i].addr);
+		assert_non_null(r);
+		uint16_t before = sim_servo_peek(&s, rows[i].addr);
+		int n = r->size == 2 ? write_u16(&s, 1, rows[i].addr, rows[i].outside, out)
+		                     : write_u8(&s, 1, rows[i].addr, (uint8_t)rows[i].outside, out);
+		assert_int_equal(n, 6);
+		if (out[4] != DXL_ERRBIT_RANGE)
+			fail_msg("%s = %u: error 0x%02x, want the range bit", r->name, rows[i].outside, out[4]);
+		assert_int_equal(sim_servo_peek(&s, rows[i].addr), before);
+		n = r->size == 2 ? write_u16(&s, 1, rows[i].addr, rows[i].inside, out)
+		                 : write_u8(&s, 1, rows[i].addr, (uint8_t)rows[i].inside, out);
+		if (rows[i].addr == DXL_AX_ID) {
+			assert_int_equal(out[2], 1);  /* answered under the old ID */
+		}
+		if (out[4] != 0)
+			fail_msg("%s = %u: error 0x%02x, want none", r->name, rows[i].inside, out[4]);
+		assert_int_equal(sim_servo_peek(&s, rows[i].addr), rows[i].inside);
+		assert_int_equal(s.count.range_errors, 1);
+	}
 }
 
 static void test_read_only_registers(void **state)
@@ -484,6 +543,7 @@ int main(void)
 		cmocka_unit_test(test_golden_sync_write),
 		cmocka_unit_test(test_golden_reg_write_action),
 		cmocka_unit_test(test_range_error_not_written),
+		cmocka_unit_test(test_emanual_ranges),
 		cmocka_unit_test(test_read_only_registers),
 		cmocka_unit_test(test_angle_limit_error),
 		cmocka_unit_test(test_wheel_mode),
