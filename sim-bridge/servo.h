@@ -14,7 +14,12 @@
  *    written and the reply carries the angle-limit error bit;
  *  - the range/angle-limit/checksum/instruction bits belong to the reply of
  *    the offending instruction; voltage, overheating and overload are
- *    conditions reported in every status packet while they last.
+ *    conditions reported in every status packet while they last;
+ *  - an alarm shutdown (any error whose bit is set in Alarm Shutdown, the
+ *    one-packet errors included) clears Torque Enable as well as the
+ *    Torque Limit the manual names;
+ *  - a READ past address 49 and an EEPROM write with torque on get the
+ *    range bit; a baud change is answered at the old rate (simbus.c).
  */
 #ifndef UNDULATE_SIM_SERVO_H
 #define UNDULATE_SIM_SERVO_H

@@ -466,6 +466,110 @@ static void test_alarm_shutdown_and_recovery(void **state)
 	assert_int_equal(s.count.shutdowns, 1);
 }
 
+static void expect_shut_down(const struct sim_servo *s, unsigned shutdowns)
+{
+	assert_int_equal(s->mem[DXL_AX_TORQUE_ENABLE], 0);
+	assert_int_equal(sim_servo_peek(s, DXL_AX_TORQUE_LIMIT), 0);
+	assert_int_equal(s->count.shutdowns, shutdowns);
+}
+
+static void torque_back_on(struct sim_servo *s)
+{
+	uint8_t out[DXL_MAX_PACKET];
+	write_u16(s, 1, DXL_AX_TORQUE_LIMIT, 1023, out);
+	assert_int_equal(out[4], 0);
+	write_u8(s, 1, DXL_AX_TORQUE_ENABLE, 1, out);
+	assert_int_equal(out[4], 0);
+	assert_int_equal(s->mem[DXL_AX_TORQUE_ENABLE], 1);
+}
+
+/* Every bit of Alarm Shutdown acts, the one-packet errors too: the reply
+ * carries the bit, torque enable and torque limit go to 0. */
+static void test_alarm_shutdown_every_bit(void **state)
+{
+	(void)state;
+	struct sim_servo s;
+	uint8_t out[DXL_MAX_PACKET];
+	servo_at_32c(&s);
+	write_u16(&s, 1, DXL_AX_CW_ANGLE_LIMIT, 100, out);
+	write_u8(&s, 1, DXL_AX_TORQUE_ENABLE, 1, out);
+	/* The factory mask (36) leaves a range error alone. */
+	write_u8(&s, 1, DXL_AX_LED, 2, out);
+	assert_int_equal(out[4], DXL_ERRBIT_RANGE);
+	assert_int_equal(s.mem[DXL_AX_TORQUE_ENABLE], 1);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_TORQUE_LIMIT), 1023);
+	write_u8(&s, 1, DXL_AX_TORQUE_ENABLE, 0, out);
+	write_u8(&s, 1, DXL_AX_ALARM_SHUTDOWN, 0x7F, out);
+	assert_int_equal(out[4], 0);
+	torque_back_on(&s);
+	/* range: LED 2 */
+	int n = write_u8(&s, 1, DXL_AX_LED, 2, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x08, 0xF4);
+	expect_shut_down(&s, 1);
+	torque_back_on(&s);
+	/* angle limit: goal 50 below the CW limit 100 */
+	n = write_u16(&s, 1, DXL_AX_GOAL_POSITION, 50, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x02, 0xFA);
+	expect_shut_down(&s, 2);
+	torque_back_on(&s);
+	/* instruction: ACTION with nothing registered */
+	n = req(&s, 1, DXL_INST_ACTION, NULL, 0, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x40, 0xBC);
+	expect_shut_down(&s, 3);
+	torque_back_on(&s);
+	/* checksum */
+	n = sim_servo_handle_bad_checksum(&s, 1, DXL_INST_PING, out, sizeof(out));
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x10, 0xEC);
+	expect_shut_down(&s, 4);
+	torque_back_on(&s);
+	/* a READ past the table: range */
+	uint8_t rd[2] = { 45, 10 };
+	n = req(&s, 1, DXL_INST_READ, rd, 2, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x08, 0xF4);
+	expect_shut_down(&s, 5);
+	torque_back_on(&s);
+	/* unreported errors act too: a broadcast write out of range, and a
+	 * SYNC_WRITE of a goal past the angle limit */
+	assert_int_equal(write_u8(&s, DXL_BROADCAST_ID, DXL_AX_LED, 2, out), 0);
+	expect_shut_down(&s, 6);
+	torque_back_on(&s);
+	uint8_t sw[5] = { DXL_AX_GOAL_POSITION, 2, 1, 50, 0 };
+	assert_int_equal(req(&s, DXL_BROADCAST_ID, DXL_INST_SYNC_WRITE, sw, 5, out), 0);
+	expect_shut_down(&s, 7);
+	/* a second error while it is shut down is not another shutdown */
+	write_u8(&s, 1, DXL_AX_LED, 2, out);
+	expect_shut_down(&s, 7);
+	assert_int_equal(s.count.range_errors, 5);   /* the first under mask 36 */
+	assert_int_equal(s.count.angle_limit_errors, 2);
+	assert_int_equal(s.count.instruction_errors, 1);
+	assert_int_equal(s.count.checksum_errors, 1);
+}
+
+/* A write is answered under the ID and the status return level the servo had
+ * when it arrived (the original AX-12 manual's Examples 7 and 14). */
+static void test_answered_before_the_write_acts(void **state)
+{
+	(void)state;
+	struct sim_servo s;
+	uint8_t out[DXL_MAX_PACKET];
+	servo_at_32c(&s);
+	/* Example 7: ID 1 -> 0, answered by ID 1 */
+	int n = SEND(&s, out, 0xFF, 0xFF, 0x01, 0x04, 0x03, 0x03, 0x00, 0xF4);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC);
+	assert_int_equal(sim_servo_id(&s), 0);
+	/* Example 14: status return level 0, the write itself answered */
+	n = SEND(&s, out, 0xFF, 0xFF, 0x00, 0x04, 0x03, 0x10, 0x00, 0xE8);
+	EXPECT(out, n, 0xFF, 0xFF, 0x00, 0x02, 0x00, 0xFD);
+	assert_int_equal(s.mem[DXL_AX_STATUS_RETURN_LEVEL], 0);
+	uint8_t rd[2] = { DXL_AX_PRESENT_TEMPERATURE, 1 };
+	assert_int_equal(req(&s, 0, DXL_INST_READ, rd, 2, out), 0);
+	/* back to 2: under the old level 0, not answered; the next one is */
+	assert_int_equal(write_u8(&s, 0, DXL_AX_STATUS_RETURN_LEVEL, 2, out), 0);
+	assert_int_equal(s.mem[DXL_AX_STATUS_RETURN_LEVEL], 2);
+	n = req(&s, 0, DXL_INST_READ, rd, 2, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x00, 0x03, 0x00, 0x20, 0xDC);
+}
+
 static void test_overheating_and_masks(void **state)
 {
 	(void)state;
@@ -554,6 +658,8 @@ int main(void)
 		cmocka_unit_test(test_factory_reset),
 		cmocka_unit_test(test_lock),
 		cmocka_unit_test(test_alarm_shutdown_and_recovery),
+		cmocka_unit_test(test_alarm_shutdown_every_bit),
+		cmocka_unit_test(test_answered_before_the_write_acts),
 		cmocka_unit_test(test_overheating_and_masks),
 		cmocka_unit_test(test_bad_checksum_and_unknown_instruction),
 		cmocka_unit_test(test_read_block_and_present_values),
