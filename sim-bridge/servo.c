@@ -477,7 +477,11 @@ void sim_servo_sense(struct sim_servo *s, const struct sim_servo_sense *in, doub
 		return;
 	uint16_t pos = dxl_rad_to_pos(in->angle);
 	dxl_put_u16(&m[DXL_AX_PRESENT_POSITION], pos);
-	dxl_put_u16(&m[DXL_AX_PRESENT_SPEED], dxl_rad_s_to_speed(in->speed));
+	/* Present Speed (e-manual): in joint mode the speed, 0.111 rpm a unit; in
+	 * wheel mode "the unit is about 0.1 %" of the output — what the servo
+	 * drives, not how fast the wheel turns. Both carry the direction in bit 10. */
+	bool wheel = dxl_is_wheel_mode(dxl_get_u16(&m[DXL_AX_CW_ANGLE_LIMIT]), dxl_get_u16(&m[DXL_AX_CCW_ANGLE_LIMIT]));
+	dxl_put_u16(&m[DXL_AX_PRESENT_SPEED], wheel ? dxl_duty_to_wheel(in->output) : dxl_rad_s_to_speed(in->speed));
 	dxl_put_u16(&m[DXL_AX_PRESENT_LOAD], dxl_fraction_to_load(in->load_fraction));
 	m[DXL_AX_PRESENT_VOLTAGE] = clamp_u8(in->voltage * 10.0);
 	m[DXL_AX_PRESENT_TEMPERATURE] = clamp_u8(in->temperature);

@@ -105,12 +105,15 @@ struct sim_servo_sense {
 	double angle;          /* rad from centre */
 	double speed;          /* rad/s */
 	double load_fraction;  /* signed, of max torque */
+	double output;         /* signed share of full output the servo drives (its PWM duty), -1..1,
+	                          positive CCW: wheel mode's present speed */
 	double voltage;        /* V */
 	double temperature;    /* °C */
 	bool overloaded;       /* delivered torque at the torque limit */
 };
 /* Update present position/speed/load/voltage/temperature/moving, the error
- * conditions and the alarm shutdown. */
+ * conditions and the alarm shutdown. Present speed is in->speed in joint mode
+ * and in->output in wheel mode, as on the AX-12A (e-manual, Present Speed). */
 void sim_servo_sense(struct sim_servo *s, const struct sim_servo_sense *in, double dt);
 /* Error conditions a status packet carries now (voltage, overheating,
  * overload). Injected stuck-error bits are added on the way out (fault.c). */

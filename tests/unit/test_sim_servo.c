@@ -290,6 +290,32 @@ static void test_angle_limit_error(void **state)
 	assert_int_equal(s.count.angle_limit_errors, 2);
 }
 
+/* Present Speed: the measured speed in joint mode, the output share in wheel
+ * mode (e-manual: "the unit is about 0.1 %"), whatever the wheel's speed. */
+static void test_present_speed_by_mode(void **state)
+{
+	(void)state;
+	struct sim_servo s;
+	uint8_t out[DXL_MAX_PACKET];
+	servo_at_32c(&s);
+	struct sim_servo_sense in = { .speed = 3.0, .output = 0.5, .voltage = 12.0, .temperature = 32.0 };
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), dxl_rad_s_to_speed(3.0));
+	write_u16(&s, 1, DXL_AX_CCW_ANGLE_LIMIT, 0, out);   /* wheel mode */
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), 512);
+	in.output = -0.25;   /* CW: bit 10 */
+	in.speed = -5.0;
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), 1024 + 256);
+	in.output = 0.0;     /* no drive: 0 while the wheel still turns */
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), 0);
+	write_u16(&s, 1, DXL_AX_CCW_ANGLE_LIMIT, 1023, out);  /* joint mode again */
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), dxl_rad_s_to_speed(-5.0));
+}
+
 static void test_wheel_mode(void **state)
 {
 	(void)state;
@@ -651,6 +677,7 @@ int main(void)
 		cmocka_unit_test(test_read_only_registers),
 		cmocka_unit_test(test_angle_limit_error),
 		cmocka_unit_test(test_wheel_mode),
+		cmocka_unit_test(test_present_speed_by_mode),
 		cmocka_unit_test(test_eeprom_vs_ram),
 		cmocka_unit_test(test_max_torque_copied_at_power_on),
 		cmocka_unit_test(test_status_return_levels),
