@@ -738,6 +738,15 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 	char why[200];
 	if (c->lcm_url[0] != '\0' && !udpm_parse_url(c->lcm_url, &url, why, sizeof why))
 		cfg_error(e, "%s: [robot] lcm_url: %s", c->source[0] ? c->source : "command line", why);
+	/* Torque actuation reads the joint's speed every cycle while the servos
+	 * are in wheel mode, where the AX-12A's present-speed register holds the
+	 * output share (e-manual, Present Speed), not a speed: the law would be
+	 * fed its own last command. Refused rather than overridden, so that what
+	 * the file says is what runs. */
+	if (c->actuation == CFG_ACT_TORQUE && c->velocity_source == CFG_VEL_SERVO)
+		cfg_error(e, "%s: [robot] velocity_source = servo cannot be used with actuation = torque: in wheel "
+		          "mode the AX-12's present speed is its output, not a speed; use velocity_source = filtered",
+		          c->source[0] ? c->source : "command line");
 	if (c->commands == CFG_CMD_NETWORK && c->command_key[0] == '\0')
 		cfg_error(e, "%s: [robot] commands = network needs command_key = FILE (the shared key: "
 		          "`undulated --gen-key FILE` makes one)", c->source[0] ? c->source : "command line");

@@ -1,7 +1,10 @@
 /*
  * dxl_table.c — the AX-12(A) control table as data, lookup, write checks,
  * unit conversions and formatting. Values from the ROBOTIS e-Manual (AX-12A)
- * and the original AX-12 manual; where they differ the desc says so.
+ * and the original AX-12 manual; where they differ the desc says so. The
+ * write ranges (min, max, and joint mode's narrower ones) are the AX-12A e-manual's: the simulated
+ * servo answers a value outside them with the range bit, and `dxl write`
+ * refuses it before the bus, so both enforce this one table.
  */
 #include "dxl_table.h"
 
@@ -35,12 +38,12 @@ const struct dxl_reg dxl_ax12_regs[] = {
 	  "clockwise angle limit (both limits 0: wheel mode)" },
 	{ "ccw_angle_limit",      8, 2, RW, EE,  0, 1023, 1023, DXL_UNIT_POSITION,
 	  "counter-clockwise angle limit" },
-	{ "temperature_limit",   11, 1, RW, EE,  0, 150, 70, DXL_UNIT_TEMPERATURE,
-	  "overheating threshold (old manual: default 85)" },
-	{ "min_voltage_limit",   12, 1, RW, EE, 50, 250, 60, DXL_UNIT_VOLTAGE,
-	  "lowest supply voltage before the voltage error" },
-	{ "max_voltage_limit",   13, 1, RW, EE, 50, 250, 140, DXL_UNIT_VOLTAGE,
-	  "highest supply voltage before the voltage error (old manual: default 190)" },
+	{ "temperature_limit",   11, 1, RW, EE,  0, 100, 70, DXL_UNIT_TEMPERATURE,
+	  "overheating threshold, 0-100 (old manual: default 85, range 0-150)" },
+	{ "min_voltage_limit",   12, 1, RW, EE, 50, 160, 60, DXL_UNIT_VOLTAGE,
+	  "lowest supply voltage before the voltage error, 50-160 (old manual: 50-250)" },
+	{ "max_voltage_limit",   13, 1, RW, EE, 50, 160, 140, DXL_UNIT_VOLTAGE,
+	  "highest supply voltage before the voltage error, 50-160 (old manual: default 190, 50-250)" },
 	{ "max_torque",          14, 2, RW, EE,  0, 1023, 1023, DXL_UNIT_TORQUE,
 	  "maximum torque, copied to torque_limit at power-on" },
 	{ "status_return_level", 16, 1, RW, EE,  0, 2, 2, DXL_UNIT_STATUS_LEVEL,
@@ -55,10 +58,10 @@ const struct dxl_reg dxl_ax12_regs[] = {
 	  "dead band in position units, CW side (old manual: default 0)" },
 	{ "ccw_compliance_margin", 27, 1, RW, RAM, 0, 255, 1, DXL_UNIT_RAW,
 	  "dead band in position units, CCW side (old manual: default 0)" },
-	{ "cw_compliance_slope",   28, 1, RW, RAM, 1, 254, 32, DXL_UNIT_RAW,
-	  "error over which torque ramps up, CW side (steps 2,4,...,128)" },
-	{ "ccw_compliance_slope",  29, 1, RW, RAM, 1, 254, 32, DXL_UNIT_RAW,
-	  "error over which torque ramps up, CCW side (steps 2,4,...,128)" },
+	{ "cw_compliance_slope",   28, 1, RW, RAM, 0, 254, 32, DXL_UNIT_RAW,
+	  "error over which torque ramps up, CW side (steps 2,4,...,128; 0-3 act as 2; old manual: 1-254)" },
+	{ "ccw_compliance_slope",  29, 1, RW, RAM, 0, 254, 32, DXL_UNIT_RAW,
+	  "error over which torque ramps up, CCW side (steps 2,4,...,128; 0-3 act as 2; old manual: 1-254)" },
 	{ "goal_position",       30, 2, RW, RAM, 0, 1023, NODEF, DXL_UNIT_POSITION,
 	  "target position (starts as the present position)" },
 	{ "moving_speed",        32, 2, RW, RAM, 0, 2047, 0, DXL_UNIT_MOVING_SPEED,
@@ -68,7 +71,7 @@ const struct dxl_reg dxl_ax12_regs[] = {
 	{ "present_position",    36, 2, R,  RAM, 0, 1023, NODEF, DXL_UNIT_POSITION,
 	  "measured position, 0-1023 over 300 deg" },
 	{ "present_speed",       38, 2, R,  RAM, 0, 2047, NODEF, DXL_UNIT_SPEED,
-	  "measured speed, bit 10 = CW" },
+	  "joint mode: measured speed; wheel mode: the output, 0.1 % a unit; bit 10 = CW" },
 	{ "present_load",        40, 2, R,  RAM, 0, 2047, NODEF, DXL_UNIT_LOAD,
 	  "load in 0.1 % of max torque, bit 10 = CW" },
 	{ "present_voltage",     42, 1, R,  RAM, 0, 255, NODEF, DXL_UNIT_VOLTAGE, "supply voltage" },
@@ -79,9 +82,20 @@ const struct dxl_reg dxl_ax12_regs[] = {
 	{ "moving",              46, 1, R,  RAM, 0, 1, 0, DXL_UNIT_BOOL, "goal not reached yet" },
 	{ "lock",                47, 1, RW, RAM, 0, 1, 0, DXL_UNIT_BOOL,
 	  "1 locks the EEPROM area until power-cycle" },
-	{ "punch",               48, 2, RW, RAM, 0, 1023, 32, DXL_UNIT_RAW, "minimum drive current" },
+	{ "punch",               48, 2, RW, RAM, 32, 1023, 32, DXL_UNIT_RAW,
+	  "minimum drive current, 0x20-0x3FF (old manual: 0-1023)" },
 };
 const size_t dxl_ax12_nregs = sizeof dxl_ax12_regs / sizeof dxl_ax12_regs[0];
+
+/* Registers whose range is narrower in joint mode than the table's max, which
+ * is the wheel-mode range (e-manual, Moving Speed: 0-1023 in joint mode,
+ * 0-2047 with bit 10 the direction in wheel mode). */
+static const struct {
+	uint8_t addr;
+	uint16_t max;
+} dxl_joint_mode_max[] = {
+	{ DXL_AX_MOVING_SPEED, 1023 },
+};
 
 /* Short names people type at a prompt. */
 static const struct {
@@ -162,6 +176,18 @@ int dxl_reg_check_write(const struct dxl_reg *reg, long value)
 		return DXL_E_ARG;
 	if (value < (long)reg->min || value > (long)reg->max)
 		return DXL_E_ARG;
+	return DXL_OK;
+}
+
+int dxl_reg_check_write_mode(const struct dxl_reg *reg, long value, bool wheel)
+{
+	if (dxl_reg_check_write(reg, value) != DXL_OK)
+		return DXL_E_ARG;
+	if (wheel)
+		return DXL_OK;
+	for (size_t i = 0; i < sizeof dxl_joint_mode_max / sizeof dxl_joint_mode_max[0]; i++)
+		if (dxl_joint_mode_max[i].addr == reg->addr && value > (long)dxl_joint_mode_max[i].max)
+			return DXL_E_ARG;
 	return DXL_OK;
 }
 

@@ -97,8 +97,13 @@ extern const size_t dxl_ax12_nregs;
 const struct dxl_reg *dxl_reg_lookup(const char *name_or_addr);
 /* The register that starts at addr, NULL if none (e.g. the high byte of a word). */
 const struct dxl_reg *dxl_reg_at(uint8_t addr);
-/* DXL_OK if value is writable into reg, else DXL_E_ARG (read-only or out of range). */
+/* DXL_OK if value is writable into reg in some mode, else DXL_E_ARG
+ * (read-only or out of range). */
 int dxl_reg_check_write(const struct dxl_reg *reg, long value);
+/* The same for a servo known to be in wheel mode (wheel) or joint mode: a few
+ * registers have a narrower range in joint mode (moving speed: 0-1023 there,
+ * 0-2047 in wheel mode). */
+int dxl_reg_check_write_mode(const struct dxl_reg *reg, long value, bool wheel);
 /* "512 (150.1 deg)"-style text for a raw value, with units. Returns buf. */
 char *dxl_reg_format(const struct dxl_reg *reg, uint16_t raw, char *buf, size_t cap);
 

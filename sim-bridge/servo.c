@@ -149,7 +149,27 @@ static int servo_reply(struct sim_servo *s, uint8_t id, uint8_t errbits, const u
 	return len;
 }
 
-static void servo_count_errors(struct sim_servo *s, uint8_t bits)
+/* Alarm shutdown (e-manual, Alarm LED/Shutdown and Torque Limit): "the motor
+ * output becomes 0 % by resetting the value of Torque Limit(34) to 0". The
+ * manual does not say what Torque Enable reads afterwards; the simulator
+ * clears it too, so a controller that reads either one back sees the torque
+ * gone (README). Counted once per cut, not per error while it is cut. */
+static void servo_shutdown(struct sim_servo *s)
+{
+	if (s->mem[DXL_AX_TORQUE_ENABLE] || dxl_get_u16(&s->mem[DXL_AX_TORQUE_LIMIT]) != 0) {
+		s->mem[DXL_AX_TORQUE_ENABLE] = 0;
+		dxl_put_u16(&s->mem[DXL_AX_TORQUE_LIMIT], 0);
+		s->count.shutdowns++;
+	}
+}
+
+/* The errors of one instruction (range, angle limit, checksum, instruction):
+ * counted, and — as the lasting conditions in servo_alarm() — a shutdown
+ * when their bit is set in Alarm Shutdown: the manual's "if errors occur"
+ * covers every bit of the register, and its Goal Position page says so of
+ * the angle-limit bit in particular. Applied whether or not a status packet
+ * reports the error (broadcast, status return level). */
+static void servo_error(struct sim_servo *s, uint8_t bits)
 {
 	if (bits & DXL_ERRBIT_RANGE)
 		s->count.range_errors++;
@@ -157,6 +177,10 @@ static void servo_count_errors(struct sim_servo *s, uint8_t bits)
 		s->count.angle_limit_errors++;
 	if (bits & DXL_ERRBIT_INSTRUCTION)
 		s->count.instruction_errors++;
+	if (bits & DXL_ERRBIT_CHECKSUM)
+		s->count.checksum_errors++;
+	if (bits & s->mem[DXL_AX_ALARM_SHUTDOWN])
+		servo_shutdown(s);
 }
 
 /* ---- writes ------------------------------------------------------------------ */
@@ -175,18 +199,18 @@ static bool servo_byte_writable(const struct sim_servo *s, const struct dxl_reg 
 	return true;
 }
 
-/* Range check of one register's new value against the new table image. */
+/* Check of one register's new value against the new table image: its range
+ * from the one table of protocol/dxl_table.c (the e-manual's, per mode),
+ * then the two rules that depend on the servo's state. */
 static uint8_t servo_value_error(const struct sim_servo *s, const uint8_t *img, const struct dxl_reg *r)
 {
 	uint16_t v = mem_get(img, r);
 	bool wheel = dxl_is_wheel_mode(dxl_get_u16(&img[DXL_AX_CW_ANGLE_LIMIT]),
 	                               dxl_get_u16(&img[DXL_AX_CCW_ANGLE_LIMIT]));
-	if (r->addr == DXL_AX_MOVING_SPEED)
-		return v > (wheel ? 2047 : 1023) ? DXL_ERRBIT_RANGE : 0;
+	if (dxl_reg_check_write_mode(r, v, wheel) != DXL_OK)
+		return DXL_ERRBIT_RANGE;
 	if (r->addr == DXL_AX_LOCK && s->mem[DXL_AX_LOCK] && v == 0)
 		return DXL_ERRBIT_RANGE;  /* only a power cycle unlocks */
-	if (dxl_reg_check_write(r, v) != DXL_OK)
-		return DXL_ERRBIT_RANGE;
 	if (r->addr == DXL_AX_GOAL_POSITION && !wheel) {
 		uint16_t cw = dxl_get_u16(&img[DXL_AX_CW_ANGLE_LIMIT]);
 		uint16_t ccw = dxl_get_u16(&img[DXL_AX_CCW_ANGLE_LIMIT]);
@@ -230,14 +254,26 @@ static uint8_t servo_write(struct sim_servo *s, uint8_t addr, const uint8_t *dat
 
 /* ---- instructions ------------------------------------------------------------ */
 
-static int servo_read(struct sim_servo *s, const struct dxl_packet *req, uint8_t *out, size_t cap)
+/* A READ's error bits: its two parameters, and the table's end (address 49:
+ * where a READ runs past it the manual is silent; the range bit). */
+static uint8_t servo_read_error(const struct dxl_packet *req)
 {
 	if (req->nparams != 2)
-		return servo_reply(s, req->id, DXL_ERRBIT_INSTRUCTION, NULL, 0, out, cap);
-	uint8_t addr = req->params[0], len = req->params[1];
-	if (len == 0 || (size_t)addr + len > DXL_AX_TABLE_SIZE)
-		return servo_reply(s, req->id, DXL_ERRBIT_RANGE, NULL, 0, out, cap);
-	return servo_reply(s, req->id, 0, &s->mem[addr], len, out, cap);
+		return DXL_ERRBIT_INSTRUCTION;
+	if (req->params[1] == 0 || (size_t)req->params[0] + req->params[1] > DXL_AX_TABLE_SIZE)
+		return DXL_ERRBIT_RANGE;
+	return 0;
+}
+
+static int servo_read(struct sim_servo *s, const struct dxl_packet *req, bool answer, uint8_t *out, size_t cap)
+{
+	uint8_t err = servo_read_error(req);
+	servo_error(s, err);
+	if (!answer)
+		return 0;
+	if (err)
+		return servo_reply(s, req->id, err, NULL, 0, out, cap);
+	return servo_reply(s, req->id, 0, &s->mem[req->params[0]], req->params[1], out, cap);
 }
 
 static uint8_t servo_reg_write(struct sim_servo *s, const struct dxl_packet *req)
@@ -276,8 +312,7 @@ static void servo_sync_write(struct sim_servo *s, const struct dxl_packet *req)
 		return;  /* malformed: a real servo cannot parse it either */
 	for (size_t off = 2; off + stride <= req->nparams; off += stride) {
 		if (req->params[off] == sim_servo_id(s)) {
-			uint8_t err = servo_write(s, addr, &req->params[off + 1], l);
-			servo_count_errors(s, err);
+			servo_error(s, servo_write(s, addr, &req->params[off + 1], l));
 			return;
 		}
 	}
@@ -313,16 +348,20 @@ int sim_servo_handle(struct sim_servo *s, const struct dxl_packet *req, uint8_t 
 	if (!sim_servo_addressed(s, req))
 		return 0;
 	s->count.instructions++;
+	/* Whether and under which ID the packet is answered is decided before it
+	 * acts: a write of the ID is answered under the old one, and a write of
+	 * the status return level under the old level (the original AX-12
+	 * manual's Examples 7 and 14; its words: "the Status Packet is not
+	 * returned starting with the following instruction"). */
 	uint8_t id = sim_servo_id(s);
 	bool broadcast = req->id == DXL_BROADCAST_ID;
+	bool answer = !broadcast && servo_level_allows(s, req->code);
 	uint8_t err = 0;
 	switch (req->code) {
 	case DXL_INST_PING:
 		return servo_reply(s, id, 0, NULL, 0, out, cap);  /* broadcast too: they collide */
 	case DXL_INST_READ:
-		if (broadcast)
-			return 0;
-		return servo_level_allows(s, req->code) ? servo_read(s, req, out, cap) : 0;
+		return broadcast ? 0 : servo_read(s, req, answer, out, cap);
 	case DXL_INST_WRITE:
 		err = req->nparams < 2 ? DXL_ERRBIT_INSTRUCTION
 		                       : servo_write(s, req->params[0], &req->params[1], req->nparams - 1u);
@@ -334,8 +373,9 @@ int sim_servo_handle(struct sim_servo *s, const struct dxl_packet *req, uint8_t 
 		err = servo_action(s);
 		break;
 	case DXL_INST_FACTORY_RESET: {
-		/* The reply goes out under the old ID, then the table resets. */
-		int len = (!broadcast && servo_level_allows(s, req->code)) ? servo_reply(s, id, 0, NULL, 0, out, cap) : 0;
+		/* The reply goes out under the old ID (the manual's example: ID 0
+		 * answers its reset as ID 0), then the table resets. */
+		int len = answer ? servo_reply(s, id, 0, NULL, 0, out, cap) : 0;
 		servo_factory_reset(s);
 		return len;
 	}
@@ -349,17 +389,15 @@ int sim_servo_handle(struct sim_servo *s, const struct dxl_packet *req, uint8_t 
 		err = DXL_ERRBIT_INSTRUCTION;  /* REBOOT, BULK_READ, ...: not on the AX-12 */
 		break;
 	}
-	servo_count_errors(s, err);
-	if (broadcast || !servo_level_allows(s, req->code))
-		return 0;
-	return servo_reply(s, id, err, NULL, 0, out, cap);
+	servo_error(s, err);
+	return answer ? servo_reply(s, id, err, NULL, 0, out, cap) : 0;
 }
 
 int sim_servo_handle_bad_checksum(struct sim_servo *s, uint8_t id, uint8_t instr, uint8_t *out, size_t cap)
 {
 	if (!s->powered || id != sim_servo_id(s))
 		return 0;
-	s->count.checksum_errors++;
+	servo_error(s, DXL_ERRBIT_CHECKSUM);
 	if (!servo_level_allows(s, instr))
 		return 0;
 	return servo_reply(s, id, DXL_ERRBIT_CHECKSUM, NULL, 0, out, cap);
@@ -418,21 +456,18 @@ static void servo_update_conditions(struct sim_servo *s, const struct sim_servo_
 	                          (hot ? DXL_ERRBIT_OVERHEAT : 0));
 }
 
-/* Alarm shutdown: the manual's reaction is torque off with torque limit 0.
- * Injected stuck-error bits never get here (fault.c adds them to replies):
- * they model a servo that *says* it is overloaded, which the controller must
- * handle without the sim acting. */
+/* Alarm shutdown for the lasting conditions (voltage, overheating,
+ * overload), checked every step: torque off with torque limit 0, again if the
+ * controller turns it on while the condition lasts. Injected stuck-error bits
+ * never get here (fault.c adds them to replies): they model a servo that
+ * *says* it is overloaded, which the controller must handle without the sim
+ * acting. */
 static void servo_alarm(struct sim_servo *s)
 {
 	uint8_t active = s->conditions;
 	s->alarm_led = (active & s->mem[DXL_AX_ALARM_LED]) != 0;
-	if (!(active & s->mem[DXL_AX_ALARM_SHUTDOWN]))
-		return;
-	if (s->mem[DXL_AX_TORQUE_ENABLE] || dxl_get_u16(&s->mem[DXL_AX_TORQUE_LIMIT]) != 0) {
-		s->mem[DXL_AX_TORQUE_ENABLE] = 0;
-		dxl_put_u16(&s->mem[DXL_AX_TORQUE_LIMIT], 0);
-		s->count.shutdowns++;
-	}
+	if (active & s->mem[DXL_AX_ALARM_SHUTDOWN])
+		servo_shutdown(s);
 }
 
 void sim_servo_sense(struct sim_servo *s, const struct sim_servo_sense *in, double dt)
@@ -442,7 +477,11 @@ void sim_servo_sense(struct sim_servo *s, const struct sim_servo_sense *in, doub
 		return;
 	uint16_t pos = dxl_rad_to_pos(in->angle);
 	dxl_put_u16(&m[DXL_AX_PRESENT_POSITION], pos);
-	dxl_put_u16(&m[DXL_AX_PRESENT_SPEED], dxl_rad_s_to_speed(in->speed));
+	/* Present Speed (e-manual): in joint mode the speed, 0.111 rpm a unit; in
+	 * wheel mode "the unit is about 0.1 %" of the output — what the servo
+	 * drives, not how fast the wheel turns. Both carry the direction in bit 10. */
+	bool wheel = dxl_is_wheel_mode(dxl_get_u16(&m[DXL_AX_CW_ANGLE_LIMIT]), dxl_get_u16(&m[DXL_AX_CCW_ANGLE_LIMIT]));
+	dxl_put_u16(&m[DXL_AX_PRESENT_SPEED], wheel ? dxl_duty_to_wheel(in->output) : dxl_rad_s_to_speed(in->speed));
 	dxl_put_u16(&m[DXL_AX_PRESENT_LOAD], dxl_fraction_to_load(in->load_fraction));
 	m[DXL_AX_PRESENT_VOLTAGE] = clamp_u8(in->voltage * 10.0);
 	m[DXL_AX_PRESENT_TEMPERATURE] = clamp_u8(in->temperature);

@@ -14,7 +14,12 @@
  *    written and the reply carries the angle-limit error bit;
  *  - the range/angle-limit/checksum/instruction bits belong to the reply of
  *    the offending instruction; voltage, overheating and overload are
- *    conditions reported in every status packet while they last.
+ *    conditions reported in every status packet while they last;
+ *  - an alarm shutdown (any error whose bit is set in Alarm Shutdown, the
+ *    one-packet errors included) clears Torque Enable as well as the
+ *    Torque Limit the manual names;
+ *  - a READ past address 49 and an EEPROM write with torque on get the
+ *    range bit; a baud change is answered at the old rate (simbus.c).
  */
 #ifndef UNDULATE_SIM_SERVO_H
 #define UNDULATE_SIM_SERVO_H
@@ -100,12 +105,15 @@ struct sim_servo_sense {
 	double angle;          /* rad from centre */
 	double speed;          /* rad/s */
 	double load_fraction;  /* signed, of max torque */
+	double output;         /* signed share of full output the servo drives (its PWM duty), -1..1,
+	                          positive CCW: wheel mode's present speed */
 	double voltage;        /* V */
 	double temperature;    /* °C */
 	bool overloaded;       /* delivered torque at the torque limit */
 };
 /* Update present position/speed/load/voltage/temperature/moving, the error
- * conditions and the alarm shutdown. */
+ * conditions and the alarm shutdown. Present speed is in->speed in joint mode
+ * and in->output in wheel mode, as on the AX-12A (e-manual, Present Speed). */
 void sim_servo_sense(struct sim_servo *s, const struct sim_servo_sense *in, double dt);
 /* Error conditions a status packet carries now (voltage, overheating,
  * overload). Injected stuck-error bits are added on the way out (fault.c). */

@@ -157,6 +157,7 @@ static void sim_sense_joint(struct sim_joint *j, double dt)
 		.angle = j->motor.angle,
 		.speed = j->motor.speed,
 		.load_fraction = cmd.torque_enable ? sim_motor_load_fraction(&j->motor, &j->params) : 0,
+		.output = cmd.torque_enable ? j->motor.drive : 0,
 		.voltage = f[SIM_FAULT_VOLTAGE].active ? f[SIM_FAULT_VOLTAGE].arg : j->params.supply_voltage,
 		.temperature = f[SIM_FAULT_TEMPERATURE].active ? f[SIM_FAULT_TEMPERATURE].arg : j->motor.temperature,
 		.overloaded = cmd.torque_enable && sim_motor_overloaded(&j->motor, &j->params, &cmd),

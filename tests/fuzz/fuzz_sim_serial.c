@@ -22,11 +22,14 @@
  *    its servos' control tables equal the model's after every read, however
  *    the stream is cut (nothing lost or delayed by the bus's loop);
  *  - a read that completes no frame changes no control table: a packet with
- *    a bad checksum, a broken header or half a packet writes nothing;
+ *    a bad checksum, a broken header or half a packet writes nothing — but
+ *    a bad checksum to a servo whose Alarm Shutdown has bit 4 cuts its torque
+ *    (torque enable and torque limit 0, and nothing else);
  *  - every servo's table stays in its documented ranges (protocol/
  *    dxl_table.c), read-only and reserved bytes keep their values, a refused
- *    write (range, angle-limit or instruction error) writes nothing, lock
- *    and torque-on protect the EEPROM, lock stays on until a reset;
+ *    write (range, angle-limit or instruction error) writes nothing but the
+ *    torque cut of an alarm shutdown when the error's bit is in the mask,
+ *    lock and torque-on protect the EEPROM, lock stays on until a reset;
  *  - every reply is one well-formed status packet from the servo's ID (the
  *    one before the instruction), only where the manual allows one (a
  *    broadcast gets none but PING; the status return level), and a READ
@@ -120,6 +123,30 @@ static void check_reply(const uint8_t *out, int len, uint8_t id, struct dxl_pack
 	CHECK(pkt->code <= DXL_ERRBIT_MASK);
 }
 
+/* An alarm shutdown since `before` (servo.c: every error bit in Alarm
+ * Shutdown cuts the torque): torque enable and torque limit are 0. */
+static bool shut_down_since(const struct sim_servo *before, const struct sim_servo *s)
+{
+	if (s->count.shutdowns == before->count.shutdowns)
+		return false;
+	CHECK(s->count.shutdowns == before->count.shutdowns + 1);
+	CHECK(s->mem[DXL_AX_TORQUE_ENABLE] == 0 && dxl_get_u16(&s->mem[DXL_AX_TORQUE_LIMIT]) == 0);
+	return true;
+}
+
+/* The table of `after` equals `before` but for the bytes a shutdown cuts. */
+static void check_only_shutdown(const uint8_t *before, const uint8_t *after, bool shut)
+{
+	uint8_t a[DXL_AX_TABLE_SIZE], b[DXL_AX_TABLE_SIZE];
+	memcpy(a, before, sizeof(a));
+	memcpy(b, after, sizeof(b));
+	if (shut) {
+		a[DXL_AX_TORQUE_ENABLE] = b[DXL_AX_TORQUE_ENABLE];
+		memcpy(&a[DXL_AX_TORQUE_LIMIT], &b[DXL_AX_TORQUE_LIMIT], 2);
+	}
+	CHECK(memcmp(a, b, sizeof(a)) == 0);
+}
+
 /* Hand one frame to a model servo and check what it did. */
 static void model_handle(int k, const struct dxl_packet *req)
 {
@@ -162,13 +189,15 @@ static void model_handle(int k, const struct dxl_packet *req)
 	/* a refused write writes nothing (ACTION has cleared `registered` first) */
 	uint32_t errs = s->count.range_errors + s->count.angle_limit_errors + s->count.instruction_errors;
 	uint32_t errs0 = before.count.range_errors + before.count.angle_limit_errors + before.count.instruction_errors;
+	bool shut = shut_down_since(&before, s);
+	if (shut)
+		CHECK(errs != errs0);   /* no frame cuts the torque without an error */
 	if (errs != errs0) {
-		uint8_t a[DXL_AX_TABLE_SIZE], b[DXL_AX_TABLE_SIZE];
+		uint8_t a[DXL_AX_TABLE_SIZE];
 		memcpy(a, before.mem, sizeof(a));
-		memcpy(b, s->mem, sizeof(b));
 		if (req->code == DXL_INST_ACTION)
-			a[DXL_AX_REGISTERED] = b[DXL_AX_REGISTERED] = 0;
-		CHECK(memcmp(a, b, sizeof(a)) == 0);
+			a[DXL_AX_REGISTERED] = s->mem[DXL_AX_REGISTERED];
+		check_only_shutdown(a, s->mem, shut);
 	}
 	/* the EEPROM is locked, or (AX-12A) writable only with torque off */
 	if (before.mem[DXL_AX_LOCK] || (before.opt.eeprom_needs_torque_off && before.mem[DXL_AX_TORQUE_ENABLE]))
@@ -182,6 +211,52 @@ struct model_counts {
 	uint64_t frames, checksum_errors, header_errors;
 };
 
+/* The bytes the model consumed, the last DXL_MAX_PACKET of them: where a
+ * packet with a bad checksum ended, to find whom it was for. */
+static uint8_t mhist[DXL_MAX_PACKET];
+static size_t mhist_n;
+
+static void mhist_push(const uint8_t *d, size_t n)
+{
+	for (size_t i = 0; i < n; i++) {
+		if (mhist_n == sizeof(mhist)) {
+			memmove(mhist, mhist + 1, sizeof(mhist) - 1);
+			mhist_n--;
+		}
+		mhist[mhist_n++] = d[i];
+	}
+}
+
+/* A packet with a bad checksum just ended: the one whose header and LEN
+ * span exactly the bytes up to here, the latest such (as a servo sees it:
+ * its ID and instruction). Its servo answers with bit 4 where the level
+ * allows, and cuts its torque if bit 4 is in its Alarm Shutdown. */
+static void model_bad_checksum(void)
+{
+	for (size_t p = mhist_n >= 6 ? mhist_n - 5 : 0; p-- > 0;) {
+		if (mhist[p] != 0xFF || mhist[p + 1] != 0xFF || p + 4 >= mhist_n ||
+		    (size_t)mhist[p + 3] + 4 != mhist_n - p)
+			continue;
+		for (int k = 0; k < NSERVOS; k++) {
+			struct sim_servo *s = &model[k];
+			struct sim_servo before = *s;
+			if (!sim_bus_baud_matches(&bus, s->mem[DXL_AX_BAUD_RATE]))
+				continue;
+			uint8_t out[DXL_MAX_PACKET];
+			int len = sim_servo_handle_bad_checksum(s, mhist[p + 2], mhist[p + 4], out, sizeof(out));
+			CHECK(len >= 0);
+			bool shut = shut_down_since(&before, s);
+			check_only_shutdown(before.mem, s->mem, shut);
+			if (len > 0) {
+				struct dxl_packet reply;
+				check_reply(out, len, mhist[p + 2], &reply);
+				CHECK(reply.nparams == 0 && (reply.code & DXL_ERRBIT_CHECKSUM));
+			}
+		}
+		return;
+	}
+}
+
 static void model_feed(struct dxl_parser *p, const uint8_t *d, size_t n, struct model_counts *mc)
 {
 	size_t off = 0;
@@ -190,6 +265,7 @@ static void model_feed(struct dxl_parser *p, const uint8_t *d, size_t n, struct 
 		struct dxl_packet pkt;
 		int r = dxl_parser_feed(p, d + off, n - off, &used, &pkt);
 		CHECK(used <= n - off);
+		mhist_push(d + off, used);
 		off += used;
 		if (r == DXL_FRAME) {
 			mc->frames++;
@@ -197,6 +273,7 @@ static void model_feed(struct dxl_parser *p, const uint8_t *d, size_t n, struct 
 				model_handle(k, &pkt);
 		} else if (r == DXL_E_CHECKSUM) {
 			mc->checksum_errors++;
+			model_bad_checksum();
 		} else if (r < 0) {
 			mc->header_errors++;
 		} else {
@@ -254,6 +331,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 		return 0;
 	setup(data[0], data + 1);
 	dxl_parser_init(&mp, DXL_PARSE_INSTRUCTION);
+	mhist_n = 0;
 	struct model_counts mc = { 0, 0, 0 };
 	uint32_t seed = (uint32_t)data[0] << 24 | (uint32_t)data[1] << 16 | (uint32_t)data[2] << 8 | data[3];
 	int64_t now = MS, last_rx = 0;
@@ -273,8 +351,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 			dxl_parser_reset(&mp);
 		last_rx = now;
 		uint8_t mem_before[NSERVOS][DXL_AX_TABLE_SIZE];
-		for (int k = 0; k < NSERVOS; k++)
+		uint32_t shutdowns_before[NSERVOS];
+		for (int k = 0; k < NSERVOS; k++) {
 			memcpy(mem_before[k], bus.joints[k].servo.mem, DXL_AX_TABLE_SIZE);
+			shutdowns_before[k] = bus.joints[k].servo.count.shutdowns;
+		}
 		uint64_t packets = bus.count.packets;
 		sim_bus_feed(&bus, data + off, n, now);
 		for (size_t i = 0; i < n; i++)
@@ -290,7 +371,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 			CHECK(memcmp(s->mem, model[k].mem, DXL_AX_TABLE_SIZE) == 0);
 			CHECK(s->reg_pending == model[k].reg_pending);
 			if (bus.count.packets == packets)
-				CHECK(memcmp(s->mem, mem_before[k], DXL_AX_TABLE_SIZE) == 0);
+				check_only_shutdown(mem_before[k], s->mem, s->count.shutdowns != shutdowns_before[k]);
 		}
 		/* the whole queue now and then (it holds up to 4096 bytes: every
 		 * read would make long inputs slow), its bounds always */

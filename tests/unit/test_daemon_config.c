@@ -205,6 +205,17 @@ static void test_whole_config_errors(void **state)
 	char b[CFG_ERR_MAX];
 	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\n", b, sizeof b), "ids: no servo IDs"));
 	assert_non_null(strstr(load_error("[robot]\nids=1\n", b, sizeof b), "port: no port configured"));
+	/* torque actuation reads the speed in wheel mode, where the servo's
+	 * present speed is its output: the servo as the speed source is refused,
+	 * whichever key comes first */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nvelocity_source=servo\nactuation=torque\n", b,
+	                               sizeof b),
+	                    "command line: [robot] velocity_source = servo cannot be used with actuation = torque: in "
+	                    "wheel mode the AX-12's present speed is its output, not a speed; use "
+	                    "velocity_source = filtered");
+	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\nactuation=torque\nvelocity_source=servo\n",
+	                                  b, sizeof b),
+	                       "velocity_source = servo cannot be used with actuation = torque"));
 	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.2]\nk=1\n", b, sizeof b),
 	                       "[joint.2]: the robot has only 1 joint(s)"));
 	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nlimit_min=0.5\n"

@@ -2,7 +2,8 @@
  * in the loop that obeys the servo's registers as the controller writes them:
  * joint mode follows the goal (27 ms lag), wheel mode takes the duty as a
  * torque (a current drive) or as a PWM duty (with back-EMF), EEPROM limits
- * change only with torque off (AX-12A). Checked: the switch into and out of
+ * change only with torque off, in wheel mode present speed is the output, not
+ * a speed (AX-12A). Checked: the switch into and out of
  * wheel mode and its register sequence, the limit cycle driven through torque,
  * the walls near the limits, a limit breach falling back to joint mode, stale
  * joints and non-finite parameters giving no drive, the back-EMF added back. */
@@ -48,6 +49,16 @@ struct servo {
 static struct servo sv[NJ_MAX];
 
 static bool wheel(const struct servo *s) { return s->cw == 0 && s->ccw == 0; }
+
+/* Present speed as an AX-12A reports it (e-manual): the speed in joint mode,
+ * in wheel mode the output it drives (0.1 % a unit, bit 10 = CW; none with
+ * torque off), which is not a speed: the controller must not take it for one. */
+static uint16_t present_speed(const struct servo *s)
+{
+	if (wheel(s))
+		return s->torque ? s->speed_reg : 0;
+	return dxl_rad_s_to_speed(s->speed);
+}
 
 static void apply_write(const struct wq_write *w)
 {
@@ -153,7 +164,7 @@ static void cycle_pwm(bool pwm)
 	t += DT;
 	for (size_t j = 0; j < nj; j++)
 		if (sv[j].answers)
-			ctl_measure(&c, j, dxl_rad_to_pos(sv[j].angle), dxl_rad_s_to_speed(sv[j].speed), 0, 0, DT);
+			ctl_measure(&c, j, dxl_rad_to_pos(sv[j].angle), present_speed(&sv[j]), 0, 0, DT);
 	ctl_step(&c, t, DT, t);
 	apply_sync();
 	send_writes();

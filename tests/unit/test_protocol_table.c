@@ -138,6 +138,23 @@ static void test_check_write(void **state)
 	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("torque_enable"), 2), DXL_E_ARG);
 	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("alarm_shutdown"), 0x80), DXL_E_ARG);
 	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("min_voltage_limit"), 49), DXL_E_ARG);
+	/* the AX-12A e-manual's ranges where the original manual's were wider */
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("max_voltage_limit"), 160), DXL_OK);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("max_voltage_limit"), 161), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("temperature_limit"), 100), DXL_OK);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("temperature_limit"), 101), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("punch"), 0x1F), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("punch"), 0x20), DXL_OK);
+	assert_int_equal(dxl_reg_check_write(dxl_reg_lookup("cw_compliance_slope"), 0), DXL_OK);
+	/* moving speed: 0-2047 in wheel mode, 0-1023 in joint mode */
+	const struct dxl_reg *ms = dxl_reg_lookup("moving_speed");
+	assert_int_equal(dxl_reg_check_write(ms, 2047), DXL_OK);
+	assert_int_equal(dxl_reg_check_write_mode(ms, 2047, true), DXL_OK);
+	assert_int_equal(dxl_reg_check_write_mode(ms, 2048, true), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write_mode(ms, 1023, false), DXL_OK);
+	assert_int_equal(dxl_reg_check_write_mode(ms, 1024, false), DXL_E_ARG);
+	assert_int_equal(dxl_reg_check_write_mode(goal, 1023, false), DXL_OK);
+	assert_int_equal(dxl_reg_check_write_mode(goal, 1024, true), DXL_E_ARG);
 	assert_int_equal(dxl_reg_check_write(NULL, 0), DXL_E_ARG);
 }
 

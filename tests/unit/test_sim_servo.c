@@ -103,11 +103,13 @@ static void test_golden_write(void **state)
 	struct sim_servo s;
 	uint8_t out[DXL_MAX_PACKET];
 	servo_at_32c(&s);
-	/* WRITE id 1, addr 12 (min voltage), 0x64 0xAA: 100 -> 10.0 V, 0xAA -> max 17.0 V. */
+	/* The e-manual's checksum example: WRITE id 1, addr 12 (min voltage),
+	 * 0x64 0xAA: 10.0 V and 17.0 V. The same manual's range is 50-160: 170
+	 * gets the range bit and neither byte is stored. */
 	int n = SEND(&s, out, 0xFF, 0xFF, 0x01, 0x05, 0x03, 0x0C, 0x64, 0xAA, 0xDC);
-	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC);
-	assert_int_equal(s.mem[12], 0x64);
-	assert_int_equal(s.mem[13], 0xAA);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x08, 0xF4);
+	assert_int_equal(s.mem[12], 60);
+	assert_int_equal(s.mem[13], 140);
 	/* WRITE id 1 goal position 512. */
 	n = SEND(&s, out, 0xFF, 0xFF, 0x01, 0x05, 0x03, 0x1E, 0x00, 0x02, 0xD6);
 	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC);
@@ -191,6 +193,63 @@ static void test_range_error_not_written(void **state)
 	assert_int_equal(sim_servo_peek(&s, DXL_AX_GOAL_POSITION), DXL_POS_CENTER);
 }
 
+/* The AX-12A e-manual's write ranges, written out here (not read from
+ * protocol/dxl_table.c, which the servo enforces): the last value inside is
+ * stored, the first outside gets the range bit and changes nothing. */
+static void test_emanual_ranges(void **state)
+{
+	(void)state;
+	static const struct {
+		uint8_t addr;
+		uint16_t inside, outside;
+	} rows[] = {
+		{ DXL_AX_ID, 253, 254 },
+		{ DXL_AX_BAUD_RATE, 254, 255 },
+		{ DXL_AX_RETURN_DELAY_TIME, 254, 255 },
+		{ DXL_AX_CW_ANGLE_LIMIT, 1023, 1024 },
+		{ DXL_AX_TEMPERATURE_LIMIT, 100, 101 },   /* e-manual 0-100 (old manual 0-150) */
+		{ DXL_AX_MIN_VOLTAGE_LIMIT, 50, 49 },     /* 50-160 (old manual 50-250) */
+		{ DXL_AX_MIN_VOLTAGE_LIMIT, 160, 161 },
+		{ DXL_AX_MAX_VOLTAGE_LIMIT, 160, 161 },
+		{ DXL_AX_MAX_TORQUE, 1023, 1024 },
+		{ DXL_AX_STATUS_RETURN_LEVEL, 2, 3 },
+		{ DXL_AX_ALARM_LED, 0x7F, 0x80 },
+		{ DXL_AX_ALARM_SHUTDOWN, 0x7F, 0x80 },
+		{ DXL_AX_TORQUE_ENABLE, 1, 2 },
+		{ DXL_AX_LED, 1, 2 },
+		{ DXL_AX_CW_COMPLIANCE_SLOPE, 254, 255 },  /* 0-254, in 7 steps */
+		{ DXL_AX_CCW_COMPLIANCE_SLOPE, 0, 255 },
+		{ DXL_AX_GOAL_POSITION, 1023, 1024 },
+		{ DXL_AX_MOVING_SPEED, 1023, 1024 },       /* joint mode */
+		{ DXL_AX_TORQUE_LIMIT, 1023, 1024 },
+		{ DXL_AX_PUNCH, 0x20, 0x1F },              /* 0x20-0x3FF (old manual 0-1023) */
+		{ DXL_AX_PUNCH, 0x3FF, 0x400 },
+	};
+	for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
+		struct sim_servo s;
+		uint8_t out[DXL_MAX_PACKET];
+		servo_at_32c(&s);
+		const struct dxl_reg *r = dxl_reg_at(rows[i].addr);
+		assert_non_null(r);
+		uint16_t before = sim_servo_peek(&s, rows[i].addr);
+		int n = r->size == 2 ? write_u16(&s, 1, rows[i].addr, rows[i].outside, out)
+		                     : write_u8(&s, 1, rows[i].addr, (uint8_t)rows[i].outside, out);
+		assert_int_equal(n, 6);
+		if (out[4] != DXL_ERRBIT_RANGE)
+			fail_msg("%s = %u: error 0x%02x, want the range bit", r->name, rows[i].outside, out[4]);
+		assert_int_equal(sim_servo_peek(&s, rows[i].addr), before);
+		n = r->size == 2 ? write_u16(&s, 1, rows[i].addr, rows[i].inside, out)
+		                 : write_u8(&s, 1, rows[i].addr, (uint8_t)rows[i].inside, out);
+		if (rows[i].addr == DXL_AX_ID) {
+			assert_int_equal(out[2], 1);  /* answered under the old ID */
+		}
+		if (out[4] != 0)
+			fail_msg("%s = %u: error 0x%02x, want none", r->name, rows[i].inside, out[4]);
+		assert_int_equal(sim_servo_peek(&s, rows[i].addr), rows[i].inside);
+		assert_int_equal(s.count.range_errors, 1);
+	}
+}
+
 static void test_read_only_registers(void **state)
 {
 	(void)state;
@@ -229,6 +288,32 @@ static void test_angle_limit_error(void **state)
 	assert_int_equal(out[4], 0);
 	assert_int_equal(sim_servo_peek(&s, DXL_AX_GOAL_POSITION), 800);
 	assert_int_equal(s.count.angle_limit_errors, 2);
+}
+
+/* Present Speed: the measured speed in joint mode, the output share in wheel
+ * mode (e-manual: "the unit is about 0.1 %"), whatever the wheel's speed. */
+static void test_present_speed_by_mode(void **state)
+{
+	(void)state;
+	struct sim_servo s;
+	uint8_t out[DXL_MAX_PACKET];
+	servo_at_32c(&s);
+	struct sim_servo_sense in = { .speed = 3.0, .output = 0.5, .voltage = 12.0, .temperature = 32.0 };
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), dxl_rad_s_to_speed(3.0));
+	write_u16(&s, 1, DXL_AX_CCW_ANGLE_LIMIT, 0, out);   /* wheel mode */
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), 512);
+	in.output = -0.25;   /* CW: bit 10 */
+	in.speed = -5.0;
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), 1024 + 256);
+	in.output = 0.0;     /* no drive: 0 while the wheel still turns */
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), 0);
+	write_u16(&s, 1, DXL_AX_CCW_ANGLE_LIMIT, 1023, out);  /* joint mode again */
+	sim_servo_sense(&s, &in, 0.001);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_PRESENT_SPEED), dxl_rad_s_to_speed(-5.0));
 }
 
 static void test_wheel_mode(void **state)
@@ -407,6 +492,110 @@ static void test_alarm_shutdown_and_recovery(void **state)
 	assert_int_equal(s.count.shutdowns, 1);
 }
 
+static void expect_shut_down(const struct sim_servo *s, unsigned shutdowns)
+{
+	assert_int_equal(s->mem[DXL_AX_TORQUE_ENABLE], 0);
+	assert_int_equal(sim_servo_peek(s, DXL_AX_TORQUE_LIMIT), 0);
+	assert_int_equal(s->count.shutdowns, shutdowns);
+}
+
+static void torque_back_on(struct sim_servo *s)
+{
+	uint8_t out[DXL_MAX_PACKET];
+	write_u16(s, 1, DXL_AX_TORQUE_LIMIT, 1023, out);
+	assert_int_equal(out[4], 0);
+	write_u8(s, 1, DXL_AX_TORQUE_ENABLE, 1, out);
+	assert_int_equal(out[4], 0);
+	assert_int_equal(s->mem[DXL_AX_TORQUE_ENABLE], 1);
+}
+
+/* Every bit of Alarm Shutdown acts, the one-packet errors too: the reply
+ * carries the bit, torque enable and torque limit go to 0. */
+static void test_alarm_shutdown_every_bit(void **state)
+{
+	(void)state;
+	struct sim_servo s;
+	uint8_t out[DXL_MAX_PACKET];
+	servo_at_32c(&s);
+	write_u16(&s, 1, DXL_AX_CW_ANGLE_LIMIT, 100, out);
+	write_u8(&s, 1, DXL_AX_TORQUE_ENABLE, 1, out);
+	/* The factory mask (36) leaves a range error alone. */
+	write_u8(&s, 1, DXL_AX_LED, 2, out);
+	assert_int_equal(out[4], DXL_ERRBIT_RANGE);
+	assert_int_equal(s.mem[DXL_AX_TORQUE_ENABLE], 1);
+	assert_int_equal(sim_servo_peek(&s, DXL_AX_TORQUE_LIMIT), 1023);
+	write_u8(&s, 1, DXL_AX_TORQUE_ENABLE, 0, out);
+	write_u8(&s, 1, DXL_AX_ALARM_SHUTDOWN, 0x7F, out);
+	assert_int_equal(out[4], 0);
+	torque_back_on(&s);
+	/* range: LED 2 */
+	int n = write_u8(&s, 1, DXL_AX_LED, 2, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x08, 0xF4);
+	expect_shut_down(&s, 1);
+	torque_back_on(&s);
+	/* angle limit: goal 50 below the CW limit 100 */
+	n = write_u16(&s, 1, DXL_AX_GOAL_POSITION, 50, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x02, 0xFA);
+	expect_shut_down(&s, 2);
+	torque_back_on(&s);
+	/* instruction: ACTION with nothing registered */
+	n = req(&s, 1, DXL_INST_ACTION, NULL, 0, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x40, 0xBC);
+	expect_shut_down(&s, 3);
+	torque_back_on(&s);
+	/* checksum */
+	n = sim_servo_handle_bad_checksum(&s, 1, DXL_INST_PING, out, sizeof(out));
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x10, 0xEC);
+	expect_shut_down(&s, 4);
+	torque_back_on(&s);
+	/* a READ past the table: range */
+	uint8_t rd[2] = { 45, 10 };
+	n = req(&s, 1, DXL_INST_READ, rd, 2, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x08, 0xF4);
+	expect_shut_down(&s, 5);
+	torque_back_on(&s);
+	/* unreported errors act too: a broadcast write out of range, and a
+	 * SYNC_WRITE of a goal past the angle limit */
+	assert_int_equal(write_u8(&s, DXL_BROADCAST_ID, DXL_AX_LED, 2, out), 0);
+	expect_shut_down(&s, 6);
+	torque_back_on(&s);
+	uint8_t sw[5] = { DXL_AX_GOAL_POSITION, 2, 1, 50, 0 };
+	assert_int_equal(req(&s, DXL_BROADCAST_ID, DXL_INST_SYNC_WRITE, sw, 5, out), 0);
+	expect_shut_down(&s, 7);
+	/* a second error while it is shut down is not another shutdown */
+	write_u8(&s, 1, DXL_AX_LED, 2, out);
+	expect_shut_down(&s, 7);
+	assert_int_equal(s.count.range_errors, 5);   /* the first under mask 36 */
+	assert_int_equal(s.count.angle_limit_errors, 2);
+	assert_int_equal(s.count.instruction_errors, 1);
+	assert_int_equal(s.count.checksum_errors, 1);
+}
+
+/* A write is answered under the ID and the status return level the servo had
+ * when it arrived (the original AX-12 manual's Examples 7 and 14). */
+static void test_answered_before_the_write_acts(void **state)
+{
+	(void)state;
+	struct sim_servo s;
+	uint8_t out[DXL_MAX_PACKET];
+	servo_at_32c(&s);
+	/* Example 7: ID 1 -> 0, answered by ID 1 */
+	int n = SEND(&s, out, 0xFF, 0xFF, 0x01, 0x04, 0x03, 0x03, 0x00, 0xF4);
+	EXPECT(out, n, 0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC);
+	assert_int_equal(sim_servo_id(&s), 0);
+	/* Example 14: status return level 0, the write itself answered */
+	n = SEND(&s, out, 0xFF, 0xFF, 0x00, 0x04, 0x03, 0x10, 0x00, 0xE8);
+	EXPECT(out, n, 0xFF, 0xFF, 0x00, 0x02, 0x00, 0xFD);
+	assert_int_equal(s.mem[DXL_AX_STATUS_RETURN_LEVEL], 0);
+	uint8_t rd[2] = { DXL_AX_PRESENT_TEMPERATURE, 1 };
+	assert_int_equal(req(&s, 0, DXL_INST_READ, rd, 2, out), 0);
+	/* back to 2: under the old level 0, not answered; the next one is */
+	assert_int_equal(write_u8(&s, 0, DXL_AX_STATUS_RETURN_LEVEL, 2, out), 0);
+	assert_int_equal(s.mem[DXL_AX_STATUS_RETURN_LEVEL], 2);
+	n = req(&s, 0, DXL_INST_READ, rd, 2, out);
+	EXPECT(out, n, 0xFF, 0xFF, 0x00, 0x03, 0x00, 0x20, 0xDC);
+}
+
 static void test_overheating_and_masks(void **state)
 {
 	(void)state;
@@ -484,9 +673,11 @@ int main(void)
 		cmocka_unit_test(test_golden_sync_write),
 		cmocka_unit_test(test_golden_reg_write_action),
 		cmocka_unit_test(test_range_error_not_written),
+		cmocka_unit_test(test_emanual_ranges),
 		cmocka_unit_test(test_read_only_registers),
 		cmocka_unit_test(test_angle_limit_error),
 		cmocka_unit_test(test_wheel_mode),
+		cmocka_unit_test(test_present_speed_by_mode),
 		cmocka_unit_test(test_eeprom_vs_ram),
 		cmocka_unit_test(test_max_torque_copied_at_power_on),
 		cmocka_unit_test(test_status_return_levels),
@@ -494,6 +685,8 @@ int main(void)
 		cmocka_unit_test(test_factory_reset),
 		cmocka_unit_test(test_lock),
 		cmocka_unit_test(test_alarm_shutdown_and_recovery),
+		cmocka_unit_test(test_alarm_shutdown_every_bit),
+		cmocka_unit_test(test_answered_before_the_write_acts),
 		cmocka_unit_test(test_overheating_and_masks),
 		cmocka_unit_test(test_bad_checksum_and_unknown_instruction),
 		cmocka_unit_test(test_read_block_and_present_values),
