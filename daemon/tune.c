@@ -222,6 +222,8 @@ static bool tune_track(struct tune *t, struct tune_joint *j, double time, double
 			int k = j->ncycles++;
 			j->period[k] = tc - j->cross_t;
 			j->p2p[k] = j->hi - j->lo;
+			j->top[k] = j->hi;
+			j->bottom[k] = j->lo;
 			j->vpk[k] = j->vmax;
 			j->start[k] = j->cross_t;
 		}
@@ -275,18 +277,45 @@ static bool tune_window_ready(const struct tune *t)
 	return all || any_full;
 }
 
+/* A joint whose motion is not a clean swing (clipped at a limit, or pushed
+ * by its neighbour into a double hump) crosses its centre more than once a
+ * cycle: its "cycles" come out short and small. Coupled joints share one
+ * fundamental, so the window's frequency is the lowest joint's, and each
+ * joint's amplitude is half its whole excursion over the last two such
+ * periods (seen on the fast test plant: joint 1 read 2.05 Hz and 0.72 rad
+ * while joint 2, clipped at 1.3 rad, read 1.0 Hz). */
+static double tune_joint_freq(const struct tune_joint *j)
+{
+	int a = j->ncycles - 1, b = j->ncycles - 2;
+	return 2.0 / (j->period[a] + j->period[b]);
+}
+
 static void tune_measure(const struct tune *t, struct tune_window *w)
 {
 	memset(w, 0, sizeof *w);
 	const struct tune_joint *j0 = &t->j[0];
-	int a = j0->ncycles - 1, b = j0->ncycles - 2;
-	w->freq = 2.0 / (j0->period[a] + j0->period[b]);
+	w->freq = tune_joint_freq(j0);
+	for (size_t i = 1; i < t->n; i++)
+		w->freq = fmin(w->freq, tune_joint_freq(&t->j[i]));
 	double e = fabs(w->freq / t->opts.target_freq - 1.0);
+	double span = 2.0 / w->freq;
 	for (size_t i = 0; i < t->n; i++) {
 		const struct tune_joint *j = &t->j[i];
-		int p = j->ncycles - 1, q = j->ncycles - 2;
-		w->amp[i] = 0.25 * (j->p2p[p] + j->p2p[q]);
-		w->vpeak[i] = fmax(j->vpk[p], j->vpk[q]);
+		int last = j->ncycles - 1;
+		double end = j->start[last] + j->period[last], hi = -INFINITY, lo = INFINITY, vpk = 0;
+		/* the cycles that end within the last two fundamental periods */
+		for (int k = last; k >= 0 && end - j->start[k] <= 1.05 * span; k--) {
+			hi = fmax(hi, j->top[k]);
+			lo = fmin(lo, j->bottom[k]);
+			vpk = fmax(vpk, j->vpk[k]);
+		}
+		if (!(hi >= lo)) {   /* a cycle longer than the span: its own */
+			hi = j->top[last];
+			lo = j->bottom[last];
+			vpk = j->vpk[last];
+		}
+		w->amp[i] = 0.5 * (hi - lo);
+		w->vpeak[i] = vpk;
 		e = fmax(e, fabs(w->amp[i] / t->opts.target_amp - 1.0));
 		w->mu[i] = t->mu[i];
 	}

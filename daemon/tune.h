@@ -54,7 +54,7 @@ enum tune_state {
 
 /* What one window measured. */
 struct tune_window {
-	double freq;                     /* Hz, joint 0's (coupled joints share it) */
+	double freq;                     /* Hz, the lowest joint's (coupled joints share it) */
 	double amp[CFG_MAX_JOINTS];      /* rad, half peak-to-peak */
 	double vpeak[CFG_MAX_JOINTS];    /* rad/s, largest |speed| seen */
 	double lag_deg;                  /* joint 1 behind joint 0, degrees in [0, 360) (NaN: one joint) */
@@ -75,6 +75,7 @@ struct tune_joint {
 	/* cycles completed since the window began */
 	int ncycles;
 	double period[TUNE_MAX_WINDOW_CYCLES + 2], p2p[TUNE_MAX_WINDOW_CYCLES + 2],
+	       top[TUNE_MAX_WINDOW_CYCLES + 2], bottom[TUNE_MAX_WINDOW_CYCLES + 2],
 	       vpk[TUNE_MAX_WINDOW_CYCLES + 2], start[TUNE_MAX_WINDOW_CYCLES + 2];
 };
 

@@ -29,6 +29,7 @@
 struct plant {
 	double f0, a0[2], ef, ea, vmax;
 	double lead_exp;   /* > 0: joint 2's amplitude grows with the lead, not with its μ */
+	double harmonic;   /* joint 1 moves as sin φ + h·sin 2φ (a double hump: extra crossings) */
 	bool dead;
 	double phase[2];
 };
@@ -80,8 +81,9 @@ static void drive(struct run *r, struct plant *p, double seconds)
 			/* phase advances by the present frequency: a change is continuous */
 			p->phase[j] += 2 * PI * f * DT;
 			double ph = p->phase[j] - (double)j * PI / 2;
-			x[j] = p->dead ? 0.0 : a[j] * sin(ph);
-			v[j] = p->dead ? 0.0 : a[j] * 2 * PI * f * cos(ph);
+			double h = j == 0 ? p->harmonic : 0.0;
+			x[j] = p->dead ? 0.0 : a[j] * (sin(ph) + h * sin(2 * ph));
+			v[j] = p->dead ? 0.0 : a[j] * 2 * PI * f * (cos(ph) + 2 * h * cos(2 * ph));
 		}
 		bool starter = r->time < 2.0;
 		bool ch = tune_sample(&r->t, r->time, x, v, starter);
@@ -135,6 +137,27 @@ static void test_converges_on_a_fast_plant(void **state)
 	/* the parameters in the configuration are the result's */
 	assert_true(fabs(r.cfg->joint[0].osc.k / r.k0 - r.t.result.k) < 1e-9);
 	assert_true(fabs(r.t.result.lag_deg - 90) < 3);
+}
+
+/* Joint 1 in a double hump crosses its centre twice a cycle: the window
+ * still reads the fundamental, and the whole excursion as its amplitude. */
+static void test_double_hump_reads_the_fundamental(void **state)
+{
+	(void)state;
+	struct run r;
+	start(&r, 2, 0.8, 0.8, false);
+	struct plant p = { .f0 = 1.0, .a0 = { 0.6, 1.2 }, .ef = 0.6, .ea = 0.4, .harmonic = 0.8 };
+	drive(&r, &p, 90);
+	assert_true(r.t.have_first);
+	assert_true(fabs(r.t.first.freq / 1.0 - 1) < 0.03);
+	double hi = -1e9, lo = 1e9;
+	for (int i = 0; i < 10000; i++) {
+		double ph = 2 * PI * i / 10000.0, x = 0.6 * (sin(ph) + 0.8 * sin(2 * ph));
+		hi = fmax(hi, x);
+		lo = fmin(lo, x);
+	}
+	assert_true(fabs(r.t.first.amp[0] / (0.5 * (hi - lo)) - 1) < 0.03);
+	assert_true(fabs(r.t.first.amp[1] / 1.2 - 1) < 0.03);
 }
 
 /* A plant already on target: one window, one to confirm, nothing changed. */
@@ -344,6 +367,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_converges_on_a_fast_plant),
+		cmocka_unit_test(test_double_hump_reads_the_fundamental),
 		cmocka_unit_test(test_on_target_confirms_without_change),
 		cmocka_unit_test(test_one_joint_other_targets),
 		cmocka_unit_test(test_speed_limit_says_what_is_reachable),
