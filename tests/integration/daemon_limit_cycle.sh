@@ -78,14 +78,22 @@ lag_ok() {
 	[ "$(echo "$lag" | field n)" -ge 6 ] 2>/dev/null && within "$lmin" 60 120 && within "$lmax" 60 120 &&
 		awk -v a="$lmin" -v b="$lmax" 'BEGIN { exit !(b - a <= 15) }'
 }
+# states the watcher did not print in cycles [from, to) (UDP multicast
+# drops what a starved reader does not take in time)
+missed() {   # ROBOT LOG FROM_CYCLE TO_CYCLE
+	awk -v r="$1" -v a="$3" -v b="$4" '$1 == "STATE" && $2 == r {
+		c = $3; sub("cycle=", "", c); c += 0; if (c >= a && c < b) n++ }
+		END { print b - a - n }' "$T/$2.log"
+}
+
 measure_window() {   # FROM_CYCLE TO_CYCLE -> sets m2, m1
 	wait_for 40 past "$R2" watch2 "$2" && wait_for 10 past "$R1" watch1 "$2" ||
 		{ tap_fail "both robots publish for $2 cycles" "$(tail -3 "$T/d2.log" "$T/d1.log")"; tap_done; exit 1; }
 	local from to; from=$(awk -v c="$1" 'BEGIN { print c * 0.01 }'); to=$(awk -v c="$2" 'BEGIN { print c * 0.01 }')
 	m2=$(samples "$R2" watch2 | measure "$from" "$to")
 	m1=$(samples "$R1" watch1 | measure "$from" "$to")
-	echo "# cycles $1..$2, two joints: ${m2//$'\n'/; }"
-	echo "# cycles $1..$2, one joint: ${m1//$'\n'/; }"
+	echo "# cycles $1..$2, two joints: ${m2//$'\n'/; } ($(missed "$R2" watch2 "$1" "$2") states not heard)"
+	echo "# cycles $1..$2, one joint: ${m1//$'\n'/; } ($(missed "$R1" watch1 "$1" "$2") states not heard)"
 	[ "$torque3" = 1 ] || return 0
 	if wait_for 10 past "$R3" watch3 "$2"; then
 		m3=$(samples "$R3" watch3 | measure "$from" "$to")
@@ -95,18 +103,22 @@ measure_window() {   # FROM_CYCLE TO_CYCLE -> sets m2, m1
 	fi
 }
 
-# A window in which a daemon counted bus errors or overruns was measured on an
-# overloaded machine (the simulator itself then falls behind real time, which
-# slows every joint): if it misses the bands, measure the next window once.
+# A window measured on an overloaded machine — a daemon counted bus errors or
+# overruns (the simulator then falls behind real time, which slows every
+# joint), or the watcher missed more than 5 % of the states (crossings fall
+# in the gaps: a full-suite run beside other work read 6 crossings in 10 s
+# at 0.82 Hz) — is measured once more if it misses the bands.
 end=$((SETTLE_CYCLES + MEASURE_CYCLES))
 measure_window "$SETTLE_CYCLES" "$end"
 if ! { joint_ok "$m2" 1 && joint_ok "$m2" 2 && joint_ok "$m1" 1 && lag_ok "$m2"; }; then
 	u=$(( $(upsets "$R2" watch2 "$SETTLE_CYCLES" "$end") + $(upsets "$R1" watch1 "$SETTLE_CYCLES" "$end") ))
-	if [ "$u" -gt 0 ]; then
-		echo "# $u bus errors/overruns in that window: measuring the next one"
+	g=$(( $(missed "$R2" watch2 "$SETTLE_CYCLES" "$end") + $(missed "$R1" watch1 "$SETTLE_CYCLES" "$end") ))
+	if [ "$u" -gt 0 ] || [ "$g" -gt $((2 * MEASURE_CYCLES / 20)) ]; then
+		echo "# $u bus errors/overruns and $g states not heard in that window: measuring the next one"
 		measure_window "$end" $((end + MEASURE_CYCLES))
 	fi
 fi
+
 
 check_joint() {   # NAME MEASUREMENT JOINT
 	local line f amin amax n
