@@ -89,13 +89,33 @@ if [ -n "$words" ] && grep -qE '^  Collisions between robots per 10 s: [0-9]+ ->
 else
 	tap_fail "summary says in words how the contact force and collisions changed" "$(sed -n '/In words/,+4p' "$out")"
 fi
-# The paper's effect, as the README promises it for the demo: the force falls
-# 5x or more (e2e_force asserts 3x over a shorter run, docs/EXPERIMENTS.md has
-# the spread); a shortfall is a TODO with its number.
-if [ -n "$ratio" ] && awk -v r="$ratio" 'BEGIN { exit !(r >= 5) }' || echo "$words" | grep -q 'fell to zero'; then
-	tap_ok "the contact force falls 5x or more after the switch (${ratio:-to zero}x)"
+# The paper's effect (docs/EXPERIMENTS.md section 4, which this run is: the
+# simulator's total impulse per second, sampled by demo.sh, over the last
+# 10 s on each side of the switch): asserted 3x or more — the least fall
+# recorded is 3.8x; 5x, as the README promises it for the demo, and the
+# paper's order of magnitude are TODOs with their number when short. (This
+# replaced e2e_force in make test: the same experiment run a second time;
+# it runs in make test-long.)
+zero=0; echo "$words" | grep -q 'fell to zero' && zero=1
+if [ "$zero" = 1 ] || { [ -n "$ratio" ] && awk -v r="$ratio" 'BEGIN { exit !(r >= 3) }'; }; then
+	tap_ok "the contact force falls 3x or more after the switch (${ratio:-to zero}x)"
 else
-	tap_todo "the contact force falls 5x or more after the switch" "${words:-no words}"
+	tap_fail "the contact force falls 3x or more after the switch" "${words:-no words}"
+fi
+for want in 5 10; do
+	if [ "$zero" = 1 ] || { [ -n "$ratio" ] && awk -v r="$ratio" -v w="$want" 'BEGIN { exit !(r >= w) }'; }; then
+		tap_ok "the contact force falls ${want}x or more after the switch (${ratio:-to zero}x)"
+	else
+		tap_todo "the contact force falls ${want}x or more after the switch" "${words:-no words}"
+	fi
+done
+# Robots that stopped would also stop colliding: every joint must still swing
+# at least 0.6 rad peak-to-peak (a crowded end robot's free joint swings least).
+sg=$(min_swing "$T/out" 2>/dev/null)
+if [ -n "$sg" ] && awk -v s="${sg%% *}" 'BEGIN { exit !(s >= 0.6) }'; then
+	tap_ok "every robot still undulates at the end (smallest peak-to-peak $sg rad)"
+else
+	tap_fail "every robot still undulates at the end" "smallest peak-to-peak over the last 10 s: '$sg' rad (< 0.6)"
 fi
 if grep -qE '^  Neighbours at the end \(\|D\| against the compatibility bound 2 asin\(d~\)\): [0-9]+ of 9 at or within it' "$out"; then
 	tap_ok "summary: each pair's final |D| against its bound ($(grep -oE '[0-9]+ of 9 at or within' "$out"))"
