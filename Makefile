@@ -146,7 +146,7 @@ check-pure:
 define program
 $(BIN)/$(1): $(OBJ)/$(firstword $(DIR_$(PROG_$(1))))/main.o $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a
 	@mkdir -p $(BIN)
-	$(CC) $(LDFLAGS) -o $$@ $$< $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a $(LDLIBS)
+	$(CC) $(LDFLAGS) -o $$@ $$< $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a $$(LDLIBS)
 endef
 $(foreach p,$(PROGRAMS),$(eval $(call program,$(p))))
 

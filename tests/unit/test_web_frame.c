@@ -108,7 +108,7 @@ static void test_new_only(void **state)
 	double t = run(0.0, 2.0, 0.0, 3);
 	struct frame_cursor c;
 	frame_cursor_init(&c, &hist);
-	size_t n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	size_t n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	assert_true(n > 0);
 	buf[n] = '\0';
 	assert_whole(buf, n);
@@ -118,24 +118,24 @@ static void test_new_only(void **state)
 	assert_non_null(strstr(buf, "\"temperature\":33"));
 	assert_non_null(strstr(buf, "\"pairs\":[{\"a\":\"r1\",\"b\":\"r2\""));
 	/* nothing new: no samples, no status (every FRAME_STATUS_EVERY-th frame) */
-	n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';
 	assert_whole(buf, n);
 	assert_int_equal(count_after(buf, "\"samples\":{\"t\":"), 0);
 	assert_null(strstr(buf, "\"status\""));
 	/* three new samples: exactly those, per joint and per pair */
 	t = run(t, 3.0 / HIST_HZ, 0.0, 3);
-	n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';
 	assert_int_equal(count_after(buf, "\"samples\":{\"t\":"), 3);
 	assert_int_equal(count_after(buf, "\"a\":["), 3);
 	assert_int_equal(count_after(buf, "\"d\":"), 3);
 	assert_int_equal(count_after(buf, "\"bound\":"), 3);
 	/* the fifth frame (index FRAME_STATUS_EVERY) carries the status again */
-	n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';
 	assert_null(strstr(buf, "\"status\""));
-	n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';
 	assert_non_null(strstr(buf, "\"status\""));
 }
@@ -148,12 +148,12 @@ static void test_bounded(void **state)
 	struct frame_cursor c;
 	frame_cursor_init(&c, &hist);
 	double t = run(0.0, HIST_SECONDS + 5, 0.0, 3);
-	size_t n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	size_t n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';
 	assert_int_equal(count_after(buf, "\"samples\":{\"t\":"), HIST_N);
 	t = run(t, 10.0, 0.0, 3);
 	size_t small = 8000;
-	n = frame_write(&hist, &model, t, &c, NULL, 0, buf, small);
+	n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, small);
 	assert_true(n > 0 && n < small);
 	buf[n] = '\0';
 	assert_whole(buf, n);
@@ -167,7 +167,7 @@ static void test_bounded(void **state)
 	/* not even an empty frame fits: 0, the cursor stays */
 	uint64_t before = c.sample;
 	t = run(t, 1.0, 0.0, 3);
-	assert_int_equal(frame_write(&hist, &model, t, &c, NULL, 0, buf, 20), 0);
+	assert_int_equal(frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, 20), 0);
 	assert_int_equal(c.sample, before);
 }
 
@@ -207,20 +207,20 @@ static void test_marks_and_notes(void **state)
 	struct frame_cursor c;
 	frame_cursor_init(&c, &hist);
 	double t = run(0.0, 1.0, 0.0, 2);
-	size_t n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	size_t n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';
 	/* a robot's first mode is no switch */
 	assert_non_null(strstr(buf, "\"marks\":[]"));
 	t = run(t, 1.0, 0.0, 3);
 	struct frame_note note = { .seq = 17, .robot = "r2", .kind = "command-accepted", .text = "mode \"OSC\"" };
-	n = frame_write(&hist, &model, t, &c, &note, 1, buf, sizeof buf);
+	n = frame_write(&hist, &model, t, &c, NULL, &note, 1, buf, sizeof buf);
 	buf[n] = '\0';
 	assert_whole(buf, n);
 	assert_non_null(strstr(buf, "\"robot\":\"r2\",\"mode\":\"OSCILLATOR\"}]"));
-	assert_non_null(strstr(buf, "\"notes\":[{\"seq\":17,\"robot\":\"r2\",\"kind\":\"command-accepted\","
+	assert_non_null(strstr(buf, "\"notes\":[{\"id\":0,\"seq\":17,\"robot\":\"r2\",\"kind\":\"command-accepted\","
 	                            "\"text\":\"mode \\\"OSC\\\"\"}]"));
 	/* once sent, a mark is not sent again */
-	n = frame_write(&hist, &model, t, &c, NULL, 0, buf, sizeof buf);
+	n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';
 	assert_non_null(strstr(buf, "\"marks\":[]"));
 }

@@ -60,7 +60,24 @@ static void frame_status_robot(struct json *j, const struct top_robot *r, double
 	json_object_end(j);
 }
 
-static void frame_status(struct json *j, const struct top_model *m, double now)
+static void frame_counters(struct json *j, const struct frame_counters *c)
+{
+	json_key(j, "server");
+	json_object_begin(j);
+	json_field_int(j, "clients", c->clients);
+	json_field_int(j, "http_requests", c->http_requests);
+	json_field_int(j, "http_refused", c->http_refused);
+	json_field_int(j, "ws_refused", c->ws_refused);
+	json_field_int(j, "msgs_refused", c->msgs_refused);
+	json_field_int(j, "commands_sent", c->commands_sent);
+	json_field_int(j, "commands_refused", c->commands_refused);
+	json_field_int(j, "frames_sent", c->frames_sent);
+	json_field_int(j, "frames_skipped", c->frames_skipped);
+	json_field_int(j, "clients_stalled", c->clients_stalled);
+	json_object_end(j);
+}
+
+static void frame_status(struct json *j, const struct top_model *m, const struct frame_counters *srv, double now)
 {
 	json_key(j, "status");
 	json_object_begin(j);
@@ -81,6 +98,8 @@ static void frame_status(struct json *j, const struct top_model *m, double now)
 	json_object_end(j);
 	json_field_int(j, "dropped_robots", m->dropped_robots);
 	json_field_int(j, "decode_errors", m->decode_errors);
+	if (srv != NULL)
+		frame_counters(j, srv);
 	json_object_end(j);
 }
 
@@ -184,6 +203,7 @@ static void frame_notes(struct json *j, const struct frame_note *notes, int n)
 	json_array_begin(j);
 	for (int i = 0; i < n; i++) {
 		json_object_begin(j);
+		json_field_int(j, "id", notes[i].id);
 		json_field_int(j, "seq", notes[i].seq);
 		json_field_string(j, "robot", notes[i].robot);
 		json_field_string(j, "kind", notes[i].kind);
@@ -200,7 +220,8 @@ static uint64_t frame_max(uint64_t a, uint64_t b)
 
 /* One attempt with the samples [from, h->next); 0 if it does not fit. */
 static size_t frame_try(const struct hist *h, const struct top_model *m, double now, const struct frame_cursor *c,
-                        uint64_t from, const struct frame_note *notes, int nnotes, char *buf, size_t cap)
+                        uint64_t from, const struct frame_counters *srv, const struct frame_note *notes, int nnotes,
+                        char *buf, size_t cap)
 {
 	FILE *f = fmemopen(buf, cap, "w");
 	if (f == NULL)
@@ -212,7 +233,7 @@ static size_t frame_try(const struct hist *h, const struct top_model *m, double 
 	json_field_string(&j, "type", "frame");
 	json_field_int(&j, "now_ms", (long long)llround((now - h->t0) * 1000.0));
 	if (c->frames % FRAME_STATUS_EVERY == 0)
-		frame_status(&j, m, now);
+		frame_status(&j, m, srv, now);
 	frame_samples(&j, h, m, from, h->next);
 	frame_marks(&j, h, m, frame_max(c->mark, hist_oldest_mark(h)));
 	frame_bins(&j, h, frame_max(c->bin, hist_oldest_bin(h)));
@@ -227,12 +248,13 @@ static size_t frame_try(const struct hist *h, const struct top_model *m, double 
 }
 
 size_t frame_write(const struct hist *h, const struct top_model *m, double now, struct frame_cursor *c,
-                   const struct frame_note *notes, int nnotes, char *buf, size_t cap)
+                   const struct frame_counters *srv, const struct frame_note *notes, int nnotes, char *buf,
+                   size_t cap)
 {
 	uint64_t from = frame_max(c->sample, hist_oldest(h));
 	uint64_t n = h->next > from ? h->next - from : 0;
 	for (;;) {
-		size_t len = frame_try(h, m, now, c, h->next - n, notes, nnotes, buf, cap);
+		size_t len = frame_try(h, m, now, c, h->next - n, srv, notes, nnotes, buf, cap);
 		if (len > 0) {
 			c->sample = h->next;
 			c->bin = h->nbins;

@@ -18,7 +18,8 @@
  *    "pairs":[{"a","b","class","d":[deltas],"bound":[bounds]}],   the current neighbours, same t
  *    "marks":[{"t","robot","mode"}],   mode switches since the last frame
  *    "bins":{"t":[ms],"coll":[n],"force":[N]},   closed simulator bins since the last frame
- *    "notes":[{"seq","robot","kind","text"}]}    answers to this browser's commands
+ *    "notes":[{"id","seq","robot","kind","text"}]}  answers to this browser's commands
+ *   with server counters (struct frame_counters) in the status as "server":{...}
  */
 #ifndef UNDULATE_WEB_FRAME_H
 #define UNDULATE_WEB_FRAME_H
@@ -41,10 +42,17 @@ struct frame_cursor {
 
 /* An answer to show on one browser (the robot's own EVENT for its command). */
 struct frame_note {
-	int64_t seq;
+	long long id;                 /* the page's number for its command (0: none) */
+	int64_t seq;                  /* the command's seq, as the robot echoes it (0: not sent) */
 	char robot[TOP_NAME_MAX];
 	char kind[32];
 	char text[FRAME_NOTE_TEXT];
+};
+
+/* The server's own counters, shown on the page (bad input is counted). */
+struct frame_counters {
+	long long clients, http_requests, http_refused, ws_refused, msgs_refused, commands_sent,
+	          commands_refused, frames_sent, frames_skipped, clients_stalled;
 };
 
 /* Starts a browser at the oldest history held: its first frame draws the
@@ -56,6 +64,7 @@ void frame_cursor_init(struct frame_cursor *c, const struct hist *h);
  * oldest samples are left out (the browser's plot starts later), never the
  * newest. Returns the length, 0 when not even a frame without samples fits. */
 size_t frame_write(const struct hist *h, const struct top_model *m, double now, struct frame_cursor *c,
-                   const struct frame_note *notes, int nnotes, char *buf, size_t cap);
+                   const struct frame_counters *srv, const struct frame_note *notes, int nnotes, char *buf,
+                   size_t cap);
 
 #endif
