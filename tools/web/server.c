@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include "clock.h"
@@ -330,6 +331,8 @@ static bool web_ws_allowed(struct lws *wsi)
 static void web_ws_open(struct lws *wsi, struct web_client *c)
 {
 	memset(c, 0, sizeof *c);
+	int sndbuf = WEB_SNDBUF;
+	setsockopt(lws_get_socket_fd(wsi), SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
 	c->wsi = wsi;
 	c->id = ++app.next_client;
 	c->authed = app.o.token == NULL;
@@ -354,6 +357,8 @@ static void web_ws_close(struct web_client *c)
 
 static int web_ws_write(struct lws *wsi, struct web_client *c)
 {
+	if (!c->want)
+		return 0; /* libwebsockets may call again: a frame goes out only when one is due */
 	unsigned char *buf = app.frame + LWS_PRE;
 	size_t n = frame_write(&app.hist, &app.model, clock_mono_s(), &c->cur, &app.n, c->notes, c->nnotes,
 	                       (char *)buf, WEB_FRAME_MAX);

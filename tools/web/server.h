@@ -16,6 +16,10 @@
 #define WEB_FRAME_EVERY 2           /* samples (HIST_HZ) per frame: 12.5 frames per second */
 #define WEB_STALL_S 30.0            /* a browser that takes no frame for this long is closed */
 #define WEB_HTTP_TIMEOUT_S 10       /* a request must arrive whole within this */
+/* Kernel send buffer per browser (the kernel doubles it): with libwebsockets'
+ * one partial frame, all a browser that stops reading can hold of ours. A
+ * frame of 20 robots is ~6 kB; a browser that reads keeps it nearly empty. */
+#define WEB_SNDBUF (16 * 1024)
 #define WEB_NOTES 16                /* answers waiting for a browser's next frame */
 
 struct web_opts {

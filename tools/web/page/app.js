@@ -232,6 +232,13 @@ function redraw() {
       while (k < d.data.length && d.data[k].t < state.now - PORTRAIT_S) k++;
       if (k) d.data.splice(0, k);
     }
+    // the portrait's axes from its points: Chart.js takes a line's x range from
+    // its first and last points (it assumes them sorted), a cycle is not
+    let ax = 0.1, aw = 0.1;
+    for (const d of r.portrait.data.datasets)
+      for (const p of d.data) { ax = Math.max(ax, Math.abs(p.x)); aw = Math.max(aw, Math.abs(p.y)); }
+    Object.assign(r.portrait.options.scales.x, { min: -1.1 * ax, max: 1.1 * ax });
+    Object.assign(r.portrait.options.scales.y, { min: -1.1 * aw, max: 1.1 * aw });
     fix(r.angles); r.angles.update('none'); r.portrait.update('none');
   }
   for (const q of state.pairs.values()) {
