@@ -32,7 +32,8 @@ static void usage(FILE *f)
 	      "                      as undulated --command --key; default: local command sockets\n"
 	      "  --lcm-url URL       LCM provider (default: $LCM_DEFAULT_URL or udpm ttl=0)\n"
 	      "  --page-dir DIR      the page's files (default: found beside the program)\n"
-	      "  --chartjs FILE      Chart.js (default " WEB_CHARTJS ", Debian libjs-chart.js)\n",
+	      "  --chartjs FILE      Chart.js (default " WEB_CHARTJS ", Debian libjs-chart.js)\n"
+	      "  -v, --verbose       more messages\n",
 	      f);
 }
 

@@ -268,6 +268,8 @@ static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
 {
 	app.n.http_requests++;
 	const char *method = web_method(wsi);
+	if (app.o.verbose)
+		fprintf(stderr, "undulate-web: %s %.200s\n", method, uri);
 	switch (req_route(method, uri)) {
 	case REQ_PAGE: return web_serve_file(wsi, app.o.page_dir, "index.html", "text/html");
 	case REQ_ASSET_JS: return web_serve_file(wsi, app.o.page_dir, "app.js", "application/javascript");
