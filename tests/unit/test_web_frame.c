@@ -117,6 +117,14 @@ static void test_new_only(void **state)
 	assert_non_null(strstr(buf, "\"status\":{\"robots\":[{\"name\":\"r1\",\"mode\":\"OSCILLATOR\""));
 	assert_non_null(strstr(buf, "\"temperature\":33"));
 	assert_non_null(strstr(buf, "\"pairs\":[{\"a\":\"r1\",\"b\":\"r2\""));
+	/* a robot not heard for HIST_GAP_S: a gap (null), not its last angle again */
+	hist_sample(&hist, &model, t + HIST_GAP_S + 0.01);
+	struct frame_cursor gap = c;
+	gap.sample = hist.next - 1;
+	n = frame_write(&hist, &model, t, &gap, NULL, NULL, 0, buf, sizeof buf);
+	buf[n] = '\0';
+	assert_non_null(strstr(buf, "\"a\":[[null]"));
+	c.sample = hist.next;
 	/* nothing new: no samples, no status (every FRAME_STATUS_EVERY-th frame) */
 	n = frame_write(&hist, &model, t, &c, NULL, NULL, 0, buf, sizeof buf);
 	buf[n] = '\0';

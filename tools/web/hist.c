@@ -62,7 +62,7 @@ static int hist_pair_slot(struct hist *h, int a, int b)
 	return s;
 }
 
-static void hist_sample_robots(struct hist *h, const struct top_model *m, int s, int64_t t_ms)
+static void hist_sample_robots(struct hist *h, const struct top_model *m, int s, int64_t t_ms, double now)
 {
 	for (int i = 0; i < m->nrobots && i < TOP_MAX_ROBOTS; i++) {
 		const struct top_robot *r = &m->robots[i];
@@ -71,7 +71,8 @@ static void hist_sample_robots(struct hist *h, const struct top_model *m, int s,
 			h->nrobots = i + 1;
 		}
 		for (int j = 0; j < TOP_MAX_JOINTS; j++) {
-			bool live = r->have_state && j < r->njoints && !top_joint_silent(&r->j[j]);
+			bool live = r->have_state && now - r->rx < HIST_GAP_S && j < r->njoints &&
+			            !top_joint_silent(&r->j[j]);
 			h->angle[i][j][s] = live ? (float)r->j[j].angle : NAN;
 			h->speed[i][j][s] = live ? (float)r->j[j].speed : NAN;
 		}
@@ -174,7 +175,7 @@ void hist_sample(struct hist *h, const struct top_model *m, double now)
 {
 	int s = hist_slot(h->next);
 	h->t_ms[s] = hist_ms(h, now);
-	hist_sample_robots(h, m, s, h->t_ms[s]);
+	hist_sample_robots(h, m, s, h->t_ms[s], now);
 	hist_sample_pairs(h, m, s);
 	hist_sample_sim(h, m, now);
 	h->next++;

@@ -27,6 +27,7 @@
 #define HIST_MARKS 64              /* mode switches kept */
 #define HIST_BIN_S 1.0             /* collision / contact-force bin */
 #define HIST_BINS 300              /* five minutes of bins */
+#define HIST_GAP_S 0.25            /* no STATE for this long: the plots show a gap, not the last angle repeated */
 
 struct hist_pair {
 	bool used;
