@@ -53,7 +53,7 @@ GEN_WARN := -w
 # ---- components -------------------------------------------------------------
 # name : directory
 # bench/ holds standalone programs compiled by bench/run.sh, not a library.
-COMPONENTS := common protocol daemon sim dxl top analyze
+COMPONENTS := common protocol daemon sim dxl top analyze web
 DIR_common   := common
 DIR_protocol := protocol protocol/io
 DIR_daemon   := daemon
@@ -61,6 +61,7 @@ DIR_sim      := sim-bridge
 DIR_dxl      := tools/dxl
 DIR_top      := tools/top
 DIR_analyze  := tools/analyze
+DIR_web      := tools/web
 
 # programs: binary name -> component, and the libraries each links (in order)
 PROG_undulated        := daemon
@@ -68,7 +69,8 @@ PROG_undulate-sim     := sim
 PROG_dxl              := dxl
 PROG_undulate-top     := top
 PROG_undulate-analyze := analyze
-ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze
+PROG_undulate-web     := web
+ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze undulate-web
 # Build only programs whose main.c exists (keeps partial trees buildable).
 PROGRAMS := $(foreach p,$(ALL_PROGRAMS),$(if $(wildcard $(firstword $(DIR_$(PROG_$(p))))/main.c),$(p)))
 DEPS_daemon   := daemon protocol common
@@ -77,6 +79,9 @@ DEPS_sim      := sim protocol common
 DEPS_dxl      := dxl daemon protocol common
 DEPS_top      := top protocol common
 DEPS_analyze  := analyze protocol common
+# undulate-web: top's model (the LCM picture, top_json), analyze's end-state
+# rules, the daemon's command validation
+DEPS_web      := web top analyze daemon protocol common
 DEPS_protocol := protocol common
 DEPS_common   := common
 
@@ -141,7 +146,7 @@ check-pure:
 define program
 $(BIN)/$(1): $(OBJ)/$(firstword $(DIR_$(PROG_$(1))))/main.o $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a
 	@mkdir -p $(BIN)
-	$(CC) $(LDFLAGS) -o $$@ $$< $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a $(LDLIBS)
+	$(CC) $(LDFLAGS) -o $$@ $$< $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a $$(LDLIBS)
 endef
 $(foreach p,$(PROGRAMS),$(eval $(call program,$(p))))
 
@@ -170,6 +175,9 @@ TOOL_BINS := $(patsubst tests/tools/%.c,$(BUILD)/tests/tools/%,$(TOOL_SRC))
 $(BUILD)/tests/tools/%: $(OBJ)/tests/tools/%.o $(call libs_of,daemon) $(LIB)/liblcmtypes.a
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $< $(call libs_of,daemon) $(LIB)/liblcmtypes.a $(LDLIBS)
+# undulate-web serves HTTP and WebSocket with libwebsockets (Debian's
+# libwebsockets-dev); only it links it.
+$(BIN)/undulate-web: LDLIBS += -lwebsockets
 # pngdata reads the plots' PNGs (libpng, from Debian's libpng-dev).
 $(BUILD)/tests/tools/pngdata: LDLIBS += -lpng
 unit-tests: $(TOOL_BINS)

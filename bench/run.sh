@@ -31,12 +31,14 @@ CYCLES=${BENCH_CYCLES:-300}
 CAP_S=${BENCH_CAP_S:-8}
 CG_S=${BENCH_CG_S:-3}
 FLEET_S=${BENCH_FLEET_S:-15}
-ONLY=${BENCH_ONLY:-loop bus missing cap codec cg}
+ONLY=${BENCH_ONLY:-loop bus missing cap codec cg web}
+WEB_S=${BENCH_WEB_S:-15}
+WEB_ROBOTS=20
 # The daemon ramps into its mode over 1.5 s after start: measure after it.
 RAMP_S=2
 # Multicast ports of the benchmark (7900-7949): one per run, so runs never
 # hear each other's messages.
-PORT_LOOP_OTHER=7900 PORT_LOOP_FIFO=7901 PORT_BUS=7902 PORT_MISSING=7903 PORT_CAP=7904 PORT_FLEET=7905 PORT_CG=7906
+PORT_LOOP_OTHER=7900 PORT_LOOP_FIFO=7901 PORT_BUS=7902 PORT_MISSING=7903 PORT_CAP=7904 PORT_FLEET=7905 PORT_CG=7906 PORT_WEB=7907
 FIFO_PRIORITY=80
 # The simulator's own real-time option (below the daemons' priority above).
 SIM_RT_PRIORITY=10
@@ -147,10 +149,54 @@ build_helpers() {
 	libs="$BUILD/lib/libprotocol.a $BUILD/lib/libcommon.a $BUILD/lib/liblcmtypes.a $(pkg-config --libs lcm libserialport inih 2>/dev/null) -lm"
 	mkdir -p "$HB"
 	local p
-	for p in logstat buscycle codec simctl; do
+	for p in logstat buscycle codec simctl webpub; do
 		# shellcheck disable=SC2086 # word splitting of the flag lists is wanted
 		${CC:-cc} $cflags $inc "bench/$p.c" -o "$HB/$p" $libs || return 1
 	done
+}
+
+# ---- undulate-web: 20 robots at 100 Hz, one browser -------------------------------
+# webpub publishes 20 robots' STATE and SIM.TRUTH at 100 Hz (2100 messages/s);
+# a WebSocket client (tests/integration/web_cdp.py frames) reads every frame.
+# The server's CPU over WEB_S seconds; the budget: 5 % of one core.
+section_web() {
+	local u d=$T/web
+	u=$(url "$PORT_WEB")
+	mkdir -p "$d"
+	if [ ! -x "$BIN/undulate-web" ]; then
+		sum "undulate-web CPU, 20 robots at 100 Hz, one browser" "≤ 5 % of a core" "not measured: not built"
+		return 0
+	fi
+	progress "web: undulate-web with $WEB_ROBOTS robots at 100 Hz and one browser, ${WEB_S} s"
+	start webpub "$HB/webpub" "$u" "$WEB_ROBOTS" $((WEB_S + 10))
+	start web "$BIN/undulate-web" --listen 127.0.0.1:0 --lcm-url "$u" --read-only
+	if ! wait_ready web 'listening on' 10 || ! wait_ready webpub 'ready' 10; then
+		sum "undulate-web CPU, 20 robots at 100 Hz, one browser" "≤ 5 % of a core" "not measured: $(why web)"
+		stop web; stop webpub
+		return 0
+	fi
+	local port wpid t0 c0 t1 c1
+	port=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/web.log")
+	sleep 2  # every robot heard, the first (whole-history) frame out of the way
+	wpid=${PID[web]}
+	t0=$(now_us) c0=$(cpu_ticks "$wpid")
+	python3 tests/integration/web_cdp.py frames 127.0.0.1 "$port" "$WEB_S" >"$d/frames" 2>&1
+	t1=$(now_us) c1=$(cpu_ticks "$wpid")
+	local pct frames bytes secs
+	pct=$(cpu_pct "$c0" "$c1" "$t0" "$t1")
+	frames=$(awk '/^FRAMES/ { print $2 }' "$d/frames")
+	bytes=$(awk '/^FRAMES/ { print $4 }' "$d/frames")
+	secs=$(awk '/^FRAMES/ { print $6 }' "$d/frames")
+	stop web; stop webpub
+	local rate kbs
+	rate=$(awk -v f="${frames:-0}" -v s="${secs:-0}" 'BEGIN { if (s > 0) printf "%.1f", f / s; else print "nan" }')
+	kbs=$(awk -v b="${bytes:-0}" -v s="${secs:-0}" 'BEGIN { if (s > 0) printf "%.0f", b / s / 1024; else print "nan" }')
+	sum "undulate-web CPU, 20 robots at 100 Hz, one browser" "≤ 5 % of a core" "$(fmt "$pct" 2) % ($(fmt "$rate" 1) frames/s, $(fmt "$kbs") kB/s)"
+	say "## undulate-web"
+	say ""
+	say "$WEB_ROBOTS robots' STATE and SIM.TRUTH at 100 Hz (bench/webpub.c), one WebSocket client reading every"
+	say "frame for ${WEB_S} s: server CPU $(fmt "$pct" 2) % of one core, $(fmt "$rate" 1) frames/s, $(fmt "$kbs") kB/s."
+	say ""
 }
 
 # ---- report -----------------------------------------------------------------------
@@ -735,6 +781,7 @@ main() {
 	wants cap && section_cap
 	wants codec && section_codec
 	wants cg && section_cg
+	wants web && section_web
 	{
 		echo "# undulate benchmarks"
 		echo

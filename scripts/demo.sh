@@ -328,9 +328,24 @@ for i in "${!robots[@]}"; do
 done
 t_ready=$(date +%s%N)
 
+# ---- the web dashboard, beside the terminal view --------------------------------
+# undulate-web on loopback (DEMO_WEB_PORT, default 8080; any free port when
+# that one is taken): the same robots in a browser, with the plots.
+web_url=""
+start_web() {
+	start web "$B/undulate-web" --listen "127.0.0.1:$1" --lcm-url "$url"
+	wait_ready web 'listening on http://' 2>/dev/null || return 1
+	web_url=$(sed -n 's|^undulate-web: listening on \(http://[^ ]*\).*|\1|p' "$run/web.log")
+}
+if [ -x "$B/undulate-web" ]; then
+	start_web "${DEMO_WEB_PORT:-8080}" || { mv "$run/web.log" "$run/web.1.log"; start_web 0; } ||
+		echo "demo: undulate-web did not start (its log: $run/web.log); the terminal view only" >&2
+fi
+
 say() { [ "$interactive" -eq 1 ] || echo "demo: $*"; }
 say "scenario $(basename "$scenario"), ${#robots[@]} robots (${robots[*]}), seed $seed, LCM $url"
 say "phases at start (rad): ${robot_phase[*]}; $start_mode until +${switch_at} s, then $switch_to"
+[ -n "$web_url" ] && echo "demo: the dashboard: open $web_url in a browser (undulate-web; undulate-top is the terminal view)"
 
 # switch_modes: one command to every robot (UNDULATE.CMD).
 switch_modes() {
@@ -368,7 +383,9 @@ banner_loop() {
 	while :; do
 		now=$(date +%s%N)
 		el=$(( (now - t_ready) / 1000000000 ))
-		if [ "$switch_at" != never ] && [ ! -f "$run/switch.time" ]; then
+		if [ -n "$web_url" ] && [ $((el % 5)) -eq 4 ]; then
+			echo "DEMO ${el}s | in a browser: $web_url | ? legend  q end" >"$run/banner.new"
+		elif [ "$switch_at" != never ] && [ ! -f "$run/switch.time" ]; then
 			left=$(awk -v s="$switch_at" -v e="$el" 'BEGIN { printf "%d", s - e }')
 			echo "DEMO ${el}s | on the CLOCK (${start_mode}) | ${switch_to} in ${left}s | ? legend  q end" >"$run/banner.new"
 		else
@@ -433,7 +450,7 @@ while :; do
 done
 fi
 for i in "${!pids[@]}"; do
-	case "${names[$i]}" in "switch timer"|banner|top) continue ;; esac
+	case "${names[$i]}" in "switch timer"|banner|top|web) continue ;; esac
 	kill -0 "${pids[$i]}" 2>/dev/null || die "${names[$i]} stopped during the run; its log:
 $(tail -n 15 "$run/${names[$i]}.log")"
 done

@@ -8,9 +8,13 @@ set -eu
 # python3 (test peers and JSON checks), iproute2 (`ss`: the sockets a daemon
 # holds, safety_commands),
 # gnuplot for plots, cyclictest for the jitter benchmark; systemd and man-db
-# for checking the units (systemd-analyze verify) and the man pages.
+# for checking the units (systemd-analyze verify) and the man pages;
+# libwebsockets and Chart.js for undulate-web (its page's plots, served from
+# the installed path). Chromium (headless: web_dashboard's browser test) is
+# optional: `scripts/deps.sh chromium`; without it that test says so and skips.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
-      libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox rt-tests procps iproute2 jq python3 socat systemd man-db)
+      libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox rt-tests procps iproute2 jq python3 socat systemd man-db curl
+      libwebsockets-dev libjs-chart.js)
 [ $# -gt 0 ] && need=("$@")
 missing=()
 for p in "${need[@]}"; do

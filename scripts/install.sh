@@ -45,11 +45,11 @@ SYSUSERSDIR=${SYSUSERSDIR:-${sys_lib:-$sys_etc}/sysusers.d}
 CONFDIR="$SYSCONFDIR/undulate"
 MANIFEST="$DATADIR/install-manifest"
 
-PROGRAMS=(undulated undulate-sim dxl undulate-top undulate-analyze)
-UNITS=(undulated@.service undulate-sim.service)
+PROGRAMS=(undulated undulate-sim dxl undulate-top undulate-analyze undulate-web)
+UNITS=(undulated@.service undulate-sim.service undulate-web.service)
 DOCS=(README.md daemon/README.md daemon/CONTROL.md sim-bridge/README.md sim-bridge/PHYSICS.md
       protocol/README.md lcmtypes/README.md systemd/README.md tools/dxl/README.md tools/top/README.md
-      tools/analyze/README.md docs/EXPERIMENTS.md)
+      tools/analyze/README.md tools/web/README.md docs/EXPERIMENTS.md)
 SERVICE_USER=undulate
 
 die() { echo "install.sh: $*" >&2; exit 1; }
@@ -234,6 +234,12 @@ do_install() {
 	for s in "$top"/sim-bridge/scenarios/*.scenario; do
 		[ -f "$s" ] || continue
 		install_file 0644 "$s" "$DATADIR/scenarios/$(basename "$s")"
+	done
+	# undulate-web's page (it looks for it in ../share/undulate/web beside itself)
+	local w
+	for w in "$top"/tools/web/page/*; do
+		[ -f "$w" ] || continue
+		install_file 0644 "$w" "$DATADIR/web/$(basename "$w")"
 	done
 	# The documentation, in the source's layout so its links between
 	# documents still work (the example config and man pages point here).

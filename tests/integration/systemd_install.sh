@@ -8,7 +8,7 @@
 . "$(dirname "$0")/../lib.sh"
 
 programs=(undulated undulate-sim dxl undulate-top undulate-analyze)
-units=(undulated@.service undulate-sim.service)
+units=(undulated@.service undulate-sim.service undulate-web.service)
 
 src_build="$BUILD"
 for p in "${programs[@]}"; do

@@ -7,6 +7,7 @@
  * long log never has to fit in memory. Only per-pair collision phase
  * differences (the return map) and the collision-rate bins are kept. */
 #include "analyze.h"
+#include "classify.h"
 #include "alog.h"
 #include "json.h"
 #include "phase.h"
@@ -47,14 +48,6 @@
 /* r of the paper's pair rig (theory.md), for logs that do not say theirs. */
 #define AN_DEFAULT_RESTITUTION 0.67
 #define AN_SWITCH_MERGE_S 0.5
-/* Classification thresholds (rad). The mean phase difference of a pair
- * in step stays within a few degrees; in anti-phase within ~0.3 rad of pi in
- * the paper's runs; a spread above AN_SPREAD_MAX means "not locked". */
-#define AN_INPHASE_TOL 0.25
-#define AN_ANTI_TOL 0.5
-#define AN_SPREAD_MAX 0.5
-/* Margin on 2 asin(d~) for sensor noise and the amplitude estimate. */
-#define AN_COMPAT_TOL 0.1
 /* Bins allowed for the collision rate (one per second): ten days. */
 #define AN_MAX_BINS (10 * 24 * 3600)
 /* Warnings of one kind printed before going quiet (the count is reported). */
@@ -1006,36 +999,14 @@ static void an_pair_separation(struct an_ctx *c, struct an_pair *p)
 		p->dsep = p->distance / (2.0 * p->amp_lateral);
 }
 
-/* The end state of a pair from the final window (see README.md for the rules). */
+/* The end state of a pair from the final window (see README.md for the
+ * rules; classify.h holds them, shared with undulate-web). */
 static const char *an_classify(const struct an_pair *p, bool have_sim, double min_swing)
 {
-	/* A joint at rest still has a phase (0 or pi from its sign, at the
-	 * daemon's last frequency): two stopped robots would pass for in-phase
-	 * or anti-phase. No phase relation means anything unless both swing.
-	 * A stopped joint whose frequency went to 0 has no phase at all: the
-	 * swing still says why, so it is asked first. */
-	bool have_angles = isfinite(p->swing_a) && isfinite(p->swing_b);
-	if (have_angles && (p->swing_a < min_swing || p->swing_b < min_swing))
-		return "not-oscillating";
-	if (p->win.n == 0)
-		return "no-data";
-	/* NAN (no finite angle in the window) counts as not swinging */
-	if (!(p->swing_a >= min_swing) || !(p->swing_b >= min_swing))
-		return "not-oscillating";
-	double mean = fabs(win_circ_mean(&p->win));
-	double spread = win_circ_spread(&p->win);
-	bool locked = spread <= AN_SPREAD_MAX;
-	if (locked && mean >= M_PI - AN_ANTI_TOL)
-		return "anti-phase";
-	if (p->win_collisions > 0)
-		return "still-colliding";
-	if (locked && mean <= AN_INPHASE_TOL)
-		return "in-phase";
-	if (locked && isfinite(p->dsep) && mean <= theory_compat_limit(p->dsep) + AN_COMPAT_TOL)
-		return "compatible";
-	if (!have_sim && locked)
-		return "locked-no-contact-data";
-	return locked ? "locked-beyond-compatibility" : "unlocked";
+	struct cls_window w = { .delta = p->win, .swing_a = p->swing_a, .swing_b = p->swing_b,
+				.collisions = p->win_collisions, .dsep = p->dsep, .have_sim = have_sim,
+				.min_swing = min_swing };
+	return cls_end_state(&w);
 }
 
 /* ---- summary ------------------------------------------------------------------ */

@@ -1,0 +1,205 @@
+#!/usr/bin/env python3
+"""web_cdp.py — the browser side of tests/integration/web_dashboard.sh, with
+the standard library only (Debian packages no WebSocket module for python3).
+
+  web_cdp.py page DEVTOOLS_PORT URL PNG ROBOT MODE
+      drives headless chromium over the DevTools protocol: loads URL, waits
+      until the page has drawn frames with samples, takes a screenshot (PNG),
+      clicks the page's MODE button of ROBOT, waits for the robot's answer to
+      appear in the page's answers box and prints it ("ANSWER <kind> <text>").
+  web_cdp.py slow HOST PORT SECONDS
+      opens a WebSocket to undulate-web and never reads from it: a browser that
+      stopped reading. Exits after SECONDS.
+  web_cdp.py frames HOST PORT SECONDS
+      reads frames for SECONDS and prints "FRAMES n BYTES b SECONDS s" and the
+      last status's server counters ("SERVER {...}").
+  web_cdp.py say HOST PORT MESSAGE
+      sends MESSAGE as a page would and prints the first note that answers
+      it ("NOTE <kind> <text>").
+  web_cdp.py freeport
+      prints a free TCP port on 127.0.0.1.
+"""
+import base64, json, os, socket, struct, sys, time, urllib.request
+
+
+class WS:
+    """A minimal RFC 6455 client: text frames, masked as a client must."""
+
+    def __init__(self, host, port, path, protocol=None, rcvbuf=None):
+        self.s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        if rcvbuf:  # before connecting: it sets the window the server may fill
+            self.s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
+        self.s.settimeout(30)
+        self.s.connect((host, port))
+        key = base64.b64encode(os.urandom(16)).decode()
+        req = (f"GET {path} HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\n"
+               f"Connection: Upgrade\r\nSec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n")
+        if protocol:
+            req += f"Sec-WebSocket-Protocol: {protocol}\r\n"
+        self.s.sendall((req + "\r\n").encode())
+        head = b""
+        while b"\r\n\r\n" not in head:
+            c = self.s.recv(1)
+            if not c:
+                raise ConnectionError("closed during the handshake")
+            head += c
+        if b" 101 " not in head.split(b"\r\n")[0]:
+            raise ConnectionError("handshake refused: " + head.split(b"\r\n")[0].decode())
+        self.buf = b""
+
+    def send(self, text):
+        data = text.encode()
+        mask = os.urandom(4)
+        n = len(data)
+        hdr = bytes([0x81]) + (bytes([0x80 | n]) if n < 126 else bytes([0x80 | 126]) + struct.pack(">H", n)
+                               if n < 65536 else bytes([0x80 | 127]) + struct.pack(">Q", n))
+        self.s.sendall(hdr + mask + bytes(b ^ mask[i % 4] for i, b in enumerate(data)))
+
+    def _need(self, n):
+        while len(self.buf) < n:
+            c = self.s.recv(65536)
+            if not c:
+                raise ConnectionError("closed")
+            self.buf += c
+        out, self.buf = self.buf[:n], self.buf[n:]
+        return out
+
+    def recv(self):
+        msg = b""
+        while True:
+            b0, b1 = self._need(2)
+            n = b1 & 0x7F
+            if n == 126:
+                n = struct.unpack(">H", self._need(2))[0]
+            elif n == 127:
+                n = struct.unpack(">Q", self._need(8))[0]
+            payload = self._need(n)
+            op = b0 & 0x0F
+            if op == 8:
+                raise ConnectionError("closed by the server")
+            if op in (9, 10):
+                continue
+            msg += payload
+            if b0 & 0x80:
+                return msg.decode()
+
+
+class CDP:
+    def __init__(self, port):
+        deadline = time.time() + 20
+        while True:
+            try:
+                tabs = json.load(urllib.request.urlopen(f"http://127.0.0.1:{port}/json"))
+                page = [t for t in tabs if t.get("type") == "page"][0]
+                break
+            except Exception:
+                if time.time() > deadline:
+                    raise
+                time.sleep(0.1)
+        url = page["webSocketDebuggerUrl"]
+        rest = url.split("://", 1)[1]
+        hostport, path = rest.split("/", 1)
+        self.ws = WS("127.0.0.1", int(hostport.rsplit(":", 1)[1]), "/" + path)
+        self.n = 0
+
+    def call(self, method, **params):
+        self.n += 1
+        self.ws.send(json.dumps({"id": self.n, "method": method, "params": params}))
+        while True:
+            m = json.loads(self.ws.recv())
+            if m.get("id") == self.n:
+                if "error" in m:
+                    raise RuntimeError(f"{method}: {m['error']}")
+                return m.get("result", {})
+
+    def js(self, expr):
+        r = self.call("Runtime.evaluate", expression=expr, returnByValue=True)
+        return r.get("result", {}).get("value")
+
+    def wait(self, expr, timeout):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            v = self.js(expr)
+            if v:
+                return v
+            time.sleep(0.1)
+        return None
+
+
+def page(devtools_port, url, png, robot, mode):
+    cdp = CDP(int(devtools_port))
+    cdp.call("Page.enable")
+    cdp.call("Emulation.setDeviceMetricsOverride", width=1300, height=1500, deviceScaleFactor=1, mobile=False)
+    cdp.call("Page.navigate", url=url)
+    # frames with samples drawn: both robots' joint plots hold points, and a
+    # pair's plot holds its phase difference
+    drawn = cdp.wait("""(() => { const c = Object.values(Chart.instances || {});
+        const pts = c.reduce((n, ch) => n + ch.data.datasets.reduce((m, d) => m + d.data.length, 0), 0);
+        return document.querySelectorAll('.robot').length >= 2 && document.querySelectorAll('.pair').length >= 1
+               && pts > 500 ? pts : 0; })()""", 20)
+    print(f"DRAWN {drawn or 0} points", flush=True)
+    print("ROBOTS " + str(cdp.js("[...document.querySelectorAll('.robot h3')].map(h => h.textContent).join(',')")))
+    print("CLASS " + str(cdp.js("[...document.querySelectorAll('.pair')].map(p => p.dataset.class).join(',')")))
+    time.sleep(1.0)  # another second of lines, so the screenshot shows them moving past
+    shot = cdp.call("Page.captureScreenshot", format="png")
+    with open(png, "wb") as f:
+        f.write(base64.b64decode(shot["data"]))
+    # the command: a click on the robot's button, as a person would
+    sel = f'button[data-robot="{robot}"][data-mode="{mode}"]'
+    clicked = cdp.js(f"(() => {{ const b = document.querySelector('#robot-{robot} {sel}'); if (!b) return false; b.click(); return true; }})()")
+    print(f"CLICKED {bool(clicked)}", flush=True)
+    ans = cdp.wait(f"""(() => {{ const a = [...document.querySelectorAll('#answers .answer')]
+        .filter(e => e.dataset.robot === '{robot}' && e.dataset.kind.startsWith('command-'));
+        return a.length ? a[0].dataset.kind + ' ' + a[0].textContent : ''; }})()""", 10)
+    print(f"ANSWER {ans}", flush=True)
+    mode_shown = cdp.wait(f"""(() => {{ const c = document.getElementById('robot-{robot}');
+        return c && c.dataset.mode === '{mode.upper()}' ? c.dataset.mode : ''; }})()""", 5)
+    print(f"MODE_SHOWN {mode_shown}", flush=True)
+
+
+def slow(host, port, seconds):
+    ws = WS(host, int(port), "/", "undulate", rcvbuf=4096)
+    print("SLOW connected", flush=True)
+    time.sleep(float(seconds))
+
+
+def frames(host, port, seconds):
+    ws = WS(host, int(port), "/", "undulate")
+    n = total = 0
+    end = time.time() + float(seconds)
+    first = None
+    server = None
+    while time.time() < end:
+        m = ws.recv()
+        if first is None:
+            first = time.time()
+        n += 1
+        total += len(m)
+        st = json.loads(m).get("status")
+        if st:
+            server = st.get("server")
+    print(f"FRAMES {n} BYTES {total} SECONDS {time.time() - (first or end):.2f}", flush=True)
+    print("SERVER " + json.dumps(server), flush=True)
+
+
+def say(host, port, message):
+    ws = WS(host, int(port), "/", "undulate")
+    ws.send(message)
+    end = time.time() + 5
+    while time.time() < end:
+        for n in json.loads(ws.recv()).get("notes", []):
+            if n["kind"] != "hello":
+                print(f"NOTE {n['kind']} {n['text']}", flush=True)
+                return
+    print("NOTE none")
+
+
+def freeport():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    print(s.getsockname()[1])
+
+
+if __name__ == "__main__":
+    cmd = sys.argv[1]
+    {"page": page, "slow": slow, "frames": frames, "say": say, "freeport": freeport}[cmd](*sys.argv[2:])

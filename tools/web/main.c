@@ -1,0 +1,192 @@
+/* undulate-web — live dashboard of every robot on the LCM network, in a
+ * browser. See tools/web/README.md. */
+#include <arpa/inet.h>
+#include <getopt.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "num.h"
+#include "req.h"
+#include "server.h"
+
+#define WEB_DEFAULT_ADDR "127.0.0.1"
+#define WEB_DEFAULT_PORT 8080
+#define WEB_CHARTJS "/usr/share/javascript/chart.js/chart.min.js"
+
+static void usage(FILE *f)
+{
+	fputs("usage: undulate-web [--listen ADDR:PORT] [--lcm-url URL] [--read-only] [--allow-remote]\n"
+	      "                    [--token-file FILE] [--key FILE] [--page-dir DIR] [--chartjs FILE] [-v]\n"
+	      "A live dashboard of every robot on the LCM network, at http://ADDR:PORT/.\n"
+	      "  --listen ADDR:PORT  where to listen (default 127.0.0.1:8080; port 0: any free port, printed)\n"
+	      "  --allow-remote      required to listen on an address other than loopback; then commands\n"
+	      "                      need --token-file, or use --read-only\n"
+	      "  --token-file FILE   commands need this secret (the file's first line; mode 0600):\n"
+	      "                      open the page as http://ADDR:PORT/#token=SECRET\n"
+	      "  --read-only         no commands: the page shows no controls, the server refuses them\n"
+	      "  --key FILE          send commands signed over LCM (robots with commands = network),\n"
+	      "                      as undulated --command --key; default: local command sockets\n"
+	      "  --lcm-url URL       LCM provider (default: $LCM_DEFAULT_URL or udpm ttl=0)\n"
+	      "  --page-dir DIR      the page's files (default: found beside the program)\n"
+	      "  --chartjs FILE      Chart.js (default " WEB_CHARTJS ", Debian libjs-chart.js)\n"
+	      "  -v, --verbose       more messages\n",
+	      f);
+}
+
+/* "ADDR:PORT", "[V6]:PORT" or ":PORT" / "PORT" (loopback). */
+static int parse_listen(const char *s, char *addr, size_t cap, int *port)
+{
+	const char *colon = strrchr(s, ':');
+	const char *p = colon ? colon + 1 : s;
+	size_t alen = colon ? (size_t)(colon - s) : 0;
+	const char *a = s;
+	if (alen >= 2 && s[0] == '[' && s[alen - 1] == ']') {
+		a++;
+		alen -= 2;
+	}
+	long v;
+	if (num_parse_long(p, 0, 65535, &v) != NUM_OK || alen >= cap) {
+		fprintf(stderr, "undulate-web: --listen: want ADDR:PORT (e.g. 127.0.0.1:8080), not \"%s\"\n", s);
+		return -1;
+	}
+	if (alen == 0)
+		snprintf(addr, cap, "%s", WEB_DEFAULT_ADDR);
+	else
+		snprintf(addr, cap, "%.*s", (int)alen, a);
+	*port = (int)v;
+	return 0;
+}
+
+static bool is_loopback(const char *addr)
+{
+	struct in_addr v4;
+	struct in6_addr v6;
+	if (inet_pton(AF_INET, addr, &v4) == 1)
+		return (ntohl(v4.s_addr) >> 24) == 127;
+	if (inet_pton(AF_INET6, addr, &v6) == 1)
+		return IN6_IS_ADDR_LOOPBACK(&v6);
+	return strcmp(addr, "localhost") == 0;
+}
+
+/* The secret: the first line of a file only its owner can read. */
+static char *read_token(const char *path)
+{
+	static char token[REQ_TOKEN_MAX];
+	FILE *f = fopen(path, "r");
+	struct stat st;
+	if (f == NULL || fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+		fprintf(stderr, "undulate-web: --token-file %s: cannot read it as a file\n", path);
+		if (f)
+			fclose(f);
+		return NULL;
+	}
+	if (st.st_mode & 077) {
+		fprintf(stderr, "undulate-web: --token-file %s: readable by others (mode %03o): chmod 600 %s\n", path,
+		        (unsigned)(st.st_mode & 0777), path);
+		fclose(f);
+		return NULL;
+	}
+	if (fgets(token, sizeof token, f) == NULL)
+		token[0] = '\0';
+	fclose(f);
+	token[strcspn(token, "\r\n")] = '\0';
+	size_t n = strlen(token);
+	if (n < 8 || strspn(token, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_.~") != n) {
+		fprintf(stderr, "undulate-web: --token-file %s: want one line of 8 to %d letters, digits or -_.~ "
+		        "(e.g. head -c 24 /dev/urandom | base64 | tr '+/' '-_' > %s)\n", path, REQ_TOKEN_MAX - 1, path);
+		return NULL;
+	}
+	return token;
+}
+
+/* The page beside the program: installed (PREFIX/bin -> PREFIX/share/undulate/web)
+ * or in the source tree (build/bin -> tools/web/page). */
+static const char *find_page_dir(void)
+{
+	static char dir[PATH_MAX];
+	char exe[PATH_MAX];
+	ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+	if (n <= 0)
+		return NULL;
+	exe[n] = '\0';
+	char *slash = strrchr(exe, '/');
+	if (slash == NULL)
+		return NULL;
+	*slash = '\0';
+	static const char *const rel[] = { "../share/undulate/web", "../../tools/web/page" };
+	for (size_t i = 0; i < sizeof rel / sizeof rel[0]; i++) {
+		char probe[PATH_MAX + 64];
+		if (strlen(exe) + strlen(rel[i]) + 2 > sizeof dir)
+			continue;
+		memcpy(dir, exe, strlen(exe));
+		dir[strlen(exe)] = '/';
+		memcpy(dir + strlen(exe) + 1, rel[i], strlen(rel[i]) + 1);
+		snprintf(probe, sizeof probe, "%s/index.html", dir);
+		if (access(probe, R_OK) == 0)
+			return dir;
+	}
+	return NULL;
+}
+
+int main(int argc, char **argv)
+{
+	enum { O_LISTEN = 256, O_URL, O_RO, O_REMOTE, O_TOKEN, O_KEY, O_PAGE, O_CHARTJS };
+	static const struct option opts[] = {
+		{ "listen", required_argument, NULL, O_LISTEN },   { "lcm-url", required_argument, NULL, O_URL },
+		{ "read-only", no_argument, NULL, O_RO },          { "allow-remote", no_argument, NULL, O_REMOTE },
+		{ "token-file", required_argument, NULL, O_TOKEN }, { "key", required_argument, NULL, O_KEY },
+		{ "page-dir", required_argument, NULL, O_PAGE },   { "chartjs", required_argument, NULL, O_CHARTJS },
+		{ "help", no_argument, NULL, 'h' },                { "verbose", no_argument, NULL, 'v' },
+		{ NULL, 0, NULL, 0 },
+	};
+	static char addr[128] = WEB_DEFAULT_ADDR;
+	struct web_opts o = { .addr = addr, .port = WEB_DEFAULT_PORT, .chartjs = WEB_CHARTJS };
+	bool remote = false;
+	const char *token_file = NULL;
+	int c;
+	while ((c = getopt_long(argc, argv, "hv", opts, NULL)) != -1) {
+		switch (c) {
+		case O_LISTEN: if (parse_listen(optarg, addr, sizeof addr, &o.port)) return 2; break;
+		case O_URL: o.lcm_url = optarg; break;
+		case O_RO: o.read_only = true; break;
+		case O_REMOTE: remote = true; break;
+		case O_TOKEN: token_file = optarg; break;
+		case O_KEY: o.key_file = optarg; break;
+		case O_PAGE: o.page_dir = optarg; break;
+		case O_CHARTJS: o.chartjs = optarg; break;
+		case 'v': o.verbose = true; break;
+		case 'h': usage(stdout); return 0;
+		default: usage(stderr); return 2;
+		}
+	}
+	if (optind < argc) {
+		fprintf(stderr, "undulate-web: unexpected argument \"%s\" (--help)\n", argv[optind]);
+		return 2;
+	}
+	if (!is_loopback(addr) && !remote) {
+		fprintf(stderr, "undulate-web: --listen %s:%d opens the dashboard to the network; say so with "
+		        "--allow-remote (and give --token-file FILE for commands, or --read-only)\n", addr, o.port);
+		return 2;
+	}
+	if (token_file != NULL && (o.token = read_token(token_file)) == NULL)
+		return 2;
+	if (!is_loopback(addr) && !o.read_only && o.token == NULL) {
+		fprintf(stderr, "undulate-web: listening on %s, commands would be open to anyone who reaches it: "
+		        "give --token-file FILE or --read-only\n", addr);
+		return 2;
+	}
+	if (o.page_dir == NULL && (o.page_dir = find_page_dir()) == NULL) {
+		fputs("undulate-web: cannot find the page (index.html) beside the program: --page-dir DIR\n", stderr);
+		return 2;
+	}
+	if (access(o.chartjs, R_OK) != 0) {
+		fprintf(stderr, "undulate-web: Chart.js not found at %s: install Debian's libjs-chart.js "
+		        "(apt-get install libjs-chart.js) or give --chartjs FILE\n", o.chartjs);
+		return 2;
+	}
+	return web_run(&o);
+}

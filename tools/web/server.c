@@ -1,0 +1,625 @@
+/* server.c — see server.h. */
+#include "server.h"
+
+#include <errno.h>
+#include <libwebsockets.h>
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "clock.h"
+#include "frame.h"
+#include "hist.h"
+#include "req.h"
+#include "wcmd.h"
+
+/* One browser on the WebSocket (libwebsockets' per-session data). */
+struct web_client {
+	struct lws *wsi;
+	unsigned id;
+	struct frame_cursor cur;
+	bool want;              /* a frame is due: asked for writable, not written yet */
+	double want_since;
+	bool authed;
+	bool dropping;          /* the rest of an oversized message */
+	struct frame_note notes[WEB_NOTES];
+	int nnotes;
+};
+
+/* One HTTP request (GET /api/snapshot's body while it is written). */
+struct web_http {
+	char *body;
+	size_t len, off;
+};
+
+#define WEB_TAG_LCM ((void *)1)
+#define WEB_TAG_CMD ((void *)2)
+#define WEB_LOG_FIRST 5      /* messages of one kind printed before one in every WEB_LOG_EVERY */
+#define WEB_LOG_EVERY 100
+
+static struct web_app {
+	struct web_opts o;
+	struct lws_context *ctx;
+	struct lws_vhost *vh;
+	lcm_t *lcm;
+	struct top_model model;
+	struct hist hist;
+	struct wcmd cmd;
+	bool cmd_ok;
+	char cmd_why[256];
+	struct web_client *clients[WEB_MAX_CLIENTS];
+	int nclients;
+	unsigned next_client;
+	lws_sorted_usec_list_t sul;
+	uint64_t ticks;
+	unsigned char *frame;       /* LWS_PRE + WEB_FRAME_MAX */
+	struct frame_counters n;
+} app;
+
+static volatile sig_atomic_t web_stop;
+
+static void web_on_signal(int sig)
+{
+	(void)sig;
+	web_stop = 1;
+	if (app.ctx != NULL)
+		lws_cancel_service(app.ctx);
+}
+
+/* A message about bad input: the first few, then one in WEB_LOG_EVERY (each
+ * kind is counted on the page either way). */
+static void web_log(long long count, const char *fmt, ...)
+{
+	if (count > WEB_LOG_FIRST && count % WEB_LOG_EVERY != 0)
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	fputs("undulate-web: ", stderr);
+	vfprintf(stderr, fmt, ap);
+	if (count > WEB_LOG_FIRST)
+		fprintf(stderr, " (%lld so far)", count);
+	fputc('\n', stderr);
+	va_end(ap);
+}
+
+/* ---- LCM ------------------------------------------------------------------------ */
+
+static bool ends_with(const char *s, const char *suffix)
+{
+	size_t n = strlen(s), m = strlen(suffix);
+	return n > m && strcmp(s + n - m, suffix) == 0;
+}
+
+static struct web_client *web_client_by_id(unsigned id)
+{
+	for (int i = 0; i < app.nclients; i++)
+		if (app.clients[i]->id == id)
+			return app.clients[i];
+	return NULL;
+}
+
+static void web_note(struct web_client *c, long long id, int64_t seq, const char *robot, const char *kind,
+                     const char *text)
+{
+	/* full: the oldest answer goes (the page also shows the robot's last event) */
+	if (c->nnotes == WEB_NOTES) {
+		memmove(c->notes, c->notes + 1, sizeof c->notes[0] * (WEB_NOTES - 1));
+		c->nnotes--;
+	}
+	struct frame_note *n = &c->notes[c->nnotes++];
+	n->id = id;
+	n->seq = seq;
+	snprintf(n->robot, sizeof n->robot, "%s", robot);
+	snprintf(n->kind, sizeof n->kind, "%s", kind);
+	snprintf(n->text, sizeof n->text, "%s", text);
+}
+
+/* A robot's answer (EVENT channel or local socket): to the browser that sent
+ * the command, once (it comes on both). */
+static void web_on_answer(void *ctx, const undulate_event_t *e)
+{
+	(void)ctx;
+	unsigned client;
+	long long id;
+	if (e->seq == 0 || !wcmd_client_of(&app.cmd, e->seq, &client, &id))
+		return;
+	struct web_client *c = web_client_by_id(client);
+	if (c == NULL)
+		return;
+	for (int i = 0; i < c->nnotes; i++)
+		if (c->notes[i].seq == e->seq && strcmp(c->notes[i].robot, e->robot) == 0 &&
+		    strcmp(c->notes[i].kind, e->kind) == 0)
+			return;
+	web_note(c, id, e->seq, e->robot, e->kind, e->text);
+}
+
+/* the last SIM.COLLISION's robots, for the pairs' end state */
+static void web_collision(const undulate_sim_collision_t *c, double now)
+{
+	if (c->left >= 0 && c->right >= 0)
+		hist_on_collision(&app.hist, &app.model, c->left_robot, c->right_robot, now);
+}
+
+#define WEB_DECODE(T, stmt)                                                                    \
+	do {                                                                                   \
+		undulate_##T msg;                                                              \
+		if (undulate_##T##_decode(rbuf->data, 0, (int)rbuf->data_size, &msg) < 0) {    \
+			app.model.decode_errors++;                                             \
+			return;                                                                \
+		}                                                                              \
+		stmt;                                                                          \
+		undulate_##T##_decode_cleanup(&msg);                                           \
+	} while (0)
+
+static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+	(void)user;
+	double now = clock_mono_s();
+	if (strcmp(channel, "SIM.TRUTH") == 0)
+		WEB_DECODE(sim_truth_t, top_on_truth(&app.model, &msg, now));
+	else if (strcmp(channel, "SIM.COLLISION") == 0)
+		WEB_DECODE(sim_collision_t, (top_on_sim_collision(&app.model, &msg, now), web_collision(&msg, now)));
+	else if (ends_with(channel, ".STATE"))
+		WEB_DECODE(robot_state_t, top_on_state(&app.model, &msg, now));
+	else if (ends_with(channel, ".BUS"))
+		WEB_DECODE(bus_stats_t, top_on_bus(&app.model, &msg));
+	else if (ends_with(channel, ".PARAMS"))
+		WEB_DECODE(osc_params_t, top_on_params(&app.model, &msg));
+	else if (ends_with(channel, ".EVENT"))
+		WEB_DECODE(event_t, (top_on_event(&app.model, &msg), web_on_answer(NULL, &msg)));
+}
+
+static int web_subscribe(void)
+{
+	/* undulate-top's channels */
+	static const char *const channels[] = { ".*\\.STATE", ".*\\.BUS", ".*\\.PARAMS", ".*\\.EVENT",
+						"SIM\\.TRUTH", "SIM\\.COLLISION" };
+	for (size_t i = 0; i < sizeof channels / sizeof channels[0]; i++)
+		if (!lcm_subscribe(app.lcm, channels[i], web_on_lcm, NULL))
+			return -1;
+	return 0;
+}
+
+/* ---- HTTP ----------------------------------------------------------------------- */
+
+static const char *web_method(struct lws *wsi)
+{
+	static const struct { enum lws_token_indexes tok; const char *name; } methods[] = {
+		{ WSI_TOKEN_GET_URI, "GET" },         { WSI_TOKEN_POST_URI, "POST" },
+		{ WSI_TOKEN_OPTIONS_URI, "OPTIONS" }, { WSI_TOKEN_PUT_URI, "PUT" },
+		{ WSI_TOKEN_PATCH_URI, "PATCH" },     { WSI_TOKEN_DELETE_URI, "DELETE" },
+		{ WSI_TOKEN_HEAD_URI, "HEAD" },
+	};
+	for (size_t i = 0; i < sizeof methods / sizeof methods[0]; i++)
+		if (lws_hdr_total_length(wsi, methods[i].tok) > 0)
+			return methods[i].name;
+	return "?";
+}
+
+static int web_http_status(struct lws *wsi, unsigned code, const char *why)
+{
+	app.n.http_refused++;
+	if (lws_return_http_status(wsi, code, why))
+		return -1;
+	return lws_http_transaction_completed(wsi) ? -1 : 0;
+}
+
+static int web_serve_file(struct lws *wsi, const char *dir, const char *name, const char *mime)
+{
+	char path[1024];
+	if (dir != NULL)
+		snprintf(path, sizeof path, "%s/%s", dir, name);
+	else
+		snprintf(path, sizeof path, "%s", name);
+	int n = lws_serve_http_file(wsi, path, mime, "cache-control: no-cache\x0d\x0a", 0);
+	if (n < 0)
+		return -1;
+	if (n > 0 && lws_http_transaction_completed(wsi))
+		return -1;
+	return 0;
+}
+
+static int web_snapshot(struct lws *wsi, struct web_http *h)
+{
+	FILE *f = open_memstream(&h->body, &h->len);
+	if (f == NULL)
+		return web_http_status(wsi, HTTP_STATUS_INTERNAL_SERVER_ERROR, "out of memory");
+	top_json(&app.model, clock_mono_s(), clock_wall_us(), f);
+	fclose(f);
+	h->off = 0;
+	unsigned char hdr[LWS_PRE + 512], *start = hdr + LWS_PRE, *p = start, *end = hdr + sizeof hdr - 1;
+	if (lws_add_http_common_headers(wsi, HTTP_STATUS_OK, "application/json", h->len, &p, end) ||
+	    lws_add_http_header_by_token(wsi, WSI_TOKEN_HTTP_CACHE_CONTROL, (const unsigned char *)"no-store", 8,
+	                                 &p, end) ||
+	    lws_finalize_write_http_header(wsi, start, &p, end))
+		return -1;
+	lws_callback_on_writable(wsi);
+	return 0;
+}
+
+static int web_http_write(struct lws *wsi, struct web_http *h)
+{
+	if (h->body == NULL)
+		return 0;
+	/* a chunk at a time: libwebsockets keeps what the socket did not take */
+	enum { CHUNK = 16384 };
+	static unsigned char buf[LWS_PRE + CHUNK];
+	size_t n = h->len - h->off < CHUNK ? h->len - h->off : CHUNK;
+	memcpy(buf + LWS_PRE, h->body + h->off, n);
+	h->off += n;
+	bool last = h->off == h->len;
+	if (lws_write(wsi, buf + LWS_PRE, n, last ? LWS_WRITE_HTTP_FINAL : LWS_WRITE_HTTP) != (int)n)
+		return -1;
+	if (!last) {
+		lws_callback_on_writable(wsi);
+		return 0;
+	}
+	free(h->body);
+	h->body = NULL;
+	return lws_http_transaction_completed(wsi) ? -1 : 0;
+}
+
+static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
+{
+	app.n.http_requests++;
+	const char *method = web_method(wsi);
+	if (app.o.verbose)
+		fprintf(stderr, "undulate-web: %s %.200s\n", method, uri);
+	switch (req_route(method, uri)) {
+	case REQ_PAGE: return web_serve_file(wsi, app.o.page_dir, "index.html", "text/html");
+	case REQ_ASSET_JS: return web_serve_file(wsi, app.o.page_dir, "app.js", "application/javascript");
+	case REQ_ASSET_CSS: return web_serve_file(wsi, app.o.page_dir, "style.css", "text/css");
+	case REQ_CHARTJS: return web_serve_file(wsi, NULL, app.o.chartjs, "application/javascript");
+	case REQ_SNAPSHOT: return web_snapshot(wsi, h);
+	case REQ_BAD_METHOD:
+		web_log(app.n.http_refused + 1, "refused %s %.64s: method not allowed", method, uri);
+		return web_http_status(wsi, HTTP_STATUS_METHOD_NOT_ALLOWED, "method not allowed");
+	case REQ_NOT_FOUND:
+	default:
+		web_log(app.n.http_refused + 1, "refused %s %.64s: not found", method, uri);
+		return web_http_status(wsi, HTTP_STATUS_NOT_FOUND, "not found");
+	}
+}
+
+static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+	struct web_http *h = user;
+	switch (reason) {
+	case LWS_CALLBACK_HTTP:
+		return web_http(wsi, h, in != NULL ? (const char *)in : "");
+	case LWS_CALLBACK_HTTP_BODY:
+		return 0; /* no request has a body worth reading: it was answered already */
+	case LWS_CALLBACK_HTTP_WRITEABLE:
+		return web_http_write(wsi, h);
+	case LWS_CALLBACK_CLOSED_HTTP:
+	case LWS_CALLBACK_HTTP_DROP_PROTOCOL:
+		if (h != NULL) {
+			free(h->body);
+			h->body = NULL;
+		}
+		return 0;
+	default:
+		return lws_callback_http_dummy(wsi, reason, user, in, len);
+	}
+}
+
+/* ---- WebSocket -------------------------------------------------------------------- */
+
+static bool web_ws_allowed(struct lws *wsi)
+{
+	char origin[256] = "", host[256] = "";
+	if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) >= (int)sizeof origin ||
+	    lws_hdr_total_length(wsi, WSI_TOKEN_HOST) >= (int)sizeof host)
+		return false;
+	lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN);
+	lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST);
+	if (!req_origin_ok(origin, host)) {
+		web_log(++app.n.ws_refused, "refused a WebSocket from origin '%.64s' (this is http://%.64s)", origin,
+		        host);
+		return false;
+	}
+	if (app.nclients >= WEB_MAX_CLIENTS) {
+		web_log(++app.n.ws_refused, "refused a WebSocket: %d browsers connected already", WEB_MAX_CLIENTS);
+		return false;
+	}
+	return true;
+}
+
+static void web_ws_open(struct lws *wsi, struct web_client *c)
+{
+	memset(c, 0, sizeof *c);
+	int sndbuf = WEB_SNDBUF;
+	setsockopt(lws_get_socket_fd(wsi), SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
+	c->wsi = wsi;
+	c->id = ++app.next_client;
+	c->authed = app.o.token == NULL;
+	frame_cursor_init(&c->cur, &app.hist);
+	app.clients[app.nclients++] = c;
+	app.n.clients = app.nclients;
+	web_note(c, 0, 0, "", "hello", app.o.read_only ? "read-only" : app.o.token ? "token" : "commands");
+	c->want = true;
+	c->want_since = clock_mono_s();
+	lws_callback_on_writable(wsi);
+}
+
+static void web_ws_close(struct web_client *c)
+{
+	for (int i = 0; i < app.nclients; i++)
+		if (app.clients[i] == c) {
+			app.clients[i] = app.clients[--app.nclients];
+			break;
+		}
+	app.n.clients = app.nclients;
+}
+
+static int web_ws_write(struct lws *wsi, struct web_client *c)
+{
+	if (!c->want)
+		return 0; /* libwebsockets may call again: a frame goes out only when one is due */
+	unsigned char *buf = app.frame + LWS_PRE;
+	size_t n = frame_write(&app.hist, &app.model, clock_mono_s(), &c->cur, &app.n, c->notes, c->nnotes,
+	                       (char *)buf, WEB_FRAME_MAX);
+	c->want = false;
+	if (n == 0)
+		return 0;
+	c->nnotes = 0;
+	app.n.frames_sent++;
+	return lws_write(wsi, buf, n, LWS_WRITE_TEXT) < (int)n ? -1 : 0;
+}
+
+static void web_refuse_msg(struct web_client *c, long long id, const char *why)
+{
+	app.n.msgs_refused++;
+	web_log(app.n.msgs_refused, "browser %u: refused a message: %s", c->id, why);
+	web_note(c, id, 0, "", "refused", why);
+}
+
+static void web_command(struct web_client *c, struct req_msg *m)
+{
+	char why[256];
+	if (app.o.read_only) {
+		app.n.commands_refused++;
+		return web_refuse_msg(c, m->id, "read-only: undulate-web sends no commands (--read-only)");
+	}
+	if (!c->authed) {
+		app.n.commands_refused++;
+		return web_refuse_msg(c, m->id, "this dashboard needs its token for commands: open its URL with #token=...");
+	}
+	if (!app.cmd_ok) {
+		app.n.commands_refused++;
+		return web_refuse_msg(c, m->id, app.cmd_why);
+	}
+	int reached = 0;
+	int64_t seq = wcmd_send(&app.cmd, &m->cmd, c->id, m->id, &reached, why, sizeof why);
+	if (seq == 0) {
+		app.n.commands_refused++;
+		return web_note(c, m->id, 0, m->robot, "not-sent", why);
+	}
+	app.n.commands_sent++;
+	char what[FRAME_NOTE_TEXT];
+	snprintf(what, sizeof what, "'%.60s' sent to %d robot%s%s, waiting for the answer", m->text, reached,
+	         reached == 1 ? "" : "s", app.cmd.signed_lcm ? " (signed, over LCM)" : "");
+	web_note(c, m->id, seq, m->robot, "sent", what);
+}
+
+static void web_ws_receive(struct lws *wsi, struct web_client *c, const char *in, size_t len)
+{
+	bool first = lws_is_first_fragment(wsi), last = lws_is_final_fragment(wsi);
+	if (c->dropping || !first || !last || lws_remaining_packet_payload(wsi) > 0) {
+		/* longer than REQ_MSG_MAX: libwebsockets hands it over in pieces */
+		if (first)
+			web_refuse_msg(c, 0, "message longer than 511 bytes");
+		c->dropping = !last;
+		return;
+	}
+	static struct req_msg m;
+	char why[256];
+	int njoints = 0;
+	/* the robot's joints as last heard, for the joint index check */
+	if (len > 4 && memcmp(in, "cmd ", 4) == 0) {
+		char robot[CFG_NAME_MAX] = "";
+		sscanf(in, "cmd %*s %47s", robot);
+		int r = top_robot_index(&app.model, robot);
+		njoints = r >= 0 ? app.model.robots[r].njoints : 0;
+	}
+	if (!req_msg_parse(in, len, njoints, &m, why, sizeof why)) {
+		if (len > 4 && memcmp(in, "cmd ", 4) == 0)
+			app.n.commands_refused++;
+		return web_refuse_msg(c, m.id, why);
+	}
+	if (m.kind == REQ_MSG_AUTH) {
+		c->authed = app.o.token != NULL && req_token_ok(app.o.token, m.token);
+		if (!c->authed)
+			web_refuse_msg(c, 0, "wrong token");
+		else
+			web_note(c, 0, 0, "", "auth", "token accepted: commands enabled");
+		return;
+	}
+	web_command(c, &m);
+}
+
+static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+	struct web_client *c = user;
+	switch (reason) {
+	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+		return web_ws_allowed(wsi) ? 0 : 1;
+	case LWS_CALLBACK_ESTABLISHED:
+		web_ws_open(wsi, c);
+		return 0;
+	case LWS_CALLBACK_SERVER_WRITEABLE:
+		return web_ws_write(wsi, c);
+	case LWS_CALLBACK_RECEIVE:
+		web_ws_receive(wsi, c, in, len);
+		return 0;
+	case LWS_CALLBACK_CLOSED:
+		web_ws_close(c);
+		return 0;
+	default:
+		return 0;
+	}
+}
+
+/* ---- the LCM and command sockets, in the same loop -------------------------------- */
+
+static int web_raw_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+	(void)user;
+	(void)in;
+	(void)len;
+	if (reason != LWS_CALLBACK_RAW_RX_FILE)
+		return 0;
+	void *tag = lws_get_opaque_user_data(wsi);
+	if (tag == WEB_TAG_LCM)
+		lcm_handle_timeout(app.lcm, 0);
+	else if (tag == WEB_TAG_CMD)
+		wcmd_read_local(&app.cmd, web_on_answer, NULL);
+	return 0;
+}
+
+/* libwebsockets closes what it adopted: give it a copy of the descriptor. */
+static int web_adopt(int fd, void *tag)
+{
+	lws_sock_file_fd_type d;
+	d.filefd = dup(fd);
+	if (d.filefd < 0)
+		return -1;
+	struct lws *wsi = lws_adopt_descriptor_vhost(app.vh, LWS_ADOPT_RAW_FILE_DESC, d, "undulate-raw", NULL);
+	if (wsi == NULL)
+		return -1;
+	lws_set_opaque_user_data(wsi, tag);
+	return 0;
+}
+
+/* ---- the clock: samples at HIST_HZ, a frame to each browser every WEB_FRAME_EVERY --- */
+
+static void web_frames_due(double now)
+{
+	for (int i = 0; i < app.nclients; i++) {
+		struct web_client *c = app.clients[i];
+		if (c->want) {
+			/* its socket has not taken the last frame: skip this one, it gets
+			 * everything new in the next (frame.h) */
+			app.n.frames_skipped++;
+			if (now - c->want_since > WEB_STALL_S) {
+				app.n.clients_stalled++;
+				web_log(app.n.clients_stalled, "browser %u took no frame for %.0f s: closed", c->id,
+				        WEB_STALL_S);
+				lws_set_timeout(c->wsi, PENDING_TIMEOUT_USER_OK, LWS_TO_KILL_ASYNC);
+			}
+			continue;
+		}
+		c->want = true;
+		c->want_since = now;
+		lws_callback_on_writable(c->wsi);
+	}
+}
+
+static void web_tick(lws_sorted_usec_list_t *sul)
+{
+	double now = clock_mono_s();
+	hist_sample(&app.hist, &app.model, now);
+	if (++app.ticks % WEB_FRAME_EVERY == 0)
+		web_frames_due(now);
+	lws_sul_schedule(app.ctx, 0, sul, web_tick, LWS_US_PER_SEC / HIST_HZ);
+}
+
+/* ---- start and run ------------------------------------------------------------------ */
+
+static const struct lws_protocols web_protocols[] = {
+	{ "http", web_http_cb, sizeof(struct web_http), 0, 0, NULL, 0 },
+	{ "undulate", web_ws_cb, sizeof(struct web_client), REQ_MSG_MAX, 0, NULL, 0 },
+	{ "undulate-raw", web_raw_cb, 0, 0, 0, NULL, 0 },
+	{ NULL, NULL, 0, 0, 0, NULL, 0 },
+};
+
+static int web_start(void)
+{
+	struct lws_context_creation_info info;
+	memset(&info, 0, sizeof info);
+	info.port = app.o.port;
+	info.iface = app.o.addr;
+	info.protocols = web_protocols;
+	info.vhost_name = "undulate-web";
+	info.options = LWS_SERVER_OPTION_VALIDATE_UTF8 | LWS_SERVER_OPTION_EXPLICIT_VHOSTS;
+	if (strchr(app.o.addr, ':') == NULL)
+		info.options |= LWS_SERVER_OPTION_DISABLE_IPV6;
+	info.max_http_header_data = WEB_HEADER_MAX;
+	info.max_http_header_pool = WEB_MAX_CONNECTIONS;
+	/* the listening socket, the LCM and command sockets, lws's own pipe, and the connections */
+	info.fd_limit_per_thread = WEB_MAX_CONNECTIONS + 8;
+	info.timeout_secs = WEB_HTTP_TIMEOUT_S;
+	info.timeout_secs_ah_idle = WEB_HTTP_TIMEOUT_S;
+	info.keepalive_timeout = 5;
+	app.ctx = lws_create_context(&info);
+	if (app.ctx == NULL)
+		return -1;
+	app.vh = lws_create_vhost(app.ctx, &info);
+	if (app.vh == NULL)
+		return -1;
+	return 0;
+}
+
+int web_run(const struct web_opts *o)
+{
+	app.o = *o;
+	top_model_init(&app.model);
+	hist_init(&app.hist, clock_mono_s());
+	app.frame = malloc(LWS_PRE + WEB_FRAME_MAX);
+	app.lcm = lcm_create(o->lcm_url);
+	if (app.frame == NULL || app.lcm == NULL || web_subscribe() != 0) {
+		fprintf(stderr, "undulate-web: cannot start LCM on %s\n", o->lcm_url ? o->lcm_url : "the default URL");
+		return 1;
+	}
+	if (!o->read_only) {
+		app.cmd_ok = wcmd_init(&app.cmd, app.lcm, o->lcm_url, o->key_file, app.cmd_why, sizeof app.cmd_why);
+		if (!app.cmd_ok && o->key_file != NULL) {
+			fprintf(stderr, "undulate-web: --key: %s\n", app.cmd_why);
+			return 1;
+		}
+		if (!app.cmd_ok)
+			fprintf(stderr, "undulate-web: commands disabled: %s\n", app.cmd_why);
+	} else {
+		app.cmd.fd = -1;
+	}
+	lws_set_log_level(LLL_ERR, NULL);
+	if (web_start() != 0) {
+		fprintf(stderr, "undulate-web: cannot listen on %s:%d (in use, or not an address of this computer)\n",
+		        o->addr, o->port);
+		return 1;
+	}
+	if (web_adopt(lcm_get_fileno(app.lcm), WEB_TAG_LCM) != 0 ||
+	    (app.cmd.fd >= 0 && web_adopt(app.cmd.fd, WEB_TAG_CMD) != 0)) {
+		fprintf(stderr, "undulate-web: cannot watch the LCM socket\n");
+		return 1;
+	}
+	struct sigaction sa;
+	memset(&sa, 0, sizeof sa);
+	sa.sa_handler = web_on_signal; /* no SA_RESTART: the loop's poll returns */
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+	signal(SIGPIPE, SIG_IGN);
+	lws_sul_schedule(app.ctx, 0, &app.sul, web_tick, LWS_US_PER_SEC / HIST_HZ);
+	int port = lws_get_vhost_listen_port(app.vh);
+	bool v6 = strchr(o->addr, ':') != NULL;
+	printf("undulate-web: listening on http://%s%s%s:%d/ (LCM %s%s)\n", v6 ? "[" : "", o->addr, v6 ? "]" : "",
+	       port, o->lcm_url ? o->lcm_url : "default URL",
+	       o->read_only ? ", read-only" : o->token ? ", commands need the token" : "");
+	fflush(stdout);
+	while (!web_stop && lws_service(app.ctx, 0) >= 0)
+		;
+	fprintf(stderr, "undulate-web: exit: %lld HTTP requests (%lld refused), %lld WebSocket refused, %lld messages "
+	        "refused, %lld commands sent (%lld refused), %lld frames sent, %lld skipped, %lld browsers stalled\n",
+	        app.n.http_requests, app.n.http_refused, app.n.ws_refused, app.n.msgs_refused, app.n.commands_sent,
+	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled);
+	lws_context_destroy(app.ctx);
+	wcmd_close(&app.cmd);
+	lcm_destroy(app.lcm);
+	free(app.frame);
+	return 0;
+}

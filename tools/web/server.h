@@ -1,0 +1,40 @@
+/* server.h — undulate-web's server: one libwebsockets event loop serving the
+ * page, its assets, GET /api/snapshot and the WebSocket the frames go out on,
+ * with the LCM socket and the local command socket adopted into the same
+ * loop (single-threaded, like the rest of the project). Owns the model
+ * (tools/top/model.h), the history (hist.h), the browsers and the command
+ * path (wcmd.h). See README.md for the limits. */
+#ifndef UNDULATE_WEB_SERVER_H
+#define UNDULATE_WEB_SERVER_H
+
+#include <stdbool.h>
+
+#define WEB_MAX_CLIENTS 32          /* WebSocket browsers at once; more are refused */
+#define WEB_MAX_CONNECTIONS 96      /* file descriptors for connections (HTTP and WebSocket) */
+#define WEB_HEADER_MAX 4096         /* bytes of request headers; beyond: refused */
+#define WEB_FRAME_MAX (2 * 1024 * 1024) /* one frame; a larger catch-up keeps the newest samples */
+#define WEB_FRAME_EVERY 2           /* samples (HIST_HZ) per frame: 12.5 frames per second */
+#define WEB_STALL_S 30.0            /* a browser that takes no frame for this long is closed */
+#define WEB_HTTP_TIMEOUT_S 10       /* a request must arrive whole within this */
+/* Kernel send buffer per browser (the kernel doubles it): with libwebsockets'
+ * one partial frame, all a browser that stops reading can hold of ours. A
+ * frame of 20 robots is ~6 kB; a browser that reads keeps it nearly empty. */
+#define WEB_SNDBUF (16 * 1024)
+#define WEB_NOTES 16                /* answers waiting for a browser's next frame */
+
+struct web_opts {
+	const char *addr;           /* "127.0.0.1" */
+	int port;                   /* 0: any free port (printed) */
+	const char *lcm_url;        /* NULL: LCM's default */
+	bool read_only;
+	const char *token;          /* NULL: commands need no secret (loopback only) */
+	const char *key_file;       /* signed LCM commands instead of local sockets */
+	const char *page_dir;       /* index.html, app.js, style.css */
+	const char *chartjs;        /* Chart.js from libjs-chart.js */
+	bool verbose;
+};
+
+/* Runs until SIGINT/SIGTERM; the exit status. */
+int web_run(const struct web_opts *o);
+
+#endif
