@@ -115,7 +115,7 @@ else
 	tap_check "the robot's answer is on the page: $(grep '^ANSWER' "$T/page.out")" \
 		grep -q '^ANSWER command-accepted .*left command-accepted: mode HOLD' "$T/page.out"
 	tap_check "the page shows left in HOLD" grep -q '^MODE_SHOWN HOLD' "$T/page.out"
-	if [ "$_tap_failed" -gt 0 ]; then mkdir -p "$BUILD/test-logs" && cp "$T/page.png" "$BUILD/test-logs/web_dashboard.png"; fi
+	if [ "$_tap_failed" -gt 0 ] || [ -n "${WEB_KEEP_SCREENSHOT:-}" ]; then mkdir -p "$BUILD/test-logs" && cp "$T/page.png" "$BUILD/test-logs/web_dashboard.png"; fi
 fi
 stop web >/dev/null
 tap_check "SIGTERM: undulate-web exits 0 and reports its counters" \

@@ -223,7 +223,9 @@ function onFrame(frame) {
 
 function redraw() {
   const tmin = state.now - SPAN_S;
-  const fix = (chart) => { chart.options.scales.x.min = tmin; chart.options.scales.x.max = state.now; };
+  // the axis starts at the first data (time 0) until the window is full:
+  // an empty stretch before the run began tells nothing
+  const fix = (chart) => { chart.options.scales.x.min = Math.max(0, tmin); chart.options.scales.x.max = state.now; };
   for (const r of state.robots.values()) {
     if (!r.angles) continue;
     for (const d of r.angles.data.datasets) trim(d.data, tmin);
