@@ -182,14 +182,21 @@ def frames(host, port, seconds):
     print("SERVER " + json.dumps(server), flush=True)
 
 
-def say(host, port, message):
+def say(host, port, message, until=None):
+    """Send one message; print the first note (not the hello), or with
+    `until` every note until one of that kind (the robot's answer)."""
     ws = WS(host, int(port), "/", "undulate")
     ws.send(message)
     end = time.time() + 5
+    seen = set()
     while time.time() < end:
         for n in json.loads(ws.recv()).get("notes", []):
-            if n["kind"] != "hello":
-                print(f"NOTE {n['kind']} {n['text']}", flush=True)
+            key = (n["kind"], n["text"])
+            if n["kind"] == "hello" or key in seen:
+                continue
+            seen.add(key)
+            print(f"NOTE {n['kind']} {n['text']}", flush=True)
+            if until is None or n["kind"] == until:
                 return
     print("NOTE none")
 

@@ -117,6 +117,31 @@ else
 	tap_check "the page shows left in HOLD" grep -q '^MODE_SHOWN HOLD' "$T/page.out"
 	if [ "$_tap_failed" -gt 0 ] || [ -n "${WEB_KEEP_SCREENSHOT:-}" ]; then mkdir -p "$BUILD/test-logs" && cp "$T/page.png" "$BUILD/test-logs/web_dashboard.png"; fi
 fi
+
+# ---- --key: signed over LCM, to a robot that takes commands from the network only --------------
+URLN=$(lcm_url 7791)
+"$D" --gen-key "$T/net.key" >/dev/null
+"$D" --gen-key "$T/wrong.key" >/dev/null
+spawn simn "$S" --link "$T/net" --ids 1 --lcm-url "$URLN" --seed 6
+wait_log simn 'ready' 10
+spawn watchn "$D" --watch net --lcm-url "$URLN"
+spawn d_net "$D" --port "$T/net" --ids 1 --robot net --lcm-url "$URLN" --mode oscillator \
+	--set robot.commands=network --set "robot.command_key=$T/net.key"
+wait_log d_net 'ready: net.STATE' 10
+spawn webw "$W" --listen 127.0.0.1:0 --lcm-url "$URLN" --key "$T/wrong.key"
+spawn webn "$W" --listen 127.0.0.1:0 --lcm-url "$URLN" --key "$T/net.key"
+wait_log webw 'listening on http://' 10 && wait_log webn 'listening on http://' 10
+wport=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/webw.log")
+nport=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/webn.log")
+python3 "$CDP" say 127.0.0.1 "$wport" "cmd 8 net mode limp" command-accepted >"$T/wrong.out" 2>&1
+tap_check "--key with the wrong key: the robot takes nothing ($(tr '\n' ' ' <"$T/wrong.out"))" \
+	bash -c "! grep -q '^NOTE command-accepted' '$T/wrong.out' && ! grep -q '^STATE net .* mode=0 ' '$T/watchn.log'"
+python3 "$CDP" say 127.0.0.1 "$nport" "cmd 9 net mode hold" command-accepted >"$T/net.out" 2>&1
+held=0; wait_for 5 grep -q '^STATE net .* mode=1 ' "$T/watchn.log" && held=1
+tap_check "--key: signed over LCM, the robot takes it and its answer comes back ($(tr '\n' ' ' <"$T/net.out"))" \
+	bash -c "[ $held = 1 ] && grep -q '^NOTE command-accepted mode HOLD' '$T/net.out'"
+stop webn >/dev/null; stop webw >/dev/null; stop d_net >/dev/null; stop watchn >/dev/null; stop simn >/dev/null
+
 stop web >/dev/null
 tap_check "SIGTERM: undulate-web exits 0 and reports its counters" \
 	bash -c "[ '$stop_rc' = 0 ] && grep -q 'exit: .* refused' '$T/web.log'"
