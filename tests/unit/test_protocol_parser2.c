@@ -323,6 +323,24 @@ static void test_cut_short_then_good(void **state)
 		 * new header over the CRC bytes is a CRC error */
 		assert_int_equal(res.stuffing_errors + res.checksum_errors, 1);
 	}
+	/* A long reply cut short, then a short good one: waiting for the long
+	 * one's LEN would hold the good one until bytes that never come; the
+	 * header inside the body is caught at once. (The long packet is built
+	 * by the encoder: only its first 20 bytes are used, its CRC never.) */
+	uint8_t stream[128], params[40];
+	memset(params, 0x11, sizeof params);
+	assert_int_equal(dxl2_encode_status(stream, sizeof stream, 3, 0, params, sizeof params), 51);
+	memcpy(stream + 20, read_reply, sizeof read_reply);
+	{
+		struct dxl2_parser q;
+		struct feed_result qres = { 0 };
+		dxl2_parser_init(&q, DXL2_PARSE_STATUS);
+		feed_all(&q, stream, 20 + sizeof read_reply, &qres);
+		assert_int_equal(qres.stuffing_errors, 1);
+		assert_int_equal(qres.nframes, 1);
+		assert_read_reply(&qres.frames[0]);
+		assert_int_equal(q.have, 0);
+	}
 	/* a body that ends in an unstuffed FF FF FD: wrong stuffing */
 	const uint8_t unstuffed[] = { HDR, 0x01, 0x07, 0x00, 0x55, 0x00, 0xFF, 0xFF, 0xFD, 0x00, 0x00 };
 	struct dxl2_parser p;
