@@ -85,6 +85,7 @@ const char *dxl_strerror(int status)
 	case DXL_E_BUSY:         return "a transaction is already pending";
 	case DXL_E_ECHO:         return "echoed bytes differ from those sent";
 	case DXL_E_UNSUPPORTED:  return "not supported";
+	case DXL_E_STUFFING:     return "byte stuffing violated in received packet (cut short?)";
 	default:                 return "unknown error";
 	}
 }

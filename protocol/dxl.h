@@ -78,6 +78,10 @@ enum dxl_status {
 	DXL_E_BUSY         = -10,  /* a transaction is already pending */
 	DXL_E_ECHO         = -11,  /* echo cancelling: the bytes read back differ */
 	DXL_E_UNSUPPORTED  = -12,  /* not supported by this servo/port/build */
+	/* Protocol 2.0 only (dxl2.h): a header inside a packet's body, i.e. an
+	 * FF FF FD not followed by the stuffed FD — a packet cut short and a new
+	 * one begun, or a sender that does not stuff. Resynchronised. */
+	DXL_E_STUFFING     = -13,
 };
 /* Message for a dxl_status value (negative) — never NULL. */
 const char *dxl_strerror(int status);

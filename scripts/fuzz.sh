@@ -6,7 +6,7 @@
 #   FUZZ_RUNS=100000 make fuzz        # a quick pass (every target, N inputs)
 #   FUZZ_ONLY=daemon make fuzz        # targets whose name contains "daemon"
 #
-# Targets and their input counts: the packet parser 10 M (the bytes every
+# Targets and their input counts: the packet parsers (1.0 and 2.0) 10 M (the bytes every
 # servo reply and every simulated request go through), every other parser of
 # outside input 2 M. Seed inputs, when a target has some, are in
 # tests/fuzz/seeds/<target>/; the corpus grows in build/fuzz/corpus/<target>/.
@@ -25,7 +25,7 @@ for bin in "$dir"/fuzz_*; do
 	[ -n "$only" ] && [[ "$name" != *$only* ]] && continue
 	runs=${FUZZ_RUNS:-}
 	if [ -z "$runs" ]; then
-		case "$name" in fuzz_protocol_parser) runs=10000000 ;; *) runs=2000000 ;; esac
+		case "$name" in fuzz_protocol_parser|fuzz_protocol_parser2) runs=10000000 ;; *) runs=2000000 ;; esac
 	fi
 	corpus="$dir/corpus/$name"
 	mkdir -p "$corpus"

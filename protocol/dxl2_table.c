@@ -1,0 +1,625 @@
+/*
+ * dxl2_table.c — the XL430-W250 and XM430-W350 control tables as data,
+ * lookup, write checks, conversions and formatting. Rows are the ROBOTIS
+ * e-manual's (ROBOTIS-GIT/emanual: docs/en/dxl/x/xl430-w250.md and
+ * xm430-w350.md, the revisions with Range and Unit columns). Where the
+ * printed range cannot be meant literally the row says what was taken.
+ */
+#include "dxl2_table.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dxl.h"
+#include "dxl2.h"
+
+#define R   DXL_ACCESS_R
+#define RW  DXL_ACCESS_RW
+#define EE  DXL_AREA_EEPROM
+#define RAM DXL_AREA_RAM
+#define U(x) DXL2_UNIT_##x
+/* Rows: name, addr, size, signed, access, area, min, max, has_default, def,
+ * unit, limit, limit register, description. */
+#define NOLIM DXL2_LIMIT_NONE, 0
+#define SYM(addr) DXL2_LIMIT_SYMMETRIC, addr
+/* Extended Position Control Mode's range (Goal Position, e-manual). */
+#define EXT_POS 1048575
+/* Read-only rows: the "range" is the type's, for formatting only. */
+#define RO_U8   0, 255
+#define RO_U16  0, 65535
+#define RO_S16  -32768, 32767
+#define RO_S32  INT32_MIN, INT32_MAX
+
+/* The first rows, the same on both models but for the model number. */
+#define X_COMMON_HEAD(model) \
+	{ "model_number",       0, 2, false, R,  EE, RO_U16, true, model, U(RAW), NOLIM, "model number" }, \
+	{ "model_information",  2, 4, false, R,  EE, 0, INT32_MAX, false, 0, U(RAW), NOLIM, "model information" }, \
+	{ "firmware_version",   6, 1, false, R,  EE, RO_U8, false, 0, U(RAW), NOLIM, "firmware version" }, \
+	{ "id",                 7, 1, false, RW, EE, 0, DXL2_MAX_ID, true, 1, U(RAW), NOLIM, \
+	    "servo ID, 0-252 (254 is broadcast)" }, \
+	{ "baud_rate",          8, 1, false, RW, EE, 0, 7, true, 1, U(BAUD), NOLIM, \
+	    "0 9600, 1 57600, 2 115200, 3 1M, 4 2M, 5 3M, 6 4M, 7 4.5M bps" }, \
+	{ "return_delay_time",  9, 1, false, RW, EE, 0, 254, true, 250, U(RETURN_DELAY), NOLIM, \
+	    "delay before a status packet, 2 us a unit (0 for speed)" }
+
+static const struct dxl2_reg xl430_regs[] = {
+	X_COMMON_HEAD(DXL2_MODEL_XL430_W250),
+	{ "drive_mode",        10, 1, false, RW, EE, 0, 13, true, 0, U(RAW), NOLIM,
+	    "bit 0 reverse direction, bit 2 time-based profile, bit 3 torque on by goal update" },
+	{ "operating_mode",    11, 1, false, RW, EE, 0, 16, true, 3, U(OPMODE), NOLIM,
+	    "1 velocity, 3 position, 4 extended position, 16 PWM" },
+	/* printed 0-252 with default 255: 253 and above switch it off */
+	{ "secondary_id",      12, 1, false, RW, EE, 0, 255, true, 255, U(RAW), NOLIM,
+	    "shadow ID, 253-255 = none" },
+	{ "protocol_type",     13, 1, false, RW, EE, 1, 2, true, 2, U(RAW), NOLIM, "1 or 2" },
+	{ "homing_offset",     20, 4, true,  RW, EE, -1044479, 1044479, true, 0, U(POSITION), NOLIM,
+	    "added to the present position, pulses" },
+	{ "moving_threshold",  24, 4, false, RW, EE, 0, 1023, true, 10, U(VELOCITY), NOLIM,
+	    "speed above which the servo counts as moving" },
+	{ "temperature_limit", 31, 1, false, RW, EE, 0, 100, true, 72, U(TEMPERATURE), NOLIM,
+	    "overheating threshold" },
+	{ "max_voltage_limit", 32, 2, false, RW, EE, 60, 140, true, 140, U(VOLTAGE), NOLIM,
+	    "highest input voltage before the voltage error" },
+	{ "min_voltage_limit", 34, 2, false, RW, EE, 60, 140, true, 60, U(VOLTAGE), NOLIM,
+	    "lowest input voltage before the voltage error" },
+	{ "pwm_limit",         36, 2, false, RW, EE, 0, 885, true, 885, U(PWM), NOLIM,
+	    "largest PWM, the limit of goal_pwm" },
+	{ "velocity_limit",    44, 4, false, RW, EE, 0, 1023, true, 265, U(VELOCITY), NOLIM,
+	    "largest speed, the limit of goal_velocity" },
+	{ "max_position_limit", 48, 4, false, RW, EE, 0, 4095, true, 4095, U(POSITION), NOLIM,
+	    "largest goal position in position mode" },
+	{ "min_position_limit", 52, 4, false, RW, EE, 0, 4095, true, 0, U(POSITION), NOLIM,
+	    "smallest goal position in position mode" },
+	/* printed range "3": bits 0 and 1 */
+	{ "startup_configuration", 60, 1, false, RW, EE, 0, 3, true, 0, U(RAW), NOLIM,
+	    "bit 0 torque on at boot, bit 1 restore RAM from backup" },
+	/* printed range "-": the hardware error bits */
+	{ "shutdown",          63, 1, false, RW, EE, 0, DXL2_HWERR_MASK, true, 52, U(HWERR), NOLIM,
+	    "hardware errors that switch the torque off" },
+	{ "torque_enable",     64, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM,
+	    "motor torque on (locks the EEPROM area)" },
+	{ "led",               65, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM, "LED on" },
+	{ "status_return_level", 68, 1, false, RW, RAM, 0, 2, true, 2, U(STATUS_LEVEL), NOLIM,
+	    "which instructions are answered: 0 ping, 1 + read, 2 all" },
+	{ "registered_instruction", 69, 1, false, R, RAM, RO_U8, true, 0, U(BOOL), NOLIM,
+	    "a REG_WRITE is waiting for ACTION" },
+	{ "hardware_error_status", 70, 1, false, R, RAM, RO_U8, true, 0, U(HWERR), NOLIM,
+	    "hardware errors now (the status packet's alert bit)" },
+	{ "velocity_i_gain",   76, 2, false, RW, RAM, 0, 16383, true, 1000, U(RAW), NOLIM, "velocity I gain" },
+	{ "velocity_p_gain",   78, 2, false, RW, RAM, 0, 16383, true, 100, U(RAW), NOLIM, "velocity P gain" },
+	{ "position_d_gain",   80, 2, false, RW, RAM, 0, 16383, true, 4000, U(RAW), NOLIM, "position D gain" },
+	{ "position_i_gain",   82, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM, "position I gain" },
+	{ "position_p_gain",   84, 2, false, RW, RAM, 0, 16383, true, 640, U(RAW), NOLIM, "position P gain" },
+	{ "feedforward_2nd_gain", 88, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM,
+	    "feedforward acceleration gain" },
+	{ "feedforward_1st_gain", 90, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM,
+	    "feedforward velocity gain" },
+	/* printed 1-127 with default 0: 0 switches the watchdog off */
+	{ "bus_watchdog",      98, 1, false, RW, RAM, 0, 127, true, 0, U(WATCHDOG), NOLIM,
+	    "stop when no packet came for this long, 20 ms a unit, 0 = off" },
+	{ "goal_pwm",         100, 2, true,  RW, RAM, -885, 885, false, 0, U(PWM), SYM(36),
+	    "target PWM (PWM mode), within +-pwm_limit" },
+	{ "goal_velocity",    104, 4, true,  RW, RAM, -1023, 1023, false, 0, U(VELOCITY), SYM(44),
+	    "target speed (velocity mode), within +-velocity_limit" },
+	/* printed "0-32767 / 0-32737" (velocity / time-based profile): the wider */
+	{ "profile_acceleration", 108, 4, false, RW, RAM, 0, 32767, true, 0, U(ACCELERATION), NOLIM,
+	    "profile acceleration, 0 = none" },
+	{ "profile_velocity", 112, 4, false, RW, RAM, 0, 32767, true, 0, U(VELOCITY), NOLIM,
+	    "profile speed, 0 = none" },
+	{ "goal_position",    116, 4, true,  RW, RAM, -EXT_POS, EXT_POS, false, 0, U(POSITION),
+	    DXL2_LIMIT_POSITION, 0, "target position, within the position limits in position mode" },
+	{ "realtime_tick",    120, 2, false, R,  RAM, RO_U16, false, 0, U(MS), NOLIM,
+	    "servo clock, 0-32767 ms, wraps" },
+	{ "moving",           122, 1, false, R,  RAM, RO_U8, true, 0, U(BOOL), NOLIM, "moving now" },
+	{ "moving_status",    123, 1, false, R,  RAM, RO_U8, true, 0, U(RAW), NOLIM, "profile and arrival bits" },
+	{ "present_pwm",      124, 2, true,  R,  RAM, RO_S16, false, 0, U(PWM), NOLIM, "PWM now" },
+	{ "present_load",     126, 2, true,  R,  RAM, RO_S16, false, 0, U(LOAD), NOLIM,
+	    "load, 0.1 % of the maximum, -1000..1000" },
+	{ "present_velocity", 128, 4, true,  R,  RAM, RO_S32, false, 0, U(VELOCITY), NOLIM, "speed now" },
+	{ "present_position", 132, 4, true,  R,  RAM, RO_S32, false, 0, U(POSITION), NOLIM, "position now" },
+	{ "velocity_trajectory", 136, 4, true, R, RAM, RO_S32, false, 0, U(VELOCITY), NOLIM,
+	    "speed the profile asks for now" },
+	{ "position_trajectory", 140, 4, true, R, RAM, RO_S32, false, 0, U(POSITION), NOLIM,
+	    "position the profile asks for now" },
+	{ "present_input_voltage", 144, 2, false, R, RAM, RO_U16, false, 0, U(VOLTAGE), NOLIM, "supply voltage" },
+	{ "present_temperature", 146, 1, false, R, RAM, RO_U8, false, 0, U(TEMPERATURE), NOLIM,
+	    "internal temperature" },
+	{ "backup_ready",     147, 1, false, R,  RAM, RO_U8, false, 0, U(BOOL), NOLIM,
+	    "a RAM backup is stored" },
+};
+
+static const struct dxl2_reg xm430_regs[] = {
+	X_COMMON_HEAD(DXL2_MODEL_XM430_W350),
+	{ "drive_mode",        10, 1, false, RW, EE, 0, 1, true, 0, U(RAW), NOLIM,
+	    "bit 0 reverse direction" },
+	{ "operating_mode",    11, 1, false, RW, EE, 0, 16, true, 3, U(OPMODE), NOLIM,
+	    "0 current, 1 velocity, 3 position, 4 extended position, 5 current-based position, 16 PWM" },
+	{ "secondary_id",      12, 1, false, RW, EE, 0, 255, true, 255, U(RAW), NOLIM,
+	    "shadow ID, 253-255 = none" },
+	{ "protocol_type",     13, 1, false, RW, EE, 1, 2, true, 2, U(RAW), NOLIM, "1 or 2" },
+	{ "homing_offset",     20, 4, true,  RW, EE, -1044479, 1044479, true, 0, U(POSITION), NOLIM,
+	    "added to the present position, pulses" },
+	{ "moving_threshold",  24, 4, false, RW, EE, 0, 1023, true, 10, U(VELOCITY), NOLIM,
+	    "speed above which the servo counts as moving" },
+	{ "temperature_limit", 31, 1, false, RW, EE, 0, 100, true, 80, U(TEMPERATURE), NOLIM,
+	    "overheating threshold" },
+	/* the XM430-W350 page prints 110-300 beside a default of 95; the
+	 * XM430-W210 page (same electronics) prints 95-160: taken */
+	{ "max_voltage_limit", 32, 2, false, RW, EE, 95, 160, true, 160, U(VOLTAGE), NOLIM,
+	    "highest input voltage before the voltage error" },
+	{ "min_voltage_limit", 34, 2, false, RW, EE, 95, 160, true, 95, U(VOLTAGE), NOLIM,
+	    "lowest input voltage before the voltage error" },
+	{ "pwm_limit",         36, 2, false, RW, EE, 0, 885, true, 885, U(PWM), NOLIM,
+	    "largest PWM, the limit of goal_pwm" },
+	{ "current_limit",     38, 2, false, RW, EE, 0, 1193, true, 1193, U(CURRENT), NOLIM,
+	    "largest current, the limit of goal_current" },
+	{ "velocity_limit",    44, 4, false, RW, EE, 0, 1023, true, 200, U(VELOCITY), NOLIM,
+	    "largest speed, the limit of goal_velocity" },
+	{ "max_position_limit", 48, 4, false, RW, EE, 0, 4095, true, 4095, U(POSITION), NOLIM,
+	    "largest goal position in position mode" },
+	{ "min_position_limit", 52, 4, false, RW, EE, 0, 4095, true, 0, U(POSITION), NOLIM,
+	    "smallest goal position in position mode" },
+	{ "shutdown",          63, 1, false, RW, EE, 0, DXL2_HWERR_MASK, true, 52, U(HWERR), NOLIM,
+	    "hardware errors that switch the torque off" },
+	{ "torque_enable",     64, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM,
+	    "motor torque on (locks the EEPROM area)" },
+	{ "led",               65, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM, "LED on" },
+	{ "status_return_level", 68, 1, false, RW, RAM, 0, 2, true, 2, U(STATUS_LEVEL), NOLIM,
+	    "which instructions are answered: 0 ping, 1 + read, 2 all" },
+	{ "registered_instruction", 69, 1, false, R, RAM, RO_U8, true, 0, U(BOOL), NOLIM,
+	    "a REG_WRITE is waiting for ACTION" },
+	{ "hardware_error_status", 70, 1, false, R, RAM, RO_U8, true, 0, U(HWERR), NOLIM,
+	    "hardware errors now (the status packet's alert bit)" },
+	{ "velocity_i_gain",   76, 2, false, RW, RAM, 0, 16383, true, 1920, U(RAW), NOLIM, "velocity I gain" },
+	{ "velocity_p_gain",   78, 2, false, RW, RAM, 0, 16383, true, 100, U(RAW), NOLIM, "velocity P gain" },
+	{ "position_d_gain",   80, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM, "position D gain" },
+	{ "position_i_gain",   82, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM, "position I gain" },
+	{ "position_p_gain",   84, 2, false, RW, RAM, 0, 16383, true, 800, U(RAW), NOLIM, "position P gain" },
+	{ "feedforward_2nd_gain", 88, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM,
+	    "feedforward acceleration gain" },
+	{ "feedforward_1st_gain", 90, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM,
+	    "feedforward velocity gain" },
+	/* the W350 page prints the unit as 20 us; the XL430 and XM430-W210
+	 * pages 20 ms: ms taken */
+	{ "bus_watchdog",      98, 1, false, RW, RAM, 0, 127, true, 0, U(WATCHDOG), NOLIM,
+	    "stop when no packet came for this long, 20 ms a unit, 0 = off" },
+	{ "goal_pwm",         100, 2, true,  RW, RAM, -885, 885, false, 0, U(PWM), SYM(36),
+	    "target PWM (PWM mode), within +-pwm_limit" },
+	{ "goal_current",     102, 2, true,  RW, RAM, -1193, 1193, false, 0, U(CURRENT), SYM(38),
+	    "target current (current modes), within +-current_limit" },
+	{ "goal_velocity",    104, 4, true,  RW, RAM, -1023, 1023, false, 0, U(VELOCITY), SYM(44),
+	    "target speed (velocity mode), within +-velocity_limit" },
+	{ "profile_acceleration", 108, 4, false, RW, RAM, 0, 32767, true, 0, U(ACCELERATION), NOLIM,
+	    "profile acceleration, 0 = none" },
+	{ "profile_velocity", 112, 4, false, RW, RAM, 0, 32767, true, 0, U(VELOCITY), NOLIM,
+	    "profile speed, 0 = none" },
+	{ "goal_position",    116, 4, true,  RW, RAM, -EXT_POS, EXT_POS, false, 0, U(POSITION),
+	    DXL2_LIMIT_POSITION, 0, "target position, within the position limits in position mode" },
+	{ "realtime_tick",    120, 2, false, R,  RAM, RO_U16, false, 0, U(MS), NOLIM,
+	    "servo clock, 0-32767 ms, wraps" },
+	{ "moving",           122, 1, false, R,  RAM, RO_U8, true, 0, U(BOOL), NOLIM, "moving now" },
+	{ "moving_status",    123, 1, false, R,  RAM, RO_U8, true, 0, U(RAW), NOLIM, "profile and arrival bits" },
+	{ "present_pwm",      124, 2, true,  R,  RAM, RO_S16, false, 0, U(PWM), NOLIM, "PWM now" },
+	{ "present_current",  126, 2, true,  R,  RAM, RO_S16, false, 0, U(CURRENT), NOLIM, "current now" },
+	{ "present_velocity", 128, 4, true,  R,  RAM, RO_S32, false, 0, U(VELOCITY), NOLIM, "speed now" },
+	{ "present_position", 132, 4, true,  R,  RAM, RO_S32, false, 0, U(POSITION), NOLIM, "position now" },
+	{ "velocity_trajectory", 136, 4, true, R, RAM, RO_S32, false, 0, U(VELOCITY), NOLIM,
+	    "speed the profile asks for now" },
+	{ "position_trajectory", 140, 4, true, R, RAM, RO_S32, false, 0, U(POSITION), NOLIM,
+	    "position the profile asks for now" },
+	{ "present_input_voltage", 144, 2, false, R, RAM, RO_U16, false, 0, U(VOLTAGE), NOLIM, "supply voltage" },
+	{ "present_temperature", 146, 1, false, R, RAM, RO_U8, false, 0, U(TEMPERATURE), NOLIM,
+	    "internal temperature" },
+};
+
+#define OPMODE_BIT(m) (1u << (m))
+static const struct dxl2_model dxl2_models[] = {
+	{ DXL2_MODEL_XL430_W250, "XL430-W250", xl430_regs, sizeof xl430_regs / sizeof xl430_regs[0],
+	  OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16) },
+	{ DXL2_MODEL_XM430_W350, "XM430-W350", xm430_regs, sizeof xm430_regs / sizeof xm430_regs[0],
+	  OPMODE_BIT(0) | OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(5) | OPMODE_BIT(16) },
+};
+#define NMODELS (sizeof dxl2_models / sizeof dxl2_models[0])
+
+static const struct {
+	const char *alias, *name;
+} dxl2_aliases[] = {
+	{ "model", "model_number" },
+	{ "firmware", "firmware_version" },
+	{ "baud", "baud_rate" },
+	{ "return_delay", "return_delay_time" },
+	{ "mode", "operating_mode" },
+	{ "torque", "torque_enable" },
+	{ "return_level", "status_return_level" },
+	{ "hardware_error", "hardware_error_status" },
+	{ "watchdog", "bus_watchdog" },
+	{ "goal", "goal_position" },
+	{ "position", "present_position" },
+	{ "velocity", "present_velocity" },
+	{ "speed", "present_velocity" },
+	{ "current", "present_current" },
+	{ "load", "present_load" },
+	{ "voltage", "present_input_voltage" },
+	{ "temperature", "present_temperature" },
+};
+
+const char *dxl2_opmode_name(uint8_t mode)
+{
+	switch (mode) {
+	case DXL2_OPMODE_CURRENT:           return "current";
+	case DXL2_OPMODE_VELOCITY:          return "velocity";
+	case DXL2_OPMODE_POSITION:          return "position";
+	case DXL2_OPMODE_EXTENDED_POSITION: return "extended position";
+	case DXL2_OPMODE_CURRENT_POSITION:  return "current-based position";
+	case DXL2_OPMODE_PWM:               return "PWM";
+	default:                            return NULL;
+	}
+}
+
+static const char *dxl2_hwerr_name(unsigned bit)
+{
+	switch (1u << bit) {
+	case DXL2_HWERR_VOLTAGE:  return "input voltage";
+	case DXL2_HWERR_OVERHEAT: return "overheating";
+	case DXL2_HWERR_ENCODER:  return "motor encoder";
+	case DXL2_HWERR_SHOCK:    return "electrical shock";
+	case DXL2_HWERR_OVERLOAD: return "overload";
+	default:                  return NULL;
+	}
+}
+
+char *dxl2_hwerr_format(uint8_t bits, char *buf, size_t cap)
+{
+	if (buf == NULL || cap == 0)
+		return buf;
+	buf[0] = '\0';
+	if (bits == 0) {
+		snprintf(buf, cap, "none");
+		return buf;
+	}
+	size_t off = 0;
+	for (unsigned i = 0; i < 8; i++) {
+		if (!(bits & (1u << i)))
+			continue;
+		const char *name = dxl2_hwerr_name(i);
+		int w = name ? snprintf(buf + off, cap - off, "%s%s", off ? "|" : "", name)
+		             : snprintf(buf + off, cap - off, "%sbit%u", off ? "|" : "", i);
+		if (w < 0 || (size_t)w >= cap - off)
+			break;
+		off += (size_t)w;
+	}
+	return buf;
+}
+
+static bool name_eq(const char *a, const char *b)
+{
+	for (;; a++, b++) {
+		int ca = (*a == '-') ? '_' : tolower((unsigned char)*a);
+		int cb = (*b == '-') ? '_' : tolower((unsigned char)*b);
+		if (ca != cb)
+			return false;
+		if (ca == '\0')
+			return true;
+	}
+}
+
+const struct dxl2_model *dxl2_model_by_number(uint16_t number)
+{
+	for (size_t i = 0; i < NMODELS; i++)
+		if (dxl2_models[i].number == number)
+			return &dxl2_models[i];
+	return NULL;
+}
+
+const struct dxl2_model *dxl2_model_by_name(const char *name)
+{
+	if (name == NULL)
+		return NULL;
+	for (size_t i = 0; i < NMODELS; i++)
+		if (name_eq(dxl2_models[i].name, name))
+			return &dxl2_models[i];
+	return NULL;
+}
+
+const struct dxl2_reg *dxl2_reg_at(const struct dxl2_model *m, uint16_t addr)
+{
+	if (m == NULL)
+		return NULL;
+	for (size_t i = 0; i < m->nregs; i++)
+		if (m->regs[i].addr == addr)
+			return &m->regs[i];
+	return NULL;
+}
+
+static const struct dxl2_reg *dxl2_reg_by_name(const struct dxl2_model *m, const char *name)
+{
+	for (size_t i = 0; i < m->nregs; i++)
+		if (name_eq(m->regs[i].name, name))
+			return &m->regs[i];
+	for (size_t i = 0; i < sizeof dxl2_aliases / sizeof dxl2_aliases[0]; i++)
+		if (name_eq(dxl2_aliases[i].alias, name))
+			return dxl2_reg_by_name(m, dxl2_aliases[i].name);
+	return NULL;
+}
+
+const struct dxl2_reg *dxl2_reg_lookup(const struct dxl2_model *m, const char *name_or_addr)
+{
+	if (m == NULL || name_or_addr == NULL || *name_or_addr == '\0')
+		return NULL;
+	if (isdigit((unsigned char)name_or_addr[0])) {
+		/* decimal, or hex with 0x; a leading 0 is not octal (the manual
+		 * writes addresses in decimal) */
+		bool hex = name_or_addr[0] == '0' && (name_or_addr[1] == 'x' || name_or_addr[1] == 'X');
+		char *end;
+		errno = 0;
+		unsigned long v = strtoul(name_or_addr, &end, hex ? 16 : 10);
+		if (errno || *end != '\0' || v > 65535)
+			return NULL;
+		return dxl2_reg_at(m, (uint16_t)v);
+	}
+	return dxl2_reg_by_name(m, name_or_addr);
+}
+
+int32_t dxl2_reg_decode(const struct dxl2_reg *r, const uint8_t *b)
+{
+	switch (r->size) {
+	case 1:
+		return r->is_signed ? (int32_t)(int8_t)b[0] : (int32_t)b[0];
+	case 2: {
+		uint16_t v = (uint16_t)(b[0] | (b[1] << 8));
+		return r->is_signed ? (int32_t)(int16_t)v : (int32_t)v;
+	}
+	default:
+		return (int32_t)dxl2_get_u32(b);
+	}
+}
+
+void dxl2_reg_encode(const struct dxl2_reg *r, int32_t value, uint8_t *b)
+{
+	uint32_t u = (uint32_t)value;
+	for (unsigned i = 0; i < r->size; i++)
+		b[i] = (uint8_t)(u >> (8 * i));
+}
+
+int dxl2_reg_check_write(const struct dxl2_model *m, const struct dxl2_reg *r, long value)
+{
+	if (m == NULL || r == NULL || r->access != DXL_ACCESS_RW)
+		return DXL_E_ARG;
+	if (value < (long)r->min || value > (long)r->max)
+		return DXL_E_ARG;
+	if (r->unit == DXL2_UNIT_OPMODE && !(m->opmodes & (1u << value)))
+		return DXL_E_ARG;
+	return DXL_OK;
+}
+
+/* The value of the register at addr in a table image; false if the image is
+ * too short or the model has no such register. */
+static bool image_value(const struct dxl2_model *m, uint16_t addr, const uint8_t *table, size_t len,
+                        int32_t *v)
+{
+	const struct dxl2_reg *r = dxl2_reg_at(m, addr);
+	if (r == NULL || table == NULL || (size_t)addr + r->size > len)
+		return false;
+	*v = dxl2_reg_decode(r, table + addr);
+	return true;
+}
+
+int dxl2_reg_range(const struct dxl2_model *m, const struct dxl2_reg *r, const uint8_t *table,
+                   size_t len, int32_t *lo, int32_t *hi)
+{
+	if (m == NULL || r == NULL || lo == NULL || hi == NULL)
+		return DXL_E_ARG;
+	*lo = r->min;
+	*hi = r->max;
+	int32_t a, b, mode;
+	switch (r->limit) {
+	case DXL2_LIMIT_SYMMETRIC:
+		if (image_value(m, r->lim_addr, table, len, &a) && a >= 0 && a < *hi) {
+			*lo = -a;
+			*hi = a;
+		}
+		break;
+	case DXL2_LIMIT_POSITION:
+		/* e-manual, Goal Position: the limits bind in position control
+		 * mode; extended and current-based position use the full range */
+		if (image_value(m, DXL2_X_OPERATING_MODE, table, len, &mode) && mode == DXL2_OPMODE_POSITION &&
+		    image_value(m, DXL2_X_MIN_POSITION_LIMIT, table, len, &a) &&
+		    image_value(m, DXL2_X_MAX_POSITION_LIMIT, table, len, &b)) {
+			*lo = a;
+			*hi = b;
+		}
+		break;
+	case DXL2_LIMIT_NONE:
+	default:
+		break;
+	}
+	return DXL_OK;
+}
+
+int dxl2_reg_check_write_live(const struct dxl2_model *m, const struct dxl2_reg *r, long value,
+                              const uint8_t *table, size_t len)
+{
+	int32_t lo, hi;
+	if (dxl2_reg_check_write(m, r, value) != DXL_OK)
+		return DXL_E_ARG;
+	if (dxl2_reg_range(m, r, table, len, &lo, &hi) != DXL_OK)
+		return DXL_E_ARG;
+	return (value < lo || value > hi) ? DXL_E_ARG : DXL_OK;
+}
+
+char *dxl2_reg_format(const struct dxl2_reg *r, int32_t raw, char *buf, size_t cap)
+{
+	char bits[96];
+	if (buf == NULL || cap == 0)
+		return buf;
+	if (r == NULL) {
+		snprintf(buf, cap, "%ld", (long)raw);
+		return buf;
+	}
+	long v = raw;
+	const char *name;
+	switch (r->unit) {
+	case DXL2_UNIT_POSITION:
+		snprintf(buf, cap, "%ld (%.1f deg)", v, raw * 360.0 / DXL2_POS_PER_REV);
+		break;
+	case DXL2_UNIT_VELOCITY:
+		snprintf(buf, cap, "%ld (%.1f rpm)", v, raw * DXL2_VELOCITY_RPM_PER_UNIT);
+		break;
+	case DXL2_UNIT_CURRENT:
+		snprintf(buf, cap, "%ld (%.0f mA)", v, raw * DXL2_CURRENT_A_PER_UNIT * 1000.0);
+		break;
+	case DXL2_UNIT_LOAD:
+		snprintf(buf, cap, "%ld (%.1f %%)", v, raw * 0.1);
+		break;
+	case DXL2_UNIT_PWM:
+		snprintf(buf, cap, "%ld (%.1f %%)", v, raw * DXL2_PWM_PER_UNIT * 100.0);
+		break;
+	case DXL2_UNIT_VOLTAGE:
+		snprintf(buf, cap, "%ld (%.1f V)", v, raw * 0.1);
+		break;
+	case DXL2_UNIT_TEMPERATURE:
+		snprintf(buf, cap, "%ld (%ld C)", v, v);
+		break;
+	case DXL2_UNIT_BAUD:
+		snprintf(buf, cap, "%ld (%ld bps)", v, dxl2_baud_from_reg((uint8_t)raw));
+		break;
+	case DXL2_UNIT_RETURN_DELAY:
+		snprintf(buf, cap, "%ld (%u us)", v, dxl2_return_delay_us((uint8_t)raw));
+		break;
+	case DXL2_UNIT_WATCHDOG:
+		if (raw == 0)
+			snprintf(buf, cap, "0 (off)");
+		else
+			snprintf(buf, cap, "%ld (%u ms)", v, dxl2_watchdog_ms((uint8_t)raw));
+		break;
+	case DXL2_UNIT_ACCELERATION:
+		snprintf(buf, cap, "%ld (%.0f rev/min2)", v, raw * 214.577);
+		break;
+	case DXL2_UNIT_MS:
+		snprintf(buf, cap, "%ld (%ld ms)", v, v);
+		break;
+	case DXL2_UNIT_BOOL:
+		snprintf(buf, cap, "%ld (%s)", v, raw ? "on" : "off");
+		break;
+	case DXL2_UNIT_HWERR:
+		snprintf(buf, cap, "%ld (%s)", v, dxl2_hwerr_format((uint8_t)raw, bits, sizeof bits));
+		break;
+	case DXL2_UNIT_STATUS_LEVEL:
+		snprintf(buf, cap, "%ld (%s)", v, raw == 0 ? "ping only" : raw == 1 ? "ping + read" :
+		                                  raw == 2 ? "all" : "invalid");
+		break;
+	case DXL2_UNIT_OPMODE:
+		name = dxl2_opmode_name((uint8_t)raw);
+		snprintf(buf, cap, "%ld (%s)", v, name ? name : "invalid");
+		break;
+	case DXL2_UNIT_RAW:
+	default:
+		snprintf(buf, cap, "%ld", v);
+		break;
+	}
+	return buf;
+}
+
+/* ---- conversions ------------------------------------------------------------ */
+
+double dxl2_pos_to_rad(int32_t raw)
+{
+	return ((double)raw - DXL2_POS_CENTER) * DXL2_POS_RAD_PER_UNIT;
+}
+
+int32_t dxl2_rad_to_pos(double rad)
+{
+	if (isnan(rad))
+		return DXL2_POS_CENTER;
+	double units = rad / DXL2_POS_RAD_PER_UNIT + DXL2_POS_CENTER;
+	if (units <= 0.0)
+		return 0;
+	if (units >= DXL2_POS_MAX)
+		return DXL2_POS_MAX;
+	return (int32_t)lround(units);
+}
+
+/* Nearest integer of x within +-limit (limit >= 0); NaN gives 0. */
+static int32_t clamp_round(double x, int32_t limit)
+{
+	if (isnan(x) || limit < 0)
+		return 0;
+	if (x >= limit)
+		return limit;
+	if (x <= -limit)
+		return -limit;
+	return (int32_t)lround(x);
+}
+
+double dxl2_velocity_to_rad_s(int32_t raw)
+{
+	return raw * DXL2_VELOCITY_RAD_S_PER_UNIT;
+}
+
+int32_t dxl2_rad_s_to_velocity(double rad_s, int32_t limit)
+{
+	return clamp_round(rad_s / DXL2_VELOCITY_RAD_S_PER_UNIT, limit);
+}
+
+double dxl2_current_to_amps(int32_t raw)
+{
+	return raw * DXL2_CURRENT_A_PER_UNIT;
+}
+
+int32_t dxl2_amps_to_current(double amps, int32_t limit)
+{
+	return clamp_round(amps / DXL2_CURRENT_A_PER_UNIT, limit);
+}
+
+double dxl2_load_to_fraction(int32_t raw)
+{
+	return raw * 0.001;
+}
+
+double dxl2_pwm_to_fraction(int32_t raw)
+{
+	return raw * DXL2_PWM_PER_UNIT;
+}
+
+double dxl2_voltage_to_volts(int32_t raw)
+{
+	return raw * 0.1;
+}
+
+/* e-manual, X series Baud Rate (8). */
+static const long dxl2_bauds[] = { 9600, 57600, 115200, 1000000, 2000000, 3000000, 4000000, 4500000 };
+#define NBAUDS (sizeof dxl2_bauds / sizeof dxl2_bauds[0])
+/* A UART's tolerance to a rate mismatch (as dxl_baud_to_reg). */
+#define DXL2_BAUD_TOLERANCE 0.03
+
+long dxl2_baud_from_reg(uint8_t v)
+{
+	return v < NBAUDS ? dxl2_bauds[v] : -1;
+}
+
+int dxl2_baud_to_reg(long bps, uint8_t *v)
+{
+	if (bps <= 0 || v == NULL)
+		return DXL_E_ARG;
+	for (size_t i = 0; i < NBAUDS; i++) {
+		if (fabs((double)dxl2_bauds[i] - (double)bps) <= DXL2_BAUD_TOLERANCE * (double)bps) {
+			*v = (uint8_t)i;
+			return DXL_OK;
+		}
+	}
+	return DXL_E_ARG;
+}
+
+unsigned dxl2_return_delay_us(uint8_t v)
+{
+	return 2u * v;
+}
+
+unsigned dxl2_watchdog_ms(uint8_t v)
+{
+	return 20u * v;
+}

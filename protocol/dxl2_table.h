@@ -1,0 +1,226 @@
+/*
+ * dxl2_table.h — control tables of the X-series servos that speak Protocol
+ * 2.0 (XL430-W250, XM430-W350) as data, lookup, write checks and unit
+ * conversions. Pure code, like dxl_table.h for the AX-12: tools address
+ * registers by name, the simulator can build its servo memory from the same
+ * rows, the daemon converts raw values to SI.
+ *
+ * Values are the ROBOTIS e-manual's control-table pages; where one printed
+ * revision disagrees with another, the row's comment in dxl2_table.c says
+ * which was taken. Values are little-endian; registers marked signed are
+ * two's complement of their size. EEPROM (addresses below 64) is writable
+ * only with Torque Enable (64) = 0; the servo answers an access error else.
+ * Not described: the indirect address/data areas (168-251, 578-661).
+ */
+#ifndef UNDULATE_DXL2_TABLE_H
+#define UNDULATE_DXL2_TABLE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dxl_table.h"   /* enum dxl_access, enum dxl_area */
+
+/* Addresses shared by the XL430-W250 and the XM430-W350. */
+enum dxl2_x_addr {
+	DXL2_X_MODEL_NUMBER          = 0,
+	DXL2_X_MODEL_INFORMATION     = 2,
+	DXL2_X_FIRMWARE_VERSION      = 6,
+	DXL2_X_ID                    = 7,
+	DXL2_X_BAUD_RATE             = 8,
+	DXL2_X_RETURN_DELAY_TIME     = 9,
+	DXL2_X_DRIVE_MODE            = 10,
+	DXL2_X_OPERATING_MODE        = 11,
+	DXL2_X_SECONDARY_ID          = 12,
+	DXL2_X_PROTOCOL_TYPE         = 13,
+	DXL2_X_HOMING_OFFSET         = 20,
+	DXL2_X_MOVING_THRESHOLD      = 24,
+	DXL2_X_TEMPERATURE_LIMIT     = 31,
+	DXL2_X_MAX_VOLTAGE_LIMIT     = 32,
+	DXL2_X_MIN_VOLTAGE_LIMIT     = 34,
+	DXL2_X_PWM_LIMIT             = 36,
+	DXL2_X_CURRENT_LIMIT         = 38,   /* XM430 only */
+	DXL2_X_VELOCITY_LIMIT        = 44,
+	DXL2_X_MAX_POSITION_LIMIT    = 48,
+	DXL2_X_MIN_POSITION_LIMIT    = 52,
+	DXL2_X_STARTUP_CONFIGURATION = 60,   /* XL430 page only */
+	DXL2_X_SHUTDOWN              = 63,
+	DXL2_X_TORQUE_ENABLE         = 64,
+	DXL2_X_LED                   = 65,
+	DXL2_X_STATUS_RETURN_LEVEL   = 68,
+	DXL2_X_REGISTERED_INSTRUCTION = 69,
+	DXL2_X_HARDWARE_ERROR_STATUS = 70,
+	DXL2_X_VELOCITY_I_GAIN       = 76,
+	DXL2_X_VELOCITY_P_GAIN       = 78,
+	DXL2_X_POSITION_D_GAIN       = 80,
+	DXL2_X_POSITION_I_GAIN       = 82,
+	DXL2_X_POSITION_P_GAIN       = 84,
+	DXL2_X_FEEDFORWARD_2ND_GAIN  = 88,
+	DXL2_X_FEEDFORWARD_1ST_GAIN  = 90,
+	DXL2_X_BUS_WATCHDOG          = 98,
+	DXL2_X_GOAL_PWM              = 100,
+	DXL2_X_GOAL_CURRENT          = 102,  /* XM430 only */
+	DXL2_X_GOAL_VELOCITY         = 104,
+	DXL2_X_PROFILE_ACCELERATION  = 108,
+	DXL2_X_PROFILE_VELOCITY      = 112,
+	DXL2_X_GOAL_POSITION         = 116,
+	DXL2_X_REALTIME_TICK         = 120,
+	DXL2_X_MOVING                = 122,
+	DXL2_X_MOVING_STATUS         = 123,
+	DXL2_X_PRESENT_PWM           = 124,
+	DXL2_X_PRESENT_LOAD          = 126,  /* XL430: load; XM430: current */
+	DXL2_X_PRESENT_CURRENT       = 126,
+	DXL2_X_PRESENT_VELOCITY      = 128,
+	DXL2_X_PRESENT_POSITION      = 132,
+	DXL2_X_VELOCITY_TRAJECTORY   = 136,
+	DXL2_X_POSITION_TRAJECTORY   = 140,
+	DXL2_X_PRESENT_INPUT_VOLTAGE = 144,
+	DXL2_X_PRESENT_TEMPERATURE   = 146,
+	DXL2_X_BACKUP_READY          = 147,  /* XL430 page only */
+};
+#define DXL2_X_EEPROM_END  64     /* addresses below are EEPROM */
+#define DXL2_X_TABLE_SIZE  148    /* bytes 0..147 described here */
+
+/* Model numbers (register 0). */
+#define DXL2_MODEL_XL430_W250 1060
+#define DXL2_MODEL_XM430_W350 1020
+
+/* Operating Mode (11) values. */
+enum dxl2_opmode {
+	DXL2_OPMODE_CURRENT          = 0,
+	DXL2_OPMODE_VELOCITY         = 1,
+	DXL2_OPMODE_POSITION         = 3,
+	DXL2_OPMODE_EXTENDED_POSITION = 4,
+	DXL2_OPMODE_CURRENT_POSITION = 5,
+	DXL2_OPMODE_PWM              = 16,
+};
+const char *dxl2_opmode_name(uint8_t mode);   /* "position", or NULL */
+
+/* Hardware Error Status (70) and Shutdown (63) bits. */
+enum dxl2_hwerr {
+	DXL2_HWERR_VOLTAGE  = 1u << 0,  /* input voltage out of the limits */
+	DXL2_HWERR_OVERHEAT = 1u << 2,
+	DXL2_HWERR_ENCODER  = 1u << 3,  /* motor encoder malfunction */
+	DXL2_HWERR_SHOCK    = 1u << 4,  /* electrical shock / insufficient power */
+	DXL2_HWERR_OVERLOAD = 1u << 5,
+};
+#define DXL2_HWERR_MASK 0x3Du
+/* "overheating|overload", "none"; unknown bits as "bitN". Returns buf. */
+char *dxl2_hwerr_format(uint8_t bits, char *buf, size_t cap);
+
+enum dxl2_unit {
+	DXL2_UNIT_RAW,
+	DXL2_UNIT_POSITION,     /* 1 pulse = 360/4096 deg, 2048 = centre */
+	DXL2_UNIT_VELOCITY,     /* 0.229 rpm */
+	DXL2_UNIT_CURRENT,      /* 2.69 mA */
+	DXL2_UNIT_LOAD,         /* 0.1 % */
+	DXL2_UNIT_PWM,          /* 0.113 % */
+	DXL2_UNIT_VOLTAGE,      /* 0.1 V */
+	DXL2_UNIT_TEMPERATURE,  /* deg C */
+	DXL2_UNIT_BAUD,         /* table: 0 = 9600 ... 7 = 4.5 M */
+	DXL2_UNIT_RETURN_DELAY, /* 2 us */
+	DXL2_UNIT_WATCHDOG,     /* 20 ms; 0 = off */
+	DXL2_UNIT_ACCELERATION, /* 214.577 rev/min^2 */
+	DXL2_UNIT_MS,           /* 1 ms */
+	DXL2_UNIT_BOOL,
+	DXL2_UNIT_HWERR,        /* hardware error bits */
+	DXL2_UNIT_STATUS_LEVEL, /* 0 ping, 1 + read, 2 all */
+	DXL2_UNIT_OPMODE,
+};
+
+/* How a register's range depends on another register's value. */
+enum dxl2_limit {
+	DXL2_LIMIT_NONE,
+	DXL2_LIMIT_SYMMETRIC,  /* -value(lim_addr) .. +value(lim_addr) */
+	DXL2_LIMIT_POSITION,   /* min .. max position limit (52, 48) in position mode */
+};
+
+struct dxl2_reg {
+	const char *name;      /* lower_snake_case */
+	uint16_t addr;
+	uint8_t size;          /* 1, 2 or 4 bytes */
+	bool is_signed;
+	enum dxl_access access;
+	enum dxl_area area;
+	int32_t min, max;      /* static write range (the widest the manual allows) */
+	bool has_default;
+	int32_t def;           /* factory default when has_default */
+	enum dxl2_unit unit;
+	enum dxl2_limit limit;
+	uint16_t lim_addr;     /* DXL2_LIMIT_SYMMETRIC: the limit register */
+	const char *desc;
+};
+
+struct dxl2_model {
+	uint16_t number;
+	const char *name;      /* "XL430-W250" */
+	const struct dxl2_reg *regs;
+	size_t nregs;
+	uint32_t opmodes;      /* bit n set: Operating Mode n exists */
+};
+
+/* NULL when unknown. Names compare case-insensitively ("xm430-w350"). */
+const struct dxl2_model *dxl2_model_by_number(uint16_t number);
+const struct dxl2_model *dxl2_model_by_name(const char *name);
+/* A register by name ('-' = '_', case-insensitive), a short alias
+ * ("position", "velocity", "goal", "torque", ...) or an address ("132",
+ * "0x84"). NULL if unknown for this model. */
+const struct dxl2_reg *dxl2_reg_lookup(const struct dxl2_model *m, const char *name_or_addr);
+/* The register starting at addr; NULL inside a register or in a gap. */
+const struct dxl2_reg *dxl2_reg_at(const struct dxl2_model *m, uint16_t addr);
+
+/* Raw bytes <-> value, sign-extended for signed registers. */
+int32_t dxl2_reg_decode(const struct dxl2_reg *r, const uint8_t *bytes);
+void dxl2_reg_encode(const struct dxl2_reg *r, int32_t value, uint8_t *bytes);
+
+/* DXL_OK if value may be written: RW, within the static range, and (for
+ * Operating Mode) a mode this model has. Else DXL_E_ARG. */
+int dxl2_reg_check_write(const struct dxl2_model *m, const struct dxl2_reg *r, long value);
+/* The range that applies now, given an image of the servo's control table
+ * (`table`, `len` bytes from address 0: the simulator's memory, or what the
+ * daemon read): Goal PWM/Current/Velocity within +-their limit register,
+ * Goal Position within the position limits in position mode. The static
+ * range when the image does not reach the limit register. */
+int dxl2_reg_range(const struct dxl2_model *m, const struct dxl2_reg *r, const uint8_t *table,
+                   size_t len, int32_t *lo, int32_t *hi);
+/* dxl2_reg_check_write and that range: the servo would answer a data limit
+ * error (6) for a value this refuses. */
+int dxl2_reg_check_write_live(const struct dxl2_model *m, const struct dxl2_reg *r, long value,
+                              const uint8_t *table, size_t len);
+/* "2048 (180.0 deg)"-style text with units. Returns buf. */
+char *dxl2_reg_format(const struct dxl2_reg *r, int32_t raw, char *buf, size_t cap);
+
+/* ---- unit conversions -------------------------------------------------------
+ * Angles in radians relative to the centre (2048), positive CCW (towards
+ * larger raw values, the servo's default Drive Mode); speeds in rad/s. */
+#define DXL2_POS_CENTER     2048
+#define DXL2_POS_MAX        4095
+#define DXL2_POS_PER_REV    4096
+#define DXL2_PI             3.14159265358979323846
+#define DXL2_POS_RAD_PER_UNIT (2.0 * DXL2_PI / DXL2_POS_PER_REV)
+#define DXL2_VELOCITY_RPM_PER_UNIT 0.229
+#define DXL2_VELOCITY_RAD_S_PER_UNIT (DXL2_VELOCITY_RPM_PER_UNIT * 2.0 * DXL2_PI / 60.0)
+#define DXL2_CURRENT_A_PER_UNIT 0.00269
+#define DXL2_PWM_PER_UNIT   0.00113   /* fraction of full PWM */
+
+double dxl2_pos_to_rad(int32_t raw);
+/* Nearest position in 0..4095 (position control mode); NaN gives the centre. */
+int32_t dxl2_rad_to_pos(double rad);
+double dxl2_velocity_to_rad_s(int32_t raw);
+/* Nearest raw velocity clamped to +-limit (Velocity Limit, 44); NaN gives 0. */
+int32_t dxl2_rad_s_to_velocity(double rad_s, int32_t limit);
+double dxl2_current_to_amps(int32_t raw);
+/* Nearest raw current clamped to +-limit (Current Limit, 38); NaN gives 0. */
+int32_t dxl2_amps_to_current(double amps, int32_t limit);
+double dxl2_load_to_fraction(int32_t raw);    /* XL430 Present Load, 0.1 % */
+double dxl2_pwm_to_fraction(int32_t raw);     /* 0.113 %: 885 = 100 % */
+double dxl2_voltage_to_volts(int32_t raw);
+/* Baud Rate (8) <-> bps: 0 9600, 1 57600, 2 115200, 3 1 M, 4 2 M, 5 3 M,
+ * 6 4 M, 7 4.5 M; -1 for other values. */
+long dxl2_baud_from_reg(uint8_t v);
+/* The register value whose rate is within 3 % of bps; DXL_E_ARG if none. */
+int dxl2_baud_to_reg(long bps, uint8_t *v);
+unsigned dxl2_return_delay_us(uint8_t v);     /* 2 us a unit */
+unsigned dxl2_watchdog_ms(uint8_t v);         /* 20 ms a unit, 0 = off */
+
+#endif
