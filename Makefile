@@ -96,7 +96,7 @@ LCM_STAMP := $(GEN)/.stamp
 # lcm-gen names files <package>_<type>.c; the package is `undulate`.
 LCM_GEN_C = $(wildcard $(GEN)/*.c)
 
-.PHONY: all deps test test-long test-busy bench demo hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
+.PHONY: all deps test-deps test test-long test-busy bench demo hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
 all: $(foreach p,$(PROGRAMS),$(BIN)/$(p)) unit-tests
 
 $(LCM_STAMP): $(LCM_SRC)
@@ -186,15 +186,20 @@ unit-tests: $(TOOL_BINS)
 deps:
 	@scripts/deps.sh
 
-test: deps
+# The tests also want a browser (web_dashboard draws the page in headless
+# chromium): installed when it can be, else that check skips and says why.
+test-deps: deps
+	@scripts/deps.sh chromium || echo "make: chromium not installed: web_dashboard's browser checks will skip"
+
+test: test-deps
 	@$(MAKE) --no-print-directory check-pure all
 	@BUILD=$(BUILD) tests/run.sh
 
-test-long: deps
+test-long: test-deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) TEST_LONG=1 tests/run.sh
 
-test-busy: deps
+test-busy: test-deps
 	@$(MAKE) --no-print-directory check-pure all
 	@scripts/busy.sh env BUILD=$(BUILD) tests/run.sh
 

@@ -11,7 +11,8 @@ set -eu
 # for checking the units (systemd-analyze verify) and the man pages;
 # libwebsockets and Chart.js for undulate-web (its page's plots, served from
 # the installed path). Chromium (headless: web_dashboard's browser test) is
-# optional: `scripts/deps.sh chromium`; without it that test says so and skips.
+# installed by `make test` when it can be (`scripts/deps.sh chromium`);
+# without it that test says so and skips.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
       libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox rt-tests procps iproute2 jq python3 socat systemd man-db curl
       libwebsockets-dev libjs-chart.js)
