@@ -46,15 +46,32 @@ line() { grep -E "^$2 +$3 " "$T/$1.out" | grep -qE -- "$4"; }
 # ---- a clean bus: every check OK, exit 0 -------------------------------------------------
 if sim_up clean 7760 --return-delay 0 --control "$T/ctl"; then
 	robot_conf clean 1,2
-	doctor clean --config "$T/clean.conf"
+	# Every check but the timed cycles: all OK, exit 0.
+	doctor clean --config "$T/clean.conf" --cycles 0
 	[ "$rc" -eq 0 ] && ! grep -qE '^(WARN|FAIL) ' "$T/clean.out" && line clean OK 'ID 1 return delay' '0 us' \
 		&& line clean OK 'ID 2 voltage' '12\.0 V' && line clean OK latency 'ms' \
 		&& tap_ok "clean bus: every line OK, exit 0" || tap_fail "clean bus: every line OK, exit 0" "$(show clean)"
-	# The budget is measured on the daemon's own cycle: three figures, the floor, the period.
-	line clean OK budget 'p50 [0-9.]+ / p99 [0-9.]+ / max [0-9.]+ ms' && line clean OK budget 'wire floor [0-9.]+ ms' \
-		&& line clean OK budget 'period 10 ms' && line clean OK budget '[0-9]+ cycles' \
-		&& tap_ok "clean bus: the budget line gives p50/p99/max, the wire floor and the period" \
-		|| tap_fail "clean bus: the budget line gives p50/p99/max, the wire floor and the period" "$(show clean)"
+	# The budget, measured on the daemon's own cycle: three figures, the floor,
+	# the period. The timed cycles share the machine with whatever else runs:
+	# beside CPU-bound work (make test-busy) the simulator's replies came late
+	# and 10-15 of 664 transactions timed out, run after run — the doctor said
+	# so (budget WARN, exit 1), and rightly: that bus was not clean then. So the
+	# budget is OK, or a WARN whose only cause is failed transactions below the
+	# FAIL share (printed); any other verdict fails.
+	doctor clean --config "$T/clean.conf"
+	budget_ok() {
+		line clean "$1" budget 'p50 [0-9.]+ / p99 [0-9.]+ / max [0-9.]+ ms' && line clean "$1" budget 'wire floor [0-9.]+ ms' \
+			&& line clean "$1" budget 'period 10 ms' && line clean "$1" budget '[0-9]+ cycles'
+	}
+	if budget_ok OK && [ "$rc" -eq 0 ]; then
+		tap_ok "clean bus: the budget line gives p50/p99/max, the wire floor and the period (OK)"
+	elif budget_ok WARN && [ "$rc" -eq 1 ] && [ "$(grep -cE '^(WARN|FAIL) ' "$T/clean.out")" = 1 ] &&
+		grep -qE '^WARN +budget .*: [0-9]+ of [0-9]+ transactions failed, 0 cycle\(s\) cut off' "$T/clean.out"; then
+		echo "# the timed cycles saw failed transactions on this machine: $(grep -oE '[0-9]+ of [0-9]+ transactions failed' "$T/clean.out")"
+		tap_ok "clean bus: the budget line gives p50/p99/max, the wire floor and the period (WARN: failed transactions on a busy machine)"
+	else
+		tap_fail "clean bus: the budget line gives p50/p99/max, the wire floor and the period" "$(show clean)"
+	fi
 	# Torque is put back as it was found: off (asked through the simulator's
 	# control socket, beside the bus).
 	t1=$(ctl peek "$T/clean.bus" 1 torque_enable) t2=$(ctl peek "$T/clean.bus" 2 torque_enable)
