@@ -181,9 +181,25 @@ bool tune_init(struct tune *t, const struct tune_opts *o, const struct cfg *cfg,
 	bool torque = cfg->actuation == CFG_ACT_TORQUE;
 	t->k = 1.0;
 	t->torque_actuation = torque;
+	/* The search box: near where it started, and never where the
+	 * configuration would refuse a value (the documented ranges, and the
+	 * natural frequency one period integrates: cfg_joint_check) — the tuner
+	 * sets parameters as a command would, so it is held to what a command
+	 * may set, and the file it writes loads. */
+	struct cfg_range kr, mr;
+	cfg_param_range("k", &kr);
+	cfg_param_range("mu", &mr);
+	t->k_lo = 1.0 / TUNE_K_RANGE;
+	t->k_hi = TUNE_K_RANGE;
 	for (size_t i = 0; i < t->n; i++) {
-		t->k0[i] = cfg->joint[i].osc.k;
-		t->mu[i] = t->mu0[i] = cfg->joint[i].osc.mu;
+		const struct cfg_joint *jt = &cfg->joint[i];
+		double w = 2.0 * M_PI * CFG_MAX_NATURAL_HZ;
+		t->k0[i] = jt->osc.k;
+		t->k_lo = fmax(t->k_lo, kr.min / jt->osc.k);
+		t->k_hi = fmin(t->k_hi, fmin(kr.max, 0.999 * w * w * jt->osc.inertia) / jt->osc.k);
+		t->mu[i] = t->mu0[i] = jt->osc.mu;
+		t->mu_lo[i] = fmax(jt->osc.mu / TUNE_MU_RANGE, mr.min);
+		t->mu_hi[i] = fmin(jt->osc.mu * TUNE_MU_RANGE, mr.max);
 		t->j[i].cross_t = NAN;
 		t->j[i].hyst = TUNE_HYST_MIN;
 	}
@@ -463,7 +479,7 @@ static void tune_update(struct tune *t, const struct tune_window *w, bool stuck)
 		step[c] *= scale;
 	double kr = exp(step[0]);
 	bool pinned = false;
-	double k = tune_clamp(t->k * kr, 1.0 / TUNE_K_RANGE, TUNE_K_RANGE);
+	double k = tune_clamp(t->k * kr, t->k_lo, t->k_hi);
 	pinned = pinned || (k != t->k * kr && fabs(w->freq / ft - 1.0) > TUNE_TOLERANCE);
 	kr = k / t->k;
 	t->k = k;
@@ -476,7 +492,7 @@ static void tune_update(struct tune *t, const struct tune_window *w, bool stuck)
 		starved = starved || w->amp[i] < at * (1.0 - TUNE_TOLERANCE);
 	for (size_t i = 0; i < t->n; i++) {
 		double mr = exp(step[i + 1]);
-		double mu = tune_clamp(t->mu[i] * mr, t->mu0[i] / TUNE_MU_RANGE, t->mu0[i] * TUNE_MU_RANGE);
+		double mu = tune_clamp(t->mu[i] * mr, t->mu_lo[i], t->mu_hi[i]);
 		bool clamped = mu != t->mu[i] * mr && fabs(w->amp[i] / at - 1.0) > TUNE_TOLERANCE;
 		if (clamped && w->amp[i] < at && mu < t->mu0[i])
 			starved = true;

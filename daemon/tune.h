@@ -106,6 +106,8 @@ struct tune {
 	struct tune_window best, result;
 	bool have_best;
 	double mu0[CFG_MAX_JOINTS];      /* the starting μ (the search stays near it) */
+	double k_lo, k_hi;               /* the search box of the k factor ... */
+	double mu_lo[CFG_MAX_JOINTS], mu_hi[CFG_MAX_JOINTS];   /* ... and of each μ (tune_init) */
 	int pinned;                      /* windows in a row that wanted k or μ beyond the search range */
 	double supply_v;                 /* V the servos report (NaN: not yet) */
 	double no_load_speed;            /* rad/s at 12 V (the configuration's) */

@@ -315,6 +315,44 @@ static void test_targets_checked_against_the_configuration(void **state)
 	assert_false(tune_init(&t, &o, c, why, sizeof why));
 }
 
+/* The tuner sets parameters as a command would: never past the ranges the
+ * configuration accepts (k <= 10, the natural frequency <= 5 Hz). A plant
+ * that would need k beyond them gets "out of reach", and nothing the daemon
+ * ran with was refusable. */
+static void test_search_stays_inside_the_configuration_ranges(void **state)
+{
+	(void)state;
+	struct run r;
+	memset(&r, 0, sizeof r);
+	r.cfg = base_cfg(2);
+	struct cfg_errors e = { 0 };
+	assert_true(cfg_override(r.cfg, "joint.1.k=6", &e) && cfg_override(r.cfg, "joint.2.k=6", &e));
+	assert_true(cfg_override(r.cfg, "joint.1.inertia=0.02", &e) && cfg_override(r.cfg, "joint.2.inertia=0.02", &e));
+	assert_true(cfg_finish(r.cfg, &e));
+	r.k0 = 6;
+	r.mu0[0] = r.cfg->joint[0].osc.mu;
+	r.mu0[1] = r.cfg->joint[1].osc.mu;
+	r.lead0 = r.cfg->servo_lead_s;
+	struct tune_opts o = { .target_freq = 0.8, .target_amp = 0.8, .max_s = 90 };
+	char why[TUNE_TEXT];
+	assert_true(tune_init(&r.t, &o, r.cfg, why, sizeof why));
+	struct plant p = { .f0 = 0.35, .a0 = { 0.8, 0.8 }, .ef = 0.66, .ea = 0.4 };
+	double kmax = 0;
+	while (r.t.state != TUNE_DONE && r.t.state != TUNE_FAILED && r.time < 95) {
+		drive(&r, &p, 0.5);
+		for (int j = 0; j < 2; j++) {
+			kmax = fmax(kmax, r.cfg->joint[j].osc.k);
+			char jwhy[128];
+			assert_true(cfg_joint_check(&r.cfg->joint[j], jwhy, sizeof jwhy));
+			struct cfg_range kr;
+			assert_true(cfg_param_range("k", &kr) && r.cfg->joint[j].osc.k <= kr.max);
+		}
+	}
+	assert_int_equal(r.t.state, TUNE_FAILED);
+	assert_non_null(strstr(r.t.why, "out of reach"));
+	assert_true(kmax > 9.0);   /* it went to the edge, not past it */
+}
+
 /* Bad samples (NaN angles, time going backwards) neither crash nor count. */
 static void test_bad_samples(void **state)
 {
@@ -377,6 +415,7 @@ int main(void)
 		cmocka_unit_test(test_dead_loop_torque_fails),
 		cmocka_unit_test(test_starter_again_is_a_stall),
 		cmocka_unit_test(test_targets_checked_against_the_configuration),
+		cmocka_unit_test(test_search_stays_inside_the_configuration_ranges),
 		cmocka_unit_test(test_bad_samples),
 		cmocka_unit_test(test_written_configuration_loads),
 	};
