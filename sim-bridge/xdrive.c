@@ -5,7 +5,7 @@
  *   Goal Velocity -> acceleration ramp -> Velocity Trajectory -> PI -> PWM
  *   Goal PWM -> PWM                                   (PWM Control Mode)
  *   Goal Current -> current loop -> torque            (XM430: Current Control)
- *   PID -> current (<= Goal Current) -> current loop  (XM430: Current-based Position)
+ *   PID -> PWM, current <= Goal Current               (XM430: Current-based Position)
  *
  * A PWM share u drives the motor's line tau = tau_stall(V)·(u − w/w0(V)) (as
  * the AX-12A's H-bridge, motor.c); a current loop holds its torque with no
@@ -172,10 +172,12 @@ static double xdrive_position_pid(struct sim_xdrive *d, const struct sim_xdrive_
 	       c->ff2 / GAIN_FF_DIV * d->traj_acc / (MS_PER_S * MS_PER_S);
 }
 
-/* The velocity loop's output in PWM units. */
+/* The velocity loop's output in PWM units. Its error is taken in pulses a
+ * second (PHYSICS.md §5: in 0.229 rpm units the factory gains would need
+ * 0.6 s to reach a goal velocity, a wheel the watchdog stops as long). */
 static double xdrive_velocity_pi(struct sim_xdrive *d, const struct sim_xdrive_cmd *c, double speed, double dt)
 {
-	double e = (d->traj_vel - speed) / SIM_XDRIVE_PULSES_PER_VEL_UNIT;
+	double e = d->traj_vel - speed;
 	double ki = c->vel_i / GAIN_I_DIV;
 	d->vel_integral += e * dt * MS_PER_S;
 	if (ki > 0)
@@ -188,11 +190,6 @@ double sim_xdrive_cap(const struct sim_xdrive_cmd *c, double stall)
 	if (c->current_limit < 0)
 		return stall;
 	return fmin(stall, c->current_limit * SIM_XDRIVE_AMPS_PER_UNIT * c->torque_constant);
-}
-
-static bool xdrive_current_mode(uint8_t mode)
-{
-	return mode == MODE_CURRENT || mode == MODE_CURPOS;
 }
 
 /* A torque asked of the current loop, bounded by what full PWM (at most
@@ -261,18 +258,14 @@ void sim_xdrive_step(struct sim_xdrive *d, const struct sim_xdrive_cmd *c, const
 		xdrive_current_line(d, c, p, c->goal_current * SIM_XDRIVE_AMPS_PER_UNIT * c->torque_constant, w, ulim, out);
 		return;
 	}
-	if (xdrive_current_mode(c->mode)) {
-		/* the PID's full output stands for the stall current; Goal Current
-		 * limits it */
-		double amps = pwm / SIM_XDRIVE_PWM_FULL * c->stall_current;
-		double lim = fabs((double)c->goal_current) * SIM_XDRIVE_AMPS_PER_UNIT;
-		xdrive_current_line(d, c, p, clamp(amps, -lim, lim) * c->torque_constant, w, ulim, out);
-		return;
-	}
 	d->duty = clamp(pwm / SIM_XDRIVE_PWM_FULL, -ulim, ulim);
 	out->a = c->dir * d->duty * stall;
 	/* back-EMF damping tau_stall / w0 does not depend on the supply */
 	out->c = p->stall_torque_12v / p->no_load_speed_12v;
 	out->cap = sim_xdrive_cap(c, stall);
+	/* Current-based Position: the same loop, its current held to Goal
+	 * Current (e-manual: "sets a limit to current") */
+	if (c->mode == MODE_CURPOS)
+		out->cap = fmin(out->cap, fabs((double)c->goal_current) * SIM_XDRIVE_AMPS_PER_UNIT * c->torque_constant);
 	out->duty = c->dir * d->duty;
 }

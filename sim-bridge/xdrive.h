@@ -55,7 +55,6 @@ struct sim_xdrive_cmd {
 	uint16_t pos_p, pos_i, pos_d, ff1, ff2;   /* Position PID Gain, Feedforward (raw table values) */
 	uint16_t vel_p, vel_i;         /* Velocity PI Gain (raw) */
 	double torque_constant;        /* N·m/A */
-	double stall_current;          /* A at 12 V: the current a full PID output stands for */
 	uint32_t goal_seq;             /* bumped on every write of a goal: a new profile */
 	uint32_t reset_seq;            /* bumped when the loops restart (mode, torque, reboot) */
 };
@@ -72,7 +71,7 @@ struct sim_xdrive {
 	enum sim_xdrive_profile profile;
 	bool profile_ongoing;
 	double pos_integral;           /* pulse·ms */
-	double vel_integral;           /* velocity unit·ms */
+	double vel_integral;           /* pulse/s·ms */
 	double duty;                   /* share of full PWM commanded, servo coordinates */
 	double torque_cmd;             /* N·m asked of a current loop (current modes) */
 };

@@ -190,6 +190,7 @@ static void xservo_boot(struct sim_xservo *s, double angle)
 	s->conditions = s->latched = 0;
 	s->mem[A_HWERR] = 0;
 	s->overload_s = s->since_packet_s = s->uptime_s = 0;
+	put(s, DXL2_X_REALTIME_TICK, 0);
 	s->reg_pending = false;
 	s->turn_offset = 0;
 	put(s, DXL2_X_PRESENT_POSITION, xservo_present(s, angle));
@@ -690,7 +691,6 @@ int sim_xservo_handle_bad_crc(struct sim_xservo *s, uint8_t id, uint8_t instr, u
 
 void sim_xservo_drive_cmd(const struct sim_xservo *s, struct sim_xdrive_cmd *c)
 {
-	const struct sim_model_info *mi = sim_model_info(s->model);
 	bool xm = has_reg(s, DXL2_X_GOAL_CURRENT);
 	int32_t pwm_limit = get(s, DXL2_X_PWM_LIMIT), goal_pwm = get(s, DXL2_X_GOAL_PWM);
 	*c = (struct sim_xdrive_cmd){
@@ -718,7 +718,6 @@ void sim_xservo_drive_cmd(const struct sim_xservo *s, struct sim_xdrive_cmd *c)
 		.vel_p = (uint16_t)get(s, DXL2_X_VELOCITY_P_GAIN),
 		.vel_i = (uint16_t)get(s, DXL2_X_VELOCITY_I_GAIN),
 		.torque_constant = sim_model_torque_constant(s->model),
-		.stall_current = mi->stall_current_a,
 		.goal_seq = s->goal_seq,
 		.reset_seq = s->reset_seq,
 	};
@@ -833,7 +832,7 @@ void sim_xservo_sense(struct sim_xservo *s, const struct sim_xservo_sense *in, d
 		return;
 	s->uptime_s += dt;
 	xservo_present_values(s, in);
-	put(s, DXL2_X_REALTIME_TICK, (int32_t)((uint64_t)(s->uptime_s * 1000.0) % TICK_WRAP_MS));
+	put(s, DXL2_X_REALTIME_TICK, (int32_t)((uint64_t)llround(s->uptime_s * 1000.0) % TICK_WRAP_MS));
 	xservo_motion(s, in->drive);
 	xservo_conditions(s, in, dt);
 	xservo_watchdog(s, dt);
