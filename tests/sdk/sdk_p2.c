@@ -142,6 +142,21 @@ static void reg_write_action(void)
 	uint32_t after = read4ByteTxRx(port, P2, xl, A_GOAL_POS);
 	result(good() && after == 2300 && read1ByteTxRx(port, P2, xl, A_REGISTERED) == 0,
 	       "action (broadcast): the registered goal is written", "goal %u; %s", after, said());
+	/* the TxOnly forms: REG_WRITE and a 4-byte WRITE whose status is not read */
+	setDataWrite(port, P2, 4, 0, 2350);
+	regWriteTxOnly(port, P2, xl, A_GOAL_POS, 4);
+	ms(20);
+	action2(port, BROADCAST_ID);
+	ms(5);
+	after = read4ByteTxRx(port, P2, xl, A_GOAL_POS);
+	result(good() && after == 2350, "regWriteTxOnly + action (broadcast)", "goal %u; %s", after, said());
+	write4ByteTxOnly(port, P2, xl, A_GOAL_POS, 2450);
+	ms(20);
+	after = read4ByteTxRx(port, P2, xl, A_GOAL_POS);
+	result(good() && after == 2450, "write4ByteTxOnly: goal position", "goal %u; %s", after, said());
+	write2ByteTxOnly(port, P2, xm, A_VEL_P, 120);
+	ms(20);
+	result(read2ByteTxRx(port, P2, xm, A_VEL_P) == 120 && good(), "write2ByteTxOnly: velocity P gain", "%s", said());
 	/* unicast ACTION: the e-manual's Action example has a status packet;
 	 * the SDK's txRxPacket2 does not wait for one (INST_ACTION) */
 	setDataWrite(port, P2, 4, 0, 2400);

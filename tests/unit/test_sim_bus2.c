@@ -264,6 +264,28 @@ static void test_bad_input_counters(void **state)
 	assert_int_equal(drain(&b, out, sizeof out, &first, &last), 14);
 }
 
+/* The adapter's latency and a single-wire echo act on a 2.0 bus as on 1.0. */
+static void test_latency_and_echo(void **state)
+{
+	(void)state;
+	struct sim_bus b;
+	uint8_t out[64];
+	int64_t first, last;
+	static const uint8_t ids[] = { 1 };
+	bus_x(&b, ids, 1, 1000000);
+	b.latency_ns = 16 * MS;
+	b.echo = true;
+	static const uint8_t ping[] = { HDR, 0x01, 0x03, 0x00, 0x01, 0x19, 0x4E };
+	sim_bus_feed(&b, ping, sizeof ping, 0);
+	size_t n = drain(&b, out, sizeof out, &first, &last);
+	assert_int_equal(n, 24);
+	assert_memory_equal(out, ping, sizeof ping);   /* our own bytes first */
+	assert_int_equal(first, 16 * MS + 10 * US);
+	assert_int_equal(last, 16 * MS + 240 * US);
+	struct dxl2_packet st;
+	assert_int_equal(statuses(out + 10, 14, &st, 1, NULL), 1);
+}
+
 /* A servo at another baud rate hears nothing. */
 static void test_wrong_baud(void **state)
 {
@@ -383,6 +405,7 @@ int main(void)
 		cmocka_unit_test(test_broadcast_ping_in_id_order),
 		cmocka_unit_test(test_bad_crc_reply),
 		cmocka_unit_test(test_bad_input_counters),
+		cmocka_unit_test(test_latency_and_echo),
 		cmocka_unit_test(test_wrong_baud),
 		cmocka_unit_test(test_faults_on_status2),
 		cmocka_unit_test(test_stuck_error_vocabularies),
