@@ -72,6 +72,12 @@ static bool has_reg(const struct sim_xservo *s, uint16_t addr)
 
 uint8_t sim_xservo_id(const struct sim_xservo *s) { return s->mem[DXL2_X_ID]; }
 
+static bool is_goal(uint16_t addr)
+{
+	return addr == DXL2_X_GOAL_PWM || addr == DXL2_X_GOAL_CURRENT || addr == DXL2_X_GOAL_VELOCITY ||
+	       addr == DXL2_X_GOAL_POSITION;
+}
+
 uint8_t sim_xservo_alert(const struct sim_xservo *s)
 {
 	return s->mem[A_HWERR] ? DXL2_ERR_ALERT : 0;
@@ -119,8 +125,10 @@ int sim_xservo_poke(struct sim_xservo *s, uint16_t addr, int32_t value)
 		return DXL_OK;
 	}
 	dxl2_reg_encode(r, value, &s->mem[addr]);
-	s->goal_seq++;
-	s->reset_seq++;
+	if (is_goal(addr))
+		s->goal_seq++;   /* a poked goal starts a profile as a written one */
+	if (addr == A_TORQUE || addr == A_MODE)
+		s->reset_seq++;
 	return DXL_OK;
 }
 
@@ -274,12 +282,6 @@ static void xservo_count(struct sim_xservo *s, uint8_t errnum)
 }
 
 /* ---- writes ----------------------------------------------------------------------- */
-
-static bool is_goal(uint16_t addr)
-{
-	return addr == DXL2_X_GOAL_PWM || addr == DXL2_X_GOAL_CURRENT || addr == DXL2_X_GOAL_VELOCITY ||
-	       addr == DXL2_X_GOAL_POSITION;
-}
 
 /* Every byte of [addr, addr+n) in a register the servo lets be written now:
  * read-only, undefined, or EEPROM with torque on is the access error. */
