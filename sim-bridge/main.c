@@ -55,6 +55,13 @@
 /* pollset tags below the control socket's (-3 - client): the lockstep socket
  * and its daemons */
 #define MAIN_TAG_VT_LISTEN (-1000)
+/* Lockstep: reply bytes are handed over in chunks of this much wire time (in
+ * real time, --tx-slice-us). A whole reply (READ(24,20): 26 bytes, 260 µs at
+ * 1 Mbps) is then one chunk and one wake-up of its daemon, not two or three;
+ * the daemon acts on whole packets only, and the chunk is released at its
+ * last byte's wire time, never earlier. Measured on the pair rig: 3.6 wake-ups
+ * a daemon per cycle with 100 µs chunks. */
+#define MAIN_LOCKSTEP_SLICE_NS 500000
 #define MAIN_TAG_VT_CLIENT (-2000)
 /* Step lateness histogram for percentiles: 10 µs bins up to 20 ms (the last
  * bin holds everything later). */
@@ -1164,6 +1171,8 @@ int main(int argc, char **argv)
 		}
 		app.lockstep = true;
 		app.lockstep_grace_ns = (int64_t)llround(opt.lockstep_grace_s * 1e9);
+		if (app.tx_slice_ns < MAIN_LOCKSTEP_SLICE_NS)
+			app.tx_slice_ns = MAIN_LOCKSTEP_SLICE_NS;
 		sim.robot_command = lockstep_robot_command;
 		sim.robot_command_ctx = &app;
 	}
