@@ -115,7 +115,8 @@ start_daemon() {
 # retried: " (N start-up retried)" or nothing
 retried() { [ "${1:-0}" != nan ] && [ "${1:-0}" -gt 0 ] && echo "; $1 start-up retried"; }
 
-url() { echo "udpm://239.255.76.67:$1?ttl=0"; }
+# TEST_PORT_OFFSET moves every port, as it does the tests': two runs side by side do not hear each other
+url() { echo "udpm://239.255.76.67:$(($1 + ${TEST_PORT_OFFSET:-0}))?ttl=0"; }
 now_us() { echo $(($(date +%s%N) / 1000)); }
 # utime + stime of a process, in clock ticks (fields 14 and 15 of stat; the
 # name field may hold spaces, so count from after its closing parenthesis).
@@ -439,6 +440,59 @@ section_bus() {
 				sum "bus time per cycle, 2 servos, return delay 0, 1 Mbps (simulated bus)" "≤ 1.5× the wire floor ($floor µs)" "$what"
 			fi
 		done
+	done
+	say ""
+	bus2_table
+}
+
+# ---- 2b: the Protocol 2.0 cycle --------------------------------------------------
+# bus2_run N: buscycle's 2.0 cycle (one SYNC_READ of present current, velocity
+# and position, 10 bytes a servo, and one SYNC_WRITE of 4-byte goals) on the
+# simulator's XM430-W350 servos when it has them (--model), else on
+# buscycle's in-process fake X bus. Return delay 0, 1 Mbps.
+bus2_run() {
+	local n=$1 d=$T/bus out=$T/bus/bc2-$1.txt
+	mkdir -p "$d"
+	if "$SIM" --model xm430-w350 --help 2>&1 | grep -q "unrecognized option '--model'"; then
+		"$HB/buscycle" --port fake --protocol 2 --read-len 10 --ids "$(ids_upto "$n")" --cycles "$CYCLES" \
+			--margin-us "$MARGIN_US" >"$out" 2>"$d/bc2-$n.err" || echo "status not measured: buscycle failed ($(tail -n1 "$d/bc2-$n.err"))" >"$out"
+		echo "bus fake" >>"$out"
+		return 0
+	fi
+	start "sim-bc2-$n" "$SIM" --model xm430-w350 --link "$d/bc2-$n.pty" --ids "$(ids_upto "$n")" --return-delay 0 --quiet
+	if ! wait_ready "sim-bc2-$n" 'ready:' 10; then
+		echo "status not measured: the simulator refused $n X servos on one bus ($(why "sim-bc2-$n"))" >"$out"
+	elif ! "$HB/buscycle" --port "$d/bc2-$n.pty" --protocol 2 --read-len 10 --ids "$(ids_upto "$n")" \
+		--cycles "$CYCLES" --margin-us "$MARGIN_US" >"$out" 2>"$d/bc2-$n.err"; then
+		echo "status not measured: buscycle failed ($(tail -n1 "$d/bc2-$n.err"))" >"$out"
+	fi
+	echo "bus simulator" >>"$out"
+	stop "sim-bc2-$n"
+}
+
+bus2_table() {
+	local n b floor1
+	progress "2/5 bus time per cycle: the Protocol 2.0 cycle, 2/6/18 servos, $CYCLES cycles each"
+	for n in 2 6 18; do bus2_run $n; done
+	say "### Protocol 2.0 (X series): one SYNC_READ, one SYNC_WRITE"
+	say ""
+	say "One cycle = SYNC_READ of present current, velocity and position (10 bytes a servo: a request of"
+	say "14 + N bytes, N replies of 21) and SYNC_WRITE of 4-byte goal positions (14 + 5N bytes); return"
+	say "delay 0, 1 Mbps. Floor = wire time at 10 bits a byte, no byte stuffed; 1.0's floor (above) beside it."
+	say "Measured as above: from the SYNC_READ to the SYNC_WRITE handed to the port."
+	say ""
+	say "| servos | 1.0 floor (µs) | 2.0 floor (µs) | of it the SYNC_READ | bus | p50 | p99 | max | p50/2.0 floor | p50/SYNC_READ floor | replies missed |"
+	say "|---|---|---|---|---|---|---|---|---|---|---|"
+	for n in 2 6 18; do
+		b=$T/bus/bc2-$n.txt
+		floor1=$(awk -v n="$n" 'BEGIN { print n * 200 + (3 * n + 8) * 10 }')
+		if [ "$(v "$b" status)" = not ]; then
+			say "| $n | $floor1 | – | – | – | $(sed -n 's/^status //p' "$b") | – | – | – | – | – |"
+			continue
+		fi
+		say "| $n | $floor1 | $(v "$b" floor_us) | $(v "$b" floor_reads_us) | $(v "$b" bus) | $(v "$b" bus_p50) | $(v "$b" bus_p99) |" \
+			"$(v "$b" bus_max) | $(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_us)") |" \
+			"$(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_reads_us)") | $(v "$b" timeouts) of $((n * CYCLES)) |"
 	done
 	say ""
 }
