@@ -219,6 +219,24 @@ void cin_local_datagram(struct cin *in, const uint8_t *d, size_t n, bool truncat
 	cin_take(in, &c);
 }
 
+void cin_clock_command(struct cin *in, const char *text)
+{
+	struct cin_cmd c = { .local = false, .direct = true };
+	char why[256];
+	in->received++;
+	snprintf(c.who, sizeof c.who, "the lockstep clock (the simulator's schedule)");
+	snprintf(c.w.source, sizeof c.w.source, "lockstep");
+	snprintf(c.w.robot, sizeof c.w.robot, "%s", in->cfg->name);
+	if (!cmd_parse_text(text, &c.w.req, c.w.param, sizeof c.w.param, why, sizeof why)) {
+		cin_reject(in, &c, why);
+		return;
+	}
+	c.w.req.source = c.w.source;
+	c.w.req.robot = c.w.robot;
+	c.w.req.utime = cin_wall(in);
+	cin_take(in, &c);
+}
+
 /* A signed command from the network: authentic, fresh, never seen. */
 static bool cin_authentic(struct cin *in, struct cin_cmd *c, const uint8_t *payload, char *why, size_t cap)
 {

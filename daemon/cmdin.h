@@ -101,6 +101,11 @@ void cin_on_network(struct cin *in);
  * and fuzzers call these directly). */
 void cin_local_datagram(struct cin *in, const uint8_t *d, size_t n, bool truncated, const struct csock_peer *peer);
 void cin_network_datagram(struct cin *in, const uint8_t *d, size_t n, bool truncated);
+/* A command the lockstep clock delivered (common/lockstep.h): the text of
+ * `undulated --command`, parsed and checked as a local one and queued for the
+ * cycle boundary like any other; answered in the log and on the event
+ * channel (the simulator that sent it reads neither). */
+void cin_clock_command(struct cin *in, const char *text);
 /* The cycle boundary: apply the queued commands to the controller and the
  * configuration it reads, answer each. */
 void cin_apply(struct cin *in, struct ctl *ctl, struct cfg *cfg);

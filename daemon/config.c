@@ -338,6 +338,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("stall_torque", T_DOUBLE, stall_torque, 0.01, 100),
 	K("no_load_speed", T_DOUBLE, no_load_speed, 0.01, 1000),
 	K("bus_margin_us", T_LONG, bus_margin_us, 0, 100000),
+	K("lockstep", T_STR, lockstep, 0, 0),
 	K("ramp_s", T_DOUBLE, ramp_s, 0, 10),
 	K("backoff_torque", T_DOUBLE, backoff_torque, 0, 1),
 	K("fault_backoff_s", T_DOUBLE, fault_backoff_s, 0.05, 600),
@@ -767,7 +768,7 @@ void cfg_print(const struct cfg *c, void *file)
 	        "actuation = %s\ntorque_drive = %s\nstall_torque = %g\nno_load_speed = %g\n"
 	        "bus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
 	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\nsilent_s = %g\n"
-	        "command_key = %s\ncommand_window_s = %g\nrun_dir = %s\n",
+	        "command_key = %s\ncommand_window_s = %g\nrun_dir = %s\nlockstep = %s\n",
 	        cfg_mode_name(c->mode), c->lcm_url, c->priority, c->mlockall ? "on" : "off",
 	        safe[c->safe_stop], safe[c->fault_action],
 	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
@@ -776,7 +777,7 @@ void cfg_print(const struct cfg *c, void *file)
 	        c->torque_drive == CFG_DRIVE_CURRENT ? "current" : "pwm", c->stall_torque, c->no_load_speed,
 	        c->bus_margin_us,
 	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit, c->silent_s,
-	        c->command_key, c->command_window_s, c->run_dir);
+	        c->command_key, c->command_window_s, c->run_dir, c->lockstep);
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ninertia = %g\nfriction = %g\n"

@@ -78,6 +78,7 @@ struct cfg {
 	double stall_torque;           /* N·m at 12 V and full output (AX-12A: 1.5) */
 	double no_load_speed;          /* rad/s at 12 V and full output (AX-12A: 59 rpm = 6.18) */
 	long bus_margin_us;            /* slack added to every bus timeout */
+	char lockstep[CFG_PATH_MAX];   /* the simulator's lockstep socket: virtual time ("": real time) */
 	double ramp_s;                 /* blend time for start-up and mode switches */
 	double backoff_torque;         /* torque limit (fraction of max) while a joint backs off */
 	double fault_backoff_s;        /* wait before a recovery attempt */

@@ -34,6 +34,7 @@
 #include "control.h"
 #include "cycle.h"
 #include "dxl.h"
+#include "lockstep.h"
 #include "log.h"
 #include "notify.h"
 #include "port.h"
@@ -84,6 +85,12 @@ struct dmn {
 	/* systemd */
 	uint64_t watchdog_interval_us, last_watchdog_us, watchdog_cycle;
 	bool stop;
+	/* lockstep: the simulator's clock paces the loop (common/lockstep.h) */
+	bool lockstep;
+	struct lks_client lks;
+	struct port_lockstep lks_port;
+	uint64_t next_tick_us;        /* lockstep: the next tick on the period's grid */
+	bool clock_lost;              /* lockstep: the simulator went away mid-run */
 	/* --tune: the tuner, fed every cycle (NULL in normal runs) */
 	struct tune *tune;
 	FILE *tune_out;
@@ -282,7 +289,13 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 		return false;
 	}
 	struct bus_io io;
-	port_bus_io(d->port, &io);
+	if (d->lockstep) {
+		/* what was announced for a port closed since is not coming */
+		d->lks.consumed = d->lks.delivered;
+		port_bus_io_lockstep(&d->lks_port, d->port, &d->lks, &io);
+	} else {
+		port_bus_io(d->port, &io);
+	}
 	struct bus_timing tm = {
 		.baud = d->cfg->baud, .return_delay_us = DMN_DEFAULT_RETURN_DELAY_US,
 		.adapter_latency_us = d->cfg->adapter_latency_us > 0 ? (uint32_t)d->cfg->adapter_latency_us : 0,
@@ -446,12 +459,10 @@ static void dmn_bus_event(struct dmn *d)
 	dmn_drive(d, cyc_step(&d->cyc));
 }
 
-static void dmn_tick(struct dmn *d)
+/* A tick at now; exp periods have passed since the last (more than one:
+ * whole periods were missed). */
+static void dmn_tick_at(struct dmn *d, uint64_t exp, uint64_t now)
 {
-	uint64_t exp = 0;
-	if (read(d->timer_fd, &exp, sizeof exp) != (ssize_t)sizeof exp || exp == 0)
-		return;
-	uint64_t now = now_us();
 	d->ticks += exp;
 	if (exp > 1) {
 		/* whole periods were missed: skip them, keep the phase */
@@ -502,6 +513,14 @@ static void dmn_tick(struct dmn *d)
 	dmn_drive(d, cyc_start(&d->cyc));
 }
 
+static void dmn_tick(struct dmn *d)
+{
+	uint64_t exp = 0;
+	if (read(d->timer_fd, &exp, sizeof exp) != (ssize_t)sizeof exp || exp == 0)
+		return;
+	dmn_tick_at(d, exp, now_us());
+}
+
 /* ---- set-up and the loop ----------------------------------------------------------------------- */
 static void dmn_realtime(const struct cfg *cfg)
 {
@@ -547,6 +566,10 @@ static void dmn_close_fds(struct dmn *d)
 static void dmn_start_timer(struct dmn *d)
 {
 	d->first_tick_us = now_us() + d->period_us;
+	d->next_tick_us = d->first_tick_us;
+	d->second_start_us = now_us();
+	if (d->lockstep)
+		return;   /* the ticks are virtual: dmn_loop_lockstep */
 	struct itimerspec its = {
 		.it_interval = { .tv_sec = (time_t)(d->period_us / 1000000),
 		                 .tv_nsec = (long)(d->period_us % 1000000) * 1000 },
@@ -554,7 +577,6 @@ static void dmn_start_timer(struct dmn *d)
 		              .tv_nsec = (long)(d->first_tick_us % 1000000) * 1000 },
 	};
 	timerfd_settime(d->timer_fd, TFD_TIMER_ABSTIME, &its, NULL);
-	d->second_start_us = now_us();
 }
 
 static bool dmn_signal(struct dmn *d)
@@ -615,6 +637,87 @@ static void dmn_loop(struct dmn *d)
 	}
 }
 
+/* ---- lockstep: the simulator's clock instead of the timers ------------------------------------ */
+static void dmn_clock_lost(struct dmn *d, const char *why)
+{
+	log_error("%s: stopping, without a safe stop (the simulated servos went with the simulator)", why);
+	d->clock_lost = true;
+	d->stop = true;
+}
+
+/* Commands the clock delivered: applied at the next cycle boundary, as the
+ * local socket's are. */
+static void dmn_clock_commands(struct dmn *d)
+{
+	char text[LKS_TEXT_MAX];
+	while (lks_client_next_cmd(&d->lks, text, sizeof text))
+		cin_clock_command(&d->cin, text);
+}
+
+/* Virtual time moved to now: the bus's reply or deadline, then the tick. */
+static void dmn_clock_moved(struct dmn *d, uint64_t now)
+{
+	if (d->connected && bus_is_pending(&d->bus))
+		dmn_bus_event(d);
+	if (now >= d->next_tick_us) {
+		uint64_t exp = 1 + (now - d->next_tick_us) / d->period_us;
+		d->next_tick_us += exp * d->period_us;
+		dmn_tick_at(d, exp, now);
+	}
+}
+
+/* The loop in lockstep: the same work as dmn_loop(), paced by the simulator.
+ * Before blocking, tell it until when there is nothing to do (the next tick,
+ * the bus deadline) and whether the bus awaits a reply; then wait for its
+ * TIME (and for signals and commands, as ever). */
+static void dmn_loop_lockstep(struct dmn *d)
+{
+	enum { P_CLOCK, P_SIGNAL, P_LOCAL, P_NET, P_N };
+	char why[256];
+	while (!d->stop) {
+		uint64_t wake = d->next_tick_us;
+		uint64_t dl = d->connected ? cyc_deadline_us(&d->cyc) : 0;
+		if (dl != 0 && dl < wake)
+			wake = dl;
+		if (lks_client_wait(&d->lks, wake, d->connected && bus_is_pending(&d->bus)) != 0) {
+			dmn_clock_lost(d, "lockstep: the simulator is gone");
+			return;
+		}
+		struct pollfd pfd[P_N];
+		pfd[P_CLOCK] = (struct pollfd){ .fd = d->lks.fd, .events = POLLIN };
+		pfd[P_SIGNAL] = (struct pollfd){ .fd = d->signal_fd, .events = POLLIN };
+		pfd[P_LOCAL] = (struct pollfd){ .fd = cin_local_fd(&d->cin), .events = POLLIN };
+		pfd[P_NET] = (struct pollfd){ .fd = cin_net_fd(&d->cin), .events = POLLIN };
+		if (poll(pfd, P_N, -1) < 0) {
+			if (errno == EINTR)
+				continue;
+			log_error("poll: %s", strerror(errno));
+			return;
+		}
+		if ((pfd[P_SIGNAL].revents & POLLIN) && dmn_signal(d))
+			return;
+		if (pfd[P_LOCAL].revents & POLLIN)
+			cin_on_local(&d->cin);
+		if (pfd[P_NET].revents & POLLIN)
+			cin_on_network(&d->cin);
+		if (!(pfd[P_CLOCK].revents & (POLLIN | POLLHUP | POLLERR)))
+			continue;
+		int r = lks_client_read(&d->lks, why, sizeof why);
+		if (r <= 0) {
+			dmn_clock_lost(d, r == 0 ? "lockstep: the simulator closed the clock" : why);
+			return;
+		}
+		dmn_clock_commands(d);
+		if (d->lks.stop) {
+			log_info("lockstep: the simulator ended the run (%s): stopping", d->lks.stop_why);
+			d->stop = true;
+			return;
+		}
+		if (lks_client_take_time(&d->lks))
+			dmn_clock_moved(d, now_us());
+	}
+}
+
 static bool dmn_open(struct dmn *d, int *status)
 {
 	char why[512];
@@ -650,6 +753,7 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	static struct dmn dmn;   /* large (bus stats per ID): not on the stack */
 	struct dmn *d = &dmn;
 	memset(d, 0, sizeof *d);
+	d->lks.fd = -1;
 	d->cfg = cfg;
 	d->tune = tune;
 	d->tune_out = tune_out;
@@ -674,10 +778,23 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	getrusage(RUSAGE_SELF, &d->ru_last);
 
 	char err[512];
+	if (cfg->lockstep[0] != '\0') {
+		/* from here on the clock is the simulator's: before the start-up
+		 * checks, whose bus transactions take virtual time too */
+		if (lks_client_open(&d->lks, cfg->lockstep, d->port_path, cfg->name, err, sizeof err) != 0) {
+			log_error("%s", err);
+			cin_close(&d->cin);
+			pub_close(&d->pub);
+			dmn_close_fds(d);
+			return 1;
+		}
+		d->lockstep = true;
+	}
 	d->epoch_us = now_us();
 	if (!dmn_connect(d, "start", err, sizeof err)) {
 		log_error("%s", err);
 		pub_event(&d->pub, 0, 2, "start-failed", err);
+		lks_client_close(&d->lks);
 		cin_close(&d->cin);
 		pub_close(&d->pub);
 		dmn_close_fds(d);
@@ -695,17 +812,22 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 		         cfg->lcm_url[0] ? " --lcm-url " : "", cfg->lcm_url[0] ? cfg->lcm_url : "");
 	dmn_realtime(cfg);
 	dmn_start_timer(d);
+	if (d->lockstep)
+		log_info("lockstep: virtual time from the simulator at %s", cfg->lockstep);
 	dmn_flush_ctl_events(d);
 	pub_params(&d->pub);
 	notify_send(&d->notify, "READY=1");
 	dmn_notify_status(d);
 	log_info("ready: %s, %.0f Hz", d->pub.ch_state, 1e6 / (double)d->period_us);
 
-	dmn_loop(d);
+	if (d->lockstep)
+		dmn_loop_lockstep(d);
+	else
+		dmn_loop(d);
 
 	notify_send(&d->notify, "STOPPING=1");
 	cyc_cut(&d->cyc);
-	if (d->connected)
+	if (d->connected && !d->clock_lost)
 		setup_safe_stop(&d->bus, &d->ctl, cfg);
 	char text[96];
 	snprintf(text, sizeof text, "%s",
@@ -713,9 +835,13 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	                                                                         : "joints holding (torque on)");
 	dmn_event(d, 0, 0, "stop", text);
 	dmn_close_port(d);
+	if (d->lks.resyncs > 0 || d->lks.cmds_dropped > 0)
+		log_warn("lockstep: %lld announced bus byte count(s) set right, %lld clock command(s) dropped",
+		         d->lks.resyncs, d->lks.cmds_dropped);
+	lks_client_close(&d->lks);
 	cin_close(&d->cin);
 	pub_close(&d->pub);
 	notify_close(&d->notify);
 	dmn_close_fds(d);
-	return 0;
+	return d->clock_lost ? 1 : 0;
 }

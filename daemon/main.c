@@ -43,6 +43,8 @@ static void main_usage(FILE *f)
 	        "      --robot NAME       = --set robot.name=NAME\n"
 	        "      --mode MODE        = --set robot.mode=MODE (limp|hold|sinusoid|oscillator)\n"
 	        "      --lcm-url URL      = --set robot.lcm_url=URL\n"
+	        "      --lockstep SOCKET  = --set robot.lockstep=SOCKET: run in the simulator's virtual\n"
+	        "                         time (undulate-sim --lockstep SOCKET), as fast as it goes\n"
 	        "      --check-config     validate the configuration, print it with -v, and exit\n"
 	        "  -v, --verbose          more log output (repeat for debug)\n"
 	        "  -q, --quiet            warnings and errors only\n"
@@ -72,7 +74,7 @@ static void main_usage(FILE *f)
 enum {
 	OPT_SET = 256, OPT_PORT, OPT_IDS, OPT_BAUD, OPT_ROBOT, OPT_MODE, OPT_LCM, OPT_CHECK, OPT_LOGLEVEL,
 	OPT_COMMAND, OPT_TIMEOUT, OPT_WATCH, OPT_KEY, OPT_SOURCE, OPT_GENKEY, OPT_TUNE, OPT_TFREQ, OPT_TAMP,
-	OPT_TTIME, OPT_OUT,
+	OPT_TTIME, OPT_OUT, OPT_LOCKSTEP,
 };
 
 struct main_args {
@@ -149,6 +151,7 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		{ "port", required_argument, NULL, OPT_PORT }, { "ids", required_argument, NULL, OPT_IDS },
 		{ "baud", required_argument, NULL, OPT_BAUD }, { "robot", required_argument, NULL, OPT_ROBOT },
 		{ "mode", required_argument, NULL, OPT_MODE }, { "lcm-url", required_argument, NULL, OPT_LCM },
+		{ "lockstep", required_argument, NULL, OPT_LOCKSTEP },
 		{ "check-config", no_argument, NULL, OPT_CHECK }, { "verbose", no_argument, NULL, 'v' },
 		{ "quiet", no_argument, NULL, 'q' }, { "log-level", required_argument, NULL, OPT_LOGLEVEL },
 		{ "command", required_argument, NULL, OPT_COMMAND }, { "timeout", required_argument, NULL, OPT_TIMEOUT },
@@ -174,6 +177,7 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		case OPT_ROBOT: a->robot = optarg; ok = ok && main_add(a, "name", optarg); break;
 		case OPT_MODE: ok = ok && main_add(a, "mode", optarg); break;
 		case OPT_LCM: a->lcm_url = optarg; ok = ok && main_add(a, "lcm_url", optarg); break;
+		case OPT_LOCKSTEP: ok = ok && main_add(a, "lockstep", optarg); break;
 		case OPT_CHECK: a->check = true; break;
 		case 'v': log_set_level(log_get_level() < LOG_LVL_DEBUG ? log_get_level() + 1 : LOG_LVL_DEBUG); break;
 		case 'q': log_set_level(LOG_LVL_WARN); break;

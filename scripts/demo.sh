@@ -20,7 +20,7 @@
 #                   [--daemon-set SEC.KEY=VAL]... [--start-mode MODE]
 #                   [--switch-at S|never] [--switch-to MODE] [--phases random|LIST]
 #                   [--seed N] [--window S] [--out DIR] [--lcm-url URL]
-#                   [--no-realtime]
+#                   [--no-realtime] [--lockstep]
 #
 # The robots start in --start-mode (default SINUSOID, each with its own phase:
 # random, or the comma-separated radians of --phases in scenario order) and are
@@ -36,6 +36,14 @@
 # its daemon at real-time priority (systemd/). Where it is not allowed each says
 # so once and runs with normal scheduling; --no-realtime (or DEMO_REALTIME=0)
 # never asks.
+#
+# --lockstep (or DEMO_LOCKSTEP=1) runs the same scenario with the same
+# programs in the simulator's virtual time, headless, as fast as the machine
+# allows: the simulator owns the clock and every daemon's cycle is paced by it
+# (sim-bridge/README.md, "Lockstep"). --seconds, --switch-at and the contact
+# samples are then simulated seconds from the start, the switch is a command
+# the simulator delivers to every daemon at that simulated time, and the same
+# --seed gives the same run.
 #
 # Everything runs in a private temporary directory on a private LCM port
 # (printed at start), so two demos, or a demo and the tests, never hear each
@@ -122,6 +130,7 @@ url=${DEMO_LCM_URL:-}
 RT_SIM=30
 RT_DAEMON=20
 realtime=${DEMO_REALTIME:-1}
+lockstep=${DEMO_LOCKSTEP:-0}
 # How long a program may take to say it is ready (s).
 READY_TIMEOUT_S=10
 
@@ -145,6 +154,7 @@ while [ $# -gt 0 ]; do
 	--out) out=$2; shift 2 ;;
 	--lcm-url) url=$2; shift 2 ;;
 	--no-realtime) realtime=0; shift ;;
+	--lockstep) lockstep=1; shift ;;
 	-h|--help) usage ;;
 	*) echo "demo: unknown argument '$1' (--help)" >&2; exit 2 ;;
 	esac
@@ -161,11 +171,10 @@ done
 [ "$switch_at" = never ] || is_number "$switch_at" || die "--switch-at: seconds or 'never'"
 is_number "$window" || die "--window: seconds"
 interactive=0
-[ -z "$seconds" ] && [ -t 1 ] && interactive=1
+[ -z "$seconds" ] && [ -t 1 ] && [ "$lockstep" != 1 ] && interactive=1
 if [ -z "$seconds" ] && [ "$interactive" -eq 0 ]; then
 	seconds=60  # not a terminal: nobody could watch or press Ctrl-C
 fi
-command -v lcm-logger >/dev/null || die "lcm-logger not found (Debian package liblcm-bin)"
 # Where the run is kept: created at the end, when there is something to keep.
 [ -n "$out" ] || out="$PWD/demo-out/$(date +%Y%m%d-%H%M%S)"
 case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
@@ -253,15 +262,34 @@ wait_ready() {
 # ---- logger -------------------------------------------------------------------
 # Always: the run is analysed and kept, watched live or not.
 log="$run/demo.lcmlog"
-# lcm-logger's -l option is broken in LCM 1.3.1: only --lcm-url= works.
-start logger lcm-logger --lcm-url="$url" --force "$log"
-wait_ready logger '^Opening log file' || exit 1
+# undulate-analyze --record rather than lcm-logger: LCM 1.3.1 queues 30
+# messages per subscription and drops the rest, which lcm-logger keeps; with
+# the robots publishing several times faster than in real time (lockstep),
+# or on a busy machine, a recorder that waits for a core lost messages.
+start logger "$B/undulate-analyze" --record "$log" --lcm-url "$url"
+wait_ready logger '^undulate-analyze: recording' || exit 1
 
 # ---- simulator --------------------------------------------------------------
-rt_sim=() rt_daemon=()
+rt_sim=() rt_daemon=() lk_sim=() lk_daemon=()
+[ "$lockstep" = 1 ] && realtime=0   # virtual time: no priority makes it truer
 if [ "$realtime" = 1 ]; then rt_sim=(--realtime "$RT_SIM"); rt_daemon=(--set "robot.priority=$RT_DAEMON"); fi
+if [ "$lockstep" = 1 ]; then
+	# The simulator ends the run after --seconds of simulated time; the
+	# contact samples (every CONTACT_SAMPLE_S, one just before the switch)
+	# and the switch are its scheduled events, at simulated times.
+	lk_sim=(--lockstep "$run/clock" --duration "$seconds")
+	t=0
+	while awk -v t="$t" -v s="$seconds" 'BEGIN { exit !(t <= s) }'; do
+		lk_sim+=(--set "events.$t=stats")
+		t=$(awk -v t="$t" 'BEGIN { print t + 5 }')
+	done
+	if [ "$switch_at" != never ] && awk -v a="$switch_at" -v s="$seconds" 'BEGIN { exit !(a < s) }'; then
+		lk_sim+=(--set "events.$switch_at=stats" --set "events.$switch_at=command * mode $switch_to")
+	fi
+	lk_daemon=(--lockstep "$run/clock")
+fi
 start sim "$B/undulate-sim" --scenario "$scenario" --link-dir "$links" --lcm-url "$url" \
-	--seed "$seed" ${rt_sim[@]+"${rt_sim[@]}"} ${sim_sets[@]+"${sim_sets[@]}"}
+	--seed "$seed" ${rt_sim[@]+"${rt_sim[@]}"} ${lk_sim[@]+"${lk_sim[@]}"} ${sim_sets[@]+"${sim_sets[@]}"}
 wait_ready sim '^undulate-sim: ready:' || exit 1
 # "ready: 4 buses: r1=/path/r1[1,2] r2=... bodies=..." names every robot, its
 # pty and its servo IDs, in scenario (left to right) order.
@@ -278,7 +306,10 @@ robot_phase=()
 if [ "$phases" = random ]; then
 	RANDOM=$seed
 	for _ in "${robots[@]}"; do
-		robot_phase+=("$(awk -v r="$RANDOM" 'BEGIN { printf "%.3f", (r / 32768.0) * 6.283185 - 3.141593 }')")
+		# drawn here, not inside $(...): bash reseeds RANDOM in every
+		# subshell, and the seed would not fix the phases
+		r=$RANDOM
+		robot_phase+=("$(awk -v r="$r" 'BEGIN { printf "%.3f", (r / 32768.0) * 6.283185 - 3.141593 }')")
 	done
 else
 	IFS=, read -r -a robot_phase <<<"$phases"
@@ -292,8 +323,14 @@ start_daemon() {
 	start "undulated-${robots[$i]}" "$B/undulated" --port "${ports[$i]}" --ids "${ids[$i]}" \
 		--robot "${robots[$i]}" --lcm-url "$url" --mode "$start_mode" \
 		--set "sinusoid.phase=${robot_phase[$i]}" ${rt_daemon[@]+"${rt_daemon[@]}"} \
-		${daemon_sets[@]+"${daemon_sets[@]}"}
+		${lk_daemon[@]+"${lk_daemon[@]}"} ${daemon_sets[@]+"${daemon_sets[@]}"}
 }
+# In lockstep every daemon starts at once: the simulated time (and so every
+# daemon's start-up) moves only once all of them have joined.
+if [ "$lockstep" = 1 ]; then
+	for i in "${!robots[@]}"; do start_daemon "$i"; done
+	for i in "${!robots[@]}"; do wait_ready "undulated-${robots[$i]}" 'ready:' || exit 1; done
+fi
 # Start-up attempts per daemon (see below).
 START_ATTEMPTS=3
 # One after the other: start-up is the busiest moment on the simulated buses
@@ -301,6 +338,7 @@ START_ATTEMPTS=3
 # not start together (SINUSOID runs on the wall clock, and the switch comes
 # when all are up).
 for i in "${!robots[@]}"; do
+	[ "$lockstep" = 1 ] && break
 	name="undulated-${robots[$i]}"
 	start_daemon "$i"
 	for attempt in $(seq "$START_ATTEMPTS"); do
@@ -337,7 +375,7 @@ start_web() {
 	wait_ready web 'listening on http://' 2>/dev/null || return 1
 	web_url=$(sed -n 's|^undulate-web: listening on \(http://[^ ]*\).*|\1|p' "$run/web.log")
 }
-if [ -x "$B/undulate-web" ]; then
+if [ -x "$B/undulate-web" ] && [ "$lockstep" != 1 ]; then
 	start_web "${DEMO_WEB_PORT:-8080}" || { mv "$run/web.log" "$run/web.1.log"; start_web 0; } ||
 		echo "demo: undulate-web did not start (its log: $run/web.log); the terminal view only" >&2
 fi
@@ -419,8 +457,20 @@ if [ "$interactive" -eq 1 ]; then
 	seconds=$(awk -v n="$(( $(date +%s%N) - t_ready ))" 'BEGIN { printf "%.0f", n / 1e9 }')
 fi
 
+# ---- lockstep: the simulator runs the schedule and ends the run -------------------
+if [ "$lockstep" = 1 ]; then
+	sim_rc=0
+	wait "$(pid_of sim)" || sim_rc=$?
+	for i in "${!robots[@]}"; do wait "$(pid_of "undulated-${robots[$i]}")" 2>/dev/null; done
+	ended=$(sed -n 's/^undulate-sim: lockstep: .*; ended: //p' "$run/sim.log")
+	[ "$sim_rc" -eq 0 ] || die "the lockstep run failed (undulate-sim exit $sim_rc): ${ended:-see its log}; its log:
+$(tail -n 15 "$run/sim.log")"
+	grep -q "event 'command \* mode $switch_to': ok" "$run/sim.log" && echo lockstep >"$run/switch.time"
+	say "lockstep: $(sed -n 's/^undulate-sim: lockstep: \([0-9.]* s of simulated time in [0-9.]* s ([0-9.]*x real time\).*/\1)/p' "$run/sim.log")"
+fi
+
 # ---- headless -------------------------------------------------------------------
-if [ "$interactive" -eq 0 ]; then
+if [ "$interactive" -eq 0 ] && [ "$lockstep" != 1 ]; then
 # sample_contact: ask the simulator for its running totals (SIM.CMD "stats");
 # the reply, with the simulated time, lands in its log. The rate of its total
 # impulse (impacts + resting contact) is the mean contact force: ground truth
@@ -450,6 +500,7 @@ while :; do
 done
 fi
 for i in "${!pids[@]}"; do
+	[ "$lockstep" = 1 ] && break   # they ended with the run, checked above
 	case "${names[$i]}" in "switch timer"|banner|top|web) continue ;; esac
 	kill -0 "${pids[$i]}" 2>/dev/null || die "${names[$i]} stopped during the run; its log:
 $(tail -n 15 "$run/${names[$i]}.log")"
@@ -550,7 +601,7 @@ awk -F, 'NR > 1 { b = int($1 / 10); n[b] += $2; imp[b] += $3; if (b > last) last
 
 # Contact force from the simulator's samples: "t,impacts,impulse,resting_impulse"
 # (simulated seconds since its start, running totals).
-sed -n "s/^undulate-sim: SIM.CMD seq [0-9]* 'stats *': ok steps=[0-9]* time=\([0-9.]*\) collisions=\([0-9]*\) impulse=\([0-9.]*\) resting_impulse=\([0-9.]*\).*/\1,\2,\3,\4/p" \
+sed -nE "s/^undulate-sim: (SIM.CMD seq [0-9]* 'stats *'|t=[0-9.]* event 'stats'): ok steps=[0-9]* time=([0-9.]*) collisions=([0-9]*) impulse=([0-9.]*) resting_impulse=([0-9.]*).*/\2,\3,\4,\5/p" \
 	"$run/sim.log" | sort -t, -k1,1n | { echo "t,impacts,impulse,resting_impulse"; cat; } >"$analysis/contact.csv"
 if [ "$(wc -l <"$analysis/contact.csv")" -gt 2 ]; then
 	echo

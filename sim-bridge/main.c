@@ -33,6 +33,7 @@
 #include "clock.h"
 #include "sim.h"
 #include "text.h"
+#include "vtime.h"
 #include "wire.h"
 #include "undulate_sim_collision_t.h"
 #include "undulate_sim_command_t.h"
@@ -50,7 +51,18 @@
 #define MAIN_TRUTH_MAX_COLLISIONS 256
 /* Encoded SIM.TRUTH: 64 bodies × ~100 B + 256 collisions × ~140 B, with room. */
 #define MAIN_TRUTH_BUF (128 * 1024)
-#define MAIN_MAX_FDS (SIM_MAX_BUSES + MAIN_MAX_CLIENTS + 2)
+#define MAIN_MAX_FDS (SIM_MAX_BUSES + MAIN_MAX_CLIENTS + 2 + VT_MAX_CLIENTS + 1)
+/* pollset tags below the control socket's (-3 - client): the lockstep socket
+ * and its daemons */
+#define MAIN_TAG_VT_LISTEN (-1000)
+/* Lockstep: reply bytes are handed over in chunks of this much wire time (in
+ * real time, --tx-slice-us). A whole reply (READ(24,20): 26 bytes, 260 µs at
+ * 1 Mbps) is then one chunk and one wake-up of its daemon, not two or three;
+ * the daemon acts on whole packets only, and the chunk is released at its
+ * last byte's wire time, never earlier. Measured on the pair rig: 3.6 wake-ups
+ * a daemon per cycle with 100 µs chunks. */
+#define MAIN_LOCKSTEP_SLICE_NS 500000
+#define MAIN_TAG_VT_CLIENT (-2000)
 /* Step lateness histogram for percentiles: 10 µs bins up to 20 ms (the last
  * bin holds everything later). */
 #define MAIN_LATE_BIN_US 10
@@ -99,7 +111,20 @@ struct app {
 	bool bench, quiet;
 	/* bad input already reported, per bus (reported at most once a second) */
 	uint64_t reported_bad[SIM_MAX_BUSES];
+	/* lockstep: virtual time, owned here and shared with the daemons */
+	bool lockstep;
+	struct vt vt;
+	int64_t lockstep_grace_ns;
+	int64_t wall_end;             /* when the run ended (wall clock) */
+	int64_t first_step_wall;      /* when simulated time first moved */
 };
+
+/* The simulation's "now" (ns) for the bus and the command language: the
+ * monotonic clock, or in lockstep the virtual time. */
+static int64_t app_now(const struct app *a)
+{
+	return a->lockstep ? (int64_t)a->vt.t_ns : mono_ns();
+}
 
 /* ---- options ---------------------------------------------------------------- */
 
@@ -114,6 +139,8 @@ struct options {
 	int realtime;           /* SCHED_FIFO priority, 0 = normal scheduling */
 	const char *lcm_url;
 	int nsim_opts;          /* options other than --cmd/--lcm-url (--cmd takes none) */
+	const char *lockstep;   /* the lockstep socket: virtual time */
+	double lockstep_grace_s;
 };
 
 static void usage(FILE *f)
@@ -147,13 +174,19 @@ static void usage(FILE *f)
 	        "  --bench              print CPU and step lateness every second\n"
 	        "  --realtime PRIO      run under SCHED_FIFO at PRIO (1-99) for steadier steps\n"
 	        "  --quiet              only the ready line, errors and the exit summary\n"
+	        "  --lockstep SOCKET    virtual time: every bus's daemon joins at SOCKET (undulated\n"
+	        "                       --lockstep SOCKET) and the run goes as fast as they take turns;\n"
+	        "                       --duration is simulated seconds (README: Lockstep)\n"
+	        "  --lockstep-grace S   wall-clock seconds a daemon may take to join or to answer before\n"
+	        "                       the run is ended as stalled (default 10)\n"
 	        "  --cmd 'VERB ARGS'    send one command to a running simulator on SIM.CMD and exit\n");
 }
 
 enum {
 	OPT_LINK = 256, OPT_IDS, OPT_NAME, OPT_SCENARIO, OPT_SET, OPT_LINK_DIR, OPT_LCM_URL, OPT_CONTROL,
 	OPT_SEED, OPT_DURATION, OPT_BAUD, OPT_RETURN_DELAY, OPT_LATENCY, OPT_ECHO, OPT_RATE, OPT_TRUTH,
-	OPT_TEMP, OPT_VOLTAGE, OPT_TX_SLICE, OPT_BENCH, OPT_QUIET, OPT_HELP, OPT_CMD, OPT_REALTIME, OPT_MODEL,
+	OPT_TEMP, OPT_VOLTAGE, OPT_TX_SLICE, OPT_BENCH, OPT_QUIET, OPT_HELP, OPT_CMD, OPT_REALTIME,
+	OPT_LOCKSTEP, OPT_LOCKSTEP_GRACE, OPT_MODEL,
 };
 
 /* Options that are [sim] keys go through the same parser as the file. */
@@ -185,11 +218,14 @@ static int parse_args(int argc, char **argv, struct options *o)
 		{ "tx-slice-us", required_argument, 0, OPT_TX_SLICE }, { "bench", no_argument, 0, OPT_BENCH },
 		{ "quiet", no_argument, 0, OPT_QUIET }, { "help", no_argument, 0, OPT_HELP },
 		{ "cmd", required_argument, 0, OPT_CMD }, { "realtime", required_argument, 0, OPT_REALTIME },
+		{ "lockstep", required_argument, 0, OPT_LOCKSTEP },
+		{ "lockstep-grace", required_argument, 0, OPT_LOCKSTEP_GRACE },
 		{ "model", required_argument, 0, OPT_MODEL },
 		{ 0, 0, 0, 0 },
 	};
 	memset(o, 0, sizeof(*o));
 	o->tx_slice_us = 100;
+	o->lockstep_grace_s = 10;
 	int c;
 	char *end;
 	long prio;
@@ -237,6 +273,21 @@ static int parse_args(int argc, char **argv, struct options *o)
 			}
 			break;
 		case OPT_QUIET: o->quiet = true; break;
+		case OPT_LOCKSTEP:
+			if (optarg[0] == '\0' || strlen(optarg) >= sizeof(((struct vt *)0)->path)) {
+				fprintf(stderr, "undulate-sim: --lockstep: a socket path of 1..%zu bytes\n",
+				        sizeof(((struct vt *)0)->path) - 1);
+				return -1;
+			}
+			o->lockstep = optarg;
+			break;
+		case OPT_LOCKSTEP_GRACE:
+			o->lockstep_grace_s = strtod(optarg, &end);
+			if (end == optarg || *end != '\0' || !(o->lockstep_grace_s >= 0.1 && o->lockstep_grace_s <= 3600)) {
+				fprintf(stderr, "undulate-sim: --lockstep-grace: seconds, 0.1..3600\n");
+				return -1;
+			}
+			break;
 		case OPT_HELP: case 'h': usage(stdout); exit(0);
 		default: usage(stderr); return -1;
 		}
@@ -320,7 +371,7 @@ static void on_sim_cmd(const lcm_recv_buf_t *rbuf, const char *channel, void *us
 		snprintf(shown_reply, sizeof shown_reply, "error: command too long (at most %d bytes) or a NUL inside",
 		         SIM_CMD_MAX - 1);
 	} else {
-		sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
+		sim_command(a->sim, line, app_now(a), reply, sizeof(reply));
 		/* whatever came from the network is one printable line in the log */
 		fprintf(stderr, "undulate-sim: SIM.CMD seq %lld '%s': %s\n", seq, text_sanitize(shown, sizeof shown, line),
 		        text_sanitize(shown_reply, sizeof shown_reply, reply));
@@ -511,7 +562,7 @@ static void control_read(struct app *a, struct client *c)
 		if (nl > line && nl[-1] == '\r')
 			nl[-1] = '\0';
 		if (*line)
-			sim_command(a->sim, line, mono_ns(), reply, sizeof(reply));
+			sim_command(a->sim, line, app_now(a), reply, sizeof(reply));
 		else
 			snprintf(reply, sizeof(reply), "error: empty command (try help)");
 		client_reply(c, reply);
@@ -686,6 +737,15 @@ static int build_pollset(struct app *a, struct pollfd *fds, int *bus_of)
 			bus_of[n] = -3 - i;
 			fds[n++] = (struct pollfd){ .fd = a->clients[i].fd, .events = POLLIN };
 		}
+	if (a->lockstep) {
+		bus_of[n] = MAIN_TAG_VT_LISTEN;
+		fds[n++] = (struct pollfd){ .fd = a->vt.listen_fd, .events = POLLIN };
+		for (int i = 0; i < VT_MAX_CLIENTS; i++)
+			if (a->vt.c[i].fd >= 0) {
+				bus_of[n] = MAIN_TAG_VT_CLIENT - i;
+				fds[n++] = (struct pollfd){ .fd = a->vt.c[i].fd, .events = POLLIN };
+			}
+	}
 	return n;
 }
 
@@ -718,7 +778,11 @@ static void serve(struct app *a, struct pollfd *fds, const int *bus_of, int n)
 		if (!fds[i].revents)
 			continue;
 		if (bus_of[i] >= 0)
-			sim_bus_read(&a->sim->buses[bus_of[i]], mono_ns());
+			sim_bus_read(&a->sim->buses[bus_of[i]], app_now(a));
+		else if (bus_of[i] == MAIN_TAG_VT_LISTEN)
+			vt_accept(&a->vt);
+		else if (bus_of[i] <= MAIN_TAG_VT_CLIENT)
+			vt_on_client(&a->vt, a->sim, (size_t)(MAIN_TAG_VT_CLIENT - bus_of[i]), mono_ns());
 		else if (bus_of[i] == -1)
 			lcm_handle_timeout(a->lcm, 0);
 		else if (bus_of[i] == -2)
@@ -832,6 +896,142 @@ static void run(struct app *a)
 	}
 }
 
+/* ---- the loop in lockstep --------------------------------------------------------- */
+
+/* The robots' daemons take commands from the schedule (sim.h robot_command). */
+static int lockstep_robot_command(void *ctx, int bus, const char *text, char *why, size_t cap)
+{
+	return vt_command(&((struct app *)ctx)->vt, bus, text, why, cap);
+}
+
+/* Virtual time is t (ns): the clocks of this process follow (LCM utimes). */
+static void lockstep_set_time(struct app *a, uint64_t t)
+{
+	a->vt.t_ns = t;
+	clock_set_virtual(a->vt.mono0_us + t / 1000u, a->vt.wall0_us + (int64_t)(t / 1000u));
+}
+
+/* The physics steps due by t, with their collisions and scheduled events. */
+static void lockstep_physics(struct app *a, int64_t t, int64_t *next_step)
+{
+	struct sim *s = a->sim;
+	while (*next_step <= t) {
+		sim_step(s);
+		report_collisions(a);
+		sim_run_events(s, (double)s->steps * s->dt, *next_step);
+		a->late_samples++;
+		*next_step += a->step_ns;
+	}
+}
+
+/* The earliest thing that happens after now: a physics step, a truth or
+ * world message, a reply's bytes, a daemon's wake-up, the end. */
+static int64_t lockstep_next(struct app *a, int64_t next_step, int64_t next_truth, int64_t next_world, int64_t end)
+{
+	struct sim *s = a->sim;
+	int64_t t = next_step;
+	if (a->lcm && next_truth < t)
+		t = next_truth;
+	if (a->lcm && next_world < t)
+		t = next_world;
+	if (!a->vt.ending && end < t)
+		t = end;
+	for (size_t i = 0; i < s->nbuses; i++) {
+		int64_t tx = sim_bus_next_tx(&s->buses[i], a->tx_slice_ns);
+		if (tx < t)
+			t = tx;
+	}
+	uint64_t w = vt_next_wake(&a->vt, s);
+	if (w != LKS_NEVER && (int64_t)w < t)
+		t = (int64_t)w;
+	return t < (int64_t)a->vt.t_ns ? (int64_t)a->vt.t_ns : t;
+}
+
+/* Time moves to t: physics, messages, replies, then the daemons due. */
+static void lockstep_advance(struct app *a, int64_t t, int64_t *next_step, int64_t *next_truth, int64_t *next_world,
+                             int64_t truth_ns)
+{
+	struct sim *s = a->sim;
+	lockstep_set_time(a, (uint64_t)t);
+	lockstep_physics(a, t, next_step);
+	if (t >= *next_truth) {
+		if (a->lcm)
+			publish_truth(a);
+		*next_truth += truth_ns;
+	}
+	if (t >= *next_world) {
+		if (a->lcm)
+			publish_world(a);
+		if (!a->quiet)
+			report_bad_input(a);
+		*next_world += 1000000000;
+	}
+	for (size_t i = 0; i < s->nbuses; i++)
+		sim_bus_flush(&s->buses[i], t);
+	vt_release(&a->vt, s, (uint64_t)t, mono_ns());
+}
+
+/* Nobody may move time yet: serve whatever is readable (the daemons' bytes
+ * and messages, LCM, the control socket) for up to 100 ms of wall time, and
+ * end the run if a daemon stalls. */
+static void lockstep_serve(struct app *a, struct pollfd *fds, int *bus_of, int64_t start_wall)
+{
+	sigset_t unblocked;
+	sigemptyset(&unblocked);
+	int n = build_pollset(a, fds, bus_of);
+	struct timespec ts = { 0, 100000000 };
+	if (wait_fds(fds, n, &ts, &unblocked) > 0)
+		serve(a, fds, bus_of, n);
+	char why[VT_WHY_MAX];
+	if (vt_stalled(&a->vt, a->sim, mono_ns(), start_wall, a->lockstep_grace_ns, why, sizeof why)) {
+		fprintf(stderr, "undulate-sim: %s: ending the run\n", why);
+		if (a->vt.ending) {
+			/* a daemon that does not finish its safe stop is left behind */
+			for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+				if (a->vt.c[i].fd >= 0) {
+					close(a->vt.c[i].fd);
+					a->vt.c[i].fd = -1;
+				}
+		}
+		vt_end(&a->vt, true, why);
+	}
+}
+
+static void run_lockstep(struct app *a)
+{
+	struct sim *s = a->sim;
+	static struct pollfd fds[MAIN_MAX_FDS];
+	static int bus_of[MAIN_MAX_FDS];
+	int64_t truth_ns = (int64_t)llround(1e9 / s->cfg.truth_hz);
+	int64_t next_step = a->step_ns, next_truth = truth_ns, next_world = 1000000000;
+	int64_t end = s->cfg.duration_s > 0 ? (int64_t)llround(s->cfg.duration_s * 1e9) : INT64_MAX;
+	int64_t start_wall = mono_ns();
+	lockstep_set_time(a, 0);
+	sim_run_events(s, 0.0, 0);
+	if (a->lcm)
+		publish_world(a);
+	for (;;) {
+		if (stop_signal && !a->vt.ending)
+			vt_end(&a->vt, false, "the simulator was stopped (signal)");
+		if (a->vt.ending && vt_clients(&a->vt) == 0)
+			break;
+		if (!vt_all_blocked(&a->vt, s)) {
+			lockstep_serve(a, fds, bus_of, start_wall);
+			continue;
+		}
+		if (!a->vt.ending && (int64_t)a->vt.t_ns >= end) {
+			char why[80];
+			snprintf(why, sizeof why, "the run's %.3f s are over", s->cfg.duration_s);
+			vt_end(&a->vt, false, why);
+		}
+		int64_t t = lockstep_next(a, next_step, next_truth, next_world, end);
+		if (a->first_step_wall == 0 && t > 0)
+			a->first_step_wall = mono_ns();
+		lockstep_advance(a, t, &next_step, &next_truth, &next_world, truth_ns);
+	}
+	a->wall_end = mono_ns();
+}
+
 /* ---- start and stop ---------------------------------------------------------- */
 
 /* After an X-series bus's word, one more: NAME.model=XL430-W250[,...] (one
@@ -862,10 +1062,41 @@ static void print_ready(const struct sim *s, const char *url)
 	fflush(stdout);
 }
 
+static void print_bus_summary(const struct app *a);
+
+/* In lockstep the exit line holds only what the simulation decided (the same
+ * seed prints the same line); the wall clock's figures have a line of their
+ * own. The speed is taken from the first step: before it, the simulator only
+ * waited for the daemons to join. */
+static void print_summary_lockstep(const struct app *a, int64_t now)
+{
+	const struct sim *s = a->sim;
+	double virt = 1e-9 * (double)a->vt.t_ns;
+	double run = a->first_step_wall > 0 ? (double)(a->wall_end - a->first_step_wall) / 1e9 : 0.0;
+	double joining = a->first_step_wall > 0 ? (double)(a->first_step_wall - a->t0) / 1e9 : 0.0;
+	printf("undulate-sim: exit: %.3f s simulated, %llu steps, %llu collisions, total impulse %.6f N*s "
+	       "(resting contact %.6f N*s over %llu pair-steps), %llu bad commands, %llu truth messages\n",
+	       virt, (unsigned long long)s->steps, s->world.total_collisions - s->world.resting_contacts,
+	       s->world.total_impulse, s->world.resting_impulse, s->world.resting_contacts,
+	       (unsigned long long)s->bad_commands, (unsigned long long)a->truth_sent);
+	printf("undulate-sim: lockstep: %.3f s of simulated time in %.3f s (%.1fx real time; %.3f s before it waiting "
+	       "for the daemons to join, %.3f s in all, cpu %.1f%%); %llu daemon(s) joined, %llu wake-up(s), %llu "
+	       "command(s) sent; ended: %s%s\n",
+	       virt, run, run > 0 ? virt / run : 0.0, joining, (double)(now - a->t0) / 1e9,
+	       now > a->t0 ? 100.0 * cpu_seconds() / ((double)(now - a->t0) / 1e9) : 0.0,
+	       (unsigned long long)a->vt.joined, (unsigned long long)a->vt.wakes, (unsigned long long)a->vt.commands,
+	       a->vt.end_why[0] ? a->vt.end_why : "-", a->vt.failed ? " (FAILED)" : "");
+	print_bus_summary(a);
+}
+
 static void print_summary(const struct app *a, int64_t now)
 {
 	const struct sim *s = a->sim;
 	double wall = (double)(now - a->t0) / 1e9;
+	if (a->lockstep) {
+		print_summary_lockstep(a, now);
+		return;
+	}
 	printf("undulate-sim: exit: %.1f s, %llu steps, %llu collisions, total impulse %.6f N*s "
 	       "(resting contact %.6f N*s over %llu pair-steps), "
 	       "worst step lateness %.0f us (p99 %.0f us, mean %.1f us), %llu overruns (simulated time stopped %.1f ms), cpu %.1f%%, "
@@ -875,6 +1106,12 @@ static void print_summary(const struct app *a, int64_t now)
 	       a->worst_late_us, late_quantile(a, 0.99), a->late_samples ? a->late_sum_us / (double)a->late_samples : 0.0,
 	       (unsigned long long)a->overruns, (double)a->lost_ns / 1e6, wall > 0 ? 100.0 * cpu_seconds() / wall : 0.0,
 	       (unsigned long long)s->bad_commands, (unsigned long long)a->truth_sent);
+	print_bus_summary(a);
+}
+
+static void print_bus_summary(const struct app *a)
+{
+	const struct sim *s = a->sim;
 	for (size_t i = 0; i < s->nbuses && !a->quiet; i++) {
 		const struct sim_bus_counters *c = &s->buses[i].count;
 		if (s->buses[i].protocol == 2) {
@@ -963,10 +1200,28 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	app.t0 = mono_ns();
+	if (opt.lockstep) {
+		if (vt_open(&app.vt, opt.lockstep, sim.nbuses, LKS_MONO0_US, LKS_WALL0_US, err, sizeof(err)) != 0) {
+			fprintf(stderr, "undulate-sim: %s\n", err);
+			sim_close(&sim);
+			return 1;
+		}
+		app.lockstep = true;
+		app.lockstep_grace_ns = (int64_t)llround(opt.lockstep_grace_s * 1e9);
+		if (app.tx_slice_ns < MAIN_LOCKSTEP_SLICE_NS)
+			app.tx_slice_ns = MAIN_LOCKSTEP_SLICE_NS;
+		sim.robot_command = lockstep_robot_command;
+		sim.robot_command_ctx = &app;
+	}
 	print_ready(&sim, cfg.lcm_url);
-	run(&app);
+	if (app.lockstep)
+		run_lockstep(&app);
+	else
+		run(&app);
 	int64_t now = mono_ns();
 	sim_close(&sim);
+	if (app.lockstep)
+		vt_close(&app.vt);
 	if (app.listen_fd >= 0) {
 		close(app.listen_fd);
 		unlink(app.control_path);
@@ -978,5 +1233,5 @@ int main(int argc, char **argv)
 		lcm_destroy(app.lcm);
 	}
 	free(app.truth_buf);
-	return 0;
+	return app.lockstep && app.vt.failed ? 1 : 0;
 }

@@ -18,7 +18,7 @@
 #include "world.h"
 
 #define SIM_MAX_BUSES 32     /* robots (one bus each); the benchmark runs 20 */
-#define SIM_MAX_EVENTS 64    /* timed commands in a scenario */
+#define SIM_MAX_EVENTS 512   /* timed commands in a scenario (a long run samples every few s) */
 #define SIM_CMD_MAX 256      /* one command line */
 #define SIM_URL_MAX 256
 /* Longest --duration: about 31 years (as int64 ns it stays far from overflow). */

@@ -687,6 +687,34 @@ static int cmd_stats(struct sim_cmd_ctx *x)
 	             (unsigned long long)s->commands, (unsigned long long)s->bad_commands), 0;
 }
 
+/* command ROBOT|* TEXT...: to the robots' daemons, at this simulated time
+ * (lockstep only: in real time, send it with undulated --command). */
+static int cmd_robot_command(struct sim_cmd_ctx *x)
+{
+	struct sim *s = x->s;
+	if (x->argc < 3)
+		return FAIL(x, "usage: command ROBOT|* TEXT (e.g. command * mode oscillator)");
+	if (!s->robot_command)
+		return FAIL(x, "command: robots take commands from the simulator only in lockstep (--lockstep); in real "
+		            "time send them with undulated --command");
+	int bus = -1;
+	if (strcmp(x->argv[1], "*") != 0) {
+		struct sim_bus *b = cmd_bus(x, "command ROBOT|* TEXT");
+		if (!b)
+			return -1;
+		bus = (int)(b - s->buses);
+	}
+	char text[SIM_CMD_MAX], why[200];
+	size_t off = 0;
+	text[0] = '\0';
+	for (int i = 2; i < x->argc && off < sizeof text; i++)
+		off += (size_t)snprintf(text + off, sizeof text - off, "%s%s", i > 2 ? " " : "", x->argv[i]);
+	int n = s->robot_command(s->robot_command_ctx, bus, text, why, sizeof why);
+	if (n < 0)
+		return FAIL(x, "command: %s", why);
+	return REPLY(x, "ok '%s' to %d daemon(s)", text, n), 0;
+}
+
 static int cmd_list(struct sim_cmd_ctx *x)
 {
 	size_t off = (size_t)REPLY(x, "ok");
@@ -702,7 +730,8 @@ static int cmd_help(struct sim_cmd_ctx *x)
 {
 	return REPLY(x, "ok commands: fault BUS ID KIND [ARG] [count=N] [prob=P] | clear BUS [ID] [KIND] | "
 	                "power BUS ID on|off | disconnect BUS | reconnect BUS | garbage BUS [N] | "
-	                "poke BUS ID REG VALUE | peek BUS ID REG | servo BUS ID | walls none|LEFT RIGHT | stats | list | help"), 0;
+	                "poke BUS ID REG VALUE | peek BUS ID REG | servo BUS ID | walls none|LEFT RIGHT | stats | list | "
+	                "command ROBOT|* TEXT (lockstep) | help"), 0;
 }
 
 static const struct {
@@ -712,7 +741,7 @@ static const struct {
 	{ "fault", cmd_fault }, { "clear", cmd_clear }, { "power", cmd_power },
 	{ "disconnect", cmd_disconnect }, { "reconnect", cmd_reconnect }, { "garbage", cmd_garbage },
 	{ "poke", cmd_poke }, { "peek", cmd_peek }, { "servo", cmd_servo }, { "walls", cmd_walls }, { "stats", cmd_stats },
-	{ "list", cmd_list }, { "help", cmd_help },
+	{ "list", cmd_list }, { "command", cmd_robot_command }, { "help", cmd_help },
 };
 
 int sim_command(struct sim *s, const char *line, int64_t now, char *reply, size_t cap)

@@ -32,6 +32,11 @@ struct sim {
 	size_t next_event;
 	uint64_t commands, bad_commands;
 	uint64_t rng;
+	/* "command ROBOT|* TEXT": a command for the robots' daemons, which only
+	 * lockstep can deliver at a simulated time (main.c sets this then);
+	 * NULL: refused. bus -1 = every robot. Returns daemons reached or -1. */
+	int (*robot_command)(void *ctx, int bus, const char *text, char *why, size_t cap);
+	void *robot_command_ctx;
 };
 
 /* Build everything from cfg (no I/O). 0 or -1 with err. */

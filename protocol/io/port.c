@@ -26,6 +26,8 @@
 
 #include "port.h"
 
+#include "clock.h"
+
 /* Longest device path we keep (Linux PATH_MAX would be wasteful: by-id
  * symlinks, the longest real names, are under 120 characters). */
 #define PORT_PATH_MAX 256
@@ -453,12 +455,10 @@ long port_pending_input(struct port *p)
 	return n;
 }
 
+/* The program's monotonic clock (common/clock.h): virtual in lockstep. */
 uint64_t port_now_us(void)
 {
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u;
+	return clock_mono_us();
 }
 
 /* ---- the bus_io seam ---------------------------------------------------------- */

@@ -45,9 +45,21 @@ int port_wait(struct port *p, uint32_t timeout_us);
 void port_flush_input(struct port *p);
 /* Bytes readable now, without waiting (FIONREAD); -1 if it cannot say. */
 long port_pending_input(struct port *p);
-/* Fill a bus_io that drives this port (clock: CLOCK_MONOTONIC). */
+/* Fill a bus_io that drives this port (clock: common/clock.h's monotonic). */
 void port_bus_io(struct port *p, struct bus_io *io);
 uint64_t port_now_us(void);
+
+/* The same port in lockstep (common/lockstep.h): time is the simulator's,
+ * waiting is a WAIT to it, and what is read is exactly what it announced
+ * (bytes it released and the tty worker has not handed over yet are waited
+ * for, not taken for silence). Every byte written is counted for its WAITs.
+ * The caller owns *pl for as long as the bus_io is used. */
+struct lks_client;
+struct port_lockstep {
+	struct port *port;
+	struct lks_client *clock;
+};
+void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_client *clock, struct bus_io *io);
 
 /* ---- RS-485 direction control (an on-board UART with a half-duplex buffer) ---- */
 /* A single-board computer's UART drives the Dynamixel line through a tri-state

@@ -171,5 +171,58 @@ if regime $n; then
 		$report "anti-phase: |D| within 0.5 of pi with collisions going on" "final D $D, collisions in the last 10 s $last, state $(col $n state); phase difference every 5 s: $(awk -F, 'NR > 1 && $3 == "\"left:right\"" && $2 >= next_t { printf "%.0fs %.2f  ", $2, $9; next_t = $2 + 5 }' "$T/$n/phase_diff.csv")"
 	fi
 fi
-keep_runs inphase compat anti
+# ---- the same three regimes in virtual time, three seeds each ---------------------------
+# scripts/demo.sh --lockstep: the same programs on the simulated bus, paced by
+# the simulator's clock. The real-time runs' seed (7) and two more; each must
+# land in the regime the theory and the real-time run put it in (the real-time
+# runs above assert the same regimes). Anti-phase must also carry the same
+# label as the real-time run; the other two are sets, not labels: a pair in
+# phase at d~ 0.05 still touches now and then ("in-phase" or "still-colliding"
+# by whether a touch fell in the final window), and a compatible one may end
+# anywhere in |D| <= 2 asin(d~) + 0.1 ("in-phase", "compatible", or
+# "still-colliding" while it grazes).
+lrun() {
+	local name=$1 sep=$2 phases=$3 seed=$4
+	env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --lockstep --scenario "$scenario" \
+		--seconds "$seconds" --switch-at 3 --seed "$seed" --phases "$phases" --set "world.separation=$sep" \
+		--lcm-url "$(lcm_url "$port")" --out "$T/$name" "${rig[@]}" >"$T/$name.log" 2>&1
+}
+# in_regime NAME REGIME: the run ended where REGIME's claim says.
+in_regime() {
+	local D lim end last
+	D=$(col "$1" meanD); lim=$(col "$1" "2asin(d~)")
+	case $2 in
+	inphase) num "${D#-} < 0.3" ;;
+	compat) num "${D#-} <= $lim + 0.1" ;;
+	anti)
+		end=$(span "$1"); last=$(collisions "$1" "$(awk "BEGIN { print $end - 10 }")" "$end")
+		num "${D#-} > 3.1416 - 0.5" && [ "$last" -gt 0 ] ;;
+	esac
+}
+lock_runs=()
+for spec in "inphase 0.05 0,2.0" "compat 0.3 0,2.0" "anti 0.7 0,3.1416"; do
+	read -r regime_name sep phases <<<"$spec"
+	report=tap_fail
+	[ "$regime_name" = anti ] && [ ${#rig[@]} -eq 0 ] && report=tap_todo
+	rt_state=-
+	[ -f "$T/$regime_name/moving" ] && rt_state=$(col "$regime_name" state)
+	for seed in 7 8 9; do
+		n="lock_${regime_name}_$seed"
+		lock_runs+=("$n")
+		if ! lrun "$n" "$sep" "$phases" "$seed" || [ ! -f "$T/$n/summary.txt" ]; then
+			tap_fail "$regime_name in lockstep, seed $seed: ran" "$(tail -n 10 "$T/$n.log")"
+			continue
+		fi
+		state=$(col "$n" state); D=$(col "$n" meanD)
+		what="$regime_name in lockstep, seed $seed: in its regime (final D $D, $state; real time, seed 7: $rt_state)"
+		if ! in_regime "$n" "$regime_name"; then
+			$report "$what" "d~ $(col "$n" d~), 2 asin(d~) $(col "$n" "2asin(d~)"), collisions in the last 10 s $(last_collisions "$T/$n")"
+		elif [ "$regime_name" = anti ] && [ "$rt_state" != - ] && [ "$state" != "$rt_state" ]; then
+			$report "$what" "the real-time run with this seed ended $rt_state"
+		else
+			tap_ok "$what"
+		fi
+	done
+done
+keep_runs inphase compat anti "${lock_runs[@]}"
 tap_done

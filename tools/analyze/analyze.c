@@ -15,6 +15,7 @@
 #include "plot.h"
 #include "theory.h"
 #include "window.h"
+#include "wire.h"
 
 #include "undulate_bus_stats_t.h"
 #include "undulate_event_t.h"
@@ -118,9 +119,9 @@ struct an_ctx {
 	int npairs;
 	/* time */
 	bool have_origin;
-	int64_t origin_ts;          /* first event's log timestamp (for --from/--to) */
+	int64_t origin_ts;          /* first event's time (an_event_time: for --from/--to) */
 	int64_t t_origin;           /* t = 0: the earlier of that and the first state's utime */
-	int64_t from_ts, to_ts;     /* selected range in log timestamps */
+	int64_t from_ts, to_ts;     /* selected range in event times */
 	int64_t last_state_utime;   /* end of the data, for the final window */
 	bool have_state;
 	int64_t last_utime;
@@ -248,35 +249,128 @@ static double an_t(const struct an_ctx *c, int64_t utime)
 
 /* ---- log iteration ------------------------------------------------------------ */
 
+/* An event's time: the utime its message carries (every message type of ours
+ * begins with it, after the 8-byte fingerprint), else the log's timestamp.
+ * The two agree within milliseconds in real time; in lockstep the messages
+ * carry the simulated time and the logger stamps its own wall clock, so only
+ * the messages' times belong together. */
+static int64_t an_event_time(const lcm_eventlog_event_t *ev)
+{
+	if (an_channel(ev->channel) == CH_UNKNOWN || ev->datalen < 16)
+		return ev->timestamp;
+	struct wire_reader w;
+	wire_reader_init(&w, ev->data, (size_t)ev->datalen);
+	(void)wire_take(&w, 8);
+	return (int64_t)wire_take(&w, 8);
+}
+
 typedef void (*an_event_fn)(struct an_ctx *c, const lcm_eventlog_event_t *ev);
 
-/* Runs FN on every event of every log inside the selected range. Returns
- * AN_EXIT_OK, AN_EXIT_BADLOG or AN_EXIT_TRUNCATED; notes truncations once. */
+/* Events are taken in the order of their time, not of their arrival at the
+ * logger: two robots' messages of one instant arrive in either order, and a
+ * pair's phase difference is taken from what each robot has said so far, so
+ * the same run must read the same whichever came first (a lockstep run is
+ * analysed to the same bytes every time). A window of this many events is
+ * sorted by (time, channel, arrival); messages arrive at most milliseconds
+ * out of order, a few hundred events at 20 robots. */
+#define AN_REORDER 4096
+
+struct an_pending {
+	lcm_eventlog_event_t *ev;
+	int64_t t;
+	uint64_t seq;
+};
+
+static bool an_pending_before(const struct an_pending *a, const struct an_pending *b)
+{
+	if (a->t != b->t)
+		return a->t < b->t;
+	int ch = strcmp(a->ev->channel, b->ev->channel);
+	return ch != 0 ? ch < 0 : a->seq < b->seq;
+}
+
+/* A binary min-heap of pending events (static: the analyser is one thread
+ * and this is 100 KB). */
+static struct an_pending an_heap[AN_REORDER];
+static size_t an_heap_n;
+
+static void an_heap_push(lcm_eventlog_event_t *ev, int64_t t, uint64_t seq)
+{
+	size_t i = an_heap_n++;
+	an_heap[i] = (struct an_pending){ ev, t, seq };
+	while (i > 0 && an_pending_before(&an_heap[i], &an_heap[(i - 1) / 2])) {
+		struct an_pending x = an_heap[i];
+		an_heap[i] = an_heap[(i - 1) / 2];
+		an_heap[(i - 1) / 2] = x;
+		i = (i - 1) / 2;
+	}
+}
+
+static struct an_pending an_heap_pop(void)
+{
+	struct an_pending top = an_heap[0];
+	an_heap[0] = an_heap[--an_heap_n];
+	for (size_t i = 0;;) {
+		size_t l = 2 * i + 1, r = l + 1, m = i;
+		if (l < an_heap_n && an_pending_before(&an_heap[l], &an_heap[m]))
+			m = l;
+		if (r < an_heap_n && an_pending_before(&an_heap[r], &an_heap[m]))
+			m = r;
+		if (m == i)
+			break;
+		struct an_pending x = an_heap[i];
+		an_heap[i] = an_heap[m];
+		an_heap[m] = x;
+		i = m;
+	}
+	return top;
+}
+
+/* One event, in time order: the origin, the range, then FN. Frees it.
+ * Another program's channel (LCM's own self-test, say) has only the logger's
+ * clock, which in lockstep is not the run's: it sets neither the origin nor
+ * the extent, and is only counted. */
+static void an_take_event(struct an_ctx *c, an_event_fn fn, bool first_pass, struct an_pending p)
+{
+	if (an_channel(p.ev->channel) == CH_UNKNOWN) {
+		fn(c, p.ev);
+		lcm_eventlog_free_event(p.ev);
+		return;
+	}
+	if (!c->have_origin) {
+		c->have_origin = true;
+		c->origin_ts = p.t;
+		if (first_pass)
+			c->t_origin = p.t;
+		c->from_ts = isnan(c->o->from_s) ? INT64_MIN : p.t + (int64_t)(c->o->from_s * 1e6);
+		c->to_ts = isnan(c->o->to_s) ? INT64_MAX : p.t + (int64_t)(c->o->to_s * 1e6);
+	}
+	if (p.t >= c->from_ts && p.t <= c->to_ts)
+		fn(c, p.ev);
+	lcm_eventlog_free_event(p.ev);
+}
+
+/* Runs FN on every event of every log inside the selected range, in time
+ * order (AN_REORDER). Returns AN_EXIT_OK, AN_EXIT_BADLOG or
+ * AN_EXIT_TRUNCATED; notes truncations once. */
 static int an_each_event(struct an_ctx *c, an_event_fn fn, bool first_pass)
 {
+	uint64_t seq = 0;
 	int rc = AN_EXIT_OK;
 	for (int i = 0; i < c->o->nlogs; i++) {
 		struct alog_reader rd;
 		char err[512];
 		if (alog_open(&rd, c->o->logs[i], err, sizeof(err)) != 0) {
 			fprintf(c->o->msg, "undulate-analyze: %s\n", err);
+			while (an_heap_n > 0)
+				lcm_eventlog_free_event(an_heap_pop().ev);
 			return AN_EXIT_BADLOG;
 		}
 		lcm_eventlog_event_t *ev;
 		while ((ev = alog_next(&rd)) != NULL) {
-			if (!c->have_origin) {
-				c->have_origin = true;
-				c->origin_ts = ev->timestamp;
-				if (first_pass)
-					c->t_origin = ev->timestamp;
-				c->from_ts = isnan(c->o->from_s) ? INT64_MIN
-					: ev->timestamp + (int64_t)(c->o->from_s * 1e6);
-				c->to_ts = isnan(c->o->to_s) ? INT64_MAX
-					: ev->timestamp + (int64_t)(c->o->to_s * 1e6);
-			}
-			if (ev->timestamp >= c->from_ts && ev->timestamp <= c->to_ts)
-				fn(c, ev);
-			lcm_eventlog_free_event(ev);
+			if (an_heap_n == AN_REORDER)
+				an_take_event(c, fn, first_pass, an_heap_pop());
+			an_heap_push(ev, an_event_time(ev), seq++);
 		}
 		if (first_pass)
 			c->log_events[i] = rd.events;
@@ -292,10 +386,14 @@ static int an_each_event(struct an_ctx *c, an_event_fn fn, bool first_pass)
 		if (rd.events == 0 && first_pass) {
 			fprintf(c->o->msg, "undulate-analyze: %s: no complete event in the log\n", c->o->logs[i]);
 			alog_close(&rd);
+			while (an_heap_n > 0)
+				lcm_eventlog_free_event(an_heap_pop().ev);
 			return AN_EXIT_BADLOG;
 		}
 		alog_close(&rd);
 	}
+	while (an_heap_n > 0)
+		an_take_event(c, fn, first_pass, an_heap_pop());
 	return rc;
 }
 
@@ -346,8 +444,8 @@ static void an_scan_truth(struct an_ctx *c, const undulate_sim_truth_t *m)
 static void an_scan_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
 {
 	c->events++;
-	if (ev->timestamp > c->last_utime)
-		c->last_utime = ev->timestamp;
+	if (an_channel(ev->channel) != CH_UNKNOWN && an_event_time(ev) > c->last_utime)
+		c->last_utime = an_event_time(ev);
 	switch (an_channel(ev->channel)) {
 	case CH_STATE: {
 		undulate_robot_state_t m;

@@ -2,6 +2,7 @@
  * an end-state classification and plots. See tools/analyze/README.md. */
 #include "analyze.h"
 #include "num.h"
+#include "record.h"
 #include "synth.h"
 
 #include <getopt.h>
@@ -17,6 +18,7 @@ static void usage(FILE *f)
 	      "                        [--restitution R] [--merge S] [--min-swing RAD] [--zero-crossings]\n"
 	      "                        [--quiet]\n"
 	      "       undulate-analyze --synth OUT.log [--duration S] [--synth-stop-after S]\n"
+	      "       undulate-analyze --record OUT.log [--lcm-url URL]\n"
 	      "Reads lcm-logger logs and writes states.csv, collisions.csv, bus.csv, events.csv,\n"
 	      "phase_diff.csv, return_map.csv, collision_rate.csv, summary.txt, summary.json\n"
 	      "(and PNG plots with --plots) into DIR (default: current directory).\n"
@@ -32,6 +34,8 @@ static void usage(FILE *f)
 	      "  --synth OUT.log   write a synthetic log with known phases and collisions\n"
 	      "  --duration S      length of the synthetic log (default 45)\n"
 	      "  --synth-stop-after S  in the synthetic log, r3 and r4 stand still from S seconds on\n"
+	      "  --record OUT.log  record the LCM group into OUT.log until SIGINT/SIGTERM, like lcm-logger\n"
+	      "                    but keeping every message when it falls behind (--lcm-url URL)\n"
 	      "exit: 0 ok, 1 usage, 2 bad/missing log, 3 truncated log (partial results),\n"
 	      "      4 plots failed, 5 output not writable\n",
 	      f);
@@ -48,7 +52,8 @@ static int parse_double(const char *opt, const char *s, double *out)
 }
 
 enum { OPT_OUT = 256, OPT_PAIRS, OPT_PLOTS, OPT_FROM, OPT_TO, OPT_WINDOW, OPT_SEP, OPT_REST,
-       OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_MIN_SWING, OPT_STOP_AFTER, OPT_HELP };
+       OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_MIN_SWING, OPT_STOP_AFTER, OPT_HELP,
+       OPT_RECORD, OPT_LCM_URL };
 
 static const struct option long_opts[] = {
 	{ "out", required_argument, NULL, OPT_OUT },       { "pairs", required_argument, NULL, OPT_PAIRS },
@@ -59,15 +64,19 @@ static const struct option long_opts[] = {
 	{ "quiet", no_argument, NULL, OPT_QUIET },         { "zero-crossings", no_argument, NULL, OPT_ZC },
 	{ "merge", required_argument, NULL, OPT_MERGE },   { "min-swing", required_argument, NULL, OPT_MIN_SWING },
 	{ "synth-stop-after", required_argument, NULL, OPT_STOP_AFTER },
+	{ "record", required_argument, NULL, OPT_RECORD }, { "lcm-url", required_argument, NULL, OPT_LCM_URL },
 	{ "help", no_argument, NULL, OPT_HELP },
 	{ NULL, 0, NULL, 0 },
 };
 
-/* What --synth takes besides the output path; 0 / NAN: not given. */
+/* What --synth takes besides the output path; 0 / NAN: not given. And
+ * --record's. */
 struct synth_args {
 	const char *path;
 	double duration;
 	double stop_after;
+	const char *record;
+	const char *lcm_url;
 };
 
 static int parse_option(int c, struct an_options *o, struct synth_args *sa)
@@ -88,6 +97,8 @@ static int parse_option(int c, struct an_options *o, struct synth_args *sa)
 	case OPT_SYNTH: sa->path = optarg; return 0;
 	case OPT_DURATION: return parse_double("--duration", optarg, &sa->duration);
 	case OPT_STOP_AFTER: return parse_double("--synth-stop-after", optarg, &sa->stop_after);
+	case OPT_RECORD: sa->record = optarg; return 0;
+	case OPT_LCM_URL: sa->lcm_url = optarg; return 0;
 	case OPT_HELP: usage(stdout); exit(AN_EXIT_OK);
 	default: return -1;
 	}
@@ -175,6 +186,18 @@ int main(int argc, char **argv)
 			usage(stderr);
 			return AN_EXIT_USAGE;
 		}
+	}
+	if (sa.record) {
+		if (optind < argc || sa.path) {
+			fprintf(stderr, "undulate-analyze: --record writes a log and reads none: unexpected '%s'\n",
+			        sa.path ? "--synth" : argv[optind]);
+			return AN_EXIT_USAGE;
+		}
+		return rec_run(sa.record, sa.lcm_url);
+	}
+	if (sa.lcm_url) {
+		fputs("undulate-analyze: --lcm-url only goes with --record\n", stderr);
+		return AN_EXIT_USAGE;
 	}
 	if (sa.path && optind < argc) {
 		/* a log named here would silently not be read */

@@ -1,0 +1,267 @@
+/* lockstep.c — see lockstep.h. */
+#include "lockstep.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include "clock.h"
+
+const char *lks_type_name(uint32_t type)
+{
+	static const char *const names[] = {
+		[LKS_HELLO] = "HELLO", [LKS_WELCOME] = "WELCOME", [LKS_WAIT] = "WAIT", [LKS_TIME] = "TIME",
+		[LKS_CMD] = "CMD", [LKS_STOP] = "STOP", [LKS_REFUSED] = "REFUSED", [LKS_BYE] = "BYE",
+	};
+	return type < sizeof names / sizeof names[0] && names[type] ? names[type] : "UNKNOWN";
+}
+
+int lks_send(int fd, const struct lks_msg *m)
+{
+	struct lks_msg out = *m;
+	out.magic = LKS_MAGIC;
+	ssize_t n;
+	do {
+		n = send(fd, &out, sizeof out, MSG_NOSIGNAL);
+	} while (n < 0 && errno == EINTR);
+	if (n == (ssize_t)sizeof out)
+		return 0;
+	if (n >= 0)
+		errno = EMSGSIZE;
+	return -1;
+}
+
+int lks_recv(int fd, struct lks_msg *m, char *why, size_t cap)
+{
+	ssize_t n;
+	do {
+		n = recv(fd, m, sizeof *m, MSG_TRUNC);
+	} while (n < 0 && errno == EINTR);
+	if (n == 0 || (n < 0 && errno == ECONNRESET))
+		return 0;   /* the peer is gone (reset: it left with our messages unread) */
+	if (n < 0) {
+		snprintf(why, cap, "lockstep socket: %s", strerror(errno));
+		return -1;
+	}
+	if (n != (ssize_t)sizeof *m || m->magic != LKS_MAGIC || m->type < LKS_HELLO || m->type > LKS_BYE) {
+		snprintf(why, cap, "lockstep socket: not a lockstep message (%zd bytes, magic %08x): the two "
+		         "programs are from different builds?", n, n >= 4 ? m->magic : 0u);
+		errno = EPROTO;
+		return -1;
+	}
+	m->name[LKS_NAME_MAX - 1] = '\0';
+	m->text[LKS_TEXT_MAX - 1] = '\0';
+	return 1;
+}
+
+static int lks_address(const char *path, struct sockaddr_un *sa, char *err, size_t cap)
+{
+	memset(sa, 0, sizeof *sa);
+	sa->sun_family = AF_UNIX;
+	if (path == NULL || path[0] == '\0' || strlen(path) >= sizeof sa->sun_path) {
+		snprintf(err, cap, "lockstep socket path '%s': empty or longer than %zu bytes", path ? path : "",
+		         sizeof sa->sun_path - 1);
+		return -1;
+	}
+	memcpy(sa->sun_path, path, strlen(path) + 1);
+	return 0;
+}
+
+int lks_listen(const char *path, char *err, size_t cap)
+{
+	struct sockaddr_un sa;
+	if (lks_address(path, &sa, err, cap) != 0)
+		return -1;
+	struct stat st;
+	if (lstat(path, &st) == 0) {
+		if (!S_ISSOCK(st.st_mode)) {
+			snprintf(err, cap, "lockstep socket %s: something that is not a socket is there", path);
+			return -1;
+		}
+		unlink(path);   /* a stale socket of an earlier run */
+	}
+	int fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+	if (fd < 0 || bind(fd, (struct sockaddr *)&sa, sizeof sa) != 0 || listen(fd, 64) != 0) {
+		snprintf(err, cap, "lockstep socket %s: %s", path, strerror(errno));
+		if (fd >= 0)
+			close(fd);
+		return -1;
+	}
+	return fd;
+}
+
+/* ---- the daemon's side ------------------------------------------------------------ */
+
+static void lks_client_set_clock(struct lks_client *c, uint64_t t_ns)
+{
+	c->t_ns = t_ns;
+	clock_set_virtual(c->mono0_us + t_ns / 1000u, c->wall0_us + (int64_t)(t_ns / 1000u));
+}
+
+uint64_t lks_client_now_us(const struct lks_client *c) { return c->mono0_us + c->t_ns / 1000u; }
+
+/* Wait up to ms for the socket to be readable: 1, 0 (time out), -1. */
+static int lks_poll_in(int fd, int ms)
+{
+	struct pollfd p = { .fd = fd, .events = POLLIN };
+	int r;
+	do {
+		r = poll(&p, 1, ms);
+	} while (r < 0 && errno == EINTR);
+	return r;
+}
+
+int lks_client_open(struct lks_client *c, const char *sock_path, const char *port_path, const char *robot,
+                    char *err, size_t cap)
+{
+	memset(c, 0, sizeof *c);
+	c->fd = -1;
+	struct sockaddr_un sa;
+	if (lks_address(sock_path, &sa, err, cap) != 0)
+		return -1;
+	c->fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+	if (c->fd < 0 || connect(c->fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+		snprintf(err, cap, "lockstep: cannot reach the simulator at %s: %s (is undulate-sim running with "
+		         "--lockstep %s?)", sock_path, strerror(errno), sock_path);
+		lks_client_close(c);
+		return -1;
+	}
+	/* the simulator knows its buses by their pty: name the device the link
+	 * points at, wherever either program was started */
+	char resolved[PATH_MAX];
+	struct lks_msg m = { .type = LKS_HELLO, .a = (uint64_t)getpid() };
+	const char *name = realpath(port_path, resolved) ? resolved : port_path;
+	if (strlen(name) >= sizeof m.text) {
+		snprintf(err, cap, "lockstep: port path longer than %zu bytes", sizeof m.text - 1);
+		lks_client_close(c);
+		return -1;
+	}
+	memcpy(m.text, name, strlen(name) + 1);
+	snprintf(m.name, sizeof m.name, "%s", robot);
+	char why[200];
+	int r;
+	if (lks_send(c->fd, &m) != 0) {
+		snprintf(err, cap, "lockstep: %s: %s", sock_path, strerror(errno));
+	} else if ((r = lks_poll_in(c->fd, LKS_CLIENT_GRACE_MS)) <= 0) {
+		snprintf(err, cap, "lockstep: the simulator at %s did not answer in %d s", sock_path,
+		         LKS_CLIENT_GRACE_MS / 1000);
+	} else if ((r = lks_recv(c->fd, &m, why, sizeof why)) <= 0) {
+		snprintf(err, cap, "lockstep: %s", r == 0 ? "the simulator closed the socket" : why);
+	} else if (m.type == LKS_REFUSED) {
+		snprintf(err, cap, "lockstep: the simulator refused %s: %s", port_path, m.text);
+	} else if (m.type != LKS_WELCOME) {
+		snprintf(err, cap, "lockstep: the simulator answered %s to HELLO", lks_type_name(m.type));
+	} else {
+		c->mono0_us = m.b;
+		c->wall0_us = (int64_t)m.c;
+		lks_client_set_clock(c, m.a);
+		return 0;
+	}
+	lks_client_close(c);
+	return -1;
+}
+
+void lks_client_close(struct lks_client *c)
+{
+	if (c->fd < 0)
+		return;
+	struct lks_msg m = { .type = LKS_BYE };
+	(void)lks_send(c->fd, &m);
+	close(c->fd);
+	c->fd = -1;
+}
+
+int lks_client_wait(struct lks_client *c, uint64_t wake_us, bool want_input)
+{
+	if (c->fd < 0)
+		return -1;
+	if (c->waiting)
+		return 0;
+	uint64_t wake_ns = LKS_NEVER;
+	if (wake_us != UINT64_MAX)
+		wake_ns = wake_us > c->mono0_us ? (wake_us - c->mono0_us) * 1000u : 0;
+	struct lks_msg m = {
+		.type = LKS_WAIT, .a = wake_ns, .b = c->written, .flags = want_input ? LKS_WANT_INPUT : 0,
+	};
+	if (lks_send(c->fd, &m) != 0)
+		return -1;
+	c->waiting = true;
+	return 0;
+}
+
+int lks_client_read(struct lks_client *c, char *why, size_t cap)
+{
+	struct lks_msg m;
+	int r = lks_recv(c->fd, &m, why, cap);
+	if (r <= 0)
+		return r;
+	switch (m.type) {
+	case LKS_TIME:
+		c->waiting = false;
+		c->time_moved = true;
+		c->delivered = m.b;
+		lks_client_set_clock(c, m.a > c->t_ns ? m.a : c->t_ns);
+		break;
+	case LKS_CMD:
+		if (c->ncmds < LKS_CMD_QUEUE)
+			snprintf(c->cmds[c->ncmds++], LKS_TEXT_MAX, "%s", m.text);
+		else
+			c->cmds_dropped++;
+		break;
+	case LKS_STOP:
+		c->stop = true;
+		snprintf(c->stop_why, sizeof c->stop_why, "%s", m.text);
+		break;
+	default:
+		snprintf(why, cap, "lockstep: unexpected %s from the simulator", lks_type_name(m.type));
+		errno = EPROTO;
+		return -1;
+	}
+	return (int)m.type;
+}
+
+int lks_client_block(struct lks_client *c, uint64_t wake_us, bool want_input, char *why, size_t cap)
+{
+	if (lks_client_wait(c, wake_us, want_input) != 0) {
+		snprintf(why, cap, "lockstep: the simulator is gone (%s)", strerror(errno));
+		return -1;
+	}
+	while (c->waiting) {
+		int r = lks_poll_in(c->fd, LKS_CLIENT_GRACE_MS);
+		if (r == 0) {
+			snprintf(why, cap, "lockstep: no word from the simulator for %d s", LKS_CLIENT_GRACE_MS / 1000);
+			return -1;
+		}
+		if (r < 0 || (r = lks_client_read(c, why, cap)) < 0)
+			return -1;
+		if (r == 0) {
+			snprintf(why, cap, "lockstep: the simulator closed the socket");
+			return -1;
+		}
+	}
+	return 0;
+}
+
+bool lks_client_take_time(struct lks_client *c)
+{
+	bool moved = c->time_moved;
+	c->time_moved = false;
+	return moved;
+}
+
+bool lks_client_next_cmd(struct lks_client *c, char *out, size_t cap)
+{
+	if (c->ncmds == 0)
+		return false;
+	snprintf(out, cap, "%s", c->cmds[0]);
+	memmove(c->cmds[0], c->cmds[1], (c->ncmds - 1) * sizeof c->cmds[0]);
+	c->ncmds--;
+	return true;
+}

@@ -1,0 +1,143 @@
+/*
+ * lockstep.h — virtual time shared by the simulator and the daemons that
+ * drive its buses: the same binaries, the same bus bytes, the same physics;
+ * only the clock changes hands (issue: lockstep simulation).
+ *
+ * The simulator owns time. Each daemon connects to its lockstep socket (a
+ * local SOCK_SEQPACKET socket: one message a datagram, in order, and the end
+ * of a peer is seen as the end of the stream), names the bus it drives, and
+ * from then on never reads the system's clock: when it has nothing to do
+ * until some time, or until its bus answers, it says so (WAIT) and blocks
+ * until the simulator says what time it is (TIME). The simulator advances
+ * its time only while every daemon is blocked, to the earliest of: its next
+ * physics step, a reply byte's wire time, a daemon's wake-up. So a daemon's
+ * computation takes no virtual time, a bus transaction takes its wire time,
+ * and nothing waits on the wall clock: a run goes as fast as the processes
+ * can take turns, and the same seed gives the same run.
+ *
+ * Bytes on the pty cross the kernel's tty buffer worker, which may hold them
+ * after write() returned. Neither side may take "nothing there" for "nothing
+ * sent", so both count: a WAIT carries the bytes the daemon has written to
+ * its bus so far, and the simulator reads its side of the pty until they have
+ * all arrived before it counts the daemon as blocked; a TIME carries the
+ * bytes the simulator has released toward the daemon, and the daemon's bus
+ * transport (port_bus_io_lockstep) reads until it has them before it lets the
+ * bus decide that a reply did not come.
+ *
+ * Messages (struct lks_msg, fixed size, same machine so host byte order):
+ *   daemon → sim: HELLO  a = pid, text = the bus's port path, name = robot
+ *                 WAIT   a = wake-up (virtual ns, LKS_NEVER: none),
+ *                        b = bytes written to the bus, flags LKS_WANT_INPUT:
+ *                        wake up as soon as bytes arrive
+ *                 BYE    the daemon is leaving (after its safe stop)
+ *   sim → daemon: WELCOME a = virtual now (ns), b = monotonic µs at virtual 0,
+ *                        c = wall-clock µs at virtual 0
+ *                 TIME   a = virtual now (ns), b = bytes released to the bus
+ *                 CMD    text = a command for the robot, applied as one from
+ *                        the robot's local socket (sent just before a TIME)
+ *                 STOP   text = why: the run is over, stop as on SIGTERM
+ *                 REFUSED text = why the daemon cannot join
+ */
+#ifndef UNDULATE_COMMON_LOCKSTEP_H
+#define UNDULATE_COMMON_LOCKSTEP_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define LKS_MAGIC 0x4c4b5331u        /* "LKS1": a version change changes it */
+#define LKS_TEXT_MAX 256             /* a port path, a command, a reason */
+#define LKS_NAME_MAX 32
+#define LKS_NEVER UINT64_MAX
+#define LKS_WANT_INPUT 1u
+/* Commands received while blocked and not yet taken by the daemon. */
+#define LKS_CMD_QUEUE 8
+/* Wall-clock patience of a daemon for its simulator (ms): the simulator
+ * itself declares a stalled daemon after its own grace and ends the run, so
+ * this only fires when the simulator is stopped (SIGSTOP) or hangs. */
+#define LKS_CLIENT_GRACE_MS 120000
+/* Wall-clock patience for bytes already announced by the other side (ms):
+ * the tty worker delivers them in microseconds; a longer gap means they were
+ * lost (a pty closed under them) and the count is set right instead. */
+#define LKS_BYTES_GRACE_MS 2000
+/* Virtual time 0 on both clocks. Fixed, so that the same seed gives the same
+ * run: SINUSOID's phase is taken from the wall clock (robots on different
+ * computers share it), and a wall clock that started wherever the real one
+ * stood would start every run at another phase. 2000-01-01T00:00:00Z on the
+ * wall clock (a lockstep log's utimes are from then, its log timestamps from
+ * now); 1000 s on the monotonic one (never 0, which code may take for
+ * "not set"). */
+#define LKS_WALL0_US 946684800000000LL
+#define LKS_MONO0_US 1000000000ULL
+
+enum lks_type {
+	LKS_HELLO = 1, LKS_WELCOME, LKS_WAIT, LKS_TIME, LKS_CMD, LKS_STOP, LKS_REFUSED, LKS_BYE,
+};
+
+struct lks_msg {
+	uint32_t magic;
+	uint32_t type;
+	uint64_t a, b, c;
+	uint32_t flags;
+	char name[LKS_NAME_MAX];
+	char text[LKS_TEXT_MAX];
+};
+
+const char *lks_type_name(uint32_t type);
+/* Send one message: 0, or -1 (errno set; EPIPE when the peer is gone). */
+int lks_send(int fd, const struct lks_msg *m);
+/* Receive one message (blocking unless the socket is not): 1 a message,
+ * 0 the peer closed, -1 an error or a malformed message (errno EPROTO;
+ * `why` says what). Strings come NUL-terminated whatever was sent. */
+int lks_recv(int fd, struct lks_msg *m, char *why, size_t cap);
+
+/* ---- the simulator's side: the listening socket ----------------------------- */
+/* Bind and listen at path (a stale socket file is replaced; anything else at
+ * path is refused). The fd, or -1 with err. */
+int lks_listen(const char *path, char *err, size_t cap);
+
+/* ---- the daemon's side -------------------------------------------------------- */
+struct lks_client {
+	int fd;
+	uint64_t mono0_us;          /* the daemon's monotonic clock at virtual 0 */
+	int64_t wall0_us;
+	uint64_t t_ns;              /* virtual now */
+	/* bus bytes: written by us, released by the simulator, read by us */
+	uint64_t written, delivered, consumed;
+	bool waiting;               /* a WAIT is out and no TIME has answered it */
+	bool time_moved;            /* a TIME came since lks_client_take_time() */
+	bool stop;                  /* the simulator ended the run */
+	char stop_why[LKS_TEXT_MAX];
+	char cmds[LKS_CMD_QUEUE][LKS_TEXT_MAX];
+	size_t ncmds;
+	long long cmds_dropped;
+	long long resyncs;          /* announced bytes that never came (or came unannounced) */
+};
+
+/* Connect to the simulator at sock_path, say which bus (port_path) and robot
+ * this is, and wait for the answer. Sets the virtual clock (clock.h). 0, or
+ * -1 with err (no simulator there, refused, or no answer in time). */
+int lks_client_open(struct lks_client *c, const char *sock_path, const char *port_path, const char *robot,
+                    char *err, size_t cap);
+/* Say goodbye and close (nothing if not open). */
+void lks_client_close(struct lks_client *c);
+/* Virtual now on the daemon's monotonic clock (µs). */
+uint64_t lks_client_now_us(const struct lks_client *c);
+/* Block until wake_us (the daemon's monotonic µs) or, with want_input, until
+ * bus bytes arrive: send the WAIT (once: a WAIT already out is not sent
+ * again). 0, or -1 when the simulator is gone. */
+int lks_client_wait(struct lks_client *c, uint64_t wake_us, bool want_input);
+/* The socket is readable: take one message. Returns its type, 0 when the
+ * simulator closed the socket, -1 on an error (with why). TIME sets the
+ * virtual clock; CMD is queued; STOP sets c->stop. */
+int lks_client_read(struct lks_client *c, char *why, size_t cap);
+/* Send a WAIT and read until the TIME that answers it (queueing commands,
+ * noting STOP): what a blocking bus call does. 0, or -1 (simulator gone or
+ * silent for LKS_CLIENT_GRACE_MS; why says which). */
+int lks_client_block(struct lks_client *c, uint64_t wake_us, bool want_input, char *why, size_t cap);
+/* True once after each TIME: the daemon's loop has a new "now" to act on. */
+bool lks_client_take_time(struct lks_client *c);
+/* The next queued command into out (false when none). */
+bool lks_client_next_cmd(struct lks_client *c, char *out, size_t cap);
+
+#endif

@@ -1,0 +1,321 @@
+/* vtime.c — see vtime.h. */
+#include "vtime.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+int vt_open(struct vt *v, const char *path, size_t expected, uint64_t mono0_us, int64_t wall0_us, char *err,
+            size_t cap)
+{
+	memset(v, 0, sizeof *v);
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+		v->c[i].fd = -1;
+	v->expected = expected;
+	v->mono0_us = mono0_us;
+	v->wall0_us = wall0_us;
+	snprintf(v->path, sizeof v->path, "%s", path);
+	v->listen_fd = lks_listen(path, err, cap);
+	return v->listen_fd >= 0 ? 0 : -1;
+}
+
+static void vt_drop(struct vt *v, struct vt_client *c)
+{
+	if (c->fd >= 0)
+		close(c->fd);
+	if (c->bus >= 0)
+		v->left++;
+	memset(c, 0, sizeof *c);
+	c->fd = -1;
+	c->bus = -1;
+}
+
+void vt_close(struct vt *v)
+{
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+		if (v->c[i].fd >= 0)
+			vt_drop(v, &v->c[i]);
+	if (v->listen_fd >= 0) {
+		close(v->listen_fd);
+		unlink(v->path);
+	}
+	v->listen_fd = -1;
+}
+
+void vt_accept(struct vt *v)
+{
+	int fd = accept(v->listen_fd, NULL, NULL);
+	if (fd < 0)
+		return;
+	fcntl(fd, F_SETFD, FD_CLOEXEC);
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+		if (v->c[i].fd < 0) {
+			memset(&v->c[i], 0, sizeof v->c[i]);
+			v->c[i].fd = fd;
+			v->c[i].bus = -1;
+			return;
+		}
+	struct lks_msg m = { .type = LKS_REFUSED };
+	snprintf(m.text, sizeof m.text, "too many connections to the lockstep socket");
+	(void)lks_send(fd, &m);
+	close(fd);
+	v->refused++;
+}
+
+size_t vt_clients(const struct vt *v)
+{
+	size_t n = 0;
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+		n += v->c[i].fd >= 0 && v->c[i].bus >= 0;
+	return n;
+}
+
+/* The bus a daemon names: its pty's device (the daemon resolves its link)
+ * or the link itself. -1 if none. */
+static int vt_find_bus(const struct sim *s, const char *path)
+{
+	char resolved[PATH_MAX];
+	for (size_t i = 0; i < s->nbuses; i++) {
+		const struct sim_bus *b = &s->buses[i];
+		if (!strcmp(path, b->link) || (b->slave_path[0] && !strcmp(path, b->slave_path)))
+			return (int)i;
+		if (realpath(b->link, resolved) && !strcmp(path, resolved))
+			return (int)i;
+	}
+	return -1;
+}
+
+static void vt_refuse(struct vt *v, struct vt_client *c, const char *why)
+{
+	struct lks_msg m = { .type = LKS_REFUSED };
+	snprintf(m.text, sizeof m.text, "%s", why);
+	(void)lks_send(c->fd, &m);
+	fprintf(stderr, "undulate-sim: lockstep: refused a daemon (pid %ld, robot '%s'): %s\n", c->pid, c->robot, why);
+	v->refused++;
+	vt_drop(v, c);
+}
+
+static void vt_hello(struct vt *v, const struct sim *s, struct vt_client *c, const struct lks_msg *m,
+                     int64_t wall_ns)
+{
+	char why[LKS_TEXT_MAX + 64];
+	c->pid = (long)m->a;
+	snprintf(c->robot, sizeof c->robot, "%s", m->name);
+	int bus = vt_find_bus(s, m->text);
+	if (v->ending)
+		return vt_refuse(v, c, "the run is over");
+	if (bus < 0) {
+		snprintf(why, sizeof why, "no bus of this simulation is at %.200s", m->text);
+		return vt_refuse(v, c, why);
+	}
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+		if (&v->c[i] != c && v->c[i].fd >= 0 && v->c[i].bus == bus) {
+			snprintf(why, sizeof why, "bus %s already has a daemon (pid %ld)", s->buses[bus].name, v->c[i].pid);
+			return vt_refuse(v, c, why);
+		}
+	c->bus = bus;
+	c->rx_base = s->buses[bus].count.rx_bytes;
+	c->tx_base = s->buses[bus].count.tx_bytes;
+	c->running_since_ns = wall_ns;
+	struct lks_msg w = { .type = LKS_WELCOME, .a = v->t_ns, .b = v->mono0_us, .c = (uint64_t)v->wall0_us };
+	if (lks_send(c->fd, &w) != 0) {
+		vt_drop(v, c);
+		return;
+	}
+	v->joined++;
+	fprintf(stderr, "undulate-sim: lockstep: robot %s (pid %ld) joined on bus %s at t=%.3f s\n", c->robot, c->pid,
+	        s->buses[bus].name, 1e-9 * (double)v->t_ns);
+}
+
+void vt_end(struct vt *v, bool failed, const char *why)
+{
+	if (!v->ending) {
+		snprintf(v->end_why, sizeof v->end_why, "%s", why);
+		v->failed = failed;
+	} else if (failed && !v->failed) {
+		v->failed = true;
+	}
+	v->ending = true;
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+		if (v->c[i].fd >= 0 && v->c[i].bus >= 0 && !v->c[i].stop_sent)
+			v->c[i].stop_pending = true;
+}
+
+void vt_on_client(struct vt *v, const struct sim *s, size_t i, int64_t wall_ns)
+{
+	struct vt_client *c = &v->c[i];
+	struct lks_msg m;
+	char why[200];
+	int r = lks_recv(c->fd, &m, why, sizeof why);
+	if (r <= 0 || m.type == LKS_BYE) {
+		if (r < 0) {
+			v->bad_messages++;
+			fprintf(stderr, "undulate-sim: %s\n", why);
+		}
+		bool joined = c->bus >= 0;
+		char what[200];
+		snprintf(what, sizeof what, "robot %s's daemon (pid %ld) left the run at t=%.3f s", c->robot, c->pid,
+		         1e-9 * (double)v->t_ns);
+		if (joined && !v->ending)
+			vt_end(v, true, what);
+		if (joined)
+			fprintf(stderr, "undulate-sim: lockstep: %s%s\n", what, v->ending && !v->failed ? "" : "");
+		vt_drop(v, c);
+		return;
+	}
+	if (m.type == LKS_HELLO && c->bus < 0)
+		return vt_hello(v, s, c, &m, wall_ns);
+	if (m.type != LKS_WAIT || c->bus < 0) {
+		v->bad_messages++;
+		snprintf(why, sizeof why, "%s out of turn", lks_type_name(m.type));
+		return vt_refuse(v, c, why);
+	}
+	c->blocked = true;
+	c->wake_ns = m.a;
+	c->want_input = (m.flags & LKS_WANT_INPUT) != 0;
+	c->written = m.b;
+}
+
+/* Every byte the daemon wrote has reached our side of its pty. */
+static bool vt_caught_up(const struct vt_client *c, const struct sim *s)
+{
+	const struct sim_bus *b = &s->buses[c->bus];
+	return !sim_bus_connected(b) || b->count.rx_bytes - c->rx_base >= c->written;
+}
+
+bool vt_all_blocked(const struct vt *v, const struct sim *s)
+{
+	if (!v->ending && vt_clients(v) < v->expected)
+		return false;
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++) {
+		const struct vt_client *c = &v->c[i];
+		if (c->fd < 0)
+			continue;
+		if (c->bus < 0 || !c->blocked || !vt_caught_up(c, s))
+			return false;
+	}
+	return true;
+}
+
+static uint64_t vt_delivered(const struct vt_client *c, const struct sim *s)
+{
+	return s->buses[c->bus].count.tx_bytes - c->tx_base;
+}
+
+/* Something to tell it now, whatever its wake-up. */
+static bool vt_due_now(const struct vt_client *c, const struct sim *s)
+{
+	return c->ncmds > 0 || c->stop_pending || (c->want_input && vt_delivered(c, s) > c->told);
+}
+
+uint64_t vt_next_wake(const struct vt *v, const struct sim *s)
+{
+	uint64_t t = LKS_NEVER;
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++) {
+		const struct vt_client *c = &v->c[i];
+		if (c->fd < 0 || c->bus < 0 || !c->blocked)
+			continue;
+		uint64_t w = vt_due_now(c, s) ? v->t_ns : c->wake_ns;
+		if (w < t)
+			t = w;
+	}
+	return t;
+}
+
+void vt_release(struct vt *v, const struct sim *s, uint64_t t, int64_t wall_ns)
+{
+	v->t_ns = t;
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++) {
+		struct vt_client *c = &v->c[i];
+		if (c->fd < 0 || c->bus < 0 || !c->blocked || (c->wake_ns > t && !vt_due_now(c, s)))
+			continue;
+		bool ok = true;
+		for (size_t k = 0; k < c->ncmds && ok; k++) {
+			struct lks_msg m = { .type = LKS_CMD };
+			snprintf(m.text, sizeof m.text, "%s", c->cmds[k]);
+			ok = lks_send(c->fd, &m) == 0;
+		}
+		c->ncmds = 0;
+		if (ok && c->stop_pending) {
+			struct lks_msg m = { .type = LKS_STOP };
+			snprintf(m.text, sizeof m.text, "%.*s", (int)sizeof m.text - 1, v->end_why);
+			ok = lks_send(c->fd, &m) == 0;
+			c->stop_pending = false;
+			c->stop_sent = true;
+		}
+		c->told = vt_delivered(c, s);
+		struct lks_msg m = { .type = LKS_TIME, .a = t, .b = c->told };
+		if (!ok || lks_send(c->fd, &m) != 0) {
+			/* it is gone: its socket's end is read next, and says so */
+			c->blocked = false;
+			continue;
+		}
+		c->blocked = false;
+		c->running_since_ns = wall_ns;
+		c->wakes++;
+		v->wakes++;
+	}
+}
+
+int vt_command(struct vt *v, int bus, const char *text, char *why, size_t cap)
+{
+	int sent = 0;
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++) {
+		struct vt_client *c = &v->c[i];
+		if (c->fd < 0 || c->bus < 0 || (bus >= 0 && c->bus != bus))
+			continue;
+		if (c->ncmds == LKS_CMD_QUEUE) {
+			snprintf(why, cap, "robot %s has %d commands waiting already", c->robot, LKS_CMD_QUEUE);
+			return -1;
+		}
+		snprintf(c->cmds[c->ncmds++], LKS_TEXT_MAX, "%s", text);
+		sent++;
+	}
+	if (sent == 0) {
+		snprintf(why, cap, "no daemon is connected%s", bus >= 0 ? " for that robot" : "");
+		return -1;
+	}
+	v->commands += (uint64_t)sent;
+	return sent;
+}
+
+bool vt_stalled(const struct vt *v, const struct sim *s, int64_t wall_ns, int64_t start_wall_ns, int64_t grace_ns,
+                char *why, size_t cap)
+{
+	if (!v->ending && vt_clients(v) < v->expected && wall_ns - start_wall_ns > grace_ns && v->t_ns == 0) {
+		size_t off = (size_t)snprintf(why, cap, "lockstep: %zu of %zu daemon(s) joined within %.0f s; missing:",
+		                              vt_clients(v), v->expected, 1e-9 * (double)grace_ns);
+		for (size_t b = 0; b < s->nbuses && off < cap; b++) {
+			bool has = false;
+			for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+				has = has || (v->c[i].fd >= 0 && v->c[i].bus == (int)b);
+			if (!has)
+				off += (size_t)snprintf(why + off, cap - off, " %s (%s)", s->buses[b].name, s->buses[b].link);
+		}
+		return true;
+	}
+	for (size_t i = 0; i < VT_MAX_CLIENTS; i++) {
+		const struct vt_client *c = &v->c[i];
+		if (c->fd < 0 || c->bus < 0 || wall_ns - c->running_since_ns <= grace_ns)
+			continue;
+		if (!c->blocked) {
+			snprintf(why, cap, "lockstep: robot %s's daemon (pid %ld) has not waited for %.0f s of wall time "
+			         "at t=%.3f s: stalled", c->robot, c->pid, 1e-9 * (double)grace_ns, 1e-9 * (double)v->t_ns);
+			return true;
+		}
+		if (!vt_caught_up(c, s)) {
+			const struct sim_bus *b = &s->buses[c->bus];
+			snprintf(why, cap, "lockstep: robot %s's daemon (pid %ld) wrote %llu byte(s) to bus %s, %llu arrived in "
+			         "%.0f s of wall time (t=%.3f s)", c->robot, c->pid, (unsigned long long)c->written, b->name,
+			         (unsigned long long)(b->count.rx_bytes - c->rx_base), 1e-9 * (double)grace_ns,
+			         1e-9 * (double)v->t_ns);
+			return true;
+		}
+	}
+	return false;
+}

@@ -1,0 +1,96 @@
+/*
+ * vtime.h — the simulator's side of lockstep (common/lockstep.h): the
+ * daemons that drive its buses, what each is waiting for, and the barrier
+ * that lets virtual time move only while every one of them is blocked.
+ *
+ * main.c owns the loop: it polls the listening socket and the daemons'
+ * sockets with everything else, and asks vt_all_blocked() before it moves
+ * time. Moving time to t is: physics up to t, replies due by t released on
+ * the buses, then vt_release(), which wakes every daemon whose wake-up came,
+ * whose bus has bytes it has not been told of (when it waits for input), or
+ * that has a command or the end of the run to receive.
+ *
+ * A daemon that does not come back within the wall-clock grace, or leaves
+ * before the end, ends the run (vt_stalled, vt_left): never a hang.
+ */
+#ifndef UNDULATE_SIM_VTIME_H
+#define UNDULATE_SIM_VTIME_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "lockstep.h"
+#include "sim.h"
+
+/* One daemon per bus, and a few connections that are not (yet) one. */
+#define VT_MAX_CLIENTS (SIM_MAX_BUSES + 4)
+#define VT_WHY_MAX 400
+
+struct vt_client {
+	int fd;                     /* -1: free */
+	int bus;                    /* index into sim->buses; -1 before HELLO */
+	char robot[LKS_NAME_MAX];
+	long pid;
+	bool blocked;               /* its WAIT is the last word: it does nothing until woken */
+	uint64_t wake_ns;           /* LKS_NEVER: only input or a command wakes it */
+	bool want_input;
+	uint64_t written;           /* bus bytes it has written (its last WAIT) */
+	uint64_t rx_base, tx_base;  /* the bus's counters when it joined */
+	uint64_t told;              /* bus bytes released toward it, as its last TIME said */
+	char cmds[LKS_CMD_QUEUE][LKS_TEXT_MAX];
+	size_t ncmds;
+	bool stop_pending;          /* STOP goes with its next TIME */
+	bool stop_sent;
+	int64_t running_since_ns;   /* wall clock: when it was last woken (stall watch) */
+	uint64_t wakes;
+};
+
+struct vt {
+	int listen_fd;
+	char path[256];
+	struct vt_client c[VT_MAX_CLIENTS];
+	size_t expected;            /* daemons the run waits for: one per bus */
+	uint64_t t_ns;              /* virtual now */
+	uint64_t mono0_us;          /* the daemons' monotonic clock at virtual 0 */
+	int64_t wall0_us;           /* and the wall clock */
+	bool ending;                /* STOP sent (or to be sent) to everyone */
+	bool failed;                /* the run ended because something went wrong */
+	char end_why[VT_WHY_MAX];
+	uint64_t joined, left, refused, bad_messages, commands, wakes;
+};
+
+/* Listen at path for `expected` daemons. mono0_us / wall0_us: the clocks'
+ * values at virtual time 0. 0, or -1 with err. */
+int vt_open(struct vt *v, const char *path, size_t expected, uint64_t mono0_us, int64_t wall0_us, char *err,
+            size_t cap);
+/* Close every connection and remove the socket file. */
+void vt_close(struct vt *v);
+/* A connection waits on the listening socket. */
+void vt_accept(struct vt *v);
+/* Client i's socket is readable: take one message (HELLO, WAIT, BYE, or its
+ * end). wall_ns: the wall clock now. */
+void vt_on_client(struct vt *v, const struct sim *s, size_t i, int64_t wall_ns);
+/* Daemons connected and joined to a bus. */
+size_t vt_clients(const struct vt *v);
+/* Time may move: every expected daemon has joined (unless the run is
+ * ending), every one is blocked, and every byte each has written to its bus
+ * has been read by the simulator. */
+bool vt_all_blocked(const struct vt *v, const struct sim *s);
+/* The earliest virtual time a blocked daemon must be woken at (ns):
+ * its wake-up, or now when it has something to receive. LKS_NEVER if none. */
+uint64_t vt_next_wake(const struct vt *v, const struct sim *s);
+/* Time is t now: wake the daemons that are due (commands, STOP, TIME). */
+void vt_release(struct vt *v, const struct sim *s, uint64_t t, int64_t wall_ns);
+/* Queue a command for the daemon of bus (or of every bus: -1). 0, or -1 with
+ * why (no daemon on that bus, its queue full). */
+int vt_command(struct vt *v, int bus, const char *text, char *why, size_t cap);
+/* End the run: every daemon gets STOP with its next TIME. failed: something
+ * went wrong (the exit status says so). */
+void vt_end(struct vt *v, bool failed, const char *why);
+/* A daemon has been running (not blocked) for longer than grace_ns of wall
+ * time, or the expected ones did not all join within it: true with *why. */
+bool vt_stalled(const struct vt *v, const struct sim *s, int64_t wall_ns, int64_t start_wall_ns, int64_t grace_ns,
+                char *why, size_t cap);
+
+#endif
