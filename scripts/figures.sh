@@ -171,8 +171,12 @@ run_stats() {
 		END { for (k in h) nh++; printf "%d %d %d %.0f %d\n", n, ok, n - ok, s, nh }'
 }
 
+# merge_module MODULE RUNS_DIR FIGDIR HOW WALL LOAD: the module's figure, and
+# FIGDIR/MODULE.run, what the page's table says of it (WALL: seconds of the
+# invocation's runs, "" when merged from elsewhere; LOAD: the machine's load
+# average at their start and end).
 merge_module() {
-	local m=$1 rdir=$2 figdir=$3 how=$4
+	local m=$1 rdir=$2 figdir=$3 how=$4 wall=$5 load=$6
 	[ -d "$rdir/$m" ] || { echo "figures: $m: no runs in $rdir/$m" >&2; return 1; }
 	local n ok failed secs hosts
 	read -r n ok failed secs hosts < <(run_stats "$rdir/$m")
@@ -191,6 +195,8 @@ merge_module() {
 		echo "ok=$ok"
 		echo "failed=$failed"
 		echo "run_seconds=$secs"
+		echo "wall_seconds=$wall"
+		echo "load=$load"
 		echo "hosts=$hosts"
 		echo "how=$how"
 	} >"$figdir/$m.run"
@@ -204,9 +210,9 @@ machine() {
 	echo "${cpu:-unknown CPU}, $(nproc) cores, $(awk '/MemTotal/ { printf "%.0f GB", $2 / 1048576 }' /proc/meminfo), $(uname -sr)"
 }
 
-# page DIR WALL_S: DIR/FIGURES.md from the fragments in DIR/figures/, in page order.
+# page DIR: DIR/FIGURES.md from the fragments in DIR/figures/, in page order.
 page() {
-	local dir=$1 wall=$2 m f
+	local dir=$1 m f
 	local figdir="$dir/figures"
 	{
 		echo "# The paper's figures, from the real daemons"
@@ -217,23 +223,26 @@ page() {
 		echo "the theory's curves from \`undulate-analyze --theory\` (theory.md's formulas, tools/analyze/theory.c)."
 		echo "The numbers of every figure are in the CSV beside its picture (\`figures/\`)."
 		echo
-		echo "Made with \`make figures\` (\`scripts/figures.sh\`) on $(machine); the last"
-		echo "invocation took $(human "$wall") of wall time. Per figure:"
+		echo "Made by \`make figures\` (\`scripts/figures.sh\`) on $(machine). Per figure: its runs,"
+		echo "the wall time of the invocation that ran them (the figures of one invocation share the"
+		echo "machine, so it is theirs together), their run time added up, the set, the date, and the"
+		echo "machine's load average at the start and the end of the runs (work beside them slows them)."
 		echo
-		echo "| figure | runs (failed) | run time, summed over runs | set | made | how |"
-		echo "|---|---|---|---|---|---|"
+		echo "| figure | runs (failed) | wall time of the runs | run time, summed | set | made | load | how |"
+		echo "|---|---|---|---|---|---|---|---|"
 		for m in $(modules); do
 			f="$figdir/$m.run"
 			[ -f "$f" ] || continue
-			awk -F= '{ v[$1] = $2 } END {
-				s = v["run_seconds"] + 0; t = s >= 3600 ? sprintf("%.1f h", s / 3600) : sprintf("%.1f min", s / 60)
-				printf "| [%s](#%s) | %d (%d) | %s | %s | %s | %s |\n", v["module"], v["module"], v["runs"], v["failed"], t, v["set"], v["date"], v["how"] }' "$f"
+			awk -F= 'function t(s) { return s >= 3600 ? sprintf("%.1f h", s / 3600) : sprintf("%.1f min", s / 60) }
+				{ v[$1] = $2 } END {
+				printf "| [%s](#%s) | %d (%d) | %s | %s | %s | %s | %s | %s |\n", v["module"], v["module"], v["runs"], v["failed"],
+					v["wall_seconds"] == "" ? "-" : t(v["wall_seconds"]), t(v["run_seconds"]), v["set"], v["date"], v["load"], v["how"] }' "$f"
 		done
 		echo
-		echo "Regenerate: \`make figures\` (the whole set, under 60 min on this machine), \`make figures"
-		echo "QUICK=1\` (fewer runs, under 10 min), one figure: \`scripts/figures.sh --only pair\` (the page"
-		echo "keeps the other figures' sections). A sweep larger than one machine: README.md, \"A sweep"
-		echo "on a cluster\" (\`--export-jobs\`, GNU parallel over ssh or a Slurm array, then \`--merge\`)."
+		echo "Regenerate: \`make figures\` (the whole set), \`make figures QUICK=1\` (fewer runs), one figure:"
+		echo "\`scripts/figures.sh --only pair\` (the page keeps the other figures' sections). A sweep larger"
+		echo "than one machine: README.md, \"A sweep on a cluster\" (\`--export-jobs\`, GNU parallel over ssh"
+		echo "or a Slurm array, then \`--merge\`)."
 		for m in $(modules); do
 			f="$figdir/$m.md"
 			[ -f "$f" ] || continue
@@ -267,9 +276,9 @@ if [ -n "$merge_dir" ]; then
 	t0=$(date +%s) rc=0
 	for m in $mods; do
 		[ -d "$merge_dir/$m" ] || { [ -n "$only" ] && { echo "figures: $m: no runs in $merge_dir" >&2; rc=1; }; continue; }
-		merge_module "$m" "$merge_dir" "$out/figures" "merged from $(basename "$merge_dir")" || rc=1
+		merge_module "$m" "$merge_dir" "$out/figures" "merged from $(basename "$merge_dir")" "" "-" || rc=1
 	done
-	page "$out" $(( $(date +%s) - t0 ))
+	page "$out"
 	echo "figures: $out/FIGURES.md"
 	exit "$rc"
 fi
@@ -312,6 +321,7 @@ total=$(wc -l <"$jobfile")
 est=$(awk -v s="$(estimate $mods)" -v j="$jobs" 'BEGIN { print s / j }')
 echo "figures: $total runs of $(echo $mods) ($([ "$quick" = 1 ] && echo quick || echo full) set), $jobs at once, raw runs in $runs"
 t0=$(date +%s)
+load0=$(cut -d' ' -f1 /proc/loadavg)
 joblog="$runs/joblog.txt"
 rm -f "$joblog"
 : >"$joblog"
@@ -323,6 +333,8 @@ trap 'kill "$watcher" 2>/dev/null' EXIT
 kill "$watcher" 2>/dev/null
 wait "$watcher" 2>/dev/null
 [ -t 1 ] && echo
+run_wall=$(( $(date +%s) - t0 ))
+load1=$(cut -d' ' -f1 /proc/loadavg)
 echo "$(progress_line "$joblog" "$total" "$t0" 0 | sed 's/, about .* left//')."
 if [ -s "$runs/failures.txt" ]; then
 	echo "figures: failed runs (their run.log says more):"
@@ -330,7 +342,7 @@ if [ -s "$runs/failures.txt" ]; then
 fi
 rc=0
 how="$(hostname), --jobs $jobs"
-for m in $mods; do merge_module "$m" "$runs" "$out/figures" "$how" || rc=1; done
-page "$out" $(( $(date +%s) - t0 ))
+for m in $mods; do merge_module "$m" "$runs" "$out/figures" "$how" "$run_wall" "$load0 → $load1" || rc=1; done
+page "$out"
 echo "figures: $out/FIGURES.md ($(human $(( $(date +%s) - t0 ))))"
 exit "$rc"
