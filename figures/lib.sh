@@ -4,7 +4,8 @@
 #   fig_die MSG...              "fig: MSG" on stderr, exit 1
 #   fig_hash TEXT               a number from TEXT (cksum): the same on every machine
 #   fig_seed TEXT               a seed in 1..999999 from TEXT (a run's name)
-#   fig_unit TEXT               a number in [0, 1) from TEXT
+#   FIG_GOLDEN                  the golden ratio's fraction: i * FIG_GOLDEN mod 1 spreads
+#                               run i's initial phase evenly, the same on every machine
 #   fig_lcm_url OUTDIR [TRY]    a private udpm URL (ttl=0) on a port in 30000-59999
 #                               from OUTDIR's name, the PID and TRY, not bound here yet
 #   fig_demo OUTDIR ARG...      one lockstep run of scripts/demo.sh into OUTDIR/demo
@@ -17,7 +18,6 @@
 #   fig_need_gnuplot            exit 1 with a message when gnuplot is missing
 #   fig_gp_head W H             gnuplot's first lines: PNG terminal and common style
 #   fig_gnuplot SCRIPT          runs gnuplot on SCRIPT (messages in SCRIPT.log)
-#   fig_pngdata PNG             data pixels of PNG (tests/tools/pngdata), or "" when not built
 #   fig_theory ARG...           undulate-analyze --theory ARG... (tools/analyze/theory.c)
 #   fig_pair_switch DSEP DELTA0 when to switch a pair started on the full sinusoid to the
 #                               oscillator: just after the clock last pressed them together
@@ -36,7 +36,7 @@ fig_die() { echo "fig: $*" >&2; exit 1; }
 
 fig_hash() { printf '%s' "$1" | cksum | cut -d' ' -f1; }
 fig_seed() { echo $(( $(fig_hash "$1") % 999999 + 1 )); }
-fig_unit() { awk -v h="$(fig_hash "$1")" 'BEGIN { printf "%.6f", (h % 1000003) / 1000003 }'; }
+FIG_GOLDEN=0.6180339887498949
 
 # Ports for the figures' runs: above the tests' (7600-8000 plus their offsets
 # of a few thousand), the demo's (17600-27599) and below the ephemeral range
@@ -152,11 +152,6 @@ fig_gnuplot() {
 		echo "fig: gnuplot: $(grep -m1 -iE 'error|warning: skipping' "$1.log") ($1.log)" >&2
 		return 1
 	fi
-}
-
-fig_pngdata() {
-	[ -x "$BUILD/tests/tools/pngdata" ] || return 0
-	"$BUILD/tests/tools/pngdata" "$1" | sed -n 's/.* coloured=\([0-9]*\).*/\1/p'
 }
 
 fig_theory() { "$FIG_BIN/undulate-analyze" --theory "$@"; }

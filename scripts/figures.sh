@@ -190,7 +190,7 @@ merge_module() {
 	{
 		echo "module=$m"
 		echo "date=$(date -u +%Y-%m-%d)"
-		echo "set=$([ "$quick" = 1 ] && echo quick || echo full)$([ "${FIG_TINY:-0}" = 1 ] && echo ' (tiny)')"
+		echo "set=$set_name"
 		echo "runs=$n"
 		echo "ok=$ok"
 		echo "failed=$failed"
@@ -207,7 +207,7 @@ merge_module() {
 machine() {
 	local cpu
 	cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo 2>/dev/null | head -1)
-	echo "${cpu:-unknown CPU}, $(nproc) cores, $(awk '/MemTotal/ { printf "%.0f GB", $2 / 1048576 }' /proc/meminfo), $(uname -sr)"
+	echo "${cpu:-unknown CPU}, $(nproc) cores, $(awk '/MemTotal/ { printf "%.0f GB", $2 / 1048576 }' /proc/meminfo), $(uname -s) $(uname -r | cut -d. -f1,2)"
 }
 
 # page DIR: DIR/FIGURES.md from the fragments in DIR/figures/, in page order.
@@ -266,6 +266,8 @@ esac
 parse "$@"
 quick_flag=()
 [ "$quick" = 1 ] && quick_flag=(--quick)
+# the set, as the page names it
+set_name=$([ "$quick" = 1 ] && echo quick || echo full)$([ "${FIG_TINY:-0}" = 1 ] && echo ' (tiny)')
 mods=$(selected) || exit 1
 case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
 
@@ -276,7 +278,14 @@ if [ -n "$merge_dir" ]; then
 	t0=$(date +%s) rc=0
 	for m in $mods; do
 		[ -d "$merge_dir/$m" ] || { [ -n "$only" ] && { echo "figures: $m: no runs in $merge_dir" >&2; rc=1; }; continue; }
-		merge_module "$m" "$merge_dir" "$out/figures" "merged from $(basename "$merge_dir")" "" "-" || rc=1
+		# runs made here keep what their invocation measured (invocation.txt)
+		inv="$merge_dir/invocation.txt" how="merged from $(basename "$merge_dir")" wall="" load="-"
+		if [ -f "$inv" ]; then
+			how="$(sed -n 's/^how=//p' "$inv"), merged again"
+			wall=$(sed -n 's/^wall_seconds=//p' "$inv") load=$(sed -n 's/^load=//p' "$inv")
+			set_name=$(sed -n 's/^set=//p' "$inv")
+		fi
+		merge_module "$m" "$merge_dir" "$out/figures" "$how" "$wall" "$load" || rc=1
 	done
 	page "$out"
 	echo "figures: $out/FIGURES.md"
@@ -341,7 +350,8 @@ if [ -s "$runs/failures.txt" ]; then
 	head -n 10 "$runs/failures.txt" | sed 's/^/  /'
 fi
 rc=0
-how="$(hostname), --jobs $jobs"
+how="here, --jobs $jobs"
+printf 'how=%s\nwall_seconds=%s\nload=%s\nset=%s\n' "$how" "$run_wall" "$load0 → $load1" "$set_name" >"$runs/invocation.txt"
 for m in $mods; do merge_module "$m" "$runs" "$out/figures" "$how" "$run_wall" "$load0 → $load1" || rc=1; done
 page "$out"
 echo "figures: $out/FIGURES.md ($(human $(( $(date +%s) - t0 ))))"

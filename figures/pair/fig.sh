@@ -43,20 +43,20 @@ SECONDS_RUN=40
 # d~_c is 0.21; above 0.8 every touching pair ends in anti-phase at both r);
 # controls at d~ = 2 (no contact: the free amplitude, and Delta kept), as
 # the paper's rig had.
+# Initial phase differences: the golden-ratio sequence (figures/lib.sh),
+# spread evenly over (-pi, pi] without following d~. The quick set fits the
+# figures' share of `make figures QUICK=1` (a few minutes here).
 FULL_067=1000 FULL_090=120 FULL_CTRL=4
-QUICK_067=100 QUICK_090=40 QUICK_CTRL=2
+QUICK_067=80 QUICK_090=30 QUICK_CTRL=2
 R09_DMAX=0.8
 CTRL_DSEP=2
-# Golden-ratio sequence: initial phase differences spread evenly over
-# (-pi, pi] without following d~.
-GOLDEN=0.6180339887498949
 # The scenario's nominal amplitude, for which world.separation is d~.
 NOMINAL_AMP=$(awk -F= '$1 ~ /^amplitude *$/ { gsub(/ /, "", $2); print $2 }' "$SCENARIO")
 
 # series TAG R N DMAX: N runs at restitution R, d~ = (i + 0.5) / N * DMAX.
 series() {
 	local tag=$1 r=$2 n=$3 dmax=$4
-	awk -v tag="$tag" -v r="$r" -v n="$n" -v dmax="$dmax" -v g="$GOLDEN" -v s="$SECONDS_RUN" 'BEGIN {
+	awk -v tag="$tag" -v r="$r" -v n="$n" -v dmax="$dmax" -v g="$FIG_GOLDEN" -v s="$SECONDS_RUN" 'BEGIN {
 		pi = atan2(0, -1)
 		for (i = 0; i < n; i++) {
 			u = (i * g + 0.5) - int(i * g + 0.5)
@@ -339,7 +339,8 @@ stats() {
 			if (pa) { npa++; if (anti) paa++ } else { npc++; if (anti) pca++ }
 			if ($c == "compatible" || $c == "in-phase") { nc++; if (abs($D) <= 2 * atan2(d, sqrt(1 - d * d)) + 0.1) within++ }
 			if ($c != "anti-phase" && $c != "compatible" && $c != "in-phase") {
-				ns++; if (lo == "" || d < lo) lo = d; if (hi == "" || d > hi) hi = d }
+				ns++; if (lo == "" || d < lo) lo = d; if (hi == "" || d > hi) hi = d
+				if (d < 1 && abs(abs($D) - 2 * atan2(d, sqrt(1 - d * d))) < 0.15) graze++ }
 			if (anti) { na++; amp += ($11 + $12) / 2; if (d < dc) below++ }
 		}
 		END {
@@ -347,8 +348,12 @@ stats() {
 			printf "other %d\nmin_anti %s\nmin_map %s\nagree %d\n", n - k["in-phase"] - k["compatible"] - k["anti-phase"] - k["still-colliding"], mina == "" ? "-" : sprintf("%.3f", mina), minp == "" ? "-" : sprintf("%.3f", minp), agree
 			printf "map_anti %d\nmap_anti_ended %d\nmap_compat %d\nmap_compat_anti %d\n", npa, paa, npc, pca
 			printf "nocontact %d\nwithin %d\nunsettled %d\nunsettled_range %s\n", nc, within, ns, ns ? sprintf("%.2f-%.2f", lo, hi) : "-"
-			printf "anti_amp %s\nanti_below_dc %d\n", na ? sprintf("%.2f", amp / na) : "-", below
+			printf "anti_amp %s\nanti_below_dc %d\ngrazing %d\n", na ? sprintf("%.2f", amp / na) : "-", below, graze
 		}' "$t/pair.csv"
+	# the bins from d~_c on: "from-to measured % / map %", for the page
+	awk -F, -v dc="$(cat "$t/dc-$r")" -v w="$BIN" 'NR > 1 && $1 + w / 2 > dc && k < 4 {
+		printf "%s%.2f–%.2f: %.0f %% / %.0f %%", k++ ? "; " : "onset_bins ", $1 - w / 2, $1 + w / 2, 100 * $3, 100 * $4 }
+		END { print k ? "" : "onset_bins -" }' "$t/bins-$r.csv"
 	# the first bin of d~ in which at least a tenth of the runs ended in anti-phase
 	awk -F, -v w="$BIN" 'NR > 1 && $3 >= 0.1 { printf "onset_bin %.2f-%.2f\n", $1 - w / 2, $1 + w / 2; f = 1; exit }
 		END { if (!f) print "onset_bin -" }' "$t/bins-$r.csv"
@@ -360,10 +365,13 @@ fragment() {
 	local t=$1 r
 	for r in $RESTITUTIONS; do stats "$t" "$r" >"$t/stats-$r"; done
 	local a=$t/stats-0.67 b=$t/stats-0.9
-	v() { awk -v k="$2" '$1 == k { print $2 }' "$1"; }
+	v() { awk -v k="$2" '$1 == k { $1 = ""; sub(/^ /, ""); print }' "$1"; }
 	pc() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.0f %%", 100 * a / b; else printf "-" }'; }
 	frac() { awk -v a="$1" -v b="$2" 'BEGIN { print (b > 0 ? a / b : 0) }'; }
 	row() { printf '| %s | %s | %s |\n' "$1" "$2" "$3"; }
+	# third R D: the third fixed point at d~ = D (the curves' nearest sample)
+	third() { awk -F, -v d="$2" 'NR > 1 { e = $1 - d; e = e < 0 ? -e : e; if (!n++ || e < best) { best = e; x = $6 } }
+		END { printf "%s", x == "" ? "none" : sprintf("%.2f", x) }' "$t/curves-$1.csv"; }
 	median() { sort -g | awk '{ a[NR] = $1 } END { if (NR) printf "%.1f", a[int((NR + 1) / 2)] }'; }
 	local ctrl wall speed secs nall dca dcb
 	nall=$(($(wc -l <"$t/pair.csv") - 1))
@@ -390,7 +398,7 @@ golden-ratio sequence), d̃ evenly over [0, 1] at r = 0.67 and over [0, $R09_DMA
 (Started on the full 0.8 rad sinusoid instead and switched as the clock released the bodies,
 the 100 runs of the quick set at r = 0.67 agreed with the map in 88 cases against 92 this
 way, 2026-11-27.) A run took
-$wall s of wall time (median, several at once; $speed× real time in lockstep). d̃ is the
+$wall s of wall time (median, four at once; $speed× real time in lockstep). d̃ is the
 separation over twice the *free* amplitude, A = $(printf '%.3f' "$amp") rad (the median of the runs that
 ended without contact); in anti-phase the swing shrinks (to $(v "$a" anti_amp) rad at r = 0.67),
 so the analyser's final-window d̃ reads higher there (\`dsep_final\` in pair.csv). Controls, as
@@ -401,7 +409,7 @@ the paper's: $ctrl.
 EOF
 	row "runs (d̃ ≤ 1)" "$(v "$a" n)" "$(v "$b" n)"
 	row "ended in phase / compatible / anti-phase" "$(v "$a" in-phase) / $(v "$a" compatible) / $(v "$a" anti-phase)" "$(v "$b" in-phase) / $(v "$b" compatible) / $(v "$b" anti-phase)"
-	row "still colliding or unlocked at the end (their d̃)" "$(v "$a" unsettled) ($(v "$a" unsettled_range))" "$(v "$b" unsettled) ($(v "$b" unsettled_range))"
+	row "still colliding or unlocked at the end (their d̃); of them grazing at \\|Δ\\| = 2·asin(d̃) ± 0.15" "$(v "$a" unsettled) ($(v "$a" unsettled_range)); $(v "$a" grazing)" "$(v "$b" unsettled) ($(v "$b" unsettled_range)); $(v "$b" grazing)"
 	row "d̃_c, theory (\\|f′(π)\\| = 1)" "$dca" "$dcb"
 	row "first run that ended in anti-phase, at d̃" "$(v "$a" min_anti)" "$(v "$b" min_anti)"
 	row "first bin (0.05 wide) with ≥ 10 % of its runs in anti-phase" "$(v "$a" onset_bin)" "$(v "$b" onset_bin)"
@@ -423,7 +431,10 @@ plus controls at d̃ = 2: in phase at d̃ = 0, compatible at d̃ ≈ 0.3, anti-p
 d̃_c = 0.316. Here the first run that ended in anti-phase is at d̃ = $(v "$a" min_anti) (r = 0.67)
 and $(v "$b" min_anti) (r = 0.9) against d̃_c = $dca and $dcb; a tenth of the runs of a bin end in
 anti-phase from d̃ = $(v "$a" onset_bin) and $(v "$b" onset_bin). Earlier sweeps here from Δ₀ = π
-put the onset between 0.30 and 0.40 at r = 0.67 (docs/EXPERIMENTS.md).
+put the onset between 0.30 and 0.40 at r = 0.67 (docs/EXPERIMENTS.md). Most runs that ended
+neither in phase, compatible nor anti-phase graze at the compatibility limit (the orange
+circles on 2·asin(d̃)): the limit is a fixed point of the map, and a pair that reaches it
+from above touches now and then, so the analyser counts it as still colliding.
 
 ![Fig. 3c: |f′(π)|, the cumulative share of anti-phase runs, and the share per bin, against d̃](figures/pair-onset.png)
 
@@ -431,7 +442,11 @@ put the onset between 0.30 and 0.40 at r = 0.67 (docs/EXPERIMENTS.md).
 fixed amplitude; from a run's d̃ and Δ₀ it says where the pair ends (\`undulate-analyze
 --theory final\`). Of the runs it leads to anti-phase, $(pc "$(v "$a" map_anti_ended)" "$(v "$a" map_anti)")
 ended there at r = 0.67 and $(pc "$(v "$b" map_anti_ended)" "$(v "$b" map_anti)") at r = 0.9: the runs'
-basin of anti-phase is $basin (the lower panels: measured against dashed). The daemons'
+basin of anti-phase is $basin (the lower panels: measured against dashed). Near d̃_c the
+map's basin is a sliver next to π (the third fixed point, its edge, is at
+$(third 0.67 0.35) rad for d̃ = 0.35 and $(third 0.67 0.40) for 0.40). The share of the runs that
+ended in anti-phase in the first bins from d̃_c, measured / the map's: at r = 0.67,
+$(v "$a" onset_bins); at r = 0.9, $(v "$b" onset_bins). The daemons'
 oscillators are not phase oscillators: a collision takes amplitude as well as phase (the
 anti-phase swing settles at $(v "$a" anti_amp) rad instead of $(printf '%.2f' "$amp")), and the amplitude
 comes back over a cycle, so the next collision is not the map's. Below d̃_c, where the map

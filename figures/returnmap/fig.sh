@@ -32,8 +32,8 @@ RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current
 # Measured: in phase (|Delta| < 0.05) 8-10 collisions after the switch,
 # two collisions a period, at r = 0.67; r = 0.9 takes longer.
 SECONDS_RUN=20
-FULL_RUNS=24 QUICK_RUNS=4
-GOLDEN=0.6180339887498949
+# Runs per restitution; |Delta0| from the golden-ratio sequence (figures/lib.sh).
+FULL_RUNS=24 QUICK_RUNS=3
 RESTITUTIONS="0.67 0.9"
 
 jobs() {
@@ -46,7 +46,7 @@ jobs() {
 	fi
 	for r in $RESTITUTIONS; do
 		# |Delta0| from 1 to 3 rad, both signs alternating
-		awk -v r="$r" -v n="$n" -v g="$GOLDEN" -v s="$SECONDS_RUN" -v base="$((k * 100))" 'BEGIN {
+		awk -v r="$r" -v n="$n" -v g="$FIG_GOLDEN" -v s="$SECONDS_RUN" -v base="$((k * 100))" 'BEGIN {
 			for (i = 0; i < n; i++) {
 				u = (i * g + 0.25) - int(i * g + 0.25); sgn = i % 2 ? -1 : 1
 				printf "r%03d-%02d %s %.4f %d %d\n", r * 100, i, r, sgn * (1 + 2 * u), 2000 + base + i, s
@@ -205,12 +205,15 @@ stats() {
 		NR > 1 && $2 == r {
 			p++; runs[$1] = 1; e = wrap($9 - $10)
 			if ($6 == 0) { s0 += e * e; n0++ } else { s1 += e * e; n1++ }
+			ae[++ne] = abs(e)
 			if (abs($8) > 0.1) { q[++nq] = abs(sin($9 / 2) / cos($9 / 2)) / abs(sin($8 / 2) / cos($8 / 2)); na++; if ($8 * $9 < 0) alt++
 				if (q[nq] > 0) { lq += log(q[nq]); nl++ } }
 			if (abs($8) > m) m = abs($8)
 		}
 		END {
 			for (k in runs) nr++
+			for (i = 2; i <= ne; i++) { v = ae[i]; for (j = i - 1; j > 0 && ae[j] > v; j--) ae[j + 1] = ae[j]; ae[j + 1] = v }
+			printf "median_err %s\n", ne ? sprintf("%.3f", ae[int((ne + 1) / 2)]) : "-"
 			for (i = 2; i <= nq; i++) { v = q[i]; for (j = i - 1; j > 0 && q[j] > v; j--) q[j + 1] = q[j]; q[j + 1] = v }
 			printf "runs %d\npoints %d\nmax_delta %.2f\n", nr, p, m
 			printf "rms_first %s\nrms_rest %s\n", n0 ? sprintf("%.2f", sqrt(s0 / n0)) : "-", n1 ? sprintf("%.2f", sqrt(s1 / n1)) : "-"
@@ -225,6 +228,8 @@ fragment() {
 	a=$(stats "$csv" 0.67) b=$(stats "$csv" 0.9)
 	v() { awk -v k="$2" '$1 == k { $1 = ""; sub(/^ /, ""); print }' <<<"$1"; }
 	row() { printf '| %s | %s | %s |\n' "$1" "$2" "$3"; }
+	# compound STATS R: tan(D/2) after 20 collisions, measured (geometric mean) against r^20
+	compound() { awk -v g="$(v "$1" geomean)" -v r="$2" 'BEGIN { if (g == "-") print "-"; else printf "%.3g of its start against the closed form'"'"'s %.3g", g ^ 20, r ^ 20 }'; }
 	local secs
 	secs=$(awk 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^seconds=/) { sub("seconds=", "", $i); print $i } }' "$runs"/*/run.info 2>/dev/null |
 		sort -g | awk '{ a[NR] = $1 } END { if (NR) printf "%.1f", a[int((NR + 1) / 2)] }')
@@ -251,7 +256,7 @@ being one contact).
 EOF
 	row "runs / collisions (points)" "$(v "$a" runs) / $(v "$a" points)" "$(v "$b" runs) / $(v "$b" points)"
 	row "largest \\|Δₙ\\| measured" "$(v "$a" max_delta)" "$(v "$b" max_delta)"
-	row "rms of Δₙ₊₁ − the closed form: from the first collision (n = 0) / the later ones" "$(v "$a" rms_first) / $(v "$a" rms_rest) rad" "$(v "$b" rms_first) / $(v "$b" rms_rest) rad"
+	row "Δₙ₊₁ − the closed form: median \\|error\\|; rms from the first collision (n = 0) / the later ones" "$(v "$a" median_err); $(v "$a" rms_first) / $(v "$a" rms_rest) rad" "$(v "$b" median_err); $(v "$b" rms_first) / $(v "$b" rms_rest) rad"
 	row "\\|tan(Δₙ₊₁/2)\\| / \\|tan(Δₙ/2)\\| for \\|Δₙ\\| > 0.1 (theory: r): median (quartiles); geometric mean" "$(v "$a" contraction) ($(v "$a" q25)–$(v "$a" q75)); $(v "$a" geomean)" "$(v "$b" contraction) ($(v "$b" q25)–$(v "$b" q75)); $(v "$b" geomean)"
 	row "the sign of Δ flipped at the collision (theory: always)" "$(v "$a" alternate)" "$(v "$b" alternate)"
 	cat <<EOF
@@ -264,7 +269,8 @@ by r (the paper prints the closed form with a leading minus; iterating the map g
 form plotted, theory.md and tools/analyze/README.md). The measured contraction of
 tan(Δ/2) per collision (the table; its geometric mean is what compounds over the sequence,
 the lower panels) against r = 0.67 and 0.9: where it is above r, the pair synchronizes more
-slowly than the phase model says. Where the points leave the curve:
+slowly than the phase model says. Compounded over 20 collisions: $(compound "$a" 0.67) at r = 0.67,
+$(compound "$b" 0.9) at r = 0.9. Where the points leave the curve:
 the model's oscillators keep one amplitude, while a collision here takes amplitude too and
 the oscillator regains it over the next half period; at small Δ the analyser's phase (from
 the angle and the daemon's speed estimate, 100 samples a second) is uncertain by a few

@@ -16,14 +16,18 @@ PNGDATA="$BUILD/tests/tools/pngdata"
 [ -x "$PNGDATA" ] || tap_skip_all "$PNGDATA is not built (make)"
 
 F="$top/scripts/figures.sh"
+# FIG_TINY=1: each module's tiny set; --only: this test's two modules (the
+# others' tests are theirs, and a module that ignored FIG_TINY would run its
+# whole set here).
 export FIG_TINY=1
+ONLY=pair,returnmap
 # The runs' LCM ports: this test's block of the tools' range (lib.sh), moved
 # by TEST_PORT_OFFSET like every test's.
 export FIG_PORT_LO FIG_PORT_SPAN=8
 FIG_PORT_LO=$(lcm_port 7780)
 
 # ---- exported jobs, run by GNU parallel as on a cluster --------------------------------
-"$F" --export-jobs "$T/jobs.txt" --runs "$T/runs" >"$T/export.out" 2>&1
+"$F" --export-jobs "$T/jobs.txt" --runs "$T/runs" --only "$ONLY" >"$T/export.out" 2>&1
 rc=$?
 n=$(grep -c '^scripts/figures.sh run ' "$T/jobs.txt" 2>/dev/null)
 if [ "$rc" = 0 ] && [ "$n" = 5 ] && [ "$(wc -l <"$T/jobs.txt")" = 5 ]; then
@@ -34,7 +38,7 @@ fi
 tap_check "--export-jobs: every line has its own output folder and seed" \
 	test "$(awk '{ print $4 }' "$T/jobs.txt" | sort -u | wc -l)" = 5
 tap_check "--export-jobs: the same lines every time (seeds from the runs, not \$RANDOM)" \
-	bash -c "'$F' --export-jobs '$T/jobs2.txt' --runs '$T/runs' >/dev/null && cmp -s '$T/jobs.txt' '$T/jobs2.txt'"
+	bash -c "'$F' --export-jobs '$T/jobs2.txt' --runs '$T/runs' --only '$ONLY' >/dev/null && cmp -s '$T/jobs.txt' '$T/jobs2.txt'"
 
 (cd "$top" && parallel --jobs 3 --joblog "$T/joblog" <"$T/jobs.txt") >"$T/parallel.out" 2>&1
 bad=$(awk -F'\t' 'NR > 1 && $7 != 0' "$T/joblog" | wc -l)
@@ -62,7 +66,7 @@ rc=$?
 tap_check "figures-slurm.sh: a task beyond the file: exit 2, saying so" bash -c "[ $rc = 2 ] && grep -q 'has no line 99' '$T/slurm2.err'"
 
 # ---- merged: the figures have their data ---------------------------------------------
-"$F" --merge "$T/runs" --out "$T/docs" >"$T/merge.out" 2>&1
+"$F" --merge "$T/runs" --only "$ONLY" --out "$T/docs" >"$T/merge.out" 2>&1
 rc=$?
 if [ "$rc" = 0 ] && [ -s "$T/docs/FIGURES.md" ]; then
 	tap_ok "--merge: exit 0, FIGURES.md written"
@@ -113,7 +117,7 @@ tap_check "the page has the figure it made and no other" bash -c "
 tap_check "--only nosuch: exit 1, naming the modules there are" bash -c "[ $rc = 1 ] && grep -q \"no module 'nosuch'\" '$T/e1' && grep -q pair '$T/e1'"
 "$F" --jobs 0 2>"$T/e2"; rc=$?
 tap_check "--jobs 0: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'jobs' '$T/e2'"
-GNUPLOT=/nonexistent/gnuplot "$F" --merge "$T/runs" --out "$T/docs3" 2>"$T/e3"; rc=$?
+GNUPLOT=/nonexistent/gnuplot "$F" --merge "$T/runs" --only "$ONLY" --out "$T/docs3" 2>"$T/e3"; rc=$?
 tap_check "gnuplot missing: exit 1, 'gnuplot is not installed'" bash -c "[ $rc = 1 ] && grep -q 'gnuplot is not installed' '$T/e3'"
 mkdir -p "$T/empty/pair"
 "$F" --merge "$T/empty" --only pair --out "$T/docs4" 2>"$T/e4"; rc=$?
