@@ -1,0 +1,264 @@
+#!/usr/bin/env bash
+# figures/forces/fig.sh — the paper's contact-force experiment (its Fig. 10)
+# through the real daemons in lockstep: ten two-joint robots in a row whose
+# walls close from 2.0 m to 0.3 m apart between 10 s and 100 s
+# (sim-bridge/scenarios/arena10.scenario), on the clock (SINUSOID, random
+# phases) until 200 s, then on the oscillator until 300 s; the median contact
+# force (the simulator's ground truth: the rate of its total impulse, impacts
+# and resting contact, per second) over 100-200 s and over 200-300 s, at
+# several controller stiffnesses.
+#
+#   fig.sh jobs [--quick]        one line per run: RUN_ID SLOPE SEED
+#   fig.sh run OUTDIR SLOPE SEED one run: OUTDIR/result.csv (+ series.csv, the force per second)
+#   fig.sh merge RUNS_DIR FIGDIR FIGDIR/forces.csv, forces.png, forces_time.png, forces.md
+#   fig.sh seconds [--quick]     wall seconds of one run on the 2-core machine
+#
+# The stiffness is the servo's: the AX-12's compliance slope (daemon
+# robot.compliance_slope, written to the servos at start-up, as a lab sets
+# it). At 12 V and full torque limit the compliance controller of
+# sim-bridge/PHYSICS.md §1.1 drives a duty of punch + (1 - punch) (|e| -
+# margin) / slope, so the torque grows with the error e at
+#     K = 1.5 N·m · (1 - 32/1023) / (slope · 5.119 mrad)
+# (punch 32, margin 0 as the daemon sets it; the servo uses the largest power
+# of two not above the slope): 17.7 N·m/rad at 16 down to 2.22 at 128. A
+# softer servo lags more, so each run first tunes the oscillator at its slope
+# the way a lab would (undulated --tune on one robot, target 0.8 Hz and
+# 0.8 rad; the tuner also sets the clock's amplitude and frequency to the gait
+# it measured) and runs all ten robots with those parameters.
+set -u
+. "$(dirname "$0")/../helpers.sh"
+fig_init forces
+
+# The experiment's timeline (s of simulated time), as the paper's.
+CLOCK_FROM=100
+SWITCH=200
+END=300
+# Compliance slopes: the AX-12 acts on 2, 4, ..., 128; these four span the
+# paper's factor of 9 in stiffness (0.015-0.135 N·m/rad) with a factor of 8.
+SLOPES="16 32 64 128"
+QUICK_SLOPES="16 128"
+REPLICATES=3
+QUICK_REPLICATES=1
+# The tuner's budget (s of simulated time) and its targets (the paper's gait).
+TUNE_S=150
+
+stiffness() { # SLOPE -> N·m/rad (see the header)
+	awk -v s="$1" 'BEGIN { e = 2; while (e * 2 <= s && e < 128) e *= 2
+		printf "%.3g", 1.5 * (1 - 32 / 1023) / (e * (300 / 1023) * 3.14159265358979 / 180) }'
+}
+
+jobs() {
+	local slopes=$SLOPES reps=$REPLICATES s r
+	[ "${1:-}" = --quick ] && slopes=$QUICK_SLOPES reps=$QUICK_REPLICATES
+	for s in $slopes; do
+		for r in $(seq "$reps"); do
+			echo "slope$s-rep$r $s $(fig_seed forces "$s" "$r")"
+		done
+	done
+}
+
+# tune OUTDIR SLOPE SEED: one robot on its own simulated bus, the tuner in
+# lockstep; OUTDIR/tuned.conf.
+tune() {
+	local out=$1 slope=$2 seed=$3 dir url rc=0
+	dir="$out/tune"
+	rm -rf "$dir" && mkdir -p "$dir" || fig_die "cannot create $dir"
+	url=$(fig_lcm_url "$dir")
+	setsid "$FIG_B/undulate-sim" --link "$dir/r1" --ids 1,2 --name r1 --lcm-url "$url" --seed "$seed" \
+		--lockstep "$dir/clock" --duration $((TUNE_S + 60)) >"$dir/sim.log" 2>&1 </dev/null &
+	local sim=$!
+	local i
+	for i in $(seq 500); do
+		grep -q 'ready:' "$dir/sim.log" 2>/dev/null && break
+		kill -0 "$sim" 2>/dev/null || break
+		sleep 0.02
+	done
+	"$FIG_B/undulated" --tune --port "$dir/r1" --ids 1,2 --robot r1 --lcm-url "$url" --lockstep "$dir/clock" \
+		--set "robot.compliance_slope=$slope" --tune-time "$TUNE_S" --out "$out/tuned.conf" \
+		>"$dir/tune.log" 2>&1 </dev/null || rc=$?
+	# the tuner leaving ends the simulator's run (it says so and exits 1)
+	wait "$sim" 2>/dev/null
+	if [ "$rc" -ne 0 ] || [ ! -f "$out/tuned.conf" ]; then
+		echo "forces: tuning at compliance slope $slope failed (undulated --tune exit $rc): $(grep -m1 -E '^tune: (not|gave)|error' "$dir/tune.log" | cut -c1-200)" >&2
+		return 1
+	fi
+	grep '^tune: done' "$dir/tune.log" >"$out/tune.txt"
+}
+
+# ini FILE SECTION KEY: a value of the tuned configuration.
+ini() {
+	awk -v sec="[$2]" -v key="$3" '/^\[/ { in_sec = ($1 == sec); next }
+		in_sec && $1 == key && $2 == "=" { print $3; exit }' "$1"
+}
+
+# median_force RUN_DIR FROM TO: the median of the per-second contact force
+# (collision_rate.csv, simulated seconds [FROM, TO)).
+force_stat() {
+	awk -F, -v a="$2" -v b="$3" 'NR > 1 && $1 >= a && $1 < b && $6 != "" { print $6 }' "$1/collision_rate.csv" |
+		if [ "$4" = mean ]; then awk '{ s += $1; n++ } END { printf "%.6g\n", n ? s / n : "nan" }'; else fig_median; fi
+}
+impact_rate() {
+	awk -F, -v a="$2" -v b="$3" -v col="$4" 'NR > 1 && $1 >= a && $1 < b { s += $col; n++ }
+		END { printf "%.4g\n", n ? s / n : "nan" }' "$1/collision_rate.csv"
+}
+
+run() {
+	[ $# -eq 3 ] || fig_usage "run OUTDIR SLOPE SEED"
+	local out=$1 slope=$2 seed=$3
+	fig_uint SLOPE "$slope" 2 254
+	fig_uint SEED "$seed" 1 999999999
+	mkdir -p "$out" || fig_die "cannot create $out"
+	local t0
+	t0=$(date +%s.%N)
+	tune "$out" "$slope" "$seed" || exit 1
+	local conf="$out/tuned.conf" sets=() key j
+	sets+=(--daemon-set "robot.compliance_slope=$slope" --daemon-set "robot.servo_lead_s=$(ini "$conf" robot servo_lead_s)")
+	for j in 1 2; do
+		for key in k c mu; do sets+=(--daemon-set "joint.$j.$key=$(ini "$conf" "joint.$j" "$key")"); done
+	done
+	for key in amplitude frequency; do sets+=(--daemon-set "sinusoid.$key=$(ini "$conf" sinusoid "$key")"); done
+	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/arena10.scenario" --seconds "$END" \
+		--switch-at "$SWITCH" --seed "$seed" --window 10 "${sets[@]}" || exit 1
+	local r="$out/run"
+	[ -s "$r/collision_rate.csv" ] || fig_die "the run has no collision_rate.csv"
+	awk -F, 'NR > 1 { printf "%s,%s,%s,%s,%s\n", $1, $6, $2, $4, $5 }' "$r/collision_rate.csv" |
+		{ echo "t,force_n,impacts,pair_impacts,wall_impacts"; cat; } >"$out/series.csv"
+	local fc fo mc mo ic io wc wo swing
+	fc=$(force_stat "$r" "$CLOCK_FROM" "$SWITCH" median)
+	fo=$(force_stat "$r" "$SWITCH" "$END" median)
+	mc=$(force_stat "$r" "$CLOCK_FROM" "$SWITCH" mean)
+	mo=$(force_stat "$r" "$SWITCH" "$END" mean)
+	ic=$(impact_rate "$r" "$CLOCK_FROM" "$SWITCH" 4)
+	io=$(impact_rate "$r" "$SWITCH" "$END" 4)
+	wc=$(impact_rate "$r" "$CLOCK_FROM" "$SWITCH" 5)
+	wo=$(impact_rate "$r" "$SWITCH" "$END" 5)
+	# the smallest swing of any contact joint in the last 10 s: robots that
+	# stopped would also stop pushing
+	swing=$(fig_min_swing "$r/summary.json")
+	[ "$fc" != nan ] && [ "$fo" != nan ] || fig_die "no contact force in the run's analysis (no SIM.TRUTH?)"
+	local wall
+	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	{
+		echo "slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s"
+		echo "$slope,$(stiffness "$slope"),$seed,$(ini "$conf" robot servo_lead_s),$(ini "$conf" joint.1 k),$(ini "$conf" sinusoid amplitude),$(ini "$conf" sinusoid frequency),$fc,$fo,$mc,$mo,$ic,$io,$wc,$wo,$swing,$wall"
+	} >"$out/result.csv"
+	fig_shrink "$out"
+}
+
+merge() {
+	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
+	local runs=$1 fig=$2
+	fig_gnuplot
+	mkdir -p "$fig" || fig_die "cannot create $fig"
+	fig_collect "$runs" "$fig/forces.csv"
+	local csv="$fig/forces.csv" term
+	term=$(fig_term)
+	# per slope: the median over replicates of each run's median, and the range
+	awk -F, 'NR > 1 { n[$1]++; k[$1] = $2; c[$1] = c[$1] " " $8; o[$1] = o[$1] " " $9 } END {
+		for (s in n) print s, k[s], n[s], c[s] "|" o[s] }' "$csv" | sort -n |
+	while read -r s k n rest; do
+		local cs=${rest%%|*} os=${rest#*|}
+		printf '%s %s %s %s %s %s %s %s %s\n' "$s" "$k" "$n" \
+			"$(tr ' ' '\n' <<<"$cs" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | head -1)" \
+			"$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | tail -1)" \
+			"$(tr ' ' '\n' <<<"$os" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
+			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)"
+	done >"$fig/forces.summary"
+	[ -s "$fig/forces.summary" ] || fig_die "no runs to summarize in $csv"
+	gnuplot >"$fig/forces.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing forces.png: $(tail -2 "$fig/forces.gp.log")"
+set terminal $term
+set output '$fig/forces.png'
+set datafile separator ','
+set termoption noenhanced
+set logscale xy
+set xlabel 'controller stiffness K (N·m/rad): AX-12 compliance slope 128, 64, 32, 16 at 12 V'
+set ylabel 'median contact force (N): all contacts in the row'
+set title 'Ten robots, walls closed to 0.3 m: median force on the clock (100-200 s) and on the oscillator (200-300 s)'
+set key top left
+set grid
+set xrange [1.5:30]
+plot '$csv' every ::1 using 2:8 with points pt 7 ps 1.2 lc rgb '#d62728' title 'clock (SINUSOID), each run', \
+     '$fig/forces.summary' using 2:4 with lines lw 2 lc rgb '#d62728' title 'clock, median of runs', \
+     '$csv' every ::1 using 2:9 with points pt 5 ps 1.2 lc rgb '#1f77b4' title 'oscillator, each run', \
+     '$fig/forces.summary' using 2:7 with lines lw 2 lc rgb '#1f77b4' title 'oscillator, median of runs', \
+     0.1 with lines dt 2 lw 2 lc rgb '#2ca02c' title "paper: below 0.1 N once synchronized"
+EOF
+	time_plot "$runs" "$fig"
+	fragment "$fig"
+}
+
+# forces_time.png: the force per second through the whole run, one run per
+# slope (its first replicate that has a series).
+time_plot() {
+	local runs=$1 fig=$2 plots="" s d colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 term
+	term=$(fig_term)
+	for s in $(cut -d' ' -f1 "$fig/forces.summary"); do
+		for d in "$runs"/*/; do
+			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
+			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$s" ] || continue
+			awk -F, 'NR > 1 && $2 != "" && $2 > 0' "$d/series.csv" >"$fig/forces_time.s$s.dat"
+			plots+="${plots:+, }'$fig/forces_time.s$s.dat' using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'"
+			i=$((i + 1))
+			break
+		done
+	done
+	[ -n "$plots" ] || { echo "forces: no series.csv in the runs: no time plot" >&2; return 0; }
+	gnuplot >"$fig/forces_time.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing forces_time.png: $(tail -2 "$fig/forces_time.gp.log")"
+set terminal $term
+set output '$fig/forces_time.png'
+set termoption noenhanced
+set logscale y
+set xlabel 'simulated time (s)'
+set ylabel 'contact force (N), per second'
+set title 'Walls close 10-100 s; clock until 200 s, oscillator after'
+set key bottom left
+set grid
+set arrow from 10, graph 0 to 10, graph 1 nohead dt 3 lc rgb 'gray'
+set arrow from 100, graph 0 to 100, graph 1 nohead dt 3 lc rgb 'gray'
+set arrow from 200, graph 0 to 200, graph 1 nohead lw 2 lc rgb 'black'
+plot $plots
+EOF
+	rm -f "$fig"/forces_time.s*.dat
+}
+
+fragment() {
+	local fig=$1 csv="$1/forces.csv" n
+	n=$(($(wc -l <"$csv") - 1))
+	{
+		echo "## Contact force on the clock and on the oscillator (the paper's Fig. 10)"
+		echo
+		echo "![median contact force against controller stiffness](figures/forces.png)"
+		echo
+		echo "![contact force per second through one run per stiffness](figures/forces_time.png)"
+		echo
+		echo "What ran: $n lockstep runs of \`sim-bridge/scenarios/arena10.scenario\` through ten \`undulated\`"
+		echo "(position servos), each 300 s of simulated time: walls closing from 2.0 m to 0.3 m apart"
+		echo "between 10 s and 100 s, SINUSOID at random phases until 200 s, OSCILLATOR until 300 s."
+		echo "Each run tuned the oscillator first at its compliance slope (\`undulated --tune\`, 0.8 Hz,"
+		echo "0.8 rad; the clock set to the gait measured). Force: the simulator's total impulse per"
+		echo "second (impacts and resting contact, robots and walls), median over 100-200 s (clock)"
+		echo "and 200-300 s (oscillator)."
+		echo
+		echo "| slope | K (N·m/rad) | runs | clock: median force (N), min-max | oscillator: median force (N), min-max | ratio |"
+		echo "|---|---|---|---|---|---|"
+		awk '{ printf "| %s | %s | %s | %.3g (%.3g-%.3g) | %.3g (%.3g-%.3g) | %.1fx |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, ($7 > 0 ? $4 / $7 : 0) }' \
+			"$fig/forces.summary"
+		echo
+		awk -F, 'NR > 1 { if (min == "" || $16 < min) min = $16; if ($16 < 0.2) stopped++; t += $17; n++ }
+			END { if (stopped) printf "In %d run(s) a joint swung less than 0.2 rad peak-to-peak in the last 10 s (smallest %.2f rad): robots that stop also stop pushing.", stopped, min
+			      else printf "Every joint of every robot still swung in the last 10 s of every run (the smallest swing %.2f rad peak-to-peak).", min
+			      printf " Wall time per run: %.0f s on average, tuning included.\n", t / n }' "$csv"
+	} >"$fig/forces.md"
+}
+
+seconds() {
+	echo 100
+}
+
+case "${1:-}" in
+jobs) shift; jobs "$@" ;;
+run) shift; run "$@" ;;
+merge) shift; merge "$@" ;;
+seconds) shift; seconds "$@" ;;
+*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR SLOPE SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
+esac
