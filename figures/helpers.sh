@@ -26,6 +26,11 @@ case "$BUILD" in /*) ;; *) BUILD="$fig_top/$BUILD" ;; esac
 FIG_B="$BUILD/bin"
 FIG_NAME=figure
 
+# A program started here runs in a session of its own where setsid exists,
+# as scripts/demo.sh starts them (its header says why).
+FIG_SESSION=()
+command -v setsid >/dev/null 2>&1 && FIG_SESSION=(setsid)
+
 fig_init() { FIG_NAME=$1; }
 fig_die() { echo "$FIG_NAME: $*" >&2; exit 1; }
 fig_usage() { echo "$FIG_NAME: $*" >&2; exit 2; }
@@ -124,7 +129,7 @@ fig_quantile() {
 	sort -g | awk -v q="$1" '{ v[NR] = $1 } END {
 		if (NR == 0) { print "nan"; exit }
 		p = 1 + q * (NR - 1); i = int(p); f = p - i
-		printf "%.6g\n", i < NR ? v[i] + f * (v[i + 1] - v[i]) : v[NR] }'
+		printf "%.6g\n", (i < NR ? v[i] + f * (v[i + 1] - v[i]) : v[NR]) }'
 }
 
 # The analyser's summary.json (one line) holds a "pairs" list of flat

@@ -64,7 +64,7 @@ tune() {
 	dir="$out/tune"
 	rm -rf "$dir" && mkdir -p "$dir" || fig_die "cannot create $dir"
 	url=$(fig_lcm_url "$dir")
-	setsid "$FIG_B/undulate-sim" --link "$dir/r1" --ids 1,2 --name r1 --lcm-url "$url" --seed "$seed" \
+	${FIG_SESSION[@]+"${FIG_SESSION[@]}"} "$FIG_B/undulate-sim" --link "$dir/r1" --ids 1,2 --name r1 --lcm-url "$url" --seed "$seed" \
 		--lockstep "$dir/clock" --duration $((TUNE_S + 60)) >"$dir/sim.log" 2>&1 </dev/null &
 	local sim=$!
 	local i
@@ -108,6 +108,7 @@ run() {
 	fig_uint SLOPE "$slope" 2 254
 	fig_uint SEED "$seed" 1 999999999
 	mkdir -p "$out" || fig_die "cannot create $out"
+	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
 	local t0
 	t0=$(date +%s.%N)
 	tune "$out" "$slope" "$seed" || exit 1
@@ -165,6 +166,9 @@ merge() {
 			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)"
 	done >"$fig/forces.summary"
 	[ -s "$fig/forces.summary" ] || fig_die "no runs to summarize in $csv"
+	tr ' ' ',' <"$fig/forces.summary" >"$fig/forces.summary.csv"
+	local xtics
+	xtics=$(awk '{ printf "%s\"%s\" %s", (NR > 1 ? ", " : ""), $2, $2 }' "$fig/forces.summary")
 	gnuplot >"$fig/forces.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing forces.png: $(tail -2 "$fig/forces.gp.log")"
 set terminal $term
 set output '$fig/forces.png'
@@ -174,17 +178,21 @@ set logscale xy
 set xlabel 'controller stiffness K (N·m/rad): AX-12 compliance slope 128, 64, 32, 16 at 12 V'
 set ylabel 'median contact force (N): all contacts in the row'
 set title 'Ten robots, walls closed to 0.3 m: median force on the clock (100-200 s) and on the oscillator (200-300 s)'
-set key top left
+set key bottom right
 set grid
 set xrange [1.5:30]
+set xtics ($xtics)
+set yrange [0.01:*]
 plot '$csv' every ::1 using 2:8 with points pt 7 ps 1.2 lc rgb '#d62728' title 'clock (SINUSOID), each run', \
-     '$fig/forces.summary' using 2:4 with lines lw 2 lc rgb '#d62728' title 'clock, median of runs', \
+     '$fig/forces.summary.csv' using 2:4 with lines lw 2 lc rgb '#d62728' title 'clock, median of runs', \
      '$csv' every ::1 using 2:9 with points pt 5 ps 1.2 lc rgb '#1f77b4' title 'oscillator, each run', \
-     '$fig/forces.summary' using 2:7 with lines lw 2 lc rgb '#1f77b4' title 'oscillator, median of runs', \
+     '$fig/forces.summary.csv' using 2:7 with lines lw 2 lc rgb '#1f77b4' title 'oscillator, median of runs', \
      0.1 with lines dt 2 lw 2 lc rgb '#2ca02c' title "paper: below 0.1 N once synchronized"
 EOF
+	rm -f "$fig/forces.summary.csv" "$fig/forces.gp.log"
 	time_plot "$runs" "$fig"
 	fragment "$fig"
+	rm -f "$fig/forces.summary"
 }
 
 # forces_time.png: the force per second through the whole run, one run per
@@ -196,7 +204,8 @@ time_plot() {
 		for d in "$runs"/*/; do
 			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
 			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$s" ] || continue
-			awk -F, 'NR > 1 && $2 != "" && $2 > 0' "$d/series.csv" >"$fig/forces_time.s$s.dat"
+			# whole seconds of the run (the last bin holds the final message alone)
+			awk -F, -v e="$END" 'NR > 1 && $2 != "" && $2 > 0 && $1 + 1 <= e' "$d/series.csv" >"$fig/forces_time.s$s.dat"
 			plots+="${plots:+, }'$fig/forces_time.s$s.dat' using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'"
 			i=$((i + 1))
 			break
@@ -206,6 +215,7 @@ time_plot() {
 	gnuplot >"$fig/forces_time.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing forces_time.png: $(tail -2 "$fig/forces_time.gp.log")"
 set terminal $term
 set output '$fig/forces_time.png'
+set datafile separator ','
 set termoption noenhanced
 set logscale y
 set xlabel 'simulated time (s)'
@@ -218,7 +228,7 @@ set arrow from 100, graph 0 to 100, graph 1 nohead dt 3 lc rgb 'gray'
 set arrow from 200, graph 0 to 200, graph 1 nohead lw 2 lc rgb 'black'
 plot $plots
 EOF
-	rm -f "$fig"/forces_time.s*.dat
+	rm -f "$fig"/forces_time.s*.dat "$fig/forces_time.gp.log"
 }
 
 fragment() {
@@ -237,18 +247,59 @@ fragment() {
 		echo "Each run tuned the oscillator first at its compliance slope (\`undulated --tune\`, 0.8 Hz,"
 		echo "0.8 rad; the clock set to the gait measured). Force: the simulator's total impulse per"
 		echo "second (impacts and resting contact, robots and walls), median over 100-200 s (clock)"
-		echo "and 200-300 s (oscillator)."
+		echo "and 200-300 s (oscillator). The arena in one dimension: the row is the length along"
+		echo "which the paper's walls closed (its 0.6 m width has no counterpart); neighbours start"
+		echo "0.2 m apart (d̃ = 0.67) and, packed evenly, would end 3 cm apart (d̃ = 0.10); the bases"
+		echo "slide when pushed (β = 0.02 s), which is how the walls push the robots together."
 		echo
-		echo "| slope | K (N·m/rad) | runs | clock: median force (N), min-max | oscillator: median force (N), min-max | ratio |"
-		echo "|---|---|---|---|---|---|"
-		awk '{ printf "| %s | %s | %s | %.3g (%.3g-%.3g) | %.3g (%.3g-%.3g) | %.1fx |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, ($7 > 0 ? $4 / $7 : 0) }' \
-			"$fig/forces.summary"
+		echo "| slope | K (N·m/rad) | runs | tuned (its first run): lead (s), k | clock: median force (N), min-max | oscillator: median force (N), min-max | ratio |"
+		echo "|---|---|---|---|---|---|---|"
+		local line slope tuned
+		while read -r line; do
+			slope=${line%% *}
+			tuned=$(awk -F, -v s="$slope" 'NR > 1 && $1 == s { printf "%.3g, %.3g", $4, $5; exit }' "$csv")
+			awk -v t="$tuned" '{ printf "| %s | %s | %s | %s | %.3g (%.3g-%.3g) | %.3g (%.3g-%.3g) | %.1fx |\n", $1, $2, $3, t, $4, $5, $6, $7, $8, $9, ($7 > 0 ? $4 / $7 : 0) }' <<<"$line"
+		done <"$fig/forces.summary"
 		echo
 		awk -F, 'NR > 1 { if (min == "" || $16 < min) min = $16; if ($16 < 0.2) stopped++; t += $17; n++ }
 			END { if (stopped) printf "In %d run(s) a joint swung less than 0.2 rad peak-to-peak in the last 10 s (smallest %.2f rad): robots that stop also stop pushing.", stopped, min
 			      else printf "Every joint of every robot still swung in the last 10 s of every run (the smallest swing %.2f rad peak-to-peak).", min
 			      printf " Wall time per run: %.0f s on average, tuning included.\n", t / n }' "$csv"
+		echo
+		beside "$fig"
 	} >"$fig/forces.md"
+}
+
+# beside FIGDIR: the paper's numbers beside these, and why they differ where
+# that is known (measured here, with the date).
+beside() {
+	awk '{ r = $7 > 0 ? $4 / $7 : 0
+		if (NR == 1 || $7 < omin) omin = $7; if (NR == 1 || $7 > omax) omax = $7
+		if (NR == 1 || $4 < cmin) cmin = $4; if (NR == 1 || $4 > cmax) cmax = $4
+		if (NR == 1 || r < rmin) rmin = r; if (NR == 1 || r > rmax) rmax = r
+		if ($7 >= 0.1) above++; n++ }
+		END {
+			printf "**Beside the paper.** The paper: once the oscillators synchronized the median contact force fell below 0.1 N, orders of magnitude below the clock'"'"'s. Here the oscillator'"'"'s median force is %.2g-%.2g N (the row'"'"'s ten robots and two walls together; %.2g-%.2g N a robot) against the clock'"'"'s %.3g-%.3g N, %.1f-%.1fx lower", omin, omax, omin / 10, omax / 10, cmin, cmax, rmin, rmax
+			if (above == 0 && rmin >= 100) print ": as the paper."
+			else if (rmin >= 1.5) printf ": the fall reproduces, its size does not (%d of %d stiffnesses above 0.1 N on the oscillator, none 100x lower).\n", above, n
+			else printf ": at some stiffness the force did not fall (less than 1.5x); %d of %d above 0.1 N on the oscillator.\n", above, n
+		}' "$1/forces.summary"
+	echo
+	echo "Why, as far as measured here:"
+	echo
+	echo "- The paper's stiffness is out of the AX-12's reach: its softest compliance slope (128) is"
+	echo "  2.2 N·m/rad, 16x the paper's stiffest (0.135). The four slopes span the paper's factor of 9"
+	echo "  with a factor of 8, and the force is drawn against the servo's own K."
+	echo "- In one dimension the arena's final 0.3 m is one robot's swept width (2 x 0.1865 m/rad x"
+	echo "  0.8 rad = 0.30 m): synchronized robots can swing only as one in-phase stack. In a run by hand"
+	echo "  (slope 32, the daemon's defaults, 2026-11-27) eight robots formed that stack, neighbours"
+	echo "  1-5 mm apart grazing about 20 times a second at |Δ| ≈ 0.04 rad, while the two end robots"
+	echo "  were pinned between the stack and the walls (swings of 0.55-0.60 rad instead of 1.6); the"
+	echo "  paper's robots could also move along the arena's other 0.6 m."
+	echo "- The bases' mobility decides how the closing walls pack the row: the same run with β ="
+	echo "  0.01, 0.02, 0.05, 0.1 s gave a fall of 12.5x, 5.8x, 2.1x, 2.0x (mean force over the last"
+	echo "  10 s before the switch and of the run; one seed each, 2026-11-27). arena10 keeps β = 0.02 s,"
+	echo "  the channel preset's, chosen before those runs."
 }
 
 seconds() {
