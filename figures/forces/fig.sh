@@ -8,8 +8,8 @@
 # and resting contact, per second) over 100-200 s and over 200-300 s, at
 # several controller stiffnesses.
 #
-#   fig.sh jobs [--quick]        one line per run: RUN_ID SLOPE SEED
-#   fig.sh run OUTDIR SLOPE SEED one run: OUTDIR/result.csv (+ series.csv, the force per second)
+#   fig.sh jobs [--quick]        one line per run: RUN_ID SLOPE SEED END
+#   fig.sh run OUTDIR SLOPE SEED [END]  one run: OUTDIR/result.csv (+ series.csv, the force per second)
 #   fig.sh merge RUNS_DIR FIGDIR FIGDIR/forces.csv, forces.png, forces_time.png, forces.md
 #   fig.sh seconds [--quick]     wall seconds of one run on the 2-core machine
 #
@@ -29,10 +29,12 @@ set -u
 . "$(dirname "$0")/../helpers.sh"
 fig_init forces
 
-# The experiment's timeline (s of simulated time), as the paper's.
-CLOCK_FROM=100
-SWITCH=200
-END=300
+# The experiment's timeline, as the paper's: END = 300 s of simulated time,
+# the walls closing from 10 s to END/3, the clock until 2 END/3, the
+# oscillator until END; the medians over END/3..2 END/3 and 2 END/3..END.
+# QUICK runs the same timeline at half scale (END = 150).
+END_FULL=300
+END_QUICK=150
 # Compliance slopes: the AX-12 acts on 2, 4, ..., 128; these four span the
 # paper's factor of 9 in stiffness (0.015-0.135 N·m/rad) with a factor of 8.
 SLOPES="16 32 64 128"
@@ -48,11 +50,11 @@ stiffness() { # SLOPE -> N·m/rad (see the header)
 }
 
 jobs() {
-	local slopes=$SLOPES reps=$REPLICATES s r
-	[ "${1:-}" = --quick ] && slopes=$QUICK_SLOPES reps=$QUICK_REPLICATES
+	local slopes=$SLOPES reps=$REPLICATES end=$END_FULL s r
+	[ "${1:-}" = --quick ] && slopes=$QUICK_SLOPES reps=$QUICK_REPLICATES end=$END_QUICK
 	for s in $slopes; do
 		for r in $(seq "$reps"); do
-			echo "slope$s-rep$r $s $(fig_seed forces "$s" "$r")"
+			echo "slope$s-rep$r $s $(fig_seed forces "$s" "$r") $end"
 		done
 	done
 }
@@ -103,10 +105,12 @@ impact_rate() {
 }
 
 run() {
-	[ $# -eq 3 ] || fig_usage "run OUTDIR SLOPE SEED"
-	local out=$1 slope=$2 seed=$3
+	[ $# -eq 3 ] || [ $# -eq 4 ] || fig_usage "run OUTDIR SLOPE SEED [END]"
+	local out=$1 slope=$2 seed=$3 end=${4:-$END_FULL}
 	fig_uint SLOPE "$slope" 2 254
 	fig_uint SEED "$seed" 1 999999999
+	fig_uint END "$end" 60 3600
+	local closed=$((end / 3)) switch=$((2 * end / 3))
 	mkdir -p "$out" || fig_die "cannot create $out"
 	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
 	local t0
@@ -118,21 +122,24 @@ run() {
 		for key in k c mu; do sets+=(--daemon-set "joint.$j.$key=$(ini "$conf" "joint.$j" "$key")"); done
 	done
 	for key in amplitude frequency; do sets+=(--daemon-set "sinusoid.$key=$(ini "$conf" sinusoid "$key")"); done
-	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/arena10.scenario" --seconds "$END" \
-		--switch-at "$SWITCH" --seed "$seed" --window 10 "${sets[@]}" || exit 1
+	# the scenario closes its walls over 90 s from 10 s; a second event at
+	# 10 s (run after the scenario's own) sets the span of this timeline
+	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/arena10.scenario" --seconds "$end" \
+		--switch-at "$switch" --seed "$seed" --window 10 --set "events.10=walls -0.15 0.15 over $((closed - 10))" \
+		"${sets[@]}" || exit 1
 	local r="$out/run"
 	[ -s "$r/collision_rate.csv" ] || fig_die "the run has no collision_rate.csv"
 	awk -F, 'NR > 1 { printf "%s,%s,%s,%s,%s\n", $1, $6, $2, $4, $5 }' "$r/collision_rate.csv" |
 		{ echo "t,force_n,impacts,pair_impacts,wall_impacts"; cat; } >"$out/series.csv"
 	local fc fo mc mo ic io wc wo swing
-	fc=$(force_stat "$r" "$CLOCK_FROM" "$SWITCH" median)
-	fo=$(force_stat "$r" "$SWITCH" "$END" median)
-	mc=$(force_stat "$r" "$CLOCK_FROM" "$SWITCH" mean)
-	mo=$(force_stat "$r" "$SWITCH" "$END" mean)
-	ic=$(impact_rate "$r" "$CLOCK_FROM" "$SWITCH" 4)
-	io=$(impact_rate "$r" "$SWITCH" "$END" 4)
-	wc=$(impact_rate "$r" "$CLOCK_FROM" "$SWITCH" 5)
-	wo=$(impact_rate "$r" "$SWITCH" "$END" 5)
+	fc=$(force_stat "$r" "$closed" "$switch" median)
+	fo=$(force_stat "$r" "$switch" "$end" median)
+	mc=$(force_stat "$r" "$closed" "$switch" mean)
+	mo=$(force_stat "$r" "$switch" "$end" mean)
+	ic=$(impact_rate "$r" "$closed" "$switch" 4)
+	io=$(impact_rate "$r" "$switch" "$end" 4)
+	wc=$(impact_rate "$r" "$closed" "$switch" 5)
+	wo=$(impact_rate "$r" "$switch" "$end" 5)
 	# the smallest swing of any contact joint in the last 10 s: robots that
 	# stopped would also stop pushing
 	swing=$(fig_min_swing "$r/summary.json")
@@ -140,8 +147,8 @@ run() {
 	local wall
 	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
 	{
-		echo "slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s"
-		echo "$slope,$(stiffness "$slope"),$seed,$(ini "$conf" robot servo_lead_s),$(ini "$conf" joint.1 k),$(ini "$conf" sinusoid amplitude),$(ini "$conf" sinusoid frequency),$fc,$fo,$mc,$mo,$ic,$io,$wc,$wo,$swing,$wall"
+		echo "slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s,end_s"
+		echo "$slope,$(stiffness "$slope"),$seed,$(ini "$conf" robot servo_lead_s),$(ini "$conf" joint.1 k),$(ini "$conf" sinusoid amplitude),$(ini "$conf" sinusoid frequency),$fc,$fo,$mc,$mo,$ic,$io,$wc,$wo,$swing,$wall,$end"
 	} >"$out/result.csv"
 	fig_shrink "$out"
 }
@@ -198,14 +205,15 @@ EOF
 # forces_time.png: the force per second through the whole run, one run per
 # slope (its first replicate that has a series).
 time_plot() {
-	local runs=$1 fig=$2 plots="" s d colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 term
+	local runs=$1 fig=$2 plots="" s d colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 term end
 	term=$(fig_term)
+	end=$(run_end "$fig/forces.csv")
 	for s in $(cut -d' ' -f1 "$fig/forces.summary"); do
 		for d in "$runs"/*/; do
 			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
 			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$s" ] || continue
 			# whole seconds of the run (the last bin holds the final message alone)
-			awk -F, -v e="$END" 'NR > 1 && $2 != "" && $2 > 0 && $1 + 1 <= e' "$d/series.csv" >"$fig/forces_time.s$s.dat"
+			awk -F, -v e="$end" 'NR > 1 && $2 != "" && $2 > 0 && $1 + 1 <= e' "$d/series.csv" >"$fig/forces_time.s$s.dat"
 			plots+="${plots:+, }'$fig/forces_time.s$s.dat' using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'"
 			i=$((i + 1))
 			break
@@ -220,20 +228,26 @@ set termoption noenhanced
 set logscale y
 set xlabel 'simulated time (s)'
 set ylabel 'contact force (N), per second'
-set title 'Walls close 10-100 s; clock until 200 s, oscillator after'
+set title 'Walls close 10-$((end / 3)) s; clock until $((2 * end / 3)) s, oscillator after'
 set key bottom left
 set grid
 set arrow from 10, graph 0 to 10, graph 1 nohead dt 3 lc rgb 'gray'
-set arrow from 100, graph 0 to 100, graph 1 nohead dt 3 lc rgb 'gray'
-set arrow from 200, graph 0 to 200, graph 1 nohead lw 2 lc rgb 'black'
+set arrow from $((end / 3)), graph 0 to $((end / 3)), graph 1 nohead dt 3 lc rgb 'gray'
+set arrow from $((2 * end / 3)), graph 0 to $((2 * end / 3)), graph 1 nohead lw 2 lc rgb 'black'
 plot $plots
 EOF
 	rm -f "$fig"/forces_time.s*.dat "$fig/forces_time.gp.log"
 }
 
+# run_end CSV: the runs' END (the first run's; a merge of mixed timelines
+# says so in its fragment).
+run_end() { awk -F, 'NR == 2 { print ($18 == "" ? 300 : $18); exit }' "$1"; }
+
 fragment() {
-	local fig=$1 csv="$1/forces.csv" n
+	local fig=$1 csv="$1/forces.csv" n end mixed
 	n=$(($(wc -l <"$csv") - 1))
+	end=$(run_end "$csv")
+	mixed=$(awk -F, 'NR > 1 { e[$18]++ } END { n = 0; for (k in e) n++; print (n > 1 ? "yes" : "") }' "$csv")
 	{
 		echo "## Contact force on the clock and on the oscillator (the paper's Fig. 10)"
 		echo
@@ -242,12 +256,14 @@ fragment() {
 		echo "![contact force per second through one run per stiffness](figures/forces_time.png)"
 		echo
 		echo "What ran: $n lockstep runs of \`sim-bridge/scenarios/arena10.scenario\` through ten \`undulated\`"
-		echo "(position servos), each 300 s of simulated time: walls closing from 2.0 m to 0.3 m apart"
-		echo "between 10 s and 100 s, SINUSOID at random phases until 200 s, OSCILLATOR until 300 s."
+		echo "(position servos), each $end s of simulated time: walls closing from 2.0 m to 0.3 m apart"
+		echo "between 10 s and $((end / 3)) s, SINUSOID at random phases until $((2 * end / 3)) s, OSCILLATOR until $end s."
+		[ "$end" -lt 300 ] && echo "(The paper's 300 s timeline at $(awk -v e="$end" 'BEGIN { printf "%g", e / 300 }') of its length: \`make figures QUICK=1\`.)"
+		[ -n "$mixed" ] && echo "(Runs of different lengths are merged here; the timeline named is the first run's.)"
 		echo "Each run tuned the oscillator first at its compliance slope (\`undulated --tune\`, 0.8 Hz,"
 		echo "0.8 rad; the clock set to the gait measured). Force: the simulator's total impulse per"
-		echo "second (impacts and resting contact, robots and walls), median over 100-200 s (clock)"
-		echo "and 200-300 s (oscillator). The arena in one dimension: the row is the length along"
+		echo "second (impacts and resting contact, robots and walls), median over $((end / 3))-$((2 * end / 3)) s (clock)"
+		echo "and $((2 * end / 3))-$end s (oscillator). The arena in one dimension: the row is the length along"
 		echo "which the paper's walls closed (its 0.6 m width has no counterpart); neighbours start"
 		echo "0.2 m apart (d̃ = 0.67) and, packed evenly, would end 3 cm apart (d̃ = 0.10); the bases"
 		echo "slide when pushed (β = 0.02 s), which is how the walls push the robots together."
@@ -302,8 +318,10 @@ beside() {
 	echo "  the channel preset's, chosen before those runs."
 }
 
+# Measured 2026-11-27 on the 2-core machine with other work beside it (load
+# average 9-17): 153 s a full run, 58 s a quick one, two at a time.
 seconds() {
-	echo 100
+	if [ "${1:-}" = --quick ]; then echo 60; else echo 150; fi
 }
 
 case "${1:-}" in

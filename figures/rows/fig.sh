@@ -305,8 +305,10 @@ beside() {
 	rm -f "$1/rows.relaxmed"
 }
 
+# Measured 2026-11-27 (load average 9-17, two at a time): 49 s a run on
+# average (18 s for 60 s sweeps, 94 s for 240 s relaxations), 31 s quick.
 seconds() {
-	if [ "${1:-}" = --quick ]; then echo 20; else echo 35; fi
+	if [ "${1:-}" = --quick ]; then echo 30; else echo 50; fi
 }
 
 case "${1:-}" in

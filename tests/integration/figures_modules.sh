@@ -25,11 +25,13 @@ result() {
 }
 
 # ---- jobs ---------------------------------------------------------------------------
+# the seed's field in a job line: the last but for forces (SLOPE SEED END)
 for m in rows channel forces; do
+	sf=NF; [ "$m" = forces ] && sf=3
 	a=$("$F/$m/fig.sh" jobs) b=$("$F/$m/fig.sh" jobs) q=$("$F/$m/fig.sh" jobs --quick)
 	ids=$(awk '{ print $1 }' <<<"$a" | sort | uniq -d)
 	bad=$(awk '$1 !~ /^[A-Za-z0-9_.-]+$/' <<<"$a")
-	seeds=$(awk '{ print $NF }' <<<"$a" | sort | uniq -d)
+	seeds=$(awk -v f="$sf" '{ print (f == "NF") ? $NF : $f }' <<<"$a" | sort | uniq -d)
 	if [ -n "$a" ] && [ "$a" = "$b" ] && [ -z "$ids" ] && [ -z "$bad" ] && [ -z "$seeds" ] && [ -n "$q" ] &&
 		[ "$(wc -l <<<"$q")" -lt "$(wc -l <<<"$a")" ]; then
 		tap_ok "$m: $(wc -l <<<"$a") jobs ($(wc -l <<<"$q") quick), the same twice, unique names and seeds"
@@ -52,13 +54,13 @@ refused "an unknown subcommand" "usage: fig.sh" "$F/rows/fig.sh" draw
 [ ! -e "$T/bad" ] && tap_ok "no run folder made by a refused run" || tap_fail "no run folder made by a refused run"
 
 # ---- forces: merge on fixed rows -----------------------------------------------------
-H="slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s"
+H="slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s,end_s"
 i=0
 for row in "16,17.7,1,0.02,0.07,0.8,0.8,30,4" "16,17.7,2,0.02,0.07,0.8,0.8,34,6" "16,17.7,3,0.02,0.07,0.8,0.8,40,5" \
 	"32,8.87,1,0.026,0.075,0.8,0.8,25,5" "32,8.87,2,0.026,0.075,0.8,0.8,27,7" \
 	"64,4.43,1,0.05,0.03,0.8,0.8,22,4" "128,2.22,1,0.11,0.017,0.82,0.81,20,4.4" "128,2.22,2,0.11,0.017,0.82,0.81,22,4"; do
 	i=$((i + 1))
-	result forces "r$i" "$H" "$row,30,5,190,170,60,30,1.4,95"
+	result forces "r$i" "$H" "$row,30,5,190,170,60,30,1.4,95,300"
 	# the force per second: walls closing 10-100 s, clock, then the oscillator
 	awk -v c="${row#*,*,*,*,*,*,*,}" 'BEGIN { split(c, v, ","); print "t,force_n,impacts,pair_impacts,wall_impacts"
 		for (t = 0; t < 300; t++) { f = t < 10 ? 1 : (t < 100 ? 1 + (v[1] - 1) * (t - 10) / 90 : (t < 200 ? v[1] : v[2]))
@@ -75,7 +77,8 @@ else tap_fail "forces_time.png shows its data" "$n coloured pixels"; fi
 # slope 16: clock 30, 34, 40 -> median 34 (30-40); oscillator 4, 6, 5 -> 5; 6.8x
 if grep -qF '| 16 | 17.7 | 3 | 0.02, 0.07 | 34 (30-40) | 5 (4-6) | 6.8x |' "$T/fig/forces.md" &&
 	grep -qF '| 128 | 2.22 | 2 | 0.11, 0.017 | 21 (20-22) | 4.2 (4-4.4) | 5.0x |' "$T/fig/forces.md" &&
-	grep -q '^!\[.*\](figures/forces.png)' "$T/fig/forces.md" && [ "$(wc -l <"$T/fig/forces.csv")" = 9 ]; then
+	grep -q '^!\[.*\](figures/forces.png)' "$T/fig/forces.md" && [ "$(wc -l <"$T/fig/forces.csv")" = 9 ] &&
+	grep -q 'median over 100-200 s (clock)' "$T/fig/forces.md"; then
 	tap_ok "forces.md: the medians per slope with their ranges and ratios, the picture linked; forces.csv 8 rows"
 else tap_fail "forces.md numbers" "$(grep '^|' "$T/fig/forces.md")"; fi
 
