@@ -306,7 +306,7 @@ beside() {
 }
 
 # Measured 2026-11-27 (load average 9-17, two at a time): 49 s a run on
-# average (18 s for 60 s sweeps, 94 s for 240 s relaxations), 31 s quick.
+# average (27 s for 60 s sweeps, 94 s for 240 s relaxations), 31 s quick.
 seconds() {
 	if [ "${1:-}" = --quick ]; then echo 30; else echo 50; fi
 }
