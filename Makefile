@@ -15,6 +15,9 @@
 #                   the first-run hardware check on a robot (dxl doctor)
 #   make SAN=1 test the same tests under AddressSanitizer + UBSan (build-san/)
 #   make fuzz       libFuzzer target for the packet parser (needs clang)
+#   make test-sdk DXL_SDK=DIR
+#                   ROBOTIS's DynamixelSDK (a checkout of it, built outside this
+#                   tree) as a client of the simulator, Protocol 1.0 and 2.0
 
 SAN      ?=
 ifeq ($(SAN),1)
@@ -96,7 +99,7 @@ LCM_STAMP := $(GEN)/.stamp
 # lcm-gen names files <package>_<type>.c; the package is `undulate`.
 LCM_GEN_C = $(wildcard $(GEN)/*.c)
 
-.PHONY: all deps test-deps test test-long test-busy bench demo hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
+.PHONY: all deps test-deps test test-long test-busy test-sdk bench demo hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
 all: $(foreach p,$(PROGRAMS),$(BIN)/$(p)) unit-tests
 
 $(LCM_STAMP): $(LCM_SRC)
@@ -191,9 +194,17 @@ deps:
 test-deps: deps
 	@scripts/deps.sh chromium || echo "make: chromium not installed: web_dashboard's browser checks will skip"
 
+# DXL_SDK=DIR: a DynamixelSDK checkout; with it `make test` also runs
+# tests/integration/sdk_client.sh (without it that test skips and says how).
+DXL_SDK ?=
 test: test-deps
 	@$(MAKE) --no-print-directory check-pure all
-	@BUILD=$(BUILD) tests/run.sh
+	@BUILD=$(BUILD) DXL_SDK=$(DXL_SDK) tests/run.sh
+
+test-sdk: deps
+	@$(MAKE) --no-print-directory all
+	@test -n "$(DXL_SDK)" || { echo "usage: make test-sdk DXL_SDK=DIR (a checkout of https://github.com/ROBOTIS-GIT/DynamixelSDK)" >&2; exit 2; }
+	@BUILD=$(BUILD) DXL_SDK=$(DXL_SDK) TEST_FILTER=sdk_client tests/run.sh
 
 test-long: test-deps
 	@$(MAKE) --no-print-directory all

@@ -5,8 +5,17 @@
  * Built by bench/run.sh against libprotocol.a; runs against a real bus or
  * the simulator's pty.
  *
- *   buscycle --port PATH --ids 1,2,3 [--baud BPS] [--cycles N] [--period-us P]
- *            [--latency-us L] [--margin-us M]
+ *   buscycle --port PATH|fake --ids 1,2,3 [--protocol 1|2] [--read-len 8|10]
+ *            [--baud BPS] [--cycles N] [--period-us P] [--latency-us L] [--margin-us M]
+ *
+ * --protocol 2: the X series' cycle instead — one SYNC_READ of read_len
+ * bytes from every servo (present velocity + position at 128, 8 bytes; with
+ * the present current at 126, 10 bytes, on the XM430) and one SYNC_WRITE
+ * of 4-byte goal positions. --port fake serves that bus in-process: a pty
+ * whose other end answers as X servos with return delay 0, holding each
+ * reply until the wire time of the request and the replies at the baud has
+ * passed (what undulate-sim does for the AX-12; its X servos come with the
+ * simulator's --model).
  *
  * IDs that do not answer a PING at start are kept in the cycle as "absent":
  * every cycle then pays their READ timeout, the cost of a missing servo.
@@ -18,16 +27,24 @@
  * time overlaps the idle rest of the period). The floor printed beside it
  * includes the SYNC_WRITE's wire time, as a bus analyser would see the cycle.
  */
+#include <fcntl.h>
 #include <inttypes.h>
 #include <math.h>
+#include <poll.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <termios.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "bus.h"
 #include "dxl.h"
+#include "dxl2.h"
+#include "dxl2_table.h"
 #include "dxl_table.h"
 #include "port.h"
 
@@ -53,6 +70,8 @@ struct bc_opts {
 	long cycles;
 	long period_us;
 	long latency_us, margin_us;
+	int protocol;
+	unsigned read_len;                  /* 2.0: bytes a servo in the SYNC_READ */
 };
 
 struct bc_run {
@@ -96,7 +115,7 @@ static int bc_parse_ids(const char *text, struct bc_opts *o)
 
 static int bc_parse(int argc, char **argv, struct bc_opts *o)
 {
-	*o = (struct bc_opts){ .baud = 1000000, .cycles = 500, .period_us = 10000 };
+	*o = (struct bc_opts){ .baud = 1000000, .cycles = 500, .period_us = 10000, .protocol = 1, .read_len = 8 };
 	for (int i = 1; i < argc; i++) {
 		const char *k = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
 		if (!v)
@@ -117,9 +136,17 @@ static int bc_parse(int argc, char **argv, struct bc_opts *o)
 			o->latency_us = atol(v);
 		else if (!strcmp(k, "--margin-us"))
 			o->margin_us = atol(v);
+		else if (!strcmp(k, "--protocol"))
+			o->protocol = atoi(v);
+		else if (!strcmp(k, "--read-len"))
+			o->read_len = (unsigned)atoi(v);
 		else
 			return -1;
 	}
+	if (o->protocol != 1 && o->protocol != 2)
+		return -1;
+	if (o->protocol == 2 && o->read_len != 8 && o->read_len != 10)
+		return -1;
 	return o->port && o->nids && o->baud > 0 && o->cycles > 0 && o->period_us > 0 ? 0 : -1;
 }
 
@@ -189,6 +216,189 @@ static void bc_sync_write(struct bc_run *r, const struct bc_opts *o)
 		r->errors++;
 }
 
+/* ---- Protocol 2.0 ------------------------------------------------------------------ */
+
+/* The SYNC_READ's first address: present velocity (128), or the present
+ * current before it (126) when 10 bytes are read. */
+static uint16_t bc2_read_addr(const struct bc_opts *o)
+{
+	return o->read_len == 10 ? DXL2_X_PRESENT_CURRENT : DXL2_X_PRESENT_VELOCITY;
+}
+
+static void bc2_discover(struct bc_run *r, const struct bc_opts *o)
+{
+	bc_timing(r, o, BC_MAX_RETURN_DELAY_US, o->margin_us > BC_DISCOVERY_MARGIN_US ? o->margin_us : BC_DISCOVERY_MARGIN_US);
+	r->return_delay_us = 0;
+	for (size_t i = 0; i < o->nids; i++) {
+		uint8_t rd = 0, err = 0;
+		uint32_t pos = 0;
+		r->present[i] = bus2_ping(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK ||
+		                bus2_ping(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK;
+		if (r->present[i] && bus2_read_u8(&r->bus, o->ids[i], DXL2_X_RETURN_DELAY_TIME, &rd, &err) == DXL_OK &&
+		    dxl2_return_delay_us(rd) > r->return_delay_us)
+			r->return_delay_us = dxl2_return_delay_us(rd);
+		if (r->present[i] && bus2_read_u32(&r->bus, o->ids[i], DXL2_X_PRESENT_POSITION, &pos, &err) == DXL_OK)
+			r->position[i] = (uint16_t)pos;
+	}
+	bc_timing(r, o, r->return_delay_us, o->margin_us);
+}
+
+/* One cycle: every servo's state in one SYNC_READ, every goal in one SYNC_WRITE. */
+static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
+{
+	uint8_t data[BC_MAX_IDS * 10], goals[BC_MAX_IDS * 4];
+	struct bus_multi m = { .data = data, .cap = sizeof data };
+	int rc = bus2_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m);
+	if (rc != DXL_OK && rc != DXL_E_TIMEOUT)
+		r->errors++;
+	for (size_t i = 0; i < m.n; i++) {
+		const uint8_t *p = bus_multi_data(&m, i);
+		if (p != NULL)
+			r->position[i] = (uint16_t)dxl2_get_u32(p + o->read_len - 4);
+		else if (m.status[i] == DXL_E_TIMEOUT)
+			r->timeouts++;
+		dxl2_put_u32(goals + 4 * i, r->position[i]);
+	}
+	if (bus2_sync_write(&r->bus, DXL2_X_GOAL_POSITION, 4, o->ids, goals, o->nids) != DXL_OK)
+		r->errors++;
+}
+
+/* Wire bytes of the 2.0 cycle: SYNC_READ request 14 + N, each reply
+ * 11 + read_len, SYNC_WRITE 14 + 5 N (no byte stuffed: the floor). */
+static void bc2_floor(const struct bc_run *r, const struct bc_opts *o, size_t n, uint32_t *reads, uint32_t *sync)
+{
+	*reads = bus_wire_time_us(&r->bus, 14 + n + n * (11 + o->read_len)) + (uint32_t)n * r->return_delay_us;
+	*sync = bus_wire_time_us(&r->bus, 14 + 5 * n);
+}
+
+/* The in-process fake X bus: the pty's master end, served by a thread. */
+struct bc_fake {
+	int master;
+	long baud;
+	atomic_bool stop;
+	pthread_t thread;
+	uint8_t mem[BC_MAX_IDS][DXL2_X_TABLE_SIZE];
+	uint8_t ids[BC_MAX_IDS];
+	size_t n;
+};
+
+static int bc_fake_servo(const struct bc_fake *f, uint8_t id)
+{
+	for (size_t i = 0; i < f->n; i++)
+		if (f->ids[i] == id)
+			return (int)i;
+	return -1;
+}
+
+static void bc_fake_sleep_us(uint64_t us)
+{
+	struct timespec ts = { (time_t)(us / 1000000u), (long)(us % 1000000u) * 1000L };
+	while (nanosleep(&ts, &ts) != 0) {
+	}
+}
+
+/* Replies queued for one request, sent once their wire time has passed. */
+static void bc_fake_answer(struct bc_fake *f, const struct dxl2_packet *pkt, uint64_t got_us)
+{
+	static uint8_t out[8192];
+	size_t len = 0;
+	int k;
+	uint16_t addr = pkt->nparams >= 2 ? (uint16_t)(pkt->params[0] | pkt->params[1] << 8) : 0;
+	uint16_t n = pkt->nparams >= 4 ? (uint16_t)(pkt->params[2] | pkt->params[3] << 8) : 0;
+	if (pkt->instr == DXL2_INST_SYNC_WRITE) {
+		for (size_t i = 4; n > 0 && i + n < pkt->nparams + 1u; i += 1u + n)
+			if ((k = bc_fake_servo(f, pkt->params[i])) >= 0 && addr + n <= DXL2_X_TABLE_SIZE)
+				memcpy(&f->mem[k][addr], &pkt->params[i + 1], n);
+		return;
+	}
+	if (pkt->instr == DXL2_INST_SYNC_READ && addr + n <= DXL2_X_TABLE_SIZE) {
+		for (size_t i = 4; i < pkt->nparams; i++) {
+			if ((k = bc_fake_servo(f, pkt->params[i])) < 0)
+				continue;   /* a missing servo: the rest still answer */
+			int w = dxl2_encode_status(out + len, sizeof out - len, pkt->params[i], 0, &f->mem[k][addr], n);
+			len += w > 0 ? (size_t)w : 0;
+		}
+	} else if ((k = bc_fake_servo(f, pkt->id)) >= 0) {
+		if (pkt->instr == DXL2_INST_PING) {
+			const uint8_t p[3] = { f->mem[k][0], f->mem[k][1], f->mem[k][DXL2_X_FIRMWARE_VERSION] };
+			int w = dxl2_encode_status(out, sizeof out, pkt->id, 0, p, 3);
+			len = w > 0 ? (size_t)w : 0;
+		} else if (pkt->instr == DXL2_INST_READ && addr + n <= DXL2_X_TABLE_SIZE) {
+			int w = dxl2_encode_status(out, sizeof out, pkt->id, 0, &f->mem[k][addr], n);
+			len = w > 0 ? (size_t)w : 0;
+		}
+	}
+	if (len == 0)
+		return;
+	/* the request took its wire time to arrive, the replies take theirs */
+	uint64_t wire_us = (uint64_t)(pkt->wire_bytes + len) * 10u * 1000000u / (uint64_t)f->baud;
+	uint64_t now = port_now_us();
+	if (got_us + wire_us > now)
+		bc_fake_sleep_us(got_us + wire_us - now);
+	for (size_t done = 0; done < len;) {
+		ssize_t wr = write(f->master, out + done, len - done);
+		if (wr <= 0)
+			return;
+		done += (size_t)wr;
+	}
+}
+
+static void *bc_fake_serve(void *arg)
+{
+	struct bc_fake *f = arg;
+	struct dxl2_parser parser;
+	struct dxl2_packet pkt;
+	uint8_t buf[1024];
+	dxl2_parser_init(&parser, DXL2_PARSE_INSTRUCTION);
+	while (!atomic_load(&f->stop)) {
+		struct pollfd pfd = { .fd = f->master, .events = POLLIN };
+		if (poll(&pfd, 1, 20) <= 0)
+			continue;
+		ssize_t n = read(f->master, buf, sizeof buf);
+		uint64_t got = port_now_us();
+		size_t off = 0;
+		while (n > 0) {
+			size_t used = 0;
+			int r = dxl2_parser_feed(&parser, buf + off, (size_t)n - off, &used, &pkt);
+			off += used;
+			if (r == DXL_NEED_MORE)
+				break;
+			if (r == DXL_FRAME)
+				bc_fake_answer(f, &pkt, got);
+		}
+	}
+	return NULL;
+}
+
+/* A pty served as X servos (model XM430-W350, return delay 0, at the centre);
+ * its slave's path in path. */
+static int bc_fake_start(struct bc_fake *f, const struct bc_opts *o, char *path, size_t cap)
+{
+	struct termios tio;
+	f->master = posix_openpt(O_RDWR | O_NOCTTY);
+	if (f->master < 0 || grantpt(f->master) != 0 || unlockpt(f->master) != 0 || tcgetattr(f->master, &tio) != 0)
+		return -1;
+	cfmakeraw(&tio);   /* both ends raw, or the line discipline mangles bytes */
+	tcsetattr(f->master, TCSANOW, &tio);
+	snprintf(path, cap, "%s", ptsname(f->master));
+	f->baud = o->baud;
+	f->n = o->nids;
+	for (size_t i = 0; i < o->nids; i++) {
+		f->ids[i] = o->ids[i];
+		memset(f->mem[i], 0, sizeof f->mem[i]);
+		dxl_put_u16(&f->mem[i][DXL2_X_MODEL_NUMBER], DXL2_MODEL_XM430_W350);
+		dxl2_put_u32(&f->mem[i][DXL2_X_PRESENT_POSITION], DXL2_POS_CENTER);
+	}
+	return pthread_create(&f->thread, NULL, bc_fake_serve, f) == 0 ? 0 : -1;
+}
+
+static void bc_fake_stop(struct bc_fake *f)
+{
+	atomic_store(&f->stop, true);
+	pthread_join(f->thread, NULL);
+	close(f->master);
+}
+
 static void bc_sleep_until(struct timespec *next, long period_us, long *overruns)
 {
 	next->tv_nsec += period_us * 1000;
@@ -214,9 +424,13 @@ static void bc_cycles(struct bc_run *r, const struct bc_opts *o)
 	clock_gettime(CLOCK_MONOTONIC, &next);
 	for (long c = 0; c < o->cycles; c++) {
 		uint64_t t0 = port_now_us();
-		for (size_t i = 0; i < o->nids; i++)
-			bc_read_one(r, o, i);
-		bc_sync_write(r, o);
+		if (o->protocol == 2) {
+			bc2_cycle(r, o);
+		} else {
+			for (size_t i = 0; i < o->nids; i++)
+				bc_read_one(r, o, i);
+			bc_sync_write(r, o);
+		}
 		r->cycle_us[c] = (double)(port_now_us() - t0);
 		bc_sleep_until(&next, o->period_us, &r->overruns);
 	}
@@ -232,12 +446,21 @@ static void bc_report(struct bc_run *r, const struct bc_opts *o)
 	uint32_t reads = (uint32_t)npresent * (bus_wire_time_us(&r->bus, BC_READ_REQ_BYTES + BC_READ_REPLY_BYTES) +
 	                                       r->return_delay_us);
 	uint32_t sync = bus_wire_time_us(&r->bus, sync_bytes);
+	uint32_t timeout = bus_timeout_us(&r->bus, BC_READ_REQ_BYTES, BC_READ_REPLY_BYTES);
+	if (o->protocol == 2) {
+		uint16_t lens[BC_MAX_IDS];
+		for (size_t i = 0; i < o->nids; i++)
+			lens[i] = (uint16_t)o->read_len;
+		bc2_floor(r, o, npresent, &reads, &sync);
+		timeout = bus_multi_timeout_us(&r->bus, 14 + o->nids, lens, o->nids);
+	}
+	printf("protocol %d\n", o->protocol);
 	qsort(r->cycle_us, (size_t)o->cycles, sizeof(double), bc_cmp);
 	printf("servos %zu\npresent %zu\nabsent %zu\n", o->nids, npresent, o->nids - npresent);
 	printf("return_delay_us %u\n", r->return_delay_us);
 	printf("floor_reads_us %" PRIu32 "\nfloor_sync_us %" PRIu32 "\nfloor_us %" PRIu32 "\n", reads, sync,
 	       reads + sync);
-	printf("timeout_us %" PRIu32 "\n", bus_timeout_us(&r->bus, BC_READ_REQ_BYTES, BC_READ_REPLY_BYTES));
+	printf("timeout_us %" PRIu32 "\n", timeout);
 	printf("cycles %ld\n", o->cycles);
 	printf("bus_p50 %.0f\nbus_p99 %.0f\nbus_max %.0f\n", bc_pct(r->cycle_us, (size_t)o->cycles, 0.5),
 	       bc_pct(r->cycle_us, (size_t)o->cycles, 0.99), r->cycle_us[o->cycles - 1]);
@@ -251,15 +474,21 @@ static void bc_report(struct bc_run *r, const struct bc_opts *o)
 int main(int argc, char **argv)
 {
 	static struct bc_run r;
+	static struct bc_fake fake;
 	struct bc_opts o;
-	char err[256];
+	char err[256], fake_path[64];
 	if (bc_parse(argc, argv, &o) != 0) {
-		fprintf(stderr, "usage: buscycle --port PATH --ids 1,2 [--baud BPS] [--cycles N] [--period-us P] "
-		                "[--latency-us L] [--margin-us M]\n");
+		fprintf(stderr, "usage: buscycle --port PATH|fake --ids 1,2 [--protocol 1|2] [--read-len 8|10] [--baud BPS] "
+		                "[--cycles N] [--period-us P] [--latency-us L] [--margin-us M]\n");
 		return 2;
 	}
+	bool fake_bus = strcmp(o.port, "fake") == 0;
+	if (fake_bus && (o.protocol != 2 || bc_fake_start(&fake, &o, fake_path, sizeof fake_path) != 0)) {
+		fprintf(stderr, "buscycle: the in-process fake serves Protocol 2.0 only (--protocol 2)\n");
+		return 1;
+	}
 	struct port_options popt = { .baud = o.baud, .force_termios = false, .low_latency = true };
-	struct port *p = port_open(o.port, &popt, err, sizeof err);
+	struct port *p = port_open(fake_bus ? fake_path : o.port, &popt, err, sizeof err);
 	if (!p) {
 		fprintf(stderr, "buscycle: %s\n", err);
 		return 1;
@@ -268,15 +497,21 @@ int main(int argc, char **argv)
 	struct bus_timing t = { .baud = o.baud };
 	port_bus_io(p, &io);
 	bus_init(&r.bus, &io, &t, false);
+	bus_set_protocol(&r.bus, o.protocol == 2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1);
 	r.cycle_us = calloc((size_t)o.cycles, sizeof(double));
 	if (!r.cycle_us) {
 		port_close(p);
 		return 1;
 	}
-	bc_discover(&r, &o);
+	if (o.protocol == 2)
+		bc2_discover(&r, &o);
+	else
+		bc_discover(&r, &o);
 	bc_cycles(&r, &o);
 	bc_report(&r, &o);
 	free(r.cycle_us);
 	port_close(p);
+	if (fake_bus)
+		bc_fake_stop(&fake);
 	return 0;
 }

@@ -11,8 +11,9 @@
 # BENCH_WINDOW_S (daemon bus-time windows, 5), BENCH_CYCLES (protocol-level
 # bus cycles per configuration, 300), BENCH_CAP_S (simulator-only capacity
 # runs, 8), BENCH_FLEET_S (20 robots with 20 daemons, 15), BENCH_CG_S (the
-# daemon under callgrind, 3), BENCH_ONLY (a list of sections to run, e.g.
-# "loop bus"; default all: loop bus missing cap codec cg),
+# daemon under callgrind, 3), BENCH_LOCK_REPS (lockstep runs per scenario, 3),
+# BENCH_ONLY (a list of sections to run, e.g.
+# "loop bus"; default all: loop bus missing cap codec cg web lockstep),
 # KEEP_BENCH_DIR=1 keeps the logs.
 set -u
 top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -31,7 +32,8 @@ CYCLES=${BENCH_CYCLES:-300}
 CAP_S=${BENCH_CAP_S:-8}
 CG_S=${BENCH_CG_S:-3}
 FLEET_S=${BENCH_FLEET_S:-15}
-ONLY=${BENCH_ONLY:-loop bus missing cap codec cg web}
+ONLY=${BENCH_ONLY:-loop bus missing cap codec cg web lockstep}
+LOCK_REPS=${BENCH_LOCK_REPS:-3}
 WEB_S=${BENCH_WEB_S:-15}
 WEB_ROBOTS=20
 # The daemon ramps into its mode over 1.5 s after start: measure after it.
@@ -39,6 +41,7 @@ RAMP_S=2
 # Multicast ports of the benchmark (7900-7949): one per run, so runs never
 # hear each other's messages.
 PORT_LOOP_OTHER=7900 PORT_LOOP_FIFO=7901 PORT_BUS=7902 PORT_MISSING=7903 PORT_CAP=7904 PORT_FLEET=7905 PORT_CG=7906 PORT_WEB=7907
+PORT_LOCK=7908
 FIFO_PRIORITY=80
 # The simulator's own real-time option (below the daemons' priority above).
 SIM_RT_PRIORITY=10
@@ -112,7 +115,8 @@ start_daemon() {
 # retried: " (N start-up retried)" or nothing
 retried() { [ "${1:-0}" != nan ] && [ "${1:-0}" -gt 0 ] && echo "; $1 start-up retried"; }
 
-url() { echo "udpm://239.255.76.67:$1?ttl=0"; }
+# TEST_PORT_OFFSET moves every port, as it does the tests': two runs side by side do not hear each other
+url() { echo "udpm://239.255.76.67:$(($1 + ${TEST_PORT_OFFSET:-0}))?ttl=0"; }
 now_us() { echo $(($(date +%s%N) / 1000)); }
 # utime + stime of a process, in clock ticks (fields 14 and 15 of stat; the
 # name field may hold spaces, so count from after its closing parenthesis).
@@ -438,6 +442,61 @@ section_bus() {
 		done
 	done
 	say ""
+	bus2_table
+}
+
+# ---- 2b: the Protocol 2.0 cycle --------------------------------------------------
+# bus2_run N: buscycle's 2.0 cycle (one SYNC_READ of present current, velocity
+# and position, 10 bytes a servo, and one SYNC_WRITE of 4-byte goals) on the
+# simulator's XM430-W350 servos when it has them (--model), else on
+# buscycle's in-process fake X bus. Return delay 0, 1 Mbps.
+bus2_run() {
+	local n=$1 d=$T/bus out=$T/bus/bc2-$1.txt
+	mkdir -p "$d"
+	if "$SIM" --model xm430-w350 --help 2>&1 | grep -q "unrecognized option '--model'"; then
+		"$HB/buscycle" --port fake --protocol 2 --read-len 10 --ids "$(ids_upto "$n")" --cycles "$CYCLES" \
+			--margin-us "$MARGIN_US" >"$out" 2>"$d/bc2-$n.err" || echo "status not measured: buscycle failed ($(tail -n1 "$d/bc2-$n.err"))" >"$out"
+		echo "bus fake" >>"$out"
+		return 0
+	fi
+	# --baud: X servos leave the factory at 57600; the cycle runs at 1 Mbps
+	start "sim-bc2-$n" "$SIM" --model xm430-w350 --link "$d/bc2-$n.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
+		--baud 1000000 --quiet
+	if ! wait_ready "sim-bc2-$n" 'ready:' 10; then
+		echo "status not measured: the simulator refused $n X servos on one bus ($(why "sim-bc2-$n"))" >"$out"
+	elif ! "$HB/buscycle" --port "$d/bc2-$n.pty" --protocol 2 --read-len 10 --ids "$(ids_upto "$n")" \
+		--cycles "$CYCLES" --margin-us "$MARGIN_US" >"$out" 2>"$d/bc2-$n.err"; then
+		echo "status not measured: buscycle failed ($(tail -n1 "$d/bc2-$n.err"))" >"$out"
+	fi
+	echo "bus simulator" >>"$out"
+	stop "sim-bc2-$n"
+}
+
+bus2_table() {
+	local n b floor1
+	progress "2/5 bus time per cycle: the Protocol 2.0 cycle, 2/6/18 servos, $CYCLES cycles each"
+	for n in 2 6 18; do bus2_run $n; done
+	say "### Protocol 2.0 (X series): one SYNC_READ, one SYNC_WRITE"
+	say ""
+	say "One cycle = SYNC_READ of present current, velocity and position (10 bytes a servo: a request of"
+	say "14 + N bytes, N replies of 21) and SYNC_WRITE of 4-byte goal positions (14 + 5N bytes); return"
+	say "delay 0, 1 Mbps. Floor = wire time at 10 bits a byte, no byte stuffed; 1.0's floor (above) beside it."
+	say "Measured as above: from the SYNC_READ to the SYNC_WRITE handed to the port."
+	say ""
+	say "| servos | 1.0 floor (µs) | 2.0 floor (µs) | of it the SYNC_READ | bus | p50 | p99 | max | p50/2.0 floor | p50/SYNC_READ floor | replies missed |"
+	say "|---|---|---|---|---|---|---|---|---|---|---|"
+	for n in 2 6 18; do
+		b=$T/bus/bc2-$n.txt
+		floor1=$(awk -v n="$n" 'BEGIN { print n * 200 + (3 * n + 8) * 10 }')
+		if [ "$(v "$b" status)" = not ]; then
+			say "| $n | $floor1 | – | – | – | $(sed -n 's/^status //p' "$b") | – | – | – | – | – |"
+			continue
+		fi
+		say "| $n | $floor1 | $(v "$b" floor_us) | $(v "$b" floor_reads_us) | $(v "$b" bus) | $(v "$b" bus_p50) | $(v "$b" bus_p99) |" \
+			"$(v "$b" bus_max) | $(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_us)") |" \
+			"$(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_reads_us)") | $(v "$b" timeouts) of $((n * CYCLES)) |"
+	done
+	say ""
 }
 
 # ---- 3: a missing servo ------------------------------------------------------------
@@ -744,6 +803,59 @@ section_cg() {
 	say ""
 }
 
+# ---- 8: lockstep (virtual time) ----------------------------------------------------
+# lock_run NAME SCENARIO SECONDS ARGS...: one scripts/demo.sh --lockstep run; the
+# simulator's lockstep line (simulated s, wall s from the first step, speed) and
+# the whole run's wall time (start-up, recording and analysis included) go to
+# $T/lock/NAME.res.
+lock_run() {
+	local name=$1 scen=$2 secs=$3 d=$T/lock t0 t1 line
+	shift 3
+	mkdir -p "$d"
+	t0=$(now_us)
+	BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --lockstep --scenario "$scen" --seconds "$secs" \
+		--seed 7 --lcm-url "$(url $PORT_LOCK)" --out "$d/$name.out" "$@" >"$d/$name.log" 2>&1
+	t1=$(now_us)
+	line=$(sed -n 's/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time in \([0-9.]*\) s (\([0-9.]*\)x real time.*/\1 \2 \3/p' \
+		"$d/$name.out/logs/sim.log" 2>/dev/null)
+	echo "${line:-nan nan nan} $(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", (b - a) / 1e6 }')" >"$d/$name.res"
+	rm -rf "$d/$name.out/demo.lcmlog"
+}
+# lock_row LABEL DAEMONS PREFIX BUDGET: the table row and the summary line of N runs
+lock_row() {
+	local label=$1 daemons=$2 prefix=$3 budget=$4 f speeds walls alls med
+	speeds=$(for f in "$T/lock/$prefix".*.res; do awk '{ print $3 }' "$f"; done | sort -n)
+	walls=$(for f in "$T/lock/$prefix".*.res; do awk '{ print $2 }' "$f"; done | sort -n | tr '\n' ' ')
+	alls=$(for f in "$T/lock/$prefix".*.res; do awk '{ print $4 }' "$f"; done | sort -n | tr '\n' ' ')
+	med=$(echo "$speeds" | awk '{ x[NR] = $1 } END { if (NR == 0 || x[1] == "nan") print "nan"; else print x[int((NR + 1) / 2)] }')
+	local range
+	range=$(echo "$speeds" | awk 'NR == 1 { lo = $1 } { hi = $1 } END { printf "%s–%s", lo, hi }')
+	say "| $label | $daemons | $(fmt "$med" 1)× ($range×) | $walls | $alls |"
+	sum "lockstep: $label ($daemons daemons)" "$budget" "$(fmt "$med" 1)× real time (median of $(echo "$speeds" | grep -c .) runs, $range×)"
+}
+section_lockstep() {
+	local i
+	progress "lockstep: the pair rig (40 s) and ten robots (45 s) in simulated time, $LOCK_REPS runs each"
+	for i in $(seq "$LOCK_REPS"); do
+		lock_run "pair.$i" "$top/sim-bridge/scenarios/pair-rig.scenario" 40 --phases 0,3.1416 \
+			--set world.separation=0.7 --daemon-set robot.actuation=torque \
+			--daemon-set robot.torque_drive=current --daemon-set sinusoid.amplitude=0.25
+		lock_run "ten.$i" "$top/sim-bridge/scenarios/force10.scenario" 45
+	done
+	say "## 8. Lockstep: simulated time against wall time"
+	say ""
+	say "scripts/demo.sh --lockstep: the simulator and one undulated per robot in the simulator's time (sim-bridge/README.md,"
+	say "\"Lockstep\"). Speed = simulated seconds over the wall seconds from the first simulated step to the end"
+	say "(the simulator's own figure); whole run = the demo from start to summary (start-up, recording, analysis)."
+	say "Real time is 1× by definition: the other sections run in it."
+	say ""
+	say "| scenario | daemons | speed, median (range) | wall s of the simulated part | whole run, s |"
+	say "|---|---|---|---|---|"
+	lock_row "pair rig, 40 s" 2 pair "≥ 20× real time"
+	lock_row "ten two-joint robots, 45 s" 10 ten "≥ 5× real time"
+	say ""
+}
+
 # ---- main -------------------------------------------------------------------------
 main() {
 	local missing=()
@@ -782,6 +894,7 @@ main() {
 	wants codec && section_codec
 	wants cg && section_cg
 	wants web && section_web
+	wants lockstep && section_lockstep
 	{
 		echo "# undulate benchmarks"
 		echo

@@ -1,9 +1,13 @@
 /*
- * bus.c — Dynamixel 1.0 transactions over struct bus_io.
+ * bus.c — Dynamixel transactions over struct bus_io, Protocol 1.0 and 2.0.
  *
  * Pure like the framing: time comes only from io->now_us, waiting only through
  * io->wait (in the blocking wrappers). The asynchronous core is bus_begin /
- * bus_step; the blocking calls are a loop of bus_step and io->wait.
+ * bus_step; the blocking calls are a loop of bus_step and io->wait (1.0's
+ * here, 2.0's in bus2_calls.c). What a request costs and how its bytes are
+ * flushed, echoed, timed and counted is one code for both protocols; only
+ * the encoding of a request and the parsing and matching of its replies
+ * branch on b->protocol.
  */
 #include "bus.h"
 
@@ -18,6 +22,15 @@
 #define BUS_READ_CHUNK 256
 /* Wire bytes of a packet with n parameters: FF FF ID LEN CODE ... CHK. */
 #define BUS_PACKET_BYTES(n) ((size_t)(n) + 6u)
+/* Protocol 2.0 PING reply: model number (2 bytes) and firmware version. */
+#define BUS2_PING_PARAMS 3
+/* A broadcast PING can be answered by every ID a servo may have (0-252). */
+#define BUS2_PING_ALL_IDS (DXL2_MAX_ID + 1)
+/* Time allowed for each of them: ROBOTIS's SDK waits 3 ms an ID after a
+ * broadcast PING (protocol2_packet_handler.cpp, broadcastPing), a figure
+ * from their firmware's behaviour that the manual does not state; the
+ * reply's own wire time and return delay are used when they are longer. */
+#define BUS2_PING_ALL_SLOT_US 3000u
 
 void bus_init(struct bus *b, const struct bus_io *io, const struct bus_timing *timing, bool echo)
 {
@@ -27,9 +40,30 @@ void bus_init(struct bus *b, const struct bus_io *io, const struct bus_timing *t
 	if (timing)
 		b->timing = *timing;
 	b->echo = echo;
+	b->protocol = BUS_PROTOCOL_1;
 	b->expect_params = -1;
 	b->line_dirty = true;   /* whatever was on the line before us */
 	dxl_parser_init(&b->parser, DXL_PARSE_STATUS);
+	dxl2_parser_init(&b->parser2, DXL2_PARSE_STATUS);
+}
+
+int bus_set_protocol(struct bus *b, enum bus_protocol protocol)
+{
+	if (protocol != BUS_PROTOCOL_1 && protocol != BUS_PROTOCOL_2)
+		return DXL_E_ARG;
+	if (b->pending)
+		return DXL_E_BUSY;
+	if (protocol != b->protocol)
+		b->line_dirty = true;   /* the other protocol's replies may still come */
+	b->protocol = protocol;
+	dxl_parser_reset(&b->parser);
+	dxl2_parser_reset(&b->parser2);
+	return DXL_OK;
+}
+
+enum bus_protocol bus_get_protocol(const struct bus *b)
+{
+	return b->protocol;
 }
 
 void bus_set_timing(struct bus *b, const struct bus_timing *timing)
@@ -52,6 +86,25 @@ uint32_t bus_timeout_us(const struct bus *b, size_t req_bytes, size_t reply_byte
 	       b->timing.adapter_latency_us + b->timing.margin_us;
 }
 
+uint32_t bus_multi_timeout_us(const struct bus *b, size_t req_bytes, const uint16_t *reply_params, size_t nreplies)
+{
+	size_t bytes = req_bytes;
+	for (size_t i = 0; i < nreplies; i++)
+		bytes += dxl2_status_bytes_max(reply_params[i]);
+	uint64_t us = (uint64_t)bus_wire_time_us(b, bytes) + (uint64_t)nreplies * b->timing.return_delay_us +
+	              b->timing.adapter_latency_us + b->timing.margin_us;
+	return us > UINT32_MAX ? UINT32_MAX : (uint32_t)us;
+}
+
+/* A broadcast PING's deadline: a slot for every ID that might answer. */
+static uint32_t bus2_ping_all_timeout_us(const struct bus *b, size_t req_bytes)
+{
+	uint32_t reply_us = bus_wire_time_us(b, dxl2_status_bytes_max(BUS2_PING_PARAMS)) + b->timing.return_delay_us;
+	uint32_t slot_us = reply_us > BUS2_PING_ALL_SLOT_US ? reply_us : BUS2_PING_ALL_SLOT_US;
+	return bus_wire_time_us(b, req_bytes) + BUS2_PING_ALL_IDS * slot_us + b->timing.adapter_latency_us +
+	       b->timing.margin_us;
+}
+
 void bus_reset_stats(struct bus *b)
 {
 	memset(b->servo, 0, sizeof b->servo);
@@ -70,6 +123,12 @@ static void bus_echo_clear(struct bus *b)
 	b->echo_left = 0;
 }
 
+/* Two packets of the protocol spoken: 1.0 keeps the queue it always had. */
+static size_t bus_echo_cap(const struct bus *b)
+{
+	return b->protocol == BUS_PROTOCOL_1 ? 2u * DXL_MAX_PACKET : sizeof b->echo_buf;
+}
+
 /* Remember bytes just written; they must come back before anything else. */
 static void bus_echo_push(struct bus *b, const uint8_t *pkt, size_t n)
 {
@@ -78,7 +137,7 @@ static void bus_echo_push(struct bus *b, const uint8_t *pkt, size_t n)
 	size_t matched = b->echo_len - b->echo_left;
 	memmove(b->echo_buf, b->echo_buf + matched, b->echo_left);
 	b->echo_len = b->echo_left;
-	if (b->echo_len + n > sizeof b->echo_buf) {
+	if (b->echo_len + n > bus_echo_cap(b)) {
 		/* an older echo never came back (wiring without echo?): forget it;
 		 * if it arrives after all, the mismatch is reported then */
 		bus_echo_clear(b);
@@ -155,6 +214,9 @@ static int bus_prepare(struct bus *b)
 		b->line_dirty = false;
 	}
 	dxl_parser_reset(&b->parser);
+	dxl2_parser_reset(&b->parser2);
+	b->echo_probe = 0;
+	b->echo_probe_dead = false;
 	return DXL_OK;
 }
 
@@ -170,10 +232,61 @@ static int bus_send(struct bus *b, const uint8_t *pkt, size_t n)
 	return DXL_OK;
 }
 
+/* Sent: the request is pending until its reply or its deadline. */
+static void bus_pend(struct bus *b, const uint8_t *pkt, size_t n, uint8_t id, uint8_t instr, int reply_params,
+                     uint64_t now, uint32_t timeout_us)
+{
+	memcpy(b->req_buf, pkt, n);
+	b->req_len = n;
+	b->reply_held = false;
+	b->pending = true;
+	b->req_id = id;
+	b->req_instr = instr;
+	b->expect_params = reply_params;
+	b->started_us = now;
+	b->deadline_us = now + timeout_us;
+}
+
+/* Encode, flush, send; *now gets the time the request went out. */
+static int bus_send_request(struct bus *b, const uint8_t *pkt, int n, uint64_t *now)
+{
+	if (n < 0)
+		return n;
+	int r = bus_prepare(b);
+	if (r < 0)
+		return r;
+	*now = b->io.now_us(b->io.ctx);
+	return bus_send(b, pkt, (size_t)n);
+}
+
+/* Protocol 2.0's bus_begin: one request, at most one reply. */
+static int bus2_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, size_t nparams,
+                      int reply_params)
+{
+	uint8_t pkt[DXL2_MAX_PACKET];
+	uint64_t now = 0;
+	if (reply_params > DXL2_MAX_READ_LEN || instr == DXL2_INST_SYNC_READ || instr == DXL2_INST_BULK_READ)
+		return DXL_E_ARG;
+	/* a broadcast PING is answered by every servo: bus_ping_all_begin */
+	if (id == DXL2_BROADCAST_ID || instr == DXL2_INST_SYNC_WRITE || instr == DXL2_INST_BULK_WRITE)
+		reply_params = -1;
+	int n = dxl2_encode_instruction(pkt, sizeof pkt, id, instr, params, nparams);
+	int r = bus_send_request(b, pkt, n, &now);
+	if (r < 0 || reply_params < 0)
+		return r;
+	b->multi = NULL;
+	bus_pend(b, pkt, (size_t)n, id, instr, reply_params, now,
+	         bus_timeout_us(b, (size_t)n, dxl2_status_bytes_max((size_t)reply_params)));
+	b->servo[id].transactions++;
+	return DXL_OK;
+}
+
 int bus_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, size_t nparams,
               int reply_params)
 {
 	uint8_t pkt[DXL_MAX_PACKET];
+	if (b->protocol == BUS_PROTOCOL_2)
+		return bus2_begin(b, id, instr, params, nparams, reply_params);
 	if (reply_params > DXL_MAX_PARAMS)
 		return DXL_E_ARG;
 	/* a broadcast is never answered (a broadcast PING is answered by every
@@ -207,7 +320,7 @@ int bus_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, s
 
 int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n)
 {
-	if (pkt == NULL || n == 0 || n > DXL_MAX_PACKET)
+	if (pkt == NULL || n == 0 || n > (b->protocol == BUS_PROTOCOL_1 ? DXL_MAX_PACKET : DXL2_MAX_PACKET))
 		return DXL_E_ARG;
 	int r = bus_prepare(b);
 	if (r < 0)
@@ -222,6 +335,25 @@ static void bus_finish(struct bus *b)
 	b->pending = false;
 	b->expect_params = -1;
 	b->reply_held = false;
+	b->multi = NULL;
+}
+
+/* A reply matched its request: counted for its servo, its error byte (1.0)
+ * or ERR field (2.0) kept as data. */
+static void bus_count_reply(struct bus *b, struct bus_servo_stats *st, uint64_t now, uint8_t err)
+{
+	uint32_t rtt = (uint32_t)(now - b->started_us);
+	st->replies++;
+	st->rtt_last_us = rtt;
+	if (rtt > st->rtt_max_us)
+		st->rtt_max_us = rtt;
+	st->rtt_sum_us += rtt;
+	st->last_errbits = err;
+	st->errbits_seen |= err;
+	if (err)
+		st->error_replies++;
+	if (b->protocol == BUS_PROTOCOL_2 && dxl2_err_alert(err))
+		st->alerts++;
 }
 
 /* Is this packet byte for byte the request we sent (read as a status)? */
@@ -250,16 +382,7 @@ static int bus_match(struct bus *b, const struct dxl_packet *pkt, uint64_t now,
 		b->line_dirty = true;
 		return DXL_E_WRONG_LENGTH;
 	}
-	uint32_t rtt = (uint32_t)(now - b->started_us);
-	st->replies++;
-	st->rtt_last_us = rtt;
-	if (rtt > st->rtt_max_us)
-		st->rtt_max_us = rtt;
-	st->rtt_sum_us += rtt;
-	st->last_errbits = pkt->code;
-	st->errbits_seen |= pkt->code;
-	if (pkt->code)
-		st->error_replies++;
+	bus_count_reply(b, st, now, pkt->code);
 	if (reply)
 		*reply = *pkt;
 	return DXL_OK;
@@ -308,6 +431,349 @@ static int bus_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t no
 	return outcome;
 }
 
+/* ---- receiving, Protocol 2.0 ------------------------------------------------------ */
+
+/* A multi-reply slot still waiting for its servo. DXL_E_WRONG_ID marks one
+ * that was expected when a packet from a servo not asked came. */
+static bool bus2_slot_open(int status)
+{
+	return status == DXL_E_TIMEOUT || status == DXL_E_WRONG_ID;
+}
+
+/* The slot the bus expects next: servos answer in request order. */
+static size_t bus2_next_open(const struct bus_multi *m)
+{
+	size_t i = 0;
+	while (i < m->n && !bus2_slot_open(m->status[i]))
+		i++;
+	return i;
+}
+
+static bool bus2_multi_settled(const struct bus_multi *m)
+{
+	return bus2_next_open(m) == m->n;
+}
+
+/* DXL_OK when every slot has its data, else the first failed slot's status. */
+static int bus2_multi_outcome(const struct bus_multi *m)
+{
+	for (size_t i = 0; i < m->n; i++)
+		if (m->status[i] != DXL_OK)
+			return m->status[i];
+	return DXL_OK;
+}
+
+static void bus2_slot_fill(struct bus *b, size_t slot, const struct dxl2_packet *pkt, uint64_t now)
+{
+	struct bus_multi *m = b->multi;
+	memcpy(m->data + m->off[slot], pkt->params, m->len[slot]);
+	m->err[slot] = pkt->err;
+	m->status[slot] = DXL_OK;
+	m->answered++;
+	bus_count_reply(b, &b->servo[pkt->id], now, pkt->err);
+}
+
+/* A broadcast PING's reply: a new slot for each servo, once. */
+static void bus2_ping_all_frame(struct bus *b, const struct dxl2_packet *pkt, uint64_t now)
+{
+	struct bus_multi *m = b->multi;
+	struct bus_servo_stats *st = &b->servo[pkt->id];
+	for (size_t i = 0; i < m->n; i++) {
+		if (m->id[i] == pkt->id) {
+			/* two servos with one ID, or one answering twice */
+			st->wrong_id++;
+			b->line_dirty = true;
+			return;
+		}
+	}
+	if (pkt->nparams != BUS2_PING_PARAMS) {
+		st->wrong_length++;
+		b->line_dirty = true;
+		return;
+	}
+	size_t slot = m->n;
+	if (slot >= BUS_MULTI_MAX || (slot + 1) * BUS2_PING_PARAMS > m->cap) {
+		b->stray_packets++;
+		return;
+	}
+	m->id[slot] = pkt->id;
+	m->len[slot] = BUS2_PING_PARAMS;
+	m->off[slot] = (uint32_t)(slot * BUS2_PING_PARAMS);
+	m->n++;
+	st->transactions++;
+	bus2_slot_fill(b, slot, pkt, now);
+}
+
+/* One status packet of a SYNC_READ / BULK_READ, checked against the request. */
+static void bus2_multi_frame(struct bus *b, const struct dxl2_packet *pkt, uint64_t now)
+{
+	struct bus_multi *m = b->multi;
+	size_t slot = 0;
+	int r = dxl2_multi_read_accept(&m->track, pkt, &slot);
+	if (r == DXL_OK) {
+		bus2_slot_fill(b, slot, pkt, now);
+		return;
+	}
+	b->line_dirty = true;
+	if (r == DXL_E_WRONG_LENGTH) {
+		/* its servo answered, with the wrong size: waiting cannot mend it */
+		b->servo[pkt->id].wrong_length++;
+		for (size_t i = 0; i < m->n; i++)
+			if (m->id[i] == pkt->id && bus2_slot_open(m->status[i]))
+				m->status[i] = DXL_E_WRONG_LENGTH;
+		return;
+	}
+	size_t next = bus2_next_open(m);
+	if (next < m->n) {
+		b->servo[m->id[next]].wrong_id++;
+		m->status[next] = DXL_E_WRONG_ID;
+	} else {
+		b->stray_packets++;
+	}
+}
+
+/* A reply was damaged (or bytes were dropped) while waiting. */
+static int bus2_damage(struct bus *b, int why)
+{
+	size_t next = b->multi != NULL ? bus2_next_open(b->multi) : 0;
+	uint8_t id = b->req_id;
+	if (b->multi != NULL) {
+		if (next >= b->multi->n)
+			return BUS_PENDING;   /* nobody left to blame: the parser counted it */
+		id = b->multi->id[next];
+	}
+	struct bus_servo_stats *st = &b->servo[id];
+	if (why != DXL_E_CHECKSUM) {
+		st->resyncs++;
+		if (why == DXL_E_STUFFING)
+			st->stuffing_errors++;
+		return BUS_PENDING;
+	}
+	st->checksum_errors++;
+	b->line_dirty = true;
+	if (b->multi != NULL) {
+		/* the servo expected next: the others may still answer */
+		b->multi->status[next] = DXL_E_CHECKSUM;
+		return BUS_PENDING;
+	}
+	bus_finish(b);
+	return DXL_E_CHECKSUM;
+}
+
+/* The one reply of a single request. */
+static int bus2_match(struct bus *b, const struct dxl2_packet *pkt, uint64_t now, struct dxl_packet *reply)
+{
+	struct bus_servo_stats *st = &b->servo[b->req_id];
+	int r = dxl2_check_reply(pkt, b->req_id, (uint16_t)b->expect_params);
+	bus_finish(b);
+	if (r != DXL_OK) {
+		if (r == DXL_E_WRONG_ID)
+			st->wrong_id++;
+		else
+			st->wrong_length++;
+		b->line_dirty = true;
+		return r;
+	}
+	bus_count_reply(b, st, now, pkt->err);
+	b->reply2.id = pkt->id;
+	b->reply2.instr = pkt->instr;
+	b->reply2.err = pkt->err;
+	b->reply2.nparams = pkt->nparams;
+	b->reply2.wire_bytes = pkt->wire_bytes;
+	memcpy(b->reply2.params, pkt->params, pkt->nparams);
+	if (reply) {
+		reply->id = pkt->id;
+		reply->code = pkt->err;
+		reply->nparams = pkt->nparams <= DXL_MAX_PARAMS ? (uint8_t)pkt->nparams : 0;
+		memcpy(reply->params, pkt->params, reply->nparams);
+	}
+	return DXL_OK;
+}
+
+static int bus2_frame(struct bus *b, const struct dxl2_packet *pkt, uint64_t now, struct dxl_packet *reply)
+{
+	if (!b->pending) {
+		b->stray_packets++;
+		b->line_dirty = true;
+		return BUS_PENDING;
+	}
+	if (b->multi == NULL)
+		return bus2_match(b, pkt, now, reply);
+	if (b->multi->ping_all)
+		bus2_ping_all_frame(b, pkt, now);
+	else
+		bus2_multi_frame(b, pkt, now);
+	if (!b->multi->ping_all && bus2_multi_settled(b->multi)) {
+		int outcome = bus2_multi_outcome(b->multi);
+		bus_finish(b);
+		return outcome;
+	}
+	return BUS_PENDING;
+}
+
+static int bus2_feed(struct bus *b, const uint8_t *data, size_t n, uint64_t now, struct dxl_packet *reply)
+{
+	int outcome = BUS_PENDING;
+	struct dxl2_packet pkt;
+	size_t off = 0;
+	for (;;) {
+		size_t used = 0;
+		int r = dxl2_parser_feed(&b->parser2, data + off, n - off, &used, &pkt);
+		off += used;
+		if (r == DXL_NEED_MORE)
+			break;
+		int o = r == DXL_FRAME ? bus2_frame(b, &pkt, now, reply) : b->pending ? bus2_damage(b, r) : BUS_PENDING;
+		if (o != BUS_PENDING)
+			outcome = o;
+	}
+	return outcome;
+}
+
+/* With echo off, our own request read back first means the wiring echoes.
+ * An instruction never parses as a status on 2.0, so nothing is mistaken
+ * for a reply; the bytes that match the request so far are held back from
+ * the parser, and dropped when the whole request came back. */
+static int bus2_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t now, struct dxl_packet *reply)
+{
+	size_t i = 0;
+	if (b->echo || b->echo_probe_dead || !b->pending)
+		return bus2_feed(b, data, n, now, reply);
+	while (i < n && b->echo_probe < b->req_len && data[i] == b->req_buf[b->echo_probe]) {
+		b->echo_probe++;
+		i++;
+	}
+	if (b->echo_probe == b->req_len) {
+		b->unexpected_echoes++;
+		b->echo_probe_dead = true;
+		return bus2_feed(b, data + i, n - i, now, reply);
+	}
+	if (i == n)
+		return BUS_PENDING;   /* all of it could still be the echo */
+	/* not our request: what was held back goes to the parser first */
+	b->echo_probe_dead = true;
+	int held = bus2_feed(b, b->req_buf, b->echo_probe, now, reply);
+	int rest = bus2_feed(b, data + i, n - i, now, reply);
+	return held != BUS_PENDING ? held : rest;
+}
+
+/* The deadline of a multi-reply request: the servos that did not answer are
+ * timeouts, the replies that came stay delivered. */
+static int bus2_multi_deadline(struct bus *b)
+{
+	struct bus_multi *m = b->multi;
+	for (size_t i = 0; i < m->n; i++)
+		if (m->status[i] == DXL_E_TIMEOUT)
+			b->servo[m->id[i]].timeouts++;
+	int outcome = m->ping_all ? DXL_OK : bus2_multi_outcome(m);
+	if (!m->ping_all && m->answered < m->n)
+		b->line_dirty = true;   /* a late reply may still come */
+	bus_finish(b);
+	dxl2_parser_reset(&b->parser2);
+	bus_echo_clear(b);
+	return outcome;
+}
+
+const struct dxl2_packet *bus_reply2(const struct bus *b)
+{
+	return &b->reply2;
+}
+
+const uint8_t *bus_multi_data(const struct bus_multi *m, size_t slot)
+{
+	if (m == NULL || slot >= m->n || m->status[slot] != DXL_OK)
+		return NULL;
+	return m->data + m->off[slot];
+}
+
+size_t bus_multi_failed(const struct bus_multi *m, uint8_t *ids, size_t cap)
+{
+	size_t failed = 0;
+	for (size_t i = 0; m != NULL && i < m->n; i++) {
+		if (m->status[i] == DXL_OK)
+			continue;
+		if (ids != NULL && failed < cap)
+			ids[failed] = m->id[i];
+		failed++;
+	}
+	return failed;
+}
+
+/* ---- multi-reply requests (Protocol 2.0) ----------------------------------------- */
+
+/* Slots from the tracker; DXL_E_BUFFER when their bytes exceed m->cap. */
+static int bus2_multi_layout(struct bus_multi *m)
+{
+	size_t off = 0;
+	m->n = m->track.n;
+	m->answered = 0;
+	m->ping_all = false;
+	for (size_t i = 0; i < m->n; i++) {
+		m->id[i] = m->track.ids[i];
+		m->len[i] = m->track.len[i];
+		m->off[i] = (uint32_t)off;
+		m->status[i] = DXL_E_TIMEOUT;
+		m->err[i] = 0;
+		off += m->len[i];
+	}
+	return m->data != NULL && off <= m->cap ? DXL_OK : DXL_E_BUFFER;
+}
+
+static int bus2_multi_begin(struct bus *b, const uint8_t *pkt, int n, struct bus_multi *m, uint8_t instr)
+{
+	uint64_t now = 0;
+	if (b->protocol != BUS_PROTOCOL_2)
+		return DXL_E_UNSUPPORTED;
+	if (b->pending)
+		return DXL_E_BUSY;
+	int r = bus_send_request(b, pkt, n, &now);
+	if (r < 0)
+		return r;
+	uint32_t timeout = instr == DXL2_INST_PING ? bus2_ping_all_timeout_us(b, (size_t)n)
+	                   : bus_multi_timeout_us(b, (size_t)n, m->len, m->n);
+	bus_pend(b, pkt, (size_t)n, DXL2_BROADCAST_ID, instr, 0, now, timeout);
+	b->multi = m;
+	for (size_t i = 0; i < m->n; i++)
+		b->servo[m->id[i]].transactions++;
+	return DXL_OK;
+}
+
+int bus_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
+                        struct bus_multi *m)
+{
+	uint8_t pkt[DXL2_MAX_PACKET];
+	if (m == NULL || dxl2_multi_read_sync(&m->track, len, ids, n) != DXL_OK)
+		return DXL_E_ARG;
+	int r = bus2_multi_layout(m);
+	if (r < 0)
+		return r;
+	return bus2_multi_begin(b, pkt, dxl2_encode_sync_read(pkt, sizeof pkt, addr, len, ids, n), m,
+	                        DXL2_INST_SYNC_READ);
+}
+
+int bus_bulk_read_begin(struct bus *b, const struct dxl2_bulk_item *items, size_t n, struct bus_multi *m)
+{
+	uint8_t pkt[DXL2_MAX_PACKET];
+	if (m == NULL || dxl2_multi_read_bulk(&m->track, items, n) != DXL_OK)
+		return DXL_E_ARG;
+	int r = bus2_multi_layout(m);
+	if (r < 0)
+		return r;
+	return bus2_multi_begin(b, pkt, dxl2_encode_bulk_read(pkt, sizeof pkt, items, n), m, DXL2_INST_BULK_READ);
+}
+
+int bus_ping_all_begin(struct bus *b, struct bus_multi *m)
+{
+	uint8_t pkt[DXL2_MAX_PACKET];
+	if (m == NULL || m->data == NULL)
+		return DXL_E_ARG;
+	m->n = 0;
+	m->answered = 0;
+	m->ping_all = true;
+	return bus2_multi_begin(b, pkt, dxl2_encode_ping(pkt, sizeof pkt, DXL2_BROADCAST_ID), m, DXL2_INST_PING);
+}
+
+/* ---- driving a transaction ---------------------------------------------------------- */
+
 int bus_step(struct bus *b, struct dxl_packet *reply)
 {
 	if (!b->pending)
@@ -332,7 +798,8 @@ int bus_step(struct bus *b, struct dxl_packet *reply)
 			return (int)echoed;
 		}
 		off = (size_t)echoed;
-		int r = bus_consume(b, chunk + off, (size_t)got - off, now, reply);
+		int r = b->protocol == BUS_PROTOCOL_2 ? bus2_consume(b, chunk + off, (size_t)got - off, now, reply)
+		                                      : bus_consume(b, chunk + off, (size_t)got - off, now, reply);
 		if (r != BUS_PENDING)
 			outcome = r;
 		/* A short read took what there was. Reading again only to be told
@@ -343,6 +810,8 @@ int bus_step(struct bus *b, struct dxl_packet *reply)
 	}
 	if (outcome != BUS_PENDING)
 		return outcome;
+	if (now >= b->deadline_us && b->multi != NULL)
+		return bus2_multi_deadline(b);
 	if (now >= b->deadline_us && b->reply_held) {
 		/* nothing followed the packet that looked like our echo: it was the
 		 * reply (bus_match clears the hold, so copy it out first) */
@@ -375,11 +844,12 @@ void bus_abort(struct bus *b)
 	/* whatever was half-read belongs to the abandoned request */
 	bus_echo_clear(b);
 	dxl_parser_reset(&b->parser);
+	dxl2_parser_reset(&b->parser2);
 }
 
 /* ---- blocking calls --------------------------------------------------------------- */
 
-static int bus_wait_reply(struct bus *b, struct dxl_packet *reply)
+int bus_wait_done(struct bus *b, struct dxl_packet *reply)
 {
 	for (;;) {
 		int r = bus_step(b, reply);
@@ -432,6 +902,7 @@ int bus_settle(struct bus *b, uint32_t quiet_us, uint32_t max_us)
 	}
 	bus_echo_clear(b);
 	dxl_parser_reset(&b->parser);
+	dxl2_parser_reset(&b->parser2);
 	return dropped > INT32_MAX ? INT32_MAX : (int)dropped;
 }
 
@@ -447,7 +918,7 @@ static int bus_transact(struct bus *b, uint8_t id, uint8_t instr, const uint8_t 
 	int r = bus_begin(b, id, instr, params, nparams, reply_params);
 	if (r < 0 || !b->pending)
 		return r;
-	r = bus_wait_reply(b, reply);
+	r = bus_wait_done(b, reply);
 	if (r == DXL_OK && errbits)
 		*errbits = reply->code;
 	return r;
@@ -456,11 +927,15 @@ static int bus_transact(struct bus *b, uint8_t id, uint8_t instr, const uint8_t 
 int bus_ping(struct bus *b, uint8_t id, uint8_t *errbits)
 {
 	struct dxl_packet reply;
+	if (b->protocol == BUS_PROTOCOL_2)
+		return bus2_ping(b, id, NULL, NULL, errbits);
 	return bus_transact(b, id, DXL_INST_PING, NULL, 0, 0, &reply, errbits);
 }
 
 int bus_read(struct bus *b, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out, uint8_t *errbits)
 {
+	if (b->protocol != BUS_PROTOCOL_1)
+		return DXL_E_UNSUPPORTED;
 	if (id > DXL_MAX_ID || len == 0 || len > DXL_MAX_PARAMS || out == NULL)
 		return DXL_E_ARG;
 	struct dxl_packet reply;
@@ -491,6 +966,8 @@ static int bus_addr_data(struct bus *b, uint8_t id, uint8_t instr, uint8_t addr,
                          const uint8_t *data, size_t n, bool expect_reply, uint8_t *errbits)
 {
 	uint8_t params[DXL_MAX_PARAMS];
+	if (b->protocol != BUS_PROTOCOL_1)
+		return DXL_E_UNSUPPORTED;
 	if (data == NULL || n == 0 || n + 1 > sizeof params)
 		return DXL_E_ARG;
 	params[0] = addr;
@@ -526,6 +1003,8 @@ int bus_reg_write(struct bus *b, uint8_t id, uint8_t addr, const uint8_t *data, 
 int bus_action(struct bus *b, uint8_t id, uint8_t *errbits)
 {
 	struct dxl_packet reply;
+	if (b->protocol != BUS_PROTOCOL_1)
+		return DXL_E_UNSUPPORTED;
 	return bus_transact(b, id, DXL_INST_ACTION, NULL, 0, 0, &reply, errbits);
 }
 
@@ -533,6 +1012,8 @@ int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
                    const uint8_t *data, size_t n)
 {
 	uint8_t pkt[DXL_MAX_PACKET];
+	if (b->protocol != BUS_PROTOCOL_1)
+		return DXL_E_UNSUPPORTED;
 	int r = dxl_encode_sync_write(pkt, sizeof pkt, addr, len, ids, data, n);
 	if (r < 0)
 		return r;
@@ -542,7 +1023,9 @@ int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
 int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsigned n, struct bus_lateness *out)
 {
 	uint32_t late[BUS_LATENESS_MAX];
-	uint32_t floor_us = bus_wire_time_us(b, 2 * BUS_PACKET_BYTES(0)) + return_delay_us;
+	/* a PING and its reply: 6 + 6 bytes on 1.0, 10 + 14 on 2.0 */
+	size_t ping_bytes = b->protocol == BUS_PROTOCOL_2 ? 10 + 14 : 2 * BUS_PACKET_BYTES(0);
+	uint32_t floor_us = bus_wire_time_us(b, ping_bytes) + return_delay_us;
 	int r = DXL_E_ARG;
 
 	memset(out, 0, sizeof *out);
@@ -578,6 +1061,8 @@ int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsi
 int bus_factory_reset(struct bus *b, uint8_t id, bool expect_reply, uint8_t *errbits)
 {
 	struct dxl_packet reply;
+	if (b->protocol != BUS_PROTOCOL_1)
+		return DXL_E_UNSUPPORTED;
 	return bus_transact(b, id, DXL_INST_FACTORY_RESET, NULL, 0, expect_reply ? 0 : -1, &reply,
 	                    errbits);
 }

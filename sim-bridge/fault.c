@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "dxl.h"
+#include "dxl2.h"
 #include "num.h"
 
 static const char *const fault_names[SIM_FAULT_KINDS] = {
@@ -79,6 +80,37 @@ int sim_fault_parse_bits(const char *text)
 	return bits;
 }
 
+/* Protocol 2.0's error numbers 1..7 by name (dxl2.h), for stuck-error. */
+static const char *const err2_words[8] = {
+	NULL, "result-fail", "instruction", "crc", "data-range", "data-length", "data-limit", "access",
+};
+
+int sim_fault_parse_err2(const char *text)
+{
+	char buf[128];
+	char *end;
+	long v = strtol(text, &end, 0);
+	if (end != text && *end == '\0')
+		return (v >= 0 && v <= 0xFF) ? (int)v : -1;
+	if (strlen(text) >= sizeof(buf))
+		return -1;
+	strcpy(buf, text);
+	int err = 0;
+	for (char *save = NULL, *tok = strtok_r(buf, "|,+", &save); tok; tok = strtok_r(NULL, "|,+", &save)) {
+		int found = -1;
+		if (strcmp(tok, "alert") == 0)
+			found = DXL2_ERR_ALERT;
+		for (int n = 1; n < 8 && found < 0; n++)
+			if (strcmp(err2_words[n], tok) == 0)
+				found = n;
+		/* the alert bit and one error number: a second number cannot share the field */
+		if (found < 0 || (found != DXL2_ERR_ALERT && (err & DXL2_ERR_NUMBER_MASK)))
+			return -1;
+		err |= found;
+	}
+	return err;
+}
+
 static int fault_kind_of(const char *name)
 {
 	for (int k = 0; k < SIM_FAULT_KINDS; k++)
@@ -106,10 +138,12 @@ static const struct {
 static int fault_parse_arg(enum sim_fault_kind kind, const char *word, struct sim_fault *out)
 {
 	if (kind == SIM_FAULT_STUCK_ERROR) {
-		int bits = sim_fault_parse_bits(word);
-		if (bits < 0)
+		/* 1.0 error bits, 2.0 ERR field, or a number meaning either */
+		int bits = sim_fault_parse_bits(word), err2 = sim_fault_parse_err2(word);
+		if (bits < 0 && err2 < 0)
 			return -1;
 		out->arg = bits;
+		out->err2 = err2;
 		return 0;
 	}
 	if (kind == SIM_FAULT_NO_REPLY || kind == SIM_FAULT_BAD_CHECKSUM)
@@ -164,6 +198,7 @@ int sim_fault_parse(int argc, char **argv, enum sim_fault_kind *kind, struct sim
 	}
 	if (k == SIM_FAULT_STUCK_ERROR && !out->has_arg) {
 		out->arg = DXL_ERRBIT_OVERLOAD;
+		out->err2 = DXL2_ERR_ALERT;
 		out->has_arg = true;
 	}
 	*kind = (enum sim_fault_kind)k;
@@ -187,13 +222,90 @@ static bool fault_fires(struct sim_fault *f, uint64_t *rng)
 	return true;
 }
 
+/* Where a status packet of one protocol keeps what the faults edit. */
+struct fault_layout {
+	size_t min_len;                 /* a whole status packet is at least this long */
+	size_t cap;                     /* room in pkt (a re-stuffed packet may grow) */
+	void (*stuck)(uint8_t *pkt, size_t *len, size_t cap, const struct sim_fault *f);
+	void (*wrong_id)(uint8_t *pkt, size_t len, const struct sim_fault *f);
+	void (*bad_checksum)(uint8_t *pkt, size_t len);
+};
+
 static void fault_fix_checksum(uint8_t *pkt, size_t len)
 {
 	pkt[len - 1] = dxl_checksum(&pkt[2], len - 3);
 }
 
-bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t *len,
-                      uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns)
+static void stuck1(uint8_t *pkt, size_t *len, size_t cap, const struct sim_fault *f)
+{
+	(void)cap;
+	double bits = f->arg;
+	pkt[4] |= bits > 0 && bits <= DXL_ERRBIT_MASK ? (uint8_t)bits : 0;
+	fault_fix_checksum(pkt, *len);
+}
+
+static uint8_t wrong_id_of(const struct sim_fault *f, uint8_t own)
+{
+	double id = f->arg;
+	return f->has_arg && id >= 0 && id <= DXL_MAX_ID ? (uint8_t)id : (uint8_t)(own + 1);
+}
+
+static void wrong_id1(uint8_t *pkt, size_t len, const struct sim_fault *f)
+{
+	pkt[2] = wrong_id_of(f, pkt[2]);
+	fault_fix_checksum(pkt, len);
+}
+
+static void bad_checksum1(uint8_t *pkt, size_t len)
+{
+	pkt[len - 1] ^= 0xFF;
+}
+
+/* Protocol 2.0: the CRC covers everything before it. */
+static void fix_crc2(uint8_t *pkt, size_t len)
+{
+	uint16_t crc = dxl2_crc_update(0, pkt, len - DXL2_CRC_BYTES);
+	pkt[len - 2] = (uint8_t)crc;
+	pkt[len - 1] = (uint8_t)(crc >> 8);
+}
+
+/* The ERR field changed: the packet is decoded and encoded again, so its
+ * stuffing stays right whatever the new byte is. */
+static void stuck2(uint8_t *pkt, size_t *len, size_t cap, const struct sim_fault *f)
+{
+	struct dxl2_parser p;
+	struct dxl2_packet st;
+	size_t used = 0;
+	if (f->err2 <= 0)
+		return;
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	if (dxl2_parser_feed(&p, pkt, *len, &used, &st) != DXL_FRAME || used != *len)
+		return;
+	uint8_t e = (uint8_t)f->err2, err = (uint8_t)(st.err | (e & DXL2_ERR_ALERT));
+	if (e & DXL2_ERR_NUMBER_MASK)
+		err = (uint8_t)((err & DXL2_ERR_ALERT) | (e & DXL2_ERR_NUMBER_MASK));
+	uint8_t out[DXL2_MAX_PACKET];
+	int n = dxl2_encode_status(out, cap < sizeof out ? cap : sizeof out, st.id, err, st.params, st.nparams);
+	if (n > 0) {
+		memcpy(pkt, out, (size_t)n);
+		*len = (size_t)n;
+	}
+}
+
+static void wrong_id2(uint8_t *pkt, size_t len, const struct sim_fault *f)
+{
+	pkt[4] = wrong_id_of(f, pkt[4]);
+	fix_crc2(pkt, len);
+}
+
+static void bad_checksum2(uint8_t *pkt, size_t len)
+{
+	pkt[len - 2] ^= 0xFF;
+	pkt[len - 1] ^= 0xFF;
+}
+
+static bool faults_apply(struct sim_faults *fs, uint64_t *rng, const struct fault_layout *ly, uint8_t *pkt,
+                         size_t *len, uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns)
 {
 	struct sim_fault *f = fs->f;
 	bool changed = false;
@@ -202,10 +314,8 @@ bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t
 	/* First what the servo says (its error byte), then what the line does
 	 * to it: a bad-checksum fault inverts the checksum of the packet with
 	 * the stuck bits in. */
-	if (*len >= 6 && fault_fires(&f[SIM_FAULT_STUCK_ERROR], rng)) {
-		double bits = f[SIM_FAULT_STUCK_ERROR].arg;
-		pkt[4] |= bits > 0 && bits <= DXL_ERRBIT_MASK ? (uint8_t)bits : 0;
-		fault_fix_checksum(pkt, *len);
+	if (*len >= ly->min_len && fault_fires(&f[SIM_FAULT_STUCK_ERROR], rng)) {
+		ly->stuck(pkt, len, ly->cap, &f[SIM_FAULT_STUCK_ERROR]);
 		changed = true;
 	}
 	if (fault_fires(&f[SIM_FAULT_SLOW], rng)) {
@@ -230,14 +340,12 @@ bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t
 		fs->applied++;
 		return true;
 	}
-	if (*len >= 6 && fault_fires(&f[SIM_FAULT_WRONG_ID], rng)) {
-		double id = f[SIM_FAULT_WRONG_ID].arg;
-		pkt[2] = f[SIM_FAULT_WRONG_ID].has_arg && id >= 0 && id <= DXL_MAX_ID ? (uint8_t)id : (uint8_t)(pkt[2] + 1);
-		fault_fix_checksum(pkt, *len);
+	if (*len >= ly->min_len && fault_fires(&f[SIM_FAULT_WRONG_ID], rng)) {
+		ly->wrong_id(pkt, *len, &f[SIM_FAULT_WRONG_ID]);
 		changed = true;
 	}
-	if (*len >= 6 && fault_fires(&f[SIM_FAULT_BAD_CHECKSUM], rng)) {
-		pkt[*len - 1] ^= 0xFF;
+	if (*len >= ly->min_len && fault_fires(&f[SIM_FAULT_BAD_CHECKSUM], rng)) {
+		ly->bad_checksum(pkt, *len);
 		changed = true;
 	}
 	if (*len > 0 && fault_fires(&f[SIM_FAULT_TRUNCATE], rng)) {
@@ -249,4 +357,18 @@ bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t
 	if (changed)
 		fs->applied++;
 	return changed;
+}
+
+bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t *len,
+                      uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns)
+{
+	static const struct fault_layout p1 = { 6, 0, stuck1, wrong_id1, bad_checksum1 };
+	return faults_apply(fs, rng, &p1, pkt, len, garbage, ngarbage, extra_delay_ns);
+}
+
+bool sim_faults_apply2(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t *len, size_t cap,
+                       uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns)
+{
+	struct fault_layout p2 = { DXL2_HEADER_BYTES + 2 + DXL2_CRC_BYTES, cap, stuck2, wrong_id2, bad_checksum2 };
+	return faults_apply(fs, rng, &p2, pkt, len, garbage, ngarbage, extra_delay_ns);
 }

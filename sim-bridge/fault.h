@@ -12,7 +12,11 @@
  * garbage         bytes (8)            ARG random bytes go out just before the reply
  * wrong-id        ID (id + 1)          the reply carries ID ARG (valid checksum)
  * stuck-error     bits (overload=32)   ARG is OR-ed into the reply's error byte (report
- *                                      only: the servo itself does not act on them)
+ *                                      only: the servo itself does not act on them).
+ *                                      On a Protocol 2.0 servo ARG is the ERR field:
+ *                                      alert (default) and/or one error number
+ *                                      (result-fail, instruction, crc, data-range,
+ *                                      data-length, data-limit, access) or 0..255
  * slow            ms (5)               the reply leaves ARG ms late
  * temperature     °C                   the servo measures ARG (can raise overheating)
  * voltage         V                    the servo measures ARG (can raise the voltage bit)
@@ -44,6 +48,10 @@ struct sim_fault {
 	bool active;
 	bool has_arg;
 	double arg;
+	/* stuck-error on a Protocol 2.0 servo: the ERR field to report (bit 7
+	 * alert, bits 0-6 an error number), -1 when ARG names 1.0 bits only
+	 * (and arg < 0 when it names 2.0 errors only). */
+	int err2;
 	long remaining;    /* replies left; < 0 = until cleared */
 	double prob;       /* 0..1 */
 };
@@ -67,6 +75,9 @@ int sim_fault_parse(int argc, char **argv, enum sim_fault_kind *kind, struct sim
 /* Parse an error-bit mask: a number or names joined by '|' or ','
  * ("overload|overheating"). -1 if invalid. */
 int sim_fault_parse_bits(const char *text);
+/* Parse a Protocol 2.0 ERR field: a number 0..255, or "alert" and/or one
+ * error number's name joined by '|' ("alert|data-range"). -1 if invalid. */
+int sim_fault_parse_err2(const char *text);
 void sim_faults_clear(struct sim_faults *fs);
 
 /* xorshift64* — small, seedable, deterministic across runs. */
@@ -81,5 +92,9 @@ double sim_rand_uniform(uint64_t *state);  /* [0, 1) */
  */
 bool sim_faults_apply(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t *len,
                       uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns);
+/* The same for a Protocol 2.0 status packet (its ERR field, ID and CRC);
+ * a changed ERR field is stuffed again, so pkt has cap bytes of room. */
+bool sim_faults_apply2(struct sim_faults *fs, uint64_t *rng, uint8_t *pkt, size_t *len, size_t cap,
+                       uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns);
 
 #endif

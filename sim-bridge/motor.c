@@ -36,12 +36,17 @@ static const double motor_units_per_rad = 1.0 / DXL_POS_RAD_PER_UNIT;
 #define MOTOR_LINK_LENGTH_M     0.1865
 #define MOTOR_ROTOR_REFLECTED   3.0e-3    /* kg·m²: ≈4.6e-8 rotor × 254² */
 
+double sim_motor_link_inertia(void)
+{
+	/* A uniform rod about its end: m L² / 3. */
+	return MOTOR_LINK_MASS_KG * MOTOR_LINK_LENGTH_M * MOTOR_LINK_LENGTH_M / 3.0;
+}
+
 void sim_motor_default_params(struct sim_motor_params *p)
 {
-	/* A uniform rod about its end: m L² / 3, plus the motor's rotor seen
-	 * through the gearbox (which dominates). */
-	p->inertia = MOTOR_LINK_MASS_KG * MOTOR_LINK_LENGTH_M * MOTOR_LINK_LENGTH_M / 3.0
-	             + MOTOR_ROTOR_REFLECTED;
+	/* The link plus the motor's rotor seen through the gearbox (which
+	 * dominates). */
+	p->inertia = sim_motor_link_inertia() + MOTOR_ROTOR_REFLECTED;
 	/* The datasheet line is measured at the output, gearbox losses included:
 	 * these are only what the link adds (bearing, drag). */
 	p->viscous = 0.002;
@@ -107,13 +112,6 @@ static double motor_round(double v)
 	return i > t ? i - 1.0 : i;
 }
 
-/* Motor torque over the step as a line in the joint speed w: tau = a - c·w
- * (duty and back-EMF), then clamped to ±cap (the torque limit). */
-struct motor_line {
-	double a, c, cap;
-	double duty;             /* signed, for reports */
-};
-
 static double motor_limit_fraction(const struct sim_motor_cmd *cmd)
 {
 	return motor_clamp(cmd->torque_limit / MOTOR_RAW_FULL, 0.0, 1.0);
@@ -122,7 +120,7 @@ static double motor_limit_fraction(const struct sim_motor_cmd *cmd)
 /* Wheel mode: moving speed is the PWM output ratio, bit 10 = CW; with a
  * current drive it is the torque ratio (no back-EMF term). */
 static void motor_wheel(const struct sim_motor_cmd *cmd, const struct sim_motor_params *p, double stall,
-                        double c_emf, double limit, struct motor_line *ln)
+                        double c_emf, double limit, struct sim_motor_drive *ln)
 {
 	double u = (cmd->moving_speed & MOTOR_SPEED_MASK) / MOTOR_RAW_FULL;
 	double dir = (cmd->moving_speed & DXL_DIRECTION_BIT) ? -1.0 : 1.0;
@@ -177,7 +175,7 @@ static double motor_setpoint(struct sim_motor *m, const struct sim_motor_cmd *cm
 }
 
 static void motor_joint(struct sim_motor *m, const struct sim_motor_cmd *cmd, double stall,
-                        double c_emf, double limit, double dt, struct motor_line *ln)
+                        double c_emf, double limit, double dt, struct sim_motor_drive *ln)
 {
 	/* The firmware sees its own 10-bit position reading: the error moves in
 	 * whole units, so margin 0 still leaves ±0.5 unit without drive (no punch
@@ -192,7 +190,7 @@ static void motor_joint(struct sim_motor *m, const struct sim_motor_cmd *cmd, do
 }
 
 static void motor_line_for(struct sim_motor *m, const struct sim_motor_params *p,
-                           const struct sim_motor_cmd *cmd, double dt, struct motor_line *ln)
+                           const struct sim_motor_cmd *cmd, double dt, struct sim_motor_drive *ln)
 {
 	double stall = sim_motor_stall_torque(p);
 	double w0 = sim_motor_no_load_speed(p);
@@ -267,14 +265,11 @@ static void motor_heat(struct sim_motor *m, const struct sim_motor_params *p, do
 	m->temperature += dt * dT;
 }
 
-void sim_motor_step(struct sim_motor *m, const struct sim_motor_params *p,
-                    const struct sim_motor_cmd *cmd, double ext_torque, double dt)
+/* One step under the line ln (state and dt already checked). */
+static void motor_integrate(struct sim_motor *m, const struct sim_motor_params *p,
+                            const struct sim_motor_drive *d, double ext_torque, double dt)
 {
-	if (!motor_sane(m, p, &ext_torque, dt))
-		return;
-	struct motor_line ln;
-	motor_line_for(m, p, cmd, dt, &ln);
-
+	struct sim_motor_drive ln = *d;
 	double viscous = p->viscous, coulomb = p->coulomb;
 	if (!(ln.cap > 0)) {
 		/* no drive at all (torque off, torque limit 0 after an alarm, no
@@ -301,6 +296,32 @@ void sim_motor_step(struct sim_motor *m, const struct sim_motor_params *p,
 	m->ext_torque = ext_torque;
 	m->drive = ln.duty;
 	motor_heat(m, p, dt);
+}
+
+void sim_motor_step(struct sim_motor *m, const struct sim_motor_params *p,
+                    const struct sim_motor_cmd *cmd, double ext_torque, double dt)
+{
+	if (!motor_sane(m, p, &ext_torque, dt))
+		return;
+	struct sim_motor_drive ln;
+	motor_line_for(m, p, cmd, dt, &ln);
+	motor_integrate(m, p, &ln, ext_torque, dt);
+}
+
+void sim_motor_step_drive(struct sim_motor *m, const struct sim_motor_params *p,
+                          const struct sim_motor_drive *d, double ext_torque, double dt)
+{
+	if (!motor_sane(m, p, &ext_torque, dt))
+		return;
+	struct sim_motor_drive ln = *d;
+	/* A controller's arithmetic on a repaired state is not trusted either. */
+	if (!isfinite(ln.a) || !isfinite(ln.c) || !isfinite(ln.cap) || !isfinite(ln.duty)) {
+		ln = (struct sim_motor_drive){ 0, 0, 0, 0 };
+		m->bad_input++;
+	}
+	if (ln.cap < 0)
+		ln.cap = 0;
+	motor_integrate(m, p, &ln, ext_torque, dt);
 }
 
 double sim_motor_load_fraction(const struct sim_motor *m, const struct sim_motor_params *p)

@@ -61,11 +61,31 @@ struct sim_motor {
 	double setpoint;           /* position units: the firmware's moving target (moving-speed profile) */
 };
 
+/*
+ * What a servo's controller asks of the motor over one step: the motor torque
+ * as a line in the joint speed w, tau = a - c*w, clamped to +-cap (the driver
+ * limits the current; cap 0 = no drive at all: torque off, the joint
+ * back-drives the gearbox). duty is the signed share of full output the
+ * controller commands (reports only). The AX-12A's compliance controller
+ * makes one from its registers inside sim_motor_step(); an X servo's
+ * controllers (xdrive.c) make one and call sim_motor_step_drive().
+ */
+struct sim_motor_drive {
+	double a, c, cap;
+	double duty;
+};
+
 void sim_motor_default_params(struct sim_motor_params *p);
+/* The link's own inertia in the defaults (kg·m²): a uniform 18.65 cm rod of
+ * 0.12 kg about its end, without any rotor. */
+double sim_motor_link_inertia(void);
 void sim_motor_init(struct sim_motor *m, const struct sim_motor_params *p, double angle);
 /* Advance dt seconds under cmd with an external torque (N·m) acting on the joint. */
 void sim_motor_step(struct sim_motor *m, const struct sim_motor_params *p,
                     const struct sim_motor_cmd *cmd, double ext_torque, double dt);
+/* The same with the drive given directly (the X servos' controllers). */
+void sim_motor_step_drive(struct sim_motor *m, const struct sim_motor_params *p,
+                          const struct sim_motor_drive *d, double ext_torque, double dt);
 /* Supply-scaled motor line: stall torque (N·m) and no-load speed (rad/s). */
 double sim_motor_stall_torque(const struct sim_motor_params *p);
 double sim_motor_no_load_speed(const struct sim_motor_params *p);

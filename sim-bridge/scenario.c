@@ -20,7 +20,9 @@ void sim_config_defaults(struct sim_config *c)
 	c->truth_hz = 100;
 	c->seed = 1;
 	snprintf(c->link_dir, sizeof(c->link_dir), "/tmp/undulate-sim");
-	c->baud = 1000000;
+	c->baud = 0;
+	c->nmodels = 1;
+	c->models[0] = SIM_MODEL_AX12A;
 	c->baud_follows_tty = true;
 	c->return_delay_us = -1;
 	c->ambient_c = 25.0;
@@ -118,6 +120,22 @@ int sim_parse_ids(const char *text, uint8_t *ids, size_t cap)
 	return n > 0 ? (int)n : -1;
 }
 
+/* "xl430-w250" or "xl430-w250,xm430-w350": one model, or one per ID. */
+static int parse_models(const char *v, enum sim_model *models, size_t cap)
+{
+	char buf[SIM_CMD_MAX];
+	size_t n = 0;
+	if (strlen(v) >= sizeof(buf))
+		return -1;
+	strcpy(buf, v);
+	for (char *save = NULL, *w = strtok_r(buf, ", \t", &save); w; w = strtok_r(NULL, ", \t", &save)) {
+		if (n >= cap || sim_model_parse(w, &models[n]) != 0)
+			return -1;
+		n++;
+	}
+	return n > 0 ? (int)n : -1;
+}
+
 /* ---- sections ------------------------------------------------------------------- */
 
 #define ERR(...) (snprintf(err, errcap, __VA_ARGS__), -1)
@@ -148,6 +166,15 @@ static int set_sim(struct sim_config *c, const char *k, const char *v, char *err
 		return parse_bool(v, &c->baud_follows_tty) ? 0 : ERR("%s: want true/false", k);
 	if (!strcmp(k, "eeprom_needs_torque_off"))
 		return parse_bool(v, &c->eeprom_needs_torque_off) ? 0 : ERR("%s: want true/false", k);
+	if (!strcmp(k, "model")) {
+		enum sim_model m[SIM_BUS_MAX_SERVOS];
+		int n = parse_models(v, m, SIM_BUS_MAX_SERVOS);
+		if (n < 0)
+			return ERR("model: '%s' is not a servo model or a list of them (%s)", v, sim_model_names());
+		memcpy(c->models, m, sizeof(m[0]) * (size_t)n);
+		c->nmodels = (size_t)n;
+		return 0;
+	}
 	if (!strcmp(k, "seed")) {
 		char buf[64];
 		uint64_t seed;
@@ -246,20 +273,23 @@ static int set_motor(struct sim_config *c, const char *k, const char *v, char *e
 	if (!strcmp(k, "drive")) {
 		if (!strcmp(v, "pwm") || !strcmp(v, "current")) {
 			m->current_drive = !strcmp(v, "current");
+			c->motor_set |= SIM_MOTOR_SET_DRIVE;
 			return 0;
 		}
 		return ERR("motor.drive: '%s' is not pwm or current", v);
 	}
 	if (!parse_num(v, &d) || d < 0)
 		return ERR("motor.%s: '%s' is not a number >= 0", k, v);
-	if (!strcmp(k, "inertia") && d > 0) m->inertia = d;
-	else if (!strcmp(k, "viscous")) m->viscous = d;
-	else if (!strcmp(k, "coulomb")) m->coulomb = d;
-	else if (!strcmp(k, "stall_torque") && d > 0) m->stall_torque_12v = d;
-	else if (!strcmp(k, "no_load_speed") && d > 0) m->no_load_speed_12v = d;
-	else if (!strcmp(k, "thermal_tau") && d > 0) m->thermal_tau_s = d;
-	else if (!strcmp(k, "heat_gain")) m->heat_gain = d;
+	unsigned set;
+	if (!strcmp(k, "inertia") && d > 0) m->inertia = d, set = SIM_MOTOR_SET_INERTIA;
+	else if (!strcmp(k, "viscous")) m->viscous = d, set = SIM_MOTOR_SET_VISCOUS;
+	else if (!strcmp(k, "coulomb")) m->coulomb = d, set = SIM_MOTOR_SET_COULOMB;
+	else if (!strcmp(k, "stall_torque") && d > 0) m->stall_torque_12v = d, set = SIM_MOTOR_SET_STALL_TORQUE;
+	else if (!strcmp(k, "no_load_speed") && d > 0) m->no_load_speed_12v = d, set = SIM_MOTOR_SET_NO_LOAD_SPEED;
+	else if (!strcmp(k, "thermal_tau") && d > 0) m->thermal_tau_s = d, set = SIM_MOTOR_SET_THERMAL_TAU;
+	else if (!strcmp(k, "heat_gain")) m->heat_gain = d, set = SIM_MOTOR_SET_HEAT_GAIN;
 	else return ERR("unknown or invalid key motor.%s", k);
+	c->motor_set |= set;
 	return 0;
 }
 
@@ -307,6 +337,15 @@ static int robot_key(struct sim_robot_config *r, const char *name, const char *k
 		return parse_bool(v, &b) ? (r->echo = b, 0) : ERR("echo: true/false");
 	if (!strcmp(k, "mirror"))
 		return parse_bool(v, &r->mirror) ? 0 : ERR("mirror: true/false");
+	if (!strcmp(k, "model")) {
+		enum sim_model m[SIM_BUS_MAX_SERVOS];
+		int nm = parse_models(v, m, SIM_BUS_MAX_SERVOS);
+		if (nm < 0)
+			return ERR("model: '%s' is not a servo model or a list of them (%s)", v, sim_model_names());
+		memcpy(r->models, m, sizeof(m[0]) * (size_t)nm);
+		r->nmodels = (size_t)nm;
+		return 0;
+	}
 	if (!strcmp(k, "baud"))
 		return parse_long(v, 1200, 4500000, &n) ? (r->baud = n, 0) : ERR("baud: '%s' is not a whole number 1200..4500000", v);
 	if (!strcmp(k, "return_delay_us"))
@@ -314,7 +353,7 @@ static int robot_key(struct sim_robot_config *r, const char *name, const char *k
 		                                 : ERR("return_delay_us: '%s' is not a whole number 0..508", v);
 	if (!strcmp(k, "servo_baud"))
 		return parse_long(v, 0, 254, &n) ? (r->servo_baud_reg = (int)n, 0)
-		                                 : ERR("servo_baud: '%s' is not a register value 0..254", v);
+		                                 : ERR("servo_baud: '%s' is not a register value 0..254 (X series: 0..7)", v);
 	if (!parse_num(v, &d))
 		return ERR("robot.%s: '%s' is not a number", k, v);
 	if (!strcmp(k, "neutral"))
@@ -492,10 +531,65 @@ int sim_config_add_robot(struct sim_config *c, const char *name, const char *lin
 	return set_robot(c, name, "link", link, err, errcap);
 }
 
+/* One model per ID, all speaking one protocol: a bus speaks one. */
+static int finish_models(const struct sim_config *c, struct sim_robot_config *r, char *err, size_t errcap)
+{
+	const enum sim_model *m = r->nmodels ? r->models : c->models;
+	size_t n = r->nmodels ? r->nmodels : c->nmodels;
+	if (n != 1 && n != r->nids)
+		return ERR("robot %s: %zu models for %zu servos (give one model, or one per ID)", r->name, n, r->nids);
+	enum sim_model all[SIM_BUS_MAX_SERVOS];
+	for (size_t k = 0; k < r->nids; k++)
+		all[k] = m[n == 1 ? 0 : k];
+	for (size_t k = 1; k < r->nids; k++) {
+		const struct sim_model_info *a = sim_model_info(all[0]), *b = sim_model_info(all[k]);
+		if (a->protocol != b->protocol)
+			return ERR("robot %s: servo %u (%s, Protocol %d.0) and servo %u (%s, Protocol %d.0) cannot share "
+			           "a bus: a bus speaks one protocol (give the robot one protocol's models, or two robots)",
+			           r->name, r->ids[0], a->label, a->protocol, r->ids[k], b->label, b->protocol);
+	}
+	memcpy(r->models, all, sizeof(all[0]) * r->nids);
+	r->nmodels = r->nids;
+	for (size_t k = 0; k < r->nids && sim_model_info(all[0])->protocol == 2; k++)
+		if (r->ids[k] > DXL2_MAX_ID)
+			return ERR("robot %s: ID %u: Protocol 2.0 IDs are 0..%d", r->name, r->ids[k], DXL2_MAX_ID);
+	if (r->servo_baud_reg > 7 && sim_model_info(all[0])->protocol == 2)
+		return ERR("robot %s: servo_baud %d: the X series' Baud Rate register is 0..7", r->name, r->servo_baud_reg);
+	return 0;
+}
+
+int sim_config_robot_protocol(const struct sim_robot_config *r)
+{
+	return r->nmodels ? sim_model_info(r->models[0])->protocol : 1;
+}
+
+void sim_config_motor_params(const struct sim_config *c, enum sim_model m, struct sim_motor_params *p)
+{
+	const struct sim_motor_params *g = &c->motor;
+	if (m == SIM_MODEL_AX12A) {
+		*p = *g;
+		return;
+	}
+	sim_model_motor_params(m, p);
+	unsigned set = c->motor_set;
+	if (set & SIM_MOTOR_SET_INERTIA) p->inertia = g->inertia;
+	if (set & SIM_MOTOR_SET_VISCOUS) p->viscous = g->viscous;
+	if (set & SIM_MOTOR_SET_COULOMB) p->coulomb = g->coulomb;
+	if (set & SIM_MOTOR_SET_STALL_TORQUE) p->stall_torque_12v = g->stall_torque_12v;
+	if (set & SIM_MOTOR_SET_NO_LOAD_SPEED) p->no_load_speed_12v = g->no_load_speed_12v;
+	if (set & SIM_MOTOR_SET_THERMAL_TAU) p->thermal_tau_s = g->thermal_tau_s;
+	if (set & SIM_MOTOR_SET_HEAT_GAIN) p->heat_gain = g->heat_gain;
+	if (set & SIM_MOTOR_SET_DRIVE) p->current_drive = g->current_drive;
+	p->supply_voltage = g->supply_voltage;
+	p->ambient_c = g->ambient_c;
+}
+
 static int finish_robot(struct sim_config *c, struct sim_robot_config *r, char *err, size_t errcap)
 {
 	if (r->nids == 0)
 		return ERR("robot %s: no ids", r->name);
+	if (finish_models(c, r, err, errcap) != 0)
+		return -1;
 	if (!r->link[0] && snprintf(r->link, sizeof(r->link), "%s/%s", c->link_dir, r->name) >= (int)sizeof(r->link))
 		return ERR("robot %s: link path too long", r->name);
 	if (r->contact_id == -2)

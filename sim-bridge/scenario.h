@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "model.h"
 #include "motor.h"
 #include "simbus.h"
 #include "textfile.h"
@@ -39,6 +40,10 @@ struct sim_robot_config {
 	int return_delay_us;         /* < 0: the [sim] value */
 	int servo_baud_reg;          /* < 0: the register matching the bus baud */
 	bool mirror;                 /* the body moves left for a positive angle (facing rigs) */
+	/* Servo models: one for every ID, or one per ID in ids' order; none:
+	 * the [sim] model. sim_config_finish() leaves one per ID. */
+	enum sim_model models[SIM_BUS_MAX_SERVOS];
+	size_t nmodels;
 };
 
 struct sim_event {
@@ -55,7 +60,7 @@ struct sim_config {
 	char lcm_url[SIM_URL_MAX];   /* empty: LCM's default */
 	char link_dir[SIM_PATH_MAX];
 	char control[SIM_PATH_MAX];  /* control socket path, empty = none */
-	long baud;                   /* the pty's initial rate */
+	long baud;                   /* the pty's initial rate; 0: the servos' factory rate */
 	bool baud_follows_tty;       /* the bus runs at the rate the controller sets */
 	double latency_ms;
 	bool echo;
@@ -73,8 +78,12 @@ struct sim_config {
 	double half_width;           /* m */
 	double effective_mass;       /* kg; <= 0: motor inertia / lever² */
 	int walls;                   /* SIM_WALLS_* */
+	/* the servo model of every robot without its own (one, or one per ID) */
+	enum sim_model models[SIM_BUS_MAX_SERVOS];
+	size_t nmodels;
 	/* [motor] */
 	struct sim_motor_params motor;
+	unsigned motor_set;          /* SIM_MOTOR_SET_* bits: the [motor] keys given */
 	/* robots, left to right */
 	struct sim_robot_config robots[SIM_MAX_BUSES];
 	size_t nrobots;
@@ -83,6 +92,26 @@ struct sim_config {
 };
 
 enum { SIM_WALLS_NONE, SIM_WALLS_AUTO, SIM_WALLS_FIXED };
+
+/* [motor] keys given in the scenario or with --set: they apply to every
+ * model; the others keep each model's own values (model.c). */
+enum {
+	SIM_MOTOR_SET_INERTIA = 1u << 0,
+	SIM_MOTOR_SET_VISCOUS = 1u << 1,
+	SIM_MOTOR_SET_COULOMB = 1u << 2,
+	SIM_MOTOR_SET_STALL_TORQUE = 1u << 3,
+	SIM_MOTOR_SET_NO_LOAD_SPEED = 1u << 4,
+	SIM_MOTOR_SET_THERMAL_TAU = 1u << 5,
+	SIM_MOTOR_SET_HEAT_GAIN = 1u << 6,
+	SIM_MOTOR_SET_DRIVE = 1u << 7,
+};
+
+/* The motor parameters of a servo of model m under this configuration: the
+ * AX-12A's are c->motor; another model's are its own with the [motor] keys
+ * given, the supply voltage and the ambient temperature on top. */
+void sim_config_motor_params(const struct sim_config *c, enum sim_model m, struct sim_motor_params *p);
+/* The protocol a robot's bus speaks (1 or 2), after sim_config_finish(). */
+int sim_config_robot_protocol(const struct sim_robot_config *r);
 
 void sim_config_defaults(struct sim_config *c);
 /* Read an INI file on top of c. Only a regular file of at most

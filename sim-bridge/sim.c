@@ -60,36 +60,79 @@ static void sim_initial_angles(struct sim *s)
 	}
 }
 
+/* The model of a robot's k-th servo (one per ID after sim_config_finish()). */
+static enum sim_model robot_model(const struct sim_robot_config *rc, size_t k)
+{
+	if (rc->nmodels == 0)
+		return SIM_MODEL_AX12A;
+	return rc->models[rc->nmodels == rc->nids ? k : 0];
+}
+
+/* The Baud Rate register value of the robot's servos. */
+static int robot_baud_reg(const struct sim_robot_config *rc, long baud, int protocol, uint8_t *reg, char *err,
+                          size_t errcap)
+{
+	if (rc->servo_baud_reg >= 0) {
+		*reg = (uint8_t)rc->servo_baud_reg;
+		return 0;
+	}
+	if (protocol == 2 && dxl2_baud_to_reg(baud, reg) != DXL_OK)
+		return snprintf(err, errcap, "robot %s: %ld bps is no X-series rate (9600, 57600, 115200, 1000000, "
+		                "2000000, 3000000, 4000000, 4500000); set servo_baud", rc->name, baud), -1;
+	if (protocol == 1 && dxl_baud_to_reg(baud, reg) != DXL_OK)
+		return snprintf(err, errcap, "robot %s: %ld bps is no AX-12 rate; set servo_baud", rc->name, baud), -1;
+	return 0;
+}
+
+/* One X servo as the scenario sets it up (ID, baud, return delay). */
+static void sim_add_xservo(const struct sim_config *c, struct sim_joint *j, enum sim_model m, uint8_t id,
+                           uint8_t baud_reg, int delay_us)
+{
+	struct sim_xservo_options xo = { c->overload_time_s };
+	sim_xservo_init(&j->xservo, m, &xo, 0.0);
+	sim_xservo_poke(&j->xservo, DXL2_X_ID, id);
+	sim_xservo_poke(&j->xservo, DXL2_X_BAUD_RATE, baud_reg);
+	if (delay_us >= 0)
+		sim_xservo_poke(&j->xservo, DXL2_X_RETURN_DELAY_TIME, delay_us / 2);
+	sim_xdrive_init(&j->xdrive);
+}
+
 static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char *err, size_t errcap)
 {
 	const struct sim_config *c = &s->cfg;
 	struct sim_bus *b = &s->buses[s->nbuses];
-	long baud = rc->baud > 0 ? rc->baud : c->baud;
+	const struct sim_model_info *mi = sim_model_info(robot_model(rc, 0));
+	long baud = rc->baud > 0 ? rc->baud : c->baud > 0 ? c->baud : mi->default_baud;
 	double latency_ms = rc->latency_ms >= 0 ? rc->latency_ms : c->latency_ms;
 	bool echo = rc->echo >= 0 ? rc->echo != 0 : c->echo;
 	sim_bus_init(b, rc->name, rc->link, baud, latency_ms / 1000.0, echo, c->seed * 1000003u + s->nbuses + 1);
 	b->follow_tty = c->baud_follows_tty;
+	if (mi->protocol == 2)
+		sim_bus_set_protocol(b, 2);
 	uint8_t baud_reg;
-	if (rc->servo_baud_reg >= 0)
-		baud_reg = (uint8_t)rc->servo_baud_reg;
-	else if (dxl_baud_to_reg(baud, &baud_reg) != DXL_OK)
-		return snprintf(err, errcap, "robot %s: %ld bps is no AX-12 rate; set servo_baud", rc->name, baud), -1;
+	if (robot_baud_reg(rc, baud, mi->protocol, &baud_reg, err, errcap) != 0)
+		return -1;
 	int delay_us = rc->return_delay_us >= 0 ? rc->return_delay_us : c->return_delay_us;
 	struct sim_servo_options so = { c->eeprom_needs_torque_off, c->overload_time_s };
 	for (size_t k = 0; k < rc->nids; k++) {
 		struct sim_joint *j = &b->joints[b->njoints++];
-		j->params = c->motor;
-		sim_servo_init(&j->servo, &so, DXL_POS_CENTER);
-		sim_servo_poke(&j->servo, DXL_AX_ID, rc->ids[k]);
-		sim_servo_poke(&j->servo, DXL_AX_BAUD_RATE, baud_reg);
-		if (delay_us >= 0)
-			sim_servo_poke(&j->servo, DXL_AX_RETURN_DELAY_TIME, (uint16_t)(delay_us / 2));
+		j->model = robot_model(rc, k);
+		sim_config_motor_params(c, j->model, &j->params);
+		if (j->model != SIM_MODEL_AX12A) {
+			sim_add_xservo(c, j, j->model, rc->ids[k], baud_reg, delay_us);
+		} else {
+			sim_servo_init(&j->servo, &so, DXL_POS_CENTER);
+			sim_servo_poke(&j->servo, DXL_AX_ID, rc->ids[k]);
+			sim_servo_poke(&j->servo, DXL_AX_BAUD_RATE, baud_reg);
+			if (delay_us >= 0)
+				sim_servo_poke(&j->servo, DXL_AX_RETURN_DELAY_TIME, (uint16_t)(delay_us / 2));
+		}
 		if (rc->ids[k] != rc->contact_id)
 			continue;
 		size_t body = s->world.nbodies;
 		struct sim_body sb = {
 			.motor = &j->motor, .lever = rc->mirror ? -c->lever : c->lever, .half_width = c->half_width, .robot = (int)s->nbuses,
-			.effective_mass = c->effective_mass > 0 ? c->effective_mass : c->motor.inertia / (c->lever * c->lever),
+			.effective_mass = c->effective_mass > 0 ? c->effective_mass : j->params.inertia / (c->lever * c->lever),
 			.neutral = rc->neutral_set ? rc->neutral : 0,
 		};
 		if (sim_world_add_body(&s->world, &sb) < 0)
@@ -150,8 +193,36 @@ void sim_close(struct sim *s)
 
 /* ---- physics ------------------------------------------------------------------ */
 
+/* An X servo's view of the last step. */
+static void sim_sense_xjoint(struct sim_joint *j, double dt)
+{
+	const struct sim_fault *f = j->faults.f;
+	bool torque = sim_joint_torque(j);
+	struct sim_xdrive_cmd xc;
+	sim_xservo_drive_cmd(&j->xservo, &xc);
+	double cap = sim_xdrive_cap(&xc, sim_motor_stall_torque(&j->params));
+	struct sim_xservo_sense in = {
+		.angle = j->motor.angle,
+		.speed = j->motor.speed,
+		.torque = torque ? j->motor.motor_torque : 0,
+		.stall_torque = sim_motor_stall_torque(&j->params),
+		.duty = torque ? j->motor.drive : 0,
+		.voltage = f[SIM_FAULT_VOLTAGE].active ? f[SIM_FAULT_VOLTAGE].arg : j->params.supply_voltage,
+		.temperature = f[SIM_FAULT_TEMPERATURE].active ? f[SIM_FAULT_TEMPERATURE].arg : j->motor.temperature,
+		.drive = &j->xdrive,
+	};
+	/* the overload's cause: the delivered torque at the driver's cap (as
+	 * the AX-12A's, within 2 % of it) */
+	in.overloaded = torque && cap > 0 && fabs(j->motor.motor_torque) >= 0.98 * cap;
+	sim_xservo_sense(&j->xservo, &in, dt);
+}
+
 static void sim_sense_joint(struct sim_joint *j, double dt)
 {
+	if (j->model != SIM_MODEL_AX12A) {
+		sim_sense_xjoint(j, dt);
+		return;
+	}
 	struct sim_motor_cmd cmd;
 	const struct sim_fault *f = j->faults.f;
 	sim_servo_motor_cmd(&j->servo, &cmd);
@@ -167,15 +238,39 @@ static void sim_sense_joint(struct sim_joint *j, double dt)
 	sim_servo_sense(&j->servo, &in, dt);
 }
 
-/* Present values before the first step (and after a power-on). */
+/* Present values before the first step and after a power-on; the goal
+ * position where the joint stands, as on power-up. */
+static void sim_joint_power_up(struct sim_joint *j)
+{
+	if (j->model != SIM_MODEL_AX12A) {
+		sim_xservo_power_on(&j->xservo, j->motor.angle);
+		sim_sense_joint(j, 0);
+		return;
+	}
+	sim_sense_joint(j, 0);
+	dxl_put_u16(&j->servo.mem[DXL_AX_GOAL_POSITION], dxl_get_u16(&j->servo.mem[DXL_AX_PRESENT_POSITION]));
+}
+
 static void sim_sync_present(struct sim *s)
 {
 	for (size_t i = 0; i < s->nbuses; i++)
-		for (size_t k = 0; k < s->buses[i].njoints; k++) {
-			struct sim_joint *j = &s->buses[i].joints[k];
-			sim_sense_joint(j, 0);
-			dxl_put_u16(&j->servo.mem[DXL_AX_GOAL_POSITION], dxl_get_u16(&j->servo.mem[DXL_AX_PRESENT_POSITION]));
-		}
+		for (size_t k = 0; k < s->buses[i].njoints; k++)
+			sim_joint_power_up(&s->buses[i].joints[k]);
+}
+
+static void sim_step_joint(struct sim_joint *j, double dt)
+{
+	if (j->model != SIM_MODEL_AX12A) {
+		struct sim_xdrive_cmd xc;
+		struct sim_motor_drive d;
+		sim_xservo_drive_cmd(&j->xservo, &xc);
+		sim_xdrive_step(&j->xdrive, &xc, &j->motor, &j->params, dt, &d);
+		sim_motor_step_drive(&j->motor, &j->params, &d, 0.0, dt);
+		return;
+	}
+	struct sim_motor_cmd cmd;
+	sim_servo_motor_cmd(&j->servo, &cmd);
+	sim_motor_step(&j->motor, &j->params, &cmd, 0.0, dt);
 }
 
 /* The walls of a "walls ... over S" at simulated time t (s). */
@@ -196,12 +291,8 @@ static void sim_walls_follow(struct sim *s, double t)
 void sim_step(struct sim *s)
 {
 	for (size_t i = 0; i < s->nbuses; i++)
-		for (size_t k = 0; k < s->buses[i].njoints; k++) {
-			struct sim_joint *j = &s->buses[i].joints[k];
-			struct sim_motor_cmd cmd;
-			sim_servo_motor_cmd(&j->servo, &cmd);
-			sim_motor_step(&j->motor, &j->params, &cmd, 0.0, s->dt);
-		}
+		for (size_t k = 0; k < s->buses[i].njoints; k++)
+			sim_step_joint(&s->buses[i].joints[k], s->dt);
 	sim_walls_follow(s, (double)(s->steps + 1) * s->dt);
 	s->nstep_collisions = sim_world_resolve(&s->world, s->dt, s->step_collisions, SIM_MAX_COLLISIONS_PER_STEP);
 	if (s->nstep_collisions > SIM_MAX_COLLISIONS_PER_STEP)
@@ -238,7 +329,7 @@ struct sim_joint *sim_find_joint(struct sim_bus *b, uint8_t id)
 {
 	/* Look up by the configured wiring slot's current ID. */
 	for (size_t k = 0; k < b->njoints; k++)
-		if (sim_servo_id(&b->joints[k].servo) == id)
+		if (sim_joint_id(&b->joints[k]) == id)
 			return &b->joints[k];
 	return NULL;
 }
@@ -260,7 +351,7 @@ static int sim_each_joint(struct sim_cmd_ctx *x, const char *bus, const char *id
 		for (size_t k = 0; k < b->njoints; k++) {
 			/* Faults follow the wiring slot: the ID it was configured with
 			 * or has now. */
-			bool hit = want < 0 || sim_servo_id(&b->joints[k].servo) == want ||
+			bool hit = want < 0 || sim_joint_id(&b->joints[k]) == want ||
 			           s->cfg.robots[i].ids[k] == want;
 			if (!hit)
 				continue;
@@ -274,28 +365,52 @@ static int sim_each_joint(struct sim_cmd_ctx *x, const char *bus, const char *id
 	return matched;
 }
 
+/* stuck-error's ARG must mean something in the servo's protocol: 1.0's
+ * error bits or 2.0's ERR field. */
+static int fault_fits(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joint *j, const struct sim_fault *f,
+                      enum sim_fault_kind kind)
+{
+	if (kind != SIM_FAULT_STUCK_ERROR)
+		return 0;
+	if (j->model != SIM_MODEL_AX12A && f->err2 < 0)
+		return FAIL(x, "stuck-error: servo %u on %s speaks Protocol 2.0: its ERR field is alert and/or one of "
+		               "result-fail, instruction, crc, data-range, data-length, data-limit, access (or 0..255)",
+		            sim_joint_id(j), b->name);
+	if (j->model == SIM_MODEL_AX12A && f->arg < 0)
+		return FAIL(x, "stuck-error: servo %u on %s speaks Protocol 1.0: its error bits are voltage, angle-limit, "
+		               "overheating, range, checksum, overload, instruction (or 0..127)", sim_joint_id(j), b->name);
+	return 0;
+}
+
+struct fault_cmd {
+	struct sim_fault f;
+	enum sim_fault_kind kind;
+	bool apply;              /* false: only check that it fits every servo */
+};
+
 static int do_fault_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joint *j, void *arg)
 {
-	(void)x;
-	(void)b;
-	const struct sim_fault *f = arg;
-	enum sim_fault_kind kind = (enum sim_fault_kind)f[1].remaining;
-	j->faults.f[kind] = f[0];
+	const struct fault_cmd *fc = arg;
+	if (!fc->apply)
+		return fault_fits(x, b, j, &fc->f, fc->kind);
+	j->faults.f[fc->kind] = fc->f;
 	return 0;
 }
 
 static int cmd_fault(struct sim_cmd_ctx *x)
 {
 	char why[200];
-	struct sim_fault f[2];
-	enum sim_fault_kind kind;
+	struct fault_cmd fc = { .apply = false };
 	if (x->argc < 4)
 		return FAIL(x, "usage: fault BUS ID|* KIND [ARG] [count=N] [prob=P]");
-	if (sim_fault_parse(x->argc - 3, x->argv + 3, &kind, &f[0], why, sizeof(why)) != 0)
+	if (sim_fault_parse(x->argc - 3, x->argv + 3, &fc.kind, &fc.f, why, sizeof(why)) != 0)
 		return FAIL(x, "%s", why);
-	f[1].remaining = (long)kind;  /* carries the kind to the callback */
-	int n = sim_each_joint(x, x->argv[1], x->argv[2], do_fault_one, f);
-	return n < 0 ? -1 : (REPLY(x, "ok %d servo(s): %s", n, sim_fault_name(kind)), 0);
+	/* every servo it names first, so that a refusal changes nothing */
+	if (sim_each_joint(x, x->argv[1], x->argv[2], do_fault_one, &fc) < 0)
+		return -1;
+	fc.apply = true;
+	int n = sim_each_joint(x, x->argv[1], x->argv[2], do_fault_one, &fc);
+	return n < 0 ? -1 : (REPLY(x, "ok %d servo(s): %s", n, sim_fault_name(fc.kind)), 0);
 }
 
 static int do_clear_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joint *j, void *arg)
@@ -331,13 +446,15 @@ static int do_power_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joi
 	(void)x;
 	(void)b;
 	if (*(bool *)arg) {
-		if (!j->servo.powered) {
-			sim_servo_power_on(&j->servo);
-			sim_sense_joint(j, 0);
-			dxl_put_u16(&j->servo.mem[DXL_AX_GOAL_POSITION], dxl_get_u16(&j->servo.mem[DXL_AX_PRESENT_POSITION]));
+		if (!sim_joint_powered(j)) {
+			if (j->model == SIM_MODEL_AX12A)
+				sim_servo_power_on(&j->servo);
+			sim_joint_power_up(j);   /* an X servo boots: RAM reset as on the real one */
 		}
-	} else {
+	} else if (j->model == SIM_MODEL_AX12A) {
 		sim_servo_power_off(&j->servo);
+	} else {
+		sim_xservo_power_off(&j->xservo);
 	}
 	return 0;
 }
@@ -427,6 +544,31 @@ static const struct dxl_reg *cmd_reg(struct sim_cmd_ctx *x, const char *name)
 	return r;
 }
 
+/* A register of an X servo's table (protocol/dxl2_table.c names and aliases). */
+static const struct dxl2_reg *cmd_xreg(struct sim_cmd_ctx *x, const struct sim_joint *j, const char *name)
+{
+	const struct dxl2_reg *r = dxl2_reg_lookup(j->xservo.table, name);
+	if (!r)
+		REPLY(x, "error: unknown register '%s' (the %s's table)", name, sim_model_info(j->model)->label);
+	return r;
+}
+
+/* poke on an X servo: any value the register's bytes can hold. */
+static int cmd_xpoke(struct sim_cmd_ctx *x, struct sim_joint *j)
+{
+	const struct dxl2_reg *r = cmd_xreg(x, j, x->argv[3]);
+	if (!r)
+		return -1;
+	int bits = 8 * r->size;
+	long lo = r->is_signed ? -(1L << (bits - 1)) : 0;
+	long hi = r->is_signed ? (1L << (bits - 1)) - 1 : (long)((1ULL << bits) - 1);
+	long v;
+	if (num_parse_long(x->argv[4], lo, hi, &v) != NUM_OK)
+		return FAIL(x, "bad value '%s' (%ld..%ld)", x->argv[4], lo, hi);
+	sim_xservo_poke(&j->xservo, r->addr, (int32_t)(uint32_t)v);
+	return REPLY(x, "ok %s=%ld", r->name, v), 0;
+}
+
 /* poke BUS ID REG VALUE: set a register without the write rules. */
 static int cmd_poke(struct sim_cmd_ctx *x)
 {
@@ -438,6 +580,8 @@ static int cmd_poke(struct sim_cmd_ctx *x)
 	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
 	if (!j)
 		return -1;
+	if (j->model != SIM_MODEL_AX12A)
+		return cmd_xpoke(x, j);
 	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
 	if (!r)
 		return -1;
@@ -458,10 +602,52 @@ static int cmd_peek(struct sim_cmd_ctx *x)
 	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
 	if (!j)
 		return -1;
+	if (j->model != SIM_MODEL_AX12A) {
+		const struct dxl2_reg *xr = cmd_xreg(x, j, x->argv[3]);
+		int32_t v = 0;
+		if (!xr)
+			return -1;
+		sim_xservo_peek(&j->xservo, xr->addr, &v);
+		return REPLY(x, "ok %ld", (long)v), 0;
+	}
 	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
 	if (!r)
 		return -1;
 	return REPLY(x, "ok %u", (unsigned)sim_servo_peek(&j->servo, r->addr)), 0;
+}
+
+/* The active faults' names after "faults=", or "none". */
+static void cmd_fault_names(struct sim_cmd_ctx *x, const struct sim_joint *j, size_t off)
+{
+	bool any = false;
+	for (int k = 0; k < SIM_FAULT_KINDS && off < x->cap; k++)
+		if (j->faults.f[k].active) {
+			off += (size_t)snprintf(x->reply + off, x->cap - off, "%s%s", any ? "," : "",
+			                        sim_fault_name((enum sim_fault_kind)k));
+			any = true;
+		}
+	if (!any && off < x->cap)
+		snprintf(x->reply + off, x->cap - off, "none");
+}
+
+/* servo BUS ID on an X servo: its model, mode, hardware errors, watchdog and
+ * the status ERR field's error numbers as counters. */
+static int cmd_xservo(struct sim_cmd_ctx *x, const struct sim_joint *j)
+{
+	const struct sim_xservo *sv = &j->xservo;
+	const struct sim_xservo_counters *c = &sv->count;
+	size_t off = (size_t)REPLY(x, "ok id=%u model=%s power=%s torque=%u mode=%u hwerr=0x%02x watchdog=%u "
+	                              "angle=%.4f speed=%.4f temp=%.1f instructions=%u replies=%u result_fail=%u "
+	                              "instruction=%u crc=%u data_range=%u data_length=%u data_limit=%u access=%u "
+	                              "shutdowns=%u watchdog_trips=%u reboots=%u faults=",
+	                           sim_xservo_id(sv), sim_model_info(j->model)->name, sv->powered ? "on" : "off",
+	                           sv->mem[DXL2_X_TORQUE_ENABLE], sv->mem[DXL2_X_OPERATING_MODE],
+	                           sv->mem[DXL2_X_HARDWARE_ERROR_STATUS], sv->mem[DXL2_X_BUS_WATCHDOG], j->motor.angle,
+	                           j->motor.speed, j->motor.temperature, c->instructions, c->replies, c->result_fail,
+	                           c->instruction_errors, c->crc_errors, c->data_range_errors, c->data_length_errors,
+	                           c->data_limit_errors, c->access_errors, c->shutdowns, c->watchdog_trips, c->reboots);
+	cmd_fault_names(x, j, off);
+	return 0;
 }
 
 /* servo BUS ID: one line of state, faults and counters (for people and tests). */
@@ -475,6 +661,8 @@ static int cmd_servo(struct sim_cmd_ctx *x)
 	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
 	if (!j)
 		return -1;
+	if (j->model != SIM_MODEL_AX12A)
+		return cmd_xservo(x, j);
 	const struct sim_servo *sv = &j->servo;
 	size_t off = (size_t)REPLY(x, "ok id=%u power=%s torque=%u errbits=0x%02x angle=%.4f speed=%.4f temp=%.1f "
 	                              "instructions=%u replies=%u range=%u angle_limit=%u instruction=%u checksum=%u "
@@ -484,15 +672,7 @@ static int cmd_servo(struct sim_cmd_ctx *x)
 	                           sv->count.instructions, sv->count.replies, sv->count.range_errors,
 	                           sv->count.angle_limit_errors, sv->count.instruction_errors, sv->count.checksum_errors,
 	                           sv->count.shutdowns);
-	bool any = false;
-	for (int k = 0; k < SIM_FAULT_KINDS && off < x->cap; k++)
-		if (j->faults.f[k].active) {
-			off += (size_t)snprintf(x->reply + off, x->cap - off, "%s%s", any ? "," : "",
-			                        sim_fault_name((enum sim_fault_kind)k));
-			any = true;
-		}
-	if (!any && off < x->cap)
-		snprintf(x->reply + off, x->cap - off, "none");
+	cmd_fault_names(x, j, off);
 	return 0;
 }
 

@@ -37,8 +37,16 @@ void sim_bus_init(struct sim_bus *b, const char *name, const char *link, long ba
 	b->echo = echo;
 	b->master = b->slave = -1;
 	dxl_parser_init(&b->parser, DXL_PARSE_INSTRUCTION);
+	b->protocol = 1;
+	dxl2_parser_init(&b->parser2, DXL2_PARSE_INSTRUCTION);
 	sim_line_init(&b->line);
 	b->rng = seed ? seed : 1;
+}
+
+void sim_bus_set_protocol(struct sim_bus *b, int protocol)
+{
+	b->protocol = protocol == 2 ? 2 : 1;
+	dxl2_parser_init(&b->parser2, DXL2_PARSE_INSTRUCTION);
 }
 
 void sim_bus_set_baud(struct sim_bus *b, long bps)
@@ -56,21 +64,51 @@ bool sim_bus_baud_matches(const struct sim_bus *b, uint8_t reg)
 	return fabs(servo - (double)b->baud) <= BUS_BAUD_TOLERANCE * (double)b->baud;
 }
 
-static void bus_hist_push(struct sim_bus *b, const uint8_t *data, size_t n)
+bool sim_joint_hears(const struct sim_bus *b, const struct sim_joint *j)
 {
-	const size_t cap = sizeof(b->hist);
+	if (j->model == SIM_MODEL_AX12A)
+		return j->servo.powered && sim_bus_baud_matches(b, j->servo.mem[DXL_AX_BAUD_RATE]);
+	double servo = (double)dxl2_baud_from_reg(j->xservo.mem[DXL2_X_BAUD_RATE]);
+	return j->xservo.powered && servo > 0 && fabs(servo - (double)b->baud) <= BUS_BAUD_TOLERANCE * (double)b->baud;
+}
+
+uint8_t sim_joint_id(const struct sim_joint *j)
+{
+	return j->model == SIM_MODEL_AX12A ? sim_servo_id(&j->servo) : sim_xservo_id(&j->xservo);
+}
+
+bool sim_joint_powered(const struct sim_joint *j)
+{
+	return j->model == SIM_MODEL_AX12A ? j->servo.powered : j->xservo.powered;
+}
+
+bool sim_joint_torque(const struct sim_joint *j)
+{
+	if (j->model == SIM_MODEL_AX12A)
+		return j->servo.powered && j->servo.mem[DXL_AX_TORQUE_ENABLE];
+	return j->xservo.powered && j->xservo.mem[DXL2_X_TORQUE_ENABLE];
+}
+
+/* Keep the last cap bytes the parser consumed. */
+static void hist_push(uint8_t *hist, size_t cap, size_t *hist_n, const uint8_t *data, size_t n)
+{
 	if (n >= cap) {
-		memcpy(b->hist, data + n - cap, cap);
-		b->hist_n = cap;
+		memcpy(hist, data + n - cap, cap);
+		*hist_n = cap;
 		return;
 	}
-	if (b->hist_n + n > cap) {
-		size_t drop = b->hist_n + n - cap;
-		memmove(b->hist, b->hist + drop, b->hist_n - drop);
-		b->hist_n -= drop;
+	if (*hist_n + n > cap) {
+		size_t drop = *hist_n + n - cap;
+		memmove(hist, hist + drop, *hist_n - drop);
+		*hist_n -= drop;
 	}
-	memcpy(b->hist + b->hist_n, data, n);
-	b->hist_n += n;
+	memcpy(hist + *hist_n, data, n);
+	*hist_n += n;
+}
+
+static void bus_hist_push(struct sim_bus *b, const uint8_t *data, size_t n)
+{
+	hist_push(b->hist, sizeof(b->hist), &b->hist_n, data, n);
 }
 
 /* Schedule one servo's status packet: it starts after the request's end on
@@ -135,10 +173,178 @@ static void bus_bad_checksum(struct sim_bus *b, int64_t req_end)
 	}
 }
 
+/* ---- Protocol 2.0 ------------------------------------------------------------- */
+
+/* The longest status packet an X servo sends: a READ of its whole table
+ * (148 bytes), stuffed at worst (dxl2_status_bytes_max(148) = 209), with
+ * room for a stuck-error fault's re-stuffing. */
+#define BUS_REPLY2_MAX 256
+
+/* Schedule one X servo's status packet: it starts `after` (the request's
+ * end, or the previous reply's in an ordered answer) plus the servo's return
+ * delay, then goes out at the baud rate. Returns when its last byte has left
+ * the wire (`after` if nothing went out). */
+static int64_t bus_send_reply2(struct sim_bus *b, struct sim_joint *j, uint8_t *pkt, size_t len, int64_t after)
+{
+	uint8_t garbage[SIM_FAULT_MAX_GARBAGE];
+	size_t ngarbage = 0;
+	int64_t extra = 0;
+	sim_faults_apply2(&j->faults, &b->rng, pkt, &len, BUS_REPLY2_MAX, garbage, &ngarbage, &extra);
+	if (len == 0 && ngarbage == 0)
+		return after;
+	int64_t start = after + (int64_t)dxl2_return_delay_us(j->xservo.mem[DXL2_X_RETURN_DELAY_TIME]) * 1000 + extra;
+	int64_t first = start + b->byte_ns;
+	if (ngarbage) {
+		sim_line_put(&b->line, first + b->latency_ns, b->byte_ns, garbage, ngarbage);
+		first += (int64_t)ngarbage * b->byte_ns;
+	}
+	if (len) {
+		sim_line_put(&b->line, first + b->latency_ns, b->byte_ns, pkt, len);
+		b->count.replies++;
+	}
+	return first + (int64_t)len * b->byte_ns - b->byte_ns;
+}
+
+struct bus_reply {
+	size_t joint;
+	int rank;
+	size_t len;
+	uint8_t bytes[BUS_REPLY2_MAX];
+};
+
+/* Whether several replies to pkt follow one another instead of colliding:
+ * SYNC_READ and BULK_READ answer in the order the request lists the servos,
+ * a broadcast PING in the order of their IDs (e-manual, Protocol 2.0). */
+static bool bus_ordered(const struct dxl2_packet *pkt)
+{
+	return pkt->instr == DXL2_INST_SYNC_READ || pkt->instr == DXL2_INST_BULK_READ ||
+	       (pkt->instr == DXL2_INST_PING && pkt->id == DXL2_BROADCAST_ID);
+}
+
+/* A servo's place among the replies to pkt: its slot in the request's list,
+ * or its ID for a broadcast PING. */
+static int bus_rank(const struct dxl2_packet *pkt, uint8_t id)
+{
+	if (pkt->instr == DXL2_INST_SYNC_READ) {
+		for (size_t k = 4; k < pkt->nparams; k++)
+			if (pkt->params[k] == id)
+				return (int)k;
+	} else if (pkt->instr == DXL2_INST_BULK_READ) {
+		for (size_t k = 0; k + 5 <= pkt->nparams; k += 5)
+			if (pkt->params[k] == id)
+				return (int)k;
+	}
+	return id;
+}
+
+/* Replies of several servos to one request: in their order, each after the
+ * one before it has ended plus its own return delay. A servo that stays
+ * silent leaves no gap (README: the manual does not say how long the others
+ * wait for it). Otherwise every reply starts from the request's end, and two
+ * servos answering one unicast request (a duplicated ID) collide. */
+static void bus_send_replies2(struct sim_bus *b, const struct dxl2_packet *pkt, struct bus_reply *r, size_t n,
+                              int64_t req_end)
+{
+	bool ordered = bus_ordered(pkt);
+	for (size_t i = 1; ordered && i < n; i++)  /* insertion sort: a few replies */
+		for (size_t k = i; k > 0 && r[k - 1].rank > r[k].rank; k--) {
+			struct bus_reply t = r[k];
+			r[k] = r[k - 1];
+			r[k - 1] = t;
+		}
+	int64_t t = req_end;
+	for (size_t i = 0; i < n; i++) {
+		int64_t end = bus_send_reply2(b, &b->joints[r[i].joint], r[i].bytes, r[i].len, ordered ? t : req_end);
+		if (ordered)
+			t = end;
+	}
+}
+
+static void bus_dispatch2(struct sim_bus *b, const struct dxl2_packet *pkt, int64_t req_end)
+{
+	struct bus_reply r[SIM_BUS_MAX_SERVOS];
+	size_t n = 0;
+	b->count.packets++;
+	for (size_t i = 0; i < b->njoints; i++) {
+		struct sim_joint *j = &b->joints[i];
+		if (j->model == SIM_MODEL_AX12A || !j->xservo.powered)
+			continue;
+		if (!sim_joint_hears(b, j)) {
+			b->count.wrong_baud++;
+			continue;  /* at another rate the servo sees only framing noise */
+		}
+		uint8_t id = sim_xservo_id(&j->xservo);
+		int len = sim_xservo_handle(&j->xservo, pkt, r[n].bytes, sizeof r[n].bytes);
+		if (len > 0) {
+			r[n].joint = i;
+			r[n].rank = bus_rank(pkt, id);
+			r[n].len = (size_t)len;
+			n++;
+		}
+	}
+	bus_send_replies2(b, pkt, r, n, req_end);
+}
+
+/* The parser dropped a packet for its CRC: find it in the bytes just
+ * consumed (header, LEN spanning exactly to here) so the addressed servo can
+ * answer with the CRC error. */
+static void bus_bad_crc(struct sim_bus *b, int64_t req_end)
+{
+	b->count.checksum_errors++;
+	for (size_t p = b->hist2_n >= 10 ? b->hist2_n - 9 : 0; p-- > 0;) {
+		const uint8_t *h = &b->hist2[p];
+		if (h[0] != 0xFF || h[1] != 0xFF || h[2] != 0xFD || h[3] != 0x00)
+			continue;
+		size_t len = (size_t)h[5] | ((size_t)h[6] << 8);
+		if (p + DXL2_HEADER_BYTES + len != b->hist2_n)
+			continue;
+		for (size_t i = 0; i < b->njoints; i++) {
+			struct sim_joint *j = &b->joints[i];
+			if (j->model == SIM_MODEL_AX12A || !sim_joint_hears(b, j))
+				continue;
+			uint8_t reply[BUS_REPLY2_MAX];
+			int n = sim_xservo_handle_bad_crc(&j->xservo, h[4], h[7], reply, sizeof(reply));
+			if (n > 0)
+				bus_send_reply2(b, j, reply, (size_t)n, req_end);
+		}
+		return;
+	}
+}
+
+/* As bus 1.0's loop below: until the parser needs more input. */
+static void bus_feed2(struct sim_bus *b, const uint8_t *data, size_t n, int64_t start)
+{
+	size_t off = 0;
+	for (size_t rounds = 0; rounds < n + DXL2_MAX_PACKET + 1; rounds++) {
+		size_t used = 0;
+		struct dxl2_packet pkt;
+		int r = dxl2_parser_feed(&b->parser2, data + off, n - off, &used, &pkt);
+		hist_push(b->hist2, sizeof(b->hist2), &b->hist2_n, data + off, used);
+		off += used;
+		int64_t end = start + (int64_t)off * b->byte_ns;
+		if (r == DXL_FRAME)
+			bus_dispatch2(b, &pkt, end);
+		else if (r == DXL_E_CHECKSUM)
+			bus_bad_crc(b, end);
+		else if (r == DXL_E_STUFFING)
+			b->count.stuffing_errors++;
+		else if (r < 0)
+			b->count.header_errors++;
+		else
+			break;
+	}
+}
+
+/* ---- feeding ---------------------------------------------------------------------- */
+
 void sim_bus_feed(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now)
 {
-	if (b->parser.have > 0 && now - b->last_rx > BUS_PACKET_GAP_NS) {
-		dxl_parser_reset(&b->parser);
+	size_t partial = b->protocol == 2 ? b->parser2.have : b->parser.have;
+	if (partial > 0 && now - b->last_rx > BUS_PACKET_GAP_NS) {
+		if (b->protocol == 2)
+			dxl2_parser_reset(&b->parser2);
+		else
+			dxl_parser_reset(&b->parser);
 		b->count.stale_drops++;
 	}
 	b->last_rx = now;
@@ -147,6 +353,10 @@ void sim_bus_feed(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now)
 	b->count.rx_bytes += n;
 	if (b->echo)
 		sim_line_put(&b->line, start + b->byte_ns + b->latency_ns, b->byte_ns, data, n);
+	if (b->protocol == 2) {
+		bus_feed2(b, data, n, start);
+		return;
+	}
 	size_t off = 0;
 	/* Until the parser needs more input, even when all of it is consumed:
 	 * after an error the bytes it still holds may be a whole packet (one
@@ -261,6 +471,7 @@ int sim_bus_open(struct sim_bus *b, char *err, size_t errcap)
 		return -1;
 	}
 	dxl_parser_reset(&b->parser);
+	dxl2_parser_reset(&b->parser2);
 	sim_line_clear(&b->line);
 	return 0;
 }
@@ -281,6 +492,7 @@ void sim_bus_close(struct sim_bus *b)
 	b->master = b->slave = -1;
 	sim_line_clear(&b->line);
 	dxl_parser_reset(&b->parser);
+	dxl2_parser_reset(&b->parser2);
 }
 
 bool sim_bus_connected(const struct sim_bus *b) { return b->master >= 0; }

@@ -14,19 +14,28 @@
 #include <stdint.h>
 
 #include "dxl.h"
+#include "dxl2.h"
 #include "fault.h"
 #include "line.h"
+#include "model.h"
 #include "motor.h"
 #include "servo.h"
+#include "xdrive.h"
+#include "xservo.h"
 
 /* Servos on one bus: robots have two; test rigs and ID scans use a few more. */
 #define SIM_BUS_MAX_SERVOS 32
 #define SIM_NAME_MAX 32        /* robot / bus names */
 #define SIM_PATH_MAX 256       /* link paths */
 
-/* One servo with its joint physics and its injected faults. */
+/* One servo with its joint physics and its injected faults. An AX-12A
+ * (model 0, SIM_MODEL_AX12A) lives in `servo`; an X-series servo in `xservo`
+ * with its controllers in `xdrive`. */
 struct sim_joint {
+	enum sim_model model;
 	struct sim_servo servo;
+	struct sim_xservo xservo;
+	struct sim_xdrive xdrive;
 	struct sim_motor motor;
 	struct sim_motor_params params;
 	struct sim_faults faults;
@@ -35,8 +44,9 @@ struct sim_joint {
 struct sim_bus_counters {
 	uint64_t rx_bytes, tx_bytes;
 	uint64_t packets;          /* good instruction packets seen */
-	uint64_t checksum_errors;  /* instruction packets with a bad checksum */
+	uint64_t checksum_errors;  /* instruction packets with a bad checksum (2.0: CRC) */
 	uint64_t header_errors;
+	uint64_t stuffing_errors;  /* Protocol 2.0: a header inside a packet's body */
 	uint64_t wrong_baud;       /* packets a servo missed because of its baud */
 	uint64_t stale_drops;      /* partial packets dropped after a 100 ms gap */
 	uint64_t tx_dropped;       /* bytes the pty would not take (nobody reading) */
@@ -54,14 +64,18 @@ struct sim_bus {
 	int64_t byte_ns;           /* 10 bits a byte at baud */
 	int64_t latency_ns;        /* USB adapter hold time toward the controller */
 	bool echo;                 /* single-wire adapter: the request comes back */
+	int protocol;              /* 1 (AX-12A) or 2 (X series): what the bus speaks */
 	int master, slave;         /* -1 when disconnected */
 	struct dxl_parser parser;
+	struct dxl2_parser parser2;
 	struct sim_line line;
 	int64_t rx_free_at;        /* ns: when the request bytes so far end on the wire */
 	int64_t last_rx;           /* ns: when the last byte came in */
 	/* The last bytes the parser consumed, to find a bad packet's ID. */
 	uint8_t hist[DXL_MAX_PACKET];
 	size_t hist_n;
+	uint8_t hist2[DXL2_MAX_PACKET];   /* the same on a 2.0 bus */
+	size_t hist2_n;
 	struct sim_joint joints[SIM_BUS_MAX_SERVOS];
 	size_t njoints;
 	uint64_t rng;
@@ -71,10 +85,20 @@ struct sim_bus {
 /* Set up the bus (no I/O): name, link path, baud, latency (s), echo. */
 void sim_bus_init(struct sim_bus *b, const char *name, const char *link, long baud, double latency_s,
                   bool echo, uint64_t seed);
+/* Protocol 2.0 (X-series servos) instead of 1.0: the bus parses and answers
+ * 2.0 packets. Its joints must all be X servos (the configuration checks). */
+void sim_bus_set_protocol(struct sim_bus *b, int protocol);
 /* The controller now talks at bps (byte time and pacing follow). */
 void sim_bus_set_baud(struct sim_bus *b, long bps);
 /* Whether a servo set to baud register value reg hears this bus (within 3 %). */
 bool sim_bus_baud_matches(const struct sim_bus *b, uint8_t reg);
+/* Whether the joint's servo is powered and set to this bus's rate. */
+bool sim_joint_hears(const struct sim_bus *b, const struct sim_joint *j);
+
+/* The joint's servo, whatever its model: ID, power, torque. */
+uint8_t sim_joint_id(const struct sim_joint *j);
+bool sim_joint_powered(const struct sim_joint *j);
+bool sim_joint_torque(const struct sim_joint *j);
 
 /* The pure core: n bytes from the controller, read at time now (ns).
  * Replies (and echo) are scheduled on b->line. */

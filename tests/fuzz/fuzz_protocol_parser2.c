@@ -1,6 +1,8 @@
 /*
  * fuzz_protocol_parser2.c — libFuzzer target for the Dynamixel 2.0 parser
- * (both kinds) and the SYNC_READ reply tracker.
+ * (both kinds), the SYNC_READ reply tracker, and the bus layer's 2.0
+ * transactions (a READ, a SYNC_READ of four servos, a broadcast PING) whose
+ * replies are the input.
  *
  * The first input byte seeds the chunk sizes, so the fuzzer also explores how
  * a stream (and a stuffed FD) is split across read() calls. Invariants are
@@ -11,10 +13,12 @@
  *
  *   make fuzz-build && build/fuzz/fuzz_protocol_parser2 -max_total_time=60
  */
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bus.h"
 #include "dxl2.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -101,6 +105,96 @@ static void run_parser(enum dxl2_parse_kind kind, const uint8_t *data, size_t si
 	CHECK(m.answered + dxl2_multi_read_missing(&m, NULL, 0) == m.n);
 }
 
+/* ---- bus transactions whose replies are the fuzz input ---------------------- */
+struct fuzz_io {
+	const uint8_t *data;
+	size_t size, off;
+	uint32_t seed;
+	uint64_t now;
+};
+
+static int fio_write(void *ctx, const uint8_t *buf, size_t n)
+{
+	(void)ctx;
+	(void)buf;
+	(void)n;
+	return DXL_OK;
+}
+
+static long fio_read(void *ctx, uint8_t *buf, size_t cap)
+{
+	struct fuzz_io *f = ctx;
+	size_t n = next_chunk(&f->seed);
+	if (n > f->size - f->off)
+		n = f->size - f->off;
+	if (n > cap)
+		n = cap;
+	memcpy(buf, f->data + f->off, n);
+	f->off += n;
+	return (long)n;
+}
+
+static int fio_wait(void *ctx, uint32_t timeout_us)
+{
+	struct fuzz_io *f = ctx;
+	if (f->off < f->size)
+		return 1;
+	f->now += timeout_us;
+	return 0;
+}
+
+static uint64_t fio_now(void *ctx)
+{
+	return ((struct fuzz_io *)ctx)->now;
+}
+
+/* Slots are either data or a failure, every one accounted for; no servo has
+ * more replies than requests. */
+static void check_multi(const struct bus *b, const struct bus_multi *m, int r)
+{
+	CHECK(!bus_is_pending(b));
+	CHECK(r == DXL_OK || r < 0);
+	CHECK(m->answered <= m->n && m->n <= BUS_MULTI_MAX);
+	CHECK(m->answered + bus_multi_failed(m, NULL, 0) == m->n);
+	for (size_t i = 0; i < m->n; i++) {
+		CHECK((bus_multi_data(m, i) != NULL) == (m->status[i] == DXL_OK));
+		CHECK(m->off[i] + m->len[i] <= m->cap);
+	}
+	for (size_t id = 0; id < BUS_NSERVOS; id++)
+		CHECK(b->servo[id].replies <= b->servo[id].transactions);
+}
+
+static void run_bus(const uint8_t *data, size_t size, uint32_t seed, bool echo)
+{
+	static struct bus b; /* large: keep it off the stack */
+	static uint8_t buf[BUS_MULTI_MAX * 4];
+	static struct bus_multi m;
+	struct fuzz_io f = { data, size, 0, seed, 0 };
+	const struct bus_io io = { &f, fio_write, fio_read, fio_wait, fio_now, NULL, NULL };
+	const struct bus_timing t = { 1000000, 0, 1000, 500 };
+	const uint8_t ids[4] = { 1, 2, 3, 4 };
+	uint8_t out[8], err = 0;
+	bus_init(&b, &io, &t, echo);
+	CHECK(bus_set_protocol(&b, BUS_PROTOCOL_2) == DXL_OK);
+	int r = bus2_read(&b, 1, 132, 8, out, &err);
+	CHECK(r == DXL_OK || r < 0);
+	CHECK(!bus_is_pending(&b));
+	memset(&m, 0, sizeof m);
+	m.data = buf;
+	m.cap = sizeof buf;
+	check_multi(&b, &m, bus2_sync_read(&b, 126, 4, ids, 4, &m));
+	memset(&m, 0, sizeof m);
+	m.data = buf;
+	m.cap = sizeof buf;
+	r = bus_ping_all_begin(&b, &m);
+	if (r == DXL_OK)
+		r = bus_wait_done(&b, NULL);
+	check_multi(&b, &m, r);
+	for (size_t i = 0; i < m.n; i++)
+		for (size_t k = i + 1; k < m.n; k++)
+			CHECK(m.id[i] != m.id[k]);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
 	if (size == 0)
@@ -108,5 +202,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	uint32_t seed = data[0];
 	run_parser(DXL2_PARSE_STATUS, data + 1, size - 1, seed);
 	run_parser(DXL2_PARSE_INSTRUCTION, data + 1, size - 1, seed);
+	run_bus(data + 1, size - 1, seed, (data[0] & 1) != 0);
 	return 0;
 }

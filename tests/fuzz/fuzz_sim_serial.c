@@ -6,9 +6,15 @@
  * fault.c, the wire queue of line.c). No pty, no clock: time is a number the
  * input advances.
  *
+ * With bit 4 of the flags the bus speaks Protocol 2.0 to three X-series
+ * servos (XL430-W250, XM430-W350, XL430-W250; sim-bridge/xservo.c, the 2.0
+ * parser of protocol/dxl2.c, fault.c's 2.0 layout) and the same model runs
+ * beside it with 2.0's rules (see model_handle2 below).
+ *
  * Input: 4 header bytes, then the byte stream.
  *   [0] flags: bit 0 echo, bit 1 a 16 ms adapter latency, bit 2 EEPROM
- *       writable with torque on (the original AX-12), bit 3 reply faults on
+ *       writable with torque on (the original AX-12), bit 3 reply faults on,
+ *       bit 4 a Protocol 2.0 bus of X servos
  *   [1] [2] [3] the fault of servo 1 when bit 3 is set: kind, ARG, count/prob
  *   the rest: the stream, cut into reads of 1..16 bytes with gaps between
  *   them (now and then over 100 ms: the servo drops a half-read packet), by
@@ -43,11 +49,14 @@
 #include <string.h>
 
 #include "dxl.h"
+#include "dxl2.h"
+#include "dxl2_table.h"
 #include "dxl_table.h"
 #include "../../sim-bridge/fault.h"
 #include "../../sim-bridge/line.h"
 #include "../../sim-bridge/servo.h"
 #include "../../sim-bridge/simbus.h"
+#include "../../sim-bridge/xservo.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -283,11 +292,202 @@ static void model_feed(struct dxl_parser *p, const uint8_t *d, size_t n, struct 
 	}
 }
 
+/* ---- Protocol 2.0: the same checks with the X series' rules ------------------------ */
+
+static struct sim_xservo xmodel[NSERVOS];
+static uint8_t xtable0[NSERVOS][DXL2_X_TABLE_SIZE];
+
+/* Every RW register within its row's static range (the watchdog may read
+ * its error value), the model and firmware as set up, REG_WRITE's flag. */
+static void check_xtable(const struct sim_xservo *s, int k)
+{
+	const struct dxl2_model *m = s->table;
+	for (size_t i = 0; i < m->nregs; i++) {
+		const struct dxl2_reg *r = &m->regs[i];
+		int32_t v = dxl2_reg_decode(r, &s->mem[r->addr]);
+		if (r->access != DXL_ACCESS_RW)
+			continue;
+		if (r->addr == DXL2_X_BUS_WATCHDOG && v == SIM_XSERVO_WATCHDOG_ERROR)
+			continue;
+		CHECK(dxl2_reg_check_write(m, r, v) == DXL_OK);
+	}
+	CHECK(memcmp(s->mem, xtable0[k], 7) == 0);   /* model number, information, firmware */
+	CHECK(s->mem[DXL2_X_REGISTERED_INSTRUCTION] == (s->reg_pending ? 1 : 0));
+	CHECK(s->reg_len <= DXL2_X_TABLE_SIZE && (size_t)s->reg_addr + s->reg_len <= DXL2_X_TABLE_SIZE);
+}
+
+/* One well-formed 2.0 status packet of len bytes from id. */
+static void check_reply2(const uint8_t *out, int len, uint8_t id, struct dxl2_packet *pkt)
+{
+	static struct dxl2_parser p;
+	size_t used = 0;
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	CHECK(len >= 11 && len <= DXL2_MAX_PACKET);
+	CHECK(dxl2_parser_feed(&p, out, (size_t)len, &used, pkt) == DXL_FRAME);
+	CHECK(used == (size_t)len);
+	CHECK(pkt->id == id);
+}
+
+static uint32_t xerrors(const struct sim_xservo *s)
+{
+	const struct sim_xservo_counters *c = &s->count;
+	return c->result_fail + c->instruction_errors + c->data_range_errors + c->data_length_errors +
+	       c->data_limit_errors + c->access_errors;
+}
+
+/* What the manual lets a servo answer: PING always, the reads at level 1,
+ * the rest at level 2; to broadcast only PING and the SYNC/BULK reads. */
+static bool may_answer2(const struct dxl2_packet *req, uint8_t level)
+{
+	bool read = req->instr == DXL2_INST_READ || req->instr == DXL2_INST_SYNC_READ || req->instr == DXL2_INST_BULK_READ;
+	if (req->instr == DXL2_INST_PING)
+		return true;
+	if (req->id == DXL2_BROADCAST_ID && req->instr != DXL2_INST_SYNC_READ && req->instr != DXL2_INST_BULK_READ)
+		return false;
+	return read ? level >= 1 : level >= 2;
+}
+
+static void model_handle2(int k, const struct dxl2_packet *req)
+{
+	struct sim_xservo *s = &xmodel[k];
+	static struct sim_xservo before;
+	memcpy(&before, s, sizeof(before));
+	uint8_t out[DXL2_MAX_PACKET];
+	long bps = dxl2_baud_from_reg(s->mem[DXL2_X_BAUD_RATE]);
+	if (bps != bus.baud)
+		return;   /* at another rate it hears nothing */
+	int len = sim_xservo_handle(s, req, out, sizeof(out));
+	CHECK(len >= 0);
+	if (!sim_xservo_addressed(&before, req)) {
+		CHECK(len == 0);
+		CHECK(memcmp(&before, s, sizeof(*s)) == 0);
+		return;
+	}
+	check_xtable(s, k);
+	if (len > 0) {
+		static struct dxl2_packet reply;
+		CHECK(may_answer2(req, before.mem[DXL2_X_STATUS_RETURN_LEVEL]));
+		check_reply2(out, len, sim_xservo_id(&before), &reply);
+		if (req->instr == DXL2_INST_PING)
+			CHECK(reply.nparams == 3 && dxl2_err_number(reply.err) == 0);
+		if (req->instr == DXL2_INST_READ && reply.err == sim_xservo_alert(&before))
+			CHECK(reply.nparams == (uint16_t)(req->params[2] | (req->params[3] << 8)) &&
+			      memcmp(reply.params, &s->mem[req->params[0] | (req->params[1] << 8)], reply.nparams) == 0);
+	} else if (req->instr == DXL2_INST_PING) {
+		CHECK(0);   /* PING is always answered */
+	}
+	if (req->instr == DXL2_INST_FACTORY_RESET || req->instr == DXL2_INST_REBOOT)
+		return;   /* a boot: RAM (and the EEPROM) back to the factory's */
+	/* a refused instruction writes nothing (ACTION clears the registration first) */
+	if (xerrors(s) != xerrors(&before)) {
+		uint8_t a[DXL2_X_TABLE_SIZE];
+		memcpy(a, before.mem, sizeof(a));
+		if (req->instr == DXL2_INST_ACTION)
+			a[DXL2_X_REGISTERED_INSTRUCTION] = s->mem[DXL2_X_REGISTERED_INSTRUCTION];
+		CHECK(memcmp(a, s->mem, sizeof(a)) == 0);
+	}
+	/* torque on locks the EEPROM */
+	if (before.mem[DXL2_X_TORQUE_ENABLE])
+		CHECK(memcmp(before.mem, s->mem, DXL2_X_EEPROM_END) == 0);
+}
+
+static uint8_t mhist2[DXL2_MAX_PACKET];
+static size_t mhist2_n;
+
+static void mhist2_push(const uint8_t *d, size_t n)
+{
+	for (size_t i = 0; i < n; i++) {
+		if (mhist2_n == sizeof(mhist2)) {
+			memmove(mhist2, mhist2 + 1, sizeof(mhist2) - 1);
+			mhist2_n--;
+		}
+		mhist2[mhist2_n++] = d[i];
+	}
+}
+
+/* A packet with a bad CRC just ended: its header and LEN span the bytes up
+ * to here; its servo answers with the CRC error where it would answer. */
+static void model_bad_crc2(void)
+{
+	for (size_t p = mhist2_n >= 10 ? mhist2_n - 9 : 0; p-- > 0;) {
+		const uint8_t *h = &mhist2[p];
+		if (h[0] != 0xFF || h[1] != 0xFF || h[2] != 0xFD || h[3] != 0 ||
+		    p + 7 + ((size_t)h[5] | ((size_t)h[6] << 8)) != mhist2_n)
+			continue;
+		for (int k = 0; k < NSERVOS; k++) {
+			struct sim_xservo *s = &xmodel[k];
+			if (dxl2_baud_from_reg(s->mem[DXL2_X_BAUD_RATE]) != bus.baud)
+				continue;
+			static uint8_t before[DXL2_X_TABLE_SIZE];
+			memcpy(before, s->mem, sizeof(before));
+			uint8_t out[DXL2_MAX_PACKET];
+			int len = sim_xservo_handle_bad_crc(s, h[4], h[7], out, sizeof(out));
+			CHECK(len >= 0 && memcmp(before, s->mem, sizeof(before)) == 0);
+			if (len > 0) {
+				static struct dxl2_packet reply;
+				check_reply2(out, len, h[4], &reply);
+				CHECK(dxl2_err_number(reply.err) == DXL2_ERRNUM_CRC && reply.nparams == 0);
+			}
+		}
+		return;
+	}
+}
+
+struct model_counts2 {
+	uint64_t frames, crc_errors, header_errors, stuffing_errors;
+};
+
+static void model_feed2(struct dxl2_parser *p, const uint8_t *d, size_t n, struct model_counts2 *mc)
+{
+	size_t off = 0;
+	for (;;) {
+		size_t used = 0;
+		static struct dxl2_packet pkt;
+		int r = dxl2_parser_feed(p, d + off, n - off, &used, &pkt);
+		CHECK(used <= n - off);
+		mhist2_push(d + off, used);
+		off += used;
+		if (r == DXL_FRAME) {
+			mc->frames++;
+			for (int k = 0; k < NSERVOS; k++)
+				model_handle2(k, &pkt);
+		} else if (r == DXL_E_CHECKSUM) {
+			mc->crc_errors++;
+			model_bad_crc2();
+		} else if (r == DXL_E_STUFFING) {
+			mc->stuffing_errors++;
+		} else if (r < 0) {
+			mc->header_errors++;
+		} else {
+			CHECK(off == n);
+			return;
+		}
+	}
+}
+
 static void check_line(const struct sim_line *l)
 {
 	CHECK(l->n <= SIM_LINE_CAP && l->head + l->n <= SIM_LINE_CAP);
 	for (size_t i = l->head + 1; i < l->head + l->n; i++)
 		CHECK(l->q[i - 1].t <= l->q[i].t);
+}
+
+static void setup_x(void)
+{
+	sim_bus_set_protocol(&bus, 2);
+	for (int k = 0; k < NSERVOS; k++) {
+		struct sim_joint *j = &bus.joints[bus.njoints++];
+		memset(j, 0, sizeof(*j));
+		j->model = k == 1 ? SIM_MODEL_XM430_W350 : SIM_MODEL_XL430_W250;
+		sim_xservo_init(&j->xservo, j->model, NULL, 0.1 * k);
+		sim_xservo_poke(&j->xservo, DXL2_X_ID, k + 1);
+		sim_xservo_poke(&j->xservo, DXL2_X_BAUD_RATE, 3);   /* the bus's 1 Mbps */
+		sim_xservo_poke(&j->xservo, DXL2_X_RETURN_DELAY_TIME, k * 20);
+		if (k == 2)
+			sim_xservo_poke(&j->xservo, DXL2_X_STATUS_RETURN_LEVEL, 1);
+		xmodel[k] = j->xservo;
+		memcpy(xtable0[k], j->xservo.mem, DXL2_X_TABLE_SIZE);
+	}
 }
 
 static void setup(uint8_t flags, const uint8_t *fault)
@@ -296,7 +496,9 @@ static void setup(uint8_t flags, const uint8_t *fault)
 	sim_servo_default_options(&o);
 	o.eeprom_needs_torque_off = !(flags & 4);
 	sim_bus_init(&bus, "fuzz", "/nonexistent/fuzz", 1000000, (flags & 2) ? 0.016 : 0, (flags & 1) != 0, 7);
-	for (int k = 0; k < NSERVOS; k++) {
+	if (flags & 16)
+		setup_x();
+	for (int k = 0; k < NSERVOS && !(flags & 16); k++) {
 		struct sim_joint *j = &bus.joints[bus.njoints++];
 		memset(j, 0, sizeof(*j));
 		sim_servo_init(&j->servo, &o, (uint16_t)(DXL_POS_CENTER + 100 * k));
@@ -319,6 +521,49 @@ static void setup(uint8_t flags, const uint8_t *fault)
 	}
 }
 
+/* The stream on a 2.0 bus, the model beside it (as the 1.0 loop below). */
+static int run_x(const uint8_t *data, size_t size)
+{
+	static struct dxl2_parser mp;
+	dxl2_parser_init(&mp, DXL2_PARSE_INSTRUCTION);
+	mhist2_n = 0;
+	struct model_counts2 mc = { 0, 0, 0, 0 };
+	uint32_t seed = (uint32_t)data[0] << 24 | (uint32_t)data[1] << 16 | (uint32_t)data[2] << 8 | data[3];
+	int64_t now = MS, last_rx = 0;
+	uint8_t drained[SIM_LINE_CAP];
+	size_t off = HEADER;
+	while (off < size) {
+		uint32_t r = next_rand(&seed);
+		size_t n = 1 + r % 16;
+		if (n > size - off)
+			n = size - off;
+		r = next_rand(&seed);
+		now += (r & 7) == 0 ? 150 * MS : (r & 7) == 1 ? 2 * MS : 20000;
+		if (mp.have > 0 && now - last_rx > GAP_NS)
+			dxl2_parser_reset(&mp);
+		last_rx = now;
+		sim_bus_feed(&bus, data + off, n, now);
+		for (size_t i = 0; i < n; i++)
+			model_feed2(&mp, data + off + i, 1, &mc);
+		off += n;
+		CHECK(bus.count.packets == mc.frames);
+		CHECK(bus.count.checksum_errors == mc.crc_errors);
+		CHECK(bus.count.header_errors == mc.header_errors);
+		CHECK(bus.count.stuffing_errors == mc.stuffing_errors);
+		CHECK(bus.parser2.have == mp.have);
+		for (int k = 0; k < NSERVOS; k++) {
+			const struct sim_xservo *s = &bus.joints[k].xservo;
+			CHECK(memcmp(s->mem, xmodel[k].mem, DXL2_X_TABLE_SIZE) == 0);
+			CHECK(s->reg_pending == xmodel[k].reg_pending);
+		}
+		CHECK(bus.line.n <= SIM_LINE_CAP && bus.line.head + bus.line.n <= SIM_LINE_CAP);
+		check_line(&bus.line);
+		sim_line_take(&bus.line, now, drained, sizeof(drained));
+	}
+	CHECK(bus.count.rx_bytes == size - HEADER);
+	return 0;
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
 	static struct dxl_parser mp;
@@ -330,6 +575,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (size < HEADER)
 		return 0;
 	setup(data[0], data + 1);
+	if (data[0] & 16)
+		return run_x(data, size);
 	dxl_parser_init(&mp, DXL_PARSE_INSTRUCTION);
 	mhist_n = 0;
 	struct model_counts mc = { 0, 0, 0 };

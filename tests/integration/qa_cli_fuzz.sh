@@ -33,10 +33,12 @@ progs = {
                      ['--seed', '--duration', '--baud', '--return-delay', '--latency-ms', '--rate-hz',
                       '--truth-hz', '--temperature', '--voltage', '--tx-slice-us', '--realtime'],
                      ['--echo', '--bench', '--quiet'], []),
-    'dxl': (['--port', '--baud', '--latency-us', '--timeout-ms', '--rs485', '--config', '--cycles'],
-            ['--baud', '--latency-us', '--timeout-ms', '--cycles'],
+    'dxl': (['--port', '--baud', '--latency-us', '--timeout-ms', '--rs485', '--config', '--cycles', '--protocol',
+             '--size', '--keep'],
+            ['--baud', '--latency-us', '--timeout-ms', '--cycles', '--protocol', '--size'],
             ['--echo'], ['ports', 'scan', 'ping', 'read', 'write', 'dump', 'set-id', 'set-baud', 'torque',
-                         'reset', 'setup', 'doctor', '--ids', '--bauds', '--units', '--yes', '--status-level']),
+                         'reset', 'reboot', 'setup', 'doctor', '--ids', '--bauds', '--units', '--yes',
+                         '--status-level']),
     'undulate-top': (['--lcm-url', '--wait', '--interval'], ['--wait', '--interval'],
                      ['--read-only', '--json', '-v'], []),
     'undulate-analyze': (['--out', '--pairs', '--from', '--to', '--window', '--separation', '--restitution',
@@ -117,6 +119,8 @@ extreme = [
     ('undulated', ['--watch', '*', '--timeout', '0.2']),
     ('undulated', ['--command', 'param k 1e308 -32768', '--robot', '*', '--timeout', '0.2']),
     ('dxl', ['--port', '/dev/null', 'ports']),
+    ('dxl', ['--protocol', '2', '--port', T + '/nothing', '--size', '4', 'read', '252', '0xFFFF']),
+    ('dxl', ['--protocol', '2', '--port', T + '/nothing', 'reset', '252', '--keep', 'id-baud', '--yes']),
 ]
 ran_extreme = []
 for prog, args in extreme:

@@ -15,6 +15,13 @@
                                              time span: "COUNT SPAN_S HZ" (HZ = (COUNT - 1) /
                                              SPAN_S, from the logger's event timestamps)
   sim_client.py check HEX                    print "valid" if HEX is one well-formed status packet
+  sim_client.py pkt2 ID INSTR [PARAM...]     a Protocol 2.0 instruction packet (hex): stuffed,
+                                             LEN and CRC filled in (a bitwise CRC-16/0x8005
+                                             written here, not the project's table)
+  sim_client.py status2 ID ERR [PARAM...]    a Protocol 2.0 status packet (hex)
+  sim_client.py split2 HEX                   the 2.0 status packets in HEX, one per line as
+                                             "ID ERR PARAMHEX" (unstuffed; "bad" for one whose
+                                             CRC or LEN is wrong)
   sim_client.py eio LINK                     print "eio" once reads on LINK fail (bus gone)
 Bytes are written in hex, e.g. FFFF010201FB; exits non-zero on usage errors.
 The pty is set to $SIM_CLIENT_BAUD bps (default 1000000): the simulator runs
@@ -63,6 +70,59 @@ def pkt(args):
     ident, instr, params = body[0], body[1], body[2:]
     frame = [ident, len(params) + 2, instr] + params
     print(bytes([0xFF, 0xFF] + frame + [(~sum(frame)) & 0xFF]).hex().upper())
+
+
+def crc16(data):
+    """CRC-16, polynomial 0x8005, initial 0, no reflection: bit by bit, as the
+    e-manual's "CRC Calculation" page defines it (not its table)."""
+    crc = 0
+    for byte in data:
+        crc ^= byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x8005) if crc & 0x8000 else (crc << 1)
+            crc &= 0xFFFF
+    return crc
+
+
+def stuff(body):
+    """Protocol 2.0 byte stuffing: an FD after FF FF gets a second FD."""
+    out = []
+    for b in body:
+        out.append(b)
+        if len(out) >= 3 and out[-3:] == [0xFF, 0xFF, 0xFD]:
+            out.append(0xFD)
+    return out
+
+
+def pkt2(args):
+    vals = [int(a, 0) for a in args]
+    ident, code, params = vals[0], vals[1], vals[2:]
+    body = stuff([code] + params)
+    frame = [0xFF, 0xFF, 0xFD, 0x00, ident, (len(body) + 2) & 0xFF, (len(body) + 2) >> 8] + body
+    crc = crc16(frame)
+    print(bytes(frame + [crc & 0xFF, crc >> 8]).hex().upper())
+
+
+def split2(hexs):
+    b = bytes.fromhex(hexs) if hexs != "-" else b""
+    i = 0
+    while True:
+        i = b.find(b"\xff\xff\xfd\x00", i)
+        if i < 0 or i + 7 > len(b):
+            return
+        n = b[i + 5] | (b[i + 6] << 8)
+        end = i + 7 + n
+        if end > len(b) or n < 4 or crc16(b[i:end - 2]) != (b[end - 2] | (b[end - 1] << 8)):
+            print("bad")
+            i += 1
+            continue
+        body, un = list(b[i + 7:end - 2]), []   # INST, ERR, parameters: stuffed
+        for k, x in enumerate(body):
+            if x == 0xFD and k >= 3 and body[k - 3:k] == [0xFF, 0xFF, 0xFD]:
+                continue
+            un.append(x)
+        print("%d %02X %s" % (b[i + 4], un[1], bytes(un[2:]).hex().upper() or "-"))
+        i = end
 
 
 def ctl(path, command):
@@ -178,6 +238,13 @@ def main(argv):
         rate(argv[2], argv[3])
     elif len(argv) == 3 and argv[1] == "check":
         check(argv[2])
+    elif len(argv) >= 4 and argv[1] == "pkt2":
+        pkt2(argv[2:])
+    elif len(argv) >= 4 and argv[1] == "status2":
+        v = [int(a, 0) for a in argv[2:]]
+        pkt2([str(v[0]), "0x55", str(v[1])] + [str(x) for x in v[2:]])
+    elif len(argv) == 3 and argv[1] == "split2":
+        split2(argv[2])
     elif len(argv) >= 3 and argv[1] == "eio":
         eio(argv[2])
     else:

@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include <errno.h>
+#include <poll.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/socket.h>
@@ -196,7 +197,10 @@ static void test_block(void **state)
  * answers as told. Exit 0 when the HELLO was as expected. */
 static void fake_sim(int lfd, const char *answer)
 {
-	int fd = accept(lfd, NULL, NULL);
+	/* the listening socket is non-blocking (the simulator polls it): wait
+	 * for the parent's connect, or accept would race it */
+	struct pollfd p = { .fd = lfd, .events = POLLIN };
+	int fd = poll(&p, 1, 10000) == 1 ? accept(lfd, NULL, NULL) : -1;
 	struct lks_msg m;
 	char why[200];
 	int ok = fd >= 0 && lks_recv(fd, &m, why, sizeof why) == 1 && m.type == LKS_HELLO &&

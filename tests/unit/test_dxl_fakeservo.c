@@ -464,8 +464,8 @@ static void test_dxl_ping_and_scan(void **state)
 	assert_non_null(strstr(f->out, "model 12 (AX-12), firmware 24"));
 	assert_int_equal(run_dxl(f, "scan", "--ids", "0-5", NULL), 0);
 	/* header + exactly the two servos, with model, firmware, baud */
-	assert_non_null(strstr(f->out, "\n1    12     AX-12         24        1000000\n"));
-	assert_non_null(strstr(f->out, "\n2    12     AX-12         24        1000000\n"));
+	assert_non_null(strstr(f->out, "\n1    12     AX-12         24        1000000  1.0\n"));
+	assert_non_null(strstr(f->out, "\n2    12     AX-12         24        1000000  1.0\n"));
 	assert_null(strstr(f->out, "\n3 "));
 	assert_string_equal(f->err, "");
 }
@@ -646,8 +646,8 @@ static void test_dxl_set_baud_then_scan(void **state)
 	assert_non_null(strstr(f->out, "now at 57143 bps"));
 	assert_int_equal(run_dxl(f, "scan", "--ids", "1-2", "--bauds", "1000000,57143", NULL), 0);
 	assert_non_null(strstr(f->out, "\n1 "));
-	assert_non_null(strstr(f->out, "1000000\n2 "));
-	assert_non_null(strstr(f->out, "57143\n"));
+	assert_non_null(strstr(f->out, "1000000  1.0\n2 "));
+	assert_non_null(strstr(f->out, "57143    1.0\n"));
 	assert_int_equal(run_dxl(f, "set-baud", "1", "1500000", NULL), DXLT_EXIT_USAGE);
 }
 

@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -407,9 +408,102 @@ static void test_driven_bodies_collide(void **state)
 	assert_int_equal(sim.steps, 1000);
 }
 
+/* Servo models: one for all, one per ID, per robot; a bus speaks one
+ * protocol; the X series' factory rate and ID range; motor parameters per
+ * model with the [motor] keys given on top. */
+static void test_models(void **state)
+{
+	(void)state;
+	char err[300], reply[600];
+	static const char x_ini[] =
+		"[sim]\nmodel = xl430-w250\n[robot a]\nids = 1,2\n[robot b]\nids = 3\nmodel = XM430-W350\n"
+		"[robot c]\nids = 4,5\nmodel = xl430-w250, xm430-w350\n[robot d]\nids = 6\nmodel = ax12a\n";
+	sim_config_defaults(&cfg);
+	assert_int_equal(sim_config_load_text(&cfg, "x", x_ini, strlen(x_ini), err, sizeof err), 0);
+	assert_int_equal(sim_config_finish(&cfg, err, sizeof err), 0);
+	assert_int_equal(cfg.robots[0].models[1], SIM_MODEL_XL430_W250);
+	assert_int_equal(cfg.robots[1].models[0], SIM_MODEL_XM430_W350);
+	assert_int_equal(cfg.robots[2].models[1], SIM_MODEL_XM430_W350);
+	assert_int_equal(sim_config_robot_protocol(&cfg.robots[2]), 2);
+	assert_int_equal(sim_config_robot_protocol(&cfg.robots[3]), 1);
+	assert_int_equal(sim_init(&sim, &cfg, err, sizeof err), 0);
+	/* X buses start at 57600 (the factory Baud Rate 1), the AX-12A's at 1 Mbps */
+	assert_int_equal(sim.buses[0].protocol, 2);
+	assert_int_equal(sim.buses[0].baud, 57600);
+	assert_int_equal(sim.buses[0].joints[0].xservo.mem[DXL2_X_BAUD_RATE], 1);
+	assert_int_equal(sim.buses[3].protocol, 1);
+	assert_int_equal(sim.buses[3].baud, 1000000);
+	assert_int_equal(sim_joint_id(&sim.buses[2].joints[1]), 5);
+	/* each model its own motor line (e-manual, 12 V) */
+	assert_float_equal(sim.buses[1].joints[0].params.stall_torque_12v, 4.1, 1e-12);
+	assert_float_equal(sim.buses[0].joints[0].params.stall_torque_12v, 1.5, 1e-12);
+	assert_float_equal(sim.buses[0].joints[0].params.no_load_speed_12v, 61 * 2 * M_PI / 60, 1e-9);
+	assert_true(sim.buses[1].joints[0].params.inertia > sim.buses[0].joints[0].params.inertia);
+	/* commands take the X table's names; the servo line says the model */
+	assert_int_equal(sim_command(&sim, "peek a 1 model_number", 0, reply, sizeof reply), 0);
+	assert_string_equal(reply, "ok 1060");
+	assert_int_equal(sim_command(&sim, "poke b 3 goal_position -5", 0, reply, sizeof reply), 0);
+	assert_int_equal(sim_command(&sim, "peek b 3 goal", 0, reply, sizeof reply), 0);
+	assert_string_equal(reply, "ok -5");
+	assert_int_equal(sim_command(&sim, "poke a 1 cw_angle_limit 0", 0, reply, sizeof reply), -1);
+	assert_non_null(strstr(reply, "XL430-W250"));
+	assert_int_equal(sim_command(&sim, "servo c 5", 0, reply, sizeof reply), 0);
+	assert_non_null(strstr(reply, "model=xm430-w350"));
+	/* stuck-error takes each protocol's own words, and a refusal changes nothing */
+	assert_int_equal(sim_command(&sim, "fault a 1 stuck-error alert|data-limit", 0, reply, sizeof reply), 0);
+	assert_true(sim.buses[0].joints[0].faults.f[SIM_FAULT_STUCK_ERROR].err2 == 0x86);
+	assert_int_equal(sim_command(&sim, "fault a 1 stuck-error overload", 0, reply, sizeof reply), -1);
+	assert_non_null(strstr(reply, "Protocol 2.0"));
+	assert_int_equal(sim_command(&sim, "fault d 6 stuck-error alert", 0, reply, sizeof reply), -1);
+	assert_int_equal(sim_command(&sim, "clear * * stuck-error", 0, reply, sizeof reply), 0);
+	assert_int_equal(sim_command(&sim, "fault * * stuck-error overheating", 0, reply, sizeof reply), -1);
+	for (size_t i = 0; i < sim.nbuses; i++)
+		for (size_t k = 0; k < sim.buses[i].njoints; k++)
+			assert_false(sim.buses[i].joints[k].faults.f[SIM_FAULT_STUCK_ERROR].active);
+	/* power loss resets an X servo's RAM */
+	assert_int_equal(sim_command(&sim, "poke a 2 led 1", 0, reply, sizeof reply), 0);
+	assert_int_equal(sim_command(&sim, "power a 2 off", 0, reply, sizeof reply), 0);
+	assert_int_equal(sim_command(&sim, "power a 2 on", 0, reply, sizeof reply), 0);
+	assert_int_equal(sim_command(&sim, "peek a 2 led", 0, reply, sizeof reply), 0);
+	assert_string_equal(reply, "ok 0");
+
+	/* refusals, each with a clear message */
+	static const struct { const char *text, *why; } bad[] = {
+		{ "[robot a]\nids = 1,2\nmodel = ax12a,xl430-w250\n", "cannot share a bus" },
+		{ "[robot a]\nids = 1,2,3\nmodel = xl430-w250,xm430-w350\n", "2 models for 3 servos" },
+		{ "[robot a]\nids = 253\nmodel = xl430-w250\n", "Protocol 2.0 IDs are 0..252" },
+		{ "[robot a]\nids = 1\nmodel = xl430-w250\nservo_baud = 9\n", "0..7" },
+		{ "[robot a]\nids = 1\nmodel = xl430-w250\nbaud = 500000\n", "no X-series rate" },
+		{ "[robot a]\nids = 1\nmodel = mx28\n", "not a servo model" },
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+		sim_config_defaults(&cfg);
+		err[0] = '\0';
+		int r = sim_config_load_text(&cfg, "bad", bad[i].text, strlen(bad[i].text), err, sizeof err);
+		if (r == 0)
+			r = sim_config_finish(&cfg, err, sizeof err);
+		if (r == 0)
+			r = sim_init(&sim, &cfg, err, sizeof err);
+		if (r == 0 || !strstr(err, bad[i].why))
+			fail_msg("'%s': %d '%s', want '%s'", bad[i].text, r, err, bad[i].why);
+	}
+	/* [motor] keys given apply to every model; the rest stay each model's */
+	sim_config_defaults(&cfg);
+	assert_int_equal(sim_config_set(&cfg, "motor.viscous=0.01", err, sizeof err), 0);
+	assert_int_equal(sim_config_set(&cfg, "sim.voltage=11.1", err, sizeof err), 0);
+	struct sim_motor_params p;
+	sim_config_motor_params(&cfg, SIM_MODEL_XM430_W350, &p);
+	assert_float_equal(p.viscous, 0.01, 1e-12);
+	assert_float_equal(p.supply_voltage, 11.1, 1e-12);
+	assert_float_equal(p.stall_torque_12v, 4.1, 1e-12);
+	sim_config_motor_params(&cfg, SIM_MODEL_AX12A, &p);
+	assert_float_equal(p.stall_torque_12v, 1.5, 1e-12);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_models),
 		cmocka_unit_test(test_load_pair),
 		cmocka_unit_test(test_config_errors),
 		cmocka_unit_test(test_long_line),

@@ -5,12 +5,29 @@
  */
 #include <string.h>
 
+#include "dxl2.h"
+#include "dxl2_table.h"
 #include "dxl_table.h"
 #include "dxlt.h"
 #include "num.h"
 
 /* Baud register values the AX-12 manual lists; `--bauds all` tries these. */
 static const uint8_t dxlt_ax12_baud_regs[] = { 1, 3, 4, 7, 9, 16, 34, 103, 207 };
+/* The X series' baud register, factory rate (57600) first: 1, 3 (1 M), ... */
+static const uint8_t dxlt_x_baud_regs[] = { 1, 3, 2, 4, 5, 6, 7, 0 };
+
+size_t dxlt_bauds_for(int protocol, long *out, size_t cap)
+{
+	size_t n = 0;
+	if (protocol == 2) {
+		for (size_t i = 0; i < sizeof dxlt_x_baud_regs && n < cap; i++)
+			out[n++] = dxl2_baud_from_reg(dxlt_x_baud_regs[i]);
+	} else {
+		for (size_t i = 0; i < sizeof dxlt_ax12_baud_regs && n < cap; i++)
+			out[n++] = dxl_baud_from_reg(dxlt_ax12_baud_regs[i]);
+	}
+	return n;
+}
 
 int dxlt_parse_id(const char *s, bool allow_broadcast, uint8_t *id)
 {
@@ -53,8 +70,16 @@ int dxlt_parse_bauds(const char *s, long *out, size_t cap, size_t *n)
 	if (s == NULL || strlen(s) >= sizeof buf)
 		return -1;
 	if (strcmp(s, "all") == 0) {
-		for (size_t i = 0; i < sizeof dxlt_ax12_baud_regs && *n < cap; i++)
-			out[(*n)++] = dxl_baud_from_reg(dxlt_ax12_baud_regs[i]);
+		long x[DXLT_MAX_BAUDS];
+		*n = dxlt_bauds_for(1, out, cap);
+		size_t nx = dxlt_bauds_for(2, x, sizeof x / sizeof x[0]);
+		for (size_t i = 0; i < nx && *n < cap; i++) {
+			bool seen = false;
+			for (size_t k = 0; k < *n; k++)
+				seen = seen || out[k] == x[i];
+			if (!seen)
+				out[(*n)++] = x[i];
+		}
 		return 0;
 	}
 	strcpy(buf, s);
@@ -82,6 +107,7 @@ static const struct dxlt_opt dxlt_opts[] = {
 	{ "--yes", OPT_FLAG },         { "--ids", OPT_VALUE },     { "--bauds", OPT_VALUE },
 	{ "--status-level", OPT_VALUE }, { "--help", OPT_FLAG },   { "-h", OPT_FLAG },
 	{ "--rs485", OPT_VALUE },      { "--config", OPT_VALUE },  { "--cycles", OPT_VALUE },
+	{ "--protocol", OPT_VALUE },   { "--size", OPT_VALUE },    { "--keep", OPT_VALUE },
 };
 
 static const struct dxlt_opt *dxlt_find_opt(const char *arg, size_t len)
@@ -137,6 +163,23 @@ static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val
 	} else if (strcmp(name, "--bauds") == 0) {
 		if (dxlt_parse_bauds(val, a->bauds, DXLT_MAX_BAUDS, &a->nbauds) != 0)
 			return dxlt_bad(err, "bad baud list (want N,N,... or all) for", name, val);
+		a->bauds_all = strcmp(val, "all") == 0;
+	} else if (strcmp(name, "--protocol") == 0) {
+		if (val == NULL || (strcmp(val, "1") != 0 && strcmp(val, "2") != 0 && strcmp(val, "1.0") != 0 &&
+		                    strcmp(val, "2.0") != 0))
+			return dxlt_bad(err, "bad protocol (want 1 or 2) for", name, val);
+		a->protocol = val[0] - '0';
+	} else if (strcmp(name, "--size") == 0) {
+		if (val == NULL || (strcmp(val, "1") != 0 && strcmp(val, "2") != 0 && strcmp(val, "4") != 0))
+			return dxlt_bad(err, "bad register size (want 1, 2 or 4 bytes) for", name, val);
+		a->size = val[0] - '0';
+	} else if (strcmp(name, "--keep") == 0) {
+		if (val != NULL && strcmp(val, "id") == 0)
+			a->keep = DXL2_RESET_KEEP_ID;
+		else if (val != NULL && strcmp(val, "id-baud") == 0)
+			a->keep = DXL2_RESET_KEEP_ID_BAUD;
+		else
+			return dxlt_bad(err, "bad reset option (want id or id-baud) for", name, val);
 	} else if (strcmp(name, "--rs485") == 0) {
 		if (!port_rs485_parse(val, &a->rs485))
 			return dxlt_bad(err, "bad mode (want rts-on-send, rts or rts-after-send, or off) for", name, val);
@@ -164,6 +207,7 @@ static void dxlt_defaults(struct dxlt_args *a)
 	a->cycles = -1;
 	a->id_lo = 0;
 	a->id_hi = DXL_MAX_ID;
+	a->keep = DXL2_RESET_ALL;
 }
 
 int dxlt_parse_args(int argc, char **argv, struct dxlt_args *a, FILE *err)
@@ -211,17 +255,19 @@ int dxlt_parse_args(int argc, char **argv, struct dxlt_args *a, FILE *err)
 
 void dxlt_usage(FILE *f)
 {
-	fputs("usage: dxl --port PATH [--baud N] [--echo] [--rs485 MODE] [--latency-us N] [--timeout-ms N] "
-	      "COMMAND [ARGS]   (dxl --help for commands)\n", f);
+	fputs("usage: dxl --port PATH [--protocol 1|2] [--baud N] [--echo] [--rs485 MODE] [--latency-us N] "
+	      "[--timeout-ms N] COMMAND [ARGS]   (dxl --help for commands)\n", f);
 }
 
 void dxlt_help(FILE *f)
 {
-	fputs("dxl — talk to Dynamixel AX-12 servos (Protocol 1.0) on a serial bus\n\n", f);
+	fputs("dxl — talk to Dynamixel servos on a serial bus: AX-12 (Protocol 1.0), XL430-W250 and\n"
+	      "XM430-W350 (Protocol 2.0, --protocol 2)\n\n", f);
 	dxlt_usage(f);
 	fputs("\ncommands:\n"
 	      "  ports                      list serial ports with USB IDs, marking Dynamixel adapters\n"
-	      "  scan [--ids A-B] [--bauds LIST|all]   ping every ID (at every baud) and list servos\n"
+	      "  scan [--ids A-B] [--bauds LIST|all]   find servos at every baud, on both protocols\n"
+	      "                             unless --protocol says one; each line names its protocol\n"
 	      "  ping ID                    ping one servo: model, firmware, round-trip time\n"
 	      "  read ID REG [--units]      print a register's raw value (REG: name or address)\n"
 	      "  write ID REG VALUE         write a register (checked against the table first)\n"
@@ -229,7 +275,9 @@ void dxlt_help(FILE *f)
 	      "  set-id OLD NEW             change a servo's ID (refused if NEW answers)\n"
 	      "  set-baud ID BAUD           change a servo's baud rate (bps) and verify it\n"
 	      "  torque ID on|off           switch the motor torque\n"
-	      "  reset ID --yes             factory reset (ID becomes 1, baud 1 Mbps)\n"
+	      "  reset ID --yes [--keep id|id-baud]   factory reset (1.0: ID 1 at 1 Mbps; 2.0: ID 1\n"
+	      "                             at 57600 bps, or keeping the ID, or the ID and the baud)\n"
+	      "  reboot ID                  restart a servo (2.0 only): clears its hardware error\n"
 	      "  setup ID... [--status-level N] [--yes]   prepare servos and adapter for a 100 Hz\n"
 	      "                             loop (--yes: turn torque off first; the joint goes limp)\n"
 	      "  doctor [ID...] [--config FILE] [--cycles N]   the first-run hardware check: adapter,\n"
@@ -239,7 +287,10 @@ void dxlt_help(FILE *f)
 	      "                             (OK/WARN/FAIL) with its fix\n"
 	      "\noptions:\n"
 	      "  --port PATH        serial device or pty (e.g. /dev/ttyUSB0, /dev/serial/by-id/...)\n"
-	      "  --baud N           bus baud rate in bps (default 1000000)\n"
+	      "  --protocol 1|2     Dynamixel Protocol 1.0 (default; AX-12) or 2.0 (X series); registers\n"
+	      "                     are named by the model PING returns\n"
+	      "  --size 1|2|4       bytes at a raw address on a 2.0 model not in dxl's tables\n"
+	      "  --baud N           bus baud rate in bps (default 1000000; an X servo's factory rate is 57600)\n"
 	      "  --echo             single-wire wiring: discard our own bytes read back\n"
 	      "  --rs485 MODE       on-board UART with a half-duplex buffer on RTS: the kernel's RS-485\n"
 	      "                     mode, rts-on-send (or rts) or rts-after-send\n"

@@ -12,13 +12,14 @@
 #include <string.h>
 #include <time.h>
 
+#include "dxl2_table.h"
 #include "dxl_table.h"
 #include "dxlt_priv.h"
 #include "num.h"
 
 /* ---- helpers ------------------------------------------------------------------ */
 
-static void dxlt_sleep_us(long us)
+void dxlt_sleep_us(long us)
 {
 	struct timespec ts = { us / 1000000L, (us % 1000000L) * 1000L };
 
@@ -55,7 +56,7 @@ void dxlt_apply_timing(struct dxlt *t)
 	bus_set_timing(&t->bus, &timing);
 }
 
-static int dxlt_set_baud(struct dxlt *t, long baud)
+int dxlt_set_baud(struct dxlt *t, long baud)
 {
 	if (port_set_baud(t->port, baud) != DXL_OK) {
 		fprintf(t->err, "dxl: cannot set %s to %ld bps\n", port_path(t->port), baud);
@@ -101,7 +102,10 @@ int dxlt_ping(struct dxlt *t, uint8_t id)
 	uint8_t e = 0;
 	int r = bus_ping(&t->bus, id, &e);
 
-	if (r == DXL_OK)
+	/* on a 2.0 bus the byte is the ERR field: kept apart, named apart */
+	if (r == DXL_OK && bus_get_protocol(&t->bus) == BUS_PROTOCOL_2)
+		t->errseen2[id] |= e;
+	else if (r == DXL_OK)
 		t->errseen[id] |= e;
 	return r;
 }
@@ -127,8 +131,9 @@ static int dxlt_write(struct dxlt *t, uint8_t id, uint8_t addr, const uint8_t *d
 	return r;
 }
 
-/* One line per servo whose replies carried error bits; exit 5 unless the
- * command already failed in a way that says more (a lost bus, bad usage). */
+/* One line per servo whose replies carried error bits (1.0) or a non-zero
+ * ERR field (2.0); exit 5 unless the command already failed in a way that
+ * says more (a lost bus, bad usage). */
 static int dxlt_report_errbits(struct dxlt *t, int rc)
 {
 	char names[128];
@@ -141,6 +146,15 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 		        dxl_errbits_format(t->errseen[id], names, sizeof names));
 		any = true;
 	}
+	for (size_t id = 0; id < sizeof t->errseen2; id++) {
+		if (t->errseen2[id] == 0)
+			continue;
+		fprintf(t->err, "dxl: ID %zu reports error 0x%02X: %s%s\n", id, t->errseen2[id],
+		        dxl2_err_format(t->errseen2[id], names, sizeof names),
+		        dxl2_err_alert(t->errseen2[id]) ? " (the alert bit: a hardware error; see dxl --protocol 2 "
+		        "read ID hardware_error_status --units, and reboot ID to clear it)" : "");
+		any = true;
+	}
 	if (!any)
 		return rc;
 	if (t->hint[0] != '\0')
@@ -148,7 +162,7 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 	return rc == DXLT_EXIT_OK ? DXLT_EXIT_SERVO : rc;
 }
 
-static int dxlt_need_args(struct dxlt *t, int n, const char *form)
+int dxlt_need_args(struct dxlt *t, int n, const char *form)
 {
 	if (t->a.npos == n)
 		return DXLT_EXIT_OK;
@@ -156,7 +170,7 @@ static int dxlt_need_args(struct dxlt *t, int n, const char *form)
 	return DXLT_EXIT_USAGE;
 }
 
-static int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id)
+int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id)
 {
 	if (dxlt_parse_id(s, allow_broadcast, id) == 0)
 		return DXLT_EXIT_OK;
@@ -246,38 +260,75 @@ static void dxlt_print_identity(struct dxlt *t, uint8_t id, long baud)
 		fprintf(t->out, "%-9u ", fw);
 	else
 		fprintf(t->out, "%-9s ", "?");
-	fprintf(t->out, "%ld\n", baud);
+	fprintf(t->out, "%-8ld 1.0\n", baud);
+}
+
+/* Protocol 1.0 at one rate: a unicast PING to every ID (a broadcast PING
+ * makes every AX-12 answer at once). */
+static int dxlt_scan1_at(struct dxlt *t, long baud, unsigned *found)
+{
+	for (unsigned id = t->a.id_lo; id <= t->a.id_hi; id++) {
+		int r = dxlt_ping(t, (uint8_t)id);
+		if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
+			return dxlt_bus_fail(t, (uint8_t)id, r);
+		if (r != DXL_OK)
+			continue;
+		(*found)++;
+		dxlt_print_identity(t, (uint8_t)id, baud);
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* The rates one protocol is scanned at: `--bauds all` gives each its own
+ * list; a list given keeps the rates that protocol's servos can run at
+ * (within 3 %); without one, --baud. */
+static size_t dxlt_scan_bauds(const struct dxlt *t, int protocol, long *out, size_t cap)
+{
+	size_t n = 0;
+	uint8_t reg;
+
+	if (t->a.bauds_all)
+		return dxlt_bauds_for(protocol, out, cap);
+	if (t->a.nbauds == 0) {
+		out[0] = t->a.baud;
+		return 1;
+	}
+	for (size_t i = 0; i < t->a.nbauds && n < cap; i++) {
+		long b = t->a.bauds[i];
+		if (protocol == 2 ? dxl2_baud_to_reg(b, &reg) == DXL_OK : dxl_baud_to_reg(b, &reg) == DXL_OK)
+			out[n++] = b;
+	}
+	return n;
 }
 
 static int dxlt_cmd_scan(struct dxlt *t)
 {
-	long own = t->a.baud;
-	const long *bauds = t->a.nbauds > 0 ? t->a.bauds : &own;
-	size_t nbauds = t->a.nbauds > 0 ? t->a.nbauds : 1;
 	unsigned found = 0;
+	size_t tried = 0;
 	int rc;
 
 	if (t->a.npos != 0)
 		return dxlt_need_args(t, 0, "scan [--ids A-B] [--bauds LIST|all]");
-	fprintf(t->out, "%-4s %-6s %-13s %-9s %s\n", "ID", "MODEL", "NAME", "FIRMWARE", "BAUD");
-	for (size_t b = 0; b < nbauds; b++) {
-		if ((rc = dxlt_set_baud(t, bauds[b])) != DXLT_EXIT_OK)
-			return rc;
-		/* Unicast PING: a broadcast PING makes every servo answer at once. */
-		for (unsigned id = t->a.id_lo; id <= t->a.id_hi; id++) {
-			int r = dxlt_ping(t, (uint8_t)id);
-			if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
-				return dxlt_bus_fail(t, (uint8_t)id, r);
-			if (r != DXL_OK)
-				continue;
-			found++;
-			dxlt_print_identity(t, (uint8_t)id, bauds[b]);
+	fprintf(t->out, "%-4s %-6s %-13s %-9s %-8s %s\n", "ID", "MODEL", "NAME", "FIRMWARE", "BAUD", "PROTOCOL");
+	for (int protocol = 1; protocol <= 2; protocol++) {
+		long bauds[DXLT_MAX_BAUDS];
+		if (t->a.protocol != 0 && t->a.protocol != protocol)
+			continue;
+		size_t nbauds = dxlt_scan_bauds(t, protocol, bauds, DXLT_MAX_BAUDS);
+		bus_set_protocol(&t->bus, protocol == 2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1);
+		for (size_t b = 0; b < nbauds; b++, tried++) {
+			if ((rc = dxlt_set_baud(t, bauds[b])) != DXLT_EXIT_OK)
+				return rc;
+			rc = protocol == 2 ? dxlt2_scan_at(t, bauds[b], &found) : dxlt_scan1_at(t, bauds[b], &found);
+			if (rc != DXLT_EXIT_OK)
+				return rc;
+			fflush(t->out);
 		}
-		fflush(t->out);
 	}
 	if (found == 0) {
-		fprintf(t->err, "dxl: no servo answered on %s (IDs %u-%u at %zu baud rate%s)%s\n",
-		        port_path(t->port), t->a.id_lo, t->a.id_hi, nbauds, nbauds == 1 ? "" : "s",
+		fprintf(t->err, "dxl: no servo answered on %s (IDs %u-%u, %zu baud rate%s on %s)%s\n",
+		        port_path(t->port), t->a.id_lo, t->a.id_hi, tried, tried == 1 ? "" : "s",
+		        t->a.protocol == 1 ? "Protocol 1.0" : t->a.protocol == 2 ? "Protocol 2.0" : "Protocols 1.0 and 2.0",
 		        t->a.nbauds == 0 ? "; try --bauds all" : "");
 		return DXLT_EXIT_BUS;
 	}
@@ -760,18 +811,29 @@ static int dxlt_cmd_setup(struct dxlt *t)
 	return worst;
 }
 
+/* REBOOT is Protocol 2.0's (and the MX series'): the AX-12 has none. */
+static int dxlt_cmd_reboot(struct dxlt *t)
+{
+	fprintf(t->err, "dxl: the AX-12 has no REBOOT (Protocol 1.0): power-cycle it; an X-series servo: "
+	        "dxl --protocol 2 --port %s reboot ID\n", port_path(t->port));
+	return DXLT_EXIT_USAGE;
+}
+
 /* ---- main --------------------------------------------------------------------- */
 
 struct dxlt_command {
 	const char *name;
-	int (*run)(struct dxlt *t);
+	int (*run)(struct dxlt *t);    /* Protocol 1.0 */
+	int (*run2)(struct dxlt *t);   /* Protocol 2.0 */
 };
 
 static const struct dxlt_command dxlt_commands[] = {
-	{ "scan", dxlt_cmd_scan },       { "ping", dxlt_cmd_ping },       { "read", dxlt_cmd_read },
-	{ "write", dxlt_cmd_write },     { "dump", dxlt_cmd_dump },       { "set-id", dxlt_cmd_set_id },
-	{ "set-baud", dxlt_cmd_set_baud }, { "torque", dxlt_cmd_torque }, { "reset", dxlt_cmd_reset },
-	{ "setup", dxlt_cmd_setup },
+	{ "scan", dxlt_cmd_scan, dxlt_cmd_scan },         { "ping", dxlt_cmd_ping, dxlt2_cmd_ping },
+	{ "read", dxlt_cmd_read, dxlt2_cmd_read },        { "write", dxlt_cmd_write, dxlt2_cmd_write },
+	{ "dump", dxlt_cmd_dump, dxlt2_cmd_dump },        { "set-id", dxlt_cmd_set_id, dxlt2_cmd_set_id },
+	{ "set-baud", dxlt_cmd_set_baud, dxlt2_cmd_set_baud }, { "torque", dxlt_cmd_torque, dxlt2_cmd_torque },
+	{ "reset", dxlt_cmd_reset, dxlt2_cmd_reset },     { "setup", dxlt_cmd_setup, dxlt2_cmd_setup },
+	{ "reboot", dxlt_cmd_reboot, dxlt2_cmd_reboot },
 };
 
 int dxlt_open(struct dxlt *t, const char *path, bool low_latency)
@@ -799,6 +861,7 @@ int dxlt_open(struct dxlt *t, const char *path, bool low_latency)
 		port_latency_check_fd(path, port_fd(t->port), false, &t->latency);
 	port_bus_io(t->port, &io);
 	bus_init(&t->bus, &io, NULL, t->a.echo);
+	bus_set_protocol(&t->bus, t->a.protocol == 2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1);
 	dxlt_apply_timing(t);
 	return DXLT_EXIT_OK;
 }
@@ -828,7 +891,7 @@ static int dxlt_dispatch(struct dxlt *t)
 		int rc = dxlt_open(t, t->a.port_path, false);
 		if (rc != DXLT_EXIT_OK)
 			return rc;
-		return dxlt_report_errbits(t, dxlt_commands[i].run(t));
+		return dxlt_report_errbits(t, t->a.protocol == 2 ? dxlt_commands[i].run2(t) : dxlt_commands[i].run(t));
 	}
 	fprintf(t->err, "dxl: unknown command '%s'\n", t->a.command);
 	dxlt_usage(t->err);

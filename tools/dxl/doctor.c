@@ -35,6 +35,7 @@
 #include "daemon/setup.h"
 #include "doctor.h"
 #include "dxl.h"
+#include "dxl2_table.h"
 #include "dxl_table.h"
 #include "dxlt_priv.h"
 
@@ -60,6 +61,7 @@ struct dr {
 	struct cfg cfg;
 	char source[CFG_PATH_MAX + 32];      /* where the robot came from, for the header */
 	struct dr_servo servo[CFG_MAX_JOINTS];
+	struct dr2_servo servo2[CFG_MAX_JOINTS];   /* Protocol 2.0: what each servo's table holds */
 	char setup_ids[CFG_MAX_JOINTS * 4 + 1];
 	struct dr_context ctx;
 	unsigned count[DR_SKIP + 1];
@@ -231,7 +233,8 @@ static int dr_find(struct dr *d, unsigned *answered)
 		int r = DXL_E_TIMEOUT;
 		s->id = d->cfg.ids[j];
 		for (int k = 0; k < DR_PING_TRIES && r != DXL_OK; k++) {
-			r = dxlt_ping(d->t, s->id);
+			/* on 2.0 the PING says the model: the baud line prices its cycle */
+			r = d->t->a.protocol == 2 ? dxlt2_ping(d->t, s->id, &d->servo2[j].model, NULL) : dxlt_ping(d->t, s->id);
 			if (dr_gone(r))
 				return dxlt_bus_fail(d->t, s->id, r);
 		}
@@ -254,7 +257,9 @@ static int dr_latency(struct dr *d)
 	if (first != NULL) {
 		/* its own return delay is no adapter's doing: read it first */
 		uint8_t rd = 0;
-		if (dxlt_read(d->t, first->id, DXL_AX_RETURN_DELAY_TIME, 1, &rd) != DXL_OK)
+		int rr = d->t->a.protocol == 2 ? dxlt2_read(d->t, first->id, DXL2_X_RETURN_DELAY_TIME, 1, &rd)
+		                               : dxlt_read(d->t, first->id, DXL_AX_RETURN_DELAY_TIME, 1, &rd);
+		if (rr != DXL_OK)
 			rd = 0;
 		int r = bus_reply_lateness(&d->t->bus, first->id, dxl_return_delay_us(rd), DR_LATENESS_PINGS, &l.late);
 		if (dr_gone(r))
@@ -313,7 +318,8 @@ static void dr_context(struct dr *d)
 	size_t off = 0;
 	d->setup_ids[0] = '\0';
 	d->ctx = (struct dr_context){ .port = d->cfg.port, .ids = d->setup_ids, .baud = d->cfg.baud,
-	                              .period_ms = d->cfg.period_ms };
+	                              .period_ms = d->cfg.period_ms, .protocol = d->t->a.protocol == 2 ? 2 : 1,
+	                              .read_len2 = DR2_READ_LEN };
 	for (size_t j = 0; j < d->cfg.njoints; j++) {
 		const struct dr_servo *s = &d->servo[j];
 		if (!s->answered)
@@ -321,7 +327,11 @@ static void dr_context(struct dr *d)
 		int w = snprintf(d->setup_ids + off, sizeof d->setup_ids - off, "%s%u", off ? " " : "", s->id);
 		if (w > 0 && (size_t)w < sizeof d->setup_ids - off)
 			off += (size_t)w;
-		d->ctx.any_torque_on = d->ctx.any_torque_on || (s->read && s->torque_enable);
+		d->ctx.any_torque_on = d->ctx.any_torque_on || (s->read && s->torque_enable) ||
+		                       (s->read && d->ctx.protocol == 2 && d->servo2[j].torque_enable);
+		/* the loop's SYNC_READ takes the present current too where there is one */
+		if (d->ctx.protocol == 2 && d->servo2[j].model == DXL2_MODEL_XM430_W350)
+			d->ctx.read_len2 = DR2_READ_LEN_CURRENT;
 	}
 }
 
@@ -737,6 +747,99 @@ out:
 	return rc;
 }
 
+/* ---- Protocol 2.0: the checks that need no cycle ------------------------------------------------ */
+
+/* One READ of the table's first DR2_IMAGE_LEN bytes per servo that answered. */
+static int dr2_read_all(struct dr *d, int *status)
+{
+	for (size_t j = 0; j < d->cfg.njoints; j++) {
+		struct dr_servo *s = &d->servo[j];
+		uint8_t mem[DR2_IMAGE_LEN];
+		int r = DXL_E_TIMEOUT;
+		status[j] = DXL_OK;
+		if (!s->answered)
+			continue;
+		for (int k = 0; k < DR_READ_TRIES && r != DXL_OK && !dr_gone(r); k++)
+			r = dxlt2_read(d->t, s->id, 0, sizeof mem, mem);
+		if (dr_gone(r))
+			return dxlt_bus_fail(d->t, s->id, r);
+		status[j] = r;
+		if (r != DXL_OK)
+			continue;
+		dr2_servo_decode(&d->servo2[j], mem);
+		d->servo2[j].id = s->id;
+		d->servo2[j].err = d->t->errseen2[s->id];
+		s->read = true;
+	}
+	return DXLT_EXIT_OK;
+}
+
+static void dr2_servo_lines(struct dr *d, size_t j, int read_status)
+{
+	const struct dr2_servo *s = &d->servo2[j];
+	struct dr_verdict v = { DR_FAIL, "" };
+
+	if (!d->servo[j].read) {
+		if (read_status == DXL_E_TIMEOUT)
+			snprintf(v.text, sizeof v.text, "answers PING but not READ: status return level 0, and the loop's "
+			         "SYNC_READ needs 1 or 2; fix: dxl --protocol 2 --port %s write %u status_return_level 2",
+			         d->cfg.port, d->servo[j].id);
+		else
+			snprintf(v.text, sizeof v.text, "answers PING, but its READ replies are bad (%s)%s",
+			         dxl_strerror(read_status), d->t->a.echo ? "" : "; a single-wire wiring? try --echo");
+		dr_servo_line(d, d->servo[j].id, "status level", &v);
+		return;
+	}
+	dr2_check_model(s, &d->ctx, &v);
+	dr_servo_line(d, s->id, "model", &v);
+	dr2_check_return_delay(s, &d->ctx, &v);
+	dr_servo_line(d, s->id, "return delay", &v);
+	dr2_check_status_level(s, &d->ctx, &v);
+	dr_servo_line(d, s->id, "status level", &v);
+	dr2_check_voltage(s, &v);
+	dr_servo_line(d, s->id, "voltage", &v);
+	dr2_check_temperature(s, &v);
+	dr_servo_line(d, s->id, "temperature", &v);
+	dr2_check_mode(s, &d->ctx, &v);
+	dr_servo_line(d, s->id, "operating mode", &v);
+	dr2_check_limits(s, &d->cfg, j, &d->ctx, &v);
+	dr_servo_line(d, s->id, "position limits", &v);
+	dr2_check_hwerr(s, &d->ctx, &v);
+	dr_servo_line(d, s->id, "hardware error", &v);
+	dr2_check_torque(s, &v);
+	dr_servo_line(d, s->id, "torque", &v);
+	dr2_check_watchdog(s, &d->ctx, &v);
+	dr_servo_line(d, s->id, "bus watchdog", &v);
+	if (dr2_check_err(s, &v))
+		dr_servo_line(d, s->id, "error field", &v);
+}
+
+/* The servos' lines on 2.0, and the budget said plainly not timed: the
+ * timed cycles are undulated's own (daemon/cycle.c), which speaks 1.0. */
+static int dr2_check_servos(struct dr *d)
+{
+	struct dr_verdict v;
+	int rc, status[CFG_MAX_JOINTS];
+
+	if ((rc = dr2_read_all(d, status)) != DXLT_EXIT_OK)
+		return rc;
+	dr_context(d);
+	for (size_t j = 0; j < d->cfg.njoints; j++)
+		if (d->servo[j].answered)
+			dr2_servo_lines(d, j, status[j]);
+		else
+			dr_servo_lines(d, j, status[j]);
+	if (dr_check_echo(d->t->a.echo, d->t->bus.unexpected_echoes, d->t->bus.echo_errors, &v))
+		dr_line(d, "echo", &v);
+	double floor_ms = 1e-3 * dr2_cycle_wire_us((unsigned)d->cfg.njoints, d->ctx.read_len2, d->cfg.baud);
+	v.level = DR_SKIP;
+	snprintf(v.text, sizeof v.text, "not timed: undulated's cycle speaks Protocol 1.0 only so far, and the timed "
+	         "check runs that cycle; the 2.0 cycle's wire floor here would be %.2f ms (one SYNC_READ, one "
+	         "SYNC_WRITE for %zu servo(s))", floor_ms, d->cfg.njoints);
+	dr_line(d, "budget", &v);
+	return DXLT_EXIT_OK;
+}
+
 /* ---- the command --------------------------------------------------------------------------------- */
 
 static int dr_check(struct dr *d)
@@ -764,6 +867,8 @@ static int dr_check(struct dr *d)
 	dr_context(d);
 	dr_check_baud(&d->ctx, (unsigned)d->cfg.njoints, answered, &v);
 	dr_line(d, "baud", &v);
+	if (t->a.protocol == 2)
+		return dr2_check_servos(d);
 	if ((rc = dr_read_all(d, status)) != DXLT_EXIT_OK)
 		return rc;
 	dr_context(d);

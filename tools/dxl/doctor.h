@@ -67,6 +67,8 @@ struct dr_context {
 	bool any_torque_on;          /* a servo had torque on (setup --yes makes it limp) */
 	long baud;
 	double period_ms;
+	int protocol;                /* 1 or 2: which cycle the baud line prices */
+	unsigned read_len2;          /* 2.0: the SYNC_READ's bytes a servo (DR2_READ_LEN...) */
 };
 
 /* ---- the bus ------------------------------------------------------------------------ */
@@ -108,6 +110,14 @@ bool dr_check_echo(bool echo, uint32_t unexpected_echoes, uint32_t echo_errors, 
 /* The wire time of one cycle of undulated's for n servos at baud: a READ of
  * 8 bytes (answered by 14) per servo and a SYNC_WRITE of the goals, in µs. */
 double dr_cycle_wire_us(unsigned nservos, long baud);
+/* Protocol 2.0's cycle (the X series): one SYNC_READ of read_len bytes from
+ * every servo — present velocity and position (128, 8 bytes), with the
+ * present current before them on the XM430 (126, 10 bytes) — and one
+ * SYNC_WRITE of 4-byte goal positions: (14 + N) + N·(11 + read_len) +
+ * (14 + 5·N) bytes, stuffing not counted (the floor). In µs. */
+#define DR2_READ_LEN 8
+#define DR2_READ_LEN_CURRENT 10
+double dr2_cycle_wire_us(unsigned nservos, unsigned read_len, long baud);
 void dr_check_baud(const struct dr_context *c, unsigned asked, unsigned answered, struct dr_verdict *v);
 
 /* ---- each servo ------------------------------------------------------------------------ */
@@ -137,6 +147,48 @@ void dr_check_alarms(const struct dr_servo *s, const struct dr_context *c, struc
 void dr_check_torque(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
 /* False (no line) when its replies carried no error bit. */
 bool dr_check_errbits(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
+
+/* ---- each servo, Protocol 2.0 (doctor_checks2.c) -------------------------------------------
+ * One READ of addresses 0..147 (model number .. present temperature) per servo. */
+#define DR2_IMAGE_LEN 148
+struct dr2_servo {
+	uint8_t id;
+	uint16_t model;
+	uint8_t firmware;
+	uint8_t return_delay;        /* 2 us a unit */
+	uint8_t operating_mode;
+	uint8_t temperature_limit, temperature;   /* °C */
+	uint16_t max_voltage, min_voltage, voltage;   /* 0.1 V */
+	int32_t max_position, min_position;
+	uint8_t shutdown;            /* hardware error bits that switch torque off */
+	uint8_t torque_enable;
+	uint8_t status_return_level;
+	uint8_t hwerr;               /* Hardware Error Status (70) */
+	uint8_t bus_watchdog;        /* 20 ms a unit; 0 off; 255 (-1): it fired */
+	uint8_t err;                 /* OR of the ERR fields of its replies */
+};
+void dr2_servo_decode(struct dr2_servo *s, const uint8_t mem[DR2_IMAGE_LEN]);
+/* The supply each model is made for (e-manual, "Specifications"): the
+ * XL430-W250 6.5..12.0 V (recommended 11.1 V), the XM430-W350 10.0..14.8 V
+ * (recommended 12.0 V). False for a model not in the tables. */
+bool dr2_model_volts(uint16_t model, double *lo, double *rec, double *hi);
+void dr2_check_model(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
+void dr2_check_return_delay(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
+void dr2_check_status_level(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
+void dr2_check_voltage(const struct dr2_servo *s, struct dr_verdict *v);
+void dr2_check_temperature(const struct dr2_servo *s, struct dr_verdict *v);
+/* Operating mode 3 (position): the servo holds its limits and takes goal positions. */
+void dr2_check_mode(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
+/* Position limits (52, 48) against the configured joint's, in the X
+ * series' 4096 a turn. */
+void dr2_check_limits(const struct dr2_servo *s, const struct cfg *cfg, size_t joint, const struct dr_context *c,
+                      struct dr_verdict *v);
+void dr2_check_hwerr(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
+void dr2_check_torque(const struct dr2_servo *s, struct dr_verdict *v);
+/* A watchdog shorter than two periods fires at the first late cycle. */
+void dr2_check_watchdog(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
+/* False (no line) when its replies carried no ERR field. */
+bool dr2_check_err(const struct dr2_servo *s, struct dr_verdict *v);
 
 /* ---- undulated's cycle, timed ------------------------------------------------------------- */
 struct dr_budget {

@@ -169,6 +169,13 @@ double dr_cycle_wire_us(unsigned nservos, long baud)
 	return baud > 0 ? bytes * 10.0 * 1e6 / (double)baud : 0.0;
 }
 
+double dr2_cycle_wire_us(unsigned nservos, unsigned read_len, long baud)
+{
+	double n = nservos;
+	double bytes = nservos > 0 ? (14.0 + n) + n * (11.0 + read_len) + (14.0 + 5.0 * n) : 0.0;
+	return baud > 0 ? bytes * 10.0 * 1e6 / (double)baud : 0.0;
+}
+
 void dr_check_baud(const struct dr_context *c, unsigned asked, unsigned answered, struct dr_verdict *v)
 {
 	if (answered == 0) {
@@ -177,11 +184,20 @@ void dr_check_baud(const struct dr_context *c, unsigned asked, unsigned answered
 		       "rs485 or echo, README \"On a robot\")", c->baud, asked, c->port);
 		return;
 	}
-	double wire_ms = 1e-3 * dr_cycle_wire_us(answered, c->baud);
+	bool p2 = c->protocol == 2;
+	double wire_ms = 1e-3 * (p2 ? dr2_cycle_wire_us(answered, c->read_len2, c->baud) : dr_cycle_wire_us(answered, c->baud));
+	if (p2 && wire_ms > c->period_ms) {
+		dr_set(v, DR_FAIL, "%ld bps: one cycle's bytes for %u servo(s) (a SYNC_READ, a SYNC_WRITE) take %.2f ms on "
+		       "the wire, more than the %g ms period; fix: dxl --protocol 2 --port %s setup %s (raises every servo "
+		       "to 1000000 bps) and baud = 1000000 in [robot]", c->baud, answered, wire_ms, c->period_ms, c->port,
+		       c->ids);
+		return;
+	}
 	if (wire_ms > 0.5 * c->period_ms) {
 		dr_set(v, DR_WARN, "%ld bps: one cycle's bytes for %u servo(s) take %.2f ms on the wire, more than half "
-		       "the %g ms period; fix: a faster rate for every servo (dxl --port %s set-baud ID 1000000) and "
-		       "baud = 1000000 in [robot]", c->baud, answered, wire_ms, c->period_ms, c->port);
+		       "the %g ms period; fix: a faster rate for every servo (dxl %s--port %s set-baud ID 1000000) and "
+		       "baud = 1000000 in [robot]", c->baud, answered, wire_ms, c->period_ms, p2 ? "--protocol 2 " : "",
+		       c->port);
 		return;
 	}
 	dr_set(v, DR_OK, "%ld bps: %u of %u servo(s) answered; one cycle's bytes take %.2f ms on the wire", c->baud,

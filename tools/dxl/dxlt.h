@@ -27,10 +27,12 @@ enum dxlt_exit {
 
 /* Most IDs/bauds a command takes on its command line. */
 #define DXLT_MAX_IDS   (DXL_MAX_ID + 1)
-#define DXLT_MAX_BAUDS 16
-/* Largest rate a command line may name, bps: twice the AX-12's own top rate
- * (2 Mbps, baud register 0), so a typo's extra digit is caught here. */
-#define DXLT_MAX_BAUD 4000000L
+#define DXLT_MAX_BAUDS 24
+/* Largest rate a command line may name, bps: the X series' top rate (4.5
+ * Mbps, baud register 7), so a typo's extra digit is caught here. */
+#define DXLT_MAX_BAUD 4500000L
+/* The X series' factory rate (Protocol 2.0). */
+#define DXLT_DEFAULT_BAUD2 57600L
 /* The AX-12 factory rate. */
 #define DXLT_DEFAULT_BAUD 1000000L
 /* Scheduling slack on top of the derived reply timeout (ms): the tool is
@@ -48,6 +50,9 @@ enum dxlt_exit {
 
 struct dxlt_args {
 	const char *port_path;
+	int protocol;            /* --protocol 1|2; 0: not given (1, and scan tries both) */
+	int size;                /* --size 1|2|4: a raw address's bytes on a model not in our tables; 0: 1 */
+	int keep;                /* --keep for a 2.0 reset: DXL2_RESET_ALL (default), _KEEP_ID, _KEEP_ID_BAUD */
 	long baud;               /* --baud, bps */
 	bool baud_given;         /* --baud was on the command line (doctor: over the configuration's) */
 	bool echo;               /* --echo: single-wire wiring, our bytes come back */
@@ -64,6 +69,7 @@ struct dxlt_args {
 	long cycles;             /* --cycles N (doctor); -1: DXLT_DOCTOR_CYCLES */
 	long bauds[DXLT_MAX_BAUDS];
 	size_t nbauds;           /* --bauds LIST; 0: just --baud */
+	bool bauds_all;          /* --bauds all: each protocol its own rates */
 	bool help;
 	const char *command;
 	char **pos;              /* the command's positional arguments */
@@ -74,8 +80,12 @@ struct dxlt_args {
  * are read by num_parse_long (common/num.h): decimal or 0x hex, never octal. */
 int dxlt_parse_id(const char *s, bool allow_broadcast, uint8_t *id);
 int dxlt_parse_id_range(const char *s, uint8_t *lo, uint8_t *hi);
-/* "1000000,57600", or "all" for every AX-12 rate the register can name. */
+/* "1000000,57600", or "all" for every rate either protocol's servos can
+ * run at: the AX-12 manual's list, then the X series' (dxlt_bauds_for). */
 int dxlt_parse_bauds(const char *s, long *out, size_t cap, size_t *n);
+/* The rates `--bauds all` tries on one protocol (1: the AX-12's, 2: the X
+ * series'). Returns how many were written (at most cap). */
+size_t dxlt_bauds_for(int protocol, long *out, size_t cap);
 
 /* Parse argv (options may come before or after the command). On failure
  * writes one line to err and returns DXLT_EXIT_USAGE. */

@@ -21,6 +21,8 @@ struct dxlt {
 	/* Error bits any reply carried, per ID: the servo's news, reported once
 	 * when the command ends (dxlt_report_errbits), whichever call saw them. */
 	uint8_t errseen[DXL_BROADCAST_ID + 1];
+	/* Protocol 2.0: the ERR fields (alert bit, error number), per ID. */
+	uint8_t errseen2[DXL2_BROADCAST_ID + 1];
 	char hint[200];          /* what to do about them, when we know */
 };
 
@@ -38,6 +40,28 @@ int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status);
 int dxlt_ping(struct dxlt *t, uint8_t id);
 int dxlt_read(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out);
 const char *dxlt_model_name(uint16_t model);
+/* Switch the port (and the reply timeouts) to baud. */
+int dxlt_set_baud(struct dxlt *t, long baud);
+void dxlt_sleep_us(long us);
+/* The command's positional count, or a usage line (form) and exit 2. */
+int dxlt_need_args(struct dxlt *t, int n, const char *form);
+int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id);
+
+/* ---- Protocol 2.0 (commands2.c) ---- */
+/* Broadcast PING at the current rate: one scan line per servo in the ID range. */
+int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found);
+int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware);
+int dxlt2_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out);
+int dxlt2_cmd_ping(struct dxlt *t);
+int dxlt2_cmd_read(struct dxlt *t);
+int dxlt2_cmd_write(struct dxlt *t);
+int dxlt2_cmd_dump(struct dxlt *t);
+int dxlt2_cmd_set_id(struct dxlt *t);
+int dxlt2_cmd_set_baud(struct dxlt *t);
+int dxlt2_cmd_torque(struct dxlt *t);
+int dxlt2_cmd_reset(struct dxlt *t);
+int dxlt2_cmd_reboot(struct dxlt *t);
+int dxlt2_cmd_setup(struct dxlt *t);
 
 /* `dxl doctor` (doctor.c): opens the port itself, after reading the
  * configuration that may name it. */

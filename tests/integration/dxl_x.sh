@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# dxl_x — `dxl` on Protocol 2.0 against the simulated X-series servos
+# (`undulate-sim --model xl430-w250|xm430-w350`): scan names the protocol and
+# model, registers go by the model's names with units, writes are checked
+# against the servo's limits and torque first, setup prepares the bus for
+# 100 Hz, reboot restarts a servo, doctor runs its checks and says the timed
+# cycles are not available on 2.0 yet. Until the simulator has --model the
+# whole script is skipped (its plan line says why).
+. "$(dirname "$0")/../lib.sh"
+
+dxl="$B/dxl"
+sim="$B/undulate-sim"
+url=$(lcm_url 7640)
+
+if [ ! -x "$dxl" ] || [ ! -x "$sim" ]; then
+	tap_fail "dxl and undulate-sim are built" "missing $dxl or $sim"
+	tap_done; exit
+fi
+if "$sim" --model xl430-w250 --help 2>&1 | grep -q "unrecognized option '--model'"; then
+	echo "1..0 # SKIP undulate-sim has no --model yet"
+	exit 0
+fi
+
+# Replies get 100 ms: the simulator is a process a loaded machine may not
+# schedule within the tool's default 5 ms of slack.
+run() {
+	local name=$1; shift
+	rc=0
+	timeout 60 "$dxl" --timeout-ms 100 --protocol 2 "$@" >"$T/$name.out" 2>"$T/$name.err" || rc=$?
+}
+says() { grep -qE -- "$2" "$T/$1.out" "$T/$1.err"; }
+check() {   # check NAME CONDITION...: ok, or the command's output as the reason
+	local name=$1 out=$2; shift 2
+	if "$@"; then tap_ok "$name"; else tap_fail "$name" "rc=$rc $(cat "$T/$out.out" "$T/$out.err")"; fi
+}
+
+xl="$T/xl"
+spawn simxl "$sim" --model xl430-w250 --link "$xl" --ids 1,2 --baud 1000000 --lcm-url "$url" --quiet
+if wait_log simxl 'ready' 10; then tap_ok "XL430-W250 simulator ready"; else tap_fail "XL430-W250 simulator ready" "$(cat "$T/simxl.log")"; tap_done; exit; fi
+
+# Both protocols at every rate: the two X servos, each line saying 2.0.
+timeout 120 "$dxl" --timeout-ms 100 --port "$xl" scan --bauds all --ids 0-5 >"$T/scan.out" 2>"$T/scan.err"; rc=$?
+found=$(grep -cE '^[12] +1060 +XL430-W250 +[0-9]+ +[0-9]+ +2\.0$' "$T/scan.out")
+check "scan finds IDs 1 and 2 as XL430-W250 on Protocol 2.0, nothing on 1.0" scan \
+	test "$rc" -eq 0 -a "$found" = 2 -a "$(grep -c ' 1\.0$' "$T/scan.out")" = 0
+baud=$(awk '$1 == 1 && $NF == "2.0" { print $5; exit }' "$T/scan.out")
+baud=${baud:-1000000}
+
+run ping --port "$xl" --baud "$baud" ping 1
+check "ping: model 1060 (XL430-W250), Protocol 2.0" ping says ping 'model 1060 \(XL430-W250\), firmware [0-9]+, Protocol 2\.0'
+
+run model --port "$xl" --baud "$baud" read 1 model_number
+run volts --port "$xl" --baud "$baud" read 2 present_input_voltage --units
+check "read by name: model_number 1060, voltage in volts" volts \
+	test "$(cat "$T/model.out")" = 1060 -a "$rc" -eq 0 -a -n "$(grep -E '^[0-9]+ \([0-9]+\.[0-9] V\)$' "$T/volts.out")"
+
+run setup --port "$xl" --baud "$baud" setup 1 2 --yes
+run rd1 --port "$xl" --baud 1000000 read 1 return_delay_time
+run rd2 --port "$xl" --baud 1000000 read 2 return_delay_time
+check "setup: return delay 0 on both, the bus at 1 Mbps, the cycle priced" setup \
+	test "$(cat "$T/rd1.out")" = 0 -a "$(cat "$T/rd2.out")" = 0 -a -n "$(grep '^bus time per cycle for 2 servos at 1000000 bps' "$T/setup.out")"
+
+run torque --port "$xl" --baud 1000000 torque 1 on
+run goal --port "$xl" --baud 1000000 write 1 goal_position 2600
+at_goal() { run pos --port "$xl" --baud 1000000 read 1 present_position; [ "$rc" -eq 0 ] && [ "$(cat "$T/pos.out")" -ge 2550 ]; }
+if wait_for 10 at_goal; then tap_ok "write goal_position moves the simulated X joint"
+else tap_fail "write goal_position moves the simulated X joint" "present $(cat "$T/pos.out" "$T/pos.err")"; fi
+
+run big --port "$xl" --baud 1000000 write 1 goal_position 5000
+check "goal outside the position limits refused before the bus (exit 2)" big \
+	test "$rc" -eq 2 -a -n "$(grep "outside goal_position's range on ID 1 now (0..4095" "$T/big.err")"
+run eeprom --port "$xl" --baud 1000000 write 1 return_delay_time 10
+check "EEPROM write with torque on refused (exit 6), the fix named" eeprom \
+	test "$rc" -eq 6 -a -n "$(grep 'torque 1 off' "$T/eeprom.err")"
+run missing --port "$xl" --baud 1000000 ping 9
+check "absent ID: exit 4" missing test "$rc" -eq 4 -a -n "$(grep 'no reply from ID 9 at 1000000 bps' "$T/missing.err")"
+
+run reboot --port "$xl" --baud 1000000 reboot 1
+run torq1 --port "$xl" --baud 1000000 read 1 torque_enable
+check "reboot: answers again, torque off" reboot \
+	test "$rc" -eq 0 -a -n "$(grep '^ID 1 rebooted' "$T/reboot.out")" -a "$(cat "$T/torq1.out")" = 0
+
+run doctor --port "$xl" --baud 1000000 doctor 1 2
+check "doctor on 2.0: the servos' lines, and the timed check said not available" doctor \
+	test -n "$(grep -E '^OK +ID 1 model +1060 \(XL430-W250\)' "$T/doctor.out")" \
+	-a -n "$(grep -E '^OK +ID 2 return delay +0 us' "$T/doctor.out")" \
+	-a -n "$(grep -E '^SKIP +budget +not timed: undulated.s cycle speaks Protocol 1.0 only' "$T/doctor.out")"
+
+xm="$T/xm"
+spawn simxm "$sim" --model xm430-w350 --link "$xm" --ids 3 --baud 1000000 --lcm-url "$(lcm_url 7641)" --quiet
+if wait_log simxm 'ready' 10; then
+	run cur --port "$xm" --baud 1000000 read 3 current_limit
+	run dump --port "$xm" --baud 1000000 dump 3
+	check "XM430-W350: its own registers (current_limit 1193, present_current)" dump \
+		test "$(cat "$T/cur.out")" = 1193 -a -n "$(grep -E '^126 +present_current' "$T/dump.out")" \
+		-a -n "$(grep '^XM430-W350 (model 1020)' "$T/dump.out")"
+else
+	tap_fail "XM430-W350 simulator ready" "$(cat "$T/simxm.log")"
+fi
+
+tap_done

@@ -1,0 +1,716 @@
+/*
+ * commands2.c — the `dxl` commands on Protocol 2.0 (X series, --protocol 2).
+ *
+ * Registers go by the names of the model's own control table (dxl2_table.h),
+ * chosen by the model number the servo's PING returns; a model not in the
+ * tables still answers raw addresses (--size bytes), and every command that
+ * falls back to them says so. The output contract is commands.c's: results
+ * on `out`, one line per failure on `err` naming the next command, the exit
+ * code the kind. Nothing is written before it was checked against the table
+ * and against what the servo holds now (limits, torque for EEPROM).
+ */
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "doctor.h"
+#include "dxl2.h"
+#include "dxl2_table.h"
+#include "dxlt_priv.h"
+#include "num.h"
+
+/* An X servo writes its EEPROM in a few ms; after a write whose reply we do
+ * not wait for (a new ID or rate) give it this long before asking. */
+#define DXLT2_SETTLE_US 20000
+/* A REBOOT takes the servo off the bus while it starts again: the e-manual
+ * gives no figure; PINGs are tried for this long. */
+#define DXLT2_REBOOT_WAIT_US 2000000L
+#define DXLT2_REBOOT_POLL_US 50000L
+/* The rate `setup` puts a slower bus at: at the factory 57600 bps one cycle
+ * of two servos takes more than the 10 ms period on the wire alone. */
+#define DXLT2_SETUP_BAUD 1000000L
+/* The first bytes of the X tables, read in one READ for `dump`, `write`'s
+ * checks and `setup` (0..147: model number .. present temperature). */
+#define DXLT2_IMAGE_LEN DXL2_X_TABLE_SIZE
+
+/* What a servo answered to PING. */
+struct dxlt2_servo {
+	uint8_t id;
+	uint16_t model;
+	uint8_t firmware;
+	const struct dxl2_model *m;   /* NULL: not in our tables, raw addresses only */
+};
+
+/* A register named on the command line: the table's row, or a raw address. */
+struct dxlt2_reg {
+	const struct dxl2_reg *row;   /* NULL for a raw address */
+	uint16_t addr;
+	uint8_t size;
+	const char *name;
+};
+
+static const char *dxlt2_model_text(const struct dxlt2_servo *s)
+{
+	return s->m != NULL ? s->m->name : "not in dxl's tables";
+}
+
+/* ---- transactions: every reply's ERR field is remembered -------------------------- */
+
+int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware)
+{
+	uint8_t e = 0;
+	int r = bus2_ping(&t->bus, id, model, firmware, &e);
+	if (r == DXL_OK)
+		t->errseen2[id] |= e;
+	return r;
+}
+
+int dxlt2_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out)
+{
+	uint8_t e = 0;
+	int r = bus2_read(&t->bus, id, addr, len, out, &e);
+	if (r == DXL_OK)
+		t->errseen2[id] |= e;
+	return r;
+}
+
+static int dxlt2_write(struct dxlt *t, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply)
+{
+	uint8_t e = 0;
+	int r = bus2_write(&t->bus, id, addr, data, n, expect_reply, &e);
+	if (r == DXL_OK)
+		t->errseen2[id] |= e;
+	return r;
+}
+
+static int dxlt2_arg_id(struct dxlt *t, const char *s, uint8_t *id)
+{
+	int rc = dxlt_arg_id(t, s, false, id);
+	if (rc != DXLT_EXIT_OK)
+		return rc;
+	if (*id > DXL2_MAX_ID) {
+		fprintf(t->err, "dxl: bad ID '%s' (0-%u on Protocol 2.0)\n", s, DXL2_MAX_ID);
+		return DXLT_EXIT_USAGE;
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* PING the servo and pick its table. */
+static int dxlt2_identify(struct dxlt *t, uint8_t id, struct dxlt2_servo *s)
+{
+	memset(s, 0, sizeof *s);
+	s->id = id;
+	int r = dxlt2_ping(t, id, &s->model, &s->firmware);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	s->m = dxl2_model_by_number(s->model);
+	return DXLT_EXIT_OK;
+}
+
+static void dxlt2_raw_note(struct dxlt *t, const struct dxlt2_servo *s, uint16_t addr, uint8_t size)
+{
+	fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): address %u taken as "
+	        "%u raw byte%s, unchecked (--size 1|2|4)\n", s->id, s->model, addr, size, size == 1 ? "" : "s");
+}
+
+/* The register REG names on this servo. */
+static int dxlt2_arg_reg(struct dxlt *t, const struct dxlt2_servo *s, const char *text, struct dxlt2_reg *out)
+{
+	long addr;
+
+	if (s->m != NULL) {
+		out->row = dxl2_reg_lookup(s->m, text);
+		if (out->row == NULL) {
+			fprintf(t->err, "dxl: unknown register '%s' for the %s (names and addresses: dxl --protocol 2 "
+			        "--port %s dump %u)\n", text, s->m->name, port_path(t->port), s->id);
+			return DXLT_EXIT_USAGE;
+		}
+		out->addr = out->row->addr;
+		out->size = out->row->size;
+		out->name = out->row->name;
+		return DXLT_EXIT_OK;
+	}
+	if (num_parse_long(text, 0, UINT16_MAX, &addr) != NUM_OK) {
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): registers by "
+		        "address only, not '%s'\n", s->id, s->model, text);
+		return DXLT_EXIT_USAGE;
+	}
+	out->row = NULL;
+	out->addr = (uint16_t)addr;
+	out->size = (uint8_t)(t->a.size > 0 ? t->a.size : 1);
+	out->name = "address";
+	dxlt2_raw_note(t, s, out->addr, out->size);
+	return DXLT_EXIT_OK;
+}
+
+static int32_t dxlt2_decode(const struct dxlt2_reg *reg, const uint8_t *raw)
+{
+	if (reg->row != NULL)
+		return dxl2_reg_decode(reg->row, raw);
+	return reg->size == 4 ? (int32_t)dxl2_get_u32(raw) : reg->size == 2 ? dxl_get_u16(raw) : raw[0];
+}
+
+/* ---- scan / ping ------------------------------------------------------------------ */
+
+int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found)
+{
+	struct bus2_found servo[BUS_MULTI_MAX];
+	size_t n = 0;
+	/* One broadcast PING: every servo answers in ID order with its model
+	 * and firmware, so a rate costs one deadline, not 253 timeouts. */
+	int r = bus2_ping_all(&t->bus, servo, BUS_MULTI_MAX, &n);
+
+	if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
+		return dxlt_bus_fail(t, DXL2_BROADCAST_ID, r);
+	for (size_t i = 0; i < n; i++) {
+		const struct bus2_found *f = &servo[i];
+		const struct dxl2_model *m = dxl2_model_by_number(f->model);
+		if (f->id < t->a.id_lo || f->id > t->a.id_hi)
+			continue;
+		t->errseen2[f->id] |= f->err;
+		(*found)++;
+		fprintf(t->out, "%-4u %-6u %-13s %-9u %-8ld 2.0\n", f->id, f->model, m != NULL ? m->name : "unknown",
+		        f->firmware, baud);
+	}
+	return DXLT_EXIT_OK;
+}
+
+int dxlt2_cmd_ping(struct dxlt *t)
+{
+	struct dxlt2_servo s;
+	uint8_t id;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 1, "--protocol 2 ping ID")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) ||
+	    (rc = dxlt2_identify(t, id, &s)))
+		return rc;
+	fprintf(t->out, "ID %u answered in %u us: model %u (%s), firmware %u, Protocol 2.0\n", id,
+	        (unsigned)t->bus.servo[id].rtt_last_us, s.model, dxlt2_model_text(&s), s.firmware);
+	if (s.m == NULL)
+		fprintf(t->err, "dxl: model %u is not in dxl's tables (XL430-W250, XM430-W350): read and write it by "
+		        "address (--size 1|2|4)\n", s.model);
+	return DXLT_EXIT_OK;
+}
+
+/* ---- read / dump ------------------------------------------------------------------ */
+
+int dxlt2_cmd_read(struct dxlt *t)
+{
+	struct dxlt2_servo s;
+	struct dxlt2_reg reg;
+	uint8_t id, raw[4] = { 0 };
+	char text[96];
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 2, "--protocol 2 read ID REG [--units]")) ||
+	    (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
+	    (rc = dxlt2_arg_reg(t, &s, t->a.pos[1], &reg)))
+		return rc;
+	int r = dxlt2_read(t, id, reg.addr, reg.size, raw);
+	if (r == DXL_E_TIMEOUT) {
+		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0 (raise it: dxl "
+		        "--protocol 2 --port %s write %u status_return_level 2)\n", id, port_path(t->port), id);
+		return DXLT_EXIT_BUS;
+	}
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	int32_t v = dxlt2_decode(&reg, raw);
+	if (t->a.units && reg.row != NULL)
+		fprintf(t->out, "%s\n", dxl2_reg_format(reg.row, v, text, sizeof text));
+	else if (reg.row == NULL || !reg.row->is_signed)
+		fprintf(t->out, "%lu\n", (unsigned long)(uint32_t)v);
+	else
+		fprintf(t->out, "%ld\n", (long)v);
+	return DXLT_EXIT_OK;
+}
+
+static void dxlt2_dump_raw(struct dxlt *t, const uint8_t *mem, size_t len)
+{
+	fprintf(t->out, "ADDR  BYTES (model not in dxl's tables: raw, little-endian)\n");
+	for (size_t a = 0; a < len; a += 16) {
+		fprintf(t->out, "%-5zu", a);
+		for (size_t k = a; k < a + 16 && k < len; k++)
+			fprintf(t->out, " %02X", mem[k]);
+		fputc('\n', t->out);
+	}
+}
+
+int dxlt2_cmd_dump(struct dxlt *t)
+{
+	struct dxlt2_servo s;
+	uint8_t id, mem[DXLT2_IMAGE_LEN];
+	char text[96];
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 1, "--protocol 2 dump ID")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) ||
+	    (rc = dxlt2_identify(t, id, &s)))
+		return rc;
+	int r = dxlt2_read(t, id, 0, sizeof mem, mem);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (s.m == NULL) {
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): bytes 0-%zu "
+		        "raw\n", id, s.model, sizeof mem - 1);
+		dxlt2_dump_raw(t, mem, sizeof mem);
+		return DXLT_EXIT_OK;
+	}
+	fprintf(t->out, "%s (model %u), firmware %u\n", s.m->name, s.model, s.firmware);
+	fprintf(t->out, "%-4s %-24s %-26s %s\n", "ADDR", "NAME", "VALUE", "DESCRIPTION");
+	for (size_t i = 0; i < s.m->nregs; i++) {
+		const struct dxl2_reg *reg = &s.m->regs[i];
+		if (reg->addr + reg->size > sizeof mem)
+			continue;
+		fprintf(t->out, "%-4u %-24s %-26s %s%s\n", reg->addr, reg->name,
+		        dxl2_reg_format(reg, dxl2_reg_decode(reg, &mem[reg->addr]), text, sizeof text), reg->desc,
+		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* ---- write / torque ------------------------------------------------------------------ */
+
+static int dxlt2_parse_value(struct dxlt *t, const struct dxlt2_reg *reg, const char *text, long *value)
+{
+	enum num_status st = num_parse_long(text, LONG_MIN, LONG_MAX, value);
+	if (st != NUM_OK && st != NUM_RANGE) {
+		fprintf(t->err, "dxl: value '%s' for %s is %s\n", text, reg->name, num_strerror(st));
+		return DXLT_EXIT_USAGE;
+	}
+	if (reg->row == NULL) {
+		long lo = reg->size == 4 ? INT32_MIN : 0, hi = reg->size == 4 ? (long)UINT32_MAX : (1L << (8 * reg->size)) - 1;
+		if (st != NUM_OK || *value < lo || *value > hi) {
+			fprintf(t->err, "dxl: value '%s' does not fit %u byte(s)\n", text, reg->size);
+			return DXLT_EXIT_USAGE;
+		}
+		return DXLT_EXIT_OK;
+	}
+	if (reg->row->access != DXL_ACCESS_RW) {
+		fprintf(t->err, "dxl: %s (address %u) is read-only\n", reg->name, reg->addr);
+		return DXLT_EXIT_USAGE;
+	}
+	if (st != NUM_OK || *value < reg->row->min || *value > reg->row->max) {
+		fprintf(t->err, "dxl: value '%s' out of range for %s (%ld..%ld)\n", text, reg->name, (long)reg->row->min,
+		        (long)reg->row->max);
+		return DXLT_EXIT_USAGE;
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* What the servo holds now decides what it takes: limits, operating modes,
+ * torque for EEPROM. The servo would answer an error; say why first. */
+static int dxlt2_check_live(struct dxlt *t, const struct dxlt2_servo *s, const struct dxlt2_reg *reg, long value,
+                            const uint8_t *mem)
+{
+	int32_t lo, hi;
+
+	if (dxl2_reg_check_write(s->m, reg->row, value) != DXL_OK) {
+		fprintf(t->err, "dxl: the %s has no %s %ld (operating modes: dxl --protocol 2 dump %u)\n", s->m->name,
+		        reg->name, value, s->id);
+		return DXLT_EXIT_USAGE;
+	}
+	if (dxl2_reg_check_write_live(s->m, reg->row, value, mem, DXLT2_IMAGE_LEN) != DXL_OK &&
+	    dxl2_reg_range(s->m, reg->row, mem, DXLT2_IMAGE_LEN, &lo, &hi) == DXL_OK) {
+		fprintf(t->err, "dxl: value %ld outside %s's range on ID %u now (%ld..%ld, from its limit registers; "
+		        "the servo would answer a data limit error)\n", value, reg->name, s->id, (long)lo, (long)hi);
+		return DXLT_EXIT_USAGE;
+	}
+	if (reg->row->area == DXL_AREA_EEPROM && mem[DXL2_X_TORQUE_ENABLE] != 0) {
+		fprintf(t->err, "dxl: ID %u has torque on, and an X-series servo refuses EEPROM writes (%s) then with "
+		        "an access error: dxl --protocol 2 --port %s torque %u off\n", s->id, reg->name, port_path(t->port),
+		        s->id);
+		return DXLT_EXIT_REFUSED;
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* Write and know whether it took, as far as the status return level lets
+ * us (68: 0 PING only, 1 PING and READ, 2 everything): as commands.c's
+ * dxlt_write_checked. */
+static int dxlt2_write_checked(struct dxlt *t, uint8_t id, const struct dxlt2_reg *reg, long value, uint8_t level)
+{
+	uint8_t raw[4], back[4];
+	bool answered = level >= 2 && reg->addr != DXL2_X_STATUS_RETURN_LEVEL;
+
+	if (reg->row != NULL)
+		dxl2_reg_encode(reg->row, (int32_t)value, raw);
+	else
+		dxl2_put_u32(raw, (uint32_t)value);
+	int r = dxlt2_write(t, id, reg->addr, raw, reg->size, answered);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (answered)
+		return DXLT_EXIT_OK;
+	uint8_t now_level = reg->addr == DXL2_X_STATUS_RETURN_LEVEL ? (uint8_t)value : level;
+	if (now_level == 0) {
+		fprintf(t->out, "ID %u: %s = %ld sent, not confirmed: the servo answers PING only (status return level "
+		        "0)\n", id, reg->name, value);
+		return DXLT_EXIT_OK;
+	}
+	if (reg->row != NULL && reg->row->area == DXL_AREA_EEPROM)
+		dxlt_sleep_us(DXLT2_SETTLE_US);
+	if ((r = dxlt2_read(t, id, reg->addr, reg->size, back)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (memcmp(back, raw, reg->size) != 0) {
+		fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld)\n", id, reg->name, (long)dxlt2_decode(reg, back),
+		        value);
+		return t->errseen2[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u: %s = %ld (read back: status return level %u does not answer WRITE)\n", id, reg->name,
+	        value, level);
+	return DXLT_EXIT_OK;
+}
+
+/* The whole write: checked against the table and the servo's image first. */
+static int dxlt2_write_reg(struct dxlt *t, const struct dxlt2_servo *s, const struct dxlt2_reg *reg, long value)
+{
+	uint8_t mem[DXLT2_IMAGE_LEN];
+	int rc, r;
+
+	if (reg->row == NULL)   /* a model we do not know: its level unknown too, a reply expected */
+		return dxlt2_write_checked(t, s->id, reg, value, 2);
+	if ((r = dxlt2_read(t, s->id, 0, sizeof mem, mem)) == DXL_E_TIMEOUT) {
+		/* level 0: PING only; nothing can be checked or confirmed */
+		fprintf(t->err, "dxl: ID %u answers PING but not READ (status return level 0): %s not checked against "
+		        "its limits\n", s->id, reg->name);
+		return dxlt2_write_checked(t, s->id, reg, value, 0);
+	}
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, s->id, r);
+	if ((rc = dxlt2_check_live(t, s, reg, value, mem)) != DXLT_EXIT_OK)
+		return rc;
+	uint8_t level = mem[DXL2_X_STATUS_RETURN_LEVEL] > 2 ? 2 : mem[DXL2_X_STATUS_RETURN_LEVEL];
+	return dxlt2_write_checked(t, s->id, reg, value, level);
+}
+
+int dxlt2_cmd_write(struct dxlt *t)
+{
+	struct dxlt2_servo s;
+	struct dxlt2_reg reg;
+	uint8_t id;
+	long value;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 3, "--protocol 2 write ID REG VALUE")) ||
+	    (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
+	    (rc = dxlt2_arg_reg(t, &s, t->a.pos[1], &reg)) || (rc = dxlt2_parse_value(t, &reg, t->a.pos[2], &value)))
+		return rc;
+	if (reg.row != NULL && (reg.addr == DXL2_X_ID || reg.addr == DXL2_X_BAUD_RATE)) {
+		fprintf(t->err, "dxl: %s moves the servo away from this ID/rate: use dxl --protocol 2 --port %s %s\n",
+		        reg.name, port_path(t->port), reg.addr == DXL2_X_ID ? "set-id OLD NEW" : "set-baud ID BAUD");
+		return DXLT_EXIT_USAGE;
+	}
+	return dxlt2_write_reg(t, &s, &reg, value);
+}
+
+int dxlt2_cmd_torque(struct dxlt *t)
+{
+	struct dxlt2_servo s;
+	struct dxlt2_reg reg = { NULL, DXL2_X_TORQUE_ENABLE, 1, "torque_enable" };
+	uint8_t id;
+	int rc;
+
+	if ((rc = dxlt_need_args(t, 2, "--protocol 2 torque ID on|off")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
+		return rc;
+	const char *w = t->a.pos[1];
+	bool on = strcmp(w, "on") == 0 || strcmp(w, "1") == 0;
+	if (!on && strcmp(w, "off") != 0 && strcmp(w, "0") != 0) {
+		fprintf(t->err, "dxl: torque takes on or off, not '%s'\n", w);
+		return DXLT_EXIT_USAGE;
+	}
+	if ((rc = dxlt2_identify(t, id, &s)) != DXLT_EXIT_OK)
+		return rc;
+	if (s.m != NULL)
+		reg.row = dxl2_reg_at(s.m, DXL2_X_TORQUE_ENABLE);
+	else
+		dxlt2_raw_note(t, &s, reg.addr, reg.size);
+	return dxlt2_write_reg(t, &s, &reg, on ? 1 : 0);
+}
+
+/* ---- set-id / set-baud / reset / reboot -------------------------------------------- */
+
+/* After a write whose reply we did not wait for, give the servo time, then ask. */
+static int dxlt2_verify_ping(struct dxlt *t, uint8_t id)
+{
+	int r = DXL_E_TIMEOUT;
+	dxlt_sleep_us(DXLT2_SETTLE_US);
+	for (int attempt = 0; attempt < 3 && r == DXL_E_TIMEOUT; attempt++)
+		r = dxlt2_ping(t, id, NULL, NULL);
+	return r;
+}
+
+/* EEPROM (ID, rate) is refused while torque is on: say so before sending. */
+static int dxlt2_need_torque_off(struct dxlt *t, uint8_t id, const char *what)
+{
+	uint8_t torque = 0;
+	int r = dxlt2_read(t, id, DXL2_X_TORQUE_ENABLE, 1, &torque);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (torque == 0)
+		return DXLT_EXIT_OK;
+	fprintf(t->err, "dxl: ID %u has torque on, and an X-series servo refuses EEPROM writes (%s) then: dxl "
+	        "--protocol 2 --port %s torque %u off\n", id, what, port_path(t->port), id);
+	return DXLT_EXIT_REFUSED;
+}
+
+int dxlt2_cmd_set_id(struct dxlt *t)
+{
+	uint8_t old_id, new_id;
+	int rc, r;
+
+	if ((rc = dxlt_need_args(t, 2, "--protocol 2 set-id OLD NEW")) ||
+	    (rc = dxlt2_arg_id(t, t->a.pos[0], &old_id)) || (rc = dxlt2_arg_id(t, t->a.pos[1], &new_id)))
+		return rc;
+	if (old_id == new_id) {
+		fprintf(t->out, "ID %u unchanged\n", old_id);
+		return DXLT_EXIT_OK;
+	}
+	if ((r = dxlt2_ping(t, old_id, NULL, NULL)) != DXL_OK)
+		return dxlt_bus_fail(t, old_id, r);
+	if (dxlt2_ping(t, new_id, NULL, NULL) == DXL_OK) {
+		fprintf(t->err, "dxl: ID %u is already taken on this bus; pick another\n", new_id);
+		return DXLT_EXIT_REFUSED;
+	}
+	if ((rc = dxlt2_need_torque_off(t, old_id, "id")) != DXLT_EXIT_OK)
+		return rc;
+	if ((r = dxlt2_write(t, old_id, DXL2_X_ID, &new_id, 1, false)) != DXL_OK)
+		return dxlt_bus_fail(t, old_id, r);
+	if ((r = dxlt2_verify_ping(t, new_id)) != DXL_OK) {
+		fprintf(t->err, "dxl: wrote ID %u to servo %u but ID %u does not answer (%s)\n", new_id, old_id, new_id,
+		        dxl_strerror(r));
+		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u is now ID %u\n", old_id, new_id);
+	return DXLT_EXIT_OK;
+}
+
+int dxlt2_cmd_set_baud(struct dxlt *t)
+{
+	uint8_t id, reg_value;
+	long bps;
+	int rc, r;
+
+	if ((rc = dxlt_need_args(t, 2, "--protocol 2 set-baud ID BAUD")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
+		return rc;
+	if (num_parse_long(t->a.pos[1], 1, DXLT_MAX_BAUD, &bps) != NUM_OK || dxl2_baud_to_reg(bps, &reg_value) != DXL_OK) {
+		fprintf(t->err, "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, "
+		        "3000000, 4000000, 4500000)\n", t->a.pos[1]);
+		return DXLT_EXIT_USAGE;
+	}
+	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if ((rc = dxlt2_need_torque_off(t, id, "baud_rate")) != DXLT_EXIT_OK)
+		return rc;
+	if ((r = dxlt2_write(t, id, DXL2_X_BAUD_RATE, &reg_value, 1, false)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	long exact = dxl2_baud_from_reg(reg_value);
+	dxlt_sleep_us(DXLT2_SETTLE_US);
+	if ((rc = dxlt_set_baud(t, exact)) != DXLT_EXIT_OK)
+		return rc;
+	if ((r = dxlt2_verify_ping(t, id)) != DXL_OK) {
+		fprintf(t->err, "dxl: ID %u does not answer at %ld bps after the change (%s); try: dxl --port %s scan "
+		        "--bauds all\n", id, exact, dxl_strerror(r), port_path(t->port));
+		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u now at %ld bps (register value %u)\n", id, exact, reg_value);
+	return DXLT_EXIT_OK;
+}
+
+int dxlt2_cmd_reset(struct dxlt *t)
+{
+	uint8_t id, e = 0;
+	int rc, r;
+
+	if ((rc = dxlt_need_args(t, 1, "--protocol 2 reset ID --yes [--keep id|id-baud]")) ||
+	    (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
+		return rc;
+	const char *what = t->a.keep == DXL2_RESET_KEEP_ID ? "every default but the ID (57600 bps)"
+	                   : t->a.keep == DXL2_RESET_KEEP_ID_BAUD ? "every default but the ID and the baud rate"
+	                   : "ID 1, 57600 bps and every default";
+	if (!t->a.yes) {
+		fprintf(t->err, "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
+		        "to do it (--keep id or id-baud keeps those)\n", what);
+		return DXLT_EXIT_USAGE;
+	}
+	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if ((r = bus2_factory_reset(&t->bus, id, (uint8_t)t->a.keep, false, &e)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	uint8_t now_id = t->a.keep == DXL2_RESET_ALL ? 1 : id;
+	long now_baud = t->a.keep == DXL2_RESET_KEEP_ID_BAUD ? port_baud(t->port) : DXLT_DEFAULT_BAUD2;
+	dxlt_sleep_us(DXLT2_SETTLE_US);
+	if ((rc = dxlt_set_baud(t, now_baud)) != DXLT_EXIT_OK)
+		return rc;
+	if ((r = dxlt2_verify_ping(t, now_id)) != DXL_OK) {
+		fprintf(t->err, "dxl: reset sent to ID %u but ID %u does not answer at %ld bps (%s)\n", id, now_id, now_baud,
+		        dxl_strerror(r));
+		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u reset to factory defaults: now ID %u at %ld bps\n", id, now_id, now_baud);
+	return DXLT_EXIT_OK;
+}
+
+int dxlt2_cmd_reboot(struct dxlt *t)
+{
+	uint8_t id, e = 0, level = 2;
+	int rc, r;
+
+	if ((rc = dxlt_need_args(t, 1, "--protocol 2 reboot ID")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
+		return rc;
+	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (dxlt2_read(t, id, DXL2_X_STATUS_RETURN_LEVEL, 1, &level) != DXL_OK)
+		level = 0;
+	/* the reply (level 2) comes before the servo restarts */
+	if ((r = bus2_reboot(&t->bus, id, level >= 2, &e)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	t->errseen2[id] |= e;
+	for (long waited = 0; waited < DXLT2_REBOOT_WAIT_US; waited += DXLT2_REBOOT_POLL_US) {
+		dxlt_sleep_us(DXLT2_REBOOT_POLL_US);
+		uint8_t hw = 0;
+		if (dxlt2_ping(t, id, NULL, NULL) != DXL_OK)
+			continue;
+		if (dxlt2_read(t, id, DXL2_X_HARDWARE_ERROR_STATUS, 1, &hw) == DXL_OK && hw != 0) {
+			char names[96];
+			fprintf(t->err, "dxl: ID %u restarted with hardware error status %u (%s): the cause is still there\n",
+			        id, hw, dxl2_hwerr_format(hw, names, sizeof names));
+			return DXLT_EXIT_SERVO;
+		}
+		fprintf(t->out, "ID %u rebooted: answers again after %ld ms, torque off\n", id,
+		        (waited + DXLT2_REBOOT_POLL_US) / 1000);
+		return DXLT_EXIT_OK;
+	}
+	fprintf(t->err, "dxl: ID %u does not answer %ld ms after REBOOT\n", id, DXLT2_REBOOT_WAIT_US / 1000);
+	return DXLT_EXIT_BUS;
+}
+
+/* ---- setup ------------------------------------------------------------------------------ */
+
+/* Write one byte if it differs, then read it back (writes not waited for:
+ * the level may be below 2, or about to change). */
+static int dxlt2_setup_byte(struct dxlt *t, uint8_t id, uint16_t addr, const char *name, uint8_t want, uint8_t have)
+{
+	uint8_t back = 0;
+	int r;
+
+	if (have == want) {
+		fprintf(t->out, "ID %u: %s already %u\n", id, name, want);
+		return DXLT_EXIT_OK;
+	}
+	if ((r = dxlt2_write(t, id, addr, &want, 1, false)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	dxlt_sleep_us(DXLT2_SETTLE_US);
+	if ((r = dxlt2_read(t, id, addr, 1, &back)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (back != want) {
+		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u)\n", id, name, back, want);
+		return t->errseen2[id] ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u: %s set to %u\n", id, name, want);
+	return DXLT_EXIT_OK;
+}
+
+static int dxlt2_setup_one(struct dxlt *t, uint8_t id, bool *xm430)
+{
+	uint8_t mem[DXLT2_IMAGE_LEN];
+	struct dxlt2_servo s;
+	int rc, r;
+
+	if ((rc = dxlt2_identify(t, id, &s)) != DXLT_EXIT_OK)
+		return rc;
+	if (s.m == NULL) {
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): setup does not "
+		        "know its registers\n", id, s.model);
+		return DXLT_EXIT_REFUSED;
+	}
+	*xm430 = *xm430 || s.model == DXL2_MODEL_XM430_W350;
+	if ((r = dxlt2_read(t, id, 0, sizeof mem, mem)) != DXL_OK) {
+		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? (the loop's SYNC_READ "
+		        "needs 1 or 2)\n", id);
+		return r == DXL_E_TIMEOUT ? DXLT_EXIT_BUS : dxlt_bus_fail(t, id, r);
+	}
+	if (mem[DXL2_X_TORQUE_ENABLE]) {
+		if (!t->a.yes) {
+			fprintf(t->err, "dxl: ID %u has torque on, and an X-series servo refuses EEPROM writes then; add --yes "
+			        "to turn it off first (the joint goes limp: support the robot)\n", id);
+			return DXLT_EXIT_REFUSED;
+		}
+		if ((rc = dxlt2_setup_byte(t, id, DXL2_X_TORQUE_ENABLE, "torque_enable", 0, 1)) != DXLT_EXIT_OK)
+			return rc;
+	}
+	/* 0: the reply follows the request at once instead of after 500 µs */
+	if ((rc = dxlt2_setup_byte(t, id, DXL2_X_RETURN_DELAY_TIME, "return_delay_time", 0,
+	                           mem[DXL2_X_RETURN_DELAY_TIME])) != DXLT_EXIT_OK)
+		return rc;
+	uint8_t want_level = (uint8_t)(t->a.status_level >= 0 ? t->a.status_level : 2);
+	return dxlt2_setup_byte(t, id, DXL2_X_STATUS_RETURN_LEVEL, "status_return_level", want_level,
+	                        mem[DXL2_X_STATUS_RETURN_LEVEL]);
+}
+
+/* A bus slower than 1 Mbps cannot carry a 100 Hz cycle (57600 bps, the
+ * factory rate, needs 16 ms for two servos' SYNC_READ and SYNC_WRITE): every
+ * servo goes to 1 Mbps, then the port, then each must answer there. */
+static int dxlt2_setup_baud(struct dxlt *t, const uint8_t *ids, int n)
+{
+	uint8_t reg;
+	int r, rc;
+
+	if (port_baud(t->port) >= DXLT2_SETUP_BAUD)
+		return DXLT_EXIT_OK;
+	dxl2_baud_to_reg(DXLT2_SETUP_BAUD, &reg);
+	for (int i = 0; i < n; i++)
+		if ((r = dxlt2_write(t, ids[i], DXL2_X_BAUD_RATE, &reg, 1, false)) != DXL_OK)
+			return dxlt_bus_fail(t, ids[i], r);
+	long before = port_baud(t->port);
+	dxlt_sleep_us(DXLT2_SETTLE_US);
+	if ((rc = dxlt_set_baud(t, DXLT2_SETUP_BAUD)) != DXLT_EXIT_OK)
+		return rc;
+	for (int i = 0; i < n; i++) {
+		if ((r = dxlt2_verify_ping(t, ids[i])) != DXL_OK) {
+			fprintf(t->err, "dxl: ID %u does not answer at %ld bps after the change (%s); try: dxl --port %s scan "
+			        "--bauds all\n", ids[i], DXLT2_SETUP_BAUD, dxl_strerror(r), port_path(t->port));
+			return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+		}
+		fprintf(t->out, "ID %u: baud_rate %ld -> %ld bps (a 100 Hz cycle does not fit the period below 1 Mbps; "
+		        "undulated's configuration needs baud = %ld)\n", ids[i], before, DXLT2_SETUP_BAUD, DXLT2_SETUP_BAUD);
+	}
+	return DXLT_EXIT_OK;
+}
+
+int dxlt2_cmd_setup(struct dxlt *t)
+{
+	uint8_t ids[DXL2_MAX_ID + 1];
+	int worst = DXLT_EXIT_OK, n = t->a.npos;
+	bool xm430 = false;
+
+	if (n < 1 || n > DXL2_MAX_ID + 1)
+		return dxlt_need_args(t, -1, "--protocol 2 setup ID... [--status-level N] [--yes]");
+	for (int i = 0; i < n; i++) {
+		int rc = dxlt2_arg_id(t, t->a.pos[i], &ids[i]);
+		if (rc != DXLT_EXIT_OK)
+			return rc;
+	}
+	for (int i = 0; i < n; i++) {
+		int rc = dxlt2_setup_one(t, ids[i], &xm430);
+		if (rc == DXLT_EXIT_PORT)
+			return rc;
+		worst = rc > worst ? rc : worst;
+	}
+	if (worst == DXLT_EXIT_OK && (worst = dxlt2_setup_baud(t, ids, n)) == DXLT_EXIT_PORT)
+		return worst;
+	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
+	fprintf(t->out, "adapter: %s\n", t->latency.note);
+	/* the loop's SYNC_READ: position + velocity, and the current on the XM430 */
+	unsigned read_len = xm430 ? DR2_READ_LEN_CURRENT : DR2_READ_LEN;
+	double wire_ms = 1e-3 * dr2_cycle_wire_us((unsigned)n, read_len, port_baud(t->port));
+	int latency_ms = t->latency.known ? t->latency.timer_ms : 0;
+	double total_ms = wire_ms + latency_ms;
+	fprintf(t->out, "bus time per cycle for %d servo%s at %ld bps: %.2f ms on the wire (one SYNC_READ of %u bytes "
+	        "each, one SYNC_WRITE) + %d ms adapter latency = %.2f ms of the 10 ms period%s\n", n, n == 1 ? "" : "s",
+	        port_baud(t->port), wire_ms, read_len, latency_ms, total_ms, total_ms > 5.0 ? " (too much for 100 Hz)" : "");
+	if (t->latency.known && t->latency.timer_ms > 1) {
+		fprintf(t->err, "dxl: %s\n", t->latency.note);
+		if (worst == DXLT_EXIT_OK)
+			worst = DXLT_EXIT_PORT;
+	}
+	return worst;
+}
