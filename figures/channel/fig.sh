@@ -126,6 +126,9 @@ fragment() {
 		echo "neighbouring pairs. Channel width = the distance between neighbouring robots (d̃ ="
 		echo "width / 0.298 m, the swept width of a contact body). Final Δ: the pair's mean over the"
 		echo "last $WINDOW s; d̃ and 2 asin(d̃): the analyser's, per pair."
+		if [ "$(awk -F, 'NR > 1 { t[$1 " " $3] = 1 } END { for (k in t) { split(k, a, " "); n[a[1]]++ } for (w in n) if (n[w] > m) m = n[w]; print m + 0 }' "$csv")" -le "$QUICK_TRIALS" ]; then
+			echo "(\`make figures QUICK=1\`: $QUICK_TRIALS trials a width; the full set runs $TRIALS.)"
+		fi
 		echo
 		echo "| width | d̃ nominal | pairs | d̃ at the end, median (range) | final \|Δ\| median | at or below 2 asin(d̃) + 0.1 | anti-phase | still colliding in the last $WINDOW s |"
 		echo "|---|---|---|---|---|---|---|---|"

@@ -258,7 +258,7 @@ fragment() {
 		echo "What ran: $n lockstep runs of \`sim-bridge/scenarios/arena10.scenario\` through ten \`undulated\`"
 		echo "(position servos), each $end s of simulated time: walls closing from 2.0 m to 0.3 m apart"
 		echo "between 10 s and $((end / 3)) s, SINUSOID at random phases until $((2 * end / 3)) s, OSCILLATOR until $end s."
-		[ "$end" -lt 300 ] && echo "(The paper's 300 s timeline at $(awk -v e="$end" 'BEGIN { printf "%g", e / 300 }') of its length: \`make figures QUICK=1\`.)"
+		[ "$end" -lt "$END_FULL" ] && echo "(\`make figures QUICK=1\`: the paper's timeline at $(awk -v e="$end" -v f="$END_FULL" 'BEGIN { printf "%g", e / f }') of its length, slopes ${QUICK_SLOPES// /, }, $QUICK_REPLICATES run(s) each; the full set runs slopes ${SLOPES// /, }, $REPLICATES runs each, $END_FULL s.)"
 		[ -n "$mixed" ] && echo "(Runs of different lengths are merged here; the timeline named is the first run's.)"
 		echo "Each run tuned the oscillator first at its compliance slope (\`undulated --tune\`, 0.8 Hz,"
 		echo "0.8 rad; the clock set to the gait measured). Force: the simulator's total impulse per"

@@ -237,6 +237,11 @@ fragment() {
 		echo "most). The end is the last $WINDOW s. Compatibility error: the mean over a row's"
 		echo "nine pairs of max(0, |Δ| − 2 asin(d̃)), each pair with its own d̃ as the analyser"
 		echo "measures it (d̃ ≥ 1: no contact possible, error 0)."
+		if awk -F, -v q="$QUICK_SWEEP_SECONDS" -v r="$QUICK_RELAX_SECONDS" 'NR > 1 && ($3 == q || $3 == r) { found = 1 } END { exit !found }' "$csv"; then
+			echo "(\`make figures QUICK=1\`: d̃ = ${QUICK_SWEEP_DSEPS// /, } with one seed and ${QUICK_SWEEP_SECONDS} s runs, β = ${QUICK_RELAX_BETAS// /, } s with one"
+			echo "seed and ${QUICK_RELAX_SECONDS} s runs; the full set runs d̃ = ${SWEEP_DSEPS// /, } with $SWEEP_SEEDS seeds of ${SWEEP_SECONDS} s and β ="
+			echo "${RELAX_BETAS// /, } s with $RELAX_SEEDS seeds of ${RELAX_SECONDS} s.)"
+		fi
 		echo
 		echo "| d̃ | β (s) | runs | collisions per pair per s | compatibility error (rad) | pairs colliding at the end | pairs compatible or in phase | anti-phase |"
 		echo "|---|---|---|---|---|---|---|---|"
