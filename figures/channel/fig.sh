@@ -165,9 +165,10 @@ fragment() {
 	} >"$fig/channel.md"
 }
 
-# Measured 2026-11-27 (load average 9-17, two at a time): 8-11 s a run.
+# Measured 2026-11-27, two runs at a time: 3.3 s a run with little else
+# running, 8-11 s beside other work (load average 9-17).
 seconds() {
-	echo 10
+	echo 5
 }
 
 case "${1:-}" in

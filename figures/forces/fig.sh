@@ -318,10 +318,11 @@ beside() {
 	echo "  the channel preset's, chosen before those runs."
 }
 
-# Measured 2026-11-27 on the 2-core machine with other work beside it (load
-# average 9-17): 153 s a full run, 58 s a quick one, two at a time.
+# Measured 2026-11-27 on the 2-core machine, two runs at a time: 70 s a full
+# run and 37 s a quick one with little else running; 153 s and 99 s beside
+# other people's fuzzing and figure runs (load average 9-17).
 seconds() {
-	if [ "${1:-}" = --quick ]; then echo 60; else echo 150; fi
+	if [ "${1:-}" = --quick ]; then echo 45; else echo 90; fi
 }
 
 case "${1:-}" in

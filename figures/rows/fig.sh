@@ -310,10 +310,11 @@ beside() {
 	rm -f "$1/rows.relaxmed"
 }
 
-# Measured 2026-11-27 (load average 9-17, two at a time): 49 s a run on
-# average (27 s for 60 s sweeps, 94 s for 240 s relaxations), 31 s quick.
+# Measured 2026-11-27, two runs at a time: 18 s a run on average and 14 s
+# quick with little else running; 49 s (27 s for a 60 s sweep, 94 s for a
+# 240 s relaxation) and 31 s beside other work (load average 9-17).
 seconds() {
-	if [ "${1:-}" = --quick ]; then echo 30; else echo 50; fi
+	if [ "${1:-}" = --quick ]; then echo 18; else echo 25; fi
 }
 
 case "${1:-}" in
