@@ -260,6 +260,8 @@ void cfg_defaults(struct cfg *c)
 	 * comes to rest near neutral stays there, each predicted step being inside
 	 * the dead band (CONTROL.md). The lead then follows the margin. */
 	c->compliance_margin = 0;
+	/* The servo's own slope (factory 32) unless the file sets one. */
+	c->compliance_slope = -1;
 	c->servo_lead_s = NAN;
 	c->actuation = CFG_ACT_POSITION;
 	c->torque_drive = CFG_DRIVE_PWM;
@@ -333,6 +335,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("period_ms", T_DOUBLE, period_ms, 2, 100),
 	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, 0.2),
 	K("compliance_margin", T_LONG, compliance_margin, -1, 255),
+	K("compliance_slope", T_LONG, compliance_slope, -1, 254),
 	K("actuation", T_ACT, actuation, 0, 0),
 	K("torque_drive", T_DRIVE, torque_drive, 0, 0),
 	K("stall_torque", T_DOUBLE, stall_torque, 0.01, 100),
@@ -765,6 +768,7 @@ void cfg_print(const struct cfg *c, void *file)
 	fprintf(f, "\nmode = %s\nlcm_url = %s\npriority = %d\nmlockall = %s\nsafe_stop = %s\n"
 	        "fault_action = %s\nvelocity_source = %s\nvelocity_cutoff_hz = %g\ncommands = %s\n"
 	        "echo = %s\nrs485 = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\n"
+	        "compliance_slope = %ld\n"
 	        "actuation = %s\ntorque_drive = %s\nstall_torque = %g\nno_load_speed = %g\n"
 	        "bus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
 	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\nsilent_s = %g\n"
@@ -773,7 +777,7 @@ void cfg_print(const struct cfg *c, void *file)
 	        safe[c->safe_stop], safe[c->fault_action],
 	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
 	        cfg_commands_name(c->commands), c->echo ? "on" : "off", port_rs485_name(c->rs485), c->adapter_latency_us, c->period_ms,
-	        c->servo_lead_s, c->compliance_margin, c->actuation == CFG_ACT_TORQUE ? "torque" : "position",
+	        c->servo_lead_s, c->compliance_margin, c->compliance_slope, c->actuation == CFG_ACT_TORQUE ? "torque" : "position",
 	        c->torque_drive == CFG_DRIVE_CURRENT ? "current" : "pwm", c->stall_torque, c->no_load_speed,
 	        c->bus_margin_us,
 	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit, c->silent_s,

@@ -73,6 +73,8 @@ struct cfg {
 	double servo_lead_s;           /* oscillator horizon beyond the period (CONTROL.md);
 	                                  NaN until cfg_finish(): then chosen by compliance_margin */
 	long compliance_margin;        /* written to both margins at start-up; -1: leave the servo's */
+	long compliance_slope;         /* written to both slopes at start-up; -1: leave the servo's (the
+	                                  position loop's stiffness: PHYSICS.md, daemon/README.md) */
 	enum cfg_actuation actuation;  /* OSCILLATOR through goals or through torque (wheel mode) */
 	enum cfg_drive torque_drive;   /* torque actuation: pwm (AX-12) or current */
 	double stall_torque;           /* N·m at 12 V and full output (AX-12A: 1.5) */

@@ -108,6 +108,7 @@ static const char *ctl_register_name(uint8_t addr)
 	case DXL_AX_TORQUE_LIMIT: return "torque limit";
 	case DXL_AX_CW_ANGLE_LIMIT: return "angle limits";
 	case DXL_AX_CW_COMPLIANCE_MARGIN: return "compliance margins";
+	case DXL_AX_CW_COMPLIANCE_SLOPE: return "compliance slopes";
 	case DXL_AX_MOVING_SPEED: return "moving speed";
 	default: return "register";
 	}
@@ -297,6 +298,10 @@ static void ctl_servo_setup(struct ctl *c, size_t j, bool torque)
 		uint32_t m = (uint32_t)c->cfg->compliance_margin;
 		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_MARGIN, 2, m | m << 8);
 	}
+	if (c->cfg->compliance_slope >= 0) {
+		uint32_t sl = (uint32_t)c->cfg->compliance_slope;
+		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_SLOPE, 2, sl | sl << 8);
+	}
 	if (!c->wheel)
 		ctl_write(c, jt->id, DXL_AX_MOVING_SPEED, 2, 0);
 	ctl_torque_write(c, j, torque);
@@ -425,6 +430,7 @@ void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits)
 	unsigned torque = REG(DXL_AX_TORQUE_ENABLE);
 	unsigned limit = dxl_get_u16(&REG(DXL_AX_TORQUE_LIMIT));
 	unsigned margin_cw = REG(DXL_AX_CW_COMPLIANCE_MARGIN), margin_ccw = REG(DXL_AX_CCW_COMPLIANCE_MARGIN);
+	unsigned slope_cw = REG(DXL_AX_CW_COMPLIANCE_SLOPE), slope_ccw = REG(DXL_AX_CCW_COMPLIANCE_SLOPE);
 	jt->torque_read = (int)torque;
 	jt->torque_limit_read = (int)limit;
 	ctl_measure_slow(c, j, REG(DXL_AX_PRESENT_VOLTAGE), REG(DXL_AX_PRESENT_TEMPERATURE), errbits);
@@ -470,6 +476,12 @@ void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits)
 		ctl_mismatch(c, j, "compliance margin", margin_cw != (unsigned)want_margin ? margin_cw : margin_ccw,
 		             (unsigned)want_margin);
 		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_MARGIN, 2, (uint32_t)want_margin | (uint32_t)want_margin << 8);
+	}
+	long want_slope = c->cfg->compliance_slope;
+	if (want_slope >= 0 && (slope_cw != (unsigned)want_slope || slope_ccw != (unsigned)want_slope)) {
+		ctl_mismatch(c, j, "compliance slope", slope_cw != (unsigned)want_slope ? slope_cw : slope_ccw,
+		             (unsigned)want_slope);
+		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_SLOPE, 2, (uint32_t)want_slope | (uint32_t)want_slope << 8);
 	}
 }
 

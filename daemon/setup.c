@@ -142,6 +142,14 @@ static bool setup_ram(struct bus *bus, uint8_t id, const struct cfg *cfg, const 
 			return false;
 		}
 	}
+	if (cfg->compliance_slope >= 0) {
+		uint8_t sl = (uint8_t)cfg->compliance_slope;
+		int wr = setup_write(bus, id, DXL_AX_CW_COMPLIANCE_SLOPE, (const uint8_t[2]){ sl, sl }, 2, reply, &eb);
+		if (wr != DXL_OK) {
+			snprintf(err, cap, "servo %u: setting compliance slope %u failed: %s", id, sl, dxl_strerror(wr));
+			return false;
+		}
+	}
 	/* A moving speed left by another program would make every goal a slow
 	 * ramp and the oscillator sluggish: 0 is "as fast as possible". */
 	uint8_t ms[2];

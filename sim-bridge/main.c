@@ -128,11 +128,18 @@ static int64_t app_now(const struct app *a)
 
 /* ---- options ---------------------------------------------------------------- */
 
+/* Settings from the command line: a --set for each scheduled event of a
+ * long run (scripts/demo.sh --lockstep samples every 5 s: 62 for 300 s) and
+ * the options that are scenario keys. */
+#define MAIN_MAX_SETS (SIM_MAX_EVENTS + 64)
+#define MAIN_MAX_KEYS 64
+
 struct options {
 	const char *scenario;
 	const char *link, *ids, *name;
-	const char *sets[64];
+	const char *sets[MAIN_MAX_SETS];
 	int nsets;
+	int nkeys;              /* of them, options stored as SECTION.KEY=VALUE (set_store) */
 	bool bench, quiet;
 	double tx_slice_us;
 	const char *send_cmd;   /* --cmd: publish one SIM.CMD and exit */
@@ -201,7 +208,7 @@ static const struct {
 	{ OPT_VOLTAGE, "sim.voltage" }, { OPT_MODEL, "sim.model" },
 };
 
-static char set_store[64][SIM_CMD_MAX + SIM_PATH_MAX];
+static char set_store[MAIN_MAX_KEYS][SIM_CMD_MAX + SIM_PATH_MAX];
 
 static int parse_args(int argc, char **argv, struct options *o)
 {
@@ -234,8 +241,10 @@ static int parse_args(int argc, char **argv, struct options *o)
 		for (size_t i = 0; i < sizeof(sim_keys) / sizeof(sim_keys[0]); i++)
 			if (sim_keys[i].opt == c)
 				key = sim_keys[i].key;
-		if (o->nsets >= 60 && (key || c == OPT_SET || c == OPT_ECHO)) {
-			fprintf(stderr, "undulate-sim: too many settings\n");
+		if ((o->nsets >= MAIN_MAX_SETS && (key || c == OPT_SET || c == OPT_ECHO)) ||
+		    (o->nkeys >= MAIN_MAX_KEYS && key)) {
+			fprintf(stderr, "undulate-sim: too many settings (at most %d, %d of them options other than --set)\n",
+			        MAIN_MAX_SETS, MAIN_MAX_KEYS);
 			return -1;
 		}
 		if (c == OPT_LCM_URL)
@@ -243,9 +252,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 		else if (c != OPT_CMD && c != OPT_HELP && c != 'h')
 			o->nsim_opts++;
 		if (key) {
-			snprintf(set_store[o->nsets], sizeof(set_store[0]), "%s=%s", key, optarg);
-			o->sets[o->nsets] = set_store[o->nsets];
-			o->nsets++;
+			snprintf(set_store[o->nkeys], sizeof(set_store[0]), "%s=%s", key, optarg);
+			o->sets[o->nsets++] = set_store[o->nkeys++];
 			continue;
 		}
 		switch (c) {

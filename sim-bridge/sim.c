@@ -14,6 +14,8 @@
 
 /* Words in one command line. */
 #define SIM_CMD_MAX_WORDS 16
+/* Longest wall motion a command may ask for: a day of simulated time. */
+#define SIM_WALL_SPAN_MAX_S 86400.0
 
 /* ---- set-up ------------------------------------------------------------------- */
 
@@ -271,11 +273,27 @@ static void sim_step_joint(struct sim_joint *j, double dt)
 	sim_motor_step(&j->motor, &j->params, &cmd, 0.0, dt);
 }
 
+/* The walls of a "walls ... over S" at simulated time t (s). */
+static void sim_walls_follow(struct sim *s, double t)
+{
+	struct sim_wall_motion *m = &s->wall_motion;
+	if (!m->active)
+		return;
+	double u = t >= m->t1 ? 1.0 : (t - m->t0) / (m->t1 - m->t0);
+	if (u < 0)
+		u = 0;
+	s->world.params.wall_left = m->from_left + u * (m->to_left - m->from_left);
+	s->world.params.wall_right = m->from_right + u * (m->to_right - m->from_right);
+	if (u >= 1.0)
+		m->active = false;
+}
+
 void sim_step(struct sim *s)
 {
 	for (size_t i = 0; i < s->nbuses; i++)
 		for (size_t k = 0; k < s->buses[i].njoints; k++)
 			sim_step_joint(&s->buses[i].joints[k], s->dt);
+	sim_walls_follow(s, (double)(s->steps + 1) * s->dt);
 	s->nstep_collisions = sim_world_resolve(&s->world, s->dt, s->step_collisions, SIM_MAX_COLLISIONS_PER_STEP);
 	if (s->nstep_collisions > SIM_MAX_COLLISIONS_PER_STEP)
 		s->nstep_collisions = SIM_MAX_COLLISIONS_PER_STEP;
@@ -658,20 +676,41 @@ static int cmd_servo(struct sim_cmd_ctx *x)
 	return 0;
 }
 
+/* walls none | walls LEFT RIGHT [over S]: at once, or moving on a straight
+ * line from where they stand to LEFT RIGHT over S simulated seconds (the
+ * paper's arena closes from 2.0 m to 0.3 m in 90 s). */
 static int cmd_walls(struct sim_cmd_ctx *x)
 {
-	struct sim_world_params *p = &x->s->world.params;
+	struct sim *s = x->s;
+	struct sim_world_params *p = &s->world.params;
 	if (x->argc == 2 && !strcmp(x->argv[1], "none")) {
+		s->wall_motion.active = false;
 		p->wall_left = p->wall_right = 0;
 		return REPLY(x, "ok no walls"), 0;
 	}
-	double l = 0, r = 0;
-	if (x->argc != 3 || num_parse_double(x->argv[1], &l) != NUM_OK || num_parse_double(x->argv[2], &r) != NUM_OK ||
-	    !(l < r))
-		return FAIL(x, "usage: walls none | walls LEFT RIGHT (m, LEFT < RIGHT)");
-	p->wall_left = l;
-	p->wall_right = r;
-	return REPLY(x, "ok walls %g %g", l, r), 0;
+	double l = 0, r = 0, span = 0;
+	bool over = x->argc == 5 && !strcmp(x->argv[3], "over");
+	if ((x->argc != 3 && !over) || num_parse_double(x->argv[1], &l) != NUM_OK ||
+	    num_parse_double(x->argv[2], &r) != NUM_OK || !(l < r))
+		return FAIL(x, "usage: walls none | walls LEFT RIGHT [over S] (m, LEFT < RIGHT; S seconds)");
+	if (over && (num_parse_double(x->argv[4], &span) != NUM_OK || !(span > 0) || span > SIM_WALL_SPAN_MAX_S))
+		return FAIL(x, "walls ... over S: S is seconds of simulated time, > 0 and at most %g, not '%s'",
+		            SIM_WALL_SPAN_MAX_S, x->argv[4]);
+	if (over && !(p->wall_left < p->wall_right))
+		return FAIL(x, "walls ... over S: there are no walls to move (place them first: walls LEFT RIGHT)");
+	s->wall_motion.active = false;
+	if (!over) {
+		p->wall_left = l;
+		p->wall_right = r;
+		return REPLY(x, "ok walls %g %g", l, r), 0;
+	}
+	double now = (double)s->steps * s->dt;
+	s->wall_motion = (struct sim_wall_motion){
+		.active = true, .from_left = p->wall_left, .from_right = p->wall_right, .to_left = l, .to_right = r,
+		.t0 = now, .t1 = now + span,
+	};
+	return REPLY(x, "ok walls %g %g -> %g %g over %g s (simulated t = %.3f .. %.3f s)", p->wall_left,
+	             p->wall_right, l, r, span, now, now + span), 0;
 }
 
 static int cmd_stats(struct sim_cmd_ctx *x)
@@ -730,7 +769,7 @@ static int cmd_help(struct sim_cmd_ctx *x)
 {
 	return REPLY(x, "ok commands: fault BUS ID KIND [ARG] [count=N] [prob=P] | clear BUS [ID] [KIND] | "
 	                "power BUS ID on|off | disconnect BUS | reconnect BUS | garbage BUS [N] | "
-	                "poke BUS ID REG VALUE | peek BUS ID REG | servo BUS ID | walls none|LEFT RIGHT | stats | list | "
+	                "poke BUS ID REG VALUE | peek BUS ID REG | servo BUS ID | walls none|LEFT RIGHT [over S] | stats | list | "
 	                "command ROBOT|* TEXT (lockstep) | help"), 0;
 }
 

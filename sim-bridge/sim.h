@@ -16,6 +16,15 @@
 #include "simbus.h"
 #include "world.h"
 
+/* Walls on their way to a target ("walls LEFT RIGHT over S"): placed on the
+ * straight line between from and to at every physics step, by simulated
+ * time, so the same run moves them the same way whatever the wall clock. */
+struct sim_wall_motion {
+	bool active;
+	double from_left, from_right, to_left, to_right;  /* m */
+	double t0, t1;                                    /* s of simulated time */
+};
+
 struct sim {
 	struct sim_config cfg;
 	struct sim_bus buses[SIM_MAX_BUSES];
@@ -32,6 +41,7 @@ struct sim {
 	size_t next_event;
 	uint64_t commands, bad_commands;
 	uint64_t rng;
+	struct sim_wall_motion wall_motion;
 	/* "command ROBOT|* TEXT": a command for the robots' daemons, which only
 	 * lockstep can deliver at a simulated time (main.c sets this then);
 	 * NULL: refused. bus -1 = every robot. Returns daemons reached or -1. */

@@ -22,9 +22,10 @@ start_sim() {
 }
 start_sim sim || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
-# silent_s 2: the short outage below resumes by itself, the long one latches
+# silent_s 2: the short outage below resumes by itself, the long one latches;
+# compliance slope 16 (factory 32): written at start-up like the margin
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode sinusoid --set robot.safe_stop=limp \
-	--set robot.silent_s=2
+	--set robot.silent_s=2 --set robot.compliance_slope=16
 wait_log d "ready: $R.STATE" 10 || { tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
 wait_for 10 cycle_at_least 250
 # start-up writes compliance margin 0 (the factory value is 1: a dead band in
@@ -32,6 +33,16 @@ wait_for 10 cycle_at_least 250
 margins() { echo "$(ctl peek r1 1 cw_compliance_margin) $(ctl peek r1 2 ccw_compliance_margin)"; }
 m=$(margins)
 if [ "$m" = "ok 0 ok 0" ]; then tap_ok "start-up set compliance margin 0"; else tap_fail "compliance margin at start-up" "$m"; fi
+slopes() { echo "$(ctl peek r1 1 cw_compliance_slope) $(ctl peek r1 2 ccw_compliance_slope)"; }
+m=$(slopes)
+if [ "$m" = "ok 16 ok 16" ]; then tap_ok "start-up set compliance slope 16"; else tap_fail "compliance slope at start-up" "$m"; fi
+# a slope changed behind the daemon's back is read back and written again
+ctl poke r1 2 ccw_compliance_slope 64 >/dev/null
+slopes_are() { [ "$(slopes)" = "$1" ]; }
+if wait_for 3 slopes_are "ok 16 ok 16" &&
+	wait_for 3 grep -q "^EVENT $R .*compliance slope read back 64, expected 16" "$T/watch.log"; then
+	tap_ok "a compliance slope changed on the servo is reported and written again"
+else tap_fail "compliance slope written again" "$(slopes); $(grep "^EVENT $R .*readback" "$T/watch.log" | tail -2)"; fi
 
 # ---- the simulator drops the bus (like an unplugged adapter) and brings it back
 ctl disconnect r1 >/dev/null
@@ -83,6 +94,9 @@ resume_check "after simulator restart"
 m=$(margins)
 if [ "$m" = "ok 0 ok 0" ]; then tap_ok "compliance margin written again on the restarted (factory-fresh) servos"
 else tap_fail "compliance margin after restart" "$m"; fi
+m=$(slopes)
+if [ "$m" = "ok 16 ok 16" ]; then tap_ok "compliance slope written again on the restarted servos"
+else tap_fail "compliance slope after restart" "$m"; fi
 c0=$(last_state | field cycle)
 wait_for 5 cycle_at_least $((c0 + 100))
 s=$(last_state)

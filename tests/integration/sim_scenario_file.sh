@@ -56,4 +56,17 @@ timeout -k 2 10 "$S" --scenario "$T/mib.scenario" --link-dir "$T/links" --lcm-ur
 	>"$T/ok.log" 2>&1; rc=$?
 if [ "$size" = 1048576 ] && [ "$rc" = 0 ] && grep -q 'ready:' "$T/ok.log"; then tap_ok "a scenario of exactly 1 MiB runs"
 else tap_fail "a scenario of exactly 1 MiB runs" "size $size, rc $rc: $(cat "$T/ok.log")"; fi
+# the command line carries a long run's schedule: scripts/demo.sh --lockstep
+# writes a --set per contact sample (every 5 s) and one for the switch, 62 for
+# 300 s, which the simulator once refused ("too many settings", over 60)
+sets=(); for t in $(seq 0 5 600); do sets+=(--set "events.$t=stats"); done
+timeout -k 2 10 "$S" --scenario "$T/ok.scenario" --link-dir "$T/links" --lcm-url "$URL" --duration 0.2 --quiet \
+	"${sets[@]}" >"$T/ok.log" 2>&1; rc=$?
+if [ "$rc" = 0 ] && grep -q "t=0.000 event 'stats': ok" "$T/ok.log"; then tap_ok "121 --set events on the command line are taken"
+else tap_fail "121 --set events on the command line" "rc $rc: $(head -3 "$T/ok.log")"; fi
+sets=(); for t in $(seq 0 600); do sets+=(--set "events.$t=stats"); done
+timeout -k 2 10 "$S" --scenario "$T/ok.scenario" --link-dir "$T/links" --lcm-url "$URL" --duration 0.2 --quiet \
+	"${sets[@]}" >"$T/ok.log" 2>&1; rc=$?
+if [ "$rc" = 2 ] && grep -q "too many settings (at most 576" "$T/ok.log"; then tap_ok "601 --set options: refused with the limit named"
+else tap_fail "601 --set options refused" "rc $rc: $(head -3 "$T/ok.log")"; fi
 tap_done

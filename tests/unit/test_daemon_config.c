@@ -433,6 +433,31 @@ static void test_overrides(void **state)
 	assert_string_equal(e.line[2], "command line: [robot] prot: unknown key");
 }
 
+/* compliance_slope: the servo's own (factory 32) unless set; the register's
+ * range; printed with the rest (what --check-config -v shows). */
+static void test_compliance_slope(void **state)
+{
+	(void)state;
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "r.conf", good, &e));
+	assert_true(cfg_finish(&c, &e));
+	assert_int_equal(c.compliance_slope, -1);
+	assert_true(cfg_override(&c, "robot.compliance_slope=128", &e));
+	assert_int_equal(c.compliance_slope, 128);
+	assert_false(cfg_override(&c, "robot.compliance_slope=255", &e));
+	assert_false(cfg_override(&c, "robot.compliance_slope=-2", &e));
+	assert_false(cfg_override(&c, "robot.compliance_slope=64.5", &e));
+	assert_int_equal(c.compliance_slope, 128);
+	char text[4096];
+	FILE *f = fmemopen(text, sizeof text, "w");
+	assert_non_null(f);
+	cfg_print(&c, f);
+	fclose(f);
+	assert_non_null(strstr(text, "\ncompliance_slope = 128\n"));
+}
+
 static void test_command_line_only(void **state)
 {
 	(void)state;
@@ -544,6 +569,7 @@ int main(void)
 		cmocka_unit_test(test_only_regular_files),
 		cmocka_unit_test(test_overrides),
 		cmocka_unit_test(test_command_line_only),
+		cmocka_unit_test(test_compliance_slope),
 		cmocka_unit_test(test_param_ranges),
 		cmocka_unit_test(test_rs485),
 	};

@@ -425,9 +425,50 @@ static void test_limits_respected(void **state)
 		fail_msg("why: %s", why);
 }
 
+/* The read-back of a joint's RAM (24..43) as a servo would send it. */
+static void readback(size_t j, uint8_t margin, uint8_t slope)
+{
+	uint8_t ram[CTL_READBACK_LEN] = { 0 };
+	ram[DXL_AX_TORQUE_ENABLE - CTL_READBACK_ADDR] = c.j[j].torque;
+	dxl_put_u16(&ram[DXL_AX_TORQUE_LIMIT - CTL_READBACK_ADDR], 1023);
+	ram[DXL_AX_CW_COMPLIANCE_MARGIN - CTL_READBACK_ADDR] = ram[DXL_AX_CCW_COMPLIANCE_MARGIN - CTL_READBACK_ADDR] = margin;
+	ram[DXL_AX_CW_COMPLIANCE_SLOPE - CTL_READBACK_ADDR] = ram[DXL_AX_CCW_COMPLIANCE_SLOPE - CTL_READBACK_ADDR] = slope;
+	ram[DXL_AX_PRESENT_VOLTAGE - CTL_READBACK_ADDR] = 120;
+	ram[DXL_AX_PRESENT_TEMPERATURE - CTL_READBACK_ADDR] = 30;
+	ctl_readback(&c, j, ram, 0);
+}
+
+/* A configured compliance slope (the position loop's stiffness) is the
+ * servo's: a slope found otherwise (another program, a reset) is counted
+ * and written again, both sides in one write; unset, the servo keeps its
+ * own. */
+static void test_compliance_slope_read_back(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_HOLD);
+	run(20);
+	drain_outputs();
+	long before = c.readback_mismatches;
+	readback(0, 0, 32);   /* the factory slope: not configured, so nothing */
+	assert_int_equal(c.wq.n, 0);
+	assert_int_equal(c.readback_mismatches, before);
+
+	cfg.compliance_slope = 128;
+	readback(0, 0, 128);
+	assert_int_equal(c.wq.n, 0);
+	readback(1, 0, 32);
+	assert_true(has_write(2, DXL_AX_CW_COMPLIANCE_SLOPE, 128 | 128 << 8));
+	assert_int_equal(c.readback_mismatches, before + 1);
+	const struct ctl_event *ev = find_event("readback");
+	assert_non_null(ev);
+	assert_non_null(strstr(ev->text, "compliance slope read back 32, expected 128"));
+	cfg.compliance_slope = -1;
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_compliance_slope_read_back),
 		cmocka_unit_test(test_start_hold),
 		cmocka_unit_test(test_switches_without_jumps),
 		cmocka_unit_test(test_oscillator_starts_from_rest),

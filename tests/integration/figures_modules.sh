@@ -1,0 +1,160 @@
+#!/usr/bin/env bash
+# figures_modules.sh — the rows, channel and forces modules of `make figures`
+# (figures/<name>/fig.sh): their job lists are the same every time, with
+# unique run names and seeds; bad arguments get one clear line and exit 2;
+# each merge, on a fixed small set of result rows written here, writes its
+# CSV, its pictures with the data drawn (the data colours' pixels counted by
+# tests/tools/pngdata: a picture that exists is not a picture that shows
+# data) and its fragment with the numbers those rows give; a merge without
+# results or without gnuplot fails with a message; and one tiny real run
+# (the channel: four robots, 32 s of simulated time in lockstep).
+. "$(dirname "$0")/../lib.sh"
+F="$top/figures"
+PNG="$BUILD/tests/tools/pngdata"
+command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
+[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+
+# pixels COLOUR PNG: how many pixels of that colour (RRGGBB)
+pixels() { "$PNG" --rgb "$1" "$2" 2>/dev/null | sed -n 's/.*matching=//p'; }
+coloured() { "$PNG" "$1" 2>/dev/null | sed -n 's/.*coloured=//p'; }
+# result NAME DIR LINES...: a run folder with its result.csv
+result() {
+	local mod=$1 id=$2; shift 2
+	mkdir -p "$T/runs/$mod/$id"
+	printf '%s\n' "$@" >"$T/runs/$mod/$id/result.csv"
+}
+
+# ---- jobs ---------------------------------------------------------------------------
+# the seed's field in a job line: the last but for forces (SLOPE SEED END)
+for m in rows channel forces; do
+	sf=NF; [ "$m" = forces ] && sf=3
+	a=$("$F/$m/fig.sh" jobs) b=$("$F/$m/fig.sh" jobs) q=$("$F/$m/fig.sh" jobs --quick)
+	ids=$(awk '{ print $1 }' <<<"$a" | sort | uniq -d)
+	bad=$(awk '$1 !~ /^[A-Za-z0-9_.-]+$/' <<<"$a")
+	seeds=$(awk -v f="$sf" '{ print (f == "NF") ? $NF : $f }' <<<"$a" | sort | uniq -d)
+	if [ -n "$a" ] && [ "$a" = "$b" ] && [ -z "$ids" ] && [ -z "$bad" ] && [ -z "$seeds" ] && [ -n "$q" ] &&
+		[ "$(wc -l <<<"$q")" -lt "$(wc -l <<<"$a")" ]; then
+		tap_ok "$m: $(wc -l <<<"$a") jobs ($(wc -l <<<"$q") quick), the same twice, unique names and seeds"
+	else tap_fail "$m: jobs" "$(head -3 <<<"$a"); duplicate ids '$ids', bad '$bad', duplicate seeds '$seeds'"; fi
+done
+
+# ---- bad arguments: one line, exit 2, nothing run --------------------------------
+refused() { # NAME WANT CMD...
+	local name=$1 want=$2 rc; shift 2
+	"$@" >"$T/out" 2>"$T/err"; rc=$?
+	if [ "$rc" = 2 ] && [ "$(wc -l <"$T/err")" = 1 ] && grep -q -- "$want" "$T/err"; then tap_ok "$name refused: $(cat "$T/err")"
+	else tap_fail "$name refused (exit 2, one line with '$want')" "rc $rc: $(cat "$T/err" "$T/out" | head -3)"; fi
+}
+refused "forces: a slope of 999" "SLOPE: want a whole number from 2 to 254, got '999'" "$F/forces/fig.sh" run "$T/bad" 999 1
+refused "rows: d~ abc" "DSEP: want a number" "$F/rows/fig.sh" run "$T/bad" abc 0 60 1
+refused "rows: 5 s (shorter than the switch and the window)" "SECONDS: want a whole number from 14" "$F/rows/fig.sh" run "$T/bad" 0.5 0 5 1
+refused "channel: width 0" "WIDTH_CM: want a number from 5 to 60" "$F/channel/fig.sh" run "$T/bad" 0 1
+refused "channel: missing seed" "run OUTDIR WIDTH_CM SEED" "$F/channel/fig.sh" run "$T/bad" 20
+refused "an unknown subcommand" "usage: fig.sh" "$F/rows/fig.sh" draw
+[ ! -e "$T/bad" ] && tap_ok "no run folder made by a refused run" || tap_fail "no run folder made by a refused run"
+
+# ---- forces: merge on fixed rows -----------------------------------------------------
+H="slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s,end_s"
+i=0
+for row in "16,17.7,1,0.02,0.07,0.8,0.8,30,4" "16,17.7,2,0.02,0.07,0.8,0.8,34,6" "16,17.7,3,0.02,0.07,0.8,0.8,40,5" \
+	"32,8.87,1,0.026,0.075,0.8,0.8,25,5" "32,8.87,2,0.026,0.075,0.8,0.8,27,7" \
+	"64,4.43,1,0.05,0.03,0.8,0.8,22,4" "128,2.22,1,0.11,0.017,0.82,0.81,20,4.4" "128,2.22,2,0.11,0.017,0.82,0.81,22,4"; do
+	i=$((i + 1))
+	result forces "r$i" "$H" "$row,30,5,190,170,60,30,1.4,95,300"
+	# the force per second: walls closing 10-100 s, clock, then the oscillator
+	awk -v c="${row#*,*,*,*,*,*,*,}" 'BEGIN { split(c, v, ","); print "t,force_n,impacts,pair_impacts,wall_impacts"
+		for (t = 0; t < 300; t++) { f = t < 10 ? 1 : (t < 100 ? 1 + (v[1] - 1) * (t - 10) / 90 : (t < 200 ? v[1] : v[2]))
+			printf "%d,%g,10,8,2\n", t, f } }' >"$T/runs/forces/r$i/series.csv"
+done
+if "$F/forces/fig.sh" merge "$T/runs/forces" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "forces: merge"
+else tap_fail "forces: merge" "$(cat "$T/merge.out")"; fi
+red=$(pixels d62728 "$T/fig/forces.png") blue=$(pixels 1f77b4 "$T/fig/forces.png")
+if [ "${red:-0}" -ge 400 ] && [ "${blue:-0}" -ge 400 ]; then tap_ok "forces.png: both series drawn ($red clock, $blue oscillator pixels)"
+else tap_fail "forces.png shows its data" "clock $red, oscillator $blue pixels of their colours"; fi
+n=$(coloured "$T/fig/forces_time.png")
+if [ "${n:-0}" -ge 3000 ]; then tap_ok "forces_time.png: four runs' forces drawn ($n coloured pixels)"
+else tap_fail "forces_time.png shows its data" "$n coloured pixels"; fi
+# slope 16: clock 30, 34, 40 -> median 34 (30-40); oscillator 4, 6, 5 -> 5; 6.8x
+if grep -qF '| 16 | 17.7 | 3 | 0.02, 0.07 | 34 (30-40) | 5 (4-6) | 6.8x |' "$T/fig/forces.md" &&
+	grep -qF '| 128 | 2.22 | 2 | 0.11, 0.017 | 21 (20-22) | 4.2 (4-4.4) | 5.0x |' "$T/fig/forces.md" &&
+	grep -q '^!\[.*\](figures/forces.png)' "$T/fig/forces.md" && [ "$(wc -l <"$T/fig/forces.csv")" = 9 ] &&
+	grep -q 'median over 100-200 s (clock)' "$T/fig/forces.md"; then
+	tap_ok "forces.md: the medians per slope with their ranges and ratios, the picture linked; forces.csv 8 rows"
+else tap_fail "forces.md numbers" "$(grep '^|' "$T/fig/forces.md")"; fi
+
+# ---- rows: merge on fixed rows ---------------------------------------------------------
+H="dsep,beta,seconds,seed,pairs,colliding_pairs,pair_collisions_hz,compat_error_rad,compat_error_max_rad,compatible_pairs,antiphase_pairs,stopped_pairs,wall_collisions_hz,relax_s,censored,min_swing_rad,wall_s"
+i=0
+for row in "0.1,0,60,1,9,0,0,0,0,9,0,0,0,20,0,1.6,14" "0.5,0,60,1,9,5,0.8,0.3,1.1,4,3,0,0,55,1,1.5,14" \
+	"0.5,0,60,2,9,3,0.6,0.1,0.9,6,1,0,0,55,1,1.5,14" "0.9,0,60,1,9,6,0.9,0.5,1.2,3,4,0,0,57,1,1.4,14" \
+	"0.1,0.1,60,1,9,0,0,0,0,9,0,0,0,12,0,1.6,14" "0.5,0.1,60,1,9,0,0,0,0,9,0,0,0,9,0,1.6,14" \
+	"0.9,0.1,60,1,9,0,0,0,0,9,0,0,0,4,0,1.6,14" "0.7,0.1,240,1,9,0,0,0,0,9,0,0,0,8,0,1.6,50" \
+	"0.7,0.02,240,1,9,0,0,0,0,9,0,0,0,30,0,1.6,50" "0.7,0.005,240,1,9,0,0,0,0,9,0,0,0,90,0,1.6,50" \
+	"0.7,0.005,240,2,9,1,0.1,0,0,8,0,0,0,236,1,1.6,50"; do
+	i=$((i + 1))
+	result rows "r$i" "$H" "$row"
+done
+if "$F/rows/fig.sh" merge "$T/runs/rows" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "rows: merge"
+else tap_fail "rows: merge" "$(cat "$T/merge.out")"; fi
+red=$(pixels d62728 "$T/fig/rows.png") blue=$(pixels 1f77b4 "$T/fig/rows.png")
+if [ "${red:-0}" -ge 600 ] && [ "${blue:-0}" -ge 400 ]; then tap_ok "rows.png: immobile and mobile drawn ($red, $blue pixels)"
+else tap_fail "rows.png shows its data" "immobile $red, mobile $blue pixels of their colours"; fi
+blue=$(pixels 1f77b4 "$T/fig/rows_relax.png") red=$(pixels d62728 "$T/fig/rows_relax.png")
+if [ "${blue:-0}" -ge 300 ] && [ "${red:-0}" -ge 60 ]; then tap_ok "rows_relax.png: relaxed runs and the censored one drawn ($blue, $red pixels)"
+else tap_fail "rows_relax.png shows its data" "relaxed $blue, censored $red pixels"; fi
+if grep -qF '| 0.5 | 0 | 2 | 0.7 | 0.2 | 8 of 18 | 10 of 18 | 4 |' "$T/fig/rows.md" &&
+	grep -qF '| 0.005 | 2 | 1 of 2 | 90, > 237 | > 237 |' "$T/fig/rows.md" && grep -qF '| 0.1 | 1 | 1 of 1 | 8 | 8 |' "$T/fig/rows.md" &&
+	grep -q 'immobile 0.1: 0 of 9, 0.5: 8 of 18, 0.9: 6 of 9; mobile 0.1: 0 of 9' "$T/fig/rows.md"; then
+	tap_ok "rows.md: means per d~ and beta, relaxation per beta with the censored run counted as the longest, pairs colliding per d~ beside the paper"
+else tap_fail "rows.md numbers" "$(grep '^|' "$T/fig/rows.md")"; fi
+
+# ---- channel: merge on fixed rows ----------------------------------------------------
+H="width_cm,nominal_dsep,seed,pair,class,mean_delta,mean_abs_delta,spread,window_collisions,collisions,impulse,distance_m,dsep,compat_limit,swing_a,swing_b,min_swing_rad,wall_s"
+result channel a "$H" "16,0.5362,1,r1:r2,compatible,1.0,1.0,0.1,0,30,3,0.16,0.55,1.1645,1.6,1.6,1.5,6" \
+	"16,0.5362,1,r2:r3,still-colliding,-1.2,1.2,0.2,3,40,3,0.17,0.57,1.2130,1.6,1.6,1.5,6" \
+	"16,0.5362,1,r3:r4,in-phase,0.1,0.1,0.1,0,20,2,0.15,0.50,1.0472,1.6,1.6,1.5,6"
+result channel b "$H" "16,0.5362,2,r1:r2,compatible,0.8,0.8,0.1,0,30,3,0.16,0.52,1.0940,1.6,1.6,1.5,6" \
+	"16,0.5362,2,r2:r3,anti-phase,3.1,3.1,0.1,9,90,9,0.17,0.60,1.2870,1.6,1.6,1.5,6" \
+	"16,0.5362,2,r3:r4,compatible,-0.9,0.9,0.1,0,20,2,0.15,0.57,1.2130,1.6,1.6,1.5,6"
+result channel c "$H" "24,0.8043,1,r1:r2,compatible,1.5,1.5,0.1,0,30,3,0.24,0.80,1.8546,1.6,1.6,1.5,6" \
+	"24,0.8043,1,r2:r3,compatible,1.7,1.7,0.1,0,40,3,0.25,0.84,1.9736,1.6,1.6,1.5,6" \
+	"24,0.8043,1,r3:r4,compatible,-1.6,1.6,0.1,0,20,2,0.23,0.78,1.7926,1.6,1.6,1.5,6"
+if "$F/channel/fig.sh" merge "$T/runs/channel" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "channel: merge"
+else tap_fail "channel: merge" "$(cat "$T/merge.out")"; fi
+blue=$(pixels 1f77b4 "$T/fig/channel.png") other=$(pixels 2ca02c "$T/fig/channel.png")
+if [ "${blue:-0}" -ge 150 ] && [ "${other:-0}" -ge 80 ]; then tap_ok "channel.png: both widths' pairs drawn ($blue, $other pixels)"
+else tap_fail "channel.png shows its data" "16 cm $blue, 24 cm $other pixels of their colours"; fi
+if grep -qF '| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 2 |' "$T/fig/channel.md" &&
+	grep -q 'In all: 8 of 9 pairs ended at or below the compatibility bound .*, 1 in anti-phase' "$T/fig/channel.md"; then
+	tap_ok "channel.md: per width the pairs at or below 2 asin(d~), anti-phase counted"
+else tap_fail "channel.md numbers" "$(grep -E '^\||In all' "$T/fig/channel.md")"; fi
+
+# ---- no results, no gnuplot ----------------------------------------------------------------
+mkdir -p "$T/empty"
+"$F/rows/fig.sh" merge "$T/empty" "$T/fig2" >"$T/out" 2>&1; rc=$?
+if [ "$rc" = 1 ] && grep -q "no results in .*result.csv: nothing to draw" "$T/out"; then tap_ok "merge without results: exit 1, said so"
+else tap_fail "merge without results" "rc $rc: $(cat "$T/out")"; fi
+mkdir -p "$T/path"
+for d in /usr/local/bin /usr/bin /bin; do
+	for p in "$d"/*; do n=${p##*/}; [ "$n" = gnuplot ] || [ -e "$T/path/$n" ] || ln -s "$p" "$T/path/$n"; done
+done
+PATH="$T/path" "$F/forces/fig.sh" merge "$T/runs/forces" "$T/fig2" >"$T/out" 2>&1; rc=$?
+if [ "$rc" = 1 ] && grep -q "gnuplot is missing" "$T/out" && [ ! -e "$T/fig2/forces.png" ]; then tap_ok "merge without gnuplot: exit 1, said so"
+else tap_fail "merge without gnuplot" "rc $rc: $(cat "$T/out")"; fi
+
+# ---- one tiny real run: the channel, four robots, 32 s in lockstep ----------------------
+if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyze" ]; then
+	start=$(date +%s)
+	(cd / && "$F/channel/fig.sh" run "$T/real/w20" 20 7) >"$T/real.out" 2>&1; rc=$?
+	r="$T/real/w20/result.csv"
+	if [ "$rc" = 0 ] && [ "$(wc -l <"$r")" = 4 ] &&
+		awk -F, 'NR > 1 && !($13 > 0.1 && $13 < 2 && $14 > 0 && $15 > 0.2 && $16 > 0.2) { bad = 1 } END { exit bad }' "$r"; then
+		tap_ok "channel: a real run from / in $(($(date +%s) - start)) s: three pairs with d~, bound and swings ($(awk -F, 'NR > 1 { printf "%s %s d~ %.2f; ", $4, $5, $13 }' "$r"))"
+	else tap_fail "channel: a real run" "rc $rc: $(cat "$T/real.out"; cat "$r" 2>/dev/null)"; fi
+	if [ ! -e "$T/real/w20/run/demo.lcmlog" ] && [ ! -e "$T/real/w20/run/states.csv" ] && [ -f "$T/real/w20/run/summary.json" ]; then
+		tap_ok "the run's LCM log and sample tables removed, its summary kept"
+	else tap_fail "large files removed" "$(ls "$T/real/w20/run" 2>&1 | tr '\n' ' ')"; fi
+else
+	tap_skip "channel: a real run" "the programs are not built"
+fi
+tap_done
