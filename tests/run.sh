@@ -5,7 +5,8 @@
 #    TAP lines: "ok ..." / "not ok ...", and a plan "1..N")
 #  - with TEST_LONG=1: $LONG_TESTS_DIR/*.sh (default tests/long) as well
 # Environment: TEST_FILTER (run the programs whose name contains it),
-# TEST_TIMEOUT (seconds one program may run, default 300; a hang is a failure).
+# TEST_TIMEOUT (seconds one program may run, default 300; a hang is a failure),
+# TEST_JOBS (integration tests run side by side, default 2; see below).
 # Logs: $BUILD/test-logs/<program>.log.
 #
 # What counts (TAP):
@@ -101,15 +102,28 @@ faults() {
 	echo "$out"
 }
 
+# execute NAME CMD...: run one program into its log; print "RC MS".
+execute() {
+	local name=$1; shift
+	local start=$(date +%s%N) rc
+	CMOCKA_MESSAGE_OUTPUT=TAP timeout --kill-after=10 "$per_test_timeout" "$@" >"$logs/$name.log" 2>&1
+	rc=$?
+	echo "$rc $(( ($(date +%s%N) - start) / 1000000 ))"
+}
+
 run_one() {
 	local name=$1; shift
-	local log="$logs/$name.log"
 	[ -n "$filter" ] && [[ "$name" != *$filter* ]] && return
+	local rc ms
+	read -r rc ms < <(execute "$name" "$@")
+	account "$name" "$rc" "$ms"
+}
+
+# account NAME RC MS: count a finished program's results and show its line.
+account() {
+	local name=$1 rc=$2 ms=$3
+	local log="$logs/$name.log"
 	programs=$((programs + 1))
-	local start=$(date +%s%N)
-	CMOCKA_MESSAGE_OUTPUT=TAP timeout --kill-after=10 "$per_test_timeout" "$@" >"$log" 2>&1
-	local rc=$?
-	local ms=$(( ($(date +%s%N) - start) / 1000000 ))
 	local p f s t plans planned plan_skip
 	read -r p f s t plans planned plan_skip < <(tap_counts "$log")
 	local results=$((p + f + s + t))
@@ -154,16 +168,64 @@ for t in "$unit_dir"/test_*; do
 	[ -f "$t" ] && [ -x "$t" ] || continue
 	run_one "$(basename "$t")" "$t"
 done
+
+# ---- integration tests, TEST_JOBS at a time ------------------------------------------
+# Most integration tests spend their time waiting: on simulated buses, on
+# timeouts, on runs in real time. TEST_JOBS of them (default 2) run side by
+# side, each on its own LCM ports and in its own temporary directory
+# (tests/lib.sh); they are counted and shown in their own order, as when run
+# one by one. A test that needs the machine to itself — it measures a gait or
+# an experiment in real time — says so with a line "# run.sh: alone" and runs
+# with nothing beside it. TEST_JOBS=1 runs them one by one.
+jobs_max=${TEST_JOBS:-2}
+[[ "$jobs_max" =~ ^[1-9][0-9]?$ ]] || { echo "run.sh: TEST_JOBS must be 1..99, not '$jobs_max'" >&2; exit 2; }
+names=() scripts=()
 for t in "$integration_dir"/*.sh; do
 	[ -f "$t" ] || continue
-	run_one "$(basename "$t" .sh)" bash "$t"
+	n=$(basename "$t" .sh)
+	[ -n "$filter" ] && [[ "$n" != *$filter* ]] && continue
+	names+=("$n"); scripts+=("$t")
 done
 if [ -n "${TEST_LONG:-}" ]; then
 	for t in "$long_dir"/*.sh; do
 		[ -f "$t" ] || continue
-		run_one "$(basename "$t" .sh)" bash "$t"
+		n=$(basename "$t" .sh)
+		[ -n "$filter" ] && [[ "$n" != *$filter* ]] && continue
+		names+=("$n"); scripts+=("$t")
 	done
 fi
+is_alone() { grep -q '^# run.sh: alone' "$1"; }
+# A started program is over when its .rc file ("RC MS") is there.
+over() { [ -f "$logs/${names[$1]}.rc" ]; }
+started=0 reported=0
+while [ "$reported" -lt "${#names[@]}" ]; do
+	# how many run now, and whether one of them wants the machine alone
+	active=0 alone_now=0
+	for ((i = reported; i < started; i++)); do
+		over "$i" && continue
+		active=$((active + 1))
+		is_alone "${scripts[$i]}" && alone_now=1
+	done
+	while [ "$started" -lt "${#names[@]}" ] && [ "$alone_now" -eq 0 ] && [ "$active" -lt "$jobs_max" ]; do
+		if is_alone "${scripts[$started]}"; then
+			[ "$active" -eq 0 ] || break
+			alone_now=1
+		fi
+		n=${names[$started]}
+		rm -f "$logs/$n.rc"
+		( execute "$n" bash "${scripts[$started]}" >"$logs/$n.rc.tmp"; mv "$logs/$n.rc.tmp" "$logs/$n.rc" ) &
+		started=$((started + 1)) active=$((active + 1))
+	done
+	# the finished ones, in order
+	while [ "$reported" -lt "$started" ] && over "$reported"; do
+		read -r rc ms <"$logs/${names[$reported]}.rc"
+		rm -f "$logs/${names[$reported]}.rc"
+		account "${names[$reported]}" "$rc" "$ms"
+		reported=$((reported + 1))
+	done
+	[ "$reported" -lt "${#names[@]}" ] && ! over "$reported" && wait -n 2>/dev/null
+done
+wait
 
 echo
 if [ "$todo" -gt 0 ]; then

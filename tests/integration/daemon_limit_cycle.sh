@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # The oscillator's defaults on the simulated robot, through the real daemon:
 # undulate-sim + undulated with no oscillator settings at all, from rest (the
 # daemon's starter), settle, then measure the joints' own angles as published

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # undulated with torque actuation against undulate-sim (daemon/README.md,
 # "Torque actuation"): OSCILLATOR puts the servos in wheel mode and drives their
 # output; the register traffic is read back from the simulator. Checked: a

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # undulated --tune, through real processes:
 #   - on the simulated robot and, at the same time, on a test plant unlike the
 #     simulator (tests/tools/plant.py: its own protocol code, joints that

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # e2e_demo.sh — `make demo DEMO_SECONDS=...` end to end, as a new user runs
 # it: the paper's contact-force scene (ten robots crowded in a row, one
 # undulated each), 20 s on the clock, then the oscillator, headless; the

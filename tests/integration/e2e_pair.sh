@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # e2e_pair.sh — the paper's pair rig through the real daemon on the simulated
 # bus (theory.md, "Two phase oscillators that touch"): two single-joint robots
 # on immobile bases, restitution r = 0.67, joints driven by torque as on the

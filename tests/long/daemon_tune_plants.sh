@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # daemon_tune_plants.sh (make test-long) — undulated --tune on plants that
 # differ: the simulator with its motor changed (return delay, load, friction,
 # supply voltage, compliance), one joint, other targets, and the test plant

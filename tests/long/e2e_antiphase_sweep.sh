@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # e2e_antiphase_sweep.sh (make test-long) — where does anti-phase appear as the
 # pair rig's separation grows? The pair rig (sim-bridge/scenarios/pair-rig.scenario,
 # r = 0.67, immobile, joints driven by torque as on the paper's rig) through

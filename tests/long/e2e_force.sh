@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # e2e_force.sh — the paper's contact-force experiment, shortened: ten
 # two-joint robots crowded in a row (sim-bridge/scenarios/force10.scenario), one
 # undulated each, driven by the clock (SINUSOID) at random phases, then
