@@ -36,6 +36,9 @@ enum cfg_drive { CFG_DRIVE_PWM, CFG_DRIVE_CURRENT };
  * only (the local command socket, whose file permissions decide who); or
  * also the LCM network, each command signed with the shared key. */
 enum cfg_commands { CFG_CMD_OFF, CFG_CMD_LOCAL, CFG_CMD_NETWORK };
+/* The bus's protocol: Dynamixel 1.0 (AX-12), 2.0 (X series), or found at
+ * start-up by PINGs (daemon/README.md, "Protocol"). */
+enum cfg_protocol { CFG_PROTO_AUTO = 0, CFG_PROTO_1 = 1, CFG_PROTO_2 = 2 };
 
 struct cfg_joint {
 	struct osc_joint_params osc;
@@ -51,6 +54,7 @@ struct cfg {
 	char port[CFG_PATH_MAX];
 	char usb_serial[64];
 	long baud;
+	enum cfg_protocol protocol;    /* 1, 2, or auto (found at start-up) */
 	uint8_t ids[CFG_MAX_JOINTS];
 	size_t njoints;
 	enum cfg_mode mode;            /* the start mode; HOLD when none is given (mode_given) */
@@ -77,6 +81,9 @@ struct cfg {
 	enum cfg_drive torque_drive;   /* torque actuation: pwm (AX-12) or current */
 	double stall_torque;           /* N·m at 12 V and full output (AX-12A: 1.5) */
 	double no_load_speed;          /* rad/s at 12 V and full output (AX-12A: 59 rpm = 6.18) */
+	bool stall_torque_given, no_load_speed_given;   /* else the servo model's datasheet line */
+	long bus_watchdog_ms;          /* X series: Bus Watchdog (98), 0 = off, in 20 ms steps */
+	int fault_reboots;             /* X series: REBOOTs of one servo after a shutdown, per 'clear' */
 	long bus_margin_us;            /* slack added to every bus timeout */
 	char lockstep[CFG_PATH_MAX];   /* the simulator's lockstep socket: virtual time ("": real time) */
 	double ramp_s;                 /* blend time for start-up and mode switches */
@@ -134,6 +141,10 @@ const char *cfg_param_commandable_list(void);
 #define CFG_MAX_NATURAL_HZ 5.0
 bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap);
 const char *cfg_commands_name(enum cfg_commands c);
+const char *cfg_protocol_name(enum cfg_protocol p);   /* "1", "2", "auto" */
+/* Bus Watchdog (98) units (20 ms each) for bus_watchdog_ms, rounded up: the
+ * servo never stops sooner than configured. */
+uint8_t cfg_watchdog_units(const struct cfg *c);
 bool cfg_param_is_joint(const char *key);   /* k, c, ..., max_step */
 bool cfg_param_is_robot(const char *key);   /* amplitude, frequency, phase */
 /* Value of a per-joint parameter by name (for commands); NULL if unknown. */
