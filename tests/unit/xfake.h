@@ -39,6 +39,8 @@ struct xfake_servo {
 	uint8_t err;                 /* forced into every status (fault injection) */
 	uint8_t hwerr_after_reboot;  /* hardware error status a REBOOT leaves (a cause still there) */
 	bool powered;                /* false: hears nothing */
+	bool refuse_writes;          /* every write refused (access error), nothing written */
+	unsigned drive_parts;        /* SYNC_WRITE parts naming it with a non-zero Goal PWM or Current */
 };
 
 struct xfake {
@@ -169,6 +171,8 @@ static inline uint8_t xfake_write_error(const struct xfake_servo *s, uint16_t ad
 {
 	if (addr + n > XFAKE_TABLE)
 		return DXL2_ERRNUM_DATA_LENGTH;
+	if (s->refuse_writes)
+		return DXL2_ERRNUM_ACCESS;
 	if (addr < DXL2_X_EEPROM_END && s->mem[64])
 		return DXL2_ERRNUM_ACCESS;
 	if (addr <= 64 && addr + n > 64 && data[64 - addr] && (s->mem[70] & s->mem[63]))
@@ -250,6 +254,8 @@ static inline void xfake_sync(struct xfake *fb, uint8_t instr, const uint8_t *p,
 		struct xfake_servo *s = xfake_servo_by_id(fb, p[off]);
 		if (s == NULL || !xfake_hears(fb, s))
 			continue;
+		if (instr == 0x83 && (addr == 100 || addr == 102) && len == 2 && (p[off + 1] | p[off + 2]) != 0)
+			s->drive_parts++;
 		if (instr == 0x82) {
 			if (s->mem[68] >= 1)
 				xfake_send_status(fb, s, 0, &s->mem[addr], len);
