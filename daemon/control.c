@@ -153,7 +153,7 @@ static const char *ctl_register_name(const struct sm_model *m, const struct wq_w
 	}
 }
 
-static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what);
+static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what, const char *after);
 
 /* X series: what an acknowledged (or given-up) write means to the joint. */
 static void ctl_x_write_done(struct ctl *c, size_t j, const struct wq_write *w, bool ok)
@@ -161,7 +161,7 @@ static void ctl_x_write_done(struct ctl *c, size_t j, const struct wq_write *w, 
 	struct ctl_joint *jt = &c->j[j];
 	if (w->len == 0) {
 		if (!ok) {
-			ctl_fault_persistent(c, j, "REBOOT unanswered");
+			ctl_fault_persistent(c, j, "shutdown", "with its REBOOT unanswered");
 			return;
 		}
 		/* the boot clears the hardware errors and the watchdog, turns the
@@ -1039,15 +1039,17 @@ static void ctl_fault_name(const struct ctl *c, size_t j, uint8_t bits, char *wh
 		dxl_errbits_format(bits, what, cap);
 }
 
-static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what)
+/* after: how it was tried (NULL: the recovery attempts counted). */
+static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what, const char *after)
 {
 	struct ctl_joint *jt = &c->j[j];
 	jt->fault = CTL_FAULT_FAILED;
-	char text[CTL_LATCH_TEXT];
+	char text[CTL_LATCH_TEXT], tried[64];
+	if (after == NULL)
+		snprintf(tried, sizeof tried, "after %d recovery attempts", jt->retries);
 	snprintf(text, sizeof text, "servo %u %s persists", jt->id, what);
-	ctl_event(c, 2, "fault-persistent", "servo %u: %s persists after %d recovery attempts: robot %s; "
-	          "cool down / check the mechanics, then 'clear'", jt->id, what, jt->retries,
-	          cfg_mode_name(ctl_fault_mode(c)));
+	ctl_event(c, 2, "fault-persistent", "servo %u: %s persists %s: robot %s; cool down / check the mechanics, "
+	          "then 'clear'", jt->id, what, after != NULL ? after : tried, cfg_mode_name(ctl_fault_mode(c)));
 	ctl_latch(c, text);
 }
 
@@ -1078,10 +1080,9 @@ static bool ctl_x_reboot(struct ctl *c, size_t j, const char *what)
 	if (!ctl_is_x(c, j) || jt->torque_read != 0)
 		return false;
 	if (jt->reboots >= c->cfg->fault_reboots) {
-		char text[CTL_LATCH_TEXT];
-		snprintf(text, sizeof text, "%s (shut down; %d REBOOT(s) allowed by fault_reboots)", what,
-		         c->cfg->fault_reboots);
-		ctl_fault_persistent(c, j, text);
+		char after[64];
+		snprintf(after, sizeof after, "after %d REBOOT(s) (fault_reboots = %d)", jt->reboots, c->cfg->fault_reboots);
+		ctl_fault_persistent(c, j, what, after);
 		return true;
 	}
 	jt->reboots++;
@@ -1152,7 +1153,7 @@ static void ctl_fault_step(struct ctl *c, size_t j)
 		if (bad) {
 			jt->retries++;
 			if (jt->retries > c->cfg->fault_retries) {
-				ctl_fault_persistent(c, j, what);
+				ctl_fault_persistent(c, j, what, NULL);
 				return;
 			}
 			ctl_backoff(c, j);
