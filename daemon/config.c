@@ -720,6 +720,10 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 			osc_default_torque_params(&d, j, c->njoints, c->torque_drive == CFG_DRIVE_PWM);
 		else
 			osc_default_params(&d, j, c->njoints);
+		if (c->actuation == CFG_ACT_TORQUE)
+			jt->torque_defaults = (isnan(jt->osc.k) ? CFG_TQ_K : 0) | (isnan(jt->osc.c) ? CFG_TQ_C : 0) |
+			                      (isnan(jt->osc.mu) ? CFG_TQ_MU : 0) | (isnan(jt->osc.inertia) ? CFG_TQ_INERTIA : 0) |
+			                      (isnan(jt->osc.friction) ? CFG_TQ_FRICTION : 0);
 		if (isnan(jt->osc.k)) jt->osc.k = d.k;
 		if (isnan(jt->osc.c)) jt->osc.c = d.c;
 		if (isnan(jt->osc.mu)) jt->osc.mu = d.mu;
@@ -735,6 +739,18 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 		 * so it never limits a healthy gait, only jumps. */
 		if (isnan(jt->max_step)) jt->max_step = 0.1;
 	}
+}
+
+void cfg_scale_torque_defaults(struct cfg *c, size_t j, double scale)
+{
+	struct cfg_joint *jt = &c->joint[j];
+	unsigned d = jt->torque_defaults;
+	if (d & CFG_TQ_K) jt->osc.k *= scale;
+	if (d & CFG_TQ_C) jt->osc.c *= scale;
+	if (d & CFG_TQ_MU) jt->osc.mu *= scale;
+	if (d & CFG_TQ_INERTIA) jt->osc.inertia *= scale;
+	if (d & CFG_TQ_FRICTION) jt->osc.friction *= scale;
+	jt->torque_defaults = 0;
 }
 
 bool cfg_finish(struct cfg *c, struct cfg_errors *e)

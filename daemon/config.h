@@ -46,7 +46,15 @@ struct cfg_joint {
 	double limit_min;      /* rad relative to neutral */
 	double limit_max;
 	double max_step;       /* rad a goal may move per cycle */
+	/* torque actuation: the physical parameters that took their defaults
+	 * (CFG_TQ_* bits), scaled once the servo model is known */
+	unsigned torque_defaults;
 };
+#define CFG_TQ_K        (1u << 0)
+#define CFG_TQ_C        (1u << 1)
+#define CFG_TQ_MU       (1u << 2)
+#define CFG_TQ_INERTIA  (1u << 3)
+#define CFG_TQ_FRICTION (1u << 4)
 
 struct cfg {
 	/* [robot] */
@@ -152,6 +160,11 @@ double *cfg_joint_param(struct cfg_joint *j, const char *key);
 
 const char *cfg_mode_name(enum cfg_mode m);     /* "OSCILLATOR" */
 bool cfg_mode_parse(const char *s, enum cfg_mode *out);   /* case-insensitive */
+
+/* Torque actuation's defaults are an AX-12A joint's: a joint on another
+ * servo has `scale` times its inertia, and the parameters that took the
+ * defaults (not those given) scale with it — once. */
+void cfg_scale_torque_defaults(struct cfg *c, size_t joint, double scale);
 
 /* Print every key with its current value as INI (for --check-config -v). */
 void cfg_print(const struct cfg *c, void *file);

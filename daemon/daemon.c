@@ -284,6 +284,24 @@ static bool dmn_protocol(struct dmn *d, char *err, size_t cap)
 	return true;
 }
 
+/* Torque actuation's default parameters are an AX-12A joint's: on another
+ * servo the joint's inertia differs, and the defaults scale with it (the
+ * same gait: CONTROL.md). Once, at the first connect, when the models are
+ * known; parameters given in the configuration are left as they are. */
+static void dmn_torque_defaults(struct dmn *d)
+{
+	if (d->cfg->actuation != CFG_ACT_TORQUE)
+		return;
+	for (size_t j = 0; j < d->ctl.n; j++) {
+		double scale = sm_torque_scale(ctl_model(&d->ctl, j));
+		if (d->cfg->joint[j].torque_defaults != 0 && scale != 1.0) {
+			log_info("joint %zu: torque actuation's default k, c, mu, inertia, friction scaled x%.3f for the %s's "
+			         "joint (its rotor through the gearbox)", j + 1, scale, ctl_model(&d->ctl, j)->name);
+			cfg_scale_torque_defaults(d->cfg, j, scale);
+		}
+	}
+}
+
 /* "AX-12A" or "XL430-W250, XM430-W350": the models found. */
 static void dmn_models(const struct dmn *d, char *out, size_t cap)
 {
@@ -831,6 +849,7 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	}
 	char models[96];
 	dmn_models(d, models, sizeof models);
+	dmn_torque_defaults(d);
 	log_info("robot %s: %zu joint(s) on %s at %ld bps, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints,
 	         d->port_path, cfg->baud, d->protocol == BUS_PROTOCOL_2 ? "2.0" : "1.0", models,
 	         cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");

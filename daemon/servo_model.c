@@ -7,6 +7,7 @@
 #include "dxl.h"
 #include "dxl2.h"
 #include "dxl_table.h"
+#include "osc.h"
 
 #define SM_RPM_TO_RAD_S (2.0 * 3.14159265358979323846 / 60.0)
 
@@ -29,6 +30,11 @@
 #define SM_X_RAM_LEN (DXL2_X_PROFILE_VELOCITY + 4 - DXL2_X_TORQUE_ENABLE)
 #define SM_X_EEPROM_ADDR DXL2_X_OPERATING_MODE
 #define SM_X_EEPROM_LEN (DXL2_X_MIN_POSITION_LIMIT + 4 - DXL2_X_OPERATING_MODE)
+/* Rotor inertia (kg·m²) × gear ratio²: the gear ratios are the datasheets';
+ * the rotors are the simulator's assumptions (sim-bridge/PHYSICS.md §5: the
+ * AX-12A's 4.6e-8, the XL430's taken as the AX-12A's, the XM430's coreless
+ * motor 5.0e-8, not published). */
+#define SM_REFLECTED(rotor, ratio) ((rotor) * (ratio) * (ratio))
 /* Goal PWM's 100 % (PWM Limit's factory value). */
 #define SM_X_PWM_FULL 885
 
@@ -42,6 +48,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.pos_max = DXL_POS_MAX, .torque_full = 1023,
 		.ref_voltage = DXL_AX12_REF_VOLTAGE, .stall_torque_nm = DXL_AX12_STALL_TORQUE_NM,
 		.no_load_speed_rad_s = DXL_AX12_NO_LOAD_SPEED_RAD_S, .stall_current_a = 1.5,
+		.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0),
 	},
 	[SM_XL430] = {
 		.family = SM_XL430, .name = "XL430-W250", .protocol = 2, .number = DXL2_MODEL_XL430_W250,
@@ -52,7 +59,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.nreadback = 2, .pos_max = DXL2_POS_MAX, .torque_full = SM_X_PWM_FULL,
 		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XL430_STALL_TORQUE_NM,
 		.no_load_speed_rad_s = DXL2_XL430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
-		.stall_current_a = DXL2_XL430_STALL_CURRENT_A,
+		.stall_current_a = DXL2_XL430_STALL_CURRENT_A, .reflected_inertia = SM_REFLECTED(4.6e-8, 258.5),
 	},
 	[SM_XM430] = {
 		.family = SM_XM430, .name = "XM430-W350", .protocol = 2, .number = DXL2_MODEL_XM430_W350,
@@ -64,6 +71,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XM430_STALL_TORQUE_NM,
 		.no_load_speed_rad_s = DXL2_XM430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
 		.stall_current_a = DXL2_XM430_STALL_CURRENT_A, .current_control = true,
+		.reflected_inertia = SM_REFLECTED(5.0e-8, 353.5),
 	},
 };
 
@@ -222,6 +230,12 @@ uint16_t sm_drive_register(const struct sm_model *m, bool current)
 	if (!sm_is_x(m))
 		return DXL_AX_MOVING_SPEED;
 	return current ? DXL2_X_GOAL_CURRENT : DXL2_X_GOAL_PWM;
+}
+
+double sm_torque_scale(const struct sm_model *m)
+{
+	double link = OSC_TORQUE_JOINT_INERTIA - sm_models[SM_AX12].reflected_inertia;
+	return (link + m->reflected_inertia) / OSC_TORQUE_JOINT_INERTIA;
 }
 
 uint8_t sm_drive_opmode(bool current)

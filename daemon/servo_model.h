@@ -69,6 +69,9 @@ struct sm_model {
 	/* the datasheet's line at ref_voltage (the simulator's motors use the same) */
 	double ref_voltage, stall_torque_nm, no_load_speed_rad_s, stall_current_a;
 	bool current_control;           /* has a current-controlled drive (XM430: mode 0) */
+	/* the motor's rotor seen through the gearbox, rotor inertia × ratio²
+	 * (kg·m²): what a joint's inertia has besides its link */
+	double reflected_inertia;
 };
 
 /* The AX-12A (what undulated assumed before it knew of others). */
@@ -152,5 +155,9 @@ uint8_t sm_drive_opmode(bool current);
  * within ±limit (PWM Limit or Current Limit, the servo refuses more); a
  * non-finite ratio gives 0. */
 uint16_t sm_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit);
+/* Torque actuation's defaults (osc_default_torque_params) are for the AX-12A's
+ * joint: the same link on this model's servo has this many times its
+ * inertia (the AX-12A: 1). */
+double sm_torque_scale(const struct sm_model *m);
 
 #endif

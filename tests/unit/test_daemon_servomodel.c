@@ -14,6 +14,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "../../daemon/config.h"
 #include "../../daemon/servo_model.h"
 #include "dxl.h"
 #include "dxl_table.h"
@@ -235,6 +236,47 @@ static void test_drive_outputs(void **state)
 	assert_int_equal(sm_drive_raw(ax, false, -0.5, 0), dxl_duty_to_wheel(-0.5));
 }
 
+/* Torque actuation's defaults are an AX-12A joint's; on another servo the
+ * same link is heavier by the rotor through the gearbox, and the defaults
+ * the configuration did not give scale with it, once. */
+static void test_torque_defaults_scale(void **state)
+{
+	(void)state;
+	assert_true(fabs(sm_torque_scale(sm_ax12()) - 1.0) < 1e-12);
+	double xm = sm_torque_scale(sm_of(SM_XM430)), xl = sm_torque_scale(sm_of(SM_XL430));
+	/* (1.42e-3 link + 5.0e-8 x 353.5^2) / 4.39e-3 */
+	assert_true(fabs(xm - (4.39e-3 - 4.6e-8 * 254 * 254 + 5.0e-8 * 353.5 * 353.5) / 4.39e-3) < 1e-9);
+	assert_true(xm > 1.7 && xm < 1.8);
+	assert_true(xl > 1.0 && xl < 1.05);
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.port=/dev/null", &e));
+	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
+	assert_true(cfg_override(&c, "robot.actuation=torque", &e));
+	assert_true(cfg_override(&c, "robot.torque_drive=current", &e));
+	assert_true(cfg_override(&c, "joint.2.k=0.3", &e));
+	assert_true(cfg_finish(&c, &e));
+	double k1 = c.joint[0].osc.k, mu1 = c.joint[0].osc.mu, i1 = c.joint[0].osc.inertia;
+	cfg_scale_torque_defaults(&c, 0, xm);
+	cfg_scale_torque_defaults(&c, 1, xm);
+	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
+	assert_true(fabs(c.joint[0].osc.mu - mu1 * xm) < 1e-12);
+	assert_true(fabs(c.joint[0].osc.inertia - i1 * xm) < 1e-12);
+	assert_true(fabs(c.joint[1].osc.k - 0.3) < 1e-12);        /* given: kept */
+	assert_true(fabs(c.joint[1].osc.mu - mu1 * xm) < 1e-12);  /* not given: scaled */
+	cfg_scale_torque_defaults(&c, 0, xm);                      /* once */
+	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
+	/* position actuation's parameters are a control law's, not a joint's: none */
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.port=/dev/null", &e));
+	assert_true(cfg_override(&c, "robot.ids=1", &e));
+	assert_true(cfg_finish(&c, &e));
+	k1 = c.joint[0].osc.k;
+	cfg_scale_torque_defaults(&c, 0, xm);
+	assert_true(fabs(c.joint[0].osc.k - k1) < 1e-12);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -246,6 +288,7 @@ int main(void)
 		cmocka_unit_test(test_readback_block_ax),
 		cmocka_unit_test(test_status_meaning),
 		cmocka_unit_test(test_drive_outputs),
+		cmocka_unit_test(test_torque_defaults_scale),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
