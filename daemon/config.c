@@ -47,7 +47,7 @@ const char *cfg_protocol_name(enum cfg_protocol p)
 
 uint8_t cfg_watchdog_units(const struct cfg *c)
 {
-	return (uint8_t)((c->bus_watchdog_ms + 19) / 20);
+	return c->bus_watchdog_ms > 0 ? (uint8_t)((c->bus_watchdog_ms + 19) / 20) : 0;
 }
 
 const char *cfg_mode_name(enum cfg_mode m)
@@ -366,7 +366,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("fault_retries", T_LONG, fault_retries, 0, 100),
 	K("stale_limit", T_LONG, stale_limit, 1, 1000),
 	K("silent_s", T_DOUBLE, silent_s, 0.05, 60),
-	K("bus_watchdog_ms", T_LONG, bus_watchdog_ms, 0, 2540),
+	K("bus_watchdog_ms", T_LONG, bus_watchdog_ms, -1, 2540),
 	K("fault_reboots", T_LONG, fault_reboots, 0, 100),
 };
 #undef K

@@ -90,7 +90,7 @@ struct cfg {
 	double stall_torque;           /* N·m at 12 V and full output (AX-12A: 1.5) */
 	double no_load_speed;          /* rad/s at 12 V and full output (AX-12A: 59 rpm = 6.18) */
 	bool stall_torque_given, no_load_speed_given;   /* else the servo model's datasheet line */
-	long bus_watchdog_ms;          /* X series: Bus Watchdog (98), 0 = off, in 20 ms steps */
+	long bus_watchdog_ms;          /* X series: Bus Watchdog (98), 0 = off, in 20 ms steps; -1 = the servo's own */
 	int fault_reboots;             /* X series: REBOOTs of one servo after a shutdown, per 'clear' */
 	long bus_margin_us;            /* slack added to every bus timeout */
 	char lockstep[CFG_PATH_MAX];   /* the simulator's lockstep socket: virtual time ("": real time) */

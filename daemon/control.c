@@ -452,7 +452,8 @@ uint16_t ctl_x_setup(struct ctl *c, size_t j, bool with_mode)
 		double hold = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
 		ctl_write_chain(c, ch, jt->id, m->goal, m->goal_size, (uint32_t)sm_rad_to_pos(m, hold));
 	}
-	ctl_write_chain(c, ch, jt->id, DXL2_X_BUS_WATCHDOG, 1, cfg_watchdog_units(c->cfg));
+	if (c->cfg->bus_watchdog_ms >= 0)
+		ctl_write_chain(c, ch, jt->id, DXL2_X_BUS_WATCHDOG, 1, cfg_watchdog_units(c->cfg));
 	ctl_write_chain(c, ch, jt->id, m->torque_limit, 2, ctl_torque_limit(c, jt));
 	if (jt->torque && c->mode != CFG_MODE_LIMP)
 		ctl_write_chain(c, ch, jt->id, m->torque_enable, 1, 1);
@@ -737,7 +738,7 @@ static void ctl_readback_x_ram(struct ctl *c, size_t j, const struct sm_state *s
 	}
 	const struct sm_model *m = ctl_model(c, j);
 	unsigned want_wd = cfg_watchdog_units(c->cfg);
-	if ((unsigned)st->watchdog != want_wd) {
+	if (c->cfg->bus_watchdog_ms >= 0 && (unsigned)st->watchdog != want_wd) {
 		ctl_mismatch(c, j, "bus watchdog", (unsigned)st->watchdog, want_wd);
 		ctl_write(c, jt->id, DXL2_X_BUS_WATCHDOG, 1, want_wd);
 	}

@@ -126,6 +126,8 @@ static bool setup_x_ram(struct bus *bus, uint8_t id, const uint8_t *t, const str
 			return false;
 	}
 	(void)m;
+	if (cfg->bus_watchdog_ms < 0)
+		return true;   /* the servo's own */
 	return setup_x_write(bus, id, DXL2_X_BUS_WATCHDOG, cfg_watchdog_units(cfg), 1, "bus watchdog", err, cap);
 }
 
