@@ -850,6 +850,10 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	char models[96];
 	dmn_models(d, models, sizeof models);
 	dmn_torque_defaults(d);
+	if (d->protocol == BUS_PROTOCOL_2 && cfg->actuation == CFG_ACT_POSITION)
+		log_info("the oscillator's defaults are the simulated AX-12A's; an X servo's position control lags "
+		         "otherwise (on the simulated XM430 they run down between restarts): undulated --tune finds this "
+		         "robot's (daemon/CONTROL.md, \"X-series servos\")");
 	log_info("robot %s: %zu joint(s) on %s at %ld bps, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints,
 	         d->port_path, cfg->baud, d->protocol == BUS_PROTOCOL_2 ? "2.0" : "1.0", models,
 	         cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");
