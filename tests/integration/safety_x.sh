@@ -35,8 +35,12 @@ spawn sim "$S" --model xm430-w350 --link "$T/bus" --ids 1,2 --name r1 --baud 100
 	--lcm-url "$URL" --control "$T/ctl" --seed 6
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
+# the oscillator tuned for the simulated XM430 (undulated --tune, daemon/CONTROL.md): with the
+# AX-12A's defaults it runs down between restarts there, and "it swings again" would mean little
+XM_TUNED=(--set robot.servo_lead_s=0.047 --set joint.1.k=0.0304 --set joint.2.k=0.0304 --set joint.1.mu=0.0757
+	--set joint.2.mu=0.0571)
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode limp --set robot.fault_action=hold \
-	--set robot.fault_backoff_s=0.3
+	--set robot.fault_backoff_s=0.3 "${XM_TUNED[@]}"
 wait_log d "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts on the X bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
 
