@@ -11,6 +11,9 @@
 #   make test-busy  make test with one CPU-bound process per core beside it
 #   make bench      benchmarks; figures printed, written to $(BUILD)/bench.md
 #   make demo       robots on the simulated bus, watched live
+#   make figures    the paper's figures from the real daemons in lockstep:
+#                   docs/FIGURES.md and docs/figures/ (QUICK=1: fewer runs;
+#                   FIGURES_ARGS='--only pair --jobs 3': scripts/figures.sh's options)
 #   make hwcheck PORT=/dev/ttyUSB0 [CONFIG=robot.conf] [IDS="1 2"]
 #                   the first-run hardware check on a robot (dxl doctor)
 #   make SAN=1 test the same tests under AddressSanitizer + UBSan (build-san/)
@@ -99,7 +102,7 @@ LCM_STAMP := $(GEN)/.stamp
 # lcm-gen names files <package>_<type>.c; the package is `undulate`.
 LCM_GEN_C = $(wildcard $(GEN)/*.c)
 
-.PHONY: all deps test-deps test test-long test-busy test-sdk bench demo hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
+.PHONY: all deps test-deps test test-long test-busy test-sdk bench demo figures hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
 all: $(foreach p,$(PROGRAMS),$(BIN)/$(p)) unit-tests
 
 $(LCM_STAMP): $(LCM_SRC)
@@ -223,6 +226,14 @@ DEMO_OUT ?=
 demo: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) DEMO_OUT=$(DEMO_OUT) scripts/demo.sh
+
+# The paper's figures (scripts/figures.sh, README.md "Figures"): every run
+# through GNU parallel here, then docs/FIGURES.md. QUICK=1: the quick set.
+QUICK ?=
+FIGURES_ARGS ?=
+figures: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) scripts/figures.sh $(if $(filter 1,$(QUICK)),--quick) $(FIGURES_ARGS)
 
 # The first command on a new robot: dxl doctor (tools/dxl/README.md). Its
 # exit status is make's: 0 all OK, 1 warnings, 7 a check failed.

@@ -7,14 +7,15 @@ set -eu
 # ports, config parsing (inih), command authentication (libsodium), unit tests (cmocka); tests and tools: jq and
 # python3 (test peers and JSON checks), iproute2 (`ss`: the sockets a daemon
 # holds, safety_commands),
-# gnuplot for plots, cyclictest for the jitter benchmark; systemd and man-db
+# gnuplot for plots, GNU parallel for the figures' runs (make figures,
+# scripts/figures.sh), cyclictest for the jitter benchmark; systemd and man-db
 # for checking the units (systemd-analyze verify) and the man pages;
 # libwebsockets and Chart.js for undulate-web (its page's plots, served from
 # the installed path). Chromium (headless: web_dashboard's browser test) is
 # installed by `make test` when it can be (`scripts/deps.sh chromium`);
 # without it that test says so and skips.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
-      libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox rt-tests procps iproute2 jq python3 socat systemd man-db curl
+      libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox parallel rt-tests procps iproute2 jq python3 socat systemd man-db curl
       libwebsockets-dev libjs-chart.js)
 [ $# -gt 0 ] && need=("$@")
 missing=()

@@ -511,7 +511,10 @@ int sim_config_set(struct sim_config *c, const char *assignment, char *err, size
 	if (!eq)
 		return ERR("--set '%s': want section.key=value", assignment);
 	*eq = '\0';
-	char *dot = strrchr(buf, '.');
+	/* section.key, split at the last dot (a robot's name may hold dots),
+	 * except in [events] and [faults], whose keys are times: 2.5 s */
+	bool timed = !strncmp(buf, "events.", 7) || !strncmp(buf, "faults.", 7);
+	char *dot = timed ? buf + 6 : strrchr(buf, '.');
 	if (!dot || dot == buf || !dot[1])
 		return ERR("--set '%s': want section.key=value", assignment);
 	*dot = '\0';

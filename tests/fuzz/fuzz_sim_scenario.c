@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "dxl.h"
+#include "dxl2.h"
 #include "../../sim-bridge/sim.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -54,7 +55,10 @@ static void check_config(const struct sim_config *c)
 	CHECK(in(c->rate_hz, 100, 20000));
 	CHECK(in(c->truth_hz, 1, 1000));
 	CHECK(in(c->duration_s, 0, SIM_MAX_DURATION_S));
-	CHECK(c->baud >= 1200 && c->baud <= 4500000);
+	CHECK(c->baud == 0 || (c->baud >= 1200 && c->baud <= 4500000));   /* 0: the models' factory rate */
+	CHECK(c->nmodels >= 1 && c->nmodels <= SIM_BUS_MAX_SERVOS);
+	for (size_t k = 0; k < c->nmodels; k++)
+		CHECK((unsigned)c->models[k] < SIM_MODELS);
 	CHECK(in(c->latency_ms, 0, 1000));
 	CHECK(c->return_delay_us == -1 || (c->return_delay_us >= 0 && c->return_delay_us <= 508));
 	CHECK(in(c->ambient_c, -40, 150) && c->ambient_c > -40 && c->ambient_c < 150);
@@ -104,6 +108,14 @@ static void check_config(const struct sim_config *c)
 		CHECK(r->echo >= -1 && r->echo <= 1);
 		CHECK(r->return_delay_us == -1 || (r->return_delay_us >= 0 && r->return_delay_us <= 508));
 		CHECK(r->servo_baud_reg >= -1 && r->servo_baud_reg <= 254);
+		/* one model per ID, one protocol per bus, 2.0's IDs and baud register */
+		CHECK(r->nmodels == r->nids);
+		int proto = sim_config_robot_protocol(r);
+		for (size_t k = 0; k < r->nids; k++) {
+			CHECK((unsigned)r->models[k] < SIM_MODELS && sim_model_info(r->models[k])->protocol == proto);
+			CHECK(proto == 1 || r->ids[k] <= DXL2_MAX_ID);
+		}
+		CHECK(proto == 1 || r->servo_baud_reg <= 7);
 		CHECK(!r->neutral_set || isfinite(r->neutral));
 		for (size_t q = 0; q < i; q++) {
 			CHECK(strcmp(c->robots[q].name, r->name) != 0);

@@ -96,6 +96,58 @@ tap_check "--synth-stop-after without --synth: exit 1" [ "$rc" = 1 ]
 "$A" --synth "$T/s3.log" "$T/s.log" 2>"$T/s3.err"; rc=$?
 tap_check "--synth with a log to read: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'reads none' '$T/s3.err'"
 
+# --frequency HZ: every joint's phase from the first sample at the given
+# frequency. Against --zero-crossings (the analyser's own estimate, known from
+# about the fourth cycle): the phase starts at once, and the known phases
+# come out (r1:r2 at 0.4 rad); a wrong frequency gives wrong phases.
+"$A" "$T/s.log" --out "$T/zc" --window 5 --quiet --zero-crossings
+"$A" "$T/s.log" --out "$T/fq" --window 5 --quiet --zero-crossings --frequency 0.8
+"$A" "$T/s.log" --out "$T/fq4" --window 5 --quiet --frequency 0.4
+first_phase() { awk -F, 'NR == 2 { print $2 }' "$1/phase_diff.csv"; }
+tap_check "--zero-crossings: no phase before the third second" awk -v t="$(first_phase "$T/zc")" 'BEGIN { exit !(t > 3) }'
+tap_check "--frequency 0.8: a phase from the first sample" awk -v t="$(first_phase "$T/fq")" 'BEGIN { exit !(t < 0.05) }'
+tap_check "--frequency 0.8: r1:r2 at its known 0.4 rad" awk -v d="$(col "$T/fq" r1:r2 meanD)" 'BEGIN { exit !(d > 0.39 && d < 0.41) }'
+tap_check "--frequency 0.4 (wrong): r1:r2 no longer at 0.4 rad" \
+	awk -v d="$(col "$T/fq4" r1:r2 spread)" 'BEGIN { exit !(d > 0.1) }'
+"$A" "$T/s.log" --out "$T/fq0" --frequency 0 2>"$T/fq0.err"; rc=$?
+tap_check "--frequency 0: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'frequency must be' '$T/fq0.err'"
+
+# --theory: the theory's curves as CSV (tools/analyze/theory.c), checked
+# against theory.md's formulas at known points.
+th() { "$A" --theory "$@"; }
+tap_check "--theory critical: d~_c = 0.316 at r = 0.67" \
+	bash -c "'$A' --theory critical | awk -F, 'NR == 2 { exit !(\$2 > 0.3150 && \$2 < 0.3160) }'"
+tap_check "--theory critical: d~_c = 0.21 at r = 0.9" \
+	bash -c "'$A' --theory critical --restitution 0.9 | awk -F, 'NR == 2 { exit !(\$2 > 0.205 && \$2 < 0.21) }'"
+th curves --points 101 >"$T/curves.csv"
+tap_check "--theory curves: 2 asin(d~), f'(pi) (theory.md), stable only above d~_c, 101 rows" awk -F, '
+	NR == 1 { ok = $1 == "dsep" && $2 == "compat_limit" && $3 == "fprime_pi" && $5 == "antiphase_stable"; next }
+	{ n++; d = $1; r = 0.67; d2 = d * d
+	  if (($2 - 2 * atan2(d, sqrt(1 - d * d)))^2 > 1e-12) ok = 0
+	  s = -(r * (d2 - 1) + d2) / (r * r * (d2 - 1) - d2); if (($3 - s)^2 > 1e-12) ok = 0
+	  if ($5 != (d > 0.3156 && d < 1)) ok = 0 }
+	END { exit !(ok && n == 101) }' "$T/curves.csv"
+tap_check "--theory curves: the third fixed point only between d~_c and 1/sqrt(1 + r)" awk -F, '
+	NR > 1 { if (($6 != "") != ($1 > 0.3156 && $1 < 0.7738)) bad = 1 } END { exit bad }' "$T/curves.csv"
+th sequence --delta0 2.5 --steps 12 --restitution 0.5 >"$T/seq.csv"
+tap_check "--theory sequence: the closed form 2 atan((-r)^n tan(D0/2)) is the map iterated" awk -F, '
+	NR > 1 { e = 2 * atan2((-0.5)^$1 * sin(1.25) / cos(1.25), 1)
+		if (($2 - e)^2 > 1e-14 || ($3 - $2)^2 > 1e-14) bad = 1; n++ } END { exit !(n == 13 && !bad) }' "$T/seq.csv"
+printf 'dsep,delta0\n0.7,3.0\n0.2,3.1\n0.5,0.5\n' | th final >"$T/final.csv"
+tap_check "--theory final: anti-phase above d~_c, compatible below, no contact inside the set" awk -F, '
+	NR == 2 { a = $3 > 3.1415 } NR == 3 { b = ($3 < 0 ? -$3 : $3) < 0.403 } NR == 4 { c = $3 == 0.5 && $4 == 0 }
+	END { exit !(a && b && c) }' "$T/final.csv"
+th map --points 8 2>"$T/th1.err"; rc=$?
+tap_check "--theory map without --separation: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'needs --separation' '$T/th1.err'"
+th curves --restitution 0 2>"$T/th2.err"; rc=$?
+tap_check "--theory with r = 0: exit 1" [ "$rc" = 1 ]
+th nonsense 2>"$T/th3.err"; rc=$?
+tap_check "--theory nonsense: exit 1, naming what there is" bash -c "[ $rc = 1 ] && grep -q 'want curves' '$T/th3.err'"
+echo '0.5,abc' | th final >/dev/null 2>"$T/th4.err"; rc=$?
+tap_check "--theory final with a bad line: exit 1 with its line number" bash -c "[ $rc = 1 ] && grep -q 'line 1' '$T/th4.err'"
+"$A" "$T/s.log" --theory curves 2>"$T/th5.err"; rc=$?
+tap_check "--theory with a log: exit 1" [ "$rc" = 1 ]
+
 # errors: missing, foreign, truncated, bad options
 "$A" "$T/nope.log" --out "$T/e1" 2>"$T/e1.err"; rc=$?
 tap_check "missing log: exit 2 and a message" bash -c "[ $rc = 2 ] && grep -q 'No such file' '$T/e1.err'"

@@ -110,6 +110,17 @@ static void test_config_errors(void **state)
 	assert_int_equal(sim_config_set(&cfg, "sim.rate_hz=abc", err, sizeof(err)), -1);
 	assert_int_equal(sim_config_set(&cfg, "world.walls=3,1", err, sizeof(err)), -1);
 	assert_int_equal(sim_config_set(&cfg, "world.walls=-1,1", err, sizeof(err)), 0);
+	/* an event's key is its time, which may hold a dot: the section is
+	 * "events", the key "2.5" (scripts/demo.sh --lockstep --switch-at 2.5) */
+	size_t had = cfg.nevents;
+	assert_int_equal(sim_config_set(&cfg, "events.2.5=command * mode oscillator", err, sizeof(err)), 0);
+	assert_int_equal(cfg.nevents, had + 1);
+	assert_true(cfg.events[had].at == 2.5);
+	assert_string_equal(cfg.events[had].command, "command * mode oscillator");
+	assert_int_equal(sim_config_set(&cfg, "faults.0.25=fault left 1 no-reply", err, sizeof(err)), 0);
+	assert_true(cfg.events[had + 1].at == 0.25);
+	assert_int_equal(sim_config_set(&cfg, "events.soon.5=stats", err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "time in seconds"));
 	/* wheel-mode drive: pwm (AX-12A) or current, nothing else */
 	assert_false(cfg.motor.current_drive);
 	assert_int_equal(sim_config_set(&cfg, "motor.drive=current", err, sizeof(err)), 0);

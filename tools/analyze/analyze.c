@@ -165,6 +165,7 @@ void an_options_default(struct an_options *o)
 	o->restitution = NAN;
 	o->merge_s = 0.1;
 	o->min_swing = AN_MIN_SWING_DEFAULT;
+	o->frequency_hz = NAN;
 	o->msg = stderr;
 }
 
@@ -720,11 +721,15 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 		phase_estimator_update(&aj->est, js->angle, t);
 		if (t >= c->window_start_t)
 			win_swing_add(&aj->win_swing, js->angle);
-		/* The daemon's running frequency estimate when it has one (it
-		 * sees every cycle, and its phase is then ours); else our own,
-		 * by the same rules (common/phase.h); else the phase is left empty. */
-		double omega = js->frequency > 0.0 && !c->o->zero_crossings ? 2.0 * M_PI * js->frequency
-		                                                            : phase_estimator_omega(&aj->est);
+		/* --frequency when given: a phase from the first sample, where
+		 * an estimate needs four cycles (a pair that collides from its
+		 * first swing). Else the daemon's running frequency estimate when
+		 * it has one (it sees every cycle, and its phase is then ours);
+		 * else our own, by the same rules (common/phase.h); else the
+		 * phase is left empty. */
+		double omega = c->o->frequency_hz > 0.0 ? 2.0 * M_PI * c->o->frequency_hz
+		               : js->frequency > 0.0 && !c->o->zero_crossings ? 2.0 * M_PI * js->frequency
+		                                                             : phase_estimator_omega(&aj->est);
 		double phase = phase_from_state(js->angle, js->speed, omega);
 		an_hist_push(aj, m->utime, t, phase, omega);
 		aj->samples++;

@@ -38,6 +38,8 @@ struct an_options {
 	FILE *msg;             /* warnings and the summary go here (stderr/stdout) */
 	bool quiet;            /* do not print the summary to msg */
 	bool zero_crossings;   /* phase from our zero-crossing frequency, never the daemon's */
+	double frequency_hz;   /* > 0: every joint's phase at this frequency, from the first
+				  sample (the gait's known frequency; NAN: estimated) */
 	double min_swing;      /* rad p-p: a pair with a joint swinging less in the final
 				  window is "not-oscillating", whatever its phases say */
 };

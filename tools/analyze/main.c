@@ -4,6 +4,7 @@
 #include "num.h"
 #include "record.h"
 #include "synth.h"
+#include "theory_cli.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -16,9 +17,12 @@ static void usage(FILE *f)
 	fputs("usage: undulate-analyze LOG... [--out DIR] [--pairs a:b,...] [--plots]\n"
 	      "                        [--from S] [--to S] [--window S] [--separation D]\n"
 	      "                        [--restitution R] [--merge S] [--min-swing RAD] [--zero-crossings]\n"
+	      "                        [--frequency HZ]\n"
 	      "                        [--quiet]\n"
 	      "       undulate-analyze --synth OUT.log [--duration S] [--synth-stop-after S]\n"
 	      "       undulate-analyze --record OUT.log [--lcm-url URL]\n"
+	      "       undulate-analyze --theory curves|critical|map|map-d0|sequence|final [--restitution R]\n"
+	      "                        [--separation D] [--delta0 RAD] [--steps N] [--points N]\n"
 	      "Reads lcm-logger logs and writes states.csv, collisions.csv, bus.csv, events.csv,\n"
 	      "phase_diff.csv, return_map.csv, collision_rate.csv, summary.txt, summary.json\n"
 	      "(and PNG plots with --plots) into DIR (default: current directory).\n"
@@ -31,11 +35,18 @@ static void usage(FILE *f)
 	      "  --min-swing RAD   a pair with a joint swinging less than RAD peak-to-peak in the final\n"
 	      "                    window is not-oscillating, whatever its phases (default 0.2)\n"
 	      "  --zero-crossings  phase from our own frequency estimate (centre crossings), not the daemon's\n"
+	      "  --frequency HZ    every joint's phase at this frequency from the first sample (no estimate)\n"
 	      "  --synth OUT.log   write a synthetic log with known phases and collisions\n"
 	      "  --duration S      length of the synthetic log (default 45)\n"
 	      "  --synth-stop-after S  in the synthetic log, r3 and r4 stand still from S seconds on\n"
 	      "  --record OUT.log  record the LCM group into OUT.log until SIGINT/SIGTERM, like lcm-logger\n"
 	      "                    but keeping every message when it falls behind (--lcm-url URL)\n"
+	      "  --theory WHAT     the contact theory as CSV on stdout (r: --restitution, default 0.67):\n"
+	      "                    curves: d~, 2 asin(d~), f'(pi), |f'(pi)|, stable, third fixed point;\n"
+	      "                    critical: d~_c; map: the return map at --separation D; map-d0: at\n"
+	      "                    d~ = 0 with its closed form; sequence: delta_n from --delta0 at d~ = 0\n"
+	      "                    (--steps N, default 10); final: where the map leads each \"dsep,delta0\"\n"
+	      "                    line of stdin; --points N: samples of a curve\n"
 	      "exit: 0 ok, 1 usage, 2 bad/missing log, 3 truncated log (partial results),\n"
 	      "      4 plots failed, 5 output not writable\n",
 	      f);
@@ -53,7 +64,7 @@ static int parse_double(const char *opt, const char *s, double *out)
 
 enum { OPT_OUT = 256, OPT_PAIRS, OPT_PLOTS, OPT_FROM, OPT_TO, OPT_WINDOW, OPT_SEP, OPT_REST,
        OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_MIN_SWING, OPT_STOP_AFTER, OPT_HELP,
-       OPT_RECORD, OPT_LCM_URL };
+       OPT_RECORD, OPT_LCM_URL, OPT_FREQ, OPT_THEORY, OPT_DELTA0, OPT_STEPS, OPT_POINTS };
 
 static const struct option long_opts[] = {
 	{ "out", required_argument, NULL, OPT_OUT },       { "pairs", required_argument, NULL, OPT_PAIRS },
@@ -65,19 +76,35 @@ static const struct option long_opts[] = {
 	{ "merge", required_argument, NULL, OPT_MERGE },   { "min-swing", required_argument, NULL, OPT_MIN_SWING },
 	{ "synth-stop-after", required_argument, NULL, OPT_STOP_AFTER },
 	{ "record", required_argument, NULL, OPT_RECORD }, { "lcm-url", required_argument, NULL, OPT_LCM_URL },
+	{ "frequency", required_argument, NULL, OPT_FREQ },
+	{ "theory", required_argument, NULL, OPT_THEORY }, { "delta0", required_argument, NULL, OPT_DELTA0 },
+	{ "steps", required_argument, NULL, OPT_STEPS },   { "points", required_argument, NULL, OPT_POINTS },
 	{ "help", no_argument, NULL, OPT_HELP },
 	{ NULL, 0, NULL, 0 },
 };
 
 /* What --synth takes besides the output path; 0 / NAN: not given. And
- * --record's. */
+ * --record's and --theory's. */
 struct synth_args {
 	const char *path;
 	double duration;
 	double stop_after;
 	const char *record;
 	const char *lcm_url;
+	const char *theory;
+	double delta0;
+	long steps, points;
 };
+
+static int parse_long_opt(const char *opt, const char *s, long *out)
+{
+	enum num_status st = num_parse_long(s, -1000000000L, 1000000000L, out);
+	if (st != NUM_OK) {
+		fprintf(stderr, "undulate-analyze: %s: \"%s\" is %s\n", opt, s, num_strerror(st));
+		return -1;
+	}
+	return 0;
+}
 
 static int parse_option(int c, struct an_options *o, struct synth_args *sa)
 {
@@ -94,15 +121,24 @@ static int parse_option(int c, struct an_options *o, struct synth_args *sa)
 	case OPT_SEP: return parse_double("--separation", optarg, &o->separation);
 	case OPT_REST: return parse_double("--restitution", optarg, &o->restitution);
 	case OPT_MIN_SWING: return parse_double("--min-swing", optarg, &o->min_swing);
+	case OPT_FREQ: return parse_double("--frequency", optarg, &o->frequency_hz);
 	case OPT_SYNTH: sa->path = optarg; return 0;
 	case OPT_DURATION: return parse_double("--duration", optarg, &sa->duration);
 	case OPT_STOP_AFTER: return parse_double("--synth-stop-after", optarg, &sa->stop_after);
 	case OPT_RECORD: sa->record = optarg; return 0;
 	case OPT_LCM_URL: sa->lcm_url = optarg; return 0;
+	case OPT_THEORY: sa->theory = optarg; return 0;
+	case OPT_DELTA0: return parse_double("--delta0", optarg, &sa->delta0);
+	case OPT_STEPS: return parse_long_opt("--steps", optarg, &sa->steps);
+	case OPT_POINTS: return parse_long_opt("--points", optarg, &sa->points);
 	case OPT_HELP: usage(stdout); exit(AN_EXIT_OK);
 	default: return -1;
 	}
 }
+
+/* Highest --frequency: half the daemons' 100 Hz state rate (a phase needs
+ * at least two samples a cycle). */
+#define AN_MAX_FREQUENCY_HZ 50.0
 
 static int check_options(const struct an_options *o)
 {
@@ -120,6 +156,10 @@ static int check_options(const struct an_options *o)
 	}
 	if (!(o->min_swing >= 0)) {
 		fputs("undulate-analyze: --min-swing must be >= 0\n", stderr);
+		return -1;
+	}
+	if (!isnan(o->frequency_hz) && !(o->frequency_hz > 0 && o->frequency_hz <= AN_MAX_FREQUENCY_HZ)) {
+		fprintf(stderr, "undulate-analyze: --frequency must be > 0 and <= %g Hz\n", AN_MAX_FREQUENCY_HZ);
 		return -1;
 	}
 	if (isfinite(o->separation) && o->separation < 0) {
@@ -171,11 +211,31 @@ static int check_synth(const struct synth_args *sa)
 	return 0;
 }
 
+/* --theory: nothing else is read or written. */
+static int run_theory(const struct an_options *o, const struct synth_args *sa, const char *stray)
+{
+	if (stray || sa->path || sa->record) {
+		fprintf(stderr, "undulate-analyze: --theory prints the theory and reads no log: unexpected '%s'\n",
+		        stray ? stray : sa->path ? "--synth" : "--record");
+		return AN_EXIT_USAGE;
+	}
+	struct theory_request q = {
+		.what = sa->theory,
+		/* the paper's rig, as for a log without SIM.WORLD */
+		.r = isnan(o->restitution) ? 0.67 : o->restitution,
+		.dsep = o->separation,
+		.delta0 = sa->delta0,
+		.points = sa->points,
+		.steps = sa->steps < 0 ? 10 : sa->steps,
+	};
+	return theory_cli_run(&q, stdin, stdout);
+}
+
 int main(int argc, char **argv)
 {
 	struct an_options o;
 	an_options_default(&o);
-	struct synth_args sa = { .path = NULL, .duration = 0, .stop_after = NAN };
+	struct synth_args sa = { .path = NULL, .duration = 0, .stop_after = NAN, .delta0 = NAN, .steps = -1 };
 	int c;
 	while ((c = getopt_long(argc, argv, "ho:", long_opts, NULL)) != -1) {
 		if (c == 'h')
@@ -186,6 +246,12 @@ int main(int argc, char **argv)
 			usage(stderr);
 			return AN_EXIT_USAGE;
 		}
+	}
+	if (sa.theory)
+		return run_theory(&o, &sa, optind < argc ? argv[optind] : NULL);
+	if (!isnan(sa.delta0) || sa.steps >= 0 || sa.points != 0) {
+		fputs("undulate-analyze: --delta0, --steps and --points only go with --theory\n", stderr);
+		return AN_EXIT_USAGE;
 	}
 	if (sa.record) {
 		if (optind < argc || sa.path) {
