@@ -353,12 +353,15 @@ buscycle_run() {
 	stop "sim-$name"
 }
 
-# daemon_bus_run N RD_US: undulated's own bus_us over WINDOW_S seconds.
+# daemon_bus_run N RD_US [MODEL]: undulated's own bus_us over WINDOW_S seconds
+# (MODEL: the simulator's X servos at 1 Mbps, Protocol 2.0; results in db2-N-RD).
 daemon_bus_run() {
-	local n=$1 rd=$2 name="db-$1-$2" d=$T/bus u
+	local n=$1 rd=$2 name="db-$1-$2" d=$T/bus u model=()
+	[ -n "${3:-}" ] && { name="db2-$1-$2"; model=(--model "$3" --baud 1000000); }
 	u=$(url $PORT_BUS)
 	mkdir -p "$d"
-	start "sim-$name" "$SIM" --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay "$rd" --lcm-url "$u" --quiet
+	start "sim-$name" "$SIM" --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay "$rd" --lcm-url "$u" \
+		${model[@]+"${model[@]}"} --quiet
 	if ! wait_ready "sim-$name" 'ready:' 10; then
 		echo "status not measured: the simulator refused $n servos on one bus ($(why "sim-$name"))" >"$d/$name"
 		stop "sim-$name"
@@ -483,18 +486,27 @@ bus2_table() {
 	say "delay 0, 1 Mbps. Floor = wire time at 10 bits a byte, no byte stuffed; 1.0's floor (above) beside it."
 	say "Measured as above: from the SYNC_READ to the SYNC_WRITE handed to the port."
 	say ""
-	say "| servos | 1.0 floor (µs) | 2.0 floor (µs) | of it the SYNC_READ | bus | p50 | p99 | max | p50/2.0 floor | p50/SYNC_READ floor | replies missed |"
-	say "|---|---|---|---|---|---|---|---|---|---|---|"
+	progress "2/5 bus time per cycle: undulated on Protocol 2.0 (XM430-W350), ${WINDOW_S} s per configuration"
+	for n in 2 6 18; do daemon_bus_run $n 0 xm430-w350; done
+	say "| servos | 1.0 floor (µs) | 2.0 floor (µs) | of it the SYNC_READ | bus | p50 | p99 | max | p50/2.0 floor | p50/SYNC_READ floor | replies missed | undulated p50 | p99 | max | p50/2.0 floor | overruns |"
+	say "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 	for n in 2 6 18; do
+		local db=$T/bus/db2-$n-0 dcells
+		if [ "$(v "$db" status)" = not ]; then
+			dcells="$(sed -n 's/^status //p' "$db") | – | – | – | –"
+		else
+			dcells="$(fmt "$(v "$db" all.bus_p50)") | $(fmt "$(v "$db" all.bus_p99)") | $(fmt "$(v "$db" all.bus_max)") |"
+			dcells="$dcells $(ratio "$(v "$db" all.bus_p50)" "$(v "$T/bus/bc2-$n.txt" floor_us)") | $(v "$db" all.overruns)"
+		fi
 		b=$T/bus/bc2-$n.txt
 		floor1=$(awk -v n="$n" 'BEGIN { print n * 200 + (3 * n + 8) * 10 }')
 		if [ "$(v "$b" status)" = not ]; then
-			say "| $n | $floor1 | – | – | – | $(sed -n 's/^status //p' "$b") | – | – | – | – | – |"
+			say "| $n | $floor1 | – | – | – | $(sed -n 's/^status //p' "$b") | – | – | – | – | – | $dcells |"
 			continue
 		fi
 		say "| $n | $floor1 | $(v "$b" floor_us) | $(v "$b" floor_reads_us) | $(v "$b" bus) | $(v "$b" bus_p50) | $(v "$b" bus_p99) |" \
 			"$(v "$b" bus_max) | $(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_us)") |" \
-			"$(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_reads_us)") | $(v "$b" timeouts) of $((n * CYCLES)) |"
+			"$(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_reads_us)") | $(v "$b" timeouts) of $((n * CYCLES)) | $dcells |"
 	done
 	say ""
 }

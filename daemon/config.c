@@ -40,6 +40,16 @@ const char *cfg_commands_name(enum cfg_commands c)
 	return c == CFG_CMD_OFF ? "off" : c == CFG_CMD_NETWORK ? "network" : "local";
 }
 
+const char *cfg_protocol_name(enum cfg_protocol p)
+{
+	return p == CFG_PROTO_1 ? "1" : p == CFG_PROTO_2 ? "2" : "auto";
+}
+
+uint8_t cfg_watchdog_units(const struct cfg *c)
+{
+	return c->bus_watchdog_ms > 0 ? (uint8_t)((c->bus_watchdog_ms + 19) / 20) : 0;
+}
+
 const char *cfg_mode_name(enum cfg_mode m)
 {
 	return (unsigned)m < CFG_NMODES ? cfg_mode_names[m] : "UNKNOWN";
@@ -276,6 +286,15 @@ void cfg_defaults(struct cfg *c)
 	/* Five periods of 10 ms stale are a hold; half a second is a servo gone
 	 * (a bus reconnect takes 0.01-0.15 s, tests/integration/daemon_bus.sh). */
 	c->silent_s = 0.5;
+	/* An X servo stops by itself when nothing reached it for 100 ms: ten
+	 * periods of 10 ms, longer than a late cycle on a loaded machine (tens of
+	 * ms), short enough that a joint at the gait's peak speed (≈ 4 rad/s)
+	 * moves at most about 0.4 rad under a controller that went quiet. */
+	c->bus_watchdog_ms = 100;
+	/* One REBOOT after a hardware-error shutdown: a transient (a collision's
+	 * overload, a supply dip) recovers without the operator; a second
+	 * shutdown means the cause is still there, and the fault latches. */
+	c->fault_reboots = 1;
 	c->adapter_latency_us = -1;
 	c->period_ms = 10.0;
 	c->ramp_s = 1.5;
@@ -301,7 +320,8 @@ void cfg_defaults(struct cfg *c)
 }
 
 /* ---- [robot] keys --------------------------------------------------------------------- */
-enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL, T_ACT, T_DRIVE, T_CMDS, T_RS485 };
+enum cfg_type { T_STR, T_LONG, T_DOUBLE, T_BOOL, T_IDS, T_MODE, T_SAFE, T_VEL, T_ACT, T_DRIVE, T_CMDS, T_RS485,
+                T_PROTO };
 struct cfg_key {
 	const char *key;
 	enum cfg_type type;
@@ -315,7 +335,8 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("name", T_STR, name, 0, 0),
 	K("port", T_STR, port, 0, 0),
 	K("usb_serial", T_STR, usb_serial, 0, 0),
-	K("baud", T_LONG, baud, 9600, 3000000),
+	K("baud", T_LONG, baud, 9600, 4500000),
+	K("protocol", T_PROTO, protocol, 0, 0),
 	K("ids", T_IDS, ids, 0, 0),
 	K("mode", T_MODE, mode, 0, 0),
 	K("lcm_url", T_STR, lcm_url, 0, 0),
@@ -348,6 +369,8 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("fault_retries", T_LONG, fault_retries, 0, 100),
 	K("stale_limit", T_LONG, stale_limit, 1, 1000),
 	K("silent_s", T_DOUBLE, silent_s, 0.05, 60),
+	K("bus_watchdog_ms", T_LONG, bus_watchdog_ms, -1, 2540),
+	K("fault_reboots", T_LONG, fault_reboots, 0, 100),
 };
 #undef K
 #define CFG_NROBOT_KEYS (sizeof cfg_robot_keys / sizeof cfg_robot_keys[0])
@@ -405,6 +428,10 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			return false;
 		}
 		*(double *)field = dv;
+		if (strcmp(key, "stall_torque") == 0)
+			c->stall_torque_given = true;
+		if (strcmp(key, "no_load_speed") == 0)
+			c->no_load_speed_given = true;
 		return true;
 	case T_BOOL:
 		if (!parse_bool(value, &bv)) {
@@ -473,6 +500,18 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 		if (!port_rs485_parse(value, &c->rs485)) {
 			cfg_error(e, "%s: [robot] rs485: '%s' is not off, rts-on-send (or rts) or rts-after-send", where,
 			          value);
+			return false;
+		}
+		return true;
+	case T_PROTO:
+		if (strcmp(value, "1") == 0 || strcmp(value, "1.0") == 0)
+			c->protocol = CFG_PROTO_1;
+		else if (strcmp(value, "2") == 0 || strcmp(value, "2.0") == 0)
+			c->protocol = CFG_PROTO_2;
+		else if (strcasecmp(value, "auto") == 0)
+			c->protocol = CFG_PROTO_AUTO;
+		else {
+			cfg_error(e, "%s: [robot] protocol: '%s' is not 1, 2 or auto", where, value);
 			return false;
 		}
 		return true;
@@ -684,6 +723,10 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 			osc_default_torque_params(&d, j, c->njoints, c->torque_drive == CFG_DRIVE_PWM);
 		else
 			osc_default_params(&d, j, c->njoints);
+		if (c->actuation == CFG_ACT_TORQUE)
+			jt->torque_defaults = (isnan(jt->osc.k) ? CFG_TQ_K : 0) | (isnan(jt->osc.c) ? CFG_TQ_C : 0) |
+			                      (isnan(jt->osc.mu) ? CFG_TQ_MU : 0) | (isnan(jt->osc.inertia) ? CFG_TQ_INERTIA : 0) |
+			                      (isnan(jt->osc.friction) ? CFG_TQ_FRICTION : 0);
 		if (isnan(jt->osc.k)) jt->osc.k = d.k;
 		if (isnan(jt->osc.c)) jt->osc.c = d.c;
 		if (isnan(jt->osc.mu)) jt->osc.mu = d.mu;
@@ -699,6 +742,18 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 		 * so it never limits a healthy gait, only jumps. */
 		if (isnan(jt->max_step)) jt->max_step = 0.1;
 	}
+}
+
+void cfg_scale_torque_defaults(struct cfg *c, size_t j, double scale)
+{
+	struct cfg_joint *jt = &c->joint[j];
+	unsigned d = jt->torque_defaults;
+	if (d & CFG_TQ_K) jt->osc.k *= scale;
+	if (d & CFG_TQ_C) jt->osc.c *= scale;
+	if (d & CFG_TQ_MU) jt->osc.mu *= scale;
+	if (d & CFG_TQ_INERTIA) jt->osc.inertia *= scale;
+	if (d & CFG_TQ_FRICTION) jt->osc.friction *= scale;
+	jt->torque_defaults = 0;
 }
 
 bool cfg_finish(struct cfg *c, struct cfg_errors *e)
@@ -765,11 +820,17 @@ void cfg_print(const struct cfg *c, void *file)
 	        c->usb_serial, c->baud);
 	for (size_t j = 0; j < c->njoints; j++)
 		fprintf(f, "%s%u", j ? "," : "", c->ids[j]);
-	fprintf(f, "\nmode = %s\nlcm_url = %s\npriority = %d\nmlockall = %s\nsafe_stop = %s\n"
+	fprintf(f, "\nprotocol = %s\nbus_watchdog_ms = %ld\nfault_reboots = %d\n", cfg_protocol_name(c->protocol),
+	        c->bus_watchdog_ms, c->fault_reboots);
+	if (c->stall_torque_given)
+		fprintf(f, "stall_torque = %g\n", c->stall_torque);
+	if (c->no_load_speed_given)
+		fprintf(f, "no_load_speed = %g\n", c->no_load_speed);
+	fprintf(f, "mode = %s\nlcm_url = %s\npriority = %d\nmlockall = %s\nsafe_stop = %s\n"
 	        "fault_action = %s\nvelocity_source = %s\nvelocity_cutoff_hz = %g\ncommands = %s\n"
 	        "echo = %s\nrs485 = %s\nadapter_latency_us = %ld\nperiod_ms = %g\nservo_lead_s = %g\ncompliance_margin = %ld\n"
 	        "compliance_slope = %ld\n"
-	        "actuation = %s\ntorque_drive = %s\nstall_torque = %g\nno_load_speed = %g\n"
+	        "actuation = %s\ntorque_drive = %s\n"
 	        "bus_margin_us = %ld\nramp_s = %g\nbackoff_torque = %g\n"
 	        "fault_backoff_s = %g\nfault_retries = %d\nstale_limit = %d\nsilent_s = %g\n"
 	        "command_key = %s\ncommand_window_s = %g\nrun_dir = %s\nlockstep = %s\n",
@@ -778,7 +839,7 @@ void cfg_print(const struct cfg *c, void *file)
 	        c->velocity_source == CFG_VEL_SERVO ? "servo" : "filtered", c->velocity_cutoff_hz,
 	        cfg_commands_name(c->commands), c->echo ? "on" : "off", port_rs485_name(c->rs485), c->adapter_latency_us, c->period_ms,
 	        c->servo_lead_s, c->compliance_margin, c->compliance_slope, c->actuation == CFG_ACT_TORQUE ? "torque" : "position",
-	        c->torque_drive == CFG_DRIVE_CURRENT ? "current" : "pwm", c->stall_torque, c->no_load_speed,
+	        c->torque_drive == CFG_DRIVE_CURRENT ? "current" : "pwm",
 	        c->bus_margin_us,
 	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit, c->silent_s,
 	        c->command_key, c->command_window_s, c->run_dir, c->lockstep);

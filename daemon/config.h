@@ -36,6 +36,9 @@ enum cfg_drive { CFG_DRIVE_PWM, CFG_DRIVE_CURRENT };
  * only (the local command socket, whose file permissions decide who); or
  * also the LCM network, each command signed with the shared key. */
 enum cfg_commands { CFG_CMD_OFF, CFG_CMD_LOCAL, CFG_CMD_NETWORK };
+/* The bus's protocol: Dynamixel 1.0 (AX-12), 2.0 (X series), or found at
+ * start-up by PINGs (daemon/README.md, "Protocol"). */
+enum cfg_protocol { CFG_PROTO_AUTO = 0, CFG_PROTO_1 = 1, CFG_PROTO_2 = 2 };
 
 struct cfg_joint {
 	struct osc_joint_params osc;
@@ -43,7 +46,15 @@ struct cfg_joint {
 	double limit_min;      /* rad relative to neutral */
 	double limit_max;
 	double max_step;       /* rad a goal may move per cycle */
+	/* torque actuation: the physical parameters that took their defaults
+	 * (CFG_TQ_* bits), scaled once the servo model is known */
+	unsigned torque_defaults;
 };
+#define CFG_TQ_K        (1u << 0)
+#define CFG_TQ_C        (1u << 1)
+#define CFG_TQ_MU       (1u << 2)
+#define CFG_TQ_INERTIA  (1u << 3)
+#define CFG_TQ_FRICTION (1u << 4)
 
 struct cfg {
 	/* [robot] */
@@ -51,6 +62,7 @@ struct cfg {
 	char port[CFG_PATH_MAX];
 	char usb_serial[64];
 	long baud;
+	enum cfg_protocol protocol;    /* 1, 2, or auto (found at start-up) */
 	uint8_t ids[CFG_MAX_JOINTS];
 	size_t njoints;
 	enum cfg_mode mode;            /* the start mode; HOLD when none is given (mode_given) */
@@ -79,6 +91,9 @@ struct cfg {
 	enum cfg_drive torque_drive;   /* torque actuation: pwm (AX-12) or current */
 	double stall_torque;           /* N·m at 12 V and full output (AX-12A: 1.5) */
 	double no_load_speed;          /* rad/s at 12 V and full output (AX-12A: 59 rpm = 6.18) */
+	bool stall_torque_given, no_load_speed_given;   /* else the servo model's datasheet line */
+	long bus_watchdog_ms;          /* X series: Bus Watchdog (98), 0 = off, in 20 ms steps; -1 = the servo's own */
+	int fault_reboots;             /* X series: REBOOTs of one servo after a shutdown, per 'clear' */
 	long bus_margin_us;            /* slack added to every bus timeout */
 	char lockstep[CFG_PATH_MAX];   /* the simulator's lockstep socket: virtual time ("": real time) */
 	double ramp_s;                 /* blend time for start-up and mode switches */
@@ -136,6 +151,10 @@ const char *cfg_param_commandable_list(void);
 #define CFG_MAX_NATURAL_HZ 5.0
 bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap);
 const char *cfg_commands_name(enum cfg_commands c);
+const char *cfg_protocol_name(enum cfg_protocol p);   /* "1", "2", "auto" */
+/* Bus Watchdog (98) units (20 ms each) for bus_watchdog_ms, rounded up: the
+ * servo never stops sooner than configured. */
+uint8_t cfg_watchdog_units(const struct cfg *c);
 bool cfg_param_is_joint(const char *key);   /* k, c, ..., max_step */
 bool cfg_param_is_robot(const char *key);   /* amplitude, frequency, phase */
 /* Value of a per-joint parameter by name (for commands); NULL if unknown. */
@@ -143,6 +162,11 @@ double *cfg_joint_param(struct cfg_joint *j, const char *key);
 
 const char *cfg_mode_name(enum cfg_mode m);     /* "OSCILLATOR" */
 bool cfg_mode_parse(const char *s, enum cfg_mode *out);   /* case-insensitive */
+
+/* Torque actuation's defaults are an AX-12A joint's: a joint on another
+ * servo has `scale` times its inertia, and the parameters that took the
+ * defaults (not those given) scale with it — once. */
+void cfg_scale_torque_defaults(struct cfg *c, size_t joint, double scale);
 
 /* Print every key with its current value as INI (for --check-config -v). */
 void cfg_print(const struct cfg *c, void *file);

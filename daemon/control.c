@@ -8,6 +8,7 @@
 
 #include "control_priv.h"
 #include "dxl.h"
+#include "dxl2.h"
 #include "dxl_table.h"
 
 /* After a recovery write, watch the error bits this long before calling it a
@@ -56,22 +57,53 @@ bool ctl_next_event(struct ctl *c, struct ctl_event *out)
 	return true;
 }
 
-static void ctl_queue_full(struct ctl *c, uint8_t id, uint8_t addr)
+static void ctl_queue_full(struct ctl *c, uint8_t id, uint16_t addr)
 {
 	ctl_event(c, 2, "write-failed", "servo %u: register %u not written: the write queue is full (%d)", id, addr,
 	          WQ_CAP);
 }
 
-void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
+void ctl_write(struct ctl *c, uint8_t id, uint16_t addr, uint8_t len, uint32_t value)
 {
 	if (!wq_put(&c->wq, id, addr, len, value))
 		ctl_queue_full(c, id, addr);
 }
 
-void ctl_write_seq(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value)
+void ctl_write_seq(struct ctl *c, uint8_t id, uint16_t addr, uint8_t len, uint32_t value)
 {
 	if (!wq_put_seq(&c->wq, id, addr, len, value))
 		ctl_queue_full(c, id, addr);
+}
+
+void ctl_write_chain(struct ctl *c, uint16_t chain, uint8_t id, uint16_t addr, uint8_t len, uint32_t value)
+{
+	if (!wq_put_chain(&c->wq, chain, id, addr, len, value))
+		ctl_queue_full(c, id, addr);
+}
+
+const struct sm_model *ctl_model(const struct ctl *c, size_t j)
+{
+	return j < c->n && c->j[j].servo.model != NULL ? c->j[j].servo.model : sm_ax12();
+}
+
+bool ctl_is_x(const struct ctl *c, size_t j)
+{
+	return ctl_model(c, j)->protocol == 2;
+}
+
+static size_t ctl_joint_of(const struct ctl *c, uint8_t id)
+{
+	size_t j = 0;
+	while (j < c->n && c->j[j].id != id)
+		j++;
+	return j;
+}
+
+/* X series under torque actuation on the PWM drive: Goal PWM is the drive
+ * itself, not a limit, and only the SYNC_WRITE sets it. */
+static bool ctl_limit_is_drive(const struct ctl *c, size_t j)
+{
+	return ctl_is_x(c, j) && c->wheel && c->cfg->torque_drive == CFG_DRIVE_PWM;
 }
 
 uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt)
@@ -85,13 +117,15 @@ uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt)
 static void ctl_torque_write(struct ctl *c, size_t j, bool on)
 {
 	struct ctl_joint *jt = &c->j[j];
+	const struct sm_model *m = ctl_model(c, j);
 	if (on) {
 		/* The manual's recovery: the torque limit back (an alarm shutdown set
 		 * it to 0), then torque enable. Harmless when nothing was wrong. */
-		ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, jt));
-		ctl_write(c, jt->id, DXL_AX_TORQUE_ENABLE, 1, 1);
+		if (!ctl_limit_is_drive(c, j))
+			ctl_write(c, jt->id, m->torque_limit, 2, ctl_torque_limit(c, jt));
+		ctl_write(c, jt->id, m->torque_enable, 1, 1);
 	} else {
-		ctl_write(c, jt->id, DXL_AX_TORQUE_ENABLE, 1, 0);
+		ctl_write(c, jt->id, m->torque_enable, 1, 0);
 	}
 	jt->torque = on;
 }
@@ -101,9 +135,15 @@ const struct wq_write *ctl_take_write(struct ctl *c)
 	return wq_take(&c->wq);
 }
 
-static const char *ctl_register_name(uint8_t addr)
+static const char *ctl_register_name(const struct sm_model *m, const struct wq_write *w)
 {
-	switch (addr) {
+	if (w->len == 0)
+		return "REBOOT";
+	if (m->protocol == 2) {
+		const struct dxl2_reg *r = dxl2_reg_at(dxl2_model_by_number(m->number), w->addr);
+		return r != NULL ? r->name : "register";
+	}
+	switch (w->addr) {
 	case DXL_AX_TORQUE_ENABLE: return "torque enable";
 	case DXL_AX_TORQUE_LIMIT: return "torque limit";
 	case DXL_AX_CW_ANGLE_LIMIT: return "angle limits";
@@ -114,39 +154,103 @@ static const char *ctl_register_name(uint8_t addr)
 	}
 }
 
+static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what, const char *after);
+
+/* X series: what an acknowledged (or given-up) write means to the joint. */
+static void ctl_x_write_done(struct ctl *c, size_t j, const struct wq_write *w, bool ok)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (w->len == 0) {
+		if (!ok) {
+			ctl_fault_persistent(c, j, "shutdown", "with its REBOOT unanswered");
+			return;
+		}
+		/* the boot clears the hardware errors and the watchdog, turns the
+		 * torque off: what the read-back would now say */
+		jt->reboot_at = c->t;
+		jt->hwerr = 0;
+		jt->torque_read = 0;
+		jt->watchdog_read = 0;
+		jt->watchdog_cleared = false;
+		return;
+	}
+	if (w->chain != 0 && w->chain == jt->drive_chain) {
+		tq_chain_result(c, j, w, ok);
+		return;
+	}
+	if (!ok && w->chain != 0) {
+		ctl_event(c, 2, "write-failed", "servo %u: set-up stopped at %s: the writes after it were not sent; "
+		          "the read-back will find what the servo holds", jt->id, ctl_register_name(ctl_model(c, j), w));
+		jt->readback_due = true;
+	}
+}
+
 void ctl_write_result(struct ctl *c, bool ok)
 {
-	struct wq_write w;
-	if (wq_done(&c->wq, ok, &w) != WQ_FAILED)
+	struct wq_write w = { 0 };
+	enum wq_outcome o = wq_done(&c->wq, ok, &w);
+	size_t j = ctl_joint_of(c, w.id);
+	if (w.tries > 0 && j < c->n && ctl_is_x(c, j) && (o == WQ_FAILED || (o == WQ_DONE && ok)))
+		ctl_x_write_done(c, j, &w, o == WQ_DONE);
+	if (o != WQ_FAILED)
 		return;
 	c->write_failures++;
 	ctl_event(c, 2, "write-failed", "servo %u: %s (%u) = %u not acknowledged after %d sends: given up; "
-	          "the read-back will tell what the servo holds", w.id, ctl_register_name(w.addr), w.addr,
+	          "the read-back will tell what the servo holds", w.id, ctl_register_name(ctl_model(c, j), &w), w.addr,
 	          (unsigned)w.value, WQ_TRIES);
 }
 
-size_t ctl_sync(const struct ctl *c, uint8_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data)
+static void ctl_put_le(uint8_t *p, uint32_t v, uint8_t width)
 {
+	for (uint8_t i = 0; i < width; i++)
+		p[i] = (uint8_t)(v >> (8 * i));
+}
+
+/* Torque actuation's outputs (or, X series leaving it, 0 for every drive). On
+ * the X series only joints whose drive switch went through: a servo still in
+ * position control would take Goal PWM as its limit. */
+static size_t ctl_sync_drive(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data)
+{
+	bool current = c->cfg->torque_drive == CFG_DRIVE_CURRENT, x = ctl_is_x(c, 0);
 	size_t n = 0;
-	*width = c->sync == CTL_SYNC_GOAL_STOP ? 4 : 2;
-	*addr = c->sync == CTL_SYNC_DUTY ? DXL_AX_MOVING_SPEED : DXL_AX_GOAL_POSITION;
+	*addr = sm_drive_register(ctl_model(c, 0), current);
+	*width = 2;
 	for (size_t j = 0; j < c->n; j++) {
 		const struct ctl_joint *jt = &c->j[j];
-		if (c->sync == CTL_SYNC_DUTY) {
-			/* the conversion clamps and turns a non-finite duty into 0 */
-			ids[n] = jt->id;
-			dxl_put_u16(&data[2 * n], dxl_duty_to_wheel(jt->duty));
-			n++;
+		if (x && c->sync == CTL_SYNC_DUTY && !jt->drive_ready)
 			continue;
-		}
+		double ratio = c->sync == CTL_SYNC_DUTY ? jt->duty : 0.0;
+		int32_t limit = current ? jt->servo.current_limit : jt->servo.max_torque;
+		ids[n] = jt->id;
+		/* the conversion keeps the servo's limits and turns a non-finite duty into 0 */
+		dxl_put_u16(&data[2 * n], sm_drive_raw(ctl_model(c, j), current, ratio, limit));
+		n++;
+	}
+	return n;
+}
+
+size_t ctl_sync(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data)
+{
+	size_t n = 0;
+	const struct sm_model *m = ctl_model(c, 0);
+	if (c->sync == CTL_SYNC_DUTY || (m->protocol == 2 && c->sync == CTL_SYNC_GOAL_STOP))
+		return ctl_sync_drive(c, addr, width, ids, data);
+	*width = c->sync == CTL_SYNC_GOAL_STOP ? 4 : m->goal_size;
+	*addr = m->goal;
+	for (size_t j = 0; j < c->n; j++) {
+		const struct ctl_joint *jt = &c->j[j];
 		/* safety_clamp() made goal finite and inside the limits; the
-		 * conversion clamps to 0..1023 as a last line */
+		 * conversion clamps to the servo's range as a last line */
 		if (!jt->write_goal || !isfinite(jt->goal))
 			continue;
 		ids[n] = jt->id;
-		dxl_put_u16(&data[*width * n], dxl_rad_to_pos(jt->goal));
-		if (*width == 4)
-			dxl_put_u16(&data[*width * n + 2], 0);   /* moving speed 0: joint mode's "fastest" */
+		if (m->protocol == 2) {
+			ctl_put_le(&data[*width * n], (uint32_t)sm_rad_to_pos(ctl_model(c, j), jt->goal), *width);
+		} else {
+			dxl_put_u16(&data[*width * n], dxl_rad_to_pos(jt->goal));
+			if (*width == 4)
+				dxl_put_u16(&data[*width * n + 2], 0);   /* moving speed 0: joint mode's "fastest" */
+		}
 		n++;
 	}
 	return n;
@@ -174,6 +278,9 @@ void ctl_init(struct ctl *c, struct cfg *cfg)
 		jt->torque_cmd = NAN;
 		jt->torque_read = -1;
 		jt->torque_limit_read = -1;
+		jt->hwerr = jt->watchdog_read = jt->opmode_read = -1;
+		jt->hwerr_at = -INFINITY;
+		jt->reboot_at = -INFINITY;
 		jt->servo.max_torque = 1023;
 		osc_velocity_filter_init(&jt->vfilter, cfg->velocity_cutoff_hz);
 		osc_estimator_init(&jt->estimator);
@@ -186,18 +293,21 @@ bool ctl_set_servo(struct ctl *c, size_t j, const struct ctl_servo_info *info, c
 {
 	struct ctl_joint *jt = &c->j[j];
 	const struct cfg_joint *cj = &c->cfg->joint[j];
+	const struct sm_model *m = info->model != NULL ? info->model : sm_ax12();
 	jt->servo = *info;
-	if (dxl_is_wheel_mode(info->cw_limit, info->ccw_limit)) {
+	jt->servo.model = m;
+	if (m->protocol == 1 && dxl_is_wheel_mode(info->cw_limit, info->ccw_limit)) {
 		snprintf(why, cap, "servo %u is in wheel mode (both angle limits 0): set its angle limits "
 		         "(dxl --port PATH write %u ccw_angle_limit 1023)", jt->id, jt->id);
 		return false;
 	}
-	if (!safety_limits_make(&jt->limits, cj->neutral, cj->limit_min, cj->limit_max, info->cw_limit,
-	                        info->ccw_limit, cj->max_step)) {
+	double lo = sm_pos_to_rad(m, info->cw_limit), hi = sm_pos_to_rad(m, info->ccw_limit);
+	if (info->cw_limit > info->ccw_limit ||
+	    !safety_limits_make_rad(&jt->limits, cj->neutral, cj->limit_min, cj->limit_max, lo, hi, cj->max_step)) {
 		snprintf(why, cap, "joint %zu (servo %u): configured limits neutral %+.3f + [%.3f, %.3f] rad and the "
-		         "servo's angle limits %u..%u (%.3f..%.3f rad) have no angle in common", j, jt->id,
-		         cj->neutral, cj->limit_min, cj->limit_max, info->cw_limit, info->ccw_limit,
-		         dxl_pos_to_rad(info->cw_limit), dxl_pos_to_rad(info->ccw_limit));
+		         "servo's %s limits %u..%u (%.3f..%.3f rad) have no angle in common", j, jt->id,
+		         cj->neutral, cj->limit_min, cj->limit_max, m->protocol == 2 ? "position" : "angle", info->cw_limit,
+		         info->ccw_limit, lo, hi);
 		return false;
 	}
 	return true;
@@ -294,6 +404,16 @@ static double ctl_present_or_goal(const struct ctl_joint *jt)
 static void ctl_servo_setup(struct ctl *c, size_t j, bool torque)
 {
 	struct ctl_joint *jt = &c->j[j];
+	if (ctl_is_x(c, j)) {
+		/* under torque actuation the servo boots in its drive's mode with
+		 * Goal PWM at its limit: every joint goes back to position control
+		 * first (the next cycle may switch them again) */
+		if (c->wheel)
+			tq_leave_wheel(c);
+		else
+			(void)ctl_x_setup(c, j, false);
+		return;
+	}
 	if (c->cfg->compliance_margin >= 0) {
 		uint32_t m = (uint32_t)c->cfg->compliance_margin;
 		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_MARGIN, 2, m | m << 8);
@@ -307,6 +427,44 @@ static void ctl_servo_setup(struct ctl *c, size_t j, bool torque)
 	ctl_torque_write(c, j, torque);
 }
 
+static void ctl_x_write_limits(struct ctl *c, uint16_t ch, size_t j)
+{
+	const struct ctl_joint *jt = &c->j[j];
+	ctl_write_chain(c, ch, jt->id, DXL2_X_MIN_POSITION_LIMIT, 4, jt->servo.cw_limit);
+	ctl_write_chain(c, ch, jt->id, DXL2_X_MAX_POSITION_LIMIT, 4, jt->servo.ccw_limit);
+}
+
+uint16_t ctl_x_setup(struct ctl *c, size_t j, bool with_mode)
+{
+	struct ctl_joint *jt = &c->j[j];
+	const struct sm_model *m = ctl_model(c, j);
+	uint16_t ch = wq_chain(&c->wq);
+	if (with_mode) {
+		/* Operating Mode and the limits are EEPROM: torque off first */
+		ctl_write_chain(c, ch, jt->id, m->torque_enable, 1, 0);
+		ctl_write_chain(c, ch, jt->id, DXL2_X_OPERATING_MODE, 1, SM_OPMODE_POSITION);
+		if (jt->limits_wrong)
+			ctl_x_write_limits(c, ch, j);
+		jt->limits_wrong = false;
+	}
+	/* after a watchdog stop the goals are read-only until it is 0 again */
+	if (jt->watchdog_cleared)
+		ctl_write_chain(c, ch, jt->id, DXL2_X_BUS_WATCHDOG, 1, 0);
+	jt->watchdog_cleared = false;
+	/* a goal where the joint is, inside the limits: the servo's goal may be
+	 * anything (a boot's, a drive mode's) */
+	if (jt->have_reading && jt->limits.max_step > 0.0) {
+		double hold = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
+		ctl_write_chain(c, ch, jt->id, m->goal, m->goal_size, (uint32_t)sm_rad_to_pos(m, hold));
+	}
+	if (c->cfg->bus_watchdog_ms >= 0)
+		ctl_write_chain(c, ch, jt->id, DXL2_X_BUS_WATCHDOG, 1, cfg_watchdog_units(c->cfg));
+	ctl_write_chain(c, ch, jt->id, m->torque_limit, 2, ctl_torque_limit(c, jt));
+	if (jt->torque && c->mode != CFG_MODE_LIMP)
+		ctl_write_chain(c, ch, jt->id, m->torque_enable, 1, 1);
+	return ch;
+}
+
 void ctl_start(struct ctl *c, double t, const char *reason)
 {
 	c->t = t;
@@ -318,6 +476,7 @@ void ctl_start(struct ctl *c, double t, const char *reason)
 		if (jt->fault != CTL_FAULT_FAILED)
 			jt->fault = CTL_FAULT_NONE;
 		jt->retries = 0;
+		jt->drive_ready = false;
 		/* the ramp starts where the joint is: no jump at torque-on */
 		jt->goal = jt->angle;
 		c->hold[j] = jt->angle;
@@ -344,6 +503,10 @@ void ctl_bus_lost(struct ctl *c)
 		c->j[j].fresh = false;
 		c->j[j].torque_read = -1;
 		c->j[j].torque_limit_read = -1;
+		c->j[j].hwerr = c->j[j].watchdog_read = c->j[j].opmode_read = -1;
+		c->j[j].hwerr_at = -INFINITY;
+		c->j[j].readback_due = false;
+		c->j[j].drive_ready = false;
 		/* the next reading after reconnecting starts a new difference */
 		osc_velocity_filter_init(&c->j[j].vfilter, c->cfg->velocity_cutoff_hz);
 	}
@@ -356,21 +519,50 @@ void ctl_bus_lost(struct ctl *c)
 void ctl_measure(struct ctl *c, size_t j, uint16_t pos_raw, uint16_t speed_raw, uint16_t load_raw,
                  uint8_t errbits, double dt)
 {
+	struct sm_present p = {
+		.pos_raw = pos_raw, .angle = dxl_pos_to_rad(pos_raw), .speed = dxl_speed_to_rad_s(speed_raw),
+		.load = dxl_load_to_fraction(load_raw), .voltage = NAN, .temperature = NAN,
+	};
+	ctl_measure_present(c, j, &p, errbits, dt);
+}
+
+/* X series: what the status says, published as Hardware Error Status (as
+ * last read) with the alert in bit 7. An alert the controller cannot explain
+ * yet (no hardware error known) asks for the RAM block at once. */
+static void ctl_x_status(struct ctl *c, size_t j, uint8_t status)
+{
+	struct ctl_joint *jt = &c->j[j];
+	bool alert = sm_alert(ctl_model(c, j), status);
+	if (alert && (!jt->alert || jt->hwerr <= 0))
+		jt->readback_due = true;
+	jt->alert = alert;
+	jt->errbits = (uint8_t)((jt->hwerr > 0 ? jt->hwerr & 0x7F : 0) | (alert ? 0x80 : 0));
+}
+
+void ctl_measure_present(struct ctl *c, size_t j, const struct sm_present *p, uint8_t status, double dt)
+{
 	struct ctl_joint *jt = &c->j[j];
 	jt->fresh = true;
 	jt->have_reading = true;
 	/* back after a gap: blend from the held goal to where the mode is now */
 	jt->resumed = jt->stale_cycles >= CTL_RESUME_STALE;
 	jt->stale_cycles = 0;
-	jt->angle = dxl_pos_to_rad(pos_raw);
-	jt->load = dxl_load_to_fraction(load_raw);
-	jt->errbits = errbits;
+	jt->angle = p->angle;
+	jt->load = p->load;
+	if (ctl_is_x(c, j))
+		ctl_x_status(c, j, status);
+	else
+		jt->errbits = status;
 	/* Keep the filter primed whichever source is configured, so switching
 	 * velocity_source at run time has no transient. */
 	double filtered = osc_velocity_filter_update(&jt->vfilter, jt->angle, dt);
-	jt->speed = c->cfg->velocity_source == CFG_VEL_SERVO ? dxl_speed_to_rad_s(speed_raw) : filtered;
+	jt->speed = c->cfg->velocity_source == CFG_VEL_SERVO ? p->speed : filtered;
 	if (!isfinite(jt->speed))
 		jt->speed = 0.0;
+	if (p->slow) {
+		jt->voltage = p->voltage;
+		jt->temperature = p->temperature;
+	}
 }
 
 void ctl_measure_slow(struct ctl *c, size_t j, uint8_t voltage_raw, uint8_t temperature_raw, uint8_t errbits)
@@ -423,18 +615,18 @@ static void ctl_mismatch(struct ctl *c, size_t j, const char *what, unsigned rea
 	          want);
 }
 
-void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits)
+/* The AX-12's read-back: torque enable, torque limit, compliance margins. */
+static void ctl_readback_ax(struct ctl *c, size_t j, const struct sm_state *st, uint8_t errbits)
 {
 	struct ctl_joint *jt = &c->j[j];
-#define REG(addr) ram[(addr) - CTL_READBACK_ADDR]
-	unsigned torque = REG(DXL_AX_TORQUE_ENABLE);
-	unsigned limit = dxl_get_u16(&REG(DXL_AX_TORQUE_LIMIT));
-	unsigned margin_cw = REG(DXL_AX_CW_COMPLIANCE_MARGIN), margin_ccw = REG(DXL_AX_CCW_COMPLIANCE_MARGIN);
-	unsigned slope_cw = REG(DXL_AX_CW_COMPLIANCE_SLOPE), slope_ccw = REG(DXL_AX_CCW_COMPLIANCE_SLOPE);
+	unsigned torque = (unsigned)st->torque, limit = (unsigned)st->torque_limit;
+	unsigned margin_cw = (unsigned)st->margin_cw, margin_ccw = (unsigned)st->margin_ccw;
+	unsigned slope_cw = (unsigned)st->slope_cw, slope_ccw = (unsigned)st->slope_ccw;
 	jt->torque_read = (int)torque;
 	jt->torque_limit_read = (int)limit;
-	ctl_measure_slow(c, j, REG(DXL_AX_PRESENT_VOLTAGE), REG(DXL_AX_PRESENT_TEMPERATURE), errbits);
-#undef REG
+	jt->voltage = st->voltage;
+	jt->temperature = st->temperature;
+	jt->errbits |= errbits;
 	/* a write to this servo is queued or on the wire: its registers are
 	 * about to change; judge them at the next read-back. A joint in a fault's
 	 * back-off, recovery or latched failure is the fault machinery's. */
@@ -483,6 +675,187 @@ void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits)
 		             (unsigned)want_slope);
 		ctl_write(c, jt->id, DXL_AX_CW_COMPLIANCE_SLOPE, 2, (uint32_t)want_slope | (uint32_t)want_slope << 8);
 	}
+}
+
+void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits)
+{
+	ctl_readback_block(c, j, 0, ram, CTL_READBACK_LEN, errbits);
+}
+
+/* X series: the Bus Watchdog stopped the servo (nothing reached it for its
+ * time: this controller was late, or the line was lost). Its goals are
+ * read-only until the watchdog is written 0: recovered like a reset, and as
+ * a reset counted (one that keeps happening latches). */
+static void ctl_watchdog_tripped(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	jt->resets++;
+	c->resets++;
+	c->watchdog_trips++;
+	unsigned ms = 20u * cfg_watchdog_units(c->cfg);
+	if (jt->resets > c->cfg->fault_retries) {
+		char what[CTL_LATCH_TEXT];
+		snprintf(what, sizeof what, "servo %u stopped by its bus watchdog %lld times", jt->id, jt->resets);
+		ctl_event(c, 2, "watchdog", "servo %u: its bus watchdog stopped it again (%lld): giving up", jt->id,
+		          jt->resets);
+		ctl_latch(c, what);
+	} else {
+		ctl_event(c, 2, "watchdog", "servo %u: its bus watchdog stopped it (nothing reached it for %u ms: "
+		          "this controller was late or the line was lost): cleared and set up again, reset %lld of %d",
+		          jt->id, ms, jt->resets, c->cfg->fault_retries);
+	}
+	wq_drop_id(&c->wq, jt->id);
+	jt->watchdog_cleared = true;
+	ctl_servo_setup(c, j, true);
+	jt->goal = jt->angle;
+	c->hold[j] = jt->angle;
+	if (jt->fault == CTL_FAULT_NONE)
+		ctl_blend_joint(c, j, jt->angle);
+}
+
+/* X series: hardware errors that are no fault (the input voltage outside the
+ * servo's limits) are reported once when they appear. */
+static void ctl_x_report_hwerr(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	uint8_t other = (uint8_t)(jt->hwerr > 0 ? jt->hwerr & ~SM_HWERR_FAULTS : 0);
+	uint8_t fresh_bits = other & (uint8_t)~jt->reported_bits;
+	jt->reported_bits = other;
+	if (fresh_bits == 0)
+		return;
+	char what[96];
+	dxl2_hwerr_format(fresh_bits, what, sizeof what);
+	ctl_event(c, 1, "servo-error", "servo %u reports %s (Hardware Error Status 0x%02x)", jt->id, what,
+	          (unsigned)jt->hwerr);
+}
+
+/* X series, the RAM block: torque, the watchdog, Goal PWM, the profiles. */
+static void ctl_readback_x_ram(struct ctl *c, size_t j, const struct sm_state *st)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (st->hwerr & SM_HWERR_FAULTS)
+		return;   /* a fault: ctl_fault_step's, at this cycle's step */
+	if (st->watchdog == SM_WATCHDOG_TRIPPED) {
+		ctl_watchdog_tripped(c, j);
+		return;
+	}
+	if (jt->torque && st->torque == 0) {
+		ctl_servo_reset(c, j);
+		return;
+	}
+	if (!jt->torque && st->torque != 0) {
+		ctl_mismatch(c, j, "torque enable", (unsigned)st->torque, 0);
+		ctl_torque_write(c, j, false);
+		return;
+	}
+	const struct sm_model *m = ctl_model(c, j);
+	unsigned want_wd = cfg_watchdog_units(c->cfg);
+	if (c->cfg->bus_watchdog_ms >= 0 && (unsigned)st->watchdog != want_wd) {
+		ctl_mismatch(c, j, "bus watchdog", (unsigned)st->watchdog, want_wd);
+		ctl_write(c, jt->id, DXL2_X_BUS_WATCHDOG, 1, want_wd);
+	}
+	if (st->profile_velocity != 0 || st->profile_acceleration != 0) {
+		/* a profile would make every goal a slow ramp */
+		ctl_mismatch(c, j, st->profile_velocity != 0 ? "profile velocity" : "profile acceleration",
+		             (unsigned)(st->profile_velocity != 0 ? st->profile_velocity : st->profile_acceleration), 0);
+		ctl_write(c, jt->id, DXL2_X_PROFILE_ACCELERATION, 4, 0);
+		ctl_write(c, jt->id, DXL2_X_PROFILE_VELOCITY, 4, 0);
+	}
+	unsigned want_limit = ctl_torque_limit(c, jt);
+	if (jt->torque && !ctl_limit_is_drive(c, j) && (unsigned)st->torque_limit != want_limit) {
+		ctl_mismatch(c, j, "goal PWM (the output limit)", (unsigned)st->torque_limit, want_limit);
+		ctl_write(c, jt->id, m->torque_limit, 2, want_limit);
+	}
+}
+
+/* X series, the EEPROM block: Operating Mode and the position limits, which
+ * only the configuration and this controller's switches decide. Found
+ * otherwise: written again (torque off for it), counted as a reset. */
+static void ctl_readback_x_eeprom(struct ctl *c, size_t j, const struct sm_state *st)
+{
+	struct ctl_joint *jt = &c->j[j];
+	int want_mode = c->wheel && jt->drive_ready ? sm_drive_opmode(c->cfg->torque_drive == CFG_DRIVE_CURRENT)
+	                                            : SM_OPMODE_POSITION;
+	bool mode_wrong = st->opmode != want_mode && !(c->wheel && !jt->drive_ready);
+	jt->limits_wrong = st->pos_min != jt->servo.cw_limit || st->pos_max != jt->servo.ccw_limit;
+	if (st->pwm_limit >= 0 && (unsigned)st->pwm_limit != jt->servo.max_torque) {
+		ctl_event(c, 1, "readback", "servo %u: PWM Limit read back %d, was %u at start: taken as the output "
+		          "limit", jt->id, st->pwm_limit, jt->servo.max_torque);
+		jt->servo.max_torque = (uint16_t)st->pwm_limit;
+	}
+	if (st->current_limit >= 0 && (unsigned)st->current_limit != jt->servo.current_limit)
+		jt->servo.current_limit = (uint16_t)st->current_limit;
+	if (!mode_wrong && !jt->limits_wrong)
+		return;
+	c->readback_mismatches++;
+	jt->resets++;
+	c->resets++;
+	const char *mode = dxl2_opmode_name((uint8_t)st->opmode);
+	ctl_event(c, 2, "readback", "servo %u: %s%s%s (operating mode %d %s, position limits %ld..%ld; this "
+	          "controller's: %d, %u..%u): written again with torque off, reset %lld of %d", jt->id,
+	          mode_wrong ? "operating mode changed" : "", mode_wrong && jt->limits_wrong ? " and " : "",
+	          jt->limits_wrong ? "position limits changed" : "", st->opmode, mode != NULL ? mode : "unknown",
+	          (long)st->pos_min, (long)st->pos_max, want_mode, jt->servo.cw_limit, jt->servo.ccw_limit, jt->resets,
+	          c->cfg->fault_retries);
+	if (jt->resets > c->cfg->fault_retries) {
+		char what[CTL_LATCH_TEXT];
+		snprintf(what, sizeof what, "servo %u keeps being changed behind this controller's back", jt->id);
+		ctl_latch(c, what);
+	}
+	wq_drop_id(&c->wq, jt->id);
+	if (c->wheel)
+		tq_leave_wheel(c);
+	else
+		(void)ctl_x_setup(c, j, true);
+}
+
+static void ctl_readback_x(struct ctl *c, size_t j, const struct sm_state *st, uint8_t status)
+{
+	struct ctl_joint *jt = &c->j[j];
+	ctl_x_status(c, j, status);
+	bool ram = st->torque >= 0;
+	if (ram) {
+		jt->torque_read = st->torque;
+		jt->torque_limit_read = st->torque_limit;
+		jt->hwerr = st->hwerr;
+		jt->hwerr_at = c->t;
+		jt->watchdog_read = st->watchdog;
+		jt->readback_due = false;
+		jt->errbits = (uint8_t)((st->hwerr & 0x7F) | (jt->alert ? 0x80 : 0));
+		ctl_x_report_hwerr(c, j);
+	} else {
+		jt->opmode_read = st->opmode;
+	}
+	/* as on the AX-12: registers about to change, or the fault machinery's */
+	if (wq_has_id(&c->wq, jt->id) || !jt->have_reading || jt->fault != CTL_FAULT_NONE)
+		return;
+	if (ram)
+		ctl_readback_x_ram(c, j, st);
+	else
+		ctl_readback_x_eeprom(c, j, st);
+}
+
+void ctl_readback_block(struct ctl *c, size_t j, size_t block, const uint8_t *bytes, size_t n, uint8_t status)
+{
+	const struct sm_model *m = ctl_model(c, j);
+	struct sm_state st;
+	sm_state_unknown(&st);
+	if (!sm_decode_readback(m, block, bytes, n, &st))
+		return;
+	if (m->protocol == 2)
+		ctl_readback_x(c, j, &st, status);
+	else
+		ctl_readback_ax(c, j, &st, status);
+}
+
+bool ctl_readback_due(const struct ctl *c, size_t *joint)
+{
+	for (size_t j = 0; j < c->n; j++)
+		if (c->j[j].readback_due) {
+			*joint = j;
+			return true;
+		}
+	return false;
 }
 
 /* ---- modes ------------------------------------------------------------------------------------ */
@@ -626,6 +999,19 @@ bool ctl_clear_faults(struct ctl *c, char *why, size_t cap)
 		}
 		jt->retries = 0;
 		jt->resets = 0;
+		jt->reboots = 0;
+		if (ctl_is_x(c, j) && jt->hwerr > 0 && (jt->hwerr & SM_HWERR_FAULTS) && jt->torque_read == 0) {
+			/* shut down: an X servo takes torque again only after a REBOOT,
+			 * which the operator's 'clear' asks for (not counted against
+			 * fault_reboots); then it is set up as after any */
+			wq_drop_id(&c->wq, jt->id);
+			ctl_write_chain(c, wq_chain(&c->wq), jt->id, 0, 0, 0);
+			c->reboots++;
+			jt->fault = CTL_FAULT_REBOOT;
+			jt->fault_since = c->t;
+			ctl_event(c, 0, "reboot", "servo %u: REBOOT ('clear'), then set up again", jt->id);
+			continue;
+		}
 		/* the manual's recovery, whatever happened while latched (an alarm
 		 * shutdown zeroes the torque limit and turns torque off) */
 		if (jt->torque)
@@ -644,27 +1030,49 @@ static void ctl_backoff(struct ctl *c, size_t j)
 	jt->fault = CTL_FAULT_BACKOFF;
 	jt->fault_since = c->t;
 	jt->fault_hold = isfinite(jt->angle) ? jt->angle : jt->goal;
-	ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, jt));
+	if (!ctl_limit_is_drive(c, j))
+		ctl_write(c, jt->id, ctl_model(c, j)->torque_limit, 2, ctl_torque_limit(c, jt));
 }
 
-static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what)
+/* The fault bits in play: the AX-12's overload and overheating in this
+ * cycle's status; an X servo's hardware errors as last read back. */
+static uint8_t ctl_fault_bits(const struct ctl *c, size_t j)
+{
+	const struct ctl_joint *jt = &c->j[j];
+	if (ctl_is_x(c, j))
+		return (uint8_t)(jt->hwerr > 0 ? jt->hwerr & SM_HWERR_FAULTS : 0);
+	return jt->fresh ? (uint8_t)(jt->errbits & (DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT)) : 0;
+}
+
+static void ctl_fault_name(const struct ctl *c, size_t j, uint8_t bits, char *what, size_t cap)
+{
+	if (ctl_is_x(c, j))
+		dxl2_hwerr_format(bits, what, cap);
+	else
+		dxl_errbits_format(bits, what, cap);
+}
+
+/* after: how it was tried (NULL: the recovery attempts counted). */
+static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what, const char *after)
 {
 	struct ctl_joint *jt = &c->j[j];
 	jt->fault = CTL_FAULT_FAILED;
-	char text[CTL_LATCH_TEXT];
+	char text[CTL_LATCH_TEXT], tried[64];
+	if (after == NULL)
+		snprintf(tried, sizeof tried, "after %d recovery attempts", jt->retries);
 	snprintf(text, sizeof text, "servo %u %s persists", jt->id, what);
-	ctl_event(c, 2, "fault-persistent", "servo %u: %s persists after %d recovery attempts: robot %s; "
-	          "cool down / check the mechanics, then 'clear'", jt->id, what, jt->retries,
-	          cfg_mode_name(ctl_fault_mode(c)));
+	ctl_event(c, 2, "fault-persistent", "servo %u: %s persists %s: robot %s; cool down / check the mechanics, "
+	          "then 'clear'", jt->id, what, after != NULL ? after : tried, cfg_mode_name(ctl_fault_mode(c)));
 	ctl_latch(c, text);
 }
 
 /* Error bits other than the fault kinds (voltage, angle limit, range,
- * checksum, instruction) are reported once when they appear. */
+ * checksum, instruction) are reported once when they appear (an X servo's at
+ * its read-back). */
 static void ctl_report_errbits(struct ctl *c, size_t j)
 {
 	struct ctl_joint *jt = &c->j[j];
-	if (!jt->fresh)
+	if (!jt->fresh || ctl_is_x(c, j))
 		return;
 	uint8_t other = jt->errbits & (uint8_t)~(DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT);
 	uint8_t fresh_bits = other & (uint8_t)~jt->reported_bits;
@@ -676,12 +1084,44 @@ static void ctl_report_errbits(struct ctl *c, size_t j)
 	ctl_event(c, 1, "servo-error", "servo %u reports %s (error byte 0x%02x)", jt->id, what, jt->errbits);
 }
 
+/* X series: a servo its hardware error shut down (torque off) recovers only
+ * by a REBOOT: one per fault_reboots since the last 'clear', else the fault
+ * latches. True when that was decided here. */
+static bool ctl_x_reboot(struct ctl *c, size_t j, const char *what)
+{
+	struct ctl_joint *jt = &c->j[j];
+	if (!ctl_is_x(c, j) || jt->torque_read != 0)
+		return false;
+	if (jt->reboots >= c->cfg->fault_reboots) {
+		char after[64];
+		snprintf(after, sizeof after, "after %d REBOOT(s) (fault_reboots = %d)", jt->reboots, c->cfg->fault_reboots);
+		ctl_fault_persistent(c, j, what, after);
+		return true;
+	}
+	jt->reboots++;
+	c->reboots++;
+	wq_drop_id(&c->wq, jt->id);
+	ctl_write_chain(c, wq_chain(&c->wq), jt->id, 0, 0, 0);
+	jt->fault = CTL_FAULT_REBOOT;
+	jt->fault_since = c->t;
+	ctl_event(c, 1, "reboot", "servo %u: %s shut it down: REBOOT %d of %d (fault_reboots), then set up again",
+	          jt->id, what, jt->reboots, c->cfg->fault_reboots);
+	return true;
+}
+
+/* X series: the hardware error status read back since `since`, if any. */
+static bool ctl_x_read_since(const struct ctl_joint *jt, double since)
+{
+	return jt->hwerr_at >= since;
+}
+
 static void ctl_fault_step(struct ctl *c, size_t j)
 {
 	struct ctl_joint *jt = &c->j[j];
-	uint8_t bad = jt->fresh ? (jt->errbits & (DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT)) : 0;
+	bool x = ctl_is_x(c, j);
+	uint8_t bad = ctl_fault_bits(c, j);
 	char what[64];
-	dxl_errbits_format(bad ? bad : jt->errbits, what, sizeof what);
+	ctl_fault_name(c, j, bad ? bad : (x ? (uint8_t)(jt->hwerr > 0 ? jt->hwerr : 0) : jt->errbits), what, sizeof what);
 	switch (jt->fault) {
 	case CTL_FAULT_NONE:
 		if (!bad)
@@ -690,11 +1130,14 @@ static void ctl_fault_step(struct ctl *c, size_t j)
 		c->faults++;
 		jt->retries = 0;
 		ctl_backoff(c, j);
-		ctl_event(c, 1, "fault", "servo %u: %s: backing off (holding at %+.3f rad, torque limit %.0f %%)",
-		          jt->id, what, jt->fault_hold, 100.0 * c->cfg->backoff_torque);
+		ctl_event(c, 1, "fault", "servo %u: %s%s: backing off (holding at %+.3f rad, torque limit %.0f %%)",
+		          jt->id, what, x && jt->torque_read == 0 ? " (shut down: torque off)" : "", jt->fault_hold,
+		          100.0 * c->cfg->backoff_torque);
 		return;
 	case CTL_FAULT_BACKOFF:
 		if (c->t - jt->fault_since < c->cfg->fault_backoff_s)
+			return;
+		if (ctl_x_reboot(c, j, what))
 			return;
 		jt->fault = CTL_FAULT_CHECK;
 		jt->fault_since = c->t;
@@ -704,11 +1147,26 @@ static void ctl_fault_step(struct ctl *c, size_t j)
 		else
 			ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, jt->servo.max_torque);
 		return;
+	case CTL_FAULT_REBOOT:
+		/* its acknowledgement sets reboot_at; then the boot's settle time */
+		if (!(jt->reboot_at >= jt->fault_since) || c->t - jt->reboot_at < CTL_REBOOT_SETTLE_S)
+			return;
+		jt->fault = CTL_FAULT_CHECK;
+		jt->fault_since = c->t;
+		(void)ctl_x_setup(c, j, true);
+		jt->readback_due = true;
+		return;
 	case CTL_FAULT_CHECK:
+		/* an X servo's faults are known from a read-back: one since the
+		 * recovery tells, an older one does not */
+		if (x && !ctl_x_read_since(jt, jt->fault_since)) {
+			jt->readback_due = true;
+			return;
+		}
 		if (bad) {
 			jt->retries++;
 			if (jt->retries > c->cfg->fault_retries) {
-				ctl_fault_persistent(c, j, what);
+				ctl_fault_persistent(c, j, what, NULL);
 				return;
 			}
 			ctl_backoff(c, j);

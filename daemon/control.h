@@ -8,8 +8,17 @@
  * writes or the events. That keeps mode switches, faults and the write
  * rules unit-testable.
  *
- * Angles: `angle`/`goal` are absolute servo radians (0 = raw 512); the
- * oscillator works in x = angle − neutral.
+ * Angles: `angle`/`goal` are absolute servo radians (0 = the servo's centre:
+ * raw 512 on the AX-12, 2048 on the X series); the oscillator works in
+ * x = angle − neutral.
+ *
+ * Servo families (servo_model.h): registers, units and sequences come from
+ * each joint's model; the rules here are one piece of code for all of them.
+ * What only the X series has — REBOOT, the Bus Watchdog, Hardware Error
+ * Status, Operating Mode — is handled by the same machinery: a shutdown is a
+ * fault (backed off, recovered by a REBOOT while fault_reboots allows, else
+ * latched), a watchdog that stopped a servo is recovered like a reset, an
+ * Operating Mode or position limits found changed are written again.
  *
  * Faults latch (as a CiA 402 drive's do): a joint silent for longer than
  * silent_s, a servo fault that persists through its recovery attempts, a
@@ -28,6 +37,7 @@
 #include "config.h"
 #include "osc.h"
 #include "safety.h"
+#include "servo_model.h"
 #include "writeq.h"
 
 /* Events (faults, recoveries, mode changes) queued per cycle for LCM; more
@@ -36,19 +46,31 @@
 #define CTL_EVENT_TEXT 160
 #define CTL_LATCH_TEXT 128
 
-/* The RAM block read back in the slow round-robin: torque enable (24)
- * through present temperature (43). */
+/* The AX-12's RAM block read back in the slow round-robin: torque enable
+ * (24) through present temperature (43). (Each model's blocks: servo_model.h.) */
 #define CTL_READBACK_ADDR 24
 #define CTL_READBACK_LEN 20
 
-enum ctl_fault { CTL_FAULT_NONE, CTL_FAULT_BACKOFF, CTL_FAULT_CHECK, CTL_FAULT_FAILED };
+enum ctl_fault {
+	CTL_FAULT_NONE,
+	CTL_FAULT_BACKOFF,   /* backing off (reduced torque limit) before a recovery attempt */
+	CTL_FAULT_REBOOT,    /* X series: a REBOOT sent, waiting for the servo to boot */
+	CTL_FAULT_CHECK,     /* recovered: watching that the fault does not come back */
+	CTL_FAULT_FAILED,    /* persisted: latched */
+};
+/* X series: after a REBOOT is acknowledged the servo boots; the set-up
+ * writes wait this long (the manual gives no boot time; a real servo is deaf
+ * for a moment, the simulator's boot is instantaneous). */
+#define CTL_REBOOT_SETTLE_S 0.3
 
 /* What this cycle's SYNC_WRITE carries. */
 enum ctl_sync {
 	CTL_SYNC_GOAL,       /* goal position (30) of the joints with write_goal */
-	CTL_SYNC_DUTY,       /* torque actuation, wheel mode: moving speed (32) = duty of every joint */
+	CTL_SYNC_DUTY,       /* torque actuation, wheel mode: moving speed (32) = duty of every joint
+	                        (X series: Goal Current 102 or Goal PWM 100 of every joint in its drive) */
 	CTL_SYNC_GOAL_STOP,  /* leaving wheel mode: goal (30) and moving speed 0 (32) of every joint
-	                        with a reading; the angle-limit writes that follow restore joint mode */
+	                        with a reading; the angle-limit writes that follow restore joint mode
+	                        (X series: the drive register 0; the mode switch's chain follows) */
 };
 
 struct ctl_event {
@@ -59,10 +81,12 @@ struct ctl_event {
 
 /* What the servo told us at start-up. */
 struct ctl_servo_info {
-	uint16_t cw_limit, ccw_limit;
-	uint16_t max_torque;
+	uint16_t cw_limit, ccw_limit;   /* X series: Min/Max Position Limit (52, 48) */
+	uint16_t max_torque;            /* X series: PWM Limit (36), Goal PWM's ceiling */
 	uint8_t return_delay;
 	uint8_t status_return_level;
+	const struct sm_model *model;   /* NULL: the AX-12A */
+	uint16_t current_limit;         /* XM430: Current Limit (38) */
 };
 
 struct ctl_joint {
@@ -74,8 +98,9 @@ struct ctl_joint {
 	double angle;               /* rad absolute, last good reading */
 	double speed;               /* rad/s, per the configured velocity source */
 	double load;
-	uint8_t errbits;
+	uint8_t errbits;            /* AX-12: the status error byte; X: Hardware Error Status, bit 7 the alert */
 	uint8_t reported_bits;      /* non-fault error bits already reported */
+	bool alert;                 /* X: the last status raised the alert */
 	double voltage, temperature;
 	int32_t stale_cycles;
 	bool resumed;               /* fresh again after CTL_RESUME_STALE stale cycles */
@@ -87,6 +112,20 @@ struct ctl_joint {
 	int torque_read;            /* torque enable (24) */
 	int torque_limit_read;      /* torque limit (34) */
 	long long resets;           /* found reset (torque off, RAM at its defaults) since the last clear */
+	/* X series, read back; -1 until read */
+	int hwerr;                  /* Hardware Error Status (70) */
+	double hwerr_at;            /* when it was last read (controller time; -inf never) */
+	int watchdog_read;          /* Bus Watchdog (98) */
+	int opmode_read;            /* Operating Mode (11) */
+	bool readback_due;          /* read its RAM block back at the next chance (an alert, a check) */
+	int reboots;                /* REBOOTs sent since the last clear */
+	double reboot_at;           /* when the last REBOOT was acknowledged */
+	bool watchdog_cleared;      /* the set-up writes the watchdog 0 first (it had stopped the servo) */
+	bool limits_wrong;          /* Min/Max Position Limit read back unlike the configuration's */
+	/* torque actuation, X series: the drive mode's switch (a chain of writes)
+	 * went through, so the SYNC_WRITE may carry this joint's drive */
+	bool drive_ready;
+	uint16_t drive_chain;       /* the chain that makes it so */
 	/* command */
 	double goal;                /* rad absolute, last sent (NaN: none yet) */
 	bool write_goal;            /* include in this cycle's SYNC_WRITE */
@@ -141,9 +180,13 @@ struct ctl {
 	long long write_failures;       /* register writes given up after WQ_TRIES sends */
 	long long readback_mismatches;  /* a register read back differed from what we wrote */
 	long long resets;               /* servos found reset */
+	long long watchdog_trips;       /* X series: servos found stopped by their bus watchdog */
+	long long reboots;              /* X series: REBOOTs sent */
 };
 
 void ctl_init(struct ctl *c, struct cfg *cfg);
+/* The joint's servo model (the AX-12A until ctl_set_servo says otherwise). */
+const struct sm_model *ctl_model(const struct ctl *c, size_t joint);
 /* After start-up checks (again after every reconnect): the servo's limits and
  * settings. False (with *why) if the configured limits and the servo's have
  * no angle in common or the servo is in wheel mode. */
@@ -160,9 +203,14 @@ void ctl_start(struct ctl *c, double t, const char *reason);
 void ctl_bus_lost(struct ctl *c);
 
 /* ---- inputs ------------------------------------------------------------------------- */
-/* This cycle's reading of joint j (raw registers 36..41 and the error byte). */
+/* This cycle's reading of joint j (raw registers 36..41 and the error byte:
+ * the AX-12's). */
 void ctl_measure(struct ctl *c, size_t j, uint16_t pos_raw, uint16_t speed_raw, uint16_t load_raw,
                  uint8_t errbits, double dt);
+/* The same from a decoded present block of any model, with the status the
+ * reply carried (AX-12 error byte; X ERR field). A slow block's voltage and
+ * temperature are taken too. */
+void ctl_measure_present(struct ctl *c, size_t j, const struct sm_present *p, uint8_t status, double dt);
 /* A voltage/temperature reading (registers 42, 43). */
 void ctl_measure_slow(struct ctl *c, size_t j, uint8_t voltage_raw, uint8_t temperature_raw, uint8_t errbits);
 /* The RAM block CTL_READBACK_ADDR.. (CTL_READBACK_LEN bytes) of joint j as the
@@ -170,6 +218,12 @@ void ctl_measure_slow(struct ctl *c, size_t j, uint8_t voltage_raw, uint8_t temp
  * temperature. Compared with what the controller wrote; a servo found reset
  * or shut down is reported and brought back (or the fault latches). */
 void ctl_readback(struct ctl *c, size_t j, const uint8_t *ram, uint8_t errbits);
+/* Read-back block `block` of joint j's model (servo_model.h), n bytes, and
+ * the status of its reply. Blocks of the wrong length are ignored. */
+void ctl_readback_block(struct ctl *c, size_t j, size_t block, const uint8_t *bytes, size_t n, uint8_t status);
+/* A joint whose RAM block should be read back now (an alert, a recovery being
+ * checked): true with *joint set. */
+bool ctl_readback_due(const struct ctl *c, size_t *joint);
 
 /* One control step at controller time t (s) with measured period dt (s) and
  * wall-clock time t_real (s, for SINUSOID's shared clock). Fills goals,
@@ -201,7 +255,8 @@ const struct wq_write *ctl_take_write(struct ctl *c);
 void ctl_write_result(struct ctl *c, bool ok);
 /* This cycle's SYNC_WRITE: register, bytes per servo, and per servo its ID
  * and data (little-endian). Returns the number of servos (0: nothing to send). */
-size_t ctl_sync(const struct ctl *c, uint8_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data);
+#define CTL_SYNC_MAX_WIDTH 4
+size_t ctl_sync(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data);
 /* The next queued event; false when none is left. */
 bool ctl_next_event(struct ctl *c, struct ctl_event *out);
 

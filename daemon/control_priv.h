@@ -13,10 +13,21 @@
 void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
 /* A register's new value (writeq.h's merge rules). */
-void ctl_write(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value);
+void ctl_write(struct ctl *c, uint8_t id, uint16_t addr, uint8_t len, uint32_t value);
 /* Appended as it is, in order: a sequence that writes one register twice
  * (torque off, EEPROM write, torque on) must not be merged. */
-void ctl_write_seq(struct ctl *c, uint8_t id, uint8_t addr, uint8_t len, uint32_t value);
+void ctl_write_seq(struct ctl *c, uint8_t id, uint16_t addr, uint8_t len, uint32_t value);
+/* A step of a chain (writeq.h): the chain stops at a step given up. len 0:
+ * a REBOOT. */
+void ctl_write_chain(struct ctl *c, uint16_t chain, uint8_t id, uint16_t addr, uint8_t len, uint32_t value);
+/* X series: the writes that make servo j what the controller expects, as one
+ * chain (returned): with_mode — torque off and Operating Mode 3 first (the
+ * EEPROM takes it only with torque off) — then Goal Position where the joint
+ * is (inside its limits), Goal PWM at its limit, the Bus Watchdog (0 first
+ * when it had stopped the servo), and torque on when it is wanted. */
+uint16_t ctl_x_setup(struct ctl *c, size_t j, bool with_mode);
+/* The joint's servo is an X series one. */
+bool ctl_is_x(const struct ctl *c, size_t j);
 /* The torque limit a joint should have: the servo's max torque, reduced to
  * backoff_torque while it backs off from a fault or holds after one that
  * persisted. */
@@ -40,5 +51,13 @@ void tq_leave_wheel(struct ctl *c);
 /* Leaving wheel mode, the SYNC_WRITE stops every drive and leaves a goal the
  * joint mode can hold. */
 void tq_stop_goals(struct ctl *c);
+/* The stall torque (N·m at the model's reference supply) and no-load speed
+ * torque actuation works with: the configuration's when given, else the
+ * joint's model's datasheet line. */
+double tq_stall_torque(const struct ctl *c, const struct ctl_joint *jt);
+double tq_no_load_speed(const struct ctl *c, const struct ctl_joint *jt);
+/* X series: a step of a drive switch's chain was acknowledged (ok) or given
+ * up; the joint's drive is ready, or the robot goes back to joint mode. */
+void tq_chain_result(struct ctl *c, size_t j, const struct wq_write *w, bool ok);
 
 #endif

@@ -2,14 +2,11 @@
 #include "cycle.h"
 
 #include <stddef.h>
+#include <string.h>
 
 #include "dxl.h"
 #include "dxl_table.h"
-
-/* Error bits in a write's acknowledgement that mean the servo did not take
- * it: a refused EEPROM write (range), an instruction it rejected, or a
- * packet it received damaged. */
-#define CYC_WRITE_REFUSED (DXL_ERRBIT_RANGE | DXL_ERRBIT_INSTRUCTION | DXL_ERRBIT_CHECKSUM)
+#include "servo_model.h"
 
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks)
 {
@@ -21,6 +18,11 @@ void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_u
 static uint64_t cyc_now(const struct cyc *y)
 {
 	return y->bus->io.now_us(y->bus->io.ctx);
+}
+
+static bool cyc_p2(const struct cyc *y)
+{
+	return bus_get_protocol(y->bus) == BUS_PROTOCOL_2;
 }
 
 bool cyc_busy(const struct cyc *y)
@@ -88,21 +90,65 @@ void cyc_cut(struct cyc *y)
 	(void)cyc_finish(y, CYC_DONE);
 }
 
-static int cyc_begin_read(struct cyc *y, uint8_t id, uint8_t addr, uint8_t len)
+static int cyc_begin_read(struct cyc *y, uint8_t id, uint16_t addr, uint16_t len)
 {
-	uint8_t params[2] = { addr, len };
+	if (cyc_p2(y)) {
+		uint8_t p2[4] = { (uint8_t)addr, (uint8_t)(addr >> 8), (uint8_t)len, (uint8_t)(len >> 8) };
+		return bus_begin(y->bus, id, DXL2_INST_READ, p2, sizeof p2, len);
+	}
+	uint8_t params[2] = { (uint8_t)addr, (uint8_t)len };
 	return bus_begin(y->bus, id, DXL_INST_READ, params, 2, len);
 }
 
 static int cyc_begin_write(struct cyc *y, const struct wq_write *w)
 {
-	uint8_t params[5] = { w->addr, (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8),
+	uint8_t params[6] = { (uint8_t)w->addr, (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8),
 	                      (uint8_t)(w->value >> 16), (uint8_t)(w->value >> 24) };
 	int reply = -1;
 	for (size_t j = 0; j < y->ctl->n; j++)
 		if (y->ctl->j[j].id == w->id && y->ctl->j[j].servo.status_return_level >= 2)
 			reply = 0;
-	return bus_begin(y->bus, w->id, DXL_INST_WRITE, params, (size_t)w->len + 1, reply);
+	if (!cyc_p2(y))
+		return bus_begin(y->bus, w->id, DXL_INST_WRITE, params, (size_t)w->len + 1, reply);
+	if (w->len == 0)
+		return bus_begin(y->bus, w->id, DXL2_INST_REBOOT, NULL, 0, reply);
+	/* 2.0: a 16-bit address before the data */
+	uint8_t p2[6] = { (uint8_t)w->addr, (uint8_t)(w->addr >> 8) };
+	memcpy(p2 + 2, params + 1, w->len);
+	return bus_begin(y->bus, w->id, DXL2_INST_WRITE, p2, (size_t)w->len + 2, reply);
+}
+
+/* Protocol 2.0: every joint's present block in one SYNC_READ. */
+static int cyc_begin_sync_read(struct cyc *y)
+{
+	uint8_t ids[CFG_MAX_JOINTS];
+	for (size_t j = 0; j < y->ctl->n; j++)
+		ids[j] = y->ctl->j[j].id;
+	y->multi.data = y->multi_buf;
+	y->multi.cap = sizeof y->multi_buf;
+	return bus_sync_read_begin(y->bus, ctl_model(y->ctl, 0)->present, y->read_len, ids, y->ctl->n, &y->multi);
+}
+
+/* This cycle's read-back, if any: a joint the controller asks for now (its
+ * RAM block), else every CYC_READBACK_EVERY cycles the next joint in turn,
+ * and after the last joint the model's next block. */
+static bool cyc_pick_readback(struct cyc *y)
+{
+	size_t due;
+	if (ctl_readback_due(y->ctl, &due)) {
+		y->readback_now_joint = due;
+		y->readback_now_block = 0;
+		return true;
+	}
+	if (y->count % CYC_READBACK_EVERY != 0)
+		return false;
+	y->readback_joint = (y->readback_joint + 1) % y->ctl->n;
+	if (y->readback_joint == 0)
+		y->readback_block++;
+	size_t nblocks = ctl_model(y->ctl, y->readback_joint)->nreadback;
+	y->readback_now_joint = y->readback_joint;
+	y->readback_now_block = nblocks > 0 ? y->readback_block % nblocks : 0;
+	return true;
 }
 
 /* Start the next transaction, skipping steps with nothing to do. */
@@ -120,6 +166,16 @@ static enum cyc_status cyc_advance(struct cyc *y)
 				y->phase = CYC_CONTROL_STEP;
 				y->control_start_us = cyc_now(y);
 				return CYC_CONTROL;
+			}
+			if (cyc_p2(y)) {
+				r = cyc_begin_sync_read(y);
+				if (cyc_port_gone(r))
+					return cyc_lost(y, r);
+				if (r == DXL_OK && bus_is_pending(y->bus))
+					return CYC_PENDING;
+				cyc_error(y, DXL2_BROADCAST_ID, "SYNC_READ", r);
+				y->idx = y->ctl->n;
+				continue;
 			}
 			r = cyc_begin_read(y, y->ctl->j[y->idx].id, DXL_AX_PRESENT_POSITION, y->read_len);
 			if (cyc_port_gone(r))
@@ -158,17 +214,19 @@ static enum cyc_status cyc_advance(struct cyc *y)
 				y->phase = CYC_READ;
 			continue;
 		}
-		case CYC_READBACK:
-			if (y->count % CYC_READBACK_EVERY != 0 || y->ctl->n == 0 || cyc_late(y))
+		case CYC_READBACK: {
+			if (y->ctl->n == 0 || cyc_late(y) || !cyc_pick_readback(y))
 				return cyc_finish(y, CYC_DONE);
-			y->readback_joint = (y->readback_joint + 1) % y->ctl->n;
-			r = cyc_begin_read(y, y->ctl->j[y->readback_joint].id, CTL_READBACK_ADDR, CTL_READBACK_LEN);
+			const struct sm_block *blk = &ctl_model(y->ctl, y->readback_now_joint)->readback[y->readback_now_block];
+			uint8_t id = y->ctl->j[y->readback_now_joint].id;
+			r = cyc_begin_read(y, id, blk->addr, blk->len);
 			if (cyc_port_gone(r))
 				return cyc_lost(y, r);
 			if (r == DXL_OK && bus_is_pending(y->bus))
 				return CYC_PENDING;
-			cyc_error(y, y->ctl->j[y->readback_joint].id, "READ(24)", r);
+			cyc_error(y, id, cyc_p2(y) ? "READ (read-back)" : "READ(24)", r);
 			return cyc_finish(y, CYC_DONE);
+		}
 		}
 	}
 }
@@ -183,12 +241,33 @@ enum cyc_status cyc_start(struct cyc *y)
 	y->start_us = cyc_now(y);
 	y->control_us = 0.0;
 	y->bus_us = 0.0;
-	y->read_len = (y->count & 1) ? 8 : 6;
+	const struct sm_model *m = ctl_model(y->ctl, 0);
+	y->read_len = (y->count & 1) ? m->present_len_slow : m->present_len;
 	if (y->starved >= CYC_STARVED_CYCLES && wq_pending(&y->ctl->wq) > 0) {
 		y->phase = CYC_WRITE_FIRST;
 		y->writes_first++;
 	}
 	return cyc_advance(y);
+}
+
+/* Protocol 2.0: the SYNC_READ's replies, one slot per joint. A servo that
+ * did not answer well is named and stale; the others are read. */
+static void cyc_readings2(struct cyc *y)
+{
+	uint64_t now = cyc_now(y);
+	for (size_t j = 0; j < y->ctl->n && j < y->multi.n; j++) {
+		const uint8_t *bytes = bus_multi_data(&y->multi, j);
+		struct sm_present p;
+		if (bytes == NULL || !sm_decode_present(ctl_model(y->ctl, j), bytes, y->multi.len[j], &p)) {
+			cyc_error(y, y->multi.id[j], "SYNC_READ", y->multi.status[j] != DXL_OK ? y->multi.status[j]
+			                                                                       : DXL_E_WRONG_LENGTH);
+			continue;
+		}
+		uint64_t last = y->read_at_us[j];
+		double dt = last != 0 && now > last ? 1e-6 * (double)(now - last) : 1e-6 * (double)y->period_us;
+		y->read_at_us[j] = now;
+		ctl_measure_present(y->ctl, j, &p, y->multi.err[j], dt);
+	}
 }
 
 static void cyc_reading(struct cyc *y, const struct dxl_packet *p)
@@ -217,6 +296,11 @@ enum cyc_status cyc_step(struct cyc *y)
 		return cyc_lost(y, r);
 	switch (y->phase) {
 	case CYC_READ:
+		if (cyc_p2(y)) {
+			cyc_readings2(y);
+			y->idx = y->ctl->n;
+			break;
+		}
 		if (r == DXL_OK)
 			cyc_reading(y, &reply);
 		else
@@ -226,11 +310,13 @@ enum cyc_status cyc_step(struct cyc *y)
 	case CYC_WRITE_FIRST:
 	case CYC_WRITES: {
 		uint8_t id = y->bus->req_id;
-		bool ok = r == DXL_OK && (reply.code & CYC_WRITE_REFUSED) == 0;
+		const struct sm_model *m = ctl_model(y->ctl, 0);
+		bool ok = r == DXL_OK && !sm_write_refused(m, reply.code);
 		if (r != DXL_OK)
-			cyc_error(y, id, "WRITE", r);
+			cyc_error(y, id, cyc_p2(y) && y->bus->req_instr == DXL2_INST_REBOOT ? "REBOOT" : "WRITE", r);
 		else if (!ok)
-			cyc_error(y, id, "WRITE refused by the servo (error byte with range, instruction or checksum)",
+			cyc_error(y, id, cyc_p2(y) ? "WRITE refused by the servo (an error number in its status)"
+			                           : "WRITE refused by the servo (error byte with range, instruction or checksum)",
 			          DXL_OK);
 		y->write_on_wire = false;
 		ctl_write_result(y->ctl, ok);
@@ -241,9 +327,11 @@ enum cyc_status cyc_step(struct cyc *y)
 	case CYC_READBACK:
 		if (r == DXL_OK) {
 			y->readbacks++;
-			ctl_readback(y->ctl, y->readback_joint, reply.params, reply.code);
+			const uint8_t *bytes = cyc_p2(y) ? bus_reply2(y->bus)->params : reply.params;
+			size_t n = cyc_p2(y) ? bus_reply2(y->bus)->nparams : reply.nparams;
+			ctl_readback_block(y->ctl, y->readback_now_joint, y->readback_now_block, bytes, n, reply.code);
 		} else {
-			cyc_error(y, y->ctl->j[y->readback_joint].id, "READ(24)", r);
+			cyc_error(y, y->ctl->j[y->readback_now_joint].id, cyc_p2(y) ? "READ (read-back)" : "READ(24)", r);
 		}
 		return cyc_finish(y, CYC_DONE);
 	default:
@@ -258,10 +346,12 @@ enum cyc_status cyc_resume(struct cyc *y)
 		return y->phase == CYC_IDLE ? CYC_DONE : CYC_PENDING;
 	y->control_us = (double)(cyc_now(y) - y->control_start_us);
 	y->phase = CYC_WRITES;
-	uint8_t addr, width, ids[CFG_MAX_JOINTS], data[4 * CFG_MAX_JOINTS], pkt[DXL_MAX_PACKET];
+	uint16_t addr;
+	uint8_t width, ids[CFG_MAX_JOINTS], data[CTL_SYNC_MAX_WIDTH * CFG_MAX_JOINTS], pkt[DXL2_MAX_PACKET];
 	size_t n = ctl_sync(y->ctl, &addr, &width, ids, data);
 	if (n > 0) {
-		int len = dxl_encode_sync_write(pkt, sizeof pkt, addr, width, ids, data, n);
+		int len = cyc_p2(y) ? dxl2_encode_sync_write(pkt, sizeof pkt, addr, width, ids, data, n)
+		                    : dxl_encode_sync_write(pkt, sizeof pkt, (uint8_t)addr, width, ids, data, n);
 		int r = len < 0 ? len : bus_send_raw(y->bus, pkt, (size_t)len);
 		if (cyc_port_gone(r))
 			return cyc_lost(y, r);

@@ -23,6 +23,15 @@
  * request cut off by the tick — finds the next cycle asking the same servo
  * for the other length and is refused as the wrong length, instead of being
  * taken for this cycle's reading.
+ *
+ * On a Protocol 2.0 bus (X series) the reads are one SYNC_READ of every
+ * joint's present block (servo_model.h: 10 or 21 bytes alternately, for the
+ * same reason), answered by one status packet per servo in the request's
+ * order; a servo that does not answer is stale as on 1.0 (the bus names it:
+ * bus_multi_failed) and the others' readings are used. The goals go out in
+ * one SYNC_WRITE, the controller's writes (and REBOOTs) one at a time, and
+ * the read-back alternates the model's blocks (RAM, EEPROM); a joint whose
+ * status raised the alert has its RAM block read at once (ctl_readback_due).
  */
 #ifndef UNDULATE_DAEMON_CYCLE_H
 #define UNDULATE_DAEMON_CYCLE_H
@@ -32,6 +41,7 @@
 
 #include "bus.h"
 #include "control.h"
+#include "dxl2.h"
 
 /* Read-back of one joint every CYC_READBACK_EVERY cycles, round-robin: each
  * of two joints every 0.1 s at 100 Hz (a servo reset is found within that),
@@ -72,8 +82,13 @@ struct cyc {
 	size_t idx;                   /* joint being read */
 	bool write_on_wire;           /* a write taken from the controller is pending */
 	size_t readback_joint;
+	size_t readback_block;        /* the model's read-back block of the round-robin */
+	size_t readback_now_joint, readback_now_block;   /* the read-back on the wire */
 	uint64_t count;               /* cycles started */
-	uint8_t read_len;             /* this cycle's READ length, 6 or 8 */
+	uint8_t read_len;             /* this cycle's READ length, 6 or 8 (2.0: the model's, 10 or 21) */
+	/* Protocol 2.0: this cycle's SYNC_READ and its replies */
+	struct bus_multi multi;
+	uint8_t multi_buf[CFG_MAX_JOINTS * 32];
 	uint64_t start_us;            /* this cycle's start (the tick) */
 	uint64_t control_start_us;
 	uint64_t read_at_us[CFG_MAX_JOINTS];   /* when each joint's last reply arrived */

@@ -68,6 +68,7 @@ struct dmn {
 	double adapter_latency_ms;
 	int max_return_delay_us;
 	bool wiring_refused;          /* the port refused the configured rs485 mode */
+	enum bus_protocol protocol;   /* found (or configured) at the first connect; 0 until then */
 	/* timing */
 	int timer_fd, deadline_fd, signal_fd;
 	uint64_t period_us;
@@ -271,6 +272,50 @@ static double dmn_ctl_time(const struct dmn *d, uint64_t t_us)
 	return 1e-6 * (double)(t_us - d->epoch_us);
 }
 
+/* The bus's protocol: configured, or found by PINGs at the first connect
+ * (setup_protocol) and kept for every reconnect. */
+static bool dmn_protocol(struct dmn *d, char *err, size_t cap)
+{
+	if (d->protocol == 0 && d->cfg->protocol != CFG_PROTO_AUTO)
+		d->protocol = d->cfg->protocol == CFG_PROTO_2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1;
+	if (d->protocol == 0 && !setup_protocol(&d->bus, d->cfg, d->port_path, &d->protocol, err, cap))
+		return false;
+	bus_set_protocol(&d->bus, d->protocol);
+	return true;
+}
+
+/* Torque actuation's default parameters are an AX-12A joint's: on another
+ * servo the joint's inertia differs, and the defaults scale with it (the
+ * same gait: CONTROL.md). Once, at the first connect, when the models are
+ * known; parameters given in the configuration are left as they are. */
+static void dmn_torque_defaults(struct dmn *d)
+{
+	if (d->cfg->actuation != CFG_ACT_TORQUE)
+		return;
+	for (size_t j = 0; j < d->ctl.n; j++) {
+		double scale = sm_torque_scale(ctl_model(&d->ctl, j));
+		if (d->cfg->joint[j].torque_defaults != 0 && scale != 1.0) {
+			log_info("joint %zu: torque actuation's default k, c, mu, inertia, friction scaled x%.3f for the %s's "
+			         "joint (its rotor through the gearbox)", j + 1, scale, ctl_model(&d->ctl, j)->name);
+			cfg_scale_torque_defaults(d->cfg, j, scale);
+		}
+	}
+}
+
+/* "AX-12A" or "XL430-W250, XM430-W350": the models found. */
+static void dmn_models(const struct dmn *d, char *out, size_t cap)
+{
+	size_t used = 0;
+	out[0] = '\0';
+	for (size_t j = 0; j < d->ctl.n && used + 1 < cap; j++) {
+		const char *name = ctl_model(&d->ctl, j)->name;
+		if (j > 0 && strcmp(name, ctl_model(&d->ctl, j - 1)->name) == 0)
+			continue;
+		int w = snprintf(out + used, cap - used, "%s%s", used ? ", " : "", name);
+		used += w > 0 ? (size_t)w : 0;
+	}
+}
+
 /* Open the port and run every start-up check. On failure *err says why. */
 static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap)
 {
@@ -302,7 +347,8 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 		.margin_us = (uint32_t)d->cfg->bus_margin_us,
 	};
 	bus_init(&d->bus, &io, &tm, d->cfg->echo);
-	bool ok = setup_servos(&d->bus, &d->ctl, d->cfg, d->port_path, &d->max_return_delay_us, err, cap);
+	bool ok = dmn_protocol(d, err, cap) &&
+	          setup_servos(&d->bus, &d->ctl, d->cfg, d->port_path, &d->max_return_delay_us, err, cap);
 	if (ok) {
 		dmn_latency(d);
 		ok = setup_read_present(&d->bus, &d->ctl, 1e-6 * (double)d->period_us, err, cap);
@@ -801,8 +847,16 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 		/* a wiring the device cannot do stays wrong: not worth a restart */
 		return d->wiring_refused ? 2 : 1;
 	}
-	log_info("robot %s: %zu joint(s) on %s at %ld bps, mode %s, LCM %s", cfg->name, cfg->njoints, d->port_path,
-	         cfg->baud, cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");
+	char models[96];
+	dmn_models(d, models, sizeof models);
+	dmn_torque_defaults(d);
+	if (d->protocol == BUS_PROTOCOL_2 && cfg->actuation == CFG_ACT_POSITION)
+		log_info("the oscillator's defaults are the simulated AX-12A's; an X servo's position control lags "
+		         "otherwise (on the simulated XM430 they run down between restarts): undulated --tune finds this "
+		         "robot's (daemon/CONTROL.md, \"X-series servos\")");
+	log_info("robot %s: %zu joint(s) on %s at %ld bps, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints,
+	         d->port_path, cfg->baud, d->protocol == BUS_PROTOCOL_2 ? "2.0" : "1.0", models,
+	         cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");
 	log_info("commands: %s (local socket %s%s)", cfg_commands_name(cfg->commands), cin_local_path(&d->cin),
 	         cfg->commands == CFG_CMD_NETWORK ? "; signed commands from the LCM group" : "");
 	if (!cfg->mode_given)

@@ -40,6 +40,8 @@ static void main_usage(FILE *f)
 	        "      --port PATH        = --set robot.port=PATH\n"
 	        "      --ids 1,2          = --set robot.ids=1,2\n"
 	        "      --baud BPS         = --set robot.baud=BPS\n"
+	        "      --protocol 1|2|auto = --set robot.protocol=...: Dynamixel 1.0 (AX-12) or 2.0\n"
+	        "                         (XL430/XM430); auto (default) PINGs 1.0, then 2.0\n"
 	        "      --robot NAME       = --set robot.name=NAME\n"
 	        "      --mode MODE        = --set robot.mode=MODE (limp|hold|sinusoid|oscillator)\n"
 	        "      --lcm-url URL      = --set robot.lcm_url=URL\n"
@@ -74,7 +76,7 @@ static void main_usage(FILE *f)
 enum {
 	OPT_SET = 256, OPT_PORT, OPT_IDS, OPT_BAUD, OPT_ROBOT, OPT_MODE, OPT_LCM, OPT_CHECK, OPT_LOGLEVEL,
 	OPT_COMMAND, OPT_TIMEOUT, OPT_WATCH, OPT_KEY, OPT_SOURCE, OPT_GENKEY, OPT_TUNE, OPT_TFREQ, OPT_TAMP,
-	OPT_TTIME, OPT_OUT, OPT_LOCKSTEP,
+	OPT_TTIME, OPT_OUT, OPT_LOCKSTEP, OPT_PROTOCOL,
 };
 
 struct main_args {
@@ -151,7 +153,7 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		{ "port", required_argument, NULL, OPT_PORT }, { "ids", required_argument, NULL, OPT_IDS },
 		{ "baud", required_argument, NULL, OPT_BAUD }, { "robot", required_argument, NULL, OPT_ROBOT },
 		{ "mode", required_argument, NULL, OPT_MODE }, { "lcm-url", required_argument, NULL, OPT_LCM },
-		{ "lockstep", required_argument, NULL, OPT_LOCKSTEP },
+		{ "lockstep", required_argument, NULL, OPT_LOCKSTEP }, { "protocol", required_argument, NULL, OPT_PROTOCOL },
 		{ "check-config", no_argument, NULL, OPT_CHECK }, { "verbose", no_argument, NULL, 'v' },
 		{ "quiet", no_argument, NULL, 'q' }, { "log-level", required_argument, NULL, OPT_LOGLEVEL },
 		{ "command", required_argument, NULL, OPT_COMMAND }, { "timeout", required_argument, NULL, OPT_TIMEOUT },
@@ -178,6 +180,7 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		case OPT_MODE: ok = ok && main_add(a, "mode", optarg); break;
 		case OPT_LCM: a->lcm_url = optarg; ok = ok && main_add(a, "lcm_url", optarg); break;
 		case OPT_LOCKSTEP: ok = ok && main_add(a, "lockstep", optarg); break;
+		case OPT_PROTOCOL: ok = ok && main_add(a, "protocol", optarg); break;
 		case OPT_CHECK: a->check = true; break;
 		case 'v': log_set_level(log_get_level() < LOG_LVL_DEBUG ? log_get_level() + 1 : LOG_LVL_DEBUG); break;
 		case 'q': log_set_level(LOG_LVL_WARN); break;

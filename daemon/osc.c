@@ -50,7 +50,7 @@
  * i.e. with −x, and softens the spring (0.61 Hz with k = 0.111); k = 0.19
  * gives 0.79–0.80 Hz, 0.77 rad there (measured, CONTROL.md).
  */
-#define OSC_TQ_INERTIA 4.39e-3
+#define OSC_TQ_INERTIA OSC_TORQUE_JOINT_INERTIA
 #define OSC_TQ_K        0.111
 #define OSC_TQ_K_PWM    0.19
 #define OSC_TQ_C        6.6e-3

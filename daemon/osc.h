@@ -65,6 +65,11 @@ void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints
  * ≈0.8 Hz, ≈0.8 rad on one simulated AX-12A joint with an 18.65 cm link, on a
  * current drive, or on the AX-12's PWM drive (`pwm`: a stiffer k). */
 void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t njoints, bool pwm);
+/* The joint those defaults are for: the simulated AX-12A's with its link
+ * (kg·m²). Another servo's joint scales them by its inertia over this one
+ * (servo_model.h, sm_torque_scale): the same law on a heavier joint gives
+ * the same gait when k, c, μ, b and I scale alike. */
+#define OSC_TORQUE_JOINT_INERTIA 4.39e-3
 
 /* Torque actuation: the law's right-hand side at the measured state,
  *     τ_j = −k (x_j + λ_j x_other) + (c − μ x_j²) ẋ_j + b·sgn(ẋ_j)   (N·m).

@@ -10,13 +10,20 @@ bool safety_limits_make(struct safety_limits *out, double neutral, double limit_
 {
 	if (dxl_is_wheel_mode(servo_cw, servo_ccw) || servo_cw > servo_ccw)
 		return false;
-	if (!isfinite(neutral) || !isfinite(limit_min) || !isfinite(limit_max) || !isfinite(max_step) ||
-	    !(max_step > 0))
-		return false;
 	/* The servo's limits are raw units; dxl_pos_to_rad() of them converts back
 	 * to the same raw value, so a clamped goal never trips the angle-limit bit. */
-	double lo = fmax(neutral + limit_min, dxl_pos_to_rad(servo_cw));
-	double hi = fmin(neutral + limit_max, dxl_pos_to_rad(servo_ccw));
+	return safety_limits_make_rad(out, neutral, limit_min, limit_max, dxl_pos_to_rad(servo_cw),
+	                              dxl_pos_to_rad(servo_ccw), max_step);
+}
+
+bool safety_limits_make_rad(struct safety_limits *out, double neutral, double limit_min, double limit_max,
+                            double servo_lo, double servo_hi, double max_step)
+{
+	if (!isfinite(neutral) || !isfinite(limit_min) || !isfinite(limit_max) || !isfinite(max_step) ||
+	    !(max_step > 0) || !isfinite(servo_lo) || !isfinite(servo_hi))
+		return false;
+	double lo = fmax(neutral + limit_min, servo_lo);
+	double hi = fmin(neutral + limit_max, servo_hi);
 	if (!(lo <= hi))
 		return false;
 	out->lo = lo;

@@ -27,6 +27,11 @@ enum safety_flag {
  * the servo is in wheel mode (both limits 0). */
 bool safety_limits_make(struct safety_limits *out, double neutral, double limit_min, double limit_max,
                         uint16_t servo_cw, uint16_t servo_ccw, double max_step);
+/* The same with the servo's limits already in radians (any servo model:
+ * the caller converts its raw limits, so that a clamped goal converts back
+ * inside them). False if the intersection is empty. */
+bool safety_limits_make_rad(struct safety_limits *out, double neutral, double limit_min, double limit_max,
+                            double servo_lo, double servo_hi, double max_step);
 
 /* The goal to send. `previous` is the last goal sent (NaN if none: no step
  * bound), `fallback` what to hold when desired is not finite (normally the

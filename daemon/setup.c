@@ -8,12 +8,13 @@
 #include "dxl.h"
 #include "dxl_table.h"
 #include "log.h"
+#include "setup_priv.h"
 
 /* Before try t (t > 0) of a transaction: wait for the line to go quiet, a
  * little longer each time. A reply that was late (a busy machine, a slow
  * adapter) lands in the wait; sent at once, the next request would collide
  * with it on the half-duplex line and lose both, as often as it is tried. */
-static void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, int last)
+void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, int last)
 {
 	if (t == 0)
 		return;
@@ -26,12 +27,13 @@ static void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, in
  * timeout on a loaded machine must not abort the start (a cycle read simply
  * holds the joint for a period, but start-up has no next period). The port
  * going away is not retried. */
-static int setup_read(struct bus *bus, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out, uint8_t *eb)
+int setup_read(struct bus *bus, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out, uint8_t *eb)
 {
+	bool p2 = bus_get_protocol(bus) == BUS_PROTOCOL_2;
 	int r = DXL_E_TIMEOUT;
 	for (int t = 0; t < SETUP_TRIES; t++) {
 		setup_pause(bus, t, id, "READ", r);
-		r = bus_read(bus, id, addr, len, out, eb);
+		r = p2 ? bus2_read(bus, id, addr, len, out, eb) : bus_read(bus, id, (uint8_t)addr, (uint8_t)len, out, eb);
 		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 			break;
 	}
@@ -39,13 +41,15 @@ static int setup_read(struct bus *bus, uint8_t id, uint8_t addr, uint8_t len, ui
 }
 
 /* The same for a write (writing the same bytes twice is harmless). */
-static int setup_write(struct bus *bus, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
-                       bool expect_reply, uint8_t *eb)
+int setup_write(struct bus *bus, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
+                uint8_t *eb)
 {
+	bool p2 = bus_get_protocol(bus) == BUS_PROTOCOL_2;
 	int r = DXL_E_TIMEOUT;
 	for (int t = 0; t < SETUP_TRIES; t++) {
 		setup_pause(bus, t, id, "WRITE", r);
-		r = bus_write(bus, id, addr, data, n, expect_reply, eb);
+		r = p2 ? bus2_write(bus, id, addr, data, n, expect_reply, eb)
+		       : bus_write(bus, id, (uint8_t)addr, data, n, expect_reply, eb);
 		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 			break;
 	}
@@ -76,10 +80,64 @@ static bool setup_find(struct bus *bus, const struct ctl *ctl, const struct cfg 
 	}
 	if (nmissing == 0)
 		return true;
+	bool p2 = bus_get_protocol(bus) == BUS_PROTOCOL_2;
 	snprintf(err, cap, "servo ID%s %s did not answer a PING on %s at %ld bps (%d tries each): check power, "
-	         "wiring, the IDs and the baud rate (`dxl --port PATH scan --bauds all`)", nmissing > 1 ? "s" : "",
-	         missing, port_path, cfg->baud, SETUP_TRIES);
+	         "wiring, the IDs and the baud rate (`dxl --port PATH scan --bauds all`)%s", nmissing > 1 ? "s" : "",
+	         missing, port_path, cfg->baud, SETUP_TRIES,
+	         p2 && cfg->baud != 57600 ? "; X-series servos leave the factory at 57600 bps: `dxl --protocol 2 "
+	                                    "--port PATH --baud 57600 setup IDS` raises them to 1 Mbps" : "");
 	return false;
+}
+
+bool setup_protocol(struct bus *bus, const struct cfg *cfg, const char *port_path, enum bus_protocol *found,
+                    char *err, size_t cap)
+{
+	static const enum bus_protocol order[] = { BUS_PROTOCOL_1, BUS_PROTOCOL_2 };
+	int r = DXL_E_TIMEOUT;
+	/* round after round, each ID on each protocol once: a servo that was
+	 * only late answers a later round, and no round's wait is logged as a
+	 * failure (one of the two protocols never answers) */
+	for (int t = 0; t < SETUP_TRIES; t++) {
+		if (t > 0)
+			(void)bus_settle(bus, (uint32_t)t * SETUP_QUIET_US, SETUP_SETTLE_MAX_US);
+		for (size_t j = 0; j < cfg->njoints; j++) {
+			for (size_t k = 0; k < sizeof order / sizeof order[0]; k++) {
+				uint8_t eb = 0;
+				bus_set_protocol(bus, order[k]);
+				r = bus_ping(bus, cfg->ids[j], &eb);
+				if (r == DXL_E_DISCONNECTED || r == DXL_E_IO) {
+					snprintf(err, cap, "%s: %s while looking for the servos' protocol", port_path,
+					         dxl_strerror(r));
+					return false;
+				}
+				if (r != DXL_OK)
+					continue;
+				*found = order[k];
+				bool p2 = order[k] == BUS_PROTOCOL_2;
+				log_info("protocol: servo %u answered a Protocol %s PING on %s at %ld bps: Protocol %s (%s)",
+				         cfg->ids[j], p2 ? "2.0" : "1.0", port_path, cfg->baud, p2 ? "2.0" : "1.0",
+				         p2 ? "X series" : "AX-12");
+				return true;
+			}
+		}
+	}
+	bus_set_protocol(bus, BUS_PROTOCOL_1);
+	snprintf(err, cap, "no servo (ID%s %u%s) answered a PING on %s at %ld bps, on Protocol 1.0 or 2.0 (%d rounds): "
+	         "check power, wiring, the IDs and the baud rate (`dxl --port PATH scan --bauds all`); X-series servos "
+	         "leave the factory at 57600 bps: `dxl --protocol 2 --port PATH --baud 57600 setup IDS` raises them to "
+	         "1 Mbps", cfg->njoints > 1 ? "s" : "", cfg->ids[0], cfg->njoints > 1 ? ", ..." : "", port_path, cfg->baud,
+	         SETUP_TRIES);
+	return false;
+}
+
+void setup_joint_limits_model(const struct sm_model *m, const struct cfg_joint *cj, int32_t *lo, int32_t *hi)
+{
+	*lo = sm_rad_to_pos(m, cj->neutral + cj->limit_min);
+	*hi = sm_rad_to_pos(m, cj->neutral + cj->limit_max);
+	if (sm_pos_to_rad(m, *lo) < cj->neutral + cj->limit_min && *lo < m->pos_max)
+		(*lo)++;
+	if (sm_pos_to_rad(m, *hi) > cj->neutral + cj->limit_max && *hi > 0)
+		(*hi)--;
 }
 
 void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw)
@@ -218,22 +276,30 @@ bool setup_servos(struct bus *bus, struct ctl *ctl, const struct cfg *cfg, const
 	*max_return_delay_us = 0;
 	if (!setup_find(bus, ctl, cfg, port_path, err, cap))
 		return false;
-	for (size_t j = 0; j < ctl->n; j++)
-		if (!setup_servo(bus, ctl, j, cfg, port_path, max_return_delay_us, err, cap))
+	bool p2 = bus_get_protocol(bus) == BUS_PROTOCOL_2;
+	for (size_t j = 0; j < ctl->n; j++) {
+		bool ok = p2 ? setup_servo_x(bus, ctl, j, cfg, port_path, max_return_delay_us, err, cap)
+		             : setup_servo(bus, ctl, j, cfg, port_path, max_return_delay_us, err, cap);
+		if (!ok)
 			return false;
+	}
 	return true;
 }
 
 bool setup_read_present(struct bus *bus, struct ctl *ctl, double dt, char *err, size_t cap)
 {
 	for (size_t j = 0; j < ctl->n; j++) {
-		uint8_t id = ctl->j[j].id, eb = 0, p[6];
-		int r = setup_read(bus, id, DXL_AX_PRESENT_POSITION, 6, p, &eb);
+		const struct sm_model *m = ctl_model(ctl, j);
+		uint8_t id = ctl->j[j].id, eb = 0, p[32];
+		struct sm_present pr;
+		int r = setup_read(bus, id, m->present, m->present_len, p, &eb);
+		if (r == DXL_OK && !sm_decode_present(m, p, m->present_len, &pr))
+			r = DXL_E_WRONG_LENGTH;
 		if (r != DXL_OK) {
 			snprintf(err, cap, "servo %u: reading its position failed: %s", id, dxl_strerror(r));
 			return false;
 		}
-		ctl_measure(ctl, j, dxl_get_u16(p), dxl_get_u16(p + 2), dxl_get_u16(p + 4), eb, dt);
+		ctl_measure_present(ctl, j, &pr, eb, dt);
 	}
 	return true;
 }
@@ -279,14 +345,15 @@ static void setup_stop_wheel(struct bus *bus, const struct ctl *ctl, bool limp)
 bool setup_limp(struct bus *bus, const struct ctl_joint *jt)
 {
 	bool reply = jt->servo.status_return_level >= 2;
+	uint16_t reg = (jt->servo.model != NULL ? jt->servo.model : sm_ax12())->torque_enable;
 	const uint8_t off = 0;
 	uint8_t eb, te = 1;
 	int r = DXL_E_TIMEOUT;
 	for (int t = 0; t < SETUP_TRIES && te != 0; t++) {
-		r = setup_write(bus, jt->id, DXL_AX_TORQUE_ENABLE, &off, 1, reply, &eb);
+		r = setup_write(bus, jt->id, reg, &off, 1, reply, &eb);
 		if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 			break;
-		r = setup_read(bus, jt->id, DXL_AX_TORQUE_ENABLE, 1, &te, &eb);
+		r = setup_read(bus, jt->id, reg, 1, &te, &eb);
 		if (r != DXL_OK)
 			te = 1;
 	}
@@ -301,6 +368,10 @@ void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *c
 	bus_abort(bus);
 	/* a robot that is limp stays limp: writing goals could bring torque back */
 	bool limp = cfg->safe_stop == CFG_SAFE_LIMP || ctl->mode == CFG_MODE_LIMP;
+	if (bus_get_protocol(bus) == BUS_PROTOCOL_2) {
+		setup_safe_stop_x(bus, ctl, limp);
+		return;
+	}
 	if (ctl->wheel)
 		setup_stop_wheel(bus, ctl, limp);
 	uint8_t ids[CFG_MAX_JOINTS], data[2 * CFG_MAX_JOINTS];

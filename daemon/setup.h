@@ -14,6 +14,15 @@
  * Safe stop: any wheel-mode drive is stopped and joint mode restored, then
  * the robot is left as configured (safe_stop: holding where it is, or limp),
  * and what matters is read back: a torque-off that did not take is said.
+ *
+ * X series (setup_x.c): the model is identified (an unknown model number is
+ * refused), Operating Mode must be position control (a torque-actuated run's
+ * current or PWM control is put back), Min/Max Position Limit are made the
+ * configuration's (EEPROM: written with torque off, only when they differ),
+ * the profiles are set to none, a bus watchdog that stopped the servo is
+ * cleared and the configured one set (bus_watchdog_ms); at the safe stop the
+ * watchdog is cleared first — a robot left holding by a clean stop is not a
+ * silent controller — then the servos hold or go limp.
  */
 #ifndef UNDULATE_DAEMON_SETUP_H
 #define UNDULATE_DAEMON_SETUP_H
@@ -32,6 +41,13 @@
 #define SETUP_QUIET_US 10000u
 #define SETUP_SETTLE_MAX_US 100000u
 
+/* The bus's protocol, protocol = auto: the first configured ID that answers
+ * a PING decides — Protocol 1.0 first (the AX-12's), then 2.0 (the X
+ * series'), each tried SETUP_TRIES times, ID after ID. False with *err when
+ * no servo answers either. *found is set on success; what was found is
+ * logged. */
+bool setup_protocol(struct bus *bus, const struct cfg *cfg, const char *port_path, enum bus_protocol *found,
+                    char *err, size_t cap);
 /* Every start-up check; *max_return_delay_us gets the largest return delay
  * found (for the bus timeouts). False with *err (one line, with the command
  * that fixes it where there is one). */
@@ -52,5 +68,7 @@ bool setup_limp(struct bus *bus, const struct ctl_joint *jt);
  * puts a servo back in joint mode, and what `dxl doctor` compares the servo's
  * own limits with. */
 void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw);
+/* The same in a model's units (X series: Min/Max Position Limit). */
+void setup_joint_limits_model(const struct sm_model *m, const struct cfg_joint *cj, int32_t *lo, int32_t *hi);
 
 #endif

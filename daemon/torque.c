@@ -8,6 +8,22 @@
  * all healthy, torqued and measured; everything else (starter, HOLD, SINUSOID,
  * faults, LIMP) runs in joint mode, where the servo itself holds positions and
  * enforces its angle limits.
+ *
+ * X series: "wheel mode" is the drive's Operating Mode — current control (0)
+ * on the XM430, PWM control (16) — and joint mode position control (3).
+ * Operating Mode is EEPROM, written only with torque off, and a new mode puts
+ * Goal PWM at PWM Limit (e-manual): each switch is one chain of writes
+ * (writeq.h) per servo, so that a step given up stops it there —
+ *   into the drive:  torque off, the mode, the drive register 0, torque on;
+ *   back:            torque off, position control, Goal Position where the
+ *                    joint is (inside its limits), Goal PWM at its limit,
+ *                    the watchdog, torque on.
+ * A joint's drive is written only once its switch is acknowledged to the
+ * last step (drive_ready): a servo still in position control would take a
+ * PWM duty as its output limit. A switch that stops half-way leaves the
+ * servo with torque off (never torque on in a mode that was not set, never
+ * a drive outside the limits); the robot goes back to joint mode, and a
+ * switch that keeps failing counts as a reset (fault_retries, then latched).
  */
 #include <math.h>
 #include <stdio.h>
@@ -22,9 +38,17 @@
  * fault_action in joint mode, where the servo enforces its limits. */
 #define TQ_WALL_MARGIN 0.15
 #define TQ_WALL_DAMPING 0.1
-/* Supply assumed for the PWM drive until the servo's voltage is read: the
- * datasheet's reference, which stall_torque and no_load_speed are given at. */
-#define TQ_NOMINAL_VOLTAGE DXL_AX12_REF_VOLTAGE
+double tq_stall_torque(const struct ctl *c, const struct ctl_joint *jt)
+{
+	const struct sm_model *m = jt->servo.model != NULL ? jt->servo.model : sm_ax12();
+	return c->cfg->stall_torque_given || m->protocol == 1 ? c->cfg->stall_torque : m->stall_torque_nm;
+}
+
+double tq_no_load_speed(const struct ctl *c, const struct ctl_joint *jt)
+{
+	const struct sm_model *m = jt->servo.model != NULL ? jt->servo.model : sm_ax12();
+	return c->cfg->no_load_speed_given || m->protocol == 1 ? c->cfg->no_load_speed : m->no_load_speed_rad_s;
+}
 
 bool tq_want_wheel(const struct ctl *c)
 {
@@ -80,14 +104,21 @@ static double tq_wall(const struct ctl_joint *jt, double stall)
 static double tq_duty(const struct ctl *c, const struct ctl_joint *jt, double tau)
 {
 	const struct cfg *cfg = c->cfg;
-	double cap = jt->servo.max_torque / 1023.0;
+	const struct sm_model *m = jt->servo.model != NULL ? jt->servo.model : sm_ax12();
+	/* the supply assumed until the servo's voltage is read: the datasheet's
+	 * reference, which the stall torque and no-load speed are given at */
+	double ref = m->ref_voltage;
+	/* the AX-12's torque limit and the X's PWM Limit cap the output; an XM430
+	 * keeps its current within Current Limit by itself (sm_drive_raw) */
+	double cap = m->protocol == 2 && cfg->torque_drive == CFG_DRIVE_CURRENT ? 1.0
+	           : jt->servo.max_torque / (double)m->torque_full;
 	double u;
 	if (cfg->torque_drive == CFG_DRIVE_CURRENT) {
-		u = tau / cfg->stall_torque;
+		u = tau / tq_stall_torque(c, jt);
 	} else {
-		double volts = isfinite(jt->voltage) && jt->voltage > 1.0 ? jt->voltage : TQ_NOMINAL_VOLTAGE;
-		double stall = cfg->stall_torque * volts / TQ_NOMINAL_VOLTAGE;
-		double w0 = cfg->no_load_speed * volts / TQ_NOMINAL_VOLTAGE;
+		double volts = isfinite(jt->voltage) && jt->voltage > 1.0 ? jt->voltage : ref;
+		double stall = tq_stall_torque(c, jt) * volts / ref;
+		double w0 = tq_no_load_speed(c, jt) * volts / ref;
 		u = tau / stall + jt->speed / w0;
 	}
 	return isfinite(u) ? fmax(-cap, fmin(cap, u)) : 0.0;
@@ -115,7 +146,7 @@ void tq_duties(struct ctl *c)
 			jt->duty = 0.0;
 			continue;
 		}
-		double wall = tq_wall(jt, c->cfg->stall_torque);
+		double wall = tq_wall(jt, tq_stall_torque(c, jt));
 		if (wall != 0.0) {
 			jt->clamp_flags = SAFETY_LIMIT;
 			c->clamps++;
@@ -145,10 +176,30 @@ static void tq_switch_limits(struct ctl *c, size_t j, uint32_t limits, bool torq
 	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
 }
 
+/* X series: into the drive's mode, one chain per servo (above). */
+static void tq_x_enter(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	bool current = c->cfg->torque_drive == CFG_DRIVE_CURRENT;
+	const struct sm_model *m = ctl_model(c, j);
+	uint16_t ch = wq_chain(&c->wq);
+	jt->drive_ready = false;
+	jt->drive_chain = ch;
+	ctl_write_chain(c, ch, jt->id, m->torque_enable, 1, 0);
+	ctl_write_chain(c, ch, jt->id, DXL2_X_OPERATING_MODE, 1, sm_drive_opmode(current));
+	/* the new mode put Goal PWM at its limit: in PWM control a full drive */
+	ctl_write_chain(c, ch, jt->id, sm_drive_register(m, current), 2, 0);
+	ctl_write_chain(c, ch, jt->id, m->torque_enable, 1, 1);
+}
+
 void tq_enter_wheel(struct ctl *c)
 {
-	for (size_t j = 0; j < c->n; j++)
-		tq_switch_limits(c, j, 0, true);
+	for (size_t j = 0; j < c->n; j++) {
+		if (ctl_is_x(c, j))
+			tq_x_enter(c, j);
+		else
+			tq_switch_limits(c, j, 0, true);
+	}
 	c->wheel = true;
 	ctl_event(c, 0, "actuation", "torque actuation: servos in wheel mode, the law drives their torque");
 }
@@ -157,7 +208,13 @@ void tq_leave_wheel(struct ctl *c)
 {
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
-		tq_switch_limits(c, j, ctl_joint_mode_limits(c, j), jt->torque && c->mode != CFG_MODE_LIMP);
+		if (ctl_is_x(c, j)) {
+			jt->drive_ready = false;
+			jt->drive_chain = 0;
+			(void)ctl_x_setup(c, j, true);
+		} else {
+			tq_switch_limits(c, j, ctl_joint_mode_limits(c, j), jt->torque && c->mode != CFG_MODE_LIMP);
+		}
 		/* position modes start where the joint is, with no step bound from a
 		 * goal it never had */
 		jt->goal = NAN;
@@ -174,9 +231,37 @@ void tq_stop_goals(struct ctl *c)
 		struct ctl_joint *jt = &c->j[j];
 		jt->duty = NAN;
 		jt->torque_cmd = NAN;
-		if (jt->write_goal || !jt->have_reading || jt->limits.max_step <= 0.0)
+		/* X series: the SYNC_WRITE stops the drives, the chain sets the goal */
+		if (jt->write_goal || !jt->have_reading || jt->limits.max_step <= 0.0 || ctl_is_x(c, j))
 			continue;
 		jt->goal = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
 		jt->write_goal = true;
 	}
+}
+
+void tq_chain_result(struct ctl *c, size_t j, const struct wq_write *w, bool ok)
+{
+	struct ctl_joint *jt = &c->j[j];
+	const struct sm_model *m = ctl_model(c, j);
+	if (ok) {
+		if (w->addr == m->torque_enable && w->value == 1)
+			jt->drive_ready = true;
+		return;
+	}
+	jt->drive_ready = false;
+	jt->drive_chain = 0;
+	jt->resets++;
+	c->resets++;
+	ctl_event(c, 2, "actuation", "servo %u: the switch to %s control stopped at register %u (not acknowledged): "
+	          "torque actuation ends, servos back in position control (reset %lld of %d)", jt->id,
+	          c->cfg->torque_drive == CFG_DRIVE_CURRENT ? "current" : "PWM", w->addr, jt->resets,
+	          c->cfg->fault_retries);
+	if (jt->resets > c->cfg->fault_retries) {
+		char what[CTL_LATCH_TEXT];
+		snprintf(what, sizeof what, "servo %u: its switch to torque actuation failed %lld times", jt->id,
+		         jt->resets);
+		ctl_latch(c, what);
+	}
+	if (c->wheel)
+		tq_leave_wheel(c);
 }

@@ -5,6 +5,7 @@
  *         bus_errors=N bad_commands=N a0= s0= g0= amp0= f0= ph0= ld0= e0= st0= tq0= ...
  *   EVENT <robot> seq=N level=L kind=K text="..."
  *   BUS <robot> connected=B reconnects=N p50= p99= max= jitter99= bus99= cpu= overruns=N
+ *       ... idJ=ID/replies/timeouts/rtt_mean/rtt_max ... badJ=checksum/wrong_id/wrong_length
  *   PARAMS <robot> k0= c0= mu0= lambda0= ... amplitude= frequency= phase=
  * Angles in rad relative to neutral, speeds rad/s.
  */
@@ -71,6 +72,10 @@ static void watch_bus(const lcm_recv_buf_t *rb, const char *ch, const undulate_b
 	for (int j = 0; j < m->nservos; j++)
 		printf(" id%d=%d/%" PRId64 "/%" PRId64 "/%.0f/%.0f", j, m->servos[j].servo_id, m->servos[j].replies,
 		       m->servos[j].timeouts, m->servos[j].rtt_mean_us, m->servos[j].rtt_max_us);
+	/* what the bus refused of each servo's replies: checksum, wrong ID, wrong length */
+	for (int j = 0; j < m->nservos; j++)
+		printf(" bad%d=%" PRId64 "/%" PRId64 "/%" PRId64, j, m->servos[j].checksum_errors, m->servos[j].wrong_id,
+		       m->servos[j].wrong_length);
 	printf("\n");
 }
 

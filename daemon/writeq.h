@@ -18,6 +18,14 @@
  *    it was answered) stays at the front and is sent again, WQ_TRIES times in
  *    all; then it is dropped and the caller is told, to report it (the
  *    controller's read-back notices what it left undone).
+ *  - A chain (wq_put_chain: the writes of one servo that only make sense
+ *    together, such as an X servo's switch of Operating Mode — torque off,
+ *    the mode, the goal, torque on) stops at its first write given up: the
+ *    rest of it is dropped, never sent after a step that did not happen
+ *    (torque on in a mode that was not set could drive a joint the servo no
+ *    longer bounds). Nothing is ever merged into a chained write, so a later
+ *    torque-off queued behind a chain is never dropped with it.
+ * A queued write may also be an instruction without data: REBOOT (X series).
  */
 #ifndef UNDULATE_DAEMON_WRITEQ_H
 #define UNDULATE_DAEMON_WRITEQ_H
@@ -36,18 +44,21 @@
 
 struct wq_write {
 	uint8_t id;
-	uint8_t addr;
-	uint8_t len;          /* 1, 2 or 4 bytes, little-endian as the registers */
+	uint16_t addr;        /* Protocol 2.0 addresses are 16 bits */
+	uint8_t len;          /* 1, 2 or 4 bytes, little-endian as the registers; 0: a REBOOT */
 	uint32_t value;
 	uint8_t tries;        /* sends so far */
+	uint16_t chain;       /* 0, or the chain it belongs to (wq_put_chain) */
 };
 
 struct wq {
 	struct wq_write w[WQ_CAP];
 	size_t n;
 	bool taken;           /* w[0] is on the wire, waiting for wq_done() */
+	uint16_t next_chain;  /* the last chain number given (never 0) */
 	/* counters */
 	long long sent, retried, failed, overflowed;
+	long long chain_dropped;   /* writes dropped with the chain whose step failed */
 };
 
 enum wq_outcome {
@@ -59,19 +70,25 @@ enum wq_outcome {
 void wq_init(struct wq *q);
 /* Queue a write of a register's new value (see the rules above). False when
  * the queue is full (counted in `overflowed`; nothing was queued). */
-bool wq_put(struct wq *q, uint8_t id, uint8_t addr, uint8_t len, uint32_t value);
+bool wq_put(struct wq *q, uint8_t id, uint16_t addr, uint8_t len, uint32_t value);
 /* Queue a write after everything queued, never merged into another. */
-bool wq_put_seq(struct wq *q, uint8_t id, uint8_t addr, uint8_t len, uint32_t value);
+bool wq_put_seq(struct wq *q, uint8_t id, uint16_t addr, uint8_t len, uint32_t value);
+/* A new chain's number, for wq_put_chain. */
+uint16_t wq_chain(struct wq *q);
+/* Queue a write as a step of `chain` (appended, never merged; see above).
+ * len 0 queues a REBOOT of servo id. */
+bool wq_put_chain(struct wq *q, uint16_t chain, uint8_t id, uint16_t addr, uint8_t len, uint32_t value);
 size_t wq_pending(const struct wq *q);
 /* True when a write to (id, addr) is queued or on the wire: what the servo
  * reports for that register may be about to change. */
-bool wq_has(const struct wq *q, uint8_t id, uint8_t addr);
+bool wq_has(const struct wq *q, uint8_t id, uint16_t addr);
 /* True when any write to servo id is queued or on the wire. */
 bool wq_has_id(const struct wq *q, uint8_t id);
 /* The next write to send (NULL: none, or one is already taken). From now on
  * it is on the wire: call wq_done() with the outcome. */
 const struct wq_write *wq_take(struct wq *q);
-/* The outcome of the taken write; *w (may be NULL) gets a copy of it. */
+/* The outcome of the taken write; *w (may be NULL) gets a copy of it. A
+ * chained write given up (WQ_FAILED) takes the rest of its chain with it. */
 enum wq_outcome wq_done(struct wq *q, bool ok, struct wq_write *w);
 /* Forget every queued write of servo id that is not on the wire (the servo
  * is being brought back from scratch). */

@@ -84,6 +84,17 @@ enum dxl2_x_addr {
 /* Model numbers (register 0). */
 #define DXL2_MODEL_XL430_W250 1060
 #define DXL2_MODEL_XM430_W350 1020
+/* The datasheet lines at the reference supply (the e-manual's specification
+ * tables; torque and speed scale about linearly with the supply): the
+ * daemon's torque actuation and the simulator's motors start from the same
+ * numbers, as the AX-12A's in dxl_table.h. */
+#define DXL2_REF_VOLTAGE               12.0   /* V */
+#define DXL2_XL430_STALL_TORQUE_NM     1.5    /* N·m at 12 V */
+#define DXL2_XL430_STALL_CURRENT_A     1.4
+#define DXL2_XL430_NO_LOAD_SPEED_RPM   61.0
+#define DXL2_XM430_STALL_TORQUE_NM     4.1
+#define DXL2_XM430_STALL_CURRENT_A     2.3
+#define DXL2_XM430_NO_LOAD_SPEED_RPM   46.0
 
 /* Operating Mode (11) values. */
 enum dxl2_opmode {

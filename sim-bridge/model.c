@@ -24,14 +24,16 @@ static const struct sim_model_info models[SIM_MODELS] = {
 	 * rotor taken as the AX-12A's (the same class of motor). */
 	[SIM_MODEL_XL430_W250] = {
 		.name = "xl430-w250", .label = "XL430-W250", .protocol = 2, .default_baud = 57600, .firmware = 46,
-		.stall_torque_nm = 1.5, .no_load_speed_rpm = 61.0, .stall_current_a = 1.4, .gear_ratio = 258.5,
+		.stall_torque_nm = DXL2_XL430_STALL_TORQUE_NM, .no_load_speed_rpm = DXL2_XL430_NO_LOAD_SPEED_RPM,
+		.stall_current_a = DXL2_XL430_STALL_CURRENT_A, .gear_ratio = 258.5,
 		.rotor_inertia = 4.6e-8, .model_number = DXL2_MODEL_XL430_W250,
 	},
 	/* 4.1 N·m at 12 V (2.3 A), 46 rpm at 12 V, 353.5:1, a coreless (Maxon)
 	 * motor: 0.5 g·cm² taken for its rotor (not published; PHYSICS.md). */
 	[SIM_MODEL_XM430_W350] = {
 		.name = "xm430-w350", .label = "XM430-W350", .protocol = 2, .default_baud = 57600, .firmware = 46,
-		.stall_torque_nm = 4.1, .no_load_speed_rpm = 46.0, .stall_current_a = 2.3, .gear_ratio = 353.5,
+		.stall_torque_nm = DXL2_XM430_STALL_TORQUE_NM, .no_load_speed_rpm = DXL2_XM430_NO_LOAD_SPEED_RPM,
+		.stall_current_a = DXL2_XM430_STALL_CURRENT_A, .gear_ratio = 353.5,
 		.rotor_inertia = 5.0e-8, .model_number = DXL2_MODEL_XM430_W350,
 	},
 };

@@ -153,6 +153,34 @@ else
 fi
 if why=$(leftovers); then tap_ok "nothing left behind after a full run"; else tap_fail "nothing left behind after a full run" "$why"; fi
 
+# ---- the same experiment on XM430-W350 robots (Protocol 2.0), in virtual time -------------------
+# Position servos as the paper's robots, with the parameters `undulated --tune`
+# found for the simulated XM430 (daemon/CONTROL.md: the AX-12A's defaults let
+# its oscillator run down between restarts there).
+xset=(--set sim.model=xm430-w350 --set sim.baud=1000000 --set sim.return_delay_us=0
+	--daemon-set robot.servo_lead_s=0.047 --daemon-set joint.1.k=0.0304 --daemon-set joint.2.k=0.0304
+	--daemon-set joint.1.mu=0.0757 --daemon-set joint.2.mu=0.0571)
+env BUILD="$BUILD" DEMO_SECONDS=$seconds TMPDIR="$T/tmp" DEMO_OUT="$T/xout" "$demo" --lockstep --lcm-url "$url" "${xset[@]}" \
+	>"$T/xdemo.log" 2>&1
+xrc=$?
+xwords=$(grep -E '^  The mean contact force (fell [0-9.]+x after the switch|fell to zero after the switch|did not fall)' "$T/xdemo.log")
+xratio=$(echo "$xwords" | sed -n 's/.*fell \([0-9.]*\)x after.*/\1/p')
+xsw=$(min_swing "$T/xout" 2>/dev/null)
+stalls=$(cat "$T/xout/logs"/undulated-r*.log 2>/dev/null | grep -c 'stall: oscillator at rest')
+if [ "$xrc" = 0 ] && grep -q 'Protocol 2.0 (XM430-W350)' "$T/xout/logs/undulated-r1.log" &&
+	{ echo "$xwords" | grep -q 'fell to zero' || { [ -n "$xratio" ] && awk -v r="$xratio" 'BEGIN { exit !(r >= 3) }'; }; } &&
+	[ -n "$xsw" ] && awk -v s="${xsw%% *}" 'BEGIN { exit !(s >= 0.6) }'; then
+	tap_ok "XM430 robots in lockstep: the contact force falls ${xratio:-to zero}x after the switch, every robot undulates (smallest swing ${xsw%% *} rad, $stalls stall restarts)"
+else
+	tap_fail "XM430 robots in lockstep: the contact force falls 3x or more, every robot undulates" "exit $xrc; ${xwords:-no words}; swing $xsw; $(tail -n 5 "$T/xdemo.log")"
+fi
+if [ -n "$xratio" ] && awk -v r="$xratio" 'BEGIN { exit !(r >= 10) }' || echo "$xwords" | grep -q 'fell to zero'; then
+	tap_ok "XM430 robots: the contact force falls 10x or more (${xratio:-to zero}x)"
+else
+	tap_todo "XM430 robots: the contact force falls 10x or more" "${xwords:-no words}"
+fi
+if why=$(leftovers); then tap_ok "nothing left behind after the lockstep run"; else tap_fail "nothing left behind after the lockstep run" "$why"; fi
+
 # ---- stopped early ---------------------------------------------------------------
 # SIGTERM (what `timeout`, a service manager or a closing terminal sends)
 # must stop every child and remove the links. (Ctrl-C in a terminal goes to

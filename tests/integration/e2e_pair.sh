@@ -16,6 +16,8 @@
 #                                  last 10 s (a TODO when one graze remains:
 #                                  docs/EXPERIMENTS.md)
 #   large d~ (0.7), D0 = pi     -> anti-phase: |D| within 0.5 of pi, collisions go on
+# The same three regimes run again in lockstep (virtual time), and on
+# XM430-W350 servos in current control (Protocol 2.0).
 # d~ is the analyser's, from the amplitude the daemons actually reach, and
 # each run first checks that it landed in the regime it is meant to test. A
 # pair that stopped swinging proves nothing: its regime checks are skipped (the
@@ -222,6 +224,37 @@ for spec in "inphase 0.05 0,2.0" "compat 0.3 0,2.0" "anti 0.7 0,3.1416"; do
 			$report "$what" "the real-time run with this seed ended $rt_state"
 		else
 			tap_ok "$what"
+		fi
+	done
+done
+# ---- the same rig on XM430-W350 servos (Protocol 2.0), in virtual time --------------------
+# The paper's rig drove currents: torque actuation in the XM430's current
+# control (operating mode 0, Goal Current), the daemon's torque defaults
+# scaled to the XM430's joint (daemon/CONTROL.md). Two seeds per regime, each
+# must land where the theory puts it, as on the AX-12A's current drive.
+xrig=(--set sim.model=xm430-w350 --set sim.baud=1000000 --set sim.return_delay_us=0
+	--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current --daemon-set sinusoid.amplitude=0.25)
+for spec in "inphase 0.05 0,2.0" "compat 0.3 0,2.0" "anti 0.7 0,3.1416"; do
+	read -r regime_name sep phases <<<"$spec"
+	for seed in 7 8; do
+		n="xm_${regime_name}_$seed"
+		lock_runs+=("$n")
+		if ! env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --lockstep --scenario "$scenario" \
+			--seconds "$seconds" --switch-at 3 --seed "$seed" --phases "$phases" --set "world.separation=$sep" \
+			--lcm-url "$(lcm_url "$port")" --out "$T/$n" "${xrig[@]}" >"$T/$n.log" 2>&1 || [ ! -f "$T/$n/summary.txt" ]; then
+			tap_fail "XM430 $regime_name in lockstep, seed $seed: ran" "$(tail -n 10 "$T/$n.log")"
+			continue
+		fi
+		if ! grep -q 'Protocol 2.0 (XM430-W350)' "$T/$n/logs/undulated-left.log"; then
+			tap_fail "XM430 $regime_name in lockstep, seed $seed: on Protocol 2.0" "$(head -3 "$T/$n/logs/undulated-left.log")"
+			continue
+		fi
+		state=$(col "$n" state); D=$(col "$n" meanD); sw=$(min_swing "$T/$n")
+		what="XM430 $regime_name in lockstep, seed $seed: in its regime (final D $D, $state, d~ $(col "$n" d~); smallest swing ${sw%% *} rad)"
+		if num "${sw%% *} >= $MIN_SWING" && in_regime "$n" "$regime_name"; then
+			tap_ok "$what"
+		else
+			tap_fail "$what" "2 asin(d~) $(col "$n" "2asin(d~)"), collisions in the last 10 s $(last_collisions "$T/$n")"
 		fi
 	done
 done

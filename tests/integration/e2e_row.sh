@@ -169,5 +169,41 @@ for seed in 11 12; do
 			"pairs outside 2 asin(d~) + 0.1: ${bad:-none}; contact $imp_last against $imp_imm N*s"
 	fi
 done
+# ---- the rows on XM430-W350 servos (Protocol 2.0), in virtual time ---------------------------
+# Each joint in the XM430's current control (torque actuation, the daemon's
+# torque defaults scaled to the XM430's joint): the same two claims.
+xrig=(--set sim.model=xm430-w350 --set sim.baud=1000000 --set sim.return_delay_us=0
+	--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current)
+for name in immobile mobile; do
+	n="xm_$name"
+	lock_runs+=("$n")
+	env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --lockstep \
+		--scenario "$top/sim-bridge/scenarios/row-$name.scenario" --seconds "$seconds" --switch-at 3 \
+		--seed 11 --lcm-url "$(lcm_url "$port")" --out "$T/$n" "${xrig[@]}" >"$T/$n.log" 2>&1
+done
+if [ ! -f "$T/xm_immobile/summary.txt" ] || [ ! -f "$T/xm_mobile/summary.txt" ] ||
+	! grep -q 'Protocol 2.0 (XM430-W350)' "$T/xm_mobile/logs/undulated-r1.log"; then
+	tap_fail "XM430 rows in lockstep: ran on Protocol 2.0" "$(tail -n 10 "$T/xm_immobile.log" "$T/xm_mobile.log")"
+else
+	r=$(rows xm_immobile)
+	nquiet=$(echo "$r" | awk '$6 == 0 { n++ } END { print n + 0 }')
+	sw=$(min_swing "$T/xm_immobile")
+	if [ "$(echo "$r" | grep -c .)" = 4 ] && [ "$nquiet" -le 1 ] && awk -v s="${sw%% *}" -v m=$MIN_SWING 'BEGIN { exit !(s >= m) }'; then
+		tap_ok "XM430 immobile row in lockstep: keeps colliding ($((4 - nquiet)) of 4 pairs in the last 10 s; smallest swing ${sw%% *} rad)"
+	else
+		tap_fail "XM430 immobile row in lockstep: keeps colliding" "$(echo "$r" | tr '\n' ';'); smallest swing $sw"
+	fi
+	r=$(rows xm_mobile)
+	bad=$(echo "$r" | awk '{ D = $3 < 0 ? -$3 : $3 } D > $5 + 0.1 { print $1 }' | tr '\n' ' ')
+	end=$(awk -F, 'NR > 1 { t = $1 } END { print t + 1 }' "$T/xm_mobile/collision_rate.csv")
+	from=$(awk "BEGIN { print $end - 10 }")
+	imp_last=$(imp xm_mobile "$from" "$end"); imp_imm=$(imp xm_immobile "$from" "$end")
+	if [ -z "$bad" ] && awk -v m="$imp_last" -v i="$imp_imm" 'BEGIN { exit !(i > 0 && m <= 0.2 * i) }'; then
+		tap_ok "XM430 mobile row in lockstep: every pair compatible, contact $imp_last against the immobile row's $imp_imm N*s"
+	else
+		tap_fail "XM430 mobile row in lockstep: every pair compatible, contact at most a fifth of the immobile row's" \
+			"pairs outside 2 asin(d~) + 0.1: ${bad:-none}; contact $imp_last against $imp_imm N*s"
+	fi
+fi
 keep_runs immobile mobile "${lock_runs[@]}"
 tap_done

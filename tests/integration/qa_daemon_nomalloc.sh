@@ -272,4 +272,32 @@ if [ "$(cat "$T/names.out")" = "sent 1000" ] && [ "$(count "$T/d.count")" = 0 ];
 else tap_fail "new channel names: nothing allocated" "$(cat "$T/names.out"); $(report "$T/d.count")"; fi
 stop d >/dev/null
 if [ "$stop_rc" = 0 ]; then tap_ok "clean stop"; else tap_fail "clean stop" "exit $stop_rc"; fi
+
+# ---- on Protocol 2.0: XM430-W350 servos in current control (torque actuation) ----------------
+# the SYNC_READ into its fixed buffer, both read-back blocks, the drive's SYNC_WRITE
+spawn simx "$S" --model xm430-w350 --link "$T/xbus" --ids 1,2 --name x1 --baud 1000000 --lcm-url "$URL" --seed 2 \
+	--return-delay 0 --control "$T/ctlx"
+wait_log simx 'ready' 10 || { tap_fail "X simulator ready" "$(cat "$T/simx.log")"; tap_done; exit 1; }
+RX="qx$$"
+spawn watchx "$D" --watch "$RX" --lcm-url "$URL"
+xcycle() { grep -a "^STATE $RX " "$T/watchx.log" | tail -1 | field cycle; }
+xcycle_at_least() { [ "$(xcycle)" -ge "$1" ] 2>/dev/null; }
+QA_MALLOC_OUT="$T/dx.count" LD_PRELOAD="$T/shim.so" spawn dx "$D" --port "$T/xbus" --ids 1,2 --robot "$RX" \
+	--mode oscillator --lcm-url "$URL" --set robot.ramp_s=0.3 --set robot.actuation=torque --set robot.torque_drive=current
+if wait_log dx "ready: $RX.STATE" 15 && wait_for 10 xcycle_at_least 250; then
+	c0=$(xcycle)
+	kill -USR1 "$pid_dx"
+	wait_for 10 xcycle_at_least $((c0 + 300))
+	kill -USR2 "$pid_dx"
+	wait_for 5 test -s "$T/dx.count"
+	n=$(count "$T/dx.count")
+	mode=$(echo 'peek x1 1 operating_mode' | socat -t 2 - UNIX-CONNECT:"$T/ctlx" 2>/dev/null)
+	if [ "$n" = 0 ] && [ "$mode" = "ok 0" ]; then
+		tap_ok "Protocol 2.0, current control: no allocation in 300 cycles of steady state"
+	else tap_fail "no allocation on Protocol 2.0, in current control" "operating mode '$mode'; ${n:-no report} allocations
+$(report "$T/dx.count")"; fi
+else
+	tap_fail "daemon runs on the X bus (shim preloaded)" "$(tail -5 "$T/dx.log")"
+fi
+stop dx >/dev/null
 tap_done

@@ -447,6 +447,72 @@ static void test_random_against_servo(void **state)
 	}
 }
 
+/* An X servo's mode switch as a chain: a step given up takes the rest of its
+ * chain with it (never torque on in a mode that was not set), but not the
+ * other servo's writes, nor a torque-off queued behind the chain, which is
+ * never merged into the chain's own torque-on. */
+#define X_TORQUE_EN 64
+#define X_MODE 11
+#define X_GOAL_PWM 100
+static void test_chain_stops_at_failed_step(void **state)
+{
+	(void)state;
+	uint16_t ch = wq_chain(&q);
+	assert_true(ch != 0);
+	assert_true(wq_put_chain(&q, ch, 1, X_TORQUE_EN, 1, 0));
+	assert_true(wq_put_chain(&q, ch, 1, X_MODE, 1, 16));
+	assert_true(wq_put_chain(&q, ch, 1, X_GOAL_PWM, 2, 0));
+	assert_true(wq_put_chain(&q, ch, 1, X_TORQUE_EN, 1, 1));
+	assert_true(wq_put(&q, 2, X_TORQUE_EN, 1, 1));
+	/* LIMP queued behind the chain: appended, not merged into its torque-on */
+	assert_true(wq_put(&q, 1, X_TORQUE_EN, 1, 0));
+	assert_int_equal(q.n, 6);
+	expect_at(3, 1, X_TORQUE_EN, 1);
+	expect_at(5, 1, X_TORQUE_EN, 0);
+	/* torque off goes through; the mode is refused three times */
+	assert_non_null(wq_take(&q));
+	assert_int_equal(wq_done(&q, true, NULL), WQ_DONE);
+	for (int t = 1; t < WQ_TRIES; t++) {
+		assert_non_null(wq_take(&q));
+		assert_int_equal(wq_done(&q, false, NULL), WQ_RETRY);
+	}
+	struct wq_write w;
+	assert_non_null(wq_take(&q));
+	assert_int_equal(wq_done(&q, false, &w), WQ_FAILED);
+	assert_int_equal(w.addr, X_MODE);
+	/* Goal PWM 0 and torque on went with it; servo 2 and the LIMP stay */
+	assert_int_equal(q.chain_dropped, 2);
+	assert_int_equal(q.n, 2);
+	expect_at(0, 2, X_TORQUE_EN, 1);
+	expect_at(1, 1, X_TORQUE_EN, 0);
+	assert_int_equal(drain_to(1, X_TORQUE_EN), 0);
+}
+
+/* A chain that goes through is sent in order, whole; chains are numbered
+ * apart, so one failing leaves the next. A REBOOT (len 0) is a step too. */
+static void test_chain_whole_and_apart(void **state)
+{
+	(void)state;
+	uint16_t a = wq_chain(&q), b = wq_chain(&q);
+	assert_true(a != b);
+	assert_true(wq_put_chain(&q, a, 3, 0, 0, 0));   /* REBOOT */
+	assert_true(wq_put_chain(&q, a, 3, X_TORQUE_EN, 1, 1));
+	assert_true(wq_put_chain(&q, b, 3, X_GOAL_PWM, 2, 885));
+	/* a plain write of the chain's register is appended, never merged */
+	assert_true(wq_put(&q, 3, X_GOAL_PWM, 2, 400));
+	assert_int_equal(q.n, 4);
+	for (int t = 0; t < WQ_TRIES; t++) {
+		assert_non_null(wq_take(&q));
+		assert_int_equal(q.w[0].len, 0);
+		assert_int_equal(wq_done(&q, false, NULL), t + 1 < WQ_TRIES ? WQ_RETRY : WQ_FAILED);
+	}
+	/* chain a lost its torque-on; chain b and the plain write remain */
+	assert_int_equal(q.n, 2);
+	expect_at(0, 3, X_GOAL_PWM, 885);
+	expect_at(1, 3, X_GOAL_PWM, 400);
+	assert_int_equal(drain_to(3, X_GOAL_PWM), 400);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -460,6 +526,8 @@ int main(void)
 		cmocka_unit_test_setup(test_drop_id, setup),
 		cmocka_unit_test_setup(test_has, setup),
 		cmocka_unit_test_setup(test_clear, setup),
+		cmocka_unit_test_setup(test_chain_stops_at_failed_step, setup),
+		cmocka_unit_test_setup(test_chain_whole_and_apart, setup),
 		cmocka_unit_test(test_random_against_servo),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -417,9 +417,21 @@ static double dr_pct(const double *v, size_t n, double p)
 	return n ? v[rank ? rank - 1 : 0] : 0.0;
 }
 
-/* What start-up hands the controller (setup.c's setup_servo), from the checks' reads. */
-static void dr_servo_info(const struct dr_servo *s, struct ctl_servo_info *info)
+/* What start-up hands the controller (setup.c's setup_servo, setup_x.c's
+ * setup_servo_x), from the checks' reads. */
+static void dr_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
 {
+	const struct dr_servo *s = &d->servo[j];
+	if (d->t->a.protocol == 2) {
+		const struct dr2_servo *x = &d->servo2[j];
+		bool in_turn = x->min_position >= 0 && x->max_position <= DXL2_POS_MAX;
+		*info = (struct ctl_servo_info){
+			.cw_limit = in_turn ? (uint16_t)x->min_position : 1, .ccw_limit = in_turn ? (uint16_t)x->max_position : 0,
+			.max_torque = x->pwm_limit, .return_delay = x->return_delay,
+			.status_return_level = x->status_return_level, .model = sm_by_number(2, x->model),
+		};
+		return;
+	}
 	*info = (struct ctl_servo_info){
 		.cw_limit = s->cw_limit, .ccw_limit = s->ccw_limit,
 		.max_torque = s->max_torque ? s->max_torque : 1023,   /* as setup.c does */
@@ -439,14 +451,15 @@ static size_t dr_set_servos(struct dr *d, struct dr_run *r, size_t n)
 	r->cfg.njoints = n;
 	ctl_init(&r->ctl, &r->cfg);
 	for (size_t k = 0; k < n; k++) {
-		const struct dr_servo *s = &d->servo[r->from[k]];
-		dr_servo_info(s, &info);
-		if (!ctl_set_servo(&r->ctl, k, &info, why, sizeof why))
+		dr_servo_info(d, r->from[k], &info);
+		/* an X model undulated does not know, or no PWM to move with: not driven */
+		if ((d->t->a.protocol == 2 && (info.model == NULL || info.max_torque == 0)) ||
+		    !ctl_set_servo(&r->ctl, k, &info, why, sizeof why))
 			continue;   /* its angle-limits line says why */
 		r->cfg.ids[kept] = r->cfg.ids[k];
 		r->cfg.joint[kept] = r->cfg.joint[k];
 		r->from[kept] = r->from[k];
-		r->rd_us[kept] = dxl_return_delay_us(s->return_delay);
+		r->rd_us[kept] = dxl_return_delay_us(info.return_delay);
 		kept++;
 	}
 	return kept;
@@ -463,9 +476,14 @@ static unsigned dr_pick_joints(struct dr *d, struct dr_run *r)
 	/* the servo's own compliance margins: a check leaves them (undulated
 	 * writes the configured one at start; the cycle costs the same) */
 	r->cfg.compliance_margin = -1;
+	/* and the X series' bus watchdog as it is (the servo's own setting);
+	 * a check reboots nothing: a shutdown found latches the hold */
+	r->cfg.bus_watchdog_ms = -1;
+	r->cfg.fault_reboots = 0;
 	for (size_t j = 0; j < d->cfg.njoints; j++) {
 		const struct dr_servo *s = &d->servo[j];
-		if (!s->read || s->status_return_level == 0)
+		uint8_t level = d->t->a.protocol == 2 ? d->servo2[j].status_return_level : s->status_return_level;
+		if (!s->read || level == 0)
 			continue;
 		r->cfg.ids[n] = s->id;
 		r->cfg.joint[n] = d->cfg.joint[j];
@@ -814,8 +832,8 @@ static void dr2_servo_lines(struct dr *d, size_t j, int read_status)
 		dr_servo_line(d, s->id, "error field", &v);
 }
 
-/* The servos' lines on 2.0, and the budget said plainly not timed: the
- * timed cycles are undulated's own (daemon/cycle.c), which speaks 1.0. */
+/* The servos' lines on 2.0, then the timed cycles: undulated's own (one
+ * SYNC_READ, one SYNC_WRITE a cycle, daemon/cycle.c), holding. */
 static int dr2_check_servos(struct dr *d)
 {
 	struct dr_verdict v;
@@ -831,13 +849,7 @@ static int dr2_check_servos(struct dr *d)
 			dr_servo_lines(d, j, status[j]);
 	if (dr_check_echo(d->t->a.echo, d->t->bus.unexpected_echoes, d->t->bus.echo_errors, &v))
 		dr_line(d, "echo", &v);
-	double floor_ms = 1e-3 * dr2_cycle_wire_us((unsigned)d->cfg.njoints, d->ctx.read_len2, d->cfg.baud);
-	v.level = DR_SKIP;
-	snprintf(v.text, sizeof v.text, "not timed: undulated's cycle speaks Protocol 1.0 only so far, and the timed "
-	         "check runs that cycle; the 2.0 cycle's wire floor here would be %.2f ms (one SYNC_READ, one "
-	         "SYNC_WRITE for %zu servo(s))", floor_ms, d->cfg.njoints);
-	dr_line(d, "budget", &v);
-	return DXLT_EXIT_OK;
+	return dr_budget(d);
 }
 
 /* ---- the command --------------------------------------------------------------------------------- */

@@ -165,6 +165,7 @@ struct dr2_servo {
 	uint8_t status_return_level;
 	uint8_t hwerr;               /* Hardware Error Status (70) */
 	uint8_t bus_watchdog;        /* 20 ms a unit; 0 off; 255 (-1): it fired */
+	uint16_t pwm_limit;          /* PWM Limit (36): Goal PWM's ceiling, undulated's torque limit */
 	uint8_t err;                 /* OR of the ERR fields of its replies */
 };
 void dr2_servo_decode(struct dr2_servo *s, const uint8_t mem[DR2_IMAGE_LEN]);

@@ -54,6 +54,7 @@ void dr2_servo_decode(struct dr2_servo *s, const uint8_t mem[DR2_IMAGE_LEN])
 	s->status_return_level = mem[DXL2_X_STATUS_RETURN_LEVEL];
 	s->hwerr = mem[DXL2_X_HARDWARE_ERROR_STATUS];
 	s->bus_watchdog = mem[DXL2_X_BUS_WATCHDOG];
+	s->pwm_limit = dr2_u16(mem, DXL2_X_PWM_LIMIT);
 	s->voltage = dr2_u16(mem, DXL2_X_PRESENT_INPUT_VOLTAGE);
 	s->temperature = mem[DXL2_X_PRESENT_TEMPERATURE];
 }

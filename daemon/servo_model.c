@@ -1,0 +1,260 @@
+/* servo_model.c — see servo_model.h. */
+#include "servo_model.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "dxl.h"
+#include "dxl2.h"
+#include "dxl_table.h"
+#include "osc.h"
+
+#define SM_RPM_TO_RAD_S (2.0 * 3.14159265358979323846 / 60.0)
+
+/* The AX-12's cycle reads 36..41 (position, speed, load), and every other
+ * cycle 36..43 (voltage and temperature too); its read-back the RAM block
+ * from torque enable (24) to present temperature (43). */
+#define SM_AX_READBACK_ADDR 24
+#define SM_AX_READBACK_LEN 20
+
+/* The X series' cycle reads 126..135 (present current or load, velocity,
+ * position), and every other cycle 126..146 (trajectories, input voltage and
+ * temperature too): 10 or 21 bytes, so that a reply a whole period late has
+ * the wrong length, as on 1.0. Read back: the RAM block from Torque Enable
+ * (64) to Profile Velocity (112..115) — torque, Hardware Error Status, Bus
+ * Watchdog, Goal PWM, the profiles — and the EEPROM block from Operating
+ * Mode (11) to Min Position Limit (52..55): the mode and the limits. */
+#define SM_X_PRESENT_LEN 10
+#define SM_X_PRESENT_LEN_SLOW 21
+#define SM_X_RAM_ADDR DXL2_X_TORQUE_ENABLE
+#define SM_X_RAM_LEN (DXL2_X_PROFILE_VELOCITY + 4 - DXL2_X_TORQUE_ENABLE)
+#define SM_X_EEPROM_ADDR DXL2_X_OPERATING_MODE
+#define SM_X_EEPROM_LEN (DXL2_X_MIN_POSITION_LIMIT + 4 - DXL2_X_OPERATING_MODE)
+/* Rotor inertia (kg·m²) × gear ratio²: the gear ratios are the datasheets';
+ * the rotors are the simulator's assumptions (sim-bridge/PHYSICS.md §5: the
+ * AX-12A's 4.6e-8, the XL430's taken as the AX-12A's, the XM430's coreless
+ * motor 5.0e-8, not published). */
+#define SM_REFLECTED(rotor, ratio) ((rotor) * (ratio) * (ratio))
+/* Goal PWM's 100 % (PWM Limit's factory value). */
+#define SM_X_PWM_FULL 885
+
+static const struct sm_model sm_models[SM_NFAMILIES] = {
+	[SM_AX12] = {
+		.family = SM_AX12, .name = "AX-12A", .protocol = 1, .number = DXL_AX12_MODEL,
+		.torque_enable = DXL_AX_TORQUE_ENABLE, .torque_limit = DXL_AX_TORQUE_LIMIT,
+		.goal = DXL_AX_GOAL_POSITION, .goal_size = 2,
+		.present = DXL_AX_PRESENT_POSITION, .present_len = 6, .present_len_slow = 8,
+		.readback = { { SM_AX_READBACK_ADDR, SM_AX_READBACK_LEN, "RAM" } }, .nreadback = 1,
+		.pos_max = DXL_POS_MAX, .torque_full = 1023,
+		.ref_voltage = DXL_AX12_REF_VOLTAGE, .stall_torque_nm = DXL_AX12_STALL_TORQUE_NM,
+		.no_load_speed_rad_s = DXL_AX12_NO_LOAD_SPEED_RAD_S, .stall_current_a = 1.5,
+		.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0),
+	},
+	[SM_XL430] = {
+		.family = SM_XL430, .name = "XL430-W250", .protocol = 2, .number = DXL2_MODEL_XL430_W250,
+		.torque_enable = DXL2_X_TORQUE_ENABLE, .torque_limit = DXL2_X_GOAL_PWM,
+		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
+		.present = DXL2_X_PRESENT_LOAD, .present_len = SM_X_PRESENT_LEN, .present_len_slow = SM_X_PRESENT_LEN_SLOW,
+		.readback = { { SM_X_RAM_ADDR, SM_X_RAM_LEN, "RAM" }, { SM_X_EEPROM_ADDR, SM_X_EEPROM_LEN, "EEPROM" } },
+		.nreadback = 2, .pos_max = DXL2_POS_MAX, .torque_full = SM_X_PWM_FULL,
+		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XL430_STALL_TORQUE_NM,
+		.no_load_speed_rad_s = DXL2_XL430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
+		.stall_current_a = DXL2_XL430_STALL_CURRENT_A, .reflected_inertia = SM_REFLECTED(4.6e-8, 258.5),
+	},
+	[SM_XM430] = {
+		.family = SM_XM430, .name = "XM430-W350", .protocol = 2, .number = DXL2_MODEL_XM430_W350,
+		.torque_enable = DXL2_X_TORQUE_ENABLE, .torque_limit = DXL2_X_GOAL_PWM,
+		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
+		.present = DXL2_X_PRESENT_CURRENT, .present_len = SM_X_PRESENT_LEN, .present_len_slow = SM_X_PRESENT_LEN_SLOW,
+		.readback = { { SM_X_RAM_ADDR, SM_X_RAM_LEN, "RAM" }, { SM_X_EEPROM_ADDR, SM_X_EEPROM_LEN, "EEPROM" } },
+		.nreadback = 2, .pos_max = DXL2_POS_MAX, .torque_full = SM_X_PWM_FULL,
+		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XM430_STALL_TORQUE_NM,
+		.no_load_speed_rad_s = DXL2_XM430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
+		.stall_current_a = DXL2_XM430_STALL_CURRENT_A, .current_control = true,
+		.reflected_inertia = SM_REFLECTED(5.0e-8, 353.5),
+	},
+};
+
+const struct sm_model *sm_ax12(void)
+{
+	return &sm_models[SM_AX12];
+}
+
+const struct sm_model *sm_of(enum sm_family f)
+{
+	return (unsigned)f < SM_NFAMILIES ? &sm_models[f] : &sm_models[SM_AX12];
+}
+
+const struct sm_model *sm_by_number(int protocol, uint16_t number)
+{
+	for (size_t i = 0; i < SM_NFAMILIES; i++)
+		if (sm_models[i].protocol == protocol && sm_models[i].number == number)
+			return &sm_models[i];
+	return NULL;
+}
+
+static bool sm_is_x(const struct sm_model *m)
+{
+	return m->protocol == 2;
+}
+
+/* The table's row: the X series' registers are read with dxl2_table's sizes
+ * and signs, never restated here. */
+static int32_t sm_x_get(const struct sm_model *m, const uint8_t *block, uint16_t block_addr, uint16_t addr)
+{
+	const struct dxl2_reg *r = dxl2_reg_at(dxl2_model_by_number(m->number), addr);
+	return r != NULL ? dxl2_reg_decode(r, &block[addr - block_addr]) : 0;
+}
+
+/* ---- units ------------------------------------------------------------------------------------- */
+double sm_pos_to_rad(const struct sm_model *m, int32_t raw)
+{
+	if (sm_is_x(m))
+		return dxl2_pos_to_rad(raw);
+	return dxl_pos_to_rad((uint16_t)(raw < 0 ? 0 : raw > DXL_POS_MAX ? DXL_POS_MAX : raw));
+}
+
+int32_t sm_rad_to_pos(const struct sm_model *m, double rad)
+{
+	return sm_is_x(m) ? dxl2_rad_to_pos(rad) : dxl_rad_to_pos(rad);
+}
+
+bool sm_decode_present(const struct sm_model *m, const uint8_t *b, size_t n, struct sm_present *out)
+{
+	if (n != m->present_len && n != m->present_len_slow)
+		return false;
+	out->slow = n == m->present_len_slow;
+	out->voltage = out->temperature = NAN;
+	if (!sm_is_x(m)) {
+		out->pos_raw = dxl_get_u16(b);
+		out->angle = dxl_pos_to_rad(dxl_get_u16(b));
+		out->speed = dxl_speed_to_rad_s(dxl_get_u16(b + 2));
+		out->load = dxl_load_to_fraction(dxl_get_u16(b + 4));
+		if (out->slow) {
+			out->voltage = dxl_voltage_to_volts(b[6]);
+			out->temperature = b[7];
+		}
+		return true;
+	}
+	int32_t load = sm_x_get(m, b, m->present, DXL2_X_PRESENT_LOAD);
+	out->pos_raw = sm_x_get(m, b, m->present, DXL2_X_PRESENT_POSITION);
+	out->angle = dxl2_pos_to_rad(out->pos_raw);
+	out->speed = dxl2_velocity_to_rad_s(sm_x_get(m, b, m->present, DXL2_X_PRESENT_VELOCITY));
+	out->load = m->current_control ? dxl2_current_to_amps(load) / m->stall_current_a : dxl2_load_to_fraction(load);
+	if (out->slow) {
+		out->voltage = dxl2_voltage_to_volts(sm_x_get(m, b, m->present, DXL2_X_PRESENT_INPUT_VOLTAGE));
+		out->temperature = sm_x_get(m, b, m->present, DXL2_X_PRESENT_TEMPERATURE);
+	}
+	return true;
+}
+
+void sm_state_unknown(struct sm_state *s)
+{
+	*s = (struct sm_state){
+		.torque = -1, .torque_limit = -1, .margin_cw = -1, .margin_ccw = -1, .slope_cw = -1, .slope_ccw = -1,
+		.hwerr = -1, .watchdog = -1,
+		.opmode = -1, .profile_velocity = -1, .profile_acceleration = -1, .pos_min = -1, .pos_max = -1,
+		.pwm_limit = -1, .current_limit = -1, .voltage = NAN, .temperature = NAN,
+	};
+}
+
+static void sm_ax_readback(const uint8_t *ram, struct sm_state *s)
+{
+#define REG(addr) ram[(addr) - SM_AX_READBACK_ADDR]
+	s->torque = REG(DXL_AX_TORQUE_ENABLE);
+	s->torque_limit = dxl_get_u16(&REG(DXL_AX_TORQUE_LIMIT));
+	s->margin_cw = REG(DXL_AX_CW_COMPLIANCE_MARGIN);
+	s->margin_ccw = REG(DXL_AX_CCW_COMPLIANCE_MARGIN);
+	s->slope_cw = REG(DXL_AX_CW_COMPLIANCE_SLOPE);
+	s->slope_ccw = REG(DXL_AX_CCW_COMPLIANCE_SLOPE);
+	s->voltage = dxl_voltage_to_volts(REG(DXL_AX_PRESENT_VOLTAGE));
+	s->temperature = REG(DXL_AX_PRESENT_TEMPERATURE);
+#undef REG
+}
+
+static void sm_x_ram(const struct sm_model *m, const uint8_t *b, struct sm_state *s)
+{
+#define GET(addr) sm_x_get(m, b, SM_X_RAM_ADDR, (addr))
+	s->torque = GET(DXL2_X_TORQUE_ENABLE);
+	s->hwerr = GET(DXL2_X_HARDWARE_ERROR_STATUS);
+	/* a byte: −1 (tripped) reads 255 */
+	s->watchdog = b[DXL2_X_BUS_WATCHDOG - SM_X_RAM_ADDR];
+	s->torque_limit = GET(DXL2_X_GOAL_PWM);
+	s->profile_acceleration = GET(DXL2_X_PROFILE_ACCELERATION);
+	s->profile_velocity = GET(DXL2_X_PROFILE_VELOCITY);
+#undef GET
+}
+
+static void sm_x_eeprom(const struct sm_model *m, const uint8_t *b, struct sm_state *s)
+{
+#define GET(addr) sm_x_get(m, b, SM_X_EEPROM_ADDR, (addr))
+	s->opmode = GET(DXL2_X_OPERATING_MODE);
+	s->pwm_limit = GET(DXL2_X_PWM_LIMIT);
+	s->current_limit = m->current_control ? GET(DXL2_X_CURRENT_LIMIT) : -1;
+	s->pos_max = GET(DXL2_X_MAX_POSITION_LIMIT);
+	s->pos_min = GET(DXL2_X_MIN_POSITION_LIMIT);
+#undef GET
+}
+
+bool sm_decode_readback(const struct sm_model *m, size_t block, const uint8_t *bytes, size_t n, struct sm_state *s)
+{
+	if (block >= m->nreadback || n != m->readback[block].len)
+		return false;
+	if (!sm_is_x(m))
+		sm_ax_readback(bytes, s);
+	else if (m->readback[block].addr == SM_X_RAM_ADDR)
+		sm_x_ram(m, bytes, s);
+	else
+		sm_x_eeprom(m, bytes, s);
+	return true;
+}
+
+/* ---- status ----------------------------------------------------------------------------------- */
+uint8_t sm_status_faults(const struct sm_model *m, uint8_t status)
+{
+	return sm_is_x(m) ? 0 : (uint8_t)(status & (DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT));
+}
+
+bool sm_alert(const struct sm_model *m, uint8_t status)
+{
+	return sm_is_x(m) && dxl2_err_alert(status);
+}
+
+bool sm_write_refused(const struct sm_model *m, uint8_t status)
+{
+	if (sm_is_x(m))
+		return dxl2_err_number(status) != DXL2_ERRNUM_NONE;
+	return (status & (DXL_ERRBIT_RANGE | DXL_ERRBIT_INSTRUCTION | DXL_ERRBIT_CHECKSUM)) != 0;
+}
+
+/* ---- torque actuation --------------------------------------------------------------------------- */
+uint16_t sm_drive_register(const struct sm_model *m, bool current)
+{
+	if (!sm_is_x(m))
+		return DXL_AX_MOVING_SPEED;
+	return current ? DXL2_X_GOAL_CURRENT : DXL2_X_GOAL_PWM;
+}
+
+double sm_torque_scale(const struct sm_model *m)
+{
+	double link = OSC_TORQUE_JOINT_INERTIA - sm_models[SM_AX12].reflected_inertia;
+	return (link + m->reflected_inertia) / OSC_TORQUE_JOINT_INERTIA;
+}
+
+uint8_t sm_drive_opmode(bool current)
+{
+	return current ? DXL2_OPMODE_CURRENT : DXL2_OPMODE_PWM;
+}
+
+uint16_t sm_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit)
+{
+	if (!sm_is_x(m))
+		return dxl_duty_to_wheel(ratio);
+	if (!isfinite(ratio))
+		return 0;
+	if (limit < 0)
+		limit = 0;
+	double raw = current ? ratio * m->stall_current_a / DXL2_CURRENT_A_PER_UNIT : ratio * SM_X_PWM_FULL;
+	raw = fmax(-(double)limit, fmin((double)limit, round(raw)));
+	return (uint16_t)(int16_t)raw;
+}

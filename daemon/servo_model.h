@@ -1,0 +1,164 @@
+/*
+ * servo_model.h — what the controller and the cycle need to know about one
+ * servo family: its protocol, the registers they write and read, the blocks
+ * they read back, its units and its datasheet line. Pure: no I/O, no clock.
+ *
+ * Three families: the AX-12A on Protocol 1.0 (protocol/dxl_table.h) and the
+ * XL430-W250 and XM430-W350 on Protocol 2.0, whose registers are the rows of
+ * protocol/dxl2_table.c (there is no second table here: only which rows the
+ * daemon uses, and why). Everything that differs between them is answered
+ * here, so that control.c keeps one set of rules (modes, blending, faults,
+ * latches, the clamp, the write queue's guarantees) over all of them.
+ *
+ * How the X series stands in for the AX-12's registers:
+ *  - torque limit: the AX-12's Torque Limit (34, 0..1023 of Max Torque) caps
+ *    its output; on the X series Goal PWM (100, 0..PWM Limit, 885 = 100 %)
+ *    caps the output of every mode but PWM control (e-manual, Goal PWM), so a
+ *    fault's back-off lowers Goal PWM, and recovery writes PWM Limit back;
+ *  - joint mode: the AX-12's angle limits not both 0; on the X series
+ *    Operating Mode 3 (position control), where the servo itself keeps Goal
+ *    Position within Min/Max Position Limit (52, 48) — extended position
+ *    control (4) would not: its goals are multi-turn and unbounded, and no
+ *    configured joint needs more than the ±2.618 rad of one turn;
+ *  - torque actuation: the AX-12's wheel mode (Moving Speed 32 as a PWM duty);
+ *    on the XM430 current control (mode 0, Goal Current 102 — the paper's rig
+ *    drove currents), on the XL430, which has no current sensing, PWM control
+ *    (mode 16, Goal PWM 100) with the back-EMF added back as on the AX-12;
+ *  - faults: the AX-12's status error byte shows overload and overheating in
+ *    every reply; an X servo's status carries only the alert bit, and the
+ *    cause is Hardware Error Status (70), read back (sm_state.hwerr).
+ */
+#ifndef UNDULATE_DAEMON_SERVO_MODEL_H
+#define UNDULATE_DAEMON_SERVO_MODEL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dxl2_table.h"
+
+enum sm_family { SM_AX12 = 0, SM_XL430 = 1, SM_XM430 = 2 };
+#define SM_NFAMILIES 3
+
+/* A register block read in one READ. */
+struct sm_block {
+	uint16_t addr, len;
+	const char *what;          /* "RAM", for messages */
+};
+/* Read-back blocks of one family (the AX-12 has one, the X series two). */
+#define SM_MAX_BLOCKS 2
+
+struct sm_model {
+	enum sm_family family;
+	const char *name;               /* "XM430-W350" */
+	int protocol;                   /* 1 or 2 */
+	uint16_t number;                /* model number (register 0) */
+	/* registers the controller writes */
+	uint16_t torque_enable;         /* 24 | 64 */
+	uint16_t torque_limit;          /* Torque Limit 34 | Goal PWM 100, 2 bytes */
+	uint16_t goal;                  /* Goal Position 30 | 116 */
+	uint8_t goal_size;              /* 2 | 4 */
+	/* the cycle's read: position, speed and load (fast), with voltage and
+	 * temperature (slow) */
+	uint16_t present;               /* 36 | 126 */
+	uint8_t present_len, present_len_slow;
+	struct sm_block readback[SM_MAX_BLOCKS];
+	size_t nreadback;
+	int32_t pos_max;                /* 1023 | 4095 */
+	uint32_t torque_full;           /* full output in torque-limit units: 1023 | 885 */
+	/* the datasheet's line at ref_voltage (the simulator's motors use the same) */
+	double ref_voltage, stall_torque_nm, no_load_speed_rad_s, stall_current_a;
+	bool current_control;           /* has a current-controlled drive (XM430: mode 0) */
+	/* the motor's rotor seen through the gearbox, rotor inertia × ratio²
+	 * (kg·m²): what a joint's inertia has besides its link */
+	double reflected_inertia;
+};
+
+/* The AX-12A (what undulated assumed before it knew of others). */
+const struct sm_model *sm_ax12(void);
+const struct sm_model *sm_of(enum sm_family f);
+/* The family a PING's model number names on that protocol; NULL when this
+ * daemon does not know it. */
+const struct sm_model *sm_by_number(int protocol, uint16_t number);
+
+/* ---- units ---------------------------------------------------------------------------------- */
+/* Angles: radians from the servo's centre (AX-12 512, X 2048), positive
+ * towards larger raw values. sm_rad_to_pos() rounds to the nearest unit
+ * within 0..pos_max, so sm_rad_to_pos(sm_pos_to_rad(n)) == n. */
+double sm_pos_to_rad(const struct sm_model *m, int32_t raw);
+int32_t sm_rad_to_pos(const struct sm_model *m, double rad);
+
+/* What one cycle read: the present block, present_len bytes (fast) or
+ * present_len_slow (slow: voltage and temperature too). */
+struct sm_present {
+	int32_t pos_raw;
+	double angle;                   /* rad, sm_pos_to_rad */
+	double speed;                   /* rad/s, the servo's own Present Speed/Velocity */
+	double load;                    /* signed fraction of full output (XM430: of the stall current) */
+	bool slow;
+	double voltage, temperature;    /* V, °C; NaN unless slow */
+};
+/* False (nothing decoded) when n is neither length. */
+bool sm_decode_present(const struct sm_model *m, const uint8_t *bytes, size_t n, struct sm_present *out);
+
+/* What a read-back says about the servo; -1 (NaN) for what the block did not
+ * hold. Each family fills what it has. */
+struct sm_state {
+	int torque;                     /* Torque Enable */
+	int torque_limit;               /* AX Torque Limit | X Goal PWM */
+	int margin_cw, margin_ccw;      /* AX compliance margins */
+	int slope_cw, slope_ccw;        /* AX compliance slopes (the position loop's stiffness) */
+	int hwerr;                      /* X Hardware Error Status (70) */
+	int watchdog;                   /* X Bus Watchdog (98): 0 off, 1..127 × 20 ms, 255 tripped */
+	int opmode;                     /* X Operating Mode (11) */
+	int profile_velocity, profile_acceleration;   /* X (112, 108): 0 = none */
+	int32_t pos_min, pos_max;       /* X Min/Max Position Limit (52, 48) */
+	int pwm_limit, current_limit;   /* X (36, 38) */
+	double voltage, temperature;
+};
+void sm_state_unknown(struct sm_state *s);
+/* Decode read-back block `block` (len bytes of it) into *s, leaving what it
+ * does not hold as it was. False when block or n is not the model's. */
+bool sm_decode_readback(const struct sm_model *m, size_t block, const uint8_t *bytes, size_t n,
+                        struct sm_state *s);
+
+/* ---- the status a servo sent ------------------------------------------------------------------
+ * AX-12: the error byte (DXL_ERRBIT_*). X series: the ERR field (alert bit
+ * 7, an error number in bits 0-6). */
+/* The fault bits in the AX-12's layout this status shows by itself:
+ * overload and overheating on the AX-12; none on the X series, whose status
+ * only raises the alert (sm_alert) and whose causes are read back. */
+uint8_t sm_status_faults(const struct sm_model *m, uint8_t status);
+bool sm_alert(const struct sm_model *m, uint8_t status);
+/* A write's acknowledgement that says the servo did not take it: AX-12 range,
+ * instruction or checksum bits; X series any error number. */
+bool sm_write_refused(const struct sm_model *m, uint8_t status);
+
+/* ---- Hardware Error Status (X series) -----------------------------------------------------------
+ * The bits that are a fault of the servo (it may have shut down: Shutdown,
+ * 63, decides): overheating, motor encoder, electrical shock, overload. An
+ * input voltage outside the limits is reported, as the AX-12's voltage bit. */
+#define SM_HWERR_FAULTS (DXL2_HWERR_OVERHEAT | DXL2_HWERR_ENCODER | DXL2_HWERR_SHOCK | DXL2_HWERR_OVERLOAD)
+/* The Bus Watchdog's value after it stopped the servo (−1 as a byte). */
+#define SM_WATCHDOG_TRIPPED 0xFF
+
+/* ---- torque actuation ----------------------------------------------------------------------
+ * The register torque actuation's SYNC_WRITE carries, 2 bytes: AX-12 Moving
+ * Speed (32, wheel mode); X Goal Current (102, current) or Goal PWM (100). */
+uint16_t sm_drive_register(const struct sm_model *m, bool current);
+/* The operating mode of that drive on the X series (0 current, 16 PWM); 3,
+ * position control, is joint mode. */
+#define SM_OPMODE_POSITION DXL2_OPMODE_POSITION
+uint8_t sm_drive_opmode(bool current);
+/* A signed output ratio in [-1, 1] as that register's raw value: a PWM
+ * duty (AX-12: 0..1023 with bit 10 CW; X: 885 = 100 %), or the share of the
+ * datasheet's stall current (XM430, 2.69 mA a unit). X values are kept
+ * within ±limit (PWM Limit or Current Limit, the servo refuses more); a
+ * non-finite ratio gives 0. */
+uint16_t sm_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit);
+/* Torque actuation's defaults (osc_default_torque_params) are for the AX-12A's
+ * joint: the same link on this model's servo has this many times its
+ * inertia (the AX-12A: 1). */
+double sm_torque_scale(const struct sm_model *m);
+
+#endif

@@ -1,0 +1,24 @@
+/*
+ * setup_priv.h — what the two files of the start-up and safe stop share:
+ * setup.c (both protocols, the AX-12's registers) and setup_x.c (the X
+ * series' registers). Nothing outside them includes this.
+ */
+#ifndef UNDULATE_DAEMON_SETUP_PRIV_H
+#define UNDULATE_DAEMON_SETUP_PRIV_H
+
+#include "setup.h"
+
+/* Before try t of a transaction: wait for a quiet line (setup.h). */
+void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, int last);
+/* A READ or WRITE tried SETUP_TRIES times, on the bus's protocol (2.0: the
+ * 16-bit address; *eb gets the error byte or ERR field). */
+int setup_read(struct bus *bus, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out, uint8_t *eb);
+int setup_write(struct bus *bus, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
+                uint8_t *eb);
+
+/* ---- setup_x.c: the X series --------------------------------------------------------------- */
+bool setup_servo_x(struct bus *bus, struct ctl *ctl, size_t j, const struct cfg *cfg, const char *port_path,
+                   int *max_return_delay_us, char *err, size_t cap);
+void setup_safe_stop_x(struct bus *bus, const struct ctl *ctl, bool limp);
+
+#endif

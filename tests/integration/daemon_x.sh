@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# undulated on X-series servos (Protocol 2.0) against undulate-sim --model:
+#  - the protocol: --protocol 1 on an X bus finds nobody and says so; auto
+#    (the default) finds Protocol 2.0 by PING and names the model;
+#  - start-up: position control, the configured position limits on the
+#    servos, the bus watchdog, torque on; HOLD, then OSCILLATOR swings;
+#  - bad input on the 2.0 bus while it runs (damaged CRCs, replies from the
+#    wrong ID, garbage before replies, a servo missing from SYNC_READs):
+#    named in the log, counted, the robot runs on in OSCILLATOR;
+#  - an Operating Mode changed behind the daemon's back is put back;
+#  - torque actuation: an XM430 in current control (the paper's rig), an
+#    XL430 in PWM control, each back in position control on HOLD and at
+#    the safe stop; current control asked of an XL430 is refused.
+. "$(dirname "$0")/../lib.sh"
+D="$B/undulated"; S="$B/undulate-sim"
+if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
+URL=$(lcm_url 7730)
+R="dx$$"
+event() { wait_for "${2:-5}" sh -c "grep -a '^EVENT $R ' '$T/watch.log' | grep -qE '$1'"; }
+state_is() { wait_for "${2:-5}" sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -qE '$1'"; }
+cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2; }
+peek() { local v; v=$(ctl peek "$1" "$2" "$3"); echo "${v#ok }"; }
+swing() {   # peak-to-peak of joint $1's angle over the last $2 states
+	states | tail -"$2" | awk -v k="a$1=" '{ for (i = 1; i <= NF; i++) if (index($i, k) == 1) { v = substr($i, 4) + 0
+		if (!n++) { lo = v; hi = v } if (v < lo) lo = v; if (v > hi) hi = v } } END { printf "%.3f", hi - lo }'
+}
+over() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a > b) }'; }
+
+cat >"$T/x.scenario" <<EOF
+[sim]
+seed = 8
+baud = 1000000
+return_delay_us = 0
+[robot r1]
+link = $T/xm
+ids = 1,2
+model = xm430-w350
+contact = none
+[robot r2]
+link = $T/xl
+ids = 1
+model = xl430-w250
+contact = none
+EOF
+spawn sim "$S" --scenario "$T/x.scenario" --lcm-url "$URL" --control "$T/ctl"
+wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
+spawn watch "$D" --watch "$R" --lcm-url "$URL"
+
+# ---- the protocol -------------------------------------------------------------------------------
+out=$(timeout 20 "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --protocol 1 2>&1); rc=$?
+if [ $rc = 1 ] && echo "$out" | grep -q "servo IDs 1, 2 did not answer a PING on $T/xm at 1000000 bps"; then
+	tap_ok "--protocol 1 on an X bus: nobody answers, said so, exit 1"
+else tap_fail "--protocol 1 on an X bus" "rc $rc: $out"; fi
+spawn d "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
+wait_log d "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
+	{ tap_fail "daemon starts on the X bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
+if grep -q "protocol: servo 1 answered a Protocol 2.0 PING on $T/xm at 1000000 bps: Protocol 2.0 (X series)" "$T/d.log" &&
+	grep -q "Protocol 2.0 (XM430-W350), mode HOLD" "$T/d.log"; then
+	tap_ok "protocol auto: Protocol 2.0 found by PING, the model named"
+else tap_fail "protocol auto" "$(head -5 "$T/d.log")"; fi
+
+# ---- start-up: what the servos hold -------------------------------------------------------------------
+got="$(peek r1 1 operating_mode) $(peek r1 2 operating_mode) $(peek r1 1 min_position_limit) $(peek r1 1 max_position_limit)"
+got="$got $(peek r1 2 bus_watchdog) $(peek r1 1 torque_enable) $(peek r1 2 torque_enable)"
+if [ "$got" = "3 3 1201 2895 5 1 1" ] && state_is ' tq0=1 tr0=1 tl0=885 .* tq1=1 tr1=1 tl1=885 ' 3; then
+	tap_ok "start-up: position control, limits 1201..2895 (±1.3 rad), watchdog 100 ms, torque on, read back"
+else tap_fail "start-up" "servos: $got; $(last_state | cut -c1-300)"; fi
+
+# ---- OSCILLATOR ----------------------------------------------------------------------------------------
+cmd 'mode oscillator' >/dev/null
+wait_cycles 600
+s0=$(swing 0 300); s1=$(swing 1 300)
+if over "$s0" 0.5 && over "$s1" 0.5; then tap_ok "OSCILLATOR swings both joints ($s0, $s1 rad peak to peak)"
+else tap_fail "OSCILLATOR swings" "$s0 / $s1 rad"; fi
+
+# ---- bad input on the 2.0 bus --------------------------------------------------------------------------
+e0=$(last_state | field bus_errors)
+ctl fault r1 2 bad-checksum prob=0.1 >/dev/null
+ctl fault r1 1 wrong-id prob=0.05 >/dev/null
+wait_cycles 150
+ctl clear r1 1 >/dev/null; ctl clear r1 2 >/dev/null
+ctl fault r1 1 garbage 12 prob=0.1 >/dev/null
+ctl fault r1 2 no-reply count=5 >/dev/null
+wait_cycles 150
+ctl clear r1 1 >/dev/null
+wait_cycles 100
+e1=$(last_state | field bus_errors)
+# the counters as the daemon publishes them (BUS, once a second): per servo
+# replies/timeouts and checksum/wrong ID/wrong length
+wait_for 3 sh -c "grep -a '^BUS $R ' '$T/watch.log' | tail -1 | grep -q ' bad1=[1-9]'"
+b=$(grep -a "^BUS $R " "$T/watch.log" | tail -1)
+cks=$(echo "$b" | sed -n 's/.* bad1=\([0-9]*\)\/.*/\1/p'); wid=$(echo "$b" | sed -n 's/.* bad0=[0-9]*\/\([0-9]*\)\/.*/\1/p')
+tmo=$(echo "$b" | sed -n 's/.* id1=2\/[0-9]*\/\([0-9]*\)\/.*/\1/p')
+if [ "${cks:-0}" -gt 0 ] && [ "${wid:-0}" -gt 0 ] && [ "${tmo:-0}" -ge 5 ] && [ "${e1:-0}" -gt "${e0:-0}" ] &&
+	grep -q 'servo 2: SYNC_READ: bad checksum' "$T/d.log" && state_is ' mode=3 .* fault="" ' 1; then
+	tap_ok "bad CRCs, wrong IDs, garbage, a servo missing from SYNC_READs: named in the log, counted ($cks bad CRCs and $tmo timeouts of servo 2, $wid wrong IDs for servo 1; $e0 -> $e1 bus errors), OSCILLATOR runs on"
+else tap_fail "bad input on the 2.0 bus" "crc $cks wrong-id $wid timeouts $tmo; errors $e0 -> $e1; $b; $(last_state | cut -c1-200)"; fi
+echo "# period while it lasted: $(echo "$b" | sed 's/.*\(p50=[0-9]* p99=[0-9]* max=[0-9]*\).*/\1/') us, overruns $(last_state | field overruns)"
+s1=$(swing 1 300)
+if over "$s1" 0.5; then tap_ok "joint 2 still swings after it ($s1 rad)"; else tap_fail "swinging after bad input" "$s1"; fi
+
+# ---- an Operating Mode changed behind the daemon's back --------------------------------------------------
+ctl poke r1 1 torque_enable 0 >/dev/null
+ctl poke r1 1 operating_mode 1 >/dev/null
+if event 'kind=readback text="servo 1: operating mode changed' 5 &&
+	wait_for 3 sh -c "[ \"\$(echo 'peek r1 1 operating_mode' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ]" &&
+	wait_for 3 sh -c "[ \"\$(echo 'peek r1 1 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]"; then
+	tap_ok "operating mode changed behind its back: found in the read-back, position control and torque again"
+else tap_fail "operating mode put back" "$(events | tail -3); mode $(peek r1 1 operating_mode)"; fi
+stop d >/dev/null
+
+# ---- torque actuation on the XM430: current control ----------------------------------------------------
+ctl poke r1 1 goal_position 2300 >/dev/null   # resting away from neutral: the law starts it
+mark_states
+spawn dt "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator \
+	--set robot.actuation=torque --set robot.torque_drive=current
+wait_log dt "ready: $R.STATE" 15 && wait_restarted 100 || { tap_fail "torque daemon starts" "$(cat "$T/dt.log")"; tap_done; exit 1; }
+wait_cycles 500
+gc=$(peek r1 1 goal_current)
+if [ "$(peek r1 1 operating_mode)" = 0 ] && [ "$(peek r1 2 operating_mode)" = 0 ] && [ "${gc#-}" -le 1193 ] &&
+	state_is ' g0=nan .* dr0=[-0-9]' 1 && over "$(swing 0 300)" 0.5; then
+	tap_ok "torque actuation on the XM430: current control, the law's current ($gc now), joint 1 swings $(swing 0 300) rad"
+else tap_fail "current control" "modes $(peek r1 1 operating_mode)/$(peek r1 2 operating_mode), current $gc, swing $(swing 0 300); $(last_state | cut -c1-200)"; fi
+cmd 'mode hold' >/dev/null
+if wait_for 3 sh -c "[ \"\$(echo 'peek r1 1 operating_mode' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ]" &&
+	[ "$(peek r1 2 operating_mode)" = 3 ] && [ "$(peek r1 1 torque_enable)" = 1 ]; then
+	tap_ok "HOLD: back in position control, torque on"
+else tap_fail "back to position control" "modes $(peek r1 1 operating_mode)/$(peek r1 2 operating_mode)"; fi
+stop dt >/dev/null
+
+# ---- the XL430: no current control; PWM control -----------------------------------------------------------
+out=$(timeout 20 "$D" --port "$T/xl" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold \
+	--set robot.actuation=torque --set robot.torque_drive=current 2>&1); rc=$?
+if [ $rc = 1 ] && echo "$out" | grep -q "servo 1 is an XL430-W250, which has no current control"; then
+	tap_ok "current control asked of an XL430: refused at start, saying why"
+else tap_fail "XL430 current refused" "rc $rc: $out"; fi
+ctl poke r2 1 goal_position 2300 >/dev/null
+mark_states
+spawn dl "$D" --port "$T/xl" --ids 1 --robot "$R" --lcm-url "$URL" --mode oscillator \
+	--set robot.actuation=torque --set robot.torque_drive=pwm
+wait_log dl "ready: $R.STATE" 15 && wait_restarted 100 || { tap_fail "XL430 daemon starts" "$(cat "$T/dl.log")"; tap_done; exit 1; }
+wait_cycles 400
+if [ "$(peek r2 1 operating_mode)" = 16 ] && over "$(swing 0 300)" 0.4; then
+	tap_ok "torque actuation on the XL430: PWM control, joint swings $(swing 0 300) rad"
+else tap_fail "PWM control" "mode $(peek r2 1 operating_mode), swing $(swing 0 300)"; fi
+stop dl >/dev/null
+if [ "$stop_rc" = 0 ] && [ "$(peek r2 1 operating_mode)" = 3 ] && [ "$(peek r2 1 torque_enable)" = 1 ] &&
+	[ "$(peek r2 1 bus_watchdog)" = 0 ]; then
+	tap_ok "safe stop after torque actuation: position control, holding, watchdog off"
+else tap_fail "safe stop" "exit $stop_rc, mode $(peek r2 1 operating_mode), torque $(peek r2 1 torque_enable)"; fi
+tap_done

@@ -1,0 +1,294 @@
+/*
+ * test_daemon_servomodel.c — the servo families (servo_model.h): which
+ * model a PING's number names, units both ways, the present block and the
+ * read-back blocks decoded from bytes laid out by hand from the e-manual's
+ * control tables (not from our encoder), the status field's meaning per
+ * protocol, and torque actuation's raw outputs within the servo's limits.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <string.h>
+
+#include "../../daemon/config.h"
+#include "../../daemon/servo_model.h"
+#include "dxl.h"
+#include "dxl_table.h"
+
+#define PI 3.14159265358979323846
+
+static void test_families_by_number(void **state)
+{
+	(void)state;
+	assert_ptr_equal(sm_by_number(1, 12), sm_ax12());
+	assert_int_equal(sm_by_number(2, 1060)->family, SM_XL430);
+	assert_int_equal(sm_by_number(2, 1020)->family, SM_XM430);
+	/* a number is only a model on its own protocol */
+	assert_null(sm_by_number(1, 1060));
+	assert_null(sm_by_number(2, 12));
+	assert_null(sm_by_number(2, 1030));   /* XM430-W210: not one this daemon knows */
+	assert_string_equal(sm_of(SM_XM430)->name, "XM430-W350");
+	assert_true(sm_of(SM_XM430)->current_control);
+	assert_false(sm_of(SM_XL430)->current_control);
+	assert_false(sm_ax12()->current_control);
+	/* the registers the controller writes, from the manuals' tables */
+	assert_int_equal(sm_ax12()->torque_enable, 24);
+	assert_int_equal(sm_ax12()->goal, 30);
+	assert_int_equal(sm_of(SM_XL430)->torque_enable, 64);
+	assert_int_equal(sm_of(SM_XL430)->goal, 116);
+	assert_int_equal(sm_of(SM_XL430)->goal_size, 4);
+	assert_int_equal(sm_of(SM_XM430)->torque_limit, 100);   /* Goal PWM caps position control */
+	/* the datasheet lines at 12 V */
+	assert_true(fabs(sm_of(SM_XM430)->stall_torque_nm - 4.1) < 1e-12);
+	assert_true(fabs(sm_of(SM_XM430)->no_load_speed_rad_s - 46.0 * 2 * PI / 60) < 1e-12);
+	assert_true(fabs(sm_of(SM_XL430)->stall_current_a - 1.4) < 1e-12);
+}
+
+static void test_positions_both_ways(void **state)
+{
+	(void)state;
+	const struct sm_model *x = sm_of(SM_XM430), *ax = sm_ax12();
+	assert_true(fabs(sm_pos_to_rad(x, 2048)) < 1e-12);
+	assert_true(fabs(sm_pos_to_rad(x, 3072) - PI / 2) < 1e-12);   /* a quarter turn: 1024 of 4096 */
+	assert_true(fabs(sm_pos_to_rad(ax, 512)) < 1e-12);
+	assert_true(fabs(sm_pos_to_rad(ax, 1023) - 511 * 300.0 / 1023 * PI / 180) < 1e-12);
+	for (int32_t n = 0; n <= 4095; n++)
+		if (sm_rad_to_pos(x, sm_pos_to_rad(x, n)) != n)
+			fail_msg("X position %d does not come back", n);
+	for (int32_t n = 0; n <= 1023; n++)
+		if (sm_rad_to_pos(ax, sm_pos_to_rad(ax, n)) != n)
+			fail_msg("AX position %d does not come back", n);
+	assert_int_equal(sm_rad_to_pos(x, 10.0), 4095);
+	assert_int_equal(sm_rad_to_pos(x, -10.0), 0);
+	assert_int_equal(sm_rad_to_pos(x, NAN), 2048);
+}
+
+/* 126..135: Present Current (XM430; Load on the XL430) 2 bytes, Present
+ * Velocity 4, Present Position 4, little-endian, signed (e-manual). */
+static void test_present_block_x(void **state)
+{
+	(void)state;
+	/* current -100 (FF9C), velocity -3, position 166 (the manual's READ example) */
+	const uint8_t fast[10] = { 0x9C, 0xFF, 0xFD, 0xFF, 0xFF, 0xFF, 0xA6, 0x00, 0x00, 0x00 };
+	struct sm_present p;
+	const struct sm_model *xm = sm_of(SM_XM430), *xl = sm_of(SM_XL430);
+	assert_true(sm_decode_present(xm, fast, sizeof fast, &p));
+	assert_false(p.slow);
+	assert_int_equal(p.pos_raw, 166);
+	assert_true(fabs(p.angle - (166 - 2048) * 2 * PI / 4096) < 1e-12);
+	assert_true(fabs(p.speed - (-3 * 0.229 * 2 * PI / 60)) < 1e-12);
+	assert_true(fabs(p.load - (-100 * 0.00269 / 2.3)) < 1e-12);   /* share of the stall current */
+	assert_true(isnan(p.voltage) && isnan(p.temperature));
+	/* the XL430's 126 is Present Load, 0.1 % a unit */
+	assert_true(sm_decode_present(xl, fast, sizeof fast, &p));
+	assert_true(fabs(p.load - (-0.100)) < 1e-12);
+	/* the slow read goes on to 146: trajectories (136..143), input voltage
+	 * 144 (0.1 V) and temperature 146 */
+	uint8_t slow[21] = { 0 };
+	memcpy(slow, fast, sizeof fast);
+	slow[18] = 118;   /* 11.8 V */
+	slow[20] = 41;
+	assert_true(sm_decode_present(xm, slow, sizeof slow, &p));
+	assert_true(p.slow);
+	assert_int_equal(p.pos_raw, 166);
+	assert_true(fabs(p.voltage - 11.8) < 1e-9);
+	assert_true(fabs(p.temperature - 41) < 1e-12);
+	/* any other length is not this block: a late reply to another request */
+	assert_false(sm_decode_present(xm, slow, 20, &p));
+	assert_false(sm_decode_present(xm, fast, 6, &p));
+}
+
+/* The AX-12's 36..43: as control.c always decoded it. */
+static void test_present_block_ax(void **state)
+{
+	(void)state;
+	const uint8_t b[8] = { 0x00, 0x02, 0x0A, 0x04, 0x64, 0x00, 0x78, 0x20 };   /* 512, 10 CW, 100 CCW, 12 V, 32 C */
+	struct sm_present p;
+	assert_true(sm_decode_present(sm_ax12(), b, 6, &p));
+	assert_false(p.slow);
+	assert_int_equal(p.pos_raw, 512);
+	assert_true(fabs(p.speed - dxl_speed_to_rad_s(0x040A)) < 1e-12);
+	assert_true(p.speed < 0);
+	assert_true(fabs(p.load - 0.1) < 1e-12);
+	assert_true(sm_decode_present(sm_ax12(), b, 8, &p));
+	assert_true(fabs(p.voltage - 12.0) < 1e-12 && fabs(p.temperature - 32) < 1e-12);
+	assert_false(sm_decode_present(sm_ax12(), b, 7, &p));
+}
+
+static void test_readback_blocks_x(void **state)
+{
+	(void)state;
+	const struct sm_model *xm = sm_of(SM_XM430);
+	assert_int_equal(xm->nreadback, 2);
+	assert_int_equal(xm->readback[0].addr, 64);
+	assert_int_equal(xm->readback[0].len, 52);   /* 64 .. 115 (Profile Velocity) */
+	assert_int_equal(xm->readback[1].addr, 11);
+	assert_int_equal(xm->readback[1].len, 45);   /* 11 .. 55 (Min Position Limit) */
+	uint8_t ram[52] = { 0 }, ee[45] = { 0 };
+	ram[64 - 64] = 1;                  /* torque on */
+	ram[70 - 64] = 0x24;               /* overheating | overload */
+	ram[98 - 64] = 0xFF;               /* the watchdog stopped it */
+	ram[100 - 64] = 0x75; ram[101 - 64] = 0x03;   /* Goal PWM 885 */
+	ram[108 - 64] = 7;                 /* Profile Acceleration 7 */
+	ram[112 - 64] = 0x2C; ram[113 - 64] = 0x01;   /* Profile Velocity 300 */
+	ee[11 - 11] = 3;                   /* position control */
+	ee[36 - 11] = 0x2C; ee[37 - 11] = 0x01;       /* PWM Limit 300 */
+	ee[38 - 11] = 0xA9; ee[39 - 11] = 0x04;       /* Current Limit 1193 */
+	ee[48 - 11] = 0xAB; ee[49 - 11] = 0x0E;       /* Max Position Limit 3755 */
+	ee[52 - 11] = 0x55; ee[53 - 11] = 0x01;       /* Min Position Limit 341 */
+	struct sm_state s;
+	sm_state_unknown(&s);
+	assert_true(sm_decode_readback(xm, 0, ram, sizeof ram, &s));
+	assert_int_equal(s.torque, 1);
+	assert_int_equal(s.hwerr, 0x24);
+	assert_int_equal(s.watchdog, SM_WATCHDOG_TRIPPED);
+	assert_int_equal(s.torque_limit, 885);
+	assert_int_equal(s.profile_acceleration, 7);
+	assert_int_equal(s.profile_velocity, 300);
+	assert_int_equal(s.opmode, -1);    /* not in this block */
+	assert_true(sm_decode_readback(xm, 1, ee, sizeof ee, &s));
+	assert_int_equal(s.opmode, 3);
+	assert_int_equal(s.pwm_limit, 300);
+	assert_int_equal(s.current_limit, 1193);
+	assert_int_equal(s.pos_max, 3755);
+	assert_int_equal(s.pos_min, 341);
+	assert_int_equal(s.torque, 1);     /* kept from the other block */
+	/* the wrong length or block is refused, nothing changed */
+	assert_false(sm_decode_readback(xm, 1, ram, sizeof ram, &s));
+	assert_false(sm_decode_readback(xm, 2, ee, sizeof ee, &s));
+	assert_int_equal(s.opmode, 3);
+	/* the XL430 has no Current Limit */
+	sm_state_unknown(&s);
+	assert_true(sm_decode_readback(sm_of(SM_XL430), 1, ee, sizeof ee, &s));
+	assert_int_equal(s.current_limit, -1);
+}
+
+static void test_readback_block_ax(void **state)
+{
+	(void)state;
+	uint8_t ram[20] = { 0 };
+	ram[24 - 24] = 1;
+	ram[26 - 24] = 0;  ram[27 - 24] = 1;
+	ram[34 - 24] = 0xFF; ram[35 - 24] = 0x03;   /* torque limit 1023 */
+	ram[42 - 24] = 110; ram[43 - 24] = 40;
+	struct sm_state s;
+	sm_state_unknown(&s);
+	assert_true(sm_decode_readback(sm_ax12(), 0, ram, sizeof ram, &s));
+	assert_int_equal(s.torque, 1);
+	assert_int_equal(s.torque_limit, 1023);
+	assert_int_equal(s.margin_cw, 0);
+	assert_int_equal(s.margin_ccw, 1);
+	assert_true(fabs(s.voltage - 11.0) < 1e-12 && fabs(s.temperature - 40) < 1e-12);
+	assert_int_equal(s.hwerr, -1);
+	assert_false(sm_decode_readback(sm_ax12(), 1, ram, sizeof ram, &s));
+}
+
+static void test_status_meaning(void **state)
+{
+	(void)state;
+	const struct sm_model *x = sm_of(SM_XL430), *ax = sm_ax12();
+	/* AX-12: overload and overheating show in the status byte itself */
+	assert_int_equal(sm_status_faults(ax, 0x24), 0x24);
+	assert_int_equal(sm_status_faults(ax, 0x01), 0);
+	assert_false(sm_alert(ax, 0x80));
+	/* X: the status raises the alert; the cause is read back */
+	assert_int_equal(sm_status_faults(x, 0x80), 0);
+	assert_true(sm_alert(x, 0x80));
+	assert_true(sm_alert(x, 0x84));
+	assert_false(sm_alert(x, 0x04));
+	/* a write is refused by an error number (X) or the range, instruction,
+	 * checksum bits (AX), not by the alert or an overload */
+	assert_true(sm_write_refused(x, 0x07));
+	assert_true(sm_write_refused(x, 0x81));
+	assert_false(sm_write_refused(x, 0x80));
+	assert_true(sm_write_refused(ax, DXL_ERRBIT_RANGE));
+	assert_false(sm_write_refused(ax, DXL_ERRBIT_OVERLOAD));
+}
+
+static int16_t s16(uint16_t v) { return (int16_t)v; }
+
+static void test_drive_outputs(void **state)
+{
+	(void)state;
+	const struct sm_model *xl = sm_of(SM_XL430), *xm = sm_of(SM_XM430), *ax = sm_ax12();
+	assert_int_equal(sm_drive_register(xl, false), 100);
+	assert_int_equal(sm_drive_register(xm, true), 102);
+	assert_int_equal(sm_drive_register(ax, false), 32);
+	assert_int_equal(sm_drive_opmode(true), 0);
+	assert_int_equal(sm_drive_opmode(false), 16);
+	/* PWM: 885 = 100 %, within +-PWM Limit */
+	assert_int_equal(s16(sm_drive_raw(xl, false, 0.5, 885)), 443);
+	assert_int_equal(s16(sm_drive_raw(xl, false, -1.0, 885)), -885);
+	assert_int_equal(s16(sm_drive_raw(xl, false, -1.0, 300)), -300);
+	assert_int_equal(s16(sm_drive_raw(xl, false, 3.0, 885)), 885);
+	/* current: the share of the stall current (2.3 A) in 2.69 mA units,
+	 * within +-Current Limit */
+	assert_int_equal(s16(sm_drive_raw(xm, true, 1.0, 1193)), 855);
+	assert_int_equal(s16(sm_drive_raw(xm, true, -0.1, 1193)), -86);
+	assert_int_equal(s16(sm_drive_raw(xm, true, 1.0, 500)), 500);
+	assert_int_equal(sm_drive_raw(xm, true, NAN, 1193), 0);
+	assert_int_equal(sm_drive_raw(xm, true, INFINITY, 1193), 0);
+	/* AX-12 wheel mode: as it always was */
+	assert_int_equal(sm_drive_raw(ax, false, -0.5, 0), dxl_duty_to_wheel(-0.5));
+}
+
+/* Torque actuation's defaults are an AX-12A joint's; on another servo the
+ * same link is heavier by the rotor through the gearbox, and the defaults
+ * the configuration did not give scale with it, once. */
+static void test_torque_defaults_scale(void **state)
+{
+	(void)state;
+	assert_true(fabs(sm_torque_scale(sm_ax12()) - 1.0) < 1e-12);
+	double xm = sm_torque_scale(sm_of(SM_XM430)), xl = sm_torque_scale(sm_of(SM_XL430));
+	/* (1.42e-3 link + 5.0e-8 x 353.5^2) / 4.39e-3 */
+	assert_true(fabs(xm - (4.39e-3 - 4.6e-8 * 254 * 254 + 5.0e-8 * 353.5 * 353.5) / 4.39e-3) < 1e-9);
+	assert_true(xm > 1.7 && xm < 1.8);
+	assert_true(xl > 1.0 && xl < 1.05);
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.port=/dev/null", &e));
+	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
+	assert_true(cfg_override(&c, "robot.actuation=torque", &e));
+	assert_true(cfg_override(&c, "robot.torque_drive=current", &e));
+	assert_true(cfg_override(&c, "joint.2.k=0.3", &e));
+	assert_true(cfg_finish(&c, &e));
+	double k1 = c.joint[0].osc.k, mu1 = c.joint[0].osc.mu, i1 = c.joint[0].osc.inertia;
+	cfg_scale_torque_defaults(&c, 0, xm);
+	cfg_scale_torque_defaults(&c, 1, xm);
+	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
+	assert_true(fabs(c.joint[0].osc.mu - mu1 * xm) < 1e-12);
+	assert_true(fabs(c.joint[0].osc.inertia - i1 * xm) < 1e-12);
+	assert_true(fabs(c.joint[1].osc.k - 0.3) < 1e-12);        /* given: kept */
+	assert_true(fabs(c.joint[1].osc.mu - mu1 * xm) < 1e-12);  /* not given: scaled */
+	cfg_scale_torque_defaults(&c, 0, xm);                      /* once */
+	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
+	/* position actuation's parameters are a control law's, not a joint's: none */
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.port=/dev/null", &e));
+	assert_true(cfg_override(&c, "robot.ids=1", &e));
+	assert_true(cfg_finish(&c, &e));
+	k1 = c.joint[0].osc.k;
+	cfg_scale_torque_defaults(&c, 0, xm);
+	assert_true(fabs(c.joint[0].osc.k - k1) < 1e-12);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_families_by_number),
+		cmocka_unit_test(test_positions_both_ways),
+		cmocka_unit_test(test_present_block_x),
+		cmocka_unit_test(test_present_block_ax),
+		cmocka_unit_test(test_readback_blocks_x),
+		cmocka_unit_test(test_readback_block_ax),
+		cmocka_unit_test(test_status_meaning),
+		cmocka_unit_test(test_drive_outputs),
+		cmocka_unit_test(test_torque_defaults_scale),
+	};
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
