@@ -90,7 +90,7 @@ e1=$(last_state | field bus_errors)
 # 2 s): which kind comes first is chance, so any of them is enough there (a
 # run beside another test logged only timeouts in its window). Per servo
 # replies/timeouts and checksum/wrong ID/wrong length
-wait_for 3 sh -c "grep -a '^BUS $R ' '$T/watch.log' | tail -1 | grep -q ' bad1=[1-9]'"
+wait_for 10 sh -c "grep -a '^BUS $R ' '$T/watch.log' | tail -1 | grep -q ' bad1=[1-9]'"
 b=$(grep -a "^BUS $R " "$T/watch.log" | tail -1)
 cks=$(echo "$b" | sed -n 's/.* bad1=\([0-9]*\)\/.*/\1/p'); wid=$(echo "$b" | sed -n 's/.* bad0=[0-9]*\/\([0-9]*\)\/.*/\1/p')
 tmo=$(echo "$b" | sed -n 's/.* id1=2\/[0-9]*\/\([0-9]*\)\/.*/\1/p')
@@ -106,8 +106,8 @@ if over "$s1" 0.5; then tap_ok "joint 2 still swings after it ($s1 rad)"; else t
 ctl poke r1 1 torque_enable 0 >/dev/null
 ctl poke r1 1 operating_mode 1 >/dev/null
 if event 'kind=readback text="servo 1: operating mode changed' 5 &&
-	wait_for 3 sh -c "[ \"\$(echo 'peek r1 1 operating_mode' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ]" &&
-	wait_for 3 sh -c "[ \"\$(echo 'peek r1 1 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]"; then
+	wait_for 10 sh -c "[ \"\$(echo 'peek r1 1 operating_mode' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ]" &&
+	wait_for 10 sh -c "[ \"\$(echo 'peek r1 1 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]"; then
 	tap_ok "operating mode changed behind its back: found in the read-back, position control and torque again"
 else tap_fail "operating mode put back" "$(events | tail -3); mode $(peek r1 1 operating_mode)"; fi
 stop d >/dev/null
@@ -125,8 +125,10 @@ if [ "$(peek r1 1 operating_mode)" = 0 ] && [ "$(peek r1 2 operating_mode)" = 0 
 	tap_ok "torque actuation on the XM430: current control, the law's current ($gc now), joint 1 swings $(swing 0 300) rad"
 else tap_fail "current control" "modes $(peek r1 1 operating_mode)/$(peek r1 2 operating_mode), current $gc, swing $(swing 0 300); $(last_state | cut -c1-200)"; fi
 cmd 'mode hold' >/dev/null
-if wait_for 3 sh -c "[ \"\$(echo 'peek r1 1 operating_mode' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ]" &&
-	[ "$(peek r1 2 operating_mode)" = 3 ] && [ "$(peek r1 1 torque_enable)" = 1 ]; then
+# The daemon writes each joint's mode in turn (torque off, mode, torque on, a
+# chain per joint over cycles): wait for the last of them, not the first.
+if wait_for 10 sh -c "for j in 1 2; do [ \"\$(echo \"peek r1 \$j operating_mode\" | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ] &&
+		[ \"\$(echo \"peek r1 \$j torque_enable\" | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ] || exit 1; done"; then
 	tap_ok "HOLD: back in position control, torque on"
 else tap_fail "back to position control" "modes $(peek r1 1 operating_mode)/$(peek r1 2 operating_mode)"; fi
 stop dt >/dev/null

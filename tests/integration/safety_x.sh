@@ -78,7 +78,7 @@ ctl power r1 2 off >/dev/null
 wait_cycles 20
 ctl power r1 2 on >/dev/null
 if event 'kind=servo-reset text="servo 2 found with torque off while OSCILLATOR wanted it on' 5 &&
-	wait_for 3 sh -c "[ \"\$(echo 'peek r1 2 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]" &&
+	wait_for 10 sh -c "[ \"\$(echo 'peek r1 2 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]" &&
 	[ "$(peek 2 bus_watchdog)" = 5 ]; then
 	tap_ok "power loss found by the read-back, reported, set up again: torque on, bus watchdog 100 ms"
 else tap_fail "power loss" "$(events | tail -3); torque $(peek 2 torque_enable) watchdog $(peek 2 bus_watchdog)"; fi
@@ -112,7 +112,7 @@ ctl clear r1 1 >/dev/null   # cooled down
 wait_cycles 20
 out=$( { cmd clear && cmd 'mode oscillator'; } 2>&1); rc=$?
 if [ $rc = 0 ] && event 'kind=reboot text="servo 1: REBOOT \(.clear.\)' 3 &&
-	wait_for 3 sh -c "[ \"\$(echo 'peek r1 1 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]"; then
+	wait_for 10 sh -c "[ \"\$(echo 'peek r1 1 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]"; then
 	tap_ok "cooled: 'clear' reboots it, OSCILLATOR accepted, torque on"
 else tap_fail "clear after cooling" "rc $rc $out; $(events | tail -3)"; fi
 
