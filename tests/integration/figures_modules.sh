@@ -132,14 +132,14 @@ else tap_fail "channel.md numbers" "$(grep -E '^\||In all' "$T/fig/channel.md")"
 # ---- no results, no gnuplot ----------------------------------------------------------------
 mkdir -p "$T/empty"
 "$F/rows/fig.sh" merge "$T/empty" "$T/fig2" >"$T/out" 2>&1; rc=$?
-if [ "$rc" = 1 ] && grep -q "no results in .*result.csv: nothing to draw" "$T/out"; then tap_ok "merge without results: exit 1, said so"
+if [ "$rc" = 1 ] && grep -q "^rows: no run in .* has a result.csv: nothing to draw" "$T/out"; then tap_ok "merge without results: exit 1, said so"
 else tap_fail "merge without results" "rc $rc: $(cat "$T/out")"; fi
 mkdir -p "$T/path"
 for d in /usr/local/bin /usr/bin /bin; do
 	for p in "$d"/*; do n=${p##*/}; [ "$n" = gnuplot ] || [ -e "$T/path/$n" ] || ln -s "$p" "$T/path/$n"; done
 done
 PATH="$T/path" "$F/forces/fig.sh" merge "$T/runs/forces" "$T/fig2" >"$T/out" 2>&1; rc=$?
-if [ "$rc" = 1 ] && grep -q "gnuplot is missing" "$T/out" && [ ! -e "$T/fig2/forces.png" ]; then tap_ok "merge without gnuplot: exit 1, said so"
+if [ "$rc" = 1 ] && grep -q "gnuplot is not installed" "$T/out" && [ ! -e "$T/fig2/forces.png" ]; then tap_ok "merge without gnuplot: exit 1, said so"
 else tap_fail "merge without gnuplot" "rc $rc: $(cat "$T/out")"; fi
 
 # ---- one tiny real run: the channel, four robots, 32 s in lockstep ----------------------
@@ -151,9 +151,9 @@ if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyz
 		awk -F, 'NR > 1 && !($13 > 0.1 && $13 < 2 && $14 > 0 && $15 > 0.2 && $16 > 0.2) { bad = 1 } END { exit bad }' "$r"; then
 		tap_ok "channel: a real run from / in $(($(date +%s) - start)) s: three pairs with d~, bound and swings ($(awk -F, 'NR > 1 { printf "%s %s d~ %.2f; ", $4, $5, $13 }' "$r"))"
 	else tap_fail "channel: a real run" "rc $rc: $(cat "$T/real.out"; cat "$r" 2>/dev/null)"; fi
-	if [ ! -e "$T/real/w20/run/demo.lcmlog" ] && [ ! -e "$T/real/w20/run/states.csv" ] && [ -f "$T/real/w20/run/summary.json" ]; then
+	if [ ! -e "$T/real/w20/demo/demo.lcmlog" ] && [ ! -e "$T/real/w20/demo/states.csv" ] && [ -f "$T/real/w20/demo/summary.json" ]; then
 		tap_ok "the run's LCM log and sample tables removed, its summary kept"
-	else tap_fail "large files removed" "$(ls "$T/real/w20/run" 2>&1 | tr '\n' ' ')"; fi
+	else tap_fail "large files removed" "$(ls "$T/real/w20/demo" 2>&1 | tr '\n' ' ')"; fi
 else
 	tap_skip "channel: a real run" "the programs are not built"
 fi
