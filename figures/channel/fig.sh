@@ -42,6 +42,8 @@ SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
 jobs() {
 	local trials=$TRIALS w t
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
+	# FIG_TINY=1 (the tests): one run at the middle width
+	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel tiny)"; return; fi
 	for w in $WIDTHS_CM; do
 		for t in $(seq "$trials"); do
 			echo "w${w}cm-t$t $w $(fig_seed channel "$w" "$t")"
@@ -88,17 +90,14 @@ merge() {
 # colour per width, beside the compatibility bound.
 draw() {
 	local fig=$1 t=$2 csv="$1/channel.csv" w i=0 series=() colors=('#1f77b4' '#2ca02c' '#ff7f0e' '#d62728' '#9467bd')
-	# the bound, as the analyser computed it for each pair (tools/analyze/theory.c),
-	# in order of d̃: the curve is drawn through the runs' own values
-	{
-		echo "dsep,compat_limit"
-		awk -F, 'NR > 1 && $13 != "nan" && $14 != "nan" { print $13 "," $14 }' "$csv" | sort -g
-	} >"$t/bound.csv"
-	fig_has "$t/bound.csv" 1 && series+=(
-		"'$t/bound.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title '2 asin(d̃), the compatibility bound (undulate-analyze)'")
-	series+=("pi with lines dt 2 lc rgb 'gray' title 'anti-phase'")
+	# the bound from the theory's own code (tools/analyze/theory.c), as the
+	# analyser's per-pair compat_limit in channel.csv
+	fig_theory curves --points 401 >"$t/curves.csv" || return 1
+	series+=("'$t/curves.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title '2 asin(d̃): the compatibility bound'"
+		"pi with lines dt 2 lc rgb 'gray' title 'anti-phase'")
 	for w in $(awk -F, 'NR > 1 { print $1 }' "$csv" | sort -gu); do
-		series+=("'$csv' every ::1 using (\$1 == $w ? \$13 : 1/0):(abs(\$6)) with points pt 7 ps 1.1 lc rgb '${colors[$((i % 5))]}' title '$w cm (d̃ $(awk -v w="$w" -v s="$SWEPT_M" 'BEGIN { printf "%.2f", w / 100 / s }') nominal)'")
+		fig_has "$csv" "\$1 == $w && \$13 != \"nan\"" && series+=(
+			"'$csv' every ::1 using (\$1 == $w ? \$13 : 1/0):(abs(\$6)) with points pt 7 ps 1.1 lc rgb '${colors[$((i % 5))]}' title '$w cm (d̃ $(awk -v w="$w" -v s="$SWEPT_M" 'BEGIN { printf "%.2f", w / 100 / s }') nominal)'")
 		i=$((i + 1))
 	done
 	{

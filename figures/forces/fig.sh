@@ -36,6 +36,7 @@ fig_init forces
 # QUICK runs the same timeline at half scale (END = 150).
 END_FULL=300
 END_QUICK=150
+END_TINY=60
 # Compliance slopes: the AX-12 acts on 2, 4, ..., 128; these four span the
 # paper's factor of 9 in stiffness (0.015-0.135 N·m/rad) with a factor of 8.
 SLOPES="16 32 64 128"
@@ -53,6 +54,8 @@ stiffness() { # SLOPE -> N·m/rad (see the header)
 jobs() {
 	local slopes=$SLOPES reps=$REPLICATES end=$END_FULL s r
 	[ "${1:-}" = --quick ] && slopes=$QUICK_SLOPES reps=$QUICK_REPLICATES end=$END_QUICK
+	# FIG_TINY=1 (the tests): one run at the shortest timeline a run takes
+	if [ "${FIG_TINY:-0}" = 1 ]; then echo "slope64-t0 64 $(fig_seed forces tiny) $END_TINY"; return; fi
 	for s in $slopes; do
 		for r in $(seq "$reps"); do
 			echo "slope$s-rep$r $s $(fig_seed forces "$s" "$r") $end"
@@ -110,7 +113,7 @@ run() {
 	local out=$1 slope=$2 seed=$3 end=${4:-$END_FULL}
 	fig_uint SLOPE "$slope" 2 254
 	fig_uint SEED "$seed" 1 999999999
-	fig_uint END "$end" 60 3600
+	fig_uint END "$end" "$END_TINY" 3600
 	local closed=$((end / 3)) switch=$((2 * end / 3))
 	mkdir -p "$out" || fig_die "cannot create $out"
 	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"

@@ -59,11 +59,20 @@ QUICK_SWEEP_DSEPS="0.1 0.5 0.9"
 QUICK_SWEEP_SECONDS=45
 QUICK_RELAX_BETAS="0.1 0.02 0.005"
 QUICK_RELAX_SECONDS=120
+# FIG_TINY=1 (the tests): one immobile sweep run and one relaxation run,
+# each only as long as the switch and the final window need.
+TINY_SWEEP_SECONDS=14
+TINY_RELAX_SECONDS=16
 RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current)
 
 jobs() {
 	local d b s seeds=$SWEEP_SEEDS rseeds=$RELAX_SEEDS dseps=$SWEEP_DSEPS secs=$SWEEP_SECONDS
 	local rbetas=$RELAX_BETAS rsecs=$RELAX_SECONDS
+	if [ "${FIG_TINY:-0}" = 1 ]; then
+		echo "sweep-t0 $RELAX_DSEP 0 $TINY_SWEEP_SECONDS $(fig_seed rows tiny sweep)"
+		echo "relax-t0 $RELAX_DSEP 0.02 $TINY_RELAX_SECONDS $(fig_seed rows tiny relax)"
+		return
+	fi
 	if [ "${1:-}" = --quick ]; then
 		seeds=1 rseeds=1 dseps=$QUICK_SWEEP_DSEPS secs=$QUICK_SWEEP_SECONDS
 		rbetas=$QUICK_RELAX_BETAS rsecs=$QUICK_RELAX_SECONDS
@@ -139,11 +148,14 @@ merge() {
 	fig_merge_begin "$fig"
 	fig_results "$runs" sorted >"$fig/rows.csv"
 	local csv="$fig/rows.csv" t=$FIG_TMP
-	# sweep points: the runs at SWEEP_BETAS; per (d̃, β) the mean over seeds
-	awk -F, -v betas=" $SWEEP_BETAS " -v secs="$SWEEP_SECONDS $QUICK_SWEEP_SECONDS" 'NR > 1 && index(betas, " " $2 " ") && index(" " secs " ", " " $3 " ") {
-			k = $1 "," $2; n[k]++; r[k] += $7; e[k] += $8; w[k] += $13 }
+	# the sweep's runs: β in SWEEP_BETAS and a sweep's length (a relaxation
+	# run at β = 0.1 is not one of them)
+	awk -F, -v betas=" $SWEEP_BETAS " -v secs=" $SWEEP_SECONDS $QUICK_SWEEP_SECONDS $TINY_SWEEP_SECONDS " \
+		'NR == 1 || (index(betas, " " $2 " ") && index(secs, " " $3 " "))' "$csv" >"$t/sweep-runs.csv"
+	# per (d̃, β) the mean over seeds
+	awk -F, 'NR > 1 { k = $1 "," $2; n[k]++; r[k] += $7; e[k] += $8; w[k] += $13 }
 		END { print "dsep,beta,runs,collisions_hz,compat_error_rad,wall_collisions_hz"
-			for (k in n) printf "%s,%d,%.5g,%.5g,%.5g\n", k, n[k], r[k] / n[k], e[k] / n[k], w[k] / n[k] }' "$csv" |
+			for (k in n) printf "%s,%d,%.5g,%.5g,%.5g\n", k, n[k], r[k] / n[k], e[k] / n[k], w[k] / n[k] }' "$t/sweep-runs.csv" |
 		{ IFS= read -r h; echo "$h"; sort -t, -k2,2g -k1,1g; } >"$t/sweep.csv"
 	fig_has "$t/sweep.csv" 1 || fig_die "no sweep runs (beta $SWEEP_BETAS, $SWEEP_SECONDS or $QUICK_SWEEP_SECONDS s) in $csv"
 	sweep_plot "$fig" "$t" || fig_die "rows.png could not be drawn"
@@ -154,7 +166,7 @@ merge() {
 # sweep_plot FIGDIR TMP: rows.png, collisions and the compatibility error
 # against d̃, each run and the mean per d̃, immobile and mobile.
 sweep_plot() {
-	local fig=$1 t=$2 csv="$1/rows.csv" col ylabel what imm=() mob=()
+	local fig=$1 t=$2 csv="$2/sweep-runs.csv" col ylabel what imm=() mob=()
 	{
 		fig_gp_head 900 800
 		echo "set output '$fig/rows.png'"
@@ -215,7 +227,8 @@ relax_plot() {
 		"'$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0 ? \$2 : 1/0):(\$14 > 0 ? \$14 : 0.5) with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'relaxed (no collision in its last $CENSOR_S s)'")
 	fig_has "$csv" "\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1" && series+=(
 		"'$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1 ? \$2 : 1/0):(\$3 - $SWITCH) with points pt 9 ps 1.6 lc rgb '#d62728' title 'censored: still colliding (drawn at its run length)'")
-	fig_has "$t/relax.csv" '$2 != "nan"' && series+=(
+	# (log scale: a median of 0 s, a row that never collided after the switch, cannot be drawn)
+	fig_has "$t/relax.csv" '$2 != "nan" && $2 > 0' && series+=(
 		"'$t/relax.csv' every ::1 using 1:2 with linespoints lw 2 pt 6 ps 2 lc rgb '#1f77b4' title 'median (censored runs counted as longest)'")
 	fig_has "$t/relax.csv" '$3 != "nan"' && series+=(
 		"'$t/relax.csv' every ::1 using 1:3 with points pt 8 ps 2.5 lw 2 lc rgb '#d62728' title 'median censored: longer than its run'")
@@ -260,9 +273,9 @@ fragment() {
 		echo
 		echo "| d̃ | β (s) | runs | collisions per pair per s | compatibility error (rad) | pairs colliding at the end | pairs compatible or in phase | anti-phase |"
 		echo "|---|---|---|---|---|---|---|---|"
-		awk -F, -v betas=" $SWEEP_BETAS " -v secs=" $SWEEP_SECONDS $QUICK_SWEEP_SECONDS " 'NR > 1 && index(betas, " " $2 " ") && index(secs, " " $3 " ") {
+		awk -F, 'NR > 1 {
 				k = $1 " " $2; n[k]++; r[k] += $7; e[k] += $8; p[k] += $5; c[k] += $6; ok[k] += $10; a[k] += $11 }
-			END { for (k in n) { split(k, kk, " "); printf "%s|%s|%d|%.3g|%.3g|%d of %d|%d of %d|%d\n", kk[1], kk[2], n[k], r[k] / n[k], e[k] / n[k], c[k], p[k], ok[k], p[k], a[k] } }' "$csv" |
+			END { for (k in n) { split(k, kk, " "); printf "%s|%s|%d|%.3g|%.3g|%d of %d|%d of %d|%d\n", kk[1], kk[2], n[k], r[k] / n[k], e[k] / n[k], c[k], p[k], ok[k], p[k], a[k] } }' "$FIG_TMP/sweep-runs.csv" |
 			sort -t'|' -k1,1g -k2,2g | awk -F'|' '{ printf "| %s | %s | %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, $8 }'
 		echo
 		echo "Relaxation of the mobile row at d̃ = $RELAX_DSEP (time from the switch to the oscillator until"
@@ -291,7 +304,7 @@ fragment() {
 # beside FIGDIR: the paper's lattice beside these rows (after relax_plot).
 beside() {
 	local csv="$1/rows.csv"
-	awk -F, -v betas=" $SWEEP_BETAS " -v secs=" $SWEEP_SECONDS $QUICK_SWEEP_SECONDS " 'NR > 1 && index(betas, " " $2 " ") && index(secs, " " $3 " ") {
+	awk -F, 'NR > 1 {
 			k = ($2 == 0) ? "i" : "m"; p[k, $1] += $5; c[k, $1] += $6; if (!($1 in seen)) { seen[$1] = 1; ds[++nd] = $1 }
 		}
 		function list(k,   i, out) {
@@ -309,7 +322,7 @@ beside() {
 			if (crowded) printf " At d̃ = 0.1 a base moves β·Δv, about 0.1 s × 1 m/s = 10 cm per impact, three times the 3 cm between neighbours, which probably keeps that row from settling (not measured further)."
 			printf "\n"
 		}
-		function asort_num(a, n,   i, j, t) { for (i = 2; i <= n; i++) for (j = i; j > 1 && a[j - 1] + 0 > a[j] + 0; j--) { t = a[j]; a[j] = a[j - 1]; a[j - 1] = t }; return n }' "$csv"
+		function asort_num(a, n,   i, j, t) { for (i = 2; i <= n; i++) for (j = i; j > 1 && a[j - 1] + 0 > a[j] + 0; j--) { t = a[j]; a[j] = a[j - 1]; a[j - 1] = t }; return n }' "$FIG_TMP/sweep-runs.csv"
 	echo
 	# the medians of relax_plot's table, by β
 	awk -F, -v d="$RELAX_DSEP" 'NR == 1 { next } NR == 2 { b0 = $1; t0 = $4 } { b1 = $1; t1 = $4; n++ }
