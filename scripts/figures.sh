@@ -20,7 +20,7 @@
 # A module is figures/<name>/fig.sh (figures/lib.sh says what it must do).
 # Raw runs go to RUNS (default $BUILD/figures/runs/<module>/<run>/); a local
 # run starts each selected module afresh unless --resume (then runs with a
-# result.csv are kept). --jobs: runs at once (default FIGURES_JOBS, else 4:
+# result.csv are kept). --jobs: runs at once (default FIGURES_JOBS, else 3:
 # the best throughput measured on this 2-core machine, README.md). FIG_TINY=1
 # asks the modules for a tiny set (the driver's test). Exit 0 when every
 # selected figure was drawn; 1 with a message otherwise (a module without any
@@ -67,7 +67,7 @@ run_one() {
 }
 
 # ---- options -------------------------------------------------------------------------
-quick=0 only="" jobs=${FIGURES_JOBS:-4} out="$top/docs" runs="" resume=0 export_file="" merge_dir=""
+quick=0 only="" jobs=${FIGURES_JOBS:-3} out="$top/docs" runs="" resume=0 export_file="" merge_dir=""
 parse() {
 	while [ $# -gt 0 ]; do
 		case "$1" in
@@ -148,8 +148,8 @@ watch_progress() {
 }
 
 # estimate MODULE...: the runs' wall seconds added up (each module's
-# `seconds`: one run's wall time with three at once); the driver divides by
-# --jobs.
+# `seconds`: one run's wall time with three at once, the default --jobs);
+# the driver divides by --jobs.
 estimate() {
 	local m s n total=0
 	for m in "$@"; do
