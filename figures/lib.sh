@@ -1,23 +1,39 @@
 # figures/lib.sh — shared by the figure modules (figures/<name>/fig.sh) and by
 # scripts/figures.sh, the driver of `make figures`. Source it; bash, set -u.
 #
-#   fig_die MSG...              "fig: MSG" on stderr, exit 1
+#   fig_init NAME               the module's name, which starts its messages
+#   fig_die MSG... / fig_usage MSG...   "NAME: MSG" on stderr, exit 1 / exit 2
+#   fig_uint NAME VALUE MIN MAX a whole number in range, else fig_usage naming NAME
+#   fig_num NAME VALUE MIN MAX  a decimal number in range, else fig_usage
 #   fig_hash TEXT               a number from TEXT (cksum): the same on every machine
-#   fig_seed TEXT               a seed in 1..999999 from TEXT (a run's name)
+#   fig_seed WORDS...           a seed in 1..999999 from the words (a run's name)
 #   FIG_GOLDEN                  the golden ratio's fraction: i * FIG_GOLDEN mod 1 spreads
 #                               run i's initial phase evenly, the same on every machine
 #   fig_lcm_url OUTDIR [TRY]    a private udpm URL (ttl=0) on a port in 30000-59999
-#                               from OUTDIR's name, the PID and TRY, not bound here yet
+#                               from GNU parallel's job slot, else OUTDIR's name and
+#                               the PID, and TRY; one nothing here is bound to yet
 #   fig_demo OUTDIR ARG...      one lockstep run of scripts/demo.sh into OUTDIR/demo
 #                               (its own LCM port; again on another port if it
 #                               heard another run); 0, or 1 with the reason on stderr
+#   FIG_SESSION                 setsid where it exists: a program started outside
+#                               fig_demo runs in a session of its own, as demo.sh's do
 #   fig_json DIR JQ             a value of DIR/summary.json (jq)
+#   fig_pairs SUMMARY_JSON      the analyser's neighbouring pairs as CSV (fig_pairs_header)
+#   fig_min_swing SUMMARY_JSON  the smallest swing of any joint in the final window
 #   fig_delta_trace DIR OUT STEP  the pair's phase difference every STEP s (OUT: t,delta)
-#   fig_clean DIR               removes the large files of a run unless FIG_KEEP=1
-#   fig_results DIR             every DIR/*/result.csv as one CSV (one header)
+#   fig_clean DIR               removes the large files of a run's analysis DIR
+#                               unless FIG_KEEP=1
+#   fig_results DIR [sorted]    every DIR/*/result.csv as one CSV (one header; the
+#                               rows sorted with `sorted`); exit 1 when there is none
+#   fig_median / fig_quantile Q of the numbers on stdin, one a line
+#   fig_merge_begin FIGDIR      for a merge: gnuplot present, FIGDIR made, and
+#                               FIG_TMP, a temporary folder removed at exit
 #   fig_need_gnuplot            exit 1 with a message when gnuplot is missing
 #   fig_gp_head W H             gnuplot's first lines: PNG terminal and common style
-#   fig_gnuplot SCRIPT          runs gnuplot on SCRIPT (messages in SCRIPT.log)
+#   fig_gnuplot SCRIPT          runs gnuplot on SCRIPT (messages in SCRIPT.log);
+#                               1 also when a series drew nothing
+#   fig_has CSV CONDITION      a row of CSV where the awk CONDITION holds
+#   fig_plot SPEC...            a gnuplot plot command of the series (empty ones left out)
 #   fig_theory ARG...           undulate-analyze --theory ARG... (tools/analyze/theory.c)
 #   fig_pair_switch DSEP DELTA0 when to switch a pair started on the full sinusoid to the
 #                               oscillator: just after the clock last pressed them together
@@ -31,11 +47,23 @@ BUILD=${BUILD:-build}
 case "$BUILD" in /*) ;; *) BUILD="$fig_top/$BUILD" ;; esac
 export BUILD
 FIG_BIN="$BUILD/bin"
+FIG_NAME=fig
 
-fig_die() { echo "fig: $*" >&2; exit 1; }
+fig_init() { FIG_NAME=$1; }
+fig_die() { echo "$FIG_NAME: $*" >&2; exit 1; }
+fig_usage() { echo "$FIG_NAME: $*" >&2; exit 2; }
+
+fig_uint() {
+	[[ "$2" =~ ^[0-9]{1,9}$ ]] && [ "$((10#$2))" -ge "$3" ] && [ "$((10#$2))" -le "$4" ] ||
+		fig_usage "$1: want a whole number from $3 to $4, got '$2'"
+}
+fig_num() {
+	[[ "$2" =~ ^-?[0-9]+([.][0-9]+)?$ ]] && awk -v x="$2" -v a="$3" -v b="$4" 'BEGIN { exit !(x >= a && x <= b) }' ||
+		fig_usage "$1: want a number from $3 to $4, got '$2'"
+}
 
 fig_hash() { printf '%s' "$1" | cksum | cut -d' ' -f1; }
-fig_seed() { echo $(( $(fig_hash "$1") % 999999 + 1 )); }
+fig_seed() { echo $(( $(fig_hash "$*") % 999999 + 1 )); }
 FIG_GOLDEN=0.6180339887498949
 
 # Ports for the figures' runs: above the tests' (7600-8000 plus their offsets
@@ -73,30 +101,65 @@ fig_lcm_url() {
 	echo "udpm://239.255.76.67:$port?ttl=0"
 }
 
+# A program started here runs in a session of its own where setsid exists,
+# as scripts/demo.sh starts them (its header says why).
+FIG_SESSION=()
+command -v setsid >/dev/null 2>&1 && FIG_SESSION=(setsid)
+
 # Attempts of one run when it heard another run on its port.
 FIG_PORT_TRIES=3
 fig_demo() {
 	local out=$1; shift
 	local try rc
-	mkdir -p "$out" || { echo "fig: cannot create $out" >&2; return 1; }
+	mkdir -p "$out" || { echo "$FIG_NAME: cannot create $out" >&2; return 1; }
 	for try in $(seq 0 $((FIG_PORT_TRIES - 1))); do
 		rm -rf "$out/demo"
 		rc=0
 		"$fig_top/scripts/demo.sh" --lockstep --out "$out/demo" --lcm-url "$(fig_lcm_url "$out" "$try")" \
-			"$@" >"$out/demo.out" 2>&1 || rc=$?
+			"$@" >"$out/demo.out" 2>&1 </dev/null || rc=$?
 		# another run took the same port at the same moment: again, elsewhere
 		grep -q 'another undulated for this robot runs on this computer' "$out/demo.out" && continue
 		if [ "$rc" -ne 0 ] || [ ! -f "$out/demo/summary.json" ]; then
-			echo "fig: $out: the lockstep run failed (demo.sh exit $rc): $(grep -m1 '^demo: ' "$out/demo.out" || tail -n 1 "$out/demo.out")" >&2
+			echo "$FIG_NAME: $out: the lockstep run failed (demo.sh exit $rc): $( { grep -m1 '^demo: ' "$out/demo.out" ||
+				tail -n 1 "$out/demo.out"; } | cut -c1-300)" >&2
 			return 1
 		fi
 		[ -f "$out/demo/crosstalk" ] || return 0
 	done
-	echo "fig: $out: another run used the run's LCM port $FIG_PORT_TRIES times in a row" >&2
+	echo "$FIG_NAME: $out: another run used the run's LCM port $FIG_PORT_TRIES times in a row" >&2
 	return 1
 }
 
 fig_json() { jq -r "$2" "$1/summary.json"; }
+
+# The analyser's summary.json (one line) holds a "pairs" list of flat
+# objects; these are the fields of its neighbouring pairs the figures use
+# (tools/analyze/README.md, "End state of a pair"). null becomes nan.
+fig_pairs_header="pair,class,mean_delta,mean_abs_delta,spread,window_collisions,collisions,impulse,distance_m,dsep,compat_limit,swing_a,swing_b"
+fig_pairs() {
+	sed -e 's/.*"pairs":\[{//' -e 's/}\],"min_swing".*//' "$1" | sed 's/},{/\n/g' |
+		awk -v keys="$fig_pairs_header" 'BEGIN { nk = split(keys, want, ",") }
+		{
+			delete v
+			n = split($0, kv, /,"/)
+			for (i = 1; i <= n; i++) {
+				sub(/^"/, "", kv[i]); p = index(kv[i], "\":")
+				if (p == 0) continue
+				k = substr(kv[i], 1, p - 1); x = substr(kv[i], p + 2)
+				gsub(/"/, "", x); if (x == "null") x = "nan"
+				v[k] = x
+			}
+			if (v["kind"] != "neighbour") next
+			line = ""
+			for (i = 1; i <= nk; i++) line = line (i > 1 ? "," : "") (want[i] in v ? v[want[i]] : "nan")
+			print line
+		}'
+}
+
+fig_min_swing() {
+	grep -o '"swing_rad":[^,}]*' "$1" | awk -F: '{ x = ($2 == "null") ? 0 : $2 + 0; if (NR == 1 || x < m) m = x }
+		END { if (NR) printf "%.3f\n", m; else print "nan" }'
+}
 
 # fig_delta_trace DIR OUT STEP: the followed pair's (the first neighbour
 # pair's) phase difference from DIR/phase_diff.csv, one sample per STEP s.
@@ -107,20 +170,42 @@ fig_delta_trace() {
 		{ echo "t,delta"; cat; } >"$2"
 }
 
-# What a run keeps: its result, the analyser's summary and small CSVs, the
-# programs' logs. The LCM log (3 MB for a 40 s pair run) and the per-sample
-# CSVs (1.5 MB) go, unless FIG_KEEP=1.
+# What a run keeps: its result, the analyser's summary and per-second rates,
+# the programs' logs. The LCM log and the per-sample and per-collision CSVs
+# go (3 MB and 1.5 MB for a 40 s pair run, 100-300 MB for a long run of ten
+# robots), unless FIG_KEEP=1.
 fig_clean() {
 	[ "${FIG_KEEP:-0}" = 1 ] && return 0
-	rm -f "$1/demo.lcmlog" "$1/states.csv" "$1/phase_diff.csv" "$1/bus.csv" "$1/params.csv"
+	rm -f "$1/demo.lcmlog" "$1/states.csv" "$1/phase_diff.csv" "$1/collisions.csv" "$1/return_map.csv" \
+		"$1/bus.csv" "$1/params.csv"
 }
 
+# fig_results DIR [sorted]: the runs' rows under the first run's header (with
+# `sorted`, the rows in sort's order); a run with another header is left out,
+# saying so. No row at all: exit 1.
 fig_results() {
-	local f first=1
-	for f in "$1"/*/result.csv; do
-		[ -f "$f" ] || continue
-		if [ "$first" = 1 ]; then cat "$f"; first=0; else tail -n +2 "$f"; fi
-	done
+	local files=("$1"/*/result.csv) out=cat
+	[ -f "${files[0]}" ] || fig_die "no run in $1 has a result.csv: nothing to draw (run the figure's jobs first)"
+	[ "${2:-}" = sorted ] && out=sort
+	awk -v name="$FIG_NAME" -v out="$out" '
+		FNR == 1 {
+			if (NR == 1) { h = $0; print; fflush() }
+			else if ($0 != h) { printf "%s: %s: another header than the first run'"'"'s; left out\n", name, FILENAME >"/dev/stderr"; nextfile }
+			next
+		}
+		{ print | out; n++ }
+		END { close(out); exit n == 0 }' "${files[@]}" ||
+		fig_die "no run in $1 has a row in its result.csv: nothing to draw"
+}
+
+fig_median() { fig_quantile 0.5; }
+# fig_quantile Q: the Q-quantile (linear between order statistics) of the
+# numbers on stdin, one per line; empty input gives "nan".
+fig_quantile() {
+	sort -g | awk -v q="$1" '{ v[NR] = $1 } END {
+		if (NR == 0) { print "nan"; exit }
+		p = 1 + q * (NR - 1); i = int(p); f = p - i
+		printf "%.6g\n", (i < NR ? v[i] + f * (v[i + 1] - v[i]) : v[NR]) }'
 }
 
 fig_need_gnuplot() {
@@ -128,10 +213,19 @@ fig_need_gnuplot() {
 		fig_die "gnuplot is not installed: no figure can be drawn (Debian: apt-get install gnuplot-nox; or scripts/deps.sh)"
 }
 
+# fig_merge_begin FIGDIR: what every merge does first. FIG_TMP holds the
+# merge's intermediate files (kept with FIG_KEEP=1).
+fig_merge_begin() {
+	fig_need_gnuplot
+	mkdir -p "$1" || fig_die "cannot create $1"
+	FIG_TMP=$(mktemp -d "${TMPDIR:-/tmp}/fig-$FIG_NAME.XXXXXX") || fig_die "no temporary directory"
+	[ "${FIG_KEEP:-0}" = 1 ] || trap 'rm -rf "$FIG_TMP"' EXIT
+}
+
 # The figures' look: one size of type, a light grid, the key inside; the
 # paper's colours are not known here, so gnuplot's first ones.
 fig_gp_head() {
-	cat <<EOF
+	cat <<EOG
 if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {
   set terminal pngcairo size $1,$2 enhanced font ',11'
 } else {
@@ -142,20 +236,31 @@ set datafile missing ''
 set grid lc rgb '#dddddd'
 set border lw 1.2
 set key box opaque samplen 2
-EOF
+EOG
 }
 
 fig_gnuplot() {
-	"${GNUPLOT:-gnuplot}" "$1" >"$1.log" 2>&1 || { echo "fig: gnuplot failed on $1: $(tail -n 3 "$1.log")" >&2; return 1; }
+	"${GNUPLOT:-gnuplot}" "$1" >"$1.log" 2>&1 || { echo "$FIG_NAME: gnuplot failed on $1: $(tail -n 3 "$1.log")" >&2; return 1; }
 	# gnuplot goes on after most errors: a script that drew nothing says so here
 	if grep -qiE '(^|[^a-z])(error|warning: skipping)' "$1.log"; then
-		echo "fig: gnuplot: $(grep -m1 -iE 'error|warning: skipping' "$1.log") ($1.log)" >&2
+		echo "$FIG_NAME: gnuplot: $(grep -m1 -iE 'error|warning: skipping' "$1.log") ($1.log)" >&2
 		return 1
 	fi
 }
 
-fig_theory() { "$FIG_BIN/undulate-analyze" --theory "$@"; }
+# fig_has CSV CONDITION: a row of CSV (after its header) where the awk
+# CONDITION holds: a series that would draw something.
+fig_has() { awk -F, "NR > 1 && ($2) { found = 1; exit } END { exit !found }" "$1"; }
+# fig_plot SPEC...: a gnuplot plot command of the series given (the modules
+# pass only those fig_has found; an empty panel without any).
+fig_plot() {
+	[ $# -gt 0 ] || { echo "plot NaN notitle"; return; }
+	local sep="plot " s
+	for s in "$@"; do printf '%s%s' "$sep" "$s"; sep=$', \\\n  '; done
+	echo
+}
 
+fig_theory() { "$FIG_BIN/undulate-analyze" --theory "$@"; }
 # ---- a pair started at full amplitude, released by the clock -------------------------
 # Where the clock would press the bodies together at once (d~ = 0: for half
 # of every period), a phase difference cannot be set by a sinusoid that runs

@@ -20,7 +20,7 @@
 # A module is figures/<name>/fig.sh (figures/lib.sh says what it must do).
 # Raw runs go to RUNS (default $BUILD/figures/runs/<module>/<run>/); a local
 # run starts each selected module afresh unless --resume (then runs with a
-# result.csv are kept). --jobs: runs at once (default FIGURES_JOBS, else 4:
+# result.csv are kept). --jobs: runs at once (default FIGURES_JOBS, else 3:
 # the best throughput measured on this 2-core machine, README.md). FIG_TINY=1
 # asks the modules for a tiny set (the driver's test). Exit 0 when every
 # selected figure was drawn; 1 with a message otherwise (a module without any
@@ -28,14 +28,13 @@
 set -u
 top=$(cd "$(dirname "$0")/.." && pwd)
 source "$top/figures/lib.sh"
+fig_init figures
 self="$top/scripts/figures.sh"
 
 # The page's order: the paper's. Modules not named here follow by name.
 ORDER="pair returnmap rows channel forces"
 # Progress: a new line this often when stdout is not a terminal (s).
 PROGRESS_EVERY_S=30
-
-die() { echo "figures: $*" >&2; exit 1; }
 
 # modules: every figures/<name>/ with an executable fig.sh, in page order.
 modules() {
@@ -49,10 +48,10 @@ fig() { local m=$1; shift; "$top/figures/$m/fig.sh" "$@"; }
 
 # ---- one run -----------------------------------------------------------------------
 run_one() {
-	[ $# -ge 2 ] || die "run: want MODULE OUTDIR ARG..."
+	[ $# -ge 2 ] || fig_die "run: want MODULE OUTDIR ARG..."
 	local m=$1 out=$2; shift 2
-	[ -x "$top/figures/$m/fig.sh" ] || die "run: no module '$m' (figures/$m/fig.sh)"
-	mkdir -p "$out" || die "run: cannot create $out"
+	[ -x "$top/figures/$m/fig.sh" ] || fig_die "run: no module '$m' (figures/$m/fig.sh)"
+	mkdir -p "$out" || fig_die "run: cannot create $out"
 	rm -f "$out/result.csv"
 	local t0 rc=0
 	t0=$(date +%s%N)
@@ -68,34 +67,34 @@ run_one() {
 }
 
 # ---- options -------------------------------------------------------------------------
-quick=0 only="" jobs=${FIGURES_JOBS:-4} out="$top/docs" runs="" resume=0 export_file="" merge_dir=""
+quick=0 only="" jobs=${FIGURES_JOBS:-3} out="$top/docs" runs="" resume=0 export_file="" merge_dir=""
 parse() {
 	while [ $# -gt 0 ]; do
 		case "$1" in
 		--quick) quick=1; shift ;;
-		--only) [ $# -ge 2 ] || die "--only: want a,b"; only=$2; shift 2 ;;
-		--jobs) [ $# -ge 2 ] || die "--jobs: want a number"; jobs=$2; shift 2 ;;
-		--out) [ $# -ge 2 ] || die "--out: want a directory"; out=$2; shift 2 ;;
-		--runs) [ $# -ge 2 ] || die "--runs: want a directory"; runs=$2; shift 2 ;;
+		--only) [ $# -ge 2 ] || fig_die "--only: want a,b"; only=$2; shift 2 ;;
+		--jobs) [ $# -ge 2 ] || fig_die "--jobs: want a number"; jobs=$2; shift 2 ;;
+		--out) [ $# -ge 2 ] || fig_die "--out: want a directory"; out=$2; shift 2 ;;
+		--runs) [ $# -ge 2 ] || fig_die "--runs: want a directory"; runs=$2; shift 2 ;;
 		--resume) resume=1; shift ;;
-		--export-jobs) [ $# -ge 2 ] || die "--export-jobs: want a file"; export_file=$2; shift 2 ;;
-		--merge) [ $# -ge 2 ] || die "--merge: want the runs' directory"; merge_dir=$2; shift 2 ;;
+		--export-jobs) [ $# -ge 2 ] || fig_die "--export-jobs: want a file"; export_file=$2; shift 2 ;;
+		--merge) [ $# -ge 2 ] || fig_die "--merge: want the runs' directory"; merge_dir=$2; shift 2 ;;
 		-h|--help) sed -n '2,/^set -u/p' "$0" | sed -e '/^set -u/d' -e 's/^# \{0,1\}//'; exit 0 ;;
-		*) die "unknown argument '$1' (--help)" ;;
+		*) fig_die "unknown argument '$1' (--help)" ;;
 		esac
 	done
-	[[ "$jobs" =~ ^[1-9][0-9]{0,2}$ ]] || die "--jobs: want a whole number 1..999, not '$jobs'"
-	[ -z "$export_file" ] || [ -z "$merge_dir" ] || die "--export-jobs and --merge: one at a time"
+	[[ "$jobs" =~ ^[1-9][0-9]{0,2}$ ]] || fig_die "--jobs: want a whole number 1..999, not '$jobs'"
+	[ -z "$export_file" ] || [ -z "$merge_dir" ] || fig_die "--export-jobs and --merge: one at a time"
 }
 
 # selected: the modules to work on (--only, checked against what exists).
 selected() {
 	local all m
 	all=$(modules)
-	[ -n "$all" ] || die "no figure module in $top/figures/"
+	[ -n "$all" ] || fig_die "no figure module in $top/figures/"
 	if [ -z "$only" ]; then echo "$all"; return; fi
 	for m in ${only//,/ }; do
-		grep -qx "$m" <<<"$all" || die "--only: no module '$m' (there are: $(echo $all))"
+		grep -qx "$m" <<<"$all" || fig_die "--only: no module '$m' (there are: $(echo $all))"
 	done
 	for m in $all; do [[ ",$only," == *",$m,"* ]] && echo "$m"; done
 	return 0
@@ -110,17 +109,17 @@ write_jobs() {
 	local prefix=$1; shift
 	local m lines id args a n
 	for m in "$@"; do
-		lines=$(fig "$m" jobs ${quick_flag[@]+"${quick_flag[@]}"}) || die "$m: fig.sh jobs failed"
+		lines=$(fig "$m" jobs ${quick_flag[@]+"${quick_flag[@]}"}) || fig_die "$m: fig.sh jobs failed"
 		n=0
 		while read -r id args; do
 			[ -n "$id" ] || continue
-			[[ "$id" =~ ^[A-Za-z0-9_.-]+$ ]] || die "$m jobs: bad RUN_ID '$id'"
-			for a in $args; do [[ "$a" =~ $SAFE_WORD ]] || die "$m jobs: $id: argument '$a' needs quoting"; done
+			[[ "$id" =~ ^[A-Za-z0-9_.-]+$ ]] || fig_die "$m jobs: bad RUN_ID '$id'"
+			for a in $args; do [[ "$a" =~ $SAFE_WORD ]] || fig_die "$m jobs: $id: argument '$a' needs quoting"; done
 			printf 'scripts/figures.sh run %s %q %s\n' "$m" "$prefix/$m/$id" "$args"
 			n=$((n + 1))
 		done <<<"$lines"
-		[ "$n" -gt 0 ] || die "$m jobs: no run"
-		[ "$(cut -d' ' -f1 <<<"$lines" | sort | uniq -d)" = "" ] || die "$m jobs: a RUN_ID twice"
+		[ "$n" -gt 0 ] || fig_die "$m jobs: no run"
+		[ "$(cut -d' ' -f1 <<<"$lines" | sort | uniq -d)" = "" ] || fig_die "$m jobs: a RUN_ID twice"
 	done
 }
 
@@ -149,8 +148,8 @@ watch_progress() {
 }
 
 # estimate MODULE...: the runs' wall seconds added up (each module's
-# `seconds`: one run's wall time with three at once); the driver divides by
-# --jobs.
+# `seconds`: one run's wall time with three at once, the default --jobs);
+# the driver divides by --jobs.
 estimate() {
 	local m s n total=0
 	for m in "$@"; do
@@ -272,9 +271,9 @@ mods=$(selected) || exit 1
 case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
 
 if [ -n "$merge_dir" ]; then
-	[ -d "$merge_dir" ] || die "--merge: no directory $merge_dir"
+	[ -d "$merge_dir" ] || fig_die "--merge: no directory $merge_dir"
 	fig_need_gnuplot
-	mkdir -p "$out/figures" || die "cannot create $out/figures"
+	mkdir -p "$out/figures" || fig_die "cannot create $out/figures"
 	t0=$(date +%s) rc=0
 	for m in $mods; do
 		[ -d "$merge_dir/$m" ] || { [ -n "$only" ] && { echo "figures: $m: no runs in $merge_dir" >&2; rc=1; }; continue; }
@@ -303,13 +302,13 @@ if [ -n "$export_file" ]; then
 fi
 
 # ---- here, through GNU parallel ----------------------------------------------------------
-command -v parallel >/dev/null 2>&1 || die "GNU parallel is not installed (Debian: apt-get install parallel; or scripts/deps.sh parallel)"
+command -v parallel >/dev/null 2>&1 || fig_die "GNU parallel is not installed (Debian: apt-get install parallel; or scripts/deps.sh parallel)"
 fig_need_gnuplot
 for p in undulate-sim undulated undulate-analyze; do
-	[ -x "$FIG_BIN/$p" ] || die "$FIG_BIN/$p is not built (run: make)"
+	[ -x "$FIG_BIN/$p" ] || fig_die "$FIG_BIN/$p is not built (run: make)"
 done
 case "$runs" in /*) ;; *) runs="$PWD/$runs" ;; esac
-mkdir -p "$runs" "$out/figures" || die "cannot create $runs or $out/figures"
+mkdir -p "$runs" "$out/figures" || fig_die "cannot create $runs or $out/figures"
 for m in $mods; do
 	[ "$resume" = 1 ] || rm -rf "${runs:?}/$m"
 	mkdir -p "$runs/$m"

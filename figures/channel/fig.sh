@@ -24,7 +24,8 @@
 # final d̃ is the analyser's, from the final neutral positions and measured
 # amplitudes, and differs from the nominal one.
 set -u
-. "$(dirname "$0")/../helpers.sh"
+here=$(cd "$(dirname "$0")" && pwd)
+source "$here/../lib.sh"
 fig_init channel
 
 WIDTHS_CM="16 18 20 22 24"
@@ -41,6 +42,8 @@ SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
 jobs() {
 	local trials=$TRIALS w t
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
+	# FIG_TINY=1 (the tests): one run at the middle width
+	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel tiny)"; return; fi
 	for w in $WIDTHS_CM; do
 		for t in $(seq "$trials"); do
 			echo "w${w}cm-t$t $w $(fig_seed channel "$w" "$t")"
@@ -61,7 +64,7 @@ run() {
 	nominal=$(awk -v d="$spacing" -v s="$SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/channel4.scenario" --seconds "$SECONDS_TOTAL" \
 		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.spacing=$spacing" || exit 1
-	local r="$out/run" wall swing
+	local r="$out/demo" wall swing
 	swing=$(fig_min_swing "$r/summary.json")
 	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
@@ -71,43 +74,46 @@ run() {
 		awk -v p="$width,$nominal,$seed," -v q=",$swing,$wall" '{ print p $0 q }' "$out/pairs.csv"
 	} >"$out/result.csv"
 	rm -f "$out/pairs.csv"
-	fig_shrink "$out"
+	fig_clean "$out/demo"
 }
 
 merge() {
 	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2 term
-	fig_gnuplot
-	mkdir -p "$fig" || fig_die "cannot create $fig"
-	fig_collect "$runs" "$fig/channel.csv"
-	local csv="$fig/channel.csv"
-	term=$(fig_term)
-	# the bound, as the analyser computed it for each pair (tools/analyze/theory.c),
-	# in order of d̃: the curve is drawn through the runs' own values
-	awk -F, 'NR > 1 && $13 != "nan" && $14 != "nan" { print $13 "," $14 }' "$csv" | sort -g >"$fig/channel.bound"
-	local w plots="" colors=('#1f77b4' '#2ca02c' '#ff7f0e' '#d62728' '#9467bd') i=0
+	local runs=$1 fig=$2
+	fig_merge_begin "$fig"
+	fig_results "$runs" sorted >"$fig/channel.csv"
+	draw "$fig" "$FIG_TMP" || fig_die "channel.png could not be drawn"
+	fragment "$fig"
+}
+
+# draw FIGDIR TMP: channel.png, each pair's final |Δ| against its d̃, one
+# colour per width, beside the compatibility bound.
+draw() {
+	local fig=$1 t=$2 csv="$1/channel.csv" w i=0 series=() colors=('#1f77b4' '#2ca02c' '#ff7f0e' '#d62728' '#9467bd')
+	# the bound from the theory's own code (tools/analyze/theory.c), as the
+	# analyser's per-pair compat_limit in channel.csv
+	fig_theory curves --points 401 >"$t/curves.csv" || return 1
+	series+=("'$t/curves.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title '2 asin(d̃): the compatibility bound'"
+		"pi with lines dt 2 lc rgb 'gray' title 'anti-phase'")
 	for w in $(awk -F, 'NR > 1 { print $1 }' "$csv" | sort -gu); do
-		plots+=", '$csv' using (\$1 == $w ? \$13 : 1/0):(abs(\$6)) with points pt 7 ps 1.1 lc rgb '${colors[$((i % 5))]}' title '$w cm (d̃ $(awk -v w="$w" -v s="$SWEPT_M" 'BEGIN { printf "%.2f", w / 100 / s }') nominal)'"
+		fig_has "$csv" "\$1 == $w && \$13 != \"nan\"" && series+=(
+			"'$csv' every ::1 using (\$1 == $w ? \$13 : 1/0):(abs(\$6)) with points pt 7 ps 1.1 lc rgb '${colors[$((i % 5))]}' title '$w cm (d̃ $(awk -v w="$w" -v s="$SWEPT_M" 'BEGIN { printf "%.2f", w / 100 / s }') nominal)'")
 		i=$((i + 1))
 	done
-	gnuplot >"$fig/channel.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing channel.png: $(tail -2 "$fig/channel.gp.log")"
-set terminal $term
-set output '$fig/channel.png'
-set datafile separator ','
-set termoption noenhanced
-set xlabel 'd̃ of the pair at the end (analyser: final neutral positions, measured amplitude)'
-set ylabel 'final |Δ| (rad), mean over the last $WINDOW s'
-set title 'Four robots in a channel, 30 s on the oscillator from random phases'
-set key top left
-set grid
-set yrange [0:3.3]
-set xrange [0:*]
-set ytics ('0' 0, 'π/4' pi/4, 'π/2' pi/2, '3π/4' 3*pi/4, 'π' pi)
-plot '$fig/channel.bound' using 1:2 with lines lw 2 lc rgb 'black' title '2 asin(d̃), the compatibility bound (undulate-analyze)', \
-     pi with lines dt 2 lc rgb 'gray' title 'anti-phase'$plots
-EOF
-	rm -f "$fig/channel.bound" "$fig/channel.gp.log"
-	fragment "$fig"
+	{
+		fig_gp_head 900 600
+		echo "set output '$fig/channel.png'"
+		echo "set termoption noenhanced"
+		echo "set xlabel 'd̃ of the pair at the end (analyser: final neutral positions, measured amplitude)'"
+		echo "set ylabel 'final |Δ| (rad), mean over the last $WINDOW s'"
+		echo "set title 'Four robots in a channel, 30 s on the oscillator from random phases'"
+		echo "set key top left"
+		echo "set yrange [0:3.3]"
+		echo "set xrange [0:*]"
+		echo "set ytics ('0' 0, 'π/4' pi/4, 'π/2' pi/2, '3π/4' 3*pi/4, 'π' pi)"
+		fig_plot "${series[@]}"
+	} >"$t/channel.gp"
+	fig_gnuplot "$t/channel.gp"
 }
 
 fragment() {

@@ -26,7 +26,8 @@
 # 0.8 rad; the tuner also sets the clock's amplitude and frequency to the gait
 # it measured) and runs all ten robots with those parameters.
 set -u
-. "$(dirname "$0")/../helpers.sh"
+here=$(cd "$(dirname "$0")" && pwd)
+source "$here/../lib.sh"
 fig_init forces
 
 # The experiment's timeline, as the paper's: END = 300 s of simulated time,
@@ -35,6 +36,7 @@ fig_init forces
 # QUICK runs the same timeline at half scale (END = 150).
 END_FULL=300
 END_QUICK=150
+END_TINY=60
 # Compliance slopes: the AX-12 acts on 2, 4, ..., 128; these four span the
 # paper's factor of 9 in stiffness (0.015-0.135 N·m/rad) with a factor of 8.
 SLOPES="16 32 64 128"
@@ -52,6 +54,8 @@ stiffness() { # SLOPE -> N·m/rad (see the header)
 jobs() {
 	local slopes=$SLOPES reps=$REPLICATES end=$END_FULL s r
 	[ "${1:-}" = --quick ] && slopes=$QUICK_SLOPES reps=$QUICK_REPLICATES end=$END_QUICK
+	# FIG_TINY=1 (the tests): one run at the shortest timeline a run takes
+	if [ "${FIG_TINY:-0}" = 1 ]; then echo "slope64-t0 64 $(fig_seed forces tiny) $END_TINY"; return; fi
 	for s in $slopes; do
 		for r in $(seq "$reps"); do
 			echo "slope$s-rep$r $s $(fig_seed forces "$s" "$r") $end"
@@ -66,7 +70,7 @@ tune() {
 	dir="$out/tune"
 	rm -rf "$dir" && mkdir -p "$dir" || fig_die "cannot create $dir"
 	url=$(fig_lcm_url "$dir")
-	${FIG_SESSION[@]+"${FIG_SESSION[@]}"} "$FIG_B/undulate-sim" --link "$dir/r1" --ids 1,2 --name r1 --lcm-url "$url" --seed "$seed" \
+	${FIG_SESSION[@]+"${FIG_SESSION[@]}"} "$FIG_BIN/undulate-sim" --link "$dir/r1" --ids 1,2 --name r1 --lcm-url "$url" --seed "$seed" \
 		--lockstep "$dir/clock" --duration $((TUNE_S + 60)) >"$dir/sim.log" 2>&1 </dev/null &
 	local sim=$!
 	local i
@@ -75,7 +79,7 @@ tune() {
 		kill -0 "$sim" 2>/dev/null || break
 		sleep 0.02
 	done
-	"$FIG_B/undulated" --tune --port "$dir/r1" --ids 1,2 --robot r1 --lcm-url "$url" --lockstep "$dir/clock" \
+	"$FIG_BIN/undulated" --tune --port "$dir/r1" --ids 1,2 --robot r1 --lcm-url "$url" --lockstep "$dir/clock" \
 		--set "robot.compliance_slope=$slope" --tune-time "$TUNE_S" --out "$out/tuned.conf" \
 		>"$dir/tune.log" 2>&1 </dev/null || rc=$?
 	# the tuner leaving ends the simulator's run (it says so and exits 1)
@@ -109,7 +113,7 @@ run() {
 	local out=$1 slope=$2 seed=$3 end=${4:-$END_FULL}
 	fig_uint SLOPE "$slope" 2 254
 	fig_uint SEED "$seed" 1 999999999
-	fig_uint END "$end" 60 3600
+	fig_uint END "$end" "$END_TINY" 3600
 	local closed=$((end / 3)) switch=$((2 * end / 3))
 	mkdir -p "$out" || fig_die "cannot create $out"
 	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
@@ -127,7 +131,7 @@ run() {
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/arena10.scenario" --seconds "$end" \
 		--switch-at "$switch" --seed "$seed" --window 10 --set "events.10=walls -0.15 0.15 over $((closed - 10))" \
 		"${sets[@]}" || exit 1
-	local r="$out/run"
+	local r="$out/demo"
 	[ -s "$r/collision_rate.csv" ] || fig_die "the run has no collision_rate.csv"
 	awk -F, 'NR > 1 { printf "%s,%s,%s,%s,%s\n", $1, $6, $2, $4, $5 }' "$r/collision_rate.csv" |
 		{ echo "t,force_n,impacts,pair_impacts,wall_impacts"; cat; } >"$out/series.csv"
@@ -150,17 +154,15 @@ run() {
 		echo "slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s,end_s"
 		echo "$slope,$(stiffness "$slope"),$seed,$(ini "$conf" robot servo_lead_s),$(ini "$conf" joint.1 k),$(ini "$conf" sinusoid amplitude),$(ini "$conf" sinusoid frequency),$fc,$fo,$mc,$mo,$ic,$io,$wc,$wo,$swing,$wall,$end"
 	} >"$out/result.csv"
-	fig_shrink "$out"
+	fig_clean "$out/demo"
 }
 
 merge() {
 	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
 	local runs=$1 fig=$2
-	fig_gnuplot
-	mkdir -p "$fig" || fig_die "cannot create $fig"
-	fig_collect "$runs" "$fig/forces.csv"
-	local csv="$fig/forces.csv" term
-	term=$(fig_term)
+	fig_merge_begin "$fig"
+	fig_results "$runs" sorted >"$fig/forces.csv"
+	local csv="$fig/forces.csv" t=$FIG_TMP
 	# per slope: the median over replicates of each run's median, and the range
 	awk -F, 'NR > 1 { n[$1]++; k[$1] = $2; c[$1] = c[$1] " " $8; o[$1] = o[$1] " " $9 } END {
 		for (s in n) print s, k[s], n[s], c[s] "|" o[s] }' "$csv" | sort -n |
@@ -171,72 +173,74 @@ merge() {
 			"$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | tail -1)" \
 			"$(tr ' ' '\n' <<<"$os" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
 			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)"
-	done >"$fig/forces.summary"
-	[ -s "$fig/forces.summary" ] || fig_die "no runs to summarize in $csv"
-	tr ' ' ',' <"$fig/forces.summary" >"$fig/forces.summary.csv"
-	local xtics
-	xtics=$(awk '{ printf "%s\"%s\" %s", (NR > 1 ? ", " : ""), $2, $2 }' "$fig/forces.summary")
-	gnuplot >"$fig/forces.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing forces.png: $(tail -2 "$fig/forces.gp.log")"
-set terminal $term
-set output '$fig/forces.png'
-set datafile separator ','
-set termoption noenhanced
-set logscale xy
-set xlabel 'controller stiffness K (N·m/rad): AX-12 compliance slope 128, 64, 32, 16 at 12 V'
-set ylabel 'median contact force (N): all contacts in the row'
-set title 'Ten robots, walls closed to 0.3 m: median force on the clock (100-200 s) and on the oscillator (200-300 s)'
-set key bottom right
-set grid
-set xrange [1.5:30]
-set xtics ($xtics)
-set yrange [0.01:*]
-plot '$csv' every ::1 using 2:8 with points pt 7 ps 1.2 lc rgb '#d62728' title 'clock (SINUSOID), each run', \
-     '$fig/forces.summary.csv' using 2:4 with lines lw 2 lc rgb '#d62728' title 'clock, median of runs', \
-     '$csv' every ::1 using 2:9 with points pt 5 ps 1.2 lc rgb '#1f77b4' title 'oscillator, each run', \
-     '$fig/forces.summary.csv' using 2:7 with lines lw 2 lc rgb '#1f77b4' title 'oscillator, median of runs', \
-     0.1 with lines dt 2 lw 2 lc rgb '#2ca02c' title "paper: below 0.1 N once synchronized"
-EOF
-	rm -f "$fig/forces.summary.csv" "$fig/forces.gp.log"
-	time_plot "$runs" "$fig"
+	done >"$t/summary"
+	[ -s "$t/summary" ] || fig_die "no runs to summarize in $csv"
+	{ echo "slope,k,runs,clock,clock_min,clock_max,osc,osc_min,osc_max"; tr ' ' ',' <"$t/summary"; } >"$t/summary.csv"
+	force_plot "$fig" "$t" || fig_die "forces.png could not be drawn"
+	time_plot "$runs" "$fig" "$t" || fig_die "forces_time.png could not be drawn"
 	fragment "$fig"
-	rm -f "$fig/forces.summary"
 }
 
-# forces_time.png: the force per second through the whole run, one run per
-# slope (its first replicate that has a series).
+# force_plot FIGDIR TMP: forces.png, the median force of each run and per
+# slope against the stiffness, on the clock and on the oscillator.
+force_plot() {
+	local fig=$1 t=$2 csv="$1/forces.csv" xtics
+	xtics=$(awk '{ printf "%s\"%s\" %s", (NR > 1 ? ", " : ""), $2, $2 }' "$t/summary")
+	{
+		fig_gp_head 900 600
+		echo "set output '$fig/forces.png'"
+		echo "set termoption noenhanced"
+		echo "set logscale xy"
+		echo "set xlabel 'controller stiffness K (N·m/rad): AX-12 compliance slope 128, 64, 32, 16 at 12 V'"
+		echo "set ylabel 'median contact force (N): all contacts in the row'"
+		echo "set title 'Ten robots, walls closed to 0.3 m: median force on the clock (100-200 s) and on the oscillator (200-300 s)'"
+		echo "set key bottom right"
+		echo "set xrange [1.5:30]"
+		echo "set xtics ($xtics)"
+		echo "set yrange [0.01:*]"
+		fig_plot "'$csv' every ::1 using 2:8 with points pt 7 ps 1.2 lc rgb '#d62728' title 'clock (SINUSOID), each run'" \
+			"'$t/summary.csv' every ::1 using 2:4 with lines lw 2 lc rgb '#d62728' title 'clock, median of runs'" \
+			"'$csv' every ::1 using 2:9 with points pt 5 ps 1.2 lc rgb '#1f77b4' title 'oscillator, each run'" \
+			"'$t/summary.csv' every ::1 using 2:7 with lines lw 2 lc rgb '#1f77b4' title 'oscillator, median of runs'" \
+			"0.1 with lines dt 2 lw 2 lc rgb '#2ca02c' title \"paper: below 0.1 N once synchronized\""
+	} >"$t/forces.gp"
+	fig_gnuplot "$t/forces.gp"
+}
+
+# time_plot RUNS_DIR FIGDIR TMP: forces_time.png, the force per second
+# through the whole run, one run per slope (its first replicate that has a
+# series).
 time_plot() {
-	local runs=$1 fig=$2 plots="" s d colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 term end
-	term=$(fig_term)
+	local runs=$1 fig=$2 t=$3 series=() s d colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 end
 	end=$(run_end "$fig/forces.csv")
-	for s in $(cut -d' ' -f1 "$fig/forces.summary"); do
+	for s in $(cut -d' ' -f1 "$t/summary"); do
 		for d in "$runs"/*/; do
 			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
 			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$s" ] || continue
 			# whole seconds of the run (the last bin holds the final message alone)
-			awk -F, -v e="$end" 'NR > 1 && $2 != "" && $2 > 0 && $1 + 1 <= e' "$d/series.csv" >"$fig/forces_time.s$s.dat"
-			plots+="${plots:+, }'$fig/forces_time.s$s.dat' using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'"
+			awk -F, -v e="$end" 'NR == 1 || ($2 != "" && $2 > 0 && $1 + 1 <= e)' "$d/series.csv" >"$t/time.s$s.csv"
+			fig_has "$t/time.s$s.csv" 1 && series+=(
+				"'$t/time.s$s.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'")
 			i=$((i + 1))
 			break
 		done
 	done
-	[ -n "$plots" ] || { echo "forces: no series.csv in the runs: no time plot" >&2; return 0; }
-	gnuplot >"$fig/forces_time.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing forces_time.png: $(tail -2 "$fig/forces_time.gp.log")"
-set terminal $term
-set output '$fig/forces_time.png'
-set datafile separator ','
-set termoption noenhanced
-set logscale y
-set xlabel 'simulated time (s)'
-set ylabel 'contact force (N), per second'
-set title 'Walls close 10-$((end / 3)) s; clock until $((2 * end / 3)) s, oscillator after'
-set key bottom left
-set grid
-set arrow from 10, graph 0 to 10, graph 1 nohead dt 3 lc rgb 'gray'
-set arrow from $((end / 3)), graph 0 to $((end / 3)), graph 1 nohead dt 3 lc rgb 'gray'
-set arrow from $((2 * end / 3)), graph 0 to $((2 * end / 3)), graph 1 nohead lw 2 lc rgb 'black'
-plot $plots
-EOF
-	rm -f "$fig"/forces_time.s*.dat "$fig/forces_time.gp.log"
+	[ ${#series[@]} -gt 0 ] || { echo "forces: no series.csv in the runs: no time plot" >&2; return 0; }
+	{
+		fig_gp_head 900 600
+		echo "set output '$fig/forces_time.png'"
+		echo "set termoption noenhanced"
+		echo "set logscale y"
+		echo "set xlabel 'simulated time (s)'"
+		echo "set ylabel 'contact force (N), per second'"
+		echo "set title 'Walls close 10-$((end / 3)) s; clock until $((2 * end / 3)) s, oscillator after'"
+		echo "set key bottom left"
+		echo "set arrow from 10, graph 0 to 10, graph 1 nohead dt 3 lc rgb 'gray'"
+		echo "set arrow from $((end / 3)), graph 0 to $((end / 3)), graph 1 nohead dt 3 lc rgb 'gray'"
+		echo "set arrow from $((2 * end / 3)), graph 0 to $((2 * end / 3)), graph 1 nohead lw 2 lc rgb 'black'"
+		fig_plot "${series[@]}"
+	} >"$t/time.gp"
+	fig_gnuplot "$t/time.gp"
 }
 
 # run_end CSV: the runs' END (the first run's; a merge of mixed timelines
@@ -275,7 +279,7 @@ fragment() {
 			slope=${line%% *}
 			tuned=$(awk -F, -v s="$slope" 'NR > 1 && $1 == s { printf "%.3g, %.3g", $4, $5; exit }' "$csv")
 			awk -v t="$tuned" '{ printf "| %s | %s | %s | %s | %.3g (%.3g-%.3g) | %.3g (%.3g-%.3g) | %.1fx |\n", $1, $2, $3, t, $4, $5, $6, $7, $8, $9, ($7 > 0 ? $4 / $7 : 0) }' <<<"$line"
-		done <"$fig/forces.summary"
+		done <"$FIG_TMP/summary"
 		echo
 		awk -F, 'NR > 1 { if (min == "" || $16 < min) min = $16; if ($16 < 0.2) stopped++; t += $17; n++ }
 			END { if (stopped) printf "In %d run(s) a joint swung less than 0.2 rad peak-to-peak in the last 10 s (smallest %.2f rad): robots that stop also stop pushing.", stopped, min
@@ -299,7 +303,7 @@ beside() {
 			if (above == 0 && rmin >= 100) print ": as the paper."
 			else if (rmin >= 1.5) printf ": the fall reproduces, its size does not (%d of %d stiffnesses above 0.1 N on the oscillator, none 100x lower).\n", above, n
 			else printf ": at some stiffness the force did not fall (less than 1.5x); %d of %d above 0.1 N on the oscillator.\n", above, n
-		}' "$1/forces.summary"
+		}' "$FIG_TMP/summary"
 	echo
 	echo "Why, as far as measured here:"
 	echo

@@ -27,6 +27,7 @@
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/../lib.sh"
+fig_init pair
 
 SCENARIO="$fig_top/sim-bridge/scenarios/pair-rig.scenario"
 RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current
@@ -93,8 +94,13 @@ seconds() { echo 4.5; }
 RESULT_HEADER="run,r,dsep_set,delta0,seed,seconds,class,delta_final,spread,dsep_final,amp_left,amp_right,freq,collisions,window_collisions,last_collision_t,delta_first,swing_min,sim_speed,wall_s,switch_s"
 
 run() {
-	[ $# -eq 6 ] || fig_die "pair run: want OUTDIR R DSEP DELTA0 SEED SECONDS, got $*"
+	[ $# -eq 6 ] || fig_usage "run: want OUTDIR R DSEP DELTA0 SEED SECONDS, got $*"
 	local out=$1 r=$2 dsep=$3 delta0=$4 seed=$5 secs=$6
+	fig_num R "$r" 0 1
+	fig_num DSEP "$dsep" 0 3
+	fig_num DELTA0 "$delta0" -3.1416 3.1416
+	fig_uint SEED "$seed" 1 999999999
+	fig_uint SECONDS "$secs" $((SWITCH_S + 1)) 3600
 	local t0 right sw
 	t0=$(date +%s%N)
 	right=$(awk -v d="$delta0" 'BEGIN { printf "%.4f", -d }')
@@ -116,7 +122,7 @@ run() {
 			 .robots[0].joints[0].amplitude_rad, .robots[1].joints[0].amplitude_rad,
 			 .robots[0].joints[0].frequency_hz, $p.collisions, $p.window_collisions, $last, $first,
 			 ([$p.swing_a, $p.swing_b] | min), $speed, $wall, $sw] | map(. // "" | tostring) | join(",")' "$d/summary.json"
-	} >"$out/result.csv" || { echo "fig: $out: cannot write result.csv" >&2; return 1; }
+	} >"$out/result.csv" || { echo "$FIG_NAME: $out: cannot write result.csv" >&2; return 1; }
 	fig_clean "$d"
 }
 
@@ -130,25 +136,20 @@ free_amplitude() {
 
 merge() {
 	local runs=$1 fig=$2
-	fig_need_gnuplot
-	mkdir -p "$fig" || fig_die "cannot create $fig"
-	tmp=$(mktemp -d "${TMPDIR:-/tmp}/fig-pair.XXXXXX") || fig_die "no temporary directory"
-	[ "${FIG_KEEP:-0}" = 1 ] || trap 'rm -rf "$tmp"' EXIT
+	fig_merge_begin "$fig"
+	tmp=$FIG_TMP
 	fig_results "$runs" >"$tmp/runs.csv"
-	local n
-	n=$(($(wc -l <"$tmp/runs.csv") - 1))
-	[ "$n" -gt 0 ] || fig_die "pair: no run in $runs has a result.csv (run the figure first)"
 	amp=$(free_amplitude "$tmp/runs.csv")
-	[ -n "$amp" ] || fig_die "pair: no run ended without contact: cannot measure the free amplitude"
-	predict "$tmp" || fig_die "pair: undulate-analyze --theory failed"
+	[ -n "$amp" ] || fig_die "no run ended without contact: cannot measure the free amplitude"
+	predict "$tmp" || fig_die "undulate-analyze --theory failed"
 	join_runs "$tmp" >"$fig/pair.csv"
 	cp "$fig/pair.csv" "$tmp/pair.csv"
 	local r
 	for r in $RESTITUTIONS; do derived "$tmp" "$r"; done
-	plot_steady "$fig" "$tmp" || fig_die "pair: pair.png could not be drawn"
-	plot_onset "$fig" "$tmp" || fig_die "pair: pair-onset.png could not be drawn"
+	plot_steady "$fig" "$tmp" || fig_die "pair.png could not be drawn"
+	plot_onset "$fig" "$tmp" || fig_die "pair-onset.png could not be drawn"
 	fragment "$tmp" >"$fig/pair.md" 2>"$tmp/fragment.err" && [ ! -s "$tmp/fragment.err" ] ||
-		fig_die "pair: the page's section failed: $(head -n 3 "$tmp/fragment.err")"
+		fig_die "the page's section failed: $(head -n 3 "$tmp/fragment.err")"
 }
 
 RESTITUTIONS="0.67 0.9"

@@ -24,6 +24,7 @@
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/../lib.sh"
+fig_init returnmap
 
 SCENARIO="$fig_top/sim-bridge/scenarios/pair-rig.scenario"
 RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current
@@ -63,8 +64,12 @@ seconds() { echo 5.0; }
 RESULT_HEADER="run,r,delta0,seed,frequency,n,t,delta_n,delta_next,theory_next"
 
 run() {
-	[ $# -eq 5 ] || fig_die "returnmap run: want OUTDIR R DELTA0 SEED SECONDS, got $*"
+	[ $# -eq 5 ] || fig_usage "run: want OUTDIR R DELTA0 SEED SECONDS, got $*"
 	local out=$1 r=$2 delta0=$3 seed=$4 secs=$5 right f sw
+	fig_num R "$r" 0 1
+	fig_num DELTA0 "$delta0" -3.1416 3.1416
+	fig_uint SEED "$seed" 1 999999999
+	fig_uint SECONDS "$secs" 4 3600
 	right=$(awk -v d="$delta0" 'BEGIN { printf "%.4f", -d }')
 	sw=$(fig_pair_switch 0 "$delta0")
 	FIG_KEEP=1 fig_demo "$out" --scenario "$SCENARIO" --seconds "$secs" --switch-at "$sw" --seed "$seed" \
@@ -72,14 +77,14 @@ run() {
 	local d="$out/demo"
 	f=$(jq -r '[.robots[].joints[0].frequency_hz] | add / length' "$d/summary.json")
 	awk -v f="$f" 'BEGIN { exit !(f > 0.2 && f < 5) }' ||
-		{ echo "fig: $out: no usable frequency from the first analysis ($f Hz)" >&2; return 1; }
+		{ echo "$FIG_NAME: $out: no usable frequency from the first analysis ($f Hz)" >&2; return 1; }
 	"$FIG_BIN/undulate-analyze" "$d/demo.lcmlog" --out "$out/fixed" --frequency "$f" --quiet >"$out/fixed.log" 2>&1 ||
-		{ echo "fig: $out: undulate-analyze --frequency failed: $(tail -n 1 "$out/fixed.log")" >&2; return 1; }
+		{ echo "$FIG_NAME: $out: undulate-analyze --frequency failed: $(tail -n 1 "$out/fixed.log")" >&2; return 1; }
 	# the collisions under the clock (pressed, not free) are not the map's:
 	# from the switch on, numbered again from 0
 	local swt
 	swt=$(awk -F, '$6 == "\"mode\"" && index($7, "-> OSCILLATOR") { print $2; exit }' "$out/fixed/events.csv")
-	[ -n "$swt" ] || { echo "fig: $out: the daemons never switched to the oscillator (events.csv)" >&2; return 1; }
+	[ -n "$swt" ] || { echo "$FIG_NAME: $out: the daemons never switched to the oscillator (events.csv)" >&2; return 1; }
 	{
 		echo "$RESULT_HEADER"
 		awk -F, -v run="$(basename "$out")" -v r="$r" -v d0="$delta0" -v seed="$seed" -v f="$f" -v sw="$swt" \
@@ -94,22 +99,18 @@ run() {
 # ---- merge -----------------------------------------------------------------------
 merge() {
 	local runs=$1 fig=$2
-	fig_need_gnuplot
-	mkdir -p "$fig" || fig_die "cannot create $fig"
-	tmp=$(mktemp -d "${TMPDIR:-/tmp}/fig-rmap.XXXXXX") || fig_die "no temporary directory"
-	[ "${FIG_KEEP:-0}" = 1 ] || trap 'rm -rf "$tmp"' EXIT
+	fig_merge_begin "$fig"
+	tmp=$FIG_TMP
 	fig_results "$runs" >"$fig/returnmap.csv"
-	local n r
-	n=$(($(wc -l <"$fig/returnmap.csv") - 1))
-	[ "$n" -gt 0 ] || fig_die "returnmap: no collision in any run's result.csv in $runs (run the figure first)"
+	local r
 	for r in $RESTITUTIONS; do
 		fig_theory map-d0 --restitution "$r" >"$tmp/map-$r.csv" || fig_die "undulate-analyze --theory failed"
 		sequences "$fig/returnmap.csv" "$r" >"$tmp/seq-$r.csv" || fig_die "undulate-analyze --theory failed"
 	done
-	plot_map "$fig" "$tmp" || fig_die "returnmap: returnmap.png could not be drawn"
-	plot_n "$fig" "$tmp" || fig_die "returnmap: returnmap-n.png could not be drawn"
+	plot_map "$fig" "$tmp" || fig_die "returnmap.png could not be drawn"
+	plot_n "$fig" "$tmp" || fig_die "returnmap-n.png could not be drawn"
 	fragment "$fig/returnmap.csv" "$runs" >"$fig/returnmap.md" 2>"$tmp/fragment.err" && [ ! -s "$tmp/fragment.err" ] ||
-		fig_die "returnmap: the page's section failed: $(head -n 3 "$tmp/fragment.err")"
+		fig_die "the page's section failed: $(head -n 3 "$tmp/fragment.err")"
 }
 
 # sequences CSV R: for each run at R, its measured Delta_n (from its first

@@ -33,7 +33,8 @@
 # run at under half the cost of twenty, whose relaxation, being the last of
 # more pairs, also takes longer.
 set -u
-. "$(dirname "$0")/../helpers.sh"
+here=$(cd "$(dirname "$0")" && pwd)
+source "$here/../lib.sh"
 fig_init rows
 
 SWITCH=3
@@ -58,11 +59,20 @@ QUICK_SWEEP_DSEPS="0.1 0.5 0.9"
 QUICK_SWEEP_SECONDS=45
 QUICK_RELAX_BETAS="0.1 0.02 0.005"
 QUICK_RELAX_SECONDS=120
+# FIG_TINY=1 (the tests): one immobile sweep run and one relaxation run,
+# each only as long as the switch and the final window need.
+TINY_SWEEP_SECONDS=14
+TINY_RELAX_SECONDS=16
 RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current)
 
 jobs() {
 	local d b s seeds=$SWEEP_SEEDS rseeds=$RELAX_SEEDS dseps=$SWEEP_DSEPS secs=$SWEEP_SECONDS
 	local rbetas=$RELAX_BETAS rsecs=$RELAX_SECONDS
+	if [ "${FIG_TINY:-0}" = 1 ]; then
+		echo "sweep-t0 $RELAX_DSEP 0 $TINY_SWEEP_SECONDS $(fig_seed rows tiny sweep)"
+		echo "relax-t0 $RELAX_DSEP 0.02 $TINY_RELAX_SECONDS $(fig_seed rows tiny relax)"
+		return
+	fi
 	if [ "${1:-}" = --quick ]; then
 		seeds=1 rseeds=1 dseps=$QUICK_SWEEP_DSEPS secs=$QUICK_SWEEP_SECONDS
 		rbetas=$QUICK_RELAX_BETAS rsecs=$QUICK_RELAX_SECONDS
@@ -100,7 +110,7 @@ run() {
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/lattice10.scenario" --seconds "$secs" \
 		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.separation=$dsep" \
 		--set "world.beta=$beta" --set "world.walls=-$wall_x,$wall_x" "${RIG[@]}" || exit 1
-	local r="$out/run" swing wall
+	local r="$out/demo" swing wall
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
 	[ -s "$out/pairs.csv" ] || fig_die "the analysis has no neighbouring pairs"
 	swing=$(fig_min_swing "$r/summary.json")
@@ -129,50 +139,61 @@ run() {
 		echo "$dsep,$beta,$secs,$seed,$ends,$walls,$relax,$censored,$swing,$wall"
 	} >"$out/result.csv"
 	mv "$out/pairs.csv" "$out/end_pairs.csv"
-	fig_shrink "$out"
+	fig_clean "$out/demo"
 }
 
 merge() {
 	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2 term
-	fig_gnuplot
-	mkdir -p "$fig" || fig_die "cannot create $fig"
-	fig_collect "$runs" "$fig/rows.csv"
-	local csv="$fig/rows.csv"
-	term=$(fig_term)
-	# sweep points: the runs at SWEEP_BETAS; per (d̃, β) the mean over seeds
-	awk -F, -v betas=" $SWEEP_BETAS " -v secs="$SWEEP_SECONDS $QUICK_SWEEP_SECONDS" 'NR > 1 && index(betas, " " $2 " ") && index(" " secs " ", " " $3 " ") {
-			k = $1 "," $2; n[k]++; r[k] += $7; e[k] += $8; w[k] += $13 }
-		END { for (k in n) printf "%s,%d,%.5g,%.5g,%.5g\n", k, n[k], r[k] / n[k], e[k] / n[k], w[k] / n[k] }' "$csv" |
-		sort -t, -k2,2g -k1,1g >"$fig/rows.sweep"
-	[ -s "$fig/rows.sweep" ] || fig_die "no sweep runs (beta $SWEEP_BETAS, $SWEEP_SECONDS or $QUICK_SWEEP_SECONDS s) in $csv"
-	gnuplot >"$fig/rows.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing rows.png: $(tail -2 "$fig/rows.gp.log")"
-set terminal $(echo "$term" | sed 's/size [0-9]*,[0-9]*/size 900,800/')
-set output '$fig/rows.png'
-set datafile separator ','
-set termoption noenhanced
-set multiplot layout 2,1 title 'Ten oscillators in a row, immobile (β = 0) and mobile (β = 0.1 s) bases: the last $WINDOW s'
-set grid
-set key top left
-set xrange [0:1.2]
-set xlabel 'd̃ (set)'
-set ylabel 'collisions per pair per second'
-set yrange [0:*]
-set offsets 0, 0, graph 0.08, 0
-plot '$csv' every ::1 using (\$2 == 0 ? \$1 - 0.01 : 1/0):7 with points pt 7 ps 0.8 lc rgb '#d62728' notitle, \
-     '$fig/rows.sweep' using (\$2 == 0 ? \$1 : 1/0):4 with linespoints lw 2 pt 7 lc rgb '#d62728' title 'immobile, mean of runs', \
-     '$csv' every ::1 using (\$2 > 0 ? \$1 + 0.01 : 1/0):7 with points pt 5 ps 0.8 lc rgb '#1f77b4' notitle, \
-     '$fig/rows.sweep' using (\$2 > 0 ? \$1 : 1/0):4 with linespoints lw 2 pt 5 lc rgb '#1f77b4' title 'mobile, mean of runs'
-set ylabel 'compatibility error (rad): |Δ| beyond 2 asin(d̃)'
-plot '$csv' every ::1 using (\$2 == 0 ? \$1 - 0.01 : 1/0):8 with points pt 7 ps 0.8 lc rgb '#d62728' notitle, \
-     '$fig/rows.sweep' using (\$2 == 0 ? \$1 : 1/0):5 with linespoints lw 2 pt 7 lc rgb '#d62728' title 'immobile, mean over pairs and runs', \
-     '$csv' every ::1 using (\$2 > 0 ? \$1 + 0.01 : 1/0):8 with points pt 5 ps 0.8 lc rgb '#1f77b4' notitle, \
-     '$fig/rows.sweep' using (\$2 > 0 ? \$1 : 1/0):5 with linespoints lw 2 pt 5 lc rgb '#1f77b4' title 'mobile, mean over pairs and runs'
-unset multiplot
-EOF
-	relax_plot "$fig"
+	local runs=$1 fig=$2
+	fig_merge_begin "$fig"
+	fig_results "$runs" sorted >"$fig/rows.csv"
+	local csv="$fig/rows.csv" t=$FIG_TMP
+	# the sweep's runs: β in SWEEP_BETAS and a sweep's length (a relaxation
+	# run at β = 0.1 is not one of them)
+	awk -F, -v betas=" $SWEEP_BETAS " -v secs=" $SWEEP_SECONDS $QUICK_SWEEP_SECONDS $TINY_SWEEP_SECONDS " \
+		'NR == 1 || (index(betas, " " $2 " ") && index(secs, " " $3 " "))' "$csv" >"$t/sweep-runs.csv"
+	# per (d̃, β) the mean over seeds
+	awk -F, 'NR > 1 { k = $1 "," $2; n[k]++; r[k] += $7; e[k] += $8; w[k] += $13 }
+		END { print "dsep,beta,runs,collisions_hz,compat_error_rad,wall_collisions_hz"
+			for (k in n) printf "%s,%d,%.5g,%.5g,%.5g\n", k, n[k], r[k] / n[k], e[k] / n[k], w[k] / n[k] }' "$t/sweep-runs.csv" |
+		{ IFS= read -r h; echo "$h"; sort -t, -k2,2g -k1,1g; } >"$t/sweep.csv"
+	fig_has "$t/sweep.csv" 1 || fig_die "no sweep runs (beta $SWEEP_BETAS, $SWEEP_SECONDS or $QUICK_SWEEP_SECONDS s) in $csv"
+	sweep_plot "$fig" "$t" || fig_die "rows.png could not be drawn"
+	relax_plot "$fig" "$t" || fig_die "rows_relax.png could not be drawn"
 	fragment "$fig"
-	rm -f "$fig/rows.sweep" "$fig/rows.relax" "$fig/rows.gp.log" "$fig/rows_relax.gp.log"
+}
+
+# sweep_plot FIGDIR TMP: rows.png, collisions and the compatibility error
+# against d̃, each run and the mean per d̃, immobile and mobile.
+sweep_plot() {
+	local fig=$1 t=$2 csv="$2/sweep-runs.csv" col ylabel what imm=() mob=()
+	{
+		fig_gp_head 900 800
+		echo "set output '$fig/rows.png'"
+		echo "set termoption noenhanced"
+		echo "set multiplot layout 2,1 title 'Ten oscillators in a row, immobile (β = 0) and mobile (β = 0.1 s) bases: the last $WINDOW s'"
+		# top right: the runs at small d̃ reach the top of the panel
+		echo "set key top right"
+		echo "set xrange [0:1.2]"
+		echo "set xlabel 'd̃ (set)'"
+		echo "set yrange [0:*]"
+		echo "set offsets 0, 0, graph 0.08, 0"
+		for col in "7;4;collisions per pair per second;mean of runs" \
+			"8;5;compatibility error (rad): |Δ| beyond 2 asin(d̃);mean over pairs and runs"; do
+			IFS=';' read -r col mcol ylabel what <<<"$col"
+			imm=() mob=()
+			fig_has "$t/sweep.csv" '$2 == 0' && imm=(
+				"'$csv' every ::1 using (\$2 == 0 ? \$1 - 0.01 : 1/0):$col with points pt 7 ps 0.8 lc rgb '#d62728' notitle"
+				"'$t/sweep.csv' every ::1 using (\$2 == 0 ? \$1 : 1/0):$mcol with linespoints lw 2 pt 7 lc rgb '#d62728' title 'immobile, $what'")
+			fig_has "$t/sweep.csv" '$2 > 0' && mob=(
+				"'$csv' every ::1 using (\$2 > 0 ? \$1 + 0.01 : 1/0):$col with points pt 5 ps 0.8 lc rgb '#1f77b4' notitle"
+				"'$t/sweep.csv' every ::1 using (\$2 > 0 ? \$1 : 1/0):$mcol with linespoints lw 2 pt 5 lc rgb '#1f77b4' title 'mobile, $what'")
+			echo "set ylabel '$ylabel'"
+			fig_plot ${imm[@]+"${imm[@]}"} ${mob[@]+"${mob[@]}"}
+		done
+		echo "unset multiplot"
+	} >"$t/rows.gp"
+	fig_gnuplot "$t/rows.gp"
 }
 
 # rows_relax.png: relaxation time against β at d̃ = RELAX_DSEP (every mobile
@@ -193,30 +214,37 @@ relax_median() {
 }
 
 relax_plot() {
-	local fig=$1 csv="$1/rows.csv" term b med
-	term=$(fig_term)
-	for b in $(awk -F, -v d="$RELAX_DSEP" 'NR > 1 && $1 == d && $2 > 0 { print $2 }' "$csv" | sort -gu); do
-		med=$(relax_median "$csv" "$b")
-		case "$med" in ">"*) echo "$b,nan,${med#>}" ;; *) echo "$b,$med,nan" ;; esac
-	done >"$fig/rows.relax"
-	[ -s "$fig/rows.relax" ] || { echo "rows: no mobile runs at d̃ = $RELAX_DSEP: no relaxation plot" >&2; return 0; }
-	gnuplot >"$fig/rows_relax.gp.log" 2>&1 <<EOF || fig_die "gnuplot failed drawing rows_relax.png: $(tail -2 "$fig/rows_relax.gp.log")"
-set terminal $term
-set output '$fig/rows_relax.png'
-set datafile separator ','
-set termoption noenhanced
-set logscale xy
-set xlabel 'mobility β (s)'
-set ylabel 'relaxation time (s): switch to the last collision'
-set title 'Mobile row at d̃ = $RELAX_DSEP: time to the last collision'
-set key top right
-set grid
-set xrange [0.0015:0.15]
-plot '$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0 ? \$2 : 1/0):(\$14 > 0 ? \$14 : 0.5) with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'relaxed (no collision in its last $CENSOR_S s)', \
-     '$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1 ? \$2 : 1/0):(\$3 - $SWITCH) with points pt 9 ps 1.6 lc rgb '#d62728' title 'censored: still colliding (drawn at its run length)', \
-     '$fig/rows.relax' using 1:2 with linespoints lw 2 pt 6 ps 2 lc rgb '#1f77b4' title 'median (censored runs counted as longest)', \
-     '$fig/rows.relax' using 1:3 with points pt 8 ps 2.5 lw 2 lc rgb '#d62728' title 'median censored: longer than its run'
-EOF
+	local fig=$1 t=$2 csv="$1/rows.csv" b med series=()
+	{
+		echo "beta,median_s,censored_median_s,median"
+		for b in $(awk -F, -v d="$RELAX_DSEP" 'NR > 1 && $1 == d && $2 > 0 { print $2 }' "$csv" | sort -gu); do
+			med=$(relax_median "$csv" "$b")
+			case "$med" in ">"*) echo "$b,nan,${med#>},$med" ;; *) echo "$b,$med,nan,$med" ;; esac
+		done
+	} >"$t/relax.csv"
+	fig_has "$t/relax.csv" 1 || { echo "rows: no mobile runs at d̃ = $RELAX_DSEP: no relaxation plot" >&2; return 0; }
+	fig_has "$csv" "\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0" && series+=(
+		"'$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0 ? \$2 : 1/0):(\$14 > 0 ? \$14 : 0.5) with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'relaxed (no collision in its last $CENSOR_S s)'")
+	fig_has "$csv" "\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1" && series+=(
+		"'$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1 ? \$2 : 1/0):(\$3 - $SWITCH) with points pt 9 ps 1.6 lc rgb '#d62728' title 'censored: still colliding (drawn at its run length)'")
+	# (log scale: a median of 0 s, a row that never collided after the switch, cannot be drawn)
+	fig_has "$t/relax.csv" '$2 != "nan" && $2 > 0' && series+=(
+		"'$t/relax.csv' every ::1 using 1:2 with linespoints lw 2 pt 6 ps 2 lc rgb '#1f77b4' title 'median (censored runs counted as longest)'")
+	fig_has "$t/relax.csv" '$3 != "nan"' && series+=(
+		"'$t/relax.csv' every ::1 using 1:3 with points pt 8 ps 2.5 lw 2 lc rgb '#d62728' title 'median censored: longer than its run'")
+	{
+		fig_gp_head 900 600
+		echo "set output '$fig/rows_relax.png'"
+		echo "set termoption noenhanced"
+		echo "set logscale xy"
+		echo "set xlabel 'mobility β (s)'"
+		echo "set ylabel 'relaxation time (s): switch to the last collision'"
+		echo "set title 'Mobile row at d̃ = $RELAX_DSEP: time to the last collision'"
+		echo "set key top right"
+		echo "set xrange [0.0015:0.15]"
+		fig_plot "${series[@]}"
+	} >"$t/relax.gp"
+	fig_gnuplot "$t/relax.gp"
 }
 
 fragment() {
@@ -245,9 +273,9 @@ fragment() {
 		echo
 		echo "| d̃ | β (s) | runs | collisions per pair per s | compatibility error (rad) | pairs colliding at the end | pairs compatible or in phase | anti-phase |"
 		echo "|---|---|---|---|---|---|---|---|"
-		awk -F, -v betas=" $SWEEP_BETAS " -v secs=" $SWEEP_SECONDS $QUICK_SWEEP_SECONDS " 'NR > 1 && index(betas, " " $2 " ") && index(secs, " " $3 " ") {
+		awk -F, 'NR > 1 {
 				k = $1 " " $2; n[k]++; r[k] += $7; e[k] += $8; p[k] += $5; c[k] += $6; ok[k] += $10; a[k] += $11 }
-			END { for (k in n) { split(k, kk, " "); printf "%s|%s|%d|%.3g|%.3g|%d of %d|%d of %d|%d\n", kk[1], kk[2], n[k], r[k] / n[k], e[k] / n[k], c[k], p[k], ok[k], p[k], a[k] } }' "$csv" |
+			END { for (k in n) { split(k, kk, " "); printf "%s|%s|%d|%.3g|%.3g|%d of %d|%d of %d|%d\n", kk[1], kk[2], n[k], r[k] / n[k], e[k] / n[k], c[k], p[k], ok[k], p[k], a[k] } }' "$FIG_TMP/sweep-runs.csv" |
 			sort -t'|' -k1,1g -k2,2g | awk -F'|' '{ printf "| %s | %s | %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, $8 }'
 		echo
 		echo "Relaxation of the mobile row at d̃ = $RELAX_DSEP (time from the switch to the oscillator until"
@@ -273,10 +301,10 @@ fragment() {
 	} >"$fig/rows.md"
 }
 
-# beside FIGDIR: the paper's lattice beside these rows.
+# beside FIGDIR: the paper's lattice beside these rows (after relax_plot).
 beside() {
 	local csv="$1/rows.csv"
-	awk -F, -v betas=" $SWEEP_BETAS " -v secs=" $SWEEP_SECONDS $QUICK_SWEEP_SECONDS " 'NR > 1 && index(betas, " " $2 " ") && index(secs, " " $3 " ") {
+	awk -F, 'NR > 1 {
 			k = ($2 == 0) ? "i" : "m"; p[k, $1] += $5; c[k, $1] += $6; if (!($1 in seen)) { seen[$1] = 1; ds[++nd] = $1 }
 		}
 		function list(k,   i, out) {
@@ -294,20 +322,16 @@ beside() {
 			if (crowded) printf " At d̃ = 0.1 a base moves β·Δv, about 0.1 s × 1 m/s = 10 cm per impact, three times the 3 cm between neighbours, which probably keeps that row from settling (not measured further)."
 			printf "\n"
 		}
-		function asort_num(a, n,   i, j, t) { for (i = 2; i <= n; i++) for (j = i; j > 1 && a[j - 1] + 0 > a[j] + 0; j--) { t = a[j]; a[j] = a[j - 1]; a[j - 1] = t }; return n }' "$csv"
+		function asort_num(a, n,   i, j, t) { for (i = 2; i <= n; i++) for (j = i; j > 1 && a[j - 1] + 0 > a[j] + 0; j--) { t = a[j]; a[j] = a[j - 1]; a[j - 1] = t }; return n }' "$FIG_TMP/sweep-runs.csv"
 	echo
-	local b
-	for b in $(awk -F, -v d="$RELAX_DSEP" 'NR > 1 && $1 == d && $2 > 0 { print $2 }' "$csv" | sort -gu); do
-		echo "$b $(relax_median "$csv" "$b")"
-	done >"$1/rows.relaxmed"
-	awk -v d="$RELAX_DSEP" 'NR == 1 { b0 = $1; t0 = $2 } { b1 = $1; t1 = $2; n++ }
+	# the medians of relax_plot's table, by β
+	awk -F, -v d="$RELAX_DSEP" 'NR == 1 { next } NR == 2 { b0 = $1; t0 = $4 } { b1 = $1; t1 = $4; n++ }
 		END {
 			if (n < 2) { print "Relaxation against β: fewer than two values of β."; exit }
 			printf "Relaxation against β (mobile row, d̃ = %s): the median time to the last collision is %s s at β = %s s and %s s at β = %s s", d, t1, b1, t0, b0
 			if (t0 !~ /^>/ && t1 + 0 > 0 && t0 + 0 > 0) printf ", as β^%.2f between the two", log(t0 / t1) / log(b0 / b1)
 			print " (the paper: growing steeply as β → 0). The runs of one β spread widely (the table): the time to the last collision depends on the random start, and late single grazes count."
-		}' "$1/rows.relaxmed"
-	rm -f "$1/rows.relaxmed"
+		}' "$FIG_TMP/relax.csv"
 }
 
 # Measured 2026-11-27, two runs at a time: 18 s a run on average and 14 s

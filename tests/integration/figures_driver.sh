@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# figures_driver.sh — `make figures`'s driver (scripts/figures.sh) on a tiny
+# figures_driver.sh — `make figures`'s driver (scripts/figures.sh): its
+# modules in the page's order, each with a tiny set of runs (FIG_TINY=1; the
+# rows, channel and forces ones run in figures_modules.sh); and on a tiny
 # set of runs (FIG_TINY=1: three short pair-rig runs and two at d~ = 0, 8-14
 # s of simulated time each, in lockstep): the runs exported as independent
 # command lines, run by GNU parallel here as a cluster would run them (one
@@ -25,6 +27,16 @@ ONLY=pair,returnmap
 # by TEST_PORT_OFFSET like every test's.
 export FIG_PORT_LO FIG_PORT_SPAN=8
 FIG_PORT_LO=$(lcm_port 7780)
+
+# ---- every module: the page's order, a tiny set each -------------------------------------
+order=$("$F" list 2>&1 | awk '{ printf "%s ", $1 }')
+tap_check "list: the five modules in the page's order (pair returnmap rows channel forces)" \
+	test "$order" = "pair returnmap rows channel forces "
+"$F" --export-jobs "$T/tiny.txt" --runs "$T/tinyruns" >"$T/tiny.out" 2>&1
+counts=$(awk '{ n[$3]++ } END { for (m in n) printf "%s %d\n", m, n[m] }' "$T/tiny.txt" 2>/dev/null | sort | tr '\n' ' ')
+tap_check "FIG_TINY=1: every module a tiny set, 1-3 runs ($counts)" awk -v c="$counts" 'BEGIN {
+	n = split(c, f, " "); if (n != 10) exit 1
+	for (i = 2; i <= n; i += 2) if (f[i] < 1 || f[i] > 3) exit 1 }'
 
 # ---- exported jobs, run by GNU parallel as on a cluster --------------------------------
 "$F" --export-jobs "$T/jobs.txt" --runs "$T/runs" --only "$ONLY" >"$T/export.out" 2>&1
@@ -120,7 +132,7 @@ tap_check "--jobs 0: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'jobs' '
 GNUPLOT=/nonexistent/gnuplot "$F" --merge "$T/runs" --only "$ONLY" --out "$T/docs3" 2>"$T/e3"; rc=$?
 tap_check "gnuplot missing: exit 1, 'gnuplot is not installed'" bash -c "[ $rc = 1 ] && grep -q 'gnuplot is not installed' '$T/e3'"
 mkdir -p "$T/empty/pair"
-"$F" --merge "$T/empty" --only pair --out "$T/docs4" 2>"$T/e4"; rc=$?
+"$F" --merge "$T/empty" --only pair --out "$T/docs4" >/dev/null 2>"$T/e4"; rc=$?
 tap_check "--merge of runs without results: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'no run' '$T/e4'"
 "$F" run pair "$T/bad" 0.67 notanumber 1.0 5 10 2>"$T/e5"; rc=$?
 tap_check "a run with a bad argument: non-zero exit and one line why" bash -c "[ $rc != 0 ] && [ \$(wc -l <'$T/e5') = 1 ] && grep -q 'failed' '$T/e5'"

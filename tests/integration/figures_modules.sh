@@ -6,8 +6,9 @@
 # CSV, its pictures with the data drawn (the data colours' pixels counted by
 # tests/tools/pngdata: a picture that exists is not a picture that shows
 # data) and its fragment with the numbers those rows give; a merge without
-# results or without gnuplot fails with a message; and one tiny real run
-# (the channel: four robots, 32 s of simulated time in lockstep).
+# results or without gnuplot fails with a message; and the three modules'
+# tiny set (FIG_TINY=1, 4 short lockstep runs, one of them from /) through the
+# driver onto a page.
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures"
 PNG="$BUILD/tests/tools/pngdata"
@@ -132,29 +133,53 @@ else tap_fail "channel.md numbers" "$(grep -E '^\||In all' "$T/fig/channel.md")"
 # ---- no results, no gnuplot ----------------------------------------------------------------
 mkdir -p "$T/empty"
 "$F/rows/fig.sh" merge "$T/empty" "$T/fig2" >"$T/out" 2>&1; rc=$?
-if [ "$rc" = 1 ] && grep -q "no results in .*result.csv: nothing to draw" "$T/out"; then tap_ok "merge without results: exit 1, said so"
+if [ "$rc" = 1 ] && grep -q "^rows: no run in .* has a result.csv: nothing to draw" "$T/out"; then tap_ok "merge without results: exit 1, said so"
 else tap_fail "merge without results" "rc $rc: $(cat "$T/out")"; fi
 mkdir -p "$T/path"
 for d in /usr/local/bin /usr/bin /bin; do
 	for p in "$d"/*; do n=${p##*/}; [ "$n" = gnuplot ] || [ -e "$T/path/$n" ] || ln -s "$p" "$T/path/$n"; done
 done
 PATH="$T/path" "$F/forces/fig.sh" merge "$T/runs/forces" "$T/fig2" >"$T/out" 2>&1; rc=$?
-if [ "$rc" = 1 ] && grep -q "gnuplot is missing" "$T/out" && [ ! -e "$T/fig2/forces.png" ]; then tap_ok "merge without gnuplot: exit 1, said so"
+if [ "$rc" = 1 ] && grep -q "gnuplot is not installed" "$T/out" && [ ! -e "$T/fig2/forces.png" ]; then tap_ok "merge without gnuplot: exit 1, said so"
 else tap_fail "merge without gnuplot" "rc $rc: $(cat "$T/out")"; fi
 
-# ---- one tiny real run: the channel, four robots, 32 s in lockstep ----------------------
-if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyze" ]; then
+# ---- the tiny set through the driver: the channel's run from /, the rest by the driver -----
+# (FIG_TINY=1: one channel run, 32 s of four robots; two rows of ten robots, 14 and 16 s,
+# the first immobile, so the mobile series are left out; one force run, 60 s after the
+# tuner's 150 s of one robot.) The channel's run is the tiny set's own, made from / into
+# the runs' folder first: the driver's --resume keeps it and runs the other three.
+if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyze" ] && command -v parallel >/dev/null 2>&1; then
+	export FIG_TINY=1 FIG_PORT_LO FIG_PORT_SPAN=8
+	FIG_PORT_LO=$(lcm_port 7790)
+	read -r id w seed <<<"$("$F/channel/fig.sh" jobs)"
+	R="$T/tiny/runs"
 	start=$(date +%s)
-	(cd / && "$F/channel/fig.sh" run "$T/real/w20" 20 7) >"$T/real.out" 2>&1; rc=$?
-	r="$T/real/w20/result.csv"
+	(cd / && "$F/channel/fig.sh" run "$R/channel/$id" "$w" "$seed") >"$T/real.out" 2>&1; rc=$?
+	r="$R/channel/$id/result.csv"
 	if [ "$rc" = 0 ] && [ "$(wc -l <"$r")" = 4 ] &&
 		awk -F, 'NR > 1 && !($13 > 0.1 && $13 < 2 && $14 > 0 && $15 > 0.2 && $16 > 0.2) { bad = 1 } END { exit bad }' "$r"; then
 		tap_ok "channel: a real run from / in $(($(date +%s) - start)) s: three pairs with d~, bound and swings ($(awk -F, 'NR > 1 { printf "%s %s d~ %.2f; ", $4, $5, $13 }' "$r"))"
 	else tap_fail "channel: a real run" "rc $rc: $(cat "$T/real.out"; cat "$r" 2>/dev/null)"; fi
-	if [ ! -e "$T/real/w20/run/demo.lcmlog" ] && [ ! -e "$T/real/w20/run/states.csv" ] && [ -f "$T/real/w20/run/summary.json" ]; then
+	if [ ! -e "$R/channel/$id/demo/demo.lcmlog" ] && [ ! -e "$R/channel/$id/demo/states.csv" ] && [ -f "$R/channel/$id/demo/summary.json" ]; then
 		tap_ok "the run's LCM log and sample tables removed, its summary kept"
-	else tap_fail "large files removed" "$(ls "$T/real/w20/run" 2>&1 | tr '\n' ' ')"; fi
+	else tap_fail "large files removed" "$(ls "$R/channel/$id/demo" 2>&1 | tr '\n' ' ')"; fi
+	"$top/scripts/figures.sh" --only rows,channel,forces --resume --jobs 2 --runs "$R" --out "$T/tiny/docs" >"$T/tiny.out" 2>&1; rc=$?
+	if [ "$rc" = 0 ] && grep -q '3/3 runs done' "$T/tiny.out"; then tap_ok "the tiny set through the driver: 3 runs more, exit 0"
+	else tap_fail "the tiny set through the driver" "rc $rc: $(tail -n 8 "$T/tiny.out")"; fi
+	P="$T/tiny/docs/FIGURES.md" G="$T/tiny/docs/figures"
+	order=$(grep -o '^<a id="[a-z]*">' "$P" 2>/dev/null | tr -dc 'a-z\n' | sed 's/^aid//' | tr '\n' ' ')
+	if [ "$order" = "rows channel forces " ] && grep -qE '^\| \[rows\]\(#rows\) \| 2 \(0\) \|' "$P" &&
+		grep -qE '^\| \[channel\]\(#channel\) \| 1 \(0\) \|' "$P" && grep -qE '^\| \[forces\]\(#forces\) \| 1 \(0\) \|' "$P"; then
+		tap_ok "FIGURES.md: the three sections in the page's order, each in the header's table with its runs"
+	else tap_fail "FIGURES.md: the three sections and the table" "order '$order': $(grep '^| \[' "$P" 2>&1)"; fi
+	red=$(pixels d62728 "$G/rows.png") blue=$(pixels 1f77b4 "$G/rows.png")
+	if [ "${red:-0}" -ge 60 ] && [ "${blue:-0}" = 0 ]; then tap_ok "rows.png: the immobile run drawn ($red pixels), the empty mobile series left out"
+	else tap_fail "rows.png: immobile drawn, mobile left out" "immobile $red, mobile $blue pixels"; fi
+	red=$(pixels d62728 "$G/rows_relax.png")
+	tap_check "rows_relax.png: the censored relaxation run drawn ($red pixels)" test "${red:-0}" -ge 60
+	n=$(coloured "$G/forces_time.png")
+	tap_check "forces_time.png: the run's force per second drawn ($n coloured pixels)" test "${n:-0}" -ge 500
 else
-	tap_skip "channel: a real run" "the programs are not built"
+	tap_skip "the tiny set through the driver" "the programs or GNU parallel are missing"
 fi
 tap_done
