@@ -727,6 +727,8 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 			jt->torque_defaults = (isnan(jt->osc.k) ? CFG_TQ_K : 0) | (isnan(jt->osc.c) ? CFG_TQ_C : 0) |
 			                      (isnan(jt->osc.mu) ? CFG_TQ_MU : 0) | (isnan(jt->osc.inertia) ? CFG_TQ_INERTIA : 0) |
 			                      (isnan(jt->osc.friction) ? CFG_TQ_FRICTION : 0);
+		else
+			jt->position_defaults = (isnan(jt->osc.k) ? CFG_TQ_K : 0) | (isnan(jt->osc.mu) ? CFG_TQ_MU : 0);
 		if (isnan(jt->osc.k)) jt->osc.k = d.k;
 		if (isnan(jt->osc.c)) jt->osc.c = d.c;
 		if (isnan(jt->osc.mu)) jt->osc.mu = d.mu;
@@ -756,6 +758,16 @@ void cfg_scale_torque_defaults(struct cfg *c, size_t j, double scale)
 	jt->torque_defaults = 0;
 }
 
+bool cfg_position_defaults(struct cfg *c, size_t j, double k, double mu)
+{
+	struct cfg_joint *jt = &c->joint[j];
+	unsigned d = jt->position_defaults;
+	if (d & CFG_TQ_K) jt->osc.k = k;
+	if (d & CFG_TQ_MU) jt->osc.mu = mu;
+	jt->position_defaults = 0;
+	return d != 0;
+}
+
 bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 {
 	size_t before = e->count;
@@ -774,6 +786,7 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 			          c->source[0] ? c->source : "command line", j + 1, c->njoints);
 	}
 	cfg_fill_joint_defaults(c);
+	c->servo_lead_default = isnan(c->servo_lead_s);
 	if (isnan(c->servo_lead_s))
 		c->servo_lead_s = c->compliance_margin == 0 ? OSC_SERVO_LEAD_MARGIN0_S : OSC_SERVO_LEAD_S;
 	for (size_t j = 0; j < c->njoints; j++) {

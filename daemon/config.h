@@ -49,6 +49,9 @@ struct cfg_joint {
 	/* torque actuation: the physical parameters that took their defaults
 	 * (CFG_TQ_* bits), scaled once the servo model is known */
 	unsigned torque_defaults;
+	/* position actuation: k and μ if they took osc.h's defaults (CFG_TQ_K,
+	 * CFG_TQ_MU), replaced by the servo model's once it is known */
+	unsigned position_defaults;
 };
 #define CFG_TQ_K        (1u << 0)
 #define CFG_TQ_C        (1u << 1)
@@ -84,6 +87,7 @@ struct cfg {
 	double period_ms;              /* control period */
 	double servo_lead_s;           /* oscillator horizon beyond the period (CONTROL.md);
 	                                  NaN until cfg_finish(): then chosen by compliance_margin */
+	bool servo_lead_default;       /* servo_lead_s took its default (cfg_finish) */
 	long compliance_margin;        /* written to both margins at start-up; -1: leave the servo's */
 	long compliance_slope;         /* written to both slopes at start-up; -1: leave the servo's (the
 	                                  position loop's stiffness: PHYSICS.md, daemon/README.md) */
@@ -167,6 +171,10 @@ bool cfg_mode_parse(const char *s, enum cfg_mode *out);   /* case-insensitive */
  * servo has `scale` times its inertia, and the parameters that took the
  * defaults (not those given) scale with it — once. */
 void cfg_scale_torque_defaults(struct cfg *c, size_t joint, double scale);
+/* Position actuation on a servo whose defaults are not osc.h's: k and μ of
+ * the joint, where they took the defaults, become these (once: later calls
+ * change nothing). True when anything changed. */
+bool cfg_position_defaults(struct cfg *c, size_t joint, double k, double mu);
 
 /* Print every key with its current value as INI (for --check-config -v). */
 void cfg_print(const struct cfg *c, void *file);

@@ -302,6 +302,44 @@ static void dmn_torque_defaults(struct dmn *d)
 	}
 }
 
+/* Position actuation's defaults are the AX-12A's (osc.h): on a servo whose
+ * position loop lags more they run down, and the model's own stand in for
+ * the k and μ the configuration did not give, and for servo_lead_s when
+ * every joint is of that model (the lead is the robot's). Once, at the first
+ * connect, as the torque defaults above. */
+static void dmn_position_defaults(struct dmn *d)
+{
+	struct cfg *cfg = d->cfg;
+	if (cfg->actuation != CFG_ACT_POSITION)
+		return;
+	const struct sm_model *first = ctl_model(&d->ctl, 0);
+	bool same = true, kept = false;
+	double k, mu, lead = 0.0;
+	for (size_t j = 0; j < d->ctl.n; j++) {
+		const struct sm_model *m = ctl_model(&d->ctl, j);
+		same = same && m == first;
+		if (!sm_position_defaults(m, j, d->ctl.n, &k, &mu, &lead)) {
+			kept = kept || m->protocol == 2;
+			continue;
+		}
+		double k0 = cfg->joint[j].osc.k, mu0 = cfg->joint[j].osc.mu;
+		if (cfg_position_defaults(cfg, j, k, mu))
+			log_info("joint %zu: position actuation's default k %.4g, mu %.4g are the %s's (the AX-12A's: "
+			         "k %.4g, mu %.4g; daemon/CONTROL.md, \"X-series servos\")", j + 1, cfg->joint[j].osc.k,
+			         cfg->joint[j].osc.mu, m->name, k0, mu0);
+	}
+	if (same && lead > 0.0 && cfg->servo_lead_default) {
+		log_info("servo_lead_s %.3f s, the %s's default (the AX-12A's: %.3f s)", lead, first->name, cfg->servo_lead_s);
+		cfg->servo_lead_s = lead;
+		cfg->servo_lead_default = false;
+	} else if (!same && cfg->servo_lead_default && d->protocol == BUS_PROTOCOL_2) {
+		kept = true;
+	}
+	if (kept)
+		log_info("some defaults stay the AX-12A's (servos of more than one model, or one without its own): "
+		         "undulated --tune finds this robot's (daemon/CONTROL.md, \"X-series servos\")");
+}
+
 /* "AX-12A" or "XL430-W250, XM430-W350": the models found. */
 static void dmn_models(const struct dmn *d, char *out, size_t cap)
 {
@@ -635,27 +673,54 @@ static bool dmn_signal(struct dmn *d)
 	return true;
 }
 
+/* What both loops wait on besides their clock: signals and the two command
+ * doors, in pfd[0..2]. */
+enum { DMN_P_SIGNAL, DMN_P_LOCAL, DMN_P_NET, DMN_P_COMMON };
+
+/* poll() the common descriptors and the loop's own (after them); false when
+ * the loop must end (a poll error, or a signal that stops the daemon). *again
+ * is set when poll was interrupted and nothing happened. */
+static bool dmn_poll(struct dmn *d, struct pollfd *pfd, nfds_t n, bool *again)
+{
+	pfd[DMN_P_SIGNAL] = (struct pollfd){ .fd = d->signal_fd, .events = POLLIN };
+	pfd[DMN_P_LOCAL] = (struct pollfd){ .fd = cin_local_fd(&d->cin), .events = POLLIN };
+	pfd[DMN_P_NET] = (struct pollfd){ .fd = cin_net_fd(&d->cin), .events = POLLIN };
+	*again = false;
+	if (poll(pfd, n, -1) < 0) {
+		if (errno == EINTR) {
+			*again = true;
+			return true;
+		}
+		log_error("poll: %s", strerror(errno));
+		return false;
+	}
+	return !((pfd[DMN_P_SIGNAL].revents & POLLIN) && dmn_signal(d));
+}
+
+/* Commands that arrived: queued, applied at the next cycle boundary. */
+static void dmn_take_commands(struct dmn *d, const struct pollfd *pfd)
+{
+	if (pfd[DMN_P_LOCAL].revents & POLLIN)
+		cin_on_local(&d->cin);
+	if (pfd[DMN_P_NET].revents & POLLIN)
+		cin_on_network(&d->cin);
+}
+
 static void dmn_loop(struct dmn *d)
 {
-	enum { P_TIMER, P_DEADLINE, P_SIGNAL, P_BUS, P_LOCAL, P_NET, P_N };
+	enum { P_TIMER = DMN_P_COMMON, P_DEADLINE, P_BUS, P_N };
 	while (!d->stop) {
 		struct pollfd pfd[P_N];
+		bool again;
 		pfd[P_TIMER] = (struct pollfd){ .fd = d->timer_fd, .events = POLLIN };
 		pfd[P_DEADLINE] = (struct pollfd){ .fd = d->deadline_fd, .events = POLLIN };
-		pfd[P_SIGNAL] = (struct pollfd){ .fd = d->signal_fd, .events = POLLIN };
 		/* bus fd: readable only matters while a reply is awaited; HUP/ERR always */
 		pfd[P_BUS] = (struct pollfd){ .fd = d->connected ? port_fd(d->port) : -1,
 		                              .events = (short)(bus_is_pending(&d->bus) ? POLLIN : 0) };
-		pfd[P_LOCAL] = (struct pollfd){ .fd = cin_local_fd(&d->cin), .events = POLLIN };
-		pfd[P_NET] = (struct pollfd){ .fd = cin_net_fd(&d->cin), .events = POLLIN };
-		if (poll(pfd, P_N, -1) < 0) {
-			if (errno == EINTR)
-				continue;
-			log_error("poll: %s", strerror(errno));
+		if (!dmn_poll(d, pfd, P_N, &again))
 			return;
-		}
-		if ((pfd[P_SIGNAL].revents & POLLIN) && dmn_signal(d))
-			return;
+		if (again)
+			continue;
 		if (pfd[P_BUS].revents & (POLLHUP | POLLERR | POLLNVAL)) {
 			if (bus_is_pending(&d->bus))
 				dmn_bus_event(d);   /* reads the remaining bytes, then reports the loss */
@@ -676,10 +741,7 @@ static void dmn_loop(struct dmn *d)
 		}
 		if (pfd[P_TIMER].revents & POLLIN)
 			dmn_tick(d);
-		if (pfd[P_LOCAL].revents & POLLIN)
-			cin_on_local(&d->cin);
-		if (pfd[P_NET].revents & POLLIN)
-			cin_on_network(&d->cin);
+		dmn_take_commands(d, pfd);
 	}
 }
 
@@ -718,7 +780,7 @@ static void dmn_clock_moved(struct dmn *d, uint64_t now)
  * TIME (and for signals and commands, as ever). */
 static void dmn_loop_lockstep(struct dmn *d)
 {
-	enum { P_CLOCK, P_SIGNAL, P_LOCAL, P_NET, P_N };
+	enum { P_CLOCK = DMN_P_COMMON, P_N };
 	char why[256];
 	while (!d->stop) {
 		uint64_t wake = d->next_tick_us;
@@ -730,22 +792,13 @@ static void dmn_loop_lockstep(struct dmn *d)
 			return;
 		}
 		struct pollfd pfd[P_N];
+		bool again;
 		pfd[P_CLOCK] = (struct pollfd){ .fd = d->lks.fd, .events = POLLIN };
-		pfd[P_SIGNAL] = (struct pollfd){ .fd = d->signal_fd, .events = POLLIN };
-		pfd[P_LOCAL] = (struct pollfd){ .fd = cin_local_fd(&d->cin), .events = POLLIN };
-		pfd[P_NET] = (struct pollfd){ .fd = cin_net_fd(&d->cin), .events = POLLIN };
-		if (poll(pfd, P_N, -1) < 0) {
-			if (errno == EINTR)
-				continue;
-			log_error("poll: %s", strerror(errno));
+		if (!dmn_poll(d, pfd, P_N, &again))
 			return;
-		}
-		if ((pfd[P_SIGNAL].revents & POLLIN) && dmn_signal(d))
-			return;
-		if (pfd[P_LOCAL].revents & POLLIN)
-			cin_on_local(&d->cin);
-		if (pfd[P_NET].revents & POLLIN)
-			cin_on_network(&d->cin);
+		if (again)
+			continue;
+		dmn_take_commands(d, pfd);
 		if (!(pfd[P_CLOCK].revents & (POLLIN | POLLHUP | POLLERR)))
 			continue;
 		int r = lks_client_read(&d->lks, why, sizeof why);
@@ -850,10 +903,7 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	char models[96];
 	dmn_models(d, models, sizeof models);
 	dmn_torque_defaults(d);
-	if (d->protocol == BUS_PROTOCOL_2 && cfg->actuation == CFG_ACT_POSITION)
-		log_info("the oscillator's defaults are the simulated AX-12A's; an X servo's position control lags "
-		         "otherwise (on the simulated XM430 they run down between restarts): undulated --tune finds this "
-		         "robot's (daemon/CONTROL.md, \"X-series servos\")");
+	dmn_position_defaults(d);
 	log_info("robot %s: %zu joint(s) on %s at %ld bps, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints,
 	         d->port_path, cfg->baud, d->protocol == BUS_PROTOCOL_2 ? "2.0" : "1.0", models,
 	         cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");

@@ -38,6 +38,17 @@
 /* Goal PWM's 100 % (PWM Limit's factory value). */
 #define SM_X_PWM_FULL 885
 
+/* Position actuation's defaults on the X servos: what `undulated --tune` found
+ * on the simulator's servos for the paper's gait, 0.8 Hz and 0.8 rad
+ * (daemon/CONTROL.md, "X-series servos", 2026-11-27: two joints and one).
+ * They are the simulated servos': a real one has its own lag; tune on it. */
+#define SM_XM430_POSITION \
+	{ .k_pair = 0.0304, .mu_even = 0.0757, .mu_odd = 0.0571, .lead_pair = 0.047, \
+	  .k_single = 0.0338, .mu_single = 0.0432, .lead_single = 0.047 }
+#define SM_XL430_POSITION \
+	{ .k_pair = 0.0179, .mu_even = 0.0298, .mu_odd = 0.0166, .lead_pair = 0.086, \
+	  .k_single = 0.0105, .mu_single = 0.0360, .lead_single = 0.117 }
+
 static const struct sm_model sm_models[SM_NFAMILIES] = {
 	[SM_AX12] = {
 		.family = SM_AX12, .name = "AX-12A", .protocol = 1, .number = DXL_AX12_MODEL,
@@ -60,6 +71,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XL430_STALL_TORQUE_NM,
 		.no_load_speed_rad_s = DXL2_XL430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
 		.stall_current_a = DXL2_XL430_STALL_CURRENT_A, .reflected_inertia = SM_REFLECTED(4.6e-8, 258.5),
+		.position = SM_XL430_POSITION,
 	},
 	[SM_XM430] = {
 		.family = SM_XM430, .name = "XM430-W350", .protocol = 2, .number = DXL2_MODEL_XM430_W350,
@@ -72,6 +84,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.no_load_speed_rad_s = DXL2_XM430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
 		.stall_current_a = DXL2_XM430_STALL_CURRENT_A, .current_control = true,
 		.reflected_inertia = SM_REFLECTED(5.0e-8, 353.5),
+		.position = SM_XM430_POSITION,
 	},
 };
 
@@ -239,6 +252,18 @@ double sm_torque_scale(const struct sm_model *m)
 {
 	double link = OSC_TORQUE_JOINT_INERTIA - sm_models[SM_AX12].reflected_inertia;
 	return (link + m->reflected_inertia) / OSC_TORQUE_JOINT_INERTIA;
+}
+
+bool sm_position_defaults(const struct sm_model *m, size_t j, size_t njoints, double *k, double *mu, double *lead)
+{
+	const struct sm_position_defaults *p = &m->position;
+	if (p->k_pair <= 0.0)
+		return false;
+	bool single = njoints < 2;
+	*k = single ? p->k_single : p->k_pair;
+	*mu = single ? p->mu_single : (j % 2 == 0 ? p->mu_even : p->mu_odd);
+	*lead = single ? p->lead_single : p->lead_pair;
+	return true;
 }
 
 uint8_t sm_drive_opmode(bool current)

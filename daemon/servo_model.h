@@ -48,6 +48,17 @@ struct sm_block {
 /* Read-back blocks of one family (the AX-12 has one, the X series two). */
 #define SM_MAX_BLOCKS 2
 
+/* The law's k and μ and the horizon's lead (servo_lead_s) that give the
+ * paper's gait (0.8 Hz, 0.8 rad) through a servo's position loop: for a robot
+ * of two or more joints (μ by the joint's parity, as osc_default_params) and
+ * for a single joint. An X servo's position loop lags the goal more than the
+ * AX-12A's compliance does, and the AX-12A's values run down on it
+ * (daemon/CONTROL.md, "X-series servos"). */
+struct sm_position_defaults {
+	double k_pair, mu_even, mu_odd, lead_pair;
+	double k_single, mu_single, lead_single;
+};
+
 struct sm_model {
 	enum sm_family family;
 	const char *name;               /* "XM430-W350" */
@@ -72,6 +83,9 @@ struct sm_model {
 	/* the motor's rotor seen through the gearbox, rotor inertia × ratio²
 	 * (kg·m²): what a joint's inertia has besides its link */
 	double reflected_inertia;
+	/* Position actuation's defaults through this servo's own position loop
+	 * (k 0: osc.h's, the AX-12A's, stand). */
+	struct sm_position_defaults position;
 };
 
 /* The AX-12A (what undulated assumed before it knew of others). */
@@ -160,5 +174,8 @@ uint16_t sm_drive_raw(const struct sm_model *m, bool current, double ratio, int3
  * joint: the same link on this model's servo has this many times its
  * inertia (the AX-12A: 1). */
 double sm_torque_scale(const struct sm_model *m);
+/* Position actuation's default k, μ (*k, *mu) for joint j of njoints, and the
+ * robot's lead (*lead), on this model; false when osc.h's (the AX-12A's) stand. */
+bool sm_position_defaults(const struct sm_model *m, size_t j, size_t njoints, double *k, double *mu, double *lead);
 
 #endif

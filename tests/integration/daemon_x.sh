@@ -67,11 +67,21 @@ if [ "$got" = "3 3 1201 2895 5 1 1" ] && state_is ' tq0=1 tr0=1 tl0=885 .* tq1=1
 else tap_fail "start-up" "servos: $got; $(last_state | cut -c1-300)"; fi
 
 # ---- OSCILLATOR ----------------------------------------------------------------------------------------
+# position actuation's defaults are the XM430's own (the AX-12A's run down on it)
+if grep -q "joint 1: position actuation's default k 0.0304, mu 0.0757 are the XM430-W350's" "$T/d.log" &&
+	grep -q "joint 2: position actuation's default k 0.0304, mu 0.0571 are the XM430-W350's" "$T/d.log" &&
+	grep -q "servo_lead_s 0.047 s, the XM430-W350's default" "$T/d.log"; then
+	tap_ok "position actuation's defaults: the XM430-W350's k, mu and servo_lead_s, logged"
+else tap_fail "the XM430's defaults" "$(grep -a "default" "$T/d.log" | head -4)"; fi
 cmd 'mode oscillator' >/dev/null
 wait_cycles 600
 s0=$(swing 0 300); s1=$(swing 1 300)
-if over "$s0" 0.5 && over "$s1" 0.5; then tap_ok "OSCILLATOR swings both joints ($s0, $s1 rad peak to peak)"
-else tap_fail "OSCILLATOR swings" "$s0 / $s1 rad"; fi
+# on those defaults the law keeps the joints going: the starter never has to
+# restart them (a 'stall' event), as it did every few seconds on the AX-12A's
+stalls=$(events | grep -c 'kind=stall')
+if over "$s0" 0.5 && over "$s1" 0.5 && [ "$stalls" = 0 ]; then
+	tap_ok "OSCILLATOR swings both joints on the defaults ($s0, $s1 rad peak to peak), no stall"
+else tap_fail "OSCILLATOR swings" "$s0 / $s1 rad, $stalls stall event(s): $(events | grep 'kind=stall' | head -2)"; fi
 
 # ---- bad input on the 2.0 bus --------------------------------------------------------------------------
 e0=$(last_state | field bus_errors)
@@ -153,4 +163,20 @@ if [ "$stop_rc" = 0 ] && [ "$(peek r2 1 operating_mode)" = 3 ] && [ "$(peek r2 1
 	[ "$(peek r2 1 bus_watchdog)" = 0 ]; then
 	tap_ok "safe stop after torque actuation: position control, holding, watchdog off"
 else tap_fail "safe stop" "exit $stop_rc, mode $(peek r2 1 operating_mode), torque $(peek r2 1 torque_enable)"; fi
+
+# ---- one XL430 joint in position control on its own defaults ------------------------------------------------
+# The XL430's position loop lags most: on the AX-12A's defaults a single joint
+# runs down to rest within seconds and the starter restarts it ('stall');
+# on the XL430's own (k 0.0105, mu 0.036, servo_lead_s 0.117) it keeps the gait.
+n0=$(events | grep -c 'kind=stall')
+mark_states
+spawn dp "$D" --port "$T/xl" --ids 1 --robot "$R" --lcm-url "$URL" --mode oscillator
+wait_log dp "ready: $R.STATE" 15 && wait_restarted 100 || { tap_fail "XL430 position daemon starts" "$(cat "$T/dp.log")"; tap_done; exit 1; }
+wait_cycles 800
+sw=$(swing 0 300); n1=$(events | grep -c 'kind=stall')
+if grep -q "joint 1: position actuation's default k 0.0105, mu 0.036 are the XL430-W250's" "$T/dp.log" &&
+	[ "$n1" = "$n0" ] && over "$sw" 1.2; then
+	tap_ok "one XL430 joint on its own defaults: swings $sw rad peak to peak, no stall in 8 s"
+else tap_fail "XL430 on its defaults" "swing $sw rad, $((n1 - n0)) stall(s); $(grep -a default "$T/dp.log" | head -2)"; fi
+stop dp >/dev/null
 tap_done

@@ -154,12 +154,10 @@ fi
 if why=$(leftovers); then tap_ok "nothing left behind after a full run"; else tap_fail "nothing left behind after a full run" "$why"; fi
 
 # ---- the same experiment on XM430-W350 robots (Protocol 2.0), in virtual time -------------------
-# Position servos as the paper's robots, with the parameters `undulated --tune`
-# found for the simulated XM430 (daemon/CONTROL.md: the AX-12A's defaults let
-# its oscillator run down between restarts there).
-xset=(--set sim.model=xm430-w350 --set sim.baud=1000000 --set sim.return_delay_us=0
-	--daemon-set robot.servo_lead_s=0.047 --daemon-set joint.1.k=0.0304 --daemon-set joint.2.k=0.0304
-	--daemon-set joint.1.mu=0.0757 --daemon-set joint.2.mu=0.0571)
+# Position servos as the paper's robots, on the daemon's defaults for the
+# XM430 (what `undulated --tune` found for the simulated servo; the AX-12A's let
+# its oscillator run down between restarts there: daemon/CONTROL.md).
+xset=(--set sim.model=xm430-w350 --set sim.baud=1000000 --set sim.return_delay_us=0)
 env BUILD="$BUILD" DEMO_SECONDS=$seconds TMPDIR="$T/tmp" DEMO_OUT="$T/xout" "$demo" --lockstep --lcm-url "$url" "${xset[@]}" \
 	>"$T/xdemo.log" 2>&1
 xrc=$?

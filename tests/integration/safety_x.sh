@@ -35,12 +35,10 @@ spawn sim "$S" --model xm430-w350 --link "$T/bus" --ids 1,2 --name r1 --baud 100
 	--lcm-url "$URL" --control "$T/ctl" --seed 6
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
-# the oscillator tuned for the simulated XM430 (undulated --tune, daemon/CONTROL.md): with the
-# AX-12A's defaults it runs down between restarts there, and "it swings again" would mean little
-XM_TUNED=(--set robot.servo_lead_s=0.047 --set joint.1.k=0.0304 --set joint.2.k=0.0304 --set joint.1.mu=0.0757
-	--set joint.2.mu=0.0571)
+# the oscillator on the XM430's own defaults (daemon/CONTROL.md, "X-series servos"): with the
+# AX-12A's it would run down between restarts there, and "it swings again" would mean little
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode limp --set robot.fault_action=hold \
-	--set robot.fault_backoff_s=0.3 "${XM_TUNED[@]}"
+	--set robot.fault_backoff_s=0.3
 wait_log d "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts on the X bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
 
@@ -108,6 +106,11 @@ if event 'kind=fault-latched text="servo 1 overheating persists: robot HOLD' 8 &
 	event 'kind=fault-persistent text="servo 1: overheating persists after 1 REBOOT\(s\) \(fault_reboots = 1\)' 1 && state_is ' mode=1 ' 2 && [ "$on_while_hot" = 0 ]; then
 	tap_ok "overheating: one REBOOT, the cause still there, the fault latches (HOLD); torque never on while it stood"
 else tap_fail "overheat latches" "$(events | tail -4); torque on while hot $on_while_hot"; fi
+# published: Hardware Error Status with ERROR_BITS_X (256) so monitors name it by the
+# X table; overheating is bit 2 (4), the alert bit 7 (128); joint 2 has none
+if state_is ' e0=(260|388) .* e1=(256|384) ' 3; then
+	tap_ok "STATE: joint 1's error bits the X servo's (overheating, ERROR_BITS_X), joint 2's none"
+else tap_fail "X error bits published" "$(grep -a '^STATE' "$T/watch.log" | tail -1 | grep -oE ' e[01]=[0-9]+' | tr '\n' ' ')"; fi
 ctl clear r1 1 >/dev/null   # cooled down
 wait_cycles 20
 out=$( { cmd clear && cmd 'mode oscillator'; } 2>&1); rc=$?

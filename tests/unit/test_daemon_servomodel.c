@@ -236,6 +236,21 @@ static void test_drive_outputs(void **state)
 	assert_int_equal(sm_drive_raw(ax, false, -0.5, 0), dxl_duty_to_wheel(-0.5));
 }
 
+/* A finished configuration on /dev/null with these assignments
+ * ("robot.ids=1,2", ..., NULL). */
+static void cfg_with(struct cfg *c, ...)
+{
+	struct cfg_errors e = { 0 };
+	cfg_defaults(c);
+	assert_true(cfg_override(c, "robot.port=/dev/null", &e));
+	va_list ap;
+	va_start(ap, c);
+	for (const char *a; (a = va_arg(ap, const char *)) != NULL;)
+		assert_true(cfg_override(c, a, &e));
+	va_end(ap);
+	assert_true(cfg_finish(c, &e));
+}
+
 /* Torque actuation's defaults are an AX-12A joint's; on another servo the
  * same link is heavier by the rotor through the gearbox, and the defaults
  * the configuration did not give scale with it, once. */
@@ -249,14 +264,7 @@ static void test_torque_defaults_scale(void **state)
 	assert_true(xm > 1.7 && xm < 1.8);
 	assert_true(xl > 1.0 && xl < 1.05);
 	struct cfg c;
-	struct cfg_errors e = { 0 };
-	cfg_defaults(&c);
-	assert_true(cfg_override(&c, "robot.port=/dev/null", &e));
-	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
-	assert_true(cfg_override(&c, "robot.actuation=torque", &e));
-	assert_true(cfg_override(&c, "robot.torque_drive=current", &e));
-	assert_true(cfg_override(&c, "joint.2.k=0.3", &e));
-	assert_true(cfg_finish(&c, &e));
+	cfg_with(&c, "robot.ids=1,2", "robot.actuation=torque", "robot.torque_drive=current", "joint.2.k=0.3", NULL);
 	double k1 = c.joint[0].osc.k, mu1 = c.joint[0].osc.mu, i1 = c.joint[0].osc.inertia;
 	cfg_scale_torque_defaults(&c, 0, xm);
 	cfg_scale_torque_defaults(&c, 1, xm);
@@ -268,13 +276,51 @@ static void test_torque_defaults_scale(void **state)
 	cfg_scale_torque_defaults(&c, 0, xm);                      /* once */
 	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
 	/* position actuation's parameters are a control law's, not a joint's: none */
-	cfg_defaults(&c);
-	assert_true(cfg_override(&c, "robot.port=/dev/null", &e));
-	assert_true(cfg_override(&c, "robot.ids=1", &e));
-	assert_true(cfg_finish(&c, &e));
+	cfg_with(&c, "robot.ids=1", NULL);
 	k1 = c.joint[0].osc.k;
 	cfg_scale_torque_defaults(&c, 0, xm);
 	assert_true(fabs(c.joint[0].osc.k - k1) < 1e-12);
+}
+
+/* Position actuation's defaults: the AX-12A has none of its own (osc.h's
+ * stand); an X model's replace the k and μ the configuration did not give,
+ * by the joint's parity and the robot's size, once; torque actuation's are
+ * left alone. */
+static void test_position_defaults(void **state)
+{
+	(void)state;
+	double k, mu, lead;
+	assert_false(sm_position_defaults(sm_ax12(), 0, 2, &k, &mu, &lead));
+	const struct sm_model *xm = sm_of(SM_XM430), *xl = sm_of(SM_XL430);
+	assert_true(sm_position_defaults(xm, 0, 2, &k, &mu, &lead));
+	assert_true(fabs(k - 0.0304) < 1e-12 && fabs(mu - 0.0757) < 1e-12 && fabs(lead - 0.047) < 1e-12);
+	assert_true(sm_position_defaults(xm, 1, 2, &k, &mu, &lead));
+	assert_true(fabs(mu - 0.0571) < 1e-12);
+	assert_true(sm_position_defaults(xm, 2, 4, &k, &mu, &lead));   /* a longer chain: by parity */
+	assert_true(fabs(mu - 0.0757) < 1e-12);
+	assert_true(sm_position_defaults(xl, 0, 1, &k, &mu, &lead));   /* a single joint */
+	assert_true(fabs(k - 0.0105) < 1e-12 && fabs(mu - 0.0360) < 1e-12 && fabs(lead - 0.117) < 1e-12);
+
+	struct cfg c;
+	cfg_with(&c, "robot.ids=1,2", "joint.2.mu=0.5", NULL);
+	assert_true(c.servo_lead_default);
+	assert_true(cfg_position_defaults(&c, 0, 0.03, 0.07));
+	assert_true(fabs(c.joint[0].osc.k - 0.03) < 1e-12 && fabs(c.joint[0].osc.mu - 0.07) < 1e-12);
+	assert_true(cfg_position_defaults(&c, 1, 0.03, 0.07));
+	assert_true(fabs(c.joint[1].osc.k - 0.03) < 1e-12);
+	assert_true(fabs(c.joint[1].osc.mu - 0.5) < 1e-12);             /* given: kept */
+	assert_false(cfg_position_defaults(&c, 0, 0.9, 0.9));           /* once */
+	assert_true(fabs(c.joint[0].osc.k - 0.03) < 1e-12);
+	/* every one given: nothing to replace */
+	cfg_with(&c, "robot.ids=1", "joint.1.k=0.2", "joint.1.mu=0.2", "robot.servo_lead_s=0.03", NULL);
+	assert_false(c.servo_lead_default);
+	assert_false(cfg_position_defaults(&c, 0, 0.03, 0.07));
+	assert_true(fabs(c.joint[0].osc.k - 0.2) < 1e-12);
+	/* torque actuation: its own defaults (scaled), never these */
+	cfg_with(&c, "robot.ids=1", "robot.actuation=torque", NULL);
+	k = c.joint[0].osc.k;
+	assert_false(cfg_position_defaults(&c, 0, 0.03, 0.07));
+	assert_true(fabs(c.joint[0].osc.k - k) < 1e-12);
 }
 
 int main(void)
@@ -289,6 +335,7 @@ int main(void)
 		cmocka_unit_test(test_status_meaning),
 		cmocka_unit_test(test_drive_outputs),
 		cmocka_unit_test(test_torque_defaults_scale),
+		cmocka_unit_test(test_position_defaults),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

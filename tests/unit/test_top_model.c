@@ -370,6 +370,43 @@ static void test_joint_health(void **state)
 	assert_non_null(strstr(screen, ">S 1 r1"));
 }
 
+/* An X servo's error_bits are its Hardware Error Status (ERROR_BITS_X set): bits 3
+ * and 4 are the motor encoder and an electrical shock there, not the AX-12A's range
+ * and checksum; the flag alone (no cause, no alert) is no error. */
+static void test_x_error_bits(void **state)
+{
+	(void)state;
+	char n[] = "x1", reason[] = "test";
+	int16_t x = UNDULATE_JOINT_STATE_T_ERROR_BITS_X;
+	undulate_joint_state_t j[2] = {
+		{ .servo_id = 1, .amplitude = 0.8, .frequency = 0.8, .temperature = 41, .voltage = 11.8,
+		  .error_bits = (int16_t)(x | 0x80 | 0x18) },
+		{ .servo_id = 2, .amplitude = 0.8, .frequency = 0.8, .temperature = 33, .voltage = 11.9,
+		  .error_bits = x },
+	};
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason, .fault = "",
+		.period_us = 10000.0, .njoints = 2, .joints = j };
+	top_on_state(&model, &s, 0.0);
+	char buf[96];
+	assert_string_equal(top_joint_status(&model.robots[0].j[0], buf, sizeof buf), "motor encoder|electrical shock");
+	assert_string_equal(top_joint_status(&model.robots[0].j[1], buf, sizeof buf), "ok");
+	assert_string_equal(top_errbits_format(0x18, buf, sizeof buf), "range|checksum");   /* the AX-12A's byte */
+	assert_string_equal(top_errbits_format(x, buf, sizeof buf), "");
+	struct top_view v = { .kind = TOP_VIEW_DETAIL };
+	top_render(&model, &v, 0.1, 24, 120, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "motor encoder|electrical shock"));
+	assert_null(strstr(screen, "checksum"));
+	/* compact view: the joint with a cause marks the robot; without it, no mark */
+	v.kind = TOP_VIEW_COMPACT;
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, ">! 1 x1"));
+	j[0].error_bits = x;
+	s.utime = 2;
+	top_on_state(&model, &s, 0.05);
+	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, ">  1 x1"));
+}
+
 /* Nobody heard: the screen says which URL it listens on; ? shows the legend. */
 static void test_empty_and_help(void **state)
 {
@@ -387,6 +424,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test_setup(test_joint_health, setup),
+		cmocka_unit_test_setup(test_x_error_bits, setup),
 		cmocka_unit_test_setup(test_empty_and_help, setup),
 		cmocka_unit_test_setup(test_rate_jitter_stale, setup),
 		cmocka_unit_test_setup(test_drive_column, setup),

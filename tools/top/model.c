@@ -1,6 +1,7 @@
 /* model.c — see model.h. */
 #include "model.h"
 #include "dxl.h"
+#include "dxl2_table.h"
 #include "json.h"
 #include "modes.h"
 #include "phase.h"
@@ -269,12 +270,24 @@ int top_robot_silent_joints(const struct top_robot *r)
 	return n;
 }
 
+char *top_errbits_format(int16_t bits, char *buf, size_t cap)
+{
+	uint8_t low = (uint8_t)(bits & 0x7F);
+	if (low == 0)
+		snprintf(buf, cap, "%s", "");
+	else if (bits & UNDULATE_JOINT_STATE_T_ERROR_BITS_X)
+		dxl2_hwerr_format(low, buf, cap);
+	else
+		dxl_errbits_format(low, buf, cap);
+	return buf;
+}
+
 const char *top_joint_status(const struct top_joint *j, char *buf, size_t cap)
 {
 	if (top_joint_silent(j))
 		snprintf(buf, cap, "SILENT x%d", (int)j->stale_cycles);
 	else if (j->error_bits & 0x7F)
-		dxl_errbits_format((uint8_t)(j->error_bits & 0x7F), buf, cap);
+		top_errbits_format(j->error_bits, buf, cap);
 	else
 		snprintf(buf, cap, "ok");
 	return buf;

@@ -132,6 +132,10 @@ bool top_joint_silent(const struct top_joint *j);
 int top_robot_silent_joints(const struct top_robot *r);
 /* A joint's health in words: "ok", "SILENT xN" (no valid reading for N cycles), or the
  * servo's error bits by name ("overload|overheating"). */
+/* The error bits of joint_state_t.error_bits by name, by the AX-12A's error byte or,
+ * with ERROR_BITS_X, an X servo's Hardware Error Status ("motor encoder"); "" when
+ * none is set (the alert, bit 7, is not a cause). Returns buf. */
+char *top_errbits_format(int16_t bits, char *buf, size_t cap);
 const char *top_joint_status(const struct top_joint *j, char *buf, size_t cap);
 double top_robot_rate_hz(const struct top_robot *r);      /* 1e6 / mean period; NAN none */
 double top_robot_rx_hz(const struct top_robot *r, double now); /* STATE messages received per second */

@@ -123,7 +123,7 @@ static void flags_text(char *out, size_t n, const struct top_robot *r, double no
 	else if (silent > 0)
 		snprintf(out, n, "%d joint%s SILENT", silent, silent == 1 ? "" : "s");
 	else if (err & 0x7F)
-		snprintf(out, n, "%s", dxl_errbits_format((uint8_t)(err & 0x7F), names, sizeof names));
+		snprintf(out, n, "%s", top_errbits_format(err, names, sizeof names));
 	else if (r->have_bus && !r->connected)
 		snprintf(out, n, "bus down");
 	else
@@ -185,7 +185,7 @@ static void robot_compact(struct rbuf *b, const struct top_model *m, const struc
 	int16_t err = 0;
 	for (int k = 0; k < r->njoints; k++)
 		err |= r->j[k].error_bits;
-	char mark = top_robot_stale(r, now) ? 'x' : top_robot_silent_joints(r) > 0 ? 'S' : err ? '!' : ' ';
+	char mark = top_robot_stale(r, now) ? 'x' : top_robot_silent_joints(r) > 0 ? 'S' : (err & 0xFF) ? '!' : ' ';
 	rb_line(b, pos == v->selected, "%c%c%2d %-10.10s %-4s %s %s %4lld %s %s %s %s %s", pos == v->selected ? '>' : ' ',
 		mark, pos + 1, r->name, r->have_state ? mode_short(r->mode) : "-",
 		num(rate, sizeof(rate), "%5.1f", top_robot_rate_hz(r), 5),

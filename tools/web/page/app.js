@@ -90,7 +90,7 @@ function robotStatus(s) {
   for (const j of s.joints) {
     const tr = el('tr');
     tr.append(el('td', {}, j.id), el('td', {}, num(j.temperature, 0)), el('td', {}, num(j.voltage, 1)),
-      el('td', {}, '0x' + j.error_bits.toString(16)), el('td', { class: j.status === 'ok' ? '' : 'bad' }, j.status),
+      el('td', {}, '0x' + (j.error_bits & 0xff).toString(16)), el('td', { class: j.status === 'ok' ? '' : 'bad' }, j.status),
       el('td', {}, j.torque ? 'on' : 'off'));
     tb.append(tr);
   }
