@@ -41,7 +41,7 @@ RAMP_S=2
 # Multicast ports of the benchmark (7900-7949): one per run, so runs never
 # hear each other's messages.
 PORT_LOOP_OTHER=7900 PORT_LOOP_FIFO=7901 PORT_BUS=7902 PORT_MISSING=7903 PORT_CAP=7904 PORT_FLEET=7905 PORT_CG=7906 PORT_WEB=7907
-PORT_LOCK=7908
+PORT_LOCK=7908 PORT_LOOP_X=7909
 FIFO_PRIORITY=80
 # The simulator's own real-time option (below the daemons' priority above).
 SIM_RT_PRIORITY=10
@@ -212,51 +212,63 @@ say() { printf '%s\n' "$*" >>"$REPORT"; }
 sum() { printf '| %s | %s | %s |\n' "$1" "$2" "$3" >>"$SUMMARY"; }
 
 # ---- 1 + 4: loop timing against cyclictest, daemon CPU and memory ------------------
-# loop_run POLICY MCAST_PORT: one robot (2 servos, return delay 0) on the simulated
-# bus, its daemon at POLICY, cyclictest at the same policy for LOOP_S seconds
-# meanwhile. Leaves $T/loop-POLICY/{stat,cyclictest,info}.
+# loop_run RUN MCAST_PORT [MODEL]: one robot (2 servos, return delay 0) on the
+# simulated bus, its daemon at RUN's policy (fifo, else SCHED_OTHER), cyclictest
+# at the same policy for LOOP_S seconds meanwhile; MODEL: X servos of that
+# model (Protocol 2.0, 1 Mbps). Leaves $T/loop-RUN/{stat,cyclictest,info}.
 loop_run() {
-	local pol=$1 d=$T/loop-$1 u
+	local run=$1 pol=other d=$T/loop-$1 u model=()
+	[ "$run" = fifo ] && pol=fifo
+	[ -n "${3:-}" ] && model=(--model "$3" --baud 1000000)
 	u=$(url "$2")
 	mkdir -p "$d"
 	echo "status ok" >"$d/info"
-	start "sim-$pol" "$SIM" --link "$d/r1" --ids 1,2 --return-delay 0 --lcm-url "$u" --quiet
-	if ! wait_ready "sim-$pol" 'ready:' 10; then
-		echo "status not measured: undulate-sim did not start ($(why "sim-$pol"))" >"$d/info"
-		stop "sim-$pol"
+	start "sim-$run" "$SIM" --link "$d/r1" --ids 1,2 --return-delay 0 --lcm-url "$u" --quiet ${model[@]+"${model[@]}"}
+	if ! wait_ready "sim-$run" 'ready:' 10; then
+		echo "status not measured: undulate-sim did not start ($(why "sim-$run"))" >"$d/info"
+		stop "sim-$run"
 		return 1
 	fi
-	start "log-$pol" lcm-logger --lcm-url="$u" -f "$d/run.lcm"
+	start "log-$run" lcm-logger --lcm-url="$u" -f "$d/run.lcm"
 	wait_file "$d/run.lcm" 10
 	local extra=()
 	[ "$pol" = fifo ] && extra=(--set "robot.priority=$FIFO_PRIORITY" --set robot.mlockall=true)
-	if ! start_daemon "dmn-$pol" "$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u" --mode oscillator "${extra[@]}"; then
-		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$pol"))" >"$d/info"
-		stop "log-$pol"; stop "sim-$pol"
+	if ! start_daemon "dmn-$run" "$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u" --mode oscillator "${extra[@]}"; then
+		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$run"))" >"$d/info"
+		stop "log-$run"; stop "sim-$run"
 		return 1
 	fi
 	echo "start_retries $RETRIES" >>"$d/info"
 	sleep "$RAMP_S"  # the ramp-in: a fixed wait, not a readiness guess
-	local dpid=${PID[dmn-$pol]} ct=(--policy=other)
+	local dpid=${PID[dmn-$run]} ct=(--policy=other)
 	[ "$pol" = fifo ] && ct=(--policy=fifo -p "$FIFO_PRIORITY")
 	echo "policy $(policy_of "$dpid" | tr ' ' '/')" >>"$d/info"
 	local t0 c0 t1 c1
 	t0=$(now_us) c0=$(cpu_ticks "$dpid")
-	start "ct-$pol" cyclictest -q -v -m -i 10000 -l $((LOOP_S * 100)) "${ct[@]}"
+	start "ct-$run" cyclictest -q -v -m -i 10000 -l $((LOOP_S * 100)) "${ct[@]}"
 	local ctrc=0
-	wait "${PID[ct-$pol]}" || ctrc=$?
-	unset "PID[ct-$pol]"
+	wait "${PID[ct-$run]}" || ctrc=$?
+	unset "PID[ct-$run]"
 	t1=$(now_us) c1=$(cpu_ticks "$dpid")
 	{
 		echo "cpu_pct $(cpu_pct "$c0" "$c1" "$t0" "$t1")"
 		echo "hwm_kb $(hwm_kb "$dpid")"
 		echo "cyclictest_rc $ctrc"
 	} >>"$d/info"
-	stop "dmn-$pol"; stop "log-$pol"; stop "sim-$pol"
+	stop "dmn-$run"; stop "log-$run"; stop "sim-$run"
 	"$HB/logstat" --from-us "$t0" --to-us "$t1" "$d/run.lcm" >"$d/stat"
 	# cyclictest -v: "thread: loop: latency_us"; loop 0 is before the first period
-	awk '$1 == "0:" && $2 + 0 > 0 { print $3 }' "$T/ct-$pol.log" >"$d/ct-lat"
+	awk '$1 == "0:" && $2 + 0 > 0 { print $3 }' "$T/ct-$run.log" >"$d/ct-lat"
 	echo "ct $(pctl "$d/ct-lat") $(wc -l <"$d/ct-lat")" >>"$d/info"
+}
+
+# loop_label RUN: the table's name of a loop_run
+loop_label() {
+	case "$1" in
+	fifo) echo "SCHED_FIFO $FIFO_PRIORITY" ;;
+	xm) echo "SCHED_OTHER, XM430-W350 (2.0)" ;;
+	*) echo "SCHED_${1^^}" ;;
+	esac
 }
 
 section_loop() {
@@ -270,6 +282,8 @@ section_loop() {
 		echo "status not measured: SCHED_FIFO not permitted for this user (CAP_SYS_NICE / RLIMIT_RTPRIO)" \
 			>"$T/loop-fifo/info"
 	fi
+	progress "1/5 loop timing at 100 Hz: SCHED_OTHER on two XM430-W350 (Protocol 2.0), ${LOOP_S} s"
+	loop_run xm $PORT_LOOP_X xm430-w350
 	say "## 1. Control loop timing at 100 Hz"
 	say ""
 	say "Wake-up lateness = how late a cycle starts after its deadline; period = time between cycle starts (µs)."
@@ -279,11 +293,11 @@ section_loop() {
 	say "| policy | program | samples | lateness p50 | p99 | max | period p50 | p99 | max | overruns | p99 vs cyclictest |"
 	say "|---|---|---|---|---|---|---|---|---|---|---|"
 	local pol d st
-	for pol in other fifo; do
+	for pol in other fifo xm; do
 		d=$T/loop-$pol
 		st=$(v "$d/info" status)
-		local label="SCHED_${pol^^}"
-		[ "$pol" = fifo ] && label="SCHED_FIFO $FIFO_PRIORITY"
+		local label
+		label=$(loop_label "$pol")
 		if [ "$st" != ok ]; then
 			say "| $label | – | – | – | – | – | – | – | – | – | $(sed -n 's/^status //p' "$d/info") |"
 			sum "loop wake-up lateness p99, $label" "≤ 2× cyclictest" "$(sed -n 's/^status //p' "$d/info")"
@@ -319,16 +333,18 @@ section_resources() {
 	say "| policy | CPU % (/proc) | CPU % (self-reported) | peak RSS (KiB) | control step p50 (µs) |"
 	say "|---|---|---|---|---|"
 	local pol d
-	for pol in other fifo; do
+	for pol in other fifo xm; do
 		d=$T/loop-$pol
 		if [ "$(v "$d/info" status)" != ok ]; then
-			say "| SCHED_${pol^^} | $(sed -n 's/^status //p' "$d/info") | – | – | – |"
+			say "| $(loop_label "$pol") | $(sed -n 's/^status //p' "$d/info") | – | – | – |"
 			[ "$pol" = other ] && sum "daemon CPU at 100 Hz" "< 2 % of one core" "$(sed -n 's/^status //p' "$d/info")"
 			continue
 		fi
 		[ "$pol" = other ] && sum "daemon CPU at 100 Hz (SCHED_OTHER, 2 servos)" "< 2 % of one core" \
 			"$(fmt "$(v "$d/info" cpu_pct)" 2) % (self-reported $(fmt "$(v "$d/stat" all.cpu_mean)" 2) %); peak RSS $(v "$d/info" hwm_kb) KiB"
-		say "| SCHED_${pol^^} | $(fmt "$(v "$d/info" cpu_pct)" 2) | $(fmt "$(v "$d/stat" all.cpu_mean)" 2) |" \
+		[ "$pol" = xm ] && sum "daemon CPU at 100 Hz (SCHED_OTHER, 2 XM430-W350, Protocol 2.0)" "< 2 % of one core" \
+			"$(fmt "$(v "$d/info" cpu_pct)" 2) % (self-reported $(fmt "$(v "$d/stat" all.cpu_mean)" 2) %); peak RSS $(v "$d/info" hwm_kb) KiB"
+		say "| $(loop_label "$pol") | $(fmt "$(v "$d/info" cpu_pct)" 2) | $(fmt "$(v "$d/stat" all.cpu_mean)" 2) |" \
 			"$(v "$d/info" hwm_kb) | $(fmt "$(v "$d/stat" all.control_p50)") |"
 	done
 	say ""
