@@ -13,13 +13,15 @@
 # command (bad_commands) and bus error, accepts none of them, and no goal
 # ever leaves the configured joint limits (narrowed to +-0.5 rad so that the
 # 0.8 rad limit cycle presses against them).
+# QA_MODEL (qa_daemon_hostile_x.sh): X servos of that model on the simulated
+# bus (Protocol 2.0, 1 Mbps) instead of AX-12A; QA_PORT its own LCM port.
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"; Q="$top/tests/integration/qa_lcm.py"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
 	tap_skip_all "undulate-sim or undulated not built"
 fi
-PORT=$(lcm_port 7952)   # the UDP port itself: qa_lcm.py talks to it raw
-URL=$(lcm_url 7952)
+PORT=$(lcm_port "${QA_PORT:-7952}")   # the UDP port itself: qa_lcm.py talks to it raw
+URL=$(lcm_url "${QA_PORT:-7952}")
 R="qa$$"
 LIM=0.5
 ctl() { python3 "$top/tests/integration/sim_client.py" ctl "$T/ctl" "$1"; }
@@ -34,15 +36,19 @@ wait_for 5 grep -qE '^[0-9a-f]{40,}$' "$T/cap.log"
 TEMPLATE=$(grep -E '^[0-9a-f]{40,}$' "$T/cap.log" | head -1)
 [ -n "$TEMPLATE" ] || { tap_fail "capture a command_t" "$(cat "$T/cap.log")"; tap_done; exit 1; }
 
-spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5 --return-delay 0
+model=()
+[ -n "${QA_MODEL:-}" ] && model=(--model "$QA_MODEL" --baud 1000000)
+spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5 --return-delay 0 \
+	${model[@]+"${model[@]}"}
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator \
 	--set robot.commands=network --set robot.command_key="$KEY" \
 	--set joint.1.limit_min=-$LIM --set joint.1.limit_max=$LIM \
 	--set joint.2.limit_min=-$LIM --set joint.2.limit_max=$LIM
-if wait_log d "ready: $R.STATE" 10 && wait_for 10 cycle_at_least 150; then
-	tap_ok "daemon runs against the simulator"
+if wait_log d "ready: $R.STATE" 10 && wait_for 10 cycle_at_least 150 &&
+	{ [ -z "${QA_MODEL:-}" ] || grep -q "Protocol 2.0 (${QA_MODEL^^})" "$T/d.log"; }; then
+	tap_ok "daemon runs against the simulator${QA_MODEL:+ (${QA_MODEL^^}, Protocol 2.0)}"
 else
 	tap_fail "daemon runs" "$(tail -5 "$T/d.log")"; tap_done; exit 1
 fi
