@@ -340,6 +340,25 @@ static void dmn_position_defaults(struct dmn *d)
 		         "undulated --tune finds this robot's (daemon/CONTROL.md, \"X-series servos\")");
 }
 
+/* --tune: the tuner began from the configuration as loaded; the model's
+ * defaults (above) may have changed k, mu and the lead since. It starts
+ * again from what the robot will run, so that the factors it finds and the
+ * file it writes are on those (on the simulated XL430 it wrote the AX-12A's
+ * k and lead beside a gait measured on the XL430's). When the target is out
+ * of reach there the run stops before it starts, saying why. */
+static void dmn_tune_rebase(struct dmn *d)
+{
+	if (d->tune == NULL)
+		return;
+	struct tune_opts o = d->tune->opts;
+	char why[sizeof d->tune->why];
+	if (!tune_init(d->tune, &o, d->cfg, why, sizeof why)) {
+		snprintf(d->tune->why, sizeof d->tune->why, "%s", why);
+		d->tune->state = TUNE_FAILED;
+		d->stop = true;
+	}
+}
+
 /* "AX-12A" or "XL430-W250, XM430-W350": the models found. */
 static void dmn_models(const struct dmn *d, char *out, size_t cap)
 {
@@ -904,6 +923,7 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	dmn_models(d, models, sizeof models);
 	dmn_torque_defaults(d);
 	dmn_position_defaults(d);
+	dmn_tune_rebase(d);
 	log_info("robot %s: %zu joint(s) on %s at %ld bps, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints,
 	         d->port_path, cfg->baud, d->protocol == BUS_PROTOCOL_2 ? "2.0" : "1.0", models,
 	         cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");

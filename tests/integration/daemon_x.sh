@@ -179,4 +179,22 @@ if grep -q "joint 1: position actuation's default k 0.0105, mu 0.036 are the XL4
 	tap_ok "one XL430 joint on its own defaults: swings $sw rad peak to peak, no stall in 8 s"
 else tap_fail "XL430 on its defaults" "swing $sw rad, $((n1 - n0)) stall(s); $(grep -a default "$T/dp.log" | head -2)"; fi
 stop dp >/dev/null
+
+# ---- --tune on an X servo: from the model's defaults, and the file says so ----------------------------------
+# (in lockstep: a simulated minute in a few seconds). The tuner starts from what
+# the robot runs once the model is known; it once wrote the AX-12A's k and lead
+# beside a gait measured on the XL430's defaults.
+spawn lsim "$S" --lockstep "$T/ls.sock" --model xl430-w250 --baud 1000000 --link "$T/lbus" --ids 1 \
+	--return-delay 0 --duration 300 --lcm-url "$URL"
+wait_log lsim 'ready' 10 || { tap_fail "lockstep simulator ready" "$(cat "$T/lsim.log")"; tap_done; exit 1; }
+timeout 120 "$D" --tune --lockstep "$T/ls.sock" --port "$T/lbus" --ids 1 --robot "$R" --lcm-url "$URL" \
+	--out "$T/tuned.conf" >"$T/tune.log" 2>&1; rc=$?
+stop lsim >/dev/null
+done_line=$(grep -a '^tune: done' "$T/tune.log" | head -1)
+kx=$(echo "$done_line" | sed -n 's/.* k x\([0-9.]*\),.*/\1/p')
+fk=$(sed -n 's/^k = //p' "$T/tuned.conf" 2>/dev/null); fl=$(sed -n 's/^servo_lead_s = //p' "$T/tuned.conf" 2>/dev/null)
+if [ "$rc" = 0 ] && [ -n "$kx" ] && [ -n "$fk" ] &&
+	awk -v k="$fk" -v x="$kx" -v l="$fl" 'BEGIN { exit !(k > 0.0105 * x * 0.99 && k < 0.0105 * x * 1.01 && l >= 0.117) }'; then
+	tap_ok "--tune on an XL430 (lockstep): from its defaults; the file's k $fk = 0.0105 x $kx, servo_lead_s $fl"
+else tap_fail "--tune on an XL430" "rc $rc; ${done_line:-no result}; file k $fk lead $fl; $(tail -3 "$T/tune.log")"; fi
 tap_done
