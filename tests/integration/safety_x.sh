@@ -111,6 +111,14 @@ else tap_fail "overheat latches" "$(events | tail -4); torque on while hot $on_w
 if state_is ' e0=(260|388) .* e1=(256|384) ' 3; then
 	tap_ok "STATE: joint 1's error bits the X servo's (overheating, ERROR_BITS_X), joint 2's none"
 else tap_fail "X error bits published" "$(grep -a '^STATE' "$T/watch.log" | tail -1 | grep -oE ' e[01]=[0-9]+' | tr '\n' ' ')"; fi
+# and a monitor names them by the X table: with the motor encoder's bit (3) set
+# as well, the AX-12A's table would say "overheating|range"
+ctl poke r1 1 hardware_error_status 12 >/dev/null
+state_is ' e0=(268|396) ' 3
+top=$(timeout 15 "$B/undulate-top" --once --json --wait 1.5 --lcm-url "$URL" 2>/dev/null)
+st=$(echo "$top" | jq -r --arg r "$R" '.robots[] | select(.name == $r) | [.joints[].status] | join(",")' 2>/dev/null)
+if [ "$st" = "overheating|motor encoder,ok" ]; then tap_ok "undulate-top names them by the X table: joint 1 $st"
+else tap_fail "undulate-top's joint status" "'$st'; $(grep -a '^STATE' "$T/watch.log" | tail -1 | grep -oE ' e[01]=[0-9]+' | tr '\n' ' ')"; fi
 ctl clear r1 1 >/dev/null   # cooled down
 wait_cycles 20
 out=$( { cmd clear && cmd 'mode oscillator'; } 2>&1); rc=$?
