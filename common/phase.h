@@ -12,7 +12,7 @@
  *
  * Unknown stays unknown: without a usable ω (≤ 0: not measured yet) or with a
  * non-finite x or ẋ the phase is NAN, never a number that looks measured (the
- * daemon's old osc_phase gave 0, the analyser's NAN; a 0 reads as "at the
+ * daemon's old phase function gave 0; a 0 reads as "at the
  * positive turning point" and pairs with real phases). Consumers already skip
  * non-finite phases (undulate-top shows "-", the analyser leaves rows empty).
  */
@@ -48,9 +48,10 @@ double phase_from_state(double x, double v, double omega);
  *   alone would put ±5 ms on every period);
  * - frequency = 1 / the median of the last PHASE_CYCLES periods, amplitude =
  *   the median of their half peak-to-peaks: a collision's phase jump shortens
- *   or lengthens one period (two if it falls on a crossing); daemon/osc.c's
- *   running mean (newest cycle weighs 0.5) lets one jump move the frequency
- *   by 16 % for cycles, the median not at all (test_common_phase). The first two crossings are timed
+ *   or lengthens one period (two if it falls on a crossing); a running
+ *   mean (newest cycle weighs 0.5, the daemon's own estimator until it took
+ *   this one) lets one jump move the frequency by 16 % for cycles, the median
+ *   not at all (test_common_phase). The first two crossings are timed
  *   against a guessed centre and give no period, so a frequency appears from
  *   the fourth crossing; a period shorter than PHASE_PERIOD_MIN_S is noise;
  * - stale: no crossing for three estimated periods (PHASE_MAX_PERIOD_S before

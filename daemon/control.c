@@ -283,7 +283,7 @@ void ctl_init(struct ctl *c, struct cfg *cfg)
 		jt->reboot_at = -INFINITY;
 		jt->servo.max_torque = 1023;
 		osc_velocity_filter_init(&jt->vfilter, cfg->velocity_cutoff_hz);
-		osc_estimator_init(&jt->estimator);
+		phase_estimator_init(&jt->estimator);
 		c->hold[j] = NAN;
 		c->blend_from[j] = NAN;
 	}
@@ -1381,10 +1381,11 @@ static void ctl_update_estimates(struct ctl *c, size_t j)
 		return;
 	const struct cfg_joint *cj = &c->cfg->joint[j];
 	double x = jt->angle - cj->neutral;
-	osc_estimator_update(&jt->estimator, x, c->t);
-	double omega = jt->estimator.frequency > 0.0 ? 2.0 * 3.14159265358979323846 * jt->estimator.frequency
+	phase_estimator_update(&jt->estimator, x, c->t);
+	/* before a frequency is measured, the law's own: sqrt(k / I) */
+	double omega = jt->estimator.frequency > 0.0 ? phase_estimator_omega(&jt->estimator)
 	                                            : sqrt(cj->osc.k / cj->osc.inertia);
-	jt->phase = osc_phase(x, jt->speed, omega);
+	jt->phase = phase_from_state(x, jt->speed, omega);
 }
 
 void ctl_step(struct ctl *c, double t, double dt, double t_real)

@@ -36,6 +36,7 @@
 
 #include "config.h"
 #include "osc.h"
+#include "phase.h"
 #include "safety.h"
 #include "servo_model.h"
 #include "writeq.h"
@@ -106,8 +107,8 @@ struct ctl_joint {
 	bool resumed;               /* fresh again after CTL_RESUME_STALE stale cycles */
 	bool have_reading;
 	struct osc_velocity_filter vfilter;
-	struct osc_estimator estimator;
-	double phase;
+	struct phase_estimator estimator;   /* published frequency and amplitude */
+	double phase;               /* rad, NAN while unknown (phase.h) */
 	/* read back (slow round-robin); -1 until read */
 	int torque_read;            /* torque enable (24) */
 	int torque_limit_read;      /* torque limit (34) */

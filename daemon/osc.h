@@ -92,34 +92,8 @@ bool osc_step(const struct osc_joint_params *p, size_t njoints, const double *x,
  * give a non-finite result: the caller checks before commanding it. */
 double osc_sinusoid(double amplitude, double frequency, double phase, size_t joint, double t);
 
-/* Phase of an oscillation from (x, ẋ): atan2(−ẋ/ω, x), in (−π, π]
- * (x = A cos φ, ẋ = −Aω sin φ; φ grows with time). 0 for bad input or ω = 0. */
-double osc_phase(double x, double v, double omega);
-/* Wrap an angle into (−π, π]. Non-finite gives 0. */
-double osc_wrap(double a);
-
-/* Running estimate of amplitude and frequency from successive samples. */
-struct osc_estimator {
-	double amplitude;      /* rad, half the peak-to-peak of recent cycles (smoothed; 0 until one cycle) */
-	double frequency;      /* Hz, from upward crossings of the centre (0 until the fourth) */
-	double last_x;
-	double last_cross_t;
-	double peak;           /* largest x since the last upward crossing */
-	bool have_last, have_cross;
-	/* added: robustness to a non-zero mean and to quantization noise */
-	double trough;         /* smallest x since the last upward crossing */
-	double centre;         /* rad, mid-point of the last cycle: crossings are counted about it */
-	double last_t;
-	bool centred;          /* centre comes from a whole cycle (not the first-cycle guess) */
-	bool last_cross_centred; /* the last crossing was timed against such a centre */
-	bool high;             /* x went above centre + hysteresis since the last crossing */
-	bool armed;            /* ... and then below centre − hysteresis: next upward crossing counts */
-	unsigned long rejected;  /* samples ignored: non-finite, or time not increasing */
-};
-void osc_estimator_init(struct osc_estimator *e);
-/* t in seconds, strictly increasing. Both estimates fall back to 0 when no
- * cycle completes for three periods (the joint stopped or moved its centre). */
-void osc_estimator_update(struct osc_estimator *e, double x, double t);
+/* The phase of a joint and its running frequency and amplitude: common/phase.h
+ * (one definition for the daemon and the analyser). */
 
 /* Velocity from positions: first-order low-pass of the finite difference
  * (the servo's own speed reading is coarse: 0.111 rpm steps, noisy). */

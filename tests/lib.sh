@@ -181,6 +181,24 @@ last_collisions() {
 	awk -F, 'NR > 1 { t[NR] = $1; n[NR] = $2; end = $1 + 1 } END { for (k in t) if (t[k] >= end - 10) s += n[k]; print s + 0 }' \
 		"$1/collision_rate.csv"
 }
+# run_diag DIR: what a failed experiment's check needs beside it, as TAP
+# comments — each robot's gait and base at the end, the collisions per 10 s,
+# and each daemon's loop (worst period p99, overruns, timeouts): a clean
+# clone's logs are gone once it ends, so the reason must be in the output.
+run_diag() {
+	local d=$1
+	[ -f "$d/summary.txt" ] && grep -E '^  [^ ]+ +joints ' "$d/summary.txt" |
+		sed -E 's/ +/ /g; s/^ /# robot /'
+	[ -f "$d/demo-summary.txt" ] && sed -n '/^collisions per 10 s window:/,/^$/p' "$d/demo-summary.txt" |
+		awk 'NR > 1 && NF { printf "%s%s", sep, $0; sep = ";" } END { if (sep) print "" }' |
+		sed -E 's/ +/ /g; s/^/# collisions per 10 s:/'
+	[ -f "$d/bus.csv" ] && awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+		{ r = $c["robot"]; gsub(/"/, "", r); if (!(r in p) || $c["period_p99_us"] > p[r]) p[r] = $c["period_p99_us"]
+		  o[r] = $c["overruns"]; to[r] = $c["timeouts"] }
+		END { for (r in p) printf "# loop %s: period p99 up to %d us, %d overruns, %d timeouts\n", r, p[r], o[r], to[r] }' \
+		"$d/bus.csv" | sort
+	return 0
+}
 
 # keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
 # test directory is removed on exit) in $BUILD/test-logs/<test>.d/.

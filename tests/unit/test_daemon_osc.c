@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "../../daemon/osc.h"
+#include "../../common/phase.h"
 
 #define PI 3.14159265358979323846
 #define TWO_JOINTS 2
@@ -288,7 +289,7 @@ static double single_run_phase(const struct osc_joint_params *p, double x, doubl
 			hi = fabs(x);
 	}
 	*amp_after = hi;
-	return osc_phase(x, v, omega);
+	return phase_from_state(x, v, omega);
 }
 
 static void test_velocity_jump_shifts_phase(void **state)
@@ -312,16 +313,16 @@ static void test_velocity_jump_shifts_phase(void **state)
 			break;
 	}
 	/* reverse and halve the speed, as against a wall with restitution 0.5 */
-	double before = osc_phase(x, v, omega), after = osc_phase(x, -0.5 * v, omega);
-	double expected = osc_wrap(after - before);
+	double before = phase_from_state(x, v, omega), after = phase_from_state(x, -0.5 * v, omega);
+	double expected = phase_wrap(after - before);
 	double amp_ref, amp_kick;
 	double ref = single_run_phase(&p, x, v, dt, 0.0, 1.0, 20.0, omega, &amp_ref);
 	double kicked = single_run_phase(&p, x, v, dt, 0.0, -0.5, 20.0, omega, &amp_kick);
-	double measured = osc_wrap(kicked - ref);
+	double measured = phase_wrap(kicked - ref);
 	print_message("phase shift expected %.3f rad, measured %.3f rad; amplitude %.4f vs %.4f\n",
 	              expected, measured, amp_kick, amp_ref);
 	assert_true(fabs(expected) > 0.8);      /* a real shift, not a no-op */
-	assert_true(fabs(osc_wrap(measured - expected)) < 0.1);
+	assert_true(fabs(phase_wrap(measured - expected)) < 0.1);
 	assert_true(fabs(amp_kick - amp_ref) < 0.01 * amp_ref);
 	/* an open-loop clock would ignore the kick; the oscillator must not */
 	assert_true(fabs(measured) > 0.5);
@@ -585,139 +586,8 @@ static void test_sinusoid_values(void **state)
 	assert_true(fabs(osc_sinusoid(A, f, 0.4, 3, 0.77) - osc_sinusoid(A, f, 0.4, 0, 0.77)) < 1e-12);
 }
 
-static void test_phase_and_wrap(void **state)
-{
-	(void)state;
-	assert_true(fabs(osc_wrap(3.0 * PI) - PI) < 1e-12);
-	assert_true(fabs(osc_wrap(-PI) - PI) < 1e-12);      /* (−π, π]: −π maps to π */
-	assert_true(fabs(osc_wrap(PI) - PI) < 1e-12);
-	assert_true(fabs(osc_wrap(7.0) - (7.0 - 2.0 * PI)) < 1e-12);
-	assert_true(fabs(osc_wrap(-7.0) - (-7.0 + 2.0 * PI)) < 1e-12);
-	assert_true(fabs(osc_wrap(1e6) - remainder(1e6, 2.0 * PI)) < 1e-9);
-	assert_true(osc_wrap(NAN) == 0.0);
-	/* on x = A cos φ, ẋ = −Aω sin φ the phase is φ (theory.md's convention) */
-	const double A = 0.8, w = 5.0;
-	for (double phi = -3.1; phi < 3.14; phi += 0.25) {
-		double got = osc_phase(A * cos(phi), -A * w * sin(phi), w);
-		assert_true(fabs(osc_wrap(got - phi)) < 1e-12);
-	}
-	assert_true(osc_phase(NAN, 0.0, w) == 0.0);
-	assert_true(osc_phase(0.1, 0.0, 0.0) == 0.0);
-}
-
-/* ---- estimator --------------------------------------------------------- */
-
-/* deterministic noise in [−1, 1] */
-static double noise(uint32_t *s)
-{
-	*s = *s * 1664525u + 1013904223u;
-	return ((*s >> 8) / (double)(1u << 24)) * 2.0 - 1.0;
-}
-
-static void test_estimator_clean_sine(void **state)
-{
-	(void)state;
-	struct osc_estimator e;
-	osc_estimator_init(&e);
-	for (int i = 0; i <= 1000; i++) {
-		double t = i * 0.01;
-		osc_estimator_update(&e, 0.8 * sin(2.0 * PI * 0.8 * t + 0.3), t);
-	}
-	print_message("clean: A %.5f f %.5f\n", e.amplitude, e.frequency);
-	assert_true(fabs(e.amplitude - 0.8) < 0.005);
-	assert_true(fabs(e.frequency - 0.8) < 0.002);
-	/* a frequency is known from the fourth crossing (the first two are timed
-	 * against a guessed centre) */
-	/* a frequency change shows within ten cycles (smoothing halves the error per cycle) */
-	for (int i = 1; i <= 834; i++) {
-		double t = 10.0 + i * 0.01;
-		osc_estimator_update(&e, 0.5 * sin(2.0 * PI * 1.2 * t), t);
-	}
-	print_message("after change: A %.5f f %.5f\n", e.amplitude, e.frequency);
-	assert_true(fabs(e.frequency - 1.2) < 0.005);
-	assert_true(fabs(e.amplitude - 0.5) < 0.005);
-}
-
-static void test_estimator_quantized_noisy_offset_sine(void **state)
-{
-	(void)state;
-	struct osc_estimator e;
-	osc_estimator_init(&e);
-	uint32_t seed = 12345;
-	for (int i = 0; i <= 2000; i++) {
-		double t = i * 0.01;
-		/* a mean of 0.3 rad: the signal crosses zero only on part of its swing */
-		double x = 0.3 + 0.4 * sin(2.0 * PI * 0.8 * t) + 2.0 * AX12_POS_STEP * noise(&seed);
-		osc_estimator_update(&e, AX12_POS_STEP * round(x / AX12_POS_STEP), t);
-	}
-	print_message("quantized noisy: A %.4f f %.4f (true 0.4, 0.8)\n", e.amplitude, e.frequency);
-	assert_true(fabs(e.frequency - 0.8) < 0.01);
-	/* peaks ride on the noise: up to 2 steps + half a step high */
-	assert_true(e.amplitude > 0.39 && e.amplitude < 0.42);
-
-	/* a swing that never reaches zero is still measured about its own centre */
-	struct osc_estimator off;
-	osc_estimator_init(&off);
-	for (int i = 0; i <= 1000; i++) {
-		double t = i * 0.01;
-		double x = 0.5 + 0.2 * sin(2.0 * PI * 0.8 * t) + AX12_POS_STEP * noise(&seed);
-		osc_estimator_update(&off, AX12_POS_STEP * round(x / AX12_POS_STEP), t);
-	}
-	print_message("mean 0.5: A %.4f f %.4f (true 0.2, 0.8)\n", off.amplitude, off.frequency);
-	assert_true(fabs(off.frequency - 0.8) < 0.01);
-	assert_true(off.amplitude > 0.19 && off.amplitude < 0.21);
-
-	/* bad samples are counted, not used */
-	unsigned long before = e.rejected;
-	double f = e.frequency;
-	osc_estimator_update(&e, NAN, 20.5);
-	osc_estimator_update(&e, 5.0, 20.0);      /* time went backwards */
-	osc_estimator_update(&e, 0.1, INFINITY);
-	assert_true(e.rejected == before + 3);
-	assert_true(e.frequency == f);
-}
-
-static void test_estimator_follows_stop_and_new_centre(void **state)
-{
-	(void)state;
-	struct osc_estimator e;
-	osc_estimator_init(&e);
-	double t = 0.0;
-	for (int i = 0; i < 800; i++, t += 0.01)
-		osc_estimator_update(&e, 0.8 * sin(2.0 * PI * 0.8 * t), t);
-	assert_true(fabs(e.frequency - 0.8) < 0.002);
-	/* the joint stops: after three periods the estimate says so */
-	for (int i = 0; i < 500; i++, t += 0.01)
-		osc_estimator_update(&e, 0.1, t);
-	assert_true(e.frequency == 0.0 && e.amplitude == 0.0);
-	/* it resumes about a new centre, entirely above the old one */
-	for (int i = 0; i < 1000; i++, t += 0.01)
-		osc_estimator_update(&e, 0.9 + 0.3 * sin(2.0 * PI * 0.6 * t), t);
-	print_message("resumed: A %.4f f %.4f (true 0.3, 0.6)\n", e.amplitude, e.frequency);
-	assert_true(fabs(e.frequency - 0.6) < 0.005);
-	assert_true(fabs(e.amplitude - 0.3) < 0.005);
-	/* a centre drifting by more than the swing is followed cycle by cycle */
-	const double t_drift = t;
-	for (int i = 0; i < 1500; i++, t += 0.01) {
-		double drift = 0.9 + 0.06 * (t - t_drift);
-		osc_estimator_update(&e, drift + 0.3 * sin(2.0 * PI * 0.6 * t), t);
-		if (i > 700)   /* after a transient of ~3 %: the centre lags one cycle */
-			assert_true(fabs(e.frequency - 0.6) < 0.01);
-	}
-}
-
-static void test_estimator_ignores_flicker_at_rest(void **state)
-{
-	(void)state;
-	struct osc_estimator e;
-	osc_estimator_init(&e);
-	/* a joint at rest flickering one position step about zero is not oscillating */
-	for (int i = 0; i < 1000; i++)
-		osc_estimator_update(&e, (i % 2) ? AX12_POS_STEP : -AX12_POS_STEP, i * 0.01);
-	assert_true(e.frequency == 0.0);
-}
-
-/* ---- velocity filter ------------------------------------------------------ */
+/* The phase and the frequency/amplitude estimator the daemon publishes:
+ * test_common_phase.c (common/phase.h). */
 
 static void test_velocity_filter_ramp(void **state)
 {
@@ -793,11 +663,6 @@ int main(void)
 		cmocka_unit_test(test_closed_loop_through_servo),
 		cmocka_unit_test(test_single_joint_through_servo),
 		cmocka_unit_test(test_sinusoid_values),
-		cmocka_unit_test(test_phase_and_wrap),
-		cmocka_unit_test(test_estimator_clean_sine),
-		cmocka_unit_test(test_estimator_quantized_noisy_offset_sine),
-		cmocka_unit_test(test_estimator_follows_stop_and_new_centre),
-		cmocka_unit_test(test_estimator_ignores_flicker_at_rest),
 		cmocka_unit_test(test_velocity_filter_ramp),
 		cmocka_unit_test(test_velocity_filter_sine),
 	};

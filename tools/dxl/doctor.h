@@ -29,6 +29,12 @@ struct dr_verdict {
 	enum dr_level level;
 	char text[DR_TEXT_MAX];
 };
+/* Set a verdict; dr_add appends (a line cut at DR_TEXT_MAX stays terminated).
+ * The checks of both protocols (doctor_checks.c, doctor_checks2.c) use them. */
+__attribute__((format(printf, 3, 4)))
+void dr_set(struct dr_verdict *v, enum dr_level level, const char *fmt, ...);
+__attribute__((format(printf, 2, 3)))
+void dr_add(struct dr_verdict *v, const char *fmt, ...);
 
 /* The two blocks read from every servo: EEPROM 0..18 (model .. alarm
  * shutdown) and RAM 24..43 (torque enable .. present temperature; the same
@@ -122,6 +128,9 @@ void dr_check_baud(const struct dr_context *c, unsigned asked, unsigned answered
 
 /* ---- each servo ------------------------------------------------------------------------ */
 void dr_check_model(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
+/* Appends the fix `dxl [PROTOCOL_OPT]--port P setup IDS --yes (WHAT)`:
+ * PROTOCOL_OPT "" for the AX-12, "--protocol 2 " for the X series. */
+void dr_setup_fix(struct dr_verdict *v, const struct dr_context *c, const char *protocol_opt, const char *what);
 void dr_check_return_delay(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
 void dr_check_status_level(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
 /* The AX-12A runs on 9..12 V (ROBOTIS: recommended 11.1 V); torque and speed

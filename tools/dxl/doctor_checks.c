@@ -24,9 +24,7 @@ const char *dr_level_name(enum dr_level level)
 	}
 }
 
-/* Set the verdict; dr_add appends (a cut line stays terminated). */
-__attribute__((format(printf, 3, 4)))
-static void dr_set(struct dr_verdict *v, enum dr_level level, const char *fmt, ...)
+void dr_set(struct dr_verdict *v, enum dr_level level, const char *fmt, ...)
 {
 	va_list ap;
 
@@ -36,8 +34,7 @@ static void dr_set(struct dr_verdict *v, enum dr_level level, const char *fmt, .
 	va_end(ap);
 }
 
-__attribute__((format(printf, 2, 3)))
-static void dr_add(struct dr_verdict *v, const char *fmt, ...)
+void dr_add(struct dr_verdict *v, const char *fmt, ...)
 {
 	size_t len = strlen(v->text);
 	va_list ap;
@@ -221,9 +218,9 @@ void dr_check_model(const struct dr_servo *s, const struct dr_context *c, struct
 	       name, s->firmware, c->port, s->id);
 }
 
-static void dr_setup_fix(struct dr_verdict *v, const struct dr_context *c, const char *what)
+void dr_setup_fix(struct dr_verdict *v, const struct dr_context *c, const char *protocol_opt, const char *what)
 {
-	dr_add(v, "; fix: dxl --port %s setup %s --yes (%s)%s", c->port, c->ids, what,
+	dr_add(v, "; fix: dxl %s--port %s setup %s --yes (%s)%s", protocol_opt, c->port, c->ids, what,
 	       c->any_torque_on ? "; --yes turns torque off first: support the robot" : "");
 }
 
@@ -237,7 +234,7 @@ void dr_check_return_delay(const struct dr_servo *s, const struct dr_context *c,
 	}
 	/* one READ of this servo per cycle, and a read-back every fifth */
 	dr_set(v, DR_WARN, "%u us before every reply: costs %.2f ms of every %g ms cycle", us, 1e-3 * us, c->period_ms);
-	dr_setup_fix(v, c, "writes return delay 0");
+	dr_setup_fix(v, c, "", "writes return delay 0");
 }
 
 void dr_check_status_level(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v)
@@ -250,7 +247,7 @@ void dr_check_status_level(const struct dr_servo *s, const struct dr_context *c,
 	case 1:
 		dr_set(v, DR_WARN, "1: WRITEs are not answered, so undulated cannot confirm its register writes (torque, "
 		       "limits) until its read-back");
-		dr_setup_fix(v, c, "writes status return level 2");
+		dr_setup_fix(v, c, "", "writes status return level 2");
 		return;
 	default:
 		dr_set(v, DR_OK, "%u", s->status_return_level);
