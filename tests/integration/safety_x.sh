@@ -119,6 +119,35 @@ top=$(timeout 15 "$B/undulate-top" --once --json --wait 1.5 --lcm-url "$URL" 2>/
 st=$(echo "$top" | jq -r --arg r "$R" '.robots[] | select(.name == $r) | [.joints[].status] | join(",")' 2>/dev/null)
 if [ "$st" = "overheating|motor encoder,ok" ]; then tap_ok "undulate-top names them by the X table: joint 1 $st"
 else tap_fail "undulate-top's joint status" "'$st'; $(grep -a '^STATE' "$T/watch.log" | tail -1 | grep -oE ' e[01]=[0-9]+' | tr '\n' ' ')"; fi
+# and the browser view, in headless chromium: the robot's servo table as drawn
+browser=$(command -v chromium || command -v chromium-browser || true)
+if [ -z "$browser" ] || [ ! -x "$B/undulate-web" ]; then
+	tap_skip "the browser view names them by the X table" "no chromium or undulate-web here (scripts/deps.sh chromium)"
+else
+	CDP="$(dirname "$0")/web_cdp.py"
+	spawn web "$B/undulate-web" --listen 127.0.0.1:0 --lcm-url "$URL" --read-only
+	wait_log web 'listening on http://' 10
+	wport=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/web.log")
+	dport=$(python3 "$CDP" freeport)
+	spawn chromium "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --user-data-dir="$T/chromium" \
+		--remote-debugging-port="$dport" about:blank
+	python3 "$CDP" servos "$dport" "http://127.0.0.1:$wport/" "$T/servos.png" "$R" "overheating|motor encoder" \
+		>"$T/servos.out" 2>&1
+	sed 's/^/# /' "$T/servos.out"
+	# servo 1: error bits 0xc (the byte the servo sent) named overheating|motor encoder; servo 2 ok
+	# (0x8c with the alert bit 7); rows: ROW id °C V bits status torque, tab-separated
+	row1=$(awk -F'\t' '$1 == "ROW" && $2 == 1 { print $5 " " $6 }' "$T/servos.out")
+	row2=$(awk -F'\t' '$1 == "ROW" && $2 == 2 { print $5 " " $6 }' "$T/servos.out")
+	if [[ "$row1" =~ ^0x8?c\ overheating\|motor\ encoder$ ]] && [ "$row2" = "0x0 ok" ]; then
+		tap_ok "the browser view (undulate-web in headless chromium) names them by the X table: servo 1 $row1, servo 2 $row2"
+	else
+		tap_fail "the browser view names them by the X table" "$(tail -5 "$T/servos.out")"
+		mkdir -p "$BUILD/test-logs" && cp "$T/servos.png" "$BUILD/test-logs/safety_x-servos.png" 2>/dev/null
+	fi
+	[ -n "${WEB_KEEP_SCREENSHOT:-}" ] && mkdir -p "$BUILD/test-logs" && cp "$T/servos.png" "$BUILD/test-logs/safety_x-servos.png"
+	stop chromium >/dev/null
+	stop web >/dev/null
+fi
 ctl clear r1 1 >/dev/null   # cooled down
 wait_cycles 20
 out=$( { cmd clear && cmd 'mode oscillator'; } 2>&1); rc=$?
