@@ -181,6 +181,14 @@ last_collisions() {
 	awk -F, 'NR > 1 { t[NR] = $1; n[NR] = $2; end = $1 + 1 } END { for (k in t) if (t[k] >= end - 10) s += n[k]; print s + 0 }' \
 		"$1/collision_rate.csv"
 }
+# end_modes DIR: each robot's last published mode, "r1=OSCILLATOR r2=..." (states.csv).
+end_modes() {
+	awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+		{ r = $c["robot"]; gsub(/"/, "", r); m[r] = $c["mode"] }
+		END { split("LIMP HOLD SINUSOID OSCILLATOR", n, " ")
+			for (r in m) printf "%s=%s\n", r, ((m[r] + 1) in n) ? n[m[r] + 1] : m[r] }' \
+		"$1/states.csv" | sort | tr '\n' ' ' | sed 's/ $//'
+}
 # run_diag DIR: what a failed experiment's check needs beside it, as TAP
 # comments — each robot's gait and base at the end, the collisions per 10 s,
 # and each daemon's loop (worst period p99, overruns, timeouts): a clean
@@ -189,6 +197,7 @@ run_diag() {
 	local d=$1
 	[ -f "$d/summary.txt" ] && grep -E '^  [^ ]+ +joints ' "$d/summary.txt" |
 		sed -E 's/ +/ /g; s/^ /# robot /'
+	[ -f "$d/states.csv" ] && echo "# mode at the end: $(end_modes "$d")"
 	[ -f "$d/demo-summary.txt" ] && sed -n '/^collisions per 10 s window:/,/^$/p' "$d/demo-summary.txt" |
 		awk 'NR > 1 && NF { printf "%s%s", sep, $0; sep = ";" } END { if (sep) print "" }' |
 		sed -E 's/ +/ /g; s/^/# collisions per 10 s:/'

@@ -52,6 +52,14 @@ for name in immobile mobile; do
 		tap_fail "$name row: nobody else on its LCM port" "another program published on the run's LCM URL; its results mix two runs"
 	elif [ "$rc" = 0 ] && [ -f "$T/$name/summary.txt" ]; then
 		tap_ok "$name row: ${seconds} s through sim + 5 daemons, log analysed"
+		# the switch is one command to every robot; a robot left on the clock
+		# would keep colliding whatever its base does
+		modes=$(end_modes "$T/$name")
+		if [ "$(echo "$modes" | grep -o '=OSCILLATOR' | wc -l)" = 5 ]; then
+			tap_ok "$name row: every robot took the switch (5 on OSCILLATOR at the end)"
+		else
+			tap_fail "$name row: every robot took the switch" "at the end: $modes; $(cat "$T/$name/logs/switch.log" 2>/dev/null | tr '\n' ';')"
+		fi
 		sw=$(min_swing "$T/$name")
 		if awk -v s="${sw%% *}" -v m=$MIN_SWING 'BEGIN { exit !(s >= m) }'; then
 			tap_ok "$name row: every robot still swings at the end (smallest peak-to-peak $sw rad)"
