@@ -271,6 +271,7 @@ void ctl_init(struct ctl *c, struct cfg *cfg)
 		jt->id = cfg->ids[j];
 		jt->goal = NAN;
 		jt->angle = NAN;
+		jt->phase = NAN;            /* unknown until the first reading (phase.h) */
 		jt->speed = 0.0;
 		jt->voltage = NAN;
 		jt->temperature = NAN;

@@ -126,20 +126,23 @@ if [ -z "$browser" ] || [ ! -x "$B/undulate-web" ]; then
 else
 	CDP="$(dirname "$0")/web_cdp.py"
 	spawn web "$B/undulate-web" --listen 127.0.0.1:0 --lcm-url "$URL" --read-only
-	wait_log web 'listening on http://' 10
+	wait_log web 'listening on http://' 10 || tap_fail "undulate-web listening" "$(tail -3 "$T/web.log")"
 	wport=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/web.log")
 	dport=$(python3 "$CDP" freeport)
-	spawn chromium "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --user-data-dir="$T/chromium" \
+	# its own TMPDIR: chromium leaves a singleton folder there even after SIGTERM
+	spawn chromium env TMPDIR="$T" "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --user-data-dir="$T/chromium" \
 		--remote-debugging-port="$dport" about:blank
 	python3 "$CDP" servos "$dport" "http://127.0.0.1:$wport/" "$T/servos.png" "$R" "overheating|motor encoder" \
 		>"$T/servos.out" 2>&1
 	sed 's/^/# /' "$T/servos.out"
-	# servo 1: error bits 0xc (the byte the servo sent) named overheating|motor encoder; servo 2 ok
-	# (0x8c with the alert bit 7); rows: ROW id °C V bits status torque, tab-separated
-	row1=$(awk -F'\t' '$1 == "ROW" && $2 == 1 { print $5 " " $6 }' "$T/servos.out")
-	row2=$(awk -F'\t' '$1 == "ROW" && $2 == 2 { print $5 " " $6 }' "$T/servos.out")
-	if [[ "$row1" =~ ^0x8?c\ overheating\|motor\ encoder$ ]] && [ "$row2" = "0x0 ok" ]; then
-		tap_ok "the browser view (undulate-web in headless chromium) names them by the X table: servo 1 $row1, servo 2 $row2"
+	# servo 1: error bits 0xc (the byte the servo sent; 0x8c with the alert bit 7) named
+	# overheating|motor encoder, its torque as read back: off, where HOLD wants it on
+	# (the servo's protection holds it off); servo 2 ok, on.
+	# Rows: ROW id °C V bits status torque, tab-separated.
+	row1=$(awk -F'\t' '$1 == "ROW" && $2 == 1 { print $5 "; " $6 "; " $7 }' "$T/servos.out")
+	row2=$(awk -F'\t' '$1 == "ROW" && $2 == 2 { print $5 "; " $6 "; " $7 }' "$T/servos.out")
+	if [[ "$row1" =~ ^0x8?c\;\ overheating\|motor\ encoder\;\ off\ \(wanted\ on\)$ ]] && [ "$row2" = "0x0; ok; on" ]; then
+		tap_ok "the browser view (undulate-web in headless chromium) names them by the X table, torque as read back: servo 1 $row1, servo 2 $row2"
 	else
 		tap_fail "the browser view names them by the X table" "$(tail -5 "$T/servos.out")"
 		mkdir -p "$BUILD/test-logs" && cp "$T/servos.png" "$BUILD/test-logs/safety_x-servos.png" 2>/dev/null

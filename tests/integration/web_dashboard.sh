@@ -100,7 +100,8 @@ if [ -z "$browser" ]; then
 		"no chromium here (Debian package chromium; scripts/deps.sh chromium)"
 else
 	dport=$(python3 "$CDP" freeport)
-	spawn chromium "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --user-data-dir="$T/chromium" \
+	# its own TMPDIR: chromium leaves a singleton folder there even after SIGTERM
+	spawn chromium env TMPDIR="$T" "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --user-data-dir="$T/chromium" \
 		--remote-debugging-port="$dport" about:blank
 	python3 "$CDP" page "$dport" "$H/" "$T/page.png" left hold >"$T/page.out" 2>&1
 	sed 's/^/# /' "$T/page.out"

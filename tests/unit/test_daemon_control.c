@@ -134,6 +134,23 @@ static void test_start_hold(void **state)
 	assert_true(c.j[0].write_goal);
 }
 
+/* The published phase is NAN until a joint has been read, never a 0 that
+ * reads as "at the positive turning point" (common/phase.h). */
+static void test_phase_unknown_until_read(void **state)
+{
+	(void)state;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&cfg);
+	cfg_override(&cfg, "robot.port=/dev/null", &e);
+	cfg_override(&cfg, "robot.ids=1,2", &e);
+	assert_true(cfg_finish(&cfg, &e));
+	ctl_init(&c, &cfg);
+	assert_true(isnan(c.j[0].phase) && isnan(c.j[1].phase));
+	setup_robot(CFG_MODE_HOLD);
+	run(5);
+	assert_true(isfinite(c.j[0].phase) && isfinite(c.j[1].phase));
+}
+
 static void test_switches_without_jumps(void **state)
 {
 	(void)state;
@@ -470,6 +487,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_compliance_slope_read_back),
 		cmocka_unit_test(test_start_hold),
+		cmocka_unit_test(test_phase_unknown_until_read),
 		cmocka_unit_test(test_switches_without_jumps),
 		cmocka_unit_test(test_oscillator_starts_from_rest),
 		cmocka_unit_test(test_stall_restart_offset),

@@ -342,9 +342,9 @@ static void test_joint_health(void **state)
 	char n[] = "r1", reason[] = "test";
 	undulate_joint_state_t j[2] = {
 		{ .servo_id = 1, .angle = 0.4321, .speed = 1.2345, .amplitude = 0.8, .frequency = 0.8,
-		  .temperature = 41, .voltage = 11.8, .error_bits = 0x24 },
+		  .temperature = 41, .voltage = 11.8, .error_bits = 0x24, .torque = 1, .torque_read = 0 },
 		{ .servo_id = 2, .angle = 0.6789, .speed = -2.3456, .amplitude = 0.8, .frequency = 0.8,
-		  .temperature = 33, .voltage = 11.9, .stale_cycles = 37 },
+		  .temperature = 33, .voltage = 11.9, .stale_cycles = 37, .torque = 1, .torque_read = 7 },
 	};
 	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 3, .mode_reason = reason, .fault = "",
 		.period_us = 10000.0, .njoints = 2, .joints = j };
@@ -364,6 +364,10 @@ static void test_joint_health(void **state)
 	const char *js = json_of(0.1);
 	assert_non_null(strstr(js, "\"status\":\"SILENT x37\""));
 	assert_non_null(strstr(js, "\"temperature\":41"));
+	/* torque as wanted and as read back (a servo that shut itself down reads 0);
+	 * a value the servo cannot report is "not read" */
+	assert_non_null(strstr(js, "\"torque\":true,\"torque_read\":0}"));
+	assert_non_null(strstr(js, "\"torque\":true,\"torque_read\":-1}"));
 	/* compact view: an S marks the robot */
 	v.kind = TOP_VIEW_COMPACT;
 	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));

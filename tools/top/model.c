@@ -80,6 +80,8 @@ void top_on_state(struct top_model *m, const undulate_robot_state_t *s, double n
 			.frequency = js->frequency, .error_bits = js->error_bits,
 			.temperature = js->temperature, .voltage = js->voltage,
 			.stale_cycles = js->stale_cycles, .torque = js->torque,
+			/* anything but the servo's 0 or 1 is "not read" */
+			.torque_read = js->torque_read == 0 || js->torque_read == 1 ? js->torque_read : -1,
 		};
 	}
 }
@@ -431,6 +433,7 @@ static void top_json_joint(struct json *j, const struct top_joint *jt)
 	char status[96];
 	json_field_string(j, "status", top_joint_status(jt, status, sizeof status));
 	json_field_bool(j, "torque", jt->torque);
+	json_field_int(j, "torque_read", jt->torque_read);
 	json_object_end(j);
 }
 

@@ -37,7 +37,8 @@ struct top_joint {
 	double voltage;        /* V */
 	int16_t error_bits;
 	int32_t stale_cycles;
-	bool torque;
+	bool torque;           /* torque wanted on (the daemon's writes) */
+	int8_t torque_read;    /* as the servo last reported it: 0, 1; -1 not read yet */
 };
 
 struct top_robot {

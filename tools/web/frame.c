@@ -27,6 +27,7 @@ static void frame_status_joint(struct json *j, const struct top_joint *jt)
 	json_field_int(j, "error_bits", jt->error_bits);
 	json_field_int(j, "stale_cycles", jt->stale_cycles);
 	json_field_bool(j, "torque", jt->torque);
+	json_field_int(j, "torque_read", jt->torque_read);
 	json_object_end(j);
 }
 
