@@ -361,6 +361,10 @@ static void test_joint_health(void **state)
 	/* the status column ends the line: whole on a wider terminal */
 	top_render(&model, &v, 0.1, 24, 100, true, screen, sizeof(screen));
 	assert_non_null(strstr(screen, "41C 11.8V overheating|overload"));
+	/* then the torque the servo reports, when it is not the one wanted */
+	top_render(&model, &v, 0.1, 24, 130, true, screen, sizeof(screen));
+	assert_non_null(strstr(screen, "41C 11.8V overheating|overload, torque off (wanted on)"));
+	assert_null(strstr(screen, "SILENT x37, torque"));   /* joint 2: not read, nothing said */
 	const char *js = json_of(0.1);
 	assert_non_null(strstr(js, "\"status\":\"SILENT x37\""));
 	assert_non_null(strstr(js, "\"temperature\":41"));

@@ -295,6 +295,13 @@ const char *top_joint_status(const struct top_joint *j, char *buf, size_t cap)
 	return buf;
 }
 
+const char *top_joint_torque_note(const struct top_joint *j)
+{
+	if (j->torque_read < 0 || (j->torque_read == 1) == j->torque)
+		return "";
+	return j->torque ? "torque off (wanted on)" : "torque on (wanted off)";
+}
+
 bool top_robot_stale(const struct top_robot *r, double now)
 {
 	return !r->have_state || now - r->rx > TOP_STALE_S;

@@ -156,7 +156,8 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 			snprintf(goal, sizeof goal, "d%+6.3f", j->drive);
 		else
 			num(goal, sizeof goal, "%+7.3f", j->goal, 7);
-		rb_line(b, false, "   j%d id%-3d %s %s %7s %s %s %s %s %s %s %s", k, j->servo_id,
+		const char *tq = top_joint_torque_note(j);
+		rb_line(b, false, "   j%d id%-3d %s %s %7s %s %s %s %s %s %s %s%s%s", k, j->servo_id,
 			num(ang, sizeof ang, "%+7.3f", live ? j->angle : nan, 7),
 			num(spd, sizeof spd, "%+7.3f", live ? j->speed : nan, 7), goal,
 			num(load, sizeof load, "%+5.2f", live ? j->load : nan, 5),
@@ -164,7 +165,7 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 			num(amp, sizeof amp, "%4.2f", j->amplitude, 4), num(freq, sizeof freq, "%4.2f", j->frequency, 4),
 			num(temp, sizeof temp, "%3.0fC", j->temperature > 0 ? j->temperature : nan, 4),
 			num(volt, sizeof volt, "%4.1fV", j->voltage > 0 ? j->voltage : nan, 5),
-			top_joint_status(j, st, sizeof st));
+			top_joint_status(j, st, sizeof st), *tq ? ", " : "", tq);
 	}
 }
 
@@ -245,7 +246,8 @@ static const char *const top_help_lines[] = {
 	"Joint line: angle (rad), speed (rad/s), goal (rad; d+x: torque drive),",
 	"  load (of max torque), phase (rad), amp (rad), freq (Hz), temp (C), volt (V);",
 	"  status: ok | SILENT xN (no valid reading for N cycles: its angle and speed",
-	"  are frozen, shown as -) | the servo's error bits by name (overload, ...)",
+	"  are frozen, shown as -) | the servo's error bits by name (overload, ...);",
+	"  then 'torque off (wanted on)' while the servo reports otherwise than wanted",
 	"Keys: up/down j/k 1-9 PgUp/PgDn Home/End select; v view (auto/detail/compact)",
 	"  m then l/h/s/o  mode of the selected robot: LIMP HOLD SINUSOID OSCILLATOR",
 	"  M then l/h/s/o  the same for every robot; the status line counts answers",
