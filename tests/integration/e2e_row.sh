@@ -10,7 +10,9 @@
 #   mobile bases (beta > 0)    -> always relax to a collision-free compatible
 #                                 state: every pair |D| <= 2 asin(d~) + 0.1 and
 #                                 the contact impulse of the last 10 s at most
-#                                 a fifth of the immobile row's (asserted);
+#                                 a fifth of the immobile row's (asserted: in
+#                                 real time in at least one of two seeds, in
+#                                 lockstep for each seed; see below why);
 #                                 no collision (pairs or walls) in the last 10 s
 #                                 (a TODO when a graze remains: docs/EXPERIMENTS.md)
 source "$(dirname "$0")/../lib.sh"
@@ -22,11 +24,12 @@ seconds=${E2E_ROW_SECONDS:-60}
 # row's claim does not reproduce reliably and is reported as TODO.
 rig=(${E2E_DAEMON_SETS---daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current})
 
+# run NAME SCENARIO SEED PORT: a row in real time, in the background
 run() {
-	local name=$1 port=$2
+	local name=$1 scenario=$2 seed=$3 port=$4
 	spawn "$name" env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" \
-		--scenario "$top/sim-bridge/scenarios/row-$name.scenario" --seconds "$seconds" --switch-at 3 \
-		--seed 11 --lcm-url "$(lcm_url "$port")" --out "$T/$name" "${rig[@]}"
+		--scenario "$top/sim-bridge/scenarios/row-$scenario.scenario" --seconds "$seconds" --switch-at 3 \
+		--seed "$seed" --lcm-url "$(lcm_url "$port")" --out "$T/$name" "${rig[@]}"
 	wait_log "$name" '^demo: phases' 20 || true
 }
 # rows NAME: "pair state meanD d~ 2asin c.win" for each neighbouring pair.
@@ -38,11 +41,21 @@ rows() {
 # Peak-to-peak (rad) every robot must keep: half of 2 x 0.8 rad.
 MIN_SWING=0.8
 
-# Two LCM ports, one of five blocks in 7870-7879.
-port=$((7870 + 2 * ($$ % 5)))
-run immobile $port
-run mobile $((port + 1))
-for name in immobile mobile; do
+# The mobile row in real time twice, seeds 11 and 12, beside the immobile row:
+# its relaxation time has a tail. Of 35 single real-time runs (seeds 1-12,
+# 2026-11-27, alone and beside CPU burners, and CI's) 33 were relaxed within
+# the 60 s and 2 (seeds 7 and 11) still collided in every pair at the end;
+# in lockstep 1 seed of 160 (54: its last collision at 57 s), and a relaxed
+# row may touch again later (seed 34 at 88 s): the phase differences drift
+# and the walls bound how far the bases spread. One run would fail the claim
+# in about 1 of 18 suites; two independent ones both fail in about 1 of 300.
+# The lockstep runs below are deterministic and judge each seed.
+# Three LCM ports, one of three blocks in 7870-7878.
+port=$((7870 + 3 * ($$ % 3)))
+run immobile immobile 11 $port
+run mobile mobile 11 $((port + 1))
+run mobile_b mobile 12 $((port + 2))
+for name in immobile mobile mobile_b; do
 	var="pid_$name"
 	wait_for $((seconds + 60)) bash -c "! kill -0 ${!var}"
 	kill -TERM "${!var}" 2>/dev/null  # only if it overran
@@ -108,40 +121,61 @@ imp() { awk -F, -v a="$2" -v b="$3" 'NR > 1 && $1 >= a && $1 < b { s += $3 } END
 report=tap_fail
 [ ${#rig[@]} -eq 0 ] && report=tap_todo
 
-if regime mobile; then
-	mobile_failed_before=$_tap_failed
-	r=$(rows mobile)
-	echo "$r" | sed 's/^/# mobile: /'
-	last=$(last_collisions "$T/mobile")
+# relaxed NAME: the mobile row NAME ended every pair compatible with at most a
+# fifth of the immobile row's contact in the last 10 s; says how it ended.
+relaxed() {
+	local name=$1 r bad last end from imp_first imp_last imp_imm
+	r=$(rows "$name")
+	echo "$r" | sed "s/^/# $name: /"
 	bad=$(echo "$r" | awk '{ D = $3 < 0 ? -$3 : $3 } D > $5 + 0.1 { print $1 }' | tr '\n' ' ')
 	# Contact impulse (N*s, pairs and walls) in the last 10 s, against the
-	# immobile row's in the same seconds of the same seeded run: the paper's
-	# contrast (a lattice that keeps colliding unless its bases can move).
-	# Not "down tenfold from the 10 s after the switch": the clock's contacts
-	# often spread the bases so far that no contact follows the switch, and a
-	# reference of 0 turned one late graze into a failure (seen in CI:
-	# 0.0000 -> 0.1271 N*s, two hits) — the claim "no contact at the end",
-	# which the TODO below reports, counted twice.
-	end=$(awk -F, 'NR > 1 { t = $1 } END { print t + 1 }' "$T/mobile/collision_rate.csv")
+	# immobile row's in the same seconds: the paper's contrast (a lattice that
+	# keeps colliding unless its bases can move). Not "down tenfold from the
+	# 10 s after the switch": the clock's contacts often spread the bases so
+	# far that no contact follows the switch, and a reference of 0 turned one
+	# late graze into a failure (seen in CI: 0.0000 -> 0.1271 N*s).
+	end=$(awk -F, 'NR > 1 { t = $1 } END { print t + 1 }' "$T/$name/collision_rate.csv")
 	from=$(awk "BEGIN { print $end - 10 }")
-	imp_first=$(imp mobile 0 10); imp_last=$(imp mobile "$from" "$end"); imp_imm=$(imp immobile "$from" "$end")
-	echo "# mobile: contact impulse $imp_first N*s in the first 10 s, $imp_last in the last 10 s; immobile: $imp_imm in the last 10 s"
-	if [ -z "$bad" ]; then tap_ok "mobile row: every pair compatible at the end (|D| <= 2 asin(d~) + 0.1)"
-	else $report "mobile row: every pair compatible at the end" "pairs outside 2 asin(d~) + 0.1: $bad"; fi
-	if [ ! -f "$T/immobile/moving" ]; then
-		tap_skip "mobile row: contact against the immobile row's" "the immobile row cannot be judged (a robot stopped)"
-	elif awk -v m="$imp_last" -v i="$imp_imm" 'BEGIN { exit !(i > 0 && m <= 0.2 * i) }'; then
-		tap_ok "mobile row: contact impulse in the last 10 s at most a fifth of the immobile row's ($imp_last against $imp_imm N*s)"
-	else $report "mobile row: contact impulse in the last 10 s at most a fifth of the immobile row's" "$imp_last against $imp_imm N*s"; fi
-	if [ "$last" -eq 0 ]; then
-		tap_ok "mobile row: collision-free in the last 10 s"
-	else
-		# The paper's "always reach collision-free states": in some runs one
-		# graze remains in the last 10 s (docs/EXPERIMENTS.md says so).
-		tap_todo "mobile row: collision-free in the last 10 s" "collisions (pairs and walls) in the last 10 s: $last, impulse $imp_last N*s (first 10 s: $imp_first, immobile row: $imp_imm)"
+	imp_first=$(imp "$name" 0 10); imp_last=$(imp "$name" "$from" "$end"); imp_imm=$(imp immobile "$from" "$end")
+	last=$(last_collisions "$T/$name")
+	echo "# $name: contact impulse $imp_first N*s in the first 10 s, $imp_last in the last 10 s" \
+		"(immobile: $imp_imm); collisions in the last 10 s: $last; pairs outside 2 asin(d~) + 0.1: ${bad:-none}"
+	[ -z "$bad" ] && awk -v m="$imp_last" -v i="$imp_imm" 'BEGIN { exit !(i > 0 && m <= 0.2 * i) }' || return 1
+	[ "$last" -eq 0 ] && : >"$T/$name/quiet"
+	return 0
+}
+if [ ! -f "$T/immobile/moving" ]; then
+	tap_skip "mobile rows: relaxed against the immobile row" "the immobile row cannot be judged (a robot stopped)"
+else
+	ok_runs=() judged=0
+	for name in mobile mobile_b; do
+		regime "$name" || continue
+		judged=$((judged + 1))
+		if relaxed "$name"; then ok_runs+=("$name"); fi
+	done
+	if [ "$judged" -gt 0 ] && [ ${#ok_runs[@]} -gt 0 ]; then
+		tap_ok "mobile row relaxed (every pair compatible, |D| <= 2 asin(d~) + 0.1; contact in the last 10 s at most a fifth of the immobile row's) in ${#ok_runs[@]} of $judged real-time runs: ${ok_runs[*]}"
+	elif [ "$judged" -gt 0 ]; then
+		# E2E_DAEMON_SETS="": position servos, where the claim does not hold reliably
+		$report "mobile row relaxed in at least one of $judged real-time runs" "none did (above)"
 	fi
-	# a real-time run is not repeatable: what the failed run did goes with it
-	[ "$_tap_failed" -gt "$mobile_failed_before" ] && { run_diag "$T/mobile"; echo "# immobile row beside it:"; run_diag "$T/immobile"; }
+	# a real-time run is not repeatable: what a row that did not relax did goes with it
+	if [ ${#ok_runs[@]} -lt "$judged" ]; then
+		for name in mobile mobile_b; do
+			[[ " ${ok_runs[*]} " != *" $name "* ]] && [ -f "$T/$name/summary.txt" ] &&
+				{ echo "# $name did not relax:"; run_diag "$T/$name"; }
+		done
+		echo "# the immobile row beside it:"; run_diag "$T/immobile"
+	fi
+	# The paper's "always reach collision-free states": in some runs one
+	# graze remains in the last 10 s (docs/EXPERIMENTS.md says so).
+	nq=0
+	for name in "${ok_runs[@]}"; do [ -f "$T/$name/quiet" ] && nq=$((nq + 1)); done
+	if [ ${#ok_runs[@]} -gt 0 ] && [ "$nq" = ${#ok_runs[@]} ]; then
+		tap_ok "mobile row: collision-free in the last 10 s (the relaxed runs)"
+	elif [ ${#ok_runs[@]} -gt 0 ]; then
+		tap_todo "mobile row: collision-free in the last 10 s" "$((${#ok_runs[@]} - nq)) of the relaxed runs still touched (above)"
+	fi
 fi
 # ---- both rows in virtual time, the real-time seed and another --------------------------
 # scripts/demo.sh --lockstep: the same programs, the simulator's clock. Each
@@ -238,5 +272,5 @@ else
 			"pairs outside 2 asin(d~) + 0.1: ${bad:-none}; contact $imp_last against $imp_imm N*s"
 	fi
 fi
-keep_runs immobile mobile "${lock_runs[@]}"
+keep_runs immobile mobile mobile_b "${lock_runs[@]}"
 tap_done
