@@ -42,7 +42,7 @@ rows() {
 MIN_SWING=0.8
 
 # The mobile row in real time twice, seeds 11 and 12, beside the immobile row:
-# its relaxation time has a tail. Of 35 single real-time runs (seeds 1-12,
+# its relaxation time has a tail. Of 35 single real-time runs (seeds 1-11,
 # 2026-11-27, alone and beside CPU burners, and CI's) 33 were relaxed within
 # the 60 s and 2 (seeds 7 and 11) still collided in every pair at the end;
 # in lockstep 1 seed of 160 (54: its last collision at 57 s), and a relaxed
