@@ -29,7 +29,8 @@ static bool servo_answers[2];
 static bool servo_blocked;   /* held in place from outside (a jam) */
 static double t;
 
-static void setup_robot(enum cfg_mode mode)
+/* Two joints configured, the controller initialised: nothing read yet. */
+static void setup_config(enum cfg_mode mode)
 {
 	struct cfg_errors e = { 0 };
 	cfg_defaults(&cfg);
@@ -40,6 +41,11 @@ static void setup_robot(enum cfg_mode mode)
 	cfg.fault_retries = 2;
 	assert_true(cfg_finish(&cfg, &e));
 	ctl_init(&c, &cfg);
+}
+
+static void setup_robot(enum cfg_mode mode)
+{
+	setup_config(mode);
 	char why[256];
 	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
 	for (size_t j = 0; j < 2; j++) {
@@ -139,12 +145,7 @@ static void test_start_hold(void **state)
 static void test_phase_unknown_until_read(void **state)
 {
 	(void)state;
-	struct cfg_errors e = { 0 };
-	cfg_defaults(&cfg);
-	cfg_override(&cfg, "robot.port=/dev/null", &e);
-	cfg_override(&cfg, "robot.ids=1,2", &e);
-	assert_true(cfg_finish(&cfg, &e));
-	ctl_init(&c, &cfg);
+	setup_config(CFG_MODE_HOLD);
 	assert_true(isnan(c.j[0].phase) && isnan(c.j[1].phase));
 	setup_robot(CFG_MODE_HOLD);
 	run(5);
