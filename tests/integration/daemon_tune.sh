@@ -76,12 +76,15 @@ if tuned_ok tplant "$rc_plant"; then
 else
 	tap_fail "test plant: tuned to 0.8 Hz, 0.8 rad within 5 %" "exit $rc_plant: $(tail -5 "$T/tplant.log")"
 fi
-# the plant is not the simulator: the defaults run it fast and wide (the audit: 1.07 Hz, 1.23-1.30 rad)
+# the plant is not the simulator: the defaults run it wide (the audit: 1.07 Hz,
+# 1.23-1.30 rad; the simulator's 0.85 rad). Fast too on an idle machine (1.06
+# Hz), but its Python loop slows with the machine: 0.905 Hz beside two CPU-bound
+# processes (make test-busy, 2026-11-27), still 1.29 rad wide.
 s=$(started "$T/tplant.conf")
-if [ -n "$s" ] && set -- $s && awk -v f="$1" -v a="$2" 'BEGIN { exit !(f > 0.95 && a > 1.0) }'; then
+if [ -n "$s" ] && set -- $s && awk -v a="$2" -v b="$3" 'BEGIN { exit !(a > 1.0 && b > 1.0) }'; then
 	tap_ok "test plant: the defaults gave another gait there ($s: f a1 a2)"
 else
-	tap_fail "test plant: the defaults gave another gait there (f > 0.95 Hz, A > 1.0 rad)" "started: '$s'"
+	tap_fail "test plant: the defaults gave another gait there (A > 1.0 rad on both joints)" "started: '$s'"
 fi
 # the SINUSOID baseline is the gait measured
 m=$(measured "$T/tplant.conf")

@@ -133,7 +133,7 @@ else
 	spawn chromium env TMPDIR="$T" "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --user-data-dir="$T/chromium" \
 		--remote-debugging-port="$dport" about:blank
 	python3 "$CDP" servos "$dport" "http://127.0.0.1:$wport/" "$T/servos.png" "$R" "overheating|motor encoder" \
-		>"$T/servos.out" 2>&1
+		"off (wanted on)" >"$T/servos.out" 2>&1
 	sed 's/^/# /' "$T/servos.out"
 	# servo 1: error bits 0xc (the byte the servo sent; 0x8c with the alert bit 7) named
 	# overheating|motor encoder, its torque as read back: off, where HOLD wants it on

@@ -7,9 +7,9 @@ the standard library only (Debian packages no WebSocket module for python3).
       until the page has drawn frames with samples, takes a screenshot (PNG),
       clicks the page's MODE button of ROBOT, waits for the robot's answer to
       appear in the page's answers box and prints it ("ANSWER <kind> <text>").
-  web_cdp.py servos DEVTOOLS_PORT URL PNG ROBOT STATUS
-      loads URL, waits until one of ROBOT's servos shows STATUS in the page's
-      servo table, prints the table's rows ("ROW id °C V error-bits status
+  web_cdp.py servos DEVTOOLS_PORT URL PNG ROBOT STATUS [TORQUE]
+      loads URL, waits until one of ROBOT's servos shows STATUS (and TORQUE in
+      its torque column, if given) in the page's servo table, prints the table's rows ("ROW id °C V error-bits status
       torque", tab-separated) and takes a screenshot (PNG).
   web_cdp.py slow HOST PORT SECONDS
       opens a WebSocket to undulate-web and never reads from it: a browser that
@@ -161,10 +161,10 @@ def page(devtools_port, url, png, robot, mode):
     print(f"MODE_SHOWN {mode_shown}", flush=True)
 
 
-def servos(devtools_port, url, png, robot, want):
+def servos(devtools_port, url, png, robot, want, torque=None):
     """The robot's servo table as the page shows it, once a row's status reads
-    WANT (or after 15 s): one "ROW id temp V error-bits status torque" line per
-    servo, tab-separated."""
+    WANT (and its torque cell TORQUE, if given) or after 15 s: one "ROW id temp V
+    error-bits status torque" line per servo, tab-separated."""
     cdp = CDP(int(devtools_port))
     cdp.call("Page.enable")
     cdp.call("Emulation.setDeviceMetricsOverride", width=1300, height=1100, deviceScaleFactor=1, mobile=False)
@@ -172,7 +172,8 @@ def servos(devtools_port, url, png, robot, want):
     rows_js = f"""(() => {{ const t = document.querySelector('#robot-{robot} table');
         return t ? [...t.querySelectorAll('tr')].slice(1)
             .map(r => [...r.children].map(c => c.textContent)) : []; }})()"""
-    found = cdp.wait(f"{rows_js}.some(r => r[4] === {json.dumps(want)})", 15)
+    also = f" && r[5] === {json.dumps(torque)}" if torque else ""
+    found = cdp.wait(f"{rows_js}.some(r => r[4] === {json.dumps(want)}{also})", 15)
     print(f"FOUND {bool(found)}", flush=True)
     for r in cdp.js(rows_js) or []:  # tab-separated: a status may hold '|'
         print("ROW\t" + "\t".join(r), flush=True)
