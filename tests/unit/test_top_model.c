@@ -372,6 +372,10 @@ static void test_joint_health(void **state)
 	 * a value the servo cannot report is "not read" */
 	assert_non_null(strstr(js, "\"torque\":true,\"torque_read\":0}"));
 	assert_non_null(strstr(js, "\"torque\":true,\"torque_read\":-1}"));
+	/* the text both monitors show */
+	assert_string_equal(top_joint_torque(&model.robots[0].j[0]), "off (wanted on)");
+	assert_string_equal(top_joint_torque(&model.robots[0].j[1]), "on (wanted; not read yet)");
+	assert_true(top_joint_torque_differs(&model.robots[0].j[0]) && !top_joint_torque_differs(&model.robots[0].j[1]));
 	/* compact view: an S marks the robot */
 	v.kind = TOP_VIEW_COMPACT;
 	top_render(&model, &v, 0.1, 24, 80, true, screen, sizeof(screen));

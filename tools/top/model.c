@@ -295,11 +295,18 @@ const char *top_joint_status(const struct top_joint *j, char *buf, size_t cap)
 	return buf;
 }
 
-const char *top_joint_torque_note(const struct top_joint *j)
+bool top_joint_torque_differs(const struct top_joint *j)
 {
-	if (j->torque_read < 0 || (j->torque_read == 1) == j->torque)
-		return "";
-	return j->torque ? "torque off (wanted on)" : "torque on (wanted off)";
+	return j->torque_read >= 0 && (j->torque_read == 1) != j->torque;
+}
+
+const char *top_joint_torque(const struct top_joint *j)
+{
+	if (j->torque_read < 0)
+		return j->torque ? "on (wanted; not read yet)" : "off (wanted; not read yet)";
+	if (top_joint_torque_differs(j))
+		return j->torque ? "off (wanted on)" : "on (wanted off)";
+	return j->torque_read ? "on" : "off";
 }
 
 bool top_robot_stale(const struct top_robot *r, double now)

@@ -138,9 +138,13 @@ int top_robot_silent_joints(const struct top_robot *r);
  * none is set (the alert, bit 7, is not a cause). Returns buf. */
 char *top_errbits_format(int16_t bits, char *buf, size_t cap);
 const char *top_joint_status(const struct top_joint *j, char *buf, size_t cap);
-/* "" while the servo's reported torque agrees with the wanted one (or was not
- * read yet); else "torque off (wanted on)" or "torque on (wanted off)". */
-const char *top_joint_torque_note(const struct top_joint *j);
+/* The joint's torque as both monitors show it: as the servo last reported it
+ * ("on", "off"), with the wanted one beside it when they differ ("off (wanted
+ * on)": a servo its protection shut down, or reset), or the wanted one while
+ * nothing was read ("on (wanted; not read yet)"). */
+const char *top_joint_torque(const struct top_joint *j);
+/* The servo reported a torque other than the one wanted. */
+bool top_joint_torque_differs(const struct top_joint *j);
 double top_robot_rate_hz(const struct top_robot *r);      /* 1e6 / mean period; NAN none */
 double top_robot_rx_hz(const struct top_robot *r, double now); /* STATE messages received per second */
 double top_robot_jitter_p99(const struct top_robot *r);   /* µs; NAN none */

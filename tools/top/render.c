@@ -156,7 +156,7 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 			snprintf(goal, sizeof goal, "d%+6.3f", j->drive);
 		else
 			num(goal, sizeof goal, "%+7.3f", j->goal, 7);
-		const char *tq = top_joint_torque_note(j);
+		bool tq = top_joint_torque_differs(j);
 		rb_line(b, false, "   j%d id%-3d %s %s %7s %s %s %s %s %s %s %s%s%s", k, j->servo_id,
 			num(ang, sizeof ang, "%+7.3f", live ? j->angle : nan, 7),
 			num(spd, sizeof spd, "%+7.3f", live ? j->speed : nan, 7), goal,
@@ -165,7 +165,7 @@ static void robot_detail(struct rbuf *b, const struct top_model *m, const struct
 			num(amp, sizeof amp, "%4.2f", j->amplitude, 4), num(freq, sizeof freq, "%4.2f", j->frequency, 4),
 			num(temp, sizeof temp, "%3.0fC", j->temperature > 0 ? j->temperature : nan, 4),
 			num(volt, sizeof volt, "%4.1fV", j->voltage > 0 ? j->voltage : nan, 5),
-			top_joint_status(j, st, sizeof st), *tq ? ", " : "", tq);
+			top_joint_status(j, st, sizeof st), tq ? ", torque " : "", tq ? top_joint_torque(j) : "");
 	}
 }
 

@@ -28,6 +28,8 @@ static void frame_status_joint(struct json *j, const struct top_joint *jt)
 	json_field_int(j, "stale_cycles", jt->stale_cycles);
 	json_field_bool(j, "torque", jt->torque);
 	json_field_int(j, "torque_read", jt->torque_read);
+	json_field_string(j, "torque_shown", top_joint_torque(jt));
+	json_field_bool(j, "torque_differs", top_joint_torque_differs(jt));
 	json_object_end(j);
 }
 

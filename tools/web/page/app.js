@@ -71,16 +71,6 @@ function robotCharts(r, nj) {
     plugins: { legend: { display: false }, title: { display: true, text: 'phase portrait (last 10 s)' } } } });
 }
 
-// Torque as the servo last reported it (read back), beside what the daemon
-// wants when the two differ: a servo shut down by its own protection, or reset,
-// has torque off whatever the daemon writes.
-function torqueCell(j) {
-  const onoff = v => v ? 'on' : 'off';
-  if (j.torque_read !== 0 && j.torque_read !== 1) return el('td', {}, onoff(j.torque) + ' (wanted; not read yet)');
-  const agree = (j.torque_read === 1) === j.torque;
-  return el('td', { class: agree ? '' : 'bad' }, onoff(j.torque_read) + (agree ? '' : ' (wanted ' + onoff(j.torque) + ')'));
-}
-
 function robotStatus(s) {
   let r = state.robots.get(s.name);
   if (!r) { r = robotCard(s.name); state.robots.set(s.name, r); }
@@ -101,7 +91,8 @@ function robotStatus(s) {
     const tr = el('tr');
     tr.append(el('td', {}, j.id), el('td', {}, num(j.temperature, 0)), el('td', {}, num(j.voltage, 1)),
       el('td', {}, '0x' + (j.error_bits & 0xff).toString(16)), el('td', { class: j.status === 'ok' ? '' : 'bad' }, j.status),
-      torqueCell(j));
+      // torque as read back, the wanted one beside it when they differ (tools/top/model.c)
+      el('td', { class: j.torque_differs ? 'bad' : '' }, j.torque_shown));
     tb.append(tr);
   }
   if (s.last_event) r.card.title = 'last event: ' + s.last_event;
