@@ -53,7 +53,8 @@ LDFLAGS  += $(SANFLAGS)
 LDLIBS   += $(PKG_LIBS) -lm
 
 # lcm-gen output is not ours: compile it without our warning set, and with
-# compat/ first on its include path (a string decoder that checks lengths).
+# compat/ first on its include path (decoders that check every length and
+# allocate through compat/lcm/lcmdec.c, which is ours and joins the library).
 GEN_WARN := -w
 
 # ---- components -------------------------------------------------------------
@@ -115,7 +116,8 @@ lcmtypes: $(LCM_STAMP)
 # The generated file list is only known after lcm-gen ran: build the library
 # through a recursive step so the wildcard is evaluated afterwards.
 LCM_COMPAT := compat/lcm/lcm_coretypes.h
-$(LIB)/liblcmtypes.a: $(LCM_STAMP) $(LCM_COMPAT)
+LCMDEC_OBJ := $(OBJ)/compat/lcm/lcmdec.o
+$(LIB)/liblcmtypes.a: $(LCM_STAMP) $(LCM_COMPAT) $(LCMDEC_OBJ)
 	@$(MAKE) --no-print-directory lcmtypes-lib
 
 .PHONY: lcmtypes-lib
@@ -128,7 +130,7 @@ lcmtypes-lib:
 	    $(CC) $(STD) $(OPT) $(SANFLAGS) $(PKG_CFLAGS) -Icompat -I$(GEN) $(GEN_WARN) -c $$c -o $$o; \
 	  fi; \
 	done; \
-	rm -f $(LIB)/liblcmtypes.a; ar rcs $(LIB)/liblcmtypes.a $(OBJ)/lcmgen/*.o
+	rm -f $(LIB)/liblcmtypes.a; ar rcs $(LIB)/liblcmtypes.a $(OBJ)/lcmgen/*.o $(LCMDEC_OBJ)
 
 # ---- objects and libraries --------------------------------------------------
 $(OBJ)/%.o: %.c $(LCM_STAMP)
@@ -148,6 +150,13 @@ $(foreach c,$(COMPONENTS),$(eval $(call component_lib,$(c))))
 check-pure:
 	@! grep -nE '#include <(unistd|libserialport|time|poll|fcntl|termios)\.h>|clock_gettime' protocol/*.c protocol/*.h \
 	  || { echo "protocol/ framing must not do I/O or read a clock (use protocol/io/)"; exit 1; }
+
+# Every program decodes LCM messages through compat/lcm/lcmdec.h (bounded,
+# checked): lcm-gen's own _decode and _subscribe trust every length.
+.PHONY: check-lcmdec
+check-lcmdec:
+	@! grep -rnE 'undulate_[a-z0-9_]+_t_(decode|subscribe)\(' common daemon protocol sim-bridge tools bench --include='*.c' \
+	  || { echo "decode LCM messages with lcmdec_decode() (compat/lcm/lcmdec.h), not lcm-gen's _decode/_subscribe"; exit 1; }
 
 define program
 $(BIN)/$(1): $(OBJ)/$(firstword $(DIR_$(PROG_$(1))))/main.o $(call libs_of,$(PROG_$(1))) $(LIB)/liblcmtypes.a
@@ -201,7 +210,7 @@ test-deps: deps
 # tests/integration/sdk_client.sh (without it that test skips and says how).
 DXL_SDK ?=
 test: test-deps
-	@$(MAKE) --no-print-directory check-pure all
+	@$(MAKE) --no-print-directory check-pure check-lcmdec all
 	@BUILD=$(BUILD) DXL_SDK=$(DXL_SDK) tests/run.sh
 
 test-sdk: deps
@@ -214,7 +223,7 @@ test-long: test-deps
 	@BUILD=$(BUILD) TEST_LONG=1 tests/run.sh
 
 test-busy: test-deps
-	@$(MAKE) --no-print-directory check-pure all
+	@$(MAKE) --no-print-directory check-pure check-lcmdec all
 	@scripts/busy.sh env BUILD=$(BUILD) tests/run.sh
 
 bench: deps
@@ -255,7 +264,8 @@ define fuzz_target
 $(BUILD)/fuzz/$(1): tests/fuzz/$(1).c $(foreach c,$(DEPS_$(call fuzz_component,$(1))),$(call libsrcs_of,$(c))) $(LCM_STAMP) $(LCM_COMPAT)
 	@mkdir -p $$(dir $$@)
 	clang $(FUZZ_FLAGS) -I. -Icommon -Iprotocol -Iprotocol/io -Icompat -I$(GEN) $(PKG_CFLAGS) -w \
-	  $$(filter %.c,$$^) $(GEN)/*.c -o $$@ $(PKG_LIBS) -lm
+	  $$(filter %.c,$$^) $(GEN)/*.c compat/lcm/lcmdec.c -o $$@ $(PKG_LIBS) \
+	  $(if $(filter web,$(call fuzz_component,$(1))),-lwebsockets) -lm
 endef
 $(foreach t,$(patsubst tests/fuzz/%.c,%,$(FUZZ_SRC)),$(eval $(call fuzz_target,$(t))))
 .PHONY: fuzz-build

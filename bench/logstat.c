@@ -35,9 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "undulate_bus_stats_t.h"
-#include "undulate_robot_state_t.h"
-#include "undulate_sim_truth_t.h"
+#include "compat/lcm/lcmdec.h"
 
 /* Robots in one log: the sim holds at most 32 buses; room to spare. */
 #define LS_MAX_ROBOTS 64
@@ -163,7 +161,7 @@ static bool ls_is_missing(const undulate_robot_state_t *m, int id)
 static void ls_state_msg(struct ls_state *st, const lcm_eventlog_event_t *ev, size_t namelen)
 {
 	undulate_robot_state_t m;
-	if (undulate_robot_state_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
+	if (ev->datalen < 0 || lcmdec_decode(&lcmdec_robot_state_t, ev->data, (size_t)ev->datalen, &m) != LCMDEC_OK) {
 		st->decode_errors++;
 		return;
 	}
@@ -173,26 +171,26 @@ static void ls_state_msg(struct ls_state *st, const lcm_eventlog_event_t *ev, si
 		if (st->missing_id >= 0)
 			ls_add_cycle(&r->c[ls_is_missing(&m, st->missing_id) ? LS_MISSING : LS_HEALTHY], &m);
 	}
-	undulate_robot_state_t_decode_cleanup(&m);
+	lcmdec_free(&lcmdec_robot_state_t, &m);
 }
 
 static void ls_bus_msg(struct ls_state *st, const lcm_eventlog_event_t *ev, size_t namelen)
 {
 	undulate_bus_stats_t m;
-	if (undulate_bus_stats_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
+	if (ev->datalen < 0 || lcmdec_decode(&lcmdec_bus_stats_t, ev->data, (size_t)ev->datalen, &m) != LCMDEC_OK) {
 		st->decode_errors++;
 		return;
 	}
 	struct ls_robot *r = ls_robot(st, ev->channel, namelen, ev->timestamp);
 	if (r && ls_in_window(st, r->t0_us, ev->timestamp))
 		ls_push(&r->cpu, m.cpu_percent);
-	undulate_bus_stats_t_decode_cleanup(&m);
+	lcmdec_free(&lcmdec_bus_stats_t, &m);
 }
 
 static void ls_truth_msg(struct ls_state *st, const lcm_eventlog_event_t *ev)
 {
 	undulate_sim_truth_t m;
-	if (undulate_sim_truth_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
+	if (ev->datalen < 0 || lcmdec_decode(&lcmdec_sim_truth_t, ev->data, (size_t)ev->datalen, &m) != LCMDEC_OK) {
 		st->decode_errors++;
 		return;
 	}
@@ -200,7 +198,7 @@ static void ls_truth_msg(struct ls_state *st, const lcm_eventlog_event_t *ev)
 		st->truth_t0_us = ev->timestamp;
 	if (ls_in_window(st, st->truth_t0_us, ev->timestamp))
 		ls_push(&st->truth_late, m.worst_lateness_us);
-	undulate_sim_truth_t_decode_cleanup(&m);
+	lcmdec_free(&lcmdec_sim_truth_t, &m);
 }
 
 static bool ls_suffix(const char *ch, size_t len, const char *suffix, size_t *namelen)

@@ -148,7 +148,7 @@ build_helpers() {
 	              -Wmissing-prototypes -Wstrict-prototypes -Wpointer-arith -Wcast-qual -Wundef -Wvla
 	              -Wformat-security -Werror"
 	local inc libs
-	inc="-Icommon -Iprotocol -Iprotocol/io -I$BUILD/lcmgen $(pkg-config --cflags lcm 2>/dev/null)"
+	inc="-I. -Icommon -Iprotocol -Iprotocol/io -I$BUILD/lcmgen $(pkg-config --cflags lcm 2>/dev/null)"
 	# libprotocol uses libcommon (number parsing), so it comes after it
 	libs="$BUILD/lib/libprotocol.a $BUILD/lib/libcommon.a $BUILD/lib/liblcmtypes.a $(pkg-config --libs lcm libserialport inih 2>/dev/null) -lm"
 	mkdir -p "$HB"

@@ -56,4 +56,14 @@ enum num_status num_parse_int(const char *s, int min, int max, int *out);
  * "-0" is refused too. */
 enum num_status num_parse_u64(const char *s, uint64_t min, uint64_t max, uint64_t *out);
 
+/* A counter from outside (a message anyone could send) added to a sum
+ * without trusting it: a negative one counts as 0, and the sum stops at
+ * INT64_MAX instead of overflowing. */
+static inline int64_t num_count_add(int64_t sum, int64_t v)
+{
+	if (v <= 0)
+		return sum;
+	return sum > INT64_MAX - v ? INT64_MAX : sum + v;
+}
+
 #endif

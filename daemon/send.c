@@ -18,6 +18,7 @@
 #include "clock.h"
 #include "auth.h"
 #include "command.h"
+#include "compat/lcm/lcmdec.h"
 #include "csock.h"
 #include "daemon.h"
 #include "udpm.h"
@@ -102,9 +103,9 @@ static int send_local(const struct send_opts *o, const uint8_t *msg, size_t len,
 			continue;
 		ssize_t got = recv(fd, buf, sizeof buf, MSG_DONTWAIT);
 		undulate_event_t e;
-		if (got > 0 && undulate_event_t_decode(buf, 0, (int)got, &e) == (int)got) {
+		if (got > 0 && lcmdec_decode(&lcmdec_event_t, buf, (size_t)got, &e) == LCMDEC_OK) {
 			send_answer(st, &e);
-			undulate_event_t_decode_cleanup(&e);
+			lcmdec_free(&lcmdec_event_t, &e);
 		}
 	}
 	close(fd);
@@ -114,11 +115,14 @@ static int send_local(const struct send_opts *o, const uint8_t *msg, size_t len,
 }
 
 /* ---- over the network, signed ------------------------------------------------------------------- */
-static void send_on_event(const lcm_recv_buf_t *rbuf, const char *channel, const undulate_event_t *e, void *user)
+static void send_on_event(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-	(void)rbuf;
 	(void)channel;
-	send_answer(user, e);
+	undulate_event_t e;
+	if (lcmdec_decode(&lcmdec_event_t, rbuf->data, rbuf->data_size, &e) != LCMDEC_OK)
+		return;
+	send_answer(user, &e);
+	lcmdec_free(&lcmdec_event_t, &e);
 }
 
 static int send_network(const struct send_opts *o, const uint8_t *msg, size_t len, struct send_state *st)
@@ -136,7 +140,7 @@ static int send_network(const struct send_opts *o, const uint8_t *msg, size_t le
 		snprintf(events, sizeof events, "%s\\.EVENT", o->robot);
 	else
 		snprintf(events, sizeof events, ".*\\.EVENT");
-	undulate_event_t_subscription_t *sub = undulate_event_t_subscribe(lcm, events, send_on_event, st);
+	lcm_subscription_t *sub = lcm_subscribe(lcm, events, send_on_event, st);
 	st->expected = single ? 1 : 0;
 	lcm_publish(lcm, chan, msg, (unsigned)len);
 	double deadline = clock_mono_s() + o->timeout_s;
@@ -147,7 +151,7 @@ static int send_network(const struct send_opts *o, const uint8_t *msg, size_t le
 		lcm_handle_timeout(lcm, left_ms);
 	}
 	/* the generated wrapper is not freed by lcm_destroy() */
-	undulate_event_t_unsubscribe(lcm, sub);
+	lcm_unsubscribe(lcm, sub);
 	lcm_destroy(lcm);
 	return send_verdict(st, o->robot, o->timeout_s);
 }

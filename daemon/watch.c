@@ -7,7 +7,9 @@
  *   BUS <robot> connected=B reconnects=N p50= p99= max= jitter99= bus99= cpu= overruns=N
  *       ... idJ=ID/replies/timeouts/rtt_mean/rtt_max ... badJ=checksum/wrong_id/wrong_length
  *   PARAMS <robot> k0= c0= mu0= lambda0= ... amplitude= frequency= phase=
- * Angles in rad relative to neutral, speeds rad/s.
+ * Angles in rad relative to neutral, speeds rad/s. A message that does not
+ * decode (anyone on the group can send one) is skipped and said on stderr,
+ * the first WATCH_BAD_SAID, then every WATCH_BAD_EVERY-th, with the count.
  */
 #include <inttypes.h>
 #include <lcm/lcm.h>
@@ -17,23 +19,22 @@
 #include <string.h>
 #include <time.h>
 
+#include "compat/lcm/lcmdec.h"
 #include "daemon.h"
-#include "undulate_bus_stats_t.h"
 #include "text.h"
-#include "undulate_event_t.h"
-#include "undulate_osc_params_t.h"
-#include "undulate_robot_state_t.h"
 
 /* Silence after which --watch says it hears nobody (seconds). */
 #define WATCH_QUIET_S 3.0
 
 static volatile sig_atomic_t watch_stop;
 static unsigned long watch_heard; /* messages printed: none at the end is a failure */
+static unsigned long watch_bad;   /* messages that did not decode */
+#define WATCH_BAD_SAID 5
+#define WATCH_BAD_EVERY 1000
 static void watch_on_signal(int sig) { (void)sig; watch_stop = 1; }
 
-static void watch_state(const lcm_recv_buf_t *rb, const char *ch, const undulate_robot_state_t *m, void *u)
+static void watch_state(const undulate_robot_state_t *m)
 {
-	(void)rb; (void)ch; (void)u;
 	watch_heard++;
 	/* whatever is on the network may say anything: one printable line each */
 	char robot[64], reason[128], fault[160];
@@ -52,21 +53,21 @@ static void watch_state(const lcm_recv_buf_t *rb, const char *ch, const undulate
 	printf("\n");
 }
 
-static void watch_event(const lcm_recv_buf_t *rb, const char *ch, const undulate_event_t *m, void *u)
+static void watch_event(const undulate_event_t *m)
 {
-	(void)rb; (void)ch; (void)u;
 	watch_heard++;
 	char robot[64], kind[48], text[600];
 	printf("EVENT %s seq=%" PRId64 " level=%d kind=%s text=\"%s\"\n", text_line(robot, sizeof robot, m->robot),
 	       m->seq, m->level, text_line(kind, sizeof kind, m->kind), text_line(text, sizeof text, m->text));
 }
 
-static void watch_bus(const lcm_recv_buf_t *rb, const char *ch, const undulate_bus_stats_t *m, void *u)
+static void watch_bus(const undulate_bus_stats_t *m)
 {
-	(void)rb; (void)ch; (void)u;
 	watch_heard++;
+	char robot[64];
 	printf("BUS %s connected=%d reconnects=%" PRId64 " p50=%.0f p99=%.0f max=%.0f jitter99=%.0f bus99=%.0f "
-	       "cpu=%.2f overruns=%" PRId64 " stray=%" PRId64 " io_errors=%" PRId64, m->robot, m->connected,
+	       "cpu=%.2f overruns=%" PRId64 " stray=%" PRId64 " io_errors=%" PRId64, text_line(robot, sizeof robot, m->robot),
+	       m->connected,
 	       m->reconnects, m->period_p50_us, m->period_p99_us, m->period_max_us, m->jitter_p99_us,
 	       m->bus_p99_us, m->cpu_percent, m->overruns, m->stray_packets, m->io_errors);
 	for (int j = 0; j < m->nservos; j++)
@@ -79,16 +80,57 @@ static void watch_bus(const lcm_recv_buf_t *rb, const char *ch, const undulate_b
 	printf("\n");
 }
 
-static void watch_params(const lcm_recv_buf_t *rb, const char *ch, const undulate_osc_params_t *m, void *u)
+static void watch_params(const undulate_osc_params_t *m)
 {
-	(void)rb; (void)ch; (void)u;
 	watch_heard++;
-	printf("PARAMS %s", m->robot);
+	char robot[64];
+	printf("PARAMS %s", text_line(robot, sizeof robot, m->robot));
 	for (int j = 0; j < m->njoints; j++)
 		printf(" k%d=%g c%d=%g mu%d=%g lambda%d=%g inertia%d=%g friction%d=%g neutral%d=%g min%d=%g max%d=%g",
 		       j, m->k[j], j, m->c[j], j, m->mu[j], j, m->lambda[j], j, m->inertia[j], j, m->friction[j], j,
 		       m->neutral[j], j, m->limit_min[j], j, m->limit_max[j]);
 	printf(" amplitude=%g frequency=%g phase=%g\n", m->amplitude, m->frequency, m->phase);
+}
+
+union watch_msg {
+	undulate_robot_state_t state;
+	undulate_event_t event;
+	undulate_bus_stats_t bus;
+	undulate_osc_params_t params;
+};
+
+/* Subscribed by channel suffix: the suffix names the type. */
+static void watch_on_lcm(const lcm_recv_buf_t *rb, const char *ch, void *u)
+{
+	(void)u;
+	static const struct { const char *suffix; const struct lcmdec_type *type; } kinds[] = {
+		{ ".STATE", &lcmdec_robot_state_t }, { ".EVENT", &lcmdec_event_t },
+		{ ".BUS", &lcmdec_bus_stats_t },     { ".PARAMS", &lcmdec_osc_params_t },
+	};
+	size_t n = strlen(ch), k = 0;
+	while (k < sizeof kinds / sizeof kinds[0] &&
+	       (n < strlen(kinds[k].suffix) || strcmp(ch + n - strlen(kinds[k].suffix), kinds[k].suffix) != 0))
+		k++;
+	if (k == sizeof kinds / sizeof kinds[0])
+		return;
+	union watch_msg m;
+	enum lcmdec_status st = lcmdec_decode(kinds[k].type, rb->data, rb->data_size, &m);
+	if (st != LCMDEC_OK) {
+		if (++watch_bad <= WATCH_BAD_SAID || watch_bad % WATCH_BAD_EVERY == 0) {
+			char why[160], shown[64];
+			fprintf(stderr, "undulated --watch: message on %s skipped: %s (%lu so far)\n",
+			        text_line(shown, sizeof shown, ch),
+			        lcmdec_describe(why, sizeof why, kinds[k].type, rb->data_size, st), watch_bad);
+		}
+		return;
+	}
+	switch (k) {
+	case 0: watch_state(&m.state); break;
+	case 1: watch_event(&m.event); break;
+	case 2: watch_bus(&m.bus); break;
+	default: watch_params(&m.params); break;
+	}
+	lcmdec_free(kinds[k].type, &m);
 }
 
 int dmn_watch(const char *lcm_url, const char *robot, double duration_s)
@@ -104,10 +146,8 @@ int dmn_watch(const char *lcm_url, const char *robot, double duration_s)
 	snprintf(ch[1], sizeof ch[1], "%s\\.EVENT", r);
 	snprintf(ch[2], sizeof ch[2], "%s\\.BUS", r);
 	snprintf(ch[3], sizeof ch[3], "%s\\.PARAMS", r);
-	undulate_robot_state_t_subscription_t *s0 = undulate_robot_state_t_subscribe(lcm, ch[0], watch_state, NULL);
-	undulate_event_t_subscription_t *s1 = undulate_event_t_subscribe(lcm, ch[1], watch_event, NULL);
-	undulate_bus_stats_t_subscription_t *s2 = undulate_bus_stats_t_subscribe(lcm, ch[2], watch_bus, NULL);
-	undulate_osc_params_t_subscription_t *s3 = undulate_osc_params_t_subscribe(lcm, ch[3], watch_params, NULL);
+	for (int i = 0; i < 4; i++)
+		lcm_subscribe(lcm, ch[i], watch_on_lcm, NULL);
 	signal(SIGINT, watch_on_signal);
 	signal(SIGTERM, watch_on_signal);
 	setvbuf(stdout, NULL, _IOLBF, 0);
@@ -130,11 +170,6 @@ int dmn_watch(const char *lcm_url, const char *robot, double duration_s)
 		if (duration_s > 0 && waited >= duration_s)
 			break;
 	}
-	/* the generated wrappers are not freed by lcm_destroy() */
-	undulate_robot_state_t_unsubscribe(lcm, s0);
-	undulate_event_t_unsubscribe(lcm, s1);
-	undulate_bus_stats_t_unsubscribe(lcm, s2);
-	undulate_osc_params_t_unsubscribe(lcm, s3);
 	lcm_destroy(lcm);
 	if (watch_heard == 0) {
 		fprintf(stderr, "undulated --watch: nothing heard from '%s' on %s in %.1f s\n", robot, url, waited);

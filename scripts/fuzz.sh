@@ -7,7 +7,9 @@
 #   FUZZ_ONLY=daemon make fuzz        # targets whose name contains "daemon"
 #
 # Targets and their input counts: the packet parsers (1.0 and 2.0) 10 M (the bytes every
-# servo reply and every simulated request go through), every other parser of
+# servo reply and every simulated request go through), every LCM message type as
+# it reaches the monitors (fuzz_web_feed) 10 M, a whole log through the analyser
+# (fuzz_analyze_log, files written per input) 20 000, every other parser of
 # outside input 2 M. Seed inputs, when a target has some, are in
 # tests/fuzz/seeds/<target>/; the corpus grows in build/fuzz/corpus/<target>/.
 # A crash leaves its input in build/fuzz/crash-<target>-* and fails the run.
@@ -25,7 +27,12 @@ for bin in "$dir"/fuzz_*; do
 	[ -n "$only" ] && [[ "$name" != *$only* ]] && continue
 	runs=${FUZZ_RUNS:-}
 	if [ -z "$runs" ]; then
-		case "$name" in fuzz_protocol_parser|fuzz_protocol_parser2) runs=10000000 ;; *) runs=2000000 ;; esac
+		case "$name" in
+		fuzz_protocol_parser|fuzz_protocol_parser2|fuzz_web_feed) runs=10000000 ;;
+		# a whole analysis into files per input: ~20 a second
+		fuzz_analyze_log) runs=20000 ;;
+		*) runs=2000000 ;;
+		esac
 	fi
 	corpus="$dir/corpus/$name"
 	mkdir -p "$corpus"

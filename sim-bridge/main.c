@@ -34,6 +34,7 @@
 #include "sim.h"
 #include "text.h"
 #include "vtime.h"
+#include "compat/lcm/lcmdec.h"
 #include "wire.h"
 #include "undulate_sim_collision_t.h"
 #include "undulate_sim_command_t.h"
@@ -605,7 +606,7 @@ static void on_sim_reply(const lcm_recv_buf_t *rbuf, const char *channel, void *
 
 	/* Our own small fixed message type from a simulator; still, the decoded
 	 * text is printed sanitized and only when it answers our seq. */
-	if (w->answered || undulate_sim_reply_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) < 0)
+	if (w->answered || lcmdec_decode(&lcmdec_sim_reply_t, rbuf->data, rbuf->data_size, &m) != LCMDEC_OK)
 		return;
 	if (m.seq == w->seq) {
 		w->answered = true;
@@ -613,7 +614,7 @@ static void on_sim_reply(const lcm_recv_buf_t *rbuf, const char *channel, void *
 		printf("%s\n", text_sanitize(shown, sizeof shown, m.reply));
 		fflush(stdout);
 	}
-	undulate_sim_reply_t_decode_cleanup(&m);
+	lcmdec_free(&lcmdec_sim_reply_t, &m);
 }
 
 /* --cmd: split "VERB ARGS" into a sim_command_t, publish it, and print the

@@ -31,6 +31,17 @@
         publish N malformed messages on CHANNEL: random bytes, the template cut
         short, and the template with its first string's length (after the
         fingerprint, utime and seq) replaced by a lie (negative, zero, huge).
+  qa_lcm.py arrays LOG OUT_LOG
+        read one message of each type with an array (STATE, PARAMS, BUS, SIM.TRUTH)
+        from the log LOG (e.g. undulate-analyze --synth) and write OUT_LOG: LOG with
+        hostile copies of them appended, each with an array length that lies
+        (0x7fffffff, 0x20000001: 8 x n wraps a 32-bit size, 200000, -1, -2^31, and
+        one more than the payload holds). Prints the hostile payloads, one line each:
+        "CHANNEL HEX".
+  qa_lcm.py templates LOG
+        the first message on each channel of LOG, one line each: "CHANNEL HEX".
+  qa_lcm.py blast PORT FILE REPEAT
+        publish every "CHANNEL HEX" line of FILE REPEAT times, in turn. Prints "sent N".
 
 A udpm message is one datagram: magic "LC02", a sequence number, the channel
 name and a NUL, then the payload (lcm_udpm.c, short messages). command_t is
@@ -246,6 +257,94 @@ def names(port, prefix, n):
     return 0
 
 
+# ---- array lengths that lie ------------------------------------------------------------------
+# Where each type's array count sits, as lcm-gen lays the fields out: the
+# fixed fields are skipped by size, strings by their own (trusted: these are
+# our own valid messages) length. 's' is a string, a number a fixed field.
+ARRAY_LAYOUT = {
+    'STATE':     [8, 8, 's', 8, 1, 's', 's', 32, 24],      # robot_state_t: ... njoints
+    'PARAMS':    [8, 8, 's'],                              # osc_params_t: ... njoints
+    'BUS':       [8, 8, 's', 's', 4, 1, 8, 8, 4, 48, 24],  # bus_stats_t: ... nservos
+    'SIM.TRUTH': [8, 80],                                  # sim_truth_t: ... nbodies
+}
+LIES = [0x7fffffff, 0x20000001, 200000, -1, -2**31]
+
+
+def read_log(path):
+    d = open(path, 'rb').read()
+    pos, events = 0, []
+    while pos + 28 <= len(d):
+        sync, ev, ts, clen, dlen = struct.unpack_from('>IqqII', d, pos)
+        ch = d[pos + 28:pos + 28 + clen].decode()
+        data = d[pos + 28 + clen:pos + 28 + clen + dlen]
+        events.append((ev, ts, ch, data))
+        pos += 28 + clen + dlen
+    return events
+
+
+def count_offset(kind, raw):
+    pos = 0
+    for f in ARRAY_LAYOUT[kind]:
+        pos += 4 + struct.unpack_from('>i', raw, pos)[0] if f == 's' else f
+    return pos
+
+
+def hostile_arrays(events):
+    """(channel, payload) for each lie in each type with an array."""
+    out, seen = [], set()
+    for _, _, ch, raw in events:
+        kind = ch if ch == 'SIM.TRUTH' else ch.rsplit('.', 1)[-1]
+        if kind not in ARRAY_LAYOUT or kind in seen:
+            continue
+        seen.add(kind)
+        at = count_offset(kind, raw)
+        n = struct.unpack_from('>i', raw, at)[0]
+        for lie in LIES + [n + 1]:
+            out.append((ch, raw[:at] + struct.pack('>i', lie) + raw[at + 4:]))
+    return out
+
+
+def arrays(log, out_log):
+    events = read_log(log)
+    bad = hostile_arrays(events)
+    with open(out_log, 'wb') as f:
+        ev, ts = events[-1][0] + 1, events[-1][1] + 1000
+        for e, t, ch, data in events + [(ev + i, ts + 1000 * i, ch, p) for i, (ch, p) in enumerate(bad)]:
+            c = ch.encode()
+            f.write(struct.pack('>IqqII', 0xEDA1DA01, e, t, len(c), len(data)) + c + data)
+    for ch, p in bad:
+        print(ch, p.hex())
+    return 0
+
+
+def templates(log):
+    seen = set()
+    for _, _, ch, raw in read_log(log):
+        if ch not in seen:
+            seen.add(ch)
+            print(ch, raw.hex())
+    return 0
+
+
+def blast(port, path, repeat):
+    out = sender()
+    lines = [l.split() for l in open(path) if l.strip()]
+    n = 0
+    for r in range(repeat):
+        for ch, hx in lines:
+            while True:
+                try:
+                    out.sendto(datagram(n, ch, bytes.fromhex(hx)), (GROUP, port))
+                    break
+                except BlockingIOError:
+                    time.sleep(0.001)
+            n += 1
+            if n % 50 == 0:
+                time.sleep(0.002)   # let the receivers keep up: lost datagrams test nothing
+    print('sent %d' % n)
+    return 0
+
+
 def main(argv):
     if len(argv) >= 4 and argv[1] == 'capture':
         return capture(int(argv[2]), argv[3], float(argv[4]) if len(argv) > 4 else 5)
@@ -264,6 +363,12 @@ def main(argv):
         return names(int(argv[2]), argv[3], int(argv[4]))
     if len(argv) == 8 and argv[1] == 'garbage':
         return garbage(int(argv[2]), argv[3], argv[4], int(argv[5]), int(argv[6]), float(argv[7]))
+    if len(argv) == 4 and argv[1] == 'arrays':
+        return arrays(argv[2], argv[3])
+    if len(argv) == 3 and argv[1] == 'templates':
+        return templates(argv[2])
+    if len(argv) == 5 and argv[1] == 'blast':
+        return blast(int(argv[2]), argv[3], int(argv[4]))
     sys.stderr.write(__doc__)
     return 2
 

@@ -39,7 +39,7 @@ EOF
 TEMPLATE=$(cat "$T/template")
 
 spawn watch "$D" --watch '*' --lcm-url "$URL"
-spawn top env LCM_DEFAULT_URL="$URL" "$TOP" --once --wait 2 --json
+spawn top env LCM_DEFAULT_URL="$URL" "$TOP" --once --wait 6 --json   # long enough on a loaded machine
 # both have joined the group once two sockets are bound to the port
 bound() { [ "$(grep -c ":$(printf '%04X' $PORT) " /proc/net/udp)" -ge 2 ]; }
 wait_for 5 bound || { tap_fail "watch and top listen" "$(cat "$T/watch.log" "$T/top.log")"; tap_done; exit 1; }
@@ -54,7 +54,7 @@ for i in range(120):
     s.sendto(qa_lcm.datagram(i, 'r1.STATE', p), (qa_lcm.GROUP, port))
     time.sleep(0.005)
 EOF
-wait_for 3 bash -c "! kill -0 $pid_top 2>/dev/null"
+wait_for 10 bash -c "! kill -0 $pid_top 2>/dev/null"
 if alive watch; then tap_ok "undulated --watch survives 100 malformed STATE messages"; else
 	tap_fail "watch survives" "$(tail -5 "$T/watch.log")"; fi
 n=$(grep -ac '^STATE r1 ' "$T/watch.log")

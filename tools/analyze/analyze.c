@@ -12,18 +12,13 @@
 #include "json.h"
 #include "phase.h"
 #include "modes.h"
+#include "num.h"
 #include "plot.h"
 #include "theory.h"
 #include "window.h"
 #include "wire.h"
 
-#include "undulate_bus_stats_t.h"
-#include "undulate_event_t.h"
-#include "undulate_osc_params_t.h"
-#include "undulate_robot_state_t.h"
-#include "undulate_sim_collision_t.h"
-#include "undulate_sim_truth_t.h"
-#include "undulate_sim_world_t.h"
+#include "compat/lcm/lcmdec.h"
 
 #include <errno.h>
 #include <math.h>
@@ -236,16 +231,27 @@ static enum an_chan an_channel(const char *ch)
 	return CH_UNKNOWN;
 }
 
-static void an_decode_failed(struct an_ctx *c, const char *channel)
+/* Decodes EV as T into OUT (lcmdec: bounded and checked, a log may hold
+ * anything anyone sent); a message that does not decode is counted and said. */
+static bool an_decode(struct an_ctx *c, const lcm_eventlog_event_t *ev, const struct lcmdec_type *t, void *out)
 {
+	enum lcmdec_status s = ev->datalen < 0 ? LCMDEC_MALFORMED : lcmdec_decode(t, ev->data, (size_t)ev->datalen, out);
+	if (s == LCMDEC_OK)
+		return true;
 	c->decode_errors++;
-	if (c->warned_decode++ < AN_WARN_LIMIT)
-		an_warn(c, "message on %s does not decode as its type (skipped)", channel);
+	if (c->warned_decode++ < AN_WARN_LIMIT) {
+		char why[160];
+		an_warn(c, "message on %s does not decode as its type (skipped): %s", ev->channel,
+		        lcmdec_describe(why, sizeof why, t, ev->datalen < 0 ? 0 : (size_t)ev->datalen, s));
+	}
+	return false;
 }
 
+/* In doubles: a message's utime is anyone's (int64 subtraction could
+ * overflow), and every real one is exact in a double (< 2^53 µs). */
 static double an_t(const struct an_ctx *c, int64_t utime)
 {
-	return (double)(utime - c->t_origin) * 1e-6;
+	return ((double)utime - (double)c->t_origin) * 1e-6;
 }
 
 /* ---- log iteration ------------------------------------------------------------ */
@@ -450,24 +456,20 @@ static void an_scan_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
 	switch (an_channel(ev->channel)) {
 	case CH_STATE: {
 		undulate_robot_state_t m;
-		if (undulate_robot_state_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
-			an_decode_failed(c, ev->channel);
+		if (!an_decode(c, ev, &lcmdec_robot_state_t, &m))
 			return;
-		}
 		if (m.utime > c->last_utime)
 			c->last_utime = m.utime;
 		an_scan_state(c, &m);
-		undulate_robot_state_t_decode_cleanup(&m);
+		lcmdec_free(&lcmdec_robot_state_t, &m);
 		break;
 	}
 	case CH_TRUTH: {
 		undulate_sim_truth_t m;
-		if (undulate_sim_truth_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
-			an_decode_failed(c, ev->channel);
+		if (!an_decode(c, ev, &lcmdec_sim_truth_t, &m))
 			return;
-		}
 		an_scan_truth(c, &m);
-		undulate_sim_truth_t_decode_cleanup(&m);
+		lcmdec_free(&lcmdec_sim_truth_t, &m);
 		break;
 	}
 	case CH_COLLISION:
@@ -475,13 +477,11 @@ static void an_scan_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
 		break;
 	case CH_WORLD: {
 		undulate_sim_world_t m;
-		if (undulate_sim_world_t_decode(ev->data, 0, ev->datalen, &m) < 0) {
-			an_decode_failed(c, ev->channel);
+		if (!an_decode(c, ev, &lcmdec_sim_world_t, &m))
 			return;
-		}
 		if (m.restitution >= 0 && m.restitution <= 1)
 			c->world_restitution = m.restitution;
-		undulate_sim_world_t_decode_cleanup(&m);
+		lcmdec_free(&lcmdec_sim_world_t, &m);
 		break;
 	}
 	case CH_UNKNOWN:
@@ -862,9 +862,9 @@ static void an_on_bus(struct an_ctx *c, const undulate_bus_stats_t *m)
 {
 	int64_t timeouts = 0, checksum = 0, errrep = 0;
 	for (int i = 0; i < m->nservos; i++) {
-		timeouts += m->servos[i].timeouts;
-		checksum += m->servos[i].checksum_errors;
-		errrep += m->servos[i].error_replies;
+		timeouts = num_count_add(timeouts, m->servos[i].timeouts);
+		checksum = num_count_add(checksum, m->servos[i].checksum_errors);
+		errrep = num_count_add(errrep, m->servos[i].error_replies);
 	}
 	FILE *f = c->bus;
 	fprintf(f, "%lld,%.6f,", (long long)m->utime, an_t(c, m->utime));
@@ -923,12 +923,10 @@ static void an_on_params(struct an_ctx *c, const undulate_osc_params_t *m)
 #define AN_DISPATCH(T, handler)                                                   \
 	do {                                                                      \
 		undulate_##T m;                                                   \
-		if (undulate_##T##_decode(ev->data, 0, ev->datalen, &m) < 0) {   \
-			an_decode_failed(c, ev->channel);                         \
+		if (!an_decode(c, ev, &lcmdec_##T, &m))                           \
 			return;                                                   \
-		}                                                                 \
 		handler(c, &m);                                                   \
-		undulate_##T##_decode_cleanup(&m);                                \
+		lcmdec_free(&lcmdec_##T, &m);                                     \
 	} while (0)
 
 /* SIM.COLLISION is the per-collision channel; the copies inside SIM.TRUTH are

@@ -1,7 +1,9 @@
 /* undulate-top — live monitor of every robot on the LCM network.
  * See tools/top/README.md. */
 #include "clock.h"
+#include "compat/lcm/lcmdec.h"
 #include "csock.h"
+#include "feed.h"
 #include "keys.h"
 #include "model.h"
 #include "modes.h"
@@ -90,12 +92,6 @@ static void set_status(struct top_app *a, const char *fmt, ...)
 
 /* ---- LCM ------------------------------------------------------------------------ */
 
-static bool ends_with(const char *s, const char *suffix)
-{
-	size_t n = strlen(s), m = strlen(suffix);
-	return n > m && strcmp(s + n - m, suffix) == 0;
-}
-
 /* Seconds after a command to every robot before the ones that did not
  * answer are counted as such. */
 #define TOP_ALL_ANSWER_S 2.0
@@ -143,42 +139,25 @@ static void show_event(struct top_app *a, const undulate_event_t *e)
 	set_status(a, "%s %s: %s: %s", t, e->robot, e->kind, e->text);
 }
 
-/* Decodes BUF as T into a local, runs STMT with `msg`, cleans up. */
-#define TOP_DECODE(T, stmt)                                                          \
-	do {                                                                         \
-		undulate_##T msg;                                                    \
-		if (undulate_##T##_decode(rbuf->data, 0, (int)rbuf->data_size, &msg) < 0) { \
-			a->model.decode_errors++;                                    \
-			return;                                                      \
-		}                                                                    \
-		stmt;                                                                \
-		undulate_##T##_decode_cleanup(&msg);                                 \
-	} while (0)
+static void top_feed_event(const undulate_event_t *e, void *user)
+{
+	show_event(user, e);
+}
 
+/* A message that does not decode is counted in the model (shown in --json and
+ * the footer): the screen is ours, so nothing is printed. */
 static void on_message(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
 	struct top_app *a = user;
-	double now = clock_mono_s();
-	if (strcmp(channel, "SIM.TRUTH") == 0)
-		TOP_DECODE(sim_truth_t, top_on_truth(&a->model, &msg, now));
-	else if (strcmp(channel, "SIM.COLLISION") == 0)
-		TOP_DECODE(sim_collision_t, top_on_sim_collision(&a->model, &msg, now));
-	else if (ends_with(channel, ".STATE"))
-		TOP_DECODE(robot_state_t, top_on_state(&a->model, &msg, now));
-	else if (ends_with(channel, ".BUS"))
-		TOP_DECODE(bus_stats_t, top_on_bus(&a->model, &msg));
-	else if (ends_with(channel, ".PARAMS"))
-		TOP_DECODE(osc_params_t, top_on_params(&a->model, &msg));
-	else if (ends_with(channel, ".EVENT"))
-		TOP_DECODE(event_t, (top_on_event(&a->model, &msg), show_event(a, &msg)));
+	const struct top_feed_hooks hooks = { .on_event = top_feed_event, .user = a };
+	char why[160];
+	top_feed(&a->model, channel, rbuf->data, rbuf->data_size, clock_mono_s(), &hooks, why, sizeof why);
 }
 
 static int top_subscribe(struct top_app *a)
 {
-	static const char *const channels[] = { ".*\\.STATE", ".*\\.BUS", ".*\\.PARAMS", ".*\\.EVENT",
-						"SIM\\.TRUTH", "SIM\\.COLLISION" };
-	for (size_t i = 0; i < sizeof(channels) / sizeof(channels[0]); i++)
-		if (!lcm_subscribe(a->lcm, channels[i], on_message, a))
+	for (size_t i = 0; i < top_feed_nchannels; i++)
+		if (!lcm_subscribe(a->lcm, top_feed_channels[i], on_message, a))
 			return -1;
 	return 0;
 }
@@ -224,11 +203,13 @@ static void read_answers(struct top_app *a)
 		if (n <= 0)
 			return;
 		undulate_event_t e;
-		if (undulate_event_t_decode(buf, 0, (int)n, &e) != (int)n)
+		if (lcmdec_decode(&lcmdec_event_t, buf, (size_t)n, &e) != LCMDEC_OK) {
+			a->model.decode_errors++;
 			continue;
+		}
 		top_on_event(&a->model, &e);
 		show_event(a, &e);
-		undulate_event_t_decode_cleanup(&e);
+		lcmdec_free(&lcmdec_event_t, &e);
 	}
 }
 

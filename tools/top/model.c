@@ -4,6 +4,7 @@
 #include "dxl2_table.h"
 #include "json.h"
 #include "modes.h"
+#include "num.h"
 #include "phase.h"
 
 #include <math.h>
@@ -99,8 +100,8 @@ void top_on_bus(struct top_model *m, const undulate_bus_stats_t *b)
 	r->io_errors = b->io_errors;
 	r->timeouts = r->checksum_errors = 0;
 	for (int i = 0; i < b->nservos; i++) {
-		r->timeouts += b->servos[i].timeouts;
-		r->checksum_errors += b->servos[i].checksum_errors;
+		r->timeouts = num_count_add(r->timeouts, b->servos[i].timeouts);
+		r->checksum_errors = num_count_add(r->checksum_errors, b->servos[i].checksum_errors);
 	}
 }
 

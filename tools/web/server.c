@@ -2,6 +2,7 @@
 #include "server.h"
 
 #include <errno.h>
+#include <inttypes.h>
 #include <libwebsockets.h>
 #include <math.h>
 #include <signal.h>
@@ -13,9 +14,11 @@
 #include <unistd.h>
 
 #include "clock.h"
+#include "tools/top/feed.h"
 #include "frame.h"
 #include "hist.h"
 #include "req.h"
+#include "text.h"
 #include "wcmd.h"
 
 /* One browser on the WebSocket (libwebsockets' per-session data). */
@@ -89,12 +92,6 @@ static void web_log(long long count, const char *fmt, ...)
 
 /* ---- LCM ------------------------------------------------------------------------ */
 
-static bool ends_with(const char *s, const char *suffix)
-{
-	size_t n = strlen(s), m = strlen(suffix);
-	return n > m && strcmp(s + n - m, suffix) == 0;
-}
-
 static struct web_client *web_client_by_id(unsigned id)
 {
 	for (int i = 0; i < app.nclients; i++)
@@ -145,42 +142,43 @@ static void web_collision(const undulate_sim_collision_t *c, double now)
 		hist_on_collision(&app.hist, &app.model, c->left_robot, c->right_robot, now);
 }
 
-#define WEB_DECODE(T, stmt)                                                                    \
-	do {                                                                                   \
-		undulate_##T msg;                                                              \
-		if (undulate_##T##_decode(rbuf->data, 0, (int)rbuf->data_size, &msg) < 0) {    \
-			app.model.decode_errors++;                                             \
-			return;                                                                \
-		}                                                                              \
-		stmt;                                                                          \
-		undulate_##T##_decode_cleanup(&msg);                                           \
-	} while (0)
+static void web_feed_event(const undulate_event_t *e, void *user)
+{
+	(void)user;
+	web_on_answer(NULL, e);
+}
 
+static void web_feed_collision(const undulate_sim_collision_t *c, double now, void *user)
+{
+	(void)user;
+	web_collision(c, now);
+}
+
+/* A message that does not decode is counted (the page shows decode_errors)
+ * and said, at most WEB_DECODE_LOG_N times, then once a minute. */
+#define WEB_DECODE_LOG_N 5
+#define WEB_DECODE_LOG_EVERY_S 60.0
 static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
 	(void)user;
+	static const struct top_feed_hooks hooks = { .on_event = web_feed_event, .on_collision = web_feed_collision };
+	static double last_said;
 	double now = clock_mono_s();
-	if (strcmp(channel, "SIM.TRUTH") == 0)
-		WEB_DECODE(sim_truth_t, top_on_truth(&app.model, &msg, now));
-	else if (strcmp(channel, "SIM.COLLISION") == 0)
-		WEB_DECODE(sim_collision_t, (top_on_sim_collision(&app.model, &msg, now), web_collision(&msg, now)));
-	else if (ends_with(channel, ".STATE"))
-		WEB_DECODE(robot_state_t, top_on_state(&app.model, &msg, now));
-	else if (ends_with(channel, ".BUS"))
-		WEB_DECODE(bus_stats_t, top_on_bus(&app.model, &msg));
-	else if (ends_with(channel, ".PARAMS"))
-		WEB_DECODE(osc_params_t, top_on_params(&app.model, &msg));
-	else if (ends_with(channel, ".EVENT"))
-		WEB_DECODE(event_t, (top_on_event(&app.model, &msg), web_on_answer(NULL, &msg)));
+	char why[160];
+	if (top_feed(&app.model, channel, rbuf->data, rbuf->data_size, now, &hooks, why, sizeof why) || !why[0])
+		return;
+	if (app.model.decode_errors <= WEB_DECODE_LOG_N || now - last_said >= WEB_DECODE_LOG_EVERY_S) {
+		char ch[64];
+		fprintf(stderr, "undulate-web: message on %s skipped: %s (%" PRId64 " so far)\n",
+		        text_line(ch, sizeof ch, channel), why, app.model.decode_errors);
+		last_said = now;
+	}
 }
 
 static int web_subscribe(void)
 {
-	/* undulate-top's channels */
-	static const char *const channels[] = { ".*\\.STATE", ".*\\.BUS", ".*\\.PARAMS", ".*\\.EVENT",
-						"SIM\\.TRUTH", "SIM\\.COLLISION" };
-	for (size_t i = 0; i < sizeof channels / sizeof channels[0]; i++)
-		if (!lcm_subscribe(app.lcm, channels[i], web_on_lcm, NULL))
+	for (size_t i = 0; i < top_feed_nchannels; i++)
+		if (!lcm_subscribe(app.lcm, top_feed_channels[i], web_on_lcm, NULL))
 			return -1;
 	return 0;
 }

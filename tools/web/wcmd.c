@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "clock.h"
+#include "compat/lcm/lcmdec.h"
 #include "csock.h"
 #include "undulate_command_t.h"
 
@@ -120,9 +121,9 @@ void wcmd_read_local(struct wcmd *w, void (*fn)(void *ctx, const undulate_event_
 		if (n <= 0)
 			return;
 		undulate_event_t e;
-		if (undulate_event_t_decode(buf, 0, (int)n, &e) != (int)n)
+		if (lcmdec_decode(&lcmdec_event_t, buf, (size_t)n, &e) != LCMDEC_OK)
 			continue;
 		fn(ctx, &e);
-		undulate_event_t_decode_cleanup(&e);
+		lcmdec_free(&lcmdec_event_t, &e);
 	}
 }
