@@ -179,7 +179,7 @@ test_component = $(word 2,$(subst _, ,$(1)))
 define unit_test
 $(BUILD)/tests/$(1): $(OBJ)/tests/unit/$(1).o $(TEST_HELPERS) $(call libs_of,$(call test_component,$(1))) $(LIB)/liblcmtypes.a
 	@mkdir -p $$(dir $$@)
-	$(CC) $(LDFLAGS) -o $$@ $$< $(TEST_HELPERS) $(call libs_of,$(call test_component,$(1))) $(LIB)/liblcmtypes.a $(LDLIBS) -lcmocka
+	$(CC) $(LDFLAGS) -o $$@ $$< $(TEST_HELPERS) $(call libs_of,$(call test_component,$(1))) $(LIB)/liblcmtypes.a $$(LDLIBS) -lcmocka
 endef
 $(foreach t,$(patsubst tests/unit/%.c,%,$(UNIT_SRC)),$(eval $(call unit_test,$(t))))
 
@@ -193,6 +193,10 @@ $(BUILD)/tests/tools/%: $(OBJ)/tests/tools/%.o $(call libs_of,daemon) $(LIB)/lib
 # undulate-web serves HTTP and WebSocket with libwebsockets (Debian's
 # libwebsockets-dev); only it links it.
 $(BIN)/undulate-web: LDLIBS += -lwebsockets
+# The simulator's plane world steps Chipmunk2D (Debian's libchipmunk-dev):
+# the simulator and its tests link it.
+$(BIN)/undulate-sim: LDLIBS += -lchipmunk
+$(patsubst tests/unit/%.c,$(BUILD)/tests/%,$(wildcard tests/unit/test_sim_*.c)): LDLIBS += -lchipmunk
 # pngdata reads the plots' PNGs (libpng, from Debian's libpng-dev).
 $(BUILD)/tests/tools/pngdata: LDLIBS += -lpng
 unit-tests: $(TOOL_BINS)
@@ -265,7 +269,8 @@ $(BUILD)/fuzz/$(1): tests/fuzz/$(1).c $(foreach c,$(DEPS_$(call fuzz_component,$
 	@mkdir -p $$(dir $$@)
 	clang $(FUZZ_FLAGS) -I. -Icommon -Iprotocol -Iprotocol/io -Icompat -I$(GEN) $(PKG_CFLAGS) -w \
 	  $$(filter %.c,$$^) $(GEN)/*.c compat/lcm/lcmdec.c -o $$@ $(PKG_LIBS) \
-	  $(if $(filter web,$(call fuzz_component,$(1))),-lwebsockets) -lm
+	  $(if $(filter web,$(call fuzz_component,$(1))),-lwebsockets) \
+	  $(if $(filter sim,$(call fuzz_component,$(1))),-lchipmunk) -lm
 endef
 $(foreach t,$(patsubst tests/fuzz/%.c,%,$(FUZZ_SRC)),$(eval $(call fuzz_target,$(t))))
 .PHONY: fuzz-build
