@@ -40,6 +40,9 @@
 #include "undulate_sim_command_t.h"
 #include "undulate_sim_reply_t.h"
 #include "undulate_sim_truth_t.h"
+#include "undulate_sim_contact_t.h"
+#include "undulate_sim_link_t.h"
+#include "undulate_sim_wall_t.h"
 #include "undulate_sim_world_t.h"
 
 /* Physics steps run back to back after a stall before the schedule is
@@ -108,6 +111,7 @@ struct app {
 	int pending_bus[MAIN_TRUTH_MAX_COLLISIONS][2];
 	size_t npending;
 	uint64_t truth_sent, truth_failed, collisions_unreported;
+	uint64_t plane_steps_at;   /* the step of the last SIM.TRUTH: its contacts' period */
 	uint8_t *truth_buf;
 	bool bench, quiet;
 	/* bad input already reported, per bus (reported at most once a second) */
@@ -438,6 +442,49 @@ static void report_collisions(struct app *a)
 	}
 }
 
+/* The plane world's links, walls and contacts since the last message, into t. */
+static void fill_plane(struct app *a, undulate_sim_truth_t *t)
+{
+	static undulate_sim_link_t links[PLANE_MAX_ROBOTS * PLANE_MAX_LINKS];
+	static undulate_sim_wall_t walls[PLANE_MAX_WALLS];
+	static undulate_sim_contact_t contacts[PLANE_MAX_CONTACTS];
+	static struct plane_contact c[PLANE_MAX_CONTACTS];
+	struct sim *s = a->sim;
+	const struct plane_params *pp = &s->cfg.plane;
+	t->world = UNDULATE_SIM_TRUTH_T_WORLD_PLANE;
+	int nl = 0;
+	for (int r = 0; r < plane_robots(s->plane); r++)
+		for (int k = 0; k <= plane_joints(s->plane, r); k++) {
+			struct plane_link_pose p;
+			plane_link(s->plane, r, k, &p);
+			links[nl++] = (undulate_sim_link_t){ .robot = (int16_t)r, .link = (int8_t)k, .x = p.x, .y = p.y,
+							     .angle = p.angle, .length = pp->link_length,
+							     .width = pp->link_width };
+		}
+	int nw = plane_walls(s->plane);
+	for (int w = 0; w < nw; w++)
+		plane_wall(s->plane, w, &walls[w].ax, &walls[w].ay, &walls[w].bx, &walls[w].by);
+	size_t nc = sim_plane_drain(s, c, PLANE_MAX_CONTACTS);
+	if (nc > PLANE_MAX_CONTACTS)
+		nc = PLANE_MAX_CONTACTS;
+	/* the period these impulses were summed over */
+	double period = (double)(s->steps - a->plane_steps_at) * s->dt;
+	a->plane_steps_at = s->steps;
+	for (size_t i = 0; i < nc; i++)
+		contacts[i] = (undulate_sim_contact_t){
+			.robot_a = (int16_t)c[i].robot_a, .link_a = (int8_t)c[i].link_a, .robot_b = (int16_t)c[i].robot_b,
+			.link_b = (int8_t)c[i].link_b, .x = c[i].x, .y = c[i].y, .nx = c[i].nx, .ny = c[i].ny,
+			.impulse = c[i].impulse, .normal_impulse = c[i].normal_impulse,
+			.force = period > 0 ? c[i].impulse / period : 0, .impact = c[i].impact,
+		};
+	t->nlinks = nl;
+	t->links = links;
+	t->nwalls = nw;
+	t->walls = walls;
+	t->ncontacts = (int32_t)nc;
+	t->contacts = contacts;
+}
+
 static void publish_truth(struct app *a)
 {
 	static undulate_sim_body_t bodies[SIM_MAX_BODIES];
@@ -465,6 +512,8 @@ static void publish_truth(struct app *a)
 	}
 	for (size_t i = 0; i < a->npending; i++)
 		fill_collision(a, &a->pending[i], a->pending_utime[i], &colls[i]);
+	if (s->plane != NULL)
+		fill_plane(a, &t);
 	a->npending = 0;
 	a->period_worst_late_us = 0;
 	int n = undulate_sim_truth_t_encode(a->truth_buf, 0, MAIN_TRUTH_BUF, &t);
@@ -1067,7 +1116,8 @@ static void print_ready(const struct sim *s, const char *url)
 		printf("]");
 		print_models(&s->buses[i]);
 	}
-	printf(" bodies=%zu rate=%.0fHz lcm=%s\n", s->world.nbodies, s->cfg.rate_hz, url[0] ? url : "default");
+	printf(" bodies=%zu world=%s rate=%.0fHz lcm=%s\n", s->world.nbodies, s->plane ? "plane" : "row", s->cfg.rate_hz,
+	       url[0] ? url : "default");
 	fflush(stdout);
 }
 
@@ -1229,6 +1279,7 @@ int main(int argc, char **argv)
 		run(&app);
 	int64_t now = mono_ns();
 	sim_close(&sim);
+	sim_free(&sim);
 	if (app.lockstep)
 		vt_close(&app.vt);
 	if (app.listen_fd >= 0) {

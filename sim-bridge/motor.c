@@ -308,6 +308,47 @@ void sim_motor_step(struct sim_motor *m, const struct sim_motor_params *p,
 	motor_integrate(m, p, &ln, ext_torque, dt);
 }
 
+void sim_motor_drive_for(struct sim_motor *m, const struct sim_motor_params *p, const struct sim_motor_cmd *cmd,
+                         double dt, struct sim_motor_drive *d)
+{
+	double none = 0;
+	if (!motor_sane(m, p, &none, dt)) {
+		*d = (struct sim_motor_drive){ 0, 0, 0, 0 };
+		return;
+	}
+	motor_line_for(m, p, cmd, dt, d);
+}
+
+double sim_motor_rotor_inertia(const struct sim_motor_params *p)
+{
+	double r = p->inertia - sim_motor_link_inertia();
+	return isfinite(r) && r > 0 ? r : 0;
+}
+
+void sim_motor_loss(const struct sim_motor_params *p, const struct sim_motor_drive *d, double *viscous,
+                    double *coulomb)
+{
+	bool driven = d->cap > 0;
+	*viscous = driven ? 0 : p->backdrive_viscous;
+	*coulomb = driven ? 0 : p->backdrive_coulomb;
+}
+
+void sim_motor_moved(struct sim_motor *m, const struct sim_motor_params *p, const struct sim_motor_drive *d,
+                     double angle, double speed, double motor_torque, double dt)
+{
+	if (!isfinite(angle) || !isfinite(speed) || !isfinite(motor_torque)) {
+		m->bad_input++;
+		return;
+	}
+	m->angle = angle;
+	m->speed = speed;
+	m->motor_torque = motor_torque;
+	m->ext_torque = 0;
+	m->drive = d->duty;
+	if (dt > 0 && isfinite(dt))
+		motor_heat(m, p, dt);
+}
+
 void sim_motor_step_drive(struct sim_motor *m, const struct sim_motor_params *p,
                           const struct sim_motor_drive *d, double ext_torque, double dt)
 {

@@ -86,6 +86,24 @@ void sim_motor_step(struct sim_motor *m, const struct sim_motor_params *p,
 /* The same with the drive given directly (the X servos' controllers). */
 void sim_motor_step_drive(struct sim_motor *m, const struct sim_motor_params *p,
                           const struct sim_motor_drive *d, double ext_torque, double dt);
+/* The plane world (plane.c) moves the links itself; a joint's motor then
+ * gives only its drive and takes back where the joint went:
+ * the AX-12A's drive over the next step from its registers (the controller's
+ * half of sim_motor_step; an X servo's comes from xdrive.c), */
+void sim_motor_drive_for(struct sim_motor *m, const struct sim_motor_params *p, const struct sim_motor_cmd *cmd,
+                         double dt, struct sim_motor_drive *d);
+/* the rotor's inertia seen through the gearbox: the joint's inertia without
+ * the link's own (the plane's links have their own mass), */
+double sim_motor_rotor_inertia(const struct sim_motor_params *p);
+/* the joint's own losses: the gearbox back-driven while there is no drive
+ * (the link's viscous and Coulomb terms are the row world's stand-in for its
+ * surroundings, which the plane models as drag), */
+void sim_motor_loss(const struct sim_motor_params *p, const struct sim_motor_drive *d, double *viscous,
+                    double *coulomb);
+/* and after the step: the joint's angle and speed, the torque the motor
+ * delivered, its heating. */
+void sim_motor_moved(struct sim_motor *m, const struct sim_motor_params *p, const struct sim_motor_drive *d,
+                     double angle, double speed, double motor_torque, double dt);
 /* Supply-scaled motor line: stall torque (N·m) and no-load speed (rad/s). */
 double sim_motor_stall_torque(const struct sim_motor_params *p);
 double sim_motor_no_load_speed(const struct sim_motor_params *p);

@@ -39,6 +39,11 @@ void sim_config_defaults(struct sim_config *c)
 	c->half_width = 0;
 	c->effective_mass = 0;
 	c->walls = SIM_WALLS_NONE;
+	c->world_kind = SIM_WORLD_ROW;
+	/* the paper's links; the AX-12A's 32 mm width; 0.12 kg as the row's
+	 * link inertia assumes; drag and friction chosen (PHYSICS.md §6) */
+	c->plane = (struct plane_params){ .link_length = 0.1865, .link_width = 0.032, .link_mass = 0.12,
+					  .friction = 0.2, .drag_tangent = 1.0, .drag_normal = 2.0, .substeps = 2 };
 	sim_motor_default_params(&c->motor);
 }
 
@@ -238,11 +243,62 @@ static int set_walls(struct sim_config *c, const char *v, char *err, size_t errc
 	return 0;
 }
 
+/* world.ends = none | BACK,FRONT: walls across the plane robots' length */
+static int set_ends(struct sim_config *c, const char *v, char *err, size_t errcap)
+{
+	if (!strcasecmp(v, "none")) {
+		c->ends_set = false;
+		return 0;
+	}
+	double b, f;
+	char back[64];
+	const char *comma = strchr(v, ',');
+	size_t n = comma ? (size_t)(comma - v) : sizeof(back);
+	if (n < sizeof(back)) {
+		memcpy(back, v, n);
+		back[n] = '\0';
+	}
+	if (n >= sizeof(back) || !parse_num(back, &b) || !parse_num(comma + 1, &f) || !(b < f))
+		return ERR("ends: none or BACK,FRONT (m along y, BACK < FRONT)");
+	c->ends_set = true;
+	c->ends_back = b;
+	c->ends_front = f;
+	return 0;
+}
+
+/* The plane world's keys (world.kind = plane); 1 when k is not one. */
+static int set_plane(struct sim_config *c, const char *k, double d, char *err, size_t errcap)
+{
+	struct plane_params *p = &c->plane;
+	if (!strcmp(k, "link_length"))
+		return d > 0 && d <= 2 ? (p->link_length = d, 0) : ERR("link_length: 0..2 m");
+	if (!strcmp(k, "link_width"))
+		return d > 0 && d <= 0.5 ? (p->link_width = d, 0) : ERR("link_width: 0..0.5 m");
+	if (!strcmp(k, "link_mass"))
+		return d > 0 && d <= 50 ? (p->link_mass = d, 0) : ERR("link_mass: 0..50 kg");
+	if (!strcmp(k, "friction"))
+		return d >= 0 && d <= 5 ? (p->friction = d, 0) : ERR("friction: 0..5");
+	if (!strcmp(k, "drag_tangent"))
+		return d >= 0 && d <= 1000 ? (p->drag_tangent = d, 0) : ERR("drag_tangent: 0..1000 N s/m per m");
+	if (!strcmp(k, "drag_normal"))
+		return d >= 0 && d <= 1000 ? (p->drag_normal = d, 0) : ERR("drag_normal: 0..1000 N s/m per m");
+	if (!strcmp(k, "substeps"))
+		return d >= 1 && d <= 64 && d == floor(d) ? (p->substeps = (int)d, 0) : ERR("substeps: a whole number 1..64");
+	return 1;
+}
+
 static int set_world(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)
 {
 	double d;
 	if (!strcmp(k, "walls"))
 		return set_walls(c, v, err, errcap);
+	if (!strcmp(k, "ends"))
+		return set_ends(c, v, err, errcap);
+	if (!strcmp(k, "kind")) {
+		if (!strcasecmp(v, "row") || !strcasecmp(v, "plane"))
+			return c->world_kind = strcasecmp(v, "row") ? SIM_WORLD_PLANE : SIM_WORLD_ROW, 0;
+		return ERR("kind: '%s' is not row (the theory's line) or plane (links in a plane)", v);
+	}
 	if (!parse_num(v, &d))
 		return ERR("%s: '%s' is not a number", k, v);
 	if (!strcmp(k, "restitution"))
@@ -263,7 +319,8 @@ static int set_world(struct sim_config *c, const char *k, const char *v, char *e
 		return d >= 0 ? (c->half_width = d, 0) : ERR("half_width: >= 0 m");
 	if (!strcmp(k, "effective_mass"))
 		return d >= 0 ? (c->effective_mass = d, 0) : ERR("effective_mass: >= 0 kg");
-	return ERR("unknown key world.%s", k);
+	int r = set_plane(c, k, d, err, errcap);
+	return r <= 0 ? r : ERR("unknown key world.%s", k);
 }
 
 static int set_motor(struct sim_config *c, const char *k, const char *v, char *err, size_t errcap)
@@ -351,6 +408,23 @@ static int robot_key(struct sim_robot_config *r, const char *name, const char *k
 	if (!strcmp(k, "return_delay_us"))
 		return parse_long(v, 0, 508, &n) ? (r->return_delay_us = (int)n, 0)
 		                                 : ERR("return_delay_us: '%s' is not a whole number 0..508", v);
+	if (!strcmp(k, "position")) {
+		double x, y;
+		char first[64];
+		const char *comma = strchr(v, ',');
+		size_t len = comma ? (size_t)(comma - v) : sizeof(first);
+		if (len < sizeof(first)) {
+			memcpy(first, v, len);
+			first[len] = '\0';
+		}
+		if (len >= sizeof(first) || !parse_num(first, &x) || !parse_num(comma + 1, &y) || fabs(x) > 1e3 ||
+		    fabs(y) > 1e3)
+			return ERR("position: X,Y in metres (the plane world), each within +-1000");
+		r->position_set = true;
+		r->x = x;
+		r->y = y;
+		return 0;
+	}
 	if (!strcmp(k, "servo_baud"))
 		return parse_long(v, 0, 254, &n) ? (r->servo_baud_reg = (int)n, 0)
 		                                 : ERR("servo_baud: '%s' is not a register value 0..254 (X series: 0..7)", v);
@@ -358,6 +432,9 @@ static int robot_key(struct sim_robot_config *r, const char *name, const char *k
 		return ERR("robot.%s: '%s' is not a number", k, v);
 	if (!strcmp(k, "neutral"))
 		return r->neutral_set = true, r->neutral = d, 0;
+	if (!strcmp(k, "heading"))
+		return fabs(d) <= 360 ? (r->heading_set = true, r->heading = d * M_PI / 180.0, 0)
+		                      : ERR("heading: -360..360 degrees");
 	if (!strcmp(k, "latency_ms"))
 		return d >= 0 && d <= 1000 ? (r->latency_ms = d, 0) : ERR("latency_ms: 0..1000");
 	return ERR("unknown key %s.%s", name, k);

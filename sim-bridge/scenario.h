@@ -13,6 +13,7 @@
 
 #include "model.h"
 #include "motor.h"
+#include "plane.h"
 #include "simbus.h"
 #include "textfile.h"
 #include "world.h"
@@ -40,6 +41,11 @@ struct sim_robot_config {
 	int return_delay_us;         /* < 0: the [sim] value */
 	int servo_baud_reg;          /* < 0: the register matching the bus baud */
 	bool mirror;                 /* the body moves left for a positive angle (facing rigs) */
+	/* the plane world: where the robot's chain is centred and where its head
+	 * points (unset: in a row along x, heads towards +y) */
+	bool position_set, heading_set;
+	double x, y;                 /* m */
+	double heading;              /* rad (the key is in degrees) */
 	/* Servo models: one for every ID, or one per ID in ids' order; none:
 	 * the [sim] model. sim_config_finish() leaves one per ID. */
 	enum sim_model models[SIM_BUS_MAX_SERVOS];
@@ -70,7 +76,12 @@ struct sim_config {
 	bool eeprom_needs_torque_off;
 	double overload_time_s;
 	/* [world] */
+	int world_kind;              /* SIM_WORLD_ROW (the theory's line) or SIM_WORLD_PLANE */
 	struct sim_world_params world;
+	/* the plane world's links, contact, drag (restitution: world's) */
+	struct plane_params plane;
+	bool ends_set;               /* walls across the robots' length at y = ends_back, ends_front */
+	double ends_back, ends_front;
 	double separation;           /* d̃ between neighbours' neutral positions */
 	double amplitude;            /* rad: A in d̃ = d / (2·lever·A) */
 	double spacing;              /* m: if > 0, neighbour distance (overrides separation) */
@@ -92,6 +103,7 @@ struct sim_config {
 };
 
 enum { SIM_WALLS_NONE, SIM_WALLS_AUTO, SIM_WALLS_FIXED };
+enum { SIM_WORLD_ROW, SIM_WORLD_PLANE };
 
 /* [motor] keys given in the scenario or with --set: they apply to every
  * model; the others keep each model's own values (model.c). */

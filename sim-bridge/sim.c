@@ -158,6 +158,121 @@ static void sim_place_bodies(struct sim *s)
 
 static void sim_sync_present(struct sim *s);
 
+/* ---- the plane world: set-up ----------------------------------------------------- */
+
+static double plane_robot_length(const struct sim_config *c, size_t njoints)
+{
+	return (double)(njoints + 1) * c->plane.link_length;
+}
+
+/* Robots without a position stand in a row along x, heads towards +y. */
+static void sim_plane_place(struct sim *s, size_t i, double *x, double *y, double *heading)
+{
+	const struct sim_robot_config *rc = &s->cfg.robots[i];
+	double d = config_spacing(&s->cfg);
+	*x = rc->position_set ? rc->x : ((double)i - (double)(s->nbuses - 1) / 2.0) * d;
+	*y = rc->position_set ? rc->y : 0.0;
+	*heading = rc->heading_set ? rc->heading : M_PI / 2;
+}
+
+/* The walls: sides at x = wall_left, wall_right along the robots' length,
+ * ends at y = back, front across it. */
+static int sim_plane_walls(struct sim *s, char *err, size_t errcap)
+{
+	const struct sim_config *c = &s->cfg;
+	double lo_x = 0, hi_x = 0, lo_y = 0, hi_y = 0;
+	for (size_t i = 0; i < s->nbuses; i++) {
+		double x, y, h, half = 0.5 * plane_robot_length(c, s->buses[i].njoints);
+		sim_plane_place(s, i, &x, &y, &h);
+		lo_x = i == 0 || x - half < lo_x ? x - half : lo_x;
+		hi_x = i == 0 || x + half > hi_x ? x + half : hi_x;
+		lo_y = i == 0 || y - half < lo_y ? y - half : lo_y;
+		hi_y = i == 0 || y + half > hi_y ? y + half : hi_y;
+	}
+	const struct sim_world_params *w = &s->world.params;
+	bool sides = w->wall_left < w->wall_right;
+	double back = c->ends_set ? c->ends_back : lo_y - 0.25, front = c->ends_set ? c->ends_front : hi_y + 0.25;
+	double left = sides ? w->wall_left : lo_x - 0.5, right = sides ? w->wall_right : hi_x + 0.5;
+	const double seg[4][4] = { { left, back, left, front }, { right, back, right, front },
+				   { left, back, right, back }, { left, front, right, front } };
+	for (int k = 0; k < 4; k++) {
+		s->plane_wall[k] = -1;
+		if (k < 2 ? !sides : !c->ends_set)
+			continue;
+		s->plane_wall[k] = plane_add_wall(s->plane, seg[k][0], seg[k][1], seg[k][2], seg[k][3], err, errcap);
+		if (s->plane_wall[k] < 0)
+			return -1;
+	}
+	return 0;
+}
+
+static int sim_plane_robot(struct sim *s, size_t i, char *err, size_t errcap)
+{
+	const struct sim_config *c = &s->cfg;
+	struct sim_bus *b = &s->buses[i];
+	double angles[PLANE_MAX_JOINTS], rotor[PLANE_MAX_JOINTS], x, y, heading;
+	for (size_t k = 0; k < b->njoints; k++) {
+		angles[k] = b->joints[k].motor.angle;
+		rotor[k] = sim_motor_rotor_inertia(&b->joints[k].params);
+	}
+	sim_plane_place(s, i, &x, &y, &heading);
+	char why[160];
+	if (plane_add_robot(s->plane, x, y, heading, (int)b->njoints, angles, rotor, why, sizeof why) < 0)
+		return snprintf(err, errcap, "robot %s: %s", b->name, why), -1;
+	if (c->ends_set && !c->robots[i].heading_set &&
+	    plane_robot_length(c, b->njoints) + c->plane.link_width > c->ends_front - c->ends_back)
+		return snprintf(err, errcap, "world.ends: the channel is %g m long, robot %s %g m (%zu links of %g m, "
+		                "%g m wide): it cannot fit", c->ends_front - c->ends_back, b->name,
+		                plane_robot_length(c, b->njoints) + c->plane.link_width, b->njoints + 1,
+		                c->plane.link_length, c->plane.link_width), -1;
+	return 0;
+}
+
+/* The plane world: the robots' chains from their joints' initial angles, the
+ * walls, and no overlap at the start. */
+static int sim_plane_build(struct sim *s, char *err, size_t errcap)
+{
+	const struct sim_config *c = &s->cfg;
+	struct plane_params pp = c->plane;
+	pp.restitution = c->world.restitution;
+	pp.wall_restitution = c->world.wall_restitution;
+	if (c->world.beta > 0)
+		return snprintf(err, errcap, "world.beta = %g: beta is the row world's mobility; in the plane the "
+		                "robots' bases move by contact and drag (remove it)", c->world.beta), -1;
+	if (s->nbuses > PLANE_MAX_ROBOTS || s->world.nbodies != s->nbuses)
+		return snprintf(err, errcap, "world.kind = plane: at most %d robots, each with a contact joint "
+		                "(contact = none has no meaning: any link touches)", PLANE_MAX_ROBOTS), -1;
+	for (size_t i = 0; i < s->nbuses; i++)
+		if (s->buses[i].njoints > PLANE_MAX_JOINTS || s->body_bus[i] != (int)i)
+			return snprintf(err, errcap, "robot %s: a plane robot has 1 to %d servos", s->buses[i].name,
+			                PLANE_MAX_JOINTS), -1;
+	char why[160];
+	s->plane = plane_new(&pp, why, sizeof why);
+	if (s->plane == NULL)
+		return snprintf(err, errcap, "%s", why), -1;
+	for (size_t i = 0; i < s->nbuses; i++)
+		if (sim_plane_robot(s, i, err, errcap) != 0)
+			return -1;
+	if (sim_plane_walls(s, why, sizeof why) != 0)
+		return snprintf(err, errcap, "world: %s", why), -1;
+	if (plane_overlap(s->plane, why, sizeof why))
+		return snprintf(err, errcap, "world: at the start %s (robots %g m apart, joints within +-%g rad): "
+		                "set world.spacing wider, positions apart, or sim.initial_spread lower", why,
+		                config_spacing(c), c->initial_spread), -1;
+	return 0;
+}
+
+/* The row world's view of the plane's robots: each body's neutral position
+ * is its robot's centre (x). */
+static void sim_plane_view(struct sim *s)
+{
+	for (size_t i = 0; i < s->world.nbodies; i++) {
+		double x, y, vx, vy;
+		plane_robot_centre(s->plane, (int)i, &x, &y, &vx, &vy);
+		s->world.bodies[i].neutral = x;
+	}
+}
+
 int sim_init(struct sim *s, const struct sim_config *cfg, char *err, size_t errcap)
 {
 	memset(s, 0, sizeof(*s));
@@ -168,11 +283,37 @@ int sim_init(struct sim *s, const struct sim_config *cfg, char *err, size_t errc
 	for (size_t i = 0; i < cfg->nrobots; i++)
 		if (sim_add_robot(s, &cfg->robots[i], err, errcap) != 0)
 			return -1;
+	if (cfg->world_kind == SIM_WORLD_PLANE) {
+		/* the row's view: bodies where the robots stand, walls from them */
+		for (size_t i = 0; i < s->world.nbodies; i++) {
+			double x, y, h;
+			sim_plane_place(s, (size_t)s->body_bus[i], &x, &y, &h);
+			s->world.bodies[i].neutral = x;
+		}
+		sim_layout_world(s);
+		for (size_t i = 0; i < s->nbuses; i++)
+			for (size_t k = 0; k < s->buses[i].njoints; k++) {
+				struct sim_joint *j = &s->buses[i].joints[k];
+				double a = (2.0 * sim_rand_uniform(&s->rng) - 1.0) * s->cfg.initial_spread;
+				sim_motor_init(&j->motor, &j->params, a);
+			}
+		if (sim_plane_build(s, err, errcap) != 0)
+			return -1;
+		sim_plane_view(s);
+		sim_sync_present(s);
+		return 0;
+	}
 	sim_place_bodies(s);
 	sim_layout_world(s);
 	sim_initial_angles(s);
 	sim_sync_present(s);
 	return 0;
+}
+
+void sim_free(struct sim *s)
+{
+	plane_free(s->plane);
+	s->plane = NULL;
 }
 
 int sim_open(struct sim *s, char *err, size_t errcap)
@@ -288,8 +429,137 @@ static void sim_walls_follow(struct sim *s, double t)
 		m->active = false;
 }
 
+/* ---- the plane world: a step ------------------------------------------------------ */
+
+/* A joint's drive over the next step, whatever its model. */
+static void sim_joint_drive(struct sim_joint *j, double dt, struct sim_motor_drive *d)
+{
+	if (j->model != SIM_MODEL_AX12A) {
+		struct sim_xdrive_cmd xc;
+		sim_xservo_drive_cmd(&j->xservo, &xc);
+		sim_xdrive_step(&j->xdrive, &xc, &j->motor, &j->params, dt, d);
+	} else {
+		struct sim_motor_cmd cmd;
+		sim_servo_motor_cmd(&j->servo, &cmd);
+		sim_motor_drive_for(&j->motor, &j->params, &cmd, dt, d);
+	}
+	/* a controller's arithmetic on a repaired state is not trusted */
+	if (!isfinite(d->a) || !isfinite(d->c) || !isfinite(d->cap) || !isfinite(d->duty)) {
+		*d = (struct sim_motor_drive){ 0, 0, 0, 0 };
+		j->motor.bad_input++;
+	}
+	if (d->cap < 0)
+		d->cap = 0;
+}
+
+static void sim_plane_walls_follow(struct sim *s)
+{
+	const struct sim_world_params *w = &s->world.params;
+	for (int k = 0; k < 2; k++) {
+		int wall = s->plane_wall[k];
+		if (wall < 0)
+			continue;
+		double ax, ay, bx, by, x = k == 0 ? w->wall_left : w->wall_right;
+		plane_wall(s->plane, wall, &ax, &ay, &bx, &by);
+		if (x != ax)
+			plane_move_wall(s->plane, wall, x, ay, x, by, s->dt);
+	}
+}
+
+/* Impulses summed per pair of links until sim_plane_drain(). */
+static void sim_plane_accumulate(struct sim *s, const struct plane_contact *c)
+{
+	for (size_t i = 0; i < s->nplane_acc; i++) {
+		struct plane_contact *a = &s->plane_acc[i];
+		if (a->robot_a == c->robot_a && a->link_a == c->link_a && a->robot_b == c->robot_b && a->link_b == c->link_b) {
+			double imp = a->impulse + c->impulse, nimp = a->normal_impulse + c->normal_impulse;
+			bool impact = a->impact || c->impact;
+			*a = *c;
+			a->impulse = imp;
+			a->normal_impulse = nimp;
+			a->impact = impact;
+			return;
+		}
+	}
+	if (s->nplane_acc < PLANE_MAX_CONTACTS)
+		s->plane_acc[s->nplane_acc++] = *c;
+	else
+		s->plane_acc_dropped++;
+}
+
+/* The step's contacts as the row world's collisions and totals: an impact is
+ * a collision, a pair still touching is resting contact. */
+static void sim_plane_collisions(struct sim *s)
+{
+	static struct plane_contact c[PLANE_MAX_CONTACTS];
+	size_t n = plane_contacts(s->plane, c, PLANE_MAX_CONTACTS);
+	if (n > PLANE_MAX_CONTACTS)
+		n = PLANE_MAX_CONTACTS;
+	s->nstep_collisions = 0;
+	for (size_t i = 0; i < n; i++) {
+		bool resting = !c[i].impact;
+		s->world.total_collisions++;
+		s->world.total_impulse += c[i].impulse;
+		if (resting) {
+			s->world.resting_contacts++;
+			s->world.resting_impulse += c[i].impulse;
+		}
+		sim_plane_accumulate(s, &c[i]);
+		if (s->nstep_collisions == SIM_MAX_COLLISIONS_PER_STEP)
+			continue;
+		s->step_collisions[s->nstep_collisions++] = (struct sim_collision){
+			.time = (double)(s->steps + 1) * s->dt, .left = c[i].robot_a,
+			.right = c[i].robot_b == PLANE_WALL ? -1 : c[i].robot_b,
+			.pre_left = c[i].approach, .post_left = -c[i].separation,
+			.impulse = c[i].impulse, .resting = resting,
+		};
+	}
+}
+
+static void sim_plane_step(struct sim *s)
+{
+	struct sim_motor_drive d[PLANE_MAX_ROBOTS][PLANE_MAX_JOINTS];
+	for (size_t i = 0; i < s->nbuses; i++)
+		for (size_t k = 0; k < s->buses[i].njoints; k++) {
+			struct sim_joint *j = &s->buses[i].joints[k];
+			struct plane_drive *pd = &s->plane_drives[i * PLANE_MAX_JOINTS + k];
+			sim_joint_drive(j, s->dt, &d[i][k]);
+			*pd = (struct plane_drive){ .a = d[i][k].a, .c = d[i][k].c, .cap = d[i][k].cap };
+			sim_motor_loss(&j->params, &d[i][k], &pd->viscous, &pd->coulomb);
+		}
+	sim_walls_follow(s, (double)(s->steps + 1) * s->dt);
+	sim_plane_walls_follow(s);
+	plane_step(s->plane, s->dt, s->plane_drives, s->plane_joints);
+	for (size_t i = 0; i < s->nbuses; i++)
+		for (size_t k = 0; k < s->buses[i].njoints; k++) {
+			struct sim_joint *j = &s->buses[i].joints[k];
+			const struct plane_joint *pj = &s->plane_joints[i * PLANE_MAX_JOINTS + k];
+			sim_motor_moved(&j->motor, &j->params, &d[i][k], pj->angle, pj->speed, pj->torque, s->dt);
+		}
+	sim_plane_view(s);
+	sim_plane_collisions(s);
+	for (size_t i = 0; i < s->nbuses; i++)
+		for (size_t k = 0; k < s->buses[i].njoints; k++)
+			sim_sense_joint(&s->buses[i].joints[k], s->dt);
+	s->steps++;
+}
+
+size_t sim_plane_drain(struct sim *s, struct plane_contact *out, size_t cap)
+{
+	size_t n = s->nplane_acc < cap ? s->nplane_acc : cap;
+	if (out != NULL && n > 0)
+		memcpy(out, s->plane_acc, n * sizeof *out);
+	size_t had = s->nplane_acc;
+	s->nplane_acc = 0;
+	return had;
+}
+
 void sim_step(struct sim *s)
 {
+	if (s->plane != NULL) {
+		sim_plane_step(s);
+		return;
+	}
 	for (size_t i = 0; i < s->nbuses; i++)
 		for (size_t k = 0; k < s->buses[i].njoints; k++)
 			sim_step_joint(&s->buses[i].joints[k], s->dt);

@@ -12,6 +12,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "plane.h"
 #include "scenario.h"
 #include "simbus.h"
 #include "world.h"
@@ -29,7 +30,18 @@ struct sim {
 	struct sim_config cfg;
 	struct sim_bus buses[SIM_MAX_BUSES];
 	size_t nbuses;
+	/* The row world, or for world.kind = plane its view of the robots: one
+	 * body per robot on its contact joint, its neutral position the robot's
+	 * centre (x), with the totals and the step's collisions as the row's. */
 	struct sim_world world;
+	struct plane *plane;           /* the plane world (NULL: the row) */
+	int plane_wall[4];             /* its walls: left, right, back, front (-1: none) */
+	struct plane_drive plane_drives[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
+	struct plane_joint plane_joints[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
+	/* contacts since the last sim_plane_drain(): impulses summed per pair */
+	struct plane_contact plane_acc[PLANE_MAX_CONTACTS];
+	size_t nplane_acc;
+	unsigned long long plane_acc_dropped;
 	/* which joint each contact body rides on */
 	int body_bus[SIM_MAX_BODIES];
 	int body_joint[SIM_MAX_BODIES];
@@ -49,8 +61,13 @@ struct sim {
 	void *robot_command_ctx;
 };
 
-/* Build everything from cfg (no I/O). 0 or -1 with err. */
+/* Build everything from cfg (no I/O). 0 or -1 with err; sim_free() after
+ * either (the plane world holds memory). */
 int sim_init(struct sim *s, const struct sim_config *cfg, char *err, size_t errcap);
+void sim_free(struct sim *s);
+/* The plane world's contacts since the last call, impulses summed per pair
+ * of links (at most cap written; returns how many there were). */
+size_t sim_plane_drain(struct sim *s, struct plane_contact *out, size_t cap);
 /* Open every bus's pty and link. 0 or -1 with err (opened ones are closed). */
 int sim_open(struct sim *s, char *err, size_t errcap);
 void sim_close(struct sim *s);
