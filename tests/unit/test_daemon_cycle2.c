@@ -626,6 +626,32 @@ static void test_writes_are_the_models(void **state)
 		for (uint8_t id = 1; id <= 2; id++)
 			assert_int_equal(reg(id, 34, 2), dxl2_reg_at(dxl2_model_by_number(models[k][0]), 34)->def);
 	}
+	/* torque actuation (XL430: PWM control, XM430: current control): into
+	 * the drive, a fault there, LIMP out of it */
+	const char *drive[][4] = {
+		{ "robot.actuation=torque", "robot.torque_drive=pwm", "robot.fault_backoff_s=0.2", NULL },
+		{ "robot.actuation=torque", "robot.torque_drive=current", "robot.fault_backoff_s=0.2", NULL },
+	};
+	for (size_t k = 0; k < sizeof models / sizeof models[0]; k++) {
+		setup_x(models[k], 2, CFG_MODE_HOLD, drive[k]);
+		xb.on_write = check_write;
+		bad_write[0] = '\0';
+		for (uint8_t id = 1; id <= 2; id++)
+			xfake_put(sv(id)->mem, 132, 2048 + 250, 4);
+		run(10);
+		ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+		run(10);
+		assert_true(c.wheel);
+		sv(2)->mem[70] = DXL2_HWERR_OVERLOAD;
+		run(10);
+		sv(2)->mem[70] = 0;
+		run(60);
+		ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+		run(20);
+		assert_false(c.wheel);
+		if (bad_write[0] != '\0')
+			fail_msg("%s", bad_write);
+	}
 }
 
 int main(void)
