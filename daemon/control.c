@@ -1423,6 +1423,7 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 		}
 	}
 	tq_check_limits(c);
+	tq_check_supply(c);
 	c->sync = CTL_SYNC_GOAL;
 	bool want = tq_want_wheel(c);
 	if (want && c->wheel) {
