@@ -102,9 +102,9 @@ void tq_check_supply(struct ctl *c)
 		char what[CTL_LATCH_TEXT];
 		snprintf(what, sizeof what, "servo %u reads its supply as %.1f V, outside the %s's %.2f..%.2f V", jt->id,
 		         jt->voltage, m->name, lo, hi);
-		ctl_event(c, 2, "supply", "%s (rated %.1f..%.1f V, %.0f %% either side): the PWM drive scales with it, "
-		          "so it is not believed: robot %s in joint mode", what, m->rated_min_v, m->rated_max_v,
-		          100.0 * SM_SUPPLY_TOLERANCE,
+		/* within CTL_EVENT_TEXT for the longest model name and reading */
+		ctl_event(c, 2, "supply", "%s (rated %.1f..%.1f V): not a gain for the PWM drive; robot %s in joint mode",
+		          what, m->rated_min_v, m->rated_max_v,
 		          cfg_mode_name(cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD));
 		ctl_latch(c, what);
 		return;

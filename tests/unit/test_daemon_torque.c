@@ -150,11 +150,15 @@ static void send_writes(void)
 	}
 }
 
+/* the last "supply" event's text, whole (it must fit CTL_EVENT_TEXT) */
+static char supply_event[CTL_EVENT_TEXT];
+
 static void take_events(void)
 {
 	struct ctl_event e;
 	while (ctl_next_event(&c, &e))
-		;
+		if (strcmp(e.kind, "supply") == 0)
+			snprintf(supply_event, sizeof supply_event, "%s", e.text);
 }
 
 /* The supply the servos report (raw, 0.1 V a unit; -1: none read, as in
@@ -492,6 +496,7 @@ static void setup_rig(int raw)
 {
 	static const char *const sets[] = { "joint.1.limit_min=-0.6", "joint.1.limit_max=0.6", NULL };
 	volts_raw = -1;
+	supply_event[0] = '\0';
 	setup_sets = sets;
 	setup("1", "pwm", CFG_MODE_HOLD);
 	setup_sets = NULL;
@@ -525,6 +530,8 @@ static void test_implausible_supply_is_a_fault(void **state)
 		double widest = run_pwm_widest(300);
 		if (!c.latched || strstr(c.latch, volts) == NULL)
 			fail_msg("supply read as %s: %s", volts, c.latched ? c.latch : "no fault latched");
+		if (supply_event[0] == '\0' || strstr(supply_event, "robot HOLD in joint mode") == NULL)
+			fail_msg("supply read as %s: event '%s'", volts, supply_event);
 		assert_int_equal(c.mode, CFG_MODE_HOLD);
 		assert_false(c.wheel);
 		assert_int_equal(sv[0].wheel_entries, 0);
