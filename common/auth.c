@@ -59,6 +59,11 @@ bool auth_key_parse(struct auth_key *k, const char *text, char *why, size_t cap)
 
 bool auth_key_load(struct auth_key *k, const char *path, bool private_only, char *why, size_t cap)
 {
+	return auth_key_load_as(k, path, private_only, geteuid(), why, cap);
+}
+
+bool auth_key_load_as(struct auth_key *k, const char *path, bool private_only, uid_t owner, char *why, size_t cap)
+{
 	int fd = open(path, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
 	if (fd < 0) {
 		snprintf(why, cap, "%s: %s", path, errno == ELOOP ? "is a symbolic link (give the file itself)"
@@ -72,9 +77,9 @@ bool auth_key_load(struct auth_key *k, const char *path, bool private_only, char
 		snprintf(why, cap, "%s: %s", path, strerror(errno));
 	} else if (!S_ISREG(st.st_mode)) {
 		snprintf(why, cap, "%s: not a regular file", path);
-	} else if (st.st_uid != geteuid() && st.st_uid != 0) {
+	} else if (st.st_uid != owner && st.st_uid != 0) {
 		snprintf(why, cap, "%s: owned by uid %u, neither this user (%u) nor root", path, (unsigned)st.st_uid,
-		         (unsigned)geteuid());
+		         (unsigned)owner);
 	} else if (private_only && (st.st_mode & 077) != 0) {
 		snprintf(why, cap, "%s: mode %04o lets others read the key: chmod 600 (or 400) it", path,
 		         (unsigned)(st.st_mode & 07777));

@@ -17,6 +17,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <sys/types.h>
 
 #define AUTH_KEY_BYTES 32
 #define AUTH_MAC_BYTES 32
@@ -34,6 +35,10 @@ bool auth_key_parse(struct auth_key *k, const char *text, char *why, size_t cap)
  * owner only (mode without group/other bits): a key others can read is no
  * key. Never blocks on a FIFO or device. */
 bool auth_key_load(struct auth_key *k, const char *path, bool private_only, char *why, size_t cap);
+/* The same checks for a program that will run as `owner`: the file owned by
+ * `owner` or root (root checking a service user's configuration). */
+bool auth_key_load_as(struct auth_key *k, const char *path, bool private_only, uid_t owner, char *why,
+                      size_t cap);
 /* Creates a new random key file (mode 0600, refuses to overwrite). */
 bool auth_key_generate(const char *path, char *why, size_t cap);
 

@@ -3,9 +3,11 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <pwd.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "text.h"
@@ -19,6 +21,37 @@
 
 static int64_t cin_wall(const struct cin *in) { return in->hooks.wall_us(in->hooks.ctx); }
 static uint64_t cin_mono(const struct cin *in) { return in->hooks.mono_us(in->hooks.ctx); }
+
+/* The shared key, private to the user the daemon runs as (auth.h): one rule
+ * for the start and for --check-config. */
+static bool cin_key_load(struct auth_key *key, const struct cfg *cfg, uid_t as, char *why, size_t cap)
+{
+	char inner[256];
+	if (auth_key_load_as(key, cfg->command_key, true, as, inner, sizeof inner))
+		return true;
+	snprintf(why, cap, "command_key: %s", inner);
+	return false;
+}
+
+bool cin_check_key(const struct cfg *cfg, char *why, size_t cap, char *note, size_t note_cap)
+{
+	note[0] = '\0';
+	if (cfg->commands != CFG_CMD_NETWORK)
+		return true;
+	uid_t as = geteuid();
+	struct stat st;
+	if (as == 0 && lstat(cfg->command_key, &st) == 0 && S_ISREG(st.st_mode) && st.st_uid != 0) {
+		as = st.st_uid;
+		const struct passwd *pw = getpwuid(as);
+		snprintf(note, note_cap, "command_key: %s is owned by uid %u%s%s%s, not root: judged for a daemon that "
+		         "runs as that user (User= in its unit)", cfg->command_key, (unsigned)as, pw ? " (" : "",
+		         pw ? pw->pw_name : "", pw ? ")" : "");
+	}
+	struct auth_key key;
+	bool ok = cin_key_load(&key, cfg, as, why, cap);
+	memset(&key, 0, sizeof key);
+	return ok;
+}
 
 bool cin_open(struct cin *in, const struct cfg *cfg, const struct cin_hooks *hooks, int64_t fingerprint,
               char *why, size_t cap)
@@ -60,8 +93,7 @@ bool cin_open(struct cin *in, const struct cfg *cfg, const struct cin_hooks *hoo
 	}
 	if (cfg->commands != CFG_CMD_NETWORK)
 		return true;
-	if (!auth_key_load(&in->key, cfg->command_key, true, inner, sizeof inner)) {
-		snprintf(why, cap, "command_key: %s", inner);
+	if (!cin_key_load(&in->key, cfg, geteuid(), why, cap)) {
 		cin_close(in);
 		return false;
 	}

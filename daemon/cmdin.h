@@ -90,6 +90,11 @@ struct cin {
 bool cin_open(struct cin *in, const struct cfg *cfg, const struct cin_hooks *hooks, int64_t fingerprint,
               char *why, size_t cap);
 void cin_close(struct cin *in);
+/* --check-config: the command key (with commands = network) judged as
+ * cin_open() judges it at start: false with the same refusal in *why. Run
+ * by root, a key owned by another user is judged for a daemon running as
+ * that user (User= in its unit), and *note says so ("" otherwise). */
+bool cin_check_key(const struct cfg *cfg, char *why, size_t cap, char *note, size_t note_cap);
 /* The descriptors to poll (-1: not open). */
 int cin_local_fd(const struct cin *in);
 int cin_net_fd(const struct cin *in);

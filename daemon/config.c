@@ -1,6 +1,7 @@
 /* config.c — see config.h. */
 #include "config.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
@@ -581,6 +582,21 @@ bool cfg_set(struct cfg *c, const char *where, const char *section, const char *
 }
 
 /* ---- INI parsing: a line-counting reader so every handler call knows its line ---------- */
+/* A key or section given twice is an error: inih hands every occurrence to
+ * the handler, and the last would silently win (a second limit_max widening
+ * a joint). Names are inih's at most 49 characters. A valid file names at
+ * most CFG_NROBOT_KEYS + 3 + CFG_MAX_JOINTS × 10 keys (282) in at most
+ * 2 + CFG_MAX_JOINTS sections: a file that fills these tables has errors
+ * already, whatever is not recorded. */
+#define CFG_INI_NAME 52
+#define CFG_SEEN_SECTIONS 64
+#define CFG_SEEN_KEYS 512
+struct cfg_seen_key {
+	int section;              /* index in cfg_parse.sections */
+	char name[CFG_INI_NAME];
+	int line;
+};
+
 struct cfg_parse {
 	struct cfg *cfg;
 	struct cfg_errors *errors;
@@ -589,9 +605,90 @@ struct cfg_parse {
 	int line;
 	int long_line;   /* first physical line too long for inih, 0 if none */
 	int line_cap;    /* the longest line inih reads (its buffer less the NUL) */
-	char last_section[64];
-	bool section_reported;
+	/* the physical line inih is handed, as inih will read it (cfg_note_line) */
+	bool continuation;  /* an indented line after a key: inih's multi-line value */
+	bool key_since_header;
+	int section;        /* the current section's index in sections, -1 before the first */
+	int key_line;       /* the last key's line */
+	struct { char name[CFG_INI_NAME]; int line; } sections[CFG_SEEN_SECTIONS];
+	size_t nsections;
+	struct cfg_seen_key keys[CFG_SEEN_KEYS];
+	size_t nkeys;
 };
+
+/* A section header at `line`: recorded, or refused when given before. */
+static void cfg_note_section(struct cfg_parse *p, const char *name, size_t len)
+{
+	if (len >= CFG_INI_NAME)
+		len = CFG_INI_NAME - 1;
+	for (size_t i = 0; i < p->nsections; i++) {
+		if (strlen(p->sections[i].name) == len && strncmp(p->sections[i].name, name, len) == 0) {
+			cfg_error(p->errors, "%s:%d: [%s]: section given twice (first at line %d): give each section once",
+			          p->name, p->line, p->sections[i].name, p->sections[i].line);
+			p->section = (int)i;   /* its keys are the first one's: a key in both is given twice */
+			return;
+		}
+	}
+	if (p->nsections == CFG_SEEN_SECTIONS) {
+		p->section = -1;
+		return;
+	}
+	memcpy(p->sections[p->nsections].name, name, len);
+	p->sections[p->nsections].name[len] = '\0';
+	p->sections[p->nsections].line = p->line;
+	p->section = (int)p->nsections++;
+}
+
+/* What inih will make of the physical line it is handed next (ini.c's own
+ * rules): a UTF-8 BOM at the start of the file skipped; blank and comment
+ * lines (';', '#') nothing; an indented line after a key the key's value
+ * continued; '[' a section header when a ']' closes it; anything else a key. */
+static void cfg_note_line(struct cfg_parse *p, const char *line)
+{
+	const char *s = line;
+	if (p->line == 1 && strncmp(s, "\xEF\xBB\xBF", 3) == 0)
+		s += 3;
+	const char *start = s;
+	while (*start != '\0' && isspace((unsigned char)*start))
+		start++;
+	p->continuation = false;
+	if (*start == '\0' || *start == ';' || *start == '#')
+		return;
+	if (start > s && p->key_since_header) {
+		p->continuation = true;
+		return;
+	}
+	if (*start == '[') {
+		const char *end = strchr(start + 1, ']');
+		if (end != NULL) {
+			cfg_note_section(p, start + 1, (size_t)(end - start - 1));
+			p->key_since_header = false;
+		}
+		return;
+	}
+	p->key_since_header = strpbrk(start, "=:") != NULL;
+}
+
+/* A key of the current section: true when it is its first occurrence. */
+static bool cfg_note_key(struct cfg_parse *p, const char *section, const char *key, const char *where)
+{
+	if (p->section < 0)
+		return true;
+	for (size_t i = 0; i < p->nkeys; i++) {
+		if (p->keys[i].section == p->section && strcmp(p->keys[i].name, key) == 0) {
+			cfg_error(p->errors, "%s: [%s] %s: given twice (first at line %d): give each key once", where, section,
+			          key, p->keys[i].line);
+			return false;
+		}
+	}
+	if (p->nkeys < CFG_SEEN_KEYS) {
+		struct cfg_seen_key *k = &p->keys[p->nkeys++];
+		k->section = p->section;
+		snprintf(k->name, sizeof k->name, "%s", key);
+		k->line = p->line;
+	}
+	return true;
+}
 
 /* Drops the rest of a physical line that did not fit inih's buffer, so that
  * inih sees one line per physical line (its own line numbers stay right) and
@@ -615,6 +712,7 @@ static char *cfg_reader(char *str, int num, void *stream)
 	}
 	str[i] = '\0';
 	p->line++;
+	cfg_note_line(p, str);
 	/* a read that fills the buffer without a newline is a line too long for
 	 * inih, unless the line ends right there: num - 1 characters fit (the
 	 * README's 199), handed over without their newline */
@@ -640,7 +738,14 @@ static int cfg_handler(void *user, const char *section, const char *name, const 
 		cfg_error(p->errors, "%s: %s: key outside any section (start with [robot])", where, name);
 		return 1;
 	}
-	cfg_set(p->cfg, where, section, name, value, p->errors);
+	if (p->continuation) {
+		cfg_error(p->errors, "%s: [%s] %s: an indented line continues the value of line %d: a value is one line "
+		          "(remove the indentation)", where, section, name, p->key_line);
+		return 1;
+	}
+	p->key_line = p->line;
+	if (cfg_note_key(p, section, name, where))
+		cfg_set(p->cfg, where, section, name, value, p->errors);
 	return 1;   /* keep going: report every error in one run */
 }
 
@@ -663,7 +768,7 @@ static bool cfg_parse_run(struct cfg_parse *p)
 
 bool cfg_load_string(struct cfg *c, const char *name, const char *text, struct cfg_errors *errors)
 {
-	struct cfg_parse p = { .cfg = c, .errors = errors, .name = name, .text = text };
+	struct cfg_parse p = { .cfg = c, .errors = errors, .name = name, .text = text, .section = -1 };
 	return cfg_parse_run(&p);
 }
 
@@ -680,7 +785,7 @@ bool cfg_load_file(struct cfg *c, const char *path, struct cfg_errors *errors)
 	}
 	/* Messages name the file as given, without directories clutter removed:
 	 * users copy that path into their editor. */
-	struct cfg_parse p = { .cfg = c, .errors = errors, .name = path, .text = text };
+	struct cfg_parse p = { .cfg = c, .errors = errors, .name = path, .text = text, .section = -1 };
 	bool ok = cfg_parse_run(&p);
 	free(text);
 	snprintf(c->source, sizeof c->source, "%s", path);

@@ -114,6 +114,16 @@ uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt)
 	return (uint16_t)lround(c->cfg->backoff_torque * jt->servo.max_torque);
 }
 
+/* The joint's output limit as ctl_torque_limit() has it, in its model's
+ * register (AX-12 Torque Limit 34, X Goal PWM 100: never another model's
+ * address), except where Goal PWM is the drive itself. */
+static void ctl_limit_write(struct ctl *c, size_t j)
+{
+	const struct ctl_joint *jt = &c->j[j];
+	if (!ctl_limit_is_drive(c, j))
+		ctl_write(c, jt->id, ctl_model(c, j)->torque_limit, 2, ctl_torque_limit(c, jt));
+}
+
 static void ctl_torque_write(struct ctl *c, size_t j, bool on)
 {
 	struct ctl_joint *jt = &c->j[j];
@@ -121,8 +131,7 @@ static void ctl_torque_write(struct ctl *c, size_t j, bool on)
 	if (on) {
 		/* The manual's recovery: the torque limit back (an alarm shutdown set
 		 * it to 0), then torque enable. Harmless when nothing was wrong. */
-		if (!ctl_limit_is_drive(c, j))
-			ctl_write(c, jt->id, m->torque_limit, 2, ctl_torque_limit(c, jt));
+		ctl_limit_write(c, j);
 		ctl_write(c, jt->id, m->torque_enable, 1, 1);
 	} else {
 		ctl_write(c, jt->id, m->torque_enable, 1, 0);
@@ -1031,8 +1040,7 @@ static void ctl_backoff(struct ctl *c, size_t j)
 	jt->fault = CTL_FAULT_BACKOFF;
 	jt->fault_since = c->t;
 	jt->fault_hold = isfinite(jt->angle) ? jt->angle : jt->goal;
-	if (!ctl_limit_is_drive(c, j))
-		ctl_write(c, jt->id, ctl_model(c, j)->torque_limit, 2, ctl_torque_limit(c, jt));
+	ctl_limit_write(c, j);
 }
 
 /* The fault bits in play: the AX-12's overload and overheating in this
@@ -1143,10 +1151,11 @@ static void ctl_fault_step(struct ctl *c, size_t j)
 		jt->fault = CTL_FAULT_CHECK;
 		jt->fault_since = c->t;
 		jt->errbits = 0;
+		/* LIMP: only the full limit back, for the torque-on that may follow */
 		if (c->mode != CFG_MODE_LIMP)
 			ctl_torque_write(c, j, true);
 		else
-			ctl_write(c, jt->id, DXL_AX_TORQUE_LIMIT, 2, jt->servo.max_torque);
+			ctl_limit_write(c, j);
 		return;
 	case CTL_FAULT_REBOOT:
 		/* its acknowledgement sets reboot_at; then the boot's settle time */
@@ -1414,6 +1423,7 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 		}
 	}
 	tq_check_limits(c);
+	tq_check_supply(c);
 	c->sync = CTL_SYNC_GOAL;
 	bool want = tq_want_wheel(c);
 	if (want && c->wheel) {

@@ -22,10 +22,12 @@
  *
  * Faults latch (as a CiA 402 drive's do): a joint silent for longer than
  * silent_s, a servo fault that persists through its recovery attempts, a
- * servo that keeps resetting, and a joint that left its limits under torque
- * actuation put the robot in its fault action (HOLD or LIMP) and keep it
- * there. Only LIMP, HOLD and `clear` are accepted then; `clear` succeeds only
- * once the cause is gone.
+ * servo that keeps resetting, a joint that left its limits under torque
+ * actuation, and under torque actuation's PWM drive a supply reading the
+ * servo cannot be running at (the drive scales with it) put the robot in its
+ * fault action (HOLD or LIMP) and keep it there. Only LIMP, HOLD and `clear`
+ * are accepted then; `clear` succeeds only once a silent joint answers (a
+ * supply still misread latches again at the next OSCILLATOR).
  */
 #ifndef UNDULATE_DAEMON_CONTROL_H
 #define UNDULATE_DAEMON_CONTROL_H

@@ -43,6 +43,10 @@ void ctl_latch(struct ctl *c, const char *what);
 bool tq_want_wheel(const struct ctl *c);
 /* A joint past its limits under torque: the fault action, latched. */
 void tq_check_limits(struct ctl *c);
+/* The PWM drive scales with the supply each servo reports: in OSCILLATOR
+ * under torque actuation a reading outside the servo's plausible range
+ * (sm_supply_plausible) is a fault, named and latched, never a gain. */
+void tq_check_supply(struct ctl *c);
 /* This cycle's duties from the law's torque (wheel mode). */
 void tq_duties(struct ctl *c);
 /* Wheel-mode switches, queued after this cycle's SYNC_WRITE. */

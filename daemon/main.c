@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "auth.h"
+#include "cmdin.h"
 #include "config.h"
 #include "daemon.h"
 #include "log.h"
@@ -392,6 +393,16 @@ int main(int argc, char **argv)
 		return a.check && !errors.file_refused ? 1 : 2;
 	}
 	if (a.check) {
+		char why[512], note[512];
+		const char *src = cfg.source[0] ? cfg.source : "command line";
+		bool key_ok = cin_check_key(&cfg, why, sizeof why, note, sizeof note);
+		if (!key_ok) {
+			/* as the daemon would refuse it at start */
+			fprintf(stderr, "undulated: config: %s: [robot] %s\n", src, why);
+			return 1;
+		}
+		if (note[0] != '\0')
+			printf("%s: note: [robot] %s\n", src, note);
 		if (log_get_level() > LOG_LVL_INFO)
 			cfg_print(&cfg, stdout);
 		printf("%s: ok (robot %s, %zu joint(s), mode %s)\n", a.config ? a.config : "command line", cfg.name,

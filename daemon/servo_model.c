@@ -59,6 +59,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.pos_max = DXL_POS_MAX, .torque_full = 1023,
 		.ref_voltage = DXL_AX12_REF_VOLTAGE, .stall_torque_nm = DXL_AX12_STALL_TORQUE_NM,
 		.no_load_speed_rad_s = DXL_AX12_NO_LOAD_SPEED_RAD_S, .stall_current_a = 1.5,
+		.rated_min_v = DXL_AX12_RATED_MIN_V, .rated_max_v = DXL_AX12_RATED_MAX_V,
 		.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0),
 	},
 	[SM_XL430] = {
@@ -71,6 +72,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XL430_STALL_TORQUE_NM,
 		.no_load_speed_rad_s = DXL2_XL430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
 		.stall_current_a = DXL2_XL430_STALL_CURRENT_A, .reflected_inertia = SM_REFLECTED(4.6e-8, 258.5),
+		.rated_min_v = DXL2_XL430_RATED_MIN_V, .rated_max_v = DXL2_XL430_RATED_MAX_V,
 		.position = SM_XL430_POSITION,
 	},
 	[SM_XM430] = {
@@ -83,6 +85,7 @@ static const struct sm_model sm_models[SM_NFAMILIES] = {
 		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XM430_STALL_TORQUE_NM,
 		.no_load_speed_rad_s = DXL2_XM430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
 		.stall_current_a = DXL2_XM430_STALL_CURRENT_A, .current_control = true,
+		.rated_min_v = DXL2_XM430_RATED_MIN_V, .rated_max_v = DXL2_XM430_RATED_MAX_V,
 		.reflected_inertia = SM_REFLECTED(5.0e-8, 353.5),
 		.position = SM_XM430_POSITION,
 	},
@@ -238,6 +241,21 @@ bool sm_write_refused(const struct sm_model *m, uint8_t status)
 	if (sm_is_x(m))
 		return dxl2_err_number(status) != DXL2_ERRNUM_NONE;
 	return (status & (DXL_ERRBIT_RANGE | DXL_ERRBIT_INSTRUCTION | DXL_ERRBIT_CHECKSUM)) != 0;
+}
+
+/* ---- the supply ------------------------------------------------------------------------------- */
+void sm_supply_range(const struct sm_model *m, double *lo, double *hi)
+{
+	*lo = m->rated_min_v * (1.0 - SM_SUPPLY_TOLERANCE);
+	*hi = m->rated_max_v * (1.0 + SM_SUPPLY_TOLERANCE);
+}
+
+bool sm_supply_plausible(const struct sm_model *m, double volts)
+{
+	double lo, hi;
+	sm_supply_range(m, &lo, &hi);
+	/* the reading is in 0.1 V: 12.6 must not fail on 12.6000000001 */
+	return volts >= lo - 1e-6 && volts <= hi + 1e-6;
 }
 
 /* ---- torque actuation --------------------------------------------------------------------------- */

@@ -79,6 +79,8 @@ struct sm_model {
 	uint32_t torque_full;           /* full output in torque-limit units: 1023 | 885 */
 	/* the datasheet's line at ref_voltage (the simulator's motors use the same) */
 	double ref_voltage, stall_torque_nm, no_load_speed_rad_s, stall_current_a;
+	/* the supply it is rated for (V): what it can be running at (sm_supply_plausible) */
+	double rated_min_v, rated_max_v;
 	bool current_control;           /* has a current-controlled drive (XM430: mode 0) */
 	/* the motor's rotor seen through the gearbox, rotor inertia × ratio²
 	 * (kg·m²): what a joint's inertia has besides its link */
@@ -155,6 +157,17 @@ bool sm_write_refused(const struct sm_model *m, uint8_t status);
 #define SM_HWERR_FAULTS (DXL2_HWERR_OVERHEAT | DXL2_HWERR_ENCODER | DXL2_HWERR_SHOCK | DXL2_HWERR_OVERLOAD)
 /* The Bus Watchdog's value after it stopped the servo (−1 as a byte). */
 #define SM_WATCHDOG_TRIPPED 0xFF
+
+/* ---- the supply ----------------------------------------------------------------------------
+ * A supply reading the servo can be running at: its rated range, widened by
+ * SM_SUPPLY_TOLERANCE either side for a supply's regulation and the 0.1 V
+ * reading (the AX-12A's 12 V top then admits a full 3S battery, 12.6 V).
+ * Anything else is a servo (or a reading) that must not be believed: the PWM
+ * drive scales with the supply, so such a reading would be a gain. */
+#define SM_SUPPLY_TOLERANCE 0.05
+bool sm_supply_plausible(const struct sm_model *m, double volts);
+/* The plausible range itself, for messages and bounds. */
+void sm_supply_range(const struct sm_model *m, double *lo, double *hi);
 
 /* ---- torque actuation ----------------------------------------------------------------------
  * The register torque actuation's SYNC_WRITE carries, 2 bytes: AX-12 Moving

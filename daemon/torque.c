@@ -84,6 +84,33 @@ void tq_check_limits(struct ctl *c)
 	}
 }
 
+void tq_check_supply(struct ctl *c)
+{
+	const struct cfg *cfg = c->cfg;
+	if (cfg->actuation != CFG_ACT_TORQUE || cfg->torque_drive != CFG_DRIVE_PWM || c->mode != CFG_MODE_OSCILLATOR)
+		return;
+	for (size_t j = 0; j < c->n; j++) {
+		struct ctl_joint *jt = &c->j[j];
+		const struct sm_model *m = ctl_model(c, j);
+		/* NaN: not read yet (the drive assumes the reference supply) */
+		if (!isfinite(jt->voltage) || sm_supply_plausible(m, jt->voltage))
+			continue;
+		double lo, hi;
+		sm_supply_range(m, &lo, &hi);
+		jt->faults++;
+		c->faults++;
+		char what[CTL_LATCH_TEXT];
+		snprintf(what, sizeof what, "servo %u reads its supply as %.1f V, outside the %s's %.2f..%.2f V", jt->id,
+		         jt->voltage, m->name, lo, hi);
+		/* within CTL_EVENT_TEXT for the longest model name and reading */
+		ctl_event(c, 2, "supply", "%s (rated %.1f..%.1f V): not a gain for the PWM drive; robot %s in joint mode",
+		          what, m->rated_min_v, m->rated_max_v,
+		          cfg_mode_name(cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD));
+		ctl_latch(c, what);
+		return;
+	}
+}
+
 /* The virtual spring near a limit (N·m), on top of the law's torque. */
 static double tq_wall(const struct ctl_joint *jt, double stall)
 {
@@ -116,12 +143,35 @@ static double tq_duty(const struct ctl *c, const struct ctl_joint *jt, double ta
 	if (cfg->torque_drive == CFG_DRIVE_CURRENT) {
 		u = tau / tq_stall_torque(c, jt);
 	} else {
-		double volts = isfinite(jt->voltage) && jt->voltage > 1.0 ? jt->voltage : ref;
+		/* the supply read, never beyond what the servo can run at: a reading
+		 * outside latches first (tq_check_supply), and is no gain here */
+		double lo, hi;
+		sm_supply_range(m, &lo, &hi);
+		double volts = isfinite(jt->voltage) ? fmin(fmax(jt->voltage, lo), hi) : ref;
 		double stall = tq_stall_torque(c, jt) * volts / ref;
 		double w0 = tq_no_load_speed(c, jt) * volts / ref;
 		u = tau / stall + jt->speed / w0;
 	}
 	return isfinite(u) ? fmax(-cap, fmin(cap, u)) : 0.0;
+}
+
+/* A joint that would be within TQ_WALL_MARGIN of a limit TQ_GUARD_S from
+ * now, moving out, is never driven outwards, whatever the law or a belief
+ * about the servo (its supply, its stall torque, its no-load speed) asks:
+ * with no drive the servo's own back-EMF brakes it (an AX-12A joint at full
+ * speed stops within ~0.11 rad: I·w0/stall = 18 ms), and the wall's push
+ * harder. TQ_GUARD_S covers what passes before the brake acts: the duty
+ * already sent holds until the next cycle's SYNC_WRITE (one period and its
+ * bus time), and the speed is filtered (20 Hz, ~8 ms behind). */
+#define TQ_GUARD_S 0.03
+static double tq_no_outward(const struct ctl_joint *jt, double u)
+{
+	double ahead = jt->angle + jt->speed * TQ_GUARD_S;
+	if (jt->speed > 0.0 && ahead > jt->limits.hi - TQ_WALL_MARGIN)
+		return fmin(u, 0.0);
+	if (jt->speed < 0.0 && ahead < jt->limits.lo + TQ_WALL_MARGIN)
+		return fmax(u, 0.0);
+	return u;
 }
 
 void tq_duties(struct ctl *c)
@@ -152,7 +202,7 @@ void tq_duties(struct ctl *c)
 			c->clamps++;
 		}
 		jt->torque_cmd = tau[j] + wall;
-		jt->duty = tq_duty(c, jt, jt->torque_cmd);
+		jt->duty = tq_no_outward(jt, tq_duty(c, jt, jt->torque_cmd));
 	}
 }
 

@@ -95,6 +95,12 @@ enum dxl2_x_addr {
 #define DXL2_XM430_STALL_TORQUE_NM     4.1
 #define DXL2_XM430_STALL_CURRENT_A     2.3
 #define DXL2_XM430_NO_LOAD_SPEED_RPM   46.0
+/* The supply each is rated for (e-manual: XL430 6.5 ~ 12.0 V, 11.1 V
+ * recommended; XM430 10.0 ~ 14.8 V, 12.0 V recommended). */
+#define DXL2_XL430_RATED_MIN_V         6.5
+#define DXL2_XL430_RATED_MAX_V         12.0
+#define DXL2_XM430_RATED_MIN_V         10.0
+#define DXL2_XM430_RATED_MAX_V         14.8
 
 /* Operating Mode (11) values. */
 enum dxl2_opmode {

@@ -56,6 +56,9 @@ enum dxl_ax12_addr {
 #define DXL_AX12_STALL_TORQUE_NM    1.5    /* N·m at 12 V, 1.5 A */
 #define DXL_AX12_NO_LOAD_SPEED_RPM  59.0   /* at 12 V */
 #define DXL_AX12_NO_LOAD_SPEED_RAD_S (DXL_AX12_NO_LOAD_SPEED_RPM * 2.0 * 3.14159265358979323846 / 60.0)
+/* The supply it is rated for (e-manual: 9 ~ 12 V, 11.1 V recommended). */
+#define DXL_AX12_RATED_MIN_V        9.0
+#define DXL_AX12_RATED_MAX_V        12.0
 
 enum dxl_access { DXL_ACCESS_R, DXL_ACCESS_RW };
 enum dxl_area { DXL_AREA_EEPROM, DXL_AREA_RAM };

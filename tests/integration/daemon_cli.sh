@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # undulated's operation: --help, --check-config (errors name file, line and
-# key; a FIFO or /dev/zero refused at once), a missing servo named with the
+# key; a FIFO or /dev/zero refused at once; the command key judged as the
+# daemon judges it at start), a missing servo named with the
 # baud tried, and the systemd notification protocol (READY, STATUS, WATCHDOG,
 # STOPPING) on a datagram socket, without libsystemd.
 . "$(dirname "$0")/../lib.sh"
@@ -69,6 +70,43 @@ else tap_fail "bad key is a config error" "rc $rc: $out"; fi
 out=$(timeout 10 "$D" --port /dev/null --ids 1 --set robot.commands=network --set robot.command_key="$T/good.key" 2>&1); rc=$?
 if [ $rc -eq 2 ] && echo "$out" | grep -q "lets others read the key"; then tap_ok "a key others can read is refused"
 else tap_fail "world-readable key refused" "rc $rc: $out"; fi
+
+# --check-config judges the command key as the daemon does at start (cmdin.c):
+# the daemon's own refusal, with exit 1 as any configuration error; a key as
+# --gen-key makes it (600) passes
+net=(--port /dev/null --ids 1 --set robot.commands=network)
+"$D" --gen-key "$T/net.key" >/dev/null
+out=$("$D" --check-config "${net[@]}" --set robot.command_key="$T/net.key" 2>&1); rc=$?
+if [ $rc -eq 0 ] && echo "$out" | grep -q ': ok (robot'; then tap_ok "--check-config: the key --gen-key made (mode 600) passes"
+else tap_fail "--check-config passes a good key" "rc $rc: $out"; fi
+ln -s "$T/net.key" "$T/link.key"
+for k in 640 604 620 602 660 link; do
+	key="$T/net.key"
+	case $k in link) key="$T/link.key" ;; *) chmod "$k" "$key" ;; esac
+	said=$(timeout 10 "$D" "${net[@]}" --set robot.command_key="$key" 2>&1 | sed -n 's/^undulated: error: //p' | head -1)
+	out=$("$D" --check-config "${net[@]}" --set robot.command_key="$key" 2>&1); rc=$?
+	if [ $rc -eq 1 ] && [ -n "$said" ] && [ "$out" = "undulated: config: command line: [robot] $said" ]; then
+		tap_ok "--check-config refuses a key of $k as the daemon does: '$said'"
+	else tap_fail "--check-config refuses a key of $k" "rc $rc: '$out'; the daemon: '$said'"; fi
+	chmod 600 "$T/net.key"
+done
+# run as root for a service user: a key owned by that user is the daemon's
+# (User= in its unit), said as a note; the mode still counts
+if [ "$(id -u)" = 0 ]; then
+	chown 65534 "$T/net.key"
+	out=$("$D" --check-config "${net[@]}" --set robot.command_key="$T/net.key" 2>&1); rc=$?
+	if [ $rc -eq 0 ] && echo "$out" | grep -q "owned by uid 65534" && echo "$out" | grep -q ': ok (robot'; then
+		tap_ok "--check-config as root: a service user's key passes with a note ($(echo "$out" | head -1 | cut -c1-120))"
+	else tap_fail "--check-config as root, a service user's key" "rc $rc: $out"; fi
+	chmod 640 "$T/net.key"
+	out=$("$D" --check-config "${net[@]}" --set robot.command_key="$T/net.key" 2>&1); rc=$?
+	if [ $rc -eq 1 ] && echo "$out" | grep -q "mode 0640 lets others read the key"; then
+		tap_ok "--check-config as root: a service user's key of mode 640 is refused"
+	else tap_fail "--check-config as root refuses mode 640" "rc $rc: $out"; fi
+	chown 0 "$T/net.key"; chmod 600 "$T/net.key"
+else
+	tap_skip "--check-config as root for a service user" "not root"
+fi
 
 # a configuration path that is no file to read is refused at once with exit 2,
 # also by --check-config (a FIFO with no writer blocked open() for ever, and

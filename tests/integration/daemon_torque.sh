@@ -96,4 +96,60 @@ if [ "$(peek 1 ccw_angle_limit)" = 0 ]; then
 else
 	tap_fail "back in wheel mode before the stop" "ccw limit $(peek 1 ccw_angle_limit)"
 fi
+
+# ---- the supply the servo reports ---------------------------------------------------------------
+# The PWM drive scales with it. An audit faked it to 1.5 V on a servo running
+# at 12 V: the drive scaled up eightfold and the joint reached 0.638 rad
+# against a 0.6 limit before the limit fault latched. A supply no AX-12A runs
+# at (1.5 V, 0, 25 V) is a fault that names it, latched before the drive
+# starts; one it may run at (8.6 V: its rated 9..12 V less 5 %) drives; the
+# joint stays inside +-0.6 rad either way.
+spawn d2 "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold \
+	--set robot.actuation=torque --set robot.torque_drive=pwm \
+	--set joint.1.limit_min=-0.6 --set joint.1.limit_max=0.6
+wait_log d2 "ready: $R.STATE" 10 || { tap_fail "daemon with +-0.6 rad starts" "$(cat "$T/d2.log")"; tap_done; exit 1; }
+cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2 >/dev/null; }
+# reads VOLTS: the daemon publishes the supply as read (v0, one decimal)
+reads() { wait_for 5 sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -q ' v0=$1 '"; }
+# widest_since N: the farthest the published angle got from neutral after line N
+widest_since() { grep -a "^STATE $R " "$T/watch.log" | tail -n +"$1" | field a0 |
+	awk '{ a = $1 < 0 ? -$1 : $1; if (a > m) m = a } END { printf "%.4f", m }'; }
+for v in 1.5 0.0 25.0; do
+	ctl fault r1 1 voltage "$v" >/dev/null
+	if ! reads "$v"; then tap_fail "supply read as $v V" "not published: $(last_state | cut -c1-200)"; continue; fi
+	from=$(grep -ac "^STATE $R " "$T/watch.log")
+	cmd 'mode oscillator'
+	if event "kind=supply text=\"servo 1 reads its supply as $v V, outside the AX-12A's 8.55..12.60 V" 5 &&
+		wait_for 5 sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -q 'mode=1 .*fault=\"servo 1 reads its supply as $v V'"; then
+		sleep_until 1
+		w=$(widest_since "$from"); lim="$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)"
+		if num "$w <= 0.6" && [ "$lim" != 0/0 ]; then
+			tap_ok "supply read as $v V: fault named and latched, HOLD in joint mode (servo angle limits $lim), joint within $w rad"
+		else tap_fail "supply read as $v V: joint inside its limits, joint mode" "widest $w rad, servo angle limits $lim"; fi
+	else tap_fail "supply read as $v V: a fault naming it" "$(events | tail -3)"; fi
+	cmd clear
+done
+ctl fault r1 1 voltage 8.6 >/dev/null
+reads 8.6
+from=$(grep -ac "^STATE $R " "$T/watch.log")
+n=$(grep -c 'servos in wheel mode' "$T/watch.log")
+cmd 'mode oscillator'
+sleep_until 8
+w=$(widest_since "$from")
+if [ "$(grep -c 'servos in wheel mode' "$T/watch.log")" -gt "$n" ] && num "$w <= 0.6 && $w > 0.3" &&
+	! events | tail -n 20 | grep -q 'kind=limit' && [ "$(last_state | field mode)" = 3 ]; then
+	tap_ok "supply read as 8.6 V (the servo at 12 V): driven in wheel mode for 8 s, widest $w rad, limits +-0.6 held"
+else tap_fail "supply read as 8.6 V: limits held in wheel mode" "widest $w rad, mode $(last_state | field mode): $(events | tail -2)"; fi
+# and read as 1.5 V while the law drives: latched at once, back to joint mode
+from=$(grep -ac "^STATE $R " "$T/watch.log")
+ctl fault r1 1 voltage 1.5 >/dev/null
+if event 'kind=supply text="servo 1 reads its supply as 1.5 V' 5 &&
+	event 'kind=actuation text="torque actuation: servos back in joint mode' 5; then
+	sleep_until 1
+	w=$(widest_since "$from")
+	if num "$w <= 0.6"; then tap_ok "read as 1.5 V while driving: latched, back in joint mode, joint within $w rad"
+	else tap_fail "read as 1.5 V while driving: limits held" "widest $w rad"; fi
+else tap_fail "read as 1.5 V while driving: a fault naming it" "$(events | tail -3)"; fi
+ctl clear r1 1 >/dev/null
+stop d2
 tap_done

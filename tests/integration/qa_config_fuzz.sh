@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # undulated --check-config fed 300 seeded mutations of the example configuration
 # (systemd/undulated.conf.example): truncated lines, bad numbers, NaN/inf, huge
-# values, unknown keys, binary bytes, broken sections, long lines. Never a
-# crash: the exit status is 0, 1 or 2 (never a signal), every rejection is
-# explained, and a mutation that breaks one line is named as FILE:LINE.
+# values, unknown keys, binary bytes, broken sections, long lines, a key given
+# twice. Never a crash: the exit status is 0, 1 or 2 (never a signal), every
+# rejection is explained, and a mutation that breaks one line is named as
+# FILE:LINE.
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"
 [ -x "$D" ] || tap_skip_all "undulated not built"
@@ -82,7 +83,9 @@ for i in range(n):
         if j is not None:
             L[j] = L[j].split(b'=')[0].strip() + b' = bad'
     elif kind == 'dup':
+        # a key given twice: refused at its second line (the second no longer wins)
         L.insert(k, L[k])
+        at, must = k + 2, 1
     elif kind == 'nul':
         p = rng.randrange(0, len(L[k]))
         L[k] = L[k][:p] + b'\x00' + L[k][p:]

@@ -216,10 +216,20 @@ static void test_key_load_owner(void **state)
 	assert_int_equal(chown(p, 54321, 54321), 0);
 	expect_load_fails(p, true, "owned by uid 54321");
 	expect_load_fails(p, false, "owned by uid 54321");
-	assert_int_equal(chown(p, 0, 54321), 0);   /* root's with another group: fine */
+	/* judged for a program that runs as uid 54321 (--check-config run by
+	 * root for a service user): its own file; the mode still counts */
 	struct auth_key k;
 	char why[400];
+	assert_true(auth_key_load_as(&k, p, true, 54321, why, sizeof why));
+	assert_false(auth_key_load_as(&k, p, true, 54322, why, sizeof why));
+	assert_non_null(strstr(why, "owned by uid 54321, neither this user (54322) nor root"));
+	assert_int_equal(chmod(p, 0640), 0);
+	assert_false(auth_key_load_as(&k, p, true, 54321, why, sizeof why));
+	assert_non_null(strstr(why, "mode 0640"));
+	assert_int_equal(chmod(p, 0600), 0);
+	assert_int_equal(chown(p, 0, 54321), 0);   /* root's with another group: fine */
 	assert_true(auth_key_load(&k, p, true, why, sizeof why));
+	assert_true(auth_key_load_as(&k, p, true, 54321, why, sizeof why));
 }
 
 /* ---- generating ------------------------------------------------------------------------------- */

@@ -127,7 +127,7 @@ static void test_defaults_from_osc(void **state)
 	assert_string_equal(c.name, "robot");
 	assert_int_equal(c.actuation, CFG_ACT_POSITION);
 	/* torque actuation takes the physical defaults, wherever the key comes */
-	load_ok(&c, "[robot]\nport=/dev/null\nids=1\n[joint.1]\nmu=0.05\n[robot]\nactuation = torque\n"
+	load_ok(&c, "[joint.1]\nmu=0.05\n[robot]\nport=/dev/null\nids=1\nactuation = torque\n"
 	        "torque_drive = current\n");
 	struct osc_joint_params t0;
 	osc_default_torque_params(&t0, 0, 1, false);
@@ -235,6 +235,59 @@ static void test_every_error_reported(void **state)
 	assert_string_equal(e.line[0], "r.conf:2: [robot] baud: not an integer 'x'");
 	assert_string_equal(e.line[1], "r.conf:5: [joint.1] k: not a number 'y'");
 	assert_string_equal(e.line[2], "r.conf:6: [joint.1] c: not a number 'z'");
+}
+
+/* A key or a section given twice is an error naming both lines: with the
+ * parser's own rule the second silently won (a second limit_max widened
+ * the joint). --set is meant to override, and still does. */
+static void test_repeated_keys_and_sections(void **state)
+{
+	(void)state;
+	char b[CFG_ERR_MAX];
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nlimit_max = 0.5\nk = 0.1\n"
+	                               "limit_max = 1.2\n", b, sizeof b),
+	                    "robot1.conf:7: [joint.1] limit_max: given twice (first at line 5): give each key once");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,2\n[joint.1]\nk = 0.1\n[joint.2]\nk = 0.1\n"
+	                               "[joint.1]\nmu = 0.1\n", b, sizeof b),
+	                    "robot1.conf:8: [joint.1]: section given twice (first at line 4): give each section once");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[robot]\nmode=hold\n", b, sizeof b),
+	                    "robot1.conf:4: [robot]: section given twice (first at line 1): give each section once");
+	/* both, when the repeated section repeats a key */
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_false(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1\n[joint.1]\nlimit_max=0.5\n"
+	                             "[sinusoid]\nphase=1\n[joint.1]\nlimit_max=1.2\n", &e));
+	assert_int_equal(e.count, 2);
+	assert_string_equal(e.line[0], "r.conf:8: [joint.1]: section given twice (first at line 4): give each section "
+	                               "once");
+	assert_string_equal(e.line[1], "r.conf:9: [joint.1] limit_max: given twice (first at line 5): give each key "
+	                               "once");
+	/* an indented line continues the value above it (the parser's multi-line
+	 * values): it was a second value for the key, now an error */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nk = 0.1\n  0.5\n", b, sizeof b),
+	                    "robot1.conf:6: [joint.1] k: an indented line continues the value of line 5: a value is "
+	                    "one line (remove the indentation)");
+	/* so is an indented key after a key (the parser's rule, not ours) */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nk = 0.1\n\n  mu = 0.2\n", b, sizeof b),
+	                    "robot1.conf:7: [joint.1] k: an indented line continues the value of line 5: a value is "
+	                    "one line (remove the indentation)");
+	/* the same key in two sections is two keys; an indented key opening a
+	 * section is a key; comments and blank lines between are nothing */
+	static struct cfg ok;
+	load_ok(&ok, "[robot]\nport=/dev/null\nids=1,2\n[joint.1]\n  k = 0.1\n  ; a comment\n\nmu = 0.2\n"
+	             "[joint.2]\nk = 0.3\n");
+	assert_double_equal(ok.joint[0].osc.k, 0.1, 1e-12);
+	assert_double_equal(ok.joint[0].osc.mu, 0.2, 1e-12);
+	assert_double_equal(ok.joint[1].osc.k, 0.3, 1e-12);
+	/* --set overrides the file's key, and a second --set the first */
+	e = (struct cfg_errors){ 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1\n[joint.1]\nlimit_max = 0.5\n", &e));
+	assert_true(cfg_override(&c, "joint.1.limit_max=0.7", &e));
+	assert_true(cfg_override(&c, "joint.1.limit_max=0.9", &e));
+	assert_true(cfg_finish(&c, &e));
+	assert_double_equal(c.joint[0].limit_max, 0.9, 1e-12);
 }
 
 /* A line longer than the INI parser's buffer is named as such, and the lines
@@ -562,6 +615,7 @@ int main(void)
 		cmocka_unit_test(test_errors_name_file_line_key),
 		cmocka_unit_test(test_whole_config_errors),
 		cmocka_unit_test(test_every_error_reported),
+		cmocka_unit_test(test_repeated_keys_and_sections),
 		cmocka_unit_test(test_long_line),
 		cmocka_unit_test(test_line_of_199_characters),
 		cmocka_unit_test(test_name_without_spaces),

@@ -323,6 +323,33 @@ static void test_position_defaults(void **state)
 	assert_true(fabs(c.joint[0].osc.k - k) < 1e-12);
 }
 
+/* The supply each model can be running at: its e-manual's rated range, 5 %
+ * either side; the reading's 0.1 V steps at the edges. */
+static void test_supply_plausible(void **state)
+{
+	(void)state;
+	static const struct { enum sm_family f; double lo_in, hi_in, lo_out, hi_out; } cases[] = {
+		{ SM_AX12, 8.6, 12.6, 8.5, 12.7 },
+		{ SM_XL430, 6.2, 12.6, 6.1, 12.7 },
+		{ SM_XM430, 9.5, 15.5, 9.4, 15.6 },
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		const struct sm_model *m = sm_of(cases[i].f);
+		assert_true(sm_supply_plausible(m, cases[i].lo_in));
+		assert_true(sm_supply_plausible(m, cases[i].hi_in));
+		assert_true(sm_supply_plausible(m, 12.0));
+		assert_false(sm_supply_plausible(m, cases[i].lo_out));
+		assert_false(sm_supply_plausible(m, cases[i].hi_out));
+		assert_false(sm_supply_plausible(m, 0.0));
+		assert_false(sm_supply_plausible(m, 1.5));
+		assert_false(sm_supply_plausible(m, 25.5));
+		assert_false(sm_supply_plausible(m, NAN));
+	}
+	/* the 0.1 V reading of the edge itself: AX-12A 12.6 V is 126 x 0.1 */
+	assert_true(sm_supply_plausible(sm_ax12(), dxl_voltage_to_volts(126)));
+	assert_false(sm_supply_plausible(sm_ax12(), dxl_voltage_to_volts(85)));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -336,6 +363,7 @@ int main(void)
 		cmocka_unit_test(test_drive_outputs),
 		cmocka_unit_test(test_torque_defaults_scale),
 		cmocka_unit_test(test_position_defaults),
+		cmocka_unit_test(test_supply_plausible),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -56,6 +56,10 @@ struct xfake {
 	 * not 0, as the e-manual has it (off: test_dxl_fakeservo2's fake, which
 	 * injects the ERR field itself) */
 	bool alert_from_hwerr;
+	/* every WRITE and SYNC_WRITE part addressed to a servo that hears, before
+	 * the servo judges it (NULL: none): what the controller sent, not what
+	 * the servo took */
+	void (*on_write)(void *ctx, const struct xfake_servo *s, uint16_t addr, size_t len);
 	atomic_uint packets;         /* well-formed instruction packets heard */
 	atomic_uint writes;          /* WRITEs executed (SYNC_WRITE parts too) */
 	atomic_uint reboots;
@@ -183,6 +187,8 @@ static inline uint8_t xfake_write_error(const struct xfake_servo *s, uint16_t ad
 static inline void xfake_write(struct xfake *fb, struct xfake_servo *s, const uint8_t *p, size_t n, bool broadcast)
 {
 	uint16_t addr = (uint16_t)xfake_get(p, 0, 2);
+	if (fb->on_write != NULL && n >= 3)
+		fb->on_write(fb->ctx, s, addr, n - 2);
 	uint8_t err = n < 3 ? DXL2_ERRNUM_DATA_LENGTH : xfake_write_error(s, addr, n - 2, p + 2);
 	if (err == 0) {
 		atomic_fetch_add(&fb->writes, 1);
@@ -256,6 +262,8 @@ static inline void xfake_sync(struct xfake *fb, uint8_t instr, const uint8_t *p,
 			continue;
 		if (instr == 0x83 && (addr == 100 || addr == 102) && len == 2 && (p[off + 1] | p[off + 2]) != 0)
 			s->drive_parts++;
+		if (instr == 0x83 && fb->on_write != NULL)
+			fb->on_write(fb->ctx, s, addr, len);
 		if (instr == 0x82) {
 			if (s->mem[68] >= 1)
 				xfake_send_status(fb, s, 0, &s->mem[addr], len);
