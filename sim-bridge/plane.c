@@ -296,7 +296,7 @@ void plane_move_wall(struct plane *pl, int wall, double ax, double ay, double bx
 	cpBodySetVelocity(b, cpvmult(cpvsub(to, cpBodyGetPosition(b)), 1.0 / dt));
 }
 
-bool plane_overlap(const struct plane *pl, char *why, size_t cap)
+bool plane_overlap(const struct plane *pl, int *robot_a, int *link_a, int *robot_b, int *link_b)
 {
 	for (int r = 0; r < pl->nrobots; r++)
 		for (int k = 0; k <= pl->robots[r].njoints; k++)
@@ -306,16 +306,19 @@ bool plane_overlap(const struct plane *pl, char *why, size_t cap)
 	for (int r = 0; r < pl->nrobots; r++)
 		for (int k = 0; k <= pl->robots[r].njoints; k++) {
 			const cpShape *a = pl->robots[r].shape[k];
+			*robot_a = r;
+			*link_a = k;
 			for (int s = r + 1; s < pl->nrobots; s++)
 				for (int m = 0; m <= pl->robots[s].njoints; m++)
 					if (cpShapesCollide(a, pl->robots[s].shape[m]).count > 0) {
-						snprintf(why, cap, "robot %d's link %d overlaps robot %d's link %d", r + 1, k + 1,
-						         s + 1, m + 1);
+						*robot_b = s;
+						*link_b = m;
 						return true;
 					}
 			for (int w = 0; w < pl->nwalls; w++)
 				if (cpShapesCollide(a, pl->wall_shape[w]).count > 0) {
-					snprintf(why, cap, "robot %d's link %d overlaps wall %d", r + 1, k + 1, w + 1);
+					*robot_b = PLANE_WALL;
+					*link_b = w;
 					return true;
 				}
 		}

@@ -98,9 +98,9 @@ int plane_add_wall(struct plane *pl, double ax, double ay, double bx, double by,
 /* Move a wall to a new segment over the next step of dt (its speed is what
  * contacts feel). */
 void plane_move_wall(struct plane *pl, int wall, double ax, double ay, double bx, double by, double dt);
-/* The first pair of shapes that overlap (robots with robots or walls): false
- * when none, else what overlaps in why. */
-bool plane_overlap(const struct plane *pl, char *why, size_t cap);
+/* The first pair of links that overlap, a robot's with another's or with a
+ * wall (robot_b PLANE_WALL, link_b the wall's index): false when none. */
+bool plane_overlap(const struct plane *pl, int *robot_a, int *link_a, int *robot_b, int *link_b);
 
 /* Advance dt under drives[robot * PLANE_MAX_JOINTS + joint]; the joints come
  * back in joints[] (the same indexing). */

@@ -255,10 +255,22 @@ static int sim_plane_build(struct sim *s, char *err, size_t errcap)
 			return -1;
 	if (sim_plane_walls(s, why, sizeof why) != 0)
 		return snprintf(err, errcap, "world: %s", why), -1;
-	if (plane_overlap(s->plane, why, sizeof why))
-		return snprintf(err, errcap, "world: at the start %s (robots %g m apart, joints within +-%g rad): "
-		                "set world.spacing wider, positions apart, or sim.initial_spread lower", why,
-		                config_spacing(c), c->initial_spread), -1;
+	int ra, la, rb, lb;
+	if (plane_overlap(s->plane, &ra, &la, &rb, &lb)) {
+		static const char *const wall[4] = { "the left wall", "the right wall", "the back wall", "the front wall" };
+		char other[80];
+		if (rb == PLANE_WALL) {
+			int k = 0;
+			while (k < 3 && s->plane_wall[k] != lb)
+				k++;
+			snprintf(other, sizeof other, "%s", wall[k]);
+		} else {
+			snprintf(other, sizeof other, "robot %s's link %d", s->buses[rb].name, lb + 1);
+		}
+		return snprintf(err, errcap, "world: at the start robot %s's link %d overlaps %s (robots %g m apart, "
+		                "joints within +-%g rad): set world.spacing wider, positions apart, or sim.initial_spread "
+		                "lower", s->buses[ra].name, la + 1, other, config_spacing(c), c->initial_spread), -1;
+	}
 	return 0;
 }
 

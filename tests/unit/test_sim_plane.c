@@ -297,13 +297,14 @@ static void test_deterministic_and_refusals(void **state)
 	double zero[2] = { 0, 0 };
 	plane_add_robot(pl, 0, 0, M_PI / 2, 2, zero, NULL, err, sizeof err);
 	plane_add_robot(pl, 0.02, 0.05, M_PI / 2, 2, zero, NULL, err, sizeof err);
-	assert_true(plane_overlap(pl, err, sizeof err));
-	assert_string_equal(err, "robot 1's link 1 overlaps robot 2's link 1");
+	int ra, la, rb, lb;
+	assert_true(plane_overlap(pl, &ra, &la, &rb, &lb));
+	assert_true(ra == 0 && la == 0 && rb == 1 && lb == 0);
 	plane_free(pl);
 	pl = plane_new(&p, err, sizeof err);
 	plane_add_robot(pl, 0, 0, M_PI / 2, 2, zero, NULL, err, sizeof err);
 	plane_add_robot(pl, 0.2, 0, M_PI / 2, 2, zero, NULL, err, sizeof err);
-	assert_false(plane_overlap(pl, err, sizeof err));
+	assert_false(plane_overlap(pl, &ra, &la, &rb, &lb));
 	plane_free(pl);
 	p.link_length = NAN;
 	assert_null(plane_new(&p, err, sizeof err));
