@@ -13,7 +13,7 @@
 # runs, 8), BENCH_FLEET_S (20 robots with 20 daemons, 15), BENCH_CG_S (the
 # daemon under callgrind, 3), BENCH_LOCK_REPS (lockstep runs per scenario, 3),
 # BENCH_ONLY (a list of sections to run, e.g.
-# "loop bus"; default all: loop bus missing cap codec cg web lockstep),
+# "loop bus"; default all: loop bus missing cap plane codec cg web lockstep),
 # KEEP_BENCH_DIR=1 keeps the logs.
 set -u
 top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -32,7 +32,7 @@ CYCLES=${BENCH_CYCLES:-300}
 CAP_S=${BENCH_CAP_S:-8}
 CG_S=${BENCH_CG_S:-3}
 FLEET_S=${BENCH_FLEET_S:-15}
-ONLY=${BENCH_ONLY:-loop bus missing cap codec cg web lockstep}
+ONLY=${BENCH_ONLY:-loop bus missing cap plane codec cg web lockstep}
 LOCK_REPS=${BENCH_LOCK_REPS:-3}
 WEB_S=${BENCH_WEB_S:-15}
 WEB_ROBOTS=20
@@ -749,6 +749,43 @@ section_cap() {
 	say ""
 }
 
+# ---- 5b: the plane world ------------------------------------------------------------
+# plane_run NAME SCENARIO: the sim alone in real time for CAP_S seconds.
+plane_run() {
+	local name=$1 scen=$2 d=$T/plane
+	mkdir -p "$d/links-$name"
+	start "sim-plane-$name" "$SIM" --scenario "$scen" --link-dir "$d/links-$name" --lcm-url "$(url $PORT_CAP)" \
+		--duration "$CAP_S" --quiet
+	wait "${PID[sim-plane-$name]}"
+	unset "PID[sim-plane-$name]"
+	cp "$T/sim-plane-$name.log" "$d/$name.out"
+}
+section_plane() {
+	progress "plane world: ten robots in the arena, the sim alone for ${CAP_S} s, beside the row's arena"
+	plane_run row "$top/sim-bridge/scenarios/arena10.scenario"
+	plane_run plane "$top/sim-bridge/scenarios/plane-arena10.scenario"
+	say "## 5b. The plane world (sim-bridge/PHYSICS.md §6)"
+	say ""
+	say "The simulator alone (no daemons: joints idle, no contact) in real time at 1 kHz, ten two-servo robots"
+	say "in the arena: the plane world (three Chipmunk2D links a robot, drag, walls) beside the row world."
+	say "Budget: ten plane robots within 10 % of a core. The lockstep figure is in §8."
+	say ""
+	say "| world | sim CPU % of a core | step lateness p99 (µs) | overruns |"
+	say "|---|---|---|---|"
+	local w f cpu
+	for w in row plane; do
+		f=$T/plane/$w.out
+		if ! grep -q 'exit:' "$f" 2>/dev/null; then
+			say "| $w | not measured: $(tail -n1 "$f" | cut -c1-120) | – | – |"
+			continue
+		fi
+		cpu=$(exit_field "$f" 'cpu \([0-9.]*\)%')
+		say "| $w | $(fmt "$cpu" 1) | $(fmt "$(exit_field "$f" '(p99 \([0-9.]*\) us')") | $(exit_field "$f" ' \([0-9]*\) overruns') |"
+		[ "$w" = plane ] && sum "simulator: ten plane robots at 1 kHz, alone" "within 10 % of a core" "$(fmt "$cpu" 1) % of a core"
+	done
+	say ""
+}
+
 # ---- 6: the framing code alone -----------------------------------------------------
 section_codec() {
 	progress "5/5 protocol framing throughput (1 s)"
@@ -869,6 +906,7 @@ section_lockstep() {
 			--set world.separation=0.7 --daemon-set robot.actuation=torque \
 			--daemon-set robot.torque_drive=current --daemon-set sinusoid.amplitude=0.25
 		lock_run "ten.$i" "$top/sim-bridge/scenarios/force10.scenario" 45
+		lock_run "plane.$i" "$top/sim-bridge/scenarios/plane-arena10.scenario" 45
 	done
 	say "## 8. Lockstep: simulated time against wall time"
 	say ""
@@ -881,6 +919,7 @@ section_lockstep() {
 	say "|---|---|---|---|---|"
 	lock_row "pair rig, 40 s" 2 pair "≥ 20× real time"
 	lock_row "ten two-joint robots, 45 s" 10 ten "≥ 5× real time"
+	lock_row "ten plane robots in the arena, 45 s" 10 plane "≥ 5× real time"
 	say ""
 }
 
@@ -919,6 +958,7 @@ main() {
 	wants missing && section_missing
 	wants loop && section_resources
 	wants cap && section_cap
+	wants plane && section_plane
 	wants codec && section_codec
 	wants cg && section_cg
 	wants web && section_web
