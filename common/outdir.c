@@ -217,6 +217,40 @@ int outdir_open(const char *path, bool create, char *err, size_t errcap)
 	return fd;
 }
 
+int outdir_open_parent(const char *path, char *name, size_t namecap, char *err, size_t errcap)
+{
+	char dir[PATH_MAX];
+	const char *slash = strrchr(path, '/');
+	const char *base = slash ? slash + 1 : path;
+	if (*base == '\0' || strcmp(base, ".") == 0 || strcmp(base, "..") == 0) {
+		snprintf(err, errcap, "%s: names a directory; give the file to write", path);
+		return -1;
+	}
+	if (snprintf(name, namecap, "%s", base) >= (int)namecap || (slash && (size_t)(slash - path) >= sizeof dir)) {
+		snprintf(err, errcap, "%s: %s", path, strerror(ENAMETOOLONG));
+		return -1;
+	}
+	if (slash == NULL)
+		snprintf(dir, sizeof dir, ".");
+	else if (slash == path)
+		snprintf(dir, sizeof dir, "/");
+	else
+		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+	return outdir_open(dir, false, err, errcap);
+}
+
+int outdir_create_in_place(int dirfd, const char *name, char *err, size_t errcap)
+{
+	if (unlinkat(dirfd, name, 0) != 0 && errno != ENOENT) {
+		snprintf(err, errcap, "%s: cannot replace it: %s", name, strerror(errno));
+		return -1;
+	}
+	int fd = openat(dirfd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+	if (fd < 0)
+		snprintf(err, errcap, "%s: cannot create: %s", name, strerror(errno));
+	return fd;
+}
+
 /* PREFIX followed by a random suffix, into out (cap bytes). */
 static void outdir_random_name(const char *prefix, char *out, size_t cap)
 {

@@ -50,6 +50,20 @@
  */
 int outdir_open(const char *path, bool create, char *err, size_t errcap);
 
+/* For a file PATH to be written (--tune --out FILE, --record FILE): opens
+ * the directory it is in with outdir_open() (not made) and puts the file's
+ * own name into name (namecap bytes). Returns the directory's descriptor, or
+ * -1 with err (also for a PATH that names a directory: "", "x/", ".."). */
+int outdir_open_parent(const char *path, char *name, size_t namecap, char *err, size_t errcap);
+
+/* Creates NAME in dirfd to write in place, for a file read while it grows (a
+ * recording), where a temporary name would hide it until the end: what has
+ * that name (a file, a link, a FIFO) is removed, then the file is made
+ * O_CREAT|O_EXCL|O_NOFOLLOW (0666 less the umask); in a directory that only
+ * we can write nothing can come in between. Returns the descriptor, or -1
+ * with err (a directory of that name is not removed). */
+int outdir_create_in_place(int dirfd, const char *name, char *err, size_t errcap);
+
 /* Makes a fresh private directory (0700) inside dirfd named PREFIX.XXXXXX
  * (a random suffix, retried if taken). Returns its descriptor and its name in
  * name (namecap bytes), or -1 with err. */

@@ -254,29 +254,13 @@ static void main_print_errors(const struct cfg_errors *e)
  * followed. 0, or 2 with a message (*dirfd closed). */
 static int main_tune_out(const char *out, int *dirfd, struct outdir_file *of)
 {
-	char dir[PATH_MAX], err[1024];
-	const char *slash = strrchr(out, '/');
-	const char *base = slash ? slash + 1 : out;
-	if (slash != NULL && (size_t)(slash - out) >= sizeof dir) {
-		fprintf(stderr, "undulated --tune: --out: path too long\n");
-		return 2;
-	}
-	if (*base == '\0' || strcmp(base, ".") == 0 || strcmp(base, "..") == 0) {
-		fprintf(stderr, "undulated --tune: --out %s: names a directory; give the file to write\n", out);
-		return 2;
-	}
-	if (slash == NULL)
-		snprintf(dir, sizeof dir, ".");
-	else if (slash == out)
-		snprintf(dir, sizeof dir, "/");
-	else
-		snprintf(dir, sizeof dir, "%.*s", (int)(slash - out), out);
-	*dirfd = outdir_open(dir, false, err, sizeof err);
+	char name[NAME_MAX + 1], err[1024];
+	*dirfd = outdir_open_parent(out, name, sizeof name, err, sizeof err);
 	if (*dirfd < 0) {
 		fprintf(stderr, "undulated --tune: --out %s: %s\n", out, err);
 		return 2;
 	}
-	if (outdir_file_create(of, *dirfd, base, err, sizeof err) < 0) {
+	if (outdir_file_create(of, *dirfd, name, err, sizeof err) < 0) {
 		fprintf(stderr, "undulated --tune: cannot write next to %s: %s\n", out, err);
 		close(*dirfd);
 		return 2;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # safety_files.sh — files a tool writes go only where it was asked. The
 # audit's attacks, prepared here inside the test's directory, against every
-# writer of results: undulate-analyze --out, scripts/demo.sh --out,
+# writer of results: undulate-analyze --out (and its --synth and --record
+# logs), scripts/demo.sh --out,
 # undulated --tune --out, and `make figures` (scripts/figures.sh, its runs
 # and its merges):
 #   (a) a directory owned by another user (nobody; as root only, else
@@ -122,6 +123,33 @@ tap_check "analyze --out a path whose parent is missing: exit 5, saying so" bash
 analyze m "$T/made"
 tap_check "analyze --out a new directory: made (0755), results in it" \
 	bash -c "[ $rc = 0 ] && [ \"\$(stat -c %a '$T/made')\" = 755 ] && test -s '$T/made/summary.json'"
+
+# --synth and --record write a log at the path given: the same rules for its directory,
+# and a link at the path is replaced (written in place, a recording is read as it grows)
+if [ "$root" = 1 ]; then
+	SF="$T/sforeign"; mkdir "$SF"; victim s1; ln -s "$T/victim.s1" "$SF/x.log"; foreign "$SF"
+	rc=0; "$A" --synth "$SF/x.log" --duration 2 >"$T/s1.out" 2>&1 || rc=$?
+	if [ "$rc" = 5 ] && grep -q 'owned by nobody' "$T/s1.out" && intact s1; then
+		tap_ok "--synth into another user's directory: exit 5, the victim unchanged: $(head -n 1 "$T/s1.out")"
+	else tap_fail "--synth into another user's directory: refused" "exit $rc: $(cat "$T/s1.out")"; fi
+else
+	tap_skip "--synth into another user's directory" "not root"
+fi
+victim s2; ln -s "$T/victim.s2" "$O/synth.log"
+rc=0; "$A" --synth "$O/synth.log" --duration 2 >"$T/s2.out" 2>&1 || rc=$?
+tap_check "--synth to a link: the link replaced by the log, the victim unchanged" \
+	bash -c "[ $rc = 0 ] && $(declare -f intact); T='$T'; intact s2 && [ -f '$O/synth.log' ] && [ ! -L '$O/synth.log' ] && [ \$(stat -c %s '$O/synth.log') -gt 10000 ]"
+victim s3; ln -s "$T/victim.s3" "$O/rec.log"
+spawn rec "$A" --record "$O/rec.log" --lcm-url "$(lcm_url 7773)"
+if wait_log rec 'recording' 10; then
+	stop rec INT >/dev/null
+	if [ "$stop_rc" = 0 ] && intact s3 && regular "$O/rec.log"; then
+		tap_ok "--record to a link: the link replaced by the recording, the victim unchanged"
+	else tap_fail "--record to a link: replaced" "exit $stop_rc: $(cat "$T/rec.log"); $(ls -l "$O/rec.log")"; fi
+else
+	stop rec >/dev/null
+	tap_fail "--record to a link: replaced" "$(cat "$T/rec.log"); victim: $(cat "$T/victim.s3" | head -c 100)"
+fi
 
 # ---- undulated --tune --out --------------------------------------------------------------
 # Refused before any motion (the port is never opened): a directory of another user.

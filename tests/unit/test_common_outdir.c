@@ -3,9 +3,9 @@
  * (made when missing, reached through our own links) and refuses, naming
  * the owner or the mode and what to do, one owned by another user, one
  * others may write (unless sticky), a link another user made, a file on the
- * way, a loop of links; outdir_file_*() and outdir_stage()/outdir_publish()
- * replace a link or a FIFO under the final name, never write through it or
- * open it, and leave no temporary behind. The cases that need another
+ * way, a loop of links; outdir_file_*(), outdir_create_in_place() and
+ * outdir_stage()/outdir_publish() replace a link or a FIFO under the final
+ * name, never write through it or open it, and leave no temporary behind. The cases that need another
  * user's files (chown) run as root only and are skipped otherwise. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -273,6 +273,47 @@ static void test_file_replaces_links_and_fifos(void **state)
 	close(dirfd);
 }
 
+static void test_parent_and_in_place(void **state)
+{
+	(void)state;
+	assert_int_equal(mkdir(at("rec"), 0755), 0);
+	write_text(at("victim3"), "precious\n");
+	assert_int_equal(symlink(at("victim3"), at("rec/run.log")), 0);
+	char name[256];
+	int dirfd = outdir_open_parent(at("rec/run.log"), name, sizeof name, err, sizeof err);
+	assert_true(dirfd >= 0);
+	assert_string_equal(name, "run.log");
+	/* in place: the link removed, a new file made under its name at once */
+	int fd = outdir_create_in_place(dirfd, name, err, sizeof err);
+	assert_true(fd >= 0);
+	assert_true(is_regular(at("rec/run.log")));
+	assert_int_equal(write(fd, "log", 3), 3);
+	close(fd);
+	expect_text(at("victim3"), "precious\n");
+	expect_text(at("rec/run.log"), "log");
+	/* a directory of that name stays, and says so */
+	assert_int_equal(mkdir(at("rec/adir"), 0755), 0);
+	assert_int_equal(outdir_create_in_place(dirfd, "adir", err, sizeof err), -1);
+	assert_non_null(strstr(err, "adir: cannot replace it: Is a directory"));
+	close(dirfd);
+	/* a bare name is in the working directory; a path naming a directory is refused */
+	char cwd[512];
+	assert_non_null(getcwd(cwd, sizeof cwd));
+	assert_int_equal(chdir(at("rec")), 0);
+	dirfd = outdir_open_parent("x.log", name, sizeof name, err, sizeof err);
+	assert_true(dirfd >= 0);
+	assert_string_equal(name, "x.log");
+	close(dirfd);
+	assert_int_equal(chdir(cwd), 0);
+	assert_int_equal(outdir_open_parent(at("rec/"), name, sizeof name, err, sizeof err), -1);
+	assert_non_null(strstr(err, "names a directory"));
+	assert_int_equal(outdir_open_parent(at("rec/.."), name, sizeof name, err, sizeof err), -1);
+	/* the directory's rules apply: one others may write */
+	assert_int_equal(chmod(at("rec"), 0777), 0);
+	assert_int_equal(outdir_open_parent(at("rec/run.log"), name, sizeof name, err, sizeof err), -1);
+	assert_non_null(strstr(err, "writable by other users"));
+}
+
 static void test_stage_and_publish(void **state)
 {
 	(void)state;
@@ -342,6 +383,7 @@ int main(void)
 		cmocka_unit_test(test_another_users),
 		cmocka_unit_test(test_links),
 		cmocka_unit_test(test_file_replaces_links_and_fifos),
+		cmocka_unit_test(test_parent_and_in_place),
 		cmocka_unit_test(test_stage_and_publish),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
