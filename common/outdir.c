@@ -230,9 +230,11 @@ int outdir_open_parent(const char *path, char *name, size_t namecap, char *err, 
 		snprintf(err, errcap, "%s: %s", path, strerror(ENAMETOOLONG));
 		return -1;
 	}
-	if (slash == NULL)
-		snprintf(dir, sizeof dir, ".");
-	else if (slash == path)
+	if (slash == NULL) {
+		/* the working directory by its name, which a refusal then shows */
+		if (getcwd(dir, sizeof dir) == NULL)
+			snprintf(dir, sizeof dir, ".");
+	} else if (slash == path)
 		snprintf(dir, sizeof dir, "/");
 	else
 		snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);

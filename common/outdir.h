@@ -52,8 +52,9 @@ int outdir_open(const char *path, bool create, char *err, size_t errcap);
 
 /* For a file PATH to be written (--tune --out FILE, --record FILE): opens
  * the directory it is in with outdir_open() (not made) and puts the file's
- * own name into name (namecap bytes). Returns the directory's descriptor, or
- * -1 with err (also for a PATH that names a directory: "", "x/", ".."). */
+ * own name into name (namecap bytes); a bare name's directory is the working
+ * one, which messages name by its path. Returns the directory's descriptor,
+ * or -1 with err (also for a PATH that names a directory: "", "x/", ".."). */
 int outdir_open_parent(const char *path, char *name, size_t namecap, char *err, size_t errcap);
 
 /* Creates NAME in dirfd to write in place, for a file read while it grows (a

@@ -186,7 +186,7 @@ static int run_synth(const struct synth_args *sa)
 	char err[1024];
 	int n = synth_write(&s, sa->path, err, sizeof err);
 	if (n < 0) {
-		fprintf(stderr, "undulate-analyze: --synth %s\n", err);
+		fprintf(stderr, "undulate-analyze: --synth %s: %s\n", sa->path, err);
 		return AN_EXIT_OUTPUT;
 	}
 	printf("%s: %.1f s, %d robots, %d collisions", sa->path, s.duration_s, SYNTH_ROBOTS, n);

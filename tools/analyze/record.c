@@ -67,7 +67,7 @@ int rec_run(const char *path, const char *url)
 	}
 	char err[1024];
 	if (alog_writer_open(&r.w, path, err, sizeof err) != 0) {
-		fprintf(stderr, "undulate-analyze: --record %s\n", err);
+		fprintf(stderr, "undulate-analyze: --record %s: %s\n", path, err);
 		lcm_destroy(lcm);
 		return AN_EXIT_OUTPUT;
 	}
