@@ -115,6 +115,10 @@ if [ "$rc" != 0 ] && grep -q 'writable by other users (mode 0777)' "$T/w.err" &&
 	[ ! -e "$W/states.csv" ]; then
 	tap_ok "analyze --out a directory others may write: refused: $(head -n 1 "$T/w.err")"
 else tap_fail "analyze --out a 0777 directory: refused, saying chmod go-w" "exit $rc: $(cat "$T/w.err")"; fi
+# said before the logs are read (a long log takes a while): even a missing log
+rc=0; "$A" "$T/nope.log" --out "$W" >/dev/null 2>"$T/w2.err" || rc=$?
+tap_check "analyze --out refused before reading the logs (exit 5, not 2, for a missing log)" \
+	bash -c "[ $rc = 5 ] && grep -q 'writable by other users' '$T/w2.err'"
 K="$T/sticky"; mkdir "$K"; chmod 1777 "$K"
 analyze k "$K"
 tap_check "analyze --out a sticky directory of ours (1777): accepted" bash -c "[ $rc = 0 ] && test -s '$K/summary.txt'"

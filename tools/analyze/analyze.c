@@ -1432,12 +1432,32 @@ static int an_run_ctx(struct an_ctx *c)
 	return rc;
 }
 
+/* An --out that exists and will be refused is refused before the logs are
+ * read (a long log takes a while); one that does not exist is made only
+ * once there is something to write (a log that is not a log writes nothing). */
+static int an_check_out_early(const struct an_options *o)
+{
+	struct stat st;
+	if (lstat(o->out_dir, &st) != 0)
+		return 0;
+	char err[1024];
+	int fd = outdir_open(o->out_dir, false, err, sizeof err);
+	if (fd < 0) {
+		fprintf(o->msg, "undulate-analyze: --out %s\n", err);
+		return -1;
+	}
+	close(fd);
+	return 0;
+}
+
 int an_run(const struct an_options *o)
 {
 	if (o->nlogs <= 0) {
 		fprintf(o->msg, "undulate-analyze: no log given\n");
 		return AN_EXIT_USAGE;
 	}
+	if (an_check_out_early(o) != 0)
+		return AN_EXIT_OUTPUT;
 	struct an_ctx *c = calloc(1, sizeof(*c));
 	if (!c) {
 		fprintf(o->msg, "undulate-analyze: out of memory\n");
