@@ -201,8 +201,15 @@ if [ "$root" = 1 ]; then
 	if [ "$rc" != 0 ] && grep -q 'owned by nobody' "$T/d1.out" && intact d1 && [ ! -e "$DF/demo.lcmlog" ]; then
 		tap_ok "demo.sh --out another user's directory: refused (exit $rc), nothing written: $(grep -m1 'owned by' "$T/d1.out")"
 	else tap_fail "demo.sh --out another user's directory: refused" "exit $rc: $(tail -n 3 "$T/d1.out"); $(ls -l "$DF")"; fi
+	# a link to our own directory, made by another user (scripts/outdir.sh walks the path)
+	mkdir "$T/dmine"; ln -s "$T/dmine" "$T/dlink"; chown -h nobody "$T/dlink"
+	demo d4 "$T/dlink"
+	if [ "$rc" != 0 ] && grep -q 'symbolic link dlink on the way is owned by nobody' "$T/d4.out" && [ -z "$(ls -A "$T/dmine")" ]; then
+		tap_ok "demo.sh --out through another user's link: refused, nothing written"
+	else tap_fail "demo.sh --out through another user's link: refused" "exit $rc: $(tail -n 3 "$T/d4.out")"; fi
 else
 	tap_skip "demo.sh --out another user's directory" "not root"
+	tap_skip "demo.sh --out through another user's link" "not root"
 fi
 DO="$T/down"; mkdir -p "$DO" "$T/vdir"
 for n in d2 d3 d4 d5 d6; do victim "$n"; done
@@ -267,6 +274,11 @@ if regular "$P/figures/channel.png" && regular "$P/figures/channel.csv" && regul
 	[ -z "$(ls -A "$P/figures" | grep '^\.')" ]; then
 	tap_ok "figures merge (b): the links replaced by the figure, its data, its section and the page"
 else tap_fail "figures merge (b): links replaced" "$(ls -lA "$P" "$P/figures"; cat "$T/m1.out")"; fi
+PW="$T/popen"; mkdir -p "$PW"; chmod 0777 "$PW"
+rc=0; timeout "$LIMIT_S" "$FIGS" --merge "$T/mruns" --only channel --out "$PW" >"$T/m4.out" 2>&1 || rc=$?
+if [ "$rc" != 0 ] && grep -q 'writable by other users (mode 0777)' "$T/m4.out" && [ -z "$(ls -A "$PW")" ]; then
+	tap_ok "figures --merge --out a directory others may write: refused, nothing written"
+else tap_fail "figures --merge --out a 0777 directory: refused" "exit $rc: $(cat "$T/m4.out")"; fi
 # (a) another user's directories: the page's, a run's, a module's merge
 if [ "$root" = 1 ]; then
 	PF="$T/pforeign"; mkdir -p "$PF/figures"; victim m7; ln -s "$T/victim.m7" "$PF/figures/channel.md"; foreign "$PF"
