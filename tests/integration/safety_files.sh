@@ -108,6 +108,12 @@ if regular "$C/plots.gp" && grep -q 'undulate-analyze plots' "$C/plots.gp" && re
 	tap_ok "analyze (c): plots.gp is now our script, and the plots were drawn"
 else tap_fail "analyze (c): plots.gp replaced by our script" "$(ls -l "$C")"; fi
 
+# ... and one nobody reads: opening it to write would wait for a reader for ever
+C3="$T/own3"; mkdir "$C3"; mkfifo "$C3/plots.gp" "$C3/summary.txt"
+rc=0; timeout 20 "$A" "$T/s.log" --out "$C3" --quiet --plots >/dev/null 2>"$T/c3.err" || rc=$?
+tap_check "analyze (c): FIFOs plots.gp and summary.txt nobody reads: no hang, exit 0 ($rc), both now files" \
+	bash -c "[ $rc = 0 ] && [ -f '$C3/plots.gp' ] && [ -f '$C3/summary.txt' ] && [ ! -p '$C3/summary.txt' ]"
+
 # a directory of ours that everyone may write: refused; sticky: accepted
 W="$T/open"; mkdir -m 0777 "$W"; chmod 0777 "$W"
 analyze w "$W"
