@@ -3,6 +3,7 @@
  */
 #include <errno.h>
 #include <getopt.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,6 +17,7 @@
 #include "config.h"
 #include "daemon.h"
 #include "log.h"
+#include "outdir.h"
 #include "tune.h"
 
 /* Command-line overrides are applied in order after the file. */
@@ -245,13 +247,26 @@ static void main_print_errors(const struct cfg_errors *e)
 		fprintf(stderr, "undulated: config: ... and %zu more error(s)\n", e->count - shown);
 }
 
-/* mkstemp makes 0600; a configuration is read by the service user: 0644
- * less the umask, as any file the user writes. */
-static void fchmod_default(const char *path)
+/* --tune --out FILE: the directory FILE is in must be ours, and no one
+ * else's to write (outdir.h): the daemon runs as root, and a configuration
+ * another user could swap decides where the joints go. The file is made
+ * there under a temporary name (0666 less the umask: the service user reads
+ * it) and renamed over FILE at the end, so a link at FILE is replaced, never
+ * followed. 0, or 2 with a message (*dirfd closed). */
+static int main_tune_out(const char *out, int *dirfd, struct outdir_file *of)
 {
-	mode_t m = umask(0);
-	umask(m);
-	chmod(path, 0666 & ~m);
+	char name[NAME_MAX + 1], err[1024];
+	*dirfd = outdir_open_parent(out, name, sizeof name, err, sizeof err);
+	if (*dirfd < 0) {
+		fprintf(stderr, "undulated --tune: --out %s: %s\n", out, err);
+		return 2;
+	}
+	if (outdir_file_create(of, *dirfd, name, err, sizeof err) < 0) {
+		fprintf(stderr, "undulated --tune: cannot write next to %s: %s\n", out, err);
+		close(*dirfd);
+		return 2;
+	}
+	return 0;
 }
 
 /* --tune: run the tuner on the robot, then write what it found. Exit 0 done,
@@ -269,7 +284,7 @@ static int main_tune(const struct main_args *a, struct cfg *cfg)
 	}
 	/* where the result goes, made before tuning: a minute on the robot is not
 	 * lost to a directory that cannot be written */
-	char def[CFG_NAME_MAX + 8], tmp[CFG_PATH_MAX + 16];
+	char def[CFG_NAME_MAX + 8];
 	snprintf(def, sizeof def, "%s.conf", cfg->name);
 	const char *out = a->out ? a->out : def;
 	bool to_stdout = strcmp(out, "-") == 0;
@@ -278,17 +293,12 @@ static int main_tune(const struct main_args *a, struct cfg *cfg)
 		        def);
 		return 2;
 	}
-	int fd = -1;
+	int dirfd = -1;
+	struct outdir_file of = { .fd = -1 };
 	if (!to_stdout) {
-		if (snprintf(tmp, sizeof tmp, "%s.XXXXXX", out) >= (int)sizeof tmp) {
-			fprintf(stderr, "undulated --tune: --out: path too long\n");
-			return 2;
-		}
-		fd = mkstemp(tmp);
-		if (fd < 0) {
-			fprintf(stderr, "undulated --tune: cannot write next to %s: %s\n", out, strerror(errno));
-			return 2;
-		}
+		int rc = main_tune_out(out, &dirfd, &of);
+		if (rc != 0)
+			return rc;
 	}
 	printf("tune: robot %s, joint(s) ", cfg->name);
 	for (size_t j = 0; j < cfg->njoints; j++)
@@ -304,9 +314,9 @@ static int main_tune(const struct main_args *a, struct cfg *cfg)
 	clock_gettime(CLOCK_MONOTONIC, &t1);
 	double took = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
 	if (rc != 0 || t.state != TUNE_DONE) {
-		if (fd >= 0) {
-			close(fd);
-			unlink(tmp);
+		if (dirfd >= 0) {
+			outdir_file_abandon(&of, false);
+			close(dirfd);
 		}
 		if (rc != 0)
 			return rc;
@@ -320,24 +330,29 @@ static int main_tune(const struct main_args *a, struct cfg *cfg)
 	char when[32];
 	time_t now = time(NULL);
 	strftime(when, sizeof when, "%Y-%m-%d %H:%M UTC", gmtime(&now));
-	FILE *f = to_stdout ? stdout : fdopen(fd, "w");
+	FILE *f = to_stdout ? stdout : fdopen(of.fd, "w");
 	if (f == NULL) {
-		fprintf(stderr, "undulated --tune: %s: %s\n", tmp, strerror(errno));
-		close(fd);
-		unlink(tmp);
+		fprintf(stderr, "undulated --tune: %s: %s\n", out, strerror(errno));
+		outdir_file_abandon(&of, false);
+		close(dirfd);
 		return 1;
 	}
 	tune_write_config(&t, cfg, when, took, f);
 	if (!to_stdout) {
+		char err[512];
 		bool ok = fflush(f) == 0 && fsync(fileno(f)) == 0;
+		int werr = ok ? 0 : errno;
 		ok = fclose(f) == 0 && ok;
-		if (ok)
-			fchmod_default(tmp);
-		if (!ok || rename(tmp, out) != 0) {
-			fprintf(stderr, "undulated --tune: writing %s: %s\n", out, strerror(errno));
-			unlink(tmp);
-			return 1;
+		if (!ok) {
+			fprintf(stderr, "undulated --tune: writing %s: %s\n", out, strerror(werr ? werr : errno));
+			outdir_file_abandon(&of, true);
+		} else if (outdir_file_commit(&of, true, err, sizeof err) != 0) {
+			fprintf(stderr, "undulated --tune: writing %s: %s\n", out, err);
+			ok = false;
 		}
+		close(dirfd);
+		if (!ok)
+			return 1;
 	}
 	printf("tune: done in %.0f s (%d windows): k x%.3f, mu ", took, t.iterations, t.result.k);
 	for (size_t j = 0; j < cfg->njoints; j++)

@@ -12,6 +12,10 @@
 #   fig_lcm_url OUTDIR [TRY]    a private udpm URL (ttl=0) on a port in 30000-59999
 #                               from GNU parallel's job slot, else OUTDIR's name and
 #                               the PID, and TRY; one nothing here is bound to yet
+#   fig_run_dir OUTDIR          a run's folder: made when missing, else it must be
+#                               ours and writable by no other user (exit 1 saying
+#                               why: scripts/outdir.sh); every file a run writes
+#                               replaces what has its name (outdir_new, outdir_put)
 #   fig_demo OUTDIR ARG...      one lockstep run of scripts/demo.sh into OUTDIR/demo
 #                               (its own LCM port; again on another port if it
 #                               heard another run); 0, or 1 with the reason on stderr
@@ -26,8 +30,12 @@
 #   fig_results DIR [sorted]    every DIR/*/result.csv as one CSV (one header; the
 #                               rows sorted with `sorted`); exit 1 when there is none
 #   fig_median / fig_quantile Q of the numbers on stdin, one a line
-#   fig_merge_begin FIGDIR      for a merge: gnuplot present, FIGDIR made, and
-#                               FIG_TMP, a temporary folder removed at exit
+#   fig_merge_begin FIGDIR      for a merge: gnuplot present, FIGDIR checked as a
+#                               run's folder, FIG_TMP (a temporary folder) and
+#                               FIG_OUT (a private folder inside FIGDIR, where
+#                               the merge writes its files), removed at exit
+#   fig_merge_end               FIG_OUT's files moved into FIGDIR, replacing
+#                               what has their names (never written through)
 #   fig_need_gnuplot            exit 1 with a message when gnuplot is missing
 #   fig_gp_head W H             gnuplot's first lines: PNG terminal and common style
 #   fig_gnuplot SCRIPT          runs gnuplot on SCRIPT (messages in SCRIPT.log);
@@ -43,6 +51,7 @@
 # with the same checkout built (README.md, "A sweep on a cluster").
 
 fig_top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+source "$fig_top/scripts/outdir.sh"
 BUILD=${BUILD:-build}
 case "$BUILD" in /*) ;; *) BUILD="$fig_top/$BUILD" ;; esac
 export BUILD
@@ -106,14 +115,25 @@ fig_lcm_url() {
 FIG_SESSION=()
 command -v setsid >/dev/null 2>&1 && FIG_SESSION=(setsid)
 
+# fig_run_dir OUTDIR: its parents made as needed, OUTDIR itself checked (or
+# made): in another user's folder, or one others may write, the names a run
+# writes may be links to our files already (scripts/outdir.sh).
+fig_run_dir() {
+	local parent
+	parent=$(dirname "$1")
+	[ -d "$parent" ] || mkdir -p -- "$parent" || fig_die "cannot create $parent"
+	outdir_check "$1" "$FIG_NAME:" || exit 1
+}
+
 # Attempts of one run when it heard another run on its port.
 FIG_PORT_TRIES=3
 fig_demo() {
 	local out=$1; shift
 	local try rc
-	mkdir -p "$out" || { echo "$FIG_NAME: cannot create $out" >&2; return 1; }
+	fig_run_dir "$out"
 	for try in $(seq 0 $((FIG_PORT_TRIES - 1))); do
 		rm -rf "$out/demo"
+		outdir_new "$out/demo.out" || { echo "$FIG_NAME: cannot write $out/demo.out" >&2; return 1; }
 		rc=0
 		"$fig_top/scripts/demo.sh" --lockstep --out "$out/demo" --lcm-url "$(fig_lcm_url "$out" "$try")" \
 			"$@" >"$out/demo.out" 2>&1 </dev/null || rc=$?
@@ -167,7 +187,7 @@ fig_delta_trace() {
 	awk -F, -v step="$3" 'NR == 1 { next }
 		$4 == "neighbour" && (pair == "" || $3 == pair) && $9 != "" && $2 >= next_t {
 			pair = $3; printf "%.2f,%s\n", $2, $9; next_t = $2 + step }' "$1/phase_diff.csv" |
-		{ echo "t,delta"; cat; } >"$2"
+		{ echo "t,delta"; cat; } | outdir_put "$2"
 }
 
 # What a run keeps: its result, the analyser's summary and per-second rates,
@@ -214,12 +234,21 @@ fig_need_gnuplot() {
 }
 
 # fig_merge_begin FIGDIR: what every merge does first. FIG_TMP holds the
-# merge's intermediate files (kept with FIG_KEEP=1).
+# merge's intermediate files (kept with FIG_KEEP=1); the merge writes its
+# figure, data and section into FIG_OUT, a private folder inside FIGDIR, and
+# fig_merge_end moves them into FIGDIR by rename: gnuplot's `set output` and
+# the shell's > never meet a link or FIFO someone left under those names.
 fig_merge_begin() {
 	fig_need_gnuplot
-	mkdir -p "$1" || fig_die "cannot create $1"
+	fig_run_dir "$1"
+	FIG_MERGE_DIR=$1
 	FIG_TMP=$(mktemp -d "${TMPDIR:-/tmp}/fig-$FIG_NAME.XXXXXX") || fig_die "no temporary directory"
-	[ "${FIG_KEEP:-0}" = 1 ] || trap 'rm -rf "$FIG_TMP"' EXIT
+	FIG_OUT=$(mktemp -d "$1/.merge-$FIG_NAME.XXXXXX") || fig_die "cannot write in $1"
+	if [ "${FIG_KEEP:-0}" = 1 ]; then trap 'rm -rf "$FIG_OUT"' EXIT
+	else trap 'rm -rf "$FIG_TMP" "$FIG_OUT"' EXIT; fi
+}
+fig_merge_end() {
+	outdir_publish "$FIG_OUT" "$FIG_MERGE_DIR" || fig_die "could not move the figure into $FIG_MERGE_DIR"
 }
 
 # The figures' look: one size of type, a light grid, the key inside; the

@@ -8,7 +8,9 @@
 #   make demo DEMO_SECONDS=60       the same headless for 60 s, then the summary
 #
 # The run is kept (the LCM log, the analysis, the programs' logs) in DEMO_OUT
-# or --out, by default demo-out/<date>-<time> in the current directory; the
+# or --out, by default demo-out/<date>-<time> in the current directory (a
+# directory of yours that no other user can write: another user's, or one
+# others may write, is refused before the run; scripts/outdir.sh); the
 # summary says how the contact force and the collisions changed at the switch,
 # each neighbouring pair's final phase difference against its compatibility
 # bound 2 asin(d~), and the command that draws the plots.
@@ -52,6 +54,7 @@
 set -u
 
 top=$(cd "$(dirname "$0")/.." && pwd)
+source "$top/scripts/outdir.sh"
 
 # ---- supervisor ---------------------------------------------------------------
 # The demo runs as two processes: this one only waits, and a worker (this
@@ -178,6 +181,9 @@ fi
 # Where the run is kept: created at the end, when there is something to keep.
 [ -n "$out" ] || out="$PWD/demo-out/$(date +%Y%m%d-%H%M%S)"
 case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
+# One that exists must be ours and writable by no other user (scripts/outdir.sh
+# says why): said now rather than after the run.
+if [ -e "$out" ] || [ -L "$out" ]; then outdir_check "$out" "demo: --out" || exit 1; fi
 
 # A private multicast port (udpm, ttl=0: nothing leaves this host). The tests
 # use 7600-7949; the demo picks one of 10000 ports above them from its PID.
@@ -509,11 +515,19 @@ done
 # Stop the robots and the simulator, then the logger, so the log is complete.
 stop_children
 
-# The run is kept: the log first, so that the analysis names the kept file.
-mkdir -p "$out" || die "cannot create $out (DEMO_OUT / --out)"
-mv "$log" "$out/demo.lcmlog" || die "cannot move the LCM log into $out"
+# The run is kept: $out checked again (it may have been made during the run),
+# the log moved in first, so that the analysis names the kept file; everything
+# else is made in $keep, inside our private $run, and moved into $out at the
+# end, replacing whatever has those names there (scripts/outdir.sh): nothing
+# is written through a link or read back from a file another user placed.
+parent=$(dirname "$out")
+[ -d "$parent" ] || mkdir -p -- "$parent" || die "cannot create $parent (DEMO_OUT / --out)"
+outdir_check "$out" "demo: --out" || exit 1
+keep="$run/keep"
+mkdir -m 700 "$keep" || die "cannot create $keep"
+outdir_mv "$log" "$out/demo.lcmlog" || die "cannot move the LCM log into $out"
 log="$out/demo.lcmlog"
-analysis="$out"
+analysis="$keep"
 "$B/undulate-analyze" "$log" --out "$analysis" --window "$window" --quiet >"$run/analyze.log" 2>&1 &
 record "$!" analyze
 rc=0
@@ -628,11 +642,12 @@ truth=$(grep -m1 '^undulate-sim: exit:' "$run/sim.log" | sed 's/^undulate-sim: e
 
 }
 
-summary | tee "$out/demo-summary.txt"
-mkdir -p "$out/logs"
-cp "$run"/*.log "$out/logs/" 2>/dev/null
-[ -n "$switch_t" ] && echo "$switch_t" >"$out/switch_t"
-echo "$seed" >"$out/seed"
+summary | tee "$keep/demo-summary.txt"
+mkdir "$keep/logs"
+cp "$run"/*.log "$keep/logs/" 2>/dev/null
+[ -n "$switch_t" ] && echo "$switch_t" >"$keep/switch_t"
+echo "$seed" >"$keep/seed"
+outdir_publish "$keep" "$out" || die "could not move everything into $out (above)"
 echo
 echo "The run is kept in $out: demo.lcmlog (the LCM log), demo-summary.txt, the analysis (summary.txt, CSV files), logs/."
 echo "Next, the plots:  $B/undulate-analyze $out/demo.lcmlog --out $out/plots --plots"

@@ -24,7 +24,8 @@
 # the best throughput measured on this 2-core machine, README.md). FIG_TINY=1
 # asks the modules for a tiny set (the driver's test). Exit 0 when every
 # selected figure was drawn; 1 with a message otherwise (a module without any
-# result, gnuplot or GNU parallel missing, a bad option).
+# result, gnuplot or GNU parallel missing, a bad option, a folder of another
+# user's or one others may write: figures/README.md, "Where the files go").
 set -u
 top=$(cd "$(dirname "$0")/.." && pwd)
 source "$top/figures/lib.sh"
@@ -51,15 +52,18 @@ run_one() {
 	[ $# -ge 2 ] || fig_die "run: want MODULE OUTDIR ARG..."
 	local m=$1 out=$2; shift 2
 	[ -x "$top/figures/$m/fig.sh" ] || fig_die "run: no module '$m' (figures/$m/fig.sh)"
-	mkdir -p "$out" || fig_die "run: cannot create $out"
+	# another user's folder, or one others may write, is refused; run.log and
+	# run.info replace whatever had their names (figures/lib.sh, scripts/outdir.sh)
+	fig_run_dir "$out"
 	rm -f "$out/result.csv"
+	outdir_new "$out/run.log" || fig_die "run: cannot write $out/run.log"
 	local t0 rc=0
 	t0=$(date +%s%N)
 	fig "$m" run "$out" "$@" >"$out/run.log" 2>&1 || rc=$?
 	[ "$rc" -ne 0 ] || [ -s "$out/result.csv" ] || { echo "fig: $m run wrote no result.csv" >>"$out/run.log"; rc=1; }
 	printf 'host=%s seconds=%s rc=%s date=%s\n' "$(hostname)" \
 		"$(awk -v a="$t0" -v b="$(date +%s%N)" 'BEGIN { printf "%.2f", (b - a) / 1e9 }')" "$rc" \
-		"$(date -u +%Y-%m-%dT%H:%M:%SZ)" >"$out/run.info"
+		"$(date -u +%Y-%m-%dT%H:%M:%SZ)" | outdir_put "$out/run.info"
 	if [ "$rc" -ne 0 ]; then
 		echo "figures: $m $(basename "$out") failed: $(grep -v '^$' "$out/run.log" | tail -n 1)" >&2
 		exit "$rc"
@@ -198,7 +202,7 @@ merge_module() {
 		echo "load=$load"
 		echo "hosts=$hosts"
 		echo "how=$how"
-	} >"$figdir/$m.run"
+	} | outdir_put "$figdir/$m.run"
 	echo "figures: $m: $ok of $n runs merged into $figdir ($(ls "$figdir/$m"*.png 2>/dev/null | xargs -n1 basename | tr '\n' ' '))"
 }
 
@@ -250,7 +254,7 @@ page() {
 			echo
 			cat "$f"
 		done
-	} >"$dir/FIGURES.md.new" && mv "$dir/FIGURES.md.new" "$dir/FIGURES.md"
+	} | outdir_put "$dir/FIGURES.md"
 }
 
 # ---- main -------------------------------------------------------------------------------
@@ -273,7 +277,8 @@ case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
 if [ -n "$merge_dir" ]; then
 	[ -d "$merge_dir" ] || fig_die "--merge: no directory $merge_dir"
 	fig_need_gnuplot
-	mkdir -p "$out/figures" || fig_die "cannot create $out/figures"
+	fig_run_dir "$out"
+	fig_run_dir "$out/figures"
 	t0=$(date +%s) rc=0
 	for m in $mods; do
 		[ -d "$merge_dir/$m" ] || { [ -n "$only" ] && { echo "figures: $m: no runs in $merge_dir" >&2; rc=1; }; continue; }
@@ -293,6 +298,7 @@ fi
 
 [ -n "$runs" ] || runs="$BUILD/figures/runs"
 if [ -n "$export_file" ]; then
+	outdir_check "$(dirname "$export_file")" "figures: --export-jobs" && outdir_new "$export_file" || exit 1
 	write_jobs "$runs" $mods >"$export_file" || exit 1
 	echo "figures: $(wc -l <"$export_file") runs in $export_file; from the top of the checkout ($top):"
 	echo "  parallel --joblog runs.joblog < $export_file                    (here, or --sshloginfile HOSTS)"
@@ -308,12 +314,16 @@ for p in undulate-sim undulated undulate-analyze; do
 	[ -x "$FIG_BIN/$p" ] || fig_die "$FIG_BIN/$p is not built (run: make)"
 done
 case "$runs" in /*) ;; *) runs="$PWD/$runs" ;; esac
-mkdir -p "$runs" "$out/figures" || fig_die "cannot create $runs or $out/figures"
+fig_run_dir "$runs"
+fig_run_dir "$out"
+fig_run_dir "$out/figures"
 for m in $mods; do
 	[ "$resume" = 1 ] || rm -rf "${runs:?}/$m"
-	mkdir -p "$runs/$m"
+	fig_run_dir "$runs/$m"
 done
+# every file written below replaces what had its name (scripts/outdir.sh)
 jobfile="$runs/jobs.txt"
+outdir_new "$jobfile.all" "$jobfile" "$runs/failures.txt" || fig_die "cannot write in $runs"
 write_jobs "$runs" $mods >"$jobfile.all" || exit 1
 if [ "$resume" = 1 ]; then
 	# keep the runs that have their result
@@ -322,7 +332,7 @@ if [ "$resume" = 1 ]; then
 		[ -s "$d/result.csv" ] || grep -F " $dir " "$jobfile.all"
 	done <"$jobfile.all" >"$jobfile"
 else
-	mv "$jobfile.all" "$jobfile"
+	outdir_mv "$jobfile.all" "$jobfile"
 fi
 rm -f "$jobfile.all"
 total=$(wc -l <"$jobfile")
@@ -331,8 +341,7 @@ echo "figures: $total runs of $(echo $mods) ($([ "$quick" = 1 ] && echo quick ||
 t0=$(date +%s)
 load0=$(cut -d' ' -f1 /proc/loadavg)
 joblog="$runs/joblog.txt"
-rm -f "$joblog"
-: >"$joblog"
+outdir_new "$joblog" || fig_die "cannot write $joblog"
 watch_progress "$joblog" "$total" "$t0" "$est" &
 watcher=$!
 trap 'kill "$watcher" 2>/dev/null' EXIT
@@ -350,7 +359,7 @@ if [ -s "$runs/failures.txt" ]; then
 fi
 rc=0
 how="here, --jobs $jobs"
-printf 'how=%s\nwall_seconds=%s\nload=%s\nset=%s\n' "$how" "$run_wall" "$load0 → $load1" "$set_name" >"$runs/invocation.txt"
+printf 'how=%s\nwall_seconds=%s\nload=%s\nset=%s\n' "$how" "$run_wall" "$load0 → $load1" "$set_name" | outdir_put "$runs/invocation.txt"
 for m in $mods; do merge_module "$m" "$runs" "$out/figures" "$how" "$run_wall" "$load0 → $load1" || rc=1; done
 page "$out"
 echo "figures: $out/FIGURES.md ($(human $(( $(date +%s) - t0 ))))"

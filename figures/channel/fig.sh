@@ -56,7 +56,7 @@ run() {
 	local out=$1 width=$2 seed=$3
 	fig_num WIDTH_CM "$width" 5 60
 	fig_uint SEED "$seed" 1 999999999
-	mkdir -p "$out" || fig_die "cannot create $out"
+	fig_run_dir "$out"
 	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
 	local t0 spacing nominal
 	t0=$(date +%s.%N)
@@ -67,6 +67,7 @@ run() {
 	local r="$out/demo" wall swing
 	swing=$(fig_min_swing "$r/summary.json")
 	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	outdir_new "$out/pairs.csv" "$out/result.csv" || fig_die "cannot write in $out"
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
 	[ -s "$out/pairs.csv" ] || fig_die "the analysis has no neighbouring pairs"
 	{
@@ -81,9 +82,11 @@ merge() {
 	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
 	local runs=$1 fig=$2
 	fig_merge_begin "$fig"
+	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
 	fig_results "$runs" sorted >"$fig/channel.csv"
 	draw "$fig" "$FIG_TMP" || fig_die "channel.png could not be drawn"
 	fragment "$fig"
+	fig_merge_end
 }
 
 # draw FIGDIR TMP: channel.png, each pair's final |Δ| against its d̃, one

@@ -88,7 +88,7 @@ tune() {
 		echo "forces: tuning at compliance slope $slope failed (undulated --tune exit $rc): $(grep -m1 -E '^tune: (not|gave)|error' "$dir/tune.log" | cut -c1-200)" >&2
 		return 1
 	fi
-	grep '^tune: done' "$dir/tune.log" >"$out/tune.txt"
+	grep '^tune: done' "$dir/tune.log" | outdir_put "$out/tune.txt"
 }
 
 # ini FILE SECTION KEY: a value of the tuned configuration.
@@ -115,7 +115,7 @@ run() {
 	fig_uint SEED "$seed" 1 999999999
 	fig_uint END "$end" "$END_TINY" 3600
 	local closed=$((end / 3)) switch=$((2 * end / 3))
-	mkdir -p "$out" || fig_die "cannot create $out"
+	fig_run_dir "$out"
 	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
 	local t0
 	t0=$(date +%s.%N)
@@ -134,7 +134,7 @@ run() {
 	local r="$out/demo"
 	[ -s "$r/collision_rate.csv" ] || fig_die "the run has no collision_rate.csv"
 	awk -F, 'NR > 1 { printf "%s,%s,%s,%s,%s\n", $1, $6, $2, $4, $5 }' "$r/collision_rate.csv" |
-		{ echo "t,force_n,impacts,pair_impacts,wall_impacts"; cat; } >"$out/series.csv"
+		{ echo "t,force_n,impacts,pair_impacts,wall_impacts"; cat; } | outdir_put "$out/series.csv"
 	local fc fo mc mo ic io wc wo swing
 	fc=$(force_stat "$r" "$closed" "$switch" median)
 	fo=$(force_stat "$r" "$switch" "$end" median)
@@ -150,6 +150,7 @@ run() {
 	[ "$fc" != nan ] && [ "$fo" != nan ] || fig_die "no contact force in the run's analysis (no SIM.TRUTH?)"
 	local wall
 	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	outdir_new "$out/result.csv" || fig_die "cannot write $out/result.csv"
 	{
 		echo "slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s,end_s"
 		echo "$slope,$(stiffness "$slope"),$seed,$(ini "$conf" robot servo_lead_s),$(ini "$conf" joint.1 k),$(ini "$conf" sinusoid amplitude),$(ini "$conf" sinusoid frequency),$fc,$fo,$mc,$mo,$ic,$io,$wc,$wo,$swing,$wall,$end"
@@ -161,6 +162,7 @@ merge() {
 	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
 	local runs=$1 fig=$2
 	fig_merge_begin "$fig"
+	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
 	fig_results "$runs" sorted >"$fig/forces.csv"
 	local csv="$fig/forces.csv" t=$FIG_TMP
 	# per slope: the median over replicates of each run's median, and the range
@@ -179,6 +181,7 @@ merge() {
 	force_plot "$fig" "$t" || fig_die "forces.png could not be drawn"
 	time_plot "$runs" "$fig" "$t" || fig_die "forces_time.png could not be drawn"
 	fragment "$fig"
+	fig_merge_end
 }
 
 # force_plot FIGDIR TMP: forces.png, the median force of each run and per

@@ -114,6 +114,7 @@ run() {
 	last=$(awk -F, 'NR > 1 { t = $2 } END { print t }' "$d/collisions.csv")
 	first=$(awk -F, 'NR == 2 { print $5 }' "$d/return_map.csv")
 	wall=$(awk -v a="$t0" -v b="$(date +%s%N)" 'BEGIN { printf "%.2f", (b - a) / 1e9 }')
+	outdir_new "$out/result.csv" || { echo "$FIG_NAME: $out: cannot write result.csv" >&2; return 1; }
 	{
 		echo "$RESULT_HEADER"
 		jq -r --arg run "$(basename "$out")" --arg r "$r" --arg ds "$dsep" --arg d0 "$delta0" --arg seed "$seed" \
@@ -137,6 +138,7 @@ free_amplitude() {
 merge() {
 	local runs=$1 fig=$2
 	fig_merge_begin "$fig"
+	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
 	tmp=$FIG_TMP
 	fig_results "$runs" >"$tmp/runs.csv"
 	amp=$(free_amplitude "$tmp/runs.csv")
@@ -150,6 +152,7 @@ merge() {
 	plot_onset "$fig" "$tmp" || fig_die "pair-onset.png could not be drawn"
 	fragment "$tmp" >"$fig/pair.md" 2>"$tmp/fragment.err" && [ ! -s "$tmp/fragment.err" ] ||
 		fig_die "the page's section failed: $(head -n 3 "$tmp/fragment.err")"
+	fig_merge_end
 }
 
 RESTITUTIONS="0.67 0.9"

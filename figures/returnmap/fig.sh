@@ -78,6 +78,7 @@ run() {
 	f=$(jq -r '[.robots[].joints[0].frequency_hz] | add / length' "$d/summary.json")
 	awk -v f="$f" 'BEGIN { exit !(f > 0.2 && f < 5) }' ||
 		{ echo "$FIG_NAME: $out: no usable frequency from the first analysis ($f Hz)" >&2; return 1; }
+	outdir_new "$out/fixed.log" "$out/result.csv" || { echo "$FIG_NAME: cannot write in $out" >&2; return 1; }
 	"$FIG_BIN/undulate-analyze" "$d/demo.lcmlog" --out "$out/fixed" --frequency "$f" --quiet >"$out/fixed.log" 2>&1 ||
 		{ echo "$FIG_NAME: $out: undulate-analyze --frequency failed: $(tail -n 1 "$out/fixed.log")" >&2; return 1; }
 	# the collisions under the clock (pressed, not free) are not the map's:
@@ -100,6 +101,7 @@ run() {
 merge() {
 	local runs=$1 fig=$2
 	fig_merge_begin "$fig"
+	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
 	tmp=$FIG_TMP
 	fig_results "$runs" >"$fig/returnmap.csv"
 	local r
@@ -111,6 +113,7 @@ merge() {
 	plot_n "$fig" "$tmp" || fig_die "returnmap-n.png could not be drawn"
 	fragment "$fig/returnmap.csv" "$runs" >"$fig/returnmap.md" 2>"$tmp/fragment.err" && [ ! -s "$tmp/fragment.err" ] ||
 		fig_die "the page's section failed: $(head -n 3 "$tmp/fragment.err")"
+	fig_merge_end
 }
 
 # sequences CSV R: for each run at R, its measured Delta_n (from its first

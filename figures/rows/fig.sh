@@ -98,7 +98,7 @@ run() {
 	fig_num BETA "$beta" 0 1
 	fig_uint SECONDS "$secs" $((SWITCH + WINDOW + 1)) 3600
 	fig_uint SEED "$seed" 1 999999999
-	mkdir -p "$out" || fig_die "cannot create $out"
+	fig_run_dir "$out"
 	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
 	local t0
 	t0=$(date +%s.%N)
@@ -111,6 +111,7 @@ run() {
 		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.separation=$dsep" \
 		--set "world.beta=$beta" --set "world.walls=-$wall_x,$wall_x" "${RIG[@]}" || exit 1
 	local r="$out/demo" swing wall
+	outdir_new "$out/pairs.csv" "$out/result.csv" || fig_die "cannot write in $out"
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
 	[ -s "$out/pairs.csv" ] || fig_die "the analysis has no neighbouring pairs"
 	swing=$(fig_min_swing "$r/summary.json")
@@ -138,7 +139,7 @@ run() {
 		echo "dsep,beta,seconds,seed,pairs,colliding_pairs,pair_collisions_hz,compat_error_rad,compat_error_max_rad,compatible_pairs,antiphase_pairs,stopped_pairs,wall_collisions_hz,relax_s,censored,min_swing_rad,wall_s"
 		echo "$dsep,$beta,$secs,$seed,$ends,$walls,$relax,$censored,$swing,$wall"
 	} >"$out/result.csv"
-	mv "$out/pairs.csv" "$out/end_pairs.csv"
+	outdir_mv "$out/pairs.csv" "$out/end_pairs.csv"
 	fig_clean "$out/demo"
 }
 
@@ -146,6 +147,7 @@ merge() {
 	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
 	local runs=$1 fig=$2
 	fig_merge_begin "$fig"
+	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
 	fig_results "$runs" sorted >"$fig/rows.csv"
 	local csv="$fig/rows.csv" t=$FIG_TMP
 	# the sweep's runs: β in SWEEP_BETAS and a sweep's length (a relaxation
@@ -161,6 +163,7 @@ merge() {
 	sweep_plot "$fig" "$t" || fig_die "rows.png could not be drawn"
 	relax_plot "$fig" "$t" || fig_die "rows_relax.png could not be drawn"
 	fragment "$fig"
+	fig_merge_end
 }
 
 # sweep_plot FIGDIR TMP: rows.png, collisions and the compatibility error

@@ -112,7 +112,7 @@ if wait_log tint '^tune: .* window 1' 40; then
 	wait "$pid_tint"; rc=$?
 	torque=$("$X" --port "$T/int" read 1 torque_enable 2>&1)
 	if [ "$rc" = 130 ] && grep -q "nothing written" "$T/tint.log" && [ ! -e "$T/tint.conf" ] &&
-		! ls "$T"/tint.conf.* >/dev/null 2>&1 && [ "$torque" = 1 ]; then
+		[ -z "$(ls -A "$T" | grep -E '^\.?tint\.conf\.')" ] && [ "$torque" = 1 ]; then
 		tap_ok "Ctrl-C: exit 130, nothing written (no temporary left), joints holding (torque on)"
 	else
 		tap_fail "Ctrl-C: exit 130, nothing written, joints holding" "exit $rc, torque: $torque; $(tail -3 "$T/tint.log"); $(ls "$T")"

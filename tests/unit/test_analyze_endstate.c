@@ -93,7 +93,8 @@ static void write_log(const char *name, const struct motion *a, const struct mot
 	char p[512];
 	snprintf(p, sizeof(p), "%s/%s.log", scratch_dir, name);
 	struct alog_writer w;
-	assert_int_equal(alog_writer_open(&w, p), 0);
+	char err[512];
+	assert_int_equal(alog_writer_open(&w, p, err, sizeof err), 0);
 	int64_t cycles = (int64_t)llround(T_SECONDS / T_DT);
 	for (int64_t c = 0; c <= cycles; c++) {
 		assert_int_equal(write_state(&w, "a", c, a), 0);

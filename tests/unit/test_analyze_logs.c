@@ -109,7 +109,8 @@ static void write_synth(const char *name, struct synth_spec *s)
 {
 	char p[512];
 	path_of(p, sizeof(p), name, NULL);
-	assert_true(synth_write(s, p) > 0);
+	char err[512];
+	assert_true(synth_write(s, p, err, sizeof err) > 0);
 }
 
 /* The whole pipeline on the default synthetic log: classes, numbers,
@@ -150,7 +151,8 @@ static void test_synthetic_classes(void **state)
 	/* collisions are sent twice (SIM.COLLISION and SIM.TRUTH) and counted once */
 	char p[512];
 	path_of(p, sizeof(p), "b.log", NULL);
-	int ncoll = synth_write(&s, p);
+	char err[512];
+	int ncoll = synth_write(&s, p, err, sizeof err);
 	assert_int_equal(count_lines("a", "collisions.csv"), 1 + ncoll);
 	assert_int_equal(count_lines("a", "events.csv"), 1 + SYNTH_ROBOTS);
 	assert_int_equal(count_lines("a", "bus.csv"), 1 + SYNTH_ROBOTS * ((long)s.duration_s + 1));

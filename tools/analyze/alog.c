@@ -1,10 +1,14 @@
 /* alog.c — see alog.h. */
 #include "alog.h"
 
+#include "outdir.h"
+
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* Checks the file's first word before handing it to liblcm: its reader scans
  * for a sync word byte by byte and would call any foreign file "0 events". */
@@ -83,11 +87,32 @@ void alog_close(struct alog_reader *r)
 	r->log = NULL;
 }
 
-int alog_writer_open(struct alog_writer *w, const char *path)
+int alog_writer_open(struct alog_writer *w, const char *path, char *err, size_t errlen)
 {
 	memset(w, 0, sizeof(*w));
-	w->log = lcm_eventlog_create(path, "w");
-	return w->log ? 0 : -1;
+	char name[NAME_MAX + 1];
+	int dirfd = outdir_open_parent(path, name, sizeof name, err, errlen);
+	if (dirfd < 0)
+		return -1;
+	/* in place, not renamed at the end: a recording is read while it grows */
+	int fd = outdir_create_in_place(dirfd, name, err, errlen);
+	close(dirfd);
+	FILE *f = fd >= 0 ? fdopen(fd, "wb") : NULL;
+	/* lcm_eventlog_create() can only fopen() a path; its handle is the
+	 * public {FILE *f; eventcount} that lcm_eventlog_destroy() fcloses and
+	 * frees, so one is made here around the file created above */
+	w->log = f ? calloc(1, sizeof(*w->log)) : NULL;
+	if (w->log == NULL) {
+		if (fd >= 0)
+			snprintf(err, errlen, "%s: %s", path, strerror(errno));
+		if (f)
+			fclose(f);
+		else if (fd >= 0)
+			close(fd);
+		return -1;
+	}
+	w->log->f = f;
+	return 0;
 }
 
 int alog_write(struct alog_writer *w, const char *channel, int64_t timestamp,

@@ -37,7 +37,11 @@ struct alog_writer {
 	lcm_eventlog_t *log;
 	int64_t events;
 };
-int alog_writer_open(struct alog_writer *w, const char *path);
+/* Creates PATH for writing (--record, --synth). Its directory must be ours
+ * and no one else's to write (common/outdir.h); what has its name (a file, a
+ * link, a FIFO) is replaced, never written through or opened. Returns 0, or
+ * -1 with a one-line reason in ERR. */
+int alog_writer_open(struct alog_writer *w, const char *path, char *err, size_t errlen);
 /* Appends one event; TIMESTAMP in µs (the receive time lcm-logger records). */
 int alog_write(struct alog_writer *w, const char *channel, int64_t timestamp,
 	       const void *data, int32_t len);

@@ -13,6 +13,7 @@
 #include "phase.h"
 #include "modes.h"
 #include "num.h"
+#include "outdir.h"
 #include "plot.h"
 #include "theory.h"
 #include "window.h"
@@ -21,11 +22,13 @@
 #include "compat/lcm/lcmdec.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* Samples kept per joint to find the state just before a collision: 160 ms
  * at 100 Hz, more than a collision message can lag the states around it. */
@@ -128,7 +131,10 @@ struct an_ctx {
 	int warned_decode;
 	bool truncated;
 	char trunc_note[AN_MAX_LOGS][160];
-	/* outputs */
+	/* outputs: written into a fresh private directory (stage) inside --out
+	 * (dirfd), moved into --out at the end (outdir.h says why) */
+	int dirfd, stagefd;
+	char stage[64];
 	FILE *states, *coll, *bus, *evt, *pdiff, *params;
 	struct an_seen seen[AN_COLL_DEDUP];
 	int seen_next;
@@ -974,16 +980,25 @@ static void an_process_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
 
 /* ---- output files ------------------------------------------------------------- */
 
+/* A new file NAME in the stage (nothing else can be there: it is ours, new
+ * and private). */
+static FILE *an_create(struct an_ctx *c, const char *name)
+{
+	int fd = openat(c->stagefd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	if (!f) {
+		fprintf(c->o->msg, "undulate-analyze: %s/%s: %s\n", c->o->out_dir, name, strerror(errno));
+		if (fd >= 0)
+			close(fd);
+	}
+	return f;
+}
+
 static FILE *an_open_out(struct an_ctx *c, const char *name, const char *header)
 {
-	char path[4096];
-	snprintf(path, sizeof(path), "%s/%s", c->o->out_dir, name);
-	FILE *f = fopen(path, "w");
-	if (!f) {
-		fprintf(c->o->msg, "undulate-analyze: %s: %s\n", path, strerror(errno));
-		return NULL;
-	}
-	fprintf(f, "%s\n", header);
+	FILE *f = an_create(c, name);
+	if (f)
+		fprintf(f, "%s\n", header);
 	return f;
 }
 
@@ -1000,12 +1015,40 @@ static int an_close_out(struct an_ctx *c, FILE **f, const char *name)
 	return 0;
 }
 
-static int an_open_outputs(struct an_ctx *c)
+/* --out: a directory of ours that no one else can write (outdir_open), and
+ * the stage inside it. */
+static int an_open_dir(struct an_ctx *c)
 {
-	if (mkdir(c->o->out_dir, 0777) != 0 && errno != EEXIST) {
-		fprintf(c->o->msg, "undulate-analyze: %s: %s\n", c->o->out_dir, strerror(errno));
+	char err[1024];
+	c->dirfd = outdir_open(c->o->out_dir, true, err, sizeof err);
+	if (c->dirfd < 0) {
+		fprintf(c->o->msg, "undulate-analyze: --out %s\n", err);
 		return -1;
 	}
+	c->stagefd = outdir_stage(c->dirfd, ".undulate-analyze", c->stage, sizeof c->stage, err, sizeof err);
+	if (c->stagefd < 0) {
+		fprintf(c->o->msg, "undulate-analyze: --out %s: %s\n", c->o->out_dir, err);
+		return -1;
+	}
+	return 0;
+}
+
+/* Moves what was written into --out, replacing what is there by name. */
+static int an_publish(struct an_ctx *c)
+{
+	char err[1024];
+	int rc = outdir_publish(c->dirfd, c->stagefd, c->stage, err, sizeof err);
+	close(c->stagefd);
+	c->stagefd = -1;
+	if (rc != 0)
+		fprintf(c->o->msg, "undulate-analyze: --out %s: %s\n", c->o->out_dir, err);
+	return rc;
+}
+
+static int an_open_outputs(struct an_ctx *c)
+{
+	if (an_open_dir(c) != 0)
+		return -1;
 	c->states = an_open_out(c, "states.csv",
 		"utime,t,robot,joint,servo_id,angle,speed,goal,load,mode,phase,amplitude,frequency,error_bits,phase_daemon,frequency_est,"
 		"robot_index");
@@ -1243,11 +1286,8 @@ static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 
 static int an_write_summary(struct an_ctx *c, int rc)
 {
-	char path[4096];
-	snprintf(path, sizeof(path), "%s/summary.txt", c->o->out_dir);
-	FILE *f = fopen(path, "w");
-	snprintf(path, sizeof(path), "%s/summary.json", c->o->out_dir);
-	FILE *g = fopen(path, "w");
+	FILE *f = an_create(c, "summary.txt");
+	FILE *g = an_create(c, "summary.json");
 	if (!f || !g) {
 		fprintf(c->o->msg, "undulate-analyze: cannot write the summary in %s\n", c->o->out_dir);
 		if (f)
@@ -1298,7 +1338,7 @@ static int an_plots(struct an_ctx *c)
 	}
 	for (int i = 0; i < c->nswitches; i++)
 		sw[i] = (struct plot_switch){ .t = c->switch_t[i], .to = mode_name(c->switch_mode[i]) };
-	struct plot_input in = { .dir = c->o->out_dir, .robots = names, .njoints = njoints, .joint_mask = joint_mask, .robot_index = robot_index, .nrobots = n,
+	struct plot_input in = { .dir = c->o->out_dir, .dirfd = c->stagefd, .robots = names, .njoints = njoints, .joint_mask = joint_mask, .robot_index = robot_index, .nrobots = n,
 				 .pairs = pp, .npairs = np, .switches = sw, .nswitches = c->nswitches,
 				 .window_start = c->window_start_t > 0 ? c->window_start_t : 0.0,
 				 .restitution = c->restitution, .restitution_from = c->restitution_from,
@@ -1320,6 +1360,12 @@ static void an_free(struct an_ctx *c)
 	free(c->bin_total);
 	free(c->bin_total_t);
 	an_close_outputs(c);
+	if (c->stagefd >= 0) {
+		outdir_discard(c->dirfd, c->stagefd, c->stage);
+		close(c->stagefd);
+	}
+	if (c->dirfd >= 0)
+		close(c->dirfd);
 }
 
 static int an_alloc_bins(struct an_ctx *c)
@@ -1384,19 +1430,47 @@ static int an_run_ctx(struct an_ctx *c)
 	return rc;
 }
 
+/* An --out that exists and will be refused is refused before the logs are
+ * read (a long log takes a while); one that does not exist is made only
+ * once there is something to write (a log that is not a log writes nothing). */
+static int an_check_out_early(const struct an_options *o)
+{
+	struct stat st;
+	if (lstat(o->out_dir, &st) != 0)
+		return 0;
+	char err[1024];
+	int fd = outdir_open(o->out_dir, false, err, sizeof err);
+	if (fd < 0) {
+		fprintf(o->msg, "undulate-analyze: --out %s\n", err);
+		return -1;
+	}
+	close(fd);
+	return 0;
+}
+
 int an_run(const struct an_options *o)
 {
 	if (o->nlogs <= 0) {
 		fprintf(o->msg, "undulate-analyze: no log given\n");
 		return AN_EXIT_USAGE;
 	}
+	if (an_check_out_early(o) != 0)
+		return AN_EXIT_OUTPUT;
 	struct an_ctx *c = calloc(1, sizeof(*c));
 	if (!c) {
 		fprintf(o->msg, "undulate-analyze: out of memory\n");
 		return AN_EXIT_OUTPUT;
 	}
 	c->o = o;
+	c->dirfd = c->stagefd = -1;
 	int rc = an_run_ctx(c);
+	/* whatever was written, even when a later step failed (a truncated log's
+	 * results, CSV files without their plots), as when it was written in place */
+	if (c->stagefd >= 0) {
+		an_close_outputs(c);
+		if (an_publish(c) != 0)
+			rc = AN_EXIT_OUTPUT;
+	}
 	an_free(c);
 	free(c);
 	return rc;

@@ -183,9 +183,10 @@ static int run_synth(const struct synth_args *sa)
 		s.duration_s = sa->duration;
 	if (!isnan(sa->stop_after))
 		s.stop_after_s = sa->stop_after;
-	int n = synth_write(&s, sa->path);
+	char err[1024];
+	int n = synth_write(&s, sa->path, err, sizeof err);
 	if (n < 0) {
-		fprintf(stderr, "undulate-analyze: cannot write %s\n", sa->path);
+		fprintf(stderr, "undulate-analyze: --synth %s: %s\n", sa->path, err);
 		return AN_EXIT_OUTPUT;
 	}
 	printf("%s: %.1f s, %d robots, %d collisions", sa->path, s.duration_s, SYNTH_ROBOTS, n);

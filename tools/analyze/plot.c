@@ -1,6 +1,9 @@
 /* plot.c — gnuplot script for undulate-analyze's CSV files (see plot.h).
  * One script, plots.gp, is left in the output directory so a user can tweak
- * and re-run it (`gnuplot plots.gp` in that directory). */
+ * and re-run it (`gnuplot plots.gp` in that directory). Written, and run,
+ * in the analyser's private directory: gnuplot runs only a script we just
+ * wrote, and its `set output` can meet no link or FIFO another user put
+ * there (tools/analyze/README.md, "Where the files go"). */
 #include "plot.h"
 #include "theory.h"
 
@@ -14,6 +17,16 @@
 
 /* Points of the theory curve over (-pi, pi]. */
 #define PLOT_THEORY_POINTS 721
+/* A new file in the private directory (nothing can be there before us). */
+static FILE *plot_create(const struct plot_input *in, const char *name)
+{
+	int fd = openat(in->dirfd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	if (!f && fd >= 0)
+		close(fd);
+	return f;
+}
+
 /* Exit status of the child when exec failed (as the shell's "not found"). */
 #define PLOT_EXEC_FAILED 127
 
@@ -223,9 +236,9 @@ static void plot_phase_diff(FILE *f, const struct plot_input *in)
 
 static int plot_theory_file(const struct plot_input *in, int k, double dsep)
 {
-	char path[4096];
-	snprintf(path, sizeof(path), "%s/theory_%d.csv", in->dir, k);
-	FILE *t = fopen(path, "w");
+	char name[64];
+	snprintf(name, sizeof(name), "theory_%d.csv", k);
+	FILE *t = plot_create(in, name);
 	if (!t)
 		return -1;
 	fputs("delta_n,delta_next\n", t);
@@ -320,9 +333,9 @@ static int plot_run(const struct plot_input *in, FILE *msg)
 		return -1;
 	}
 	if (pid == 0) {
-		if (chdir(in->dir) != 0)
+		if (fchdir(in->dirfd) != 0)
 			_exit(PLOT_EXEC_FAILED - 1);
-		int fd = open("plots.log", O_WRONLY | O_CREAT | O_TRUNC, 0666);
+		int fd = open("plots.log", O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW, 0666);
 		if (fd >= 0) {
 			dup2(fd, STDOUT_FILENO);
 			dup2(fd, STDERR_FILENO);
@@ -347,11 +360,9 @@ static int plot_run(const struct plot_input *in, FILE *msg)
 
 int plot_all(const struct plot_input *in, FILE *msg)
 {
-	char path[4096];
-	snprintf(path, sizeof(path), "%s/plots.gp", in->dir);
-	FILE *f = fopen(path, "w");
+	FILE *f = plot_create(in, "plots.gp");
 	if (!f) {
-		fprintf(msg, "undulate-analyze: %s: %s\n", path, strerror(errno));
+		fprintf(msg, "undulate-analyze: %s/plots.gp: %s\n", in->dir, strerror(errno));
 		return -1;
 	}
 	plot_header(f);

@@ -23,7 +23,9 @@ struct plot_switch {
 };
 
 struct plot_input {
-	const char *dir;           /* where the CSV files are and the PNGs go */
+	const char *dir;           /* --out, for messages */
+	int dirfd;                 /* where the CSV files are and the PNGs go: a
+	                            * private directory only we can write (outdir.h) */
 	const char *const *robots; /* robot names in display order */
 	const int *njoints;        /* joints of each robot */
 	const unsigned *joint_mask; /* bit j: robot's joint j has samples (only those are drawn) */
@@ -40,7 +42,7 @@ struct plot_input {
 	bool have_force;           /* a contact force in collision_rate.csv (SIM.TRUTH) */
 };
 
-/* Writes DIR/plots.gp and runs gnuplot on it. Returns 0, or -1 with a reason
+/* Writes plots.gp into dirfd and runs gnuplot on it there. Returns 0, or -1 with a reason
  * printed to MSG (gnuplot missing, gnuplot failed). */
 int plot_all(const struct plot_input *in, FILE *msg);
 /* The gnuplot program to run: $GNUPLOT or "gnuplot". */

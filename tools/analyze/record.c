@@ -65,8 +65,9 @@ int rec_run(const char *path, const char *url)
 		fprintf(stderr, "undulate-analyze: --record: cannot open LCM at %s\n", full);
 		return AN_EXIT_USAGE;
 	}
-	if (alog_writer_open(&r.w, path) != 0) {
-		fprintf(stderr, "undulate-analyze: --record: cannot create %s: %s\n", path, strerror(errno));
+	char err[1024];
+	if (alog_writer_open(&r.w, path, err, sizeof err) != 0) {
+		fprintf(stderr, "undulate-analyze: --record %s: %s\n", path, err);
 		lcm_destroy(lcm);
 		return AN_EXIT_OUTPUT;
 	}

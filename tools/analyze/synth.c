@@ -12,6 +12,7 @@
 #include "undulate_sim_collision_t.h"
 #include "undulate_sim_truth_t.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -238,10 +239,10 @@ static int synth_bus_and_event(struct alog_writer *w, int i, int64_t utime, int6
 	return alog_write_event_t(w, chan, utime + SYNTH_LOG_LAG_US, &e);
 }
 
-int synth_write(const struct synth_spec *s, const char *path)
+int synth_write(const struct synth_spec *s, const char *path, char *err, size_t errlen)
 {
 	struct alog_writer w;
-	if (alog_writer_open(&w, path) != 0)
+	if (alog_writer_open(&w, path, err, errlen) != 0)
 		return -1;
 	int count = 0, rc = 0;
 	double impulse = 0.0;
@@ -260,7 +261,9 @@ int synth_write(const struct synth_spec *s, const char *path)
 		if (rc == 0 && s->truth)
 			rc = synth_truth(s, &w, cyc, t, utime, phi, &count, &impulse);
 	}
-	if (alog_writer_close(&w) != 0 || rc != 0)
+	if (alog_writer_close(&w) != 0 || rc != 0) {
+		snprintf(err, errlen, "%s: cannot write: %s", path, strerror(errno));
 		return -1;
+	}
 	return count;
 }

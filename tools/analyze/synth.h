@@ -20,6 +20,7 @@
 #ifndef UNDULATE_ANALYZE_SYNTH_H
 #define UNDULATE_ANALYZE_SYNTH_H
 
+#include <stddef.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -54,7 +55,9 @@ void synth_default(struct synth_spec *s);
 double synth_delta34(const struct synth_spec *s, double t);
 /* The impulse (N*s) of collision number K (0-based) of the log. */
 double synth_impulse(int k);
-/* Writes the log; returns the number of collisions written, or -1. */
-int synth_write(const struct synth_spec *s, const char *path);
+/* Writes the log (alog_writer_open: PATH's directory must be ours alone; what
+ * has its name is replaced); returns the number of collisions written, or -1
+ * with a one-line reason in ERR. */
+int synth_write(const struct synth_spec *s, const char *path, char *err, size_t errlen);
 
 #endif
