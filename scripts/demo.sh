@@ -585,7 +585,7 @@ if [ -n "$switch_t" ]; then
 		}' "$analysis/collision_rate.csv"
 	# the median contact force of the 10 ms periods with contact (the analyser's)
 	jq -r --arg from "$start_mode" --arg to "$switch_to" '.force | select(.median_before_n != null and .median_after_n != null) |
-		"  Median contact force while touching (10 ms periods with contact): \(.median_before_n * 1000 | round / 1000) N on the \($from) (\(.periods_before) periods before the switch) -> \(.median_after_n * 1000 | round / 1000) N on the \($to) (\(.periods_after) in the final window)."' \
+		"  Median contact force of \(if .of == "contacts" then "all contacts (each touching pair over each 10 ms)" else "the 10 ms periods with contact" end): \(.median_before_n * 1000 | round / 1000) N on the \($from) (\(.samples_before) before the switch) -> \(.median_after_n * 1000 | round / 1000) N on the \($to) (\(.samples_after) in the final window)."' \
 		"$analysis/summary.json" 2>/dev/null
 fi
 awk '

@@ -984,16 +984,9 @@ static void an_on_params(struct an_ctx *c, const undulate_osc_params_t *m)
 /* SIM.COLLISION is the per-collision channel; the copies inside SIM.TRUTH are
  * used only for logs without it (the simulator stamps those copies with the
  * truth message's time, so they cannot be matched to the originals). */
-/* The contact force over the SIM.TRUTH period that ended at m (its total
- * impulse's rise over its simulated time), kept when there was contact. */
-static void an_truth_force(struct an_ctx *c, const undulate_sim_truth_t *m, double t)
+static void an_force_push(struct an_ctx *c, double t, double f)
 {
-	bool have = c->have_prev_truth;
-	double di = m->total_impulse - c->prev_total, dt = m->sim_time - c->prev_sim_t;
-	c->have_prev_truth = isfinite(m->total_impulse) && isfinite(m->sim_time);
-	c->prev_total = m->total_impulse;
-	c->prev_sim_t = m->sim_time;
-	if (!have || !c->have_prev_truth || !(dt > 0) || !(di > 0) || c->nforce == AN_MAX_FORCES)
+	if (c->nforce == AN_MAX_FORCES || !isfinite(f))
 		return;
 	if (c->nforce == c->force_cap) {
 		size_t cap = c->force_cap ? 2 * c->force_cap : 4096;
@@ -1008,7 +1001,28 @@ static void an_truth_force(struct an_ctx *c, const undulate_sim_truth_t *m, doub
 		c->force_cap = cap;
 	}
 	c->force_t[c->nforce] = t;
-	c->force_n[c->nforce++] = di / dt;
+	c->force_n[c->nforce++] = f;
+}
+
+/* The contact forces of the SIM.TRUTH period that ended at m: each touching
+ * pair's mean force over it (SIM.TRUTH's contacts: impacts and resting
+ * contact, walls included); a log without contacts gives the period's total
+ * (its total impulse's rise over its simulated time) when there was contact. */
+static void an_truth_force(struct an_ctx *c, const undulate_sim_truth_t *m, double t)
+{
+	bool have = c->have_prev_truth;
+	double di = m->total_impulse - c->prev_total, dt = m->sim_time - c->prev_sim_t;
+	c->have_prev_truth = isfinite(m->total_impulse) && isfinite(m->sim_time);
+	c->prev_total = m->total_impulse;
+	c->prev_sim_t = m->sim_time;
+	if (m->ncontacts > 0) {
+		for (int i = 0; i < m->ncontacts; i++)
+			if (m->contacts[i].impulse > 0)
+				an_force_push(c, t, m->contacts[i].force);
+		return;
+	}
+	if (have && c->have_prev_truth && dt > 0 && di > 0 && !c->have_contacts)
+		an_force_push(c, t, di / dt);
 }
 
 /* Every pair's contact impulse in the final window, impacts and resting
@@ -1374,13 +1388,16 @@ static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 	struct an_forces fo;
 	an_forces(c, &fo);
 	if (isfinite(fo.switch_t))
-		fprintf(f, "contact force, median of the %.2f s truth periods with contact: %.4g N before the switch to "
-			"OSCILLATOR at %.1f s (%.1f..%.1f s, %zu periods), %.4g N in the final window (%.1f..%.1f s, "
-			"%zu periods)\n", 1.0 / 100.0, fo.before, fo.switch_t, fo.before_from, fo.switch_t, fo.nbefore,
-			fo.after, fo.after_from, fo.end, fo.nafter);
+		fprintf(f, "contact force, median of %s: %.4g N before the switch to OSCILLATOR at %.1f s (%.1f..%.1f s, "
+			"%zu of them), %.4g N in the final window (%.1f..%.1f s, %zu)\n",
+			c->have_contacts ? "every contact (a touching pair's mean force over a truth period)"
+			                 : "the truth periods with contact (their total)",
+			fo.before, fo.switch_t, fo.before_from, fo.switch_t, fo.nbefore, fo.after, fo.after_from, fo.end,
+			fo.nafter);
 	else if (c->truth_msgs > 0)
-		fprintf(f, "contact force, median of the truth periods with contact in the final window: %.4g N "
-			"(%zu periods; no switch to OSCILLATOR in the log)\n", fo.after, fo.nafter);
+		fprintf(f, "contact force, median of %s in the final window: %.4g N (%zu of them; no switch to OSCILLATOR "
+			"in the log)\n", c->have_contacts ? "every contact" : "the truth periods with contact", fo.after,
+			fo.nafter);
 	fprintf(f, "grazing: a pair locked within its compatibility bound + %.2f rad whose contacts in the final "
 		"window average at most %.3f N (F.win: %s over the window; more: still-colliding)\n", CLS_COMPAT_TOL,
 		CLS_GRAZE_FORCE_N, c->have_contacts ? "every contact's impulse, resting included," : "the impacts' impulse");
@@ -1477,9 +1494,10 @@ static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 	json_object_begin(&j);
 	json_field_number(&j, "switch_s", fo.switch_t);
 	json_field_number(&j, "median_before_n", fo.before);
-	json_field_int(&j, "periods_before", (int64_t)fo.nbefore);
+	json_field_string(&j, "of", c->have_contacts ? "contacts" : "periods");
+	json_field_int(&j, "samples_before", (int64_t)fo.nbefore);
 	json_field_number(&j, "median_after_n", fo.after);
-	json_field_int(&j, "periods_after", (int64_t)fo.nafter);
+	json_field_int(&j, "samples_after", (int64_t)fo.nafter);
 	json_field_number(&j, "before_from_s", fo.before_from);
 	json_field_number(&j, "after_from_s", fo.after_from);
 	json_object_end(&j);
