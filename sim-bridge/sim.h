@@ -53,6 +53,7 @@ struct sim {
 int sim_init(struct sim *s, const struct sim_config *cfg, char *err, size_t errcap);
 /* Open every bus's pty and link. 0 or -1 with err (opened ones are closed). */
 int sim_open(struct sim *s, char *err, size_t errcap);
+/* Close every bus and let its link go (sim_bus_release). */
 void sim_close(struct sim *s);
 /* One physics step of s->dt: motors from the servo registers, contacts,
  * then the servos' present values and alarms. */
