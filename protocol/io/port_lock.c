@@ -81,9 +81,7 @@ static bool port_lock_file_live(const struct holder *f)
  * if it is wrong). */
 static bool port_lock_file_holder(const char *file, struct holder *h)
 {
-	struct holder f;
-
-	struct holder now;
+	struct holder f, now;
 
 	if (!holder_read_file(file, &f) || !port_lock_file_live(&f))
 		return false;
@@ -145,7 +143,9 @@ static void port_lock_file_write(struct port_claim *c, const char *file, const c
 	snprintf(me.detail, sizeof me.detail, "%s", owner != NULL ? owner : "");
 	int n = holder_line(&me, line, sizeof line);
 	int w = snprintf(tmp, sizeof tmp, "%s/LTMP.%ld", port_lock_dir(), me.pid);
-	int fd = n > 0 && file[0] != '\0' && w > 0 && (size_t)w < sizeof tmp ? open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644) : -1;
+	if (n <= 0 || file[0] == '\0' || w <= 0 || (size_t)w >= sizeof tmp)
+		return;
+	int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
 	if (fd < 0)
 		return;
 	/* readable by everybody whatever the umask: a pid and a name */
