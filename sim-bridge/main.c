@@ -545,6 +545,16 @@ static void publish_world(struct app *a)
 
 /* ---- control socket ---------------------------------------------------------- */
 
+/* Whether a simulator listens on the socket at addr (a killed one's is dead). */
+static bool control_alive(const struct sockaddr_un *addr)
+{
+	int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+	bool alive = fd >= 0 && connect(fd, (const struct sockaddr *)addr, sizeof(*addr)) == 0;
+	if (fd >= 0)
+		close(fd);
+	return alive;
+}
+
 static int control_open(struct app *a, const char *path)
 {
 	struct sockaddr_un addr = { .sun_family = AF_UNIX };
@@ -557,6 +567,10 @@ static int control_open(struct app *a, const char *path)
 	if (lstat(path, &st) == 0) {
 		if (!S_ISSOCK(st.st_mode)) {
 			fprintf(stderr, "undulate-sim: --control %s exists and is not a socket: refusing to replace it\n", path);
+			return -1;
+		}
+		if (control_alive(&addr)) {
+			fprintf(stderr, "undulate-sim: --control %s: another simulator listens on it\n", path);
 			return -1;
 		}
 		unlink(path);  /* a stale socket from a killed run */
@@ -1257,12 +1271,14 @@ int main(int argc, char **argv)
 		fprintf(stderr, "undulate-sim: LCM (%s) unavailable: no ground truth, no SIM.CMD\n",
 		        cfg.lcm_url[0] ? cfg.lcm_url : "default");
 	lcm_subscription_t *sub = app.lcm ? lcm_subscribe(app.lcm, "SIM.CMD", on_sim_cmd, &app) : NULL;
-	if (!app.truth_buf || (cfg.control[0] && control_open(&app, cfg.control) != 0) ||
-	    sim_open(&sim, err, sizeof(err)) != 0) {
+	/* the links first: a simulator refused its links (another one serves
+	 * them) must not have touched that one's control socket either */
+	bool opened = app.truth_buf && sim_open(&sim, err, sizeof(err)) == 0;
+	if (!opened || (cfg.control[0] && control_open(&app, cfg.control) != 0)) {
 		if (err[0])
 			fprintf(stderr, "undulate-sim: %s\n", err);
-		if (app.listen_fd >= 0)
-			unlink(app.control_path);
+		if (opened)
+			sim_close(&sim);
 		return 1;
 	}
 	app.t0 = mono_ns();

@@ -341,7 +341,7 @@ int sim_open(struct sim *s, char *err, size_t errcap)
 void sim_close(struct sim *s)
 {
 	for (size_t i = 0; i < s->nbuses; i++)
-		sim_bus_close(&s->buses[i]);
+		sim_bus_release(&s->buses[i]);
 }
 
 /* ---- physics ------------------------------------------------------------------ */

@@ -73,6 +73,7 @@ void sim_free(struct sim *s);
 size_t sim_contacts_drain(struct sim *s, struct plane_contact *out, size_t cap);
 /* Open every bus's pty and link. 0 or -1 with err (opened ones are closed). */
 int sim_open(struct sim *s, char *err, size_t errcap);
+/* Close every bus and let its link go (sim_bus_release). */
 void sim_close(struct sim *s);
 /* One physics step of s->dt: motors from the servo registers, contacts,
  * then the servos' present values and alarms. */

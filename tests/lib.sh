@@ -38,6 +38,9 @@ T=$(mktemp -d "${TMPDIR:-/tmp}/undulate-test.XXXXXX")
 # Each test's daemons put their local command sockets here, and
 # `undulated --command` looks for them here: tests never command each other.
 export UNDULATE_RUN_DIR="$T"
+# ... and the UUCP lock files that name a bus's holder (protocol/io/port_lock.c)
+# go here, not to the machine's /var/lock.
+export UNDULATE_LOCK_DIR="$T"
 _pids=()
 _tap_n=0
 _tap_failed=0
