@@ -20,11 +20,14 @@
 static void usage(FILE *f)
 {
 	fputs("usage: undulate-web [--listen ADDR:PORT] [--lcm-url URL] [--read-only] [--allow-remote]\n"
-	      "                    [--token-file FILE] [--key FILE] [--page-dir DIR] [--chartjs FILE] [-v]\n"
+	      "                    [--allow-host NAME]... [--token-file FILE] [--key FILE] [--page-dir DIR]\n"
+	      "                    [--chartjs FILE] [-v]\n"
 	      "A live dashboard of every robot on the LCM network, at http://ADDR:PORT/.\n"
 	      "  --listen ADDR:PORT  where to listen (default 127.0.0.1:8080; port 0: any free port, printed)\n"
 	      "  --allow-remote      required to listen on an address other than loopback; then commands\n"
 	      "                      need --token-file, or use --read-only\n"
+	      "  --allow-host NAME   a name by which browsers reach this server (repeatable); always allowed:\n"
+	      "                      localhost, its address, and beyond loopback this computer's name\n"
 	      "  --token-file FILE   commands need this secret (the file's first line; mode 0600):\n"
 	      "                      open the page as http://ADDR:PORT/#token=SECRET\n"
 	      "  --read-only         no commands: the page shows no controls, the server refuses them\n"
@@ -70,6 +73,28 @@ static bool is_loopback(const char *addr)
 	if (inet_pton(AF_INET6, addr, &v6) == 1)
 		return IN6_IS_ADDR_LOOPBACK(&v6);
 	return strcmp(addr, "localhost") == 0;
+}
+
+/* A name for --allow-host: a DNS name's characters, not an address (those
+ * are allowed by what they are, req.h). */
+static bool host_name_ok(const char *s)
+{
+	size_t n = strlen(s);
+	return n > 0 && n < 254 && strspn(s, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789.-") == n;
+}
+
+/* Beyond loopback, this computer's own name reaches it (http://labpc:8080/):
+ * as gethostname says, and its first label. */
+static void add_own_names(struct req_hosts *h)
+{
+	static char full[256], label[256];
+	if (gethostname(full, sizeof full - 1) != 0 || !host_name_ok(full))
+		return;
+	snprintf(label, sizeof label, "%.*s", (int)strcspn(full, "."), full);
+	if (h->nnames < REQ_HOSTS_MAX)
+		h->names[h->nnames++] = full;
+	if (strcmp(label, full) != 0 && h->nnames < REQ_HOSTS_MAX)
+		h->names[h->nnames++] = label;
 }
 
 /* The secret: the first line of a file only its owner can read. */
@@ -134,10 +159,11 @@ static const char *find_page_dir(void)
 
 int main(int argc, char **argv)
 {
-	enum { O_LISTEN = 256, O_URL, O_RO, O_REMOTE, O_TOKEN, O_KEY, O_PAGE, O_CHARTJS };
+	enum { O_LISTEN = 256, O_URL, O_RO, O_REMOTE, O_TOKEN, O_KEY, O_PAGE, O_CHARTJS, O_HOST };
 	static const struct option opts[] = {
 		{ "listen", required_argument, NULL, O_LISTEN },   { "lcm-url", required_argument, NULL, O_URL },
 		{ "read-only", no_argument, NULL, O_RO },          { "allow-remote", no_argument, NULL, O_REMOTE },
+		{ "allow-host", required_argument, NULL, O_HOST },
 		{ "token-file", required_argument, NULL, O_TOKEN }, { "key", required_argument, NULL, O_KEY },
 		{ "page-dir", required_argument, NULL, O_PAGE },   { "chartjs", required_argument, NULL, O_CHARTJS },
 		{ "help", no_argument, NULL, 'h' },                { "verbose", no_argument, NULL, 'v' },
@@ -154,6 +180,15 @@ int main(int argc, char **argv)
 		case O_URL: o.lcm_url = optarg; break;
 		case O_RO: o.read_only = true; break;
 		case O_REMOTE: remote = true; break;
+		case O_HOST:
+			/* two places stay for this computer's own names */
+			if (!host_name_ok(optarg) || o.hosts.nnames >= REQ_HOSTS_MAX - 2) {
+				fprintf(stderr, "undulate-web: --allow-host \"%s\": want a host name (letters, digits, "
+				        "'.', '-'), at most %d of them\n", optarg, REQ_HOSTS_MAX - 2);
+				return 2;
+			}
+			o.hosts.names[o.hosts.nnames++] = optarg;
+			break;
 		case O_TOKEN: token_file = optarg; break;
 		case O_KEY: o.key_file = optarg; break;
 		case O_PAGE: o.page_dir = optarg; break;
@@ -167,6 +202,9 @@ int main(int argc, char **argv)
 		fprintf(stderr, "undulate-web: unexpected argument \"%s\" (--help)\n", argv[optind]);
 		return 2;
 	}
+	o.hosts.listen = addr;
+	if (!is_loopback(addr))
+		add_own_names(&o.hosts);
 	if (!is_loopback(addr) && !remote) {
 		fprintf(stderr, "undulate-web: --listen %s:%d opens the dashboard to the network; say so with "
 		        "--allow-remote (and give --token-file FILE for commands, or --read-only)\n", addr, o.port);

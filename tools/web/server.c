@@ -16,6 +16,7 @@
 #include "frame.h"
 #include "hist.h"
 #include "req.h"
+#include "text.h"
 #include "wcmd.h"
 
 /* One browser on the WebSocket (libwebsockets' per-session data). */
@@ -264,12 +265,31 @@ static int web_http_write(struct lws *wsi, struct web_http *h)
 	return lws_http_transaction_completed(wsi) ? -1 : 0;
 }
 
+/* The request's Host header (empty when missing or longer than cap). */
+static void web_host(struct lws *wsi, char *host, size_t cap)
+{
+	host[0] = '\0';
+	int n = lws_hdr_total_length(wsi, WSI_TOKEN_HOST);
+	if (n > 0 && n < (int)cap)
+		lws_hdr_copy(wsi, host, (int)cap, WSI_TOKEN_HOST);
+}
+
 static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
 {
 	app.n.http_requests++;
 	const char *method = web_method(wsi);
+	char quoted[80], host[256];
+	text_sanitize(quoted, sizeof quoted, uri);
 	if (app.o.verbose)
-		fprintf(stderr, "undulate-web: %s %.200s\n", method, uri);
+		fprintf(stderr, "undulate-web: %s %s\n", method, quoted);
+	web_host(wsi, host, sizeof host);
+	if (!req_host_ok(&app.o.hosts, host)) {
+		char qhost[80];
+		web_log(app.n.http_refused + 1, "refused %s %s: Host '%s' does not name this server (a page of another "
+		        "site whose name points here: DNS rebinding; --allow-host NAME for a name of this computer)",
+		        method, quoted, text_sanitize(qhost, sizeof qhost, host));
+		return web_http_status(wsi, HTTP_STATUS_FORBIDDEN, "this Host does not name this server");
+	}
 	switch (req_route(method, uri)) {
 	case REQ_PAGE: return web_serve_file(wsi, app.o.page_dir, "index.html", "text/html");
 	case REQ_ASSET_JS: return web_serve_file(wsi, app.o.page_dir, "app.js", "application/javascript");
@@ -277,11 +297,11 @@ static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
 	case REQ_CHARTJS: return web_serve_file(wsi, NULL, app.o.chartjs, "application/javascript");
 	case REQ_SNAPSHOT: return web_snapshot(wsi, h);
 	case REQ_BAD_METHOD:
-		web_log(app.n.http_refused + 1, "refused %s %.64s: method not allowed", method, uri);
+		web_log(app.n.http_refused + 1, "refused %s %s: method not allowed", method, quoted);
 		return web_http_status(wsi, HTTP_STATUS_METHOD_NOT_ALLOWED, "method not allowed");
 	case REQ_NOT_FOUND:
 	default:
-		web_log(app.n.http_refused + 1, "refused %s %.64s: not found", method, uri);
+		web_log(app.n.http_refused + 1, "refused %s %s: not found", method, quoted);
 		return web_http_status(wsi, HTTP_STATUS_NOT_FOUND, "not found");
 	}
 }
@@ -292,6 +312,11 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 	switch (reason) {
 	case LWS_CALLBACK_HTTP:
 		return web_http(wsi, h, in != NULL ? (const char *)in : "");
+	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+		/* a WebSocket that named no protocol, or "http": libwebsockets
+		 * would give it to this callback, past every check of "undulate" */
+		web_log(++app.n.ws_refused, "refused a WebSocket without the protocol 'undulate'");
+		return 1;
 	case LWS_CALLBACK_HTTP_BODY:
 		return 0; /* no request has a body worth reading: it was answered already */
 	case LWS_CALLBACK_HTTP_WRITEABLE:
@@ -312,15 +337,21 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 
 static bool web_ws_allowed(struct lws *wsi)
 {
-	char origin[256] = "", host[256] = "";
-	if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) >= (int)sizeof origin ||
-	    lws_hdr_total_length(wsi, WSI_TOKEN_HOST) >= (int)sizeof host)
+	char origin[256] = "", host[256], qo[80], qh[80];
+	if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) >= (int)sizeof origin) {
+		web_log(++app.n.ws_refused, "refused a WebSocket: Origin longer than %zu bytes", sizeof origin - 1);
 		return false;
+	}
 	lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN);
-	lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST);
+	web_host(wsi, host, sizeof host);
+	if (!req_host_ok(&app.o.hosts, host)) {
+		web_log(++app.n.ws_refused, "refused a WebSocket for Host '%s': not a name of this server (DNS "
+		        "rebinding?)", text_sanitize(qh, sizeof qh, host));
+		return false;
+	}
 	if (!req_origin_ok(origin, host)) {
-		web_log(++app.n.ws_refused, "refused a WebSocket from origin '%.64s' (this is http://%.64s)", origin,
-		        host);
+		web_log(++app.n.ws_refused, "refused a WebSocket from origin '%s' (this is http://%s)",
+		        text_sanitize(qo, sizeof qo, origin), text_sanitize(qh, sizeof qh, host));
 		return false;
 	}
 	if (app.nclients >= WEB_MAX_CLIENTS) {
@@ -472,6 +503,10 @@ static int web_raw_cb(struct lws *wsi, enum lws_callback_reasons reason, void *u
 	(void)user;
 	(void)in;
 	(void)len;
+	if (reason == LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION) {
+		web_log(++app.n.ws_refused, "refused a WebSocket asking for the internal protocol 'undulate-raw'");
+		return 1;
+	}
 	if (reason != LWS_CALLBACK_RAW_RX_FILE)
 		return 0;
 	void *tag = lws_get_opaque_user_data(wsi);

@@ -9,6 +9,8 @@
 
 #include <stdbool.h>
 
+#include "req.h"
+
 #define WEB_MAX_CLIENTS 32          /* WebSocket browsers at once; more are refused */
 #define WEB_MAX_CONNECTIONS 96      /* file descriptors for connections (HTTP and WebSocket) */
 #define WEB_HEADER_MAX 4096         /* bytes of request headers; beyond: refused */
@@ -24,6 +26,7 @@
 
 struct web_opts {
 	const char *addr;           /* "127.0.0.1" */
+	struct req_hosts hosts;     /* what a request's Host may name (req_host_ok) */
 	int port;                   /* 0: any free port (printed) */
 	const char *lcm_url;        /* NULL: LCM's default */
 	bool read_only;
