@@ -12,6 +12,7 @@
 #include "num.h"
 #include "req.h"
 #include "server.h"
+#include "wtok.h"
 
 #define WEB_DEFAULT_ADDR "127.0.0.1"
 #define WEB_DEFAULT_PORT 8080
@@ -29,7 +30,10 @@ static void usage(FILE *f)
 	      "  --allow-host NAME   a name by which browsers reach this server (repeatable); always allowed:\n"
 	      "                      localhost, its address, and beyond loopback this computer's name\n"
 	      "  --token-file FILE   commands need this secret (the file's first line; mode 0600):\n"
-	      "                      open the page as http://ADDR:PORT/#token=SECRET\n"
+	      "                      open the page as http://ADDR:PORT/#token=SECRET. Without it\n"
+	      "                      (on loopback) a token is made at start, written to the run\n"
+	      "                      directory (mode 0600) and printed in the page's URL; a page\n"
+	      "                      without the token watches and never commands\n"
 	      "  --read-only         no commands: the page shows no controls, the server refuses them\n"
 	      "  --key FILE          send commands signed over LCM (robots with commands = network),\n"
 	      "                      as undulated --command --key; default: local command sockets\n"
@@ -95,37 +99,6 @@ static void add_own_names(struct req_hosts *h)
 		h->names[h->nnames++] = full;
 	if (strcmp(label, full) != 0 && h->nnames < REQ_HOSTS_MAX)
 		h->names[h->nnames++] = label;
-}
-
-/* The secret: the first line of a file only its owner can read. */
-static char *read_token(const char *path)
-{
-	static char token[REQ_TOKEN_MAX];
-	FILE *f = fopen(path, "r");
-	struct stat st;
-	if (f == NULL || fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-		fprintf(stderr, "undulate-web: --token-file %s: cannot read it as a file\n", path);
-		if (f)
-			fclose(f);
-		return NULL;
-	}
-	if (st.st_mode & 077) {
-		fprintf(stderr, "undulate-web: --token-file %s: readable by others (mode %03o): chmod 600 %s\n", path,
-		        (unsigned)(st.st_mode & 0777), path);
-		fclose(f);
-		return NULL;
-	}
-	if (fgets(token, sizeof token, f) == NULL)
-		token[0] = '\0';
-	fclose(f);
-	token[strcspn(token, "\r\n")] = '\0';
-	size_t n = strlen(token);
-	if (n < 8 || strspn(token, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_.~") != n) {
-		fprintf(stderr, "undulate-web: --token-file %s: want one line of 8 to %d letters, digits or -_.~ "
-		        "(e.g. head -c 24 /dev/urandom | base64 | tr '+/' '-_' > %s)\n", path, REQ_TOKEN_MAX - 1, path);
-		return NULL;
-	}
-	return token;
 }
 
 /* The page beside the program: installed (PREFIX/bin -> PREFIX/share/undulate/web)
@@ -210,13 +183,23 @@ int main(int argc, char **argv)
 		        "--allow-remote (and give --token-file FILE for commands, or --read-only)\n", addr, o.port);
 		return 2;
 	}
-	if (token_file != NULL && (o.token = read_token(token_file)) == NULL)
-		return 2;
+	static char token[REQ_TOKEN_MAX];
+	char why[256];
+	if (token_file != NULL) {
+		if (!wtok_read(token_file, token, why, sizeof why)) {
+			fprintf(stderr, "undulate-web: --token-file %s: %s\n", token_file, why);
+			return 2;
+		}
+		o.token = token;
+	}
 	if (!is_loopback(addr) && !o.read_only && o.token == NULL) {
 		fprintf(stderr, "undulate-web: listening on %s, commands would be open to anyone who reaches it: "
 		        "give --token-file FILE or --read-only\n", addr);
 		return 2;
 	}
+	/* commands carry this process's identity: on loopback too they need a
+	 * token, made now when none was given (wtok.h) */
+	o.make_token = !o.read_only && o.token == NULL;
 	if (o.page_dir == NULL && (o.page_dir = find_page_dir()) == NULL) {
 		fputs("undulate-web: cannot find the page (index.html) beside the program: --page-dir DIR\n", stderr);
 		return 2;

@@ -5,6 +5,7 @@
 #include <libwebsockets.h>
 #include <math.h>
 #include <signal.h>
+#include <sodium.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,11 +14,13 @@
 #include <unistd.h>
 
 #include "clock.h"
+#include "csock.h"
 #include "frame.h"
 #include "hist.h"
 #include "req.h"
 #include "text.h"
 #include "wcmd.h"
+#include "wtok.h"
 
 /* One browser on the WebSocket (libwebsockets' per-session data). */
 struct web_client {
@@ -26,7 +29,8 @@ struct web_client {
 	struct frame_cursor cur;
 	bool want;              /* a frame is due: asked for writable, not written yet */
 	double want_since;
-	bool authed;
+	bool authed;            /* holds the token: may command */
+	bool wrong_token;       /* offered one at the handshake, not ours */
 	bool dropping;          /* the rest of an oversized message */
 	struct frame_note notes[WEB_NOTES];
 	int nnotes;
@@ -55,6 +59,9 @@ static struct web_app {
 	char cmd_why[256];
 	struct web_client *clients[WEB_MAX_CLIENTS];
 	int nclients;
+	int nwatchers;              /* of them without the token */
+	char token[REQ_TOKEN_MAX];  /* made at start (wtok.h) */
+	char token_path[CSOCK_PATH_MAX + 64];
 	unsigned next_client;
 	lws_sorted_usec_list_t sul;
 	uint64_t ticks;
@@ -354,25 +361,55 @@ static bool web_ws_allowed(struct lws *wsi)
 		        text_sanitize(qo, sizeof qo, origin), text_sanitize(qh, sizeof qh, host));
 		return false;
 	}
-	if (app.nclients >= WEB_MAX_CLIENTS) {
-		web_log(++app.n.ws_refused, "refused a WebSocket: %d browsers connected already", WEB_MAX_CLIENTS);
-		return false;
-	}
 	return true;
+}
+
+static void web_refuse_msg(struct web_client *c, long long id, const char *why)
+{
+	app.n.msgs_refused++;
+	web_log(app.n.msgs_refused, "browser %u: refused a message: %s", c->id, why);
+	web_note(c, id, 0, "", "refused", why);
+}
+
+/* The token offered at the handshake (the page's subprotocol "undulate-token.T"). */
+static void web_ws_token(struct lws *wsi, struct web_client *c)
+{
+	char list[256], token[REQ_TOKEN_MAX];
+	int n = lws_hdr_total_length(wsi, WSI_TOKEN_PROTOCOL);
+	if (app.o.token == NULL || n <= 0 || n >= (int)sizeof list)
+		return;
+	lws_hdr_copy(wsi, list, sizeof list, WSI_TOKEN_PROTOCOL);
+	if (!req_ws_token(list, token, sizeof token))
+		return;
+	c->authed = req_token_ok(app.o.token, token);
+	c->wrong_token = !c->authed;
+}
+
+/* Room for it: watchers may not take the places kept for the token's holders. */
+static bool web_ws_room(const struct web_client *c)
+{
+	if (req_ws_room(app.nclients, app.nwatchers, c->authed, WEB_MAX_CLIENTS, WEB_MAX_WATCHERS))
+		return true;
+	web_log(++app.n.ws_refused, "refused a WebSocket%s: %d browsers connected, %d of them without the token "
+	        "(at most %d; the rest is kept for the token's holders)", c->authed ? " with the token" : "",
+	        app.nclients, app.nwatchers, WEB_MAX_WATCHERS);
+	return false;
 }
 
 static void web_ws_open(struct lws *wsi, struct web_client *c)
 {
-	memset(c, 0, sizeof *c);
+	/* authed and wrong_token were set at the handshake (FILTER_PROTOCOL_CONNECTION) */
 	int sndbuf = WEB_SNDBUF;
 	setsockopt(lws_get_socket_fd(wsi), SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
 	c->wsi = wsi;
 	c->id = ++app.next_client;
-	c->authed = app.o.token == NULL;
 	frame_cursor_init(&c->cur, &app.hist);
 	app.clients[app.nclients++] = c;
+	app.nwatchers += !c->authed;
 	app.n.clients = app.nclients;
-	web_note(c, 0, 0, "", "hello", app.o.read_only ? "read-only" : app.o.token ? "token" : "commands");
+	web_note(c, 0, 0, "", "hello", app.o.read_only ? "read-only" : c->authed ? "commands" : "watch");
+	if (c->wrong_token)
+		web_refuse_msg(c, 0, "wrong token: this page only watches (open the URL undulate-web printed)");
 	c->want = true;
 	c->want_since = clock_mono_s();
 	lws_callback_on_writable(wsi);
@@ -383,6 +420,7 @@ static void web_ws_close(struct web_client *c)
 	for (int i = 0; i < app.nclients; i++)
 		if (app.clients[i] == c) {
 			app.clients[i] = app.clients[--app.nclients];
+			app.nwatchers -= !c->authed;
 			break;
 		}
 	app.n.clients = app.nclients;
@@ -403,13 +441,6 @@ static int web_ws_write(struct lws *wsi, struct web_client *c)
 	return lws_write(wsi, buf, n, LWS_WRITE_TEXT) < (int)n ? -1 : 0;
 }
 
-static void web_refuse_msg(struct web_client *c, long long id, const char *why)
-{
-	app.n.msgs_refused++;
-	web_log(app.n.msgs_refused, "browser %u: refused a message: %s", c->id, why);
-	web_note(c, id, 0, "", "refused", why);
-}
-
 static void web_command(struct web_client *c, struct req_msg *m)
 {
 	char why[256];
@@ -419,7 +450,8 @@ static void web_command(struct web_client *c, struct req_msg *m)
 	}
 	if (!c->authed) {
 		app.n.commands_refused++;
-		return web_refuse_msg(c, m->id, "this dashboard needs its token for commands: open its URL with #token=...");
+		return web_refuse_msg(c, m->id, "commands need the dashboard's token: open the URL undulate-web printed "
+		                      "(with #token=...); without it this page only watches");
 	}
 	if (!app.cmd_ok) {
 		app.n.commands_refused++;
@@ -464,11 +496,12 @@ static void web_ws_receive(struct lws *wsi, struct web_client *c, const char *in
 		return web_refuse_msg(c, m.id, why);
 	}
 	if (m.kind == REQ_MSG_AUTH) {
-		c->authed = app.o.token != NULL && req_token_ok(app.o.token, m.token);
-		if (!c->authed)
-			web_refuse_msg(c, 0, "wrong token");
-		else
-			web_note(c, 0, 0, "", "auth", "token accepted: commands enabled");
+		bool ok = app.o.token != NULL && req_token_ok(app.o.token, m.token);
+		if (!ok)
+			return web_refuse_msg(c, 0, "wrong token: this page only watches");
+		app.nwatchers -= !c->authed;
+		c->authed = true;
+		web_note(c, 0, 0, "", "auth", "token accepted: commands enabled");
 		return;
 	}
 	web_command(c, &m);
@@ -479,7 +512,10 @@ static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
 	struct web_client *c = user;
 	switch (reason) {
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
-		return web_ws_allowed(wsi) ? 0 : 1;
+		if (!web_ws_allowed(wsi))
+			return 1;
+		web_ws_token(wsi, c);
+		return web_ws_room(c) ? 0 : 1;
 	case LWS_CALLBACK_ESTABLISHED:
 		web_ws_open(wsi, c);
 		return 0;
@@ -600,6 +636,29 @@ static int web_start(void)
 	return 0;
 }
 
+/* No --token-file, commands on: a token of our own, in a file only this
+ * user reads (wtok.h), and the URL that carries it. Without a file (the run
+ * directory not ours) the printed URL is the only copy. */
+static int web_make_token(int port)
+{
+	char dir[CSOCK_PATH_MAX], why[256];
+	if (!wtok_make(app.token)) {
+		fprintf(stderr, "undulate-web: cannot make a token (libsodium has no entropy source)\n");
+		return -1;
+	}
+	app.o.token = app.token;
+	if (!csock_daemon_dir(dir, sizeof dir, "", why, sizeof why) ||
+	    !wtok_write(dir, port, app.token, app.token_path, sizeof app.token_path, why, sizeof why)) {
+		app.token_path[0] = '\0';
+		fprintf(stderr, "undulate-web: the token is not written to a file: %s\n", why);
+	}
+	bool v6 = strchr(app.o.addr, ':') != NULL;
+	printf("undulate-web: open http://%s%s%s:%d/#token=%s to command (without the token the page only watches)%s%s\n",
+	       v6 ? "[" : "", app.o.addr, v6 ? "]" : "", port, app.token, app.token_path[0] ? "; the token is in " : "",
+	       app.token_path);
+	return 0;
+}
+
 int web_run(const struct web_opts *o)
 {
 	app.o = *o;
@@ -643,8 +702,9 @@ int web_run(const struct web_opts *o)
 	int port = lws_get_vhost_listen_port(app.vh);
 	bool v6 = strchr(o->addr, ':') != NULL;
 	printf("undulate-web: listening on http://%s%s%s:%d/ (LCM %s%s)\n", v6 ? "[" : "", o->addr, v6 ? "]" : "",
-	       port, o->lcm_url ? o->lcm_url : "default URL",
-	       o->read_only ? ", read-only" : o->token ? ", commands need the token" : "");
+	       port, o->lcm_url ? o->lcm_url : "default URL", o->read_only ? ", read-only" : ", commands need the token");
+	if (o->make_token && web_make_token(port) != 0)
+		return 1;
 	fflush(stdout);
 	while (!web_stop && lws_service(app.ctx, 0) >= 0)
 		;
@@ -653,6 +713,9 @@ int web_run(const struct web_opts *o)
 	        app.n.http_requests, app.n.http_refused, app.n.ws_refused, app.n.msgs_refused, app.n.commands_sent,
 	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled);
 	lws_context_destroy(app.ctx);
+	if (app.token_path[0] != '\0')
+		unlink(app.token_path);
+	sodium_memzero(app.token, sizeof app.token);
 	wcmd_close(&app.cmd);
 	lcm_destroy(app.lcm);
 	free(app.frame);

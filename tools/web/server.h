@@ -12,6 +12,7 @@
 #include "req.h"
 
 #define WEB_MAX_CLIENTS 32          /* WebSocket browsers at once; more are refused */
+#define WEB_MAX_WATCHERS 24         /* of them without the token: the rest is kept for its holders */
 #define WEB_MAX_CONNECTIONS 96      /* file descriptors for connections (HTTP and WebSocket) */
 #define WEB_HEADER_MAX 4096         /* bytes of request headers; beyond: refused */
 #define WEB_FRAME_MAX (2 * 1024 * 1024) /* one frame; a larger catch-up keeps the newest samples */
@@ -30,7 +31,8 @@ struct web_opts {
 	int port;                   /* 0: any free port (printed) */
 	const char *lcm_url;        /* NULL: LCM's default */
 	bool read_only;
-	const char *token;          /* NULL: commands need no secret (loopback only) */
+	const char *token;          /* --token-file's: commands need it */
+	bool make_token;            /* no token given, commands on: make one at start (wtok.h) */
 	const char *key_file;       /* signed LCM commands instead of local sockets */
 	const char *page_dir;       /* index.html, app.js, style.css */
 	const char *chartjs;        /* Chart.js from libjs-chart.js */
