@@ -20,6 +20,7 @@
 #include "req.h"
 #include "text.h"
 #include "wcmd.h"
+#include "wsrecv.h"
 #include "wtok.h"
 
 /* One browser on the WebSocket (libwebsockets' per-session data). */
@@ -32,6 +33,7 @@ struct web_client {
 	bool authed;            /* holds the token: may command */
 	bool wrong_token;       /* offered one at the handshake, not ours */
 	bool dropping;          /* the rest of an oversized message */
+	bool failed;            /* closed for what its client sent: nothing more from it counts */
 	struct frame_note notes[WEB_NOTES];
 	int nnotes;
 };
@@ -317,6 +319,9 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 {
 	struct web_http *h = user;
 	switch (reason) {
+	case LWS_CALLBACK_FILTER_NETWORK_CONNECTION:
+		/* a new connection: what its client sends is watched from its first byte */
+		return wsr_watch((int)(intptr_t)in) ? 0 : 1;
 	case LWS_CALLBACK_HTTP:
 		return web_http(wsi, h, in != NULL ? (const char *)in : "");
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
@@ -398,11 +403,10 @@ static bool web_ws_room(const struct web_client *c)
 
 static void web_ws_open(struct lws *wsi, struct web_client *c)
 {
-	/* authed and wrong_token were set at the handshake (FILTER_PROTOCOL_CONNECTION) */
+	/* authed and wrong_token were set at the handshake (FILTER_PROTOCOL_CONNECTION), id at ESTABLISHED */
 	int sndbuf = WEB_SNDBUF;
 	setsockopt(lws_get_socket_fd(wsi), SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
 	c->wsi = wsi;
-	c->id = ++app.next_client;
 	frame_cursor_init(&c->cur, &app.hist);
 	app.clients[app.nclients++] = c;
 	app.nwatchers += !c->authed;
@@ -507,9 +511,44 @@ static void web_ws_receive(struct lws *wsi, struct web_client *c, const char *in
 	web_command(c, &m);
 }
 
+/* What its client sent breaks RFC 6455 where libwebsockets 4.1 lets it
+ * through (wsguard.h): close with 1002 before acting on anything. */
+static bool web_ws_bad(struct lws *wsi, struct web_client *c, enum wsg_verdict v)
+{
+	if (c->failed)
+		return true;
+	if (v == WSG_OK)
+		return false;
+	c->failed = true;
+	app.n.ws_bad_frames++;
+	if (!wsr_interposed())
+		web_log(app.n.ws_bad_frames, "cannot see what browsers send (recv() is not this program's): "
+		        "every WebSocket is refused");
+	else
+		web_log(app.n.ws_bad_frames, "browser %u: closed: %s", c->id, wsg_why(v));
+	const char *why = wsg_why(v);
+	lws_close_reason(wsi, LWS_CLOSE_STATUS_PROTOCOL_ERR, (unsigned char *)(uintptr_t)why, strlen(why));
+	return true;
+}
+
+/* The protocol is text (JSON out, "cmd ..." in): a binary frame is not ours
+ * to guess at (RFC 6455 7.4.1: 1003, a type it cannot accept). */
+static bool web_ws_binary(struct lws *wsi, struct web_client *c)
+{
+	static const char why[] = "the undulate protocol is text only";
+	if (!lws_frame_is_binary(wsi))
+		return false;
+	c->failed = true;
+	app.n.ws_bad_frames++;
+	web_log(app.n.ws_bad_frames, "browser %u: closed: a binary frame (%s)", c->id, why);
+	lws_close_reason(wsi, LWS_CLOSE_STATUS_UNACCEPTABLE_OPCODE, (unsigned char *)(uintptr_t)why, sizeof why - 1);
+	return true;
+}
+
 static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
 	struct web_client *c = user;
+	int fd = lws_get_socket_fd(wsi);
 	switch (reason) {
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
 		if (!web_ws_allowed(wsi))
@@ -517,14 +556,23 @@ static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
 		web_ws_token(wsi, c);
 		return web_ws_room(c) ? 0 : 1;
 	case LWS_CALLBACK_ESTABLISHED:
+		c->id = ++app.next_client;
+		if (web_ws_bad(wsi, c, wsr_upgraded(fd)))
+			return -1;
 		web_ws_open(wsi, c);
 		return 0;
 	case LWS_CALLBACK_SERVER_WRITEABLE:
+		/* also what came in control frames, which reach no callback */
+		if (web_ws_bad(wsi, c, wsr_verdict(fd)))
+			return -1;
 		return web_ws_write(wsi, c);
 	case LWS_CALLBACK_RECEIVE:
+		if (web_ws_bad(wsi, c, wsr_verdict(fd)) || web_ws_binary(wsi, c))
+			return -1;
 		web_ws_receive(wsi, c, in, len);
 		return 0;
 	case LWS_CALLBACK_CLOSED:
+		wsr_forget(fd);
 		web_ws_close(c);
 		return 0;
 	default:
