@@ -44,6 +44,19 @@ struct web_http {
 	size_t len, off;
 };
 
+/* One TCP connection, from its adoption to its end (the crowd's rules, server.h). */
+enum web_conn_state {
+	WEB_CONN_WAITING,       /* no request being served: just accepted, or idle after an answer */
+	WEB_CONN_BUSY,          /* a request arrived whole and is being answered */
+	WEB_CONN_WS,            /* a WebSocket (counted apart: WEB_MAX_CLIENTS) */
+	WEB_CONN_EVICTED,       /* closed to make room; gone at its WSI_DESTROY */
+};
+struct web_conn {
+	struct lws *wsi;
+	double since;           /* when it started waiting */
+	enum web_conn_state state;
+};
+
 #define WEB_TAG_LCM ((void *)1)
 #define WEB_TAG_CMD ((void *)2)
 #define WEB_LOG_FIRST 5      /* messages of one kind printed before one in every WEB_LOG_EVERY */
@@ -59,6 +72,8 @@ static struct web_app {
 	struct wcmd cmd;
 	bool cmd_ok;
 	char cmd_why[256];
+	struct web_conn conns[WEB_FD_LIMIT];
+	int nconns, nevicted;
 	struct web_client *clients[WEB_MAX_CLIENTS];
 	int nclients;
 	int nwatchers;              /* of them without the token */
@@ -195,6 +210,76 @@ static int web_subscribe(void)
 	return 0;
 }
 
+/* ---- connections: room for one more ------------------------------------------------ */
+
+static struct web_conn *web_conn_of(struct lws *wsi)
+{
+	for (int i = 0; i < app.nconns; i++)
+		if (app.conns[i].wsi == wsi)
+			return &app.conns[i];
+	return NULL;
+}
+
+static void web_conn_set(struct lws *wsi, enum web_conn_state state)
+{
+	struct web_conn *k = web_conn_of(wsi);
+	if (k == NULL || k->state == WEB_CONN_EVICTED)
+		return;
+	k->state = state;
+	if (state == WEB_CONN_WAITING)
+		k->since = clock_mono_s();
+}
+
+/* The connection to close for a new one: the one waiting longest, else the
+ * longest busy one; never a WebSocket. NULL if none. */
+static struct web_conn *web_conn_victim(void)
+{
+	struct web_conn *best = NULL;
+	for (int i = 0; i < app.nconns; i++) {
+		struct web_conn *k = &app.conns[i];
+		if (k->state != WEB_CONN_WAITING && k->state != WEB_CONN_BUSY)
+			continue;
+		if (best == NULL || (k->state == WEB_CONN_WAITING && best->state == WEB_CONN_BUSY) ||
+		    (k->state == best->state && k->since < best->since))
+			best = k;
+	}
+	return best;
+}
+
+/* A connection was accepted (its descriptor is in libwebsockets' table):
+ * kept, after another made room if the table of live ones is full. */
+static int web_conn_add(struct lws *wsi)
+{
+	if (app.nconns - app.nevicted >= WEB_MAX_CONNECTIONS) {
+		struct web_conn *v = web_conn_victim();
+		if (v != NULL) {
+			v->state = WEB_CONN_EVICTED;
+			app.nevicted++;
+			app.n.conns_evicted++;
+			web_log(app.n.conns_evicted, "%d connections: closed the one that waited longest for a request "
+			        "(%.1f s)", WEB_MAX_CONNECTIONS, clock_mono_s() - v->since);
+			lws_set_timeout(v->wsi, PENDING_TIMEOUT_USER_OK, LWS_TO_KILL_ASYNC);
+		}
+	}
+	if (app.nconns - app.nevicted >= WEB_MAX_CONNECTIONS || app.nconns >= WEB_FD_LIMIT) {
+		app.n.http_refused++;
+		web_log(app.n.http_refused, "refused a connection: %d open, none of them can give way",
+		        WEB_MAX_CONNECTIONS);
+		return 1;
+	}
+	app.conns[app.nconns++] = (struct web_conn){ .wsi = wsi, .since = clock_mono_s(), .state = WEB_CONN_WAITING };
+	return 0;
+}
+
+static void web_conn_drop(struct lws *wsi)
+{
+	struct web_conn *k = web_conn_of(wsi);
+	if (k == NULL)
+		return;
+	app.nevicted -= k->state == WEB_CONN_EVICTED;
+	*k = app.conns[--app.nconns];
+}
+
 /* ---- HTTP ----------------------------------------------------------------------- */
 
 static const char *web_method(struct lws *wsi)
@@ -211,12 +296,19 @@ static const char *web_method(struct lws *wsi)
 	return "?";
 }
 
+/* An answer went out whole: the connection waits for its next request. */
+static int web_http_done(struct lws *wsi)
+{
+	web_conn_set(wsi, WEB_CONN_WAITING);
+	return lws_http_transaction_completed(wsi) ? -1 : 0;
+}
+
 static int web_http_status(struct lws *wsi, unsigned code, const char *why)
 {
 	app.n.http_refused++;
 	if (lws_return_http_status(wsi, code, why))
 		return -1;
-	return lws_http_transaction_completed(wsi) ? -1 : 0;
+	return web_http_done(wsi);
 }
 
 static int web_serve_file(struct lws *wsi, const char *dir, const char *name, const char *mime)
@@ -229,9 +321,7 @@ static int web_serve_file(struct lws *wsi, const char *dir, const char *name, co
 	int n = lws_serve_http_file(wsi, path, mime, "cache-control: no-cache\x0d\x0a", 0);
 	if (n < 0)
 		return -1;
-	if (n > 0 && lws_http_transaction_completed(wsi))
-		return -1;
-	return 0;
+	return n > 0 ? web_http_done(wsi) : 0;
 }
 
 static int web_snapshot(struct lws *wsi, struct web_http *h)
@@ -271,7 +361,7 @@ static int web_http_write(struct lws *wsi, struct web_http *h)
 	}
 	free(h->body);
 	h->body = NULL;
-	return lws_http_transaction_completed(wsi) ? -1 : 0;
+	return web_http_done(wsi);
 }
 
 /* The request's Host header (empty when missing or longer than cap). */
@@ -286,6 +376,7 @@ static void web_host(struct lws *wsi, char *host, size_t cap)
 static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
 {
 	app.n.http_requests++;
+	web_conn_set(wsi, WEB_CONN_BUSY);
 	const char *method = web_method(wsi);
 	char quoted[80], host[256];
 	text_sanitize(quoted, sizeof quoted, uri);
@@ -322,6 +413,13 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 	case LWS_CALLBACK_FILTER_NETWORK_CONNECTION:
 		/* a new connection: what its client sends is watched from its first byte */
 		return wsr_watch((int)(intptr_t)in) ? 0 : 1;
+	case LWS_CALLBACK_SERVER_NEW_CLIENT_INSTANTIATED:
+		return web_conn_add(wsi);
+	case LWS_CALLBACK_WSI_DESTROY:
+		web_conn_drop(wsi);
+		return 0;
+	case LWS_CALLBACK_HTTP_FILE_COMPLETION:
+		return web_http_done(wsi);
 	case LWS_CALLBACK_HTTP:
 		return web_http(wsi, h, in != NULL ? (const char *)in : "");
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
@@ -551,6 +649,7 @@ static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
 	int fd = lws_get_socket_fd(wsi);
 	switch (reason) {
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+		web_conn_set(wsi, WEB_CONN_BUSY);
 		if (!web_ws_allowed(wsi))
 			return 1;
 		web_ws_token(wsi, c);
@@ -560,6 +659,7 @@ static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
 		if (web_ws_bad(wsi, c, wsr_upgraded(fd)))
 			return -1;
 		web_ws_open(wsi, c);
+		web_conn_set(wsi, WEB_CONN_WS);
 		return 0;
 	case LWS_CALLBACK_SERVER_WRITEABLE:
 		/* also what came in control frames, which reach no callback */
@@ -669,9 +769,9 @@ static int web_start(void)
 	if (strchr(app.o.addr, ':') == NULL)
 		info.options |= LWS_SERVER_OPTION_DISABLE_IPV6;
 	info.max_http_header_data = WEB_HEADER_MAX;
+	/* a header buffer for every connection that may be waiting for its request */
 	info.max_http_header_pool = WEB_MAX_CONNECTIONS;
-	/* the listening socket, the LCM and command sockets, lws's own pipe, and the connections */
-	info.fd_limit_per_thread = WEB_MAX_CONNECTIONS + 8;
+	info.fd_limit_per_thread = WEB_FD_LIMIT;
 	info.timeout_secs = WEB_HTTP_TIMEOUT_S;
 	info.timeout_secs_ah_idle = WEB_HTTP_TIMEOUT_S;
 	info.keepalive_timeout = 5;
@@ -757,9 +857,11 @@ int web_run(const struct web_opts *o)
 	while (!web_stop && lws_service(app.ctx, 0) >= 0)
 		;
 	fprintf(stderr, "undulate-web: exit: %lld HTTP requests (%lld refused), %lld WebSocket refused, %lld messages "
-	        "refused, %lld commands sent (%lld refused), %lld frames sent, %lld skipped, %lld browsers stalled\n",
+	        "refused, %lld commands sent (%lld refused), %lld frames sent, %lld skipped, %lld browsers stalled, "
+	        "%lld closed for their frames, %lld connections closed to make room\n",
 	        app.n.http_requests, app.n.http_refused, app.n.ws_refused, app.n.msgs_refused, app.n.commands_sent,
-	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled);
+	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled,
+	        app.n.ws_bad_frames, app.n.conns_evicted);
 	lws_context_destroy(app.ctx);
 	if (app.token_path[0] != '\0')
 		unlink(app.token_path);

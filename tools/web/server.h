@@ -13,12 +13,20 @@
 
 #define WEB_MAX_CLIENTS 32          /* WebSocket browsers at once; more are refused */
 #define WEB_MAX_WATCHERS 24         /* of them without the token: the rest is kept for its holders */
-#define WEB_MAX_CONNECTIONS 96      /* file descriptors for connections (HTTP and WebSocket) */
+/* Connections at once (HTTP and WebSocket). One more is taken by closing the
+ * connection that has waited longest without a request being served (half
+ * open, or idle between requests): a crowd that connects and sends nothing
+ * only pushes its own out, and a client that sends its request at once (a
+ * browser, the operator) is served. */
+#define WEB_MAX_CONNECTIONS 128
+/* libwebsockets' descriptors: the connections, those being closed to make
+ * room, the listening socket, LCM's and the command socket, its own pipe */
+#define WEB_FD_LIMIT (WEB_MAX_CONNECTIONS + 64)
 #define WEB_HEADER_MAX 4096         /* bytes of request headers; beyond: refused */
 #define WEB_FRAME_MAX (2 * 1024 * 1024) /* one frame; a larger catch-up keeps the newest samples */
 #define WEB_FRAME_EVERY 2           /* samples (HIST_HZ) per frame: 12.5 frames per second */
 #define WEB_STALL_S 30.0            /* a browser that takes no frame for this long is closed */
-#define WEB_HTTP_TIMEOUT_S 10       /* a request must arrive whole within this */
+#define WEB_HTTP_TIMEOUT_S 5        /* a request must arrive whole within this; idle keep-alive as long */
 /* Kernel send buffer per browser (the kernel doubles it): with libwebsockets'
  * one partial frame, all a browser that stops reading can hold of ours. A
  * frame of 20 robots is ~6 kB; a browser that reads keeps it nearly empty. */
