@@ -2,6 +2,7 @@
 #include "server.h"
 
 #include <errno.h>
+#include <inttypes.h>
 #include <libwebsockets.h>
 #include <math.h>
 #include <signal.h>
@@ -566,6 +567,11 @@ static void web_command(struct web_client *c, struct req_msg *m)
 		return web_note(c, m->id, 0, m->robot, "not-sent", why);
 	}
 	app.n.commands_sent++;
+	/* the robot logs this process; this log says which browser it was for */
+	char peer[64] = "?", quoted[128];
+	lws_get_peer_simple(c->wsi, peer, sizeof peer);
+	fprintf(stderr, "undulate-web: browser %u (%s, with the token): command %" PRId64 " '%s' to %s, %d reached\n",
+	        c->id, peer, seq, text_sanitize(quoted, sizeof quoted, m->text), m->robot, reached);
 	char what[FRAME_NOTE_TEXT];
 	snprintf(what, sizeof what, "'%.60s' sent to %d robot%s%s, waiting for the answer", m->text, reached,
 	         reached == 1 ? "" : "s", app.cmd.signed_lcm ? " (signed, over LCM)" : "");
