@@ -114,7 +114,7 @@ bool req_msg_parse(const char *data, size_t len, int njoints, struct req_msg *m,
 	if (strcmp(word, "auth") == 0) {
 		m->kind = REQ_MSG_AUTH;
 		if (!req_word(&p, m->token, sizeof m->token) || *p != '\0')
-			return req_fail(why, cap, "auth: one token of at most 127 characters");
+			return req_fail(why, cap, "auth: one token of at most 64 characters");
 		return true;
 	}
 	if (strcmp(word, "cmd") != 0)
