@@ -2,7 +2,6 @@
 #include "req.h"
 
 #include <arpa/inet.h>
-#include <ctype.h>
 #include <sodium.h>
 #include <strings.h>
 #include <stdio.h>
@@ -10,6 +9,7 @@
 #include <string.h>
 
 #include "daemon/config.h"
+#include "text.h"
 
 static bool req_path_is(const char *path, const char *want)
 {
@@ -32,17 +32,10 @@ enum req_route req_route(const char *method, const char *path)
 	return REQ_NOT_FOUND;
 }
 
+/* A robot's name (the monitors' rule, common/text.h), or "*": every robot. */
 static bool req_name_ok(const char *s)
 {
-	if (strcmp(s, "*") == 0)
-		return true;
-	size_t n = strlen(s);
-	if (n == 0 || n >= CFG_NAME_MAX)
-		return false;
-	for (size_t i = 0; i < n; i++)
-		if (!isalnum((unsigned char)s[i]) && s[i] != '_' && s[i] != '-')
-			return false;
-	return true;
+	return strcmp(s, "*") == 0 || text_is_name(s, CFG_NAME_MAX - 1);
 }
 
 /* The next space-separated word of *p into out (cap); false if none or too long. */
