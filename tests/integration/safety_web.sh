@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: alone — its crowd (a few thousand connections in seconds) is a load of its own, and it times the operator under it (tests/run.sh)
 # safety_web.sh — undulate-web against hostile clients, as the security
 # review reproduced them (each succeeded on the dashboard before its fix):
 #  - DNS rebinding: a page of another site whose name now points to this

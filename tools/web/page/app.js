@@ -226,7 +226,17 @@ function onFrame(frame) {
     if (q.seen !== state.frames) { q.chart.destroy(); q.card.remove(); state.pairs.delete(key); }
   simData(frame);
   document.body.dataset.frames = state.frames;
-  redraw();
+  scheduleRedraw();
+}
+
+// One redraw for however many frames arrived since the last: a browser short
+// of CPU (a busy machine) takes the frames the server sends it, and redrawing
+// after each one would queue work without end; the data is kept either way.
+let redrawPending = false;
+function scheduleRedraw() {
+  if (redrawPending) return;
+  redrawPending = true;
+  setTimeout(() => { redrawPending = false; redraw(); }, 0);
 }
 
 function redraw() {
