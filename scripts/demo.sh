@@ -374,12 +374,13 @@ t_ready=$(date +%s%N)
 
 # ---- the web dashboard, beside the terminal view --------------------------------
 # undulate-web on loopback (DEMO_WEB_PORT, default 8080; any free port when
-# that one is taken): the same robots in a browser, with the plots.
+# that one is taken): the same robots in a browser, with the plots. Its URL
+# carries the token it made (commands need it; a page without it watches).
 web_url=""
 start_web() {
 	start web "$B/undulate-web" --listen "127.0.0.1:$1" --lcm-url "$url"
-	wait_ready web 'listening on http://' 2>/dev/null || return 1
-	web_url=$(sed -n 's|^undulate-web: listening on \(http://[^ ]*\).*|\1|p' "$run/web.log")
+	wait_ready web 'open http://[^ ]*#token=' 2>/dev/null || return 1
+	web_url=$(sed -n 's|^undulate-web: open \(http://[^ ]*#token=[^ ]*\) .*|\1|p' "$run/web.log")
 }
 if [ -x "$B/undulate-web" ] && [ "$lockstep" != 1 ]; then
 	start_web "${DEMO_WEB_PORT:-8080}" || { mv "$run/web.log" "$run/web.1.log"; start_web 0; } ||
