@@ -177,6 +177,10 @@ static const struct cfg_param_def cfg_params[] = {
 	{ "amplitude", { 0.0, CFG_SERVO_HALF_RANGE, false }, false, true },
 	{ "frequency", { 0.0, 5.0, false }, false, true },
 	{ "phase",     { -2.0 * CFG_PI, 2.0 * CFG_PI, false }, false, true },
+	/* the clock as a torque law: the paper's 0.015..0.135 N·m/rad and far
+	 * beyond (the position loop's own stiffness is 9.2 N·m/rad); 0 = off */
+	{ "stiffness", { 0.0, 10.0, false }, false, true },
+	{ "damping",   { 0.0, 1.0, false }, false, true },
 };
 #define CFG_NPARAMS (sizeof cfg_params / sizeof cfg_params[0])
 
@@ -205,7 +209,28 @@ bool cfg_param_commandable(const char *key)
 
 const char *cfg_param_commandable_list(void)
 {
-	return "k, c, mu, lambda, inertia, friction (per joint), amplitude, frequency, phase (sinusoid)";
+	return "k, c, mu, lambda, inertia, friction (per joint), amplitude, frequency, phase, stiffness, damping "
+	       "(sinusoid)";
+}
+
+double *cfg_robot_param(struct cfg *c, const char *key)
+{
+	if (strcmp(key, "amplitude") == 0) return &c->amplitude;
+	if (strcmp(key, "frequency") == 0) return &c->frequency;
+	if (strcmp(key, "phase") == 0) return &c->phase;
+	if (strcmp(key, "stiffness") == 0) return &c->sin_stiffness;
+	if (strcmp(key, "damping") == 0) return &c->sin_damping;
+	return NULL;
+}
+
+bool cfg_robot_param_check(const struct cfg *c, const char *key, double value, char *why, size_t cap)
+{
+	if (strcmp(key, "stiffness") == 0 && value > 0.0 && c->actuation != CFG_ACT_TORQUE) {
+		snprintf(why, cap, "stiffness %g drives the clock as a torque: it needs [robot] actuation = torque "
+		         "(with position actuation SINUSOID follows the clock with the servo's position loop)", value);
+		return false;
+	}
+	return true;
 }
 
 bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap)
@@ -318,6 +343,9 @@ void cfg_defaults(struct cfg *c)
 	c->amplitude = 0.8;
 	c->frequency = 0.8;
 	c->phase = 0.0;
+	/* SINUSOID through the servo's position loop unless a stiffness is given */
+	c->sin_stiffness = 0.0;
+	c->sin_damping = 0.0;
 }
 
 /* ---- [robot] keys --------------------------------------------------------------------- */
@@ -554,11 +582,10 @@ bool cfg_set(struct cfg *c, const char *where, const char *section, const char *
 	if (strcmp(section, "robot") == 0)
 		return cfg_set_robot(c, where, key, value, e);
 	if (strcmp(section, "sinusoid") == 0) {
-		double *f = strcmp(key, "amplitude") == 0 ? &c->amplitude
-		          : strcmp(key, "frequency") == 0 ? &c->frequency
-		          : strcmp(key, "phase") == 0 ? &c->phase : NULL;
+		double *f = cfg_robot_param(c, key);
 		if (f == NULL) {
-			cfg_error(e, "%s: [sinusoid] %s: unknown key (amplitude, frequency, phase)", where, key);
+			cfg_error(e, "%s: [sinusoid] %s: unknown key (amplitude, frequency, phase, stiffness, damping)",
+			          where, key);
 			return false;
 		}
 		return cfg_set_param(f, where, section, key, value, e);
@@ -924,6 +951,9 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 		cfg_error(e, "%s: [robot] velocity_source = servo cannot be used with actuation = torque: in wheel "
 		          "mode the AX-12's present speed is its output, not a speed; use velocity_source = filtered",
 		          c->source[0] ? c->source : "command line");
+	char pwhy[200];
+	if (!cfg_robot_param_check(c, "stiffness", c->sin_stiffness, pwhy, sizeof pwhy))
+		cfg_error(e, "%s: [sinusoid] %s", c->source[0] ? c->source : "command line", pwhy);
 	if (c->commands == CFG_CMD_NETWORK && c->command_key[0] == '\0')
 		cfg_error(e, "%s: [robot] commands = network needs command_key = FILE (the shared key: "
 		          "`undulated --gen-key FILE` makes one)", c->source[0] ? c->source : "command line");
@@ -968,6 +998,6 @@ void cfg_print(const struct cfg *c, void *file)
 		        jt->osc.c, jt->osc.mu, jt->osc.lambda, jt->osc.inertia, jt->osc.friction, jt->neutral,
 		        jt->limit_min, jt->limit_max, jt->max_step);
 	}
-	fprintf(f, "\n[sinusoid]\namplitude = %g\nfrequency = %g\nphase = %g\n", c->amplitude, c->frequency,
-	        c->phase);
+	fprintf(f, "\n[sinusoid]\namplitude = %g\nfrequency = %g\nphase = %g\nstiffness = %g\ndamping = %g\n",
+	        c->amplitude, c->frequency, c->phase, c->sin_stiffness, c->sin_damping);
 }

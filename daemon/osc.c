@@ -249,6 +249,34 @@ double osc_sinusoid(double amplitude, double frequency, double phase, size_t joi
 	return amplitude * sin(phase + (2.0 * OSC_PI / 3.0) * (double)joint - 2.0 * OSC_PI * cycles);
 }
 
+double osc_sinusoid_rate(double amplitude, double frequency, double phase, size_t joint, double t)
+{
+	double cycles = frequency * t;
+	cycles -= floor(cycles);
+	return -2.0 * OSC_PI * frequency * amplitude *
+	       cos(phase + (2.0 * OSC_PI / 3.0) * (double)joint - 2.0 * OSC_PI * cycles);
+}
+
+bool osc_clock_torque(const struct osc_clock *k, size_t njoints, double t, const double *x, const double *v,
+                      double *torque)
+{
+	if (njoints == 0 || njoints > OSC_MAX_JOINTS)
+		return false;
+	bool ok = osc_all_finite(x, njoints) && osc_all_finite(v, njoints) && isfinite(t) &&
+	          isfinite(k->amplitude) && isfinite(k->frequency) && isfinite(k->phase) &&
+	          isfinite(k->stiffness) && isfinite(k->damping);
+	for (size_t j = 0; j < njoints; j++) {
+		double target = osc_sinusoid(k->amplitude, k->frequency, k->phase, j, t);
+		double rate = osc_sinusoid_rate(k->amplitude, k->frequency, k->phase, j, t);
+		torque[j] = ok ? k->stiffness * (target - x[j]) + k->damping * (rate - v[j]) : 0.0;
+		ok = ok && isfinite(torque[j]);
+	}
+	if (!ok)
+		for (size_t j = 0; j < njoints; j++)
+			torque[j] = 0.0;
+	return ok;
+}
+
 void osc_velocity_filter_init(struct osc_velocity_filter *f, double cutoff_hz)
 {
 	f->cutoff_hz = cutoff_hz;

@@ -91,6 +91,26 @@ bool osc_step(const struct osc_joint_params *p, size_t njoints, const double *x,
 /* The baseline: commanded angle of joint j at time t (s). Non-finite arguments
  * give a non-finite result: the caller checks before commanding it. */
 double osc_sinusoid(double amplitude, double frequency, double phase, size_t joint, double t);
+/* Its speed, dx̄_j/dt (rad/s), with the same care for a wall-clock t. */
+double osc_sinusoid_rate(double amplitude, double frequency, double phase, size_t joint, double t);
+
+/* Torque actuation's SINUSOID: the clock as a torque law, as the paper's
+ * force simulations drove their joints (k_s 0.015..0.135 N·m/rad there):
+ *     τ_j = k_s (x̄_j(t) − x_j) + d_s (dx̄_j/dt − ẋ_j)      (N·m)
+ * from the measured state. d_s = 0 is the paper's (purely proportional) law;
+ * the damping acts on the difference from the clock's own speed, so it never
+ * resists following the clock. Non-finite state, time or parameters give 0
+ * for every joint (no drive) and false; njoints 0 or > OSC_MAX_JOINTS:
+ * false, nothing written. */
+struct osc_clock {
+	double amplitude;   /* rad */
+	double frequency;   /* Hz */
+	double phase;       /* rad */
+	double stiffness;   /* k_s, N·m/rad */
+	double damping;     /* d_s, N·m·s/rad */
+};
+bool osc_clock_torque(const struct osc_clock *k, size_t njoints, double t, const double *x, const double *v,
+                      double *torque);
 
 /* The phase of a joint and its running frequency and amplitude: common/phase.h
  * (one definition for the daemon and the analyser). */
