@@ -170,6 +170,7 @@ static const struct cfg_param_def cfg_params[] = {
 	{ "lambda",    { -10.0, 10.0, false }, true, true },
 	{ "inertia",   { 1e-5, 1.0, false }, true, true },
 	{ "friction",  { 0.0, 1.0, false }, true, true },
+	{ "coupling_phase", { -CFG_PI, CFG_PI, false }, true, true },
 	{ "neutral",   { -CFG_SERVO_HALF_RANGE, CFG_SERVO_HALF_RANGE, false }, true, false },
 	{ "limit_min", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
 	{ "limit_max", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
@@ -209,8 +210,8 @@ bool cfg_param_commandable(const char *key)
 
 const char *cfg_param_commandable_list(void)
 {
-	return "k, c, mu, lambda, inertia, friction (per joint), amplitude, frequency, phase, stiffness, damping "
-	       "(sinusoid)";
+	return "k, c, mu, lambda, coupling_phase, inertia, friction (per joint), amplitude, frequency, phase, "
+	       "stiffness, damping (sinusoid)";
 }
 
 double *cfg_robot_param(struct cfg *c, const char *key)
@@ -262,6 +263,7 @@ double *cfg_joint_param(struct cfg_joint *j, const char *key)
 	if (strcmp(key, "c") == 0) return &j->osc.c;
 	if (strcmp(key, "mu") == 0) return &j->osc.mu;
 	if (strcmp(key, "lambda") == 0) return &j->osc.lambda;
+	if (strcmp(key, "coupling_phase") == 0) return &j->osc.coupling_phase;
 	if (strcmp(key, "inertia") == 0) return &j->osc.inertia;
 	if (strcmp(key, "friction") == 0) return &j->osc.friction;
 	if (strcmp(key, "neutral") == 0) return &j->neutral;
@@ -333,7 +335,7 @@ void cfg_defaults(struct cfg *c)
 	for (size_t j = 0; j < CFG_MAX_JOINTS; j++) {
 		struct cfg_joint *jt = &c->joint[j];
 		jt->osc.k = jt->osc.c = jt->osc.mu = jt->osc.lambda = NAN;
-		jt->osc.inertia = jt->osc.friction = NAN;
+		jt->osc.inertia = jt->osc.friction = jt->osc.coupling_phase = NAN;
 		jt->neutral = NAN;
 		jt->limit_min = NAN;
 		jt->limit_max = NAN;
@@ -865,6 +867,7 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 		if (isnan(jt->osc.c)) jt->osc.c = d.c;
 		if (isnan(jt->osc.mu)) jt->osc.mu = d.mu;
 		if (isnan(jt->osc.lambda)) jt->osc.lambda = d.lambda;
+		if (isnan(jt->osc.coupling_phase)) jt->osc.coupling_phase = d.coupling_phase;
 		if (isnan(jt->osc.inertia)) jt->osc.inertia = d.inertia;
 		if (isnan(jt->osc.friction)) jt->osc.friction = d.friction;
 		if (isnan(jt->neutral)) jt->neutral = 0.0;
@@ -912,7 +915,8 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 	for (size_t j = c->njoints; j < CFG_MAX_JOINTS; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		if (!isnan(jt->osc.k) || !isnan(jt->osc.c) || !isnan(jt->osc.mu) || !isnan(jt->osc.lambda) ||
-		    !isnan(jt->osc.inertia) || !isnan(jt->osc.friction) || !isnan(jt->neutral) ||
+		    !isnan(jt->osc.inertia) || !isnan(jt->osc.friction) || !isnan(jt->osc.coupling_phase) ||
+		    !isnan(jt->neutral) ||
 		    !isnan(jt->limit_min) || !isnan(jt->limit_max) || !isnan(jt->max_step))
 			cfg_error(e, "%s: [joint.%zu]: the robot has only %zu joint(s) (ids)",
 			          c->source[0] ? c->source : "command line", j + 1, c->njoints);
@@ -993,9 +997,10 @@ void cfg_print(const struct cfg *c, void *file)
 	        c->command_key, c->command_window_s, c->run_dir, c->lockstep);
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
-		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ninertia = %g\nfriction = %g\n"
-		        "neutral = %g\nlimit_min = %g\nlimit_max = %g\nmax_step = %g\n", j + 1, jt->osc.k,
-		        jt->osc.c, jt->osc.mu, jt->osc.lambda, jt->osc.inertia, jt->osc.friction, jt->neutral,
+		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ncoupling_phase = %g\ninertia = %g\n"
+		        "friction = %g\nneutral = %g\nlimit_min = %g\nlimit_max = %g\nmax_step = %g\n", j + 1, jt->osc.k,
+		        jt->osc.c, jt->osc.mu, jt->osc.lambda, jt->osc.coupling_phase, jt->osc.inertia, jt->osc.friction,
+		        jt->neutral,
 		        jt->limit_min, jt->limit_max, jt->max_step);
 	}
 	fprintf(f, "\n[sinusoid]\namplitude = %g\nfrequency = %g\nphase = %g\nstiffness = %g\ndamping = %g\n",

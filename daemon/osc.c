@@ -73,6 +73,7 @@ void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints
 	p->mu = OSC_DEF_MU0;
 	p->inertia = OSC_DEF_INERTIA;
 	p->friction = 0.0;
+	p->coupling_phase = 0.0;
 	if (njoints < 2) {
 		p->lambda = 0.0;   /* uncoupled: a van der Pol oscillator */
 		p->mu = OSC_DEF_MU_SINGLE;
@@ -92,6 +93,7 @@ void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t 
 	p->mu = OSC_TQ_MU;
 	p->inertia = OSC_TQ_INERTIA;
 	p->friction = OSC_TQ_FRICTION;
+	p->coupling_phase = 0.0;
 	p->lambda = njoints < 2 ? 0.0 : (joint % 2 == 0 ? OSC_DEF_LAMBDA0 : OSC_DEF_LAMBDA1);
 }
 
@@ -102,11 +104,25 @@ static size_t osc_other(size_t j, size_t njoints)
 	return (j + 1 < njoints) ? j + 1 : j - 1;
 }
 
+/* The other joint as joint j's coupling sees it: its angle θ_j further on in
+ * its cycle, from its angle and speed (on x = a cos ωt, exactly
+ * a cos(ωt + θ) when ω is the law's own √(k/I)). θ = 0: the angle as it is,
+ * bit for bit the law without the term. */
+static double osc_coupled(const struct osc_joint_params *p, size_t j, double x_other, double v_other)
+{
+	double theta = p[j].coupling_phase;
+	if (theta == 0.0)
+		return x_other;
+	double omega = sqrt(p[j].k / p[j].inertia);
+	return x_other * cos(theta) + v_other / omega * sin(theta);
+}
+
 /* The right-hand side of the law for joint j at state (x, v). */
 static double osc_law(const struct osc_joint_params *p, size_t njoints, const double *x,
                       const double *v, size_t j)
 {
-	double coupled = (njoints >= 2) ? p[j].lambda * x[osc_other(j, njoints)] : 0.0;
+	size_t o = njoints >= 2 ? osc_other(j, njoints) : j;
+	double coupled = (njoints >= 2) ? p[j].lambda * osc_coupled(p, j, x[o], v[o]) : 0.0;
 	double torque = -p[j].k * (x[j] + coupled) + (p[j].c - p[j].mu * x[j] * x[j]) * v[j];
 	if (p[j].friction != 0.0)
 		torque += p[j].friction * tanh(v[j] / OSC_FRICTION_BAND);
@@ -134,7 +150,8 @@ static bool osc_params_ok(const struct osc_joint_params *p, size_t njoints)
 	for (size_t j = 0; j < njoints; j++) {
 		const struct osc_joint_params *q = &p[j];
 		if (!isfinite(q->k) || !isfinite(q->c) || !isfinite(q->mu) || !isfinite(q->lambda) ||
-		    !isfinite(q->friction) || !isfinite(q->inertia) || !(q->inertia > 0.0))
+		    !isfinite(q->friction) || !isfinite(q->inertia) || !(q->inertia > 0.0) ||
+		    !isfinite(q->coupling_phase))
 			return false;
 	}
 	return true;
@@ -228,7 +245,8 @@ bool osc_torque(const struct osc_joint_params *p, size_t njoints, const double *
 	bool ok = osc_all_finite(x, njoints) && osc_all_finite(v, njoints);
 	for (size_t j = 0; ok && j < njoints; j++)
 		ok = isfinite(p[j].k) && isfinite(p[j].c) && isfinite(p[j].mu) && isfinite(p[j].lambda) &&
-		     isfinite(p[j].friction);
+		     isfinite(p[j].friction) && isfinite(p[j].coupling_phase) &&
+		     (p[j].coupling_phase == 0.0 || p[j].inertia > 0.0);
 	for (size_t j = 0; j < njoints; j++)
 		torque[j] = ok ? osc_law(p, njoints, x, v, j) : 0.0;
 	for (size_t j = 0; ok && j < njoints; j++)

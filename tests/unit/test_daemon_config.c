@@ -243,6 +243,16 @@ static void test_sinusoid_stiffness(void **state)
 	cfg_defaults(&c);
 	assert_true(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1,2\n", &e) && cfg_finish(&c, &e));
 	assert_true(c.sin_stiffness == 0.0 && c.sin_damping == 0.0);
+	/* and the coupling's phase 0: the paper's law */
+	assert_true(c.joint[0].osc.coupling_phase == 0.0 && c.joint[1].osc.coupling_phase == 0.0);
+	cfg_defaults(&c);
+	e.count = 0;
+	assert_true(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1,2\n[joint.1]\ncoupling_phase = 0.6\n"
+	                            "[joint.2]\ncoupling_phase = -0.6\n", &e) && cfg_finish(&c, &e));
+	assert_true(c.joint[0].osc.coupling_phase == 0.6 && c.joint[1].osc.coupling_phase == -0.6);
+	assert_false(cfg_load_string(&c, "r.conf", "[joint.1]\ncoupling_phase = 4\n", &e));
+	assert_non_null(strstr(e.line[e.count - 1], "[joint.1] coupling_phase: 4 out of range -3.14159..3.14159"));
+	e.count = 0;
 	cfg_defaults(&c);
 	assert_true(cfg_load_string(&c, "r.conf", "[sinusoid]\nstiffness = 0.135\ndamping = 0.01\n[robot]\n"
 	                            "port=/dev/null\nids=1,2\nactuation = torque\n", &e));
@@ -643,6 +653,11 @@ static void test_param_ranges(void **state)
 	assert_true(cfg_param_is_robot("amplitude"));
 	struct cfg_joint j;
 	assert_ptr_equal(cfg_joint_param(&j, "friction"), &j.osc.friction);
+	/* the coupling's phase (CONTROL.md, "The joints' lag"): per joint, commandable, ±π */
+	assert_ptr_equal(cfg_joint_param(&j, "coupling_phase"), &j.osc.coupling_phase);
+	assert_true(cfg_param_range("coupling_phase", &r) && cfg_param_commandable("coupling_phase") &&
+	            cfg_param_is_joint("coupling_phase"));
+	assert_true(fabs(r.min + M_PI) < 1e-9 && fabs(r.max - M_PI) < 1e-9);
 	assert_null(cfg_joint_param(&j, "amplitude"));
 	enum cfg_mode m;
 	assert_true(cfg_mode_parse("Oscillator", &m));
