@@ -49,12 +49,24 @@
  * from a speed estimate a few ms late: the error goes with the acceleration,
  * i.e. with −x, and softens the spring (0.61 Hz with k = 0.111); k = 0.19
  * gives 0.79–0.80 Hz, 0.77 rad there (measured, CONTROL.md).
+ * Two or more joints: the paper's coupling pumps energy into the travelling
+ * wave (growth ≈ 0.37·ω in the bare law), so one joint's μ let two joints
+ * swing 2.0/1.6 rad, past the ±1.3 rad limits (measured on the simulated
+ * robot: the limit fault at 13 s on the current drive, 1.13 rad at 0.90 Hz on
+ * the PWM drive). A larger μ, smaller on the odd joints as in the position
+ * defaults, found by `undulated --tune` on the simulated two-joint robot in
+ * lockstep and rounded: 0.809 Hz, 0.82/0.80 rad (current), 0.813 Hz,
+ * 0.83/0.80 rad (PWM).
  */
 #define OSC_TQ_INERTIA OSC_TORQUE_JOINT_INERTIA
 #define OSC_TQ_K        0.111
 #define OSC_TQ_K_PWM    0.19
 #define OSC_TQ_C        6.6e-3
 #define OSC_TQ_MU       0.032
+#define OSC_TQ_MU0      0.18     /* two or more joints, even joints, current drive */
+#define OSC_TQ_MU1      0.10     /* ... odd joints */
+#define OSC_TQ_MU0_PWM  0.26     /* two or more joints on the PWM drive */
+#define OSC_TQ_MU1_PWM  0.15
 #define OSC_TQ_FRICTION 0.005
 
 /* Width (rad/s) of the smooth sign used for friction compensation:
@@ -90,7 +102,12 @@ void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t 
 {
 	p->k = pwm ? OSC_TQ_K_PWM : OSC_TQ_K;
 	p->c = OSC_TQ_C;
-	p->mu = OSC_TQ_MU;
+	if (njoints < 2)
+		p->mu = OSC_TQ_MU;
+	else if (joint % 2 == 0)
+		p->mu = pwm ? OSC_TQ_MU0_PWM : OSC_TQ_MU0;
+	else
+		p->mu = pwm ? OSC_TQ_MU1_PWM : OSC_TQ_MU1;
 	p->inertia = OSC_TQ_INERTIA;
 	p->friction = OSC_TQ_FRICTION;
 	p->coupling_phase = 0.0;

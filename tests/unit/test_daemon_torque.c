@@ -347,6 +347,34 @@ static void test_limit_cycle_through_torque(void **state)
 	assert_int_equal(c.starts, 0);
 }
 
+/* Two coupled joints on the torque defaults: the coupling pumps energy into
+ * the travelling wave (CONTROL.md), so a two-joint robot needs a larger mu
+ * than one joint; with one joint's mu (0.032) the bare law swings 2.0/1.6 rad
+ * and left the +-1.3 rad limits. The limit cycle stays well inside them, on
+ * either drive, with no limit trip and no restart. */
+static void test_two_joint_defaults_inside_limits(void **state)
+{
+	(void)state;
+	static const char *const drives[] = { "current", "pwm" };
+	for (size_t d = 0; d < 2; d++) {
+		bool pwm = d == 1;
+		setup("1,2", drives[d], CFG_MODE_OSCILLATOR);
+		double widest[2] = { 0.0, 0.0 };
+		for (int i = 0; i < 4000; i++) {
+			cycle_pwm(pwm);
+			for (size_t j = 0; j < nj; j++)
+				if (i >= 2000)
+					widest[j] = fmax(widest[j], fabs(sv[j].angle));
+		}
+		if (c.limit_trips != 0 || c.latched || !c.wheel || !(widest[0] < 1.0 && widest[1] < 1.0) ||
+		    !(widest[0] > 0.5 && widest[1] > 0.5))
+			fail_msg("%s drive, defaults mu %.3f/%.3f: widest %.3f/%.3f rad in 20..40 s, %lld limit trip(s), %s",
+			         drives[d], cfg.joint[0].osc.mu, cfg.joint[1].osc.mu, widest[0], widest[1], c.limit_trips,
+			         c.latched ? c.latch : "no fault");
+		assert_int_equal(c.starts, 0);
+	}
+}
+
 /* From rest at chosen angles the law starts at once, at phases 0 and pi:
  * joints held apart in anti-phase stay exactly in anti-phase. */
 static void test_start_from_rest_displaced(void **state)
@@ -356,6 +384,7 @@ static void test_start_from_rest_displaced(void **state)
 	start_angle[1] = -0.5;
 	setup("1,2", "current", CFG_MODE_HOLD);
 	cfg.joint[0].osc.lambda = cfg.joint[1].osc.lambda = 0.0;   /* two independent oscillators */
+	cfg.joint[1].osc.mu = cfg.joint[0].osc.mu;                  /* and alike */
 	run(50);
 	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
 	start_angle[0] = 0.2;
@@ -763,11 +792,6 @@ static void test_clock_to_oscillator_stays_in_drive(void **state)
 {
 	(void)state;
 	setup_clock("1,2", "current", "0.015");
-	/* the torque defaults were tuned on one joint: on two coupled joints
-	 * without damping the bare law swings 2.0/1.6 rad, past the limits; a
-	 * larger mu keeps them at 0.8/0.7 rad (CONTROL.md, "Torque actuation") */
-	cfg.joint[0].osc.mu = 0.2;
-	cfg.joint[1].osc.mu = 0.14;
 	run_into_wheel();
 	run(300);
 	for (size_t j = 0; j < nj; j++)
@@ -886,6 +910,7 @@ int main(void)
 		cmocka_unit_test(test_pwm_adds_back_emf),
 		cmocka_unit_test(test_switch_at_turning_point),
 		cmocka_unit_test(test_start_from_rest_displaced),
+		cmocka_unit_test(test_two_joint_defaults_inside_limits),
 		cmocka_unit_test(test_implausible_supply_is_a_fault),
 		cmocka_unit_test(test_no_outward_drive_at_the_wall),
 		cmocka_unit_test(test_limits_hold_for_every_reading),
