@@ -750,6 +750,23 @@ static void test_clock_drives_the_law(void **state)
 	}
 	/* the joints swing on the clock's wave: joint 1 behind joint 0 */
 	assert_true(fabs(sv[0].speed) > 0.05 || fabs(sv[1].speed) > 0.05);
+	/* a joint without a reading gets no drive; a non-finite law none at all */
+	sv[1].answers = false;
+	cycle();
+	assert_true(c.wheel && c.j[1].duty == 0.0 && c.j[0].duty != 0.0);
+	sv[1].answers = true;
+	run(5);
+	long long nonfinite = c.nonfinite;
+	cfg.amplitude = NAN;   /* (no file or command can set one) */
+	cycle();
+	assert_true(c.wheel && c.nonfinite > nonfinite);
+	assert_true(c.j[0].duty == 0.0 && c.j[1].duty == 0.0);
+	cfg.amplitude = 0.8;
+	/* nor a stiffness: not a torque law, back to joint mode */
+	cfg.sin_stiffness = NAN;
+	cycle();
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);
 }
 
 /* The safeties of torque actuation hold for the clock: the wall near a limit,
