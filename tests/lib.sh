@@ -228,7 +228,8 @@ samples() { awk -v r="$1" '$1 == "STATE" && $2 == r && $4 == "mode=3" {
 # Per joint over [from, to): upward crossings of the window's centre with
 # hysteresis (a tenth of the swing, well above the 5 mrad position step);
 # frequency from the first to the last crossing; each whole cycle's half
-# peak-to-peak; joint 2's crossing after each of joint 1's, as a lag in degrees.
+# peak-to-peak (least, most, mean); joint 2's crossing after each of joint 1's,
+# as a lag in degrees (least, most, mean and sd over the cycles).
 measure() {
 	awk -v from="$1" -v to="$2" '
 	function cross(j, t, x) {

@@ -6,7 +6,10 @@
  * a speed (AX-12A). Checked: the switch into and out of
  * wheel mode and its register sequence, the limit cycle driven through torque,
  * the walls near the limits, a limit breach falling back to joint mode, stale
- * joints and non-finite parameters giving no drive, the back-EMF added back. */
+ * joints and non-finite parameters giving no drive, the back-EMF added back,
+ * the supply as the PWM drive's gain, two joints on the defaults; and the
+ * clock as a torque law ([sinusoid] stiffness): its torque, the same guards,
+ * the switch to and from OSCILLATOR inside the drive. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
