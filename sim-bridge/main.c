@@ -519,8 +519,15 @@ static void publish_truth(struct app *a)
 	for (size_t i = 0; i < a->npending; i++)
 		fill_collision(a, &a->pending[i], a->pending_utime[i], &colls[i]);
 	fill_contacts(a, &t);
-	if (s->plane != NULL)
+	if (s->plane != NULL) {
 		fill_plane(a, &t);
+		/* where the walls stand: a crowd may hold them short of the motion */
+		t.wall_left = s->wall_face[0];
+		t.wall_right = s->wall_face[1];
+		t.escaped_links = (int64_t)s->escaped;
+		t.wall_force_left = s->wall_force[0];
+		t.wall_force_right = s->wall_force[1];
+	}
 	a->npending = 0;
 	a->period_worst_late_us = 0;
 	int n = undulate_sim_truth_t_encode(a->truth_buf, 0, MAIN_TRUTH_BUF, &t);

@@ -20,7 +20,6 @@
 #define PLANE_SLOP_M 2e-4
 #define PLANE_BIAS_LEFT_AFTER_1S 1e-100
 #define PLANE_ITERATIONS 20
-#define PLANE_WALL_RADIUS_M 0.005
 
 enum { PLANE_CT_LINK = 1, PLANE_CT_WALL = 2 };
 
@@ -278,7 +277,7 @@ int plane_add_wall(struct plane *pl, double ax, double ay, double bx, double by,
 	pl->wall_body[w] = cpSpaceAddBody(pl->space, cpBodyNewKinematic());
 	cpBodySetPosition(pl->wall_body[w], mid);
 	pl->wall_shape[w] = cpSpaceAddShape(pl->space, cpSegmentShapeNew(pl->wall_body[w], cpvsub(cpv(ax, ay), mid),
-	                                                                  cpvsub(cpv(bx, by), mid), PLANE_WALL_RADIUS_M));
+	                                                                  cpvsub(cpv(bx, by), mid), PLANE_WALL_RADIUS));
 	cpShapeSetCollisionType(pl->wall_shape[w], PLANE_CT_WALL);
 	pl->wall_tag[w] = (struct plane_tag){ PLANE_WALL, w };
 	cpShapeSetUserData(pl->wall_shape[w], &pl->wall_tag[w]);

@@ -37,6 +37,9 @@
 #define PLANE_MAX_WALLS 8
 #define PLANE_MAX_CONTACTS 256               /* touching pairs reported per step */
 #define PLANE_WALL -1                        /* robot index of a wall in a contact */
+/* A wall's half thickness (m): thick enough that links a crowd presses into
+ * it are pushed back to its own side, not through it */
+#define PLANE_WALL_RADIUS 0.02
 
 struct plane_params {
 	double link_length;       /* m (the paper: 0.1865) */

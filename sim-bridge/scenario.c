@@ -44,6 +44,7 @@ void sim_config_defaults(struct sim_config *c)
 	 * link inertia assumes; drag and friction chosen (PHYSICS.md §6) */
 	c->plane = (struct plane_params){ .link_length = 0.1865, .link_width = 0.032, .link_mass = 0.12,
 					  .friction = 0.2, .drag_tangent = 1.0, .drag_normal = 2.0, .substeps = 2 };
+	c->wall_force_max = 20.0;
 	sim_motor_default_params(&c->motor);
 }
 
@@ -282,6 +283,8 @@ static int set_plane(struct sim_config *c, const char *k, double d, char *err, s
 		return d >= 0 && d <= 1000 ? (p->drag_tangent = d, 0) : ERR("drag_tangent: 0..1000 N s/m per m");
 	if (!strcmp(k, "drag_normal"))
 		return d >= 0 && d <= 1000 ? (p->drag_normal = d, 0) : ERR("drag_normal: 0..1000 N s/m per m");
+	if (!strcmp(k, "wall_force_max"))
+		return d >= 0 && d <= 1e4 ? (c->wall_force_max = d, 0) : ERR("wall_force_max: 0..10000 N (0: walls never hold)");
 	if (!strcmp(k, "substeps"))
 		return d >= 1 && d <= 64 && d == floor(d) ? (p->substeps = (int)d, 0) : ERR("substeps: a whole number 1..64");
 	return 1;

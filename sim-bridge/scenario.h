@@ -82,6 +82,7 @@ struct sim_config {
 	struct plane_params plane;
 	bool ends_set;               /* walls across the robots' length at y = ends_back, ends_front */
 	double ends_back, ends_front;
+	double wall_force_max;       /* N: a closing side wall holds while the robots push it harder (0: never) */
 	double separation;           /* d̃ between neighbours' neutral positions */
 	double amplitude;            /* rad: A in d̃ = d / (2·lever·A) */
 	double spacing;              /* m: if > 0, neighbour distance (overrides separation) */

@@ -193,8 +193,13 @@ static int sim_plane_walls(struct sim *s, char *err, size_t errcap)
 	bool sides = w->wall_left < w->wall_right;
 	double back = c->ends_set ? c->ends_back : lo_y - 0.25, front = c->ends_set ? c->ends_front : hi_y + 0.25;
 	double left = sides ? w->wall_left : lo_x - 0.5, right = sides ? w->wall_right : hi_x + 0.5;
-	const double seg[4][4] = { { left, back, left, front }, { right, back, right, front },
-				   { left, back, right, back }, { left, front, right, front } };
+	s->wall_face[0] = left;
+	s->wall_face[1] = right;
+	/* the coordinates are the walls' faces: each segment stands its half
+	 * thickness further out */
+	const double r = PLANE_WALL_RADIUS, e = 2 * r;
+	const double seg[4][4] = { { left - r, back - e, left - r, front + e }, { right + r, back - e, right + r, front + e },
+				   { left - e, back - r, right + e, back - r }, { left - e, front + r, right + e, front + r } };
 	for (int k = 0; k < 4; k++) {
 		s->plane_wall[k] = -1;
 		if (k < 2 ? !sides : !c->ends_set)
@@ -464,18 +469,67 @@ static void sim_joint_drive(struct sim_joint *j, double dt, struct sim_motor_dri
 		d->cap = 0;
 }
 
+/* The side walls towards where "walls ... over S" puts them (wall_left,
+ * wall_right), at no more than the motion's own speed, and never inwards
+ * while the robots push a wall harder than wall_force_max: a crowd denser
+ * than its links allow would otherwise be crushed through each other (the
+ * paper's arena closes to 0.3 m; ten of these robots lying side by side take
+ * 0.32 m). The faces reported (SIM.TRUTH's wall_left, wall_right) are where
+ * the walls stand. */
 static void sim_plane_walls_follow(struct sim *s)
 {
-	const struct sim_world_params *w = &s->world.params;
+	struct sim_world_params *w = &s->world.params;
+	const struct sim_wall_motion *m = &s->wall_motion;
+	double speed = m->t1 > m->t0 ? fmax(fabs(m->to_left - m->from_left), fabs(m->to_right - m->from_right)) /
+	                                   (m->t1 - m->t0)
+	                             : INFINITY;
+	double step = speed * s->dt;
 	for (int k = 0; k < 2; k++) {
 		int wall = s->plane_wall[k];
 		if (wall < 0)
 			continue;
-		double ax, ay, bx, by, x = k == 0 ? w->wall_left : w->wall_right;
+		double want = k == 0 ? w->wall_left : w->wall_right, now = s->wall_face[k];
+		double move = fmax(-step, fmin(step, want - now));
+		bool inwards = k == 0 ? move > 0 : move < 0;
+		if (inwards && s->cfg.wall_force_max > 0 && s->wall_force[k] > s->cfg.wall_force_max) {
+			move = 0;
+			s->held_steps++;
+		}
+		if (move == 0)
+			continue;
+		s->wall_face[k] = now + move;
+		double ax, ay, bx, by, x = s->wall_face[k] + (k == 0 ? -PLANE_WALL_RADIUS : PLANE_WALL_RADIUS);
 		plane_wall(s->plane, wall, &ax, &ay, &bx, &by);
-		if (x != ax)
-			plane_move_wall(s->plane, wall, x, ay, x, by, s->dt);
+		plane_move_wall(s->plane, wall, x, ay, x, by, s->dt);
 	}
+}
+
+/* The force on each wall in the last step, and links that ended up outside
+ * the walls (a world the solver could not hold together: said, counted). */
+static void sim_plane_walls_check(struct sim *s, const struct plane_contact *c, size_t n)
+{
+	for (int k = 0; k < 4; k++)
+		s->wall_force[k] = 0;
+	for (size_t i = 0; i < n; i++)
+		if (c[i].robot_b == PLANE_WALL)
+			for (int k = 0; k < 4; k++)
+				if (s->plane_wall[k] == c[i].link_b)
+					s->wall_force[k] += c[i].normal_impulse / s->dt;
+	const struct sim_config *cfg = &s->cfg;
+	bool sides = s->plane_wall[0] >= 0, ends = s->plane_wall[2] >= 0;
+	double slack = cfg->plane.link_width;
+	for (int r = 0; r < plane_robots(s->plane); r++)
+		for (int l = 0; l <= plane_joints(s->plane, r); l++) {
+			struct plane_link_pose p;
+			plane_link(s->plane, r, l, &p);
+			bool out = (sides && (p.x < s->wall_face[0] - slack || p.x > s->wall_face[1] + slack)) ||
+			           (ends && (p.y < cfg->ends_back - slack || p.y > cfg->ends_front + slack)) ||
+			           !isfinite(p.x) || !isfinite(p.y);
+			if (out && s->escaped++ % 1000 == 0)
+				fprintf(stderr, "undulate-sim: the plane world broke: robot %s's link %d is outside the walls "
+				        "at (%.3f, %.3f) m, t = %.3f s (%llu link-steps so far)\n", s->buses[r].name, l + 1,
+				        p.x, p.y, (double)s->steps * s->dt, s->escaped);
+		}
 }
 
 /* Impulses summed per pair of links until sim_contacts_drain(). */
@@ -508,6 +562,7 @@ static void sim_plane_collisions(struct sim *s)
 	if (n > PLANE_MAX_CONTACTS)
 		n = PLANE_MAX_CONTACTS;
 	s->nstep_collisions = 0;
+	sim_plane_walls_check(s, c, n);
 	for (size_t i = 0; i < n; i++) {
 		bool resting = !c[i].impact;
 		s->world.total_collisions++;

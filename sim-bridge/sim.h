@@ -36,6 +36,11 @@ struct sim {
 	struct sim_world world;
 	struct plane *plane;           /* the plane world (NULL: the row) */
 	int plane_wall[4];             /* its walls: left, right, back, front (-1: none) */
+	double wall_face[2];           /* m: where the side walls' faces stand (x), which a
+					  crowd pushing harder than wall_force_max holds back */
+	double wall_force[4];          /* N the robots pushed each wall with in the last step */
+	unsigned long long escaped;    /* link-steps found outside the walls: a broken world */
+	unsigned long long held_steps; /* steps a closing wall held against the crowd */
 	struct plane_drive plane_drives[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
 	struct plane_joint plane_joints[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
 	/* contacts since the last sim_contacts_drain(), either world: impulses

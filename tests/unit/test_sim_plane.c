@@ -127,21 +127,22 @@ static void test_press_balances(void **state)
 	plane_link(pl, 0, 1, &tail);
 	/* the head between two walls along it, touching, short of its ends (the
 	 * tail turns about the head's rear end) */
-	double hw = 0.5 * WIDTH + 0.005;
+	double hw = 0.5 * WIDTH + PLANE_WALL_RADIUS;
 	double ux = cos(head.angle), uy = sin(head.angle), nx = -uy, ny = ux;
 	for (int s = -1; s <= 1; s += 2)
 		assert_true(plane_add_wall(pl, head.x - 0.35 * L * ux + s * hw * nx, head.y - 0.35 * L * uy + s * hw * ny,
 					   head.x + 0.35 * L * ux + s * hw * nx, head.y + 0.35 * L * uy + s * hw * ny, err,
 					   sizeof err) >= 0);
 	/* and a stop at its front end: the post's push has a part along the head */
-	double fx = head.x + (0.5 * L + 0.5 * WIDTH + 0.005) * ux, fy = head.y + (0.5 * L + 0.5 * WIDTH + 0.005) * uy;
+	double fx = head.x + (0.5 * L + 0.5 * WIDTH + PLANE_WALL_RADIUS) * ux,
+	       fy = head.y + (0.5 * L + 0.5 * WIDTH + PLANE_WALL_RADIUS) * uy;
 	assert_true(plane_add_wall(pl, fx - 0.03 * nx, fy - 0.03 * ny, fx + 0.03 * nx, fy + 0.03 * ny, err, sizeof err) >= 0);
 	/* a post (a short wall: a disc of the wall's radius) beside the tail at
 	 * 0.8 L from the joint, where the tail's side meets it once the joint
 	 * has closed to 0.3 rad: closing turns the tail towards (-sin, cos) of
 	 * its direction */
 	double jx = head.x - 0.5 * L * ux, jy = head.y - 0.5 * L * uy;
-	double stop = head.angle + 0.3, rho = 0.8 * L, side = 0.5 * WIDTH + 0.005;
+	double stop = head.angle + 0.3, rho = 0.8 * L, side = 0.5 * WIDTH + PLANE_WALL_RADIUS;
 	double px = jx - rho * cos(stop) - side * sin(stop), py = jy - rho * sin(stop) + side * cos(stop);
 	int w = plane_add_wall(pl, px, py, px + 1e-4 * cos(stop), py + 1e-4 * sin(stop), err, sizeof err);
 	assert_true(w >= 0);

@@ -141,16 +141,40 @@ static void test_closing_walls_squeeze(void **state)
 	steps(&sim, 3000);
 	double ax, ay, bx, by;
 	plane_wall(sim.plane, 0, &ax, &ay, &bx, &by);
-	print_message("# closing walls: left wall at x = %.4f m (asked -0.12), %llu contacts, %.4f N s, robot centres "
-		      "%.3f %.3f %.3f\n", ax, sim.world.total_collisions, sim.world.total_impulse,
+	print_message("# closing walls: left wall's face at x = %.4f m (asked -0.12), %llu contacts, %.4f N s, robot centres "
+		      "%.3f %.3f %.3f\n", sim.wall_face[0], sim.world.total_collisions, sim.world.total_impulse,
 		      sim.world.bodies[0].neutral, sim.world.bodies[1].neutral, sim.world.bodies[2].neutral);
-	assert_true(fabs(ax + 0.12) < 1e-6);
+	/* the face where asked, the segment its half thickness further out */
+	assert_true(fabs(sim.wall_face[0] + 0.12) < 1e-6);
+	assert_true(fabs(ax + 0.12 + PLANE_WALL_RADIUS) < 1e-6);
+	assert_int_equal(sim.escaped, 0);
 	assert_true(sim.world.total_collisions > 0 && sim.world.total_impulse > 0);
 	assert_true(sim.world.bodies[0].neutral > -0.12 && sim.world.bodies[2].neutral < 0.12);
 	struct plane_contact c[16];
 	size_t n = sim_contacts_drain(&sim, c, 16);
 	assert_true(n > 0);
 	assert_int_equal(sim_contacts_drain(&sim, c, 16), 0);   /* drained */
+	sim_free(&sim);
+}
+
+/* Walls asked to close narrower than the robots lying side by side (ten of
+ * them need 0.32 m; asked: 0.2 m): they hold where the crowd pushes back
+ * with more than wall_force_max, and no link is pushed through a wall. */
+static void test_walls_hold_against_a_crowd(void **state)
+{
+	(void)state;
+	const char *sets[] = { "world.spacing=0.2", "world.walls=-1,1", "world.ends=-0.33,0.33",
+			       "sim.initial_spread=0.2", "world.wall_force_max=20" };
+	assert_int_equal(plane(10, sets, 5), 0);
+	assert_int_equal(cmd("walls -0.1 0.1 over 10"), 0);
+	steps(&sim, 16000);
+	double width = sim.wall_face[1] - sim.wall_face[0];
+	print_message("# a crowd against closing walls: asked 0.2 m, the walls stopped %.3f m apart after %llu held "
+		      "steps; %llu link-steps outside; last forces %.1f / %.1f N\n", width, sim.held_steps, sim.escaped,
+		      sim.wall_force[0], sim.wall_force[1]);
+	assert_true(width > 0.3);
+	assert_true(sim.held_steps > 0);
+	assert_int_equal(sim.escaped, 0);
 	sim_free(&sim);
 }
 
@@ -192,6 +216,7 @@ int main(void)
 		cmocka_unit_test(test_bad_scenarios_refused),
 		cmocka_unit_test(test_servo_drives_the_links),
 		cmocka_unit_test(test_closing_walls_squeeze),
+		cmocka_unit_test(test_walls_hold_against_a_crowd),
 		cmocka_unit_test(test_deterministic),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -172,6 +172,8 @@ struct an_ctx {
 	char broken[AN_MAX_BROKEN][AN_BROKEN_TEXT];
 	int nbroken;
 	int64_t late_msgs;          /* SIM.TRUTH periods with a step AN_LATE_US late */
+	int64_t escaped;            /* the plane world's links outside the walls (link-steps), last seen */
+	double escaped_first_t;
 	double late_worst_us, late_first_t;
 	/* the contact force over each SIM.TRUTH period with contact */
 	double *force_t, *force_n;
@@ -1048,6 +1050,11 @@ static void an_truth_collisions(struct an_ctx *c, const undulate_sim_truth_t *m)
 {
 	double t = an_t(c, m->utime);
 	c->plane |= m->world == UNDULATE_SIM_TRUTH_T_WORLD_PLANE;
+	if (m->escaped_links > c->escaped) {
+		if (c->escaped == 0)
+			c->escaped_first_t = t;
+		c->escaped = m->escaped_links;
+	}
 	if (m->worst_lateness_us > AN_LATE_US) {
 		if (c->late_msgs++ == 0)
 			c->late_first_t = t;
@@ -1288,6 +1295,9 @@ static void an_check_broken(struct an_ctx *c)
 			an_broken(c, "robot %s stopped publishing at %.1f s (the log runs to %.1f s): its daemon died or "
 			          "lost its bus", r->name, r->last_t, end);
 	}
+	if (c->escaped > 0)
+		an_broken(c, "the simulated world broke: links were pushed out through the walls (%lld link-steps outside, "
+		          "the first seen at %.1f s)", (long long)c->escaped, c->escaped_first_t);
 	if (c->late_msgs > 0)
 		an_broken(c, "the simulator fell behind real time: %lld truth period(s) with a step more than %.0f ms "
 		          "late, the first at %.1f s, the worst %.0f ms", (long long)c->late_msgs, AN_LATE_US / 1000.0,
