@@ -173,6 +173,7 @@ struct an_ctx {
 	int nbroken;
 	int64_t late_msgs;          /* SIM.TRUTH periods with a step AN_LATE_US late */
 	int64_t escaped;            /* the plane world's links outside the walls (link-steps), last seen */
+	double wall_left, wall_right;   /* m, the walls as the last SIM.TRUTH had them (NAN: none) */
 	double escaped_first_t;
 	double late_worst_us, late_first_t;
 	/* the contact force over each SIM.TRUTH period with contact */
@@ -1050,6 +1051,8 @@ static void an_truth_collisions(struct an_ctx *c, const undulate_sim_truth_t *m)
 {
 	double t = an_t(c, m->utime);
 	c->plane |= m->world == UNDULATE_SIM_TRUTH_T_WORLD_PLANE;
+	c->wall_left = m->wall_left < m->wall_right ? m->wall_left : NAN;
+	c->wall_right = m->wall_left < m->wall_right ? m->wall_right : NAN;
 	if (m->escaped_links > c->escaped) {
 		if (c->escaped == 0)
 			c->escaped_first_t = t;
@@ -1500,6 +1503,11 @@ static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 	json_array_end(&j);
 	struct an_forces fo;
 	an_forces(c, &fo);
+	json_key(&j, "walls");
+	json_object_begin(&j);
+	json_field_number(&j, "left_m", c->wall_left);
+	json_field_number(&j, "right_m", c->wall_right);
+	json_object_end(&j);
 	json_key(&j, "force");
 	json_object_begin(&j);
 	json_field_number(&j, "switch_s", fo.switch_t);
@@ -1643,6 +1651,7 @@ static int an_run_ctx(struct an_ctx *c)
 {
 	const struct an_options *o = c->o;
 	c->world_restitution = NAN;
+	c->wall_left = c->wall_right = NAN;
 	int rc = an_each_event(c, an_scan_event, true);
 	if (rc == AN_EXIT_BADLOG)
 		return rc;
