@@ -2,9 +2,12 @@
 # scripts/demo.sh — robots on the simulated bus, one undulated per robot.
 #
 #   make demo                       the paper's contact-force experiment, watched live:
-#                                   ten robots crowded in a row, 20 s on the clock
-#                                   (SINUSOID), then on the oscillator; q stops it and
-#                                   prints the summary
+#                                   ten three-link robots in the plane, in an arena
+#                                   whose walls close over its first 12 s, 20 s on
+#                                   the clock (SINUSOID), then on the oscillator,
+#                                   the joints torque-driven as in the paper's
+#                                   force simulations; q stops it and prints the
+#                                   summary
 #   make demo DEMO_SECONDS=60       the same headless for 60 s, then the summary
 #
 # The run is kept (the LCM log, the analysis, the programs' logs) in DEMO_OUT
@@ -117,10 +120,23 @@ BUILD=${BUILD:-build}
 case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
 B="$BUILD/bin"
 
-scenario="$top/sim-bridge/scenarios/force10.scenario"
+scenario="$top/sim-bridge/scenarios/plane-demo.scenario"
+default_scenario=1
 seconds=${DEMO_SECONDS:-}
 sim_sets=()
 daemon_sets=()
+# make demo's robots (plane-demo.scenario), driven as the paper's force
+# simulations were: torque-driven joints on a current drive, the clock as
+# tau = k (alpha_bar - alpha) with the paper's stiffest k (and the damping the
+# plane robot's joints need: daemon/CONTROL.md, "The clock as a torque law"),
+# then the oscillator as a torque law with the parameters undulated --tune
+# found on the plane robot, its joints 2 pi / 3 apart ("The joints' lag").
+# Given only for the default scenario; another scenario runs the daemon's
+# defaults and the --daemon-set given.
+plane_demo_sets=(--set robot.actuation=torque --set robot.torque_drive=current
+	--set sinusoid.stiffness=0.135 --set sinusoid.damping=0.01 --set sinusoid.amplitude=0.8 --set sinusoid.frequency=0.8
+	--set joint.1.k=0.0368 --set joint.2.k=0.0368 --set joint.1.mu=0.064 --set joint.2.mu=0.088
+	--set joint.1.coupling_phase=-0.05 --set joint.2.coupling_phase=0.05)
 start_mode=sinusoid
 switch_at=20
 switch_to=oscillator
@@ -144,7 +160,7 @@ usage() {
 
 while [ $# -gt 0 ]; do
 	case "$1" in
-	--scenario) scenario=$2; shift 2 ;;
+	--scenario) scenario=$2; default_scenario=0; shift 2 ;;
 	--seconds) seconds=$2; shift 2 ;;
 	--set) sim_sets+=(--set "$2"); shift 2 ;;
 	--daemon-set) daemon_sets+=(--set "$2"); shift 2 ;;
@@ -164,6 +180,7 @@ while [ $# -gt 0 ]; do
 done
 
 die() { echo "demo: $*" >&2; exit 1; }
+[ "$default_scenario" = 1 ] && daemon_sets=("${plane_demo_sets[@]}" ${daemon_sets[@]+"${daemon_sets[@]}"})
 is_number() { [[ "$1" =~ ^-?[0-9]+([.][0-9]+)?$ ]]; }
 
 [ -f "$scenario" ] || die "no scenario file '$scenario'"
@@ -600,7 +617,7 @@ awk '
 		if ($col["end"] == "grazing") grazing++
 		if ($col["end"] == "still-colliding") colliding++
 		rows = rows sprintf("    %-10s |D| %5.2f rad %s bound %4.2f: %s (%s N)\n", $col["pair"], d, d <= b + 0.1 ? "<=" : "> ", b, $col["end"], $col["F.win"]) }
-	END { if (n) { printf "  Neighbours at the end (|D| against the compatibility bound 2 asin(d~)): %d of %d at or within it; %d grazing it (touching with at most 0.1 N on average), %d still colliding harder.\n%s", within, n, grazing, colliding, rows } }
+	END { if (n) { printf "  Neighbours at the end (|D| against the compatibility bound 2 asin(d~)): %d of %d at or within it; %d grazing (touching with at most 0.1 N on average), %d touching harder (still-colliding).\n%s", within, n, grazing, colliding, rows } }
 ' "$analysis/summary.txt"
 
 echo

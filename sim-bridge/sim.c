@@ -235,6 +235,7 @@ static int sim_plane_robot(struct sim *s, size_t i, char *err, size_t errcap)
 
 /* The plane world: the robots' chains from their joints' initial angles, the
  * walls, and no overlap at the start. */
+#define SIM_PLANE_STRAIGHTEN 6
 static int sim_plane_build(struct sim *s, char *err, size_t errcap)
 {
 	const struct sim_config *c = &s->cfg;
@@ -252,15 +253,32 @@ static int sim_plane_build(struct sim *s, char *err, size_t errcap)
 			return snprintf(err, errcap, "robot %s: a plane robot has 1 to %d servos", s->buses[i].name,
 			                PLANE_MAX_JOINTS), -1;
 	char why[160];
-	s->plane = plane_new(&pp, why, sizeof why);
-	if (s->plane == NULL)
-		return snprintf(err, errcap, "%s", why), -1;
-	for (size_t i = 0; i < s->nbuses; i++)
-		if (sim_plane_robot(s, i, err, errcap) != 0)
-			return -1;
-	if (sim_plane_walls(s, why, sizeof why) != 0)
-		return snprintf(err, errcap, "world: %s", why), -1;
 	int ra, la, rb, lb;
+	/* Robots whose seeded bends make them start inside each other (or a
+	 * wall) are straightened, halving their joints' angles, up to
+	 * SIM_PLANE_STRAIGHTEN times (the row nudges its bodies apart the same
+	 * way); what still overlaps then is refused. Deterministic per seed. */
+	for (int tries = 0;; tries++) {
+		s->plane = plane_new(&pp, why, sizeof why);
+		if (s->plane == NULL)
+			return snprintf(err, errcap, "%s", why), -1;
+		for (size_t i = 0; i < s->nbuses; i++)
+			if (sim_plane_robot(s, i, err, errcap) != 0)
+				return -1;
+		if (sim_plane_walls(s, why, sizeof why) != 0)
+			return snprintf(err, errcap, "world: %s", why), -1;
+		if (!plane_overlap(s->plane, &ra, &la, &rb, &lb) || tries == SIM_PLANE_STRAIGHTEN)
+			break;
+		plane_free(s->plane);
+		s->plane = NULL;
+		for (int r = 0; r < 2; r++) {
+			int bus = r == 0 ? ra : rb;
+			if (bus == PLANE_WALL)
+				continue;
+			for (size_t k = 0; k < s->buses[bus].njoints; k++)
+				s->buses[bus].joints[k].motor.angle *= 0.5;
+		}
+	}
 	if (plane_overlap(s->plane, &ra, &la, &rb, &lb)) {
 		static const char *const wall[4] = { "the left wall", "the right wall", "the back wall", "the front wall" };
 		char other[80];

@@ -262,8 +262,8 @@ plot_steady() {
 			echo "  P $(gp_class "$r" "c(0) eq 'anti-phase'") with points pt 7 ps 0.5 lc rgb '$COL_ANTI' title 'run: anti-phase', \\"
 			echo "  P $(gp_class "$r" "c(0) eq 'compatible'") with points pt 7 ps 0.5 lc rgb '$COL_COMPAT' title 'run: compatible', \\"
 			echo "  P $(gp_class "$r" "c(0) eq 'in-phase'") with points pt 7 ps 0.5 lc rgb '$COL_INPHASE' title 'run: in phase', \\"
-			echo "  P $(gp_class "$r" "c(0) eq 'still-colliding'") with points pt 6 ps 0.7 lc rgb '$COL_COLL' title 'run: still colliding', \\"
-			echo "  P $(gp_class "$r" "c(0) ne 'anti-phase' && c(0) ne 'compatible' && c(0) ne 'in-phase' && c(0) ne 'still-colliding'") with points pt 2 ps 0.8 lc rgb '$COL_OTHER' title 'run: other (unlocked ...)'"
+			echo "  P $(gp_class "$r" "c(0) eq 'still-colliding' || c(0) eq 'grazing'") with points pt 6 ps 0.7 lc rgb '$COL_COLL' title 'run: still touching (colliding or grazing)', \\"
+			echo "  P $(gp_class "$r" "c(0) ne 'anti-phase' && c(0) ne 'compatible' && c(0) ne 'in-phase' && c(0) ne 'still-colliding' && c(0) ne 'grazing'") with points pt 2 ps 0.8 lc rgb '$COL_OTHER' title 'run: other (unlocked ...)'"
 		done
 		echo "unset multiplot"
 	} >"$t/steady.gp"
@@ -348,8 +348,8 @@ stats() {
 			if (anti) { na++; amp += ($11 + $12) / 2; if (d < dc) below++ }
 		}
 		END {
-			printf "n %d\nin-phase %d\ncompatible %d\nanti-phase %d\nstill-colliding %d\n", n, k["in-phase"], k["compatible"], k["anti-phase"], k["still-colliding"]
-			printf "other %d\nmin_anti %s\nmin_map %s\nagree %d\n", n - k["in-phase"] - k["compatible"] - k["anti-phase"] - k["still-colliding"], mina == "" ? "-" : sprintf("%.3f", mina), minp == "" ? "-" : sprintf("%.3f", minp), agree
+			printf "n %d\nin-phase %d\ncompatible %d\nanti-phase %d\nstill-colliding %d\n", n, k["in-phase"], k["compatible"], k["anti-phase"], k["still-colliding"] + k["grazing"]
+			printf "other %d\nmin_anti %s\nmin_map %s\nagree %d\n", n - k["in-phase"] - k["compatible"] - k["anti-phase"] - k["still-colliding"] - k["grazing"], mina == "" ? "-" : sprintf("%.3f", mina), minp == "" ? "-" : sprintf("%.3f", minp), agree
 			printf "map_anti %d\nmap_anti_ended %d\nmap_compat %d\nmap_compat_anti %d\n", npa, paa, npc, pca
 			printf "nocontact %d\nwithin %d\nunsettled %d\nunsettled_range %s\n", nc, within, ns, ns ? sprintf("%.2f-%.2f", lo, hi) : "-"
 			printf "anti_amp %s\nanti_below_dc %d\ngrazing %d\n", na ? sprintf("%.2f", amp / na) : "-", below, graze

@@ -56,7 +56,7 @@ else
 	tap_fail "summary printed" "$(tail -n 30 "$out")"
 fi
 # One row per neighbouring pair: name, state, final phase difference, d~, 2 asin(d~), collisions.
-pair_rows=$(awk '$1 ~ /^r[0-9]+:r[0-9]+$/ && $2 ~ /^(in-phase|compatible|anti-phase|still-colliding|no-data|not-oscillating|unlocked|locked-[a-z-]*)$/ \
+pair_rows=$(awk '$1 ~ /^r[0-9]+:r[0-9]+$/ && $2 ~ /^(in-phase|compatible|anti-phase|grazing|still-colliding|no-data|not-oscillating|unlocked|locked-[a-z-]*)$/ \
 	&& $3 ~ /^-?[0-9.]+$/ && $4 ~ /^[0-9.]+$/' "$out" | awk '{ print $1 }' | tr '\n' ' ')
 if [ "$pair_rows" = "r1:r2 r2:r3 r3:r4 r4:r5 r5:r6 r6:r7 r7:r8 r8:r9 r9:r10 " ]; then
 	tap_ok "summary has the nine neighbouring pairs with phase difference, d~ and state"
@@ -65,7 +65,7 @@ else
 fi
 # Every pair's final phase difference is a real angle and its d~ comes from a
 # measured amplitude (force10: d~ = 0.4 at 0.8 rad).
-bad=$(awk '$1 ~ /^r[0-9]+:r[0-9]+$/ && $2 ~ /^(in-phase|compatible|anti-phase|still-colliding|no-data|not-oscillating|unlocked|locked-[a-z-]*)$/ \
+bad=$(awk '$1 ~ /^r[0-9]+:r[0-9]+$/ && $2 ~ /^(in-phase|compatible|anti-phase|grazing|still-colliding|no-data|not-oscillating|unlocked|locked-[a-z-]*)$/ \
 	&& ($3 < -3.1416 || $3 > 3.1416 || $4 <= 0.05 || $4 > 2) { print }' "$out")
 if [ -z "$bad" ]; then tap_ok "phase differences within (-pi, pi], d~ plausible"; else tap_fail "phase differences within (-pi, pi], d~ plausible" "$bad"; fi
 windows=$(awk '/^collisions per 10 s window:/ { on = 1; next } on && /collisions/ { n++ } END { print n + 0 }' "$out")

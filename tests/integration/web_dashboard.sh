@@ -112,7 +112,7 @@ else
 	tap_check "the page draws both robots and their pair (${drawn:-0} points in its plots)" \
 		bash -c "[ '${drawn:-0}' -gt 500 ] && grep -q '^ROBOTS left,right' '$T/page.out'"
 	tap_check "the pair's end state is shown, named as undulate-analyze names it" \
-		grep -qE '^CLASS (in-phase|anti-phase|compatible|still-colliding|unlocked|locked-[a-z-]+|not-oscillating|no-data)$' "$T/page.out"
+		grep -qE '^CLASS (in-phase|anti-phase|compatible|grazing|still-colliding|unlocked|locked-[a-z-]+|not-oscillating|no-data)$' "$T/page.out"
 	blue=$("$BUILD/tests/tools/pngdata" --rgb 1f77b4 "$T/page.png" 2>&1 | sed -n 's/.*matching=//p')
 	tap_check "the screenshot shows drawn plots (${blue:-0} pixels of joint 0's colour, > 1500)" [ "${blue:-0}" -gt 1500 ]
 	tap_check "the click reached the daemon: left publishes HOLD" wait_for 5 grep -q '^STATE left .* mode=1 ' "$T/watch.log"

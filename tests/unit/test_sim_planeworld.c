@@ -78,7 +78,7 @@ static void test_bad_scenarios_refused(void **state)
 	sim_free(&sim);
 	const char *tight[] = { "world.spacing=0.01", "sim.initial_spread=0.5" };
 	assert_int_equal(plane(2, tight, 2), -1);
-	assert_non_null(strstr(err, "world: at the start robot r1's link 2 overlaps robot r2's link 2 (robots 0.01 m apart"));
+	assert_non_null(strstr(err, "world: at the start robot r1's link 1 overlaps robot r2's link 1 (robots 0.01 m apart"));
 	sim_free(&sim);
 	const char *short_ends[] = { "world.ends=-0.2,0.2", "sim.initial_spread=0" };
 	assert_int_equal(plane(2, short_ends, 2), -1);
@@ -100,6 +100,26 @@ static void test_bad_scenarios_refused(void **state)
 	const char *none[] = { "robot r1.contact=none" };
 	assert_int_equal(plane(2, none, 1), -1);
 	assert_non_null(strstr(err, "contact = none has no meaning"));
+	sim_free(&sim);
+}
+
+/* Robots whose seeded bends would start them inside each other are
+ * straightened (their angles halved) until they fit: a crowded scenario
+ * starts, the same way for a seed, with no link inside another. */
+static void test_straightened_to_fit(void **state)
+{
+	(void)state;
+	const char *sets[] = { "world.spacing=0.1", "sim.initial_spread=0.8", "sim.seed=3" };
+	if (plane(6, sets, 3) != 0)
+		fail_msg("%s", err);
+	int ra, la, rb, lb;
+	assert_false(plane_overlap(sim.plane, &ra, &la, &rb, &lb));
+	double widest = 0;
+	for (size_t i = 0; i < 6; i++)
+		for (size_t k = 0; k < 2; k++)
+			widest = fmax(widest, fabs(sim.buses[i].joints[k].motor.angle));
+	print_message("# 6 robots 0.1 m apart, seeded bends up to 0.8 rad: started with joints within %.3f rad\n", widest);
+	assert_true(widest > 0);
 	sim_free(&sim);
 }
 
@@ -214,6 +234,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_builds_a_row_of_robots),
 		cmocka_unit_test(test_bad_scenarios_refused),
+		cmocka_unit_test(test_straightened_to_fit),
 		cmocka_unit_test(test_servo_drives_the_links),
 		cmocka_unit_test(test_closing_walls_squeeze),
 		cmocka_unit_test(test_walls_hold_against_a_crowd),
