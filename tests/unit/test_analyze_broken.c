@@ -52,7 +52,8 @@ struct run {
 	double clock_force_n;     /* before the switch */
 	double fault_at;          /* b latches a fault then (< 0: never) */
 	double b_stops_at;        /* b's last state (< 0: to the end) */
-	double late_at;           /* a truth period 35 ms late then (< 0: never) */
+	double late_at;           /* truth periods 35 ms late from then (< 0: never) */
+	int late_n;               /* how many */
 	bool plane;
 };
 
@@ -98,7 +99,8 @@ static int write_truth(struct alog_writer *w, int64_t cycle, const struct run *r
 	int64_t utime = T_START_UTIME + cycle * 10000;
 	undulate_sim_truth_t m = {
 		.utime = utime, .step = cycle * 10, .sim_time = t, .total_impulse = total_impulse,
-		.worst_lateness_us = r->late_at >= 0 && fabs(t - r->late_at) < 0.005 ? 35000.0 : 50.0,
+		.worst_lateness_us = r->late_at >= 0 && t >= r->late_at - 0.001 &&
+		                     t < r->late_at + r->late_n * T_DT - 0.001 ? 35000.0 : 50.0,
 		.nbodies = 2, .bodies = bodies, .ncontacts = f > 0 ? 1 : 0, .contacts = &contact,
 		.world = r->plane ? UNDULATE_SIM_TRUTH_T_WORLD_PLANE : UNDULATE_SIM_TRUTH_T_WORLD_ROW,
 	};
@@ -184,14 +186,27 @@ static void test_clean_world_and_force(void **state)
 	free(js);
 }
 
+/* five late steps in 30 s are a hiccup the schedule catches up, not a
+ * broken run (a loaded machine shows them) */
+static void test_a_few_late_steps_are_not_broken(void **state)
+{
+	(void)state;
+	struct run r = { .force_n = 0.05, .clock_force_n = 1.0, .fault_at = -1, .b_stops_at = -1, .late_at = 12.0,
+			 .late_n = 5 };
+	char *js = analyse("hiccup", &r);
+	assert_non_null(strstr(js, "\"broken\":[]"));
+	free(js);
+}
+
 static void test_broken_runs(void **state)
 {
 	(void)state;
-	struct run r = { .force_n = 0.05, .clock_force_n = 1.0, .fault_at = 15.0, .b_stops_at = 25.0, .late_at = 12.0 };
+	struct run r = { .force_n = 0.05, .clock_force_n = 1.0, .fault_at = 15.0, .b_stops_at = 25.0, .late_at = 12.0,
+			 .late_n = 100 };
 	char *js = analyse("broken", &r);
 	assert_non_null(strstr(js, "\"robot b latched a fault at 15.0 s: servo 1 silent for 0.50 s\""));
 	assert_non_null(strstr(js, "\"robot b stopped publishing at 25.0 s (the log runs to 30.0 s)"));
-	assert_non_null(strstr(js, "\"the simulator fell behind real time: 1 truth period(s) with a step more than 10 ms "
+	assert_non_null(strstr(js, "\"the simulator fell behind real time: 100 truth period(s) with a step more than 10 ms "
 	                           "late, the first at 12.0 s, the worst 35 ms\""));
 	free(js);
 	char *txt = scratch_slurp("broken/summary.txt", 1 << 20);
@@ -205,6 +220,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_grazing_against_colliding),
 		cmocka_unit_test(test_clean_world_and_force),
+		cmocka_unit_test(test_a_few_late_steps_are_not_broken),
 		cmocka_unit_test(test_broken_runs),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
