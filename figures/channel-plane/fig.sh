@@ -313,7 +313,7 @@ fragment() {
 					if ($9 > 0) c++
 					if ($17 > mx) mx = $17 }
 				END {
-					printf "**Without end walls** (the control: %d runs, the same widths and timeline, grey circles in the figure): %d of %d pairs ended at or below the curve, %d in anti-phase, %d still touched in the last '"$WINDOW"' s. Their neighbours'"'"' centres ended %.3f m apart along the channel (median; up to %.3f m), against %.3f m with the ends: the end walls are what keeps the robots side by side, as the paper'"'"'s 55 cm channel does.\n", runs, b, n, a, c, cdy, mx, dy
+					printf "**Without end walls** (the control, %d run%s at the same widths and timeline, grey circles in the figure): %d of %d pairs ended at or below the curve, %d in anti-phase, %d still touched in the last '"$WINDOW"' s. Their neighbours'"'"' centres ended %.3f m apart along the channel (median; up to %.3f m), against %.3f m with the ends: the end walls are what keeps the robots side by side, as the paper'"'"'s 55 cm channel does.\n", runs, runs == 1 ? "" : "s", b, n, a, c, cdy, mx, dy
 				}' "$control"
 		fi
 	} >"$fig/channel-plane.md"
