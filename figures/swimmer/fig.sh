@@ -94,6 +94,26 @@ run() {
 	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
 	# the swim from SETTLE s to the end: the centre's displacement along the
 	# mean heading and across it, per period of the joints' mean frequency
+	# how wide the swimming body is: per period from SETTLE s, the span of
+	# its links' ends (their centre lines) across the period's mean heading;
+	# the median over the whole periods. The row's d̃ takes a contact body
+	# to sweep 2 x lever x A = 0.298 m at 0.8 rad.
+	local sweep
+	sweep=$(awk -F, -v from="$SETTLE" -v f1="$f1" -v f2="$f2" 'NR > 1 && $2 >= from && f1 + f2 > 0 {
+			per = 2 / (f1 + f2); w = int(($2 - from) / per); n[w]++; hs[w] += $13
+			k++; W[k] = w; X[k] = $6; Y[k] = $7; A[k] = $8; L[k] = $9 }
+		END {
+			for (i = 1; i <= k; i++) {
+				w = W[i]; h = hs[w] / n[w]
+				for (s = -1; s <= 1; s += 2) {
+					p = -(X[i] + s * L[i] / 2 * cos(A[i])) * sin(h) + (Y[i] + s * L[i] / 2 * sin(A[i])) * cos(h)
+					if (!(w in lo) || p < lo[w]) lo[w] = p
+					if (!(w in hi) || p > hi[w]) hi[w] = p
+				}
+			}
+			for (w in n) if (n[w] >= 0.9 * nmax(n)) print hi[w] - lo[w]
+		}
+		function nmax(a,   m, j) { m = 0; for (j in a) if (a[j] > m) m = a[j]; return m }' "$r/plane.csv" | fig_median)
 	local swim
 	swim=$(awk -F, -v from="$SETTLE" -v f1="$f1" -v f2="$f2" 'NR > 1 && $1 >= from {
 			if (!n++) { t0 = $1; x0 = $2; y0 = $3; h0 = $4 }
@@ -105,8 +125,8 @@ run() {
 			periods = (t1 - t0) * (f1 + f2) / 2
 			printf "%.6f,%.6f,%.6f,%.6f,%.4f\n", along / periods, across / periods, along / (t1 - t0), h1 - h0, periods }' "$out/path.csv")
 	{
-		echo "mode,seed,seconds,freq1_hz,freq2_hz,amp1_rad,amp2_rad,lag_rad,lag_spread_rad,along_per_period_m,across_per_period_m,speed_m_s,turn_rad,periods,min_swing_rad,wall_s"
-		echo "$mode,$seed,$secs,$f1,$f2,$a1,$a2,$lag,$spread,$swim,$swing,$wall"
+		echo "mode,seed,seconds,freq1_hz,freq2_hz,amp1_rad,amp2_rad,lag_rad,lag_spread_rad,along_per_period_m,across_per_period_m,speed_m_s,turn_rad,periods,min_swing_rad,wall_s,sweep_m"
+		echo "$mode,$seed,$secs,$f1,$f2,$a1,$a2,$lag,$spread,$swim,$swing,$wall,$sweep"
 	} >"$out/result.csv"
 	[ "${FIG_KEEP:-0}" = 1 ] || rm -f "$r/plane.csv" "$r/plane_walls.csv"
 	fig_clean "$r"
@@ -206,20 +226,21 @@ fragment() {
 		echo "phase difference of the analyser's joints pair; swim: the centre's displacement from"
 		echo "$SETTLE s to the end along the robot's mean heading (positive: head first) and across it."
 		echo
-		echo "| mode | runs | frequency (Hz), joint 1 / 2 | amplitude (rad), joint 1 / 2 | lag of joint 2 | along the heading per period | across per period | speed | turned |"
-		echo "|---|---|---|---|---|---|---|---|---|"
+		echo "| mode | runs | frequency (Hz), joint 1 / 2 | amplitude (rad), joint 1 / 2 | lag of joint 2 | along the heading per period | across per period | speed | turned | sweep across the heading |"
+		echo "|---|---|---|---|---|---|---|---|---|---|"
 		awk -F, 'NR > 1 { m = $1; n[m]++; f1[m] += $4; f2[m] += $5; a1[m] += $6; a2[m] += $7; l[m] += $8
-				al[m] += $10; ac[m] += $11; sp[m] += $12; tu[m] += ($13 < 0 ? -$13 : $13)
+				al[m] += $10; ac[m] += $11; sp[m] += $12; tu[m] += ($13 < 0 ? -$13 : $13); sw[m] += $17
 				if (!(m in lo) || $10 < lo[m]) lo[m] = $10; if (!(m in hi) || $10 > hi[m]) hi[m] = $10 }
-			END { for (m in n) printf "| %s | %d | %.3f / %.3f | %.3f / %.3f | %.2f rad (%.0f°) | %.2f cm (%.2f-%.2f) | %.2f cm | %.2f cm/s | %.2f rad |\n",
+			END { for (m in n) printf "| %s | %d | %.3f / %.3f | %.3f / %.3f | %.2f rad (%.0f°) | %.2f cm (%.2f-%.2f) | %.2f cm | %.2f cm/s | %.2f rad | %.3f m |\n",
 				m == "sinusoid" ? "clock" : m, n[m], f1[m] / n[m], f2[m] / n[m], a1[m] / n[m], a2[m] / n[m], l[m] / n[m],
 				l[m] / n[m] * 180 / 3.14159265, 100 * al[m] / n[m], 100 * lo[m], 100 * hi[m], 100 * ac[m] / n[m],
-				100 * sp[m] / n[m], tu[m] / n[m] }' "$csv" | sort
+				100 * sp[m] / n[m], tu[m] / n[m], sw[m] / n[m] }' "$csv" | sort
 		echo
 		echo "(Means over the runs of a mode; the range of the distance per period in brackets; *turned*: the"
-		echo "heading's change over the run, its size.)"
+		echo "heading's change over the run, its size; *sweep*: per period, the span of the links' ends (their"
+		echo "centre lines) across the period's mean heading, the median over the periods.)"
 		echo
-		awk -F, 'NR > 1 && $1 == "oscillator" { n++; l += $8; f += ($4 + $5) / 2; a += ($6 + $7) / 2; d += $10 }
+		awk -F, 'NR > 1 && $1 == "oscillator" { n++; l += $8; f += ($4 + $5) / 2; a += ($6 + $7) / 2; d += $10; sw += $17 }
 			NR > 1 && $1 == "sinusoid" { m++; dc += $10 }
 			END {
 				pi = 3.14159265
@@ -229,7 +250,9 @@ fragment() {
 				printf " The robot swims head first, as a Purcell swimmer in drag should"
 				if (n) printf ": %.2f cm a period on the oscillator", 100 * d / n
 				if (m) printf ", %.2f cm on the clock", 100 * dc / m
-				printf " (drag coefficients chosen, not measured: sim-bridge/PHYSICS.md §6.2; PHYSICS.md §6.4 has the same swimmer reversing with the lag). The paper gives no distance per period to compare.\n"
+				printf " (drag coefficients chosen, not measured: sim-bridge/PHYSICS.md §6.2; PHYSICS.md §6.4 has the same swimmer reversing with the lag). The paper gives no distance per period to compare."
+				if (n) printf " Its body sweeps %.3f m across its heading per period (the links'"'"' centre lines; %.3f m with their 3.2 cm width), where the row'"'"'s d̃ takes a contact body to sweep 2 x 0.1865 m/rad x 0.8 rad = 0.298 m: the plane robot'"'"'s swing is narrower than the row'"'"'s reading of it (the robots in a channel, below).", sw / n, sw / n + 0.032
+				printf "\n"
 			}' "$csv"
 	} >"$fig/swimmer.md"
 }

@@ -179,10 +179,10 @@ if grep -qF '| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 1 |
 else tap_fail "channel-plane.md numbers" "$(grep -E '^\||In all|Without' "$T/fig/channel-plane.md")"; fi
 
 # ---- swimmer: merge on fixed rows ---------------------------------------------------------
-H="mode,seed,seconds,freq1_hz,freq2_hz,amp1_rad,amp2_rad,lag_rad,lag_spread_rad,along_per_period_m,across_per_period_m,speed_m_s,turn_rad,periods,min_swing_rad,wall_s"
-result swimmer oscillator-s1 "$H" "oscillator,1,30,0.82,0.82,0.80,0.81,1.80,0.3,0.0140,0.0001,0.0115,0.2,20.5,1.6,10"
-result swimmer oscillator-s2 "$H" "oscillator,2,30,0.82,0.82,0.80,0.81,1.78,0.3,0.0146,-0.0001,0.0120,-0.3,20.5,1.6,10"
-result swimmer sinusoid-s1 "$H" "sinusoid,3,30,0.824,0.824,0.80,0.80,2.09,0.04,0.0116,0,0.0095,0.25,20.6,1.6,10"
+H="mode,seed,seconds,freq1_hz,freq2_hz,amp1_rad,amp2_rad,lag_rad,lag_spread_rad,along_per_period_m,across_per_period_m,speed_m_s,turn_rad,periods,min_swing_rad,wall_s,sweep_m"
+result swimmer oscillator-s1 "$H" "oscillator,1,30,0.82,0.82,0.80,0.81,1.80,0.3,0.0140,0.0001,0.0115,0.2,20.5,1.6,10,0.18"
+result swimmer oscillator-s2 "$H" "oscillator,2,30,0.82,0.82,0.80,0.81,1.78,0.3,0.0146,-0.0001,0.0120,-0.3,20.5,1.6,10,0.20"
+result swimmer sinusoid-s1 "$H" "sinusoid,3,30,0.824,0.824,0.80,0.80,2.09,0.04,0.0116,0,0.0095,0.25,20.6,1.6,10,0.17"
 for id in oscillator-s1 oscillator-s2 sinusoid-s1; do
 	d="$T/runs/swimmer/$id"
 	awk 'BEGIN { print "t,joint1_rad,joint2_rad"; for (i = 0; i <= 500; i++) { t = 25 + i / 100
@@ -198,9 +198,10 @@ blue=$(pixels 1f77b4 "$T/fig/swimmer.png") orange=$(pixels ff7f0e "$T/fig/swimme
 if [ "${blue:-0}" -ge 1000 ] && [ "${orange:-0}" -ge 1000 ] && [ "${red:-0}" -ge 100 ]; then
 	tap_ok "swimmer.png: both joints' angles and the centre's path drawn ($blue, $orange, $red pixels)"
 else tap_fail "swimmer.png shows its data" "joint 1 $blue, joint 2 $orange, path $red pixels of their colours"; fi
-if grep -qF '| oscillator | 2 | 0.820 / 0.820 | 0.800 / 0.810 | 1.79 rad (103°) | 1.43 cm (1.40-1.46) | 0.00 cm | 1.18 cm/s | 0.25 rad |' "$T/fig/swimmer.md" &&
-	grep -qF '| clock | 1 | 0.824 / 0.824 | 0.800 / 0.800 | 2.09 rad (120°) | 1.16 cm (1.16-1.16) | 0.00 cm | 0.95 cm/s | 0.25 rad |' "$T/fig/swimmer.md" &&
-	grep -q 'joints settle 1.79 rad (103°) apart, not 2π/3' "$T/fig/swimmer.md" && [ "$(wc -l <"$T/fig/swimmer.csv")" = 4 ]; then
+if grep -qF '| oscillator | 2 | 0.820 / 0.820 | 0.800 / 0.810 | 1.79 rad (103°) | 1.43 cm (1.40-1.46) | 0.00 cm | 1.18 cm/s | 0.25 rad | 0.190 m |' "$T/fig/swimmer.md" &&
+	grep -qF '| clock | 1 | 0.824 / 0.824 | 0.800 / 0.800 | 2.09 rad (120°) | 1.16 cm (1.16-1.16) | 0.00 cm | 0.95 cm/s | 0.25 rad | 0.170 m |' "$T/fig/swimmer.md" &&
+	grep -q 'joints settle 1.79 rad (103°) apart, not 2π/3' "$T/fig/swimmer.md" &&
+	grep -q 'sweeps 0.190 m across its heading per period (.*0.222 m with' "$T/fig/swimmer.md" && [ "$(wc -l <"$T/fig/swimmer.csv")" = 4 ]; then
 	tap_ok "swimmer.md: per mode the gait, the lag and the swim per period, the lag beside the paper's 2 pi / 3"
 else tap_fail "swimmer.md numbers" "$(grep -E '^\||Beside' "$T/fig/swimmer.md")"; fi
 
@@ -259,8 +260,8 @@ if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyz
 	# the plane modules' real runs: a gait near the tuned 0.8 Hz and 0.8 rad, the robot
 	# swimming head first; four robots drawn from the run's own frames
 	s="$R/swimmer/oscillator-t0/result.csv"
-	if awk -F, 'NR == 2 { exit !($4 > 0.7 && $4 < 0.95 && $6 > 0.7 && $6 < 0.9 && $8 > 1.2 && $8 < 2.4 && $10 > 0.005) }' "$s" 2>/dev/null; then
-		tap_ok "swimmer: a real run: $(awk -F, 'NR == 2 { printf "%.2f Hz, %.2f rad, joint 2 %.0f deg behind, %.2f cm a period", $4, $6, $8 * 57.2958, 100 * $10 }' "$s")"
+	if awk -F, 'NR == 2 { exit !($4 > 0.7 && $4 < 0.95 && $6 > 0.7 && $6 < 0.9 && $8 > 1.2 && $8 < 2.4 && $10 > 0.005 && $17 > 0.1 && $17 < 0.3) }' "$s" 2>/dev/null; then
+		tap_ok "swimmer: a real run: $(awk -F, 'NR == 2 { printf "%.2f Hz, %.2f rad, joint 2 %.0f deg behind, %.2f cm a period, %.3f m wide", $4, $6, $8 * 57.2958, 100 * $10, $17 }' "$s")"
 	else tap_fail "swimmer: a real run's gait and swim" "$(cat "$s" 2>&1)"; fi
 	blue=$(pixels 1f77b4 "$G/swimmer.png") red=$(pixels d62728 "$G/swimmer.png")
 	tap_check "swimmer.png: the run's joints and path drawn ($blue, $red pixels)" test "${blue:-0}" -ge 1000 -a "${red:-0}" -ge 20
