@@ -2,6 +2,7 @@
 #include "lockstep.h"
 
 #include <errno.h>
+#include <stdbool.h>
 #include <limits.h>
 #include <poll.h>
 #include <stdlib.h>
@@ -83,6 +84,16 @@ int lks_listen(const char *path, char *err, size_t cap)
 	if (lstat(path, &st) == 0) {
 		if (!S_ISSOCK(st.st_mode)) {
 			snprintf(err, cap, "lockstep socket %s: something that is not a socket is there", path);
+			return -1;
+		}
+		/* a live simulator's is refused, not replaced: a connection there
+		 * succeeds (it accepts, sees nobody register, and drops it) */
+		int probe = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+		bool alive = probe >= 0 && connect(probe, (struct sockaddr *)&sa, sizeof sa) == 0;
+		if (probe >= 0)
+			close(probe);
+		if (alive) {
+			snprintf(err, cap, "lockstep socket %s: another simulator listens on it", path);
 			return -1;
 		}
 		unlink(path);   /* a stale socket of an earlier run */

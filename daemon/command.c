@@ -52,8 +52,12 @@ static enum cmd_verdict cmd_check_param(const struct cmd_request *r, const struc
 	if (below || r->value > range.max)
 		return reject(why, cap, "parameter %s: %g out of range %s%g..%g", name, r->value,
 		              range.min_open ? ">" : "", range.min, range.max);
-	if (cfg_param_is_robot(name))
+	if (cfg_param_is_robot(name)) {
+		char inner[200];
+		if (!cfg_robot_param_check(cfg, name, r->value, inner, sizeof inner))
+			return reject(why, cap, "parameter %s: %s", name, inner);
 		return CMD_ACCEPT;
+	}
 	/* what the range table cannot express: the joint's parameters together */
 	size_t first = r->joint < 0 ? 0 : (size_t)r->joint;
 	size_t last = r->joint < 0 ? cfg->njoints : first + 1;
@@ -179,9 +183,11 @@ void cmd_apply_param(struct cfg *cfg, const struct cmd_request *r)
 	const char *name = nz(r->param);
 	if (!cfg_param_commandable(name))
 		return;   /* cmd_check() refused it; a caller that skipped it changes nothing */
-	if (strcmp(name, "amplitude") == 0) { cfg->amplitude = r->value; return; }
-	if (strcmp(name, "frequency") == 0) { cfg->frequency = r->value; return; }
-	if (strcmp(name, "phase") == 0) { cfg->phase = r->value; return; }
+	double *robot = cfg_robot_param(cfg, name);
+	if (robot != NULL) {
+		*robot = r->value;
+		return;
+	}
 	size_t first = r->joint < 0 ? 0 : (size_t)r->joint;
 	size_t last = r->joint < 0 ? cfg->njoints : first + 1;
 	for (size_t j = first; j < last && j < cfg->njoints; j++) {

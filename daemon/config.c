@@ -170,6 +170,7 @@ static const struct cfg_param_def cfg_params[] = {
 	{ "lambda",    { -10.0, 10.0, false }, true, true },
 	{ "inertia",   { 1e-5, 1.0, false }, true, true },
 	{ "friction",  { 0.0, 1.0, false }, true, true },
+	{ "coupling_phase", { -CFG_PI, CFG_PI, false }, true, true },
 	{ "neutral",   { -CFG_SERVO_HALF_RANGE, CFG_SERVO_HALF_RANGE, false }, true, false },
 	{ "limit_min", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
 	{ "limit_max", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
@@ -177,6 +178,10 @@ static const struct cfg_param_def cfg_params[] = {
 	{ "amplitude", { 0.0, CFG_SERVO_HALF_RANGE, false }, false, true },
 	{ "frequency", { 0.0, 5.0, false }, false, true },
 	{ "phase",     { -2.0 * CFG_PI, 2.0 * CFG_PI, false }, false, true },
+	/* the clock as a torque law: the paper's 0.015..0.135 N·m/rad and far
+	 * beyond (the position loop's own stiffness is 9.2 N·m/rad); 0 = off */
+	{ "stiffness", { 0.0, 10.0, false }, false, true },
+	{ "damping",   { 0.0, 1.0, false }, false, true },
 };
 #define CFG_NPARAMS (sizeof cfg_params / sizeof cfg_params[0])
 
@@ -205,7 +210,28 @@ bool cfg_param_commandable(const char *key)
 
 const char *cfg_param_commandable_list(void)
 {
-	return "k, c, mu, lambda, inertia, friction (per joint), amplitude, frequency, phase (sinusoid)";
+	return "k, c, mu, lambda, coupling_phase, inertia, friction (per joint), amplitude, frequency, phase, "
+	       "stiffness, damping (sinusoid)";
+}
+
+double *cfg_robot_param(struct cfg *c, const char *key)
+{
+	if (strcmp(key, "amplitude") == 0) return &c->amplitude;
+	if (strcmp(key, "frequency") == 0) return &c->frequency;
+	if (strcmp(key, "phase") == 0) return &c->phase;
+	if (strcmp(key, "stiffness") == 0) return &c->sin_stiffness;
+	if (strcmp(key, "damping") == 0) return &c->sin_damping;
+	return NULL;
+}
+
+bool cfg_robot_param_check(const struct cfg *c, const char *key, double value, char *why, size_t cap)
+{
+	if (strcmp(key, "stiffness") == 0 && value > 0.0 && c->actuation != CFG_ACT_TORQUE) {
+		snprintf(why, cap, "stiffness %g drives the clock as a torque: it needs [robot] actuation = torque "
+		         "(with position actuation SINUSOID follows the clock with the servo's position loop)", value);
+		return false;
+	}
+	return true;
 }
 
 bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap)
@@ -237,6 +263,7 @@ double *cfg_joint_param(struct cfg_joint *j, const char *key)
 	if (strcmp(key, "c") == 0) return &j->osc.c;
 	if (strcmp(key, "mu") == 0) return &j->osc.mu;
 	if (strcmp(key, "lambda") == 0) return &j->osc.lambda;
+	if (strcmp(key, "coupling_phase") == 0) return &j->osc.coupling_phase;
 	if (strcmp(key, "inertia") == 0) return &j->osc.inertia;
 	if (strcmp(key, "friction") == 0) return &j->osc.friction;
 	if (strcmp(key, "neutral") == 0) return &j->neutral;
@@ -308,7 +335,7 @@ void cfg_defaults(struct cfg *c)
 	for (size_t j = 0; j < CFG_MAX_JOINTS; j++) {
 		struct cfg_joint *jt = &c->joint[j];
 		jt->osc.k = jt->osc.c = jt->osc.mu = jt->osc.lambda = NAN;
-		jt->osc.inertia = jt->osc.friction = NAN;
+		jt->osc.inertia = jt->osc.friction = jt->osc.coupling_phase = NAN;
 		jt->neutral = NAN;
 		jt->limit_min = NAN;
 		jt->limit_max = NAN;
@@ -318,6 +345,9 @@ void cfg_defaults(struct cfg *c)
 	c->amplitude = 0.8;
 	c->frequency = 0.8;
 	c->phase = 0.0;
+	/* SINUSOID through the servo's position loop unless a stiffness is given */
+	c->sin_stiffness = 0.0;
+	c->sin_damping = 0.0;
 }
 
 /* ---- [robot] keys --------------------------------------------------------------------- */
@@ -554,11 +584,10 @@ bool cfg_set(struct cfg *c, const char *where, const char *section, const char *
 	if (strcmp(section, "robot") == 0)
 		return cfg_set_robot(c, where, key, value, e);
 	if (strcmp(section, "sinusoid") == 0) {
-		double *f = strcmp(key, "amplitude") == 0 ? &c->amplitude
-		          : strcmp(key, "frequency") == 0 ? &c->frequency
-		          : strcmp(key, "phase") == 0 ? &c->phase : NULL;
+		double *f = cfg_robot_param(c, key);
 		if (f == NULL) {
-			cfg_error(e, "%s: [sinusoid] %s: unknown key (amplitude, frequency, phase)", where, key);
+			cfg_error(e, "%s: [sinusoid] %s: unknown key (amplitude, frequency, phase, stiffness, damping)",
+			          where, key);
 			return false;
 		}
 		return cfg_set_param(f, where, section, key, value, e);
@@ -838,6 +867,7 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 		if (isnan(jt->osc.c)) jt->osc.c = d.c;
 		if (isnan(jt->osc.mu)) jt->osc.mu = d.mu;
 		if (isnan(jt->osc.lambda)) jt->osc.lambda = d.lambda;
+		if (isnan(jt->osc.coupling_phase)) jt->osc.coupling_phase = d.coupling_phase;
 		if (isnan(jt->osc.inertia)) jt->osc.inertia = d.inertia;
 		if (isnan(jt->osc.friction)) jt->osc.friction = d.friction;
 		if (isnan(jt->neutral)) jt->neutral = 0.0;
@@ -885,7 +915,8 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 	for (size_t j = c->njoints; j < CFG_MAX_JOINTS; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		if (!isnan(jt->osc.k) || !isnan(jt->osc.c) || !isnan(jt->osc.mu) || !isnan(jt->osc.lambda) ||
-		    !isnan(jt->osc.inertia) || !isnan(jt->osc.friction) || !isnan(jt->neutral) ||
+		    !isnan(jt->osc.inertia) || !isnan(jt->osc.friction) || !isnan(jt->osc.coupling_phase) ||
+		    !isnan(jt->neutral) ||
 		    !isnan(jt->limit_min) || !isnan(jt->limit_max) || !isnan(jt->max_step))
 			cfg_error(e, "%s: [joint.%zu]: the robot has only %zu joint(s) (ids)",
 			          c->source[0] ? c->source : "command line", j + 1, c->njoints);
@@ -924,6 +955,9 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 		cfg_error(e, "%s: [robot] velocity_source = servo cannot be used with actuation = torque: in wheel "
 		          "mode the AX-12's present speed is its output, not a speed; use velocity_source = filtered",
 		          c->source[0] ? c->source : "command line");
+	char pwhy[200];
+	if (!cfg_robot_param_check(c, "stiffness", c->sin_stiffness, pwhy, sizeof pwhy))
+		cfg_error(e, "%s: [sinusoid] %s", c->source[0] ? c->source : "command line", pwhy);
 	if (c->commands == CFG_CMD_NETWORK && c->command_key[0] == '\0')
 		cfg_error(e, "%s: [robot] commands = network needs command_key = FILE (the shared key: "
 		          "`undulated --gen-key FILE` makes one)", c->source[0] ? c->source : "command line");
@@ -963,11 +997,12 @@ void cfg_print(const struct cfg *c, void *file)
 	        c->command_key, c->command_window_s, c->run_dir, c->lockstep);
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
-		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ninertia = %g\nfriction = %g\n"
-		        "neutral = %g\nlimit_min = %g\nlimit_max = %g\nmax_step = %g\n", j + 1, jt->osc.k,
-		        jt->osc.c, jt->osc.mu, jt->osc.lambda, jt->osc.inertia, jt->osc.friction, jt->neutral,
+		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ncoupling_phase = %g\ninertia = %g\n"
+		        "friction = %g\nneutral = %g\nlimit_min = %g\nlimit_max = %g\nmax_step = %g\n", j + 1, jt->osc.k,
+		        jt->osc.c, jt->osc.mu, jt->osc.lambda, jt->osc.coupling_phase, jt->osc.inertia, jt->osc.friction,
+		        jt->neutral,
 		        jt->limit_min, jt->limit_max, jt->max_step);
 	}
-	fprintf(f, "\n[sinusoid]\namplitude = %g\nfrequency = %g\nphase = %g\n", c->amplitude, c->frequency,
-	        c->phase);
+	fprintf(f, "\n[sinusoid]\namplitude = %g\nfrequency = %g\nphase = %g\nstiffness = %g\ndamping = %g\n",
+	        c->amplitude, c->frequency, c->phase, c->sin_stiffness, c->sin_damping);
 }

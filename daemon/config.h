@@ -110,6 +110,10 @@ struct cfg {
 	struct cfg_joint joint[CFG_MAX_JOINTS];
 	/* [sinusoid] */
 	double amplitude, frequency, phase;
+	/* torque actuation: the clock as a torque law (osc_clock_torque); 0: the
+	 * servo's own position loop follows the clock, in joint mode */
+	double sin_stiffness;          /* k_s, N·m/rad */
+	double sin_damping;            /* d_s, N·m·s/rad */
 
 	/* where a config came from, for messages */
 	char source[CFG_PATH_MAX];
@@ -160,7 +164,13 @@ const char *cfg_protocol_name(enum cfg_protocol p);   /* "1", "2", "auto" */
  * servo never stops sooner than configured. */
 uint8_t cfg_watchdog_units(const struct cfg *c);
 bool cfg_param_is_joint(const char *key);   /* k, c, ..., max_step */
-bool cfg_param_is_robot(const char *key);   /* amplitude, frequency, phase */
+bool cfg_param_is_robot(const char *key);   /* amplitude, frequency, phase, stiffness, damping */
+/* A robot parameter's value in the context of the whole configuration (the
+ * range table cannot say it): [sinusoid] stiffness > 0 needs torque
+ * actuation. False with *why. */
+bool cfg_robot_param_check(const struct cfg *c, const char *key, double value, char *why, size_t cap);
+/* Value of a per-robot parameter by name (for commands); NULL if unknown. */
+double *cfg_robot_param(struct cfg *c, const char *key);
 /* Value of a per-joint parameter by name (for commands); NULL if unknown. */
 double *cfg_joint_param(struct cfg_joint *j, const char *key);
 

@@ -1264,10 +1264,10 @@ static void ctl_targets(struct ctl *c, enum cfg_mode mode, double dt, double t_r
 		return;
 	case CFG_MODE_OSCILLATOR:
 	case CFG_MODE_SINUSOID:
-		if (mode == CFG_MODE_OSCILLATOR && !c->starter_active && c->cfg->actuation == CFG_ACT_TORQUE) {
+		if (tq_mode_drives(c, mode) && !(mode == CFG_MODE_OSCILLATOR && c->starter_active)) {
 			/* torque actuation drives through duties (torque.c); as a
 			 * position it stands for where the joint is (the cycles that
-			 * switch servo modes, fades out of it) */
+			 * switch servo modes, a fault's back-off, fades out of it) */
 			for (size_t j = 0; j < c->n; j++)
 				target[j] = c->j[j].angle;
 			return;
@@ -1428,7 +1428,7 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 	bool want = tq_want_wheel(c);
 	if (want && c->wheel) {
 		c->sync = CTL_SYNC_DUTY;
-		tq_duties(c);
+		tq_duties(c, t_real);
 		for (size_t j = 0; j < c->n; j++) {
 			ctl_update_estimates(c, j);
 			c->j[j].fresh = false;

@@ -38,17 +38,21 @@ void ctl_hold_at_present(struct ctl *c);
 void ctl_latch(struct ctl *c, const char *what);
 
 /* ---- torque.c ------------------------------------------------------------------------- */
-/* The servos go into wheel mode only for a running OSCILLATOR whose joints are
- * all healthy, torqued and measured. */
+/* Under torque actuation `mode` drives the servos' torque: OSCILLATOR, and
+ * SINUSOID with a [sinusoid] stiffness (the clock as a torque law). */
+bool tq_mode_drives(const struct ctl *c, enum cfg_mode mode);
+/* The servos go into wheel mode only for such a mode running (not the
+ * oscillator's starter) whose joints are all healthy, torqued and measured. */
 bool tq_want_wheel(const struct ctl *c);
 /* A joint past its limits under torque: the fault action, latched. */
 void tq_check_limits(struct ctl *c);
-/* The PWM drive scales with the supply each servo reports: in OSCILLATOR
- * under torque actuation a reading outside the servo's plausible range
- * (sm_supply_plausible) is a fault, named and latched, never a gain. */
+/* The PWM drive scales with the supply each servo reports: in a mode that
+ * drives torque (tq_mode_drives) a reading outside the servo's plausible
+ * range (sm_supply_plausible) is a fault, named and latched, never a gain. */
 void tq_check_supply(struct ctl *c);
-/* This cycle's duties from the law's torque (wheel mode). */
-void tq_duties(struct ctl *c);
+/* This cycle's duties from the mode's law (wheel mode); t_real is the
+ * SINUSOID's shared clock (ctl_step). */
+void tq_duties(struct ctl *c, double t_real);
 /* Wheel-mode switches, queued after this cycle's SYNC_WRITE. */
 void tq_enter_wheel(struct ctl *c);
 void tq_leave_wheel(struct ctl *c);

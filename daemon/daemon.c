@@ -378,10 +378,21 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 {
 	if (!dmn_find_port(d, err, cap))
 		return false;
-	struct port_options opt = { .baud = d->cfg->baud, .force_termios = false, .low_latency = true };
+	/* the port is this robot's alone (protocol/io/port_lock.c): what the
+	 * lock names, so that a program refused beside us can say who holds it */
+	char owner[CFG_NAME_MAX + 8];
+	struct holder held;
+	snprintf(owner, sizeof owner, "robot %s", d->cfg->name);
+	struct port_options opt = { .baud = d->cfg->baud, .force_termios = false, .low_latency = true,
+	                            .owner = owner, .holder = &held };
 	d->port = port_open(d->port_path, &opt, err, cap);
-	if (d->port == NULL)
+	if (d->port == NULL) {
+		size_t len = strlen(err);
+		if ((held.pid > 0 || held.program[0] != '\0') && len < cap)
+			snprintf(err + len, cap - len, ": one program drives a bus at a time; stop that one first, or give "
+			         "this robot a port of its own");
 		return false;
+	}
 	/* A UART behind a half-duplex buffer: the kernel switches the direction
 	 * around every packet. A device that cannot (a USB adapter, a pty) must
 	 * not run with the wiring silently wrong: one error, and no start. */

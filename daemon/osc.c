@@ -49,12 +49,24 @@
  * from a speed estimate a few ms late: the error goes with the acceleration,
  * i.e. with −x, and softens the spring (0.61 Hz with k = 0.111); k = 0.19
  * gives 0.79–0.80 Hz, 0.77 rad there (measured, CONTROL.md).
+ * Two or more joints: the paper's coupling pumps energy into the travelling
+ * wave (growth ≈ 0.37·ω in the bare law), so one joint's μ let two joints
+ * swing 2.0/1.6 rad, past the ±1.3 rad limits (measured on the simulated
+ * robot: the limit fault at 13 s on the current drive, 1.13 rad at 0.90 Hz on
+ * the PWM drive). A larger μ, smaller on the odd joints as in the position
+ * defaults, found by `undulated --tune` on the simulated two-joint robot in
+ * lockstep and rounded: 0.809 Hz, 0.82/0.80 rad (current), 0.813 Hz,
+ * 0.83/0.80 rad (PWM).
  */
 #define OSC_TQ_INERTIA OSC_TORQUE_JOINT_INERTIA
 #define OSC_TQ_K        0.111
 #define OSC_TQ_K_PWM    0.19
 #define OSC_TQ_C        6.6e-3
 #define OSC_TQ_MU       0.032
+#define OSC_TQ_MU0      0.18     /* two or more joints, even joints, current drive */
+#define OSC_TQ_MU1      0.10     /* ... odd joints */
+#define OSC_TQ_MU0_PWM  0.26     /* two or more joints on the PWM drive */
+#define OSC_TQ_MU1_PWM  0.15
 #define OSC_TQ_FRICTION 0.005
 
 /* Width (rad/s) of the smooth sign used for friction compensation:
@@ -73,6 +85,7 @@ void osc_default_params(struct osc_joint_params *p, size_t joint, size_t njoints
 	p->mu = OSC_DEF_MU0;
 	p->inertia = OSC_DEF_INERTIA;
 	p->friction = 0.0;
+	p->coupling_phase = 0.0;
 	if (njoints < 2) {
 		p->lambda = 0.0;   /* uncoupled: a van der Pol oscillator */
 		p->mu = OSC_DEF_MU_SINGLE;
@@ -89,9 +102,15 @@ void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t 
 {
 	p->k = pwm ? OSC_TQ_K_PWM : OSC_TQ_K;
 	p->c = OSC_TQ_C;
-	p->mu = OSC_TQ_MU;
+	if (njoints < 2)
+		p->mu = OSC_TQ_MU;
+	else if (joint % 2 == 0)
+		p->mu = pwm ? OSC_TQ_MU0_PWM : OSC_TQ_MU0;
+	else
+		p->mu = pwm ? OSC_TQ_MU1_PWM : OSC_TQ_MU1;
 	p->inertia = OSC_TQ_INERTIA;
 	p->friction = OSC_TQ_FRICTION;
+	p->coupling_phase = 0.0;
 	p->lambda = njoints < 2 ? 0.0 : (joint % 2 == 0 ? OSC_DEF_LAMBDA0 : OSC_DEF_LAMBDA1);
 }
 
@@ -102,11 +121,25 @@ static size_t osc_other(size_t j, size_t njoints)
 	return (j + 1 < njoints) ? j + 1 : j - 1;
 }
 
+/* The other joint as joint j's coupling sees it: its angle θ_j further on in
+ * its cycle, from its angle and speed (on x = a cos ωt, exactly
+ * a cos(ωt + θ) when ω is the law's own √(k/I)). θ = 0: the angle as it is,
+ * bit for bit the law without the term. */
+static double osc_coupled(const struct osc_joint_params *p, size_t j, double x_other, double v_other)
+{
+	double theta = p[j].coupling_phase;
+	if (theta == 0.0)
+		return x_other;
+	double omega = sqrt(p[j].k / p[j].inertia);
+	return x_other * cos(theta) + v_other / omega * sin(theta);
+}
+
 /* The right-hand side of the law for joint j at state (x, v). */
 static double osc_law(const struct osc_joint_params *p, size_t njoints, const double *x,
                       const double *v, size_t j)
 {
-	double coupled = (njoints >= 2) ? p[j].lambda * x[osc_other(j, njoints)] : 0.0;
+	size_t o = njoints >= 2 ? osc_other(j, njoints) : j;
+	double coupled = (njoints >= 2) ? p[j].lambda * osc_coupled(p, j, x[o], v[o]) : 0.0;
 	double torque = -p[j].k * (x[j] + coupled) + (p[j].c - p[j].mu * x[j] * x[j]) * v[j];
 	if (p[j].friction != 0.0)
 		torque += p[j].friction * tanh(v[j] / OSC_FRICTION_BAND);
@@ -134,7 +167,8 @@ static bool osc_params_ok(const struct osc_joint_params *p, size_t njoints)
 	for (size_t j = 0; j < njoints; j++) {
 		const struct osc_joint_params *q = &p[j];
 		if (!isfinite(q->k) || !isfinite(q->c) || !isfinite(q->mu) || !isfinite(q->lambda) ||
-		    !isfinite(q->friction) || !isfinite(q->inertia) || !(q->inertia > 0.0))
+		    !isfinite(q->friction) || !isfinite(q->inertia) || !(q->inertia > 0.0) ||
+		    !isfinite(q->coupling_phase))
 			return false;
 	}
 	return true;
@@ -228,7 +262,8 @@ bool osc_torque(const struct osc_joint_params *p, size_t njoints, const double *
 	bool ok = osc_all_finite(x, njoints) && osc_all_finite(v, njoints);
 	for (size_t j = 0; ok && j < njoints; j++)
 		ok = isfinite(p[j].k) && isfinite(p[j].c) && isfinite(p[j].mu) && isfinite(p[j].lambda) &&
-		     isfinite(p[j].friction);
+		     isfinite(p[j].friction) && isfinite(p[j].coupling_phase) &&
+		     (p[j].coupling_phase == 0.0 || p[j].inertia > 0.0);
 	for (size_t j = 0; j < njoints; j++)
 		torque[j] = ok ? osc_law(p, njoints, x, v, j) : 0.0;
 	for (size_t j = 0; ok && j < njoints; j++)
@@ -247,6 +282,34 @@ double osc_sinusoid(double amplitude, double frequency, double phase, size_t joi
 	double cycles = frequency * t;
 	cycles -= floor(cycles);
 	return amplitude * sin(phase + (2.0 * OSC_PI / 3.0) * (double)joint - 2.0 * OSC_PI * cycles);
+}
+
+double osc_sinusoid_rate(double amplitude, double frequency, double phase, size_t joint, double t)
+{
+	double cycles = frequency * t;
+	cycles -= floor(cycles);
+	return -2.0 * OSC_PI * frequency * amplitude *
+	       cos(phase + (2.0 * OSC_PI / 3.0) * (double)joint - 2.0 * OSC_PI * cycles);
+}
+
+bool osc_clock_torque(const struct osc_clock *k, size_t njoints, double t, const double *x, const double *v,
+                      double *torque)
+{
+	if (njoints == 0 || njoints > OSC_MAX_JOINTS)
+		return false;
+	bool ok = osc_all_finite(x, njoints) && osc_all_finite(v, njoints) && isfinite(t) &&
+	          isfinite(k->amplitude) && isfinite(k->frequency) && isfinite(k->phase) &&
+	          isfinite(k->stiffness) && isfinite(k->damping);
+	for (size_t j = 0; j < njoints; j++) {
+		double target = osc_sinusoid(k->amplitude, k->frequency, k->phase, j, t);
+		double rate = osc_sinusoid_rate(k->amplitude, k->frequency, k->phase, j, t);
+		torque[j] = ok ? k->stiffness * (target - x[j]) + k->damping * (rate - v[j]) : 0.0;
+		ok = ok && isfinite(torque[j]);
+	}
+	if (!ok)
+		for (size_t j = 0; j < njoints; j++)
+			torque[j] = 0.0;
+	return ok;
 }
 
 void osc_velocity_filter_init(struct osc_velocity_filter *f, double cutoff_hz)

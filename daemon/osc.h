@@ -2,7 +2,10 @@
  * osc.h — the control laws, pure: no clock (dt is an argument), no I/O.
  *
  * OSCILLATOR (the paper's limit cycle, integrated from the *measured* state):
- *     I ẍ_j = −k (x_j + λ_j x_other) + (c − μ x_j²) ẋ_j  [+ b·sgn(ẋ_j)]
+ *     I ẍ_j = −k (x_j + λ_j x̃_other) + (c − μ x_j²) ẋ_j  [+ b·sgn(ẋ_j)]
+ *     x̃_other = x_other cos θ_j + (ẋ_other / ω_j) sin θ_j,   ω_j = √(k_j / I_j)
+ * θ_j = 0 (the default) is the paper's law, x̃_other = x_other; a θ turns the
+ * joints' lag (CONTROL.md, "The joints' lag").
  * Each cycle takes the measured (x, ẋ) of both joints, integrates the coupled
  * equations over the horizon (one control period plus OSC_SERVO_LEAD_S, RK4
  * sub-steps), and returns the angle to command. "Other" is the next joint in
@@ -31,6 +34,8 @@ struct osc_joint_params {
 	double lambda;    /* coupling to the other joint (paper: 1.5, −0.5) */
 	double inertia;   /* kg·m² */
 	double friction;  /* b, N·m: friction compensation (0 = off) */
+	double coupling_phase;   /* θ, rad: the coupling sees the other joint θ further on in its
+	                            cycle (0: its angle as it is; CONTROL.md, "The joints' lag") */
 };
 
 /* What the daemon should pass as `horizon`: the measured dt plus this lead.
@@ -72,7 +77,7 @@ void osc_default_torque_params(struct osc_joint_params *p, size_t joint, size_t 
 #define OSC_TORQUE_JOINT_INERTIA 4.39e-3
 
 /* Torque actuation: the law's right-hand side at the measured state,
- *     τ_j = −k (x_j + λ_j x_other) + (c − μ x_j²) ẋ_j + b·sgn(ẋ_j)   (N·m).
+ *     τ_j = −k (x_j + λ_j x̃_other) + (c − μ x_j²) ẋ_j + b·sgn(ẋ_j)   (N·m).
  * Non-finite state or parameters give 0 for every joint (no drive) and false;
  * njoints 0 or > OSC_MAX_JOINTS: false, nothing written. */
 bool osc_torque(const struct osc_joint_params *p, size_t njoints, const double *x, const double *v,
@@ -91,6 +96,26 @@ bool osc_step(const struct osc_joint_params *p, size_t njoints, const double *x,
 /* The baseline: commanded angle of joint j at time t (s). Non-finite arguments
  * give a non-finite result: the caller checks before commanding it. */
 double osc_sinusoid(double amplitude, double frequency, double phase, size_t joint, double t);
+/* Its speed, dx̄_j/dt (rad/s), with the same care for a wall-clock t. */
+double osc_sinusoid_rate(double amplitude, double frequency, double phase, size_t joint, double t);
+
+/* Torque actuation's SINUSOID: the clock as a torque law, as the paper's
+ * force simulations drove their joints (k_s 0.015..0.135 N·m/rad there):
+ *     τ_j = k_s (x̄_j(t) − x_j) + d_s (dx̄_j/dt − ẋ_j)      (N·m)
+ * from the measured state. d_s = 0 is the paper's (purely proportional) law;
+ * the damping acts on the difference from the clock's own speed, so it never
+ * resists following the clock. Non-finite state, time or parameters give 0
+ * for every joint (no drive) and false; njoints 0 or > OSC_MAX_JOINTS:
+ * false, nothing written. */
+struct osc_clock {
+	double amplitude;   /* rad */
+	double frequency;   /* Hz */
+	double phase;       /* rad */
+	double stiffness;   /* k_s, N·m/rad */
+	double damping;     /* d_s, N·m·s/rad */
+};
+bool osc_clock_torque(const struct osc_clock *k, size_t njoints, double t, const double *x, const double *v,
+                      double *torque);
 
 /* The phase of a joint and its running frequency and amplitude: common/phase.h
  * (one definition for the daemon and the analyser). */

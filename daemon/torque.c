@@ -2,12 +2,16 @@
  * torque.c — torque actuation: OSCILLATOR drives the law's torque itself
  * through the servo's wheel mode (the paper's torque-controlled pair rig;
  * CONTROL.md), on the AX-12's PWM drive (back-EMF added back) or on a
- * current-controlled drive. Part of the controller (control_priv.h).
+ * current-controlled drive; so does SINUSOID given a [sinusoid] stiffness
+ * (the clock as a torque law, as the paper's force simulations drove their
+ * joints). Part of the controller (control_priv.h).
  *
- * The servos go into wheel mode only for a running OSCILLATOR whose joints are
- * all healthy, torqued and measured; everything else (starter, HOLD, SINUSOID,
- * faults, LIMP) runs in joint mode, where the servo itself holds positions and
- * enforces its angle limits.
+ * The servos go into wheel mode only for a running OSCILLATOR or such a
+ * SINUSOID whose joints are all healthy, torqued and measured; everything
+ * else (the oscillator's starter, HOLD, SINUSOID without a stiffness, faults,
+ * LIMP) runs in joint mode, where the servo itself holds positions and
+ * enforces its angle limits. Between the two driving modes the servos stay
+ * in the drive: only the law changes, at the cycle boundary.
  *
  * X series: "wheel mode" is the drive's Operating Mode — current control (0)
  * on the XM430, PWM control (16) — and joint mode position control (3).
@@ -50,10 +54,16 @@ double tq_no_load_speed(const struct ctl *c, const struct ctl_joint *jt)
 	return c->cfg->no_load_speed_given || m->protocol == 1 ? c->cfg->no_load_speed : m->no_load_speed_rad_s;
 }
 
+bool tq_mode_drives(const struct ctl *c, enum cfg_mode mode)
+{
+	if (c->cfg->actuation != CFG_ACT_TORQUE)
+		return false;
+	return mode == CFG_MODE_OSCILLATOR || (mode == CFG_MODE_SINUSOID && c->cfg->sin_stiffness > 0.0);
+}
+
 bool tq_want_wheel(const struct ctl *c)
 {
-	if (c->cfg->actuation != CFG_ACT_TORQUE || c->mode != CFG_MODE_OSCILLATOR || c->starter_active ||
-	    c->latched)
+	if (!tq_mode_drives(c, c->mode) || c->starter_active || c->latched)
 		return false;
 	for (size_t j = 0; j < c->n; j++) {
 		const struct ctl_joint *jt = &c->j[j];
@@ -87,7 +97,7 @@ void tq_check_limits(struct ctl *c)
 void tq_check_supply(struct ctl *c)
 {
 	const struct cfg *cfg = c->cfg;
-	if (cfg->actuation != CFG_ACT_TORQUE || cfg->torque_drive != CFG_DRIVE_PWM || c->mode != CFG_MODE_OSCILLATOR)
+	if (cfg->torque_drive != CFG_DRIVE_PWM || !tq_mode_drives(c, c->mode))
 		return;
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
@@ -174,16 +184,31 @@ static double tq_no_outward(const struct ctl_joint *jt, double u)
 	return u;
 }
 
-void tq_duties(struct ctl *c)
+/* The mode's law at the measured state: the oscillator's, or the clock's at
+ * the SINUSOID's shared time t_real. */
+static bool tq_law(const struct ctl *c, double t_real, const double *x, const double *v, double *tau)
+{
+	const struct cfg *cfg = c->cfg;
+	if (c->mode == CFG_MODE_SINUSOID) {
+		const struct osc_clock k = { .amplitude = cfg->amplitude, .frequency = cfg->frequency,
+		                             .phase = cfg->phase, .stiffness = cfg->sin_stiffness,
+		                             .damping = cfg->sin_damping };
+		return osc_clock_torque(&k, c->n, t_real, x, v, tau);
+	}
+	struct osc_joint_params p[CFG_MAX_JOINTS];
+	for (size_t j = 0; j < c->n; j++)
+		p[j] = cfg->joint[j].osc;
+	return osc_torque(p, c->n, x, v, tau);
+}
+
+void tq_duties(struct ctl *c, double t_real)
 {
 	double x[CFG_MAX_JOINTS], v[CFG_MAX_JOINTS], tau[CFG_MAX_JOINTS];
-	struct osc_joint_params p[CFG_MAX_JOINTS];
 	for (size_t j = 0; j < c->n; j++) {
-		p[j] = c->cfg->joint[j].osc;
 		x[j] = c->j[j].angle - c->cfg->joint[j].neutral;
 		v[j] = c->j[j].fresh ? c->j[j].speed : 0.0;
 	}
-	if (!osc_torque(p, c->n, x, v, tau))
+	if (!tq_law(c, t_real, x, v, tau))
 		c->nonfinite++;
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];

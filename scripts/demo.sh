@@ -374,12 +374,13 @@ t_ready=$(date +%s%N)
 
 # ---- the web dashboard, beside the terminal view --------------------------------
 # undulate-web on loopback (DEMO_WEB_PORT, default 8080; any free port when
-# that one is taken): the same robots in a browser, with the plots.
+# that one is taken): the same robots in a browser, with the plots. Its URL
+# carries the token it made (commands need it; a page without it watches).
 web_url=""
 start_web() {
 	start web "$B/undulate-web" --listen "127.0.0.1:$1" --lcm-url "$url"
-	wait_ready web 'listening on http://' 2>/dev/null || return 1
-	web_url=$(sed -n 's|^undulate-web: listening on \(http://[^ ]*\).*|\1|p' "$run/web.log")
+	wait_ready web 'open http://[^ ]*#token=' 2>/dev/null || return 1
+	web_url=$(sed -n 's|^undulate-web: open \(http://[^ ]*#token=[^ ]*\) .*|\1|p' "$run/web.log")
 }
 if [ -x "$B/undulate-web" ] && [ "$lockstep" != 1 ]; then
 	start_web "${DEMO_WEB_PORT:-8080}" || { mv "$run/web.log" "$run/web.1.log"; start_web 0; } ||
@@ -546,6 +547,14 @@ fi
 summary() {
 echo
 echo "=== undulate demo summary: ${#robots[@]} robots, $seconds s, $(basename "$scenario") ==="
+# A run that broke says so first: what follows describes a broken run
+# (the analyser's "broken": latched faults, robots that stopped publishing,
+# a simulator that fell behind real time).
+broken=$(jq -r '.broken[]?' "$analysis/summary.json" 2>/dev/null)
+if [ -n "$broken" ]; then
+	echo "THIS RUN BROKE: what follows is not the experiment's result:"
+	sed 's/^/  - /' <<<"$broken"
+fi
 [ -n "$switch_t" ] && echo "switched $start_mode -> $switch_to at t = $switch_t s"
 
 # In words: the contact force and the collisions between robots in the last
@@ -575,6 +584,10 @@ if [ -n "$switch_t" ]; then
 				printf "  The mean contact force did not fall: %.3f N on the %s (t = %.0f-%.0f s), %.3f N on the %s (t = %.0f-%.0f s).\n", fb, from, b0, sw, fa, to, a0, last + 1
 			printf "  Collisions between robots per 10 s: %.0f -> %.0f; against the walls: %.0f -> %.0f.\n", bp * 10 / bs, ap * 10 / as, bw * 10 / bs, aw * 10 / as
 		}' "$analysis/collision_rate.csv"
+	# the median contact force of the 10 ms periods with contact (the analyser's)
+	jq -r --arg from "$start_mode" --arg to "$switch_to" '.force | select(.median_before_n != null and .median_after_n != null) |
+		"  Median contact force of \(if .of == "contacts" then "all contacts (each touching pair over each 10 ms)" else "the 10 ms periods with contact" end): \(.median_before_n * 1000 | round / 1000) N on the \($from) (\(.samples_before) before the switch) -> \(.median_after_n * 1000 | round / 1000) N on the \($to) (\(.samples_after) in the final window)."' \
+		"$analysis/summary.json" 2>/dev/null
 fi
 awk '
 	$1 == "pair" && !hdr {
@@ -584,8 +597,10 @@ awk '
 	hdr == 1 && NF > 5 && $col["end"] != "-" && $col["2asin(d~)"] ~ /^[0-9.]+$/ {
 		n++; d = $col["meanD"]; if (d < 0) d = -d; b = $col["2asin(d~)"]
 		if (d <= b + 0.1) within++
-		rows = rows sprintf("    %-10s |D| %5.2f rad %s bound %4.2f: %s\n", $col["pair"], d, d <= b + 0.1 ? "<=" : "> ", b, $col["end"]) }
-	END { if (n) { printf "  Neighbours at the end (|D| against the compatibility bound 2 asin(d~)): %d of %d at or within it.\n%s", within, n, rows } }
+		if ($col["end"] == "grazing") grazing++
+		if ($col["end"] == "still-colliding") colliding++
+		rows = rows sprintf("    %-10s |D| %5.2f rad %s bound %4.2f: %s (%s N)\n", $col["pair"], d, d <= b + 0.1 ? "<=" : "> ", b, $col["end"], $col["F.win"]) }
+	END { if (n) { printf "  Neighbours at the end (|D| against the compatibility bound 2 asin(d~)): %d of %d at or within it; %d grazing it (touching with at most 0.1 N on average), %d still colliding harder.\n%s", within, n, grazing, colliding, rows } }
 ' "$analysis/summary.txt"
 
 echo

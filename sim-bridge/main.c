@@ -111,7 +111,7 @@ struct app {
 	int pending_bus[MAIN_TRUTH_MAX_COLLISIONS][2];
 	size_t npending;
 	uint64_t truth_sent, truth_failed, collisions_unreported;
-	uint64_t plane_steps_at;   /* the step of the last SIM.TRUTH: its contacts' period */
+	uint64_t contacts_steps_at;   /* the step of the last SIM.TRUTH: its contacts' period */
 	uint8_t *truth_buf;
 	bool bench, quiet;
 	/* bad input already reported, per bus (reported at most once a second) */
@@ -442,13 +442,34 @@ static void report_collisions(struct app *a)
 	}
 }
 
-/* The plane world's links, walls and contacts since the last message, into t. */
+/* Every pair touching since the last message (either world), into t. */
+static void fill_contacts(struct app *a, undulate_sim_truth_t *t)
+{
+	static undulate_sim_contact_t contacts[PLANE_MAX_CONTACTS];
+	static struct plane_contact c[PLANE_MAX_CONTACTS];
+	struct sim *s = a->sim;
+	size_t nc = sim_contacts_drain(s, c, PLANE_MAX_CONTACTS);
+	if (nc > PLANE_MAX_CONTACTS)
+		nc = PLANE_MAX_CONTACTS;
+	/* the period these impulses were summed over */
+	double period = (double)(s->steps - a->contacts_steps_at) * s->dt;
+	a->contacts_steps_at = s->steps;
+	for (size_t i = 0; i < nc; i++)
+		contacts[i] = (undulate_sim_contact_t){
+			.robot_a = (int16_t)c[i].robot_a, .link_a = (int8_t)c[i].link_a, .robot_b = (int16_t)c[i].robot_b,
+			.link_b = (int8_t)c[i].link_b, .x = c[i].x, .y = c[i].y, .nx = c[i].nx, .ny = c[i].ny,
+			.impulse = c[i].impulse, .normal_impulse = c[i].normal_impulse,
+			.force = period > 0 ? c[i].impulse / period : 0, .impact = c[i].impact,
+		};
+	t->ncontacts = (int32_t)nc;
+	t->contacts = contacts;
+}
+
+/* The plane world's links and walls, into t. */
 static void fill_plane(struct app *a, undulate_sim_truth_t *t)
 {
 	static undulate_sim_link_t links[PLANE_MAX_ROBOTS * PLANE_MAX_LINKS];
 	static undulate_sim_wall_t walls[PLANE_MAX_WALLS];
-	static undulate_sim_contact_t contacts[PLANE_MAX_CONTACTS];
-	static struct plane_contact c[PLANE_MAX_CONTACTS];
 	struct sim *s = a->sim;
 	const struct plane_params *pp = &s->cfg.plane;
 	t->world = UNDULATE_SIM_TRUTH_T_WORLD_PLANE;
@@ -464,25 +485,10 @@ static void fill_plane(struct app *a, undulate_sim_truth_t *t)
 	int nw = plane_walls(s->plane);
 	for (int w = 0; w < nw; w++)
 		plane_wall(s->plane, w, &walls[w].ax, &walls[w].ay, &walls[w].bx, &walls[w].by);
-	size_t nc = sim_plane_drain(s, c, PLANE_MAX_CONTACTS);
-	if (nc > PLANE_MAX_CONTACTS)
-		nc = PLANE_MAX_CONTACTS;
-	/* the period these impulses were summed over */
-	double period = (double)(s->steps - a->plane_steps_at) * s->dt;
-	a->plane_steps_at = s->steps;
-	for (size_t i = 0; i < nc; i++)
-		contacts[i] = (undulate_sim_contact_t){
-			.robot_a = (int16_t)c[i].robot_a, .link_a = (int8_t)c[i].link_a, .robot_b = (int16_t)c[i].robot_b,
-			.link_b = (int8_t)c[i].link_b, .x = c[i].x, .y = c[i].y, .nx = c[i].nx, .ny = c[i].ny,
-			.impulse = c[i].impulse, .normal_impulse = c[i].normal_impulse,
-			.force = period > 0 ? c[i].impulse / period : 0, .impact = c[i].impact,
-		};
 	t->nlinks = nl;
 	t->links = links;
 	t->nwalls = nw;
 	t->walls = walls;
-	t->ncontacts = (int32_t)nc;
-	t->contacts = contacts;
 }
 
 static void publish_truth(struct app *a)
@@ -512,6 +518,7 @@ static void publish_truth(struct app *a)
 	}
 	for (size_t i = 0; i < a->npending; i++)
 		fill_collision(a, &a->pending[i], a->pending_utime[i], &colls[i]);
+	fill_contacts(a, &t);
 	if (s->plane != NULL)
 		fill_plane(a, &t);
 	a->npending = 0;
@@ -538,6 +545,16 @@ static void publish_world(struct app *a)
 
 /* ---- control socket ---------------------------------------------------------- */
 
+/* Whether a simulator listens on the socket at addr (a killed one's is dead). */
+static bool control_alive(const struct sockaddr_un *addr)
+{
+	int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+	bool alive = fd >= 0 && connect(fd, (const struct sockaddr *)addr, sizeof(*addr)) == 0;
+	if (fd >= 0)
+		close(fd);
+	return alive;
+}
+
 static int control_open(struct app *a, const char *path)
 {
 	struct sockaddr_un addr = { .sun_family = AF_UNIX };
@@ -550,6 +567,10 @@ static int control_open(struct app *a, const char *path)
 	if (lstat(path, &st) == 0) {
 		if (!S_ISSOCK(st.st_mode)) {
 			fprintf(stderr, "undulate-sim: --control %s exists and is not a socket: refusing to replace it\n", path);
+			return -1;
+		}
+		if (control_alive(&addr)) {
+			fprintf(stderr, "undulate-sim: --control %s: another simulator listens on it\n", path);
 			return -1;
 		}
 		unlink(path);  /* a stale socket from a killed run */
@@ -1250,12 +1271,14 @@ int main(int argc, char **argv)
 		fprintf(stderr, "undulate-sim: LCM (%s) unavailable: no ground truth, no SIM.CMD\n",
 		        cfg.lcm_url[0] ? cfg.lcm_url : "default");
 	lcm_subscription_t *sub = app.lcm ? lcm_subscribe(app.lcm, "SIM.CMD", on_sim_cmd, &app) : NULL;
-	if (!app.truth_buf || (cfg.control[0] && control_open(&app, cfg.control) != 0) ||
-	    sim_open(&sim, err, sizeof(err)) != 0) {
+	/* the links first: a simulator refused its links (another one serves
+	 * them) must not have touched that one's control socket either */
+	bool opened = app.truth_buf && sim_open(&sim, err, sizeof(err)) == 0;
+	if (!opened || (cfg.control[0] && control_open(&app, cfg.control) != 0)) {
 		if (err[0])
 			fprintf(stderr, "undulate-sim: %s\n", err);
-		if (app.listen_fd >= 0)
-			unlink(app.control_path);
+		if (opened)
+			sim_close(&sim);
 		return 1;
 	}
 	app.t0 = mono_ns();

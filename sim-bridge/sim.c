@@ -341,7 +341,7 @@ int sim_open(struct sim *s, char *err, size_t errcap)
 void sim_close(struct sim *s)
 {
 	for (size_t i = 0; i < s->nbuses; i++)
-		sim_bus_close(&s->buses[i]);
+		sim_bus_release(&s->buses[i]);
 }
 
 /* ---- physics ------------------------------------------------------------------ */
@@ -478,11 +478,11 @@ static void sim_plane_walls_follow(struct sim *s)
 	}
 }
 
-/* Impulses summed per pair of links until sim_plane_drain(). */
-static void sim_plane_accumulate(struct sim *s, const struct plane_contact *c)
+/* Impulses summed per pair of links until sim_contacts_drain(). */
+static void sim_contact_accumulate(struct sim *s, const struct plane_contact *c)
 {
-	for (size_t i = 0; i < s->nplane_acc; i++) {
-		struct plane_contact *a = &s->plane_acc[i];
+	for (size_t i = 0; i < s->ncontact_acc; i++) {
+		struct plane_contact *a = &s->contact_acc[i];
 		if (a->robot_a == c->robot_a && a->link_a == c->link_a && a->robot_b == c->robot_b && a->link_b == c->link_b) {
 			double imp = a->impulse + c->impulse, nimp = a->normal_impulse + c->normal_impulse;
 			bool impact = a->impact || c->impact;
@@ -493,10 +493,10 @@ static void sim_plane_accumulate(struct sim *s, const struct plane_contact *c)
 			return;
 		}
 	}
-	if (s->nplane_acc < PLANE_MAX_CONTACTS)
-		s->plane_acc[s->nplane_acc++] = *c;
+	if (s->ncontact_acc < PLANE_MAX_CONTACTS)
+		s->contact_acc[s->ncontact_acc++] = *c;
 	else
-		s->plane_acc_dropped++;
+		s->contact_acc_dropped++;
 }
 
 /* The step's contacts as the row world's collisions and totals: an impact is
@@ -516,7 +516,7 @@ static void sim_plane_collisions(struct sim *s)
 			s->world.resting_contacts++;
 			s->world.resting_impulse += c[i].impulse;
 		}
-		sim_plane_accumulate(s, &c[i]);
+		sim_contact_accumulate(s, &c[i]);
 		if (s->nstep_collisions == SIM_MAX_COLLISIONS_PER_STEP)
 			continue;
 		s->step_collisions[s->nstep_collisions++] = (struct sim_collision){
@@ -556,13 +556,33 @@ static void sim_plane_step(struct sim *s)
 	s->steps++;
 }
 
-size_t sim_plane_drain(struct sim *s, struct plane_contact *out, size_t cap)
+/* The row's step collisions, impacts and resting contact, as contacts per
+ * pair of bodies: a point on the line where they touch, the normal along it. */
+static void sim_row_contacts(struct sim *s)
 {
-	size_t n = s->nplane_acc < cap ? s->nplane_acc : cap;
+	for (size_t i = 0; i < s->nstep_collisions; i++) {
+		const struct sim_collision *c = &s->step_collisions[i];
+		int a = c->left >= 0 ? c->left : c->right, b = c->left >= 0 ? c->right : -1;
+		if (a < 0)
+			continue;
+		double x = sim_world_lateral(&s->world, (size_t)a);
+		struct plane_contact pc = {
+			.robot_a = a, .robot_b = b >= 0 ? b : PLANE_WALL, .link_b = -1, .impulse = c->impulse,
+			.normal_impulse = c->impulse, .x = x, .nx = c->left >= 0 ? 1.0 : -1.0,
+			.approach = c->pre_left - c->pre_right, .separation = c->post_right - c->post_left,
+			.impact = !c->resting,
+		};
+		sim_contact_accumulate(s, &pc);
+	}
+}
+
+size_t sim_contacts_drain(struct sim *s, struct plane_contact *out, size_t cap)
+{
+	size_t n = s->ncontact_acc < cap ? s->ncontact_acc : cap;
 	if (out != NULL && n > 0)
-		memcpy(out, s->plane_acc, n * sizeof *out);
-	size_t had = s->nplane_acc;
-	s->nplane_acc = 0;
+		memcpy(out, s->contact_acc, n * sizeof *out);
+	size_t had = s->ncontact_acc;
+	s->ncontact_acc = 0;
 	return had;
 }
 
@@ -579,6 +599,7 @@ void sim_step(struct sim *s)
 	s->nstep_collisions = sim_world_resolve(&s->world, s->dt, s->step_collisions, SIM_MAX_COLLISIONS_PER_STEP);
 	if (s->nstep_collisions > SIM_MAX_COLLISIONS_PER_STEP)
 		s->nstep_collisions = SIM_MAX_COLLISIONS_PER_STEP;
+	sim_row_contacts(s);
 	for (size_t i = 0; i < s->nbuses; i++)
 		for (size_t k = 0; k < s->buses[i].njoints; k++)
 			sim_sense_joint(&s->buses[i].joints[k], s->dt);

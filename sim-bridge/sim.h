@@ -38,10 +38,11 @@ struct sim {
 	int plane_wall[4];             /* its walls: left, right, back, front (-1: none) */
 	struct plane_drive plane_drives[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
 	struct plane_joint plane_joints[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
-	/* contacts since the last sim_plane_drain(): impulses summed per pair */
-	struct plane_contact plane_acc[PLANE_MAX_CONTACTS];
-	size_t nplane_acc;
-	unsigned long long plane_acc_dropped;
+	/* contacts since the last sim_contacts_drain(), either world: impulses
+	 * summed per pair (the row: its bodies, link 0, a wall's index -1) */
+	struct plane_contact contact_acc[PLANE_MAX_CONTACTS];
+	size_t ncontact_acc;
+	unsigned long long contact_acc_dropped;
 	/* which joint each contact body rides on */
 	int body_bus[SIM_MAX_BODIES];
 	int body_joint[SIM_MAX_BODIES];
@@ -65,11 +66,14 @@ struct sim {
  * either (the plane world holds memory). */
 int sim_init(struct sim *s, const struct sim_config *cfg, char *err, size_t errcap);
 void sim_free(struct sim *s);
-/* The plane world's contacts since the last call, impulses summed per pair
- * of links (at most cap written; returns how many there were). */
-size_t sim_plane_drain(struct sim *s, struct plane_contact *out, size_t cap);
+/* The contacts since the last call, impulses summed per pair of links (the
+ * row world: of bodies, link 0; a wall's link_b its index, -1 for the row's
+ * walls) and whether any began then; at most cap written, returns how many
+ * there were. */
+size_t sim_contacts_drain(struct sim *s, struct plane_contact *out, size_t cap);
 /* Open every bus's pty and link. 0 or -1 with err (opened ones are closed). */
 int sim_open(struct sim *s, char *err, size_t errcap);
+/* Close every bus and let its link go (sim_bus_release). */
 void sim_close(struct sim *s);
 /* One physics step of s->dt: motors from the servo registers, contacts,
  * then the servos' present values and alarms. */

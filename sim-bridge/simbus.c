@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "dxl_table.h"
+#include "holder.h"
 #include "port.h"
 
 /* Bytes read from the pty per read() call. */
@@ -36,6 +37,7 @@ void sim_bus_init(struct sim_bus *b, const char *name, const char *link, long ba
 	b->latency_ns = (int64_t)llround(latency_s * 1e9);
 	b->echo = echo;
 	b->master = b->slave = -1;
+	b->link_lock = -1;
 	dxl_parser_init(&b->parser, DXL_PARSE_INSTRUCTION);
 	b->protocol = 1;
 	dxl2_parser_init(&b->parser2, DXL2_PARSE_INSTRUCTION);
@@ -418,7 +420,44 @@ static void bus_make_dirs(const char *path)
 	}
 }
 
-/* Point the link at the slave atomically (a reconnect re-points it). */
+/* LINK.lock beside the link: the link's owner. */
+static void bus_link_lock_path(const struct sim_bus *b, char *out, size_t cap)
+{
+	snprintf(out, cap, "%s.lock", b->link);
+}
+
+/* Take the link for this simulator, for as long as it runs (a disconnect
+ * keeps it): a lock file beside it, flock()ed, so that a second simulator
+ * is refused with the first one named, and one killed leaves a lock that
+ * the next one takes over. Not a lock on the pty: clients lock that
+ * (protocol/io/port_lock.c), and a killed simulator's pty number goes to
+ * the next pty opened anywhere. */
+static int bus_link_lock(struct sim_bus *b, char *err, size_t errcap)
+{
+	char path[SIM_PATH_MAX + 8], detail[SIM_NAME_MAX + 8], why[SIM_PATH_MAX + 64], who[HOLDER_DETAIL_MAX + 64];
+	struct holder h;
+	if (b->link_lock >= 0)
+		return 0;
+	bus_make_dirs(b->link);
+	bus_link_lock_path(b, path, sizeof(path));
+	snprintf(detail, sizeof(detail), "bus %s", b->name);
+	b->link_lock = holder_lockfile_take(path, detail, &h, why, sizeof(why));
+	if (b->link_lock >= 0)
+		return 0;
+	if (b->link_lock == HOLDER_HELD) {
+		holder_format(&h, who, sizeof(who));
+		snprintf(err, errcap, "%s: held by %s: another simulator serves this link (stop it first, or choose "
+		         "another --link)", b->link, who);
+	} else {
+		snprintf(err, errcap, "%s: %s", b->link, why);
+	}
+	b->link_lock = -1;
+	return -1;
+}
+
+/* Point the link at the slave atomically (a reconnect re-points it). With
+ * the link's lock held (bus_link_lock), a symlink already there is stale: a
+ * killed simulator's. */
 static int bus_link(struct sim_bus *b, char *err, size_t errcap)
 {
 	char tmp[SIM_PATH_MAX + 16];
@@ -441,6 +480,8 @@ static int bus_link(struct sim_bus *b, char *err, size_t errcap)
 
 int sim_bus_open(struct sim_bus *b, char *err, size_t errcap)
 {
+	if (bus_link_lock(b, err, errcap) != 0)
+		return -1;
 	int m = posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
 	if (m < 0 || grantpt(m) != 0 || unlockpt(m) != 0) {
 		snprintf(err, errcap, "%s: cannot create a pseudo-terminal: %s", b->name, strerror(errno));
@@ -493,6 +534,17 @@ void sim_bus_close(struct sim_bus *b)
 	sim_line_clear(&b->line);
 	dxl_parser_reset(&b->parser);
 	dxl2_parser_reset(&b->parser2);
+}
+
+void sim_bus_release(struct sim_bus *b)
+{
+	char path[SIM_PATH_MAX + 8];
+	sim_bus_close(b);
+	if (b->link_lock < 0)
+		return;
+	bus_link_lock_path(b, path, sizeof(path));
+	holder_lockfile_drop(path, b->link_lock);
+	b->link_lock = -1;
 }
 
 bool sim_bus_connected(const struct sim_bus *b) { return b->master >= 0; }

@@ -66,6 +66,7 @@ struct sim_bus {
 	bool echo;                 /* single-wire adapter: the request comes back */
 	int protocol;              /* 1 (AX-12A) or 2 (X series): what the bus speaks */
 	int master, slave;         /* -1 when disconnected */
+	int link_lock;             /* the lock on the link (LINK.lock), held from the first open to release; -1 none */
 	struct dxl_parser parser;
 	struct dxl2_parser parser2;
 	struct sim_line line;
@@ -108,10 +109,16 @@ void sim_bus_inject(struct sim_bus *b, const uint8_t *data, size_t n, int64_t no
 
 /* ---- pty I/O ------------------------------------------------------------------ */
 /* Create the pty (raw on both sides, a slave fd kept open so the pty survives
- * the controller closing it) and point the link at it. 0 or -1 with err. */
+ * the controller closing it) and point the link at it. 0 or -1 with err.
+ * The first open takes the link for this process (a lock file LINK.lock):
+ * a link another live simulator holds is refused ("LINK: held by
+ * undulate-sim (pid N, bus r1)"); one a killed simulator left is replaced. */
 int sim_bus_open(struct sim_bus *b, char *err, size_t errcap);
-/* Close the pty and remove the link (if it still points at our pty). */
+/* Close the pty and remove the link (if it still points at our pty); the
+ * link stays ours (the disconnect fault: a reconnect re-points it). */
 void sim_bus_close(struct sim_bus *b);
+/* sim_bus_close, and let the link go (its lock file removed). */
+void sim_bus_release(struct sim_bus *b);
 bool sim_bus_connected(const struct sim_bus *b);
 /* Read whatever the controller wrote and feed it. */
 void sim_bus_read(struct sim_bus *b, int64_t now);

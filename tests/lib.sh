@@ -38,6 +38,9 @@ T=$(mktemp -d "${TMPDIR:-/tmp}/undulate-test.XXXXXX")
 # Each test's daemons put their local command sockets here, and
 # `undulated --command` looks for them here: tests never command each other.
 export UNDULATE_RUN_DIR="$T"
+# ... and the UUCP lock files that name a bus's holder (protocol/io/port_lock.c)
+# go here, not to the machine's /var/lock.
+export UNDULATE_LOCK_DIR="$T"
 _pids=()
 _tap_n=0
 _tap_failed=0
@@ -228,7 +231,8 @@ samples() { awk -v r="$1" '$1 == "STATE" && $2 == r && $4 == "mode=3" {
 # Per joint over [from, to): upward crossings of the window's centre with
 # hysteresis (a tenth of the swing, well above the 5 mrad position step);
 # frequency from the first to the last crossing; each whole cycle's half
-# peak-to-peak; joint 2's crossing after each of joint 1's, as a lag in degrees.
+# peak-to-peak (least, most, mean); joint 2's crossing after each of joint 1's,
+# as a lag in degrees (least, most, mean and sd over the cycles).
 measure() {
 	awk -v from="$1" -v to="$2" '
 	function cross(j, t, x) {
@@ -237,7 +241,7 @@ measure() {
 		if (armed[j] && px[j] < c[j] && x >= c[j]) {
 			tc = pt + (t - pt) * (c[j] - px[j]) / (x - px[j])
 			n[j]++; ct[j, n[j]] = tc
-			if (n[j] > 1) { amp = (mx[j] - mn[j]) / 2; if (amp < amin[j]) amin[j] = amp; if (amp > amax[j]) amax[j] = amp }
+			if (n[j] > 1) { amp = (mx[j] - mn[j]) / 2; if (amp < amin[j]) amin[j] = amp; if (amp > amax[j]) amax[j] = amp; asum[j] += amp }
 			mx[j] = x; mn[j] = x; hi[j] = 0; armed[j] = 0
 		}
 	}
@@ -253,17 +257,28 @@ measure() {
 				if (x > mx[j]) mx[j] = x; if (x < mn[j]) mn[j] = x
 			}
 			f[j] = n[j] > 1 ? (n[j] - 1) / (ct[j, n[j]] - ct[j, 1]) : 0
-			printf "j%d n=%d f=%.3f amin=%.3f amax=%.3f\n", j, n[j], f[j], amin[j] == 1e9 ? 0 : amin[j], amax[j]
+			printf "j%d n=%d f=%.3f amin=%.3f amax=%.3f amean=%.3f\n", j, n[j], f[j], amin[j] == 1e9 ? 0 : amin[j], amax[j],
+				(n[j] > 1 ? asum[j] / (n[j] - 1) : 0)
 		}
 		if (nj >= 2 && f[1] > 0) {
 			k = 0; lmin = 1e9; lmax = -1e9
 			for (a = 1; a < n[1]; a++) for (b = 1; b <= n[2]; b++)
 				if (ct[2, b] >= ct[1, a] && ct[2, b] < ct[1, a + 1]) {
 					l = 360 * (ct[2, b] - ct[1, a]) / (ct[1, a + 1] - ct[1, a]); if (l > 180) l -= 360
-					k++; if (l < lmin) lmin = l; if (l > lmax) lmax = l; break
+					k++; if (l < lmin) lmin = l; if (l > lmax) lmax = l; ls += l; lss += l * l; break
 				}
-			printf "lag n=%d min=%.1f max=%.1f\n", k, k ? lmin : 0, k ? lmax : 0
+			lm = k ? ls / k : 0; lsd = k > 1 ? sqrt((lss - k * lm * lm) / (k - 1) > 0 ? (lss - k * lm * lm) / (k - 1) : 0) : 0
+			printf "lag n=%d min=%.1f max=%.1f mean=%.1f sd=%.1f\n", k, k ? lmin : 0, k ? lmax : 0, lm, lsd
 		}
 	}'
+}
+# csv_samples DIR ROBOT MODE: "t a0 [a1]" per state of ROBOT in MODE (0..3)
+# from a demo run's DIR/states.csv (scripts/demo.sh --out DIR), for measure.
+csv_samples() {
+	awk -F, -v r="\"$2\"" -v m="$3" 'NR > 1 && $3 == r && $10 == m {
+		if ($2 != t && line != "") print line
+		if ($2 != t) { t = $2; line = t }
+		line = line " " $6 }
+		END { if (line != "") print line }' "$1/states.csv"
 }
 within() { awk -v v="$1" -v lo="$2" -v hi="$3" 'BEGIN { exit !(v >= lo && v <= hi) }'; }

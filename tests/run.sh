@@ -164,6 +164,13 @@ show() {
 	fi
 }
 
+# The UUCP lock files that name a bus's holder (protocol/io/port_lock.c) go
+# to a directory of this run's own, not the machine's /var/lock (integration
+# tests have their own, tests/lib.sh).
+UNDULATE_LOCK_DIR=$(mktemp -d "${TMPDIR:-/tmp}/undulate-locks.XXXXXX")
+export UNDULATE_LOCK_DIR
+trap 'rm -rf "$UNDULATE_LOCK_DIR"' EXIT
+
 for t in "$unit_dir"/test_*; do
 	[ -f "$t" ] && [ -x "$t" ] || continue
 	run_one "$(basename "$t")" "$t"

@@ -7,7 +7,8 @@
  * a pseudo-terminal with libserialport 0.1.1, which wants a sysfs entry and
  * TIOCMGET — the device is opened as a plain fd. Both backends end the same
  * way: raw mode set by port_termios_raw() and O_NONBLOCK, so the transaction
- * layer sees one kind of fd; real ports are also claimed with TIOCEXCL.
+ * layer sees one kind of fd. Before either, the device is taken for this
+ * program (port_lock.c); real ports are also claimed with TIOCEXCL.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -20,6 +21,8 @@
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/select.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
@@ -34,6 +37,10 @@
 /* How long port_write waits for room in the output queue before calling the
  * port stuck. 100 ms: longer than any AX-12 packet at 9600 bps (250 B, 26 ms). */
 #define PORT_WRITE_STALL_MS 100
+/* Unix98 pty slaves (/dev/pts/N): majors 136..143 (UNIX98_PTY_SLAVE_MAJOR,
+ * UNIX98_PTY_MAJOR_COUNT in the kernel's major.h). */
+#define PORT_PTY_SLAVE_MAJOR 136
+#define PORT_PTY_MAJOR_COUNT 8
 
 struct port {
 	int fd;
@@ -47,6 +54,8 @@ struct port {
 	 * close, so a later program that did not ask for it does not get it */
 	bool rs485_changed;
 	struct serial_rs485 rs485_found;
+	struct port_claim claim;     /* this program's hold on the device */
+	bool exclusive;              /* TIOCEXCL set: cleared at close */
 };
 
 /* ---- raw mode ----------------------------------------------------------------- */
@@ -126,6 +135,14 @@ static void port_errf(char *err, size_t errcap, const char *fmt, const char *pat
 		snprintf(err, errcap, fmt, path, why);
 }
 
+static bool port_is_pty(int fd)
+{
+	struct stat st;
+
+	return fstat(fd, &st) == 0 && S_ISCHR(st.st_mode) && major(st.st_rdev) >= PORT_PTY_SLAVE_MAJOR &&
+	       major(st.st_rdev) < PORT_PTY_SLAVE_MAJOR + PORT_PTY_MAJOR_COUNT;
+}
+
 static int port_finish_fd(struct port *p, char *err, size_t errcap)
 {
 	int flags = fcntl(p->fd, F_GETFL);
@@ -139,12 +156,12 @@ static int port_finish_fd(struct port *p, char *err, size_t errcap)
 		port_errf(err, errcap, "%s is not a serial port (raw mode: %s)", p->path, strerror(errno));
 		return DXL_E_IO;
 	}
-	/* One master per real bus: a second program (dxl while the daemon runs)
-	 * gets EBUSY instead of interleaving its packets with ours. Not on the
-	 * termios backend: a simulator keeps its pty slaves open, so the flag
-	 * would outlive a crashed client and lock its restart out. */
-	if (p->backend == PORT_BACKEND_SERIALPORT)
-		(void)ioctl(p->fd, TIOCEXCL);
+	/* One master per real bus: beside the lock (port_lock.c), which our
+	 * programs honour, the kernel refuses other programs' opens with EBUSY
+	 * (root's excepted). Not on a pty: a simulator keeps its slaves open, so
+	 * the flag would outlive a crashed client and lock its restart out. */
+	if (!port_is_pty(p->fd))
+		p->exclusive = ioctl(p->fd, TIOCEXCL) == 0;
 	return DXL_OK;
 }
 
@@ -203,10 +220,17 @@ struct port *port_open(const char *path, const struct port_options *opt, char *e
 	}
 	p->fd = -1;
 	snprintf(p->path, sizeof p->path, "%s", path);
+	/* before libserialport, whose sp_open() already sets the line up: a
+	 * port held by another program is not touched at all */
+	if (port_claim_take(&p->claim, real, path, opt != NULL ? opt->owner : NULL, opt != NULL ? opt->holder : NULL, err,
+	                    errcap) != DXL_OK) {
+		free(p);
+		return NULL;
+	}
 	if ((opt == NULL || !opt->force_termios) && port_open_serialport(p, real)) {
 		/* opened by libserialport */
 	} else if (port_open_termios(p, real, err, errcap) != DXL_OK) {
-		free(p);
+		port_close(p);
 		return NULL;
 	}
 	if (port_finish_fd(p, err, errcap) != DXL_OK) {
@@ -233,13 +257,15 @@ void port_close(struct port *p)
 		return;
 	if (p->rs485_changed)
 		(void)ioctl(p->fd, TIOCSRS485, &p->rs485_found);
-	if (p->sp != NULL) {
+	if (p->exclusive)
 		(void)ioctl(p->fd, TIOCNXCL);
+	if (p->sp != NULL) {
 		sp_close(p->sp);
 		sp_free_port(p->sp);
 	} else if (p->fd >= 0) {
 		close(p->fd);
 	}
+	port_claim_drop(&p->claim);
 	free(p);
 }
 

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "bus.h"
+#include "holder.h"
 
 struct port; /* opaque */
 
@@ -25,10 +26,21 @@ struct port_options {
 	long baud;                  /* bps; must be a rate the backend can set */
 	bool force_termios;         /* use the termios backend even for a real tty */
 	bool low_latency;           /* try to set the FTDI latency timer to 1 ms */
+	/* What this program does with the bus, written beside its lock so that a
+	 * refused second program can say who holds it: "robot r1" (undulated),
+	 * "command scan" (dxl). NULL: nothing. */
+	const char *owner;
+	/* Out, may be NULL: when port_open() refuses a port because another
+	 * program holds it, who that is (pid > 0 or a program name; the message
+	 * in err names it too); zeroed otherwise. */
+	struct holder *holder;
 };
 
-/* Open path (a device or a symlink to one). On failure returns NULL and
- * writes one clear line into err. */
+/* Open path (a device or a symlink to one) and take it for this program:
+ * one owner per bus (port_lock.c). A port another program holds is refused
+ * ("cannot open PATH: held by undulated (pid 812, robot r1)", *opt->holder)
+ * before anything on it is touched. On failure returns NULL and writes one
+ * clear line into err. port_close() lets it go. */
 struct port *port_open(const char *path, const struct port_options *opt, char *err, size_t errcap);
 void port_close(struct port *p);
 int port_fd(const struct port *p);
@@ -112,6 +124,31 @@ void port_latency_check_fd(const char *path, int fd, bool lower, struct port_lat
  * lowering it — and 0 for a device without one. *lat (may be NULL) gets the
  * check's outcome; known = false when configured_us decided. */
 long port_adapter_latency_us(struct port *p, long configured_us, struct port_latency *lat);
+
+/* ---- one owner per bus (port_lock.c) ------------------------------------------ */
+/* The directory of UUCP lock files (LCK..ttyUSB0): $UNDULATE_LOCK_DIR when
+ * set (tests), else /var/lock. */
+const char *port_lock_dir(void);
+/* Who holds the bus device behind path (symlinks resolved) now: the process
+ * holding its flock() (our programs, picocom, pyserial), named by its lock
+ * file or /proc, or a live program named by a UUCP lock file. False when
+ * nobody is seen. */
+bool port_holder(const char *path, struct holder *h);
+
+/* What port_open() holds while a port is open: the device, open and
+ * flock()ed, and the UUCP lock file it wrote. Exposed for tests. */
+#define PORT_LOCKFILE_MAX 320   /* "<lock dir>/LCK..<device below /dev>" */
+struct port_claim {
+	int fd;                             /* -1: none */
+	char lockfile[PORT_LOCKFILE_MAX];   /* "" when none was written */
+};
+/* Take the device at real (a resolved path; `shown` is the caller's name
+ * for it, for messages) before anything touches the line. DXL_OK;
+ * DXL_E_BUSY with the holder in *holder (may be NULL) and err; DXL_E_ARG
+ * (no such device) or DXL_E_IO with err. */
+int port_claim_take(struct port_claim *c, const char *real, const char *shown, const char *owner,
+                    struct holder *holder, char *err, size_t errcap);
+void port_claim_drop(struct port_claim *c);
 
 /* ---- low-level helpers (used by both backends; exposed for tests) ------------ */
 /* Where sysfs is: $UNDULATE_SYSFS_ROOT when set (tests), else "/sys". */

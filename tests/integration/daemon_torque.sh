@@ -7,7 +7,10 @@
 # torque actuation; the starter runs in joint mode, then wheel mode with the
 # law's duty (published as `drive`, goals NaN) and a limit cycle; HOLD goes
 # back to joint mode holding where the joint is; the safe stop leaves no servo
-# driving in wheel mode.
+# driving in wheel mode. And the clock as a torque law ([sinusoid] stiffness),
+# in lockstep: at the paper's stiffest k undamped (the limit fault), damped
+# (0.8 Hz, the 2pi/3 lag, the linear law's amplitude, then the oscillator in
+# the same drive), at its softest (a small swing, measured).
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then
@@ -152,4 +155,76 @@ if event 'kind=supply text="servo 1 reads its supply as 1.5 V' 5 &&
 else tap_fail "read as 1.5 V while driving: a fault naming it" "$(events | tail -3)"; fi
 ctl clear r1 1 >/dev/null
 stop d2
+
+# ---- the clock as a torque law ([sinusoid] stiffness) ---------------------------------------------------
+# The paper's force simulations drove the joints on the clock with
+# tau = k (xbar(t) - x), k 0.015..0.135 N·m/rad. In lockstep (scripts/demo.sh,
+# one two-joint robot: tests/scenarios/one-robot.scenario, seed 1), the
+# simulated AX-12A's wheel mode as a current drive, measured from the published
+# states. The joint's inertia (4.39e-3 kg·m², the rotor through the gearbox
+# most of it) puts the stiff law's natural frequency at sqrt(k/I)/2pi =
+# 0.88 Hz, next to the clock's 0.8: undamped, the joints resonate past their
+# limits; with the tracking damping d the amplitude is the linear law's,
+#   A |k + i d w| / |k - I w^2 + i (d + c_j) w|   (c_j 0.002: the link's own damping),
+# and the soft law (natural 0.29 Hz) swings the joints little, against the clock
+# (daemon/CONTROL.md, "The clock as a torque law").
+scenario="$top/tests/scenarios/one-robot.scenario"
+clock_run() {   # NAME SECONDS ARGS...: a lockstep run of the clock, kept in $T/NAME
+	local name=$1 secs=$2; shift 2
+	env BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --lockstep --scenario "$scenario" \
+		--lcm-url "$(lcm_url 7706)" --out "$T/$name" --start-mode sinusoid --seconds "$secs" --seed 1 \
+		--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current --set motor.drive=current \
+		"$@" >"$T/$name.out" 2>&1
+}
+clock_events() { tail -n +2 "$T/$1/events.csv" | cut -d, -f2,6-; }   # t,"kind","text"
+val() { echo "$1" | grep "^$2 " | field "$3"; }
+# linear_amp K D: the linear law's amplitude on the simulated joint at the clock's 0.8 rad, 0.8 Hz
+linear_amp() { awk -v k="$1" -v d="$2" 'BEGIN { i = 4.39e-3; cj = 0.002; w = 2 * 3.14159265 * 0.8
+	re = k - i * w * w; im = (d + cj) * w; printf "%.3f", 0.8 * sqrt(k * k + d * d * w * w) / sqrt(re * re + im * im) }'; }
+
+if clock_run k135 20 --switch-at never --daemon-set sinusoid.stiffness=0.135; then
+	ev=$(clock_events k135)
+	widest=$(awk -F, 'NR > 1 { a = $6 < 0 ? -$6 : $6; if (a > m) m = a } END { printf "%.3f", m }' "$T/k135/states.csv")
+	lt=$(echo "$ev" | awk -F, '$2 == "\"limit\"" { print $1; exit }')
+	if [ -n "$lt" ] && num "$lt < 3" && echo "$ev" | grep -q '"mode","SINUSOID -> HOLD (fault: servo' &&
+		echo "$ev" | grep -q 'servos back in joint mode (HOLD)' && num "$widest < 1.35"; then
+		tap_ok "k 0.135, the paper's law undamped: resonance; the limit fault at $lt s holds it (HOLD in joint mode, widest $widest rad)"
+	else tap_fail "k 0.135 undamped: the limit fault holds it" "limit at '${lt}' s, widest $widest rad: $(echo "$ev" | head -5)"; fi
+else tap_fail "k 0.135: the lockstep run ended by itself" "$(tail -n 15 "$T/k135.out")"; fi
+
+# the experiment in short: the clock (k 0.135, d 0.035) for 40 s, then the oscillator
+if clock_run k135d 60 --switch-at 40 --daemon-set sinusoid.stiffness=0.135 --daemon-set sinusoid.damping=0.035; then
+	m=$(csv_samples "$T/k135d" r1 2 | measure 15 40)
+	echo "# k 0.135, d 0.035, 15..40 s: ${m//$'\n'/; } (linear law: $(linear_amp 0.135 0.035) rad)"
+	want=$(linear_amp 0.135 0.035)
+	f1=$(val "$m" j1 f); f2=$(val "$m" j2 f); a1=$(val "$m" j1 amean); a2=$(val "$m" j2 amean)
+	lm=$(val "$m" lag mean); lsd=$(val "$m" lag sd); ln=$(val "$m" lag n)
+	if [ "${ln:-0}" -ge 18 ] && num "$f1 > 0.79 && $f1 < 0.81 && $f2 > 0.79 && $f2 < 0.81 && $lm > 117 && $lm < 123 && $lsd < 2"; then
+		tap_ok "k 0.135, d 0.035: the joints swing at $f1 Hz, joint 2 behind joint 1 by $lm deg (sd $lsd over $ln periods)"
+	else tap_fail "k 0.135, d 0.035: 0.8 Hz with the 2pi/3 lag" "${m//$'\n'/; }"; fi
+	if num "$a1 > 0.92 * $want && $a1 < 1.08 * $want && $a2 > 0.92 * $want && $a2 < 1.08 * $want"; then
+		tap_ok "k 0.135, d 0.035: amplitudes $a1/$a2 rad, the linear law on the joint's inertia gives $want"
+	else tap_fail "k 0.135, d 0.035: amplitude as the law and the inertia give ($want rad +- 8 %)" "${m//$'\n'/; }"; fi
+	ev=$(clock_events k135d)
+	after=$(echo "$ev" | awk -F, '$1 >= 39.9')
+	o=$(csv_samples "$T/k135d" r1 3 | measure 45 60)
+	echo "# after the switch, 45..60 s: ${o//$'\n'/; }"
+	if echo "$after" | grep -q '"mode","SINUSOID -> OSCILLATOR' && ! echo "$after" | grep -q '"actuation"\|"limit"\|"stall"' &&
+		num "$(val "$o" j1 amean) > 0.5 && $(val "$o" j2 amean) > 0.5"; then
+		tap_ok "SINUSOID -> OSCILLATOR at 40 s: no servo mode switch (the drive kept), the oscillator swings $(val "$o" j1 amean)/$(val "$o" j2 amean) rad"
+	else tap_fail "SINUSOID -> OSCILLATOR in the drive" "events after 40 s: $after; ${o//$'\n'/; }"; fi
+else tap_fail "k 0.135, d 0.035: the lockstep run ended by itself" "$(tail -n 15 "$T/k135d.out")"; fi
+
+# the paper's softest law: small, measured and reported; bounded by the frictionless linear law
+if clock_run k015 45 --switch-at never --daemon-set sinusoid.stiffness=0.015; then
+	m=$(csv_samples "$T/k015" r1 2 | measure 15 45)
+	bound=$(linear_amp 0.015 0)
+	echo "# k 0.015, 15..45 s: ${m//$'\n'/; } (linear law without friction: $bound rad)"
+	f1=$(val "$m" j1 f); a1=$(val "$m" j1 amean); a2=$(val "$m" j2 amean); lm=$(val "$m" lag mean)
+	if num "$f1 > 0.79 && $f1 < 0.81 && $a1 > 0.5 * $bound && $a1 < $bound && $a2 > 0.5 * $bound && $a2 < $bound && $lm > 110 && $lm < 130" &&
+		! clock_events k015 | grep -q '"limit"'; then
+		tap_ok "k 0.015: the joints swing $a1/$a2 rad at $f1 Hz, lag $lm deg (the law alone would give $bound: the link's friction takes the rest)"
+	else tap_fail "k 0.015: a small swing at 0.8 Hz under the linear bound $bound rad" "${m//$'\n'/; }"; fi
+else tap_fail "k 0.015: the lockstep run ended by itself" "$(tail -n 15 "$T/k015.out")"; fi
+keep_runs k135 k135d k015
 tap_done

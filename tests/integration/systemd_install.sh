@@ -184,6 +184,24 @@ else
 	tap_fail "undulated@.service has the required settings" "$(printf '%s\n' "${bad[@]}")"
 fi
 
+# ---- /run/undulate is shared (the daemons' command sockets, the simulator's links):
+# a unit that names it without RuntimeDirectoryPreserve=yes has systemd remove the
+# whole directory when that unit stops, every other program's sockets with it (the
+# audit's finding 9: stopping undulate-sim removed the daemons' command sockets).
+bad=()
+for u in "${units[@]}"; do
+	f="$R$P/lib/systemd/system/$u"
+	grep -qxF RuntimeDirectory=undulate "$f" || continue
+	grep -qxF RuntimeDirectoryPreserve=yes "$f" || bad+=("$u: RuntimeDirectory=undulate without RuntimeDirectoryPreserve=yes")
+done
+# the daemon writes the UUCP lock file naming it as the bus's holder (protocol/README.md)
+grep -qxF "ReadWritePaths=-/run/lock" "$unit" || bad+=("undulated@.service: /run/lock not writable (ReadWritePaths=-/run/lock)")
+if [ ${#bad[@]} -eq 0 ]; then
+	tap_ok "no unit removes the shared /run/undulate when it stops; the daemon may write its bus lock file in /run/lock"
+else
+	tap_fail "the shared run directory outlives each unit" "$(printf '%s\n' "${bad[@]}")"
+fi
+
 # ---- re-install keeps an edited config; uninstall removes exactly the rest ------------
 conf="$R/etc/undulate/undulated.conf.example"
 robot_conf="$R/etc/undulate/robot1.conf"

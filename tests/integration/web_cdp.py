@@ -11,35 +11,58 @@ the standard library only (Debian packages no WebSocket module for python3).
       loads URL, waits until one of ROBOT's servos shows STATUS (and TORQUE in
       its torque column, if given) in the page's servo table, prints the table's rows ("ROW id °C V error-bits status
       torque", tab-separated) and takes a screenshot (PNG).
+  web_cdp.py view DEVTOOLS_PORT URL PNG
+      loads URL and prints whether the page offers commands ("VIEW
+      commands=<bool> watching=<bool> buttons=<visible mode buttons>");
+      takes a screenshot (PNG).
   web_cdp.py slow HOST PORT SECONDS
       opens a WebSocket to undulate-web and never reads from it: a browser that
       stopped reading. Exits after SECONDS.
   web_cdp.py frames HOST PORT SECONDS
       reads frames for SECONDS and prints "FRAMES n BYTES b SECONDS s" and the
       last status's server counters ("SERVER {...}").
-  web_cdp.py say HOST PORT MESSAGE
-      sends MESSAGE as a page would and prints the first note that answers
-      it ("NOTE <kind> <text>").
+  web_cdp.py say HOST PORT MESSAGE [UNTIL]
+      sends MESSAGE as a page would (with the token in $WEB_TOKEN, if set)
+      and prints the first note that answers it ("NOTE <kind> <text>"), or
+      every note until one of kind UNTIL.
   web_cdp.py freeport
       prints a free TCP port on 127.0.0.1.
 """
 import base64, json, os, socket, struct, sys, time, urllib.request
 
 
-class WS:
-    """A minimal RFC 6455 client: text frames, masked as a client must."""
+class Closed(ConnectionError):
+    """The server's close frame: its status code (RFC 6455 7.4) and reason."""
 
-    def __init__(self, host, port, path, protocol=None, rcvbuf=None):
+    def __init__(self, code, reason):
+        super().__init__(f"closed by the server: {code} {reason}")
+        self.code, self.reason = code, reason
+
+
+def token_protocols(token):
+    """The subprotocols a page offers: "undulate", and with a token the token
+    itself as "undulate-token.TOKEN" (tools/web/req.h), as the page does."""
+    return "undulate" + (f", undulate-token.{token}" if token else "")
+
+
+class WS:
+    """A minimal RFC 6455 client: text frames, masked as a client must (a test
+    may send an unmasked or a binary one: send(masked=False, opcode=2)).
+    host_header and origin: what a browser on another site would send."""
+
+    def __init__(self, host, port, path, protocol=None, rcvbuf=None, host_header=None, origin=None):
         self.s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         if rcvbuf:  # before connecting: it sets the window the server may fill
             self.s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
         self.s.settimeout(30)
         self.s.connect((host, port))
         key = base64.b64encode(os.urandom(16)).decode()
-        req = (f"GET {path} HTTP/1.1\r\nHost: {host}:{port}\r\nUpgrade: websocket\r\n"
+        req = (f"GET {path} HTTP/1.1\r\nHost: {host_header or f'{host}:{port}'}\r\nUpgrade: websocket\r\n"
                f"Connection: Upgrade\r\nSec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n")
         if protocol:
             req += f"Sec-WebSocket-Protocol: {protocol}\r\n"
+        if origin:
+            req += f"Origin: {origin}\r\n"
         self.s.sendall((req + "\r\n").encode())
         head = b""
         while b"\r\n\r\n" not in head:
@@ -51,13 +74,15 @@ class WS:
             raise ConnectionError("handshake refused: " + head.split(b"\r\n")[0].decode())
         self.buf = b""
 
-    def send(self, text):
+    def send(self, text, masked=True, opcode=1):
         data = text.encode()
-        mask = os.urandom(4)
+        mask = os.urandom(4) if masked else b""
+        m = 0x80 if masked else 0
         n = len(data)
-        hdr = bytes([0x81]) + (bytes([0x80 | n]) if n < 126 else bytes([0x80 | 126]) + struct.pack(">H", n)
-                               if n < 65536 else bytes([0x80 | 127]) + struct.pack(">Q", n))
-        self.s.sendall(hdr + mask + bytes(b ^ mask[i % 4] for i, b in enumerate(data)))
+        hdr = bytes([0x80 | opcode]) + (bytes([m | n]) if n < 126 else bytes([m | 126]) + struct.pack(">H", n)
+                                        if n < 65536 else bytes([m | 127]) + struct.pack(">Q", n))
+        body = bytes(b ^ mask[i % 4] for i, b in enumerate(data)) if masked else data
+        self.s.sendall(hdr + mask + body)
 
     def _need(self, n):
         while len(self.buf) < n:
@@ -80,7 +105,8 @@ class WS:
             payload = self._need(n)
             op = b0 & 0x0F
             if op == 8:
-                raise ConnectionError("closed by the server")
+                code = struct.unpack(">H", payload[:2])[0] if len(payload) >= 2 else 1005
+                raise Closed(code, payload[2:].decode(errors="replace"))
             if op in (9, 10):
                 continue
             msg += payload
@@ -182,6 +208,24 @@ def servos(devtools_port, url, png, robot, want, torque=None):
         f.write(base64.b64decode(shot["data"]))
 
 
+def view(devtools_port, url, png):
+    """Loads URL and, once the page has its robots, says whether it offers
+    commands: "VIEW commands=<bool> watching=<bool> buttons=<visible mode buttons>",
+    and takes a screenshot (PNG)."""
+    cdp = CDP(int(devtools_port))
+    cdp.call("Page.enable")
+    cdp.call("Emulation.setDeviceMetricsOverride", width=1300, height=900, deviceScaleFactor=1, mobile=False)
+    cdp.call("Page.navigate", url=url)
+    cdp.wait("document.querySelectorAll('.robot').length >= 1 && Number(document.body.dataset.frames || 0) > 3", 20)
+    v = cdp.js("""(() => ({ commands: document.body.classList.contains('commands'),
+        watching: !document.getElementById('watching').hidden,
+        buttons: [...document.querySelectorAll('button[data-mode]')].filter(b => b.offsetParent !== null).length }))()""")
+    print(f"VIEW commands={v['commands']} watching={v['watching']} buttons={v['buttons']}", flush=True)
+    shot = cdp.call("Page.captureScreenshot", format="png")
+    with open(png, "wb") as f:
+        f.write(base64.b64decode(shot["data"]))
+
+
 def slow(host, port, seconds):
     ws = WS(host, int(port), "/", "undulate", rcvbuf=4096)
     print("SLOW connected", flush=True)
@@ -210,7 +254,7 @@ def frames(host, port, seconds):
 def say(host, port, message, until=None):
     """Send one message; print the first note (not the hello), or with
     `until` every note until one of that kind (the robot's answer)."""
-    ws = WS(host, int(port), "/", "undulate")
+    ws = WS(host, int(port), "/", token_protocols(os.environ.get("WEB_TOKEN")))
     ws.send(message)
     end = time.time() + 5
     seen = set()
@@ -234,4 +278,4 @@ def freeport():
 
 if __name__ == "__main__":
     cmd = sys.argv[1]
-    {"page": page, "servos": servos, "slow": slow, "frames": frames, "say": say, "freeport": freeport}[cmd](*sys.argv[2:])
+    {"page": page, "view": view, "servos": servos, "slow": slow, "frames": frames, "say": say, "freeport": freeport}[cmd](*sys.argv[2:])

@@ -34,6 +34,9 @@ spawn web "$W" --listen 127.0.0.1:0 --lcm-url "$URL"
 wait_log web 'listening on http://' 10 || { tap_fail "undulate-web listening" "$(cat "$T/web.log")"; tap_done; exit 1; }
 port=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/web.log")
 H="http://127.0.0.1:$port"
+# the token it made: commands need it (the URL it printed carries it)
+token_of() { sed -n 's|.*open http://[^ ]*/#token=\([A-Za-z0-9_.~-]*\) .*|\1|p' "$T/$1.log"; }
+wait_log web 'open http://.*#token=' 5
 # both robots heard (the snapshot lists them)
 wait_for 10 bash -c "curl -s '$H/api/snapshot' | jq -e '.nrobots == 2' "
 
@@ -103,7 +106,7 @@ else
 	# its own TMPDIR: chromium leaves a singleton folder there even after SIGTERM
 	spawn chromium env TMPDIR="$T" "$browser" --headless=new --no-sandbox --disable-gpu --no-first-run --user-data-dir="$T/chromium" \
 		--remote-debugging-port="$dport" about:blank
-	python3 "$CDP" page "$dport" "$H/" "$T/page.png" left hold >"$T/page.out" 2>&1
+	python3 "$CDP" page "$dport" "$H/#token=$(token_of web)" "$T/page.png" left hold >"$T/page.out" 2>&1
 	sed 's/^/# /' "$T/page.out"
 	drawn=$(awk '/^DRAWN/ { print $2 }' "$T/page.out")
 	tap_check "the page draws both robots and their pair (${drawn:-0} points in its plots)" \
@@ -116,7 +119,10 @@ else
 	tap_check "the robot's answer is on the page: $(grep '^ANSWER' "$T/page.out")" \
 		grep -q '^ANSWER command-accepted .*left command-accepted: mode HOLD' "$T/page.out"
 	tap_check "the page shows left in HOLD" grep -q '^MODE_SHOWN HOLD' "$T/page.out"
-	if [ "$_tap_failed" -gt 0 ] || [ -n "${WEB_KEEP_SCREENSHOT:-}" ]; then mkdir -p "$BUILD/test-logs" && cp "$T/page.png" "$BUILD/test-logs/web_dashboard.png"; fi
+	python3 "$CDP" view "$dport" "$H/" "$T/watch.png" >"$T/view.out" 2>&1
+	tap_check "without the token the page watches: no command buttons, and says how to get them ($(cat "$T/view.out"))" \
+		grep -q '^VIEW commands=False watching=True buttons=0$' "$T/view.out"
+	if [ "$_tap_failed" -gt 0 ] || [ -n "${WEB_KEEP_SCREENSHOT:-}" ]; then mkdir -p "$BUILD/test-logs" && cp "$T/page.png" "$BUILD/test-logs/web_dashboard.png"; cp "$T/watch.png" "$BUILD/test-logs/web_dashboard_watch.png"; fi
 fi
 
 # ---- --key: signed over LCM, to a robot that takes commands from the network only --------------
@@ -131,13 +137,13 @@ spawn d_net "$D" --port "$T/net" --ids 1 --robot net --lcm-url "$URLN" --mode os
 wait_log d_net 'ready: net.STATE' 10
 spawn webw "$W" --listen 127.0.0.1:0 --lcm-url "$URLN" --key "$T/wrong.key"
 spawn webn "$W" --listen 127.0.0.1:0 --lcm-url "$URLN" --key "$T/net.key"
-wait_log webw 'listening on http://' 10 && wait_log webn 'listening on http://' 10
+wait_log webw 'open http://' 10 && wait_log webn 'open http://' 10
 wport=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/webw.log")
 nport=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/webn.log")
-python3 "$CDP" say 127.0.0.1 "$wport" "cmd 8 net mode limp" command-accepted >"$T/wrong.out" 2>&1
+WEB_TOKEN=$(token_of webw) python3 "$CDP" say 127.0.0.1 "$wport" "cmd 8 net mode limp" command-accepted >"$T/wrong.out" 2>&1
 tap_check "--key with the wrong key: the robot takes nothing ($(tr '\n' ' ' <"$T/wrong.out"))" \
 	bash -c "! grep -q '^NOTE command-accepted' '$T/wrong.out' && ! grep -q '^STATE net .* mode=0 ' '$T/watchn.log'"
-python3 "$CDP" say 127.0.0.1 "$nport" "cmd 9 net mode hold" command-accepted >"$T/net.out" 2>&1
+WEB_TOKEN=$(token_of webn) python3 "$CDP" say 127.0.0.1 "$nport" "cmd 9 net mode hold" command-accepted >"$T/net.out" 2>&1
 held=0; wait_for 5 grep -q '^STATE net .* mode=1 ' "$T/watchn.log" && held=1
 tap_check "--key: signed over LCM, the robot takes it and its answer comes back ($(tr '\n' ' ' <"$T/net.out"))" \
 	bash -c "[ $held = 1 ] && grep -q '^NOTE command-accepted mode HOLD' '$T/net.out'"

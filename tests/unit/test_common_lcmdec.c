@@ -201,7 +201,8 @@ static void test_trailing_long_and_strings(void **state)
 	b[16 + 4 + 2] = 'x'; /* "r1" loses its NUL */
 	assert_int_equal(lcmdec_decode(&lcmdec_robot_state_t, b, (size_t)n, &m), LCMDEC_MALFORMED);
 	/* another type's fingerprint */
-	assert_int_equal(lcmdec_decode(&lcmdec_bus_stats_t, buf, (size_t)n, &m), LCMDEC_MALFORMED);
+	undulate_bus_stats_t other;
+	assert_int_equal(lcmdec_decode(&lcmdec_bus_stats_t, buf, (size_t)n, &other), LCMDEC_MALFORMED);
 	char why[160];
 	lcmdec_describe(why, sizeof why, &lcmdec_robot_state_t, 293, LCMDEC_OVER_BUDGET);
 	assert_string_equal(why, "robot_state_t: 293 bytes do not decode (an array count larger than the message could hold)");

@@ -16,6 +16,7 @@
 #include <poll.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -270,6 +271,20 @@ static void test_join(void **state)
 	fclose(f);
 	assert_int_equal(lks_listen(file, err, sizeof err), -1);
 	assert_non_null(strstr(err, "not a socket"));
+	/* a live simulator's socket is refused and left alone; a dead one's replaced */
+	char live[300];
+	snprintf(live, sizeof live, "%s/live.sock", scratch_dir);
+	int first = lks_listen(live, err, sizeof err);
+	assert_true(first >= 0);
+	assert_int_equal(lks_listen(live, err, sizeof err), -1);
+	assert_non_null(strstr(err, "another simulator listens on it"));
+	struct stat st;
+	assert_int_equal(stat(live, &st), 0);
+	close(first);
+	int again = lks_listen(live, err, sizeof err);
+	assert_true(again >= 0);
+	close(again);
+	unlink(live);
 }
 
 int main(void)

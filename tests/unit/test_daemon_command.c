@@ -187,6 +187,43 @@ static void test_apply(void **state)
 	assert_true(c.phase == 1.25);
 }
 
+/* The clock's stiffness (torque actuation's SINUSOID as a torque law) is a
+ * robot parameter, commandable within 0..10 N·m/rad, and only where the
+ * servos' torque is driven: with position actuation only 0 (off). */
+static void test_sinusoid_stiffness(void **state)
+{
+	(void)state;
+	struct cmd_request r = base(CMD_KIND_PARAM);
+	r.param = "stiffness";
+	r.value = 0.135;
+	expect_reject(&r, true, "needs [robot] actuation = torque");
+	r.value = 0.0;
+	expect_accept(&r);
+	struct cfg saved = cfg;
+	cfg.actuation = CFG_ACT_TORQUE;
+	r.value = 0.135;
+	expect_accept(&r);
+	r.value = 10.5;
+	expect_reject(&r, true, "out of range 0..10");
+	r.value = 0.135;
+	r.joint = 1;
+	expect_reject(&r, true, "per robot: joint must be -1");
+	r = base(CMD_KIND_PARAM);
+	r.param = "damping";
+	r.value = 0.02;
+	expect_accept(&r);
+	r.value = -0.01;
+	expect_reject(&r, true, "out of range 0..1");
+	struct cfg c = cfg;
+	r.value = 0.02;
+	cmd_apply_param(&c, &r);
+	r.param = "stiffness";
+	r.value = 0.015;
+	cmd_apply_param(&c, &r);
+	assert_true(c.sin_stiffness == 0.015 && c.sin_damping == 0.02);
+	cfg = saved;
+}
+
 static void test_parse_text(void **state)
 {
 	(void)state;
@@ -339,6 +376,7 @@ int main(void)
 		cmocka_unit_test(test_limits_not_commandable),
 		cmocka_unit_test(test_encode),
 		cmocka_unit_test(test_apply),
+		cmocka_unit_test(test_sinusoid_stiffness),
 		cmocka_unit_test(test_parse_text),
 		cmocka_unit_test(test_decode),
 	};

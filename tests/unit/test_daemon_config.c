@@ -192,7 +192,11 @@ static void test_errors_name_file_line_key(void **state)
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\nfrequency = 9\n", b, sizeof b),
 	                    "robot1.conf:5: [sinusoid] frequency: 9 out of range 0..5");
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\nperiod = 1\n", b, sizeof b),
-	                    "robot1.conf:5: [sinusoid] period: unknown key (amplitude, frequency, phase)");
+	                    "robot1.conf:5: [sinusoid] period: unknown key (amplitude, frequency, phase, stiffness, damping)");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\nstiffness = 11\n", b, sizeof b),
+	                    "robot1.conf:5: [sinusoid] stiffness: 11 out of range 0..10");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\ndamping = -0.1\n", b, sizeof b),
+	                    "robot1.conf:5: [sinusoid] damping: -0.1 out of range 0..1");
 	assert_string_equal(load_error("k = 1\n[robot]\nport=/dev/null\nids=1\n", b, sizeof b),
 	                    "robot1.conf:1: k: key outside any section (start with [robot])");
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nthis line has no equals\n", b, sizeof b),
@@ -216,12 +220,62 @@ static void test_whole_config_errors(void **state)
 	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\nactuation=torque\nvelocity_source=servo\n",
 	                                  b, sizeof b),
 	                       "velocity_source = servo cannot be used with actuation = torque"));
+	/* the clock as a torque law needs the servos' torque drive */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\n[sinusoid]\nstiffness=0.135\n", b, sizeof b),
+	                    "command line: [sinusoid] stiffness 0.135 drives the clock as a torque: it needs [robot] "
+	                    "actuation = torque (with position actuation SINUSOID follows the clock with the servo's "
+	                    "position loop)");
 	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.2]\nk=1\n", b, sizeof b),
 	                       "[joint.2]: the robot has only 1 joint(s)"));
 	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nlimit_min=0.5\n"
 	                                  "limit_max=0.2\n", b, sizeof b), "limit_min: 0.5 is not below limit_max"));
 	assert_non_null(strstr(load_error("[robot]\nport=/dev/null\nids=1\n[joint.1]\nneutral=2\nlimit_max=1\n",
 	                                  b, sizeof b), "leaves the servo's"));
+}
+
+/* [sinusoid] stiffness and damping: the clock as a torque law (CONTROL.md,
+ * "The clock as a torque law"), off (0) unless given, printed back. */
+static void test_sinusoid_stiffness(void **state)
+{
+	(void)state;
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1,2\n", &e) && cfg_finish(&c, &e));
+	assert_true(c.sin_stiffness == 0.0 && c.sin_damping == 0.0);
+	/* and the coupling's phase 0: the paper's law */
+	assert_true(c.joint[0].osc.coupling_phase == 0.0 && c.joint[1].osc.coupling_phase == 0.0);
+	cfg_defaults(&c);
+	e.count = 0;
+	assert_true(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1,2\n[joint.1]\ncoupling_phase = 0.6\n"
+	                            "[joint.2]\ncoupling_phase = -0.6\n", &e) && cfg_finish(&c, &e));
+	assert_true(c.joint[0].osc.coupling_phase == 0.6 && c.joint[1].osc.coupling_phase == -0.6);
+	assert_false(cfg_load_string(&c, "r.conf", "[joint.1]\ncoupling_phase = 4\n", &e));
+	assert_non_null(strstr(e.line[e.count - 1], "[joint.1] coupling_phase: 4 out of range -3.14159..3.14159"));
+	e.count = 0;
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "r.conf", "[sinusoid]\nstiffness = 0.135\ndamping = 0.01\n[robot]\n"
+	                            "port=/dev/null\nids=1,2\nactuation = torque\n", &e));
+	assert_true(cfg_finish(&c, &e));
+	assert_int_equal(e.count, 0);
+	assert_true(c.sin_stiffness == 0.135 && c.sin_damping == 0.01);
+	assert_true(cfg_param_is_robot("stiffness") && cfg_param_commandable("damping"));
+	assert_ptr_equal(cfg_robot_param(&c, "stiffness"), &c.sin_stiffness);
+	char why[200];
+	assert_true(cfg_robot_param_check(&c, "stiffness", 0.5, why, sizeof why));
+	c.actuation = CFG_ACT_POSITION;
+	assert_false(cfg_robot_param_check(&c, "stiffness", 0.5, why, sizeof why));
+	assert_true(cfg_robot_param_check(&c, "stiffness", 0.0, why, sizeof why));
+	c.actuation = CFG_ACT_TORQUE;
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	assert_non_null(f);
+	cfg_print(&c, f);
+	fclose(f);
+	assert_non_null(strstr(text, "\n[sinusoid]\namplitude = 0.8\nfrequency = 0.8\nphase = 0\nstiffness = 0.135\n"
+	                             "damping = 0.01\n"));
+	free(text);
 }
 
 static void test_every_error_reported(void **state)
@@ -599,6 +653,11 @@ static void test_param_ranges(void **state)
 	assert_true(cfg_param_is_robot("amplitude"));
 	struct cfg_joint j;
 	assert_ptr_equal(cfg_joint_param(&j, "friction"), &j.osc.friction);
+	/* the coupling's phase (CONTROL.md, "The joints' lag"): per joint, commandable, ±π */
+	assert_ptr_equal(cfg_joint_param(&j, "coupling_phase"), &j.osc.coupling_phase);
+	assert_true(cfg_param_range("coupling_phase", &r) && cfg_param_commandable("coupling_phase") &&
+	            cfg_param_is_joint("coupling_phase"));
+	assert_true(fabs(r.min + M_PI) < 1e-9 && fabs(r.max - M_PI) < 1e-9);
 	assert_null(cfg_joint_param(&j, "amplitude"));
 	enum cfg_mode m;
 	assert_true(cfg_mode_parse("Oscillator", &m));
@@ -614,6 +673,7 @@ int main(void)
 		cmocka_unit_test(test_defaults_from_osc),
 		cmocka_unit_test(test_errors_name_file_line_key),
 		cmocka_unit_test(test_whole_config_errors),
+		cmocka_unit_test(test_sinusoid_stiffness),
 		cmocka_unit_test(test_every_error_reported),
 		cmocka_unit_test(test_repeated_keys_and_sections),
 		cmocka_unit_test(test_long_line),

@@ -484,6 +484,52 @@ static void test_current_control_switch(void **state)
 	}
 }
 
+/* The clock as a torque law ([sinusoid] stiffness) on the XM430: SINUSOID
+ * switches the servos into current control as OSCILLATOR does, the drive is
+ * the clock's torque, and at the switch to OSCILLATOR (the experiment: the
+ * clock, then the oscillator) they stay there: no new chain, no torque off,
+ * Operating Mode 0 all along. HOLD brings them back to position control. */
+static void test_clock_in_current_control(void **state)
+{
+	(void)state;
+	const char *sets[] = { "robot.actuation=torque", "robot.torque_drive=current", "sinusoid.stiffness=0.135",
+	                       NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	run(10);
+	ctl_set_mode(&c, CFG_MODE_SINUSOID, "test");
+	run(5);
+	assert_true(c.wheel);
+	uint16_t chain[2];
+	for (uint8_t id = 1; id <= 2; id++) {
+		const struct ctl_joint *jt = &c.j[id - 1];
+		assert_int_equal(sv(id)->mem[11], 0);
+		assert_true(jt->drive_ready);
+		chain[id - 1] = jt->drive_chain;
+		double tau = cfg.sin_stiffness * (osc_sinusoid(cfg.amplitude, cfg.frequency, cfg.phase, id - 1u, c.t) -
+		                                  (jt->angle - cfg.joint[id - 1].neutral));
+		assert_true(fabs(jt->torque_cmd - tau) < 1e-9);
+		int16_t cur = (int16_t)reg(id, 102, 2);
+		assert_true(cur != 0 && (cur > 0) == (tau > 0.0));
+	}
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	for (int i = 0; i < 50; i++) {
+		tick();
+		for (uint8_t id = 1; id <= 2; id++)
+			if (!c.wheel || sv(id)->mem[11] != 0 || sv(id)->mem[64] != 1 || !c.j[id - 1].drive_ready ||
+			    c.j[id - 1].drive_chain != chain[id - 1])
+				fail_msg("cycle %d after the switch, servo %u: wheel %d, mode %u, torque %u, chain %u (was %u)", i,
+				         id, c.wheel, sv(id)->mem[11], sv(id)->mem[64], c.j[id - 1].drive_chain, chain[id - 1]);
+	}
+	assert_null(find_event("back in joint mode"));
+	ctl_set_mode(&c, CFG_MODE_HOLD, "test");
+	run(5);
+	assert_false(c.wheel);
+	for (uint8_t id = 1; id <= 2; id++) {
+		assert_int_equal(sv(id)->mem[11], 3);
+		assert_int_equal(sv(id)->mem[64], 1);
+	}
+}
+
 /* Servo 2 refuses every write (the access error, nothing written): its
  * switch stops at the first step, it is never sent a drive, and the robot
  * goes back to joint mode. */
@@ -666,6 +712,7 @@ int main(void)
 		cmocka_unit_test(test_power_loss_set_up_again),
 		cmocka_unit_test(test_operating_mode_changed),
 		cmocka_unit_test(test_torque_off_never_lost),
+		cmocka_unit_test(test_clock_in_current_control),
 		cmocka_unit_test(test_current_control_switch),
 		cmocka_unit_test(test_switch_stops_half_way),
 		cmocka_unit_test(test_drive_only_where_ready),

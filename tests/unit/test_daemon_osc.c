@@ -198,6 +198,53 @@ static void test_coupling_gives_steady_travelling_wave(void **state)
 	assert_true(s.lag_deg < -80.0 && s.lag_deg > -92.0);
 }
 
+/* The coupling's phase θ_j (coupling_phase): joint j couples to the other
+ * joint's angle a phase θ_j further on in its cycle,
+ *     x_o cos θ_j + (ẋ_o / ω_j) sin θ_j,   ω_j = √(k_j / I_j),
+ * from the other joint's measured angle and speed (no clock). With λ on the
+ * angle alone the two joints' linear mode is a quarter period apart whatever λ
+ * (86.5° with the damping terms); θ = (+35°, −35°) turns it to 120°, the
+ * baseline's 2π/3, and leaves the frequency and the amplitudes as they were. */
+static void test_coupling_phase_sets_the_lag(void **state)
+{
+	(void)state;
+	struct osc_joint_params p[TWO_JOINTS];
+	defaults(p, TWO_JOINTS);
+	assert_true(p[0].coupling_phase == 0.0 && p[1].coupling_phase == 0.0);
+	const double x0[2] = { 0.05, 0.0 }, v0[2] = { 0.0, 0.0 };
+	struct cycle r0 = run_ideal(p, TWO_JOINTS, x0, v0, 0.01, 4, 40.0, 60.0);
+	p[0].coupling_phase = 35.0 * PI / 180.0;
+	p[1].coupling_phase = -35.0 * PI / 180.0;
+	struct cycle r = run_ideal(p, TWO_JOINTS, x0, v0, 0.01, 4, 40.0, 60.0);
+	print_message("coupling phase +-35 deg: lag %.2f deg (0: %.2f), f %.4f Hz (%.4f), A %.3f/%.3f (%.3f/%.3f)\n",
+	              r.lag_deg, r0.lag_deg, r.freq, r0.freq, r.amp[0], r.amp[1], r0.amp[0], r0.amp[1]);
+	assert_true(fabs(r.lag_deg - 120.0) < 1.5);
+	assert_true(fabs(r.freq - r0.freq) < 0.01 * r0.freq);
+	assert_true(fabs(r.amp[0] - r0.amp[0]) < 0.02 * r0.amp[0] && fabs(r.amp[1] - r0.amp[1]) < 0.02 * r0.amp[1]);
+	/* the term itself: joint 0 at rest at neutral feels only the coupling */
+	double w = sqrt(p[0].k / p[0].inertia);
+	double x[2] = { 0.0, 0.4 }, v[2] = { 0.0, -1.5 }, tau[2];
+	assert_true(osc_torque(p, TWO_JOINTS, x, v, tau));
+	double seen = -p[0].k * p[0].lambda * (0.4 * cos(p[0].coupling_phase) - 1.5 / w * sin(p[0].coupling_phase));
+	assert_true(fabs(tau[0] - seen) < 1e-12);
+	/* one joint: no other, no coupling, whatever θ holds */
+	struct osc_joint_params q;
+	osc_default_params(&q, 0, 1);
+	double a = 0.3, b = 0.7, t1;
+	assert_true(osc_torque(&q, 1, &a, &b, &t1));
+	q.coupling_phase = 1.0;
+	double t2;
+	assert_true(osc_torque(&q, 1, &a, &b, &t2));
+	assert_true(t1 == t2);
+	/* not finite: hold, no torque */
+	p[1].coupling_phase = NAN;
+	double xn[2];
+	assert_false(osc_step(p, TWO_JOINTS, x, v, 0.01, 4, xn, NULL));
+	assert_true(xn[0] == x[0] && xn[1] == x[1]);
+	assert_false(osc_torque(p, TWO_JOINTS, x, v, tau));
+	assert_true(tau[0] == 0.0 && tau[1] == 0.0);
+}
+
 static void test_chain_of_three_couples_to_next_joint(void **state)
 {
 	(void)state;
@@ -654,6 +701,7 @@ int main(void)
 		cmocka_unit_test(test_limit_cycle_same_from_any_start),
 		cmocka_unit_test(test_single_joint_limit_cycle),
 		cmocka_unit_test(test_coupling_gives_steady_travelling_wave),
+		cmocka_unit_test(test_coupling_phase_sets_the_lag),
 		cmocka_unit_test(test_chain_of_three_couples_to_next_joint),
 		cmocka_unit_test(test_rk4_matches_exact_harmonic),
 		cmocka_unit_test(test_independent_of_step_size),

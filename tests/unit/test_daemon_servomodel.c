@@ -265,14 +265,14 @@ static void test_torque_defaults_scale(void **state)
 	assert_true(xl > 1.0 && xl < 1.05);
 	struct cfg c;
 	cfg_with(&c, "robot.ids=1,2", "robot.actuation=torque", "robot.torque_drive=current", "joint.2.k=0.3", NULL);
-	double k1 = c.joint[0].osc.k, mu1 = c.joint[0].osc.mu, i1 = c.joint[0].osc.inertia;
+	double k1 = c.joint[0].osc.k, mu1 = c.joint[0].osc.mu, i1 = c.joint[0].osc.inertia, mu2 = c.joint[1].osc.mu;
 	cfg_scale_torque_defaults(&c, 0, xm);
 	cfg_scale_torque_defaults(&c, 1, xm);
 	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
 	assert_true(fabs(c.joint[0].osc.mu - mu1 * xm) < 1e-12);
 	assert_true(fabs(c.joint[0].osc.inertia - i1 * xm) < 1e-12);
 	assert_true(fabs(c.joint[1].osc.k - 0.3) < 1e-12);        /* given: kept */
-	assert_true(fabs(c.joint[1].osc.mu - mu1 * xm) < 1e-12);  /* not given: scaled */
+	assert_true(fabs(c.joint[1].osc.mu - mu2 * xm) < 1e-12);  /* not given: scaled */
 	cfg_scale_torque_defaults(&c, 0, xm);                      /* once */
 	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
 	/* position actuation's parameters are a control law's, not a joint's: none */

@@ -6,7 +6,10 @@
  * a speed (AX-12A). Checked: the switch into and out of
  * wheel mode and its register sequence, the limit cycle driven through torque,
  * the walls near the limits, a limit breach falling back to joint mode, stale
- * joints and non-finite parameters giving no drive, the back-EMF added back. */
+ * joints and non-finite parameters giving no drive, the back-EMF added back,
+ * the supply as the PWM drive's gain, two joints on the defaults; and the
+ * clock as a torque law ([sinusoid] stiffness): its torque, the same guards,
+ * the switch to and from OSCILLATOR inside the drive. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -347,6 +350,34 @@ static void test_limit_cycle_through_torque(void **state)
 	assert_int_equal(c.starts, 0);
 }
 
+/* Two coupled joints on the torque defaults: the coupling pumps energy into
+ * the travelling wave (CONTROL.md), so a two-joint robot needs a larger mu
+ * than one joint; with one joint's mu (0.032) the bare law swings 2.0/1.6 rad
+ * and left the +-1.3 rad limits. The limit cycle stays well inside them, on
+ * either drive, with no limit trip and no restart. */
+static void test_two_joint_defaults_inside_limits(void **state)
+{
+	(void)state;
+	static const char *const drives[] = { "current", "pwm" };
+	for (size_t d = 0; d < 2; d++) {
+		bool pwm = d == 1;
+		setup("1,2", drives[d], CFG_MODE_OSCILLATOR);
+		double widest[2] = { 0.0, 0.0 };
+		for (int i = 0; i < 4000; i++) {
+			cycle_pwm(pwm);
+			for (size_t j = 0; j < nj; j++)
+				if (i >= 2000)
+					widest[j] = fmax(widest[j], fabs(sv[j].angle));
+		}
+		if (c.limit_trips != 0 || c.latched || !c.wheel || !(widest[0] < 1.0 && widest[1] < 1.0) ||
+		    !(widest[0] > 0.5 && widest[1] > 0.5))
+			fail_msg("%s drive, defaults mu %.3f/%.3f: widest %.3f/%.3f rad in 20..40 s, %lld limit trip(s), %s",
+			         drives[d], cfg.joint[0].osc.mu, cfg.joint[1].osc.mu, widest[0], widest[1], c.limit_trips,
+			         c.latched ? c.latch : "no fault");
+		assert_int_equal(c.starts, 0);
+	}
+}
+
 /* From rest at chosen angles the law starts at once, at phases 0 and pi:
  * joints held apart in anti-phase stay exactly in anti-phase. */
 static void test_start_from_rest_displaced(void **state)
@@ -356,6 +387,7 @@ static void test_start_from_rest_displaced(void **state)
 	start_angle[1] = -0.5;
 	setup("1,2", "current", CFG_MODE_HOLD);
 	cfg.joint[0].osc.lambda = cfg.joint[1].osc.lambda = 0.0;   /* two independent oscillators */
+	cfg.joint[1].osc.mu = cfg.joint[0].osc.mu;                  /* and alike */
 	run(50);
 	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
 	start_angle[0] = 0.2;
@@ -616,6 +648,277 @@ static void test_limits_hold_for_every_reading(void **state)
 	volts_raw = -1;
 }
 
+/* ---- the clock as a torque law ([sinusoid] stiffness) --------------------------------------------
+ * The paper's force simulations drove the joints on the clock with
+ * tau_j = k (xbar_j(t) - x_j), k 0.015..0.135 N·m/rad: under torque
+ * actuation SINUSOID with a stiffness drives that torque through the same
+ * path as the oscillator (the drive mode, the walls, the guard, the faults). */
+/* The paper's softest law: on this test's joint (4.39e-3 kg·m², no damping
+ * on the current drive) its natural frequency, 0.29 Hz, is far below the
+ * clock's and the swing stays small. The stiffest, 0.135, puts it at
+ * 0.88 Hz, next to the clock's 0.8: undamped, the joint resonates into its
+ * walls within a second (the limit fault then holds it; CONTROL.md has what
+ * the simulated joint does). */
+#define CLOCK_K 0.015
+
+/* The clock's torque at time t for a joint at (x, v) rad, rad/s from neutral. */
+static double clock_tau(size_t j, double tt, double x, double v)
+{
+	double target = osc_sinusoid(cfg.amplitude, cfg.frequency, cfg.phase, j, tt);
+	double rate = osc_sinusoid_rate(cfg.amplitude, cfg.frequency, cfg.phase, j, tt);
+	return cfg.sin_stiffness * (target - x) + cfg.sin_damping * (rate - v);
+}
+
+static void setup_clock(const char *ids, const char *drive, const char *stiffness)
+{
+	static char set[64];
+	static const char *sets[] = { set, NULL };
+	snprintf(set, sizeof set, "sinusoid.stiffness=%s", stiffness);
+	setup_sets = sets;
+	setup(ids, drive, CFG_MODE_SINUSOID);
+	setup_sets = NULL;
+}
+
+/* The law itself, pure: at a quarter period (0.8 Hz: 0.3125 s) joint 0 of the
+ * clock is at -A, joint 1 a third of a period behind it (sin(2pi/3 - pi/2)). */
+static void test_clock_law_pure(void **state)
+{
+	(void)state;
+	const struct osc_clock k = { .amplitude = 0.8, .frequency = 0.8, .phase = 0.0, .stiffness = 0.135, .damping = 0.0 };
+	double x[2] = { 0.1, -0.2 }, v[2] = { 1.0, -3.0 }, tau[2];
+	assert_true(osc_clock_torque(&k, 2, 0.3125, x, v, tau));
+	assert_true(fabs(tau[0] - 0.135 * (-0.8 - 0.1)) < 1e-12);
+	assert_true(fabs(tau[1] - 0.135 * (0.8 * sin(2.0 * M_PI / 3.0 - M_PI / 2.0) + 0.2)) < 1e-12);
+	/* damping acts on the difference of speeds: at the clock's own speed, none */
+	struct osc_clock kd = k;
+	kd.damping = 0.02;
+	double w = 2.0 * M_PI * 0.8;
+	v[0] = -0.8 * w * cos(-M_PI / 2.0);   /* the clock's speed at a quarter period: 0 */
+	v[1] = -0.8 * w * cos(2.0 * M_PI / 3.0 - M_PI / 2.0);
+	assert_true(osc_clock_torque(&kd, 2, 0.3125, x, v, tau));
+	assert_true(fabs(tau[0] - 0.135 * (-0.8 - 0.1)) < 1e-12);
+	assert_true(fabs(tau[1] - 0.135 * (0.8 * sin(2.0 * M_PI / 3.0 - M_PI / 2.0) + 0.2)) < 1e-12);
+	v[0] += 1.0;
+	assert_true(osc_clock_torque(&kd, 2, 0.3125, x, v, tau));
+	assert_true(fabs(tau[0] - (0.135 * (-0.8 - 0.1) - 0.02)) < 1e-12);
+	/* a non-finite state or parameter: no drive */
+	x[1] = NAN;
+	assert_false(osc_clock_torque(&k, 2, 0.3125, x, v, tau));
+	assert_true(tau[0] == 0.0 && tau[1] == 0.0);
+	x[1] = 0.0;
+	kd.stiffness = INFINITY;
+	assert_false(osc_clock_torque(&kd, 2, 0.3125, x, v, tau));
+	assert_true(tau[0] == 0.0 && tau[1] == 0.0);
+}
+
+/* SINUSOID under torque actuation with a stiffness: the servos go into wheel
+ * mode (no starter, no goals), and every cycle each joint's drive is the
+ * law's torque for that cycle's time and measured state (current drive:
+ * duty = torque / stall). */
+static void test_clock_drives_the_law(void **state)
+{
+	(void)state;
+	setup_clock("1,2", "current", "0.015");
+	assert_true(cfg.sin_stiffness == CLOCK_K);
+	run_into_wheel();
+	assert_false(c.starter_active);
+	for (int i = 0; i < 300; i++) {
+		cycle();
+		if (c.sync != CTL_SYNC_DUTY)
+			fail_msg("cycle %d: out of the drive at %+.3f / %+.3f rad: %s", i, sv[0].angle, sv[1].angle,
+			         c.latched ? c.latch : "no fault");
+		for (size_t j = 0; j < nj; j++) {
+			const struct ctl_joint *jt = &c.j[j];
+			assert_false(jt->write_goal);
+			assert_true(isnan(jt->goal));
+			if (jt->clamp_flags != 0)
+				continue;   /* the wall's: below */
+			double x = jt->angle - cfg.joint[j].neutral;
+			double expect = clock_tau(j, t, x, jt->speed);
+			if (!(fabs(jt->torque_cmd - expect) < 1e-12) || !(fabs(jt->duty - expect / STALL) < 1e-12))
+				fail_msg("cycle %d joint %zu at %+.3f rad: torque %+.5f duty %+.5f, the law's %+.5f", i, j, x,
+				         jt->torque_cmd, jt->duty, expect);
+		}
+	}
+	/* and with damping, against the clock's speed */
+	cfg.sin_damping = 0.01;
+	for (int i = 0; i < 50; i++) {
+		cycle();
+		for (size_t j = 0; j < nj; j++) {
+			const struct ctl_joint *jt = &c.j[j];
+			double expect = clock_tau(j, t, jt->angle - cfg.joint[j].neutral, jt->speed);
+			if (jt->clamp_flags == 0 && !(fabs(jt->torque_cmd - expect) < 1e-12))
+				fail_msg("damped: joint %zu torque %+.5f, the law's %+.5f", j, jt->torque_cmd, expect);
+		}
+	}
+	/* the joints swing on the clock's wave: joint 1 behind joint 0 */
+	assert_true(fabs(sv[0].speed) > 0.05 || fabs(sv[1].speed) > 0.05);
+	/* a joint without a reading gets no drive; a non-finite law none at all */
+	sv[1].answers = false;
+	cycle();
+	assert_true(c.wheel && c.j[1].duty == 0.0 && c.j[0].duty != 0.0);
+	sv[1].answers = true;
+	run(5);
+	long long nonfinite = c.nonfinite;
+	cfg.amplitude = NAN;   /* (no file or command can set one) */
+	cycle();
+	assert_true(c.wheel && c.nonfinite > nonfinite);
+	assert_true(c.j[0].duty == 0.0 && c.j[1].duty == 0.0);
+	cfg.amplitude = 0.8;
+	/* nor a stiffness: not a torque law, back to joint mode */
+	cfg.sin_stiffness = NAN;
+	cycle();
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);
+}
+
+/* The safeties of torque actuation hold for the clock: the wall near a limit,
+ * no outward drive, a limit breach latches the fault action in joint mode. */
+static void test_clock_walls_and_breach(void **state)
+{
+	(void)state;
+	setup_clock("1", "current", "0.135");
+	cfg.joint[0].limit_min = -1.0;
+	cfg.joint[0].limit_max = 1.0;
+	ctl_params_changed(&c);
+	run_into_wheel();
+	double hi = c.j[0].limits.hi;
+	sv[0].angle = hi - 0.05;
+	sv[0].speed = 2.0;
+	cycle();
+	assert_true(c.wheel);
+	assert_true(c.j[0].clamp_flags & SAFETY_LIMIT);
+	assert_true(c.j[0].torque_cmd < 0.0);
+	assert_true(c.j[0].duty <= 0.0);   /* moving out near the wall: never driven outwards */
+	sv[0].angle = hi + 0.05;
+	sv[0].speed = 0.0;
+	long long trips = c.limit_trips;
+	cycle();
+	assert_int_equal(c.limit_trips, trips + 1);
+	assert_true(c.latched);
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+	assert_false(c.wheel);
+	assert_false(wheel(&sv[0]));
+	/* a fault latched: SINUSOID is refused until cleared */
+	char why[256];
+	assert_false(ctl_mode_allowed(&c, CFG_MODE_SINUSOID, why, sizeof why));
+}
+
+/* The experiment: the clock, then the oscillator, at run time, under torque
+ * actuation. The servos stay in their drive mode across the switch (no
+ * register written, no joint-mode detour), the law changes at the cycle
+ * boundary; back to SINUSOID the same; HOLD and LIMP leave it as before. */
+static void test_clock_to_oscillator_stays_in_drive(void **state)
+{
+	(void)state;
+	setup_clock("1,2", "current", "0.015");
+	run_into_wheel();
+	run(300);
+	for (size_t j = 0; j < nj; j++)
+		assert_int_equal(sv[j].wheel_entries, 1);
+	enum cfg_mode next[] = { CFG_MODE_OSCILLATOR, CFG_MODE_SINUSOID, CFG_MODE_OSCILLATOR };
+	for (size_t m = 0; m < sizeof next / sizeof next[0]; m++) {
+		ctl_set_mode(&c, next[m], "test");
+		assert_false(c.starter_active);
+		for (int i = 0; i < 200; i++) {
+			cycle();
+			if (!c.wheel || c.sync != CTL_SYNC_DUTY || nsent != 0)
+				fail_msg("%s, cycle %d: wheel %d, sync %d, %zu register write(s); starter %d, starts %lld, %s; "
+				         "at %+.3f/%+.3f rad, %+.2f/%+.2f rad/s", cfg_mode_name(next[m]), i, c.wheel, c.sync, nsent,
+				         c.starter_active, c.starts, c.latched ? c.latch : "no fault", sv[0].angle, sv[1].angle,
+				         sv[0].speed, sv[1].speed);
+		}
+		/* the law of the mode drives */
+		double x[2], v[2], tau[2];
+		struct osc_joint_params p[2];
+		for (size_t j = 0; j < nj; j++) {
+			x[j] = c.j[j].angle - cfg.joint[j].neutral;
+			v[j] = c.j[j].speed;
+			p[j] = cfg.joint[j].osc;
+		}
+		assert_true(osc_torque(p, nj, x, v, tau));
+		for (size_t j = 0; j < nj; j++) {
+			double expect = next[m] == CFG_MODE_OSCILLATOR ? tau[j] : clock_tau(j, t, x[j], v[j]);
+			if (c.j[j].clamp_flags == 0 && !(fabs(c.j[j].torque_cmd - expect) < 1e-12))
+				fail_msg("%s: joint %zu torque %+.5f, its law's %+.5f", cfg_mode_name(next[m]), j,
+				         c.j[j].torque_cmd, expect);
+		}
+	}
+	for (size_t j = 0; j < nj; j++) {
+		assert_int_equal(sv[j].wheel_entries, 1);
+		assert_int_equal(sv[j].wheel_exits, 0);
+		assert_int_equal(sv[j].eeprom_refused, 0);
+	}
+	ctl_set_mode(&c, CFG_MODE_HOLD, "test");
+	cycle();
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);
+	for (size_t j = 0; j < nj; j++) {
+		assert_int_equal(sv[j].wheel_exits, 1);
+		assert_true(sv[j].torque && !wheel(&sv[j]));
+	}
+	ctl_set_mode(&c, CFG_MODE_SINUSOID, "test");
+	run(5);
+	assert_true(c.wheel);
+	ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+	cycle();
+	assert_false(c.wheel);
+	for (size_t j = 0; j < nj; j++) {
+		assert_false(sv[j].torque);
+		assert_false(wheel(&sv[j]));
+		assert_int_equal(sv[j].speed_reg, 0);
+	}
+}
+
+/* Stiffness 0 (the default): SINUSOID follows the clock with the servo's own
+ * position loop, in joint mode, as before. A stiffness set at run time (a
+ * command) moves it into the drive; 0 again, back to joint mode. */
+static void test_clock_stiffness_zero_is_joint_mode(void **state)
+{
+	(void)state;
+	setup("1,2", "current", CFG_MODE_SINUSOID);
+	assert_true(cfg.sin_stiffness == 0.0);
+	run(300);
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL);
+	assert_true(c.j[0].write_goal);
+	cfg.sin_stiffness = CLOCK_K;
+	ctl_params_changed(&c);
+	run(3);
+	assert_true(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_DUTY);
+	cfg.sin_stiffness = 0.0;
+	ctl_params_changed(&c);
+	cycle();
+	assert_false(c.wheel);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);
+	run(100);
+	assert_int_equal(c.sync, CTL_SYNC_GOAL);
+	assert_true(c.j[0].write_goal && isfinite(c.j[0].goal));
+}
+
+/* The supply is a gain of the PWM drive for the clock too: read as 1.5 V it
+ * latches the fault before the drive starts. */
+static void test_clock_supply_checked(void **state)
+{
+	(void)state;
+	static const char *const sets[] = { "sinusoid.stiffness=0.135", "joint.1.limit_min=-0.6",
+	                                    "joint.1.limit_max=0.6", NULL };
+	volts_raw = -1;
+	setup_sets = sets;
+	setup("1", "pwm", CFG_MODE_HOLD);
+	setup_sets = NULL;
+	volts_raw = 15;
+	cycle_pwm(true);
+	ctl_set_mode(&c, CFG_MODE_SINUSOID, "test");
+	double widest = run_pwm_widest(100);
+	if (!c.latched || strstr(c.latch, "1.5 V") == NULL)
+		fail_msg("clock, supply read as 1.5 V: %s", c.latched ? c.latch : "no fault latched");
+	assert_int_equal(sv[0].wheel_entries, 0);
+	assert_true(widest <= 0.6);
+	volts_raw = -1;
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -627,9 +930,16 @@ int main(void)
 		cmocka_unit_test(test_pwm_adds_back_emf),
 		cmocka_unit_test(test_switch_at_turning_point),
 		cmocka_unit_test(test_start_from_rest_displaced),
+		cmocka_unit_test(test_two_joint_defaults_inside_limits),
 		cmocka_unit_test(test_implausible_supply_is_a_fault),
 		cmocka_unit_test(test_no_outward_drive_at_the_wall),
 		cmocka_unit_test(test_limits_hold_for_every_reading),
+		cmocka_unit_test(test_clock_law_pure),
+		cmocka_unit_test(test_clock_drives_the_law),
+		cmocka_unit_test(test_clock_walls_and_breach),
+		cmocka_unit_test(test_clock_to_oscillator_stays_in_drive),
+		cmocka_unit_test(test_clock_stiffness_zero_is_joint_mode),
+		cmocka_unit_test(test_clock_supply_checked),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

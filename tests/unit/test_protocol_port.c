@@ -1,7 +1,10 @@
 /*
  * test_protocol_port.c — the serial transport on real pseudo-terminals:
  * raw mode byte-exactness, non-blocking reads, disconnection, baud setting,
- * and the FTDI latency-timer logic against a fake sysfs tree.
+ * the FTDI latency-timer logic against a fake sysfs tree, and one owner per
+ * bus: a second open of a held pty refused with its holder named, through
+ * any path to it, and free again at close; UUCP lock files honoured when
+ * their program lives, replaced when stale.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -13,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <termios.h>
 #include <unistd.h>
 #include <cmocka.h>
@@ -225,6 +229,175 @@ static void test_open_missing_port(void **state)
 	assert_non_null(strstr(err, "/dev/null"));
 }
 
+/* ---- one owner per bus ------------------------------------------------------------ */
+
+struct lockdir {
+	char dir[64];
+	char lck[PORT_LOCKFILE_MAX];    /* LCK.. for the peer's pty in it */
+	struct ptypeer peer;
+};
+
+/* A lock directory of the test's own ($UNDULATE_LOCK_DIR) and a pty. */
+static void lockdir_make(struct lockdir *l)
+{
+	snprintf(l->dir, sizeof l->dir, "/tmp/test_port_lock.XXXXXX");
+	assert_non_null(mkdtemp(l->dir));
+	assert_int_equal(setenv("UNDULATE_LOCK_DIR", l->dir, 1), 0);
+	assert_int_equal(ptypeer_open(&l->peer), 0);
+	/* /dev/pts/3 -> LCK..pts_3, as minicom names it */
+	assert_true(strncmp(l->peer.slave_path, "/dev/pts/", 9) == 0);
+	snprintf(l->lck, sizeof l->lck, "%s/LCK..pts_%s", l->dir, l->peer.slave_path + 9);
+}
+
+static void lockdir_remove(struct lockdir *l)
+{
+	char alias[128];
+	ptypeer_close(&l->peer);
+	snprintf(alias, sizeof alias, "%s/alias", l->dir);
+	unlink(alias);
+	unlink(l->lck);
+	assert_int_equal(rmdir(l->dir), 0);   /* nothing else left behind */
+	unsetenv("UNDULATE_LOCK_DIR");
+}
+
+static void write_lck(const char *path, const char *text)
+{
+	FILE *fp = fopen(path, "w");
+	assert_non_null(fp);
+	fputs(text, fp);
+	assert_int_equal(fclose(fp), 0);
+}
+
+/* A second open of a held port, as a second program's would be (another open
+ * file: flock() does not care that it is the same process), is refused
+ * before it touches the line, and names the holder from its lock file. */
+static void test_second_open_refused(void **state)
+{
+	(void)state;
+	struct lockdir l;
+	struct holder h, f;
+	char err[300] = "", alias[128];
+	lockdir_make(&l);
+	struct port_options mine = { .baud = 1000000, .owner = "robot t1" };
+	struct port *p = port_open(l.peer.slave_path, &mine, err, sizeof err);
+	assert_non_null(p);
+	assert_true(holder_read_file(l.lck, &f));
+	assert_int_equal(f.pid, getpid());
+	assert_string_equal(f.robot, "t1");
+
+	struct port_options other = { .baud = 57600, .holder = &h };
+	assert_null(port_open(l.peer.slave_path, &other, err, sizeof err));
+	assert_int_equal(h.pid, getpid());
+	assert_string_equal(h.detail, "robot t1");
+	assert_string_equal(h.robot, "t1");
+	char want[200];
+	snprintf(want, sizeof want, "cannot open %s: held by %s (pid %ld, robot t1)", l.peer.slave_path, f.program,
+	         (long)getpid());
+	assert_string_equal(err, want);
+	/* the refused open changed nothing: the holder's rate stands */
+	struct termios tio;
+	assert_int_equal(tcgetattr(port_fd(p), &tio), 0);
+	assert_int_equal(cfgetospeed(&tio), B1000000);
+	/* any other path to the device meets the same lock */
+	snprintf(alias, sizeof alias, "%s/alias", l.dir);
+	assert_int_equal(symlink(l.peer.slave_path, alias), 0);
+	assert_null(port_open(alias, &other, err, sizeof err));
+	assert_non_null(strstr(err, "held by"));
+	assert_true(port_holder(alias, &h));
+	assert_int_equal(h.pid, getpid());
+
+	/* closed: free again, our lock file gone */
+	port_close(p);
+	assert_int_equal(access(l.lck, F_OK), -1);
+	assert_false(port_holder(alias, &h));
+	p = port_open(alias, &other, err, sizeof err);
+	assert_non_null(p);
+	assert_int_equal(h.pid, 0);   /* not refused: zeroed */
+	port_close(p);
+	lockdir_remove(&l);
+}
+
+static long reaped_pid(void)
+{
+	pid_t c = fork();
+	assert_true(c >= 0);
+	if (c == 0)
+		_exit(0);
+	assert_int_equal(waitpid(c, NULL, 0), c);
+	return (long)c;
+}
+
+/* minicom's lock files: a live program's refuses the port; a dead one's, or
+ * one whose pid now runs another program (reused after a kill), is replaced. */
+static void test_uucp_lock_files(void **state)
+{
+	(void)state;
+	struct lockdir l;
+	struct holder h, f, parent;
+	char err[400], text[96];
+	lockdir_make(&l);
+	struct port_options opt = { .baud = 1000000, .holder = &h, .owner = "command scan" };
+	assert_true(holder_from_pid((long)getppid(), &parent));
+
+	/* a live program named in its file: honoured */
+	snprintf(text, sizeof text, "%10ld %s someone\n", (long)getppid(), parent.program);
+	write_lck(l.lck, text);
+	assert_null(port_open(l.peer.slave_path, &opt, err, sizeof err));
+	assert_int_equal(h.pid, getppid());
+	assert_string_equal(h.program, parent.program);
+	char want[PORT_LOCKFILE_MAX + 16];
+	snprintf(want, sizeof want, "lock file %s", l.lck);
+	assert_string_equal(h.detail, want);
+	/* HDB's pid alone: honoured, the program named from /proc */
+	snprintf(text, sizeof text, "%10ld\n", (long)getppid());
+	write_lck(l.lck, text);
+	assert_null(port_open(l.peer.slave_path, &opt, err, sizeof err));
+	assert_string_equal(h.program, parent.program);
+	assert_non_null(strstr(err, "held by"));
+
+	/* stale: the pid is gone, or runs another program now */
+	const char *stale[] = { "%10ld undulated robot r9\n", "%10ld minicom-not-this-one x\n" };
+	for (size_t i = 0; i < 2; i++) {
+		snprintf(text, sizeof text, stale[i], i == 0 ? reaped_pid() : (long)getppid());
+		write_lck(l.lck, text);
+		struct port *p = port_open(l.peer.slave_path, &opt, err, sizeof err);
+		if (p == NULL)
+			fail_msg("stale lock file %zu refused: %s", i, err);
+		assert_true(holder_read_file(l.lck, &f));
+		assert_int_equal(f.pid, getpid());
+		assert_string_equal(f.detail, "command scan");
+		port_close(p);
+		assert_int_equal(access(l.lck, F_OK), -1);
+	}
+	/* garbage is not a lock */
+	write_lck(l.lck, "not a pid\n");
+	struct port *p = port_open(l.peer.slave_path, &opt, err, sizeof err);
+	assert_non_null(p);
+	port_close(p);
+	lockdir_remove(&l);
+}
+
+/* A lock directory we cannot write costs the name in a refusal, not the lock. */
+static void test_unwritable_lock_dir(void **state)
+{
+	(void)state;
+	struct ptypeer peer;
+	struct holder h;
+	char err[300];
+	assert_int_equal(setenv("UNDULATE_LOCK_DIR", "/nonexistent/undulate-locks", 1), 0);
+	assert_int_equal(ptypeer_open(&peer), 0);
+	struct port_options opt = { .baud = 1000000, .holder = &h, .owner = "robot t2" };
+	struct port *p = port_open(peer.slave_path, &opt, err, sizeof err);
+	assert_non_null(p);
+	assert_null(port_open(peer.slave_path, &opt, err, sizeof err));
+	/* named from /proc instead: this test program, its command line */
+	assert_int_equal(h.pid, getpid());
+	assert_true(strncmp(h.program, "test_protocol_p", 15) == 0);
+	port_close(p);
+	ptypeer_close(&peer);
+	unsetenv("UNDULATE_LOCK_DIR");
+}
+
 /* ---- latency timer against a fake sysfs tree ------------------------------------ */
 
 struct fake_sysfs {
@@ -384,7 +557,11 @@ static void test_latency_not_ftdi(void **state)
 	assert_false(lat.lowered);
 	assert_non_null(strstr(lat.note, "no latency timer"));
 	fake_sysfs_remove(&s);
-	/* A pty, through port_open's own check. */
+	assert_null(port_get_latency(f->port)); /* not asked for */
+	/* A pty, through port_open's own check (the fixture's port let go
+	 * first: one owner per bus). */
+	port_close(f->port);
+	f->port = NULL;
 	struct port_options opt = { .baud = 1000000, .low_latency = true };
 	char err[200];
 	struct port *p = port_open(f->peer.slave_path, &opt, err, sizeof err);
@@ -392,7 +569,6 @@ static void test_latency_not_ftdi(void **state)
 	assert_non_null(port_get_latency(p));
 	assert_false(port_get_latency(p)->known);
 	port_close(p);
-	assert_null(port_get_latency(f->port)); /* not asked for */
 }
 
 static void test_adapter_names(void **state)
@@ -512,6 +688,9 @@ int main(void)
 		cmocka_unit_test_setup_teardown(test_bus_io_drives_the_port, setup_pty, teardown_pty),
 		cmocka_unit_test_setup_teardown(test_baud_rates, setup_pty, teardown_pty),
 		cmocka_unit_test(test_open_missing_port),
+		cmocka_unit_test(test_second_open_refused),
+		cmocka_unit_test(test_uucp_lock_files),
+		cmocka_unit_test(test_unwritable_lock_dir),
 		cmocka_unit_test(test_latency_reported_not_lowered),
 		cmocka_unit_test(test_latency_timer_text),
 		cmocka_unit_test(test_latency_lowered_through_symlink),

@@ -2,7 +2,9 @@
  * test_sim_bus.c — one simulated bus without a pty: wire timing, collisions,
  * wrong baud, echo, adapter latency, the bad-checksum reply and every reply
  * fault, checked with our own encoder and parser (the controller's view) and
- * with raw bytes from the manual.
+ * with raw bytes from the manual; and the link's owner: a second simulator on
+ * a live link refused with the first named, a killed one's link replaced, a
+ * disconnect keeping the link its own.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -12,6 +14,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -19,6 +23,7 @@
 
 #include "dxl.h"
 #include "dxl_table.h"
+#include "holder.h"
 #include "port.h"
 #include "../../sim-bridge/fault.h"
 #include "../../sim-bridge/line.h"
@@ -393,9 +398,73 @@ static void test_bus_follows_pty_rate(void **state)
 	sim_bus_read(&b, 0);
 	assert_int_equal(b.baud, 117647);
 	close(fd);
-	sim_bus_close(&b);
+	sim_bus_release(&b);
 	assert_int_equal(port_termios2_get_baud(-1), DXL_E_IO);
-	assert_int_equal(rmdir(dir), 0);  /* the link went with the bus */
+	assert_int_equal(rmdir(dir), 0);  /* the link and its lock file went with the bus */
+}
+
+/* One simulator per link. A second bus on a live link (another simulator:
+ * a lock file is another open file to flock(), even in one process) is
+ * refused before it makes a pty, naming the first, and leaves the link
+ * alone; a disconnect keeps the link the first one's; one left by a killed
+ * simulator (a dangling link, a lock file no process holds) is replaced. */
+static void test_link_has_one_owner(void **state)
+{
+	(void)state;
+	char dir[] = "/tmp/test_sim_link.XXXXXX", link[64], lock[80], target[SIM_PATH_MAX];
+	assert_non_null(mkdtemp(dir));
+	snprintf(link, sizeof(link), "%s/bus", dir);
+	snprintf(lock, sizeof(lock), "%s/bus.lock", dir);
+	static struct sim_bus a, b2;
+	char err[400];
+	sim_bus_init(&a, "r1", link, 1000000, 0, false, 1);
+	sim_bus_init(&b2, "r2", link, 1000000, 0, false, 1);
+	assert_int_equal(sim_bus_open(&a, err, sizeof(err)), 0);
+	struct holder f;
+	assert_true(holder_read_file(lock, &f));
+	assert_int_equal(f.pid, getpid());
+	assert_string_equal(f.detail, "bus r1");
+
+	assert_int_equal(sim_bus_open(&b2, err, sizeof(err)), -1);
+	char want[300];
+	snprintf(want, sizeof(want), "%s: held by %s (pid %ld, bus r1)", link, f.program, (long)getpid());
+	assert_non_null(strstr(err, want));
+	assert_false(sim_bus_connected(&b2));
+	ssize_t n = readlink(link, target, sizeof(target) - 1);
+	assert_true(n > 0);
+	target[n] = '\0';
+	assert_string_equal(target, a.slave_path);
+	sim_bus_release(&b2);   /* never held: the link and the lock stay */
+	assert_int_equal(access(lock, F_OK), 0);
+	assert_true(readlink(link, target, sizeof(target)) > 0);
+
+	/* a disconnect removes the link but keeps it ours */
+	sim_bus_close(&a);
+	assert_int_equal(readlink(link, target, sizeof(target)), -1);
+	assert_int_equal(sim_bus_open(&b2, err, sizeof(err)), -1);
+	assert_int_equal(sim_bus_open(&a, err, sizeof(err)), 0);
+	sim_bus_release(&a);
+	assert_int_equal(access(lock, F_OK), -1);
+
+	/* what a SIGKILLed simulator leaves: a link to a pty that is gone, a
+	 * lock file naming a dead pid */
+	pid_t c = fork();
+	assert_true(c >= 0);
+	if (c == 0)
+		_exit(0);
+	assert_int_equal(waitpid(c, NULL, 0), c);
+	assert_int_equal(symlink("/dev/pts/999999", link), 0);
+	FILE *fp = fopen(lock, "w");
+	assert_non_null(fp);
+	fprintf(fp, "%10ld undulate-sim bus r1\n", (long)c);
+	fclose(fp);
+	assert_int_equal(sim_bus_open(&b2, err, sizeof(err)), 0);
+	n = readlink(link, target, sizeof(target) - 1);
+	assert_true(n > 0);
+	target[n] = '\0';
+	assert_string_equal(target, b2.slave_path);
+	sim_bus_release(&b2);
+	assert_int_equal(rmdir(dir), 0);
 }
 
 /* A whole packet inside a damaged one (here in the parameters of a WRITE
@@ -499,6 +568,7 @@ int main(void)
 		cmocka_unit_test(test_reply_faults),
 		cmocka_unit_test(test_stuck_error_count_and_prob),
 		cmocka_unit_test(test_bus_follows_pty_rate),
+		cmocka_unit_test(test_link_has_one_owner),
 		cmocka_unit_test(test_packet_inside_a_bad_packet),
 		cmocka_unit_test(test_fault_parse_errors),
 		cmocka_unit_test(test_line_queue),

@@ -148,9 +148,9 @@ static void test_closing_walls_squeeze(void **state)
 	assert_true(sim.world.total_collisions > 0 && sim.world.total_impulse > 0);
 	assert_true(sim.world.bodies[0].neutral > -0.12 && sim.world.bodies[2].neutral < 0.12);
 	struct plane_contact c[16];
-	size_t n = sim_plane_drain(&sim, c, 16);
+	size_t n = sim_contacts_drain(&sim, c, 16);
 	assert_true(n > 0);
-	assert_int_equal(sim_plane_drain(&sim, c, 16), 0);   /* drained */
+	assert_int_equal(sim_contacts_drain(&sim, c, 16), 0);   /* drained */
 	sim_free(&sim);
 }
 

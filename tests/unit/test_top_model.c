@@ -256,10 +256,14 @@ static void test_render_twenty(void **state)
 static void test_json(void **state)
 {
 	(void)state;
+	/* a name with a quote is no robot's (test_bad_names); text from the
+	 * network is escaped (test_json_hostile_text) */
 	feed_state("r\"1", 0, 0.25, -1.0, 10, 2);
+	feed_state("r1", 0, 0.25, -1.0, 10, 2);
 	feed_state("r2", 0, 0.75, -1.0, 10, 3);
 	const char *buf = json_of(0.1);
-	assert_non_null(strstr(buf, "\"name\":\"r\\\"1\""));
+	assert_null(strstr(buf, "\"name\":\"r\\\"1\""));
+	assert_non_null(strstr(buf, "\"name\":\"r1\""));
 	assert_non_null(strstr(buf, "\"mode\":\"SINUSOID\""));
 	assert_non_null(strstr(buf, "\"dphase\":0.5"));
 	assert_non_null(strstr(buf, "\"rate_hz\":100"));
@@ -420,6 +424,49 @@ static void test_x_error_bits(void **state)
 }
 
 /* Nobody heard: the screen says which URL it listens on; ? shows the legend. */
+/* A name that is not a robot's name never becomes a robot: '*' (whose card's
+ * buttons would command every robot), control characters, spaces, '.', '/',
+ * 48 characters. What a daemon may be called (common/text.h, text_is_name)
+ * does. From every message that names a robot. */
+static void test_bad_names(void **state)
+{
+	(void)state;
+	char long_ok[TOP_NAME_MAX], too_long[TOP_NAME_MAX + 1];
+	memset(long_ok, 'r', sizeof long_ok - 1);
+	long_ok[sizeof long_ok - 1] = '\0';
+	memset(too_long, 'r', sizeof too_long - 1);
+	too_long[sizeof too_long - 1] = '\0';
+	const char *bad[] = { "*", "", "a\x01" "b", "bell\a", "two words", "tab\tname", "a.b", "../x", "r1\n", "caf\xc3\xa9",
+	                      "a*", too_long };
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+		char n[TOP_NAME_MAX + 8], reason[] = "test", kind[] = "mode", text[] = "x";
+		snprintf(n, sizeof n, "%s", bad[i]);
+		undulate_joint_state_t j[1] = { { .servo_id = 1 } };
+		undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 1, .mode_reason = reason, .fault = "",
+			.period_us = 10000.0, .njoints = 1, .joints = j };
+		top_on_state(&model, &s, 0.0);
+		undulate_event_t e = { .utime = 1, .robot = n, .seq = 1, .level = 1, .kind = kind, .text = text };
+		top_on_event(&model, &e);
+		undulate_bus_stats_t b = { .utime = 1, .robot = n };
+		top_on_bus(&model, &b);
+		undulate_osc_params_t p = { .utime = 1, .robot = n };
+		top_on_params(&model, &p);
+		if (model.nrobots != 0)
+			fail_msg("'%s' became a robot", bad[i]);
+	}
+	assert_int_equal(model.dropped_robots, 4 * (int)(sizeof bad / sizeof bad[0]));
+	feed_state("r_1-X", 0.0, 0, 0, 0, 1);
+	char n[TOP_NAME_MAX];
+	snprintf(n, sizeof n, "%s", long_ok);
+	undulate_joint_state_t j[1] = { { .servo_id = 1 } };
+	char reason[] = "test";
+	undulate_robot_state_t s = { .utime = 1, .robot = n, .mode = 1, .mode_reason = reason, .fault = "",
+		.period_us = 10000.0, .njoints = 1, .joints = j };
+	top_on_state(&model, &s, 0.0);
+	assert_int_equal(model.nrobots, 2);
+	assert_int_equal(top_robot_index(&model, long_ok), 1);
+}
+
 static void test_empty_and_help(void **state)
 {
 	(void)state;
@@ -438,6 +485,7 @@ int main(void)
 		cmocka_unit_test_setup(test_joint_health, setup),
 		cmocka_unit_test_setup(test_x_error_bits, setup),
 		cmocka_unit_test_setup(test_empty_and_help, setup),
+		cmocka_unit_test_setup(test_bad_names, setup),
 		cmocka_unit_test_setup(test_rate_jitter_stale, setup),
 		cmocka_unit_test_setup(test_drive_column, setup),
 		cmocka_unit_test_setup(test_unknown_phase, setup),

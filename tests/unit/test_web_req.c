@@ -136,6 +136,98 @@ static void test_origin(void **state)
 	assert_false(req_origin_ok("null", "127.0.0.1:8080"));
 }
 
+/* DNS rebinding: a page of evil.example whose name now points at this
+ * computer reaches the server with Host: evil.example. Only names of this
+ * server pass: localhost, a loopback or the listening address, any address
+ * when listening on all of them (a browser sends an address only when it
+ * connected to that address), and the names given. */
+static void test_host(void **state)
+{
+	(void)state;
+	struct req_hosts lo = { .listen = "127.0.0.1" };
+	assert_true(req_host_ok(&lo, "127.0.0.1:8080"));
+	assert_true(req_host_ok(&lo, "127.0.0.1"));
+	assert_true(req_host_ok(&lo, "localhost:8080"));
+	assert_true(req_host_ok(&lo, "LocalHost:8080"));
+	assert_true(req_host_ok(&lo, "[::1]:8080"));
+	assert_true(req_host_ok(&lo, "127.0.0.2:9000")); /* ssh -L 9000:127.0.0.2:8080 on a laptop */
+	assert_false(req_host_ok(&lo, "evil.example:8080"));
+	assert_false(req_host_ok(&lo, "evil.example"));
+	assert_false(req_host_ok(&lo, "localhost.evil.example:8080"));
+	assert_false(req_host_ok(&lo, "127.0.0.1.evil.example:8080"));
+	assert_false(req_host_ok(&lo, "10.0.0.5:8080"));  /* not an address it listens on */
+	assert_false(req_host_ok(&lo, "127.1:8080"));     /* browsers send the dotted quad */
+	assert_false(req_host_ok(&lo, ""));
+	assert_false(req_host_ok(&lo, NULL));
+	assert_false(req_host_ok(&lo, ":8080"));
+	assert_false(req_host_ok(&lo, "localhost:"));
+	assert_false(req_host_ok(&lo, "localhost:80x"));
+	assert_false(req_host_ok(&lo, "localhost:123456"));
+	assert_false(req_host_ok(&lo, "localhost:8080:1"));
+	assert_false(req_host_ok(&lo, "[::1"));
+	assert_false(req_host_ok(&lo, "[::1]x"));
+	assert_false(req_host_ok(&lo, "[localhost]:8080"));
+	assert_false(req_host_ok(&lo, "local host"));
+	assert_false(req_host_ok(&lo, "localhost\r\nX: y"));
+	struct req_hosts any = { .listen = "0.0.0.0", .names = { "labpc", "lab.example" }, .nnames = 2 };
+	assert_true(req_host_ok(&any, "10.0.0.5:8080"));
+	assert_true(req_host_ok(&any, "[fe80::1]:8080"));
+	assert_true(req_host_ok(&any, "labpc:8080"));
+	assert_true(req_host_ok(&any, "Lab.Example"));
+	assert_true(req_host_ok(&any, "localhost:8080"));
+	assert_false(req_host_ok(&any, "evil.example:8080"));
+	assert_false(req_host_ok(&any, "labpc.evil.example:8080"));
+	assert_false(req_host_ok(&any, "xlabpc"));
+	struct req_hosts v6any = { .listen = "::" };
+	assert_true(req_host_ok(&v6any, "192.168.1.2"));
+	assert_false(req_host_ok(&v6any, "labpc"));
+	struct req_hosts one = { .listen = "10.0.0.5" };
+	assert_true(req_host_ok(&one, "10.0.0.5:8080"));
+	assert_false(req_host_ok(&one, "10.0.0.6:8080"));
+	assert_true(req_host_ok(&one, "127.0.0.1:8080"));
+	struct req_hosts v6 = { .listen = "::1" };
+	assert_true(req_host_ok(&v6, "[0:0::1]:8080"));
+	assert_false(req_host_ok(&v6, "[::2]:8080"));
+}
+
+/* The page offers its token as a subprotocol beside "undulate", so the
+ * server knows it at the handshake (and keeps room for it). */
+static void test_ws_token(void **state)
+{
+	(void)state;
+	char t[REQ_TOKEN_MAX];
+	assert_true(req_ws_token("undulate, undulate-token.abc_DEF-1", t, sizeof t));
+	assert_string_equal(t, "abc_DEF-1");
+	assert_true(req_ws_token("undulate,undulate-token.x.y~z", t, sizeof t));
+	assert_string_equal(t, "x.y~z");
+	assert_true(req_ws_token("undulate-token.first , undulate", t, sizeof t));
+	assert_string_equal(t, "first");
+	assert_false(req_ws_token("undulate", t, sizeof t));
+	assert_false(req_ws_token("", t, sizeof t));
+	assert_false(req_ws_token(NULL, t, sizeof t));
+	assert_false(req_ws_token("undulate, undulate-token.", t, sizeof t));
+	assert_false(req_ws_token("undulate, xundulate-token.abc", t, sizeof t));
+	assert_false(req_ws_token("undulate, undulate-token.a/b", t, sizeof t));
+	char longer[200] = "undulate, undulate-token.";
+	memset(longer + strlen(longer), 'a', REQ_TOKEN_MAX);
+	assert_false(req_ws_token(longer, t, sizeof t));
+}
+
+/* Watchers (no token) may take WEB_MAX_WATCHERS of the places; the rest
+ * stays for the token's holders, so a crowd cannot lock them out. */
+static void test_ws_room(void **state)
+{
+	(void)state;
+	assert_true(req_ws_room(0, 0, false, 32, 24));
+	assert_true(req_ws_room(23, 23, false, 32, 24));
+	assert_false(req_ws_room(24, 24, false, 32, 24));
+	assert_true(req_ws_room(24, 24, true, 32, 24));
+	assert_true(req_ws_room(31, 24, true, 32, 24));
+	assert_false(req_ws_room(32, 24, true, 32, 24));
+	assert_false(req_ws_room(32, 10, false, 32, 24));
+	assert_true(req_ws_room(31, 10, false, 32, 24));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -144,6 +236,9 @@ int main(void)
 		cmocka_unit_test(test_commands_invalid),
 		cmocka_unit_test(test_auth),
 		cmocka_unit_test(test_origin),
+		cmocka_unit_test(test_host),
+		cmocka_unit_test(test_ws_token),
+		cmocka_unit_test(test_ws_room),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

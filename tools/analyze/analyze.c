@@ -16,6 +16,7 @@
 #include "outdir.h"
 #include "planecsv.h"
 #include "plot.h"
+#include "text.h"
 #include "theory.h"
 #include "window.h"
 #include "wire.h"
@@ -54,6 +55,16 @@
 #define AN_WARN_LIMIT 5
 /* Significant digits of summary.json numbers: finer than any estimate here. */
 #define AN_JSON_DIGITS 9
+/* What breaks a run (README.md, "Broken runs"): a robot silent this long
+ * before the log's end stopped (a dead daemon, a lost bus); a physics step
+ * later than a control period means the simulator fell behind real time. */
+#define AN_STOPPED_S 1.0
+#define AN_LATE_US 10000.0
+#define AN_MAX_BROKEN 16
+#define AN_BROKEN_TEXT 200
+/* Contact-force samples kept (one per SIM.TRUTH period with contact): a
+ * 100 Hz truth over 11 hours. */
+#define AN_MAX_FORCES (4 * 1000 * 1000)
 
 struct an_sample {
 	int64_t utime;
@@ -83,6 +94,8 @@ struct an_robot {
 	int contact_joint;  /* joint the contact body is on; 0 without a simulator */
 	bool seen_mode;     /* mode: its last published mode, once seen */
 	int mode;
+	double last_t;      /* s, its last state */
+	bool faulted;       /* a latched fault was published (the first one told) */
 };
 
 enum an_pair_kind { AN_PAIR_NEIGHBOUR, AN_PAIR_USER, AN_PAIR_JOINTS };
@@ -93,7 +106,8 @@ struct an_pair {
 	char name[2 * AN_NAME_MAX + 8];
 	struct win_circ win;
 	int64_t rows, finite_rows, collisions, win_collisions, contacts;
-	double impulse;
+	double impulse, win_impulse;
+	double win_contact_impulse;   /* N·s of every contact in the window (SIM.TRUTH's contacts) */
 	double last_coll_t;   /* s, NAN before the first */
 	double *deltas;       /* phase difference just before each collision */
 	int64_t *delta_utime;
@@ -158,6 +172,18 @@ struct an_ctx {
 	double switch_t[AN_MAX_SWITCHES];
 	int switch_mode[AN_MAX_SWITCHES];
 	int nswitches;
+	/* the world the simulator ran (SIM.TRUTH), and what broke the run */
+	bool plane;
+	char broken[AN_MAX_BROKEN][AN_BROKEN_TEXT];
+	int nbroken;
+	int64_t late_msgs;          /* SIM.TRUTH periods with a step AN_LATE_US late */
+	double late_worst_us, late_first_t;
+	/* the contact force over each SIM.TRUTH period with contact */
+	double *force_t, *force_n;
+	size_t nforce, force_cap;
+	bool have_prev_truth;
+	double prev_total, prev_sim_t;
+	bool have_contacts;         /* SIM.TRUTH lists contacts per pair (impacts and resting) */
 };
 
 void an_options_default(struct an_options *o)
@@ -705,6 +731,17 @@ static void an_update_pairs(struct an_ctx *c, int ri, int64_t utime, double t)
 	}
 }
 
+/* One reason the run broke, in words (README.md, "Broken runs"). */
+static void an_broken(struct an_ctx *c, const char *fmt, ...)
+{
+	if (c->nbroken == AN_MAX_BROKEN)
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(c->broken[c->nbroken++], AN_BROKEN_TEXT, fmt, ap);
+	va_end(ap);
+}
+
 /* A robot's mode changed at t: one mark per switch of the group. */
 static void an_note_switch(struct an_ctx *c, double t, int mode)
 {
@@ -729,6 +766,12 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 		an_note_switch(c, t, m->mode);
 	r->seen_mode = true;
 	r->mode = m->mode;
+	r->last_t = t;
+	if (!r->faulted && m->fault != NULL && m->fault[0] != '\0') {
+		char fault[120];
+		r->faulted = true;
+		an_broken(c, "robot %s latched a fault at %.1f s: %s", r->name, t, text_line(fault, sizeof fault, m->fault));
+	}
 	for (int j = 0; j < nj; j++) {
 		const undulate_joint_state_t *js = &m->joints[j];
 		struct an_joint *aj = &r->j[j];
@@ -842,8 +885,11 @@ static void an_on_collision(struct an_ctx *c, const undulate_sim_collision_t *m)
 			delta = phase_wrap(an_phase_at(sb, t) - an_phase_at(sa, t));
 		p->collisions++;
 		p->impulse += m->impulse;
-		if (t >= c->window_start_t)
+		if (t >= c->window_start_t) {
 			p->win_collisions++;
+			if (isfinite(m->impulse))
+				p->win_impulse += m->impulse;
+		}
 		/* A contact can be reported as a burst of collisions (one per
 		 * physics step while the bodies touch); the return map wants
 		 * one point per contact: the first of the burst. */
@@ -984,9 +1030,78 @@ static void an_on_plane(struct an_ctx *c, const undulate_sim_truth_t *m)
 /* SIM.COLLISION is the per-collision channel; the copies inside SIM.TRUTH are
  * used only for logs without it (the simulator stamps those copies with the
  * truth message's time, so they cannot be matched to the originals). */
+static void an_force_push(struct an_ctx *c, double t, double f)
+{
+	if (c->nforce == AN_MAX_FORCES || !isfinite(f))
+		return;
+	if (c->nforce == c->force_cap) {
+		size_t cap = c->force_cap ? 2 * c->force_cap : 4096;
+		double *ft = realloc(c->force_t, cap * sizeof *ft);
+		if (ft != NULL)
+			c->force_t = ft;
+		double *fn = realloc(c->force_n, cap * sizeof *fn);
+		if (fn != NULL)
+			c->force_n = fn;
+		if (ft == NULL || fn == NULL)
+			return;
+		c->force_cap = cap;
+	}
+	c->force_t[c->nforce] = t;
+	c->force_n[c->nforce++] = f;
+}
+
+/* The contact forces of the SIM.TRUTH period that ended at m: each touching
+ * pair's mean force over it (SIM.TRUTH's contacts: impacts and resting
+ * contact, walls included); a log without contacts gives the period's total
+ * (its total impulse's rise over its simulated time) when there was contact. */
+static void an_truth_force(struct an_ctx *c, const undulate_sim_truth_t *m, double t)
+{
+	bool have = c->have_prev_truth;
+	double di = m->total_impulse - c->prev_total, dt = m->sim_time - c->prev_sim_t;
+	c->have_prev_truth = isfinite(m->total_impulse) && isfinite(m->sim_time);
+	c->prev_total = m->total_impulse;
+	c->prev_sim_t = m->sim_time;
+	if (m->ncontacts > 0) {
+		for (int i = 0; i < m->ncontacts; i++)
+			if (m->contacts[i].impulse > 0)
+				an_force_push(c, t, m->contacts[i].force);
+		return;
+	}
+	if (have && c->have_prev_truth && dt > 0 && di > 0 && !c->have_contacts)
+		an_force_push(c, t, di / dt);
+}
+
+/* Every pair's contact impulse in the final window, impacts and resting
+ * contact alike, from SIM.TRUTH's contacts (bodies by index). */
+static void an_truth_contacts(struct an_ctx *c, const undulate_sim_truth_t *m, double t)
+{
+	if (m->ncontacts > 0)
+		c->have_contacts = true;
+	if (t < c->window_start_t)
+		return;
+	for (int i = 0; i < m->ncontacts; i++) {
+		const undulate_sim_contact_t *k = &m->contacts[i];
+		if (k->robot_a < 0 || k->robot_a >= m->nbodies || k->robot_b < 0 || k->robot_b >= m->nbodies ||
+		    !isfinite(k->impulse))
+			continue;
+		struct an_pair *p = an_pair_of(c, m->bodies[k->robot_a].robot, m->bodies[k->robot_b].robot);
+		if (p != NULL)
+			p->win_contact_impulse += k->impulse;
+	}
+}
+
 static void an_truth_collisions(struct an_ctx *c, const undulate_sim_truth_t *m)
 {
 	double t = an_t(c, m->utime);
+	c->plane |= m->world == UNDULATE_SIM_TRUTH_T_WORLD_PLANE;
+	if (m->worst_lateness_us > AN_LATE_US) {
+		if (c->late_msgs++ == 0)
+			c->late_first_t = t;
+		if (m->worst_lateness_us > c->late_worst_us)
+			c->late_worst_us = m->worst_lateness_us;
+	}
+	an_truth_force(c, m, t);
+	an_truth_contacts(c, m, t);
 	int64_t bin = (int64_t)floor(t / AN_RATE_BIN_S);
 	if (bin >= 0 && bin < c->nbins && isfinite(m->total_impulse)) {
 		c->bin_total[bin] = m->total_impulse;
@@ -1202,12 +1317,95 @@ static void an_pair_separation(struct an_ctx *c, struct an_pair *p)
 
 /* The end state of a pair from the final window (see README.md for the
  * rules; classify.h holds them, shared with undulate-web). */
-static const char *an_classify(const struct an_pair *p, bool have_sim, double min_swing)
+/* A pair's contact impulse in the final window: every contact's when the log
+ * lists them, else its impacts' (older logs). */
+static double an_pair_win_impulse(const struct an_pair *p, bool have_contacts)
+{
+	return have_contacts ? p->win_contact_impulse : p->win_impulse;
+}
+
+static const char *an_classify(const struct an_pair *p, bool have_sim, double min_swing, double window_s,
+                               bool have_contacts)
 {
 	struct cls_window w = { .delta = p->win, .swing_a = p->swing_a, .swing_b = p->swing_b,
-				.collisions = p->win_collisions, .dsep = p->dsep, .have_sim = have_sim,
-				.min_swing = min_swing };
+				.collisions = p->win_collisions, .impulse = an_pair_win_impulse(p, have_contacts),
+				.window_s = window_s,
+				.dsep = p->dsep, .have_sim = have_sim, .min_swing = min_swing };
 	return cls_end_state(&w);
+}
+
+/* What broke the run besides the faults seen on the way: robots that
+ * stopped publishing before the log's end, a simulator that fell behind. */
+static void an_check_broken(struct an_ctx *c)
+{
+	double end = an_t(c, c->last_utime);
+	for (int k = 0; k < c->nrobots; k++) {
+		const struct an_robot *r = &c->robots[c->order[k]];
+		if (r->states > 0 && end - r->last_t > AN_STOPPED_S)
+			an_broken(c, "robot %s stopped publishing at %.1f s (the log runs to %.1f s): its daemon died or "
+			          "lost its bus", r->name, r->last_t, end);
+	}
+	if (c->late_msgs > 0)
+		an_broken(c, "the simulator fell behind real time: %lld truth period(s) with a step more than %.0f ms "
+		          "late, the first at %.1f s, the worst %.0f ms", (long long)c->late_msgs, AN_LATE_US / 1000.0,
+		          c->late_first_t, c->late_worst_us / 1000.0);
+}
+
+/* The switch from the clock to the oscillator: the first mode switch to
+ * OSCILLATOR; NAN when the run never switched. */
+static double an_switch_time(const struct an_ctx *c)
+{
+	for (int i = 0; i < c->nswitches; i++)
+		if (c->switch_mode[i] == UNDULATE_ROBOT_STATE_T_MODE_OSCILLATOR)
+			return c->switch_t[i];
+	return NAN;
+}
+
+static int an_cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+/* The median contact force (N) of the truth periods with contact in
+ * [from, to); NAN when none (*n = 0). */
+static double an_force_median(const struct an_ctx *c, double from, double to, size_t *n)
+{
+	*n = 0;
+	if (!(to > from) || c->nforce == 0)
+		return NAN;
+	double *v = malloc(c->nforce * sizeof *v);
+	if (v == NULL)
+		return NAN;
+	for (size_t i = 0; i < c->nforce; i++)
+		if (c->force_t[i] >= from && c->force_t[i] < to)
+			v[(*n)++] = c->force_n[i];
+	double med = NAN;
+	if (*n > 0) {
+		qsort(v, *n, sizeof *v, an_cmp_double);
+		med = *n % 2 ? v[*n / 2] : 0.5 * (v[*n / 2 - 1] + v[*n / 2]);
+	}
+	free(v);
+	return med;
+}
+
+struct an_forces {
+	double switch_t, before, after;   /* s; N, N */
+	size_t nbefore, nafter;
+	double before_from, after_from, end;
+};
+
+/* Before: the --window seconds before the switch; after: the final window. */
+static void an_forces(const struct an_ctx *c, struct an_forces *f)
+{
+	f->end = an_t(c, c->last_utime);
+	f->switch_t = an_switch_time(c);
+	f->before_from = isfinite(f->switch_t) ? fmax(0.0, f->switch_t - c->o->window_s) : NAN;
+	f->after_from = fmax(isfinite(f->switch_t) ? f->switch_t : 0.0, f->end - c->o->window_s);
+	f->before = isfinite(f->switch_t) ? an_force_median(c, f->before_from, f->switch_t, &f->nbefore) : NAN;
+	if (!isfinite(f->switch_t))
+		f->nbefore = 0;
+	f->after = an_force_median(c, f->after_from, f->end + 1e-9, &f->nafter);
 }
 
 /* ---- summary ------------------------------------------------------------------ */
@@ -1215,6 +1413,8 @@ static const char *an_classify(const struct an_pair *p, bool have_sim, double mi
 static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 {
 	fprintf(f, "undulate-analyze summary\n");
+	for (int i = 0; i < c->nbroken; i++)
+		fprintf(f, "BROKEN: %s\n", c->broken[i]);
 	for (int i = 0; i < c->o->nlogs; i++)
 		fprintf(f, "log: %s (%lld events)%s%s\n", c->o->logs[i], (long long)c->log_events[i],
 			c->trunc_note[i][0] ? " WARNING: " : "", c->trunc_note[i]);
@@ -1238,20 +1438,40 @@ static void an_summary_text(struct an_ctx *c, FILE *f, int rc)
 			fputs(" rad p-p", f);
 		fputc('\n', f);
 	}
+	fprintf(f, "world: %s\n", c->plane ? "plane (links in a plane)" : c->truth_msgs > 0 ? "row (the theory's line)"
+	                                                                       : "unknown (no simulator in the log)");
 	fprintf(f, "collisions: %lld (%lld with walls), total impulse %.6g N*s\n", (long long)c->collisions,
 		(long long)c->wall_collisions, c->impulse);
+	struct an_forces fo;
+	an_forces(c, &fo);
+	if (isfinite(fo.switch_t))
+		fprintf(f, "contact force, median of %s: %.4g N before the switch to OSCILLATOR at %.1f s (%.1f..%.1f s, "
+			"%zu of them), %.4g N in the final window (%.1f..%.1f s, %zu)\n",
+			c->have_contacts ? "every contact (a touching pair's mean force over a truth period)"
+			                 : "the truth periods with contact (their total)",
+			fo.before, fo.switch_t, fo.before_from, fo.switch_t, fo.nbefore, fo.after, fo.after_from, fo.end,
+			fo.nafter);
+	else if (c->truth_msgs > 0)
+		fprintf(f, "contact force, median of %s in the final window: %.4g N (%zu of them; no switch to OSCILLATOR "
+			"in the log)\n", c->have_contacts ? "every contact" : "the truth periods with contact", fo.after,
+			fo.nafter);
+	fprintf(f, "grazing: a pair locked within its compatibility bound + %.2f rad whose contacts in the final "
+		"window average at most %.3f N (F.win: %s over the window; more: still-colliding)\n", CLS_COMPAT_TOL,
+		CLS_GRAZE_FORCE_N, c->have_contacts ? "every contact's impulse, resting included," : "the impacts' impulse");
 	fprintf(f, "restitution for theory: %.3f (%s); collisions less than %.3f s apart are one contact\n",
 		c->restitution, c->restitution_from, c->o->merge_s);
 	fprintf(f, "not oscillating: a joint of the pair swings less than %.3f rad peak-to-peak in the final window\n",
 		c->o->min_swing);
-	fprintf(f, "%-24s %-28s %8s %8s %8s %6s %6s %7s %9s %5s %8s %8s\n", "pair", "end state", "mean|D|", "meanD",
-		"spread", "coll", "c.win", "d~", "2asin(d~)", "map", "swing_a", "swing_b");
+	double win = fmin(c->o->window_s, t_end);
+	fprintf(f, "%-24s %-28s %8s %8s %8s %6s %6s %7s %9s %5s %8s %8s %8s\n", "pair", "end state", "mean|D|", "meanD",
+		"spread", "coll", "c.win", "d~", "2asin(d~)", "map", "F.win", "swing_a", "swing_b");
 	for (int k = 0; k < c->npairs; k++) {
 		const struct an_pair *p = &c->pairs[k];
-		fprintf(f, "%-24s %-28s %8.4f %8.4f %8.4f %6lld %6lld %7.4f %9.4f %5zu %8.4f %8.4f\n", p->name,
+		fprintf(f, "%-24s %-28s %8.4f %8.4f %8.4f %6lld %6lld %7.4f %9.4f %5zu %8.4f %8.4f %8.4f\n", p->name,
 			p->cls, win_circ_mean_abs(&p->win), win_circ_mean(&p->win), win_circ_spread(&p->win),
 			(long long)p->collisions, (long long)p->win_collisions, p->dsep,
-			theory_compat_limit(p->dsep), p->ndeltas > 0 ? p->ndeltas - 1 : 0, p->swing_a, p->swing_b);
+			theory_compat_limit(p->dsep), p->ndeltas > 0 ? p->ndeltas - 1 : 0,
+			win > 0 ? an_pair_win_impulse(p, c->have_contacts) / win : NAN, p->swing_a, p->swing_b);
 	}
 	if (c->decode_errors)
 		fprintf(f, "undecodable messages: %lld\n", (long long)c->decode_errors);
@@ -1290,6 +1510,8 @@ static void an_json_pair(struct json *j, const struct an_pair *p)
 	json_field_int(j, "collisions", p->collisions);
 	json_field_int(j, "contacts", p->contacts);
 	json_field_int(j, "window_collisions", p->win_collisions);
+	json_field_number(j, "window_impulse", p->win_impulse);
+	json_field_number(j, "window_contact_impulse", p->win_contact_impulse);
 	json_field_number(j, "impulse", p->impulse);
 	json_field_number(j, "distance_m", p->distance);
 	json_field_number(j, "amplitude_m", p->amp_lateral);
@@ -1317,6 +1539,25 @@ static void an_summary_json(struct an_ctx *c, FILE *f, int rc)
 	}
 	json_array_end(&j);
 	json_field_bool(&j, "truncated", rc == AN_EXIT_TRUNCATED);
+	json_field_string(&j, "world", c->plane ? "plane" : c->truth_msgs > 0 ? "row" : "unknown");
+	json_key(&j, "broken");
+	json_array_begin(&j);
+	for (int i = 0; i < c->nbroken; i++)
+		json_string(&j, c->broken[i]);
+	json_array_end(&j);
+	struct an_forces fo;
+	an_forces(c, &fo);
+	json_key(&j, "force");
+	json_object_begin(&j);
+	json_field_number(&j, "switch_s", fo.switch_t);
+	json_field_number(&j, "median_before_n", fo.before);
+	json_field_string(&j, "of", c->have_contacts ? "contacts" : "periods");
+	json_field_int(&j, "samples_before", (int64_t)fo.nbefore);
+	json_field_number(&j, "median_after_n", fo.after);
+	json_field_int(&j, "samples_after", (int64_t)fo.nafter);
+	json_field_number(&j, "before_from_s", fo.before_from);
+	json_field_number(&j, "after_from_s", fo.after_from);
+	json_object_end(&j);
 	json_field_number(&j, "t_end", c->have_state ? an_t(c, c->last_state_utime) : NAN);
 	json_field_number(&j, "window_s", c->o->window_s);
 	json_field_number(&j, "restitution", c->restitution);
@@ -1416,6 +1657,8 @@ static void an_free(struct an_ctx *c)
 	free(c->bin_walls);
 	free(c->bin_total);
 	free(c->bin_total_t);
+	free(c->force_t);
+	free(c->force_n);
 	an_close_outputs(c);
 	if (c->stagefd >= 0) {
 		outdir_discard(c->dirfd, c->stagefd, c->stage);
@@ -1478,8 +1721,10 @@ static int an_run_ctx(struct an_ctx *c)
 		if (p->kind != AN_PAIR_JOINTS)
 			an_pair_separation(c, p);
 		p->cls = p->kind == AN_PAIR_JOINTS ? "-"
-			: an_classify(p, c->truth_msgs > 0 || c->collisions > 0, o->min_swing);
+			: an_classify(p, c->truth_msgs > 0 || c->collisions > 0, o->min_swing,
+			              fmin(o->window_s, an_t(c, c->last_state_utime)), c->have_contacts);
 	}
+	an_check_broken(c);
 	if (an_close_outputs(c) != 0 || an_write_return_map(c) != 0 || an_write_summary(c, rc) != 0)
 		return AN_EXIT_OUTPUT;
 	if (o->plots && an_plots(c) != 0)

@@ -25,8 +25,12 @@ const char *cls_end_state(const struct cls_window *w)
 	bool locked = spread <= CLS_SPREAD_MAX;
 	if (locked && mean >= M_PI - CLS_ANTI_TOL)
 		return "anti-phase";
-	if (w->collisions > 0)
-		return "still-colliding";
+	/* touching: an impact, or (with SIM.TRUTH's contacts) any contact impulse */
+	if (w->collisions > 0 || (isfinite(w->impulse) && w->impulse > 0)) {
+		bool within = isfinite(w->dsep) && mean <= theory_compat_limit(w->dsep) + CLS_COMPAT_TOL;
+		bool light = w->window_s > 0 && isfinite(w->impulse) && w->impulse / w->window_s <= CLS_GRAZE_FORCE_N;
+		return locked && within && light ? "grazing" : "still-colliding";
+	}
 	if (locked && mean <= CLS_INPHASE_TOL)
 		return "in-phase";
 	if (locked && isfinite(w->dsep) && mean <= theory_compat_limit(w->dsep) + CLS_COMPAT_TOL)

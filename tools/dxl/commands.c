@@ -836,15 +836,39 @@ static const struct dxlt_command dxlt_commands[] = {
 	{ "reboot", dxlt_cmd_reboot, dxlt2_cmd_reboot },
 };
 
+/* What to do instead when another program holds the bus: dxl's packets
+ * would collide with its own. A robot's daemon is watched through the
+ * daemon (read-only, LCM), or stopped first. */
+static void dxlt_held(struct dxlt *t, const char *why, const struct holder *h)
+{
+	const char *robot = h->robot[0] != '\0' ? h->robot : NULL;
+
+	if (strcmp(h->program, "undulated") == 0)
+		fprintf(t->err, "dxl: %s: a robot's daemon drives this bus, and dxl's packets would collide with its cycle; "
+		        "watch its servos (angles, speeds, loads, voltages, temperatures, error bits) through the daemon: "
+		        "undulated --watch %s; or stop the robot first (systemctl stop undulated@%s if that is its service, or "
+		        "kill %ld), then run dxl\n", why, robot != NULL ? robot : "'*'", robot != NULL ? robot : "ROBOT", h->pid);
+	else if (strcmp(h->program, "dxl") == 0)
+		fprintf(t->err, "dxl: %s: another dxl is using this bus; run this one when it is done\n", why);
+	else
+		fprintf(t->err, "dxl: %s: one program drives a bus at a time; stop that one first\n", why);
+}
+
 int dxlt_open(struct dxlt *t, const char *path, bool low_latency)
 {
-	struct port_options opt = { .baud = t->a.baud, .low_latency = low_latency };
+	char owner[64];
+	struct holder held;
+	struct port_options opt = { .baud = t->a.baud, .low_latency = low_latency, .owner = owner, .holder = &held };
 	struct bus_io io;
 	char why[512];
 
+	snprintf(owner, sizeof owner, "command %s", t->a.command != NULL ? t->a.command : "?");
 	t->port = port_open(path, &opt, why, sizeof why);
 	if (t->port == NULL) {
-		fprintf(t->err, "dxl: %s\n", why);
+		if (held.pid > 0 || held.program[0] != '\0')
+			dxlt_held(t, why, &held);
+		else
+			fprintf(t->err, "dxl: %s\n", why);
 		return DXLT_EXIT_PORT;
 	}
 	/* A UART behind a half-duplex buffer: the kernel switches the direction

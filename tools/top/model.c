@@ -6,6 +6,7 @@
 #include "modes.h"
 #include "num.h"
 #include "phase.h"
+#include "text.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -24,14 +25,20 @@ int top_robot_index(const struct top_model *m, const char *name)
 	return -1;
 }
 
-/* The robot called NAME, added on first sight; NULL when the table is full
- * (counted) or the name is empty or too long. */
+/* The robot called NAME, added on first sight; NULL (counted) when the table
+ * is full or NAME is not a robot's name: '*' would be a robot whose commands
+ * go to every robot, a control character or a space would reach the screen
+ * and the page, and none of them is a name a daemon may take. */
 static struct top_robot *top_robot_get(struct top_model *m, const char *name)
 {
+	if (!text_is_name(name, TOP_NAME_MAX - 1)) {
+		m->dropped_robots++;
+		return NULL;
+	}
 	int i = top_robot_index(m, name);
 	if (i >= 0)
 		return &m->robots[i];
-	if (!name || !name[0] || strlen(name) >= TOP_NAME_MAX || m->nrobots >= TOP_MAX_ROBOTS) {
+	if (m->nrobots >= TOP_MAX_ROBOTS) {
 		m->dropped_robots++;
 		return NULL;
 	}

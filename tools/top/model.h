@@ -82,7 +82,7 @@ struct top_seen {
 struct top_model {
 	struct top_robot robots[TOP_MAX_ROBOTS];
 	int nrobots;
-	int64_t dropped_robots;
+	int64_t dropped_robots;     /* messages of a robot not kept: table full, or not a robot's name */
 	int order[TOP_MAX_ROBOTS];  /* display order (indices into robots) */
 	bool order_lateral;
 	/* simulator */

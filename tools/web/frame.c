@@ -77,6 +77,8 @@ static void frame_counters(struct json *j, const struct frame_counters *c)
 	json_field_int(j, "frames_sent", c->frames_sent);
 	json_field_int(j, "frames_skipped", c->frames_skipped);
 	json_field_int(j, "clients_stalled", c->clients_stalled);
+	json_field_int(j, "ws_bad_frames", c->ws_bad_frames);
+	json_field_int(j, "conns_evicted", c->conns_evicted);
 	json_object_end(j);
 }
 

@@ -52,7 +52,9 @@ struct frame_note {
 /* The server's own counters, shown on the page (bad input is counted). */
 struct frame_counters {
 	long long clients, http_requests, http_refused, ws_refused, msgs_refused, commands_sent,
-	          commands_refused, frames_sent, frames_skipped, clients_stalled;
+	          commands_refused, frames_sent, frames_skipped, clients_stalled,
+	          ws_bad_frames,        /* WebSockets closed for a frame RFC 6455 forbids (wsguard.h), or binary */
+	          conns_evicted;        /* connections without a whole request closed to make room */
 };
 
 /* Starts a browser at the oldest history held: its first frame draws the

@@ -12,6 +12,7 @@
 #include "num.h"
 #include "req.h"
 #include "server.h"
+#include "wtok.h"
 
 #define WEB_DEFAULT_ADDR "127.0.0.1"
 #define WEB_DEFAULT_PORT 8080
@@ -20,13 +21,19 @@
 static void usage(FILE *f)
 {
 	fputs("usage: undulate-web [--listen ADDR:PORT] [--lcm-url URL] [--read-only] [--allow-remote]\n"
-	      "                    [--token-file FILE] [--key FILE] [--page-dir DIR] [--chartjs FILE] [-v]\n"
+	      "                    [--allow-host NAME]... [--token-file FILE] [--key FILE] [--page-dir DIR]\n"
+	      "                    [--chartjs FILE] [-v]\n"
 	      "A live dashboard of every robot on the LCM network, at http://ADDR:PORT/.\n"
 	      "  --listen ADDR:PORT  where to listen (default 127.0.0.1:8080; port 0: any free port, printed)\n"
 	      "  --allow-remote      required to listen on an address other than loopback; then commands\n"
 	      "                      need --token-file, or use --read-only\n"
+	      "  --allow-host NAME   a name by which browsers reach this server (repeatable); always allowed:\n"
+	      "                      localhost, its address, and beyond loopback this computer's name\n"
 	      "  --token-file FILE   commands need this secret (the file's first line; mode 0600):\n"
-	      "                      open the page as http://ADDR:PORT/#token=SECRET\n"
+	      "                      open the page as http://ADDR:PORT/#token=SECRET. Without it\n"
+	      "                      (on loopback) a token is made at start, written to the run\n"
+	      "                      directory (mode 0600) and printed in the page's URL; a page\n"
+	      "                      without the token watches and never commands\n"
 	      "  --read-only         no commands: the page shows no controls, the server refuses them\n"
 	      "  --key FILE          send commands signed over LCM (robots with commands = network),\n"
 	      "                      as undulated --command --key; default: local command sockets\n"
@@ -72,35 +79,26 @@ static bool is_loopback(const char *addr)
 	return strcmp(addr, "localhost") == 0;
 }
 
-/* The secret: the first line of a file only its owner can read. */
-static char *read_token(const char *path)
+/* A name for --allow-host: a DNS name's characters, not an address (those
+ * are allowed by what they are, req.h). */
+static bool host_name_ok(const char *s)
 {
-	static char token[REQ_TOKEN_MAX];
-	FILE *f = fopen(path, "r");
-	struct stat st;
-	if (f == NULL || fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-		fprintf(stderr, "undulate-web: --token-file %s: cannot read it as a file\n", path);
-		if (f)
-			fclose(f);
-		return NULL;
-	}
-	if (st.st_mode & 077) {
-		fprintf(stderr, "undulate-web: --token-file %s: readable by others (mode %03o): chmod 600 %s\n", path,
-		        (unsigned)(st.st_mode & 0777), path);
-		fclose(f);
-		return NULL;
-	}
-	if (fgets(token, sizeof token, f) == NULL)
-		token[0] = '\0';
-	fclose(f);
-	token[strcspn(token, "\r\n")] = '\0';
-	size_t n = strlen(token);
-	if (n < 8 || strspn(token, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_.~") != n) {
-		fprintf(stderr, "undulate-web: --token-file %s: want one line of 8 to %d letters, digits or -_.~ "
-		        "(e.g. head -c 24 /dev/urandom | base64 | tr '+/' '-_' > %s)\n", path, REQ_TOKEN_MAX - 1, path);
-		return NULL;
-	}
-	return token;
+	size_t n = strlen(s);
+	return n > 0 && n < 254 && strspn(s, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789.-") == n;
+}
+
+/* Beyond loopback, this computer's own name reaches it (http://labpc:8080/):
+ * as gethostname says, and its first label. */
+static void add_own_names(struct req_hosts *h)
+{
+	static char full[256], label[256];
+	if (gethostname(full, sizeof full - 1) != 0 || !host_name_ok(full))
+		return;
+	snprintf(label, sizeof label, "%.*s", (int)strcspn(full, "."), full);
+	if (h->nnames < REQ_HOSTS_MAX)
+		h->names[h->nnames++] = full;
+	if (strcmp(label, full) != 0 && h->nnames < REQ_HOSTS_MAX)
+		h->names[h->nnames++] = label;
 }
 
 /* The page beside the program: installed (PREFIX/bin -> PREFIX/share/undulate/web)
@@ -134,10 +132,11 @@ static const char *find_page_dir(void)
 
 int main(int argc, char **argv)
 {
-	enum { O_LISTEN = 256, O_URL, O_RO, O_REMOTE, O_TOKEN, O_KEY, O_PAGE, O_CHARTJS };
+	enum { O_LISTEN = 256, O_URL, O_RO, O_REMOTE, O_TOKEN, O_KEY, O_PAGE, O_CHARTJS, O_HOST };
 	static const struct option opts[] = {
 		{ "listen", required_argument, NULL, O_LISTEN },   { "lcm-url", required_argument, NULL, O_URL },
 		{ "read-only", no_argument, NULL, O_RO },          { "allow-remote", no_argument, NULL, O_REMOTE },
+		{ "allow-host", required_argument, NULL, O_HOST },
 		{ "token-file", required_argument, NULL, O_TOKEN }, { "key", required_argument, NULL, O_KEY },
 		{ "page-dir", required_argument, NULL, O_PAGE },   { "chartjs", required_argument, NULL, O_CHARTJS },
 		{ "help", no_argument, NULL, 'h' },                { "verbose", no_argument, NULL, 'v' },
@@ -154,6 +153,15 @@ int main(int argc, char **argv)
 		case O_URL: o.lcm_url = optarg; break;
 		case O_RO: o.read_only = true; break;
 		case O_REMOTE: remote = true; break;
+		case O_HOST:
+			/* two places stay for this computer's own names */
+			if (!host_name_ok(optarg) || o.hosts.nnames >= REQ_HOSTS_MAX - 2) {
+				fprintf(stderr, "undulate-web: --allow-host \"%s\": want a host name (letters, digits, "
+				        "'.', '-'), at most %d of them\n", optarg, REQ_HOSTS_MAX - 2);
+				return 2;
+			}
+			o.hosts.names[o.hosts.nnames++] = optarg;
+			break;
 		case O_TOKEN: token_file = optarg; break;
 		case O_KEY: o.key_file = optarg; break;
 		case O_PAGE: o.page_dir = optarg; break;
@@ -167,18 +175,31 @@ int main(int argc, char **argv)
 		fprintf(stderr, "undulate-web: unexpected argument \"%s\" (--help)\n", argv[optind]);
 		return 2;
 	}
+	o.hosts.listen = addr;
+	if (!is_loopback(addr))
+		add_own_names(&o.hosts);
 	if (!is_loopback(addr) && !remote) {
 		fprintf(stderr, "undulate-web: --listen %s:%d opens the dashboard to the network; say so with "
 		        "--allow-remote (and give --token-file FILE for commands, or --read-only)\n", addr, o.port);
 		return 2;
 	}
-	if (token_file != NULL && (o.token = read_token(token_file)) == NULL)
-		return 2;
+	static char token[REQ_TOKEN_MAX];
+	char why[256];
+	if (token_file != NULL) {
+		if (!wtok_read(token_file, token, why, sizeof why)) {
+			fprintf(stderr, "undulate-web: --token-file %s: %s\n", token_file, why);
+			return 2;
+		}
+		o.token = token;
+	}
 	if (!is_loopback(addr) && !o.read_only && o.token == NULL) {
 		fprintf(stderr, "undulate-web: listening on %s, commands would be open to anyone who reaches it: "
 		        "give --token-file FILE or --read-only\n", addr);
 		return 2;
 	}
+	/* commands carry this process's identity: on loopback too they need a
+	 * token, made now when none was given (wtok.h) */
+	o.make_token = !o.read_only && o.token == NULL;
 	if (o.page_dir == NULL && (o.page_dir = find_page_dir()) == NULL) {
 		fputs("undulate-web: cannot find the page (index.html) beside the program: --page-dir DIR\n", stderr);
 		return 2;

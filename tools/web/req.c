@@ -1,13 +1,15 @@
 /* req.c — see req.h. */
 #include "req.h"
 
-#include <ctype.h>
+#include <arpa/inet.h>
 #include <sodium.h>
+#include <strings.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "daemon/config.h"
+#include "text.h"
 
 static bool req_path_is(const char *path, const char *want)
 {
@@ -30,17 +32,10 @@ enum req_route req_route(const char *method, const char *path)
 	return REQ_NOT_FOUND;
 }
 
+/* A robot's name (the monitors' rule, common/text.h), or "*": every robot. */
 static bool req_name_ok(const char *s)
 {
-	if (strcmp(s, "*") == 0)
-		return true;
-	size_t n = strlen(s);
-	if (n == 0 || n >= CFG_NAME_MAX)
-		return false;
-	for (size_t i = 0; i < n; i++)
-		if (!isalnum((unsigned char)s[i]) && s[i] != '_' && s[i] != '-')
-			return false;
-	return true;
+	return strcmp(s, "*") == 0 || text_is_name(s, CFG_NAME_MAX - 1);
 }
 
 /* The next space-separated word of *p into out (cap); false if none or too long. */
@@ -112,7 +107,7 @@ bool req_msg_parse(const char *data, size_t len, int njoints, struct req_msg *m,
 	if (strcmp(word, "auth") == 0) {
 		m->kind = REQ_MSG_AUTH;
 		if (!req_word(&p, m->token, sizeof m->token) || *p != '\0')
-			return req_fail(why, cap, "auth: one token of at most 127 characters");
+			return req_fail(why, cap, "auth: one token of at most 64 characters");
 		return true;
 	}
 	if (strcmp(word, "cmd") != 0)
@@ -148,4 +143,114 @@ bool req_origin_ok(const char *origin, const char *host)
 	static const char scheme[] = "http://";
 	return host != NULL && host[0] != '\0' && strncmp(origin, scheme, sizeof scheme - 1) == 0 &&
 	       strcmp(origin + sizeof scheme - 1, host) == 0;
+}
+
+/* host without its port into name (cap); false if the syntax is wrong. */
+static bool req_host_name(const char *host, char *name, size_t cap, bool *bracketed)
+{
+	const char *end, *port;
+	*bracketed = host[0] == '[';
+	if (*bracketed) {
+		end = strchr(host, ']');
+		if (end == NULL)
+			return false;
+		host++;
+		port = end + 1;
+	} else {
+		end = host + strcspn(host, ":");
+		port = end;
+	}
+	size_t n = (size_t)(end - host);
+	if (n == 0 || n >= cap)
+		return false;
+	if (*port == ':') {
+		port++;
+		size_t digits = strspn(port, "0123456789");
+		if (digits == 0 || digits > 5 || port[digits] != '\0')
+			return false;
+	} else if (*port != '\0') {
+		return false;
+	}
+	memcpy(name, host, n);
+	name[n] = '\0';
+	return true;
+}
+
+/* An address literal: its family and bytes; 0 if name is not one. */
+static int req_addr(const char *name, unsigned char addr[16])
+{
+	if (inet_pton(AF_INET, name, addr) == 1)
+		return AF_INET;
+	if (inet_pton(AF_INET6, name, addr) == 1)
+		return AF_INET6;
+	return 0;
+}
+
+static bool req_addr_loopback(int family, const unsigned char *a)
+{
+	static const unsigned char v6_loopback[16] = { [15] = 1 };
+	return family == AF_INET ? a[0] == 127 : memcmp(a, v6_loopback, 16) == 0;
+}
+
+static bool req_addr_wildcard(int family, const unsigned char *a)
+{
+	static const unsigned char zero[16];
+	return memcmp(a, zero, family == AF_INET ? 4 : 16) == 0;
+}
+
+bool req_host_ok(const struct req_hosts *h, const char *host)
+{
+	char name[256];
+	bool bracketed;
+	if (host == NULL || !req_host_name(host, name, sizeof name, &bracketed))
+		return false;
+	unsigned char addr[16], listen[16];
+	int family = req_addr(name, addr);
+	/* [..] holds an IPv6 literal and nothing else; a bare name holds no ':' */
+	if (bracketed != (family == AF_INET6))
+		return false;
+	if (family == 0) {
+		if (strcasecmp(name, "localhost") == 0)
+			return true;
+		for (int i = 0; i < h->nnames; i++)
+			if (h->names[i] != NULL && strcasecmp(name, h->names[i]) == 0)
+				return true;
+		return false;
+	}
+	if (req_addr_loopback(family, addr))
+		return true;
+	int lfamily = h->listen != NULL ? req_addr(h->listen, listen) : 0;
+	if (lfamily == 0)
+		return false;
+	if (req_addr_wildcard(lfamily, listen))
+		return true;
+	return lfamily == family && memcmp(addr, listen, family == AF_INET ? 4 : 16) == 0;
+}
+
+bool req_ws_token(const char *protocols, char *out, size_t cap)
+{
+	static const char prefix[] = REQ_TOKEN_PROTOCOL;
+	const char *p = protocols;
+	while (p != NULL && *p != '\0') {
+		p += strspn(p, " \t,");
+		size_t n = strcspn(p, " \t,");
+		if (n > sizeof prefix - 1 && strncmp(p, prefix, sizeof prefix - 1) == 0) {
+			const char *t = p + sizeof prefix - 1;
+			size_t tn = n - (sizeof prefix - 1);
+			if (tn >= cap || tn >= REQ_TOKEN_MAX || strspn(t, REQ_TOKEN_CHARS) < tn)
+				return false;
+			memcpy(out, t, tn);
+			out[tn] = '\0';
+			return true;
+		}
+		p += n;
+	}
+	return false;
+}
+
+bool req_ws_room(int clients, int watchers, bool token, int max_clients, int max_watchers)
+{
+	if (clients >= max_clients)
+		return false;
+	return token || watchers < max_watchers;
 }

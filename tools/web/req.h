@@ -34,10 +34,16 @@ enum req_route req_route(const char *method, const char *path);
 /* Longest message a browser may send on the WebSocket (bytes); longer ones
  * are refused and counted. A command is under 100 bytes. */
 #define REQ_MSG_MAX 512
-#define REQ_TOKEN_MAX 128
+/* A token: 8 to 64 of [A-Za-z0-9-_.~]. The page offers it as a WebSocket
+ * subprotocol, and libwebsockets 4.1 refuses a Sec-WebSocket-Protocol list
+ * longer than 127 bytes (its copy in lws_process_ws_upgrade). */
+#define REQ_TOKEN_MAX 65
+#define REQ_TOKEN_CHARS "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_.~"
+#define REQ_TOKEN_PROTOCOL "undulate-token." /* the subprotocol that carries it: "undulate-token.TOKEN" */
 
 /* A message from the page, one of
- *   "auth TOKEN"               the secret of --token-file (kept for the connection)
+ *   "auth TOKEN"               the token (kept for the connection), for a client
+ *                              that did not offer it at the handshake
  *   "cmd ID ROBOT TEXT"        ID: the page's number for it (echoed), 1..15 digits;
  *                              ROBOT: a robot name or "*" (every robot);
  *                              TEXT: as `undulated --command` takes it */
@@ -63,7 +69,39 @@ bool req_token_ok(const char *expected, const char *given);
 
 /* A WebSocket upgrade from a browser carries Origin; a page from another
  * site (cross-site WebSocket hijacking) has an Origin that is not this
- * server. Allowed: no Origin (not a browser), or "http://" + host exactly. */
+ * server. Allowed: no Origin (not a browser), or "http://" + host exactly
+ * (and host must pass req_host_ok). */
 bool req_origin_ok(const char *origin, const char *host);
+
+/* The names that reach this server. DNS rebinding: a page of evil.example,
+ * whose name the attacker then points at 127.0.0.1, is same-origin with
+ * whatever answers there, and its requests carry Host: evil.example. So a
+ * request's Host must name this server:
+ *  - "localhost", or an address literal that is loopback (a tunnel such as
+ *    ssh -L ends there) or the listening address;
+ *  - with a wildcard listening address (0.0.0.0, ::), any address literal:
+ *    a browser sends an address only when it connected to that address, and
+ *    a rebinding attack always carries a name;
+ *  - a name given (--allow-host; this computer's name when it listens
+ *    beyond loopback), case-insensitively.
+ * The port is not compared (a tunnel may change it; the name is what an
+ * attacker controls), but must be digits. Pure: the literals are parsed,
+ * nothing is resolved. */
+#define REQ_HOSTS_MAX 8
+struct req_hosts {
+	const char *listen;                     /* the listening address, as given */
+	const char *names[REQ_HOSTS_MAX];
+	int nnames;
+};
+bool req_host_ok(const struct req_hosts *h, const char *host);
+
+/* The token in a Sec-WebSocket-Protocol list ("undulate, undulate-token.T"):
+ * true with T in out (cap >= REQ_TOKEN_MAX) if one is there and well-formed. */
+bool req_ws_token(const char *protocols, char *out, size_t cap);
+
+/* Whether a WebSocket may open: browsers without the token ("watchers") may
+ * take max_watchers of the max_clients places; the rest is kept for the
+ * token's holders, so token-less connections cannot lock the operator out. */
+bool req_ws_room(int clients, int watchers, bool token, int max_clients, int max_watchers);
 
 #endif

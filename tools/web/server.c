@@ -6,6 +6,7 @@
 #include <libwebsockets.h>
 #include <math.h>
 #include <signal.h>
+#include <sodium.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,12 +15,15 @@
 #include <unistd.h>
 
 #include "clock.h"
+#include "csock.h"
 #include "tools/top/feed.h"
 #include "frame.h"
 #include "hist.h"
 #include "req.h"
 #include "text.h"
 #include "wcmd.h"
+#include "wsrecv.h"
+#include "wtok.h"
 
 /* One browser on the WebSocket (libwebsockets' per-session data). */
 struct web_client {
@@ -28,8 +32,10 @@ struct web_client {
 	struct frame_cursor cur;
 	bool want;              /* a frame is due: asked for writable, not written yet */
 	double want_since;
-	bool authed;
+	bool authed;            /* holds the token: may command */
+	bool wrong_token;       /* offered one at the handshake, not ours */
 	bool dropping;          /* the rest of an oversized message */
+	bool failed;            /* closed for what its client sent: nothing more from it counts */
 	struct frame_note notes[WEB_NOTES];
 	int nnotes;
 };
@@ -38,6 +44,19 @@ struct web_client {
 struct web_http {
 	char *body;
 	size_t len, off;
+};
+
+/* One TCP connection, from its adoption to its end (the crowd's rules, server.h). */
+enum web_conn_state {
+	WEB_CONN_WAITING,       /* no request being served: just accepted, or idle after an answer */
+	WEB_CONN_BUSY,          /* a request arrived whole and is being answered */
+	WEB_CONN_WS,            /* a WebSocket (counted apart: WEB_MAX_CLIENTS) */
+	WEB_CONN_EVICTED,       /* closed to make room; gone at its WSI_DESTROY */
+};
+struct web_conn {
+	struct lws *wsi;
+	double since;           /* when it started waiting */
+	enum web_conn_state state;
 };
 
 #define WEB_TAG_LCM ((void *)1)
@@ -55,8 +74,13 @@ static struct web_app {
 	struct wcmd cmd;
 	bool cmd_ok;
 	char cmd_why[256];
+	struct web_conn conns[WEB_FD_LIMIT];
+	int nconns, nevicted;
 	struct web_client *clients[WEB_MAX_CLIENTS];
 	int nclients;
+	int nwatchers;              /* of them without the token */
+	char token[REQ_TOKEN_MAX];  /* made at start (wtok.h) */
+	char token_path[CSOCK_PATH_MAX + 64];
 	unsigned next_client;
 	lws_sorted_usec_list_t sul;
 	uint64_t ticks;
@@ -183,6 +207,76 @@ static int web_subscribe(void)
 	return 0;
 }
 
+/* ---- connections: room for one more ------------------------------------------------ */
+
+static struct web_conn *web_conn_of(struct lws *wsi)
+{
+	for (int i = 0; i < app.nconns; i++)
+		if (app.conns[i].wsi == wsi)
+			return &app.conns[i];
+	return NULL;
+}
+
+static void web_conn_set(struct lws *wsi, enum web_conn_state state)
+{
+	struct web_conn *k = web_conn_of(wsi);
+	if (k == NULL || k->state == WEB_CONN_EVICTED)
+		return;
+	k->state = state;
+	if (state == WEB_CONN_WAITING)
+		k->since = clock_mono_s();
+}
+
+/* The connection to close for a new one: the one waiting longest, else the
+ * longest busy one; never a WebSocket. NULL if none. */
+static struct web_conn *web_conn_victim(void)
+{
+	struct web_conn *best = NULL;
+	for (int i = 0; i < app.nconns; i++) {
+		struct web_conn *k = &app.conns[i];
+		if (k->state != WEB_CONN_WAITING && k->state != WEB_CONN_BUSY)
+			continue;
+		if (best == NULL || (k->state == WEB_CONN_WAITING && best->state == WEB_CONN_BUSY) ||
+		    (k->state == best->state && k->since < best->since))
+			best = k;
+	}
+	return best;
+}
+
+/* A connection was accepted (its descriptor is in libwebsockets' table):
+ * kept, after another made room if the table of live ones is full. */
+static int web_conn_add(struct lws *wsi)
+{
+	if (app.nconns - app.nevicted >= WEB_MAX_CONNECTIONS) {
+		struct web_conn *v = web_conn_victim();
+		if (v != NULL) {
+			v->state = WEB_CONN_EVICTED;
+			app.nevicted++;
+			app.n.conns_evicted++;
+			web_log(app.n.conns_evicted, "%d connections: closed the one that waited longest for a request "
+			        "(%.1f s)", WEB_MAX_CONNECTIONS, clock_mono_s() - v->since);
+			lws_set_timeout(v->wsi, PENDING_TIMEOUT_USER_OK, LWS_TO_KILL_ASYNC);
+		}
+	}
+	if (app.nconns - app.nevicted >= WEB_MAX_CONNECTIONS || app.nconns >= WEB_FD_LIMIT) {
+		app.n.http_refused++;
+		web_log(app.n.http_refused, "refused a connection: %d open, none of them can give way",
+		        WEB_MAX_CONNECTIONS);
+		return 1;
+	}
+	app.conns[app.nconns++] = (struct web_conn){ .wsi = wsi, .since = clock_mono_s(), .state = WEB_CONN_WAITING };
+	return 0;
+}
+
+static void web_conn_drop(struct lws *wsi)
+{
+	struct web_conn *k = web_conn_of(wsi);
+	if (k == NULL)
+		return;
+	app.nevicted -= k->state == WEB_CONN_EVICTED;
+	*k = app.conns[--app.nconns];
+}
+
 /* ---- HTTP ----------------------------------------------------------------------- */
 
 static const char *web_method(struct lws *wsi)
@@ -199,12 +293,19 @@ static const char *web_method(struct lws *wsi)
 	return "?";
 }
 
+/* An answer went out whole: the connection waits for its next request. */
+static int web_http_done(struct lws *wsi)
+{
+	web_conn_set(wsi, WEB_CONN_WAITING);
+	return lws_http_transaction_completed(wsi) ? -1 : 0;
+}
+
 static int web_http_status(struct lws *wsi, unsigned code, const char *why)
 {
 	app.n.http_refused++;
 	if (lws_return_http_status(wsi, code, why))
 		return -1;
-	return lws_http_transaction_completed(wsi) ? -1 : 0;
+	return web_http_done(wsi);
 }
 
 static int web_serve_file(struct lws *wsi, const char *dir, const char *name, const char *mime)
@@ -217,9 +318,7 @@ static int web_serve_file(struct lws *wsi, const char *dir, const char *name, co
 	int n = lws_serve_http_file(wsi, path, mime, "cache-control: no-cache\x0d\x0a", 0);
 	if (n < 0)
 		return -1;
-	if (n > 0 && lws_http_transaction_completed(wsi))
-		return -1;
-	return 0;
+	return n > 0 ? web_http_done(wsi) : 0;
 }
 
 static int web_snapshot(struct lws *wsi, struct web_http *h)
@@ -259,15 +358,35 @@ static int web_http_write(struct lws *wsi, struct web_http *h)
 	}
 	free(h->body);
 	h->body = NULL;
-	return lws_http_transaction_completed(wsi) ? -1 : 0;
+	return web_http_done(wsi);
+}
+
+/* The request's Host header (empty when missing or longer than cap). */
+static void web_host(struct lws *wsi, char *host, size_t cap)
+{
+	host[0] = '\0';
+	int n = lws_hdr_total_length(wsi, WSI_TOKEN_HOST);
+	if (n > 0 && n < (int)cap)
+		lws_hdr_copy(wsi, host, (int)cap, WSI_TOKEN_HOST);
 }
 
 static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
 {
 	app.n.http_requests++;
+	web_conn_set(wsi, WEB_CONN_BUSY);
 	const char *method = web_method(wsi);
+	char quoted[80], host[256];
+	text_sanitize(quoted, sizeof quoted, uri);
 	if (app.o.verbose)
-		fprintf(stderr, "undulate-web: %s %.200s\n", method, uri);
+		fprintf(stderr, "undulate-web: %s %s\n", method, quoted);
+	web_host(wsi, host, sizeof host);
+	if (!req_host_ok(&app.o.hosts, host)) {
+		char qhost[80];
+		web_log(app.n.http_refused + 1, "refused %s %s: Host '%s' does not name this server (a page of another "
+		        "site whose name points here: DNS rebinding; --allow-host NAME for a name of this computer)",
+		        method, quoted, text_sanitize(qhost, sizeof qhost, host));
+		return web_http_status(wsi, HTTP_STATUS_FORBIDDEN, "this Host does not name this server");
+	}
 	switch (req_route(method, uri)) {
 	case REQ_PAGE: return web_serve_file(wsi, app.o.page_dir, "index.html", "text/html");
 	case REQ_ASSET_JS: return web_serve_file(wsi, app.o.page_dir, "app.js", "application/javascript");
@@ -275,11 +394,11 @@ static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
 	case REQ_CHARTJS: return web_serve_file(wsi, NULL, app.o.chartjs, "application/javascript");
 	case REQ_SNAPSHOT: return web_snapshot(wsi, h);
 	case REQ_BAD_METHOD:
-		web_log(app.n.http_refused + 1, "refused %s %.64s: method not allowed", method, uri);
+		web_log(app.n.http_refused + 1, "refused %s %s: method not allowed", method, quoted);
 		return web_http_status(wsi, HTTP_STATUS_METHOD_NOT_ALLOWED, "method not allowed");
 	case REQ_NOT_FOUND:
 	default:
-		web_log(app.n.http_refused + 1, "refused %s %.64s: not found", method, uri);
+		web_log(app.n.http_refused + 1, "refused %s %s: not found", method, quoted);
 		return web_http_status(wsi, HTTP_STATUS_NOT_FOUND, "not found");
 	}
 }
@@ -288,8 +407,23 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 {
 	struct web_http *h = user;
 	switch (reason) {
+	case LWS_CALLBACK_FILTER_NETWORK_CONNECTION:
+		/* a new connection: what its client sends is watched from its first byte */
+		return wsr_watch((int)(intptr_t)in) ? 0 : 1;
+	case LWS_CALLBACK_SERVER_NEW_CLIENT_INSTANTIATED:
+		return web_conn_add(wsi);
+	case LWS_CALLBACK_WSI_DESTROY:
+		web_conn_drop(wsi);
+		return 0;
+	case LWS_CALLBACK_HTTP_FILE_COMPLETION:
+		return web_http_done(wsi);
 	case LWS_CALLBACK_HTTP:
 		return web_http(wsi, h, in != NULL ? (const char *)in : "");
+	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+		/* a WebSocket that named no protocol, or "http": libwebsockets
+		 * would give it to this callback, past every check of "undulate" */
+		web_log(++app.n.ws_refused, "refused a WebSocket without the protocol 'undulate'");
+		return 1;
 	case LWS_CALLBACK_HTTP_BODY:
 		return 0; /* no request has a body worth reading: it was answered already */
 	case LWS_CALLBACK_HTTP_WRITEABLE:
@@ -310,36 +444,71 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 
 static bool web_ws_allowed(struct lws *wsi)
 {
-	char origin[256] = "", host[256] = "";
-	if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) >= (int)sizeof origin ||
-	    lws_hdr_total_length(wsi, WSI_TOKEN_HOST) >= (int)sizeof host)
-		return false;
-	lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN);
-	lws_hdr_copy(wsi, host, sizeof host, WSI_TOKEN_HOST);
-	if (!req_origin_ok(origin, host)) {
-		web_log(++app.n.ws_refused, "refused a WebSocket from origin '%.64s' (this is http://%.64s)", origin,
-		        host);
+	char origin[256] = "", host[256], qo[80], qh[80];
+	if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) >= (int)sizeof origin) {
+		web_log(++app.n.ws_refused, "refused a WebSocket: Origin longer than %zu bytes", sizeof origin - 1);
 		return false;
 	}
-	if (app.nclients >= WEB_MAX_CLIENTS) {
-		web_log(++app.n.ws_refused, "refused a WebSocket: %d browsers connected already", WEB_MAX_CLIENTS);
+	lws_hdr_copy(wsi, origin, sizeof origin, WSI_TOKEN_ORIGIN);
+	web_host(wsi, host, sizeof host);
+	if (!req_host_ok(&app.o.hosts, host)) {
+		web_log(++app.n.ws_refused, "refused a WebSocket for Host '%s': not a name of this server (DNS "
+		        "rebinding?)", text_sanitize(qh, sizeof qh, host));
+		return false;
+	}
+	if (!req_origin_ok(origin, host)) {
+		web_log(++app.n.ws_refused, "refused a WebSocket from origin '%s' (this is http://%s)",
+		        text_sanitize(qo, sizeof qo, origin), text_sanitize(qh, sizeof qh, host));
 		return false;
 	}
 	return true;
 }
 
+static void web_refuse_msg(struct web_client *c, long long id, const char *why)
+{
+	app.n.msgs_refused++;
+	web_log(app.n.msgs_refused, "browser %u: refused a message: %s", c->id, why);
+	web_note(c, id, 0, "", "refused", why);
+}
+
+/* The token offered at the handshake (the page's subprotocol "undulate-token.T"). */
+static void web_ws_token(struct lws *wsi, struct web_client *c)
+{
+	char list[256], token[REQ_TOKEN_MAX];
+	int n = lws_hdr_total_length(wsi, WSI_TOKEN_PROTOCOL);
+	if (app.o.token == NULL || n <= 0 || n >= (int)sizeof list)
+		return;
+	lws_hdr_copy(wsi, list, sizeof list, WSI_TOKEN_PROTOCOL);
+	if (!req_ws_token(list, token, sizeof token))
+		return;
+	c->authed = req_token_ok(app.o.token, token);
+	c->wrong_token = !c->authed;
+}
+
+/* Room for it: watchers may not take the places kept for the token's holders. */
+static bool web_ws_room(const struct web_client *c)
+{
+	if (req_ws_room(app.nclients, app.nwatchers, c->authed, WEB_MAX_CLIENTS, WEB_MAX_WATCHERS))
+		return true;
+	web_log(++app.n.ws_refused, "refused a WebSocket%s: %d browsers connected, %d of them without the token "
+	        "(at most %d; the rest is kept for the token's holders)", c->authed ? " with the token" : "",
+	        app.nclients, app.nwatchers, WEB_MAX_WATCHERS);
+	return false;
+}
+
 static void web_ws_open(struct lws *wsi, struct web_client *c)
 {
-	memset(c, 0, sizeof *c);
+	/* authed and wrong_token were set at the handshake (FILTER_PROTOCOL_CONNECTION), id at ESTABLISHED */
 	int sndbuf = WEB_SNDBUF;
 	setsockopt(lws_get_socket_fd(wsi), SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
 	c->wsi = wsi;
-	c->id = ++app.next_client;
-	c->authed = app.o.token == NULL;
 	frame_cursor_init(&c->cur, &app.hist);
 	app.clients[app.nclients++] = c;
+	app.nwatchers += !c->authed;
 	app.n.clients = app.nclients;
-	web_note(c, 0, 0, "", "hello", app.o.read_only ? "read-only" : app.o.token ? "token" : "commands");
+	web_note(c, 0, 0, "", "hello", app.o.read_only ? "read-only" : c->authed ? "commands" : "watch");
+	if (c->wrong_token)
+		web_refuse_msg(c, 0, "wrong token: this page only watches (open the URL undulate-web printed)");
 	c->want = true;
 	c->want_since = clock_mono_s();
 	lws_callback_on_writable(wsi);
@@ -350,6 +519,7 @@ static void web_ws_close(struct web_client *c)
 	for (int i = 0; i < app.nclients; i++)
 		if (app.clients[i] == c) {
 			app.clients[i] = app.clients[--app.nclients];
+			app.nwatchers -= !c->authed;
 			break;
 		}
 	app.n.clients = app.nclients;
@@ -370,13 +540,6 @@ static int web_ws_write(struct lws *wsi, struct web_client *c)
 	return lws_write(wsi, buf, n, LWS_WRITE_TEXT) < (int)n ? -1 : 0;
 }
 
-static void web_refuse_msg(struct web_client *c, long long id, const char *why)
-{
-	app.n.msgs_refused++;
-	web_log(app.n.msgs_refused, "browser %u: refused a message: %s", c->id, why);
-	web_note(c, id, 0, "", "refused", why);
-}
-
 static void web_command(struct web_client *c, struct req_msg *m)
 {
 	char why[256];
@@ -386,7 +549,8 @@ static void web_command(struct web_client *c, struct req_msg *m)
 	}
 	if (!c->authed) {
 		app.n.commands_refused++;
-		return web_refuse_msg(c, m->id, "this dashboard needs its token for commands: open its URL with #token=...");
+		return web_refuse_msg(c, m->id, "commands need the dashboard's token: open the URL undulate-web printed "
+		                      "(with #token=...); without it this page only watches");
 	}
 	if (!app.cmd_ok) {
 		app.n.commands_refused++;
@@ -399,6 +563,11 @@ static void web_command(struct web_client *c, struct req_msg *m)
 		return web_note(c, m->id, 0, m->robot, "not-sent", why);
 	}
 	app.n.commands_sent++;
+	/* the robot logs this process; this log says which browser it was for */
+	char peer[64] = "?", quoted[128];
+	lws_get_peer_simple(c->wsi, peer, sizeof peer);
+	fprintf(stderr, "undulate-web: browser %u (%s, with the token): command %" PRId64 " '%s' to %s, %d reached\n",
+	        c->id, peer, seq, text_sanitize(quoted, sizeof quoted, m->text), m->robot, reached);
 	char what[FRAME_NOTE_TEXT];
 	snprintf(what, sizeof what, "'%.60s' sent to %d robot%s%s, waiting for the answer", m->text, reached,
 	         reached == 1 ? "" : "s", app.cmd.signed_lcm ? " (signed, over LCM)" : "");
@@ -431,31 +600,81 @@ static void web_ws_receive(struct lws *wsi, struct web_client *c, const char *in
 		return web_refuse_msg(c, m.id, why);
 	}
 	if (m.kind == REQ_MSG_AUTH) {
-		c->authed = app.o.token != NULL && req_token_ok(app.o.token, m.token);
-		if (!c->authed)
-			web_refuse_msg(c, 0, "wrong token");
-		else
-			web_note(c, 0, 0, "", "auth", "token accepted: commands enabled");
+		bool ok = app.o.token != NULL && req_token_ok(app.o.token, m.token);
+		if (!ok)
+			return web_refuse_msg(c, 0, "wrong token: this page only watches");
+		app.nwatchers -= !c->authed;
+		c->authed = true;
+		web_note(c, 0, 0, "", "auth", "token accepted: commands enabled");
 		return;
 	}
 	web_command(c, &m);
 }
 
+/* What its client sent breaks RFC 6455 where libwebsockets 4.1 lets it
+ * through (wsguard.h): close with 1002 before acting on anything. */
+static bool web_ws_bad(struct lws *wsi, struct web_client *c, enum wsg_verdict v)
+{
+	if (c->failed)
+		return true;
+	if (v == WSG_OK)
+		return false;
+	c->failed = true;
+	app.n.ws_bad_frames++;
+	if (!wsr_interposed())
+		web_log(app.n.ws_bad_frames, "cannot see what browsers send (recv() is not this program's): "
+		        "every WebSocket is refused");
+	else
+		web_log(app.n.ws_bad_frames, "browser %u: closed: %s", c->id, wsg_why(v));
+	const char *why = wsg_why(v);
+	lws_close_reason(wsi, LWS_CLOSE_STATUS_PROTOCOL_ERR, (unsigned char *)(uintptr_t)why, strlen(why));
+	return true;
+}
+
+/* The protocol is text (JSON out, "cmd ..." in): a binary frame is not ours
+ * to guess at (RFC 6455 7.4.1: 1003, a type it cannot accept). */
+static bool web_ws_binary(struct lws *wsi, struct web_client *c)
+{
+	static const char why[] = "the undulate protocol is text only";
+	if (!lws_frame_is_binary(wsi))
+		return false;
+	c->failed = true;
+	app.n.ws_bad_frames++;
+	web_log(app.n.ws_bad_frames, "browser %u: closed: a binary frame (%s)", c->id, why);
+	lws_close_reason(wsi, LWS_CLOSE_STATUS_UNACCEPTABLE_OPCODE, (unsigned char *)(uintptr_t)why, sizeof why - 1);
+	return true;
+}
+
 static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
 	struct web_client *c = user;
+	int fd = lws_get_socket_fd(wsi);
 	switch (reason) {
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
-		return web_ws_allowed(wsi) ? 0 : 1;
+		web_conn_set(wsi, WEB_CONN_BUSY);
+		if (!web_ws_allowed(wsi))
+			return 1;
+		web_ws_token(wsi, c);
+		return web_ws_room(c) ? 0 : 1;
 	case LWS_CALLBACK_ESTABLISHED:
+		c->id = ++app.next_client;
+		if (web_ws_bad(wsi, c, wsr_upgraded(fd)))
+			return -1;
 		web_ws_open(wsi, c);
+		web_conn_set(wsi, WEB_CONN_WS);
 		return 0;
 	case LWS_CALLBACK_SERVER_WRITEABLE:
+		/* also what came in control frames, which reach no callback */
+		if (web_ws_bad(wsi, c, wsr_verdict(fd)))
+			return -1;
 		return web_ws_write(wsi, c);
 	case LWS_CALLBACK_RECEIVE:
+		if (web_ws_bad(wsi, c, wsr_verdict(fd)) || web_ws_binary(wsi, c))
+			return -1;
 		web_ws_receive(wsi, c, in, len);
 		return 0;
 	case LWS_CALLBACK_CLOSED:
+		wsr_forget(fd);
 		web_ws_close(c);
 		return 0;
 	default:
@@ -470,6 +689,10 @@ static int web_raw_cb(struct lws *wsi, enum lws_callback_reasons reason, void *u
 	(void)user;
 	(void)in;
 	(void)len;
+	if (reason == LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION) {
+		web_log(++app.n.ws_refused, "refused a WebSocket asking for the internal protocol 'undulate-raw'");
+		return 1;
+	}
 	if (reason != LWS_CALLBACK_RAW_RX_FILE)
 		return 0;
 	void *tag = lws_get_opaque_user_data(wsi);
@@ -548,9 +771,9 @@ static int web_start(void)
 	if (strchr(app.o.addr, ':') == NULL)
 		info.options |= LWS_SERVER_OPTION_DISABLE_IPV6;
 	info.max_http_header_data = WEB_HEADER_MAX;
+	/* a header buffer for every connection that may be waiting for its request */
 	info.max_http_header_pool = WEB_MAX_CONNECTIONS;
-	/* the listening socket, the LCM and command sockets, lws's own pipe, and the connections */
-	info.fd_limit_per_thread = WEB_MAX_CONNECTIONS + 8;
+	info.fd_limit_per_thread = WEB_FD_LIMIT;
 	info.timeout_secs = WEB_HTTP_TIMEOUT_S;
 	info.timeout_secs_ah_idle = WEB_HTTP_TIMEOUT_S;
 	info.keepalive_timeout = 5;
@@ -560,6 +783,29 @@ static int web_start(void)
 	app.vh = lws_create_vhost(app.ctx, &info);
 	if (app.vh == NULL)
 		return -1;
+	return 0;
+}
+
+/* No --token-file, commands on: a token of our own, in a file only this
+ * user reads (wtok.h), and the URL that carries it. Without a file (the run
+ * directory not ours) the printed URL is the only copy. */
+static int web_make_token(int port)
+{
+	char dir[CSOCK_PATH_MAX], why[256];
+	if (!wtok_make(app.token)) {
+		fprintf(stderr, "undulate-web: cannot make a token (libsodium has no entropy source)\n");
+		return -1;
+	}
+	app.o.token = app.token;
+	if (!csock_daemon_dir(dir, sizeof dir, "", why, sizeof why) ||
+	    !wtok_write(dir, port, app.token, app.token_path, sizeof app.token_path, why, sizeof why)) {
+		app.token_path[0] = '\0';
+		fprintf(stderr, "undulate-web: the token is not written to a file: %s\n", why);
+	}
+	bool v6 = strchr(app.o.addr, ':') != NULL;
+	printf("undulate-web: open http://%s%s%s:%d/#token=%s to command (without the token the page only watches)%s%s\n",
+	       v6 ? "[" : "", app.o.addr, v6 ? "]" : "", port, app.token, app.token_path[0] ? "; the token is in " : "",
+	       app.token_path);
 	return 0;
 }
 
@@ -606,16 +852,22 @@ int web_run(const struct web_opts *o)
 	int port = lws_get_vhost_listen_port(app.vh);
 	bool v6 = strchr(o->addr, ':') != NULL;
 	printf("undulate-web: listening on http://%s%s%s:%d/ (LCM %s%s)\n", v6 ? "[" : "", o->addr, v6 ? "]" : "",
-	       port, o->lcm_url ? o->lcm_url : "default URL",
-	       o->read_only ? ", read-only" : o->token ? ", commands need the token" : "");
+	       port, o->lcm_url ? o->lcm_url : "default URL", o->read_only ? ", read-only" : ", commands need the token");
+	if (o->make_token && web_make_token(port) != 0)
+		return 1;
 	fflush(stdout);
 	while (!web_stop && lws_service(app.ctx, 0) >= 0)
 		;
 	fprintf(stderr, "undulate-web: exit: %lld HTTP requests (%lld refused), %lld WebSocket refused, %lld messages "
-	        "refused, %lld commands sent (%lld refused), %lld frames sent, %lld skipped, %lld browsers stalled\n",
+	        "refused, %lld commands sent (%lld refused), %lld frames sent, %lld skipped, %lld browsers stalled, "
+	        "%lld closed for their frames, %lld connections closed to make room\n",
 	        app.n.http_requests, app.n.http_refused, app.n.ws_refused, app.n.msgs_refused, app.n.commands_sent,
-	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled);
+	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled,
+	        app.n.ws_bad_frames, app.n.conns_evicted);
 	lws_context_destroy(app.ctx);
+	if (app.token_path[0] != '\0')
+		unlink(app.token_path);
+	sodium_memzero(app.token, sizeof app.token);
 	wcmd_close(&app.cmd);
 	lcm_destroy(app.lcm);
 	free(app.frame);

@@ -7,7 +7,11 @@ const SPAN_S = 30;
 const PORTRAIT_S = 10;
 const COLORS = ['#1f77b4', '#d62728', '#2ca02c', '#9467bd'];
 const state = { robots: new Map(), pairs: new Map(), now: 0, frames: 0, nextId: 1,
-                commands: true, ws: null, marks: [], bins: [] };
+                ws: null, marks: [], bins: [] };
+// The dashboard's token, from the URL undulate-web printed (#token=...): the
+// fragment never leaves the browser in a request line. Offered at the
+// handshake as the subprotocol "undulate-token.TOKEN" (tools/web/req.h).
+const token = () => (/token=([A-Za-z0-9._~-]+)/.exec(location.hash) || [])[1];
 
 function el(tag, attrs, text) {
   const e = document.createElement(tag);
@@ -36,15 +40,14 @@ function robotCard(name) {
   const card = el('div', { class: 'card robot', id: 'robot-' + name });
   const info = el('div');
   info.append(el('h3', {}, name), el('div', { class: 'line' }), el('table', { class: 'status' }));
-  if (state.commands) {
-    const row = el('div', { class: 'row' });
-    for (const m of ['limp', 'hold', 'sinusoid', 'oscillator']) {
-      const b = el('button', { 'data-robot': name, 'data-mode': m }, m.toUpperCase());
-      b.addEventListener('click', () => command(name, 'mode ' + m));
-      row.append(b);
-    }
-    info.append(row);
+  // shown only while this page may command (body.commands, set by the server's hello)
+  const row = el('div', { class: 'row cmd' });
+  for (const m of ['limp', 'hold', 'sinusoid', 'oscillator']) {
+    const b = el('button', { 'data-robot': name, 'data-mode': m }, m.toUpperCase());
+    b.addEventListener('click', () => command(name, 'mode ' + m));
+    row.append(b);
   }
+  info.append(row);
   const a = el('div', { class: 'chartbox' }), p = el('div', { class: 'chartbox portrait' });
   const ca = el('canvas'), cp = el('canvas');
   a.append(ca); p.append(cp);
@@ -189,11 +192,15 @@ function answer(n) {
   while (box.childNodes.length > 100) box.lastChild.remove();
 }
 
+// hello: "commands" (this page holds the token), "watch" (it does not) or
+// "read-only" (the server sends no commands); "auth": a token taken later.
 function note(n) {
-  if (n.kind === 'hello') {
-    state.commands = n.text !== 'read-only';
-    document.getElementById('controls').hidden = !state.commands;
-    return;
+  if (n.kind === 'hello' || n.kind === 'auth') {
+    const commands = n.kind === 'auth' || n.text === 'commands';
+    document.body.classList.toggle('commands', commands);
+    document.getElementById('controls').hidden = !commands;
+    document.getElementById('watching').hidden = commands || n.text === 'read-only';
+    if (n.kind === 'hello') return;
   }
   answer(n);
 }
@@ -219,7 +226,17 @@ function onFrame(frame) {
     if (q.seen !== state.frames) { q.chart.destroy(); q.card.remove(); state.pairs.delete(key); }
   simData(frame);
   document.body.dataset.frames = state.frames;
-  redraw();
+  scheduleRedraw();
+}
+
+// One redraw for however many frames arrived since the last: a browser short
+// of CPU (a busy machine) takes the frames the server sends it, and redrawing
+// after each one would queue work without end; the data is kept either way.
+let redrawPending = false;
+function scheduleRedraw() {
+  if (redrawPending) return;
+  redrawPending = true;
+  setTimeout(() => { redrawPending = false; redraw(); }, 0);
 }
 
 function redraw() {
@@ -257,14 +274,11 @@ function redraw() {
 }
 
 function connect() {
-  const ws = new WebSocket(`ws://${location.host}/`, 'undulate');
+  const t = token();
+  const ws = new WebSocket(`ws://${location.host}/`, t ? ['undulate', 'undulate-token.' + t] : 'undulate');
   state.ws = ws;
   const conn = document.getElementById('conn');
-  ws.onopen = () => {
-    conn.textContent = 'live'; conn.className = 'ok';
-    const m = /token=([^&]+)/.exec(location.hash);
-    if (m) ws.send('auth ' + decodeURIComponent(m[1]));
-  };
+  ws.onopen = () => { conn.textContent = 'live'; conn.className = 'ok'; };
   ws.onmessage = (ev) => { try { onFrame(JSON.parse(ev.data)); } catch (e) { console.error(e); } };
   ws.onclose = () => { conn.textContent = 'disconnected: reconnecting…'; conn.className = 'bad';
                        setTimeout(connect, 1000); };
@@ -278,4 +292,6 @@ document.getElementById('paramform').addEventListener('submit', (ev) => {
 });
 for (const b of document.querySelectorAll('#controls button[data-mode]'))
   b.addEventListener('click', () => command(b.dataset.robot, 'mode ' + b.dataset.mode));
+// a token pasted into the address bar of an open page: connect again with it
+window.addEventListener('hashchange', () => { if (state.ws) state.ws.close(); });
 connect();
