@@ -154,7 +154,7 @@ struct an_ctx {
 	/* the plane world (SIM.TRUTH with links): plane.csv, plane_walls.csv */
 	bool plane_seen;
 	struct pcsv_sampler plane_sampler;
-	FILE *plane, *plane_walls;
+	FILE *plane_csv, *plane_walls_csv;
 	struct an_seen seen[AN_COLL_DEDUP];
 	int seen_next;
 	int64_t *bins, *bin_walls;
@@ -994,7 +994,7 @@ static void an_on_params(struct an_ctx *c, const undulate_osc_params_t *m)
 static void an_on_plane(struct an_ctx *c, const undulate_sim_truth_t *m)
 {
 	double t = an_t(c, m->utime);
-	if (!c->plane || m->world != UNDULATE_SIM_TRUTH_T_WORLD_PLANE || !pcsv_take(&c->plane_sampler, t))
+	if (!c->plane_csv || m->world != UNDULATE_SIM_TRUTH_T_WORLD_PLANE || !pcsv_take(&c->plane_sampler, t))
 		return;
 	for (int i = 0; i < m->nlinks; i++) {
 		const undulate_sim_link_t *l = &m->links[i];
@@ -1003,27 +1003,27 @@ static void an_on_plane(struct an_ctx *c, const undulate_sim_truth_t *m)
 		    !pcsv_robot_pose(m->links, m->nlinks, l->robot, &cx, &cy, &heading))
 			continue;
 		const char *name = m->bodies[l->robot].robot;
-		fprintf(c->plane, "%lld,%.6f,", (long long)m->utime, t);
-		an_csv_str(c->plane, name);
-		fprintf(c->plane, ",%d,%d", an_robot_find(c, name, false), l->link);
-		an_csv_num(c->plane, l->x);
-		an_csv_num(c->plane, l->y);
-		an_csv_num(c->plane, l->angle);
-		an_csv_num(c->plane, l->length);
-		an_csv_num(c->plane, l->width);
-		an_csv_num(c->plane, cx);
-		an_csv_num(c->plane, cy);
-		an_csv_num(c->plane, heading);
-		fputc('\n', c->plane);
+		fprintf(c->plane_csv, "%lld,%.6f,", (long long)m->utime, t);
+		an_csv_str(c->plane_csv, name);
+		fprintf(c->plane_csv, ",%d,%d", an_robot_find(c, name, false), l->link);
+		an_csv_num(c->plane_csv, l->x);
+		an_csv_num(c->plane_csv, l->y);
+		an_csv_num(c->plane_csv, l->angle);
+		an_csv_num(c->plane_csv, l->length);
+		an_csv_num(c->plane_csv, l->width);
+		an_csv_num(c->plane_csv, cx);
+		an_csv_num(c->plane_csv, cy);
+		an_csv_num(c->plane_csv, heading);
+		fputc('\n', c->plane_csv);
 	}
 	for (int i = 0; i < m->nwalls; i++) {
 		const undulate_sim_wall_t *w = &m->walls[i];
-		fprintf(c->plane_walls, "%lld,%.6f,%d", (long long)m->utime, t, i);
-		an_csv_num(c->plane_walls, w->ax);
-		an_csv_num(c->plane_walls, w->ay);
-		an_csv_num(c->plane_walls, w->bx);
-		an_csv_num(c->plane_walls, w->by);
-		fputc('\n', c->plane_walls);
+		fprintf(c->plane_walls_csv, "%lld,%.6f,%d", (long long)m->utime, t, i);
+		an_csv_num(c->plane_walls_csv, w->ax);
+		an_csv_num(c->plane_walls_csv, w->ay);
+		an_csv_num(c->plane_walls_csv, w->bx);
+		an_csv_num(c->plane_walls_csv, w->by);
+		fputc('\n', c->plane_walls_csv);
 	}
 }
 
@@ -1231,10 +1231,10 @@ static int an_open_outputs(struct an_ctx *c)
 	if (!c->plane_seen)
 		return 0;
 	pcsv_sampler_init(&c->plane_sampler, c->o->plane_every_s);
-	c->plane = an_open_out(c, "plane.csv",
+	c->plane_csv = an_open_out(c, "plane.csv",
 		"utime,t,robot,robot_index,link,x,y,angle,length,width,centre_x,centre_y,heading");
-	c->plane_walls = an_open_out(c, "plane_walls.csv", "utime,t,wall,ax,ay,bx,by");
-	return c->plane && c->plane_walls ? 0 : -1;
+	c->plane_walls_csv = an_open_out(c, "plane_walls.csv", "utime,t,wall,ax,ay,bx,by");
+	return c->plane_csv && c->plane_walls_csv ? 0 : -1;
 }
 
 static int an_close_outputs(struct an_ctx *c)
@@ -1246,8 +1246,8 @@ static int an_close_outputs(struct an_ctx *c)
 	rc |= an_close_out(c, &c->evt, "events.csv");
 	rc |= an_close_out(c, &c->pdiff, "phase_diff.csv");
 	rc |= an_close_out(c, &c->params, "params.csv");
-	rc |= an_close_out(c, &c->plane, "plane.csv");
-	rc |= an_close_out(c, &c->plane_walls, "plane_walls.csv");
+	rc |= an_close_out(c, &c->plane_csv, "plane.csv");
+	rc |= an_close_out(c, &c->plane_walls_csv, "plane_walls.csv");
 	return rc;
 }
 
