@@ -338,10 +338,16 @@ fig_pair_switch() {
 # `undulated --tune` made in lockstep on one robot of the plane world
 # (fig_plane_tune; the file's head says when and what it measured), so that
 # every run of every module has the same, committed parameters.
-FIG_PLANE_CONF="$fig_top/figures/plane-oscillator.conf"
+FIG_PLANE_CONF=${FIG_PLANE_CONF:-"$fig_top/figures/plane-oscillator.conf"}
 # The keys the tuner sets (and the clock's gait it measured): what a
 # configuration of the plane robot needs beyond the daemon's defaults.
-FIG_PLANE_KEYS="robot.servo_lead_s joint.1.k joint.1.c joint.1.mu joint.1.lambda joint.2.k joint.2.c joint.2.mu joint.2.lambda sinusoid.amplitude sinusoid.frequency"
+FIG_PLANE_KEYS="robot.servo_lead_s joint.1.k joint.1.c joint.1.mu joint.1.lambda joint.1.coupling_phase joint.2.k joint.2.c joint.2.mu joint.2.lambda joint.2.coupling_phase sinusoid.amplitude sinusoid.frequency"
+# The paper holds its robots' joints 2 pi / 3 apart; the oscillator's
+# coupling on the angle alone gives 104 deg on the plane robot. coupling_phase
+# +THETA on joint 1 and -THETA on joint 2 turns the lag (daemon/CONTROL.md,
+# "The joints' lag": +-0.30 rad gives 120 deg on the plane robot with the
+# default oscillator); the tuner runs with it, so k and mu are tuned with it.
+FIG_PLANE_COUPLING=${FIG_PLANE_COUPLING:-0.30}
 
 fig_ini() {
 	awk -v sec="[$2]" -v key="$3" '/^\[/ { in_sec = ($1 == sec); next }
@@ -363,7 +369,8 @@ fig_plane_sets() {
 
 # fig_plane_tune OUT [SEED] [TUNE_S]: one plane robot (two joints, no walls:
 # sim-bridge/scenarios/plane-swimmer.scenario) on its own simulated bus, the
-# tuner in lockstep (0.8 Hz, 0.8 rad, the daemon's defaults otherwise); OUT
+# tuner in lockstep (0.8 Hz, 0.8 rad, coupling_phase +-FIG_PLANE_COUPLING,
+# the daemon's defaults otherwise); OUT
 # gets the tuned keys under the tuner's own comments. The work folder is
 # OUT.d, removed after.
 fig_plane_tune() {
@@ -380,6 +387,7 @@ fig_plane_tune() {
 		sleep 0.02
 	done
 	"$FIG_BIN/undulated" --tune --lockstep "$dir/clock" --port "$dir/r1" --ids 1,2 --robot r1 --lcm-url "$url" \
+		--set "joint.1.coupling_phase=$FIG_PLANE_COUPLING" --set "joint.2.coupling_phase=-$FIG_PLANE_COUPLING" \
 		--tune-time "$budget" --out "$dir/tuned.conf" >"$dir/tune.log" 2>&1 </dev/null || rc=$?
 	wait "$sim" 2>/dev/null
 	if [ "$rc" -ne 0 ] || [ ! -f "$dir/tuned.conf" ]; then
@@ -390,7 +398,8 @@ fig_plane_tune() {
 		echo "# The oscillator of the plane world's three-link robot, for the figures"
 		echo "# (figures/lib.sh: FIG_PLANE_CONF). Made by fig_plane_tune: undulated --tune"
 		echo "# in lockstep on one robot of the plane world (two AX-12A joints, links of"
-		echo "# 18.65 cm, drag, no walls; sim seed $seed), targets 0.8 Hz and 0.8 rad:"
+		echo "# 18.65 cm, drag, no walls; sim seed $seed), targets 0.8 Hz and 0.8 rad, with"
+		echo "# coupling_phase +$FIG_PLANE_COUPLING / -$FIG_PLANE_COUPLING rad for the paper's 2 pi / 3 between the joints:"
 		grep -E '^# (r1: written|target|the parameters)' "$dir/tuned.conf"
 		grep '^tune: done' "$dir/tune.log" | sed 's/; written to .*//; s/^tune: done in [0-9.]* s (\(.*\)):/# after \1:/'
 		echo "# Only the tuned keys; everything else is the daemon's default."
