@@ -38,9 +38,9 @@
 # and the page gives it beside 0.298 m.
 #
 # The oscillator: figures/plane-oscillator.conf (made by `undulated --tune`
-# in lockstep on one plane robot: figures/lib.sh, fig_plane_tune), passed to
-# every daemon as --daemon-set values; the clock (SINUSOID) at the gait the
-# tuner measured.
+# in lockstep on one plane robot, its joints 2 pi / 3 apart by coupling_phase
+# +-0.30 rad: figures/lib.sh, fig_plane_tune), passed to every daemon as
+# --daemon-set values; the clock (SINUSOID) at the gait the tuner measured.
 set -u
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/../lib.sh"
@@ -55,6 +55,13 @@ SWITCH=2
 SECONDS_TOTAL=32
 WINDOW=5
 SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
+# A free plane robot on this oscillator sweeps 0.189 m across its heading per
+# period (its links' centre lines: figures/swimmer's sweep_m, 3 runs,
+# 2026-11-28); two robots side by side, their centre lines a width less
+# the links' 3.2 cm apart, can touch only below a "plane d̃" of
+# (width - 0.032 m) / 0.189 m: the page sets it beside the row's.
+FREE_SWEEP_M=0.189
+LINK_WIDTH_M=0.032
 # The moments of the picture: the switch, two on the way, the end.
 FRAMES="2 5 15 32"
 
@@ -255,7 +262,8 @@ fragment() {
 		echo "neighbouring robots' midlines, side walls half a width beyond the end robots, end walls across"
 		echo "their length 0.61 m apart (the paper's channel is 55 cm long: it keeps the robots side by side;"
 		echo "0.61 m is the least that holds a straight robot, as they start). The oscillator tuned for this robot"
-		echo "(\`figures/plane-oscillator.conf\`, \`undulated --tune\` in lockstep: 0.82 Hz, 0.80 rad); $SWITCH s on"
+		echo "(\`figures/plane-oscillator.conf\`, \`undulated --tune\` in lockstep: 0.82 Hz, 0.78 rad, the joints 2π/3 apart"
+		echo "through the coupling's phase, the swimmer's section above); $SWITCH s on"
 		echo "the clock at random phases, then $((SECONDS_TOTAL - SWITCH)) s on the oscillator; $pairs neighbouring pairs. Final Δ: the"
 		echo "pair's mean over the last $WINDOW s; d̃ and 2 asin(d̃): the analyser's per pair (final centres,"
 		echo "lever 0.1865 m/rad, measured amplitude)."
@@ -285,7 +293,11 @@ fragment() {
 		local sweep dy
 		sweep=$(awk -F, 'NR > 1 { print $18; print $19 }' "$csv" | grep -v nan | fig_median)
 		dy=$(awk -F, 'NR > 1 { print $17 }' "$csv" | grep -v nan | fig_median)
-		awk -F, -v sweep="$sweep" -v dy="$dy" -v swept="$SWEPT_M" 'NR > 1 { n++; d = $6 < 0 ? -$6 : $6
+		local plane
+		plane=$(for w in $(awk -F, 'NR > 1 { print $1 }' "$csv" | sort -gu); do
+			awk -v w="$w" -v lw="$LINK_WIDTH_M" -v f="$FREE_SWEEP_M" 'BEGIN { printf "%s cm %.2f, ", w, (w / 100 - lw) / f }'
+		done | sed 's/, $//')
+		awk -F, -v sweep="$sweep" -v dy="$dy" -v swept="$SWEPT_M" -v free="$FREE_SWEEP_M" -v lw="$LINK_WIDTH_M" -v plane="$plane" 'NR > 1 { n++; d = $6 < 0 ? -$6 : $6
 				if ($5 == "anti-phase") { a++; if ($9 > 0) ac++; ad = ad sprintf(" %.2f", $13) }
 				if ($14 != "nan" && d <= $14 + 0.1) b++
 				else { over++; ex = ex sprintf(" %.2f", d - $14) }
@@ -300,7 +312,7 @@ fragment() {
 				printf "; %d in anti-phase", a
 				if (a) printf " (at d̃%s; %d of them still touching in the last '"$WINDOW"' s)", ad, ac
 				printf "; %d of %d pairs still touched in the last '"$WINDOW"' s. ", c, n
-				printf "The d̃ is the row'"'"'s reading of the plane: a robot'"'"'s links swept %.3f m across the channel in the final window (the median over the robots), against 2 x 0.1865 m/rad x 0.8 rad = %.3f m that d̃ assumes; and neighbours'"'"' centres ended %.3f m apart along the channel (median), a shift along the body that the row has no room for and that changes which phase difference lets two robots pass without touching.\n", sweep, swept, dy
+				printf "The d̃ is the row'"'"'s reading of the plane, a contact body sweeping 2 x 0.1865 m/rad x 0.8 rad = %.3f m. A free robot on this oscillator sweeps %.3f m across its heading per period (its links'"'"' centre lines: the swimmer'"'"'s section above), so two of them side by side and aligned could touch at all only while (width - %.3f m) / %.3f m is below 1 (%s), and then only out of phase. Here they touched far more than that: in the channel a robot occupied %.3f m across it over the final window (the median over the robots, width included: it turns and is pushed about as well as swinging), the side walls stand half a width beyond the end robots, and the robots pressed together (the d̃ at the end below the nominal, the table). Neighbours'"'"' centres ended %.3f m apart along the channel (median): the end walls hold them side by side.\n", swept, free, lw, free, plane, sweep, dy
 			}' "$csv"
 		if [ "$(wc -l <"$control")" -gt 1 ]; then
 			echo

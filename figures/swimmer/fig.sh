@@ -17,8 +17,9 @@
 # on position servos, links of 18.65 cm, drag on every link, no walls), the
 # daemon with the oscillator tuned for it (figures/plane-oscillator.conf,
 # made by `undulated --tune` in lockstep: figures/lib.sh, fig_plane_tune).
-# MODE oscillator runs the limit cycle from the start, whose joints settle
-# at the lag their coupling (lambda 1.5 / -0.5) gives; MODE sinusoid runs
+# MODE oscillator runs the limit cycle from the start, its joints at the lag
+# their coupling gives (lambda 1.5 / -0.5 on the other joint's angle, turned
+# by coupling_phase +-0.30 rad to the paper's 2 pi / 3); MODE sinusoid runs
 # the daemon's clock at the gait the tuner measured, with the paper's lag of
 # 2 pi / 3 between the joints (DESIGN.md: x_j = A sin(phi + (2 pi / 3)(j - 1)
 # - 2 pi f t)). The seed sets the robot's random start (initial_spread
@@ -240,12 +241,13 @@ fragment() {
 		echo "heading's change over the run, its size; *sweep*: per period, the span of the links' ends (their"
 		echo "centre lines) across the period's mean heading, the median over the periods.)"
 		echo
-		awk -F, 'NR > 1 && $1 == "oscillator" { n++; l += $8; f += ($4 + $5) / 2; a += ($6 + $7) / 2; d += $10; sw += $17 }
+		awk -F, -v cp1="$(fig_ini "$FIG_PLANE_CONF" joint.1 coupling_phase)" -v cp2="$(fig_ini "$FIG_PLANE_CONF" joint.2 coupling_phase)" \
+			'NR > 1 && $1 == "oscillator" { n++; l += $8; f += ($4 + $5) / 2; a += ($6 + $7) / 2; d += $10; sw += $17 }
 			NR > 1 && $1 == "sinusoid" { m++; dc += $10 }
 			END {
 				pi = 3.14159265
 				printf "**Beside the paper.** The paper'"'"'s robots oscillate at about 0.8 Hz and 0.8 rad, and its Fig. 8b shows the joint angles of experiment and simulation with joint 2 about 2π/3 behind joint 1, a lag the paper enforces."
-				if (n) printf " Here the oscillator runs at %.2f Hz and %.2f rad (the tuner'"'"'s targets, 0.8 and 0.8, within 5 %%), but its joints settle %.2f rad (%.0f°) apart, not 2π/3 (2.09 rad, 120°): the daemon couples its two joints by λ = 1.5 and −0.5 (DESIGN.md) and the lag is what that coupling gives on this robot, on the row'"'"'s joints it gives 88-96° (daemon/README.md) — the daemon has no setting that enforces a lag.", f / n, a / n, l / n, l / n * 180 / pi
+				if (n) printf " Here the oscillator runs at %.2f Hz and %.2f rad (the tuner'"'"'s targets, 0.8 and 0.8, within 5 %%) with joint 2 %.2f rad (%.0f°) behind joint 1 (2π/3: 2.09 rad). The oscillator couples its joints by λ = 1.5 and −0.5 on the other joint'"'"'s angle, which alone puts them about a quarter period apart, 103° on this robot (measured here 2026-11-28 before the coupling'"'"'s phase was set: 1.79 rad, and 1.44 cm a period); the coupling'"'"'s phase (coupling_phase %s / %s rad in plane-oscillator.conf: daemon/CONTROL.md, \"The joints'"'"' lag\") turns the lag to 120°, and the oscillator still answers only its joints'"'"' measured angles and speeds.", f / n, a / n, l / n, l / n * 180 / pi, cp1, cp2
 				if (m) printf " The clock, which sets the lag, gives 2π/3 as the paper'"'"'s."
 				printf " The robot swims head first, as a Purcell swimmer in drag should"
 				if (n) printf ": %.2f cm a period on the oscillator", 100 * d / n

@@ -200,7 +200,7 @@ if [ "${blue:-0}" -ge 1000 ] && [ "${orange:-0}" -ge 1000 ] && [ "${red:-0}" -ge
 else tap_fail "swimmer.png shows its data" "joint 1 $blue, joint 2 $orange, path $red pixels of their colours"; fi
 if grep -qF '| oscillator | 2 | 0.820 / 0.820 | 0.800 / 0.810 | 1.79 rad (103°) | 1.43 cm (1.40-1.46) | 0.00 cm | 1.18 cm/s | 0.25 rad | 0.190 m |' "$T/fig/swimmer.md" &&
 	grep -qF '| clock | 1 | 0.824 / 0.824 | 0.800 / 0.800 | 2.09 rad (120°) | 1.16 cm (1.16-1.16) | 0.00 cm | 0.95 cm/s | 0.25 rad | 0.170 m |' "$T/fig/swimmer.md" &&
-	grep -q 'joints settle 1.79 rad (103°) apart, not 2π/3' "$T/fig/swimmer.md" &&
+	grep -q 'with joint 2 1.79 rad (103°) behind joint 1 (2π/3: 2.09 rad)' "$T/fig/swimmer.md" &&
 	grep -q 'sweeps 0.190 m across its heading per period (.*0.222 m with' "$T/fig/swimmer.md" && [ "$(wc -l <"$T/fig/swimmer.csv")" = 4 ]; then
 	tap_ok "swimmer.md: per mode the gait, the lag and the swim per period, the lag beside the paper's 2 pi / 3"
 else tap_fail "swimmer.md numbers" "$(grep -E '^\||Beside' "$T/fig/swimmer.md")"; fi
