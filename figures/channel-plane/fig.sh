@@ -55,12 +55,12 @@ SWITCH=2
 SECONDS_TOTAL=32
 WINDOW=5
 SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
-# A free plane robot on this oscillator sweeps 0.189 m across its heading per
-# period (its links' centre lines: figures/swimmer's sweep_m, 3 runs,
-# 2026-11-28); two robots side by side, their centre lines a width less
+# A free plane robot on this oscillator sweeps 0.159 m across its heading per
+# period (its links' centre lines: figures/swimmer's sweep_m, 3 runs, 0.1590-
+# 0.1595 m, 2026-11-28; 0.189 m with the joints 103 deg apart); two robots side by side, their centre lines a width less
 # the links' 3.2 cm apart, can touch only below a "plane d̃" of
 # (width - 0.032 m) / 0.189 m: the page sets it beside the row's.
-FREE_SWEEP_M=0.189
+FREE_SWEEP_M=0.159
 LINK_WIDTH_M=0.032
 # The moments of the picture: the switch, two on the way, the end.
 FRAMES="2 5 15 32"
