@@ -45,6 +45,12 @@
 #   fig_theory ARG...           undulate-analyze --theory ARG... (tools/analyze/theory.c)
 #   fig_pair_switch DSEP DELTA0 when to switch a pair started on the full sinusoid to the
 #                               oscillator: just after the clock last pressed them together
+#   FIG_PLANE_CONF              the oscillator tuned for the plane world's robot
+#                               (figures/plane-oscillator.conf, made by fig_plane_tune)
+#   fig_plane_sets [CONF]       its parameters as demo.sh --daemon-set words, one a line
+#   fig_plane_tune OUT [SEED] [S]  the tuner in lockstep on one plane robot: OUT, a
+#                               configuration of the tuned keys and how they were made
+#   fig_ini FILE SECTION KEY    a value of an INI file (a daemon configuration)
 #
 # Programs come from $BUILD/bin (BUILD: default build/ of this checkout); the
 # modules use nothing else outside their OUTDIR, so a run goes to any machine
@@ -322,4 +328,90 @@ fig_pair_switch() {
 			if (te >= tmin) { printf "%.3f\n", te + after; exit }
 		}
 	}'
+}
+
+# ---- the oscillator tuned for the plane world's robot -------------------------------
+# The daemon's default oscillator was tuned on the row's joint (one link
+# swinging against its gearbox); on the plane's three-link robot, whose
+# links swim in drag, it runs at 1.04 Hz and 0.72-0.79 rad. The plane modules
+# (swimmer, channel-plane) run the robots with FIG_PLANE_CONF, a file that
+# `undulated --tune` made in lockstep on one robot of the plane world
+# (fig_plane_tune; the file's head says when and what it measured), so that
+# every run of every module has the same, committed parameters.
+FIG_PLANE_CONF=${FIG_PLANE_CONF:-"$fig_top/figures/plane-oscillator.conf"}
+# The keys the tuner sets (and the clock's gait it measured): what a
+# configuration of the plane robot needs beyond the daemon's defaults.
+FIG_PLANE_KEYS="robot.servo_lead_s joint.1.k joint.1.c joint.1.mu joint.1.lambda joint.1.coupling_phase joint.2.k joint.2.c joint.2.mu joint.2.lambda joint.2.coupling_phase sinusoid.amplitude sinusoid.frequency"
+# The paper holds its robots' joints 2 pi / 3 apart; the oscillator's
+# coupling on the angle alone gives 104 deg on the plane robot. coupling_phase
+# +THETA on joint 1 and -THETA on joint 2 turns the lag (daemon/CONTROL.md,
+# "The joints' lag": +-0.30 rad gives 120 deg on the plane robot with the
+# default oscillator); the tuner runs with it, so k and mu are tuned with it.
+FIG_PLANE_COUPLING=${FIG_PLANE_COUPLING:-0.30}
+
+fig_ini() {
+	awk -v sec="[$2]" -v key="$3" '/^\[/ { in_sec = ($1 == sec); next }
+		in_sec && $1 == key && $2 == "=" { print $3; exit }' "$1"
+}
+
+# fig_plane_sets [CONF]: "--daemon-set" and "SEC.KEY=VALUE" on lines of their
+# own, for mapfile; exit 1 naming a key the file lacks.
+fig_plane_sets() {
+	local conf=${1:-$FIG_PLANE_CONF} k sec key v
+	[ -f "$conf" ] || { echo "$FIG_NAME: no tuned configuration $conf (figures/lib.sh, fig_plane_tune)" >&2; return 1; }
+	for k in $FIG_PLANE_KEYS; do
+		sec=${k%.*} key=${k##*.}
+		v=$(fig_ini "$conf" "$sec" "$key")
+		[ -n "$v" ] || { echo "$FIG_NAME: $conf has no [$sec] $key" >&2; return 1; }
+		printf -- '--daemon-set\n%s=%s\n' "$k" "$v"
+	done
+}
+
+# fig_plane_tune OUT [SEED] [TUNE_S]: one plane robot (two joints, no walls:
+# sim-bridge/scenarios/plane-swimmer.scenario) on its own simulated bus, the
+# tuner in lockstep (0.8 Hz, 0.8 rad, coupling_phase +-FIG_PLANE_COUPLING,
+# the daemon's defaults otherwise); OUT
+# gets the tuned keys under the tuner's own comments. The work folder is
+# OUT.d, removed after.
+fig_plane_tune() {
+	local out=$1 seed=${2:-1} budget=${3:-200} dir url rc=0 sim i k sec key
+	dir="$out.d"
+	rm -rf "$dir" && mkdir -p "$dir" || fig_die "cannot create $dir"
+	url=$(fig_lcm_url "$dir")
+	${FIG_SESSION[@]+"${FIG_SESSION[@]}"} "$FIG_BIN/undulate-sim" --scenario "$fig_top/sim-bridge/scenarios/plane-swimmer.scenario" \
+		--set "sim.seed=$seed" --link-dir "$dir" --lockstep "$dir/clock" --duration $((budget + 60)) --lcm-url "$url" >"$dir/sim.log" 2>&1 </dev/null &
+	sim=$!
+	for i in $(seq 500); do
+		grep -q 'ready:' "$dir/sim.log" 2>/dev/null && break
+		kill -0 "$sim" 2>/dev/null || break
+		sleep 0.02
+	done
+	"$FIG_BIN/undulated" --tune --lockstep "$dir/clock" --port "$dir/r1" --ids 1,2 --robot r1 --lcm-url "$url" \
+		--set "joint.1.coupling_phase=$FIG_PLANE_COUPLING" --set "joint.2.coupling_phase=-$FIG_PLANE_COUPLING" \
+		--tune-time "$budget" --out "$dir/tuned.conf" >"$dir/tune.log" 2>&1 </dev/null || rc=$?
+	wait "$sim" 2>/dev/null
+	if [ "$rc" -ne 0 ] || [ ! -f "$dir/tuned.conf" ]; then
+		echo "$FIG_NAME: tuning the plane robot failed (undulated --tune exit $rc): $(grep -m1 -E '^tune: (not|gave)|error' "$dir/tune.log" | cut -c1-200)" >&2
+		return 1
+	fi
+	{
+		echo "# The oscillator of the plane world's three-link robot, for the figures"
+		echo "# (figures/lib.sh: FIG_PLANE_CONF). Made by fig_plane_tune: undulated --tune"
+		echo "# in lockstep on one robot of the plane world (two AX-12A joints, links of"
+		echo "# 18.65 cm, drag, no walls; sim seed $seed), targets 0.8 Hz and 0.8 rad, with"
+		echo "# coupling_phase +$FIG_PLANE_COUPLING / -$FIG_PLANE_COUPLING rad for the paper's 2 pi / 3 between the joints:"
+		grep -E '^# (r1: written|target|the parameters)' "$dir/tuned.conf"
+		grep '^tune: done' "$dir/tune.log" | sed 's/; written to .*//; s/^tune: done in [0-9.]* s (\(.*\)):/# after \1:/'
+		echo "# Only the tuned keys; everything else is the daemon's default."
+		for sec in robot joint.1 joint.2 sinusoid; do
+			echo
+			echo "[$sec]"
+			for k in $FIG_PLANE_KEYS; do
+				[ "${k%.*}" = "$sec" ] || continue
+				key=${k##*.}
+				echo "$key = $(fig_ini "$dir/tuned.conf" "$sec" "$key")"
+			done
+		done
+	} | outdir_put "$out" || return 1
+	rm -rf "$dir"
 }

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# figures/channel/fig.sh — four robots in a channel (the paper's Figs. 5 and
-# 9) through the real daemons in lockstep: four two-joint robots driven as the
-# paper's were (position servos, the daemon's default actuation), started on
-# the clock at random phases, then 30 s on the oscillator; the final phase
+# figures/channel/fig.sh — four robots in a channel (the paper's Figs. 8
+# and 9) in the row world, through the real daemons in lockstep: four
+# two-joint robots driven as the paper's were (position servos, the
+# daemon's default actuation), started on the clock at random phases, then
+# 30 s on the oscillator; the final phase
 # difference of each neighbouring pair against d̃ beside the compatibility
 # bound 2 asin(d̃), at five channel widths.
 #
@@ -125,7 +126,7 @@ fragment() {
 	runs=$(awk -F, 'NR > 1 { print $1 " " $3 }' "$csv" | sort -u | wc -l)
 	pairs=$(($(wc -l <"$csv") - 1))
 	{
-		echo "## Four robots in a channel (the paper's Figs. 5 and 9)"
+		echo "## Four robots in a channel, in the row world (the paper's Figs. 8 and 9)"
 		echo
 		echo "![final phase difference against d̃ beside the compatibility bound](figures/channel.png)"
 		echo

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# figures/pair/fig.sh — the paper's pair rig, Fig. 3b and 3c: the steady
-# phase difference of two touching oscillators against their separation d~,
-# from random initial phase differences, over the theory's return map; and
+# figures/pair/fig.sh — the paper's pair rig, its Figs. 5b and 5c: the
+# steady phase difference of two touching oscillators against their
+# separation d~, from random initial phase differences, over the theory's
+# return map's fixed points (its Fig. 3b); and
 # where anti-phase sets in, against the stability of the anti-phase fixed
 # point |f'(pi)|, at r = 0.67 (the rig's) and r = 0.9 (where d~_c moves).
 #
@@ -228,7 +229,7 @@ gp_class() {
 	echo "using ((\$$C_R == $1 && ($2)) ? \$$C_DSEP : 1/0):(abs(\$$C_DELTA))"
 }
 
-# plot_steady FIG TMP: pair.png (Fig. 3b): |delta| at the end against d~,
+# plot_steady FIG TMP: pair.png (the paper's Fig. 5b): |delta| at the end against d~,
 # one point per run coloured by its end state, over the theory's fixed
 # points: the compatible set (shaded, bounded by 2 asin(d~)), anti-phase pi
 # (solid where stable), the third fixed point (dashed: the basins' boundary).
@@ -270,7 +271,7 @@ plot_steady() {
 	fig_gnuplot "$t/steady.gp"
 }
 
-# plot_onset FIG TMP: pair-onset.png (Fig. 3c): |f'(pi)| against d~ (anti-
+# plot_onset FIG TMP: pair-onset.png (the paper's Fig. 5c): |f'(pi)| against d~ (anti-
 # phase stable below 1), the cumulative share of the runs that ended in
 # anti-phase, and per bin of d~ the share of runs that did, measured and
 # where the map leads from each run's delta0.
@@ -389,9 +390,9 @@ fragment() {
 	speed=$(awk -F, 'NR > 1 && $19 != "" { print $19 }' "$t/pair.csv" | median)
 	secs=$(awk -F, 'NR == 2 { print $6 }' "$t/pair.csv")
 	cat <<EOF
-## Pair rig: the steady state against d̃ (Fig. 3b), where anti-phase sets in (Fig. 3c)
+## Pair rig: the steady state against d̃ (the paper's Fig. 5b), where anti-phase sets in (Fig. 5c)
 
-![Fig. 3b: |Δ| at the end of each run against d̃, over the return map's fixed points](figures/pair.png)
+![Fig. 5b: |Δ| at the end of each run against d̃, over the return map's fixed points (Fig. 3b)](figures/pair.png)
 
 **What ran.** $nall runs of the paper's pair rig as \`e2e_pair\` runs it
 (\`sim-bridge/scenarios/pair-rig.scenario\`: two single-joint robots on immobile bases, the
@@ -440,7 +441,7 @@ neither in phase, compatible nor anti-phase graze at the compatibility limit (th
 circles on 2·asin(d̃)): the limit is a fixed point of the map, and a pair that reaches it
 from above touches now and then, so the analyser counts it as still colliding.
 
-![Fig. 3c: |f′(π)|, the cumulative share of anti-phase runs, and the share per bin, against d̃](figures/pair-onset.png)
+![Fig. 5c: |f′(π)|, the cumulative share of anti-phase runs, and the share per bin, against d̃](figures/pair-onset.png)
 
 **Where the runs and the map disagree.** The map (theory.md) is for two phase oscillators of
 fixed amplitude; from a run's d̃ and Δ₀ it says where the pair ends (\`undulate-analyze

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# figures/returnmap/fig.sh — the return map at d~ = 0: the phase difference
+# figures/returnmap/fig.sh — the return map at d~ = 0 (the paper's Fig. 5a
+# measures the pair rig's return map): the phase difference
 # after a collision, Delta_{n+1}, against the one before, Delta_n, beside
 # theory.md's closed form -2 atan(r tan(Delta_n / 2)); and Delta_n against
 # n beside 2 atan((-r)^n tan(Delta_0 / 2)), at r = 0.67 and 0.9.
@@ -238,7 +239,7 @@ fragment() {
 	secs=$(awk 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^seconds=/) { sub("seconds=", "", $i); print $i } }' "$runs"/*/run.info 2>/dev/null |
 		sort -g | awk '{ a[NR] = $1 } END { if (NR) printf "%.1f", a[int((NR + 1) / 2)] }')
 	cat <<EOF
-## The return map at d̃ = 0
+## The return map at d̃ = 0 (the paper's Fig. 5a)
 
 ![Δₙ₊₁ against Δₙ at every collision, at d̃ = 0, beside the closed form](figures/returnmap.png)
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# figures/rows/fig.sh — rows of oscillators (the paper's lattice, its Fig. 4)
+# figures/rows/fig.sh — rows of oscillators (the paper's lattices, its Figs. 6
+# and 7: per-pair results against d~, Fig. 6c; relaxation against beta, 7b)
 # through the real daemons in lockstep: ten single-joint robots in a row with
 # fixed ends (sim-bridge/scenarios/lattice10.scenario), each joint driven by
 # the oscillator's torque as on the pair rig, started on the clock at random
@@ -254,11 +255,11 @@ fragment() {
 	local fig=$1 csv="$1/rows.csv" n
 	n=$(($(wc -l <"$csv") - 1))
 	{
-		echo "## Rows of oscillators: immobile against mobile bases (the paper's Fig. 4)"
+		echo "## Rows of oscillators: immobile against mobile bases (the paper's Figs. 6c and 7b)"
 		echo
-		echo "![collisions and compatibility error against d̃, immobile and mobile rows](figures/rows.png)"
+		echo "![Fig. 6c: collisions and compatibility error against d̃, immobile and mobile rows](figures/rows.png)"
 		echo
-		echo "![relaxation time against mobility](figures/rows_relax.png)"
+		echo "![Fig. 7b: relaxation time against mobility](figures/rows_relax.png)"
 		echo
 		echo "What ran: $n lockstep runs of \`sim-bridge/scenarios/lattice10.scenario\`: ten single-joint"
 		echo "robots in a row with walls at both ends, r = 0.67, joints driven by the oscillator's torque"

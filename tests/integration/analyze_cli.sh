@@ -111,6 +111,10 @@ tap_check "--frequency 0.4 (wrong): r1:r2 no longer at 0.4 rad" \
 	awk -v d="$(col "$T/fq4" r1:r2 spread)" 'BEGIN { exit !(d > 0.1) }'
 "$A" "$T/s.log" --out "$T/fq0" --frequency 0 2>"$T/fq0.err"; rc=$?
 tap_check "--frequency 0: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'frequency must be' '$T/fq0.err'"
+# --plane-every S: plane.csv's spacing; a negative one is refused (a row
+# world's log has no plane.csv: test_analyze_logs checks the files' content)
+"$A" "$T/s.log" --out "$T/pe" --plane-every -1 2>"$T/pe.err"; rc=$?
+tap_check "--plane-every -1: exit 1, saying so" bash -c "[ $rc = 1 ] && grep -q 'plane-every must be' '$T/pe.err'"
 
 # --theory: the theory's curves as CSV (tools/analyze/theory.c), checked
 # against theory.md's formulas at known points.

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# figures_modules.sh — the rows, channel and forces modules of `make figures`
+# figures_modules.sh — the rows, channel, forces, swimmer and channel-plane
+# modules of `make figures`
 # (figures/<name>/fig.sh): their job lists are the same every time, with
 # unique run names and seeds; bad arguments get one clear line and exit 2;
 # each merge, on a fixed small set of result rows written here, writes its
 # CSV, its pictures with the data drawn (the data colours' pixels counted by
 # tests/tools/pngdata: a picture that exists is not a picture that shows
 # data) and its fragment with the numbers those rows give; a merge without
-# results or without gnuplot fails with a message; and the three modules'
-# tiny set (FIG_TINY=1, 4 short lockstep runs, one of them from /) through the
+# results or without gnuplot fails with a message; and the five modules'
+# tiny set (FIG_TINY=1, 6 short lockstep runs, one of them from /) through the
 # driver onto a page.
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures"
@@ -27,8 +28,9 @@ result() {
 
 # ---- jobs ---------------------------------------------------------------------------
 # the seed's field in a job line: the last but for forces (SLOPE SEED END)
-for m in rows channel forces; do
-	sf=NF; [ "$m" = forces ] && sf=3
+# and channel-plane (WIDTH SEED ENDS)
+for m in rows channel forces swimmer channel-plane; do
+	sf=NF; [ "$m" = forces ] || [ "$m" = channel-plane ] && sf=3
 	a=$("$F/$m/fig.sh" jobs) b=$("$F/$m/fig.sh" jobs) q=$("$F/$m/fig.sh" jobs --quick)
 	ids=$(awk '{ print $1 }' <<<"$a" | sort | uniq -d)
 	bad=$(awk '$1 !~ /^[A-Za-z0-9_.-]+$/' <<<"$a")
@@ -51,6 +53,10 @@ refused "rows: d~ abc" "DSEP: want a number" "$F/rows/fig.sh" run "$T/bad" abc 0
 refused "rows: 5 s (shorter than the switch and the window)" "SECONDS: want a whole number from 14" "$F/rows/fig.sh" run "$T/bad" 0.5 0 5 1
 refused "channel: width 0" "WIDTH_CM: want a number from 5 to 60" "$F/channel/fig.sh" run "$T/bad" 0 1
 refused "channel: missing seed" "run OUTDIR WIDTH_CM SEED" "$F/channel/fig.sh" run "$T/bad" 20
+refused "channel-plane: width 50" "WIDTH_CM: want a number from 10 to 40" "$F/channel-plane/fig.sh" run "$T/bad" 50 1
+refused "channel-plane: ends 'open'" "ENDS: want ends or none" "$F/channel-plane/fig.sh" run "$T/bad" 20 1 open
+refused "swimmer: mode 'clock'" "MODE: want oscillator or sinusoid" "$F/swimmer/fig.sh" run "$T/bad" clock 20 1
+refused "swimmer: 5 s (shorter than settling and the picture)" "SECONDS: want a whole number from 12" "$F/swimmer/fig.sh" run "$T/bad" oscillator 5 1
 refused "an unknown subcommand" "usage: fig.sh" "$F/rows/fig.sh" draw
 [ ! -e "$T/bad" ] && tap_ok "no run folder made by a refused run" || tap_fail "no run folder made by a refused run"
 
@@ -130,6 +136,75 @@ if grep -qF '| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 2 |
 	tap_ok "channel.md: per width the pairs at or below 2 asin(d~), anti-phase counted"
 else tap_fail "channel.md numbers" "$(grep -E '^\||In all' "$T/fig/channel.md")"; fi
 
+# ---- channel-plane: merge on fixed rows --------------------------------------------------
+H="width_cm,nominal_dsep,seed,pair,class,mean_delta,mean_abs_delta,spread,window_collisions,collisions,impulse,distance_m,dsep,compat_limit,swing_a,swing_b,dy_m,sweep_a_m,sweep_b_m,min_swing_rad,wall_s,ends"
+result channel-plane w16cm-t1 "$H" "16,0.5362,1,r1:r2,compatible,1.0,1.0,0.1,0,30,3,0.16,0.55,1.1645,1.6,1.6,0.01,0.30,0.32,1.5,20,ends" \
+	"16,0.5362,1,r2:r3,still-colliding,-1.2,1.2,0.2,3,40,3,0.17,0.57,1.2130,1.6,1.6,0.02,0.32,0.34,1.5,20,ends" \
+	"16,0.5362,1,r3:r4,in-phase,0.1,0.1,0.1,0,20,2,0.15,0.50,1.0472,1.6,1.6,0.03,0.34,0.36,1.5,20,ends"
+result channel-plane w16cm-t2 "$H" "16,0.5362,2,r1:r2,compatible,0.8,0.8,0.1,0,30,3,0.16,0.52,1.0940,1.6,1.6,0.01,0.30,0.30,1.5,22,ends" \
+	"16,0.5362,2,r2:r3,anti-phase,3.1,3.1,0.1,9,90,9,0.17,0.60,1.2870,1.6,1.6,0.01,0.30,0.30,1.5,22,ends" \
+	"16,0.5362,2,r3:r4,compatible,-0.9,0.9,0.1,0,20,2,0.15,0.57,1.2130,1.6,1.6,0.01,0.30,0.30,1.5,22,ends"
+result channel-plane w24cm-t1 "$H" "24,0.8043,1,r1:r2,compatible,1.5,1.5,0.1,0,30,3,0.24,0.80,1.8546,1.6,1.6,0.01,0.30,0.30,1.5,18,ends" \
+	"24,0.8043,1,r2:r3,compatible,1.7,1.7,0.1,0,40,3,0.25,0.84,1.9736,1.6,1.6,0.01,0.30,0.30,1.5,18,ends" \
+	"24,0.8043,1,r3:r4,compatible,-1.6,1.6,0.1,0,20,2,0.23,0.78,1.7926,1.6,1.6,0.01,0.30,0.30,1.5,18,ends"
+result channel-plane noends-w20cm-t1 "$H" "20,0.6702,5,r1:r2,compatible,0.5,0.5,0.1,0,10,1,0.2,0.6,1.2870,1.6,1.6,0.10,0.3,0.3,1.5,18,none" \
+	"20,0.6702,5,r2:r3,compatible,0.6,0.6,0.1,0,10,1,0.2,0.6,1.2870,1.6,1.6,0.05,0.3,0.3,1.5,18,none" \
+	"20,0.6702,5,r3:r4,still-colliding,2.0,2.0,0.1,2,10,1,0.2,0.6,1.2870,1.6,1.6,0.20,0.3,0.3,1.5,18,none"
+# the frames of the narrowest and the widest run: four straight robots a width apart, walls
+for id in w16cm-t1 w24cm-t1; do
+	w=${id#w}; w=${w%%cm*}
+	awk -v w="$w" 'BEGIN { print "moment,kind,index,x,y,angle_or_bx,length_or_by,robot_index"; d = w / 100
+		n = split("2 5 15 32", m, " ")
+		for (i = 1; i <= n; i++) {
+			for (r = 0; r < 4; r++) for (k = 0; k < 3; k++)
+				printf "%s,link,%d,%.4f,%.4f,1.5708,0.1865,%d\n", m[i], k, (r - 1.5) * d, 0.1865 * (1 - k), r
+			printf "%s,wall,0,%.3f,-0.305,%.3f,0.305,-1\n", m[i], -2 * d, -2 * d
+			printf "%s,wall,1,%.3f,-0.305,%.3f,0.305,-1\n", m[i], 2 * d, 2 * d
+		} }' >"$T/runs/channel-plane/$id/frames.csv"
+done
+if "$F/channel-plane/fig.sh" merge "$T/runs/channel-plane" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "channel-plane: merge"
+else tap_fail "channel-plane: merge" "$(cat "$T/merge.out")"; fi
+blue=$(pixels 1f77b4 "$T/fig/channel-plane.png") green=$(pixels 2ca02c "$T/fig/channel-plane.png") grey=$(pixels 888888 "$T/fig/channel-plane.png")
+if [ "${blue:-0}" -ge 150 ] && [ "${green:-0}" -ge 80 ] && [ "${grey:-0}" -ge 40 ]; then tap_ok "channel-plane.png: both widths' pairs and the control drawn ($blue, $green, $grey pixels)"
+else tap_fail "channel-plane.png shows its data" "16 cm $blue, 24 cm $green, control $grey pixels of their colours"; fi
+# gnuplot's first four line colours: one robot each
+r1=$(pixels 9400d3 "$T/fig/channel-plane-frames.png") r4=$(pixels e69f00 "$T/fig/channel-plane-frames.png")
+if [ "${r1:-0}" -ge 400 ] && [ "${r4:-0}" -ge 400 ]; then tap_ok "channel-plane-frames.png: the robots drawn in eight panels ($r1, $r4 pixels of two robots' colours)"
+else tap_fail "channel-plane-frames.png shows the robots" "robot 1 $r1, robot 4 $r4 pixels of their colours"; fi
+if grep -qF '| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 1 | 2 |' "$T/fig/channel-plane.md" &&
+	grep -q 'In all: 8 of 9 pairs ended at or below the compatibility curve .*, 1 in anti-phase, 1 more than 2π/3 apart' "$T/fig/channel-plane.md" &&
+	grep -q 'Without end walls.* 2 of 3 pairs ended at or below the curve, 0 in anti-phase, 1 still touched.* 0.100 m apart along the channel (median; up to 0.200 m), against 0.010 m with the ends' "$T/fig/channel-plane.md" &&
+	grep -q '^!\[.*\](figures/channel-plane-frames.png)' "$T/fig/channel-plane.md" && [ "$(wc -l <"$T/fig/channel-plane.csv")" = 13 ]; then
+	tap_ok "channel-plane.md: per width the pairs at or below 2 asin(d~), anti-phase counted, the control apart"
+else tap_fail "channel-plane.md numbers" "$(grep -E '^\||In all|Without' "$T/fig/channel-plane.md")"; fi
+
+# ---- swimmer: merge on fixed rows ---------------------------------------------------------
+H="mode,seed,seconds,freq1_hz,freq2_hz,amp1_rad,amp2_rad,lag_rad,lag_spread_rad,along_per_period_m,across_per_period_m,speed_m_s,turn_rad,periods,min_swing_rad,wall_s,sweep_m"
+result swimmer oscillator-s1 "$H" "oscillator,1,30,0.82,0.82,0.80,0.81,1.80,0.3,0.0140,0.0001,0.0115,0.2,20.5,1.6,10,0.18"
+result swimmer oscillator-s2 "$H" "oscillator,2,30,0.82,0.82,0.80,0.81,1.78,0.3,0.0146,-0.0001,0.0120,-0.3,20.5,1.6,10,0.20"
+result swimmer sinusoid-s1 "$H" "sinusoid,3,30,0.824,0.824,0.80,0.80,2.09,0.04,0.0116,0,0.0095,0.25,20.6,1.6,10,0.17"
+for id in oscillator-s1 oscillator-s2 sinusoid-s1; do
+	d="$T/runs/swimmer/$id"
+	awk 'BEGIN { print "t,joint1_rad,joint2_rad"; for (i = 0; i <= 500; i++) { t = 25 + i / 100
+		printf "%.2f,%.4f,%.4f\n", t, 0.8 * cos(5.15 * t), 0.8 * cos(5.15 * t - 2.09) } }' >"$d/joints.csv"
+	awk 'BEGIN { print "t,x,y,heading"; for (i = 0; i <= 300; i++) printf "%.1f,0,%.4f,1.5708\n", i / 10, 0.012 * i / 10 }' >"$d/path.csv"
+	awk 'BEGIN { print "utime,t,robot,robot_index,link,x,y,angle,length,width,centre_x,centre_y,heading"
+		for (t = 0; t <= 30; t += 5) for (k = 0; k < 3; k++)
+			printf "0,%d,\"r1\",0,%d,0,%.4f,1.5708,0.1865,0.032,0,%.4f,1.5708\n", t, k, 0.012 * t + 0.1865 * (1 - k), 0.012 * t }' >"$d/body.csv"
+done
+if "$F/swimmer/fig.sh" merge "$T/runs/swimmer" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "swimmer: merge"
+else tap_fail "swimmer: merge" "$(cat "$T/merge.out")"; fi
+blue=$(pixels 1f77b4 "$T/fig/swimmer.png") orange=$(pixels ff7f0e "$T/fig/swimmer.png") red=$(pixels d62728 "$T/fig/swimmer.png")
+if [ "${blue:-0}" -ge 1000 ] && [ "${orange:-0}" -ge 1000 ] && [ "${red:-0}" -ge 100 ]; then
+	tap_ok "swimmer.png: both joints' angles and the centre's path drawn ($blue, $orange, $red pixels)"
+else tap_fail "swimmer.png shows its data" "joint 1 $blue, joint 2 $orange, path $red pixels of their colours"; fi
+if grep -qF '| oscillator | 2 | 0.820 / 0.820 | 0.800 / 0.810 | 1.79 rad (103°) | 1.43 cm (1.40-1.46) | 0.00 cm | 1.18 cm/s | 0.25 rad | 0.190 m |' "$T/fig/swimmer.md" &&
+	grep -qF '| clock | 1 | 0.824 / 0.824 | 0.800 / 0.800 | 2.09 rad (120°) | 1.16 cm (1.16-1.16) | 0.00 cm | 0.95 cm/s | 0.25 rad | 0.170 m |' "$T/fig/swimmer.md" &&
+	grep -q 'with joint 2 1.79 rad (103°) behind joint 1 (2π/3: 2.09 rad)' "$T/fig/swimmer.md" &&
+	grep -q 'sweeps 0.190 m across its heading per period (.*0.222 m with' "$T/fig/swimmer.md" && [ "$(wc -l <"$T/fig/swimmer.csv")" = 4 ]; then
+	tap_ok "swimmer.md: per mode the gait, the lag and the swim per period, the lag beside the paper's 2 pi / 3"
+else tap_fail "swimmer.md numbers" "$(grep -E '^\||Beside' "$T/fig/swimmer.md")"; fi
+
 # ---- no results, no gnuplot ----------------------------------------------------------------
 mkdir -p "$T/empty"
 "$F/rows/fig.sh" merge "$T/empty" "$T/fig2" >"$T/out" 2>&1; rc=$?
@@ -146,7 +221,8 @@ else tap_fail "merge without gnuplot" "rc $rc: $(cat "$T/out")"; fi
 # ---- the tiny set through the driver: the channel's run from /, the rest by the driver -----
 # (FIG_TINY=1: one channel run, 32 s of four robots; two rows of ten robots, 14 and 16 s,
 # the first immobile, so the mobile series are left out; one force run, 60 s after the
-# tuner's 150 s of one robot.) The channel's run is the tiny set's own, made from / into
+# tuner's 150 s of one robot; one swimmer run, 12 s of one plane robot; one channel-plane
+# run, 32 s of four plane robots.) The channel's run is the tiny set's own, made from / into
 # the runs' folder first: the driver's --resume keeps it and runs the other three.
 if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyze" ] && command -v parallel >/dev/null 2>&1; then
 	export FIG_TINY=1 FIG_PORT_LO FIG_PORT_SPAN=8
@@ -163,15 +239,17 @@ if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyz
 	if [ ! -e "$R/channel/$id/demo/demo.lcmlog" ] && [ ! -e "$R/channel/$id/demo/states.csv" ] && [ -f "$R/channel/$id/demo/summary.json" ]; then
 		tap_ok "the run's LCM log and sample tables removed, its summary kept"
 	else tap_fail "large files removed" "$(ls "$R/channel/$id/demo" 2>&1 | tr '\n' ' ')"; fi
-	"$top/scripts/figures.sh" --only rows,channel,forces --resume --jobs 2 --runs "$R" --out "$T/tiny/docs" >"$T/tiny.out" 2>&1; rc=$?
-	if [ "$rc" = 0 ] && grep -q '3/3 runs done' "$T/tiny.out"; then tap_ok "the tiny set through the driver: 3 runs more, exit 0"
+	"$top/scripts/figures.sh" --only rows,channel,forces,swimmer,channel-plane --resume --jobs 2 --runs "$R" \
+		--out "$T/tiny/docs" >"$T/tiny.out" 2>&1; rc=$?
+	if [ "$rc" = 0 ] && grep -q '5/5 runs done' "$T/tiny.out"; then tap_ok "the tiny set through the driver: 5 runs more, exit 0"
 	else tap_fail "the tiny set through the driver" "rc $rc: $(tail -n 8 "$T/tiny.out")"; fi
 	P="$T/tiny/docs/FIGURES.md" G="$T/tiny/docs/figures"
 	order=$(grep -o '^<a id="[a-z]*">' "$P" 2>/dev/null | tr -dc 'a-z\n' | sed 's/^aid//' | tr '\n' ' ')
-	if [ "$order" = "rows channel forces " ] && grep -qE '^\| \[rows\]\(#rows\) \| 2 \(0\) \|' "$P" &&
-		grep -qE '^\| \[channel\]\(#channel\) \| 1 \(0\) \|' "$P" && grep -qE '^\| \[forces\]\(#forces\) \| 1 \(0\) \|' "$P"; then
-		tap_ok "FIGURES.md: the three sections in the page's order, each in the header's table with its runs"
-	else tap_fail "FIGURES.md: the three sections and the table" "order '$order': $(grep '^| \[' "$P" 2>&1)"; fi
+	if [ "$order" = "rows channel swimmer channel-plane forces " ] && grep -qE '^\| \[rows\]\(#rows\) \| 2 \(0\) \|' "$P" &&
+		grep -qE '^\| \[channel\]\(#channel\) \| 1 \(0\) \|' "$P" && grep -qE '^\| \[forces\]\(#forces\) \| 1 \(0\) \|' "$P" &&
+		grep -qE '^\| \[swimmer\]\(#swimmer\) \| 1 \(0\) \|' "$P" && grep -qE '^\| \[channel-plane\]\(#channel-plane\) \| 1 \(0\) \|' "$P"; then
+		tap_ok "FIGURES.md: the five sections in the page's order, each in the header's table with its runs"
+	else tap_fail "FIGURES.md: the five sections and the table" "order '$order': $(grep '^| \[' "$P" 2>&1)"; fi
 	red=$(pixels d62728 "$G/rows.png") blue=$(pixels 1f77b4 "$G/rows.png")
 	if [ "${red:-0}" -ge 60 ] && [ "${blue:-0}" = 0 ]; then tap_ok "rows.png: the immobile run drawn ($red pixels), the empty mobile series left out"
 	else tap_fail "rows.png: immobile drawn, mobile left out" "immobile $red, mobile $blue pixels"; fi
@@ -179,6 +257,21 @@ if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyz
 	tap_check "rows_relax.png: the censored relaxation run drawn ($red pixels)" test "${red:-0}" -ge 60
 	n=$(coloured "$G/forces_time.png")
 	tap_check "forces_time.png: the run's force per second drawn ($n coloured pixels)" test "${n:-0}" -ge 500
+	# the plane modules' real runs: a gait near the tuned 0.8 Hz and 0.8 rad, the robot
+	# swimming head first; four robots drawn from the run's own frames
+	s="$R/swimmer/oscillator-t0/result.csv"
+	if awk -F, 'NR == 2 { exit !($4 > 0.7 && $4 < 0.95 && $6 > 0.7 && $6 < 0.9 && $8 > 1.2 && $8 < 2.4 && $10 > 0.005 && $17 > 0.1 && $17 < 0.3) }' "$s" 2>/dev/null; then
+		tap_ok "swimmer: a real run: $(awk -F, 'NR == 2 { printf "%.2f Hz, %.2f rad, joint 2 %.0f deg behind, %.2f cm a period, %.3f m wide", $4, $6, $8 * 57.2958, 100 * $10, $17 }' "$s")"
+	else tap_fail "swimmer: a real run's gait and swim" "$(cat "$s" 2>&1)"; fi
+	blue=$(pixels 1f77b4 "$G/swimmer.png") red=$(pixels d62728 "$G/swimmer.png")
+	tap_check "swimmer.png: the run's joints and path drawn ($blue, $red pixels)" test "${blue:-0}" -ge 1000 -a "${red:-0}" -ge 20
+	c="$R/channel-plane/w20cm-t0"
+	if [ "$(wc -l <"$c/result.csv" 2>/dev/null)" = 4 ] && awk -F, 'NR > 1 && !($13 > 0.05 && $13 < 2 && $15 > 0.2 && $16 > 0.2 && $18 > 0.1 && $22 == "ends") { bad = 1 } END { exit bad }' "$c/result.csv" &&
+		[ "$(grep -c ',link,' "$c/frames.csv")" = 48 ] && [ ! -e "$c/demo/plane.csv" ]; then
+		tap_ok "channel-plane: a real run: three pairs with d~, bound, swings and sweeps; 48 links in its frames; plane.csv removed"
+	else tap_fail "channel-plane: a real run" "$(cat "$c/result.csv" 2>&1 | head -4); $(grep -c ',link,' "$c/frames.csv" 2>&1) links"; fi
+	r1=$(pixels 9400d3 "$G/channel-plane-frames.png")
+	tap_check "channel-plane-frames.png: the run's robots drawn ($r1 pixels of one robot's colour)" test "${r1:-0}" -ge 100
 else
 	tap_skip "the tiny set through the driver" "the programs or GNU parallel are missing"
 fi

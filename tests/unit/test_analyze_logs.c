@@ -459,6 +459,107 @@ static void test_plots(void **state)
 	assert_false(is_png("pl", "return_map_0.png")); /* r1:r2 never touch */
 }
 
+/* One row of plane.csv: utime,t,robot,robot_index,link,x,y,angle,length,
+ * width,centre_x,centre_y,heading. */
+struct plane_row {
+	double t, x, y, angle, length, cx, cy, heading;
+	int robot, index, link;
+};
+
+static int plane_row_parse(const char *line, struct plane_row *r)
+{
+	long long utime;
+	double width;
+	return sscanf(line, "%lld,%lf,\"r%d\",%d,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &utime, &r->t, &r->robot,
+		      &r->index, &r->link, &r->x, &r->y, &r->angle, &r->length, &width, &r->cx, &r->cy,
+		      &r->heading) == 13;
+}
+
+/* Every row of DIR/plane.csv against the synthetic plane (synth_plane_links):
+ * the link's pose as logged, its robot's centre the mean of its links' centres
+ * (the neutral position, moving along +y), its heading +y; samples EVERY s
+ * apart. Returns the rows checked. */
+static long check_plane_csv(const char *dir, const struct synth_spec *s, double every)
+{
+	char p[512], line[512];
+	path_of(p, sizeof(p), dir, "plane.csv");
+	FILE *f = fopen(p, "r");
+	assert_non_null(f);
+	assert_non_null(fgets(line, sizeof line, f));
+	assert_string_equal(line, "utime,t,robot,robot_index,link,x,y,angle,length,width,centre_x,centre_y,heading\n");
+	long n = 0;
+	double last_t = -1.0;
+	while (fgets(line, sizeof line, f)) {
+		struct plane_row r;
+		assert_true(plane_row_parse(line, &r));
+		assert_true(r.robot >= 1 && r.robot <= SYNTH_ROBOTS && r.link >= 0 && r.link < SYNTH_LINKS);
+		double x[SYNTH_LINKS], y[SYNTH_LINKS], a[SYNTH_LINKS], mx = 0.0, my = 0.0;
+		synth_plane_links(s, r.robot - 1, r.t, x, y, a);
+		assert_float_equal(r.x, x[r.link], 1e-6);
+		assert_float_equal(r.y, y[r.link], 1e-6);
+		assert_float_equal(r.angle, a[r.link], 1e-6);
+		assert_float_equal(r.length, SYNTH_LINK_M, 1e-9);
+		for (int k = 0; k < SYNTH_LINKS; k++) {
+			mx += x[k] / SYNTH_LINKS;
+			my += y[k] / SYNTH_LINKS;
+		}
+		assert_float_equal(r.cx, mx, 1e-6);
+		assert_float_equal(r.cy, my, 1e-6);
+		assert_float_equal(r.cy, SYNTH_PLANE_SPEED * r.t, 1e-6);
+		assert_float_equal(r.heading, M_PI / 2.0, 1e-6);
+		if (r.t > last_t + 1e-9) {
+			/* a new sample: EVERY after the last (the log's 10 ms steps) */
+			if (last_t >= 0)
+				assert_float_equal(r.t - last_t, every, 0.011);
+			last_t = r.t;
+		}
+		n++;
+	}
+	fclose(f);
+	return n;
+}
+
+static void plane_every_half(struct an_options *o)
+{
+	o->plane_every_s = 0.5;
+}
+
+/* The plane world's SIM.TRUTH: plane.csv holds every link of every robot at
+ * the default 0.1 s (--plane-every), with its robot's centre and heading;
+ * plane_walls.csv the walls; a row world's log has neither file. */
+static void test_plane_csv(void **state)
+{
+	(void)state;
+	struct synth_spec s;
+	synth_default(&s);
+	s.duration_s = 10.0;
+	s.ncoll = 2;
+	s.plane = true;
+	write_synth("plane.log", &s);
+	assert_int_equal(run("plane.log", "plane", NULL), AN_EXIT_OK);
+	/* 0, 0.1, ..., 10 s: 101 samples of 4 robots' 3 links, 2 walls */
+	assert_int_equal(check_plane_csv("plane", &s, 0.1), 101 * SYNTH_ROBOTS * SYNTH_LINKS);
+	assert_int_equal(count_lines("plane", "plane_walls.csv"), 1 + 101 * 2);
+	char *w = slurp("plane", "plane_walls.csv");
+	assert_non_null(w);
+	assert_non_null(strstr(w, "utime,t,wall,ax,ay,bx,by\n"));
+	assert_non_null(strstr(w, ",0,-1,-1,-1,1\n"));
+	assert_non_null(strstr(w, ",1,1,-1,1,1\n"));
+	free(w);
+	/* the analysis otherwise as a row run's */
+	char *json = slurp("plane", "summary.json");
+	assert_non_null(json);
+	assert_string_equal(pair_has(json, "r1:r2", "\"class\":\"compatible\"") ? "compatible" : "other", "compatible");
+	free(json);
+	assert_int_equal(run("plane.log", "half", plane_every_half), AN_EXIT_OK);
+	assert_int_equal(check_plane_csv("half", &s, 0.5), 21 * SYNTH_ROBOTS * SYNTH_LINKS);
+	s.plane = false;
+	write_synth("row.log", &s);
+	assert_int_equal(run("row.log", "row", NULL), AN_EXIT_OK);
+	assert_int_equal(count_lines("row", "plane.csv"), -1);
+	assert_int_equal(count_lines("row", "plane_walls.csv"), -1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -473,6 +574,7 @@ int main(void)
 		cmocka_unit_test(test_json_path_escaped),
 		cmocka_unit_test(test_damaged_middle),
 		cmocka_unit_test(test_plots),
+		cmocka_unit_test(test_plane_csv),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -14,6 +14,7 @@
 #include "modes.h"
 #include "num.h"
 #include "outdir.h"
+#include "planecsv.h"
 #include "plot.h"
 #include "text.h"
 #include "theory.h"
@@ -152,6 +153,10 @@ struct an_ctx {
 	int dirfd, stagefd;
 	char stage[64];
 	FILE *states, *coll, *bus, *evt, *pdiff, *params;
+	/* the plane world (SIM.TRUTH with links): plane.csv, plane_walls.csv */
+	bool plane_seen;
+	struct pcsv_sampler plane_sampler;
+	FILE *plane_csv, *plane_walls_csv;
 	struct an_seen seen[AN_COLL_DEDUP];
 	int seen_next;
 	int64_t *bins, *bin_walls;
@@ -198,6 +203,7 @@ void an_options_default(struct an_options *o)
 	o->merge_s = 0.1;
 	o->min_swing = AN_MIN_SWING_DEFAULT;
 	o->frequency_hz = NAN;
+	o->plane_every_s = AN_PLANE_EVERY_DEFAULT;
 	o->msg = stderr;
 }
 
@@ -466,6 +472,8 @@ static void an_scan_state(struct an_ctx *c, const undulate_robot_state_t *m)
 static void an_scan_truth(struct an_ctx *c, const undulate_sim_truth_t *m)
 {
 	c->truth_msgs++;
+	if (m->world == UNDULATE_SIM_TRUTH_T_WORLD_PLANE && m->nlinks > 0)
+		c->plane_seen = true;
 	for (int i = 0; i < m->nbodies; i++) {
 		const undulate_sim_body_t *b = &m->bodies[i];
 		int ri = an_robot_find(c, b->robot, true);
@@ -986,6 +994,44 @@ static void an_on_params(struct an_ctx *c, const undulate_osc_params_t *m)
 		lcmdec_free(&lcmdec_##T, &m);                                     \
 	} while (0)
 
+/* The plane's links and walls, at most every --plane-every seconds. A
+ * link's robot is an index into the message's bodies (one per robot). */
+static void an_on_plane(struct an_ctx *c, const undulate_sim_truth_t *m)
+{
+	double t = an_t(c, m->utime);
+	if (!c->plane_csv || m->world != UNDULATE_SIM_TRUTH_T_WORLD_PLANE || !pcsv_take(&c->plane_sampler, t))
+		return;
+	for (int i = 0; i < m->nlinks; i++) {
+		const undulate_sim_link_t *l = &m->links[i];
+		double cx, cy, heading;
+		if (l->robot < 0 || l->robot >= m->nbodies ||
+		    !pcsv_robot_pose(m->links, m->nlinks, l->robot, &cx, &cy, &heading))
+			continue;
+		const char *name = m->bodies[l->robot].robot;
+		fprintf(c->plane_csv, "%lld,%.6f,", (long long)m->utime, t);
+		an_csv_str(c->plane_csv, name);
+		fprintf(c->plane_csv, ",%d,%d", an_robot_find(c, name, false), l->link);
+		an_csv_num(c->plane_csv, l->x);
+		an_csv_num(c->plane_csv, l->y);
+		an_csv_num(c->plane_csv, l->angle);
+		an_csv_num(c->plane_csv, l->length);
+		an_csv_num(c->plane_csv, l->width);
+		an_csv_num(c->plane_csv, cx);
+		an_csv_num(c->plane_csv, cy);
+		an_csv_num(c->plane_csv, heading);
+		fputc('\n', c->plane_csv);
+	}
+	for (int i = 0; i < m->nwalls; i++) {
+		const undulate_sim_wall_t *w = &m->walls[i];
+		fprintf(c->plane_walls_csv, "%lld,%.6f,%d", (long long)m->utime, t, i);
+		an_csv_num(c->plane_walls_csv, w->ax);
+		an_csv_num(c->plane_walls_csv, w->ay);
+		an_csv_num(c->plane_walls_csv, w->bx);
+		an_csv_num(c->plane_walls_csv, w->by);
+		fputc('\n', c->plane_walls_csv);
+	}
+}
+
 /* SIM.COLLISION is the per-collision channel; the copies inside SIM.TRUTH are
  * used only for logs without it (the simulator stamps those copies with the
  * truth message's time, so they cannot be matched to the originals). */
@@ -1073,6 +1119,7 @@ static void an_truth_collisions(struct an_ctx *c, const undulate_sim_truth_t *m)
 		c->bin_total[bin] = m->total_impulse;
 		c->bin_total_t[bin] = t;
 	}
+	an_on_plane(c, m);
 	if (c->collision_msgs > 0)
 		return;
 	for (int i = 0; i < m->ncollisions; i++)
@@ -1191,7 +1238,15 @@ static int an_open_outputs(struct an_ctx *c)
 	c->params = an_open_out(c, "params.csv",
 		"utime,t,robot,joint,k,c,mu,lambda,inertia,friction,neutral,limit_min,limit_max,"
 		"sin_amplitude,sin_frequency,sin_phase");
-	return c->states && c->coll && c->bus && c->evt && c->pdiff && c->params ? 0 : -1;
+	if (!c->states || !c->coll || !c->bus || !c->evt || !c->pdiff || !c->params)
+		return -1;
+	if (!c->plane_seen)
+		return 0;
+	pcsv_sampler_init(&c->plane_sampler, c->o->plane_every_s);
+	c->plane_csv = an_open_out(c, "plane.csv",
+		"utime,t,robot,robot_index,link,x,y,angle,length,width,centre_x,centre_y,heading");
+	c->plane_walls_csv = an_open_out(c, "plane_walls.csv", "utime,t,wall,ax,ay,bx,by");
+	return c->plane_csv && c->plane_walls_csv ? 0 : -1;
 }
 
 static int an_close_outputs(struct an_ctx *c)
@@ -1203,6 +1258,8 @@ static int an_close_outputs(struct an_ctx *c)
 	rc |= an_close_out(c, &c->evt, "events.csv");
 	rc |= an_close_out(c, &c->pdiff, "phase_diff.csv");
 	rc |= an_close_out(c, &c->params, "params.csv");
+	rc |= an_close_out(c, &c->plane_csv, "plane.csv");
+	rc |= an_close_out(c, &c->plane_walls_csv, "plane_walls.csv");
 	return rc;
 }
 

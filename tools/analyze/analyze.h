@@ -42,11 +42,16 @@ struct an_options {
 				  sample (the gait's known frequency; NAN: estimated) */
 	double min_swing;      /* rad p-p: a pair with a joint swinging less in the final
 				  window is "not-oscillating", whatever its phases say */
+	double plane_every_s;  /* plane.csv: the links' poses at most this often (s; 0:
+				  every SIM.TRUTH) */
 };
 
 /* Default of min_swing (rad peak-to-peak): the robots swing about 1.6 rad
  * p-p; a stopped AX-12 reads within a few 0.005 rad steps of one angle. */
 #define AN_MIN_SWING_DEFAULT 0.2
+/* Default of plane_every_s: ten poses a second draw a 0.8 Hz gait at 12 a
+ * cycle and keep a long run's plane.csv small (10 robots, 300 s: 9 MB). */
+#define AN_PLANE_EVERY_DEFAULT 0.1
 
 void an_options_default(struct an_options *o);
 /* Runs the whole analysis; returns an enum an_exit. */

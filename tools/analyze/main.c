@@ -17,7 +17,7 @@ static void usage(FILE *f)
 	fputs("usage: undulate-analyze LOG... [--out DIR] [--pairs a:b,...] [--plots]\n"
 	      "                        [--from S] [--to S] [--window S] [--separation D]\n"
 	      "                        [--restitution R] [--merge S] [--min-swing RAD] [--zero-crossings]\n"
-	      "                        [--frequency HZ]\n"
+	      "                        [--frequency HZ] [--plane-every S]\n"
 	      "                        [--quiet]\n"
 	      "       undulate-analyze --synth OUT.log [--duration S] [--synth-stop-after S]\n"
 	      "       undulate-analyze --record OUT.log [--lcm-url URL]\n"
@@ -25,7 +25,8 @@ static void usage(FILE *f)
 	      "                        [--separation D] [--delta0 RAD] [--steps N] [--points N]\n"
 	      "Reads lcm-logger logs and writes states.csv, collisions.csv, bus.csv, events.csv,\n"
 	      "phase_diff.csv, return_map.csv, collision_rate.csv, summary.txt, summary.json\n"
-	      "(and PNG plots with --plots) into DIR (default: current directory).\n"
+	      "(plane.csv and plane_walls.csv for a plane world's log; PNG plots with --plots)\n"
+	      "into DIR (default: current directory).\n"
 	      "  --pairs a:b,...   pairs to follow (default: neighbours by SIM.TRUTH position, else name)\n"
 	      "  --from/--to S     only events between S seconds after the log start\n"
 	      "  --window S        final window for the end-state classification (default 10)\n"
@@ -36,6 +37,8 @@ static void usage(FILE *f)
 	      "                    window is not-oscillating, whatever its phases (default 0.2)\n"
 	      "  --zero-crossings  phase from our own frequency estimate (centre crossings), not the daemon's\n"
 	      "  --frequency HZ    every joint's phase at this frequency from the first sample (no estimate)\n"
+	      "  --plane-every S   plane.csv: the links' poses every S seconds (default 0.1; 0: every\n"
+	      "                    SIM.TRUTH)\n"
 	      "  --synth OUT.log   write a synthetic log with known phases and collisions\n"
 	      "  --duration S      length of the synthetic log (default 45)\n"
 	      "  --synth-stop-after S  in the synthetic log, r3 and r4 stand still from S seconds on\n"
@@ -64,7 +67,7 @@ static int parse_double(const char *opt, const char *s, double *out)
 
 enum { OPT_OUT = 256, OPT_PAIRS, OPT_PLOTS, OPT_FROM, OPT_TO, OPT_WINDOW, OPT_SEP, OPT_REST,
        OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_MIN_SWING, OPT_STOP_AFTER, OPT_HELP,
-       OPT_RECORD, OPT_LCM_URL, OPT_FREQ, OPT_THEORY, OPT_DELTA0, OPT_STEPS, OPT_POINTS };
+       OPT_RECORD, OPT_LCM_URL, OPT_FREQ, OPT_THEORY, OPT_DELTA0, OPT_STEPS, OPT_POINTS, OPT_PLANE_EVERY };
 
 static const struct option long_opts[] = {
 	{ "out", required_argument, NULL, OPT_OUT },       { "pairs", required_argument, NULL, OPT_PAIRS },
@@ -76,7 +79,7 @@ static const struct option long_opts[] = {
 	{ "merge", required_argument, NULL, OPT_MERGE },   { "min-swing", required_argument, NULL, OPT_MIN_SWING },
 	{ "synth-stop-after", required_argument, NULL, OPT_STOP_AFTER },
 	{ "record", required_argument, NULL, OPT_RECORD }, { "lcm-url", required_argument, NULL, OPT_LCM_URL },
-	{ "frequency", required_argument, NULL, OPT_FREQ },
+	{ "frequency", required_argument, NULL, OPT_FREQ }, { "plane-every", required_argument, NULL, OPT_PLANE_EVERY },
 	{ "theory", required_argument, NULL, OPT_THEORY }, { "delta0", required_argument, NULL, OPT_DELTA0 },
 	{ "steps", required_argument, NULL, OPT_STEPS },   { "points", required_argument, NULL, OPT_POINTS },
 	{ "help", no_argument, NULL, OPT_HELP },
@@ -122,6 +125,7 @@ static int parse_option(int c, struct an_options *o, struct synth_args *sa)
 	case OPT_REST: return parse_double("--restitution", optarg, &o->restitution);
 	case OPT_MIN_SWING: return parse_double("--min-swing", optarg, &o->min_swing);
 	case OPT_FREQ: return parse_double("--frequency", optarg, &o->frequency_hz);
+	case OPT_PLANE_EVERY: return parse_double("--plane-every", optarg, &o->plane_every_s);
 	case OPT_SYNTH: sa->path = optarg; return 0;
 	case OPT_DURATION: return parse_double("--duration", optarg, &sa->duration);
 	case OPT_STOP_AFTER: return parse_double("--synth-stop-after", optarg, &sa->stop_after);
@@ -139,6 +143,8 @@ static int parse_option(int c, struct an_options *o, struct synth_args *sa)
 /* Highest --frequency: half the daemons' 100 Hz state rate (a phase needs
  * at least two samples a cycle). */
 #define AN_MAX_FREQUENCY_HZ 50.0
+/* Longest --plane-every: an hour (one pose of a long run). */
+#define AN_MAX_PLANE_EVERY_S 3600.0
 
 static int check_options(const struct an_options *o)
 {
@@ -160,6 +166,10 @@ static int check_options(const struct an_options *o)
 	}
 	if (!isnan(o->frequency_hz) && !(o->frequency_hz > 0 && o->frequency_hz <= AN_MAX_FREQUENCY_HZ)) {
 		fprintf(stderr, "undulate-analyze: --frequency must be > 0 and <= %g Hz\n", AN_MAX_FREQUENCY_HZ);
+		return -1;
+	}
+	if (!(o->plane_every_s >= 0 && o->plane_every_s <= AN_MAX_PLANE_EVERY_S)) {
+		fprintf(stderr, "undulate-analyze: --plane-every must be >= 0 and <= %g s\n", AN_MAX_PLANE_EVERY_S);
 		return -1;
 	}
 	if (isfinite(o->separation) && o->separation < 0) {

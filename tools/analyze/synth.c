@@ -91,6 +91,37 @@ static double synth_neutral(const struct synth_spec *s, int i)
 	return n[i];
 }
 
+void synth_plane_links(const struct synth_spec *s, int i, double t, double x[SYNTH_LINKS],
+		       double y[SYNTH_LINKS], double angle[SYNTH_LINKS])
+{
+	double phi[SYNTH_ROBOTS];
+	synth_phases(s, t, phi);
+	/* the joints' angles as synth_state publishes them */
+	double a1 = s->amplitude * cos(phi[i]), a2 = s->amplitude * cos(phi[i] - 2.0 * M_PI / 3.0);
+	double rel[SYNTH_LINKS] = { 0.0, a1, a1 + a2 }, sx = 0.0, sy = 0.0;
+	for (int k = 0; k < SYNTH_LINKS; k++) {
+		sx += cos(rel[k]);
+		sy += sin(rel[k]);
+	}
+	/* turned so that the links' mean direction is +y */
+	double head = M_PI / 2.0 - atan2(sy, sx);
+	double fx = 0.0, fy = 0.0, mx = 0.0, my = 0.0;
+	for (int k = 0; k < SYNTH_LINKS; k++) {
+		angle[k] = head + rel[k];
+		/* link k's front end is link k-1's rear end */
+		x[k] = fx - 0.5 * SYNTH_LINK_M * cos(angle[k]);
+		y[k] = fy - 0.5 * SYNTH_LINK_M * sin(angle[k]);
+		fx -= SYNTH_LINK_M * cos(angle[k]);
+		fy -= SYNTH_LINK_M * sin(angle[k]);
+		mx += x[k] / SYNTH_LINKS;
+		my += y[k] / SYNTH_LINKS;
+	}
+	for (int k = 0; k < SYNTH_LINKS; k++) {
+		x[k] += synth_neutral(s, i) - mx;
+		y[k] += SYNTH_PLANE_SPEED * t - my;
+	}
+}
+
 static int synth_state(const struct synth_spec *s, struct alog_writer *w, int i, int64_t cycle,
 		       int64_t utime, double phi, bool stopped)
 {
@@ -198,6 +229,24 @@ static int synth_truth(const struct synth_spec *s, struct alog_writer *w, int64_
 		.total_collisions = *count, .total_impulse = *impulse, .worst_lateness_us = 5.0,
 		.nbodies = SYNTH_ROBOTS, .bodies = bodies, .ncollisions = nc, .collisions = coll,
 	};
+	undulate_sim_link_t links[SYNTH_ROBOTS * SYNTH_LINKS];
+	undulate_sim_wall_t walls[2] = { { .ax = -1.0, .ay = -1.0, .bx = -1.0, .by = 1.0 },
+					 { .ax = 1.0, .ay = -1.0, .bx = 1.0, .by = 1.0 } };
+	if (s->plane) {
+		for (int i = 0; i < SYNTH_ROBOTS; i++) {
+			double x[SYNTH_LINKS], y[SYNTH_LINKS], a[SYNTH_LINKS];
+			synth_plane_links(s, i, t, x, y, a);
+			for (int k = 0; k < SYNTH_LINKS; k++)
+				links[i * SYNTH_LINKS + k] = (undulate_sim_link_t){ .robot = (int16_t)i,
+					.link = (int8_t)k, .x = x[k], .y = y[k], .angle = a[k],
+					.length = SYNTH_LINK_M, .width = 0.032 };
+		}
+		m.world = UNDULATE_SIM_TRUTH_T_WORLD_PLANE;
+		m.nlinks = SYNTH_ROBOTS * SYNTH_LINKS;
+		m.links = links;
+		m.nwalls = 2;
+		m.walls = walls;
+	}
 	return alog_write_sim_truth_t(w, "SIM.TRUTH", utime + SYNTH_LOG_LAG_US + 10, &m);
 }
 

@@ -16,7 +16,11 @@
  * collision involving them. r2:r3 then has one stopped robot, r3:r4 two.
  * SIM.TRUTH at every cycle carries the bodies and the collisions, which are
  * also sent on SIM.COLLISION (the analyser must count each once); the
- * copies in SIM.TRUTH carry the truth message's time, as the simulator's do. */
+ * copies in SIM.TRUTH carry the truth message's time, as the simulator's do.
+ * With plane set, SIM.TRUTH is the plane world's: every robot three links of
+ * SYNTH_LINK_M bent by its two joints' angles (synth_plane_links), its centre
+ * at x = its neutral position moving along +y at SYNTH_PLANE_SPEED, and two
+ * side walls at x = -1 and +1 m. */
 #ifndef UNDULATE_ANALYZE_SYNTH_H
 #define UNDULATE_ANALYZE_SYNTH_H
 
@@ -45,7 +49,12 @@ struct synth_spec {
 	int burst;             /* each r3:r4 contact reported as this many collisions, 1 ms apart */
 	double stop_after_s;   /* robots in stop_mask stand still from here on; < 0: never */
 	unsigned stop_mask;    /* bit i: robot i (r1 = bit 0) */
+	bool plane;            /* SIM.TRUTH of the plane world: links and walls */
 };
+
+#define SYNTH_LINKS 3             /* links of a plane robot (two joints) */
+#define SYNTH_LINK_M 0.1865       /* m, the paper's link */
+#define SYNTH_PLANE_SPEED 0.01    /* m/s: every robot's centre along +y */
 
 /* Robots that stop by default: r3 and r4. */
 #define SYNTH_STOP_DEFAULT_MASK 0xCu
@@ -55,6 +64,13 @@ void synth_default(struct synth_spec *s);
 double synth_delta34(const struct synth_spec *s, double t);
 /* The impulse (N*s) of collision number K (0-based) of the log. */
 double synth_impulse(int k);
+/* Robot I's links at time T in the plane log: centre (x, y) and direction
+ * (rad, rear to front; link 0 the head), each joint's angle being the next
+ * link's direction less its own; the links' centres average to the robot's
+ * centre (its neutral position, SYNTH_PLANE_SPEED * T), and the sum of their
+ * directions' unit vectors points along +y. */
+void synth_plane_links(const struct synth_spec *s, int i, double t, double x[SYNTH_LINKS],
+		       double y[SYNTH_LINKS], double angle[SYNTH_LINKS]);
 /* Writes the log (alog_writer_open: PATH's directory must be ours alone; what
  * has its name is replaced); returns the number of collisions written, or -1
  * with a one-line reason in ERR. */
