@@ -243,7 +243,7 @@ def world(devtools_port, url, png, kind, robots):
     cdp.call("Emulation.setDeviceMetricsOverride", width=1300, height=1100, deviceScaleFactor=1, mobile=False)
     cdp.call("Page.navigate", url=url)
     got = cdp.wait(f"""(() => {{ const c = document.getElementById('worldcanvas');
-        return c && c.dataset.kind === {json.dumps(kind)} && Number(c.dataset.robots) >= {int(robots)}; }})()""", 25)
+        return c && c.dataset.kind === {json.dumps(kind)} && Number(c.dataset.robots) >= {int(robots)}; }})()""", 40)
     time.sleep(1.0)  # a second of frames: marks appear and fade
     # in one evaluation, between two redraws: what was drawn and the pixels under it
     v = cdp.js("""(() => { const c = document.getElementById('worldcanvas'), ctx = c.getContext('2d');
