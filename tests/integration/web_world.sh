@@ -76,7 +76,7 @@ print(f"KIND {last['kind']} WALLS {len(last['walls'])} ROBOTS {len(r)} "
 EOF
 sed 's/^/# /' "$T/plane.frames"
 tap_check "the plane: frames carry the world ($(head -1 "$T/plane.frames"))" \
-	bash -c "awk '/^FRAMES/ { exit !(\$2 >= 20 && \$4 >= \$2 - 2) }' '$T/plane.frames'"
+	bash -c "awk '/^FRAMES/ { ok = \$2 >= 20 && \$4 >= \$2 - 2 } END { exit !ok }' '$T/plane.frames'"
 tap_check "the plane's world: 4 walls, 10 robots of 3 links each, contacts summed between frames ($(sed -n 2p "$T/plane.frames"))" \
 	grep -qE '^KIND plane WALLS 4 ROBOTS 10 LINKS 3 MARKS [1-9]' "$T/plane.frames"
 
@@ -97,7 +97,7 @@ tap_check "forged links, walls and contacts are refused and counted ($(cat "$T/r
 	jq -e '.index > 100 and .number > 100 and .overflow > 0' "$T/refused"
 tap_check "... and said in the server's log" grep -q 'SIM.TRUTH: .* refused so far' "$T/web.log"
 tap_check "... the server lives on, no robot was made by them ($before robots), frames keep coming ($(head -1 "$T/after.frames"))" \
-	bash -c "kill -0 $pid_web && [ \"\$(curl -s '$H/api/snapshot' | jq '.nrobots')\" = 10 ] && awk '/^FRAMES/ { exit !(\$2 >= 15) }' '$T/after.frames'"
+	bash -c "kill -0 $pid_web && [ \"\$(curl -s '$H/api/snapshot' | jq '.nrobots')\" = 10 ] && awk '/^FRAMES/ { ok = \$2 >= 15 } END { exit !ok }' '$T/after.frames'"
 
 # ---- headless chromium draws it ---------------------------------------------------------
 if [ -z "$browser" ]; then
