@@ -15,6 +15,15 @@ the standard library only (Debian packages no WebSocket module for python3).
       loads URL and prints whether the page offers commands ("VIEW
       commands=<bool> watching=<bool> buttons=<visible mode buttons>");
       takes a screenshot (PNG).
+  web_cdp.py world DEVTOOLS_PORT URL PNG KIND ROBOTS
+      loads URL, waits until the world view (canvas #worldcanvas) draws KIND
+      ("plane" or "row") with ROBOTS robots, then reads the canvas's own pixels
+      at every drawn robot's link centres (the page keeps them, in device
+      pixels) and prints "WORLD kind=K robots=N links=L marks=M", one
+      "ROBOT name colour matching/centres" line per robot (a centre matches
+      when its pixel is the robot's colour) and "COLOURED n" (robots with a
+      centre in their colour); takes a screenshot of the page (PNG) and of
+      the world view alone (PNG with .world before .png).
   web_cdp.py slow HOST PORT SECONDS
       opens a WebSocket to undulate-web and never reads from it: a browser that
       stopped reading. Exits after SECONDS.
@@ -226,6 +235,41 @@ def view(devtools_port, url, png):
         f.write(base64.b64decode(shot["data"]))
 
 
+def world(devtools_port, url, png, kind, robots):
+    """The world view as drawn: what the page says it drew, checked against the
+    canvas's pixels, and screenshots of the page and of the view."""
+    cdp = CDP(int(devtools_port))
+    cdp.call("Page.enable")
+    cdp.call("Emulation.setDeviceMetricsOverride", width=1300, height=1100, deviceScaleFactor=1, mobile=False)
+    cdp.call("Page.navigate", url=url)
+    got = cdp.wait(f"""(() => {{ const c = document.getElementById('worldcanvas');
+        return c && c.dataset.kind === {json.dumps(kind)} && Number(c.dataset.robots) >= {int(robots)}; }})()""", 40)
+    time.sleep(1.0)  # a second of frames: marks appear and fade
+    # in one evaluation, between two redraws: what was drawn and the pixels under it
+    v = cdp.js("""(() => { const c = document.getElementById('worldcanvas'), ctx = c.getContext('2d');
+        const rgb = (h) => { const e = document.createElement('canvas').getContext('2d'); e.fillStyle = h;
+            const s = e.fillStyle; return [1, 3, 5].map(i => parseInt(s.slice(i, i + 2), 16)); };
+        const near = (p, q) => p.every((v, i) => Math.abs(v - q[i]) <= 24);
+        return { kind: c.dataset.kind, robots: Number(c.dataset.robots), links: Number(c.dataset.links),
+                 marks: Number(c.dataset.marks),
+                 drawn: world.drawn.map(d => ({ name: d.name, color: d.color, n: d.centres.length,
+                     hit: d.centres.filter(([x, y]) => near([...ctx.getImageData(x, y, 1, 1).data].slice(0, 3),
+                                                            rgb(d.color))).length })) }; })()""")
+    print(f"WORLD ready={bool(got)} kind={v['kind']} robots={v['robots']} links={v['links']} marks={v['marks']}",
+          flush=True)
+    for d in v["drawn"]:
+        print(f"ROBOT {d['name']} {d['color']} {d['hit']}/{d['n']}", flush=True)
+    print(f"COLOURED {sum(1 for d in v['drawn'] if d['hit'] > 0)}", flush=True)
+    shot = cdp.call("Page.captureScreenshot", format="png")
+    with open(png, "wb") as f:
+        f.write(base64.b64decode(shot["data"]))
+    r = cdp.js("""(() => { const b = document.getElementById('worldcanvas').getBoundingClientRect();
+        return { x: b.left + window.scrollX, y: b.top + window.scrollY, width: b.width, height: b.height }; })()""")
+    shot = cdp.call("Page.captureScreenshot", format="png", clip=dict(r, scale=1), captureBeyondViewport=True)
+    with open(png[:-4] + ".world.png", "wb") as f:
+        f.write(base64.b64decode(shot["data"]))
+
+
 def slow(host, port, seconds):
     ws = WS(host, int(port), "/", "undulate", rcvbuf=4096)
     print("SLOW connected", flush=True)
@@ -278,4 +322,4 @@ def freeport():
 
 if __name__ == "__main__":
     cmd = sys.argv[1]
-    {"page": page, "view": view, "servos": servos, "slow": slow, "frames": frames, "say": say, "freeport": freeport}[cmd](*sys.argv[2:])
+    {"page": page, "view": view, "servos": servos, "world": world, "slow": slow, "frames": frames, "say": say, "freeport": freeport}[cmd](*sys.argv[2:])

@@ -467,6 +467,171 @@ static void test_bad_names(void **state)
 	assert_int_equal(top_robot_index(&model, long_ok), 1);
 }
 
+/* A plane SIM.TRUTH: robots named by bodies[], each link at x = robot index,
+ * link k at y = k / 10; two walls; CONTACTS as given. */
+static undulate_sim_truth_t plane_truth(undulate_sim_body_t *bodies, char (*names)[8], int nbodies,
+                                        undulate_sim_link_t *links, undulate_sim_wall_t *walls,
+                                        undulate_sim_contact_t *contacts, int ncontacts)
+{
+	for (int i = 0; i < nbodies; i++) {
+		snprintf(names[i], sizeof names[i], "p%d", i);
+		bodies[i] = (undulate_sim_body_t){ .robot = names[i], .servo_id = 1, .neutral = 0.2 * i };
+		for (int k = 0; k < 3; k++)
+			links[3 * i + k] = (undulate_sim_link_t){ .robot = (int16_t)i, .link = (int8_t)k, .x = i,
+				.y = k / 10.0, .angle = M_PI / 2 + 4 * M_PI, .length = 0.1865, .width = 0.032 };
+	}
+	walls[0] = (undulate_sim_wall_t){ -1, -0.32, -1, 0.32 };
+	walls[1] = (undulate_sim_wall_t){ 1, -0.32, 1, 0.32 };
+	return (undulate_sim_truth_t){ .world = UNDULATE_SIM_TRUTH_T_WORLD_PLANE, .wall_left = -1, .wall_right = 1,
+		.nbodies = nbodies, .bodies = bodies, .nlinks = 3 * nbodies, .links = links, .nwalls = 2,
+		.walls = walls, .ncontacts = ncontacts, .contacts = contacts };
+}
+
+/* The plane's world as the last SIM.TRUTH drew it: each robot's links by
+ * index, the walls, the contacts with their robots as the model's. */
+static void test_world_plane(void **state)
+{
+	(void)state;
+	feed_state("p2", 0, 0, 0, 10, 3);   /* p2 heard first: model index 0, body index 2 */
+	undulate_sim_body_t bodies[3];
+	char names[3][8];
+	undulate_sim_link_t links[9];
+	undulate_sim_wall_t walls[2];
+	undulate_sim_contact_t contacts[2] = {
+		{ .robot_a = 1, .link_a = 2, .robot_b = 2, .link_b = 0, .x = 0.5, .y = 0.1, .nx = 1, .ny = 0,
+		  .impulse = 0.01, .normal_impulse = 0.01, .force = 1.0, .impact = 1 },
+		{ .robot_a = 0, .link_a = 1, .robot_b = -1, .link_b = 1, .x = 0.9, .y = 0.2, .nx = NAN, .ny = 0,
+		  .impulse = 0.002, .force = 0.2, .impact = 0 },
+	};
+	undulate_sim_truth_t t = plane_truth(bodies, names, 3, links, walls, contacts, 2);
+	top_on_truth(&model, &t, 1.0);
+	const struct top_world *w = &model.world;
+	assert_int_equal(model.nrobots, 3);
+	assert_int_equal(w->truths, 1);
+	assert_true(w->plane);
+	assert_int_equal(w->nwalls, 2);
+	assert_true(w->walls[1].ax == 1 && w->walls[1].by == 0.32);
+	assert_true(w->wall_left == -1 && w->wall_right == 1);
+	const struct top_robot *p2 = &model.robots[top_robot_index(&model, "p2")];
+	assert_true(p2->links[0].have && p2->links[2].have && !p2->links[3].have);
+	assert_true(p2->links[1].x == 2 && p2->links[1].y == 0.1 && p2->links[1].length == 0.1865);
+	/* the angle wrapped: 4 pi + pi/2 -> pi/2 */
+	assert_true(fabs(p2->links[0].angle - M_PI / 2) < 1e-12);
+	assert_int_equal(w->ncontacts, 2);
+	assert_string_equal(model.robots[w->contacts[0].a].name, "p1");
+	assert_string_equal(model.robots[w->contacts[0].b].name, "p2");
+	assert_true(w->contacts[0].impact && w->contacts[0].force == 1.0 && w->contacts[0].link_a == 2);
+	assert_int_equal(w->contacts[1].b, -1);           /* a wall, its index in walls[] */
+	assert_int_equal(w->contacts[1].link_b, 1);
+	assert_true(w->contacts[1].nx == 0 && !w->contacts[1].impact);   /* a normal that is not finite: none */
+	assert_int_equal(w->bad_index + w->bad_number + w->overflow, 0);
+	/* the next message replaces the world: no links, the row's walls absent */
+	undulate_sim_truth_t row = { .nbodies = 3, .bodies = bodies, .wall_left = 0.5, .wall_right = 0.5 };
+	top_on_truth(&model, &row, 1.01);
+	assert_false(w->plane);
+	assert_false(p2->links[0].have);
+	assert_int_equal(w->nwalls + w->ncontacts, 0);
+	assert_true(isnan(w->wall_left) && isnan(w->wall_right));
+	assert_int_equal(w->bad_index + w->bad_number + w->overflow, 0);
+}
+
+/* Links, walls and contacts from the network that name what the message does
+ * not hold, or carry numbers no arena has, are refused and counted, never kept
+ * and never indexed with. */
+static void test_world_hostile(void **state)
+{
+	(void)state;
+	undulate_sim_body_t bodies[3];
+	char names[3][8];
+	undulate_sim_link_t links[9];
+	undulate_sim_wall_t walls[2];
+	undulate_sim_truth_t t = plane_truth(bodies, names, 3, links, walls, NULL, 0);
+	/* body 1 is no robot's name: its links and contacts have no robot */
+	snprintf(names[1], sizeof names[1], "*");
+	/* indices: a robot beyond bodies[], negative, a link beyond a robot's */
+	links[0].robot = 3;
+	links[1].robot = -1;
+	links[2].link = TOP_MAX_LINKS;
+	links[6].link = -1;
+	/* numbers: NaN, inf, beyond the extent, a zero and a huge size */
+	links[7].x = NAN;
+	links[8].angle = INFINITY;
+	undulate_sim_link_t more[6] = {
+		{ .robot = 2, .link = 0, .x = 1e9, .y = 0, .length = 0.1, .width = 0.01 },
+		{ .robot = 2, .link = 0, .x = 0, .y = -INFINITY, .length = 0.1, .width = 0.01 },
+		{ .robot = 2, .link = 0, .x = 0, .y = 0, .length = 0, .width = 0.01 },
+		{ .robot = 2, .link = 0, .x = 0, .y = 0, .length = 0.1, .width = 1e30 },
+		{ .robot = 2, .link = 0, .x = 0, .y = 0, .length = NAN, .width = 0.01 },
+		{ .robot = 2, .link = 1, .x = 0.5, .y = 0.25, .angle = 1e300, .length = 0.1, .width = 0.01 },
+	};
+	undulate_sim_link_t all[15];
+	memcpy(all, links, sizeof links);
+	memcpy(all + 9, more, sizeof more);
+	t.nlinks = 15;
+	t.links = all;
+	undulate_sim_wall_t wall_bad[TOP_WORLD_WALLS + 3];
+	for (int i = 0; i < TOP_WORLD_WALLS + 3; i++)
+		wall_bad[i] = (undulate_sim_wall_t){ 0, 0, 1, 1 };
+	wall_bad[0].ax = NAN;
+	wall_bad[1].by = -1e6;
+	t.walls = wall_bad;
+	t.nwalls = TOP_WORLD_WALLS + 3;   /* one beyond what is kept, after the two refused */
+	t.wall_left = NAN;
+	undulate_sim_contact_t c[] = {
+		{ .robot_a = 3, .robot_b = 0, .x = 0, .y = 0 },            /* a beyond bodies[] */
+		{ .robot_a = 0, .robot_b = 7, .x = 0, .y = 0 },            /* b beyond */
+		{ .robot_a = 0, .robot_b = 1, .x = 0, .y = 0 },            /* b: no robot's name */
+		{ .robot_a = -1, .robot_b = 0, .x = 0, .y = 0 },           /* a wall as a */
+		{ .robot_a = 0, .link_a = 9, .robot_b = 2, .x = 0, .y = 0 },
+		{ .robot_a = 0, .robot_b = 2, .link_b = -1, .x = 0, .y = 0 },
+		{ .robot_a = 0, .robot_b = -1, .link_b = TOP_WORLD_WALLS + 3, .x = 0, .y = 0 }, /* a wall beyond walls[] */
+		{ .robot_a = 0, .robot_b = 2, .x = NAN, .y = 0 },
+		{ .robot_a = 0, .robot_b = 2, .x = 0, .y = 1e200 },
+		{ .robot_a = 0, .robot_b = 2, .x = 0, .y = 0, .force = -1 },
+		{ .robot_a = 0, .robot_b = 2, .x = 0, .y = 0, .impulse = INFINITY },
+		{ .robot_a = 0, .robot_b = 2, .x = 0.1, .y = 0.2, .force = 2, .impulse = 0.02 },  /* the good one */
+	};
+	t.contacts = c;
+	t.ncontacts = (int32_t)(sizeof c / sizeof c[0]);
+	top_on_truth(&model, &t, 1.0);
+	const struct top_world *w = &model.world;
+	assert_int_equal(model.nrobots, 2);                     /* "*" made none */
+	const struct top_robot *p0 = &model.robots[top_robot_index(&model, "p0")];
+	const struct top_robot *p2 = &model.robots[top_robot_index(&model, "p2")];
+	for (int k = 0; k < TOP_MAX_LINKS; k++)
+		assert_false(p0->links[k].have);                  /* 0: robot 3, 1: robot -1, 2: link 5 */
+	assert_false(p2->links[0].have);                      /* link -1; 7 NaN; every "more" one refused */
+	assert_false(p2->links[2].have);                      /* angle inf */
+	assert_true(p2->links[1].have && fabs(p2->links[1].angle) <= M_PI);   /* 1e300 wrapped */
+	assert_int_equal(w->bad_index, 3 + 4 + 7);            /* p1's three links; links 0, 1, 2, 6; seven contacts */
+	assert_int_equal(w->bad_number, 2 + 5 + 2 + 1 + 4);   /* links 7, 8; five "more"; two walls; wall_left; four contacts */
+	assert_int_equal(w->nwalls, TOP_WORLD_WALLS);
+	assert_int_equal(w->overflow, 1);
+	assert_true(isnan(w->wall_left));
+	assert_int_equal(w->ncontacts, 1);
+	assert_int_equal(w->contacts[0].a, top_robot_index(&model, "p0"));
+	/* more contacts than kept: the rest counted; a negative count is none */
+	static undulate_sim_contact_t many[TOP_WORLD_CONTACTS + 5];
+	for (int i = 0; i < TOP_WORLD_CONTACTS + 5; i++)
+		many[i] = (undulate_sim_contact_t){ .robot_a = 0, .robot_b = 2, .force = 1, .impulse = 0.01 };
+	undulate_sim_truth_t t2 = { .world = 7, .nbodies = 3, .bodies = bodies, .ncontacts = TOP_WORLD_CONTACTS + 5,
+		.contacts = many, .nlinks = -4, .links = NULL, .nwalls = -1, .walls = NULL };
+	int64_t over = w->overflow;
+	top_on_truth(&model, &t2, 1.01);
+	assert_int_equal(w->ncontacts, TOP_WORLD_CONTACTS);
+	assert_int_equal(w->overflow - over, 5);
+	assert_false(w->plane);                               /* an unknown kind: drawn as the row */
+	/* more bodies than mapped: a link naming one beyond is refused, not read past the map */
+	static undulate_sim_body_t crowd[TOP_WORLD_BODIES + 2];
+	for (int i = 0; i < TOP_WORLD_BODIES + 2; i++)
+		crowd[i] = bodies[2];
+	undulate_sim_link_t far = { .robot = TOP_WORLD_BODIES + 1, .link = 0, .x = 0, .y = 0, .length = 0.1, .width = 0.01 };
+	undulate_sim_truth_t t3 = { .nbodies = TOP_WORLD_BODIES + 2, .bodies = crowd, .nlinks = 1, .links = &far };
+	int64_t bad = w->bad_index;
+	top_on_truth(&model, &t3, 1.02);
+	assert_int_equal(w->bad_index - bad, 1);
+}
+
 static void test_empty_and_help(void **state)
 {
 	(void)state;
@@ -496,6 +661,8 @@ int main(void)
 		cmocka_unit_test_setup(test_render_twenty, setup),
 		cmocka_unit_test_setup(test_json, setup),
 		cmocka_unit_test_setup(test_json_hostile_text, setup),
+		cmocka_unit_test_setup(test_world_plane, setup),
+		cmocka_unit_test_setup(test_world_hostile, setup),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

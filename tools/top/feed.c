@@ -55,6 +55,8 @@ static void feed_apply(struct top_model *m, const struct lcmdec_type *t, const u
 		top_on_params(m, &u->params);
 	} else if (t == &lcmdec_sim_truth_t) {
 		top_on_truth(m, &u->truth, now);
+		if (h != NULL && h->on_truth != NULL)
+			h->on_truth(m, now, h->user);
 	} else if (t == &lcmdec_sim_collision_t) {
 		top_on_sim_collision(m, &u->collision, now);
 		if (h != NULL && h->on_collision != NULL)

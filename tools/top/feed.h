@@ -22,6 +22,8 @@ struct top_feed_hooks {
 	void (*on_event)(const undulate_event_t *e, void *user);
 	/* a collision on SIM.COLLISION, after the model took it */
 	void (*on_collision)(const undulate_sim_collision_t *c, double now, void *user);
+	/* a SIM.TRUTH, after the model took it (its world: m->world) */
+	void (*on_truth)(const struct top_model *m, double now, void *user);
 	void *user;
 };
 

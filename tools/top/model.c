@@ -15,6 +15,7 @@
 void top_model_init(struct top_model *m)
 {
 	memset(m, 0, sizeof(*m));
+	m->world.wall_left = m->world.wall_right = NAN;
 }
 
 int top_robot_index(const struct top_model *m, const char *name)
@@ -208,6 +209,127 @@ int top_trend(const struct top_model *m, int64_t *coll, double *force, int n)
 	return have;
 }
 
+/* ---- the world (SIM.TRUTH's links, walls and contacts) ----------------------------- */
+
+/* A coordinate of a place in an arena. */
+static bool top_world_place(double v)
+{
+	return isfinite(v) && fabs(v) <= TOP_WORLD_EXTENT_M;
+}
+
+static bool top_world_size(double v)
+{
+	return isfinite(v) && v > 0 && v <= TOP_WORLD_SIZE_M;
+}
+
+/* The model's robot of body index i of the message (-1: none: outside
+ * bodies[], beyond what is mapped, or not a robot's name). */
+static int top_world_robot(const int *body_robot, int nbodies, int i)
+{
+	if (i < 0 || i >= nbodies || i >= TOP_WORLD_BODIES)
+		return -1;
+	return body_robot[i];
+}
+
+static void top_world_links(struct top_model *m, const undulate_sim_truth_t *t, const int *body_robot)
+{
+	struct top_world *w = &m->world;
+	for (int i = 0; i < m->nrobots; i++)
+		for (int k = 0; k < TOP_MAX_LINKS; k++)
+			m->robots[i].links[k].have = false;
+	for (int i = 0; i < t->nlinks; i++) {
+		const undulate_sim_link_t *l = &t->links[i];
+		int r = top_world_robot(body_robot, t->nbodies, l->robot);
+		if (r < 0 || l->link < 0 || l->link >= TOP_MAX_LINKS) {
+			w->bad_index++;
+			continue;
+		}
+		if (!top_world_place(l->x) || !top_world_place(l->y) || !isfinite(l->angle) ||
+		    !top_world_size(l->length) || !top_world_size(l->width)) {
+			w->bad_number++;
+			continue;
+		}
+		m->robots[r].links[l->link] = (struct top_link){ .have = true, .x = l->x, .y = l->y,
+			.angle = remainder(l->angle, 2 * M_PI), .length = l->length, .width = l->width };
+	}
+}
+
+static void top_world_walls(struct top_world *w, const undulate_sim_truth_t *t)
+{
+	/* the row's walls: none when wall_left >= wall_right (sim-bridge/world.h) */
+	bool walls = top_world_place(t->wall_left) && top_world_place(t->wall_right) && t->wall_left < t->wall_right;
+	if (!walls && (!isfinite(t->wall_left) || !isfinite(t->wall_right)))
+		w->bad_number++;
+	w->wall_left = walls ? t->wall_left : NAN;
+	w->wall_right = walls ? t->wall_right : NAN;
+	w->nwalls = 0;
+	for (int i = 0; i < t->nwalls; i++) {
+		const undulate_sim_wall_t *s = &t->walls[i];
+		if (!top_world_place(s->ax) || !top_world_place(s->ay) || !top_world_place(s->bx) ||
+		    !top_world_place(s->by)) {
+			w->bad_number++;
+		} else if (w->nwalls == TOP_WORLD_WALLS) {
+			w->overflow++;
+		} else {
+			w->walls[w->nwalls].ax = s->ax;
+			w->walls[w->nwalls].ay = s->ay;
+			w->walls[w->nwalls].bx = s->bx;
+			w->walls[w->nwalls].by = s->by;
+			w->nwalls++;
+		}
+	}
+}
+
+/* The contact's indices checked and mapped into out; false: refused (counted). */
+static bool top_world_contact(struct top_world *w, const undulate_sim_truth_t *t, const int *body_robot,
+                              const undulate_sim_contact_t *c, struct top_contact *out)
+{
+	int a = top_world_robot(body_robot, t->nbodies, c->robot_a);
+	int b = c->robot_b == -1 ? -1 : top_world_robot(body_robot, t->nbodies, c->robot_b);
+	/* a wall's link is its index in walls[] (the plane) or -1 (the row) */
+	bool link_b_ok = c->robot_b == -1 ? c->link_b >= -1 && c->link_b < t->nwalls
+	                                  : c->link_b >= 0 && c->link_b < TOP_MAX_LINKS;
+	if (a < 0 || (c->robot_b != -1 && b < 0) || c->link_a < 0 || c->link_a >= TOP_MAX_LINKS || !link_b_ok) {
+		w->bad_index++;
+		return false;
+	}
+	if (!top_world_place(c->x) || !top_world_place(c->y) || !isfinite(c->impulse) || c->impulse < 0 ||
+	    !isfinite(c->force) || c->force < 0) {
+		w->bad_number++;
+		return false;
+	}
+	bool normal = isfinite(c->nx) && isfinite(c->ny);
+	*out = (struct top_contact){ .a = a, .b = b, .link_a = c->link_a, .link_b = c->link_b, .x = c->x, .y = c->y,
+		.nx = normal ? c->nx : 0, .ny = normal ? c->ny : 0, .impulse = c->impulse, .force = c->force,
+		.impact = c->impact != 0 };
+	return true;
+}
+
+static void top_world_contacts(struct top_world *w, const undulate_sim_truth_t *t, const int *body_robot)
+{
+	w->ncontacts = 0;
+	for (int i = 0; i < t->ncontacts; i++) {
+		struct top_contact c;
+		if (!top_world_contact(w, t, body_robot, &t->contacts[i], &c))
+			continue;
+		if (w->ncontacts == TOP_WORLD_CONTACTS) {
+			w->overflow++;
+			continue;
+		}
+		w->contacts[w->ncontacts++] = c;
+	}
+}
+
+static void top_world_update(struct top_model *m, const undulate_sim_truth_t *t, const int *body_robot)
+{
+	struct top_world *w = &m->world;
+	w->truths++;
+	w->plane = t->world == UNDULATE_SIM_TRUTH_T_WORLD_PLANE;
+	top_world_links(m, t, body_robot);
+	top_world_walls(w, t);
+	top_world_contacts(w, t, body_robot);
+}
+
 void top_on_truth(struct top_model *m, const undulate_sim_truth_t *t, double now)
 {
 	m->have_sim = true;
@@ -215,9 +337,13 @@ void top_on_truth(struct top_model *m, const undulate_sim_truth_t *t, double now
 	m->sim_total_collisions = t->total_collisions;
 	m->sim_total_impulse = t->total_impulse;
 	bool moved = false;
+	/* the model's robot of each body, for the links and contacts that name bodies by index */
+	int body_robot[TOP_WORLD_BODIES];
 	for (int i = 0; i < t->nbodies; i++) {
 		const undulate_sim_body_t *b = &t->bodies[i];
 		struct top_robot *r = top_robot_get(m, b->robot);
+		if (i < TOP_WORLD_BODIES)
+			body_robot[i] = r ? (int)(r - m->robots) : -1;
 		if (!r || (r->have_body && r->body_servo != b->servo_id))
 			continue;
 		moved |= !r->have_body || r->neutral != b->neutral;
@@ -229,6 +355,7 @@ void top_on_truth(struct top_model *m, const undulate_sim_truth_t *t, double now
 		if (fabs(b->angle) > TOP_LEVER_MIN_ANGLE)
 			r->lever = (b->lateral - b->neutral) / b->angle;
 	}
+	top_world_update(m, t, body_robot);
 	top_trend_update(m, t, now);
 	/* SIM.COLLISION is the per-collision channel; the copies inside
 	 * SIM.TRUTH (stamped with the truth message's time, so not matchable)

@@ -28,6 +28,15 @@
 #define TOP_JSON_DIGITS 12     /* significant digits of --json numbers */
 #define TOP_TREND_S 5.0        /* contact trend: window length, s */
 #define TOP_TREND_N 12         /* windows kept (a minute) */
+/* The simulator's world as its last SIM.TRUTH drew it (struct top_world).
+ * Everything in it came from the network: indices are checked against what
+ * the message holds, numbers against what an arena can be. */
+#define TOP_MAX_LINKS (TOP_MAX_JOINTS + 1) /* a robot's links in the plane: one more than its joints */
+#define TOP_WORLD_WALLS 16     /* wall segments kept (the simulator makes at most 8) */
+#define TOP_WORLD_CONTACTS 256 /* touching pairs kept of one message (the simulator lists at most 256) */
+#define TOP_WORLD_BODIES 256   /* bodies[] a link or contact may name (more: refused) */
+#define TOP_WORLD_EXTENT_M 100.0 /* |x|, |y| beyond this is no place in an arena: refused */
+#define TOP_WORLD_SIZE_M 10.0  /* a link longer or wider than this is no robot's: refused */
 
 struct top_joint {
 	int16_t servo_id;
@@ -39,6 +48,14 @@ struct top_joint {
 	int32_t stale_cycles;
 	bool torque;           /* torque wanted on (the daemon's writes) */
 	int8_t torque_read;    /* as the servo last reported it: 0, 1; -1 not read yet */
+};
+
+/* One rigid link of a robot in the plane world, from the last SIM.TRUTH. */
+struct top_link {
+	bool have;
+	double x, y;               /* m, its centre */
+	double angle;              /* rad, rear to front, wrapped to (-pi, pi] */
+	double length, width;      /* m */
 };
 
 struct top_robot {
@@ -64,6 +81,7 @@ struct top_robot {
 	double c[TOP_MAX_JOINTS], mu[TOP_MAX_JOINTS], k[TOP_MAX_JOINTS];
 	double sin_amplitude, sin_frequency;
 	/* SIM.TRUTH */
+	struct top_link links[TOP_MAX_LINKS]; /* the plane: its links, by index (0: the head) */
 	bool have_body;
 	int16_t body_servo;
 	double neutral, lateral;
@@ -77,6 +95,34 @@ struct top_robot {
 struct top_seen {
 	int64_t utime;
 	int32_t left, right;
+};
+
+/* A pair touching in the last SIM.TRUTH's period (sim_contact_t), its
+ * robots as model indices. */
+struct top_contact {
+	int a, b;                  /* robots (indices into top_model.robots); b -1: a wall */
+	int link_a, link_b;        /* links; a wall's index in walls[] when b is -1 (-1 on the row) */
+	double x, y;               /* m, the last contact point */
+	double nx, ny;             /* the contact normal, a to b (0 when the message's was not finite) */
+	double impulse;            /* N·s over the period */
+	double force;              /* N, the period's mean contact force */
+	bool impact;               /* began touching in it (else resting contact) */
+};
+
+struct top_world {
+	int64_t truths;            /* SIM.TRUTH messages taken (0: none) */
+	bool plane;                /* world = WORLD_PLANE (else the row) */
+	double wall_left, wall_right; /* m; NAN both: no walls (the row's wall_left >= wall_right) */
+	int nwalls;
+	struct { double ax, ay, bx, by; } walls[TOP_WORLD_WALLS];
+	int ncontacts;             /* of the last message */
+	struct top_contact contacts[TOP_WORLD_CONTACTS];
+	/* links, walls and contacts refused, by why (all counted, none kept): */
+	int64_t bad_index;         /* a robot index outside bodies[] (or not a robot's), a link outside
+	                              0..TOP_MAX_LINKS-1, a wall outside walls[] */
+	int64_t bad_number;        /* NaN, inf, beyond TOP_WORLD_EXTENT_M, a size outside (0, TOP_WORLD_SIZE_M],
+	                              a negative impulse or force */
+	int64_t overflow;          /* more walls or contacts than kept */
 };
 
 struct top_model {
@@ -107,6 +153,7 @@ struct top_model {
 	double trend_force[TOP_TREND_N];
 	int ntrend, trendnext;
 	int64_t decode_errors;
+	struct top_world world;     /* the simulator's, as its last SIM.TRUTH drew it */
 };
 
 void top_model_init(struct top_model *m);
@@ -115,6 +162,8 @@ void top_on_state(struct top_model *m, const undulate_robot_state_t *s, double n
 void top_on_bus(struct top_model *m, const undulate_bus_stats_t *b);
 void top_on_params(struct top_model *m, const undulate_osc_params_t *p);
 void top_on_event(struct top_model *m, const undulate_event_t *e);
+/* Also the world (m->world, each robot's links): replaced by every message,
+ * what does not pass the checks of struct top_world refused and counted. */
 void top_on_truth(struct top_model *m, const undulate_sim_truth_t *t, double now);
 void top_on_collision(struct top_model *m, const undulate_sim_collision_t *c, double now);
 /* A collision received on SIM.COLLISION itself. */

@@ -13,6 +13,8 @@ void frame_cursor_init(struct frame_cursor *c, const struct hist *h)
 	c->sample = hist_oldest(h);
 	c->bin = hist_oldest_bin(h);
 	c->mark = hist_oldest_mark(h);
+	c->contact = wct_oldest(&h->contacts);
+	c->truths = -1;
 	c->frames = 0;
 }
 
@@ -82,7 +84,8 @@ static void frame_counters(struct json *j, const struct frame_counters *c)
 	json_object_end(j);
 }
 
-static void frame_status(struct json *j, const struct top_model *m, const struct frame_counters *srv, double now)
+static void frame_status(struct json *j, const struct hist *h, const struct top_model *m,
+                         const struct frame_counters *srv, double now)
 {
 	json_key(j, "status");
 	json_object_begin(j);
@@ -103,6 +106,13 @@ static void frame_status(struct json *j, const struct top_model *m, const struct
 	json_object_end(j);
 	json_field_int(j, "dropped_robots", m->dropped_robots);
 	json_field_int(j, "decode_errors", m->decode_errors);
+	json_key(j, "world_refused");
+	json_object_begin(j);
+	json_field_int(j, "index", m->world.bad_index);
+	json_field_int(j, "number", m->world.bad_number);
+	json_field_int(j, "overflow", m->world.overflow);
+	json_field_int(j, "marks", h->contacts.overflow);
+	json_object_end(j);
 	if (srv != NULL)
 		frame_counters(j, srv);
 	json_object_end(j);
@@ -218,6 +228,107 @@ static void frame_notes(struct json *j, const struct frame_note *notes, int n)
 	json_array_end(j);
 }
 
+/* ---- the world ---------------------------------------------------------------------- */
+
+static void frame_world_robot(struct json *j, const struct top_robot *r)
+{
+	json_object_begin(j);
+	json_field_string(j, "name", r->name);
+	json_field_number(j, "lateral", r->have_body ? r->lateral : NAN);
+	json_field_number(j, "neutral", r->have_body ? r->neutral : NAN);
+	int nlinks = 0;
+	for (int k = 0; k < TOP_MAX_LINKS; k++)
+		if (r->links[k].have)
+			nlinks = k + 1;
+	json_key(j, "links");
+	json_array_begin(j);
+	for (int k = 0; k < nlinks; k++) {
+		const struct top_link *l = &r->links[k];
+		if (!l->have) {
+			json_null(j);
+			continue;
+		}
+		json_array_begin(j);
+		json_number(j, l->x);
+		json_number(j, l->y);
+		json_number(j, l->angle);
+		json_number(j, l->length);
+		json_number(j, l->width);
+		json_array_end(j);
+	}
+	json_array_end(j);
+	json_object_end(j);
+}
+
+/* the first mark to send: new to this browser and young enough to be seen */
+static uint64_t frame_marks_from(const struct wct *w, uint64_t from, int64_t now_ms)
+{
+	if (from < wct_oldest(w))
+		from = wct_oldest(w);
+	while (from < w->n && wct_at(w, from)->t_ms < now_ms - (int64_t)(WCT_SHOW_S * 1000))
+		from++;
+	return from;
+}
+
+enum frame_mark_field { FM_T, FM_A, FM_B, FM_X, FM_Y, FM_F, FM_IMP, FM_IMPACT };
+
+static void frame_mark_series(struct json *j, const struct wct *w, uint64_t from, const char *key,
+                              enum frame_mark_field f)
+{
+	json_key(j, key);
+	json_array_begin(j);
+	for (uint64_t i = from; i < w->n; i++) {
+		const struct wct_mark *k = wct_at(w, i);
+		switch (f) {
+		case FM_T: json_int(j, k->t_ms); break;
+		case FM_A: json_int(j, k->a); break;
+		case FM_B: json_int(j, k->b); break;
+		case FM_X: json_number(j, k->x); break;
+		case FM_Y: json_number(j, k->y); break;
+		case FM_F: json_number(j, k->force); break;
+		case FM_IMP: json_number(j, k->impulse); break;
+		case FM_IMPACT: json_int(j, k->impact); break;
+		}
+	}
+	json_array_end(j);
+}
+
+static void frame_world(struct json *j, const struct hist *h, const struct top_model *m, uint64_t from)
+{
+	const struct top_world *w = &m->world;
+	json_key(j, "world");
+	json_object_begin(j);
+	json_field_string(j, "kind", w->plane ? "plane" : "row");
+	json_field_number(j, "wall_left", w->wall_left);
+	json_field_number(j, "wall_right", w->wall_right);
+	json_key(j, "walls");
+	json_array_begin(j);
+	for (int i = 0; i < w->nwalls && i < TOP_WORLD_WALLS; i++) {
+		json_array_begin(j);
+		json_number(j, w->walls[i].ax);
+		json_number(j, w->walls[i].ay);
+		json_number(j, w->walls[i].bx);
+		json_number(j, w->walls[i].by);
+		json_array_end(j);
+	}
+	json_array_end(j);
+	json_key(j, "robots");
+	json_array_begin(j);
+	for (int i = 0; i < m->nrobots && i < TOP_MAX_ROBOTS; i++)
+		frame_world_robot(j, &m->robots[i]);
+	json_array_end(j);
+	static const struct { const char *key; enum frame_mark_field f; } fields[] = {
+		{ "t", FM_T }, { "a", FM_A }, { "b", FM_B }, { "x", FM_X }, { "y", FM_Y },
+		{ "f", FM_F }, { "imp", FM_IMP }, { "impact", FM_IMPACT },
+	};
+	json_key(j, "contacts");
+	json_object_begin(j);
+	for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++)
+		frame_mark_series(j, &h->contacts, from, fields[i].key, fields[i].f);
+	json_object_end(j);
+	json_object_end(j);
+}
+
 static uint64_t frame_max(uint64_t a, uint64_t b)
 {
 	return a > b ? a : b;
@@ -236,13 +347,17 @@ static size_t frame_try(const struct hist *h, const struct top_model *m, double 
 	json_init(&j, f, FRAME_DIGITS);
 	json_object_begin(&j);
 	json_field_string(&j, "type", "frame");
-	json_field_int(&j, "now_ms", (long long)llround((now - h->t0) * 1000.0));
+	int64_t now_ms = llround((now - h->t0) * 1000.0);
+	json_field_int(&j, "now_ms", now_ms);
 	if (c->frames % FRAME_STATUS_EVERY == 0)
-		frame_status(&j, m, srv, now);
+		frame_status(&j, h, m, srv, now);
 	frame_samples(&j, h, m, from, h->next);
 	frame_marks(&j, h, m, frame_max(c->mark, hist_oldest_mark(h)));
 	frame_bins(&j, h, frame_max(c->bin, hist_oldest_bin(h)));
 	frame_notes(&j, notes, nnotes);
+	uint64_t marks = frame_marks_from(&h->contacts, c->contact, now_ms);
+	if (m->world.truths > 0 && (m->world.truths != c->truths || marks < h->contacts.n))
+		frame_world(&j, h, m, marks);
 	json_object_end(&j);
 	bool ok = json_end(&j);
 	long len = ftell(f);
@@ -264,6 +379,8 @@ size_t frame_write(const struct hist *h, const struct top_model *m, double now, 
 			c->sample = h->next;
 			c->bin = h->nbins;
 			c->mark = h->nmarks;
+			c->contact = h->contacts.n;
+			c->truths = m->world.truths;
 			c->frames++;
 			return len;
 		}

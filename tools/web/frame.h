@@ -18,8 +18,21 @@
  *    "pairs":[{"a","b","class","d":[deltas],"bound":[bounds]}],   the current neighbours, same t
  *    "marks":[{"t","robot","mode"}],   mode switches since the last frame
  *    "bins":{"t":[ms],"coll":[n],"force":[N]},   closed simulator bins since the last frame
- *    "notes":[{"id","seq","robot","kind","text"}]}  answers to this browser's commands
- *   with server counters (struct frame_counters) in the status as "server":{...}
+ *    "notes":[{"id","seq","robot","kind","text"}],  answers to this browser's commands
+ *    "world":{...}}   the simulator's world, when a SIM.TRUTH or a contact came since the last frame:
+ *        "kind":"plane"|"row",
+ *        "wall_left","wall_right":   m, the row's walls (also sent in the plane); null both: no walls
+ *        "walls":[[ax,ay,bx,by],...]  m, the plane's wall segments
+ *        "robots":[{"name","lateral","neutral",   every robot of the model, in the order first heard
+ *                   "links":[[x,y,angle,length,width] or null,...]}]  (the index is the contact
+ *                   marks' a and b); lateral, neutral: m, null without a body; links by link index
+ *                   (0 the head: its centre, rad from rear to front, m), null where none, [] on the row
+ *        "contacts":{"t":[ms],"a":[robot],"b":[robot, -1 a wall],"x":[m],"y":[m],"f":[N],"imp":[N·s],
+ *                    "impact":[0|1]}   touching pairs summed between two frames (wcontact.h),
+ *                   new to this browser and at most WCT_SHOW_S old
+ *   with server counters (struct frame_counters) in the status as "server":{...}, and the
+ *   world's refusals as "world_refused":{"index","number","overflow","marks"} (struct top_world;
+ *   marks: pairs not summed, more than WCT_PENDING between two frames)
  */
 #ifndef UNDULATE_WEB_FRAME_H
 #define UNDULATE_WEB_FRAME_H
@@ -37,6 +50,8 @@
 
 struct frame_cursor {
 	uint64_t sample, bin, mark;   /* next index this browser has not seen */
+	uint64_t contact;             /* next contact mark (wcontact.h) */
+	int64_t truths;               /* the model's world.truths at its last world */
 	uint32_t frames;              /* frames sent */
 };
 

@@ -15,6 +15,7 @@ void hist_init(struct hist *h, double now)
 		h->pair_of[i] = -1;
 		h->last_mode[i] = -1;
 	}
+	wct_init(&h->contacts);
 }
 
 uint64_t hist_oldest(const struct hist *h)
@@ -200,4 +201,9 @@ void hist_on_collision(struct hist *h, const struct top_model *m, const char *le
 	}
 	if (a >= 0 && b >= 0)
 		h->untracked_collisions++;
+}
+
+void hist_close_contacts(struct hist *h, double now)
+{
+	wct_close(&h->contacts, hist_ms(h, now));
 }

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "tools/top/model.h"
+#include "wcontact.h"
 
 #define HIST_HZ 25                 /* samples per second: smooth at a 10-20 Hz frame rate */
 #define HIST_SECONDS 30            /* the plots' time span */
@@ -70,6 +71,7 @@ struct hist {
 	int32_t bin_coll[HIST_BINS];
 	float bin_force[HIST_BINS];  /* N: total impulse (impacts and resting contact) per second */
 	int64_t untracked_collisions; /* SIM.COLLISION naming robots that are no neighbouring pair */
+	struct wct contacts;         /* the simulator's contacts, for the world view's marks */
 };
 
 void hist_init(struct hist *h, double now);
@@ -79,6 +81,10 @@ void hist_sample(struct hist *h, const struct top_model *m, double now);
  * is ""), for the end state's "still-colliding". */
 void hist_on_collision(struct hist *h, const struct top_model *m, const char *left, const char *right,
                        double now);
+
+/* The contacts summed since the last call become marks stamped now (call
+ * at the frame rate: wcontact.h). */
+void hist_close_contacts(struct hist *h, double now);
 
 /* Oldest sample index still held. */
 uint64_t hist_oldest(const struct hist *h);

@@ -178,6 +178,14 @@ static void web_feed_collision(const undulate_sim_collision_t *c, double now, vo
 	web_collision(c, now);
 }
 
+/* every SIM.TRUTH's contacts, summed until the next frame (wcontact.h) */
+static void web_feed_truth(const struct top_model *m, double now, void *user)
+{
+	(void)now;
+	(void)user;
+	wct_add(&app.hist.contacts, m);
+}
+
 /* A message that does not decode is counted (the page shows decode_errors)
  * and said, at most WEB_DECODE_LOG_N times, then once a minute. */
 #define WEB_DECODE_LOG_N 5
@@ -185,7 +193,8 @@ static void web_feed_collision(const undulate_sim_collision_t *c, double now, vo
 static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
 	(void)user;
-	static const struct top_feed_hooks hooks = { .on_event = web_feed_event, .on_collision = web_feed_collision };
+	static const struct top_feed_hooks hooks = { .on_event = web_feed_event, .on_collision = web_feed_collision,
+	                                             .on_truth = web_feed_truth };
 	static double last_said;
 	double now = clock_mono_s();
 	char why[160];
@@ -741,12 +750,31 @@ static void web_frames_due(double now)
 	}
 }
 
+/* What SIM.TRUTH carried that the world view could not take (the page shows
+ * the counts): said when it grows, the first few times, then rarely. */
+static void web_world_refusals(void)
+{
+	static int64_t said, times;
+	const struct top_world *w = &app.model.world;
+	int64_t n = w->bad_index + w->bad_number + w->overflow + app.hist.contacts.overflow;
+	if (n == said)
+		return;
+	said = n;
+	web_log(++times, "SIM.TRUTH: %" PRId64 " links, walls or contacts refused so far (%" PRId64 " naming a "
+	        "body, link or wall the message does not hold, %" PRId64 " with a number no arena has, %" PRId64
+	        " beyond what is kept)", n, w->bad_index, w->bad_number, w->overflow + app.hist.contacts.overflow);
+}
+
 static void web_tick(lws_sorted_usec_list_t *sul)
 {
 	double now = clock_mono_s();
 	hist_sample(&app.hist, &app.model, now);
-	if (++app.ticks % WEB_FRAME_EVERY == 0)
+	if (++app.ticks % WEB_FRAME_EVERY == 0) {
+		/* the contacts since the last frame become its marks */
+		hist_close_contacts(&app.hist, now);
+		web_world_refusals();
 		web_frames_due(now);
+	}
 	lws_sul_schedule(app.ctx, 0, sul, web_tick, LWS_US_PER_SEC / HIST_HZ);
 }
 

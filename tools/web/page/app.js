@@ -176,6 +176,244 @@ function simData(frame) {
   for (const k of frame.marks) m.data.push({ x: k.t / 1000, y: 0, label: k.robot + ' → ' + k.mode });
 }
 
+// ---- the world from above -----------------------------------------------------
+// The simulator's world as the frames carry it (frame.h, "world"): in the
+// plane each robot's links as thick segments in its colour and its name at its
+// head, the wall segments; on the row each robot's contact body as a disc on
+// the line between the walls. Contacts are marks at their point, fading over
+// FADE_S: filled red for an impact, a black ring for resting contact, the area
+// growing with the pair's mean force. Whatever the network sent, a number that
+// is not finite is not drawn.
+const FADE_S = 1.2;
+const MAX_MARKS = 4000;           // marks kept (the server sends each once)
+const WORLD_W = 780;              // CSS pixels
+const ROBOT_COLORS = ['#1f77b4', '#ff7f0e', '#2ca02c', '#9467bd', '#8c564b', '#e377c2', '#17becf',
+                      '#bcbd22', '#393b79', '#637939'];
+const world = { last: null, kind: null, box: null, marks: [], colors: new Map(), simPresent: true, drawn: [] };
+const fin = (v) => typeof v === 'number' && Number.isFinite(v);
+
+// a robot keeps its colour for the page's life (worldData gives them out)
+function robotColor(name) {
+  let c = world.colors.get(name);
+  if (!c) {
+    const n = world.colors.size;
+    c = n < ROBOT_COLORS.length ? ROBOT_COLORS[n] : `hsl(${Math.round(n * 137.5) % 360}, 60%, 40%)`;
+    world.colors.set(name, c);
+  }
+  return c;
+}
+
+const isLink = (l) => Array.isArray(l) && l.length >= 5 && l.every(fin) && l[3] > 0 && l[4] > 0;
+const linkEnds = (l) => {
+  const dx = Math.cos(l[2]) * l[3] / 2, dy = Math.sin(l[2]) * l[3] / 2;
+  return [[l[0] - dx, l[1] - dy], [l[0] + dx, l[1] + dy]];   // rear, front
+};
+
+function worldData(w) {
+  if (!w || typeof w !== 'object' || !Array.isArray(w.robots)) return;
+  if (w.kind !== world.kind) { world.kind = w.kind; world.box = null; }
+  world.last = w;
+  const c = w.contacts || {};
+  const n = Array.isArray(c.t) ? c.t.length : 0;
+  for (let i = 0; i < n; i++) {
+    if (!fin(c.t[i]) || !fin(c.x[i]) || !fin(c.y[i])) continue;
+    world.marks.push({ t: c.t[i] / 1000, a: c.a[i], b: c.b[i], x: c.x[i], y: c.y[i],
+                       f: fin(c.f[i]) && c.f[i] > 0 ? c.f[i] : 0, impact: c.impact[i] === 1 });
+  }
+  if (world.marks.length > MAX_MARKS) world.marks.splice(0, world.marks.length - MAX_MARKS);
+  // colours in the order the robots stand, left to right, when first seen
+  const seen = w.robots.filter(r => !world.colors.has(r.name) && ((r.links || []).some(isLink) || fin(r.lateral)));
+  const at = (r) => fin(r.neutral) ? r.neutral : fin(r.lateral) ? r.lateral : 0;
+  seen.sort((p, q) => at(p) - at(q)).forEach(r => robotColor(r.name));
+  document.getElementById('world').hidden = false;
+  document.getElementById('world-kind').textContent = w.kind === 'plane' ? '(the plane)' : '(the row)';
+}
+
+// What the view must hold: walls and robots as seen so far (it only grows, so
+// closing walls are seen moving, not the view zooming with them).
+function worldExtent(w) {
+  const b = { x0: Infinity, x1: -Infinity, y0: Infinity, y1: -Infinity };
+  const add = (x, y) => {
+    if (!fin(x) || !fin(y)) return;
+    b.x0 = Math.min(b.x0, x); b.x1 = Math.max(b.x1, x); b.y0 = Math.min(b.y0, y); b.y1 = Math.max(b.y1, y);
+  };
+  add(w.wall_left, 0); add(w.wall_right, 0);
+  for (const s of w.walls || []) if (Array.isArray(s)) { add(s[0], s[1]); add(s[2], s[3]); }
+  for (const r of w.robots) {
+    if (w.kind !== 'plane') { add(r.lateral, 0); add(r.neutral, 0); }
+    for (const l of r.links || []) if (isLink(l)) for (const [x, y] of linkEnds(l)) add(x, y);
+  }
+  if (!(b.x1 >= b.x0)) return world.box;
+  const o = world.box;
+  return o ? { x0: Math.min(o.x0, b.x0), x1: Math.max(o.x1, b.x1), y0: Math.min(o.y0, b.y0), y1: Math.max(o.y1, b.y1) } : b;
+}
+
+// The row's robots in their order along it (by neutral position: bodies on
+// the line never pass each other), one lane each: bodies pressed together
+// stand at the same x, and each is still seen.
+const LANE = 16;
+function rowLanes(w) {
+  const idx = [];
+  w.robots.forEach((r, i) => { if (fin(r.lateral)) idx.push(i); });
+  const key = (i) => fin(w.robots[i].neutral) ? w.robots[i].neutral : w.robots[i].lateral;
+  idx.sort((a, b) => key(a) - key(b) || a - b);
+  const lane = new Map();
+  idx.forEach((i, k) => lane.set(i, k));
+  return { idx, lane };
+}
+
+// The canvas, sized for the box: world metres to CSS pixels (the plane: y up;
+// the row: x only, a lane per robot below each other).
+function worldView(canvas, box, plane, lanes) {
+  const pad = 36, w = Math.max(box.x1 - box.x0, 0.05), h = plane ? Math.max(box.y1 - box.y0, 0.05) : 0;
+  const cssH = plane ? Math.min(520, Math.max(160, (WORLD_W - 2 * pad) * h / w + 2 * pad))
+                     : 2 * pad + Math.max(lanes - 1, 1) * LANE;
+  const dpr = window.devicePixelRatio || 1;
+  if (canvas.width !== Math.round(WORLD_W * dpr) || canvas.height !== Math.round(cssH * dpr)) {
+    canvas.width = Math.round(WORLD_W * dpr); canvas.height = Math.round(cssH * dpr);
+    canvas.style.width = WORLD_W + 'px'; canvas.style.height = cssH + 'px';
+  }
+  const s = plane ? Math.min((WORLD_W - 2 * pad) / w, (cssH - 2 * pad) / h) : (WORLD_W - 2 * pad) / w;
+  const cx = (box.x0 + box.x1) / 2, cy = (box.y0 + box.y1) / 2;
+  const ctx = canvas.getContext('2d');
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  return { ctx, s, dpr, cssH, px: (x) => WORLD_W / 2 + (x - cx) * s, py: (y) => cssH / 2 - (y - cy) * s,
+           lane: (k) => pad + k * LANE };
+}
+
+function drawScale(v) {
+  // a bar of a round length near 1/8 of the width
+  const target = WORLD_W / 8 / v.s, pow = Math.pow(10, Math.floor(Math.log10(target)));
+  const len = [1, 2, 5, 10].map(k => k * pow).filter(l => l <= target).pop() || pow;
+  const { ctx } = v, x = 10, y = v.cssH - 10;
+  ctx.strokeStyle = '#000'; ctx.lineWidth = 2; ctx.lineCap = 'butt';
+  ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(x + len * v.s, y); ctx.stroke();
+  ctx.fillStyle = '#000'; ctx.font = '11px sans-serif'; ctx.textAlign = 'left';
+  ctx.fillText(len >= 1 ? `${len} m` : `${Math.round(len * 100 * 10) / 10} cm`, x + len * v.s + 4, y + 4);
+}
+
+function drawWalls(v, w) {
+  const { ctx } = v;
+  ctx.strokeStyle = '#555'; ctx.lineWidth = 4; ctx.lineCap = 'butt';
+  for (const s of w.walls || []) {
+    if (!Array.isArray(s) || !s.slice(0, 4).every(fin)) continue;
+    ctx.beginPath(); ctx.moveTo(v.px(s[0]), v.py(s[1])); ctx.lineTo(v.px(s[2]), v.py(s[3])); ctx.stroke();
+  }
+  if (w.kind !== 'plane' && fin(w.wall_left) && fin(w.wall_right)) {
+    ctx.lineWidth = 5;
+    for (const x of [w.wall_left, w.wall_right]) {
+      ctx.beginPath(); ctx.moveTo(v.px(x), 8); ctx.lineTo(v.px(x), v.cssH - 22); ctx.stroke();
+    }
+  }
+}
+
+// The plane's robots; returns what was drawn (link centres in device pixels, for tests)
+function drawLinks(v, w) {
+  const { ctx } = v, drawn = [];
+  for (const r of w.robots) {
+    const links = (r.links || []).filter(isLink);
+    if (!links.length) continue;
+    const color = robotColor(r.name), centres = [];
+    ctx.strokeStyle = color; ctx.lineCap = 'round';
+    for (const l of links) {
+      const [a, b] = linkEnds(l);
+      ctx.lineWidth = Math.max(4, l[4] * v.s);
+      ctx.beginPath(); ctx.moveTo(v.px(a[0]), v.py(a[1])); ctx.lineTo(v.px(b[0]), v.py(b[1])); ctx.stroke();
+      centres.push([Math.round(v.px(l[0]) * v.dpr), Math.round(v.py(l[1]) * v.dpr)]);
+    }
+    drawn.push({ name: r.name, color, centres, links: links.length });
+  }
+  // names after every link, beyond each head's front end; every other one
+  // further out, so that neighbours side by side do not write over each other
+  ctx.font = 'bold 11px sans-serif'; ctx.textAlign = 'center'; ctx.fillStyle = '#111';
+  let k = 0;
+  for (const r of w.robots) {
+    const head = (r.links || [])[0];
+    if (!isLink(head)) continue;
+    const [, f] = linkEnds(head), ux = Math.cos(head[2]), uy = Math.sin(head[2]), d = k++ % 2 ? 23 : 11;
+    ctx.fillText(r.name, v.px(f[0]) + ux * d, v.py(f[1]) - uy * d + 4);
+  }
+  return drawn;
+}
+
+function drawBodies(v, w, lanes) {
+  const { ctx } = v, drawn = [];
+  for (const i of lanes.idx) {
+    const r = w.robots[i], y = v.lane(lanes.lane.get(i)), color = robotColor(r.name), x = v.px(r.lateral);
+    ctx.strokeStyle = '#ccc'; ctx.lineWidth = 1;
+    ctx.beginPath(); ctx.moveTo(0, y); ctx.lineTo(WORLD_W, y); ctx.stroke();
+    if (fin(r.neutral)) {
+      ctx.strokeStyle = '#777';
+      ctx.beginPath(); ctx.moveTo(v.px(r.neutral), y - 6); ctx.lineTo(v.px(r.neutral), y + 6); ctx.stroke();
+    }
+    ctx.fillStyle = color;
+    ctx.beginPath(); ctx.arc(x, y, 6, 0, 2 * Math.PI); ctx.fill();
+    ctx.fillStyle = '#111'; ctx.font = 'bold 11px sans-serif'; ctx.textAlign = 'left';
+    ctx.fillText(r.name, x + 10, y + 4);
+    drawn.push({ name: r.name, color, centres: [[Math.round(x * v.dpr), Math.round(y * v.dpr)]], links: 0 });
+  }
+  return drawn;
+}
+
+// the row: a mark between the lanes of its two robots (on its robot's lane
+// for a wall); null when its robot has no lane
+function rowMarkY(v, lanes, m) {
+  const a = lanes.lane.get(m.a), b = m.b === -1 ? a : lanes.lane.get(m.b);
+  return a === undefined || b === undefined ? null : (v.lane(a) + v.lane(b)) / 2;
+}
+
+function drawMarks(v, lanes) {
+  const { ctx } = v;
+  let n = 0;
+  for (const m of world.marks) {
+    const age = state.now - m.t;
+    if (age < 0 || age > FADE_S) continue;
+    const alpha = 1 - age / FADE_S, r = Math.min(22, 3 + 4 * Math.sqrt(m.f));
+    const x = v.px(m.x), y = lanes ? rowMarkY(v, lanes, m) : v.py(m.y);
+    if (y === null) continue;
+    ctx.beginPath(); ctx.arc(x, y, r, 0, 2 * Math.PI);
+    if (m.impact) { ctx.fillStyle = `rgba(214, 39, 40, ${alpha})`; ctx.fill(); }
+    else { ctx.strokeStyle = `rgba(0, 0, 0, ${alpha})`; ctx.lineWidth = 2; ctx.stroke(); }
+    n++;
+  }
+  return n;
+}
+
+function worldSummary(w) {
+  const recent = world.marks.filter(m => state.now - m.t <= 1.0 && state.now >= m.t);
+  const name = (i) => i === -1 ? 'a wall' : ((w.robots[i] || {}).name || '?');
+  let top = null;
+  for (const m of recent) if (!top || m.f > top.f) top = m;
+  document.getElementById('world-summary').textContent = (world.simPresent ? '' : 'simulator not heard: the last world it sent · ') +
+    `${recent.length} contact marks in the last second (${recent.filter(m => m.impact).length} impacts)` +
+    (top ? ` · strongest: ${name(top.a)} – ${name(top.b)}, ${num(top.f, 2)} N` : '');
+}
+
+function drawWorld() {
+  const w = world.last;
+  if (!w) return;
+  const trimTo = state.now - FADE_S;
+  let k = 0;
+  while (k < world.marks.length && world.marks[k].t < trimTo) k++;
+  if (k) world.marks.splice(0, k);
+  world.box = worldExtent(w);
+  if (!world.box) return;
+  const canvas = document.getElementById('worldcanvas'), plane = w.kind === 'plane';
+  const lanes = plane ? null : rowLanes(w);
+  const v = worldView(canvas, world.box, plane, lanes ? lanes.idx.length : 0);
+  v.ctx.clearRect(0, 0, WORLD_W, v.cssH);
+  v.ctx.fillStyle = world.simPresent ? '#fff' : '#eee';
+  v.ctx.fillRect(0, 0, WORLD_W, v.cssH);
+  drawWalls(v, w);
+  world.drawn = plane ? drawLinks(v, w) : drawBodies(v, w, lanes);
+  const marks = drawMarks(v, lanes);
+  drawScale(v);
+  // what was drawn, for whoever checks the page (tests/integration/web_cdp.py)
+  Object.assign(canvas.dataset, { kind: w.kind, robots: world.drawn.length,
+    links: world.drawn.reduce((n, d) => n + d.links, 0), marks });
+  worldSummary(w);
+}
+
 // ---- commands ---------------------------------------------------------------
 function command(robot, text) {
   if (!state.ws || state.ws.readyState !== 1) return answer({ kind: 'not-sent', robot, text: 'not connected' });
@@ -213,6 +451,7 @@ function onFrame(frame) {
   if (frame.status) {
     for (const s of frame.status.robots) robotStatus(s);
     const st = frame.status;
+    world.simPresent = st.sim.present;
     document.getElementById('summary').textContent = `${st.robots.length} robots · ` +
       (st.sim.present ? `simulator: ${st.sim.collisions_10s} collisions in 10 s, ${num(st.sim.impulse_10s, 3)} N·s` : 'no simulator') +
       ` · ${st.decode_errors} undecodable messages`;
@@ -225,6 +464,7 @@ function onFrame(frame) {
   for (const [key, q] of state.pairs)   // no longer neighbours
     if (q.seen !== state.frames) { q.chart.destroy(); q.card.remove(); state.pairs.delete(key); }
   simData(frame);
+  worldData(frame.world);
   document.body.dataset.frames = state.frames;
   scheduleRedraw();
 }
@@ -265,6 +505,7 @@ function redraw() {
     for (const d of q.chart.data.datasets) trim(d.data, tmin);
     fix(q.chart); q.chart.update('none');
   }
+  drawWorld();
   if (simChart) {
     const smin = state.now - 300;
     for (const d of simChart.data.datasets) trim(d.data, smin);
