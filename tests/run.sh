@@ -5,8 +5,9 @@
 #    TAP lines: "ok ..." / "not ok ...", and a plan "1..N")
 #  - with TEST_LONG=1: $LONG_TESTS_DIR/*.sh (default tests/long) as well
 # Environment: TEST_FILTER (run the programs whose name contains it),
-# TEST_TIMEOUT (seconds one program may run, default 300; a hang is a failure),
-# TEST_JOBS (integration tests run side by side, default 2; see below).
+# TEST_TIMEOUT (seconds one program may run, default 300; a hang is a failure;
+# a script that says "# run.sh: timeout SECONDS" may run that long if longer:
+# a soak of minutes), # TEST_JOBS (integration tests run side by side, default 2; see below).
 # Logs: $BUILD/test-logs/<program>.log.
 #
 # What counts (TAP):
@@ -61,11 +62,11 @@ tap_counts() {
 	' "$1"
 }
 
-# exit_reason RC SECONDS: what a non-zero exit status means, in words.
+# exit_reason RC SECONDS LIMIT: what a non-zero exit status means, in words.
 exit_reason() {
-	local rc=$1 secs=$2
-	if [ "$rc" -eq 124 ] || { [ "$rc" -eq 137 ] && [ "$secs" -ge "$per_test_timeout" ]; }; then
-		echo "timed out after ${per_test_timeout}s (TEST_TIMEOUT)"
+	local rc=$1 secs=$2 limit=$3
+	if [ "$rc" -eq 124 ] || { [ "$rc" -eq 137 ] && [ "$secs" -ge "$limit" ]; }; then
+		echo "timed out after ${limit}s (TEST_TIMEOUT)"
 	elif [ "$rc" -gt 128 ]; then
 		echo "killed by signal $((rc - 128)) (exit status $rc)"
 	else
@@ -79,14 +80,14 @@ tap_lines() {
 	grep -E "$3" "$1" | sed -E "s/^(not )?ok[[:space:]]*[0-9]*[[:space:]]*(- )?/$2: /"
 }
 
-# faults RC SECONDS FAILED RESULTS PLANS PLANNED PLAN_SKIP: what the runner
-# finds wrong with a program beyond its own "not ok" lines, as "a; b", or "".
+# faults RC SECONDS LIMIT FAILED RESULTS PLANS PLANNED PLAN_SKIP: what the
+# runner finds wrong with a program beyond its own "not ok" lines, as "a; b", or "".
 faults() {
-	local rc=$1 secs=$2 f=$3 results=$4 plans=$5 planned=$6 plan_skip=$7
+	local rc=$1 secs=$2 limit=$3 f=$4 results=$5 plans=$6 planned=$7 plan_skip=$8
 	local why=()
 	if [ "$rc" -ne 0 ]; then
 		# a "not ok" explains a non-zero exit; nothing explains a crash without one
-		[ "$f" -eq 0 ] && why+=("$(exit_reason "$rc" "$secs")")
+		[ "$f" -eq 0 ] && why+=("$(exit_reason "$rc" "$secs" "$limit")")
 	elif [ "$results" -eq 0 ] && [ "$plan_skip" -eq 0 ]; then
 		why+=("ran no test")
 	fi
@@ -96,32 +97,41 @@ faults() {
 		why+=("plan says $planned test(s), printed $results result(s)")
 	fi
 	# a program that stopped early shows it in its plan: say why it stopped
-	[ "${#why[@]}" -gt 0 ] && [ "$rc" -ne 0 ] && [ "$f" -gt 0 ] && why+=("$(exit_reason "$rc" "$secs")")
+	[ "${#why[@]}" -gt 0 ] && [ "$rc" -ne 0 ] && [ "$f" -gt 0 ] && why+=("$(exit_reason "$rc" "$secs" "$limit")")
 	local out="" w
 	for w in "${why[@]}"; do out+="${out:+; }$w"; done
 	echo "$out"
 }
 
-# execute NAME CMD...: run one program into its log; print "RC MS".
+# timeout_of SCRIPT: the seconds SCRIPT may run: TEST_TIMEOUT, or more when it
+# says so in a line "# run.sh: timeout SECONDS" (a soak of minutes); never less.
+timeout_of() {
+	local n
+	n=$(sed -n 's/^# run\.sh: timeout \([0-9]\{1,6\}\)\([^0-9].*\)\{0,1\}$/\1/p' "$1" 2>/dev/null | head -n 1)
+	if [ -n "$n" ] && [ "$((10#$n))" -gt "$per_test_timeout" ]; then echo "$((10#$n))"; else echo "$per_test_timeout"; fi
+}
+
+# execute NAME LIMIT CMD...: run one program into its log, for at most LIMIT
+# seconds; print "RC MS LIMIT".
 execute() {
-	local name=$1; shift
+	local name=$1 limit=$2; shift 2
 	local start=$(date +%s%N) rc
-	CMOCKA_MESSAGE_OUTPUT=TAP timeout --kill-after=10 "$per_test_timeout" "$@" >"$logs/$name.log" 2>&1
+	CMOCKA_MESSAGE_OUTPUT=TAP timeout --kill-after=10 "$limit" "$@" >"$logs/$name.log" 2>&1
 	rc=$?
-	echo "$rc $(( ($(date +%s%N) - start) / 1000000 ))"
+	echo "$rc $(( ($(date +%s%N) - start) / 1000000 )) $limit"
 }
 
 run_one() {
 	local name=$1; shift
 	[ -n "$filter" ] && [[ "$name" != *$filter* ]] && return
-	local rc ms
-	read -r rc ms < <(execute "$name" "$@")
-	account "$name" "$rc" "$ms"
+	local rc ms limit
+	read -r rc ms limit < <(execute "$name" "$per_test_timeout" "$@")
+	account "$name" "$rc" "$ms" "$limit"
 }
 
-# account NAME RC MS: count a finished program's results and show its line.
+# account NAME RC MS LIMIT: count a finished program's results and show its line.
 account() {
-	local name=$1 rc=$2 ms=$3
+	local name=$1 rc=$2 ms=$3 limit=$4
 	local log="$logs/$name.log"
 	programs=$((programs + 1))
 	local p f s t plans planned plan_skip
@@ -132,7 +142,7 @@ account() {
 		skips+=("$name: $(grep -m1 -E '^1\.\.0' "$log" | sed -E 's/^1\.\.0[[:space:]]*#[[:space:]]*[Ss][Kk][Ii][Pp][[:alpha:]]*[[:space:]]*//')")
 	fi
 	local reason
-	reason=$(faults "$rc" "$((ms / 1000))" "$f" "$results" "$plans" "$planned" "$plan_skip")
+	reason=$(faults "$rc" "$((ms / 1000))" "$limit" "$f" "$results" "$plans" "$planned" "$plan_skip")
 	if [ -n "$reason" ]; then
 		f=$((f + 1))
 		echo "not ok - $name: $reason" >>"$log"
@@ -220,14 +230,15 @@ while [ "$reported" -lt "${#names[@]}" ]; do
 		fi
 		n=${names[$started]}
 		rm -f "$logs/$n.rc"
-		( execute "$n" bash "${scripts[$started]}" >"$logs/$n.rc.tmp"; mv "$logs/$n.rc.tmp" "$logs/$n.rc" ) &
+		( execute "$n" "$(timeout_of "${scripts[$started]}")" bash "${scripts[$started]}" >"$logs/$n.rc.tmp"
+		  mv "$logs/$n.rc.tmp" "$logs/$n.rc" ) &
 		started=$((started + 1)) active=$((active + 1))
 	done
 	# the finished ones, in order
 	while [ "$reported" -lt "$started" ] && over "$reported"; do
-		read -r rc ms <"$logs/${names[$reported]}.rc"
+		read -r rc ms limit <"$logs/${names[$reported]}.rc"
 		rm -f "$logs/${names[$reported]}.rc"
-		account "${names[$reported]}" "$rc" "$ms"
+		account "${names[$reported]}" "$rc" "$ms" "$limit"
 		reported=$((reported + 1))
 	done
 	[ "$reported" -lt "${#names[@]}" ] && ! over "$reported" && wait -n 2>/dev/null

@@ -37,8 +37,11 @@ wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; t
 spawn watch "$D" --watch "$R" --lcm-url "$URL"
 # the oscillator on the XM430's own defaults (daemon/CONTROL.md, "X-series servos"): with the
 # AX-12A's it would run down between restarts there, and "it swings again" would mean little
+# silent_s 5 (as safety_servo): the power loss below lasts two control-socket
+# calls, and at load 10-12 on 2 cores those took more than the default 0.5 s:
+# the joint's silence latched HOLD first, and every check after it failed
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode limp --set robot.fault_action=hold \
-	--set robot.fault_backoff_s=0.3
+	--set robot.fault_backoff_s=0.3 --set robot.silent_s=5
 wait_log d "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts on the X bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
 

@@ -169,6 +169,23 @@ expect "a hang is stopped at TEST_TIMEOUT and is a failure" "1 passed, 1 failed,
 if [ "$secs" -lt 15 ]; then tap_ok "...and stopped in time (${secs}s for TEST_TIMEOUT=2)"
 else tap_fail "hang stopped in time" "the runner took ${secs}s with TEST_TIMEOUT=2"; fi
 
+# a soak says how long it runs: more than TEST_TIMEOUT, never less
+fake soak integration soak <<'EOF'
+# run.sh: timeout 20
+echo "ok 1 - ran its 3 s"
+sleep 3
+echo "1..1"
+EOF
+fake soak integration short <<'EOF'
+# run.sh: timeout 1
+echo "ok 1 - started"
+sleep 4
+echo "1..1"
+EOF
+suite soak TEST_TIMEOUT=2
+expect "'# run.sh: timeout 20' outlasts TEST_TIMEOUT=2; 'timeout 1' does not shorten it" \
+	"2 passed, 1 failed, 0 skipped" 1 'short: .*timed out after 2s'
+
 # A real cmocka program: what its TAP output says for skip(), with two groups
 # (two plans, added up).
 mkdir -p "$T/cmocka/unit"
