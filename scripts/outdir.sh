@@ -64,7 +64,7 @@ _outdir_walk() {
 		esac
 		next="$cur/$comp"
 		if [ -L "$next" ]; then
-			owner=$(stat -c %u -- "$next") || return 1
+			owner=$(command stat -c %u -- "$next") || return 1
 			if [ "$owner" != 0 ] && [ "$owner" != "$(id -u)" ]; then
 				echo "$_outdir_path: the symbolic link $comp on the way is owned by $(_outdir_who "$owner"), not by you or root: another user chooses where it leads; give the directory itself"
 				return 1
@@ -97,7 +97,7 @@ outdir_check() {
 		mkdir -m "$(printf '%o' $((0755 & ~0$(umask))))" -- "$res" 2>/dev/null || [ -d "$res" ] ||
 			{ echo "${prefix:+$prefix }$dir: cannot create it" >&2; return 1; }
 	fi
-	read -r uid gid mode < <(stat -L -c '%u %g %a' -- "$res") || return 1
+	read -r uid gid mode < <(command stat -L -c '%u %g %a' -- "$res") || return 1
 	mode=$((8#$mode))
 	if [ "$uid" != "$(id -u)" ]; then
 		why="owned by $(_outdir_who "$uid"), not by you ($(id -un)): another user could put links or FIFOs in it under the names written there; choose a directory of yours (a new one is made)"

@@ -57,9 +57,9 @@ jobs() {
 	done
 }
 
-# stat RUN_DIR FROM TO median|mean: of the per-second contact force
+# force_stat RUN_DIR FROM TO median|mean: of the per-second contact force
 # (collision_rate.csv's contact_force, simulated seconds [FROM, TO))
-stat() {
+force_stat() {
 	awk -F, -v a="$2" -v b="$3" 'NR > 1 && $1 >= a && $1 < b && $6 != "" { print $6 }' "$1/collision_rate.csv" |
 		if [ "$4" = mean ]; then awk '{ s += $1; n++ } END { printf "%.6g\n", n ? s / n : "nan" }'; else fig_median; fi
 }
@@ -96,8 +96,8 @@ run() {
 	mdo=$(fig_json "$r" '.force.median_after_n // "nan"')
 	nc=$(fig_json "$r" '.force.samples_before // 0')
 	no=$(fig_json "$r" '.force.samples_after // 0')
-	mc=$(stat "$r" "$closed" "$switch" mean)
-	mo=$(stat "$r" "$switch" "$end" mean)
+	mc=$(force_stat "$r" "$closed" "$switch" mean)
+	mo=$(force_stat "$r" "$switch" "$end" mean)
 	broken=$(fig_json "$r" '.broken | length')
 	swing=$(fig_min_swing "$r/summary.json")
 	# where the walls stood at the end (a crowd may hold them short of WALLS)
@@ -121,19 +121,29 @@ merge() {
 	fig_results "$runs" sorted >"$fig/forces-plane.csv"
 	local csv="$fig/forces-plane.csv" t=$FIG_TMP
 	# per k, over the runs that did not break: the median of the runs' medians and their range
-	awk -F, 'NR > 1 && $12 == 0 { n[$1]++; c[$1] = c[$1] " " $6; o[$1] = o[$1] " " $7 }
+	# fields: k runs broken, the medians of all contacts (clock: median of the runs'
+	# medians, min, max; oscillator: the same), then the runs' medians of the mean
+	# force per second (clock, oscillator) and of the contacts counted (clock, oscillator)
+	awk -F, 'NR > 1 && $12 == 0 { n[$1]++; c[$1] = c[$1] " " $6; o[$1] = o[$1] " " $7
+			mc[$1] = mc[$1] " " $10; mo[$1] = mo[$1] " " $11; nc[$1] = nc[$1] " " $8; no[$1] = no[$1] " " $9 }
 		NR > 1 && $12 != 0 { b[$1]++ }
-		END { for (k in n) print k, n[k], b[k] + 0, c[k] "|" o[k]; for (k in b) if (!(k in n)) print k, 0, b[k], "|" }' "$csv" |
+		END { for (k in n) print k, n[k], b[k] + 0, c[k] "|" o[k] "|" mc[k] "|" mo[k] "|" nc[k] "|" no[k]
+		      for (k in b) if (!(k in n)) print k, 0, b[k], "|||||" }' "$csv" |
 	sort -g | while read -r k n b rest; do
-		local cs=${rest%%|*} os=${rest#*|}
-		printf '%s %s %s %s %s %s %s %s %s\n' "$k" "$n" "$b" \
-			"$(tr ' ' '\n' <<<"$cs" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | head -1)" \
+		local cs os f
+		IFS='|' read -r cs os f <<<"$rest"
+		local -a more
+		IFS='|' read -r -a more <<<"${f}"
+		med() { tr ' ' '\n' <<<"$1" | grep . | fig_median; }
+		printf '%s %s %s %s %s %s %s %s %s %s %s %s %s\n' "$k" "$n" "$b" \
+			"$(med "$cs")" "$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | head -1)" \
 			"$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | tail -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)"
+			"$(med "$os")" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
+			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)" \
+			"$(med "${more[0]:-}")" "$(med "${more[1]:-}")" "$(med "${more[2]:-}")" "$(med "${more[3]:-}")"
 	done >"$t/summary"
 	[ -s "$t/summary" ] || fig_die "no runs to summarize in $csv"
-	{ echo "k,runs,broken,clock,clock_min,clock_max,osc,osc_min,osc_max"; tr ' ' ',' <"$t/summary"; } >"$t/summary.csv"
+	{ echo "k,runs,broken,clock,clock_min,clock_max,osc,osc_min,osc_max,mean_clock,mean_osc,contacts_clock,contacts_osc"; tr ' ' ',' <"$t/summary"; } >"$t/summary.csv"
 	force_plot "$fig" "$t" || fig_die "forces-plane.png could not be drawn"
 	time_plot "$runs" "$fig" "$t" || fig_die "forces-plane_time.png could not be drawn"
 	fragment "$fig"
@@ -143,15 +153,17 @@ merge() {
 force_plot() {
 	local fig=$1 t=$2 csv="$1/forces-plane.csv"
 	{
-		fig_gp_head 900 600
+		fig_gp_head 900 660
 		echo "set output '$fig/forces-plane.png'"
 		echo "set termoption noenhanced"
 		echo "set logscale y"
 		echo "set xlabel 'clock stiffness k (N·m/rad): tau = k (alpha_bar - alpha)'"
 		echo "set ylabel 'median force of all contacts (N)'"
 		echo "set title 'Ten three-link robots in the plane arena: clock (END/3..2 END/3) against oscillator (2 END/3..END)'"
-		echo "set key top left"
+		echo "set key below"
+		echo "set bmargin 9"
 		echo "set xrange [0:0.15]"
+		echo "set yrange [0.05:*]"
 		fig_plot "'$csv' every ::1 using (\$12 == 0 ? \$1 - 0.002 : 1/0):6 with points pt 7 ps 1.1 lc rgb '#d62728' title 'clock, each run'" \
 			"'$t/summary.csv' every ::1 using 1:4 with linespoints lw 2 pt 7 lc rgb '#d62728' title 'clock, median of runs'" \
 			"'$csv' every ::1 using (\$12 == 0 ? \$1 + 0.002 : 1/0):7 with points pt 5 ps 1.1 lc rgb '#1f77b4' title 'oscillator, each run'" \
@@ -218,9 +230,14 @@ fragment() {
 		echo "pushed out of the arena, a simulator behind): $broken, left out of the medians."
 		[ "$end" -lt "$END_FULL" ] && echo "(\`make figures QUICK=1\`: the paper's timeline at $(awk -v e="$end" -v f="$END_FULL" 'BEGIN { printf "%g", e / f }') of its length, k ${QUICK_KS// /, }, $QUICK_SEEDS seed(s) each; the full set runs k ${KS// /, }, $SEEDS seeds each, $END_FULL s.)"
 		echo
-		echo "| k (N·m/rad) | runs | broken | clock: median force (N), min-max | oscillator: median force (N), min-max | clock / oscillator |"
-		echo "|---|---|---|---|---|---|"
-		awk '{ printf "| %s | %s | %s | %.3g (%.3g-%.3g) | %.3g (%.3g-%.3g) | %.1fx |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, ($7 > 0 ? $4 / $7 : 0) }' "$FIG_TMP/summary"
+		echo "| k (N·m/rad) | runs | broken | clock: median force (N), min-max | oscillator: median force (N), min-max | clock / oscillator | mean force per second (N), clock → oscillator | contacts, clock → oscillator |"
+		echo "|---|---|---|---|---|---|---|---|"
+		awk '{ printf "| %s | %s | %s | %.3g (%.3g-%.3g) | %.3g (%.3g-%.3g) | %.1fx | %.3g → %.3g (%.1fx) | %.0f → %.0f (%.1fx) |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, ($7 > 0 ? $4 / $7 : 0),
+			$10, $11, ($11 > 0 ? $10 / $11 : 0), $12, $13, ($13 > 0 ? $12 / $13 : 0) }' "$FIG_TMP/summary"
+		echo
+		echo "Contacts: each touching pair's 10 ms truth periods in the window, summed over pairs. The mean force"
+		echo "per second is over all of the window's seconds (the force a second, contact or not): it falls when"
+		echo "contacts become fewer even if each contact is as hard, which the median of all contacts does not show."
 		echo
 		awk -F, 'NR > 1 { if (min == "" || $13 < min) min = $13; if ($13 < 0.2) stopped++; t += $14; n++ }
 			END { if (stopped) printf "In %d run(s) a joint swung less than 0.2 rad peak-to-peak in the final window (smallest %.2f rad).", stopped, min
@@ -233,7 +250,7 @@ fragment() {
 
 # beside: the paper's claims against these numbers, and what differs by design.
 beside() {
-	awk 'BEGIN { n = 0 } $2 > 0 { k[n] = $1; c[n] = $4; o[n] = $7; n++; if ($7 >= 0.1) above++ }
+	awk 'BEGIN { n = 0 } $2 > 0 { k[n] = $1; c[n] = $4; o[n] = $7; mc[n] = $10; mo[n] = $11; cc[n] = $12; co[n] = $13; n++; if ($7 >= 0.1) above++ }
 		END {
 			if (n == 0) { print "**Beside the paper.** No run finished whole: nothing to compare."; exit }
 			printf "**Beside the paper.** The paper: the oscillator'"'"'s median contact force below 0.1 N, and the clock'"'"'s growing linearly with k. Here the oscillator'"'"'s median is %.3g-%.3g N (%d of %d k above 0.1 N)", o[0], o[n - 1], above, n
@@ -242,9 +259,11 @@ beside() {
 				for (i = 0; i < n; i++) { sx += k[i]; sy += c[i]; sxx += k[i] * k[i]; sxy += k[i] * c[i] }
 				b = (n * sxy - sx * sy) / (n * sxx - sx * sx); a = (sy - b * sx) / n
 				for (i = 0; i < n; i++) { e = c[i] - a - b * k[i]; ss += e * e; d = c[i] - sy / n; st += d * d }
-				printf "; the clock'"'"'s median goes from %.3g N at k %s to %.3g N at k %s (a line through them: %.3g + %.3g k N, R² %.2f)", c[0], k[0], c[n - 1], k[n - 1], a, b, st > 0 ? 1 - ss / st : 1
+				printf "; the clock'"'"'s median goes from %.3g N at k %s to %.3g N at k %s (a line through them: %.3g + %.3g k N, R² %.2f)", c[0], k[0], c[n - 1], k[n - 1], a, b, (st > 0 ? 1 - ss / st : 1)
 			}
 			print "."
+			for (i = 0; i < n; i++) if (o[i] > 0 && mo[i] > 0) printf "%sAt k %s the oscillator made the mean force per second %.1fx smaller with %.1fx fewer contacts, each %s.", (i ? " " : "\n"), k[i], mc[i] / mo[i], cc[i] / (co[i] > 0 ? co[i] : 1), (o[i] < 0.8 * c[i] ? "softer" : (o[i] > 1.25 * c[i] ? "harder" : "about as hard"))
+			if (n) print ""
 		}' "$FIG_TMP/summary"
 	echo
 	echo "Where this differs from the paper by design, measured:"

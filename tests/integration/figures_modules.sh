@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# figures_modules.sh — the rows, channel, forces, swimmer and channel-plane
-# modules of `make figures`
+# figures_modules.sh — the rows, channel, forces, forces-plane, swimmer and
+# channel-plane modules of `make figures`
 # (figures/<name>/fig.sh): their job lists are the same every time, with
 # unique run names and seeds; bad arguments get one clear line and exit 2;
 # each merge, on a fixed small set of result rows written here, writes its
@@ -27,10 +27,10 @@ result() {
 }
 
 # ---- jobs ---------------------------------------------------------------------------
-# the seed's field in a job line: the last but for forces (SLOPE SEED END)
-# and channel-plane (WIDTH SEED ENDS)
-for m in rows channel forces swimmer channel-plane; do
-	sf=NF; [ "$m" = forces ] || [ "$m" = channel-plane ] && sf=3
+# the seed's field in a job line: the last but for forces (SLOPE SEED END),
+# forces-plane (K SEED END WALLS) and channel-plane (WIDTH SEED ENDS)
+for m in rows channel forces forces-plane swimmer channel-plane; do
+	sf=NF; case $m in forces | forces-plane | channel-plane) sf=3 ;; esac
 	a=$("$F/$m/fig.sh" jobs) b=$("$F/$m/fig.sh" jobs) q=$("$F/$m/fig.sh" jobs --quick)
 	ids=$(awk '{ print $1 }' <<<"$a" | sort | uniq -d)
 	bad=$(awk '$1 !~ /^[A-Za-z0-9_.-]+$/' <<<"$a")
@@ -57,6 +57,8 @@ refused "channel-plane: width 50" "WIDTH_CM: want a number from 10 to 40" "$F/ch
 refused "channel-plane: ends 'open'" "ENDS: want ends or none" "$F/channel-plane/fig.sh" run "$T/bad" 20 1 open
 refused "swimmer: mode 'clock'" "MODE: want oscillator or sinusoid" "$F/swimmer/fig.sh" run "$T/bad" clock 20 1
 refused "swimmer: 5 s (shorter than settling and the picture)" "SECONDS: want a whole number from 12" "$F/swimmer/fig.sh" run "$T/bad" oscillator 5 1
+refused "forces-plane: k 2" "K: want a number from 0 to 1, got '2'" "$F/forces-plane/fig.sh" run "$T/bad" 2 1
+refused "forces-plane: walls 0.1 m" "WALLS: want a number from 0.3 to 2" "$F/forces-plane/fig.sh" run "$T/bad" 0.1 1 150 0.1
 refused "an unknown subcommand" "usage: fig.sh" "$F/rows/fig.sh" draw
 [ ! -e "$T/bad" ] && tap_ok "no run folder made by a refused run" || tap_fail "no run folder made by a refused run"
 
@@ -88,6 +90,36 @@ if grep -qF '| 16 | 17.7 | 3 | 0.02, 0.07 | 34 (30-40) | 5 (4-6) | 6.8x |' "$T/f
 	grep -q 'median over 100-200 s (clock)' "$T/fig/forces.md"; then
 	tap_ok "forces.md: the medians per slope with their ranges and ratios, the picture linked; forces.csv 8 rows"
 else tap_fail "forces.md numbers" "$(grep '^|' "$T/fig/forces.md")"; fi
+
+# ---- forces-plane: merge on fixed rows ---------------------------------------------------
+# Two k, two whole runs each and one broken run (left out of the medians, counted).
+H="k_nm_rad,seed,end_s,walls_m,damping,median_clock_n,median_osc_n,contacts_clock,contacts_osc,mean_clock_n,mean_osc_n,broken,min_swing_rad,wall_s,walls_end_m"
+i=0
+for row in "0.015,1,150,0.6,0.01,0.8,0.4,5000,3000,3.0,1.4,0,1.2,400,0.6" "0.015,2,150,0.6,0.01,0.9,0.5,5100,2900,3.1,1.5,0,1.1,410,0.6" \
+	"0.135,1,150,0.6,0.01,0.5,0.05,6000,900,13,3.3,0,1.3,420,0.61" "0.135,2,150,0.6,0.01,0.6,0.07,6100,800,14,3.4,0,1.25,430,0.6" \
+	"0.135,3,150,0.6,0.01,9,9,6000,6000,40,40,1,0.1,440,0.44"; do
+	i=$((i + 1))
+	result forces-plane "p$i" "$H" "$row"
+	# the force per second: walls closing 10-50 s, clock to 100 s, then the oscillator
+	awk -v c="$row" 'BEGIN { split(c, v, ","); print "t,force_n,pair_impacts,wall_impacts"
+		for (t = 0; t < 150; t++) { f = t < 50 ? 0.5 + v[10] * t / 50 : (t < 100 ? v[10] : v[11])
+			printf "%d,%g,8,2\n", t, f } }' >"$T/runs/forces-plane/p$i/series.csv"
+done
+if "$F/forces-plane/fig.sh" merge "$T/runs/forces-plane" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "forces-plane: merge"
+else tap_fail "forces-plane: merge" "$(cat "$T/merge.out")"; fi
+red=$(pixels d62728 "$T/fig/forces-plane.png") blue=$(pixels 1f77b4 "$T/fig/forces-plane.png")
+if [ "${red:-0}" -ge 400 ] && [ "${blue:-0}" -ge 400 ]; then tap_ok "forces-plane.png: both series drawn ($red clock, $blue oscillator pixels)"
+else tap_fail "forces-plane.png shows its data" "clock $red, oscillator $blue pixels of their colours"; fi
+a=$(pixels 9467bd "$T/fig/forces-plane_time.png") b=$(pixels 1f77b4 "$T/fig/forces-plane_time.png")
+if [ "${a:-0}" -ge 300 ] && [ "${b:-0}" -ge 300 ]; then tap_ok "forces-plane_time.png: a run per k drawn ($a and $b pixels)"
+else tap_fail "forces-plane_time.png shows its data" "k 0.015: $a, k 0.135: $b pixels of their colours"; fi
+if grep -qF '| 0.015 | 2 | 0 | 0.85 (0.8-0.9) | 0.45 (0.4-0.5) | 1.9x | 3.05 → 1.45 (2.1x) | 5050 → 2950 (1.7x) |' "$T/fig/forces-plane.md" &&
+	grep -q 'a simulator behind): 1, left out of the medians' "$T/fig/forces-plane.md" &&
+	grep -q '(1 of 2 k above 0.1 N); the clock.s median goes from 0.85 N at k 0.015 to 0.55 N at k 0.135' "$T/fig/forces-plane.md" &&
+	grep -qF '| 0.135 | 2 | 1 | 0.55 (0.5-0.6) | 0.06 (0.05-0.07) | 9.2x | 13.5 → 3.35 (4.0x) | 6050 → 850 (7.1x) |' "$T/fig/forces-plane.md" &&
+	grep -q '^!\[.*\](figures/forces-plane.png)' "$T/fig/forces-plane.md" && [ "$(wc -l <"$T/fig/forces-plane.csv")" = 6 ]; then
+	tap_ok "forces-plane.md: per k the runs' medians with their ranges and ratios, the broken run left out and counted; forces-plane.csv 5 rows"
+else tap_fail "forces-plane.md numbers" "$(grep -E '^\||broken|above' "$T/fig/forces-plane.md")"; fi
 
 # ---- rows: merge on fixed rows ---------------------------------------------------------
 H="dsep,beta,seconds,seed,pairs,colliding_pairs,pair_collisions_hz,compat_error_rad,compat_error_max_rad,compatible_pairs,antiphase_pairs,stopped_pairs,wall_collisions_hz,relax_s,censored,min_swing_rad,wall_s"
@@ -244,7 +276,7 @@ if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyz
 	if [ "$rc" = 0 ] && grep -q '5/5 runs done' "$T/tiny.out"; then tap_ok "the tiny set through the driver: 5 runs more, exit 0"
 	else tap_fail "the tiny set through the driver" "rc $rc: $(tail -n 8 "$T/tiny.out")"; fi
 	P="$T/tiny/docs/FIGURES.md" G="$T/tiny/docs/figures"
-	order=$(grep -o '^<a id="[a-z]*">' "$P" 2>/dev/null | tr -dc 'a-z\n' | sed 's/^aid//' | tr '\n' ' ')
+	order=$(grep -o '^<a id="[a-z-]*">' "$P" 2>/dev/null | tr -dc 'a-z\n-' | sed 's/^aid//' | tr '\n' ' ')
 	if [ "$order" = "rows channel swimmer channel-plane forces " ] && grep -qE '^\| \[rows\]\(#rows\) \| 2 \(0\) \|' "$P" &&
 		grep -qE '^\| \[channel\]\(#channel\) \| 1 \(0\) \|' "$P" && grep -qE '^\| \[forces\]\(#forces\) \| 1 \(0\) \|' "$P" &&
 		grep -qE '^\| \[swimmer\]\(#swimmer\) \| 1 \(0\) \|' "$P" && grep -qE '^\| \[channel-plane\]\(#channel-plane\) \| 1 \(0\) \|' "$P"; then
