@@ -227,7 +227,7 @@ frames() {
 		echo "set multiplot layout $rows,$nf title 'The robots in the channel (links from SIM.TRUTH): the oscillator from ${SWITCH} s'"
 		echo "unset key"
 		echo "set size ratio -1"
-		echo "set xtics 0.1 font ',8'; set ytics 0.1 font ',8'"
+		echo "set xtics 0.2 font ',8'; set ytics 0.1 font ',8'"
 		echo "set format x '%.1f'; set format y '%.1f'"
 		for wd in "${widths[@]}"; do
 			w=${wd%%|*} d=${wd#*|}

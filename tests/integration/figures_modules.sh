@@ -9,7 +9,10 @@
 # data) and its fragment with the numbers those rows give; a merge without
 # results or without gnuplot fails with a message; and the five modules'
 # tiny set (FIG_TINY=1, 6 short lockstep runs, one of them from /) through the
-# driver onto a page.
+# driver onto a page. Alone at load 6 it takes about 230 s, most of it the tiny
+# set's lockstep runs; beside the rest of the suite on two cores it ran past
+# the runner's 300 s default once:
+# run.sh: timeout 600
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures"
 PNG="$BUILD/tests/tools/pngdata"
