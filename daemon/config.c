@@ -12,6 +12,7 @@
 #include <strings.h>
 
 #include "dxl_table.h"
+#include "text.h"
 #include "textfile.h"
 #include "udpm.h"
 
@@ -428,9 +429,12 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 			cfg_error(e, "%s: [robot] %s: longer than %zu characters", where, key, k->size - 1);
 			return false;
 		}
-		if (strcmp(key, "name") == 0 && (value[0] == '\0' || strpbrk(value, ".* \t\r\n\v\f") != NULL)) {
-			cfg_error(e, "%s: [robot] name: '%s' must be non-empty without '.', '*' or spaces "
-			          "(it prefixes LCM channels)", where, value);
+		/* The monitors make robots only of such names (text_is_name): a
+		 * robot named otherwise would run unseen, or prefix channels with '/'. */
+		if (strcmp(key, "name") == 0 && !text_is_name(value, CFG_NAME_MAX - 1)) {
+			char shown[CFG_NAME_MAX];
+			cfg_error(e, "%s: [robot] name: '%s' must be letters, digits, '_' or '-' "
+			          "(it prefixes LCM channels)", where, text_line(shown, sizeof shown, value));
 			return false;
 		}
 		memcpy(field, value, strlen(value) + 1);

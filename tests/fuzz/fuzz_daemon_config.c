@@ -20,8 +20,8 @@
  *    is never accepted (daemon/README.md, "Configuration");
  *  - a configuration accepted with no error at all (what main.c runs) has
  *    every value in its documented range (daemon/README.md): numbers
- *    finite, enums among their names, a robot name without '.', '*' or
- *    spaces, a port, 1..CFG_MAX_JOINTS unique servo IDs 0..253, every joint
+ *    finite, enums among their names, a robot name of letters, digits,
+ *    '_' and '-', a port, 1..CFG_MAX_JOINTS unique servo IDs 0..253, every joint
  *    filled in, limits ordered, containing 0 and inside the servo's ±2.618
  *    rad around neutral, and no joint beyond the IDs configured;
  *  - cfg_print() handles it.
@@ -121,11 +121,11 @@ static void check_config(const struct cfg *c)
 	/* [robot] */
 	CHECK(terminated(c->name, sizeof c->name) && c->name[0] != '\0');
 	for (const char *p = c->name; *p; p++)
-		CHECK(*p != '.' && *p != '*' && !isspace((unsigned char)*p));
+		CHECK(isalnum((unsigned char)*p) || *p == '_' || *p == '-');
 	CHECK(terminated(c->port, sizeof c->port) && terminated(c->usb_serial, sizeof c->usb_serial));
 	CHECK(c->port[0] != '\0' || c->usb_serial[0] != '\0');
 	CHECK(terminated(c->lcm_url, sizeof c->lcm_url) && terminated(c->source, sizeof c->source));
-	CHECK(c->baud >= 9600 && c->baud <= 3000000);
+	CHECK(c->baud >= 9600 && c->baud <= 4500000);
 	CHECK(c->njoints >= 1 && c->njoints <= CFG_MAX_JOINTS);
 	for (size_t k = 0; k < c->njoints; k++) {
 		CHECK(c->ids[k] <= 253);

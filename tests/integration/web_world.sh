@@ -44,9 +44,12 @@ wait_log sim 'ready' 10 && wait_log web 'listening on http://' 10 ||
 H="http://127.0.0.1:$(port_of web)"
 wait_for 10 bash -c "curl -s '$H/api/snapshot' | jq -e '.nrobots == 10' "
 # the walls meet the outer robots about 0.7 s after they start moving (at 1 s)
-wait_for 15 bash -c "curl -s '$H/api/snapshot' | jq -e '.sim.total_impulse > 0' "
+wait_for 15 bash -c "curl -s '$H/api/snapshot' | jq -e '.sim.total_impulse > 0' " ||
+	echo "# no contact in the simulator's first 15 s: $(curl -s "$H/api/snapshot" | jq -c '.sim' 2>&1 | head -c 300)"
 
-# Frames for 3 s: the world in each, and the contacts of every frame.
+# Frames for 3 s (longer, up to 15 s, until a contact has come: a loaded
+# machine once gave 3 s of frames without one): the world in each, and the
+# contacts of every frame.
 python3 - "$(port_of web)" >"$T/plane.frames" 2>&1 <<EOF
 import json, sys, time
 sys.path.insert(0, '$top/tests/integration')
@@ -55,7 +58,8 @@ ws = web_cdp.WS('127.0.0.1', int(sys.argv[1]), '/', 'undulate')
 n = worlds = marks = impacts = size = wsize = 0
 last = None
 end = time.time() + 3
-while time.time() < end:
+deadline = time.time() + 15
+while time.time() < end or (marks == 0 and time.time() < deadline):
     m = ws.recv()
     f = json.loads(m)
     n += 1
