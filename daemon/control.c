@@ -215,6 +215,23 @@ static void ctl_put_le(uint8_t *p, uint32_t v, uint8_t width)
 		p[i] = (uint8_t)(v >> (8 * i));
 }
 
+/* A goal's register value, rounded to the nearest step but never past the
+ * limits it was clamped into: rounding to the nearest put a goal of +0.5 rad
+ * against +-0.5 limits at 98 steps (+0.5015 rad) on the AX-12A, past the
+ * configuration's limit by up to half a step (qa_soak: 28 of 138 goal
+ * registers sampled, by up to 0.0016 rad). */
+static int32_t ctl_goal_pos(const struct ctl_joint *jt, const struct sm_model *m, double rad)
+{
+	int32_t pos = sm_rad_to_pos(m, rad);
+	if (jt->limits.max_step > 0.0) {
+		if (sm_pos_to_rad(m, pos) > jt->limits.hi && pos > 0)
+			pos--;
+		else if (sm_pos_to_rad(m, pos) < jt->limits.lo && pos < m->pos_max)
+			pos++;
+	}
+	return pos;
+}
+
 /* Torque actuation's outputs (or, X series leaving it, 0 for every drive). On
  * the X series only joints whose drive switch went through: a servo still in
  * position control would take Goal PWM as its limit. */
@@ -254,9 +271,9 @@ size_t ctl_sync(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *id
 			continue;
 		ids[n] = jt->id;
 		if (m->protocol == 2) {
-			ctl_put_le(&data[*width * n], (uint32_t)sm_rad_to_pos(ctl_model(c, j), jt->goal), *width);
+			ctl_put_le(&data[*width * n], (uint32_t)ctl_goal_pos(jt, ctl_model(c, j), jt->goal), *width);
 		} else {
-			dxl_put_u16(&data[*width * n], dxl_rad_to_pos(jt->goal));
+			dxl_put_u16(&data[*width * n], (uint16_t)ctl_goal_pos(jt, ctl_model(c, j), jt->goal));
 			if (*width == 4)
 				dxl_put_u16(&data[*width * n + 2], 0);   /* moving speed 0: joint mode's "fastest" */
 		}
@@ -465,7 +482,7 @@ uint16_t ctl_x_setup(struct ctl *c, size_t j, bool with_mode)
 	 * anything (a boot's, a drive mode's) */
 	if (jt->have_reading && jt->limits.max_step > 0.0) {
 		double hold = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
-		ctl_write_chain(c, ch, jt->id, m->goal, m->goal_size, (uint32_t)sm_rad_to_pos(m, hold));
+		ctl_write_chain(c, ch, jt->id, m->goal, m->goal_size, (uint32_t)ctl_goal_pos(jt, m, hold));
 	}
 	if (c->cfg->bus_watchdog_ms >= 0)
 		ctl_write_chain(c, ch, jt->id, DXL2_X_BUS_WATCHDOG, 1, cfg_watchdog_units(c->cfg));
@@ -582,10 +599,19 @@ void ctl_measure_slow(struct ctl *c, size_t j, uint8_t voltage_raw, uint8_t temp
 	c->j[j].errbits |= errbits;
 }
 
+/* Where a joint found at `angle` is held: there, or at the nearer limit when
+ * it is past one (moved by hand while limp, or a servo that reset there). */
+static double ctl_hold_point(const struct ctl_joint *jt, double angle)
+{
+	if (jt->limits.max_step <= 0.0 || !isfinite(angle))
+		return angle;   /* no limits yet (never set up), or nothing measured */
+	return safety_clamp(&jt->limits, angle, NAN, angle, NULL);
+}
+
 void ctl_hold_at_present(struct ctl *c)
 {
 	for (size_t j = 0; j < c->n; j++)
-		c->hold[j] = isfinite(c->j[j].angle) ? c->j[j].angle : c->j[j].goal;
+		c->hold[j] = ctl_hold_point(&c->j[j], isfinite(c->j[j].angle) ? c->j[j].angle : c->j[j].goal);
 }
 
 /* A servo found with torque off that should be on: it lost power (or browned
@@ -611,11 +637,11 @@ static void ctl_servo_reset(struct ctl *c, size_t j)
 	}
 	wq_drop_id(&c->wq, jt->id);
 	ctl_servo_setup(c, j, true);
-	/* it may have been moved while limp: start where it is */
-	jt->goal = jt->angle;
-	c->hold[j] = jt->angle;
+	/* it may have been moved while limp: start where it is (inside the limits) */
+	jt->goal = ctl_hold_point(jt, jt->angle);
+	c->hold[j] = jt->goal;
 	if (jt->fault == CTL_FAULT_NONE)
-		ctl_blend_joint(c, j, jt->angle);
+		ctl_blend_joint(c, j, jt->goal);
 }
 
 static void ctl_mismatch(struct ctl *c, size_t j, const char *what, unsigned read, unsigned want)
@@ -919,10 +945,11 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 		}
 		double from = ctl_present_or_goal(jt);
 		if (!jt->torque) {
-			/* from LIMP: the joint may have been moved by hand; start where it is */
+			/* from LIMP: the joint may have been moved by hand; start where it
+			 * is, or at the nearer limit when that is past one */
 			ctl_torque_write(c, j, true);
-			from = jt->angle;
-			jt->goal = jt->angle;
+			from = ctl_hold_point(jt, jt->angle);
+			jt->goal = from;
 			ctl_blend_joint(c, j, from);
 		}
 		c->hold[j] = from;
@@ -968,10 +995,17 @@ void ctl_latch(struct ctl *c, const char *what)
 	} else {
 		c->latched = true;
 		snprintf(c->latch, sizeof c->latch, "%s", what);
-		ctl_event(c, 2, "fault-latched", "%s: robot %s until 'clear'", what, cfg_mode_name(m));
+		/* a fault never turns torque on: a robot the operator made LIMP
+		 * stays LIMP (its joints may be in someone's hands) */
+		ctl_event(c, 2, "fault-latched", "%s: robot %s until 'clear'", what,
+		          cfg_mode_name(c->mode == CFG_MODE_LIMP ? CFG_MODE_LIMP : m));
 	}
 	char reason[sizeof c->reason];
 	snprintf(reason, sizeof reason, "fault: %.80s", what);
+	if (c->mode == CFG_MODE_LIMP) {
+		snprintf(c->reason, sizeof c->reason, "%s", reason);
+		return;
+	}
 	/* hold where the joints are, not where a failing joint was told to go */
 	ctl_hold_at_present(c);
 	if (c->mode == m) {

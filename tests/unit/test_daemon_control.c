@@ -399,6 +399,95 @@ static void test_torque_commands(void **state)
 	assert_true(fabs(c.j[0].goal - 0.9) < 0.003);   /* holds where the hand left it */
 }
 
+/* A fault while the operator has the robot LIMP latches, and the robot stays
+ * LIMP: the fault action (HOLD here) never turns torque on. The soak (make
+ * test-long, qa_soak) found a servo going silent while LIMP switching the
+ * robot to HOLD, torque on, 393 states over 34 LIMPs. */
+static void test_fault_while_limp_stays_limp(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_OSCILLATOR);
+	cfg.fault_action = CFG_SAFE_HOLD;
+	run(50);
+	ctl_torque(&c, false);
+	assert_int_equal(c.mode, CFG_MODE_LIMP);
+	run(5);
+	drain_outputs();
+	servo_answers[1] = false;
+	int n = (int)(cfg.silent_s / (cfg.period_ms * 1e-3)) + 20;
+	bool torque_on = false;
+	for (int i = 0; i < n; i++) {
+		cycle();
+		torque_on = torque_on || has_write(1, DXL_AX_TORQUE_ENABLE, 1) || has_write(2, DXL_AX_TORQUE_ENABLE, 1);
+	}
+	assert_true(c.latched);
+	assert_int_equal(c.mode, CFG_MODE_LIMP);
+	assert_false(torque_on);
+	assert_false(c.j[0].torque || c.j[1].torque);
+	assert_non_null(strstr(c.reason, "silent"));
+	/* the operator may still choose HOLD (the fault action) */
+	char why[256];
+	assert_true(ctl_mode_allowed(&c, CFG_MODE_HOLD, why, sizeof why));
+	servo_answers[1] = true;
+}
+
+/* A joint found past its limit (moved by hand while limp, or a servo that
+ * reset there) is held at the limit, never at where it is: the goal the
+ * controller keeps and publishes is inside the limits from the first cycle. */
+static void test_hold_from_past_limit_inside_limits(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_HOLD);
+	run(20);
+	ctl_torque(&c, false);
+	run(3);
+	servo_angle[1] = c.j[1].limits.lo - 0.01;   /* pushed past the limit by hand */
+	run(3);
+	drain_outputs();
+	ctl_torque(&c, true);
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+	assert_true(c.j[1].goal >= c.j[1].limits.lo);
+	assert_true(c.hold[1] >= c.j[1].limits.lo);
+	for (int i = 0; i < 5; i++) {
+		cycle();
+		assert_true(c.j[1].goal >= c.j[1].limits.lo && c.j[1].goal <= c.j[1].limits.hi);
+	}
+}
+
+/* The goal register never names an angle past the limits: +0.5 rad against
+ * +-0.5 limits rounds to 98 steps (+0.5011 rad) on the AX-12A; the register
+ * takes 97. */
+static void test_goal_register_inside_limits(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_SINUSOID);
+	cfg.amplitude = 2.5;
+	cfg.joint[1].limit_min = -0.5;
+	cfg.joint[1].limit_max = 0.5;
+	char why[512];
+	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023 };
+	assert_true(ctl_set_servo(&c, 1, &info, why, sizeof why));
+	ctl_params_changed(&c);
+	uint16_t addr;
+	uint8_t width, ids[8], data[64];
+	int at_hi = 0, at_lo = 0;
+	for (int i = 0; i < 400; i++) {
+		cycle();
+		size_t n = ctl_sync(&c, &addr, &width, ids, data);
+		for (size_t k = 0; k < n; k++) {
+			if (ids[k] != 2)
+				continue;
+			uint16_t pos = dxl_get_u16(&data[width * k]);
+			double rad = dxl_pos_to_rad(pos);
+			if (rad > 0.5 || rad < -0.5)
+				fail_msg("goal register %u = %+.4f rad, past +-0.5", pos, rad);
+			at_hi += pos == 512 + 97;
+			at_lo += pos == 512 - 97;
+		}
+	}
+	assert_true(at_hi > 0 && at_lo > 0);   /* it went to each limit */
+}
+
 static void test_nonfinite_never_reaches_goal(void **state)
 {
 	(void)state;
@@ -497,6 +586,9 @@ int main(void)
 		cmocka_unit_test(test_fault_persistent),
 		cmocka_unit_test(test_other_error_bits_reported_once),
 		cmocka_unit_test(test_torque_commands),
+		cmocka_unit_test(test_fault_while_limp_stays_limp),
+		cmocka_unit_test(test_hold_from_past_limit_inside_limits),
+		cmocka_unit_test(test_goal_register_inside_limits),
 		cmocka_unit_test(test_nonfinite_never_reaches_goal),
 		cmocka_unit_test(test_limits_respected),
 	};
