@@ -104,16 +104,24 @@ else tap_fail "the port is free after SIGKILL" "rc=$rc; $(cat "$T/ping1.err")"; 
 # ---- a UUCP lock file of a live program (minicom writes them) is honoured
 lck="$T/LCK..$(echo "${pts#/dev/}" | tr / _)"
 spawn foreign sleep 300
+# until it has exec'd, the process is still "setsid": a lock file naming
+# "sleep" would read as a pid reused by another program (stale), and dxl
+# would rightly take the port (it did once, in a loaded make test)
+wait_for 10 bash -c "[ \"\$(cat /proc/$pid_foreign/comm 2>/dev/null)\" = sleep ]"
 printf '%10d sleep\n' "$pid_foreign" >"$lck"
 dxl_run uucp --port "$bus" ping 1
+rc_uucp=$rc
 printf '%10d\n' "$pid_foreign" >"$lck"
 dxl_run hdb --port "$bus" ping 1
+rc_hdb=$rc
+# what each run said and whether the holder still lived: printed on failure
+alive_hdb=$(alive foreign && echo alive || echo gone)
 stop foreign >/dev/null
 dxl_run uucp2 --port "$bus" ping 1
 if [ "$(cat "$T/uucp.err" "$T/hdb.err" | grep -cE "held by sleep \(pid $pid_foreign, lock file $lck\)")" = 2 ] &&
 	[ "$rc" = 0 ] && [ ! -e "$lck" ]; then
 	tap_ok "a UUCP lock file naming a live program refuses dxl; once that program is gone dxl takes the port and removes its own"
-else tap_fail "UUCP lock files honoured" "rc=$rc; $(cat "$T/uucp.err" "$T/hdb.err" "$T/uucp2.err"; ls "$T" | grep LCK)"; fi
+else tap_fail "UUCP lock files honoured" "rc uucp=$rc_uucp hdb=$rc_hdb uucp2=$rc; holder after hdb: $alive_hdb; $(cat "$T/uucp.err" "$T/hdb.err" "$T/hdb.out" "$T/uucp2.err"; ls "$T" | grep LCK)"; fi
 
 # ---- a daemon takes its port again when the bus comes back
 mark_states
