@@ -224,9 +224,11 @@ static int32_t ctl_goal_pos(const struct ctl_joint *jt, const struct sm_model *m
 {
 	int32_t pos = sm_rad_to_pos(m, rad);
 	if (jt->limits.max_step > 0.0) {
-		if (sm_pos_to_rad(m, pos) > jt->limits.hi && pos > 0)
+		/* limits narrower than a step keep the nearest step: none is inside */
+		if (sm_pos_to_rad(m, pos) > jt->limits.hi && pos > 0 && sm_pos_to_rad(m, pos - 1) >= jt->limits.lo)
 			pos--;
-		else if (sm_pos_to_rad(m, pos) < jt->limits.lo && pos < m->pos_max)
+		else if (sm_pos_to_rad(m, pos) < jt->limits.lo && pos < m->pos_max &&
+		         sm_pos_to_rad(m, pos + 1) <= jt->limits.hi)
 			pos++;
 	}
 	return pos;

@@ -199,11 +199,13 @@ fig_delta_trace() {
 # What a run keeps: its result, the analyser's summary and per-second rates,
 # the programs' logs. The LCM log and the per-sample and per-collision CSVs
 # go (3 MB and 1.5 MB for a 40 s pair run, 100-300 MB for a long run of ten
-# robots), unless FIG_KEEP=1.
+# robots; the plane world's plane.csv, 11 MB for 300 s of ten robots, which
+# forces-plane's runs kept until this removed it for every module), unless
+# FIG_KEEP=1.
 fig_clean() {
 	[ "${FIG_KEEP:-0}" = 1 ] && return 0
 	rm -f "$1/demo.lcmlog" "$1/states.csv" "$1/phase_diff.csv" "$1/collisions.csv" "$1/return_map.csv" \
-		"$1/bus.csv" "$1/params.csv"
+		"$1/bus.csv" "$1/params.csv" "$1/plane.csv" "$1/plane_walls.csv"
 }
 
 # fig_results DIR [sorted]: the runs' rows under the first run's header (with

@@ -145,7 +145,6 @@ run() {
 			"$out/robots.txt" "$out/pairs.csv"
 	} >"$out/result.csv"
 	rm -f "$out/pairs.csv"
-	[ "${FIG_KEEP:-0}" = 1 ] || rm -f "$r/plane.csv" "$r/plane_walls.csv"
 	fig_clean "$r"
 }
 

@@ -129,7 +129,6 @@ run() {
 		echo "mode,seed,seconds,freq1_hz,freq2_hz,amp1_rad,amp2_rad,lag_rad,lag_spread_rad,along_per_period_m,across_per_period_m,speed_m_s,turn_rad,periods,min_swing_rad,wall_s,sweep_m"
 		echo "$mode,$seed,$secs,$f1,$f2,$a1,$a2,$lag,$spread,$swim,$swing,$wall,$sweep"
 	} >"$out/result.csv"
-	[ "${FIG_KEEP:-0}" = 1 ] || rm -f "$r/plane.csv" "$r/plane_walls.csv"
 	fig_clean "$r"
 }
 

@@ -4,6 +4,8 @@
 #include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 char scratch_dir[256];
 
@@ -41,4 +43,14 @@ char *scratch_slurp(const char *rel, size_t cap)
 		buf[n] = '\0';
 	fclose(f);
 	return buf;
+}
+
+long scratch_dead_pid(void)
+{
+	pid_t c = fork();
+	if (c < 0)
+		return -1;
+	if (c == 0)
+		_exit(0);
+	return waitpid(c, NULL, 0) == c ? (long)c : -1;
 }

@@ -1,6 +1,6 @@
 /*
  * scratch.h — a private scratch directory for a unit test that writes files
- * (logs, analyser output), and reading a file back whole. Linked into every
+ * (logs, analyser output), reading a file back whole, and a pid nobody has. Linked into every
  * unit test, like ptypeer.c.
  */
 #ifndef UNDULATE_SCRATCH_H
@@ -19,5 +19,7 @@ int scratch_remove(void);
 /* A file under the scratch directory, NUL-terminated, at most cap bytes read
  * (free() it); NULL if it cannot be opened. `rel` is relative to scratch_dir. */
 char *scratch_slurp(const char *rel, size_t cap);
+/* A pid nobody has: a child that exited and was reaped (-1 if fork failed). */
+long scratch_dead_pid(void);
 
 #endif

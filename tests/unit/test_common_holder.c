@@ -50,17 +50,6 @@ static void write_text(const char *path, const char *text)
 	assert_int_equal(fclose(f), 0);
 }
 
-/* A pid nobody has: a child that exited and was reaped. */
-static long dead_pid(void)
-{
-	pid_t c = fork();
-	assert_true(c >= 0);
-	if (c == 0)
-		_exit(0);
-	assert_int_equal(waitpid(c, NULL, 0), c);
-	return (long)c;
-}
-
 static void test_line_round_trip(void **state)
 {
 	(void)state;
@@ -148,7 +137,8 @@ static void test_processes(void **state)
 	assert_true(strncmp(me, "test_common_hol", 15) == 0);
 	assert_true(holder_alive((long)getpid()));
 	assert_true(holder_alive(1));   /* EPERM or not: it is there */
-	long gone = dead_pid();
+	long gone = scratch_dead_pid();
+	assert_true(gone > 0);
 	assert_false(holder_alive(gone));
 	assert_false(holder_alive(0));
 	assert_false(holder_alive(-1));
@@ -240,7 +230,7 @@ static void test_lockfile(void **state)
 	assert_int_equal(access(path, F_OK), -1);
 	/* a dead holder's file (no lock on it any more) is taken over */
 	char line[64];
-	snprintf(line, sizeof line, "%10ld undulate-sim bus r1\n", dead_pid());
+	snprintf(line, sizeof line, "%10ld undulate-sim bus r1\n", scratch_dead_pid());
 	write_text(path, line);
 	fd = holder_lockfile_take(path, "bus r3", &who, err, sizeof err);
 	assert_true(fd >= 0);

@@ -23,6 +23,7 @@
 
 #include "port.h"
 #include "ptypeer.h"
+#include "scratch.h"
 
 struct fixture {
 	struct ptypeer peer;
@@ -317,16 +318,6 @@ static void test_second_open_refused(void **state)
 	lockdir_remove(&l);
 }
 
-static long reaped_pid(void)
-{
-	pid_t c = fork();
-	assert_true(c >= 0);
-	if (c == 0)
-		_exit(0);
-	assert_int_equal(waitpid(c, NULL, 0), c);
-	return (long)c;
-}
-
 /* minicom's lock files: a live program's refuses the port; a dead one's, or
  * one whose pid now runs another program (reused after a kill), is replaced. */
 static void test_uucp_lock_files(void **state)
@@ -358,7 +349,7 @@ static void test_uucp_lock_files(void **state)
 	/* stale: the pid is gone, or runs another program now */
 	const char *stale[] = { "%10ld undulated robot r9\n", "%10ld minicom-not-this-one x\n" };
 	for (size_t i = 0; i < 2; i++) {
-		snprintf(text, sizeof text, stale[i], i == 0 ? reaped_pid() : (long)getppid());
+		snprintf(text, sizeof text, stale[i], i == 0 ? scratch_dead_pid() : (long)getppid());
 		write_lck(l.lck, text);
 		struct port *p = port_open(l.peer.slave_path, &opt, err, sizeof err);
 		if (p == NULL)
