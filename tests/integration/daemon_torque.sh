@@ -86,9 +86,10 @@ if [ "$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)" = 278/746 ] && [ "$ms"
 else tap_fail "joint mode holds" "limits $(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit) speed $ms present $pos goal $goal"; fi
 
 # ---- the safe stop from wheel mode
-"$D" --command 'mode oscillator' --robot "$R" --lcm-url "$URL" >/dev/null
-n=$(grep -c 'servos in wheel mode' "$T/watch.log")
-wait_for 10 bash -c "[ \$(grep -c 'servos in wheel mode' '$T/watch.log') -gt $n ]"
+# the servo's own register says wheel mode (an event counted after the
+# command may already be in the log before the count is taken)
+said=$("$D" --command 'mode oscillator' --robot "$R" --lcm-url "$URL" --timeout 5 2>&1); said_rc=$?
+wait_for 15 bash -c "[ \"\$(echo 'peek r1 1 ccw_angle_limit' | socat -t 2 - UNIX-CONNECT:$T/ctl)\" = 'ok 0' ]"
 if [ "$(peek 1 ccw_angle_limit)" = 0 ]; then
 	stop d
 	lim="$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)"; ms=$(peek 1 moving_speed); te=$(peek 1 torque_enable)
@@ -97,7 +98,8 @@ if [ "$(peek 1 ccw_angle_limit)" = 0 ]; then
 		tap_ok "SIGTERM in wheel mode: drive stopped, joint mode back, holding (exit 0)"
 	else tap_fail "safe stop from wheel mode" "exit $stop_rc, limits $lim, speed $ms, torque $te"; fi
 else
-	tap_fail "back in wheel mode before the stop" "ccw limit $(peek 1 ccw_angle_limit)"
+	tap_fail "back in wheel mode before the stop" "ccw limit $(peek 1 ccw_angle_limit); the command said (exit $said_rc): $said; $(grep "EVENT $R" "$T/watch.log" | tail -4)"
+	stop d
 fi
 
 # ---- the supply the servo reports ---------------------------------------------------------------
