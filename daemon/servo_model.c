@@ -135,6 +135,16 @@ int32_t sm_rad_to_pos(const struct sm_model *m, double rad)
 	return sm_is_x(m) ? dxl2_rad_to_pos(rad) : dxl_rad_to_pos(rad);
 }
 
+void sm_joint_range(const struct sm_model *m, double lo_rad, double hi_rad, int32_t *lo, int32_t *hi)
+{
+	*lo = sm_rad_to_pos(m, lo_rad);
+	*hi = sm_rad_to_pos(m, hi_rad);
+	if (sm_pos_to_rad(m, *lo) < lo_rad && *lo < m->pos_max)
+		(*lo)++;
+	if (sm_pos_to_rad(m, *hi) > hi_rad && *hi > 0)
+		(*hi)--;
+}
+
 bool sm_decode_present(const struct sm_model *m, const uint8_t *b, size_t n, struct sm_present *out)
 {
 	if (n != m->present_len && n != m->present_len_slow)

@@ -104,6 +104,16 @@ const struct sm_model *sm_by_number(int protocol, uint16_t number);
 double sm_pos_to_rad(const struct sm_model *m, int32_t raw);
 int32_t sm_rad_to_pos(const struct sm_model *m, double rad);
 
+/* A joint's range [lo_rad, hi_rad] (neutral included) as the model's
+ * position registers, in whole units inside it: the nearest unit, moved one
+ * inward when the nearest lies outside (never past 0..pos_max). The one rule
+ * for every program that writes or checks a servo's own limits: undulated's
+ * start-up (angle limits, Min/Max Position Limit) and `dxl doctor`'s
+ * expectation of them; two roundings drifted apart once (the X doctor
+ * rounded to the nearest and expected 1722..2374 where undulated wrote
+ * 1723..2373 for +-0.5 rad). */
+void sm_joint_range(const struct sm_model *m, double lo_rad, double hi_rad, int32_t *lo, int32_t *hi);
+
 /* What one cycle read: the present block, present_len bytes (fast) or
  * present_len_slow (slow: voltage and temperature too). */
 struct sm_present {

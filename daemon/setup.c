@@ -132,22 +132,15 @@ bool setup_protocol(struct bus *bus, const struct cfg *cfg, const char *port_pat
 
 void setup_joint_limits_model(const struct sm_model *m, const struct cfg_joint *cj, int32_t *lo, int32_t *hi)
 {
-	*lo = sm_rad_to_pos(m, cj->neutral + cj->limit_min);
-	*hi = sm_rad_to_pos(m, cj->neutral + cj->limit_max);
-	if (sm_pos_to_rad(m, *lo) < cj->neutral + cj->limit_min && *lo < m->pos_max)
-		(*lo)++;
-	if (sm_pos_to_rad(m, *hi) > cj->neutral + cj->limit_max && *hi > 0)
-		(*hi)--;
+	sm_joint_range(m, cj->neutral + cj->limit_min, cj->neutral + cj->limit_max, lo, hi);
 }
 
 void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw)
 {
-	*cw = dxl_rad_to_pos(cj->neutral + cj->limit_min);
-	*ccw = dxl_rad_to_pos(cj->neutral + cj->limit_max);
-	if (dxl_pos_to_rad(*cw) < cj->neutral + cj->limit_min && *cw < DXL_POS_MAX)
-		(*cw)++;
-	if (dxl_pos_to_rad(*ccw) > cj->neutral + cj->limit_max && *ccw > 0)
-		(*ccw)--;
+	int32_t lo, hi;
+	setup_joint_limits_model(sm_ax12(), cj, &lo, &hi);
+	*cw = (uint16_t)lo;
+	*ccw = (uint16_t)hi;
 }
 
 /* Torque actuation found a servo in wheel mode (the daemon was stopped

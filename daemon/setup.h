@@ -68,7 +68,8 @@ bool setup_limp(struct bus *bus, const struct ctl_joint *jt);
  * puts a servo back in joint mode, and what `dxl doctor` compares the servo's
  * own limits with. */
 void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw);
-/* The same in a model's units (X series: Min/Max Position Limit). */
+/* The same in a model's units (X series: Min/Max Position Limit):
+ * sm_joint_range, the one rule. */
 void setup_joint_limits_model(const struct sm_model *m, const struct cfg_joint *cj, int32_t *lo, int32_t *hi);
 
 #endif

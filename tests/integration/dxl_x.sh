@@ -86,6 +86,31 @@ check "doctor on 2.0: the servos' lines, and 300 of undulated's own 2.0 cycles t
 	-a -n "$(grep -E '^OK +ID 2 return delay +0 us' "$T/doctor.out")" \
 	-a -n "$(grep -E '^(OK|WARN) +budget +bus time per cycle p50 .* 300 cycles of undulated.s own loop on 2 joint\(s\), holding' "$T/doctor.out")"
 
+# undulated sets the joints' limits up, the doctor expects what it wrote: one
+# rule (whole units inside the limits) for both; at +-0.5 rad the doctor once
+# rounded to the nearest unit and warned about the servos undulated had just
+# set up ("1723..2373, narrower than the configuration's 1722..2374")
+cat >"$T/half.conf" <<EOF
+[robot]
+name = t$$
+port = $xl
+ids = 1,2
+baud = 1000000
+[joint.1]
+limit_min = -0.5
+limit_max = 0.5
+[joint.2]
+limit_min = -0.5
+limit_max = 0.5
+EOF
+spawn dhalf "$B/undulated" --config "$T/half.conf" --lcm-url "$url" --mode hold
+if wait_log dhalf "ready: t$$.STATE" 15; then
+	stop dhalf
+	run halfdoc --port "$xl" --baud 1000000 doctor 1 2 --config "$T/half.conf" --cycles 20
+	check "doctor after undulated set +-0.5 rad up: position limits 1723..2373 OK on both, as written" halfdoc \
+		test "$(grep -cE '^OK +ID [12] position limits +1723\.\.2373, around the configuration.s 1723\.\.2373' "$T/halfdoc.out")" = 2
+else tap_fail "undulated sets +-0.5 rad up on the X bus" "$(cat "$T/dhalf.log")"; fi
+
 xm="$T/xm"
 spawn simxm "$sim" --model xm430-w350 --link "$xm" --ids 3 --baud 1000000 --lcm-url "$(lcm_url 7641)" --quiet
 if wait_log simxm 'ready' 10; then

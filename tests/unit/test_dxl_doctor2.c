@@ -13,6 +13,8 @@
 #include <cmocka.h>
 
 #include "../../tools/dxl/doctor.h"
+#include "../../daemon/servo_model.h"
+#include "../../daemon/setup.h"
 #include "dxl2.h"
 #include "dxl2_table.h"
 
@@ -179,6 +181,25 @@ static void test_limits(void **state)
 	s.torque_enable = 1;
 	dr2_check_limits(&s, &cfg, 0, &ctx, &v);
 	expect(&v, DR_FAIL, "no position in common", "torque off first", NULL);
+	/* What undulated writes is what the doctor expects: the joint limits
+	 * rounded inward to whole units (setup rounds +-0.5 rad to 1723..2373;
+	 * rounding to the nearest unit made the doctor expect 1722..2374 and
+	 * warn that the servo undulated had just set up was "narrower") */
+	const double lims[] = { 0.5, 0.8, 1.0, 1.3 };
+	for (size_t i = 0; i < sizeof lims / sizeof lims[0]; i++) {
+		cfg.joint[0].limit_min = -lims[i];
+		cfg.joint[0].limit_max = lims[i];
+		int32_t lo, hi;
+		setup_joint_limits_model(sm_of(SM_XL430), &cfg.joint[0], &lo, &hi);
+		s.min_position = lo, s.max_position = hi;
+		s.torque_enable = 0;
+		dr2_check_limits(&s, &cfg, 0, &ctx, &v);
+		expect(&v, DR_OK, NULL);
+	}
+	s.min_position = 1723, s.max_position = 2373;
+	cfg.joint[0].limit_min = -0.5, cfg.joint[0].limit_max = 0.5;
+	dr2_check_limits(&s, &cfg, 0, &ctx, &v);
+	expect(&v, DR_OK, "1723..2373, around the configuration's 1723..2373", NULL);
 }
 
 static void test_hwerr_watchdog_err(void **state)

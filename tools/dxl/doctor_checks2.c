@@ -8,6 +8,8 @@
 #include "doctor.h"
 #include "dxl2.h"
 #include "dxl2_table.h"
+#include "daemon/servo_model.h"
+#include "daemon/setup.h"
 
 static uint16_t dr2_u16(const uint8_t *m, unsigned a)
 {
@@ -147,7 +149,11 @@ void dr2_check_limits(const struct dr2_servo *s, const struct cfg *cfg, size_t j
                       struct dr_verdict *v)
 {
 	const struct cfg_joint *cj = &cfg->joint[joint];
-	int32_t lo = dxl2_rad_to_pos(cj->neutral + cj->limit_min), hi = dxl2_rad_to_pos(cj->neutral + cj->limit_max);
+	/* what undulated writes (setup_joint_limits_model): inside the limits;
+	 * every X model has the XL430's 4096 units a turn around 2048 */
+	const struct sm_model *m = sm_by_number(2, s->model);
+	int32_t lo, hi;
+	setup_joint_limits_model(m != NULL ? m : sm_of(SM_XL430), cj, &lo, &hi);
 	char conf[160];
 
 	snprintf(conf, sizeof conf, "the configuration's %ld..%ld (joint %zu: neutral %+.3f + [%.3f, %.3f] rad)",
