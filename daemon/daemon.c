@@ -325,11 +325,14 @@ static void dmn_position_defaults(struct dmn *d)
 		double k0 = cfg->joint[j].osc.k, mu0 = cfg->joint[j].osc.mu;
 		if (cfg_position_defaults(cfg, j, k, mu))
 			log_info("joint %zu: position actuation's default k %.4g, mu %.4g are the %s's (the AX-12A's: "
-			         "k %.4g, mu %.4g; daemon/CONTROL.md, \"X-series servos\")", j + 1, cfg->joint[j].osc.k,
-			         cfg->joint[j].osc.mu, m->name, k0, mu0);
+			         "k %.4g, mu %.4g; daemon/CONTROL.md, \"X-series servos\")%s", j + 1, cfg->joint[j].osc.k,
+			         cfg->joint[j].osc.mu, m->position_from, k0, mu0,
+			         strcmp(m->position_from, m->name) != 0 ? ": nobody tuned them on this model yet, "
+			         "undulated --tune finds its own" : "");
 	}
 	if (same && lead > 0.0 && cfg->servo_lead_default) {
-		log_info("servo_lead_s %.3f s, the %s's default (the AX-12A's: %.3f s)", lead, first->name, cfg->servo_lead_s);
+		log_info("servo_lead_s %.3f s, the %s's default (the AX-12A's: %.3f s)", lead, first->position_from,
+		         cfg->servo_lead_s);
 		cfg->servo_lead_s = lead;
 		cfg->servo_lead_default = false;
 	} else if (!same && cfg->servo_lead_default && d->protocol == BUS_PROTOCOL_2) {

@@ -49,63 +49,83 @@
 	{ .k_pair = 0.0179, .mu_even = 0.0298, .mu_odd = 0.0166, .lead_pair = 0.086, \
 	  .k_single = 0.0105, .mu_single = 0.0360, .lead_single = 0.117 }
 
-static const struct sm_model sm_models[SM_NFAMILIES] = {
-	[SM_AX12] = {
-		.family = SM_AX12, .name = "AX-12A", .protocol = 1, .number = DXL_AX12_MODEL,
-		.torque_enable = DXL_AX_TORQUE_ENABLE, .torque_limit = DXL_AX_TORQUE_LIMIT,
-		.goal = DXL_AX_GOAL_POSITION, .goal_size = 2,
-		.present = DXL_AX_PRESENT_POSITION, .present_len = 6, .present_len_slow = 8,
-		.readback = { { SM_AX_READBACK_ADDR, SM_AX_READBACK_LEN, "RAM" } }, .nreadback = 1,
-		.pos_max = DXL_POS_MAX, .torque_full = 1023,
-		.ref_voltage = DXL_AX12_REF_VOLTAGE, .stall_torque_nm = DXL_AX12_STALL_TORQUE_NM,
-		.no_load_speed_rad_s = DXL_AX12_NO_LOAD_SPEED_RAD_S, .stall_current_a = 1.5,
-		.rated_min_v = DXL_AX12_RATED_MIN_V, .rated_max_v = DXL_AX12_RATED_MAX_V,
-		.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0),
-	},
-	[SM_XL430] = {
-		.family = SM_XL430, .name = "XL430-W250", .protocol = 2, .number = DXL2_MODEL_XL430_W250,
+/* Which tuned defaults a model takes: its own where --tune ran on it, else
+ * the XL430-W250's (the PWM-driven X servo whose position loop the others'
+ * resemble most) until someone tunes it: `undulated --tune` prints the
+ * values to add here. */
+static const struct {
+	uint16_t number;
+	struct sm_position_defaults position;
+} sm_tuned[] = {
+	{ DXL2_MODEL_XM430_W350, SM_XM430_POSITION },
+	{ DXL2_MODEL_XL430_W250, SM_XL430_POSITION },
+};
+
+static const struct sm_model sm_ax = {
+	.name = "AX-12A", .protocol = 1, .number = DXL_AX12_MODEL,
+	.torque_enable = DXL_AX_TORQUE_ENABLE, .torque_limit = DXL_AX_TORQUE_LIMIT,
+	.goal = DXL_AX_GOAL_POSITION, .goal_size = 2,
+	.present = DXL_AX_PRESENT_POSITION, .present_len = 6, .present_len_slow = 8,
+	.readback = { { SM_AX_READBACK_ADDR, SM_AX_READBACK_LEN, "RAM" } }, .nreadback = 1,
+	.pos_max = DXL_POS_MAX, .torque_full = 1023,
+	.ref_voltage = DXL_AX12_REF_VOLTAGE, .stall_torque_nm = DXL_AX12_STALL_TORQUE_NM,
+	.no_load_speed_rad_s = DXL_AX12_NO_LOAD_SPEED_RAD_S, .stall_current_a = 1.5,
+	.rated_min_v = DXL_AX12_RATED_MIN_V, .rated_max_v = DXL_AX12_RATED_MAX_V,
+	.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0), .position_from = "AX-12A",
+};
+
+/* The X models, made once from protocol/dxl2_table.c's descriptors: every
+ * X servo is read and driven through the same registers; what differs is
+ * its descriptor's data. */
+#define SM_MAX_X 32
+static struct sm_model sm_x[SM_MAX_X];
+static bool sm_x_made[SM_MAX_X];
+
+static const struct sm_model *sm_x_model(size_t i)
+{
+	const struct dxl2_model *d = dxl2_model_at(i);
+	if (d == NULL || i >= SM_MAX_X)
+		return NULL;
+	if (sm_x_made[i])
+		return &sm_x[i];
+	struct sm_model *m = &sm_x[i];
+	*m = (struct sm_model){
+		.name = d->name, .protocol = 2, .number = d->number, .desc = d,
 		.torque_enable = DXL2_X_TORQUE_ENABLE, .torque_limit = DXL2_X_GOAL_PWM,
 		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
+		/* Present Current where it senses current, Present Load else: 126 */
 		.present = DXL2_X_PRESENT_LOAD, .present_len = SM_X_PRESENT_LEN, .present_len_slow = SM_X_PRESENT_LEN_SLOW,
 		.readback = { { SM_X_RAM_ADDR, SM_X_RAM_LEN, "RAM" }, { SM_X_EEPROM_ADDR, SM_X_EEPROM_LEN, "EEPROM" } },
 		.nreadback = 2, .pos_max = DXL2_POS_MAX, .torque_full = SM_X_PWM_FULL,
-		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XL430_STALL_TORQUE_NM,
-		.no_load_speed_rad_s = DXL2_XL430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
-		.stall_current_a = DXL2_XL430_STALL_CURRENT_A, .reflected_inertia = SM_REFLECTED(4.6e-8, 258.5),
-		.rated_min_v = DXL2_XL430_RATED_MIN_V, .rated_max_v = DXL2_XL430_RATED_MAX_V,
-		.position = SM_XL430_POSITION,
-	},
-	[SM_XM430] = {
-		.family = SM_XM430, .name = "XM430-W350", .protocol = 2, .number = DXL2_MODEL_XM430_W350,
-		.torque_enable = DXL2_X_TORQUE_ENABLE, .torque_limit = DXL2_X_GOAL_PWM,
-		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
-		.present = DXL2_X_PRESENT_CURRENT, .present_len = SM_X_PRESENT_LEN, .present_len_slow = SM_X_PRESENT_LEN_SLOW,
-		.readback = { { SM_X_RAM_ADDR, SM_X_RAM_LEN, "RAM" }, { SM_X_EEPROM_ADDR, SM_X_EEPROM_LEN, "EEPROM" } },
-		.nreadback = 2, .pos_max = DXL2_POS_MAX, .torque_full = SM_X_PWM_FULL,
-		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = DXL2_XM430_STALL_TORQUE_NM,
-		.no_load_speed_rad_s = DXL2_XM430_NO_LOAD_SPEED_RPM * SM_RPM_TO_RAD_S,
-		.stall_current_a = DXL2_XM430_STALL_CURRENT_A, .current_control = true,
-		.rated_min_v = DXL2_XM430_RATED_MIN_V, .rated_max_v = DXL2_XM430_RATED_MAX_V,
-		.reflected_inertia = SM_REFLECTED(5.0e-8, 353.5),
-		.position = SM_XM430_POSITION,
-	},
-};
+		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = d->sheet.stall_torque_nm,
+		.no_load_speed_rad_s = d->sheet.no_load_speed_rpm * SM_RPM_TO_RAD_S,
+		.stall_current_a = d->sheet.stall_current_a, .current_control = d->current_sensing,
+		.rated_min_v = d->sheet.rated_min_v, .rated_max_v = d->sheet.rated_max_v,
+		.reflected_inertia = SM_REFLECTED(d->sheet.rotor_inertia, d->sheet.gear_ratio),
+		.position = sm_tuned[sizeof sm_tuned / sizeof sm_tuned[0] - 1].position,
+	};
+	m->position_from = "XL430-W250";
+	for (size_t t = 0; t < sizeof sm_tuned / sizeof sm_tuned[0]; t++)
+		if (sm_tuned[t].number == d->number) {
+			m->position = sm_tuned[t].position;
+			m->position_from = d->name;
+		}
+	sm_x_made[i] = true;
+	return m;
+}
 
 const struct sm_model *sm_ax12(void)
 {
-	return &sm_models[SM_AX12];
-}
-
-const struct sm_model *sm_of(enum sm_family f)
-{
-	return (unsigned)f < SM_NFAMILIES ? &sm_models[f] : &sm_models[SM_AX12];
+	return &sm_ax;
 }
 
 const struct sm_model *sm_by_number(int protocol, uint16_t number)
 {
-	for (size_t i = 0; i < SM_NFAMILIES; i++)
-		if (sm_models[i].protocol == protocol && sm_models[i].number == number)
-			return &sm_models[i];
+	if (protocol == 1)
+		return number == sm_ax.number ? &sm_ax : NULL;
+	for (size_t i = 0; i < dxl2_model_count(); i++)
+		if (dxl2_model_at(i)->number == number)
+			return sm_x_model(i);
 	return NULL;
 }
 
@@ -278,7 +298,7 @@ uint16_t sm_drive_register(const struct sm_model *m, bool current)
 
 double sm_torque_scale(const struct sm_model *m)
 {
-	double link = OSC_TORQUE_JOINT_INERTIA - sm_models[SM_AX12].reflected_inertia;
+	double link = OSC_TORQUE_JOINT_INERTIA - sm_ax.reflected_inertia;
 	return (link + m->reflected_inertia) / OSC_TORQUE_JOINT_INERTIA;
 }
 

@@ -3,12 +3,15 @@
  * servo family: its protocol, the registers they write and read, the blocks
  * they read back, its units and its datasheet line. Pure: no I/O, no clock.
  *
- * Three families: the AX-12A on Protocol 1.0 (protocol/dxl_table.h) and the
- * XL430-W250 and XM430-W350 on Protocol 2.0, whose registers are the rows of
- * protocol/dxl2_table.c (there is no second table here: only which rows the
- * daemon uses, and why). Everything that differs between them is answered
- * here, so that control.c keeps one set of rules (modes, blending, faults,
- * latches, the clamp, the write queue's guarantees) over all of them.
+ * The AX-12A on Protocol 1.0 (protocol/dxl_table.h) and every X-series model
+ * protocol/dxl2_table.c describes (XL430-W250, XM430-W350, XC430-W150): an
+ * X model here is made from its descriptor there (datasheet, current
+ * sensing), so a new X model is data in that file and nothing here but,
+ * once `undulated --tune` ran on it, its tuned defaults (sm_tuned). Only
+ * which registers the daemon uses, and why, is said here. Everything that
+ * differs between models is answered here, so that control.c keeps one set
+ * of rules (modes, blending, faults, latches, the clamp, the write queue's
+ * guarantees) over all of them.
  *
  * How the X series stands in for the AX-12's registers:
  *  - torque limit: the AX-12's Torque Limit (34, 0..1023 of Max Torque) caps
@@ -37,8 +40,6 @@
 
 #include "dxl2_table.h"
 
-enum sm_family { SM_AX12 = 0, SM_XL430 = 1, SM_XM430 = 2 };
-#define SM_NFAMILIES 3
 
 /* A register block read in one READ. */
 struct sm_block {
@@ -60,10 +61,10 @@ struct sm_position_defaults {
 };
 
 struct sm_model {
-	enum sm_family family;
 	const char *name;               /* "XM430-W350" */
 	int protocol;                   /* 1 or 2 */
 	uint16_t number;                /* model number (register 0) */
+	const struct dxl2_model *desc;  /* Protocol 2.0: its descriptor (control table, datasheet); NULL on 1.0 */
 	/* registers the controller writes */
 	uint16_t torque_enable;         /* 24 | 64 */
 	uint16_t torque_limit;          /* Torque Limit 34 | Goal PWM 100, 2 bytes */
@@ -86,13 +87,14 @@ struct sm_model {
 	 * (kg·m²): what a joint's inertia has besides its link */
 	double reflected_inertia;
 	/* Position actuation's defaults through this servo's own position loop
-	 * (k 0: osc.h's, the AX-12A's, stand). */
+	 * (k 0: osc.h's, the AX-12A's, stand; an X model nobody tuned yet has the
+	 * XL430-W250's, and position_from says so). */
 	struct sm_position_defaults position;
+	const char *position_from;      /* the model `position` was tuned on: its own name once tuned on it */
 };
 
 /* The AX-12A (what undulated assumed before it knew of others). */
 const struct sm_model *sm_ax12(void);
-const struct sm_model *sm_of(enum sm_family f);
 /* The family a PING's model number names on that protocol; NULL when this
  * daemon does not know it. */
 const struct sm_model *sm_by_number(int protocol, uint16_t number);

@@ -42,13 +42,15 @@ static const struct sm_model *setup_x_model(const uint8_t *t, uint8_t id, const 
 	uint16_t number = dxl_get_u16(&t[DXL2_X_MODEL_NUMBER]);
 	const struct sm_model *m = sm_by_number(2, number);
 	if (m == NULL) {
-		snprintf(err, cap, "servo %u: model number %u is none undulated drives on Protocol 2.0 (XL430-W250 %u, "
-		         "XM430-W350 %u): its registers may differ", id, number, DXL2_MODEL_XL430_W250, DXL2_MODEL_XM430_W350);
+		char known[160];
+		snprintf(err, cap, "servo %u: model number %u is none undulated drives on Protocol 2.0 (%s): its "
+		         "registers may differ", id, number, dxl2_model_names(known, sizeof known));
 		return NULL;
 	}
 	if (cfg->actuation == CFG_ACT_TORQUE && cfg->torque_drive == CFG_DRIVE_CURRENT && !m->current_control) {
-		snprintf(err, cap, "servo %u is an %s, which has no current control: torque_drive = current needs an "
-		         "XM430; use torque_drive = pwm (PWM control, the back-EMF added back)", id, m->name);
+		snprintf(err, cap, "servo %u is an %s, which has no current control: torque_drive = current needs a "
+		         "servo that senses its current (an XM430); use torque_drive = pwm (PWM control, the back-EMF added "
+		         "back)", id, m->name);
 		return NULL;
 	}
 	return m;

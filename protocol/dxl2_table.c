@@ -1,5 +1,5 @@
 /*
- * dxl2_table.c — the XL430-W250 and XM430-W350 control tables as data,
+ * dxl2_table.c — the XL430-W250, XM430-W350 and XC430-W150 control tables and datasheets as data,
  * lookup, write checks, conversions and formatting. Rows are the ROBOTIS
  * e-manual's (ROBOTIS-GIT/emanual: docs/en/dxl/x/xl430-w250.md and
  * xm430-w350.md, the revisions with Range and Unit columns). Where the
@@ -46,90 +46,104 @@
 	{ "return_delay_time",  9, 1, false, RW, EE, 0, 254, true, 250, U(RETURN_DELAY), NOLIM, \
 	    "delay before a status packet, 2 us a unit (0 for speed)" }
 
+/* The rows of an X servo without current sensing (XL430-W250, XC430-W150):
+ * one layout; what differs between the models' pages is the factory values
+ * (Moving Threshold, Temperature Limit, Velocity Limit, the gains) and the
+ * highest supply its voltage limits take. */
+#define X_PWM_ROWS(model, mov_thr, temp_lim, volt_max, vel_lim, vel_i, pos_d, pos_p) \
+	X_COMMON_HEAD(model), \
+	{ "drive_mode",        10, 1, false, RW, EE, 0, 13, true, 0, U(RAW), NOLIM, \
+	    "bit 0 reverse direction, bit 2 time-based profile, bit 3 torque on by goal update" }, \
+	{ "operating_mode",    11, 1, false, RW, EE, 0, 16, true, 3, U(OPMODE), NOLIM, \
+	    "1 velocity, 3 position, 4 extended position, 16 PWM" }, \
+	/* printed 0-252 with default 255: 253 and above switch it off */ \
+	{ "secondary_id",      12, 1, false, RW, EE, 0, 255, true, 255, U(RAW), NOLIM, \
+	    "shadow ID, 253-255 = none" }, \
+	{ "protocol_type",     13, 1, false, RW, EE, 1, 2, true, 2, U(RAW), NOLIM, "1 or 2" }, \
+	{ "homing_offset",     20, 4, true,  RW, EE, -1044479, 1044479, true, 0, U(POSITION), NOLIM, \
+	    "added to the present position, pulses" }, \
+	{ "moving_threshold",  24, 4, false, RW, EE, 0, 1023, true, mov_thr, U(VELOCITY), NOLIM, \
+	    "speed above which the servo counts as moving" }, \
+	{ "temperature_limit", 31, 1, false, RW, EE, 0, 100, true, temp_lim, U(TEMPERATURE), NOLIM, \
+	    "overheating threshold" }, \
+	{ "max_voltage_limit", 32, 2, false, RW, EE, 60, volt_max, true, volt_max, U(VOLTAGE), NOLIM, \
+	    "highest input voltage before the voltage error" }, \
+	{ "min_voltage_limit", 34, 2, false, RW, EE, 60, volt_max, true, 60, U(VOLTAGE), NOLIM, \
+	    "lowest input voltage before the voltage error" }, \
+	{ "pwm_limit",         36, 2, false, RW, EE, 0, 885, true, 885, U(PWM), NOLIM, \
+	    "largest PWM, the limit of goal_pwm" }, \
+	{ "velocity_limit",    44, 4, false, RW, EE, 0, 1023, true, vel_lim, U(VELOCITY), NOLIM, \
+	    "largest speed, the limit of goal_velocity" }, \
+	{ "max_position_limit", 48, 4, false, RW, EE, 0, 4095, true, 4095, U(POSITION), NOLIM, \
+	    "largest goal position in position mode" }, \
+	{ "min_position_limit", 52, 4, false, RW, EE, 0, 4095, true, 0, U(POSITION), NOLIM, \
+	    "smallest goal position in position mode" }, \
+	/* printed range "3": bits 0 and 1 */ \
+	{ "startup_configuration", 60, 1, false, RW, EE, 0, 3, true, 0, U(RAW), NOLIM, \
+	    "bit 0 torque on at boot, bit 1 restore RAM from backup" }, \
+	/* printed range "-": the hardware error bits */ \
+	{ "shutdown",          63, 1, false, RW, EE, 0, DXL2_HWERR_MASK, true, 52, U(HWERR), NOLIM, \
+	    "hardware errors that switch the torque off" }, \
+	{ "torque_enable",     64, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM, \
+	    "motor torque on (locks the EEPROM area)" }, \
+	{ "led",               65, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM, "LED on" }, \
+	{ "status_return_level", 68, 1, false, RW, RAM, 0, 2, true, 2, U(STATUS_LEVEL), NOLIM, \
+	    "which instructions are answered: 0 ping, 1 + read, 2 all" }, \
+	{ "registered_instruction", 69, 1, false, R, RAM, RO_U8, true, 0, U(BOOL), NOLIM, \
+	    "a REG_WRITE is waiting for ACTION" }, \
+	{ "hardware_error_status", 70, 1, false, R, RAM, RO_U8, true, 0, U(HWERR), NOLIM, \
+	    "hardware errors now (the status packet's alert bit)" }, \
+	{ "velocity_i_gain",   76, 2, false, RW, RAM, 0, 16383, true, vel_i, U(RAW), NOLIM, "velocity I gain" }, \
+	{ "velocity_p_gain",   78, 2, false, RW, RAM, 0, 16383, true, 100, U(RAW), NOLIM, "velocity P gain" }, \
+	{ "position_d_gain",   80, 2, false, RW, RAM, 0, 16383, true, pos_d, U(RAW), NOLIM, "position D gain" }, \
+	{ "position_i_gain",   82, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM, "position I gain" }, \
+	{ "position_p_gain",   84, 2, false, RW, RAM, 0, 16383, true, pos_p, U(RAW), NOLIM, "position P gain" }, \
+	{ "feedforward_2nd_gain", 88, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM, \
+	    "feedforward acceleration gain" }, \
+	{ "feedforward_1st_gain", 90, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM, \
+	    "feedforward velocity gain" }, \
+	/* printed 1-127 with default 0: 0 switches the watchdog off */ \
+	{ "bus_watchdog",      98, 1, false, RW, RAM, 0, 127, true, 0, U(WATCHDOG), NOLIM, \
+	    "stop when no packet came for this long, 20 ms a unit, 0 = off" }, \
+	{ "goal_pwm",         100, 2, true,  RW, RAM, -885, 885, false, 0, U(PWM), SYM(36), \
+	    "target PWM (PWM mode), within +-pwm_limit" }, \
+	{ "goal_velocity",    104, 4, true,  RW, RAM, -1023, 1023, false, 0, U(VELOCITY), SYM(44), \
+	    "target speed (velocity mode), within +-velocity_limit" }, \
+	/* printed "0-32767 / 0-32737" (velocity / time-based profile): the wider */ \
+	{ "profile_acceleration", 108, 4, false, RW, RAM, 0, 32767, true, 0, U(ACCELERATION), NOLIM, \
+	    "profile acceleration, 0 = none" }, \
+	{ "profile_velocity", 112, 4, false, RW, RAM, 0, 32767, true, 0, U(VELOCITY), NOLIM, \
+	    "profile speed, 0 = none" }, \
+	{ "goal_position",    116, 4, true,  RW, RAM, -EXT_POS, EXT_POS, false, 0, U(POSITION), \
+	    DXL2_LIMIT_POSITION, 0, "target position, within the position limits in position mode" }, \
+	{ "realtime_tick",    120, 2, false, R,  RAM, RO_U16, false, 0, U(MS), NOLIM, \
+	    "servo clock, 0-32767 ms, wraps" }, \
+	{ "moving",           122, 1, false, R,  RAM, RO_U8, true, 0, U(BOOL), NOLIM, "moving now" }, \
+	{ "moving_status",    123, 1, false, R,  RAM, RO_U8, true, 0, U(RAW), NOLIM, "profile and arrival bits" }, \
+	{ "present_pwm",      124, 2, true,  R,  RAM, RO_S16, false, 0, U(PWM), NOLIM, "PWM now" }, \
+	{ "present_load",     126, 2, true,  R,  RAM, RO_S16, false, 0, U(LOAD), NOLIM, \
+	    "load, 0.1 % of the maximum, -1000..1000" }, \
+	{ "present_velocity", 128, 4, true,  R,  RAM, RO_S32, false, 0, U(VELOCITY), NOLIM, "speed now" }, \
+	{ "present_position", 132, 4, true,  R,  RAM, RO_S32, false, 0, U(POSITION), NOLIM, "position now" }, \
+	{ "velocity_trajectory", 136, 4, true, R, RAM, RO_S32, false, 0, U(VELOCITY), NOLIM, \
+	    "speed the profile asks for now" }, \
+	{ "position_trajectory", 140, 4, true, R, RAM, RO_S32, false, 0, U(POSITION), NOLIM, \
+	    "position the profile asks for now" }, \
+	{ "present_input_voltage", 144, 2, false, R, RAM, RO_U16, false, 0, U(VOLTAGE), NOLIM, "supply voltage" }, \
+	{ "present_temperature", 146, 1, false, R, RAM, RO_U8, false, 0, U(TEMPERATURE), NOLIM, \
+	    "internal temperature" }, \
+	{ "backup_ready",     147, 1, false, R,  RAM, RO_U8, false, 0, U(BOOL), NOLIM, \
+	    "a RAM backup is stored" }
+
 static const struct dxl2_reg xl430_regs[] = {
-	X_COMMON_HEAD(DXL2_MODEL_XL430_W250),
-	{ "drive_mode",        10, 1, false, RW, EE, 0, 13, true, 0, U(RAW), NOLIM,
-	    "bit 0 reverse direction, bit 2 time-based profile, bit 3 torque on by goal update" },
-	{ "operating_mode",    11, 1, false, RW, EE, 0, 16, true, 3, U(OPMODE), NOLIM,
-	    "1 velocity, 3 position, 4 extended position, 16 PWM" },
-	/* printed 0-252 with default 255: 253 and above switch it off */
-	{ "secondary_id",      12, 1, false, RW, EE, 0, 255, true, 255, U(RAW), NOLIM,
-	    "shadow ID, 253-255 = none" },
-	{ "protocol_type",     13, 1, false, RW, EE, 1, 2, true, 2, U(RAW), NOLIM, "1 or 2" },
-	{ "homing_offset",     20, 4, true,  RW, EE, -1044479, 1044479, true, 0, U(POSITION), NOLIM,
-	    "added to the present position, pulses" },
-	{ "moving_threshold",  24, 4, false, RW, EE, 0, 1023, true, 10, U(VELOCITY), NOLIM,
-	    "speed above which the servo counts as moving" },
-	{ "temperature_limit", 31, 1, false, RW, EE, 0, 100, true, 72, U(TEMPERATURE), NOLIM,
-	    "overheating threshold" },
-	{ "max_voltage_limit", 32, 2, false, RW, EE, 60, 140, true, 140, U(VOLTAGE), NOLIM,
-	    "highest input voltage before the voltage error" },
-	{ "min_voltage_limit", 34, 2, false, RW, EE, 60, 140, true, 60, U(VOLTAGE), NOLIM,
-	    "lowest input voltage before the voltage error" },
-	{ "pwm_limit",         36, 2, false, RW, EE, 0, 885, true, 885, U(PWM), NOLIM,
-	    "largest PWM, the limit of goal_pwm" },
-	{ "velocity_limit",    44, 4, false, RW, EE, 0, 1023, true, 265, U(VELOCITY), NOLIM,
-	    "largest speed, the limit of goal_velocity" },
-	{ "max_position_limit", 48, 4, false, RW, EE, 0, 4095, true, 4095, U(POSITION), NOLIM,
-	    "largest goal position in position mode" },
-	{ "min_position_limit", 52, 4, false, RW, EE, 0, 4095, true, 0, U(POSITION), NOLIM,
-	    "smallest goal position in position mode" },
-	/* printed range "3": bits 0 and 1 */
-	{ "startup_configuration", 60, 1, false, RW, EE, 0, 3, true, 0, U(RAW), NOLIM,
-	    "bit 0 torque on at boot, bit 1 restore RAM from backup" },
-	/* printed range "-": the hardware error bits */
-	{ "shutdown",          63, 1, false, RW, EE, 0, DXL2_HWERR_MASK, true, 52, U(HWERR), NOLIM,
-	    "hardware errors that switch the torque off" },
-	{ "torque_enable",     64, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM,
-	    "motor torque on (locks the EEPROM area)" },
-	{ "led",               65, 1, false, RW, RAM, 0, 1, true, 0, U(BOOL), NOLIM, "LED on" },
-	{ "status_return_level", 68, 1, false, RW, RAM, 0, 2, true, 2, U(STATUS_LEVEL), NOLIM,
-	    "which instructions are answered: 0 ping, 1 + read, 2 all" },
-	{ "registered_instruction", 69, 1, false, R, RAM, RO_U8, true, 0, U(BOOL), NOLIM,
-	    "a REG_WRITE is waiting for ACTION" },
-	{ "hardware_error_status", 70, 1, false, R, RAM, RO_U8, true, 0, U(HWERR), NOLIM,
-	    "hardware errors now (the status packet's alert bit)" },
-	{ "velocity_i_gain",   76, 2, false, RW, RAM, 0, 16383, true, 1000, U(RAW), NOLIM, "velocity I gain" },
-	{ "velocity_p_gain",   78, 2, false, RW, RAM, 0, 16383, true, 100, U(RAW), NOLIM, "velocity P gain" },
-	{ "position_d_gain",   80, 2, false, RW, RAM, 0, 16383, true, 4000, U(RAW), NOLIM, "position D gain" },
-	{ "position_i_gain",   82, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM, "position I gain" },
-	{ "position_p_gain",   84, 2, false, RW, RAM, 0, 16383, true, 640, U(RAW), NOLIM, "position P gain" },
-	{ "feedforward_2nd_gain", 88, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM,
-	    "feedforward acceleration gain" },
-	{ "feedforward_1st_gain", 90, 2, false, RW, RAM, 0, 16383, true, 0, U(RAW), NOLIM,
-	    "feedforward velocity gain" },
-	/* printed 1-127 with default 0: 0 switches the watchdog off */
-	{ "bus_watchdog",      98, 1, false, RW, RAM, 0, 127, true, 0, U(WATCHDOG), NOLIM,
-	    "stop when no packet came for this long, 20 ms a unit, 0 = off" },
-	{ "goal_pwm",         100, 2, true,  RW, RAM, -885, 885, false, 0, U(PWM), SYM(36),
-	    "target PWM (PWM mode), within +-pwm_limit" },
-	{ "goal_velocity",    104, 4, true,  RW, RAM, -1023, 1023, false, 0, U(VELOCITY), SYM(44),
-	    "target speed (velocity mode), within +-velocity_limit" },
-	/* printed "0-32767 / 0-32737" (velocity / time-based profile): the wider */
-	{ "profile_acceleration", 108, 4, false, RW, RAM, 0, 32767, true, 0, U(ACCELERATION), NOLIM,
-	    "profile acceleration, 0 = none" },
-	{ "profile_velocity", 112, 4, false, RW, RAM, 0, 32767, true, 0, U(VELOCITY), NOLIM,
-	    "profile speed, 0 = none" },
-	{ "goal_position",    116, 4, true,  RW, RAM, -EXT_POS, EXT_POS, false, 0, U(POSITION),
-	    DXL2_LIMIT_POSITION, 0, "target position, within the position limits in position mode" },
-	{ "realtime_tick",    120, 2, false, R,  RAM, RO_U16, false, 0, U(MS), NOLIM,
-	    "servo clock, 0-32767 ms, wraps" },
-	{ "moving",           122, 1, false, R,  RAM, RO_U8, true, 0, U(BOOL), NOLIM, "moving now" },
-	{ "moving_status",    123, 1, false, R,  RAM, RO_U8, true, 0, U(RAW), NOLIM, "profile and arrival bits" },
-	{ "present_pwm",      124, 2, true,  R,  RAM, RO_S16, false, 0, U(PWM), NOLIM, "PWM now" },
-	{ "present_load",     126, 2, true,  R,  RAM, RO_S16, false, 0, U(LOAD), NOLIM,
-	    "load, 0.1 % of the maximum, -1000..1000" },
-	{ "present_velocity", 128, 4, true,  R,  RAM, RO_S32, false, 0, U(VELOCITY), NOLIM, "speed now" },
-	{ "present_position", 132, 4, true,  R,  RAM, RO_S32, false, 0, U(POSITION), NOLIM, "position now" },
-	{ "velocity_trajectory", 136, 4, true, R, RAM, RO_S32, false, 0, U(VELOCITY), NOLIM,
-	    "speed the profile asks for now" },
-	{ "position_trajectory", 140, 4, true, R, RAM, RO_S32, false, 0, U(POSITION), NOLIM,
-	    "position the profile asks for now" },
-	{ "present_input_voltage", 144, 2, false, R, RAM, RO_U16, false, 0, U(VOLTAGE), NOLIM, "supply voltage" },
-	{ "present_temperature", 146, 1, false, R, RAM, RO_U8, false, 0, U(TEMPERATURE), NOLIM,
-	    "internal temperature" },
-	{ "backup_ready",     147, 1, false, R,  RAM, RO_U8, false, 0, U(BOOL), NOLIM,
-	    "a RAM backup is stored" },
+	/*                               threshold  temp  volts  velocity  vel I  pos D  pos P */
+	X_PWM_ROWS(DXL2_MODEL_XL430_W250, 10,       72,   140,   265,      1000,  4000,  640),
+};
+
+/* The XC430-W150's page (docs/en/dxl/x/xc430-w150.md): the XL430's layout
+ * with its own factory values and a supply up to 16.0 V. */
+static const struct dxl2_reg xc430_regs[] = {
+	X_PWM_ROWS(DXL2_MODEL_XC430_W150, 20,       80,   160,   460,      1920,  0,     460),
 };
 
 static const struct dxl2_reg xm430_regs[] = {
@@ -218,10 +232,30 @@ static const struct dxl2_reg xm430_regs[] = {
 
 #define OPMODE_BIT(m) (1u << (m))
 static const struct dxl2_model dxl2_models[] = {
+	/* 1.5 N·m at 12 V (1.4 A), 61 rpm at 12 V, 258.5:1, 6.5-12.0 V (11.1
+	 * recommended); a cored motor: its rotor taken as the AX-12A's */
 	{ DXL2_MODEL_XL430_W250, "XL430-W250", xl430_regs, sizeof xl430_regs / sizeof xl430_regs[0],
-	  OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16) },
+	  OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
+	  .sheet = { .stall_torque_nm = 1.5, .stall_current_a = 1.4, .no_load_speed_rpm = 61.0, .gear_ratio = 258.5,
+	             .rotor_inertia = 4.6e-8, .rated_min_v = 6.5, .rated_rec_v = 11.1, .rated_max_v = 12.0 },
+	  .factory_baud = 57600, .firmware = 46 },
+	/* 4.1 N·m at 12 V (2.3 A), 46 rpm at 12 V, 353.5:1, 10.0-14.8 V (12.0
+	 * recommended); a coreless (Maxon) motor: 0.5 g·cm² taken for its rotor */
 	{ DXL2_MODEL_XM430_W350, "XM430-W350", xm430_regs, sizeof xm430_regs / sizeof xm430_regs[0],
-	  OPMODE_BIT(0) | OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(5) | OPMODE_BIT(16) },
+	  OPMODE_BIT(0) | OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(5) | OPMODE_BIT(16),
+	  .current_sensing = true,
+	  .sheet = { .stall_torque_nm = 4.1, .stall_current_a = 2.3, .no_load_speed_rpm = 46.0, .gear_ratio = 353.5,
+	             .rotor_inertia = 5.0e-8, .rated_min_v = 10.0, .rated_rec_v = 12.0, .rated_max_v = 14.8 },
+	  .factory_baud = 57600, .firmware = 46 },
+	/* docs/en/dxl/x/xc430-w150.md: 1.6 N·m at 12 V (1.4 A), 106 rpm at
+	 * 12 V, 159.59:1, 6.5-14.8 V (12.0 recommended); velocity, position,
+	 * extended position and PWM control, Present Load (no current sensing);
+	 * a coreless motor: its rotor taken as the XM430's */
+	{ DXL2_MODEL_XC430_W150, "XC430-W150", xc430_regs, sizeof xc430_regs / sizeof xc430_regs[0],
+	  OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
+	  .sheet = { .stall_torque_nm = 1.6, .stall_current_a = 1.4, .no_load_speed_rpm = 106.0, .gear_ratio = 159.59,
+	             .rotor_inertia = 5.0e-8, .rated_min_v = 6.5, .rated_rec_v = 12.0, .rated_max_v = 14.8 },
+	  .factory_baud = 57600, .firmware = 46 },
 };
 #define NMODELS (sizeof dxl2_models / sizeof dxl2_models[0])
 
@@ -313,6 +347,31 @@ const struct dxl2_model *dxl2_model_by_number(uint16_t number)
 		if (dxl2_models[i].number == number)
 			return &dxl2_models[i];
 	return NULL;
+}
+
+size_t dxl2_model_count(void)
+{
+	return NMODELS;
+}
+
+const struct dxl2_model *dxl2_model_at(size_t i)
+{
+	return i < NMODELS ? &dxl2_models[i] : NULL;
+}
+
+char *dxl2_model_names(char *buf, size_t cap)
+{
+	size_t off = 0;
+	if (cap == 0)
+		return buf;
+	buf[0] = '\0';
+	for (size_t i = 0; i < NMODELS; i++) {
+		int w = snprintf(buf + off, cap - off, "%s%s", i ? ", " : "", dxl2_models[i].name);
+		if (w < 0 || (size_t)w >= cap - off)
+			break;
+		off += (size_t)w;
+	}
+	return buf;
 }
 
 const struct dxl2_model *dxl2_model_by_name(const char *name)

@@ -84,23 +84,10 @@ enum dxl2_x_addr {
 /* Model numbers (register 0). */
 #define DXL2_MODEL_XL430_W250 1060
 #define DXL2_MODEL_XM430_W350 1020
-/* The datasheet lines at the reference supply (the e-manual's specification
- * tables; torque and speed scale about linearly with the supply): the
- * daemon's torque actuation and the simulator's motors start from the same
- * numbers, as the AX-12A's in dxl_table.h. */
+#define DXL2_MODEL_XC430_W150 1070
+/* The datasheet lines are at this supply (the e-manual's specification
+ * tables; torque and speed scale about linearly with it). */
 #define DXL2_REF_VOLTAGE               12.0   /* V */
-#define DXL2_XL430_STALL_TORQUE_NM     1.5    /* N·m at 12 V */
-#define DXL2_XL430_STALL_CURRENT_A     1.4
-#define DXL2_XL430_NO_LOAD_SPEED_RPM   61.0
-#define DXL2_XM430_STALL_TORQUE_NM     4.1
-#define DXL2_XM430_STALL_CURRENT_A     2.3
-#define DXL2_XM430_NO_LOAD_SPEED_RPM   46.0
-/* The supply each is rated for (e-manual: XL430 6.5 ~ 12.0 V, 11.1 V
- * recommended; XM430 10.0 ~ 14.8 V, 12.0 V recommended). */
-#define DXL2_XL430_RATED_MIN_V         6.5
-#define DXL2_XL430_RATED_MAX_V         12.0
-#define DXL2_XM430_RATED_MIN_V         10.0
-#define DXL2_XM430_RATED_MAX_V         14.8
 
 /* Operating Mode (11) values. */
 enum dxl2_opmode {
@@ -168,13 +155,46 @@ struct dxl2_reg {
 	const char *desc;
 };
 
+/* A model's datasheet (its e-manual page's specification table): the
+ * daemon's torque actuation, its supply check, `dxl doctor` and the
+ * simulator's motors all start from these numbers. */
+struct dxl2_datasheet {
+	double stall_torque_nm;        /* at DXL2_REF_VOLTAGE */
+	double stall_current_a;
+	double no_load_speed_rpm;
+	double gear_ratio;
+	/* The motor rotor's own inertia (kg·m²): no page publishes it; the
+	 * simulator's estimate for the motor's class (sim-bridge/PHYSICS.md §5),
+	 * seen through the gearbox as rotor × ratio². */
+	double rotor_inertia;
+	double rated_min_v, rated_rec_v, rated_max_v;   /* the supply it is rated for, and the recommended one */
+};
+
+/* One Protocol 2.0 servo model: everything a program needs to know of it.
+ * A new model is one of these and its control table's rows (dxl2_table.c):
+ * what differs between models in the code's behaviour is asked of these
+ * fields (current_sensing, opmodes, the registers the table has), never of
+ * the model number. */
 struct dxl2_model {
 	uint16_t number;
 	const char *name;      /* "XL430-W250" */
 	const struct dxl2_reg *regs;
 	size_t nregs;
 	uint32_t opmodes;      /* bit n set: Operating Mode n exists */
+	/* Present Current (126), Current Limit (38), Goal Current (102) and
+	 * current control (mode 0): the XM series; without it 126 is Present
+	 * Load and the only torque drive is PWM control. */
+	bool current_sensing;
+	struct dxl2_datasheet sheet;
+	long factory_baud;     /* Baud Rate 1 */
+	uint8_t firmware;      /* the firmware a simulated one reports */
 };
+
+/* The models known, in a fixed order (0 .. dxl2_model_count() - 1). */
+size_t dxl2_model_count(void);
+const struct dxl2_model *dxl2_model_at(size_t i);
+/* Their names for messages, "XL430-W250, XM430-W350, ..." into buf. */
+char *dxl2_model_names(char *buf, size_t cap);
 
 /* NULL when unknown. Names compare case-insensitively ("xm430-w350"). */
 const struct dxl2_model *dxl2_model_by_number(uint16_t number);

@@ -163,8 +163,8 @@ static void usage(FILE *f)
 	        "options (each is also a [sim] key; the command line wins):\n"
 	        "  --link PATH          the bus's pty appears at PATH (quick form)\n"
 	        "  --ids LIST           servo IDs on that bus, e.g. 1,2 or 1-4\n"
-	        "  --model MODEL        ax12a (default, Protocol 1.0), xl430-w250 or xm430-w350\n"
-	        "                       (Protocol 2.0); a list gives one model per ID\n"
+	        "  --model MODEL        ax12a (default, Protocol 1.0) or an X model on Protocol 2.0\n"
+	        "                       (%s); a list gives one model per ID\n"
 	        "  --name NAME          robot name of the quick-form bus (default: the link's basename)\n"
 	        "  --scenario FILE      robots, world, motors and timed faults (README: scenario format)\n"
 	        "  --set SEC.KEY=VAL    override any scenario key, e.g. world.separation=0.4\n"
@@ -191,7 +191,8 @@ static void usage(FILE *f)
 	        "                       --duration is simulated seconds (README: Lockstep)\n"
 	        "  --lockstep-grace S   wall-clock seconds a daemon may take to join or to answer before\n"
 	        "                       the run is ended as stalled (default 10)\n"
-	        "  --cmd 'VERB ARGS'    send one command to a running simulator on SIM.CMD and exit\n");
+	        "  --cmd 'VERB ARGS'    send one command to a running simulator on SIM.CMD and exit\n",
+	        sim_model_names() + strlen("ax12a, "));
 }
 
 enum {

@@ -1,46 +1,60 @@
 /*
  * model.c — the simulated servo models and their datasheet facts (model.h).
- * Numbers: the ROBOTIS e-manual's specification tables (ROBOTIS-GIT/emanual,
- * _data/dxl_x_info.yml for the X series; the AX-12A page for the AX-12A), at
- * 12 V; PHYSICS.md §5 says how each is used.
+ * Numbers: the ROBOTIS e-manual's specification tables, at 12 V: the X
+ * series' are protocol/dxl2_table.c's descriptors (the daemon and dxl read
+ * the same ones), the AX-12A's dxl_table.h; PHYSICS.md §5 says how each is
+ * used.
  */
 #include "model.h"
 
 #include <ctype.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "dxl_table.h"
 
 #define RPM_TO_RAD_S (2.0 * 3.14159265358979323846 / 60.0)
 
-static const struct sim_model_info models[SIM_MODELS] = {
-	[SIM_MODEL_AX12A] = {
-		.name = "ax12a", .label = "AX-12A", .protocol = 1, .default_baud = 1000000, .firmware = 24,
-		.stall_torque_nm = DXL_AX12_STALL_TORQUE_NM, .no_load_speed_rpm = DXL_AX12_NO_LOAD_SPEED_RPM,
-		.stall_current_a = 1.5, .gear_ratio = 254.0, .rotor_inertia = 4.6e-8,
-		.model_number = DXL_AX12_MODEL,
-	},
-	/* 1.5 N·m at 12 V (1.4 A), 61 rpm at 12 V, 258.5:1, a cored motor: its
-	 * rotor taken as the AX-12A's (the same class of motor). */
-	[SIM_MODEL_XL430_W250] = {
-		.name = "xl430-w250", .label = "XL430-W250", .protocol = 2, .default_baud = 57600, .firmware = 46,
-		.stall_torque_nm = DXL2_XL430_STALL_TORQUE_NM, .no_load_speed_rpm = DXL2_XL430_NO_LOAD_SPEED_RPM,
-		.stall_current_a = DXL2_XL430_STALL_CURRENT_A, .gear_ratio = 258.5,
-		.rotor_inertia = 4.6e-8, .model_number = DXL2_MODEL_XL430_W250,
-	},
-	/* 4.1 N·m at 12 V (2.3 A), 46 rpm at 12 V, 353.5:1, a coreless (Maxon)
-	 * motor: 0.5 g·cm² taken for its rotor (not published; PHYSICS.md). */
-	[SIM_MODEL_XM430_W350] = {
-		.name = "xm430-w350", .label = "XM430-W350", .protocol = 2, .default_baud = 57600, .firmware = 46,
-		.stall_torque_nm = DXL2_XM430_STALL_TORQUE_NM, .no_load_speed_rpm = DXL2_XM430_NO_LOAD_SPEED_RPM,
-		.stall_current_a = DXL2_XM430_STALL_CURRENT_A, .gear_ratio = 353.5,
-		.rotor_inertia = 5.0e-8, .model_number = DXL2_MODEL_XM430_W350,
-	},
+static const struct sim_model_info ax12a = {
+	.name = "ax12a", .label = "AX-12A", .protocol = 1, .default_baud = 1000000, .firmware = 24,
+	.stall_torque_nm = DXL_AX12_STALL_TORQUE_NM, .no_load_speed_rpm = DXL_AX12_NO_LOAD_SPEED_RPM,
+	.stall_current_a = 1.5, .gear_ratio = 254.0, .rotor_inertia = 4.6e-8,
+	.model_number = DXL_AX12_MODEL,
 };
+
+/* The X models: model m is protocol/dxl2_table.c's descriptor m - 1, its
+ * facts taken from there (a new model there is one here). */
+#define SIM_MAX_X 32
+static struct sim_model_info xinfo[SIM_MAX_X];
+static char xname[SIM_MAX_X][24];
+static bool xmade[SIM_MAX_X];
+
+int sim_model_count(void)
+{
+	size_t n = dxl2_model_count();
+	return 1 + (int)(n < SIM_MAX_X ? n : SIM_MAX_X);
+}
 
 const struct sim_model_info *sim_model_info(enum sim_model m)
 {
-	return (unsigned)m < SIM_MODELS ? &models[m] : &models[SIM_MODEL_AX12A];
+	if ((int)m <= 0 || (int)m >= sim_model_count())
+		return &ax12a;
+	size_t i = (size_t)m - 1;
+	if (!xmade[i]) {
+		const struct dxl2_model *d = dxl2_model_at(i);
+		size_t k = 0;
+		for (; d->name[k] != '\0' && k + 1 < sizeof xname[i]; k++)
+			xname[i][k] = (char)tolower((unsigned char)d->name[k]);
+		xname[i][k] = '\0';
+		xinfo[i] = (struct sim_model_info){
+			.name = xname[i], .label = d->name, .protocol = 2, .default_baud = d->factory_baud,
+			.firmware = d->firmware, .stall_torque_nm = d->sheet.stall_torque_nm,
+			.no_load_speed_rpm = d->sheet.no_load_speed_rpm, .stall_current_a = d->sheet.stall_current_a,
+			.gear_ratio = d->sheet.gear_ratio, .rotor_inertia = d->sheet.rotor_inertia, .model_number = d->number,
+		};
+		xmade[i] = true;
+	}
+	return &xinfo[i];
 }
 
 /* Case-insensitive, '-' and '_' ignored: "AX-12A", "ax12a", "XL430_W250". */
@@ -64,8 +78,8 @@ int sim_model_parse(const char *name, enum sim_model *m)
 {
 	if (name == NULL)
 		return -1;
-	for (int i = 0; i < SIM_MODELS; i++)
-		if (model_name_eq(name, models[i].name)) {
+	for (int i = 0; i < sim_model_count(); i++)
+		if (model_name_eq(name, sim_model_info((enum sim_model)i)->name)) {
 			*m = (enum sim_model)i;
 			return 0;
 		}
@@ -74,7 +88,17 @@ int sim_model_parse(const char *name, enum sim_model *m)
 
 const char *sim_model_names(void)
 {
-	return "ax12a, xl430-w250, xm430-w350";
+	static char names[SIM_MAX_X * 26];
+	size_t off = 0;
+	names[0] = '\0';
+	for (int i = 0; i < sim_model_count(); i++) {
+		int w = snprintf(names + off, sizeof names - off, "%s%s", i ? ", " : "",
+		                 sim_model_info((enum sim_model)i)->name);
+		if (w < 0 || (size_t)w >= sizeof names - off)
+			break;
+		off += (size_t)w;
+	}
+	return names;
 }
 
 const struct dxl2_model *sim_model_table(enum sim_model m)

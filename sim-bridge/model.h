@@ -16,12 +16,14 @@
 #include "dxl2_table.h"
 #include "motor.h"
 
+/* 0 is the AX-12A, 1.. the X models of protocol/dxl2_table.c in its order
+ * (sim_model_count() in all); the two named here are the first two there. */
 enum sim_model {
-	SIM_MODEL_AX12A,
-	SIM_MODEL_XL430_W250,
-	SIM_MODEL_XM430_W350,
-	SIM_MODELS
+	SIM_MODEL_AX12A = 0,
+	SIM_MODEL_XL430_W250 = 1,
+	SIM_MODEL_XM430_W350 = 2,
 };
+int sim_model_count(void);
 
 struct sim_model_info {
 	const char *name;            /* "xl430-w250": the option and scenario value */
@@ -42,10 +44,10 @@ struct sim_model_info {
 };
 
 const struct sim_model_info *sim_model_info(enum sim_model m);
-/* "ax12a", "xl430-w250", "xm430-w350" (case-insensitive; "AX-12A" too).
+/* "ax12a", "xl430-w250", "xm430-w350", ... (case-insensitive; "AX-12A" too).
  * Returns 0 and *m, or -1. */
 int sim_model_parse(const char *name, enum sim_model *m);
-/* The names accepted, for messages: "ax12a, xl430-w250, xm430-w350". */
+/* The names accepted, for messages: "ax12a, xl430-w250, xm430-w350, ...". */
 const char *sim_model_names(void);
 /* The X table of a Protocol 2.0 model; NULL for the AX-12A. */
 const struct dxl2_model *sim_model_table(enum sim_model m);

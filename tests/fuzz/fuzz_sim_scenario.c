@@ -58,7 +58,7 @@ static void check_config(const struct sim_config *c)
 	CHECK(c->baud == 0 || (c->baud >= 1200 && c->baud <= 4500000));   /* 0: the models' factory rate */
 	CHECK(c->nmodels >= 1 && c->nmodels <= SIM_BUS_MAX_SERVOS);
 	for (size_t k = 0; k < c->nmodels; k++)
-		CHECK((unsigned)c->models[k] < SIM_MODELS);
+		CHECK((unsigned)c->models[k] < sim_model_count());
 	CHECK(in(c->latency_ms, 0, 1000));
 	CHECK(c->return_delay_us == -1 || (c->return_delay_us >= 0 && c->return_delay_us <= 508));
 	CHECK(in(c->ambient_c, -40, 150) && c->ambient_c > -40 && c->ambient_c < 150);
@@ -112,7 +112,7 @@ static void check_config(const struct sim_config *c)
 		CHECK(r->nmodels == r->nids);
 		int proto = sim_config_robot_protocol(r);
 		for (size_t k = 0; k < r->nids; k++) {
-			CHECK((unsigned)r->models[k] < SIM_MODELS && sim_model_info(r->models[k])->protocol == proto);
+			CHECK((unsigned)r->models[k] < sim_model_count() && sim_model_info(r->models[k])->protocol == proto);
 			CHECK(proto == 1 || r->ids[k] <= DXL2_MAX_ID);
 		}
 		CHECK(proto == 1 || r->servo_baud_reg <= 7);

@@ -25,33 +25,34 @@ static void test_families_by_number(void **state)
 {
 	(void)state;
 	assert_ptr_equal(sm_by_number(1, 12), sm_ax12());
-	assert_int_equal(sm_by_number(2, 1060)->family, SM_XL430);
-	assert_int_equal(sm_by_number(2, 1020)->family, SM_XM430);
+	assert_string_equal(sm_by_number(2, 1060)->name, "XL430-W250");
+	assert_string_equal(sm_by_number(2, 1020)->name, "XM430-W350");
+	assert_string_equal(sm_by_number(2, 1070)->name, "XC430-W150");
 	/* a number is only a model on its own protocol */
 	assert_null(sm_by_number(1, 1060));
 	assert_null(sm_by_number(2, 12));
 	assert_null(sm_by_number(2, 1030));   /* XM430-W210: not one this daemon knows */
-	assert_string_equal(sm_of(SM_XM430)->name, "XM430-W350");
-	assert_true(sm_of(SM_XM430)->current_control);
-	assert_false(sm_of(SM_XL430)->current_control);
+	assert_string_equal(sm_by_number(2, 1020)->name, "XM430-W350");
+	assert_true(sm_by_number(2, 1020)->current_control);
+	assert_false(sm_by_number(2, 1060)->current_control);
 	assert_false(sm_ax12()->current_control);
 	/* the registers the controller writes, from the manuals' tables */
 	assert_int_equal(sm_ax12()->torque_enable, 24);
 	assert_int_equal(sm_ax12()->goal, 30);
-	assert_int_equal(sm_of(SM_XL430)->torque_enable, 64);
-	assert_int_equal(sm_of(SM_XL430)->goal, 116);
-	assert_int_equal(sm_of(SM_XL430)->goal_size, 4);
-	assert_int_equal(sm_of(SM_XM430)->torque_limit, 100);   /* Goal PWM caps position control */
+	assert_int_equal(sm_by_number(2, 1060)->torque_enable, 64);
+	assert_int_equal(sm_by_number(2, 1060)->goal, 116);
+	assert_int_equal(sm_by_number(2, 1060)->goal_size, 4);
+	assert_int_equal(sm_by_number(2, 1020)->torque_limit, 100);   /* Goal PWM caps position control */
 	/* the datasheet lines at 12 V */
-	assert_true(fabs(sm_of(SM_XM430)->stall_torque_nm - 4.1) < 1e-12);
-	assert_true(fabs(sm_of(SM_XM430)->no_load_speed_rad_s - 46.0 * 2 * PI / 60) < 1e-12);
-	assert_true(fabs(sm_of(SM_XL430)->stall_current_a - 1.4) < 1e-12);
+	assert_true(fabs(sm_by_number(2, 1020)->stall_torque_nm - 4.1) < 1e-12);
+	assert_true(fabs(sm_by_number(2, 1020)->no_load_speed_rad_s - 46.0 * 2 * PI / 60) < 1e-12);
+	assert_true(fabs(sm_by_number(2, 1060)->stall_current_a - 1.4) < 1e-12);
 }
 
 static void test_positions_both_ways(void **state)
 {
 	(void)state;
-	const struct sm_model *x = sm_of(SM_XM430), *ax = sm_ax12();
+	const struct sm_model *x = sm_by_number(2, 1020), *ax = sm_ax12();
 	assert_true(fabs(sm_pos_to_rad(x, 2048)) < 1e-12);
 	assert_true(fabs(sm_pos_to_rad(x, 3072) - PI / 2) < 1e-12);   /* a quarter turn: 1024 of 4096 */
 	assert_true(fabs(sm_pos_to_rad(ax, 512)) < 1e-12);
@@ -75,7 +76,7 @@ static void test_present_block_x(void **state)
 	/* current -100 (FF9C), velocity -3, position 166 (the manual's READ example) */
 	const uint8_t fast[10] = { 0x9C, 0xFF, 0xFD, 0xFF, 0xFF, 0xFF, 0xA6, 0x00, 0x00, 0x00 };
 	struct sm_present p;
-	const struct sm_model *xm = sm_of(SM_XM430), *xl = sm_of(SM_XL430);
+	const struct sm_model *xm = sm_by_number(2, 1020), *xl = sm_by_number(2, 1060);
 	assert_true(sm_decode_present(xm, fast, sizeof fast, &p));
 	assert_false(p.slow);
 	assert_int_equal(p.pos_raw, 166);
@@ -122,7 +123,7 @@ static void test_present_block_ax(void **state)
 static void test_readback_blocks_x(void **state)
 {
 	(void)state;
-	const struct sm_model *xm = sm_of(SM_XM430);
+	const struct sm_model *xm = sm_by_number(2, 1020);
 	assert_int_equal(xm->nreadback, 2);
 	assert_int_equal(xm->readback[0].addr, 64);
 	assert_int_equal(xm->readback[0].len, 52);   /* 64 .. 115 (Profile Velocity) */
@@ -163,7 +164,7 @@ static void test_readback_blocks_x(void **state)
 	assert_int_equal(s.opmode, 3);
 	/* the XL430 has no Current Limit */
 	sm_state_unknown(&s);
-	assert_true(sm_decode_readback(sm_of(SM_XL430), 1, ee, sizeof ee, &s));
+	assert_true(sm_decode_readback(sm_by_number(2, 1060), 1, ee, sizeof ee, &s));
 	assert_int_equal(s.current_limit, -1);
 }
 
@@ -190,7 +191,7 @@ static void test_readback_block_ax(void **state)
 static void test_status_meaning(void **state)
 {
 	(void)state;
-	const struct sm_model *x = sm_of(SM_XL430), *ax = sm_ax12();
+	const struct sm_model *x = sm_by_number(2, 1060), *ax = sm_ax12();
 	/* AX-12: overload and overheating show in the status byte itself */
 	assert_int_equal(sm_status_faults(ax, 0x24), 0x24);
 	assert_int_equal(sm_status_faults(ax, 0x01), 0);
@@ -214,7 +215,7 @@ static int16_t s16(uint16_t v) { return (int16_t)v; }
 static void test_drive_outputs(void **state)
 {
 	(void)state;
-	const struct sm_model *xl = sm_of(SM_XL430), *xm = sm_of(SM_XM430), *ax = sm_ax12();
+	const struct sm_model *xl = sm_by_number(2, 1060), *xm = sm_by_number(2, 1020), *ax = sm_ax12();
 	assert_int_equal(sm_drive_register(xl, false), 100);
 	assert_int_equal(sm_drive_register(xm, true), 102);
 	assert_int_equal(sm_drive_register(ax, false), 32);
@@ -258,7 +259,7 @@ static void test_torque_defaults_scale(void **state)
 {
 	(void)state;
 	assert_true(fabs(sm_torque_scale(sm_ax12()) - 1.0) < 1e-12);
-	double xm = sm_torque_scale(sm_of(SM_XM430)), xl = sm_torque_scale(sm_of(SM_XL430));
+	double xm = sm_torque_scale(sm_by_number(2, 1020)), xl = sm_torque_scale(sm_by_number(2, 1060));
 	/* (1.42e-3 link + 5.0e-8 x 353.5^2) / 4.39e-3 */
 	assert_true(fabs(xm - (4.39e-3 - 4.6e-8 * 254 * 254 + 5.0e-8 * 353.5 * 353.5) / 4.39e-3) < 1e-9);
 	assert_true(xm > 1.7 && xm < 1.8);
@@ -291,7 +292,7 @@ static void test_position_defaults(void **state)
 	(void)state;
 	double k, mu, lead;
 	assert_false(sm_position_defaults(sm_ax12(), 0, 2, &k, &mu, &lead));
-	const struct sm_model *xm = sm_of(SM_XM430), *xl = sm_of(SM_XL430);
+	const struct sm_model *xm = sm_by_number(2, 1020), *xl = sm_by_number(2, 1060);
 	assert_true(sm_position_defaults(xm, 0, 2, &k, &mu, &lead));
 	assert_true(fabs(k - 0.0304) < 1e-12 && fabs(mu - 0.0757) < 1e-12 && fabs(lead - 0.047) < 1e-12);
 	assert_true(sm_position_defaults(xm, 1, 2, &k, &mu, &lead));
@@ -328,13 +329,14 @@ static void test_position_defaults(void **state)
 static void test_supply_plausible(void **state)
 {
 	(void)state;
-	static const struct { enum sm_family f; double lo_in, hi_in, lo_out, hi_out; } cases[] = {
-		{ SM_AX12, 8.6, 12.6, 8.5, 12.7 },
-		{ SM_XL430, 6.2, 12.6, 6.1, 12.7 },
-		{ SM_XM430, 9.5, 15.5, 9.4, 15.6 },
+	static const struct { int protocol; uint16_t number; double lo_in, hi_in, lo_out, hi_out; } cases[] = {
+		{ 1, 12, 8.6, 12.6, 8.5, 12.7 },
+		{ 2, 1060, 6.2, 12.6, 6.1, 12.7 },
+		{ 2, 1020, 9.5, 15.5, 9.4, 15.6 },
+		{ 2, 1070, 6.2, 15.5, 6.1, 15.6 },   /* XC430-W150: 6.5 .. 14.8 V */
 	};
 	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-		const struct sm_model *m = sm_of(cases[i].f);
+		const struct sm_model *m = sm_by_number(cases[i].protocol, cases[i].number);
 		assert_true(sm_supply_plausible(m, cases[i].lo_in));
 		assert_true(sm_supply_plausible(m, cases[i].hi_in));
 		assert_true(sm_supply_plausible(m, 12.0));

@@ -190,7 +190,7 @@ static void test_limits(void **state)
 		cfg.joint[0].limit_min = -lims[i];
 		cfg.joint[0].limit_max = lims[i];
 		int32_t lo, hi;
-		setup_joint_limits_model(sm_of(SM_XL430), &cfg.joint[0], &lo, &hi);
+		setup_joint_limits_model(sm_by_number(2, DXL2_MODEL_XL430_W250), &cfg.joint[0], &lo, &hi);
 		s.min_position = lo, s.max_position = hi;
 		s.torque_enable = 0;
 		dr2_check_limits(&s, &cfg, 0, &ctx, &v);

@@ -261,8 +261,9 @@ void dxlt_usage(FILE *f)
 
 void dxlt_help(FILE *f)
 {
-	fputs("dxl — talk to Dynamixel servos on a serial bus: AX-12 (Protocol 1.0), XL430-W250 and\n"
-	      "XM430-W350 (Protocol 2.0, --protocol 2)\n\n", f);
+	char x[160];
+	fprintf(f, "dxl — talk to Dynamixel servos on a serial bus: AX-12 (Protocol 1.0), %s\n"
+	        "(Protocol 2.0, --protocol 2)\n\n", dxl2_model_names(x, sizeof x));
 	dxlt_usage(f);
 	fputs("\ncommands:\n"
 	      "  ports                      list serial ports with USB IDs, marking Dynamixel adapters\n"

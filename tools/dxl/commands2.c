@@ -49,6 +49,13 @@ struct dxlt2_reg {
 	const char *name;
 };
 
+/* The models dxl knows on Protocol 2.0, for messages: protocol/dxl2_table.c's. */
+static const char *dxlt2_known(void)
+{
+	static char names[160];
+	return dxl2_model_names(names, sizeof names);
+}
+
 static const char *dxlt2_model_text(const struct dxlt2_servo *s)
 {
 	return s->m != NULL ? s->m->name : "not in dxl's tables";
@@ -109,8 +116,8 @@ static int dxlt2_identify(struct dxlt *t, uint8_t id, struct dxlt2_servo *s)
 
 static void dxlt2_raw_note(struct dxlt *t, const struct dxlt2_servo *s, uint16_t addr, uint8_t size)
 {
-	fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): address %u taken as "
-	        "%u raw byte%s, unchecked (--size 1|2|4)\n", s->id, s->model, addr, size, size == 1 ? "" : "s");
+	fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): address %u taken as "
+	        "%u raw byte%s, unchecked (--size 1|2|4)\n", s->id, s->model, dxlt2_known(), addr, size, size == 1 ? "" : "s");
 }
 
 /* The register REG names on this servo. */
@@ -131,8 +138,8 @@ static int dxlt2_arg_reg(struct dxlt *t, const struct dxlt2_servo *s, const char
 		return DXLT_EXIT_OK;
 	}
 	if (num_parse_long(text, 0, UINT16_MAX, &addr) != NUM_OK) {
-		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): registers by "
-		        "address only, not '%s'\n", s->id, s->model, text);
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): registers by "
+		        "address only, not '%s'\n", s->id, s->model, dxlt2_known(), text);
 		return DXLT_EXIT_USAGE;
 	}
 	out->row = NULL;
@@ -187,8 +194,8 @@ int dxlt2_cmd_ping(struct dxlt *t)
 	fprintf(t->out, "ID %u answered in %u us: model %u (%s), firmware %u, Protocol 2.0\n", id,
 	        (unsigned)t->bus.servo[id].rtt_last_us, s.model, dxlt2_model_text(&s), s.firmware);
 	if (s.m == NULL)
-		fprintf(t->err, "dxl: model %u is not in dxl's tables (XL430-W250, XM430-W350): read and write it by "
-		        "address (--size 1|2|4)\n", s.model);
+		fprintf(t->err, "dxl: model %u is not in dxl's tables (%s): read and write it by "
+		        "address (--size 1|2|4)\n", s.model, dxlt2_known());
 	return DXLT_EXIT_OK;
 }
 
@@ -249,8 +256,8 @@ int dxlt2_cmd_dump(struct dxlt *t)
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (s.m == NULL) {
-		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): bytes 0-%zu "
-		        "raw\n", id, s.model, sizeof mem - 1);
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): bytes 0-%zu "
+		        "raw\n", id, s.model, dxlt2_known(), sizeof mem - 1);
 		dxlt2_dump_raw(t, mem, sizeof mem);
 		return DXLT_EXIT_OK;
 	}
@@ -609,7 +616,7 @@ static int dxlt2_setup_byte(struct dxlt *t, uint8_t id, uint16_t addr, const cha
 	return DXLT_EXIT_OK;
 }
 
-static int dxlt2_setup_one(struct dxlt *t, uint8_t id, bool *xm430)
+static int dxlt2_setup_one(struct dxlt *t, uint8_t id, bool *current)
 {
 	uint8_t mem[DXLT2_IMAGE_LEN];
 	struct dxlt2_servo s;
@@ -618,11 +625,11 @@ static int dxlt2_setup_one(struct dxlt *t, uint8_t id, bool *xm430)
 	if ((rc = dxlt2_identify(t, id, &s)) != DXLT_EXIT_OK)
 		return rc;
 	if (s.m == NULL) {
-		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (XL430-W250, XM430-W350): setup does not "
-		        "know its registers\n", id, s.model);
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): setup does not "
+		        "know its registers\n", id, s.model, dxlt2_known());
 		return DXLT_EXIT_REFUSED;
 	}
-	*xm430 = *xm430 || s.model == DXL2_MODEL_XM430_W350;
+	*current = *current || s.m->current_sensing;
 	if ((r = dxlt2_read(t, id, 0, sizeof mem, mem)) != DXL_OK) {
 		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? (the loop's SYNC_READ "
 		        "needs 1 or 2)\n", id);
@@ -680,7 +687,7 @@ int dxlt2_cmd_setup(struct dxlt *t)
 {
 	uint8_t ids[DXL2_MAX_ID + 1];
 	int worst = DXLT_EXIT_OK, n = t->a.npos;
-	bool xm430 = false;
+	bool current = false;   /* a servo senses its current: the loop reads it too */
 
 	if (n < 1 || n > DXL2_MAX_ID + 1)
 		return dxlt_need_args(t, -1, "--protocol 2 setup ID... [--status-level N] [--yes]");
@@ -690,7 +697,7 @@ int dxlt2_cmd_setup(struct dxlt *t)
 			return rc;
 	}
 	for (int i = 0; i < n; i++) {
-		int rc = dxlt2_setup_one(t, ids[i], &xm430);
+		int rc = dxlt2_setup_one(t, ids[i], &current);
 		if (rc == DXLT_EXIT_PORT)
 			return rc;
 		worst = rc > worst ? rc : worst;
@@ -700,7 +707,7 @@ int dxlt2_cmd_setup(struct dxlt *t)
 	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
 	fprintf(t->out, "adapter: %s\n", t->latency.note);
 	/* the loop's SYNC_READ: position + velocity, and the current on the XM430 */
-	unsigned read_len = xm430 ? DR2_READ_LEN_CURRENT : DR2_READ_LEN;
+	unsigned read_len = current ? DR2_READ_LEN_CURRENT : DR2_READ_LEN;
 	double wire_ms = 1e-3 * dr2_cycle_wire_us((unsigned)n, read_len, port_baud(t->port));
 	int latency_ms = t->latency.known ? t->latency.timer_ms : 0;
 	double total_ms = wire_ms + latency_ms;

@@ -330,7 +330,8 @@ static void dr_context(struct dr *d)
 		d->ctx.any_torque_on = d->ctx.any_torque_on || (s->read && s->torque_enable) ||
 		                       (s->read && d->ctx.protocol == 2 && d->servo2[j].torque_enable);
 		/* the loop's SYNC_READ takes the present current too where there is one */
-		if (d->ctx.protocol == 2 && d->servo2[j].model == DXL2_MODEL_XM430_W350)
+		const struct dxl2_model *xm = d->ctx.protocol == 2 ? dxl2_model_by_number(d->servo2[j].model) : NULL;
+		if (xm != NULL && xm->current_sensing)
 			d->ctx.read_len2 = DR2_READ_LEN_CURRENT;
 	}
 }

@@ -39,15 +39,11 @@ void dr2_servo_decode(struct dr2_servo *s, const uint8_t mem[DR2_IMAGE_LEN])
 
 bool dr2_model_volts(uint16_t model, double *lo, double *rec, double *hi)
 {
-	if (model == DXL2_MODEL_XL430_W250) {
-		*lo = 6.5, *rec = 11.1, *hi = 12.0;
-		return true;
-	}
-	if (model == DXL2_MODEL_XM430_W350) {
-		*lo = 10.0, *rec = 12.0, *hi = 14.8;
-		return true;
-	}
-	return false;
+	const struct dxl2_model *m = dxl2_model_by_number(model);
+	if (m == NULL)
+		return false;
+	*lo = m->sheet.rated_min_v, *rec = m->sheet.rated_rec_v, *hi = m->sheet.rated_max_v;
+	return true;
 }
 
 void dr2_check_model(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v)
@@ -57,9 +53,11 @@ void dr2_check_model(const struct dr2_servo *s, const struct dr_context *c, stru
 		dr_set(v, DR_OK, "%u (%s), firmware %u", s->model, m->name, s->firmware);
 		return;
 	}
-	dr_set(v, DR_WARN, "%u, firmware %u: not in dxl's tables (XL430-W250, XM430-W350); the checks below read it "
+	char known[160];
+	dr_set(v, DR_WARN, "%u, firmware %u: not in dxl's tables (%s); the checks below read it "
 	        "with the X series' addresses, which it may not share; fix: check its control table (dxl --protocol 2 "
-	        "--port %s dump %u prints it raw)", s->model, s->firmware, c->port, s->id);
+	        "--port %s dump %u prints it raw)", s->model, s->firmware, dxl2_model_names(known, sizeof known), c->port,
+	        s->id);
 }
 
 void dr2_check_return_delay(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v)
@@ -153,7 +151,7 @@ void dr2_check_limits(const struct dr2_servo *s, const struct cfg *cfg, size_t j
 	 * every X model has the XL430's 4096 units a turn around 2048 */
 	const struct sm_model *m = sm_by_number(2, s->model);
 	int32_t lo, hi;
-	setup_joint_limits_model(m != NULL ? m : sm_of(SM_XL430), cj, &lo, &hi);
+	setup_joint_limits_model(m != NULL ? m : sm_by_number(2, DXL2_MODEL_XL430_W250), cj, &lo, &hi);
 	char conf[160];
 
 	snprintf(conf, sizeof conf, "the configuration's %ld..%ld (joint %zu: neutral %+.3f + [%.3f, %.3f] rad)",
