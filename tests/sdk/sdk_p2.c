@@ -7,6 +7,8 @@
  * way round) shows here.
  *
  *   sdk_p2 PORT XL_ID XM_ID
+ *   sdk_p2 PORT --xc430 ID ID   (two XC430-W150: the model added as data
+ *                                only; its own values, a sync loop)
  *
  * The bus starts at the servos' factory 57600 bps. Output: one line per
  * check, "ok WHAT" or "not ok WHAT: WHY", and "# ..." comments; tests/sdk/
@@ -331,10 +333,71 @@ static void baud_change(void)
 	       "setBaudRate %d, %u, %u; %s", set, a, b, said());
 }
 
+/* Two XC430-W150 (model 1070): its page's own factory values, and the
+ * loop undulated runs (sync write of goals, sync read of positions). */
+#define A_VEL_LIMIT 44
+#define A_PRESENT_LOAD 126
+static void xc430(uint8_t a, uint8_t b)
+{
+	uint16_t ma = pingGetModelNum(port, P2, a);
+	bool oka = good();
+	uint16_t mb = pingGetModelNum(port, P2, b);
+	result(oka && good() && ma == 1070 && mb == 1070, "ping: both XC430-W150 answer with model 1070", "%u, %u; %s",
+	       ma, mb, said());
+	uint32_t vl = read4ByteTxRx(port, P2, a, A_VEL_LIMIT);
+	result(good() && vl == 460, "read4ByteTxRx: velocity limit 460 (the XC430-W150 page's, the XL430's is 265)",
+	       "read %u; %s", vl, said());
+	uint16_t mv = read2ByteTxRx(port, P2, b, A_MAX_VOLTAGE);
+	result(good() && mv == 160, "read2ByteTxRx: max voltage limit 160 (16.0 V)", "read %u; %s", mv, said());
+	uint16_t pp = read2ByteTxRx(port, P2, a, A_POS_P);
+	result(good() && pp == 460, "read2ByteTxRx: position P gain 460", "read %u; %s", pp, said());
+	(void)read2ByteTxRx(port, P2, a, A_PRESENT_LOAD);
+	result(good(), "read2ByteTxRx: present load (126)", "%s", said());
+	write1ByteTxRx(port, P2, a, A_TORQUE, 1);
+	write1ByteTxRx(port, P2, b, A_TORQUE, 1);
+	int gw = groupSyncWrite(port, P2, A_GOAL_POS, 4);
+	groupSyncWriteAddParam(gw, a, 2300, 4);
+	groupSyncWriteAddParam(gw, b, 1800, 4);
+	groupSyncWriteTxPacket(gw);
+	bool sent = comm() == COMM_SUCCESS;
+	int gr = groupSyncRead(port, P2, A_PRESENT_POS, 4);
+	groupSyncReadAddParam(gr, a);
+	groupSyncReadAddParam(gr, b);
+	uint32_t pa = 0, pb = 0;
+	bool there = false;
+	for (int i = 0; i < 40 && !there; i++) {   /* up to 2 s: 0.1 rad at its speed takes ~0.1 s */
+		ms(50);
+		groupSyncReadTxRxPacket(gr);
+		if (comm() != COMM_SUCCESS || !groupSyncReadIsAvailable(gr, a, A_PRESENT_POS, 4) ||
+		    !groupSyncReadIsAvailable(gr, b, A_PRESENT_POS, 4))
+			continue;
+		pa = groupSyncReadGetData(gr, a, A_PRESENT_POS, 4);
+		pb = groupSyncReadGetData(gr, b, A_PRESENT_POS, 4);
+		there = pa > 2270 && pa < 2330 && pb > 1770 && pb < 1830;
+	}
+	result(sent && there, "groupSyncWrite goals 2300/1800, groupSyncRead: both joints get there",
+	       "sent %d, present %u, %u; %s", sent, pa, pb, said());
+	write1ByteTxRx(port, P2, a, A_TORQUE, 0);
+	write1ByteTxRx(port, P2, b, A_TORQUE, 0);
+	result(good(), "torque off again", "%s", said());
+}
+
 int main(int argc, char **argv)
 {
+	if (argc == 5 && strcmp(argv[2], "--xc430") == 0) {
+		port = portHandler(argv[1]);
+		packetHandler();
+		if (!openPort(port) || !setBaudRate(port, 57600)) {
+			printf("not ok openPort/setBaudRate(57600) on %s\n", argv[1]);
+			return 1;
+		}
+		result(true, "openPort and setBaudRate(57600) on the XC430 bus", "");
+		xc430((uint8_t)atoi(argv[3]), (uint8_t)atoi(argv[4]));
+		closePort(port);
+		return 0;
+	}
 	if (argc != 4) {
-		fprintf(stderr, "usage: sdk_p2 PORT XL_ID XM_ID\n");
+		fprintf(stderr, "usage: sdk_p2 PORT XL_ID XM_ID | sdk_p2 PORT --xc430 ID ID\n");
 		return 2;
 	}
 	xl = (uint8_t)atoi(argv[2]);
