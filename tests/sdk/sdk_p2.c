@@ -384,24 +384,11 @@ static void xc430(uint8_t a, uint8_t b)
 
 int main(int argc, char **argv)
 {
-	if (argc == 5 && strcmp(argv[2], "--xc430") == 0) {
-		port = portHandler(argv[1]);
-		packetHandler();
-		if (!openPort(port) || !setBaudRate(port, 57600)) {
-			printf("not ok openPort/setBaudRate(57600) on %s\n", argv[1]);
-			return 1;
-		}
-		result(true, "openPort and setBaudRate(57600) on the XC430 bus", "");
-		xc430((uint8_t)atoi(argv[3]), (uint8_t)atoi(argv[4]));
-		closePort(port);
-		return 0;
-	}
-	if (argc != 4) {
+	bool xc = argc == 5 && strcmp(argv[2], "--xc430") == 0;
+	if (argc != 4 && !xc) {
 		fprintf(stderr, "usage: sdk_p2 PORT XL_ID XM_ID | sdk_p2 PORT --xc430 ID ID\n");
 		return 2;
 	}
-	xl = (uint8_t)atoi(argv[2]);
-	xm = (uint8_t)atoi(argv[3]);
 	port = portHandler(argv[1]);
 	packetHandler();
 	if (!openPort(port) || !setBaudRate(port, 57600)) {
@@ -409,6 +396,13 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	result(true, "openPort and setBaudRate(57600) on the simulator's pty", "");
+	if (xc) {
+		xc430((uint8_t)atoi(argv[3]), (uint8_t)atoi(argv[4]));
+		closePort(port);
+		return 0;
+	}
+	xl = (uint8_t)atoi(argv[2]);
+	xm = (uint8_t)atoi(argv[3]);
 	ping_and_models();
 	reads_and_writes();
 	reg_write_action();
