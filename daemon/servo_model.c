@@ -45,6 +45,13 @@
 #define SM_XM430_POSITION \
 	{ .k_pair = 0.0304, .mu_even = 0.0757, .mu_odd = 0.0571, .lead_pair = 0.047, \
 	  .k_single = 0.0338, .mu_single = 0.0432, .lead_single = 0.047 }
+/* The XC430-W150 (2026-11-28): one joint tuned from the XL430's values (k
+ * x2.385); two joints from the one-joint values (k 0.025, mu 0.12/0.07,
+ * lead 0.117: from the XL430's the search box ends short, mu needs 10x):
+ * 0.807 Hz, 0.799/0.798 rad, lag 96 deg. */
+#define SM_XC430_POSITION \
+	{ .k_pair = 0.0234, .mu_even = 0.2838, .mu_odd = 0.2410, .lead_pair = 0.117, \
+	  .k_single = 0.0250, .mu_single = 0.2256, .lead_single = 0.117 }
 #define SM_XL430_POSITION \
 	{ .k_pair = 0.0179, .mu_even = 0.0298, .mu_odd = 0.0166, .lead_pair = 0.086, \
 	  .k_single = 0.0105, .mu_single = 0.0360, .lead_single = 0.117 }
@@ -58,6 +65,7 @@ static const struct {
 	struct sm_position_defaults position;
 } sm_tuned[] = {
 	{ DXL2_MODEL_XM430_W350, SM_XM430_POSITION },
+	{ DXL2_MODEL_XC430_W150, SM_XC430_POSITION },
 	{ DXL2_MODEL_XL430_W250, SM_XL430_POSITION },
 };
 
@@ -102,7 +110,7 @@ static const struct sm_model *sm_x_model(size_t i)
 		.stall_current_a = d->sheet.stall_current_a, .current_control = d->current_sensing,
 		.rated_min_v = d->sheet.rated_min_v, .rated_max_v = d->sheet.rated_max_v,
 		.reflected_inertia = SM_REFLECTED(d->sheet.rotor_inertia, d->sheet.gear_ratio),
-		.position = sm_tuned[sizeof sm_tuned / sizeof sm_tuned[0] - 1].position,
+		.position = SM_XL430_POSITION,
 	};
 	m->position_from = "XL430-W250";
 	for (size_t t = 0; t < sizeof sm_tuned / sizeof sm_tuned[0]; t++)

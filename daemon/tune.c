@@ -391,6 +391,18 @@ static void tune_fail_unreachable(struct tune *t, const char *how)
 			weak = i;
 	double v = b->vpeak[weak], f = t->opts.target_freq, a = t->opts.target_amp;
 	char why[TUNE_TEXT];
+	if (v >= tune_needed_speed(f, a)) {
+		/* Not the speed: the joints were fast enough and the parameters ran
+		 * into the box around where the search started (two XC430-W150
+		 * joints from the XL430's defaults: mu needed 10x and more) */
+		snprintf(why, sizeof why,
+		         "target not reached (%s), though joint %zu was fast enough (%.2f rad/s at most, %.2f needed): the "
+		         "search stays within x%.0f of where it started; start it nearer (--set joint.N.k=, joint.N.mu=, "
+		         "robot.servo_lead_s=). Closest: %s",
+		         how, weak + 1, v, tune_needed_speed(f, a), TUNE_K_RANGE, best);
+		tune_fail(t, why);
+		return;
+	}
 	snprintf(why, sizeof why,
 	         "target out of reach (%s): %.2f Hz at %.2f rad needs a peak speed of %.2f rad/s; joint %zu reached "
 	         "%.2f rad/s at most, at %.2f rad. Closest: %s. Reachable at that speed: about %.2f Hz at %.2f rad, "
