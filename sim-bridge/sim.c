@@ -84,19 +84,6 @@ static int robot_baud_reg(const struct sim_robot_config *rc, long baud, int prot
 	return 0;
 }
 
-/* One X servo as the scenario sets it up (ID, baud, return delay). */
-static void sim_add_xservo(const struct sim_config *c, struct sim_joint *j, enum sim_model m, uint8_t id,
-                           uint8_t baud_reg, int delay_us)
-{
-	struct sim_xservo_options xo = { c->overload_time_s };
-	sim_xservo_init(&j->xservo, m, &xo, 0.0);
-	sim_xservo_poke(&j->xservo, DXL2_X_ID, id);
-	sim_xservo_poke(&j->xservo, DXL2_X_BAUD_RATE, baud_reg);
-	if (delay_us >= 0)
-		sim_xservo_poke(&j->xservo, DXL2_X_RETURN_DELAY_TIME, delay_us / 2);
-	sim_xdrive_init(&j->xdrive);
-}
-
 static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char *err, size_t errcap)
 {
 	const struct sim_config *c = &s->cfg;
@@ -113,20 +100,14 @@ static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char 
 	if (robot_baud_reg(rc, baud, mi->protocol, &baud_reg, err, errcap) != 0)
 		return -1;
 	int delay_us = rc->return_delay_us >= 0 ? rc->return_delay_us : c->return_delay_us;
-	struct sim_servo_options so = { c->eeprom_needs_torque_off, c->overload_time_s };
 	for (size_t k = 0; k < rc->nids; k++) {
 		struct sim_joint *j = &b->joints[b->njoints++];
-		j->model = robot_model(rc, k);
+		struct sim_joint_place place = {
+			.id = rc->ids[k], .baud_reg = baud_reg, .delay_us = delay_us,
+			.eeprom_needs_torque_off = c->eeprom_needs_torque_off, .overload_time_s = c->overload_time_s,
+		};
+		sim_joint_place(j, robot_model(rc, k), &place);
 		sim_config_motor_params(c, j->model, &j->params);
-		if (j->model != SIM_MODEL_AX12A) {
-			sim_add_xservo(c, j, j->model, rc->ids[k], baud_reg, delay_us);
-		} else {
-			sim_servo_init(&j->servo, &so, DXL_POS_CENTER);
-			sim_servo_poke(&j->servo, DXL_AX_ID, rc->ids[k]);
-			sim_servo_poke(&j->servo, DXL_AX_BAUD_RATE, baud_reg);
-			if (delay_us >= 0)
-				sim_servo_poke(&j->servo, DXL_AX_RETURN_DELAY_TIME, (uint16_t)(delay_us / 2));
-		}
 		if (rc->ids[k] != rc->contact_id)
 			continue;
 		size_t body = s->world.nbodies;
@@ -369,84 +350,21 @@ void sim_close(struct sim *s)
 
 /* ---- physics ------------------------------------------------------------------ */
 
-/* An X servo's view of the last step. */
-static void sim_sense_xjoint(struct sim_joint *j, double dt)
-{
-	const struct sim_fault *f = j->faults.f;
-	bool torque = sim_joint_torque(j);
-	struct sim_xdrive_cmd xc;
-	sim_xservo_drive_cmd(&j->xservo, &xc);
-	double cap = sim_xdrive_cap(&xc, sim_motor_stall_torque(&j->params));
-	struct sim_xservo_sense in = {
-		.angle = j->motor.angle,
-		.speed = j->motor.speed,
-		.torque = torque ? j->motor.motor_torque : 0,
-		.stall_torque = sim_motor_stall_torque(&j->params),
-		.duty = torque ? j->motor.drive : 0,
-		.voltage = f[SIM_FAULT_VOLTAGE].active ? f[SIM_FAULT_VOLTAGE].arg : j->params.supply_voltage,
-		.temperature = f[SIM_FAULT_TEMPERATURE].active ? f[SIM_FAULT_TEMPERATURE].arg : j->motor.temperature,
-		.drive = &j->xdrive,
-	};
-	/* the overload's cause: the delivered torque at the driver's cap (as
-	 * the AX-12A's, within 2 % of it) */
-	in.overloaded = torque && cap > 0 && fabs(j->motor.motor_torque) >= 0.98 * cap;
-	sim_xservo_sense(&j->xservo, &in, dt);
-}
-
 static void sim_sense_joint(struct sim_joint *j, double dt)
 {
-	if (j->model != SIM_MODEL_AX12A) {
-		sim_sense_xjoint(j, dt);
-		return;
-	}
-	struct sim_motor_cmd cmd;
-	const struct sim_fault *f = j->faults.f;
-	sim_servo_motor_cmd(&j->servo, &cmd);
-	struct sim_servo_sense in = {
-		.angle = j->motor.angle,
-		.speed = j->motor.speed,
-		.load_fraction = cmd.torque_enable ? sim_motor_load_fraction(&j->motor, &j->params) : 0,
-		.output = cmd.torque_enable ? j->motor.drive : 0,
-		.voltage = f[SIM_FAULT_VOLTAGE].active ? f[SIM_FAULT_VOLTAGE].arg : j->params.supply_voltage,
-		.temperature = f[SIM_FAULT_TEMPERATURE].active ? f[SIM_FAULT_TEMPERATURE].arg : j->motor.temperature,
-		.overloaded = cmd.torque_enable && sim_motor_overloaded(&j->motor, &j->params, &cmd),
-	};
-	sim_servo_sense(&j->servo, &in, dt);
-}
-
-/* Present values before the first step and after a power-on; the goal
- * position where the joint stands, as on power-up. */
-static void sim_joint_power_up(struct sim_joint *j)
-{
-	if (j->model != SIM_MODEL_AX12A) {
-		sim_xservo_power_on(&j->xservo, j->motor.angle);
-		sim_sense_joint(j, 0);
-		return;
-	}
-	sim_sense_joint(j, 0);
-	dxl_put_u16(&j->servo.mem[DXL_AX_GOAL_POSITION], dxl_get_u16(&j->servo.mem[DXL_AX_PRESENT_POSITION]));
+	j->ops->sense(j, dt);
 }
 
 static void sim_sync_present(struct sim *s)
 {
 	for (size_t i = 0; i < s->nbuses; i++)
 		for (size_t k = 0; k < s->buses[i].njoints; k++)
-			sim_joint_power_up(&s->buses[i].joints[k]);
+			s->buses[i].joints[k].ops->power_up(&s->buses[i].joints[k]);
 }
 
 static void sim_step_joint(struct sim_joint *j, double dt)
 {
-	if (j->model != SIM_MODEL_AX12A) {
-		struct sim_xdrive_cmd xc;
-		struct sim_motor_drive d;
-		sim_xservo_drive_cmd(&j->xservo, &xc);
-		sim_xdrive_step(&j->xdrive, &xc, &j->motor, &j->params, dt, &d);
-		sim_motor_step_drive(&j->motor, &j->params, &d, 0.0, dt);
-		return;
-	}
-	struct sim_motor_cmd cmd;
-	sim_servo_motor_cmd(&j->servo, &cmd);
-	sim_motor_step(&j->motor, &j->params, &cmd, 0.0, dt);
+	j->ops->step(j, dt);
 }
 
 /* The walls of a "walls ... over S" at simulated time t (s). */
@@ -469,15 +387,7 @@ static void sim_walls_follow(struct sim *s, double t)
 /* A joint's drive over the next step, whatever its model. */
 static void sim_joint_drive(struct sim_joint *j, double dt, struct sim_motor_drive *d)
 {
-	if (j->model != SIM_MODEL_AX12A) {
-		struct sim_xdrive_cmd xc;
-		sim_xservo_drive_cmd(&j->xservo, &xc);
-		sim_xdrive_step(&j->xdrive, &xc, &j->motor, &j->params, dt, d);
-	} else {
-		struct sim_motor_cmd cmd;
-		sim_servo_motor_cmd(&j->servo, &cmd);
-		sim_motor_drive_for(&j->motor, &j->params, &cmd, dt, d);
-	}
+	j->ops->drive(j, dt, d);
 	/* a controller's arithmetic on a repaired state is not trusted */
 	if (!isfinite(d->a) || !isfinite(d->c) || !isfinite(d->cap) || !isfinite(d->duty)) {
 		*d = (struct sim_motor_drive){ 0, 0, 0, 0 };
@@ -748,13 +658,9 @@ static int fault_fits(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joint
 {
 	if (kind != SIM_FAULT_STUCK_ERROR)
 		return 0;
-	if (j->model != SIM_MODEL_AX12A && f->err2 < 0)
-		return FAIL(x, "stuck-error: servo %u on %s speaks Protocol 2.0: its ERR field is alert and/or one of "
-		               "result-fail, instruction, crc, data-range, data-length, data-limit, access (or 0..255)",
-		            sim_joint_id(j), b->name);
-	if (j->model == SIM_MODEL_AX12A && f->arg < 0)
-		return FAIL(x, "stuck-error: servo %u on %s speaks Protocol 1.0: its error bits are voltage, angle-limit, "
-		               "overheating, range, checksum, overload, instruction (or 0..127)", sim_joint_id(j), b->name);
+	const char *why;
+	if (!j->ops->error_fits(f, &why))
+		return FAIL(x, "stuck-error: servo %u on %s %s", sim_joint_id(j), b->name, why);
 	return 0;
 }
 
@@ -822,15 +728,10 @@ static int do_power_one(struct sim_cmd_ctx *x, struct sim_bus *b, struct sim_joi
 	(void)x;
 	(void)b;
 	if (*(bool *)arg) {
-		if (!sim_joint_powered(j)) {
-			if (j->model == SIM_MODEL_AX12A)
-				sim_servo_power_on(&j->servo);
-			sim_joint_power_up(j);   /* an X servo boots: RAM reset as on the real one */
-		}
-	} else if (j->model == SIM_MODEL_AX12A) {
-		sim_servo_power_off(&j->servo);
+		if (!sim_joint_powered(j))
+			j->ops->power_on(j);
 	} else {
-		sim_xservo_power_off(&j->xservo);
+		j->ops->power_off(j);
 	}
 	return 0;
 }
@@ -912,40 +813,18 @@ static struct sim_joint *cmd_joint(struct sim_cmd_ctx *x, struct sim_bus *b, con
 	return j;
 }
 
-static const struct dxl_reg *cmd_reg(struct sim_cmd_ctx *x, const char *name)
+/* A register of j's table by name (its aliases too); false with the reply set. */
+static bool cmd_reg(struct sim_cmd_ctx *x, const struct sim_joint *j, const char *name, struct sim_joint_reg *r)
 {
-	const struct dxl_reg *r = dxl_reg_lookup(name);
-	if (!r)
-		REPLY(x, "error: unknown register '%s'", name);
-	return r;
+	char why[128];
+	if (j->ops->reg(j, name, r, why, sizeof why))
+		return true;
+	REPLY(x, "error: %s", why);
+	return false;
 }
 
-/* A register of an X servo's table (protocol/dxl2_table.c names and aliases). */
-static const struct dxl2_reg *cmd_xreg(struct sim_cmd_ctx *x, const struct sim_joint *j, const char *name)
-{
-	const struct dxl2_reg *r = dxl2_reg_lookup(j->xservo.table, name);
-	if (!r)
-		REPLY(x, "error: unknown register '%s' (the %s's table)", name, sim_model_info(j->model)->label);
-	return r;
-}
-
-/* poke on an X servo: any value the register's bytes can hold. */
-static int cmd_xpoke(struct sim_cmd_ctx *x, struct sim_joint *j)
-{
-	const struct dxl2_reg *r = cmd_xreg(x, j, x->argv[3]);
-	if (!r)
-		return -1;
-	int bits = 8 * r->size;
-	long lo = r->is_signed ? -(1L << (bits - 1)) : 0;
-	long hi = r->is_signed ? (1L << (bits - 1)) - 1 : (long)((1ULL << bits) - 1);
-	long v;
-	if (num_parse_long(x->argv[4], lo, hi, &v) != NUM_OK)
-		return FAIL(x, "bad value '%s' (%ld..%ld)", x->argv[4], lo, hi);
-	sim_xservo_poke(&j->xservo, r->addr, (int32_t)(uint32_t)v);
-	return REPLY(x, "ok %s=%ld", r->name, v), 0;
-}
-
-/* poke BUS ID REG VALUE: set a register without the write rules. */
+/* poke BUS ID REG VALUE: set a register without the write rules (any value
+ * its bytes can hold). */
 static int cmd_poke(struct sim_cmd_ctx *x)
 {
 	struct sim_bus *b = cmd_bus(x, "poke BUS ID REG VALUE");
@@ -954,18 +833,14 @@ static int cmd_poke(struct sim_cmd_ctx *x)
 	if (x->argc != 5)
 		return FAIL(x, "usage: poke BUS ID REG VALUE");
 	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
-	if (!j)
-		return -1;
-	if (j->model != SIM_MODEL_AX12A)
-		return cmd_xpoke(x, j);
-	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
-	if (!r)
+	struct sim_joint_reg r;
+	if (!j || !cmd_reg(x, j, x->argv[3], &r))
 		return -1;
 	long v;
-	if (num_parse_long(x->argv[4], 0, r->size == 2 ? 65535 : 255, &v) != NUM_OK)
-		return FAIL(x, "bad value '%s' (0..%d)", x->argv[4], r->size == 2 ? 65535 : 255);
-	sim_servo_poke(&j->servo, r->addr, (uint16_t)v);
-	return REPLY(x, "ok %s=%ld", r->name, v), 0;
+	if (num_parse_long(x->argv[4], r.lo, r.hi, &v) != NUM_OK)
+		return FAIL(x, "bad value '%s' (%ld..%ld)", x->argv[4], r.lo, r.hi);
+	j->ops->poke(j, r.addr, v);
+	return REPLY(x, "ok %s=%ld", r.name, v), 0;
 }
 
 static int cmd_peek(struct sim_cmd_ctx *x)
@@ -976,20 +851,10 @@ static int cmd_peek(struct sim_cmd_ctx *x)
 	if (x->argc != 4)
 		return FAIL(x, "usage: peek BUS ID REG");
 	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
-	if (!j)
+	struct sim_joint_reg r;
+	if (!j || !cmd_reg(x, j, x->argv[3], &r))
 		return -1;
-	if (j->model != SIM_MODEL_AX12A) {
-		const struct dxl2_reg *xr = cmd_xreg(x, j, x->argv[3]);
-		int32_t v = 0;
-		if (!xr)
-			return -1;
-		sim_xservo_peek(&j->xservo, xr->addr, &v);
-		return REPLY(x, "ok %ld", (long)v), 0;
-	}
-	const struct dxl_reg *r = cmd_reg(x, x->argv[3]);
-	if (!r)
-		return -1;
-	return REPLY(x, "ok %u", (unsigned)sim_servo_peek(&j->servo, r->addr)), 0;
+	return REPLY(x, "ok %ld", j->ops->peek(j, r.addr)), 0;
 }
 
 /* The active faults' names after "faults=", or "none". */
@@ -1006,26 +871,6 @@ static void cmd_fault_names(struct sim_cmd_ctx *x, const struct sim_joint *j, si
 		snprintf(x->reply + off, x->cap - off, "none");
 }
 
-/* servo BUS ID on an X servo: its model, mode, hardware errors, watchdog and
- * the status ERR field's error numbers as counters. */
-static int cmd_xservo(struct sim_cmd_ctx *x, const struct sim_joint *j)
-{
-	const struct sim_xservo *sv = &j->xservo;
-	const struct sim_xservo_counters *c = &sv->count;
-	size_t off = (size_t)REPLY(x, "ok id=%u model=%s power=%s torque=%u mode=%u hwerr=0x%02x watchdog=%u "
-	                              "angle=%.4f speed=%.4f temp=%.1f instructions=%u replies=%u result_fail=%u "
-	                              "instruction=%u crc=%u data_range=%u data_length=%u data_limit=%u access=%u "
-	                              "shutdowns=%u watchdog_trips=%u reboots=%u faults=",
-	                           sim_xservo_id(sv), sim_model_info(j->model)->name, sv->powered ? "on" : "off",
-	                           sv->mem[DXL2_X_TORQUE_ENABLE], sv->mem[DXL2_X_OPERATING_MODE],
-	                           sv->mem[DXL2_X_HARDWARE_ERROR_STATUS], sv->mem[DXL2_X_BUS_WATCHDOG], j->motor.angle,
-	                           j->motor.speed, j->motor.temperature, c->instructions, c->replies, c->result_fail,
-	                           c->instruction_errors, c->crc_errors, c->data_range_errors, c->data_length_errors,
-	                           c->data_limit_errors, c->access_errors, c->shutdowns, c->watchdog_trips, c->reboots);
-	cmd_fault_names(x, j, off);
-	return 0;
-}
-
 /* servo BUS ID: one line of state, faults and counters (for people and tests). */
 static int cmd_servo(struct sim_cmd_ctx *x)
 {
@@ -1037,17 +882,9 @@ static int cmd_servo(struct sim_cmd_ctx *x)
 	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
 	if (!j)
 		return -1;
-	if (j->model != SIM_MODEL_AX12A)
-		return cmd_xservo(x, j);
-	const struct sim_servo *sv = &j->servo;
-	size_t off = (size_t)REPLY(x, "ok id=%u power=%s torque=%u errbits=0x%02x angle=%.4f speed=%.4f temp=%.1f "
-	                              "instructions=%u replies=%u range=%u angle_limit=%u instruction=%u checksum=%u "
-	                              "shutdowns=%u faults=",
-	                           sim_servo_id(sv), sv->powered ? "on" : "off", sv->mem[DXL_AX_TORQUE_ENABLE],
-	                           sim_servo_condition_bits(sv), j->motor.angle, j->motor.speed, j->motor.temperature,
-	                           sv->count.instructions, sv->count.replies, sv->count.range_errors,
-	                           sv->count.angle_limit_errors, sv->count.instruction_errors, sv->count.checksum_errors,
-	                           sv->count.shutdowns);
+	char line[640];
+	j->ops->describe(j, line, sizeof line);
+	size_t off = (size_t)REPLY(x, "ok %sfaults=", line);
 	cmd_fault_names(x, j, off);
 	return 0;
 }

@@ -68,27 +68,23 @@ bool sim_bus_baud_matches(const struct sim_bus *b, uint8_t reg)
 
 bool sim_joint_hears(const struct sim_bus *b, const struct sim_joint *j)
 {
-	if (j->model == SIM_MODEL_AX12A)
-		return j->servo.powered && sim_bus_baud_matches(b, j->servo.mem[DXL_AX_BAUD_RATE]);
-	double servo = (double)dxl2_baud_from_reg(j->xservo.mem[DXL2_X_BAUD_RATE]);
-	return j->xservo.powered && servo > 0 && fabs(servo - (double)b->baud) <= BUS_BAUD_TOLERANCE * (double)b->baud;
+	double servo = (double)j->ops->baud(j);
+	return j->ops->powered(j) && servo > 0 && fabs(servo - (double)b->baud) <= BUS_BAUD_TOLERANCE * (double)b->baud;
 }
 
 uint8_t sim_joint_id(const struct sim_joint *j)
 {
-	return j->model == SIM_MODEL_AX12A ? sim_servo_id(&j->servo) : sim_xservo_id(&j->xservo);
+	return j->ops->id(j);
 }
 
 bool sim_joint_powered(const struct sim_joint *j)
 {
-	return j->model == SIM_MODEL_AX12A ? j->servo.powered : j->xservo.powered;
+	return j->ops->powered(j);
 }
 
 bool sim_joint_torque(const struct sim_joint *j)
 {
-	if (j->model == SIM_MODEL_AX12A)
-		return j->servo.powered && j->servo.mem[DXL_AX_TORQUE_ENABLE];
-	return j->xservo.powered && j->xservo.mem[DXL2_X_TORQUE_ENABLE];
+	return j->ops->torque(j);
 }
 
 /* Keep the last cap bytes the parser consumed. */
@@ -269,7 +265,7 @@ static void bus_dispatch2(struct sim_bus *b, const struct dxl2_packet *pkt, int6
 	b->count.packets++;
 	for (size_t i = 0; i < b->njoints; i++) {
 		struct sim_joint *j = &b->joints[i];
-		if (j->model == SIM_MODEL_AX12A || !j->xservo.powered)
+		if (j->ops->protocol != 2 || !j->xservo.powered)
 			continue;
 		if (!sim_joint_hears(b, j)) {
 			b->count.wrong_baud++;
@@ -302,7 +298,7 @@ static void bus_bad_crc(struct sim_bus *b, int64_t req_end)
 			continue;
 		for (size_t i = 0; i < b->njoints; i++) {
 			struct sim_joint *j = &b->joints[i];
-			if (j->model == SIM_MODEL_AX12A || !sim_joint_hears(b, j))
+			if (j->ops->protocol != 2 || !sim_joint_hears(b, j))
 				continue;
 			uint8_t reply[BUS_REPLY2_MAX];
 			int n = sim_xservo_handle_bad_crc(&j->xservo, h[4], h[7], reply, sizeof(reply));

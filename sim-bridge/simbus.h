@@ -16,6 +16,7 @@
 #include "dxl.h"
 #include "dxl2.h"
 #include "fault.h"
+#include "joint.h"
 #include "line.h"
 #include "model.h"
 #include "motor.h"
@@ -33,6 +34,7 @@
  * with its controllers in `xdrive`. */
 struct sim_joint {
 	enum sim_model model;
+	const struct sim_joint_ops *ops;   /* its family's (joint.h): set by sim_joint_place */
 	struct sim_servo servo;
 	struct sim_xservo xservo;
 	struct sim_xdrive xdrive;

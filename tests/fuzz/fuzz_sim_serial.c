@@ -479,6 +479,7 @@ static void setup_x(void)
 		struct sim_joint *j = &bus.joints[bus.njoints++];
 		memset(j, 0, sizeof(*j));
 		j->model = k == 1 ? SIM_MODEL_XM430_W350 : SIM_MODEL_XL430_W250;
+		j->ops = sim_joint_ops_of(j->model);
 		sim_xservo_init(&j->xservo, j->model, NULL, 0.1 * k);
 		sim_xservo_poke(&j->xservo, DXL2_X_ID, k + 1);
 		sim_xservo_poke(&j->xservo, DXL2_X_BAUD_RATE, 3);   /* the bus's 1 Mbps */
@@ -501,6 +502,7 @@ static void setup(uint8_t flags, const uint8_t *fault)
 	for (int k = 0; k < NSERVOS && !(flags & 16); k++) {
 		struct sim_joint *j = &bus.joints[bus.njoints++];
 		memset(j, 0, sizeof(*j));
+		j->ops = sim_joint_ops_of(SIM_MODEL_AX12A);
 		sim_servo_init(&j->servo, &o, (uint16_t)(DXL_POS_CENTER + 100 * k));
 		sim_servo_poke(&j->servo, DXL_AX_ID, (uint16_t)(k + 1));
 		/* different return delays: fewer collisions on the line */

@@ -39,6 +39,7 @@ static void bus_two(struct sim_bus *b, double latency_s, bool echo)
 	for (uint8_t id = 1; id <= 2; id++) {
 		struct sim_joint *j = &b->joints[b->njoints++];
 		memset(j, 0, sizeof(*j));
+		j->ops = sim_joint_ops_of(SIM_MODEL_AX12A);
 		sim_servo_init(&j->servo, NULL, DXL_POS_CENTER);
 		sim_servo_poke(&j->servo, DXL_AX_ID, id);
 		sim_servo_poke(&j->servo, DXL_AX_RETURN_DELAY_TIME, 0);

@@ -40,6 +40,7 @@ static void bus_x(struct sim_bus *b, const uint8_t *ids, size_t n, long baud)
 		struct sim_joint *j = &b->joints[b->njoints++];
 		memset(j, 0, sizeof(*j));
 		j->model = k % 2 ? SIM_MODEL_XM430_W350 : SIM_MODEL_XL430_W250;
+		j->ops = sim_joint_ops_of(j->model);
 		sim_xservo_init(&j->xservo, j->model, NULL, 0.0);
 		sim_xservo_poke(&j->xservo, DXL2_X_ID, ids[k]);
 		sim_xservo_poke(&j->xservo, DXL2_X_BAUD_RATE, reg);
