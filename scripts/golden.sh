@@ -18,6 +18,8 @@
 #   scripts/golden.sh --run NAME DIR [LCM_URL]   one run into DIR/NAME/ and its
 #                                                record into DIR/NAME.rec
 #   scripts/golden.sh --compare NAME REC         REC against tests/golden/NAME.chk
+#   scripts/golden.sh --record DIR               the record of a run kept in DIR
+#                                                (demo.sh --out DIR, or --keep's)
 # --compare prints one line per difference and a last line starting "= ";
 # exit 0: as recorded; 1: something differs; 3: every value as recorded, the
 # digests not, and the expectation was recorded on another platform (where
@@ -107,14 +109,26 @@ record() {
 		/^world: / { put("world", substr($0, 8)); next }
 		/^collisions: / { put("collisions", substr($0, 13)); next }
 		/^contact force, median of every contact/ { v = $0; sub(/^[^:]*: /, "", v); put("contact_median", v); next }
-		/^  [^ ]+ +joints / { v = $0; sub(/^ *[^ ]+ +/, "", v); put("robot." $1, v); next }
+		# "left joints 1 states 2999 j0 1.033 Hz 0.645 rad neutral -0.1044 m lever
+		# 0.1865 m/rad swing j0 1.310 rad p-p": each number after its name
+		/^  [^ ]+ +joints / {
+			v = ""
+			for (i = 2; i <= NF; i++) {
+				if ($i == "joints" || $i == "states") { v = v " " $i "=" $(i + 1); i++ }
+				else if ($i ~ /^j[0-9]+$/ && $(i + 2) == "Hz") { v = v " " $i ".hz=" $(i + 1) " " $i ".amp=" $(i + 3); i += 4 }
+				else if ($i == "neutral" || $i == "lever") { v = v " " $i "=" $(i + 1); i += 2 }
+				else if ($i == "swing") { for (i++; $i ~ /^j[0-9]+$/; i += 2) v = v " " $i ".swing=" $(i + 1); i++ }
+				else v = v " " $i
+			}
+			put("robot." $1, v); next
+		}
 		# the pair table: a line per pair, each value after its column'"'"'s name
 		# ("end state" is one column)
 		$1 == "pair" && !hdr {
 			for (i = 1; i <= NF; i++) if ($i == "end" && $(i + 1) == "state") { col[++n] = "state"; i++ } else col[++n] = $i
 			hdr = 1; next
 		}
-		hdr && NF == n { v = ""; for (i = 2; i <= n; i++) v = v " " col[i] " " $i; put("pair." $1, v) }
+		hdr && NF == n { v = ""; for (i = 2; i <= n; i++) v = v " " col[i] "=" $i; put("pair." $1, v) }
 	' "$d/summary.txt"
 	awk '
 		function put(k, v) { gsub(/[ \t]+/, " ", v); sub(/^ /, "", v); sub(/ $/, "", v); printf "%-22s %s\n", k, v }
@@ -165,10 +179,11 @@ run_one() {
 # ---- comparing --------------------------------------------------------------------
 # compare CHK REC: see the header. Differences are printed as
 #   KEY: OLD -> NEW                          (a value of one word)
-#   KEY: words [OLD -> NEW] words ...        (the words of a longer one that changed)
+#   KEY: NAME OLD -> NEW; ...                (the NAME=VALUE words that changed)
+#   KEY: word [OLD -> NEW] word; ...         (the numbers of prose that changed)
 #   KEY: gone (was: ...) / KEY: new: ...
 compare() {
-	awk -v chk="$1" '
+	awk -v chk="${1#"$top/"}" '
 		function trim(s) { sub(/^[ \t]+/, "", s); sub(/[ \t]+$/, "", s); gsub(/[ \t]+/, " ", s); return s }
 		# a number, maybe in brackets or before a comma, unit or colon: "(5", "15,", "18.7x"
 		function split_num(t, part) {
@@ -180,21 +195,33 @@ compare() {
 		function unit(s,   p) { p = index(s, "."); return p ? 10 ^ (p - length(s)) : 0 }
 		function same_word(a, b,   pa, pb, u, d) {
 			if (a == b) return 1
+			# NAME=VALUE: the same name and the same value
+			if (a ~ /=/ || b ~ /=/) {
+				if (index(a, "=") == 0 || substr(a, 1, index(a, "=")) != substr(b, 1, index(b, "="))) return 0
+				return same_word(substr(a, index(a, "=") + 1), substr(b, index(b, "=") + 1))
+			}
 			if (!split_num(a, pa) || !split_num(b, pb) || pa[1] != pb[1] || pa[3] != pb[3]) return 0
 			u = unit(pa[2]); if (unit(pb[2]) > u) u = unit(pb[2])
 			d = pa[2] - pb[2]; if (d < 0) d = -d
 			return d <= u * (1 + 1e-9)
 		}
 		# what: "" when OLD and NEW match, else how they differ
-		# (each changed word of a longer value between the words around it, which
-		# name it: "meanD [3.1409 -> 3.0012] spread", "j0 [1.035 -> 1.041] Hz")
-		function differ(old, new,   na, nb, a, b, i, out) {
+		# (each changed word of a longer value by its name, "meanD -3.1384 -> -3.1396",
+		# or in prose between the words around it: "fell [18.7x -> 17.9x] after")
+		function differ(old, new,   na, nb, a, b, i, out, e, p) {
 			na = split(old, a, " "); nb = split(new, b, " ")
 			if (na != nb) return "\"" old "\" -> \"" new "\""
-			if (na == 1) return same_word(a[1], b[1]) ? "" : a[1] " -> " b[1]
+			if (na == 1 && a[1] !~ /=/) return same_word(a[1], b[1]) ? "" : a[1] " -> " b[1]
 			for (i = 1; i <= na; i++) {
 				if (same_word(a[i], b[i])) continue
-				out = out (out != "" ? "; " : "") (i > 1 ? a[i - 1] " " : "") "[" a[i] " -> " b[i] "]" (i < na ? " " a[i + 1] : "")
+				out = out (out != "" ? "; " : "")
+				if ((e = index(a[i], "=")) > 0 && substr(a[i], 1, e) == substr(b[i], 1, e)) {
+					out = out substr(a[i], 1, e - 1) " " substr(a[i], e + 1) " -> " substr(b[i], e + 1)
+					continue
+				}
+				if (i > 1 && !split_num(a[i - 1], p)) out = out a[i - 1] " "
+				out = out "[" a[i] " -> " b[i] "]"
+				if (i < na && !split_num(a[i + 1], p)) out = out " " a[i + 1]
 			}
 			return out
 		}
@@ -270,6 +297,12 @@ case "${1:-}" in
 --compare)
 	[ $# -eq 3 ] || usage
 	compare_named "$2" "$3"
+	exit
+	;;
+--record)
+	[ $# -eq 2 ] || usage
+	for f in summary.txt demo-summary.txt events.csv; do [ -f "$2/$f" ] || die "$2 holds no $f: not a run kept by demo.sh --out"; done
+	record "$2"
 	exit
 	;;
 esac
