@@ -18,6 +18,7 @@
 #   scripts/golden.sh --run NAME DIR [LCM_URL]   one run into DIR/NAME/ and its
 #                                                record into DIR/NAME.rec
 #   scripts/golden.sh --compare NAME REC         REC against tests/golden/NAME.chk
+#                                                (or against the file NAME, a path)
 #   scripts/golden.sh --record DIR               the record of a run kept in DIR
 #                                                (demo.sh --out DIR, or --keep's)
 # --compare prints one line per difference and a last line starting "= ";
@@ -270,6 +271,7 @@ compare() {
 # compare_named NAME REC: REC against tests/golden/NAME.chk (which must exist).
 compare_named() {
 	local chk="$golden/$1.chk"
+	case "$1" in */*) chk=$1 ;; esac
 	if [ ! -f "$chk" ]; then
 		echo "= no tests/golden/$1.chk: record it with scripts/golden.sh --update $1 (make golden)"
 		return 1

@@ -74,5 +74,56 @@ $last
 If the change was meant: make golden (or scripts/golden.sh --update $n), and commit tests/golden/$n.chk with it." ;;
 	esac
 done
+
+# ---- the comparison fails where it should ------------------------------------------------
+# On the first run's record, changed by hand: a number moved by 0.01 is named
+# with both values; a last digit that rounded the other way passes; other
+# digests fail on the platform of the expectation and are only reported on another.
+rec="$T/${names[0]}.rec"
+# edit WHAT: the record with one change: "meanD+0.01", "meanD+unit" (its last
+# digit), "digest" (the states log's), "platform"
+edit() {
+	awk -v what="$1" '
+		what == "platform" && $1 == "platform" { print "platform another-cpu; another compiler; another libc"; next }
+		what == "digest" && $1 == "sha256.states.csv" { print $1, "0" substr($2, 2); next }
+		what ~ /^meanD/ && !done && match($0, / meanD=-?[0-9]+\.[0-9]+/) {
+			v = substr($0, RSTART + 7, RLENGTH - 7); d = length(v) - index(v, ".")
+			nv = sprintf("%." d "f", v + (what == "meanD+unit" ? 10 ^ -d : 0.01))
+			print substr($0, 1, RSTART + 6) nv substr($0, RSTART + RLENGTH); done = 1; next
+		}
+		{ print }' "$rec"
+}
+cmp_edit() { "$top/scripts/golden.sh" --compare "$T/expect.chk" "$T/edited.rec" >"$T/cmp.out"; echo $?; }
+if [ -f "$rec" ] && grep -q ' meanD=' "$rec"; then
+	cp "$rec" "$T/expect.chk"
+	old_d=$(grep -m1 -o ' meanD=[^ ]*' "$rec" | cut -d= -f2)
+	edit meanD+0.01 >"$T/edited.rec"; rc=$(cmp_edit)
+	new_d=$(grep -m1 -o ' meanD=[^ ]*' "$T/edited.rec" | cut -d= -f2)
+	if [ "$rc" = 1 ] && grep -qF "meanD $old_d -> $new_d" "$T/cmp.out" && grep -q '^= 1 of [0-9]* values differ' "$T/cmp.out"; then
+		tap_ok "a final phase difference moved by 0.01 fails, named with both values ('$(grep -m1 meanD "$T/cmp.out")')"
+	else
+		tap_fail "a final phase difference moved by 0.01 fails, named with both values" "exit $rc: $(cat "$T/cmp.out")"
+	fi
+	edit meanD+unit >"$T/edited.rec"; rc=$(cmp_edit)
+	if [ "$rc" = 0 ] && ! cmp -s "$rec" "$T/edited.rec"; then
+		tap_ok "... moved by one unit of its last digit (a rounding the other way), it passes"
+	else
+		tap_fail "... moved by one unit of its last digit (a rounding the other way), it passes" "exit $rc: $(cat "$T/cmp.out")"
+	fi
+	edit digest >"$T/edited.rec"; rc=$(cmp_edit)
+	if [ "$rc" = 1 ] && grep -q '^sha256.states.csv: ' "$T/cmp.out"; then
+		tap_ok "the states log's digest changed, every number the same: it fails on the expectation's platform"
+	else
+		tap_fail "the states log's digest changed: it fails on the expectation's platform" "exit $rc: $(cat "$T/cmp.out")"
+	fi
+	edit platform >"$T/expect.chk"; rc=$(cmp_edit)
+	if [ "$rc" = 3 ] && grep -q 'informational: recorded on another-cpu' "$T/cmp.out"; then
+		tap_ok "... and on another platform it is reported, not failed (exit 3)"
+	else
+		tap_fail "... and on another platform it is reported, not failed (exit 3)" "exit $rc: $(cat "$T/cmp.out")"
+	fi
+else
+	tap_fail "the first run's record holds a pair's meanD to change" "$(head -n 20 "$rec" 2>&1)"
+fi
 keep_runs "${names[@]}"
 tap_done
