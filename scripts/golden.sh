@@ -136,7 +136,6 @@ record() {
 		/^switched / { put("switch", $0); next }
 		/^  The mean contact force / { put("words.force", $0); next }
 		/^  Collisions between robots per 10 s/ { v = $0; sub(/^[^:]*: /, "", v); put("words.collisions", v); next }
-		/^  Median contact force/ { v = $0; sub(/^[^:]*: /, "", v); put("words.median", v); next }
 		/^  Neighbours at the end/ { v = $0; sub(/^[^:]*: /, "", v); put("words.neighbours", v); next }
 		/^collisions per 10 s window:/ { sec = "collisions"; next }
 		/^mean contact force between samples/ { sec = "force"; next }
@@ -181,7 +180,7 @@ run_one() {
 # compare CHK REC: see the header. Differences are printed as
 #   KEY: OLD -> NEW                          (a value of one word)
 #   KEY: NAME OLD -> NEW; ...                (the NAME=VALUE words that changed)
-#   KEY: word [OLD -> NEW] word; ...         (the numbers of prose that changed)
+#   KEY: prose {OLD => NEW} prose ...        (a sentence, its changed words marked)
 #   KEY: gone (was: ...) / KEY: new: ...
 compare() {
 	awk -v chk="${1#"$top/"}" '
@@ -207,24 +206,25 @@ compare() {
 			return d <= u * (1 + 1e-9)
 		}
 		# what: "" when OLD and NEW match, else how they differ
-		# (each changed word of a longer value by its name, "meanD -3.1384 -> -3.1396",
-		# or in prose between the words around it: "fell [18.7x -> 17.9x] after")
-		function differ(old, new,   na, nb, a, b, i, out, e, p) {
+		# (NAME=VALUE words that changed by their names: "meanD -3.1384 -> -3.1396";
+		# prose whole, each changed word in it as "{OLD => NEW}")
+		function differ(old, new,   na, nb, a, b, i, out, e, changed) {
 			na = split(old, a, " "); nb = split(new, b, " ")
 			if (na != nb) return "\"" old "\" -> \"" new "\""
 			if (na == 1 && a[1] !~ /=/) return same_word(a[1], b[1]) ? "" : a[1] " -> " b[1]
-			for (i = 1; i <= na; i++) {
-				if (same_word(a[i], b[i])) continue
-				out = out (out != "" ? "; " : "")
-				if ((e = index(a[i], "=")) > 0 && substr(a[i], 1, e) == substr(b[i], 1, e)) {
-					out = out substr(a[i], 1, e - 1) " " substr(a[i], e + 1) " -> " substr(b[i], e + 1)
-					continue
+			if (old ~ /[^ =]=[^ =]/) {
+				for (i = 1; i <= na; i++) {
+					if (same_word(a[i], b[i])) continue
+					e = index(a[i], "=")
+					out = out (out != "" ? "; " : "") (e ? substr(a[i], 1, e - 1) " " substr(a[i], e + 1) " -> " substr(b[i], e + 1) : a[i] " -> " b[i])
 				}
-				if (i > 1 && !split_num(a[i - 1], p)) out = out a[i - 1] " "
-				out = out "[" a[i] " -> " b[i] "]"
-				if (i < na && !split_num(a[i + 1], p)) out = out " " a[i + 1]
+				return out
 			}
-			return out
+			for (i = 1; i <= na; i++) {
+				if (same_word(a[i], b[i])) { out = out (i > 1 ? " " : "") a[i]; continue }
+				out = out (i > 1 ? " " : "") "{" a[i] " => " b[i] "}"; changed = 1
+			}
+			return changed ? out : ""
 		}
 		function short(h) { return substr(h, 1, 12) "..." }
 		FNR == 1 { file++ }
