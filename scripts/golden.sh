@@ -318,7 +318,7 @@ while [ $# -gt 0 ]; do
 	--lcm-port) port=${2:-}; shift 2 || usage ;;
 	-h|--help) usage ;;
 	-*) echo "golden: unknown option '$1' (--help)" >&2; exit 2 ;;
-	*) names+=("${1%.run}"); shift ;;
+	*) names+=("$(basename "${1%.run}")"); shift ;;
 	esac
 done
 [[ "$jobs" =~ ^[1-9][0-9]?$ ]] || die "--jobs: a number of runs from 1 to 99, not '$jobs'"
