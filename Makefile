@@ -14,6 +14,9 @@
 #   make figures    the paper's figures from the real daemons in lockstep:
 #                   docs/FIGURES.md and docs/figures/ (QUICK=1: fewer runs;
 #                   FIGURES_ARGS='--only pair --jobs 3': scripts/figures.sh's options)
+#   make golden     the golden runs (tests/golden/): run, show what changed,
+#                   rewrite their expectations (GOLDEN_ARGS='pair_anti': one;
+#                   scripts/golden.sh without --update only compares)
 #   make hwcheck PORT=/dev/ttyUSB0 [CONFIG=robot.conf] [IDS="1 2"]
 #                   the first-run hardware check on a robot (dxl doctor)
 #   make SAN=1 test the same tests under AddressSanitizer + UBSan (build-san/)
@@ -103,7 +106,7 @@ LCM_STAMP := $(GEN)/.stamp
 # lcm-gen names files <package>_<type>.c; the package is `undulate`.
 LCM_GEN_C = $(wildcard $(GEN)/*.c)
 
-.PHONY: all deps test-deps test test-long test-busy test-sdk bench demo figures hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
+.PHONY: all deps test-deps test test-long test-busy test-sdk bench demo figures golden hwcheck fuzz spy-jar spy install uninstall clean lcmtypes
 all: $(foreach p,$(PROGRAMS),$(BIN)/$(p)) unit-tests
 
 $(LCM_STAMP): $(LCM_SRC)
@@ -247,6 +250,15 @@ FIGURES_ARGS ?=
 figures: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) scripts/figures.sh $(if $(filter 1,$(QUICK)),--quick) $(FIGURES_ARGS)
+
+# The golden runs (tests/golden/README.md), after a change of behaviour that
+# was meant: each run again, every value that changed printed old -> new, and
+# tests/golden/NAME.chk rewritten; commit them with the change.
+# tests/integration/golden_runs.sh (make test) holds the runs to them.
+GOLDEN_ARGS ?=
+golden: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) scripts/golden.sh --update $(GOLDEN_ARGS)
 
 # The first command on a new robot: dxl doctor (tools/dxl/README.md). Its
 # exit status is make's: 0 all OK, 1 warnings, 7 a check failed.
