@@ -6,8 +6,10 @@
  *   controller steps (control.c) ─→ its goals and writes go out ─→ the
  *   state is published (publish.c).
  *
- * One thread, one poll() over the control timer, the bus and its deadline
- * timer, the command sockets and signals. Start-up checks and the safe stop
+ * One thread, one loop, one poll() over the command sockets, signals and the
+ * clock's descriptors: the control timer, the bus and its deadline timer in
+ * real time, the simulator's socket in lockstep (struct dmn_clock: the clock
+ * is a source of ticks, not a second loop). Start-up checks and the safe stop
  * (setup.c) block; nothing else does. Nothing here writes the controller's
  * state: it calls the controller.
  */
@@ -50,6 +52,38 @@
 /* Assumed until the servos are read: the AX-12's factory return delay. */
 #define DMN_DEFAULT_RETURN_DELAY_US 500
 
+struct dmn;
+
+/* What a wake-up of the loop brought (filled by the clock, below). */
+struct dmn_wake {
+	bool bus_hup;        /* the port hung up */
+	bool bus_in;         /* reply bytes may be there */
+	bool bus_deadline;   /* the bus's deadline passed */
+	uint64_t ticks;      /* periods since the last tick: 0 none, more than 1 some were missed */
+	uint64_t now;        /* the tick's time */
+};
+
+/* Descriptors a clock adds to the loop's poll(), at most. */
+#define DMN_CLOCK_FDS 3
+
+/* What paces the loop: the system's clock (timerfds, the bus fd) or, in
+ * lockstep, the simulator's (common/lockstep.h). The loop and everything
+ * done at a tick or a bus event are one; a clock only arms the tick and the
+ * bus deadline, waits, and says what the wake-up brought — as chrony's one
+ * scheduler serves every module whatever its time source. */
+struct dmn_clock {
+	/* the ticks start at d->first_tick_us, one period apart */
+	void (*start)(struct dmn *d);
+	/* the bus's deadline is now d->cyc's (0: none) */
+	void (*arm_deadline)(struct dmn *d);
+	/* about to block: may end the run (d->stop) when the clock is gone */
+	void (*before_wait)(struct dmn *d);
+	/* its descriptors into pfd: how many (<= DMN_CLOCK_FDS) */
+	nfds_t (*fds)(struct dmn *d, struct pollfd *pfd);
+	/* poll() returned: what came, from its descriptors' revents */
+	void (*woke)(struct dmn *d, const struct pollfd *pfd, struct dmn_wake *w);
+};
+
 struct dmn {
 	struct cfg *cfg;
 	struct ctl ctl;
@@ -86,6 +120,7 @@ struct dmn {
 	/* systemd */
 	uint64_t watchdog_interval_us, last_watchdog_us, watchdog_cycle;
 	bool stop;
+	const struct dmn_clock *clock;
 	/* lockstep: the simulator's clock paces the loop (common/lockstep.h) */
 	bool lockstep;
 	struct lks_client lks;
@@ -468,18 +503,7 @@ static void dmn_try_reconnect(struct dmn *d, uint64_t now)
 }
 
 /* ---- the cycle ---------------------------------------------------------------------------------- */
-static void dmn_arm_deadline(struct dmn *d)
-{
-	struct itimerspec its = { 0 };
-	uint64_t dl = d->connected ? cyc_deadline_us(&d->cyc) : 0;
-	if (dl != 0) {
-		its.it_value.tv_sec = (time_t)(dl / 1000000);
-		its.it_value.tv_nsec = (long)(dl % 1000000) * 1000;
-		if (its.it_value.tv_sec == 0 && its.it_value.tv_nsec == 0)
-			its.it_value.tv_nsec = 1;
-	}
-	timerfd_settime(d->deadline_fd, TFD_TIMER_ABSTIME, &its, NULL);
-}
+static void dmn_arm_deadline(struct dmn *d) { d->clock->arm_deadline(d); }
 
 /* The cycle boundary: the commands that came in since the last cycle are
  * applied now, before the control step, never while a cycle's writes are on
@@ -630,14 +654,6 @@ static void dmn_tick_at(struct dmn *d, uint64_t exp, uint64_t now)
 	dmn_drive(d, cyc_start(&d->cyc));
 }
 
-static void dmn_tick(struct dmn *d)
-{
-	uint64_t exp = 0;
-	if (read(d->timer_fd, &exp, sizeof exp) != (ssize_t)sizeof exp || exp == 0)
-		return;
-	dmn_tick_at(d, exp, now_us());
-}
-
 /* ---- set-up and the loop ----------------------------------------------------------------------- */
 static void dmn_realtime(const struct cfg *cfg)
 {
@@ -685,15 +701,7 @@ static void dmn_start_timer(struct dmn *d)
 	d->first_tick_us = now_us() + d->period_us;
 	d->next_tick_us = d->first_tick_us;
 	d->second_start_us = now_us();
-	if (d->lockstep)
-		return;   /* the ticks are virtual: dmn_loop_lockstep */
-	struct itimerspec its = {
-		.it_interval = { .tv_sec = (time_t)(d->period_us / 1000000),
-		                 .tv_nsec = (long)(d->period_us % 1000000) * 1000 },
-		.it_value = { .tv_sec = (time_t)(d->first_tick_us / 1000000),
-		              .tv_nsec = (long)(d->first_tick_us % 1000000) * 1000 },
-	};
-	timerfd_settime(d->timer_fd, TFD_TIMER_ABSTIME, &its, NULL);
+	d->clock->start(d);
 }
 
 static bool dmn_signal(struct dmn *d)
@@ -706,11 +714,11 @@ static bool dmn_signal(struct dmn *d)
 	return true;
 }
 
-/* What both loops wait on besides their clock: signals and the two command
- * doors, in pfd[0..2]. */
+/* What the loop waits on besides its clock: signals and the two command
+ * doors, in pfd[0..2]; the clock's descriptors follow. */
 enum { DMN_P_SIGNAL, DMN_P_LOCAL, DMN_P_NET, DMN_P_COMMON };
 
-/* poll() the common descriptors and the loop's own (after them); false when
+/* poll() the common descriptors and the clock's (after them); false when
  * the loop must end (a poll error, or a signal that stops the daemon). *again
  * is set when poll was interrupted and nothing happened. */
 static bool dmn_poll(struct dmn *d, struct pollfd *pfd, nfds_t n, bool *again)
@@ -739,46 +747,113 @@ static void dmn_take_commands(struct dmn *d, const struct pollfd *pfd)
 		cin_on_network(&d->cin);
 }
 
+/* What a wake-up brought, the bus first: a cycle whose last reply came with
+ * the tick ends whole instead of being cut by it. */
+static void dmn_woke(struct dmn *d, const struct dmn_wake *w)
+{
+	if (w->bus_hup) {
+		if (bus_is_pending(&d->bus))
+			dmn_bus_event(d);   /* reads the remaining bytes, then reports the loss */
+		if (d->connected) {
+			bool busy = cyc_busy(&d->cyc);
+			dmn_bus_lost(d, DXL_E_DISCONNECTED);
+			if (busy)
+				dmn_cycle_done(d);
+		}
+	} else if (w->bus_in) {
+		dmn_bus_event(d);
+	}
+	if (w->bus_deadline)
+		dmn_bus_event(d);
+	if (w->ticks > 0)
+		dmn_tick_at(d, w->ticks, w->now);
+}
+
+/* The loop, whatever the clock: wait for it, signals and commands; act on
+ * what came. A signal ends it here (the safe stop follows in dmn_run_with),
+ * so does the clock when it ends the run or goes away. */
 static void dmn_loop(struct dmn *d)
 {
-	enum { P_TIMER = DMN_P_COMMON, P_DEADLINE, P_BUS, P_N };
 	while (!d->stop) {
-		struct pollfd pfd[P_N];
+		struct pollfd pfd[DMN_P_COMMON + DMN_CLOCK_FDS];
 		bool again;
-		pfd[P_TIMER] = (struct pollfd){ .fd = d->timer_fd, .events = POLLIN };
-		pfd[P_DEADLINE] = (struct pollfd){ .fd = d->deadline_fd, .events = POLLIN };
-		/* bus fd: readable only matters while a reply is awaited; HUP/ERR always */
-		pfd[P_BUS] = (struct pollfd){ .fd = d->connected ? port_fd(d->port) : -1,
-		                              .events = (short)(bus_is_pending(&d->bus) ? POLLIN : 0) };
-		if (!dmn_poll(d, pfd, P_N, &again))
+		d->clock->before_wait(d);
+		if (d->stop)
+			return;
+		nfds_t n = DMN_P_COMMON + d->clock->fds(d, pfd + DMN_P_COMMON);
+		if (!dmn_poll(d, pfd, n, &again))
 			return;
 		if (again)
 			continue;
-		if (pfd[P_BUS].revents & (POLLHUP | POLLERR | POLLNVAL)) {
-			if (bus_is_pending(&d->bus))
-				dmn_bus_event(d);   /* reads the remaining bytes, then reports the loss */
-			if (d->connected) {
-				bool busy = cyc_busy(&d->cyc);
-				dmn_bus_lost(d, DXL_E_DISCONNECTED);
-				if (busy)
-					dmn_cycle_done(d);
-			}
-		} else if (pfd[P_BUS].revents & POLLIN) {
-			dmn_bus_event(d);
-		}
-		if (pfd[P_DEADLINE].revents & POLLIN) {
-			uint64_t x;
-			if (read(d->deadline_fd, &x, sizeof x) < 0 && errno != EAGAIN)
-				log_debug("deadline timer: %s", strerror(errno));
-			dmn_bus_event(d);
-		}
-		if (pfd[P_TIMER].revents & POLLIN)
-			dmn_tick(d);
 		dmn_take_commands(d, pfd);
+		struct dmn_wake w = { 0 };
+		d->clock->woke(d, pfd + DMN_P_COMMON, &w);
+		dmn_woke(d, &w);
 	}
 }
 
-/* ---- lockstep: the simulator's clock instead of the timers ------------------------------------ */
+/* ---- the system's clock: a periodic timerfd, a deadline timerfd, the bus fd ------------------- */
+enum { DMN_RT_TIMER, DMN_RT_DEADLINE, DMN_RT_BUS, DMN_RT_N };
+
+static struct timespec dmn_timespec(uint64_t us)
+{
+	return (struct timespec){ .tv_sec = (time_t)(us / 1000000), .tv_nsec = (long)(us % 1000000) * 1000 };
+}
+
+static void dmn_rt_start(struct dmn *d)
+{
+	struct itimerspec its = { .it_interval = dmn_timespec(d->period_us), .it_value = dmn_timespec(d->first_tick_us) };
+	timerfd_settime(d->timer_fd, TFD_TIMER_ABSTIME, &its, NULL);
+}
+
+static void dmn_rt_arm_deadline(struct dmn *d)
+{
+	struct itimerspec its = { 0 };
+	uint64_t dl = d->connected ? cyc_deadline_us(&d->cyc) : 0;
+	if (dl != 0) {
+		its.it_value = dmn_timespec(dl);
+		if (its.it_value.tv_sec == 0 && its.it_value.tv_nsec == 0)
+			its.it_value.tv_nsec = 1;   /* all zero would disarm it */
+	}
+	timerfd_settime(d->deadline_fd, TFD_TIMER_ABSTIME, &its, NULL);
+}
+
+static void dmn_rt_before_wait(struct dmn *d) { (void)d; }
+
+static nfds_t dmn_rt_fds(struct dmn *d, struct pollfd *pfd)
+{
+	pfd[DMN_RT_TIMER] = (struct pollfd){ .fd = d->timer_fd, .events = POLLIN };
+	pfd[DMN_RT_DEADLINE] = (struct pollfd){ .fd = d->deadline_fd, .events = POLLIN };
+	/* bus fd: readable only matters while a reply is awaited; HUP/ERR always */
+	pfd[DMN_RT_BUS] = (struct pollfd){ .fd = d->connected ? port_fd(d->port) : -1,
+	                                   .events = (short)(bus_is_pending(&d->bus) ? POLLIN : 0) };
+	return DMN_RT_N;
+}
+
+static void dmn_rt_woke(struct dmn *d, const struct pollfd *pfd, struct dmn_wake *w)
+{
+	w->bus_hup = (pfd[DMN_RT_BUS].revents & (POLLHUP | POLLERR | POLLNVAL)) != 0;
+	w->bus_in = (pfd[DMN_RT_BUS].revents & POLLIN) != 0;
+	if (pfd[DMN_RT_DEADLINE].revents & POLLIN) {
+		uint64_t x;
+		if (read(d->deadline_fd, &x, sizeof x) < 0 && errno != EAGAIN)
+			log_debug("deadline timer: %s", strerror(errno));
+		w->bus_deadline = true;
+	}
+	uint64_t exp = 0;
+	if ((pfd[DMN_RT_TIMER].revents & POLLIN) && read(d->timer_fd, &exp, sizeof exp) == (ssize_t)sizeof exp &&
+	    exp > 0) {
+		w->ticks = exp;   /* more than one: whole periods were missed */
+		w->now = now_us();
+	}
+}
+
+static const struct dmn_clock dmn_clock_real = {
+	.start = dmn_rt_start, .arm_deadline = dmn_rt_arm_deadline, .before_wait = dmn_rt_before_wait,
+	.fds = dmn_rt_fds, .woke = dmn_rt_woke,
+};
+
+/* ---- lockstep: the simulator's clock over its socket ------------------------------------------ */
 static void dmn_clock_lost(struct dmn *d, const char *why)
 {
 	log_error("%s: stopping, without a safe stop (the simulated servos went with the simulator)", why);
@@ -795,60 +870,64 @@ static void dmn_clock_commands(struct dmn *d)
 		cin_clock_command(&d->cin, text);
 }
 
-/* Virtual time moved to now: the bus's reply or deadline, then the tick. */
-static void dmn_clock_moved(struct dmn *d, uint64_t now)
+/* The ticks are virtual: d->next_tick_us, told to the simulator in the WAIT. */
+static void dmn_lks_start(struct dmn *d) { (void)d; }
+/* The deadline goes out with the next WAIT. */
+static void dmn_lks_arm_deadline(struct dmn *d) { (void)d; }
+
+/* Tell the simulator until when there is nothing to do (the next tick, the
+ * bus deadline) and whether the bus awaits a reply: time moves only while
+ * every daemon has said so. */
+static void dmn_lks_before_wait(struct dmn *d)
 {
-	if (d->connected && bus_is_pending(&d->bus))
-		dmn_bus_event(d);
+	uint64_t wake = d->next_tick_us;
+	uint64_t dl = d->connected ? cyc_deadline_us(&d->cyc) : 0;
+	if (dl != 0 && dl < wake)
+		wake = dl;
+	if (lks_client_wait(&d->lks, wake, d->connected && bus_is_pending(&d->bus)) != 0)
+		dmn_clock_lost(d, "lockstep: the simulator is gone");
+}
+
+static nfds_t dmn_lks_fds(struct dmn *d, struct pollfd *pfd)
+{
+	pfd[0] = (struct pollfd){ .fd = d->lks.fd, .events = POLLIN };
+	return 1;
+}
+
+/* The simulator's message: commands, the end of the run, or TIME. When
+ * virtual time moved, the bus may have its reply or deadline, and the tick
+ * may have come. */
+static void dmn_lks_woke(struct dmn *d, const struct pollfd *pfd, struct dmn_wake *w)
+{
+	char why[256];
+	if (!(pfd[0].revents & (POLLIN | POLLHUP | POLLERR)))
+		return;
+	int r = lks_client_read(&d->lks, why, sizeof why);
+	if (r <= 0) {
+		dmn_clock_lost(d, r == 0 ? "lockstep: the simulator closed the clock" : why);
+		return;
+	}
+	dmn_clock_commands(d);
+	if (d->lks.stop) {
+		log_info("lockstep: the simulator ended the run (%s): stopping", d->lks.stop_why);
+		d->stop = true;
+		return;
+	}
+	if (!lks_client_take_time(&d->lks))
+		return;
+	uint64_t now = now_us();
+	w->bus_in = d->connected && bus_is_pending(&d->bus);
 	if (now >= d->next_tick_us) {
-		uint64_t exp = 1 + (now - d->next_tick_us) / d->period_us;
-		d->next_tick_us += exp * d->period_us;
-		dmn_tick_at(d, exp, now);
+		w->ticks = 1 + (now - d->next_tick_us) / d->period_us;
+		w->now = now;
+		d->next_tick_us += w->ticks * d->period_us;
 	}
 }
 
-/* The loop in lockstep: the same work as dmn_loop(), paced by the simulator.
- * Before blocking, tell it until when there is nothing to do (the next tick,
- * the bus deadline) and whether the bus awaits a reply; then wait for its
- * TIME (and for signals and commands, as ever). */
-static void dmn_loop_lockstep(struct dmn *d)
-{
-	enum { P_CLOCK = DMN_P_COMMON, P_N };
-	char why[256];
-	while (!d->stop) {
-		uint64_t wake = d->next_tick_us;
-		uint64_t dl = d->connected ? cyc_deadline_us(&d->cyc) : 0;
-		if (dl != 0 && dl < wake)
-			wake = dl;
-		if (lks_client_wait(&d->lks, wake, d->connected && bus_is_pending(&d->bus)) != 0) {
-			dmn_clock_lost(d, "lockstep: the simulator is gone");
-			return;
-		}
-		struct pollfd pfd[P_N];
-		bool again;
-		pfd[P_CLOCK] = (struct pollfd){ .fd = d->lks.fd, .events = POLLIN };
-		if (!dmn_poll(d, pfd, P_N, &again))
-			return;
-		if (again)
-			continue;
-		dmn_take_commands(d, pfd);
-		if (!(pfd[P_CLOCK].revents & (POLLIN | POLLHUP | POLLERR)))
-			continue;
-		int r = lks_client_read(&d->lks, why, sizeof why);
-		if (r <= 0) {
-			dmn_clock_lost(d, r == 0 ? "lockstep: the simulator closed the clock" : why);
-			return;
-		}
-		dmn_clock_commands(d);
-		if (d->lks.stop) {
-			log_info("lockstep: the simulator ended the run (%s): stopping", d->lks.stop_why);
-			d->stop = true;
-			return;
-		}
-		if (lks_client_take_time(&d->lks))
-			dmn_clock_moved(d, now_us());
-	}
-}
+static const struct dmn_clock dmn_clock_lockstep = {
+	.start = dmn_lks_start, .arm_deadline = dmn_lks_arm_deadline, .before_wait = dmn_lks_before_wait,
+	.fds = dmn_lks_fds, .woke = dmn_lks_woke,
+};
 
 static bool dmn_open(struct dmn *d, int *status)
 {
@@ -894,6 +973,7 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	d->lim_events = (struct log_limit)LOG_LIMIT_INIT(30, 100000);
 	d->period_us = (uint64_t)llround(cfg->period_ms * 1000.0);
 	d->timer_fd = d->deadline_fd = d->signal_fd = -1;
+	d->clock = &dmn_clock_real;
 	snprintf(d->port_path, sizeof d->port_path, "%s", cfg->port);
 	ctl_init(&d->ctl, cfg);
 	struct cyc_hooks ch = { .ctx = d, .bus_error = dmn_bus_error_hook };
@@ -921,6 +1001,7 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 			return 1;
 		}
 		d->lockstep = true;
+		d->clock = &dmn_clock_lockstep;
 	}
 	d->epoch_us = now_us();
 	if (!dmn_connect(d, "start", err, sizeof err)) {
@@ -958,10 +1039,7 @@ static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
 	dmn_notify_status(d);
 	log_info("ready: %s, %.0f Hz", d->pub.ch_state, 1e6 / (double)d->period_us);
 
-	if (d->lockstep)
-		dmn_loop_lockstep(d);
-	else
-		dmn_loop(d);
+	dmn_loop(d);
 
 	notify_send(&d->notify, "STOPPING=1");
 	cyc_cut(&d->cyc);

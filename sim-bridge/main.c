@@ -5,10 +5,12 @@
  *   undulate-sim --link PATH --ids 1,2 [options]      one bus (quick form)
  *   undulate-sim --scenario FILE [--set sec.key=val]   robots, world, faults
  *
- * One single-threaded loop (ppoll) owns everything: the physics runs on an
+ * One single-threaded loop (pselect) owns everything: the physics runs on an
  * absolute schedule at rate_hz, replies leave each bus's line queue when
  * their wire time has come, LCM and the control socket are served in
- * between. See sim-bridge/README.md.
+ * between. Its clock is the system's, or with --lockstep the virtual time
+ * this process owns (struct sim_clock): one loop either way. See
+ * sim-bridge/README.md.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -91,8 +93,11 @@ struct client {
 	char buf[MAIN_LINE_MAX];
 };
 
+struct sim_clock;
+
 struct app {
 	struct sim *sim;
+	const struct sim_clock *clock;   /* what paces the loop (run) */
 	lcm_t *lcm;
 	int listen_fd;
 	char control_path[SIM_PATH_MAX];
@@ -114,6 +119,10 @@ struct app {
 	uint64_t contacts_steps_at;   /* the step of the last SIM.TRUTH: its contacts' period */
 	uint8_t *truth_buf;
 	bool bench, quiet;
+	/* real time: the descriptors were served since the last work; --bench's figures */
+	bool served;
+	int64_t next_bench, bench_at;
+	double bench_cpu;
 	/* bad input already reported, per bus (reported at most once a second) */
 	uint64_t reported_bad[SIM_MAX_BUSES];
 	/* lockstep: virtual time, owned here and shared with the daemons */
@@ -122,6 +131,7 @@ struct app {
 	int64_t lockstep_grace_ns;
 	int64_t wall_end;             /* when the run ended (wall clock) */
 	int64_t first_step_wall;      /* when simulated time first moved */
+	int64_t start_wall;           /* when the loop started (the daemons' join grace) */
 };
 
 /* The simulation's "now" (ns) for the bus and the command language: the
@@ -763,6 +773,10 @@ static double cpu_seconds(void)
 	       ((double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_usec) / 1e6;
 }
 
+/* The physics steps due by now. In real time a step runs late by however
+ * long the loop took to come round, and a stall is given up rather than
+ * replayed; in lockstep time stops at every step (now == *next_step): never
+ * late, never behind. */
 static void physics(struct app *a, int64_t now, int64_t *next_step)
 {
 	struct sim *s = a->sim;
@@ -928,62 +942,164 @@ static void report_bad_input(struct app *a)
 	}
 }
 
+/* ---- one loop, two clocks ------------------------------------------------------------ */
+
+/* What is due and when, on the clock's time line (ns): the monotonic clock
+ * from t0 in real time, virtual time from 0 in lockstep. */
+struct sched {
+	int64_t next_step, next_truth, next_world, end, truth_ns;
+};
+
+/* The loop's next move, as the clock decides it. */
+enum clk_next {
+	CLK_NOW,    /* time is *now: do what is due by then */
+	CLK_WAIT,   /* serve the descriptors for up to *wait */
+	CLK_END,    /* the run is over */
+};
+
+/* What paces the loop: the system's monotonic clock, or in lockstep the
+ * virtual time this process owns and shares with the daemons (vtime.h). The
+ * loop, the physics, the messages, the buses' replies and the descriptors
+ * served are the same for both; as in the daemon, the clock is a source of
+ * time, not a second loop. */
+struct sim_clock {
+	int64_t (*start)(struct app *a);           /* the time line's 0: the run's start */
+	enum clk_next (*next)(struct app *a, const struct sched *sc, int64_t *now, struct timespec *wait);
+	void (*served)(struct app *a);             /* after a CLK_WAIT */
+	void (*moved)(struct app *a, int64_t now); /* after the work due by now */
+};
+
+/* The earliest thing the simulation itself has due: a physics step, a truth
+ * or world message, a reply's bytes. */
+static int64_t sched_next(const struct app *a, const struct sched *sc)
+{
+	const struct sim *s = a->sim;
+	int64_t t = sc->next_step;
+	if (a->lcm && sc->next_truth < t)
+		t = sc->next_truth;
+	if (a->lcm && sc->next_world < t)
+		t = sc->next_world;
+	for (size_t i = 0; i < s->nbuses; i++) {
+		int64_t tx = sim_bus_next_tx(&s->buses[i], a->tx_slice_ns);
+		if (tx < t)
+			t = tx;
+	}
+	return t;
+}
+
+/* Time is now: physics, messages, replies due by then, then the clock's own. */
+static void advance(struct app *a, struct sched *sc, int64_t now)
+{
+	struct sim *s = a->sim;
+	physics(a, now, &sc->next_step);
+	if (now >= sc->next_truth) {
+		if (a->lcm)
+			publish_truth(a);
+		sc->next_truth += sc->truth_ns;
+		if (sc->next_truth <= now)
+			sc->next_truth = now + sc->truth_ns;
+	}
+	if (now >= sc->next_world) {
+		if (a->lcm)
+			publish_world(a);
+		if (!a->quiet)
+			report_bad_input(a);
+		sc->next_world += 1000000000;
+	}
+	for (size_t i = 0; i < s->nbuses; i++)
+		sim_bus_flush(&s->buses[i], now);
+	a->clock->moved(a, now);
+}
+
+/* Serve what is readable (the buses, LCM, the control socket, in lockstep
+ * the daemons) for up to *wait; signals come in only here. */
+static void serve_for(struct app *a, const struct timespec *wait)
+{
+	static struct pollfd fds[MAIN_MAX_FDS];
+	static int bus_of[MAIN_MAX_FDS];
+	sigset_t unblocked;
+	sigemptyset(&unblocked);
+	int n = build_pollset(a, fds, bus_of);
+	if (wait_fds(fds, n, wait, &unblocked) > 0)
+		serve(a, fds, bus_of, n);
+}
+
 static void run(struct app *a)
 {
 	struct sim *s = a->sim;
-	struct pollfd fds[MAIN_MAX_FDS];
-	int bus_of[MAIN_MAX_FDS];
-	int64_t truth_ns = (int64_t)llround(1e9 / s->cfg.truth_hz);
-	int64_t next_step = a->t0 + a->step_ns, next_truth = a->t0 + truth_ns, next_bench = a->t0 + 1000000000;
-	int64_t end = s->cfg.duration_s > 0 ? a->t0 + (int64_t)llround(s->cfg.duration_s * 1e9) : INT64_MAX;
-	double cpu_prev = cpu_seconds();
-	int64_t bench_prev = a->t0;
-	sigset_t unblocked;
-	sigemptyset(&unblocked);
-	sim_run_events(s, 0.0, a->t0);
+	int64_t t0 = a->clock->start(a);
+	struct sched sc = { .truth_ns = (int64_t)llround(1e9 / s->cfg.truth_hz) };
+	sc.next_step = t0 + a->step_ns;
+	sc.next_truth = t0 + sc.truth_ns;
+	sc.next_world = t0 + 1000000000;
+	sc.end = s->cfg.duration_s > 0 ? t0 + (int64_t)llround(s->cfg.duration_s * 1e9) : INT64_MAX;
+	sim_run_events(s, 0.0, t0);
 	if (a->lcm)
 		publish_world(a);
-	while (!stop_signal) {
-		int64_t now = mono_ns();
-		if (now >= end)
+	for (;;) {
+		int64_t now;
+		struct timespec wait;
+		enum clk_next next = a->clock->next(a, &sc, &now, &wait);
+		if (next == CLK_END)
 			break;
-		physics(a, now, &next_step);
-		if (now >= next_truth) {
-			if (a->lcm)
-				publish_truth(a);
-			next_truth += truth_ns;
-			if (next_truth <= now)
-				next_truth = now + truth_ns;
+		if (next == CLK_WAIT) {
+			serve_for(a, &wait);
+			a->clock->served(a);
+			continue;
 		}
-		if (now >= next_bench) {
-			if (a->lcm)
-				publish_world(a);
-			if (a->bench)
-				bench_line(a, now, &cpu_prev, &bench_prev);
-			if (!a->quiet)
-				report_bad_input(a);
-			next_bench += 1000000000;
-		}
-		int64_t deadline = next_step < next_truth ? next_step : next_truth;
-		for (size_t i = 0; i < s->nbuses; i++) {
-			sim_bus_flush(&s->buses[i], now);
-			int64_t tx = sim_bus_next_tx(&s->buses[i], a->tx_slice_ns);
-			if (tx < deadline)
-				deadline = tx;
-		}
-		if (end < deadline)
-			deadline = end;
-		int n = build_pollset(a, fds, bus_of);
-		int64_t wait = deadline - mono_ns();
-		struct timespec ts = { 0, 0 };
-		if (wait > 0)
-			ts = (struct timespec){ (time_t)(wait / 1000000000), (long)(wait % 1000000000) };
-		if (wait_fds(fds, n, &ts, &unblocked) > 0)
-			serve(a, fds, bus_of, n);
+		advance(a, &sc, now);
 	}
+	a->wall_end = mono_ns();
 }
 
-/* ---- the loop in lockstep --------------------------------------------------------- */
+/* ---- the system's clock ------------------------------------------------------------- */
+
+static int64_t rt_start(struct app *a)
+{
+	a->served = true;   /* the first move is work at now */
+	a->bench_cpu = cpu_seconds();
+	a->bench_at = a->t0;
+	a->next_bench = a->t0 + 1000000000;
+	return a->t0;
+}
+
+/* Work at the clock's now and a wait until the next thing due take turns:
+ * the descriptors are served once between two rounds of work even when
+ * something is due at once. */
+static enum clk_next rt_next(struct app *a, const struct sched *sc, int64_t *now, struct timespec *wait)
+{
+	if (!a->served) {
+		int64_t deadline = sched_next(a, sc);
+		if (sc->end < deadline)
+			deadline = sc->end;
+		int64_t left = deadline - mono_ns();
+		*wait = left > 0 ? (struct timespec){ (time_t)(left / 1000000000), (long)(left % 1000000000) }
+		                 : (struct timespec){ 0, 0 };
+		return CLK_WAIT;
+	}
+	a->served = false;
+	if (stop_signal)
+		return CLK_END;
+	*now = mono_ns();
+	return *now >= sc->end ? CLK_END : CLK_NOW;
+}
+
+static void rt_served(struct app *a) { a->served = true; }
+
+/* --bench: CPU and step lateness, once a second. */
+static void rt_moved(struct app *a, int64_t now)
+{
+	if (!a->bench || now < a->next_bench)
+		return;
+	bench_line(a, now, &a->bench_cpu, &a->bench_at);
+	a->next_bench += 1000000000;
+}
+
+static const struct sim_clock clock_real = {
+	.start = rt_start, .next = rt_next, .served = rt_served, .moved = rt_moved,
+};
+
+/* ---- lockstep: virtual time ---------------------------------------------------------- */
 
 /* The robots' daemons take commands from the schedule (sim.h robot_command). */
 static int lockstep_robot_command(void *ctx, int bus, const char *text, char *why, size_t cap)
@@ -998,126 +1114,76 @@ static void lockstep_set_time(struct app *a, uint64_t t)
 	clock_set_virtual(a->vt.mono0_us + t / 1000u, a->vt.wall0_us + (int64_t)(t / 1000u));
 }
 
-/* The physics steps due by t, with their collisions and scheduled events. */
-static void lockstep_physics(struct app *a, int64_t t, int64_t *next_step)
+static int64_t lockstep_start(struct app *a)
 {
-	struct sim *s = a->sim;
-	while (*next_step <= t) {
-		sim_step(s);
-		report_collisions(a);
-		sim_run_events(s, (double)s->steps * s->dt, *next_step);
-		a->late_samples++;
-		*next_step += a->step_ns;
-	}
+	a->start_wall = mono_ns();
+	lockstep_set_time(a, 0);
+	return 0;
 }
 
-/* The earliest thing that happens after now: a physics step, a truth or
- * world message, a reply's bytes, a daemon's wake-up, the end. */
-static int64_t lockstep_next(struct app *a, int64_t next_step, int64_t next_truth, int64_t next_world, int64_t end)
+/* Time moves only while every daemon is blocked, to the earliest thing that
+ * happens after now: what the simulation has due, a daemon's wake-up, the
+ * end. Until then the descriptors are served, 100 ms of wall time at a time
+ * (the stall watch runs in between). A signal, or the end, ends the run for
+ * the daemons first: they make their safe stop in virtual time, and the
+ * loop ends when they have left. */
+static enum clk_next lockstep_next(struct app *a, const struct sched *sc, int64_t *now, struct timespec *wait)
 {
-	struct sim *s = a->sim;
-	int64_t t = next_step;
-	if (a->lcm && next_truth < t)
-		t = next_truth;
-	if (a->lcm && next_world < t)
-		t = next_world;
-	if (!a->vt.ending && end < t)
-		t = end;
-	for (size_t i = 0; i < s->nbuses; i++) {
-		int64_t tx = sim_bus_next_tx(&s->buses[i], a->tx_slice_ns);
-		if (tx < t)
-			t = tx;
+	if (stop_signal && !a->vt.ending)
+		vt_end(&a->vt, false, "the simulator was stopped (signal)");
+	if (a->vt.ending && vt_clients(&a->vt) == 0)
+		return CLK_END;
+	if (!vt_all_blocked(&a->vt, a->sim)) {
+		*wait = (struct timespec){ 0, 100000000 };
+		return CLK_WAIT;
 	}
-	uint64_t w = vt_next_wake(&a->vt, s);
+	if (!a->vt.ending && (int64_t)a->vt.t_ns >= sc->end) {
+		char why[80];
+		snprintf(why, sizeof why, "the run's %.3f s are over", a->sim->cfg.duration_s);
+		vt_end(&a->vt, false, why);
+	}
+	int64_t t = sched_next(a, sc);
+	if (!a->vt.ending && sc->end < t)
+		t = sc->end;
+	uint64_t w = vt_next_wake(&a->vt, a->sim);
 	if (w != LKS_NEVER && (int64_t)w < t)
 		t = (int64_t)w;
-	return t < (int64_t)a->vt.t_ns ? (int64_t)a->vt.t_ns : t;
-}
-
-/* Time moves to t: physics, messages, replies, then the daemons due. */
-static void lockstep_advance(struct app *a, int64_t t, int64_t *next_step, int64_t *next_truth, int64_t *next_world,
-                             int64_t truth_ns)
-{
-	struct sim *s = a->sim;
+	if (t < (int64_t)a->vt.t_ns)
+		t = (int64_t)a->vt.t_ns;
+	if (a->first_step_wall == 0 && t > 0)
+		a->first_step_wall = mono_ns();
 	lockstep_set_time(a, (uint64_t)t);
-	lockstep_physics(a, t, next_step);
-	if (t >= *next_truth) {
-		if (a->lcm)
-			publish_truth(a);
-		*next_truth += truth_ns;
-	}
-	if (t >= *next_world) {
-		if (a->lcm)
-			publish_world(a);
-		if (!a->quiet)
-			report_bad_input(a);
-		*next_world += 1000000000;
-	}
-	for (size_t i = 0; i < s->nbuses; i++)
-		sim_bus_flush(&s->buses[i], t);
-	vt_release(&a->vt, s, (uint64_t)t, mono_ns());
+	*now = t;
+	return CLK_NOW;
 }
 
-/* Nobody may move time yet: serve whatever is readable (the daemons' bytes
- * and messages, LCM, the control socket) for up to 100 ms of wall time, and
- * end the run if a daemon stalls. */
-static void lockstep_serve(struct app *a, struct pollfd *fds, int *bus_of, int64_t start_wall)
+/* A daemon that stalls ends the run. */
+static void lockstep_served(struct app *a)
 {
-	sigset_t unblocked;
-	sigemptyset(&unblocked);
-	int n = build_pollset(a, fds, bus_of);
-	struct timespec ts = { 0, 100000000 };
-	if (wait_fds(fds, n, &ts, &unblocked) > 0)
-		serve(a, fds, bus_of, n);
 	char why[VT_WHY_MAX];
-	if (vt_stalled(&a->vt, a->sim, mono_ns(), start_wall, a->lockstep_grace_ns, why, sizeof why)) {
-		fprintf(stderr, "undulate-sim: %s: ending the run\n", why);
-		if (a->vt.ending) {
-			/* a daemon that does not finish its safe stop is left behind */
-			for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
-				if (a->vt.c[i].fd >= 0) {
-					close(a->vt.c[i].fd);
-					a->vt.c[i].fd = -1;
-				}
-		}
-		vt_end(&a->vt, true, why);
+	if (!vt_stalled(&a->vt, a->sim, mono_ns(), a->start_wall, a->lockstep_grace_ns, why, sizeof why))
+		return;
+	fprintf(stderr, "undulate-sim: %s: ending the run\n", why);
+	if (a->vt.ending) {
+		/* a daemon that does not finish its safe stop is left behind */
+		for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
+			if (a->vt.c[i].fd >= 0) {
+				close(a->vt.c[i].fd);
+				a->vt.c[i].fd = -1;
+			}
 	}
+	vt_end(&a->vt, true, why);
 }
 
-static void run_lockstep(struct app *a)
+/* The daemons due are woken with the new time. */
+static void lockstep_moved(struct app *a, int64_t now)
 {
-	struct sim *s = a->sim;
-	static struct pollfd fds[MAIN_MAX_FDS];
-	static int bus_of[MAIN_MAX_FDS];
-	int64_t truth_ns = (int64_t)llround(1e9 / s->cfg.truth_hz);
-	int64_t next_step = a->step_ns, next_truth = truth_ns, next_world = 1000000000;
-	int64_t end = s->cfg.duration_s > 0 ? (int64_t)llround(s->cfg.duration_s * 1e9) : INT64_MAX;
-	int64_t start_wall = mono_ns();
-	lockstep_set_time(a, 0);
-	sim_run_events(s, 0.0, 0);
-	if (a->lcm)
-		publish_world(a);
-	for (;;) {
-		if (stop_signal && !a->vt.ending)
-			vt_end(&a->vt, false, "the simulator was stopped (signal)");
-		if (a->vt.ending && vt_clients(&a->vt) == 0)
-			break;
-		if (!vt_all_blocked(&a->vt, s)) {
-			lockstep_serve(a, fds, bus_of, start_wall);
-			continue;
-		}
-		if (!a->vt.ending && (int64_t)a->vt.t_ns >= end) {
-			char why[80];
-			snprintf(why, sizeof why, "the run's %.3f s are over", s->cfg.duration_s);
-			vt_end(&a->vt, false, why);
-		}
-		int64_t t = lockstep_next(a, next_step, next_truth, next_world, end);
-		if (a->first_step_wall == 0 && t > 0)
-			a->first_step_wall = mono_ns();
-		lockstep_advance(a, t, &next_step, &next_truth, &next_world, truth_ns);
-	}
-	a->wall_end = mono_ns();
+	vt_release(&a->vt, a->sim, (uint64_t)now, mono_ns());
 }
+
+static const struct sim_clock clock_lockstep = {
+	.start = lockstep_start, .next = lockstep_next, .served = lockstep_served, .moved = lockstep_moved,
+};
 
 /* ---- start and stop ---------------------------------------------------------- */
 
@@ -1229,7 +1295,7 @@ static void setup_signals(void)
 	sigaction(SIGINT, &sa, NULL);
 	sigaction(SIGTERM, &sa, NULL);
 	signal(SIGPIPE, SIG_IGN);
-	/* Signals arrive only inside ppoll(): no half-done step is interrupted. */
+	/* Signals arrive only inside pselect(): no half-done step is interrupted. */
 	sigset_t block;
 	sigemptyset(&block);
 	sigaddset(&block, SIGINT);
@@ -1304,10 +1370,8 @@ int main(int argc, char **argv)
 		sim.robot_command_ctx = &app;
 	}
 	print_ready(&sim, cfg.lcm_url);
-	if (app.lockstep)
-		run_lockstep(&app);
-	else
-		run(&app);
+	app.clock = app.lockstep ? &clock_lockstep : &clock_real;
+	run(&app);
 	int64_t now = mono_ns();
 	sim_close(&sim);
 	sim_free(&sim);
