@@ -327,9 +327,9 @@ enum cyc_status cyc_step(struct cyc *y)
 	case CYC_READBACK:
 		if (r == DXL_OK) {
 			y->readbacks++;
-			const uint8_t *bytes = cyc_p2(y) ? bus_reply2(y->bus)->params : reply.params;
-			size_t n = cyc_p2(y) ? bus_reply2(y->bus)->nparams : reply.nparams;
-			ctl_readback_block(y->ctl, y->readback_now_joint, y->readback_now_block, bytes, n, reply.code);
+			const struct dxl_frame *got = bus_reply(y->bus);
+			ctl_readback_block(y->ctl, y->readback_now_joint, y->readback_now_block, got->params, got->nparams,
+			                   reply.code);
 		} else {
 			cyc_error(y, y->ctl->j[y->readback_now_joint].id, cyc_p2(y) ? "READ (read-back)" : "READ(24)", r);
 		}

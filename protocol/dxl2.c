@@ -656,14 +656,21 @@ int dxl2_multi_read_bulk(struct dxl2_multi_read *m, const struct dxl2_bulk_item 
 
 int dxl2_multi_read_accept(struct dxl2_multi_read *m, const struct dxl2_packet *pkt, size_t *slot)
 {
-	if (m == NULL || pkt == NULL)
+	if (pkt == NULL)
+		return DXL_E_ARG;
+	return dxl2_multi_read_take(m, pkt->id, pkt->nparams, slot);
+}
+
+int dxl2_multi_read_take(struct dxl2_multi_read *m, uint8_t id, uint16_t nparams, size_t *slot)
+{
+	if (m == NULL)
 		return DXL_E_ARG;
 	size_t i = 0;
-	while (i < m->n && m->ids[i] != pkt->id)
+	while (i < m->n && m->ids[i] != id)
 		i++;
 	if (i == m->n || m->got[i])
 		return DXL_E_WRONG_ID;
-	if (pkt->nparams != m->len[i])
+	if (nparams != m->len[i])
 		return DXL_E_WRONG_LENGTH;
 	if (i != m->next)
 		m->out_of_order++;
