@@ -232,12 +232,12 @@ static void bc2_discover(struct bc_run *r, const struct bc_opts *o)
 	for (size_t i = 0; i < o->nids; i++) {
 		uint8_t rd = 0, err = 0;
 		uint32_t pos = 0;
-		r->present[i] = bus2_ping(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK ||
-		                bus2_ping(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK;
-		if (r->present[i] && bus2_read_u8(&r->bus, o->ids[i], DXL2_X_RETURN_DELAY_TIME, &rd, &err) == DXL_OK &&
+		r->present[i] = bus_ping_model(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK ||
+		                bus_ping_model(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK;
+		if (r->present[i] && bus_read_u8(&r->bus, o->ids[i], DXL2_X_RETURN_DELAY_TIME, &rd, &err) == DXL_OK &&
 		    dxl2_return_delay_us(rd) > r->return_delay_us)
 			r->return_delay_us = dxl2_return_delay_us(rd);
-		if (r->present[i] && bus2_read_u32(&r->bus, o->ids[i], DXL2_X_PRESENT_POSITION, &pos, &err) == DXL_OK)
+		if (r->present[i] && bus_read_u32(&r->bus, o->ids[i], DXL2_X_PRESENT_POSITION, &pos, &err) == DXL_OK)
 			r->position[i] = (uint16_t)pos;
 	}
 	bc_timing(r, o, r->return_delay_us, o->margin_us);
@@ -248,7 +248,7 @@ static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
 {
 	uint8_t data[BC_MAX_IDS * 10], goals[BC_MAX_IDS * 4];
 	struct bus_multi m = { .data = data, .cap = sizeof data };
-	int rc = bus2_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m);
+	int rc = bus_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m);
 	if (rc != DXL_OK && rc != DXL_E_TIMEOUT)
 		r->errors++;
 	for (size_t i = 0; i < m.n; i++) {
@@ -259,7 +259,7 @@ static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
 			r->timeouts++;
 		dxl2_put_u32(goals + 4 * i, r->position[i]);
 	}
-	if (bus2_sync_write(&r->bus, DXL2_X_GOAL_POSITION, 4, o->ids, goals, o->nids) != DXL_OK)
+	if (bus_sync_write(&r->bus, DXL2_X_GOAL_POSITION, 4, o->ids, goals, o->nids) != DXL_OK)
 		r->errors++;
 }
 

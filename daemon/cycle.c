@@ -327,9 +327,9 @@ enum cyc_status cyc_step(struct cyc *y)
 	case CYC_READBACK:
 		if (r == DXL_OK) {
 			y->readbacks++;
-			const uint8_t *bytes = cyc_p2(y) ? bus_reply2(y->bus)->params : reply.params;
-			size_t n = cyc_p2(y) ? bus_reply2(y->bus)->nparams : reply.nparams;
-			ctl_readback_block(y->ctl, y->readback_now_joint, y->readback_now_block, bytes, n, reply.code);
+			const struct dxl_frame *got = bus_reply(y->bus);
+			ctl_readback_block(y->ctl, y->readback_now_joint, y->readback_now_block, got->params, got->nparams,
+			                   reply.code);
 		} else {
 			cyc_error(y, y->ctl->j[y->readback_now_joint].id, cyc_p2(y) ? "READ (read-back)" : "READ(24)", r);
 		}
@@ -347,12 +347,10 @@ enum cyc_status cyc_resume(struct cyc *y)
 	y->control_us = (double)(cyc_now(y) - y->control_start_us);
 	y->phase = CYC_WRITES;
 	uint16_t addr;
-	uint8_t width, ids[CFG_MAX_JOINTS], data[CTL_SYNC_MAX_WIDTH * CFG_MAX_JOINTS], pkt[DXL2_MAX_PACKET];
+	uint8_t width, ids[CFG_MAX_JOINTS], data[CTL_SYNC_MAX_WIDTH * CFG_MAX_JOINTS];
 	size_t n = ctl_sync(y->ctl, &addr, &width, ids, data);
 	if (n > 0) {
-		int len = cyc_p2(y) ? dxl2_encode_sync_write(pkt, sizeof pkt, addr, width, ids, data, n)
-		                    : dxl_encode_sync_write(pkt, sizeof pkt, (uint8_t)addr, width, ids, data, n);
-		int r = len < 0 ? len : bus_send_raw(y->bus, pkt, (size_t)len);
+		int r = bus_sync_write(y->bus, addr, width, ids, data, n);
 		if (cyc_port_gone(r))
 			return cyc_lost(y, r);
 		if (r != DXL_OK)

@@ -29,11 +29,10 @@ void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, int last)
  * going away is not retried. */
 int setup_read(struct bus *bus, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out, uint8_t *eb)
 {
-	bool p2 = bus_get_protocol(bus) == BUS_PROTOCOL_2;
 	int r = DXL_E_TIMEOUT;
 	for (int t = 0; t < SETUP_TRIES; t++) {
 		setup_pause(bus, t, id, "READ", r);
-		r = p2 ? bus2_read(bus, id, addr, len, out, eb) : bus_read(bus, id, (uint8_t)addr, (uint8_t)len, out, eb);
+		r = bus_read(bus, id, addr, len, out, eb);
 		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 			break;
 	}
@@ -44,12 +43,10 @@ int setup_read(struct bus *bus, uint8_t id, uint16_t addr, uint16_t len, uint8_t
 int setup_write(struct bus *bus, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
                 uint8_t *eb)
 {
-	bool p2 = bus_get_protocol(bus) == BUS_PROTOCOL_2;
 	int r = DXL_E_TIMEOUT;
 	for (int t = 0; t < SETUP_TRIES; t++) {
 		setup_pause(bus, t, id, "WRITE", r);
-		r = p2 ? bus2_write(bus, id, addr, data, n, expect_reply, eb)
-		       : bus_write(bus, id, (uint8_t)addr, data, n, expect_reply, eb);
+		r = bus_write(bus, id, addr, data, n, expect_reply, eb);
 		if (r == DXL_OK || r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 			break;
 	}

@@ -215,7 +215,7 @@ static void setup_x_stop_drive(struct bus *bus, const struct ctl *ctl, bool limp
 	bool current = ctl->cfg->torque_drive == CFG_DRIVE_CURRENT;
 	for (size_t j = 0; j < ctl->n; j++)
 		ids[j] = ctl->j[j].id;
-	bus2_sync_write(bus, sm_drive_register(ctl_model(ctl, 0), current), 2, ids, zero, ctl->n);
+	bus_sync_write(bus, sm_drive_register(ctl_model(ctl, 0), current), 2, ids, zero, ctl->n);
 	for (size_t j = 0; j < ctl->n; j++) {
 		const struct ctl_joint *jt = &ctl->j[j];
 		setup_x_stop_write(bus, jt, DXL2_X_TORQUE_ENABLE, 0, 1, "torque off");
@@ -259,6 +259,6 @@ void setup_safe_stop_x(struct bus *bus, const struct ctl *ctl, bool limp)
 		n++;
 	}
 	if (n > 0)
-		bus2_sync_write(bus, DXL2_X_GOAL_POSITION, 4, ids, data, n);
+		bus_sync_write(bus, DXL2_X_GOAL_POSITION, 4, ids, data, n);
 	log_info("safe stop: %s; bus watchdogs off", limp ? "torque off (limp)" : "holding present positions, torque on");
 }

@@ -1,13 +1,14 @@
 /*
- * bus.c — Dynamixel transactions over struct bus_io, Protocol 1.0 and 2.0.
+ * bus.c — Dynamixel transactions over struct bus_io, for any protocol with
+ * a table (dxl_proto.h).
  *
  * Pure like the framing: time comes only from io->now_us, waiting only through
- * io->wait (in the blocking wrappers). The asynchronous core is bus_begin /
- * bus_step; the blocking calls are a loop of bus_step and io->wait (1.0's
- * here, 2.0's in bus2_calls.c). What a request costs and how its bytes are
- * flushed, echoed, timed and counted is one code for both protocols; only
- * the encoding of a request and the parsing and matching of its replies
- * branch on b->protocol.
+ * io->wait (in the blocking calls). The asynchronous core is bus_begin /
+ * bus_step; the blocking calls are a begin and a loop of bus_step and
+ * io->wait. What a request costs and how its bytes are flushed, echoed, timed
+ * and counted is one code; encoding a request and parsing its replies are
+ * b->proto's, and what a protocol cannot do is a capability it lacks, never
+ * a branch on its number.
  */
 #include "bus.h"
 
@@ -17,20 +18,14 @@
 #define BUS_BITS_PER_BYTE 10u
 /* Used when the timing names no baud: the AX-12's factory rate. */
 #define BUS_DEFAULT_BAUD 1000000L
-/* Bytes read from the transport per call in bus_step (a status packet is at
- * most DXL_MAX_PACKET; more is simply read on the next turn of the loop). */
+/* Bytes read from the transport per call in bus_step (more is simply read
+ * on the next turn of the loop). */
 #define BUS_READ_CHUNK 256
-/* Wire bytes of a packet with n parameters: FF FF ID LEN CODE ... CHK. */
-#define BUS_PACKET_BYTES(n) ((size_t)(n) + 6u)
-/* Protocol 2.0 PING reply: model number (2 bytes) and firmware version. */
-#define BUS2_PING_PARAMS 3
-/* A broadcast PING can be answered by every ID a servo may have (0-252). */
-#define BUS2_PING_ALL_IDS (DXL2_MAX_ID + 1)
-/* Time allowed for each of them: ROBOTIS's SDK waits 3 ms an ID after a
- * broadcast PING (protocol2_packet_handler.cpp, broadcastPing), a figure
- * from their firmware's behaviour that the manual does not state; the
- * reply's own wire time and return delay are used when they are longer. */
-#define BUS2_PING_ALL_SLOT_US 3000u
+/* Time allowed for each ID after a broadcast PING: ROBOTIS's SDK waits
+ * 3 ms an ID (protocol2_packet_handler.cpp, broadcastPing), a figure from
+ * their firmware's behaviour that the manual does not state; the reply's
+ * own wire time and return delay are used when they are longer. */
+#define BUS_PING_ALL_SLOT_US 3000u
 
 void bus_init(struct bus *b, const struct bus_io *io, const struct bus_timing *timing, bool echo)
 {
@@ -40,30 +35,41 @@ void bus_init(struct bus *b, const struct bus_io *io, const struct bus_timing *t
 	if (timing)
 		b->timing = *timing;
 	b->echo = echo;
-	b->protocol = BUS_PROTOCOL_1;
+	b->proto = &dxl_proto_v1;
 	b->expect_params = -1;
 	b->line_dirty = true;   /* whatever was on the line before us */
-	dxl_parser_init(&b->parser, DXL_PARSE_STATUS);
-	dxl2_parser_init(&b->parser2, DXL2_PARSE_STATUS);
+	b->proto->parser_init(&b->parser, false);
+}
+
+int bus_set_proto(struct bus *b, const struct dxl_proto *proto)
+{
+	if (proto == NULL)
+		return DXL_E_ARG;
+	if (b->pending)
+		return DXL_E_BUSY;
+	if (proto == b->proto) {
+		proto->parser_reset(&b->parser);
+		return DXL_OK;
+	}
+	b->line_dirty = true;   /* the other protocol's replies may still come */
+	b->proto = proto;
+	proto->parser_init(&b->parser, false);
+	return DXL_OK;
+}
+
+const struct dxl_proto *bus_proto(const struct bus *b)
+{
+	return b->proto;
 }
 
 int bus_set_protocol(struct bus *b, enum bus_protocol protocol)
 {
-	if (protocol != BUS_PROTOCOL_1 && protocol != BUS_PROTOCOL_2)
-		return DXL_E_ARG;
-	if (b->pending)
-		return DXL_E_BUSY;
-	if (protocol != b->protocol)
-		b->line_dirty = true;   /* the other protocol's replies may still come */
-	b->protocol = protocol;
-	dxl_parser_reset(&b->parser);
-	dxl2_parser_reset(&b->parser2);
-	return DXL_OK;
+	return bus_set_proto(b, dxl_proto_by_number((int)protocol));
 }
 
 enum bus_protocol bus_get_protocol(const struct bus *b)
 {
-	return b->protocol;
+	return (enum bus_protocol)b->proto->number;
 }
 
 void bus_set_timing(struct bus *b, const struct bus_timing *timing)
@@ -90,18 +96,19 @@ uint32_t bus_multi_timeout_us(const struct bus *b, size_t req_bytes, const uint1
 {
 	size_t bytes = req_bytes;
 	for (size_t i = 0; i < nreplies; i++)
-		bytes += dxl2_status_bytes_max(reply_params[i]);
+		bytes += b->proto->status_bytes_max(reply_params[i]);
 	uint64_t us = (uint64_t)bus_wire_time_us(b, bytes) + (uint64_t)nreplies * b->timing.return_delay_us +
 	              b->timing.adapter_latency_us + b->timing.margin_us;
 	return us > UINT32_MAX ? UINT32_MAX : (uint32_t)us;
 }
 
 /* A broadcast PING's deadline: a slot for every ID that might answer. */
-static uint32_t bus2_ping_all_timeout_us(const struct bus *b, size_t req_bytes)
+static uint32_t bus_ping_all_timeout_us(const struct bus *b, size_t req_bytes)
 {
-	uint32_t reply_us = bus_wire_time_us(b, dxl2_status_bytes_max(BUS2_PING_PARAMS)) + b->timing.return_delay_us;
-	uint32_t slot_us = reply_us > BUS2_PING_ALL_SLOT_US ? reply_us : BUS2_PING_ALL_SLOT_US;
-	return bus_wire_time_us(b, req_bytes) + BUS2_PING_ALL_IDS * slot_us + b->timing.adapter_latency_us +
+	const struct dxl_proto *pr = b->proto;
+	uint32_t reply_us = bus_wire_time_us(b, pr->status_bytes_max(pr->ping_reply_params)) + b->timing.return_delay_us;
+	uint32_t slot_us = reply_us > BUS_PING_ALL_SLOT_US ? reply_us : BUS_PING_ALL_SLOT_US;
+	return bus_wire_time_us(b, req_bytes) + ((uint32_t)pr->max_id + 1) * slot_us + b->timing.adapter_latency_us +
 	       b->timing.margin_us;
 }
 
@@ -123,12 +130,6 @@ static void bus_echo_clear(struct bus *b)
 	b->echo_left = 0;
 }
 
-/* Two packets of the protocol spoken: 1.0 keeps the queue it always had. */
-static size_t bus_echo_cap(const struct bus *b)
-{
-	return b->protocol == BUS_PROTOCOL_1 ? 2u * DXL_MAX_PACKET : sizeof b->echo_buf;
-}
-
 /* Remember bytes just written; they must come back before anything else. */
 static void bus_echo_push(struct bus *b, const uint8_t *pkt, size_t n)
 {
@@ -137,7 +138,8 @@ static void bus_echo_push(struct bus *b, const uint8_t *pkt, size_t n)
 	size_t matched = b->echo_len - b->echo_left;
 	memmove(b->echo_buf, b->echo_buf + matched, b->echo_left);
 	b->echo_len = b->echo_left;
-	if (b->echo_len + n > bus_echo_cap(b)) {
+	/* two packets of the protocol spoken */
+	if (b->echo_len + n > 2 * b->proto->max_packet) {
 		/* an older echo never came back (wiring without echo?): forget it;
 		 * if it arrives after all, the mismatch is reported then */
 		bus_echo_clear(b);
@@ -146,7 +148,6 @@ static void bus_echo_push(struct bus *b, const uint8_t *pkt, size_t n)
 	b->echo_len += n;
 	b->echo_left += n;
 }
-
 /* Match received bytes against the echo queue. Returns how many of the n
  * bytes were echo (discarded), or DXL_E_ECHO on the first differing byte. */
 static long bus_echo_eat(struct bus *b, const uint8_t *data, size_t n)
@@ -213,8 +214,7 @@ static int bus_prepare(struct bus *b)
 		b->io.flush_input(b->io.ctx);
 		b->line_dirty = false;
 	}
-	dxl_parser_reset(&b->parser);
-	dxl2_parser_reset(&b->parser2);
+	b->proto->parser_reset(&b->parser);
 	b->echo_probe = 0;
 	b->echo_probe_dead = false;
 	return DXL_OK;
@@ -247,7 +247,8 @@ static void bus_pend(struct bus *b, const uint8_t *pkt, size_t n, uint8_t id, ui
 	b->deadline_us = now + timeout_us;
 }
 
-/* Encode, flush, send; *now gets the time the request went out. */
+/* Encoded (n bytes, or the encoder's negative status): flush, send; *now
+ * gets the time the request went out. */
 static int bus_send_request(struct bus *b, const uint8_t *pkt, int n, uint64_t *now)
 {
 	if (n < 0)
@@ -259,24 +260,20 @@ static int bus_send_request(struct bus *b, const uint8_t *pkt, int n, uint64_t *
 	return bus_send(b, pkt, (size_t)n);
 }
 
-/* Protocol 2.0's bus_begin: one request, at most one reply. */
-static int bus2_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, size_t nparams,
-                      int reply_params)
+/* One encoded request, at most one reply: pending until it comes, unless
+ * none will (reply_params < 0, or broadcast: a broadcast is never answered
+ * by one servo). */
+static int bus_request(struct bus *b, const uint8_t *pkt, int n, uint8_t id, uint8_t instr, int reply_params)
 {
-	uint8_t pkt[DXL2_MAX_PACKET];
 	uint64_t now = 0;
-	if (reply_params > DXL2_MAX_READ_LEN || instr == DXL2_INST_SYNC_READ || instr == DXL2_INST_BULK_READ)
-		return DXL_E_ARG;
-	/* a broadcast PING is answered by every servo: bus_ping_all_begin */
-	if (id == DXL2_BROADCAST_ID || instr == DXL2_INST_SYNC_WRITE || instr == DXL2_INST_BULK_WRITE)
+	if (id == b->proto->broadcast_id)
 		reply_params = -1;
-	int n = dxl2_encode_instruction(pkt, sizeof pkt, id, instr, params, nparams);
 	int r = bus_send_request(b, pkt, n, &now);
 	if (r < 0 || reply_params < 0)
 		return r;
 	b->multi = NULL;
 	bus_pend(b, pkt, (size_t)n, id, instr, reply_params, now,
-	         bus_timeout_us(b, (size_t)n, dxl2_status_bytes_max((size_t)reply_params)));
+	         bus_timeout_us(b, (size_t)n, b->proto->status_bytes_max((size_t)reply_params)));
 	b->servo[id].transactions++;
 	return DXL_OK;
 }
@@ -284,43 +281,20 @@ static int bus2_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *p
 int bus_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, size_t nparams,
               int reply_params)
 {
-	uint8_t pkt[DXL_MAX_PACKET];
-	if (b->protocol == BUS_PROTOCOL_2)
-		return bus2_begin(b, id, instr, params, nparams, reply_params);
-	if (reply_params > DXL_MAX_PARAMS)
+	uint8_t pkt[BUS_MAX_PACKET];
+	const struct dxl_proto *pr = b->proto;
+	int replies = pr->instr_replies(instr);
+	if (reply_params > (int)pr->max_read_len || replies == DXL_E_ARG)
 		return DXL_E_ARG;
-	/* a broadcast is never answered (a broadcast PING is answered by every
-	 * servo at once: a collision, not a reply); SYNC_WRITE is always broadcast */
-	if (id == DXL_BROADCAST_ID || instr == DXL_INST_SYNC_WRITE)
+	if (replies < 0)
 		reply_params = -1;
-	int n = dxl_encode_instruction(pkt, sizeof pkt, id, instr, params, nparams);
-	if (n < 0)
-		return n;
-	int r = bus_prepare(b);
-	if (r < 0)
-		return r;
-	uint64_t now = b->io.now_us(b->io.ctx);
-	r = bus_send(b, pkt, (size_t)n);
-	if (r < 0)
-		return r;
-	if (reply_params < 0)
-		return DXL_OK;
-	memcpy(b->req_buf, pkt, (size_t)n);
-	b->req_len = (size_t)n;
-	b->reply_held = false;
-	b->pending = true;
-	b->req_id = id;
-	b->req_instr = instr;
-	b->expect_params = reply_params;
-	b->started_us = now;
-	b->deadline_us = now + bus_timeout_us(b, (size_t)n, BUS_PACKET_BYTES(reply_params));
-	b->servo[id].transactions++;
-	return DXL_OK;
+	int n = pr->encode_instruction(pkt, sizeof pkt, id, instr, params, nparams);
+	return bus_request(b, pkt, n, id, instr, reply_params);
 }
 
 int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n)
 {
-	if (pkt == NULL || n == 0 || n > (b->protocol == BUS_PROTOCOL_1 ? DXL_MAX_PACKET : DXL2_MAX_PACKET))
+	if (pkt == NULL || n == 0 || n > b->proto->max_packet)
 		return DXL_E_ARG;
 	int r = bus_prepare(b);
 	if (r < 0)
@@ -338,6 +312,18 @@ static void bus_finish(struct bus *b)
 	b->multi = NULL;
 }
 
+static void bus_frame_copy(struct dxl_frame *dst, const struct dxl_frame *src)
+{
+	if (dst == src)
+		return;
+	dst->id = src->id;
+	dst->instr = src->instr;
+	dst->err = src->err;
+	dst->nparams = src->nparams;
+	dst->wire_bytes = src->wire_bytes;
+	memcpy(dst->params, src->params, src->nparams);
+}
+
 /* A reply matched its request: counted for its servo, its error byte (1.0)
  * or ERR field (2.0) kept as data. */
 static void bus_count_reply(struct bus *b, struct bus_servo_stats *st, uint64_t now, uint8_t err)
@@ -352,21 +338,23 @@ static void bus_count_reply(struct bus *b, struct bus_servo_stats *st, uint64_t 
 	st->errbits_seen |= err;
 	if (err)
 		st->error_replies++;
-	if (b->protocol == BUS_PROTOCOL_2 && dxl2_err_alert(err))
+	if (err & b->proto->err_alert)
 		st->alerts++;
 }
 
 /* Is this packet byte for byte the request we sent (read as a status)? */
-static bool bus_is_own_request(const struct bus *b, const struct dxl_packet *pkt)
+static bool bus_is_own_request(const struct bus *b, const struct dxl_frame *pkt)
 {
-	return b->req_len == BUS_PACKET_BYTES(pkt->nparams) && pkt->id == b->req_buf[2] &&
-	       pkt->code == b->req_buf[4] && memcmp(pkt->params, b->req_buf + 5, pkt->nparams) == 0;
+	uint8_t again[BUS_MAX_PACKET];
+	if (pkt->wire_bytes != b->req_len)
+		return false;
+	int n = b->proto->encode_status(again, sizeof again, pkt->id, pkt->err, pkt->params, pkt->nparams);
+	return n == (int)b->req_len && memcmp(again, b->req_buf, b->req_len) == 0;
 }
 
-/* A whole packet arrived while a request is pending: check it against the
- * request (libmodbus's check_confirmation). */
-static int bus_match(struct bus *b, const struct dxl_packet *pkt, uint64_t now,
-                     struct dxl_packet *reply)
+/* The one reply of a single request, checked against it (libmodbus's
+ * check_confirmation): same ID, the expected parameter count. */
+static int bus_match(struct bus *b, const struct dxl_frame *pkt, uint64_t now, struct dxl_packet *reply)
 {
 	struct bus_servo_stats *st = &b->servo[b->req_id];
 	int expect_params = b->expect_params;
@@ -382,80 +370,42 @@ static int bus_match(struct bus *b, const struct dxl_packet *pkt, uint64_t now,
 		b->line_dirty = true;
 		return DXL_E_WRONG_LENGTH;
 	}
-	bus_count_reply(b, st, now, pkt->code);
-	if (reply)
-		*reply = *pkt;
+	bus_count_reply(b, st, now, pkt->err);
+	bus_frame_copy(&b->reply, pkt);
+	if (reply) {
+		reply->id = pkt->id;
+		reply->code = pkt->err;
+		reply->nparams = pkt->nparams <= DXL_MAX_PARAMS ? (uint8_t)pkt->nparams : 0;
+		memcpy(reply->params, pkt->params, reply->nparams);
+	}
 	return DXL_OK;
 }
 
-/* Feed received bytes to the parser. Returns BUS_PENDING while the reply is
- * incomplete, else the transaction's outcome; packets beyond the reply are
- * counted as strays. */
-static int bus_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t now,
-                       struct dxl_packet *reply)
-{
-	int outcome = BUS_PENDING;
-	struct dxl_packet pkt;
-	size_t off = 0;
-	for (;;) {
-		size_t used = 0;
-		int r = dxl_parser_feed(&b->parser, data + off, n - off, &used, &pkt);
-		off += used;
-		if (r == DXL_NEED_MORE)
-			break;
-		if (r == DXL_FRAME) {
-			if (!b->pending) {
-				b->stray_packets++;
-				b->line_dirty = true;
-			} else if (!b->echo && !b->reply_held && bus_is_own_request(b, &pkt)) {
-				b->reply_held = true;
-				b->reply = pkt;
-			} else {
-				if (b->reply_held)
-					b->unexpected_echoes++;
-				outcome = bus_match(b, &pkt, now, reply);
-			}
-		} else if (b->pending) {
-			struct bus_servo_stats *st = &b->servo[b->req_id];
-			if (r == DXL_E_CHECKSUM) {
-				/* the reply is damaged; waiting longer cannot repair it */
-				st->checksum_errors++;
-				bus_finish(b);
-				b->line_dirty = true;
-				outcome = DXL_E_CHECKSUM;
-			} else {
-				st->resyncs++;
-			}
-		}
-	}
-	return outcome;
-}
-
-/* ---- receiving, Protocol 2.0 ------------------------------------------------------ */
+/* ---- multi-reply requests: SYNC_READ, BULK_READ, broadcast PING ------------------ */
 
 /* A multi-reply slot still waiting for its servo. DXL_E_WRONG_ID marks one
  * that was expected when a packet from a servo not asked came. */
-static bool bus2_slot_open(int status)
+static bool bus_slot_open(int status)
 {
 	return status == DXL_E_TIMEOUT || status == DXL_E_WRONG_ID;
 }
 
 /* The slot the bus expects next: servos answer in request order. */
-static size_t bus2_next_open(const struct bus_multi *m)
+static size_t bus_next_open(const struct bus_multi *m)
 {
 	size_t i = 0;
-	while (i < m->n && !bus2_slot_open(m->status[i]))
+	while (i < m->n && !bus_slot_open(m->status[i]))
 		i++;
 	return i;
 }
 
-static bool bus2_multi_settled(const struct bus_multi *m)
+static bool bus_multi_settled(const struct bus_multi *m)
 {
-	return bus2_next_open(m) == m->n;
+	return bus_next_open(m) == m->n;
 }
 
 /* DXL_OK when every slot has its data, else the first failed slot's status. */
-static int bus2_multi_outcome(const struct bus_multi *m)
+static int bus_multi_outcome(const struct bus_multi *m)
 {
 	for (size_t i = 0; i < m->n; i++)
 		if (m->status[i] != DXL_OK)
@@ -463,7 +413,7 @@ static int bus2_multi_outcome(const struct bus_multi *m)
 	return DXL_OK;
 }
 
-static void bus2_slot_fill(struct bus *b, size_t slot, const struct dxl2_packet *pkt, uint64_t now)
+static void bus_slot_fill(struct bus *b, size_t slot, const struct dxl_frame *pkt, uint64_t now)
 {
 	struct bus_multi *m = b->multi;
 	memcpy(m->data + m->off[slot], pkt->params, m->len[slot]);
@@ -474,10 +424,11 @@ static void bus2_slot_fill(struct bus *b, size_t slot, const struct dxl2_packet 
 }
 
 /* A broadcast PING's reply: a new slot for each servo, once. */
-static void bus2_ping_all_frame(struct bus *b, const struct dxl2_packet *pkt, uint64_t now)
+static void bus_ping_all_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t now)
 {
 	struct bus_multi *m = b->multi;
 	struct bus_servo_stats *st = &b->servo[pkt->id];
+	size_t nparams = b->proto->ping_reply_params;
 	for (size_t i = 0; i < m->n; i++) {
 		if (m->id[i] == pkt->id) {
 			/* two servos with one ID, or one answering twice */
@@ -486,32 +437,32 @@ static void bus2_ping_all_frame(struct bus *b, const struct dxl2_packet *pkt, ui
 			return;
 		}
 	}
-	if (pkt->nparams != BUS2_PING_PARAMS) {
+	if (pkt->nparams != nparams) {
 		st->wrong_length++;
 		b->line_dirty = true;
 		return;
 	}
 	size_t slot = m->n;
-	if (slot >= BUS_MULTI_MAX || (slot + 1) * BUS2_PING_PARAMS > m->cap) {
+	if (slot >= BUS_MULTI_MAX || (slot + 1) * nparams > m->cap) {
 		b->stray_packets++;
 		return;
 	}
 	m->id[slot] = pkt->id;
-	m->len[slot] = BUS2_PING_PARAMS;
-	m->off[slot] = (uint32_t)(slot * BUS2_PING_PARAMS);
+	m->len[slot] = (uint16_t)nparams;
+	m->off[slot] = (uint32_t)(slot * nparams);
 	m->n++;
 	st->transactions++;
-	bus2_slot_fill(b, slot, pkt, now);
+	bus_slot_fill(b, slot, pkt, now);
 }
 
 /* One status packet of a SYNC_READ / BULK_READ, checked against the request. */
-static void bus2_multi_frame(struct bus *b, const struct dxl2_packet *pkt, uint64_t now)
+static void bus_multi_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t now)
 {
 	struct bus_multi *m = b->multi;
 	size_t slot = 0;
-	int r = dxl2_multi_read_accept(&m->track, pkt, &slot);
+	int r = dxl2_multi_read_take(&m->track, pkt->id, pkt->nparams, &slot);
 	if (r == DXL_OK) {
-		bus2_slot_fill(b, slot, pkt, now);
+		bus_slot_fill(b, slot, pkt, now);
 		return;
 	}
 	b->line_dirty = true;
@@ -519,11 +470,11 @@ static void bus2_multi_frame(struct bus *b, const struct dxl2_packet *pkt, uint6
 		/* its servo answered, with the wrong size: waiting cannot mend it */
 		b->servo[pkt->id].wrong_length++;
 		for (size_t i = 0; i < m->n; i++)
-			if (m->id[i] == pkt->id && bus2_slot_open(m->status[i]))
+			if (m->id[i] == pkt->id && bus_slot_open(m->status[i]))
 				m->status[i] = DXL_E_WRONG_LENGTH;
 		return;
 	}
-	size_t next = bus2_next_open(m);
+	size_t next = bus_next_open(m);
 	if (next < m->n) {
 		b->servo[m->id[next]].wrong_id++;
 		m->status[next] = DXL_E_WRONG_ID;
@@ -532,10 +483,12 @@ static void bus2_multi_frame(struct bus *b, const struct dxl2_packet *pkt, uint6
 	}
 }
 
+/* ---- feeding the parser ---------------------------------------------------------- */
+
 /* A reply was damaged (or bytes were dropped) while waiting. */
-static int bus2_damage(struct bus *b, int why)
+static int bus_damage(struct bus *b, int why)
 {
-	size_t next = b->multi != NULL ? bus2_next_open(b->multi) : 0;
+	size_t next = b->multi != NULL ? bus_next_open(b->multi) : 0;
 	uint8_t id = b->req_id;
 	if (b->multi != NULL) {
 		if (next >= b->multi->n)
@@ -549,6 +502,7 @@ static int bus2_damage(struct bus *b, int why)
 			st->stuffing_errors++;
 		return BUS_PENDING;
 	}
+	/* the reply is damaged; waiting longer cannot repair it */
 	st->checksum_errors++;
 	b->line_dirty = true;
 	if (b->multi != NULL) {
@@ -560,69 +514,51 @@ static int bus2_damage(struct bus *b, int why)
 	return DXL_E_CHECKSUM;
 }
 
-/* The one reply of a single request. */
-static int bus2_match(struct bus *b, const struct dxl2_packet *pkt, uint64_t now, struct dxl_packet *reply)
-{
-	struct bus_servo_stats *st = &b->servo[b->req_id];
-	int r = dxl2_check_reply(pkt, b->req_id, (uint16_t)b->expect_params);
-	bus_finish(b);
-	if (r != DXL_OK) {
-		if (r == DXL_E_WRONG_ID)
-			st->wrong_id++;
-		else
-			st->wrong_length++;
-		b->line_dirty = true;
-		return r;
-	}
-	bus_count_reply(b, st, now, pkt->err);
-	b->reply2.id = pkt->id;
-	b->reply2.instr = pkt->instr;
-	b->reply2.err = pkt->err;
-	b->reply2.nparams = pkt->nparams;
-	b->reply2.wire_bytes = pkt->wire_bytes;
-	memcpy(b->reply2.params, pkt->params, pkt->nparams);
-	if (reply) {
-		reply->id = pkt->id;
-		reply->code = pkt->err;
-		reply->nparams = pkt->nparams <= DXL_MAX_PARAMS ? (uint8_t)pkt->nparams : 0;
-		memcpy(reply->params, pkt->params, reply->nparams);
-	}
-	return DXL_OK;
-}
-
-static int bus2_frame(struct bus *b, const struct dxl2_packet *pkt, uint64_t now, struct dxl_packet *reply)
+/* A whole packet arrived: the reply, one of several, or a stray. */
+static int bus_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t now, struct dxl_packet *reply)
 {
 	if (!b->pending) {
 		b->stray_packets++;
 		b->line_dirty = true;
 		return BUS_PENDING;
 	}
-	if (b->multi == NULL)
-		return bus2_match(b, pkt, now, reply);
+	if (b->multi == NULL) {
+		if (b->proto->echo_reads_as_status && !b->echo && !b->reply_held && bus_is_own_request(b, pkt)) {
+			b->reply_held = true;
+			bus_frame_copy(&b->reply, pkt);
+			return BUS_PENDING;
+		}
+		if (b->reply_held)
+			b->unexpected_echoes++;
+		return bus_match(b, pkt, now, reply);
+	}
 	if (b->multi->ping_all)
-		bus2_ping_all_frame(b, pkt, now);
+		bus_ping_all_frame(b, pkt, now);
 	else
-		bus2_multi_frame(b, pkt, now);
-	if (!b->multi->ping_all && bus2_multi_settled(b->multi)) {
-		int outcome = bus2_multi_outcome(b->multi);
+		bus_multi_frame(b, pkt, now);
+	if (!b->multi->ping_all && bus_multi_settled(b->multi)) {
+		int outcome = bus_multi_outcome(b->multi);
 		bus_finish(b);
 		return outcome;
 	}
 	return BUS_PENDING;
 }
 
-static int bus2_feed(struct bus *b, const uint8_t *data, size_t n, uint64_t now, struct dxl_packet *reply)
+/* Feed received bytes to the parser. Returns BUS_PENDING while the reply is
+ * incomplete, else the transaction's outcome; packets beyond the reply are
+ * counted as strays. */
+static int bus_feed(struct bus *b, const uint8_t *data, size_t n, uint64_t now, struct dxl_packet *reply)
 {
 	int outcome = BUS_PENDING;
-	struct dxl2_packet pkt;
+	struct dxl_frame pkt;
 	size_t off = 0;
 	for (;;) {
 		size_t used = 0;
-		int r = dxl2_parser_feed(&b->parser2, data + off, n - off, &used, &pkt);
+		int r = b->proto->parser_feed(&b->parser, data + off, n - off, &used, &pkt);
 		off += used;
 		if (r == DXL_NEED_MORE)
 			break;
-		int o = r == DXL_FRAME ? bus2_frame(b, &pkt, now, reply) : b->pending ? bus2_damage(b, r) : BUS_PENDING;
+		int o = r == DXL_FRAME ? bus_frame(b, &pkt, now, reply) : b->pending ? bus_damage(b, r) : BUS_PENDING;
 		if (o != BUS_PENDING)
 			outcome = o;
 	}
@@ -630,14 +566,15 @@ static int bus2_feed(struct bus *b, const uint8_t *data, size_t n, uint64_t now,
 }
 
 /* With echo off, our own request read back first means the wiring echoes.
- * An instruction never parses as a status on 2.0, so nothing is mistaken
- * for a reply; the bytes that match the request so far are held back from
- * the parser, and dropped when the whole request came back. */
-static int bus2_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t now, struct dxl_packet *reply)
+ * Where an instruction never parses as a status (2.0), nothing is mistaken
+ * for a reply: the bytes that match the request so far are held back from
+ * the parser, and dropped when the whole request came back. (Where it does,
+ * 1.0, bus_frame holds the whole packet instead.) */
+static int bus_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t now, struct dxl_packet *reply)
 {
 	size_t i = 0;
-	if (b->echo || b->echo_probe_dead || !b->pending)
-		return bus2_feed(b, data, n, now, reply);
+	if (b->echo || b->proto->echo_reads_as_status || b->echo_probe_dead || !b->pending)
+		return bus_feed(b, data, n, now, reply);
 	while (i < n && b->echo_probe < b->req_len && data[i] == b->req_buf[b->echo_probe]) {
 		b->echo_probe++;
 		i++;
@@ -645,37 +582,37 @@ static int bus2_consume(struct bus *b, const uint8_t *data, size_t n, uint64_t n
 	if (b->echo_probe == b->req_len) {
 		b->unexpected_echoes++;
 		b->echo_probe_dead = true;
-		return bus2_feed(b, data + i, n - i, now, reply);
+		return bus_feed(b, data + i, n - i, now, reply);
 	}
 	if (i == n)
 		return BUS_PENDING;   /* all of it could still be the echo */
 	/* not our request: what was held back goes to the parser first */
 	b->echo_probe_dead = true;
-	int held = bus2_feed(b, b->req_buf, b->echo_probe, now, reply);
-	int rest = bus2_feed(b, data + i, n - i, now, reply);
+	int held = bus_feed(b, b->req_buf, b->echo_probe, now, reply);
+	int rest = bus_feed(b, data + i, n - i, now, reply);
 	return held != BUS_PENDING ? held : rest;
 }
 
 /* The deadline of a multi-reply request: the servos that did not answer are
  * timeouts, the replies that came stay delivered. */
-static int bus2_multi_deadline(struct bus *b)
+static int bus_multi_deadline(struct bus *b)
 {
 	struct bus_multi *m = b->multi;
 	for (size_t i = 0; i < m->n; i++)
 		if (m->status[i] == DXL_E_TIMEOUT)
 			b->servo[m->id[i]].timeouts++;
-	int outcome = m->ping_all ? DXL_OK : bus2_multi_outcome(m);
+	int outcome = m->ping_all ? DXL_OK : bus_multi_outcome(m);
 	if (!m->ping_all && m->answered < m->n)
 		b->line_dirty = true;   /* a late reply may still come */
 	bus_finish(b);
-	dxl2_parser_reset(&b->parser2);
+	b->proto->parser_reset(&b->parser);
 	bus_echo_clear(b);
 	return outcome;
 }
 
-const struct dxl2_packet *bus_reply2(const struct bus *b)
+const struct dxl_frame *bus_reply(const struct bus *b)
 {
-	return &b->reply2;
+	return &b->reply;
 }
 
 const uint8_t *bus_multi_data(const struct bus_multi *m, size_t slot)
@@ -698,10 +635,10 @@ size_t bus_multi_failed(const struct bus_multi *m, uint8_t *ids, size_t cap)
 	return failed;
 }
 
-/* ---- multi-reply requests (Protocol 2.0) ----------------------------------------- */
+/* ---- beginning a multi-reply request ------------------------------------------------ */
 
 /* Slots from the tracker; DXL_E_BUFFER when their bytes exceed m->cap. */
-static int bus2_multi_layout(struct bus_multi *m)
+static int bus_multi_layout(struct bus_multi *m)
 {
 	size_t off = 0;
 	m->n = m->track.n;
@@ -718,58 +655,76 @@ static int bus2_multi_layout(struct bus_multi *m)
 	return m->data != NULL && off <= m->cap ? DXL_OK : DXL_E_BUFFER;
 }
 
-static int bus2_multi_begin(struct bus *b, const uint8_t *pkt, int n, struct bus_multi *m, uint8_t instr)
+/* Send the request the protocol's encoder wrote (n bytes or its status). */
+static int bus_multi_send(struct bus *b, const uint8_t *pkt, int n, struct bus_multi *m, uint8_t instr)
 {
 	uint64_t now = 0;
-	if (b->protocol != BUS_PROTOCOL_2)
-		return DXL_E_UNSUPPORTED;
-	if (b->pending)
-		return DXL_E_BUSY;
 	int r = bus_send_request(b, pkt, n, &now);
 	if (r < 0)
 		return r;
-	uint32_t timeout = instr == DXL2_INST_PING ? bus2_ping_all_timeout_us(b, (size_t)n)
+	uint32_t timeout = m->ping_all ? bus_ping_all_timeout_us(b, (size_t)n)
 	                   : bus_multi_timeout_us(b, (size_t)n, m->len, m->n);
-	bus_pend(b, pkt, (size_t)n, DXL2_BROADCAST_ID, instr, 0, now, timeout);
+	bus_pend(b, pkt, (size_t)n, b->proto->broadcast_id, instr, 0, now, timeout);
 	b->multi = m;
 	for (size_t i = 0; i < m->n; i++)
 		b->servo[m->id[i]].transactions++;
 	return DXL_OK;
 }
 
+/* Before encoding: the protocol can, and the bus is free. */
+static int bus_multi_ready(const struct bus *b, uint32_t cap)
+{
+	if (!dxl_proto_can(b->proto, cap))
+		return DXL_E_UNSUPPORTED;
+	return b->pending ? DXL_E_BUSY : DXL_OK;
+}
+
 int bus_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
                         struct bus_multi *m)
 {
-	uint8_t pkt[DXL2_MAX_PACKET];
+	uint8_t pkt[BUS_MAX_PACKET];
 	if (m == NULL || dxl2_multi_read_sync(&m->track, len, ids, n) != DXL_OK)
 		return DXL_E_ARG;
-	int r = bus2_multi_layout(m);
+	int r = bus_multi_layout(m);
+	if (r == DXL_OK)
+		r = bus_multi_ready(b, DXL_CAP_SYNC_READ);
 	if (r < 0)
 		return r;
-	return bus2_multi_begin(b, pkt, dxl2_encode_sync_read(pkt, sizeof pkt, addr, len, ids, n), m,
-	                        DXL2_INST_SYNC_READ);
+	return bus_multi_send(b, pkt, b->proto->encode_sync_read(pkt, sizeof pkt, addr, len, ids, n), m,
+	                      DXL2_INST_SYNC_READ);
 }
 
-int bus_bulk_read_begin(struct bus *b, const struct dxl2_bulk_item *items, size_t n, struct bus_multi *m)
+int bus_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
 {
-	uint8_t pkt[DXL2_MAX_PACKET];
-	if (m == NULL || dxl2_multi_read_bulk(&m->track, items, n) != DXL_OK)
+	uint8_t pkt[BUS_MAX_PACKET];
+	struct dxl2_bulk_item asked[DXL2_MULTI_MAX];
+	if (m == NULL || items == NULL || n == 0 || n > DXL2_MULTI_MAX)
 		return DXL_E_ARG;
-	int r = bus2_multi_layout(m);
+	for (size_t i = 0; i < n; i++)
+		asked[i] = (struct dxl2_bulk_item){ items[i].id, items[i].addr, items[i].len, NULL };
+	if (dxl2_multi_read_bulk(&m->track, asked, n) != DXL_OK)
+		return DXL_E_ARG;
+	int r = bus_multi_layout(m);
+	if (r == DXL_OK)
+		r = bus_multi_ready(b, DXL_CAP_BULK_READ);
 	if (r < 0)
 		return r;
-	return bus2_multi_begin(b, pkt, dxl2_encode_bulk_read(pkt, sizeof pkt, items, n), m, DXL2_INST_BULK_READ);
+	return bus_multi_send(b, pkt, b->proto->encode_bulk_read(pkt, sizeof pkt, items, n), m, DXL2_INST_BULK_READ);
 }
 
 int bus_ping_all_begin(struct bus *b, struct bus_multi *m)
 {
-	uint8_t pkt[DXL2_MAX_PACKET];
+	uint8_t pkt[BUS_MAX_PACKET];
 	if (m == NULL || m->data == NULL)
 		return DXL_E_ARG;
 	m->n = 0;
 	m->answered = 0;
 	m->ping_all = true;
-	return bus2_multi_begin(b, pkt, dxl2_encode_ping(pkt, sizeof pkt, DXL2_BROADCAST_ID), m, DXL2_INST_PING);
+	int r = bus_multi_ready(b, DXL_CAP_BROADCAST_PING);
+	if (r < 0)
+		return r;
+	return bus_multi_send(b, pkt, b->proto->encode_ping(pkt, sizeof pkt, b->proto->broadcast_id), m,
+	                      DXL_INST_PING);
 }
 
 /* ---- driving a transaction ---------------------------------------------------------- */
@@ -798,8 +753,7 @@ int bus_step(struct bus *b, struct dxl_packet *reply)
 			return (int)echoed;
 		}
 		off = (size_t)echoed;
-		int r = b->protocol == BUS_PROTOCOL_2 ? bus2_consume(b, chunk + off, (size_t)got - off, now, reply)
-		                                      : bus_consume(b, chunk + off, (size_t)got - off, now, reply);
+		int r = bus_consume(b, chunk + off, (size_t)got - off, now, reply);
 		if (r != BUS_PENDING)
 			outcome = r;
 		/* A short read took what there was. Reading again only to be told
@@ -811,12 +765,11 @@ int bus_step(struct bus *b, struct dxl_packet *reply)
 	if (outcome != BUS_PENDING)
 		return outcome;
 	if (now >= b->deadline_us && b->multi != NULL)
-		return bus2_multi_deadline(b);
+		return bus_multi_deadline(b);
 	if (now >= b->deadline_us && b->reply_held) {
 		/* nothing followed the packet that looked like our echo: it was the
-		 * reply (bus_match clears the hold, so copy it out first) */
-		struct dxl_packet held = b->reply;
-		return bus_match(b, &held, now, reply);
+		 * reply, held in b->reply */
+		return bus_match(b, &b->reply, now, reply);
 	}
 	if (now >= b->deadline_us) {
 		b->servo[b->req_id].timeouts++;
@@ -843,8 +796,7 @@ void bus_abort(struct bus *b)
 	bus_finish(b);
 	/* whatever was half-read belongs to the abandoned request */
 	bus_echo_clear(b);
-	dxl_parser_reset(&b->parser);
-	dxl2_parser_reset(&b->parser2);
+	b->proto->parser_reset(&b->parser);
 }
 
 /* ---- blocking calls --------------------------------------------------------------- */
@@ -901,131 +853,240 @@ int bus_settle(struct bus *b, uint32_t quiet_us, uint32_t max_us)
 		}
 	}
 	bus_echo_clear(b);
-	dxl_parser_reset(&b->parser);
-	dxl2_parser_reset(&b->parser2);
+	b->proto->parser_reset(&b->parser);
 	return dropped > INT32_MAX ? INT32_MAX : (int)dropped;
 }
 
-/* One request, its reply (if any) and the error byte. */
-static int bus_transact(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params,
-                        size_t nparams, int reply_params, struct dxl_packet *reply,
-                        uint8_t *errbits)
+/* One encoded request (n bytes, or the encoder's negative status), its
+ * reply if one is expected, and the reply's error byte / ERR field. The
+ * reply stays in the bus (bus_reply) for the caller to copy out. */
+static int bus_transact(struct bus *b, const uint8_t *pkt, int n, uint8_t id, uint8_t instr, int reply_params,
+                        uint8_t *err)
 {
-	if (errbits)
-		*errbits = 0;
-	reply->code = 0;
-	reply->nparams = 0;
-	int r = bus_begin(b, id, instr, params, nparams, reply_params);
+	if (err)
+		*err = 0;
+	int r = bus_request(b, pkt, n, id, instr, reply_params);
 	if (r < 0 || !b->pending)
 		return r;
-	r = bus_wait_done(b, reply);
-	if (r == DXL_OK && errbits)
-		*errbits = reply->code;
+	r = bus_wait_done(b, NULL);
+	if (r == DXL_OK && err)
+		*err = b->reply.err;
 	return r;
 }
 
-int bus_ping(struct bus *b, uint8_t id, uint8_t *errbits)
+static int bus_ping_params(struct bus *b, uint8_t id, uint8_t *err)
 {
-	struct dxl_packet reply;
-	if (b->protocol == BUS_PROTOCOL_2)
-		return bus2_ping(b, id, NULL, NULL, errbits);
-	return bus_transact(b, id, DXL_INST_PING, NULL, 0, 0, &reply, errbits);
-}
-
-int bus_read(struct bus *b, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out, uint8_t *errbits)
-{
-	if (b->protocol != BUS_PROTOCOL_1)
-		return DXL_E_UNSUPPORTED;
-	if (id > DXL_MAX_ID || len == 0 || len > DXL_MAX_PARAMS || out == NULL)
+	uint8_t pkt[BUS_MAX_PACKET];
+	const struct dxl_proto *pr = b->proto;
+	/* where every servo answers a broadcast PING in turn, bus_ping_all */
+	if (id > pr->max_id && dxl_proto_can(pr, DXL_CAP_BROADCAST_PING))
 		return DXL_E_ARG;
-	struct dxl_packet reply;
-	const uint8_t params[2] = { addr, len };
-	int r = bus_transact(b, id, DXL_INST_READ, params, sizeof params, len, &reply, errbits);
+	return bus_transact(b, pkt, pr->encode_ping(pkt, sizeof pkt, id), id, DXL_INST_PING, pr->ping_reply_params,
+	                    err);
+}
+
+int bus_ping(struct bus *b, uint8_t id, uint8_t *err)
+{
+	return bus_ping_params(b, id, err);
+}
+
+int bus_ping_model(struct bus *b, uint8_t id, uint16_t *model, uint8_t *firmware, uint8_t *err)
+{
+	if (err)
+		*err = 0;
+	if (id > b->proto->max_id)
+		return DXL_E_ARG;   /* broadcast: bus_ping_all */
+	if (!dxl_proto_can(b->proto, DXL_CAP_PING_MODEL))
+		return DXL_E_UNSUPPORTED;
+	int r = bus_ping_params(b, id, err);
+	if (r != DXL_OK)
+		return r;
+	if (model)
+		*model = dxl_get_u16(b->reply.params);
+	if (firmware)
+		*firmware = b->reply.params[2];
+	return DXL_OK;
+}
+
+int bus_ping_all(struct bus *b, struct bus_found *found, size_t cap, size_t *n)
+{
+	uint8_t data[BUS_MULTI_MAX * 3];
+	struct bus_multi m = { .data = data, .cap = sizeof data };
+	*n = 0;
+	int r = bus_ping_all_begin(b, &m);
 	if (r == DXL_OK)
-		memcpy(out, reply.params, len);
+		r = bus_wait_done(b, NULL);
+	for (size_t i = 0; i < m.n && *n < cap; i++) {
+		const uint8_t *p = bus_multi_data(&m, i);
+		if (p == NULL)
+			continue;
+		found[(*n)++] = (struct bus_found){ m.id[i], dxl_get_u16(p), p[2], m.err[i] };
+	}
 	return r;
 }
 
-int bus_read_u8(struct bus *b, uint8_t id, uint8_t addr, uint8_t *v, uint8_t *errbits)
+int bus_read(struct bus *b, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out, uint8_t *err)
 {
-	return bus_read(b, id, addr, 1, v, errbits);
+	uint8_t pkt[BUS_MAX_PACKET];
+	const struct dxl_proto *pr = b->proto;
+	if (err)
+		*err = 0;
+	if (id > pr->max_id || len == 0 || len > pr->max_read_len || out == NULL)
+		return DXL_E_ARG;
+	int r = bus_transact(b, pkt, pr->encode_read(pkt, sizeof pkt, id, addr, len), id, DXL_INST_READ, len, err);
+	if (r == DXL_OK)
+		memcpy(out, b->reply.params, len);
+	return r;
 }
 
-int bus_read_u16(struct bus *b, uint8_t id, uint8_t addr, uint16_t *v, uint8_t *errbits)
+int bus_read_u8(struct bus *b, uint8_t id, uint16_t addr, uint8_t *v, uint8_t *err)
+{
+	return bus_read(b, id, addr, 1, v, err);
+}
+
+int bus_read_u16(struct bus *b, uint8_t id, uint16_t addr, uint16_t *v, uint8_t *err)
 {
 	uint8_t raw[2];
 	if (v == NULL)
 		return DXL_E_ARG;
-	int r = bus_read(b, id, addr, 2, raw, errbits);
+	int r = bus_read(b, id, addr, 2, raw, err);
 	if (r == DXL_OK)
 		*v = dxl_get_u16(raw);
 	return r;
 }
 
-static int bus_addr_data(struct bus *b, uint8_t id, uint8_t instr, uint8_t addr,
-                         const uint8_t *data, size_t n, bool expect_reply, uint8_t *errbits)
+int bus_read_u32(struct bus *b, uint8_t id, uint16_t addr, uint32_t *v, uint8_t *err)
 {
-	uint8_t params[DXL_MAX_PARAMS];
-	if (b->protocol != BUS_PROTOCOL_1)
-		return DXL_E_UNSUPPORTED;
-	if (data == NULL || n == 0 || n + 1 > sizeof params)
+	uint8_t raw[4];
+	if (v == NULL)
 		return DXL_E_ARG;
-	params[0] = addr;
-	memcpy(params + 1, data, n);
-	struct dxl_packet reply;
-	return bus_transact(b, id, instr, params, n + 1, expect_reply ? 0 : -1, &reply, errbits);
+	int r = bus_read(b, id, addr, 4, raw, err);
+	if (r == DXL_OK)
+		*v = dxl2_get_u32(raw);
+	return r;
 }
 
-int bus_write(struct bus *b, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
-              bool expect_reply, uint8_t *errbits)
+/* WRITE and REG_WRITE: an address and the data. */
+static int bus_addr_data(struct bus *b, uint8_t id, bool registered, uint16_t addr, const uint8_t *data, size_t n,
+                         bool expect_reply, uint8_t *err)
 {
-	return bus_addr_data(b, id, DXL_INST_WRITE, addr, data, n, expect_reply, errbits);
+	uint8_t pkt[BUS_MAX_PACKET];
+	const struct dxl_proto *pr = b->proto;
+	if (err)
+		*err = 0;
+	if (data == NULL || n == 0 || n + pr->addr_bytes > pr->max_params)
+		return DXL_E_ARG;
+	int len = registered ? pr->encode_reg_write(pkt, sizeof pkt, id, addr, data, n)
+	                     : pr->encode_write(pkt, sizeof pkt, id, addr, data, n);
+	return bus_transact(b, pkt, len, id, registered ? DXL_INST_REG_WRITE : DXL_INST_WRITE, expect_reply ? 0 : -1,
+	                    err);
 }
 
-int bus_write_u8(struct bus *b, uint8_t id, uint8_t addr, uint8_t v, uint8_t *errbits)
+int bus_write(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
+              uint8_t *err)
 {
-	return bus_write(b, id, addr, &v, 1, true, errbits);
+	return bus_addr_data(b, id, false, addr, data, n, expect_reply, err);
 }
 
-int bus_write_u16(struct bus *b, uint8_t id, uint8_t addr, uint16_t v, uint8_t *errbits)
+int bus_write_u8(struct bus *b, uint8_t id, uint16_t addr, uint8_t v, uint8_t *err)
+{
+	return bus_write(b, id, addr, &v, 1, true, err);
+}
+
+int bus_write_u16(struct bus *b, uint8_t id, uint16_t addr, uint16_t v, uint8_t *err)
 {
 	uint8_t raw[2];
 	dxl_put_u16(raw, v);
-	return bus_write(b, id, addr, raw, 2, true, errbits);
+	return bus_write(b, id, addr, raw, 2, true, err);
 }
 
-int bus_reg_write(struct bus *b, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
-                  bool expect_reply, uint8_t *errbits)
+int bus_write_u32(struct bus *b, uint8_t id, uint16_t addr, uint32_t v, uint8_t *err)
 {
-	return bus_addr_data(b, id, DXL_INST_REG_WRITE, addr, data, n, expect_reply, errbits);
+	uint8_t raw[4];
+	dxl2_put_u32(raw, v);
+	return bus_write(b, id, addr, raw, 4, true, err);
 }
 
-int bus_action(struct bus *b, uint8_t id, uint8_t *errbits)
+int bus_reg_write(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
+                  uint8_t *err)
 {
-	struct dxl_packet reply;
-	if (b->protocol != BUS_PROTOCOL_1)
+	return bus_addr_data(b, id, true, addr, data, n, expect_reply, err);
+}
+
+int bus_action(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	return bus_transact(b, pkt, b->proto->encode_action(pkt, sizeof pkt, id), id, DXL_INST_ACTION,
+	                    expect_reply ? 0 : -1, err);
+}
+
+int bus_factory_reset(struct bus *b, uint8_t id, uint8_t option, bool expect_reply, uint8_t *err)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	return bus_transact(b, pkt, b->proto->encode_factory_reset(pkt, sizeof pkt, id, option), id,
+	                    DXL_INST_FACTORY_RESET, expect_reply ? 0 : -1, err);
+}
+
+/* An instruction the protocol may not have: (cap) or DXL_E_UNSUPPORTED. */
+static int bus_optional(struct bus *b, uint32_t cap, int (*encode)(uint8_t *, size_t, uint8_t), uint8_t id,
+                        uint8_t instr, bool expect_reply, uint8_t *err)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	if (err)
+		*err = 0;
+	if (!dxl_proto_can(b->proto, cap) || encode == NULL)
 		return DXL_E_UNSUPPORTED;
-	return bus_transact(b, id, DXL_INST_ACTION, NULL, 0, 0, &reply, errbits);
+	return bus_transact(b, pkt, encode(pkt, sizeof pkt, id), id, instr, expect_reply ? 0 : -1, err);
 }
 
-int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
-                   const uint8_t *data, size_t n)
+int bus_reboot(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err)
 {
-	uint8_t pkt[DXL_MAX_PACKET];
-	if (b->protocol != BUS_PROTOCOL_1)
+	return bus_optional(b, DXL_CAP_REBOOT, b->proto->encode_reboot, id, DXL_INST_REBOOT, expect_reply, err);
+}
+
+int bus_clear_multi_turn(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err)
+{
+	return bus_optional(b, DXL_CAP_CLEAR, b->proto->encode_clear_multi_turn, id, DXL2_INST_CLEAR, expect_reply,
+	                    err);
+}
+
+int bus_sync_write(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, const uint8_t *data, size_t n)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	int r = b->proto->encode_sync_write(pkt, sizeof pkt, addr, len, ids, data, n);
+	return r < 0 ? r : bus_send_raw(b, pkt, (size_t)r);
+}
+
+int bus_bulk_write(struct bus *b, const struct dxl_item *items, size_t n)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	if (!dxl_proto_can(b->proto, DXL_CAP_BULK_WRITE))
 		return DXL_E_UNSUPPORTED;
-	int r = dxl_encode_sync_write(pkt, sizeof pkt, addr, len, ids, data, n);
-	if (r < 0)
-		return r;
-	return bus_send_raw(b, pkt, (size_t)r);
+	int r = b->proto->encode_bulk_write(pkt, sizeof pkt, items, n);
+	return r < 0 ? r : bus_send_raw(b, pkt, (size_t)r);
+}
+
+static int bus_multi_wait(struct bus *b, int begun)
+{
+	if (begun < 0)
+		return begun;
+	return bus_wait_done(b, NULL);
+}
+
+int bus_sync_read(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n, struct bus_multi *m)
+{
+	return bus_multi_wait(b, bus_sync_read_begin(b, addr, len, ids, n, m));
+}
+
+int bus_bulk_read(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
+{
+	return bus_multi_wait(b, bus_bulk_read_begin(b, items, n, m));
 }
 
 int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsigned n, struct bus_lateness *out)
 {
 	uint32_t late[BUS_LATENESS_MAX];
-	/* a PING and its reply: 6 + 6 bytes on 1.0, 10 + 14 on 2.0 */
-	size_t ping_bytes = b->protocol == BUS_PROTOCOL_2 ? 10 + 14 : 2 * BUS_PACKET_BYTES(0);
-	uint32_t floor_us = bus_wire_time_us(b, ping_bytes) + return_delay_us;
+	uint32_t floor_us = bus_wire_time_us(b, b->proto->ping_round_trip_bytes) + return_delay_us;
 	int r = DXL_E_ARG;
 
 	memset(out, 0, sizeof *out);
@@ -1056,13 +1117,4 @@ int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsi
 	/* the lower median: one slow wake-up in an even count does not move it */
 	out->median_us = late[(out->replies - 1) / 2];
 	return DXL_OK;
-}
-
-int bus_factory_reset(struct bus *b, uint8_t id, bool expect_reply, uint8_t *errbits)
-{
-	struct dxl_packet reply;
-	if (b->protocol != BUS_PROTOCOL_1)
-		return DXL_E_UNSUPPORTED;
-	return bus_transact(b, id, DXL_INST_FACTORY_RESET, NULL, 0, expect_reply ? 0 : -1, &reply,
-	                    errbits);
 }

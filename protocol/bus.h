@@ -18,13 +18,13 @@
  * baud rate, the bytes on the wire, the servo's return delay and the adapter
  * latency — a missing servo costs that, not tens of milliseconds.
  *
- * One bus, either protocol: bus_init starts on Protocol 1.0 (every 1.0
- * caller is unchanged); bus_set_protocol switches. Echo cancelling, the
- * derived timeouts, flushing, settling, lateness and the per-servo counters
- * are shared; only the framing differs (dxl.c or dxl2.c). On Protocol 2.0
- * the asynchronous core also runs SYNC_READ and BULK_READ (one request, one
- * reply per servo: bus_sync_read_begin / bus_bulk_read_begin), and the
- * blocking calls are the bus2_ ones below (16-bit addresses, 32-bit values).
+ * One bus, either protocol: the framing is a table (dxl_proto.h), and this
+ * layer calls b->proto->... without asking which one it has. bus_init starts
+ * on Protocol 1.0; bus_set_protocol switches. Echo cancelling, the derived
+ * timeouts, flushing, settling, lateness and the per-servo counters are one
+ * code. The calls take 16-bit addresses and 32-bit values; what a protocol
+ * cannot do (dxl_proto_can: SYNC_READ, BULK_READ, REBOOT, ...) returns
+ * DXL_E_UNSUPPORTED and sends nothing.
  */
 #ifndef UNDULATE_BUS_H
 #define UNDULATE_BUS_H
@@ -35,6 +35,7 @@
 
 #include "dxl.h"
 #include "dxl2.h"
+#include "dxl_proto.h"
 
 /* The transport seam. All functions are required unless noted. */
 struct bus_io {
@@ -79,7 +80,7 @@ struct bus_servo_stats {
 	uint32_t error_replies;    /* replies with any error bit set (2.0: ERR field not 0) */
 	uint8_t errbits_seen;      /* OR of every error byte seen (2.0: of every ERR field) */
 	uint8_t last_errbits;
-	uint32_t alerts;           /* 2.0: replies with the alert bit (read Hardware Error Status) */
+	uint32_t alerts;           /* replies with proto->err_alert set (2.0: read Hardware Error Status) */
 	uint32_t stuffing_errors;  /* 2.0: a header inside a reply's body (also counted in resyncs) */
 	uint32_t rtt_last_us, rtt_max_us;
 	uint64_t rtt_sum_us;       /* mean = rtt_sum_us / replies */
@@ -91,17 +92,20 @@ enum bus_step_result {
 };
 
 #define BUS_NSERVOS 254
+/* The largest packet of any protocol: buffers sized once for both. */
+#define BUS_MAX_PACKET DXL2_MAX_PACKET
 /* Echo bytes remembered: a reply-less request's echo plus the next request
- * (Protocol 1.0 uses the first 2 * DXL_MAX_PACKET of it, as it always did). */
-#define BUS_ECHO_QUEUE (2 * DXL2_MAX_PACKET)
+ * (two of the spoken protocol's largest packets). */
+#define BUS_ECHO_QUEUE (2 * BUS_MAX_PACKET)
 
+/* Protocol numbers as configuration files give them (dxl_proto_by_number). */
 enum bus_protocol {
 	BUS_PROTOCOL_1 = 1,        /* Dynamixel Protocol 1.0 (dxl.h) */
 	BUS_PROTOCOL_2 = 2,        /* Dynamixel Protocol 2.0 (dxl2.h) */
 };
 
 /*
- * One SYNC_READ, BULK_READ or broadcast PING on Protocol 2.0: a request
+ * One SYNC_READ, BULK_READ or broadcast PING (where the protocol has them): a request
  * answered by one status packet per servo. The caller owns it, sets `data`
  * and `cap`, and leaves it alone from the begin call until bus_step returns
  * anything but BUS_PENDING (or bus_abort): the bus writes the replies into
@@ -136,9 +140,8 @@ struct bus {
 	struct bus_io io;
 	struct bus_timing timing;
 	bool echo;                 /* single-wire wiring: our own bytes come back first */
-	enum bus_protocol protocol;
-	struct dxl_parser parser;
-	struct dxl2_parser parser2;
+	const struct dxl_proto *proto;     /* the protocol spoken: its table */
+	union dxl_proto_parser parser;     /* its status parser (proto->parser_*) */
 	/* the pending transaction */
 	bool pending;
 	uint8_t req_id, req_instr;
@@ -154,20 +157,22 @@ struct bus {
 	 * reply, with a damaged one or one from elsewhere. The next request
 	 * flushes the input first. */
 	bool line_dirty;
-	struct dxl_packet reply;
-	/* The request as written. With echo off, a packet identical to it may be
-	 * an unexpected echo — or a genuine reply (a PING answered with the
-	 * input-voltage bit reads FF FF ID 02 01 CHK both ways): it is held in
-	 * `reply` and delivered only if nothing else comes before the deadline. */
-	uint8_t req_buf[DXL2_MAX_PACKET];
-	size_t req_len;
+	/* The last single reply (bus_reply). With echo off, on a protocol whose
+	 * request reads as a status (proto->echo_reads_as_status), a packet
+	 * identical to the request may be an unexpected echo — or a genuine
+	 * reply (a 1.0 PING answered with the input-voltage bit reads
+	 * FF FF ID 02 01 CHK both ways): it is held here and delivered only if
+	 * nothing else comes before the deadline. */
+	struct dxl_frame reply;
 	bool reply_held;
-	/* Protocol 2.0: the last reply (bus_reply2), the multi-reply request in
-	 * flight (NULL for a single reply), and how much of our own request has
-	 * come back at the start of the input with echo off (an instruction
-	 * never parses as a status on 2.0: the bytes are held, not fed to the
-	 * parser, until they differ or the whole request matched). */
-	struct dxl2_packet reply2;
+	/* The request as written. */
+	uint8_t req_buf[BUS_MAX_PACKET];
+	size_t req_len;
+	/* The multi-reply request in flight (NULL for a single reply), and, on
+	 * a protocol whose request never reads as a status, how much of our own
+	 * request has come back at the start of the input with echo off: those
+	 * bytes are held, not fed to the parser, until they differ or the
+	 * whole request matched. */
 	struct bus_multi *multi;
 	size_t echo_probe;
 	bool echo_probe_dead;
@@ -182,37 +187,39 @@ struct bus {
 
 void bus_init(struct bus *b, const struct bus_io *io, const struct bus_timing *timing, bool echo);
 void bus_set_timing(struct bus *b, const struct bus_timing *timing);
-/* Speak Protocol 1.0 (bus_init's choice) or 2.0 from the next request on.
- * DXL_OK, DXL_E_BUSY while a transaction is pending, DXL_E_ARG for another
- * value. Bytes of the other protocol still on the line are flushed before
- * the next request. */
+/* Speak another protocol from the next request on: DXL_OK, DXL_E_BUSY
+ * while a transaction is pending, DXL_E_ARG for NULL. Bytes of the other
+ * protocol still on the line are flushed before the next request. */
+int bus_set_proto(struct bus *b, const struct dxl_proto *proto);
+const struct dxl_proto *bus_proto(const struct bus *b);
+/* The same by number (1 or 2; DXL_E_ARG for another value). */
 int bus_set_protocol(struct bus *b, enum bus_protocol protocol);
 enum bus_protocol bus_get_protocol(const struct bus *b);
 /* Wire time of n bytes at the current baud, in µs (10 bits a byte). */
 uint32_t bus_wire_time_us(const struct bus *b, size_t nbytes);
 /* Timeout for a request of req_bytes answered by reply_bytes. */
 uint32_t bus_timeout_us(const struct bus *b, size_t req_bytes, size_t reply_bytes);
-/* Protocol 2.0, a request of req_bytes answered by nreplies status packets
- * of reply_params[i] parameters: the wire time of the request and of every
- * reply at its worst-case stuffing (dxl2_status_bytes_max), one return
- * delay per reply, the adapter latency and the margin. */
+/* A request of req_bytes answered by nreplies status packets of
+ * reply_params[i] parameters: the wire time of the request and of every
+ * reply at its largest (proto->status_bytes_max: 2.0's worst-case
+ * stuffing), one return delay per reply, the adapter latency and the margin. */
 uint32_t bus_multi_timeout_us(const struct bus *b, size_t req_bytes, const uint16_t *reply_params, size_t nreplies);
 void bus_reset_stats(struct bus *b);
 
 /* ---- asynchronous core ------------------------------------------------------ */
-/* Send a request. reply_params: the parameter count the status packet must
- * have, or -1 when no reply is expected (broadcast, SYNC_WRITE, status return
- * level too low). Returns DXL_OK (pending, or done when no reply expected) or
- * a negative dxl_status. On Protocol 2.0, instr and params are 2.0's
- * (dxl2.h: DXL2_INST_*, 16-bit addresses and lengths); SYNC_WRITE and
- * BULK_WRITE wait for nothing; SYNC_READ and BULK_READ go through
- * bus_sync_read_begin / bus_bulk_read_begin (DXL_E_ARG here). */
+/* Send a request: the protocol's instruction code and raw parameters
+ * (2.0: 16-bit addresses and lengths). reply_params: the parameter count
+ * the status packet must have, or -1 when no reply is expected (status
+ * return level too low). Broadcast, SYNC_WRITE and BULK_WRITE wait for
+ * nothing; SYNC_READ and BULK_READ go through bus_sync_read_begin /
+ * bus_bulk_read_begin (DXL_E_ARG here). Returns DXL_OK (pending, or done
+ * when no reply expected) or a negative dxl_status. */
 int bus_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, size_t nparams,
               int reply_params);
-/* Send pre-encoded bytes (e.g. from dxl_encode_sync_write) expecting no reply. */
+/* Send pre-encoded bytes (e.g. a SYNC_WRITE) expecting no reply. */
 int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n);
-/* Protocol 2.0: one SYNC_READ of len bytes at addr from n servos, or one
- * BULK_READ, into *m (its data/cap set by the caller; the rest is filled
+/* One SYNC_READ of len bytes at addr from n servos, or one BULK_READ
+ * (DXL_CAP_SYNC_READ, DXL_CAP_BULK_READ; else DXL_E_UNSUPPORTED), into *m (its data/cap set by the caller; the rest is filled
  * here). The deadline is bus_multi_timeout_us of all n replies. Replies are
  * checked against the request one by one (dxl2_multi_read_accept): a servo
  * not asked, or answering twice, is DXL_E_WRONG_ID; the wrong size
@@ -221,26 +228,26 @@ int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n);
  * replies cannot all fit m->cap. */
 int bus_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
                         struct bus_multi *m);
-int bus_bulk_read_begin(struct bus *b, const struct dxl2_bulk_item *items, size_t n, struct bus_multi *m);
-/* Protocol 2.0: a broadcast PING. Every servo answers, in ID order, each
- * after its return delay; the deadline allows for all 253 (the wire time of
- * 253 PING replies and 253 return delays), and each reply found becomes a
+int bus_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m);
+/* A broadcast PING (DXL_CAP_BROADCAST_PING). Every servo answers, in ID order, each
+ * after its return delay; the deadline allows for every ID (the wire time
+ * of a PING reply and a return delay each, at least 3 ms), and each reply found becomes a
  * slot of *m (its 3 bytes: model number, firmware). m->data needs 3 bytes a
  * servo; servos past m->cap are counted as stray packets. */
 int bus_ping_all_begin(struct bus *b, struct bus_multi *m);
 /* Drive a pending transaction: reads what is available, matches the reply.
  * Returns BUS_PENDING, DXL_OK (reply in *reply, if reply != NULL) or a negative
  * dxl_status (DXL_E_TIMEOUT once now >= deadline).
- * Protocol 2.0, one reply: *reply gets its ID, its ERR field as `code` and
- * its parameters when they fit DXL_MAX_PARAMS (else nparams 0: read them
- * with bus_reply2). A multi-reply request ends when every servo answered
+ * One reply: *reply gets its ID, the servo's error byte / ERR field as
+ * `code` and its parameters when they fit DXL_MAX_PARAMS (else nparams 0:
+ * read them with bus_reply). A multi-reply request ends when every servo answered
  * (DXL_OK) or at the deadline, or as soon as every slot is settled; the
  * result is DXL_OK when every slot has its data, else the first failed
  * slot's status — the replies that came are in the bus_multi either way,
  * and bus_multi_failed names the servos that did not answer. */
 int bus_step(struct bus *b, struct dxl_packet *reply);
-/* Protocol 2.0: the last single reply bus_step delivered, whole. */
-const struct dxl2_packet *bus_reply2(const struct bus *b);
+/* The last single reply bus_step delivered, whole. */
+const struct dxl_frame *bus_reply(const struct bus *b);
 /* Blocking: drive the pending transaction to its end with io->wait (what
  * every blocking call does after its begin). DXL_OK when nothing is pending. */
 int bus_wait_done(struct bus *b, struct dxl_packet *reply);
@@ -250,30 +257,56 @@ bool bus_is_pending(const struct bus *b);
 void bus_abort(struct bus *b);
 
 /* ---- blocking calls (tools, start-up) ------------------------------------------
- * Each returns DXL_OK or a negative dxl_status; *errbits (if not NULL) gets the
- * servo's error byte, which is data, not failure.
- * These are Protocol 1.0's: on a 2.0 bus they return DXL_E_UNSUPPORTED, except
- * bus_ping (a 2.0 PING, *errbits its ERR field) and bus_reply_lateness. */
-int bus_ping(struct bus *b, uint8_t id, uint8_t *errbits);
-int bus_read(struct bus *b, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out, uint8_t *errbits);
-int bus_read_u8(struct bus *b, uint8_t id, uint8_t addr, uint8_t *v, uint8_t *errbits);
-int bus_read_u16(struct bus *b, uint8_t id, uint8_t addr, uint16_t *v, uint8_t *errbits);
-/* WRITE waits for a reply unless id is broadcast or expect_reply is false
- * (status return level < 2). */
-int bus_write(struct bus *b, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
-              bool expect_reply, uint8_t *errbits);
-int bus_write_u8(struct bus *b, uint8_t id, uint8_t addr, uint8_t v, uint8_t *errbits);
-int bus_write_u16(struct bus *b, uint8_t id, uint8_t addr, uint16_t v, uint8_t *errbits);
-int bus_reg_write(struct bus *b, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
-                  bool expect_reply, uint8_t *errbits);
-int bus_action(struct bus *b, uint8_t id, uint8_t *errbits); /* broadcast: no reply */
-int bus_sync_write(struct bus *b, uint8_t addr, uint8_t len, const uint8_t *ids,
-                   const uint8_t *data, size_t n);
-int bus_factory_reset(struct bus *b, uint8_t id, bool expect_reply, uint8_t *errbits);
+ * Each returns DXL_OK or a negative dxl_status; *err (if not NULL) gets the
+ * reply's error byte (1.0) or ERR field (2.0) — data, not failure, counted
+ * per servo (error_replies, alerts). Writes wait for a reply unless id is
+ * broadcast or expect_reply is false (status return level < 2). What the
+ * protocol cannot do returns DXL_E_UNSUPPORTED and sends nothing. */
+/* A broadcast PING here is sent on a protocol without DXL_CAP_BROADCAST_PING
+ * (1.0: the replies collide; nothing is waited for) and refused with
+ * DXL_E_ARG where bus_ping_all is the way. */
+int bus_ping(struct bus *b, uint8_t id, uint8_t *err);
+/* DXL_CAP_PING_MODEL: the model number and firmware the reply carries. */
+int bus_ping_model(struct bus *b, uint8_t id, uint16_t *model, uint8_t *firmware, uint8_t *err);
+/* A servo found by a broadcast PING. */
+struct bus_found {
+	uint8_t id;
+	uint16_t model;
+	uint8_t firmware;
+	uint8_t err;
+};
+/* DXL_CAP_BROADCAST_PING: the servos that answered, in the order they did
+ * (ID order), up to cap. DXL_OK even when none did (*n = 0). */
+int bus_ping_all(struct bus *b, struct bus_found *found, size_t cap, size_t *n);
+int bus_read(struct bus *b, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out, uint8_t *err);
+int bus_read_u8(struct bus *b, uint8_t id, uint16_t addr, uint8_t *v, uint8_t *err);
+int bus_read_u16(struct bus *b, uint8_t id, uint16_t addr, uint16_t *v, uint8_t *err);
+int bus_read_u32(struct bus *b, uint8_t id, uint16_t addr, uint32_t *v, uint8_t *err);
+int bus_write(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
+              uint8_t *err);
+int bus_write_u8(struct bus *b, uint8_t id, uint16_t addr, uint8_t v, uint8_t *err);
+int bus_write_u16(struct bus *b, uint8_t id, uint16_t addr, uint16_t v, uint8_t *err);
+int bus_write_u32(struct bus *b, uint8_t id, uint16_t addr, uint32_t v, uint8_t *err);
+int bus_reg_write(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
+                  uint8_t *err);
+int bus_action(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err);
+/* option: enum dxl_reset_option (1.0: DXL_RESET_ALL only; 2.0 refuses
+ * broadcast with DXL_RESET_ALL). */
+int bus_factory_reset(struct bus *b, uint8_t id, uint8_t option, bool expect_reply, uint8_t *err);
+int bus_reboot(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err);      /* DXL_CAP_REBOOT */
+/* DXL_CAP_CLEAR: the multi-turn position back within one turn. */
+int bus_clear_multi_turn(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err);
+int bus_sync_write(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, const uint8_t *data,
+                   size_t n);
+int bus_bulk_write(struct bus *b, const struct dxl_item *items, size_t n);      /* DXL_CAP_BULK_WRITE */
+/* SYNC_READ / BULK_READ into *m (data/cap set by the caller); the result as
+ * bus_step's for them. */
+int bus_sync_read(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n, struct bus_multi *m);
+int bus_bulk_read(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m);
+
 /* How late replies come: n PINGs to id (at most BUS_LATENESS_MAX), each round
- * trip less the wire time of the PING and its reply (6 bytes each on 1.0;
- * 10 and 14 on 2.0) and the
- * servo's return delay. What is left is time the bytes were held between the
+ * trip less the wire time of the PING and its reply
+ * (proto->ping_round_trip_bytes) and the servo's return delay. What is left is time the bytes were held between the
  * line and us: an adapter's latency timer (an FTDI chip holds a short reply
  * up to 16 ms), a USB-serial bridge, a reader scheduled late. It is measured
  * where no setting can be read (a CDC-ACM adapter, an on-board UART, a pty).
@@ -291,47 +324,5 @@ int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsi
  * the bytes discarded (>= 0; the line is clean if it went quiet), DXL_E_BUSY
  * while a transaction is pending, or an I/O error. */
 int bus_settle(struct bus *b, uint32_t quiet_us, uint32_t max_us);
-
-/* ---- blocking calls, Protocol 2.0 (bus2_calls.c) --------------------------------
- * The same contract on a bus set to Protocol 2.0 (DXL_E_UNSUPPORTED on 1.0):
- * DXL_OK or a negative dxl_status; *err (if not NULL) gets the reply's ERR
- * field — the alert bit and the error number are data, not failure, and
- * are counted per servo (error_replies, alerts). Writes wait for a reply
- * unless id is broadcast or expect_reply is false (status return level < 2:
- * level 1 answers only PING and READ). */
-int bus2_ping(struct bus *b, uint8_t id, uint16_t *model, uint8_t *firmware, uint8_t *err);
-/* A servo found by a broadcast PING. */
-struct bus2_found {
-	uint8_t id;
-	uint16_t model;
-	uint8_t firmware;
-	uint8_t err;
-};
-/* Broadcast PING; the servos that answered, in the order they did (ID
- * order), up to cap. DXL_OK even when none did (*n = 0). */
-int bus2_ping_all(struct bus *b, struct bus2_found *found, size_t cap, size_t *n);
-int bus2_read(struct bus *b, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out, uint8_t *err);
-int bus2_read_u8(struct bus *b, uint8_t id, uint16_t addr, uint8_t *v, uint8_t *err);
-int bus2_read_u16(struct bus *b, uint8_t id, uint16_t addr, uint16_t *v, uint8_t *err);
-int bus2_read_u32(struct bus *b, uint8_t id, uint16_t addr, uint32_t *v, uint8_t *err);
-int bus2_write(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
-               uint8_t *err);
-int bus2_write_u8(struct bus *b, uint8_t id, uint16_t addr, uint8_t v, uint8_t *err);
-int bus2_write_u16(struct bus *b, uint8_t id, uint16_t addr, uint16_t v, uint8_t *err);
-int bus2_write_u32(struct bus *b, uint8_t id, uint16_t addr, uint32_t v, uint8_t *err);
-int bus2_reg_write(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
-                   uint8_t *err);
-int bus2_action(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err);
-int bus2_reboot(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err);
-/* CLEAR option 1: the multi-turn position back within one turn. */
-int bus2_clear_multi_turn(struct bus *b, uint8_t id, bool expect_reply, uint8_t *err);
-/* option: enum dxl2_reset_option (broadcast with RESET_ALL is refused). */
-int bus2_factory_reset(struct bus *b, uint8_t id, uint8_t option, bool expect_reply, uint8_t *err);
-/* SYNC_READ / BULK_READ into *m (data/cap set by the caller); the result as
- * bus_step's for them. */
-int bus2_sync_read(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n, struct bus_multi *m);
-int bus2_bulk_read(struct bus *b, const struct dxl2_bulk_item *items, size_t n, struct bus_multi *m);
-int bus2_sync_write(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, const uint8_t *data, size_t n);
-int bus2_bulk_write(struct bus *b, const struct dxl2_bulk_item *items, size_t n);
 
 #endif

@@ -4,6 +4,7 @@
  * allocation; every buffer belongs to the caller.
  */
 #include "dxl.h"
+#include "dxl_lex.h"
 
 #include <stdbool.h>
 #include <stdio.h>
@@ -264,8 +265,7 @@ void dxl_parser_reset(struct dxl_parser *p)
 
 static void dxl_parser_drop(struct dxl_parser *p, size_t n)
 {
-	memmove(p->buf, p->buf + n, p->have - n);
-	p->have -= n;
+	dxl_lex_drop(p->buf, &p->have, n);
 }
 
 /* A header field is wrong: count it, drop one byte, let the caller rescan. */
@@ -292,14 +292,9 @@ static bool dxl_parser_id_ok(const struct dxl_parser *p, uint8_t id)
 static int dxl_parser_scan(struct dxl_parser *p, struct dxl_packet *out)
 {
 	for (;;) {
-		if (p->have == 0)
+		static const uint8_t lead[2] = { DXL_LEAD, DXL_LEAD };
+		if (!dxl_lex_sync(p->buf, &p->have, lead, sizeof lead, &p->bytes_dropped))
 			return DXL_NEED_MORE;
-		if (p->buf[0] != DXL_LEAD || (p->have >= 2 && p->buf[1] != DXL_LEAD)) {
-			/* not a header start: plain garbage, dropped silently but counted */
-			p->bytes_dropped++;
-			dxl_parser_drop(p, 1);
-			continue;
-		}
 		if (p->have < 3)
 			return DXL_NEED_MORE;
 		if (!dxl_parser_id_ok(p, p->buf[2]))
@@ -329,25 +324,14 @@ static int dxl_parser_scan(struct dxl_parser *p, struct dxl_packet *out)
 	}
 }
 
+static int dxl_parser_scan_any(void *p, void *out)
+{
+	return dxl_parser_scan(p, out);
+}
+
 int dxl_parser_feed(struct dxl_parser *p, const uint8_t *data, size_t n, size_t *used,
                     struct dxl_packet *out)
 {
 	struct dxl_packet scratch;
-	size_t i = 0;
-	if (out == NULL)
-		out = &scratch;
-	if (data == NULL)
-		n = 0;
-	/* Scan before taking each byte: bytes left over from an earlier error may
-	 * already hold a whole packet. scan() returns NEED_MORE only while the
-	 * buffer is shorter than the packet it expects, so there is always room. */
-	for (;;) {
-		int r = dxl_parser_scan(p, out);
-		if (r != DXL_NEED_MORE || i == n) {
-			if (used)
-				*used = i;
-			return r;
-		}
-		p->buf[p->have++] = data[i++];
-	}
+	return dxl_lex_feed(p, p->buf, &p->have, dxl_parser_scan_any, out ? out : &scratch, data, n, used);
 }

@@ -7,6 +7,7 @@
  * read to make the same one, and the comment says so.
  */
 #include "dxl2.h"
+#include "dxl_lex.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -452,8 +453,7 @@ void dxl2_parser_reset(struct dxl2_parser *p)
 
 static void dxl2_parser_drop(struct dxl2_parser *p, size_t n)
 {
-	memmove(p->buf, p->buf + n, p->have - n);
-	p->have -= n;
+	dxl_lex_drop(p->buf, &p->have, n);
 	p->checked = 0;  /* a new candidate starts at buf[0] */
 }
 
@@ -535,16 +535,13 @@ static bool dxl2_parser_unstuff(const struct dxl2_parser *p, size_t body_end, st
 static int dxl2_parser_scan(struct dxl2_parser *p, struct dxl2_packet *out)
 {
 	for (;;) {
+		static const uint8_t lead[3] = { H1, H2, H3 };
 		const uint8_t *b = p->buf;
-		if (p->have == 0)
-			return DXL_NEED_MORE;
-		if (b[0] != H1 || (p->have >= 2 && b[1] != H2) || (p->have >= 3 && b[2] != H3)) {
-			/* not a header start: plain garbage, dropped silently but counted */
-			p->bytes_dropped++;
-			dxl2_parser_drop(p, 1);
-			continue;
-		}
-		if (p->have <= OFF_RESERVED)
+		size_t had = p->have;
+		bool synced = dxl_lex_sync(p->buf, &p->have, lead, sizeof lead, &p->bytes_dropped);
+		if (p->have != had)
+			p->checked = 0;  /* a new candidate starts at buf[0] */
+		if (!synced || p->have <= OFF_RESERVED)
 			return DXL_NEED_MORE;
 		if (b[OFF_RESERVED] == H3) {
 			/* FF FF FD FD: stuffed data of a packet we came into in the
@@ -590,27 +587,16 @@ static int dxl2_parser_scan(struct dxl2_parser *p, struct dxl2_packet *out)
 	}
 }
 
+static int dxl2_parser_scan_any(void *p, void *out)
+{
+	return dxl2_parser_scan(p, out);
+}
+
 int dxl2_parser_feed(struct dxl2_parser *p, const uint8_t *data, size_t n, size_t *used,
                      struct dxl2_packet *out)
 {
 	struct dxl2_packet scratch;
-	size_t i = 0;
-	if (out == NULL)
-		out = &scratch;
-	if (data == NULL)
-		n = 0;
-	/* Scan before taking each byte (see dxl_parser_feed): scan() returns
-	 * NEED_MORE only while the buffer is shorter than the packet it expects,
-	 * which is at most DXL2_MAX_PACKET, so there is always room. */
-	for (;;) {
-		int r = dxl2_parser_scan(p, out);
-		if (r != DXL_NEED_MORE || i == n) {
-			if (used)
-				*used = i;
-			return r;
-		}
-		p->buf[p->have++] = data[i++];
-	}
+	return dxl_lex_feed(p, p->buf, &p->have, dxl2_parser_scan_any, out ? out : &scratch, data, n, used);
 }
 
 /* ---- matching replies ------------------------------------------------------ */
@@ -670,14 +656,21 @@ int dxl2_multi_read_bulk(struct dxl2_multi_read *m, const struct dxl2_bulk_item 
 
 int dxl2_multi_read_accept(struct dxl2_multi_read *m, const struct dxl2_packet *pkt, size_t *slot)
 {
-	if (m == NULL || pkt == NULL)
+	if (pkt == NULL)
+		return DXL_E_ARG;
+	return dxl2_multi_read_take(m, pkt->id, pkt->nparams, slot);
+}
+
+int dxl2_multi_read_take(struct dxl2_multi_read *m, uint8_t id, uint16_t nparams, size_t *slot)
+{
+	if (m == NULL)
 		return DXL_E_ARG;
 	size_t i = 0;
-	while (i < m->n && m->ids[i] != pkt->id)
+	while (i < m->n && m->ids[i] != id)
 		i++;
 	if (i == m->n || m->got[i])
 		return DXL_E_WRONG_ID;
-	if (pkt->nparams != m->len[i])
+	if (nparams != m->len[i])
 		return DXL_E_WRONG_LENGTH;
 	if (i != m->next)
 		m->out_of_order++;

@@ -254,6 +254,9 @@ int dxl2_multi_read_bulk(struct dxl2_multi_read *m, const struct dxl2_bulk_item 
  * DXL_E_WRONG_ID for an ID not asked or answering twice; DXL_E_WRONG_LENGTH
  * for a reply of the wrong size (the slot stays unanswered). */
 int dxl2_multi_read_accept(struct dxl2_multi_read *m, const struct dxl2_packet *pkt, size_t *slot);
+/* The same for a reply known by its ID and parameter count (the bus's
+ * frames are either protocol's). */
+int dxl2_multi_read_take(struct dxl2_multi_read *m, uint8_t id, uint16_t nparams, size_t *slot);
 static inline bool dxl2_multi_read_done(const struct dxl2_multi_read *m) { return m->answered == m->n; }
 /* Copies the IDs not answered (in request order) into ids (up to cap);
  * returns how many are missing. */

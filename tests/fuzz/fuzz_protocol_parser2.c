@@ -176,13 +176,13 @@ static void run_bus(const uint8_t *data, size_t size, uint32_t seed, bool echo)
 	uint8_t out[8], err = 0;
 	bus_init(&b, &io, &t, echo);
 	CHECK(bus_set_protocol(&b, BUS_PROTOCOL_2) == DXL_OK);
-	int r = bus2_read(&b, 1, 132, 8, out, &err);
+	int r = bus_read(&b, 1, 132, 8, out, &err);
 	CHECK(r == DXL_OK || r < 0);
 	CHECK(!bus_is_pending(&b));
 	memset(&m, 0, sizeof m);
 	m.data = buf;
 	m.cap = sizeof buf;
-	check_multi(&b, &m, bus2_sync_read(&b, 126, 4, ids, 4, &m));
+	check_multi(&b, &m, bus_sync_read(&b, 126, 4, ids, 4, &m));
 	memset(&m, 0, sizeof m);
 	m.data = buf;
 	m.cap = sizeof buf;

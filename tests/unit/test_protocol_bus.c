@@ -240,7 +240,7 @@ static void test_checksum_error(void **state)
 	assert_int_equal(bus_read_u8(&bus, 1, 43, &v, NULL), DXL_E_CHECKSUM);
 	assert_int_equal(fk.now - start, 70);
 	assert_int_equal(bus.servo[1].checksum_errors, 1);
-	assert_int_equal(bus.parser.checksum_errors, 1);
+	assert_int_equal(bus.parser.v1.checksum_errors, 1);
 	assert_int_equal(bus.servo[1].replies, 0);
 }
 
@@ -283,7 +283,7 @@ static void test_no_wait(void **state)
 	assert_int_equal(bus_write_u8(&bus, DXL_BROADCAST_ID, 3, 1, &err), DXL_OK);
 	assert_memory_equal(fk.tx + sizeof sync_golden, bc_id1_golden, sizeof bc_id1_golden);
 	assert_int_equal(err, 0);
-	assert_int_equal(bus_action(&bus, DXL_BROADCAST_ID, NULL), DXL_OK);
+	assert_int_equal(bus_action(&bus, DXL_BROADCAST_ID, true, NULL), DXL_OK);
 	assert_int_equal(bus_begin(&bus, DXL_BROADCAST_ID, DXL_INST_PING, NULL, 0, 0), DXL_OK);
 	assert_false(bus_is_pending(&bus));
 	/* a unicast write with status return level < 2 */
@@ -306,7 +306,7 @@ static void test_echo(void **state)
 	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_OK);
 	assert_int_equal(bus.servo[1].replies, 1);
 	assert_int_equal(bus.bytes_in, 12);
-	assert_int_equal(bus.parser.bytes_dropped, 0);
+	assert_int_equal(bus.parser.v1.bytes_dropped, 0);
 
 	/* the echo of a reply-less SYNC_WRITE arrives after the next request
 	 * started: it is still matched and discarded */

@@ -93,18 +93,24 @@ static void test_protocol_switch(void **state)
 	assert_int_equal(bus_get_protocol(&bus), BUS_PROTOCOL_2);
 	assert_int_equal(bus_set_protocol(&bus, (enum bus_protocol)3), DXL_E_ARG);
 	uint8_t out[2], err = 0;
-	/* 1.0's calls on a 2.0 bus, and 2.0's on a 1.0 bus: refused, nothing sent */
-	assert_int_equal(bus_read(&bus, 1, 36, 2, out, &err), DXL_E_UNSUPPORTED);
-	assert_int_equal(bus_write_u8(&bus, 1, 24, 1, &err), DXL_E_UNSUPPORTED);
-	assert_int_equal(bus_action(&bus, 1, &err), DXL_E_UNSUPPORTED);
-	assert_int_equal(bus_factory_reset(&bus, 1, false, &err), DXL_E_UNSUPPORTED);
-	assert_int_equal(bus_sync_write(&bus, 30, 2, (const uint8_t[]){ 1 }, out, 1), DXL_E_UNSUPPORTED);
+	/* one API: what 1.0 cannot do is refused on a 1.0 bus, nothing sent;
+	 * what it can (a READ of an address past its 8 bits aside) goes out */
 	assert_int_equal(bus_set_protocol(&bus, BUS_PROTOCOL_1), DXL_OK);
-	assert_int_equal(bus2_read(&bus, 1, 132, 4, out, &err), DXL_E_UNSUPPORTED);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, &err), DXL_E_UNSUPPORTED);
+	assert_int_equal(bus_read(&bus, 1, 0x100, 4, out, &err), DXL_E_ARG);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, &err), DXL_E_UNSUPPORTED);
+	assert_int_equal(bus_reboot(&bus, 1, true, &err), DXL_E_UNSUPPORTED);
+	assert_int_equal(bus_clear_multi_turn(&bus, 1, true, &err), DXL_E_UNSUPPORTED);
+	assert_int_equal(bus_factory_reset(&bus, 1, DXL_RESET_KEEP_ID, false, &err), DXL_E_ARG);
+	assert_int_equal(bus_bulk_write(&bus, (const struct dxl_item[]){ { 1, 30, 1, out } }, 1), DXL_E_UNSUPPORTED);
+	size_t nfound = 9;
+	struct bus_found found[1];
+	assert_int_equal(bus_ping_all(&bus, found, 1, &nfound), DXL_E_UNSUPPORTED);
+	assert_int_equal(nfound, 0);
 	uint8_t data[8];
 	struct bus_multi m = { .data = data, .cap = sizeof data };
 	assert_int_equal(bus_sync_read_begin(&bus, 132, 4, (const uint8_t[]){ 1, 2 }, 2, &m), DXL_E_UNSUPPORTED);
+	assert_int_equal(bus_bulk_read_begin(&bus, (const struct dxl_item[]){ { 1, 36, 2, NULL } }, 1, &m),
+	                 DXL_E_UNSUPPORTED);
 	assert_int_equal(fk.writes, 0);
 	/* not while a transaction is pending */
 	assert_int_equal(bus_set_protocol(&bus, BUS_PROTOCOL_2), DXL_OK);
@@ -122,7 +128,7 @@ static void test_ping(void **state)
 	script(ping1_reply, sizeof ping1_reply, 90);
 	uint16_t model = 0;
 	uint8_t fw = 0, err = 0xEE;
-	assert_int_equal(bus2_ping(&bus, 1, &model, &fw, &err), DXL_OK);
+	assert_int_equal(bus_ping_model(&bus, 1, &model, &fw, &err), DXL_OK);
 	assert_int_equal(fk.ntx, sizeof ping1);
 	assert_memory_equal(fk.tx, ping1, sizeof ping1);
 	assert_int_equal(model, 1030);
@@ -138,9 +144,9 @@ static void test_ping(void **state)
 	script(ping1_reply, sizeof ping1_reply, 90);
 	assert_int_equal(bus_ping(&bus, 1, &err), DXL_OK);
 	assert_memory_equal(fk.tx + 10, ping1, sizeof ping1);
-	assert_int_equal(bus_reply2(&bus)->nparams, 3);
-	/* broadcast is for bus2_ping_all */
-	assert_int_equal(bus2_ping(&bus, DXL2_BROADCAST_ID, &model, &fw, &err), DXL_E_ARG);
+	assert_int_equal(bus_reply(&bus)->nparams, 3);
+	/* broadcast is for bus_ping_all */
+	assert_int_equal(bus_ping_model(&bus, DXL2_BROADCAST_ID, &model, &fw, &err), DXL_E_ARG);
 }
 
 /* The timeout: wire time of the request and of the reply at its worst
@@ -152,13 +158,13 @@ static void test_timeout_exact(void **state)
 	/* PING: 10 bytes, reply of 3 parameters at most 15 bytes (one stuffed) */
 	assert_int_equal(dxl2_status_bytes_max(3), 15);
 	uint64_t start = fk.now;
-	assert_int_equal(bus2_ping(&bus, 7, NULL, NULL, NULL), DXL_E_TIMEOUT);
+	assert_int_equal(bus_ping_model(&bus, 7, NULL, NULL, NULL), DXL_E_TIMEOUT);
 	assert_int_equal(fk.now - start, 250 + 1000 + 500);
 	assert_int_equal(bus.servo[7].timeouts, 1);
 	/* READ of 4: 14 bytes out, at most 17 back */
 	start = fk.now;
 	uint32_t v;
-	assert_int_equal(bus2_read_u32(&bus, 7, 132, &v, NULL), DXL_E_TIMEOUT);
+	assert_int_equal(bus_read_u32(&bus, 7, 132, &v, NULL), DXL_E_TIMEOUT);
 	assert_int_equal(fk.now - start, 310 + 1500);
 	/* at 57600 with the factory 500 µs return delay */
 	const struct bus_timing slow = { 57600, 500, 16000, 0 };
@@ -169,11 +175,11 @@ static void test_timeout_exact(void **state)
 	fk.now += 10000;
 	start = fk.now;
 	script(ping1_reply, sizeof ping1_reply, 1750);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_OK);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_OK);
 	assert_int_equal(fk.now - start, 1750);
 	start = fk.now;
 	script(ping1_reply, sizeof ping1_reply, 1751);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_E_TIMEOUT);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_E_TIMEOUT);
 	assert_int_equal(fk.now - start, 1750);
 }
 
@@ -184,13 +190,13 @@ static void test_read_write_golden(void **state)
 	uint32_t pos = 0;
 	uint8_t err = 0xEE;
 	script(pos1_reply, sizeof pos1_reply, 120);
-	assert_int_equal(bus2_read_u32(&bus, 1, 132, &pos, &err), DXL_OK);
+	assert_int_equal(bus_read_u32(&bus, 1, 132, &pos, &err), DXL_OK);
 	assert_memory_equal(fk.tx, read_pos1, sizeof read_pos1);
 	assert_int_equal(pos, 166);
 	assert_int_equal(err, 0);
 	size_t at = fk.ntx;
 	script(ok1, sizeof ok1, 60);
-	assert_int_equal(bus2_write_u32(&bus, 1, 116, 512, &err), DXL_OK);
+	assert_int_equal(bus_write_u32(&bus, 1, 116, 512, &err), DXL_OK);
 	assert_memory_equal(fk.tx + at, write_goal1, sizeof write_goal1);
 	const uint8_t vel200[4] = { 0xC8, 0, 0, 0 };
 	struct row {
@@ -200,15 +206,15 @@ static void test_read_write_golden(void **state)
 	} rows[5];
 	at = fk.ntx;
 	script(ok1, sizeof ok1, 60);
-	rows[0] = (struct row){ regw1, sizeof regw1, bus2_reg_write(&bus, 1, 104, vel200, 4, true, &err) };
+	rows[0] = (struct row){ regw1, sizeof regw1, bus_reg_write(&bus, 1, 104, vel200, 4, true, &err) };
 	script(ok1, sizeof ok1, 60);
-	rows[1] = (struct row){ action1, sizeof action1, bus2_action(&bus, 1, true, &err) };
+	rows[1] = (struct row){ action1, sizeof action1, bus_action(&bus, 1, true, &err) };
 	script(ok1, sizeof ok1, 60);
-	rows[2] = (struct row){ reset1, sizeof reset1, bus2_factory_reset(&bus, 1, DXL2_RESET_KEEP_ID, true, &err) };
+	rows[2] = (struct row){ reset1, sizeof reset1, bus_factory_reset(&bus, 1, DXL2_RESET_KEEP_ID, true, &err) };
 	script(ok1, sizeof ok1, 60);
-	rows[3] = (struct row){ reboot1, sizeof reboot1, bus2_reboot(&bus, 1, true, &err) };
+	rows[3] = (struct row){ reboot1, sizeof reboot1, bus_reboot(&bus, 1, true, &err) };
 	script(ok1, sizeof ok1, 60);
-	rows[4] = (struct row){ clear1, sizeof clear1, bus2_clear_multi_turn(&bus, 1, true, &err) };
+	rows[4] = (struct row){ clear1, sizeof clear1, bus_clear_multi_turn(&bus, 1, true, &err) };
 	for (size_t i = 0; i < 5; i++) {
 		assert_int_equal(rows[i].r, DXL_OK);
 		assert_memory_equal(fk.tx + at, rows[i].want, rows[i].n);
@@ -216,12 +222,12 @@ static void test_read_write_golden(void **state)
 	}
 	assert_int_equal(bus.servo[1].replies, 7);
 	/* never broadcast + reset all; nothing sent */
-	assert_int_equal(bus2_factory_reset(&bus, DXL2_BROADCAST_ID, DXL2_RESET_ALL, false, &err), DXL_E_ARG);
+	assert_int_equal(bus_factory_reset(&bus, DXL2_BROADCAST_ID, DXL2_RESET_ALL, false, &err), DXL_E_ARG);
 	assert_int_equal(fk.ntx, at);
 	/* a reply whose data is stuffed: FF FF FD comes back unstuffed */
 	uint8_t three[3];
 	script(stuffed1_reply, sizeof stuffed1_reply, 80);
-	assert_int_equal(bus2_read(&bus, 1, 0, 3, three, &err), DXL_OK);
+	assert_int_equal(bus_read(&bus, 1, 0, 3, three, &err), DXL_OK);
 	assert_memory_equal(three, ((const uint8_t[]){ 0xFF, 0xFF, 0xFD }), 3);
 }
 
@@ -232,7 +238,7 @@ static void test_err_field(void **state)
 	setup_bus2(false);
 	uint8_t err = 0;
 	script(alert1, sizeof alert1, 50);
-	assert_int_equal(bus2_write_u8(&bus, 1, 65, 1, &err), DXL_OK);
+	assert_int_equal(bus_write_u8(&bus, 1, 65, 1, &err), DXL_OK);
 	assert_int_equal(err, 0x84);
 	assert_true(dxl2_err_alert(err));
 	assert_int_equal(dxl2_err_number(err), DXL2_ERRNUM_DATA_RANGE);
@@ -240,7 +246,7 @@ static void test_err_field(void **state)
 	assert_int_equal(bus.servo[1].alerts, 1);
 	assert_int_equal(bus.servo[1].errbits_seen, 0x84);
 	script(ok1, sizeof ok1, 50);
-	assert_int_equal(bus2_write_u8(&bus, 1, 65, 0, &err), DXL_OK);
+	assert_int_equal(bus_write_u8(&bus, 1, 65, 0, &err), DXL_OK);
 	assert_int_equal(err, 0);
 	assert_int_equal(bus.servo[1].last_errbits, 0);
 	assert_int_equal(bus.servo[1].alerts, 1);
@@ -255,20 +261,20 @@ static void test_bad_replies(void **state)
 	uint8_t v;
 	/* wrong ID */
 	script(ping2_reply, sizeof ping2_reply, 50);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_E_WRONG_ID);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_E_WRONG_ID);
 	assert_int_equal(bus.servo[1].wrong_id, 1);
 	/* wrong length: a READ of 1 answered with 3 bytes */
 	script(ping1_reply, sizeof ping1_reply, 50);
-	assert_int_equal(bus2_read_u8(&bus, 1, 146, &v, NULL), DXL_E_WRONG_LENGTH);
+	assert_int_equal(bus_read_u8(&bus, 1, 146, &v, NULL), DXL_E_WRONG_LENGTH);
 	assert_int_equal(bus.servo[1].wrong_length, 1);
 	/* bad CRC: at once, not at the deadline */
 	uint32_t pos;
 	uint64_t start = fk.now;
 	script(pos1_reply_bad, sizeof pos1_reply_bad, 70);
-	assert_int_equal(bus2_read_u32(&bus, 1, 132, &pos, NULL), DXL_E_CHECKSUM);
+	assert_int_equal(bus_read_u32(&bus, 1, 132, &pos, NULL), DXL_E_CHECKSUM);
 	assert_int_equal(fk.now - start, 70);
 	assert_int_equal(bus.servo[1].checksum_errors, 1);
-	assert_int_equal(bus.parser2.checksum_errors, 1);
+	assert_int_equal(bus.parser.v2.checksum_errors, 1);
 	/* a reply cut short by the header of the good one: a stuffing error,
 	 * counted, and the good reply still delivered */
 	static uint8_t cut2[5 + 4 + sizeof pos1_reply];
@@ -277,21 +283,21 @@ static void test_bad_replies(void **state)
 	memcpy(cut2 + 9, pos1_reply, sizeof pos1_reply);
 	/* after 55 00 (INST, ERR) comes FF FF FD 00: a header in the body */
 	script(cut2, 9 + sizeof pos1_reply, 70);
-	assert_int_equal(bus2_read_u32(&bus, 1, 132, &pos, NULL), DXL_OK);
+	assert_int_equal(bus_read_u32(&bus, 1, 132, &pos, NULL), DXL_OK);
 	assert_int_equal(pos, 166);
 	assert_int_equal(bus.servo[1].stuffing_errors, 1);
 	assert_true(bus.servo[1].resyncs >= 1);
 	/* a reply from a broadcast-looking ID is no status: resynced, then a timeout */
 	static const uint8_t from_bc[] = { HDR, 0xFE, 0x04, 0x00, 0x55, 0x00, 0x00, 0x00 };
 	script(from_bc, sizeof from_bc, 40);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_E_TIMEOUT);
-	assert_true(bus.parser2.header_errors >= 1);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_E_TIMEOUT);
+	assert_true(bus.parser.v2.header_errors >= 1);
 	/* a second packet after the reply is a stray */
 	static uint8_t two[sizeof ok1 * 2];
 	memcpy(two, ok1, sizeof ok1);
 	memcpy(two + sizeof ok1, ok1, sizeof ok1);
 	script(two, sizeof two, 30);
-	assert_int_equal(bus2_write_u8(&bus, 1, 65, 1, NULL), DXL_OK);
+	assert_int_equal(bus_write_u8(&bus, 1, 65, 1, NULL), DXL_OK);
 	assert_int_equal(bus.stray_packets, 1);
 }
 
@@ -309,7 +315,7 @@ static void test_sync_read(void **state)
 	n = sizeof pos1_reply + sizeof pos2_reply;
 	script(queue, n, 100);
 	uint64_t start = fk.now;
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, ids, 2, &m), DXL_OK);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, ids, 2, &m), DXL_OK);
 	assert_memory_equal(fk.tx, sync_read12, sizeof sync_read12);
 	assert_int_equal(fk.now - start, 100);   /* done with the last reply, not at the deadline */
 	assert_int_equal(m.n, 2);
@@ -323,11 +329,11 @@ static void test_sync_read(void **state)
 	assert_int_equal(bus_multi_failed(&m, NULL, 0), 0);
 	/* the buffer must hold every reply */
 	struct bus_multi small = { .data = data, .cap = 7 };
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, ids, 2, &small), DXL_E_BUFFER);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, ids, 2, &small), DXL_E_BUFFER);
 	/* bad lists: refused before anything is sent */
 	size_t before = fk.ntx;
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, (const uint8_t[]){ 1, 1 }, 2, &m), DXL_E_ARG);
-	assert_int_equal(bus2_sync_read(&bus, 132, 0, ids, 2, &m), DXL_E_ARG);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, (const uint8_t[]){ 1, 1 }, 2, &m), DXL_E_ARG);
+	assert_int_equal(bus_sync_read(&bus, 132, 0, ids, 2, &m), DXL_E_ARG);
 	assert_int_equal(fk.ntx, before);
 }
 
@@ -342,7 +348,7 @@ static void test_sync_read_missing(void **state)
 	const uint8_t ids[2] = { 1, 2 };
 	script(pos1_reply, sizeof pos1_reply, 100);
 	uint64_t start = fk.now;
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_TIMEOUT);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_TIMEOUT);
 	/* 14 + 2 bytes out, 2 x 17 back at worst, two return delays (0 here) */
 	const uint16_t lens[2] = { 4, 4 };
 	assert_int_equal(bus_multi_timeout_us(&bus, 16, lens, 2), 500 + 1000 + 500);
@@ -358,7 +364,7 @@ static void test_sync_read_missing(void **state)
 	assert_true(bus.line_dirty);
 	/* the first servo missing, the second answering: out of order, accepted */
 	script(pos2_reply, sizeof pos2_reply, 100);
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_TIMEOUT);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_TIMEOUT);
 	assert_int_equal(m.status[0], DXL_E_TIMEOUT);
 	assert_int_equal(dxl2_get_u32(bus_multi_data(&m, 1)), 2079);
 	assert_int_equal(m.track.out_of_order, 1);
@@ -380,7 +386,7 @@ static void test_sync_read_bad_replies(void **state)
 	memcpy(queue + sizeof pos1_reply_bad, pos2_reply, sizeof pos2_reply);
 	script(queue, sizeof pos1_reply_bad + sizeof pos2_reply, 100);
 	uint64_t start = fk.now;
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_CHECKSUM);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_CHECKSUM);
 	assert_int_equal(fk.now - start, 100);
 	assert_int_equal(m.status[0], DXL_E_CHECKSUM);
 	assert_int_equal(m.status[1], DXL_OK);
@@ -390,7 +396,7 @@ static void test_sync_read_bad_replies(void **state)
 	memcpy(queue, pos1_reply, sizeof pos1_reply);
 	memcpy(queue + sizeof pos1_reply, temp2_reply, sizeof temp2_reply);
 	script(queue, sizeof pos1_reply + sizeof temp2_reply, 100);
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_WRONG_LENGTH);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, ids, 2, &m), DXL_E_WRONG_LENGTH);
 	assert_int_equal(m.status[1], DXL_E_WRONG_LENGTH);
 	assert_int_equal(bus.servo[2].wrong_length, 1);
 	assert_int_equal(dxl2_get_u32(bus_multi_data(&m, 0)), 166);
@@ -399,12 +405,12 @@ static void test_sync_read_bad_replies(void **state)
 	memcpy(queue, ping2_reply, sizeof ping2_reply);
 	memcpy(queue + sizeof ping2_reply, pos1_reply, sizeof pos1_reply);
 	script(queue, sizeof ping2_reply + sizeof pos1_reply, 100);
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, (const uint8_t[]){ 1 }, 1, &m), DXL_OK);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, (const uint8_t[]){ 1 }, 1, &m), DXL_OK);
 	assert_int_equal(bus.servo[1].wrong_id, 1);
 	assert_int_equal(m.status[0], DXL_OK);
 	/* ... and when it never does, its slot says so */
 	script(pos2_reply, sizeof pos2_reply, 100);
-	assert_int_equal(bus2_sync_read(&bus, 132, 4, (const uint8_t[]){ 1 }, 1, &m), DXL_E_WRONG_ID);
+	assert_int_equal(bus_sync_read(&bus, 132, 4, (const uint8_t[]){ 1 }, 1, &m), DXL_E_WRONG_ID);
 	assert_int_equal(bus.servo[1].wrong_id, 2);
 }
 
@@ -445,7 +451,7 @@ static void test_sync_read_async(void **state)
 	bus_abort(&bus);
 	assert_false(bus_is_pending(&bus));
 	script(ping1_reply, sizeof ping1_reply, 10);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_OK);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_OK);
 }
 
 static void test_bulk(void **state)
@@ -454,11 +460,11 @@ static void test_bulk(void **state)
 	setup_bus2(false);
 	uint8_t data[3];
 	struct bus_multi m = { .data = data, .cap = sizeof data };
-	const struct dxl2_bulk_item items[2] = { { 1, 144, 2, NULL }, { 2, 146, 1, NULL } };
+	const struct dxl_item items[2] = { { 1, 144, 2, NULL }, { 2, 146, 1, NULL } };
 	memcpy(queue, volt1_reply, sizeof volt1_reply);
 	memcpy(queue + sizeof volt1_reply, temp2_reply, sizeof temp2_reply);
 	script(queue, sizeof volt1_reply + sizeof temp2_reply, 100);
-	assert_int_equal(bus2_bulk_read(&bus, items, 2, &m), DXL_OK);
+	assert_int_equal(bus_bulk_read(&bus, items, 2, &m), DXL_OK);
 	assert_memory_equal(fk.tx, bulk_read12, sizeof bulk_read12);
 	assert_int_equal(dxl_get_u16(bus_multi_data(&m, 0)), 119);   /* 11.9 V */
 	assert_int_equal(*bus_multi_data(&m, 1), 36);                 /* 36 °C */
@@ -468,12 +474,12 @@ static void test_bulk(void **state)
 	uint8_t goals[8];
 	dxl2_put_u32(goals, 150);
 	dxl2_put_u32(goals + 4, 170);
-	assert_int_equal(bus2_sync_write(&bus, 116, 4, (const uint8_t[]){ 1, 2 }, goals, 2), DXL_OK);
+	assert_int_equal(bus_sync_write(&bus, 116, 4, (const uint8_t[]){ 1, 2 }, goals, 2), DXL_OK);
 	assert_memory_equal(fk.tx + at, sync_write12, sizeof sync_write12);
 	at += sizeof sync_write12;
 	const uint8_t d1[2] = { 0xA0, 0x00 }, d2[1] = { 0x50 };
-	const struct dxl2_bulk_item w[2] = { { 1, 0x20, 2, d1 }, { 2, 0x1F, 1, d2 } };
-	assert_int_equal(bus2_bulk_write(&bus, w, 2), DXL_OK);
+	const struct dxl_item w[2] = { { 1, 0x20, 2, d1 }, { 2, 0x1F, 1, d2 } };
+	assert_int_equal(bus_bulk_write(&bus, w, 2), DXL_OK);
 	assert_memory_equal(fk.tx + at, bulk_write12, sizeof bulk_write12);
 	assert_int_equal(fk.now, now);
 	assert_false(bus_is_pending(&bus));
@@ -488,10 +494,10 @@ static void test_ping_all(void **state)
 	/* queued before the request; the flush before it drops only what arrived */
 	fake_push(&fk, ping1_reply, sizeof ping1_reply, fk.now + 100);
 	fake_push(&fk, ping2_reply, sizeof ping2_reply, fk.now + 3100);
-	struct bus2_found found[4];
+	struct bus_found found[4];
 	size_t n = 9;
 	uint64_t start = fk.now;
-	assert_int_equal(bus2_ping_all(&bus, found, 4, &n), DXL_OK);
+	assert_int_equal(bus_ping_all(&bus, found, 4, &n), DXL_OK);
 	assert_memory_equal(fk.tx, ping_bc, sizeof ping_bc);
 	assert_int_equal(n, 2);
 	assert_int_equal(found[0].id, 1);
@@ -503,13 +509,13 @@ static void test_ping_all(void **state)
 	assert_int_equal(found[0].model, 1030);
 	assert_int_equal(bus.servo[2].replies, 1);
 	/* nobody: no servo, not an error */
-	assert_int_equal(bus2_ping_all(&bus, found, 4, &n), DXL_OK);
+	assert_int_equal(bus_ping_all(&bus, found, 4, &n), DXL_OK);
 	assert_int_equal(n, 0);
 	/* one ID twice: counted, listed once */
 	memcpy(queue, ping1_reply, sizeof ping1_reply);
 	memcpy(queue + sizeof ping1_reply, ping1_reply, sizeof ping1_reply);
 	script(queue, 2 * sizeof ping1_reply, 100);
-	assert_int_equal(bus2_ping_all(&bus, found, 4, &n), DXL_OK);
+	assert_int_equal(bus_ping_all(&bus, found, 4, &n), DXL_OK);
 	assert_int_equal(n, 1);
 	assert_int_equal(bus.servo[1].wrong_id, 1);
 }
@@ -520,22 +526,22 @@ static void test_echo(void **state)
 	(void)state;
 	setup_bus2(true);
 	script(ping1_reply, sizeof ping1_reply, 100);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_OK);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_OK);
 	assert_int_equal(bus.bytes_in, 24);
 	assert_int_equal(bus.echo_errors, 0);
 	/* a SYNC_WRITE's echo arriving during the next request: matched */
 	fk.echo_delay_us = 50;
 	uint8_t goals[8] = { 0 };
-	assert_int_equal(bus2_sync_write(&bus, 116, 4, (const uint8_t[]){ 1, 2 }, goals, 2), DXL_OK);
+	assert_int_equal(bus_sync_write(&bus, 116, 4, (const uint8_t[]){ 1, 2 }, goals, 2), DXL_OK);
 	uint32_t pos = 0;
 	script(pos1_reply, sizeof pos1_reply, 150);
-	assert_int_equal(bus2_read_u32(&bus, 1, 132, &pos, NULL), DXL_OK);
+	assert_int_equal(bus_read_u32(&bus, 1, 132, &pos, NULL), DXL_OK);
 	assert_int_equal(pos, 166);
 	/* a differing echo byte */
 	fk.echo_delay_us = 0;
 	fk.echo_corrupt_at = 6;
 	script(ping1_reply, sizeof ping1_reply, 100);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_E_ECHO);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_E_ECHO);
 	assert_int_equal(bus.echo_errors, 1);
 	fk.echo_corrupt_at = 0;
 	/* echo off, wiring that echoes: the echo is recognised, not parsed,
@@ -544,16 +550,16 @@ static void test_echo(void **state)
 	fk.echo = true;
 	script(ping1_reply, sizeof ping1_reply, 100);
 	uint64_t start = fk.now;
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_OK);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_OK);
 	assert_int_equal(fk.now - start, 100);
 	assert_int_equal(bus.unexpected_echoes, 1);
 	assert_int_equal(bus.servo[1].resyncs, 0);
-	assert_int_equal(bus.parser2.header_errors, 0);
+	assert_int_equal(bus.parser.v2.header_errors, 0);
 	/* and a reply that starts like the request, then differs, is parsed
 	 * whole (the held bytes go to the parser first) */
 	setup_bus2(false);
 	script(ping1_reply, sizeof ping1_reply, 100);
-	assert_int_equal(bus2_ping(&bus, 1, NULL, NULL, NULL), DXL_OK);
+	assert_int_equal(bus_ping_model(&bus, 1, NULL, NULL, NULL), DXL_OK);
 	assert_int_equal(bus.unexpected_echoes, 0);
 }
 

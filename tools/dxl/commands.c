@@ -657,7 +657,7 @@ static int dxlt_cmd_reset(struct dxlt *t)
 	int r = dxlt_ping(t, id);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	r = bus_factory_reset(&t->bus, id, false, &e);
+	r = bus_factory_reset(&t->bus, id, DXL_RESET_ALL, false, &e);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);

@@ -66,7 +66,7 @@ static const char *dxlt2_model_text(const struct dxlt2_servo *s)
 int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware)
 {
 	uint8_t e = 0;
-	int r = bus2_ping(&t->bus, id, model, firmware, &e);
+	int r = bus_ping_model(&t->bus, id, model, firmware, &e);
 	if (r == DXL_OK)
 		t->errseen2[id] |= e;
 	return r;
@@ -75,7 +75,7 @@ int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware)
 int dxlt2_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out)
 {
 	uint8_t e = 0;
-	int r = bus2_read(&t->bus, id, addr, len, out, &e);
+	int r = bus_read(&t->bus, id, addr, len, out, &e);
 	if (r == DXL_OK)
 		t->errseen2[id] |= e;
 	return r;
@@ -84,7 +84,7 @@ int dxlt2_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t 
 static int dxlt2_write(struct dxlt *t, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply)
 {
 	uint8_t e = 0;
-	int r = bus2_write(&t->bus, id, addr, data, n, expect_reply, &e);
+	int r = bus_write(&t->bus, id, addr, data, n, expect_reply, &e);
 	if (r == DXL_OK)
 		t->errseen2[id] |= e;
 	return r;
@@ -161,16 +161,16 @@ static int32_t dxlt2_decode(const struct dxlt2_reg *reg, const uint8_t *raw)
 
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found)
 {
-	struct bus2_found servo[BUS_MULTI_MAX];
+	struct bus_found servo[BUS_MULTI_MAX];
 	size_t n = 0;
 	/* One broadcast PING: every servo answers in ID order with its model
 	 * and firmware, so a rate costs one deadline, not 253 timeouts. */
-	int r = bus2_ping_all(&t->bus, servo, BUS_MULTI_MAX, &n);
+	int r = bus_ping_all(&t->bus, servo, BUS_MULTI_MAX, &n);
 
 	if (r == DXL_E_DISCONNECTED || r == DXL_E_IO)
 		return dxlt_bus_fail(t, DXL2_BROADCAST_ID, r);
 	for (size_t i = 0; i < n; i++) {
-		const struct bus2_found *f = &servo[i];
+		const struct bus_found *f = &servo[i];
 		const struct dxl2_model *m = dxl2_model_by_number(f->model);
 		if (f->id < t->a.id_lo || f->id > t->a.id_hi)
 			continue;
@@ -540,7 +540,7 @@ int dxlt2_cmd_reset(struct dxlt *t)
 	}
 	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	if ((r = bus2_factory_reset(&t->bus, id, (uint8_t)t->a.keep, false, &e)) != DXL_OK)
+	if ((r = bus_factory_reset(&t->bus, id, (uint8_t)t->a.keep, false, &e)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	uint8_t now_id = t->a.keep == DXL2_RESET_ALL ? 1 : id;
 	long now_baud = t->a.keep == DXL2_RESET_KEEP_ID_BAUD ? port_baud(t->port) : DXLT_DEFAULT_BAUD2;
@@ -568,7 +568,7 @@ int dxlt2_cmd_reboot(struct dxlt *t)
 	if (dxlt2_read(t, id, DXL2_X_STATUS_RETURN_LEVEL, 1, &level) != DXL_OK)
 		level = 0;
 	/* the reply (level 2) comes before the servo restarts */
-	if ((r = bus2_reboot(&t->bus, id, level >= 2, &e)) != DXL_OK)
+	if ((r = bus_reboot(&t->bus, id, level >= 2, &e)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	t->errseen2[id] |= e;
 	for (long waited = 0; waited < DXLT2_REBOOT_WAIT_US; waited += DXLT2_REBOOT_POLL_US) {

@@ -1,0 +1,232 @@
+/*
+ * dxl_proto.c — Protocol 1.0 and 2.0 as tables (dxl_proto.h). Each entry is
+ * the protocol's own function from dxl.c or dxl2.c, or a few lines fitting
+ * it to the table's shape: 16-bit addresses, one frame type. Pure code.
+ */
+#include "dxl_proto.h"
+
+#include <string.h>
+
+/* ---- Protocol 1.0 ------------------------------------------------------------ */
+
+/* Bytes around a 1.0 packet's parameters: FF FF ID LEN ERR ... CHK. */
+#define V1_OVERHEAD 6
+/* The 8-bit fields of a 1.0 READ, WRITE and SYNC_WRITE. */
+#define V1_FIELD_MAX 0xFFu
+
+static size_t v1_status_bytes(size_t nparams)
+{
+	return nparams + V1_OVERHEAD;
+}
+
+static int v1_instr_replies(uint8_t instr)
+{
+	/* SYNC_WRITE is always broadcast */
+	return instr == DXL_INST_SYNC_WRITE ? -1 : 0;
+}
+
+static int v1_encode_read(uint8_t *buf, size_t cap, uint8_t id, uint16_t addr, uint16_t len)
+{
+	if (addr > V1_FIELD_MAX || len > V1_FIELD_MAX)
+		return DXL_E_ARG;
+	return dxl_encode_read(buf, cap, id, (uint8_t)addr, (uint8_t)len);
+}
+
+static int v1_encode_write(uint8_t *buf, size_t cap, uint8_t id, uint16_t addr, const uint8_t *data, size_t n)
+{
+	return addr > V1_FIELD_MAX ? DXL_E_ARG : dxl_encode_write(buf, cap, id, (uint8_t)addr, data, n);
+}
+
+static int v1_encode_reg_write(uint8_t *buf, size_t cap, uint8_t id, uint16_t addr, const uint8_t *data,
+                               size_t n)
+{
+	return addr > V1_FIELD_MAX ? DXL_E_ARG : dxl_encode_reg_write(buf, cap, id, (uint8_t)addr, data, n);
+}
+
+static int v1_encode_factory_reset(uint8_t *buf, size_t cap, uint8_t id, uint8_t option)
+{
+	/* 1.0's FACTORY_RESET has no option: it resets everything, ID included */
+	return option != DXL_RESET_ALL ? DXL_E_ARG : dxl_encode_factory_reset(buf, cap, id);
+}
+
+static int v1_encode_sync_write(uint8_t *buf, size_t cap, uint16_t addr, uint16_t len, const uint8_t *ids,
+                                const uint8_t *data, size_t n)
+{
+	if (addr > V1_FIELD_MAX || len > V1_FIELD_MAX)
+		return DXL_E_ARG;
+	return dxl_encode_sync_write(buf, cap, (uint8_t)addr, (uint8_t)len, ids, data, n);
+}
+
+static void v1_parser_init(union dxl_proto_parser *p, bool instructions)
+{
+	dxl_parser_init(&p->v1, instructions ? DXL_PARSE_INSTRUCTION : DXL_PARSE_STATUS);
+}
+
+static void v1_parser_reset(union dxl_proto_parser *p)
+{
+	dxl_parser_reset(&p->v1);
+}
+
+static int v1_parser_feed(union dxl_proto_parser *p, const uint8_t *data, size_t n, size_t *used,
+                          struct dxl_frame *out)
+{
+	struct dxl_packet pkt;
+	int r = dxl_parser_feed(&p->v1, data, n, used, &pkt);
+	if (r != DXL_FRAME || out == NULL)
+		return r;
+	bool status = p->v1.kind == DXL_PARSE_STATUS;
+	out->id = pkt.id;
+	out->instr = status ? 0 : pkt.code;
+	out->err = status ? pkt.code : 0;
+	out->nparams = pkt.nparams;
+	out->wire_bytes = (uint16_t)(pkt.nparams + V1_OVERHEAD);
+	memcpy(out->params, pkt.params, pkt.nparams);
+	return r;
+}
+
+/* The AX-12, the 1.0 servo driven here, has no REBOOT, SYNC_READ or
+ * BULK_READ (ax12.md): the MX series' REBOOT and BULK_READ are left out
+ * until a 1.0 servo that has them is driven. */
+const struct dxl_proto dxl_proto_v1 = {
+	.name = "1.0",
+	.number = 1,
+	.caps = 0,
+	.max_id = DXL_MAX_ID,
+	.broadcast_id = DXL_BROADCAST_ID,
+	.max_packet = DXL_MAX_PACKET,
+	.max_params = DXL_MAX_PARAMS,
+	.max_read_len = DXL_MAX_PARAMS,
+	.addr_bytes = 1,
+	.ping_reply_params = 0,
+	.ping_round_trip_bytes = 2 * V1_OVERHEAD,
+	.err_alert = 0,
+	.echo_reads_as_status = true,
+	.status_bytes_max = v1_status_bytes,
+	.instr_replies = v1_instr_replies,
+	.encode_instruction = dxl_encode_instruction,
+	.encode_ping = dxl_encode_ping,
+	.encode_read = v1_encode_read,
+	.encode_write = v1_encode_write,
+	.encode_reg_write = v1_encode_reg_write,
+	.encode_action = dxl_encode_action,
+	.encode_factory_reset = v1_encode_factory_reset,
+	.encode_sync_write = v1_encode_sync_write,
+	.encode_status = dxl_encode_status,
+	.parser_init = v1_parser_init,
+	.parser_reset = v1_parser_reset,
+	.parser_feed = v1_parser_feed,
+	.instruction_name = dxl_instruction_name,
+	.err_format = dxl_errbits_format,
+};
+
+/* ---- Protocol 2.0 ------------------------------------------------------------ */
+
+/* A PING (10 bytes) and its reply with model number and firmware (14). */
+#define V2_PING_ROUND_TRIP 24
+
+static int v2_instr_replies(uint8_t instr)
+{
+	switch (instr) {
+	case DXL2_INST_SYNC_READ:
+	case DXL2_INST_BULK_READ:
+		return DXL_E_ARG;
+	case DXL2_INST_SYNC_WRITE:
+	case DXL2_INST_BULK_WRITE:
+		return -1;
+	default:
+		return 0;
+	}
+}
+
+static int v2_encode_bulk(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n, bool write)
+{
+	struct dxl2_bulk_item v2[DXL2_MULTI_MAX];
+	if (items == NULL || n == 0 || n > DXL2_MULTI_MAX)
+		return DXL_E_ARG;
+	for (size_t i = 0; i < n; i++)
+		v2[i] = (struct dxl2_bulk_item){ items[i].id, items[i].addr, items[i].len, items[i].data };
+	return write ? dxl2_encode_bulk_write(buf, cap, v2, n) : dxl2_encode_bulk_read(buf, cap, v2, n);
+}
+
+static int v2_encode_bulk_read(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n)
+{
+	return v2_encode_bulk(buf, cap, items, n, false);
+}
+
+static int v2_encode_bulk_write(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n)
+{
+	return v2_encode_bulk(buf, cap, items, n, true);
+}
+
+static void v2_parser_init(union dxl_proto_parser *p, bool instructions)
+{
+	dxl2_parser_init(&p->v2, instructions ? DXL2_PARSE_INSTRUCTION : DXL2_PARSE_STATUS);
+}
+
+static void v2_parser_reset(union dxl_proto_parser *p)
+{
+	dxl2_parser_reset(&p->v2);
+}
+
+static int v2_parser_feed(union dxl_proto_parser *p, const uint8_t *data, size_t n, size_t *used,
+                          struct dxl_frame *out)
+{
+	struct dxl2_packet pkt;
+	int r = dxl2_parser_feed(&p->v2, data, n, used, &pkt);
+	if (r != DXL_FRAME || out == NULL)
+		return r;
+	out->id = pkt.id;
+	out->instr = pkt.instr;
+	out->err = pkt.err;
+	out->nparams = pkt.nparams;
+	out->wire_bytes = pkt.wire_bytes;
+	memcpy(out->params, pkt.params, pkt.nparams);
+	return r;
+}
+
+const struct dxl_proto dxl_proto_v2 = {
+	.name = "2.0",
+	.number = 2,
+	.caps = DXL_CAP_SYNC_READ | DXL_CAP_BULK_READ | DXL_CAP_BULK_WRITE | DXL_CAP_REBOOT | DXL_CAP_CLEAR |
+	        DXL_CAP_PING_MODEL | DXL_CAP_BROADCAST_PING | DXL_CAP_RESET_OPTIONS,
+	.max_id = DXL2_MAX_ID,
+	.broadcast_id = DXL2_BROADCAST_ID,
+	.max_packet = DXL2_MAX_PACKET,
+	.max_params = DXL2_MAX_PARAMS,
+	.max_read_len = DXL2_MAX_READ_LEN,
+	.addr_bytes = 2,
+	.ping_reply_params = 3,
+	.ping_round_trip_bytes = V2_PING_ROUND_TRIP,
+	.err_alert = DXL2_ERR_ALERT,
+	.echo_reads_as_status = false,
+	.status_bytes_max = dxl2_status_bytes_max,
+	.instr_replies = v2_instr_replies,
+	.encode_instruction = dxl2_encode_instruction,
+	.encode_ping = dxl2_encode_ping,
+	.encode_read = dxl2_encode_read,
+	.encode_write = dxl2_encode_write,
+	.encode_reg_write = dxl2_encode_reg_write,
+	.encode_action = dxl2_encode_action,
+	.encode_factory_reset = dxl2_encode_factory_reset,
+	.encode_reboot = dxl2_encode_reboot,
+	.encode_clear_multi_turn = dxl2_encode_clear_multi_turn,
+	.encode_sync_write = dxl2_encode_sync_write,
+	.encode_sync_read = dxl2_encode_sync_read,
+	.encode_bulk_read = v2_encode_bulk_read,
+	.encode_bulk_write = v2_encode_bulk_write,
+	.encode_status = dxl2_encode_status,
+	.parser_init = v2_parser_init,
+	.parser_reset = v2_parser_reset,
+	.parser_feed = v2_parser_feed,
+	.instruction_name = dxl2_instruction_name,
+	.err_format = dxl2_err_format,
+};
+
+const struct dxl_proto *dxl_proto_by_number(int number)
+{
+	switch (number) {
+	case 1: return &dxl_proto_v1;
+	case 2: return &dxl_proto_v2;
+	default: return NULL;
+	}
+}
