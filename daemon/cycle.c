@@ -2,6 +2,7 @@
 #include "cycle.h"
 
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "dxl.h"
@@ -20,9 +21,11 @@ static uint64_t cyc_now(const struct cyc *y)
 	return y->bus->io.now_us(y->bus->io.ctx);
 }
 
-static bool cyc_p2(const struct cyc *y)
+/* One SYNC_READ for every joint's present block where the protocol has it
+ * (2.0); else one READ a joint (1.0). */
+static bool cyc_sync_reads(const struct cyc *y)
 {
-	return bus_get_protocol(y->bus) == BUS_PROTOCOL_2;
+	return dxl_proto_can(bus_proto(y->bus), DXL_CAP_SYNC_READ);
 }
 
 bool cyc_busy(const struct cyc *y)
@@ -92,33 +95,24 @@ void cyc_cut(struct cyc *y)
 
 static int cyc_begin_read(struct cyc *y, uint8_t id, uint16_t addr, uint16_t len)
 {
-	if (cyc_p2(y)) {
-		uint8_t p2[4] = { (uint8_t)addr, (uint8_t)(addr >> 8), (uint8_t)len, (uint8_t)(len >> 8) };
-		return bus_begin(y->bus, id, DXL2_INST_READ, p2, sizeof p2, len);
-	}
-	uint8_t params[2] = { (uint8_t)addr, (uint8_t)len };
-	return bus_begin(y->bus, id, DXL_INST_READ, params, 2, len);
+	return bus_read_begin(y->bus, id, addr, len);
 }
 
+/* A queued write; one of no bytes is a REBOOT (the X series' recovery). */
 static int cyc_begin_write(struct cyc *y, const struct wq_write *w)
 {
-	uint8_t params[6] = { (uint8_t)w->addr, (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8),
-	                      (uint8_t)(w->value >> 16), (uint8_t)(w->value >> 24) };
-	int reply = -1;
+	uint8_t data[4] = { (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8), (uint8_t)(w->value >> 16),
+	                    (uint8_t)(w->value >> 24) };
+	bool reply = false;
 	for (size_t j = 0; j < y->ctl->n; j++)
 		if (y->ctl->j[j].id == w->id && y->ctl->j[j].servo.status_return_level >= 2)
-			reply = 0;
-	if (!cyc_p2(y))
-		return bus_begin(y->bus, w->id, DXL_INST_WRITE, params, (size_t)w->len + 1, reply);
+			reply = true;
 	if (w->len == 0)
-		return bus_begin(y->bus, w->id, DXL2_INST_REBOOT, NULL, 0, reply);
-	/* 2.0: a 16-bit address before the data */
-	uint8_t p2[6] = { (uint8_t)w->addr, (uint8_t)(w->addr >> 8) };
-	memcpy(p2 + 2, params + 1, w->len);
-	return bus_begin(y->bus, w->id, DXL2_INST_WRITE, p2, (size_t)w->len + 2, reply);
+		return bus_reboot_begin(y->bus, w->id, reply);
+	return bus_write_begin(y->bus, w->id, w->addr, data, w->len, reply);
 }
 
-/* Protocol 2.0: every joint's present block in one SYNC_READ. */
+/* Where the protocol has it: every joint's present block in one SYNC_READ. */
 static int cyc_begin_sync_read(struct cyc *y)
 {
 	uint8_t ids[CFG_MAX_JOINTS];
@@ -167,7 +161,7 @@ static enum cyc_status cyc_advance(struct cyc *y)
 				y->control_start_us = cyc_now(y);
 				return CYC_CONTROL;
 			}
-			if (cyc_p2(y)) {
+			if (cyc_sync_reads(y)) {
 				r = cyc_begin_sync_read(y);
 				if (cyc_port_gone(r))
 					return cyc_lost(y, r);
@@ -224,7 +218,7 @@ static enum cyc_status cyc_advance(struct cyc *y)
 				return cyc_lost(y, r);
 			if (r == DXL_OK && bus_is_pending(y->bus))
 				return CYC_PENDING;
-			cyc_error(y, id, cyc_p2(y) ? "READ (read-back)" : "READ(24)", r);
+			cyc_error(y, id, "READ (read-back)", r);
 			return cyc_finish(y, CYC_DONE);
 		}
 		}
@@ -296,7 +290,7 @@ enum cyc_status cyc_step(struct cyc *y)
 		return cyc_lost(y, r);
 	switch (y->phase) {
 	case CYC_READ:
-		if (cyc_p2(y)) {
+		if (cyc_sync_reads(y)) {
 			cyc_readings2(y);
 			y->idx = y->ctl->n;
 			break;
@@ -313,11 +307,13 @@ enum cyc_status cyc_step(struct cyc *y)
 		const struct sm_model *m = ctl_model(y->ctl, 0);
 		bool ok = r == DXL_OK && !sm_write_refused(m, reply.code);
 		if (r != DXL_OK)
-			cyc_error(y, id, cyc_p2(y) && y->bus->req_instr == DXL2_INST_REBOOT ? "REBOOT" : "WRITE", r);
-		else if (!ok)
-			cyc_error(y, id, cyc_p2(y) ? "WRITE refused by the servo (an error number in its status)"
-			                           : "WRITE refused by the servo (error byte with range, instruction or checksum)",
-			          DXL_OK);
+			cyc_error(y, id, y->bus->req_instr == DXL_INST_REBOOT ? "REBOOT" : "WRITE", r);
+		else if (!ok) {
+			char said[96], what[128];
+			snprintf(what, sizeof what, "WRITE refused by the servo (its status: %s)",
+			         bus_proto(y->bus)->err_format(reply.code, said, sizeof said));
+			cyc_error(y, id, what, DXL_OK);
+		}
 		y->write_on_wire = false;
 		ctl_write_result(y->ctl, ok);
 		if (y->phase == CYC_WRITE_FIRST)
@@ -331,7 +327,7 @@ enum cyc_status cyc_step(struct cyc *y)
 			ctl_readback_block(y->ctl, y->readback_now_joint, y->readback_now_block, got->params, got->nparams,
 			                   reply.code);
 		} else {
-			cyc_error(y, y->ctl->j[y->readback_now_joint].id, cyc_p2(y) ? "READ (read-back)" : "READ(24)", r);
+			cyc_error(y, y->ctl->j[y->readback_now_joint].id, "READ (read-back)", r);
 		}
 		return cyc_finish(y, CYC_DONE);
 	default:

@@ -292,6 +292,34 @@ int bus_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, s
 	return bus_request(b, pkt, n, id, instr, reply_params);
 }
 
+int bus_read_begin(struct bus *b, uint8_t id, uint16_t addr, uint16_t len)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	const struct dxl_proto *pr = b->proto;
+	if (id > pr->max_id || len == 0 || len > pr->max_read_len)
+		return DXL_E_ARG;
+	return bus_request(b, pkt, pr->encode_read(pkt, sizeof pkt, id, addr, len), id, DXL_INST_READ, len);
+}
+
+int bus_write_begin(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	const struct dxl_proto *pr = b->proto;
+	if (data == NULL || n == 0 || n + pr->addr_bytes > pr->max_params)
+		return DXL_E_ARG;
+	return bus_request(b, pkt, pr->encode_write(pkt, sizeof pkt, id, addr, data, n), id, DXL_INST_WRITE,
+	                   expect_reply ? 0 : -1);
+}
+
+int bus_reboot_begin(struct bus *b, uint8_t id, bool expect_reply)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	const struct dxl_proto *pr = b->proto;
+	if (!dxl_proto_can(pr, DXL_CAP_REBOOT) || pr->encode_reboot == NULL)
+		return DXL_E_UNSUPPORTED;
+	return bus_request(b, pkt, pr->encode_reboot(pkt, sizeof pkt, id), id, DXL_INST_REBOOT, expect_reply ? 0 : -1);
+}
+
 int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n)
 {
 	if (pkt == NULL || n == 0 || n > b->proto->max_packet)

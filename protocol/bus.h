@@ -216,6 +216,12 @@ void bus_reset_stats(struct bus *b);
  * when no reply expected) or a negative dxl_status. */
 int bus_begin(struct bus *b, uint8_t id, uint8_t instr, const uint8_t *params, size_t nparams,
               int reply_params);
+/* One READ, WRITE or REBOOT by the protocol's table (16-bit addresses on
+ * either protocol; 1.0 refuses an address above 255, and has no REBOOT:
+ * DXL_E_UNSUPPORTED), left pending as bus_begin's. */
+int bus_read_begin(struct bus *b, uint8_t id, uint16_t addr, uint16_t len);
+int bus_write_begin(struct bus *b, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply);
+int bus_reboot_begin(struct bus *b, uint8_t id, bool expect_reply);
 /* Send pre-encoded bytes (e.g. a SYNC_WRITE) expecting no reply. */
 int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n);
 /* One SYNC_READ of len bytes at addr from n servos, or one BULK_READ
