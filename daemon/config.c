@@ -258,20 +258,65 @@ bool cfg_param_is_robot(const char *key)
 	return d != NULL && !d->joint;
 }
 
+/* A joint's oscillator parameter by name: the commandable ones. */
+static double *cfg_osc_param(struct osc_joint_params *o, const char *key)
+{
+	if (strcmp(key, "k") == 0) return &o->k;
+	if (strcmp(key, "c") == 0) return &o->c;
+	if (strcmp(key, "mu") == 0) return &o->mu;
+	if (strcmp(key, "lambda") == 0) return &o->lambda;
+	if (strcmp(key, "coupling_phase") == 0) return &o->coupling_phase;
+	if (strcmp(key, "inertia") == 0) return &o->inertia;
+	if (strcmp(key, "friction") == 0) return &o->friction;
+	return NULL;
+}
+
 double *cfg_joint_param(struct cfg_joint *j, const char *key)
 {
-	if (strcmp(key, "k") == 0) return &j->osc.k;
-	if (strcmp(key, "c") == 0) return &j->osc.c;
-	if (strcmp(key, "mu") == 0) return &j->osc.mu;
-	if (strcmp(key, "lambda") == 0) return &j->osc.lambda;
-	if (strcmp(key, "coupling_phase") == 0) return &j->osc.coupling_phase;
-	if (strcmp(key, "inertia") == 0) return &j->osc.inertia;
-	if (strcmp(key, "friction") == 0) return &j->osc.friction;
+	double *osc = cfg_osc_param(&j->osc, key);
+	if (osc != NULL)
+		return osc;
 	if (strcmp(key, "neutral") == 0) return &j->neutral;
 	if (strcmp(key, "limit_min") == 0) return &j->limit_min;
 	if (strcmp(key, "limit_max") == 0) return &j->limit_max;
 	if (strcmp(key, "max_step") == 0) return &j->max_step;
 	return NULL;
+}
+
+void cfg_params_init(struct cfg_params *p, const struct cfg *c)
+{
+	memset(p, 0, sizeof *p);
+	for (size_t j = 0; j < c->njoints && j < CFG_MAX_JOINTS; j++)
+		p->osc[j] = c->joint[j].osc;
+	p->servo_lead_s = c->servo_lead_s;
+	p->amplitude = c->amplitude;
+	p->frequency = c->frequency;
+	p->phase = c->phase;
+	p->sin_stiffness = c->sin_stiffness;
+	p->sin_damping = c->sin_damping;
+}
+
+void cfg_params_put(struct cfg *c, const struct cfg_params *p)
+{
+	for (size_t j = 0; j < c->njoints && j < CFG_MAX_JOINTS; j++)
+		c->joint[j].osc = p->osc[j];
+	c->servo_lead_s = p->servo_lead_s;
+	c->amplitude = p->amplitude;
+	c->frequency = p->frequency;
+	c->phase = p->phase;
+	c->sin_stiffness = p->sin_stiffness;
+	c->sin_damping = p->sin_damping;
+}
+
+double *cfg_params_field(struct cfg_params *p, const char *key, size_t j)
+{
+	if (strcmp(key, "amplitude") == 0) return &p->amplitude;
+	if (strcmp(key, "frequency") == 0) return &p->frequency;
+	if (strcmp(key, "phase") == 0) return &p->phase;
+	if (strcmp(key, "stiffness") == 0) return &p->sin_stiffness;
+	if (strcmp(key, "damping") == 0) return &p->sin_damping;
+	if (strcmp(key, "servo_lead_s") == 0) return &p->servo_lead_s;
+	return j < CFG_MAX_JOINTS ? cfg_osc_param(&p->osc[j], key) : NULL;
 }
 
 static bool range_ok(const struct cfg_range *r, double v)
@@ -280,6 +325,59 @@ static bool range_ok(const struct cfg_range *r, double v)
 		return false;
 	return v <= r->max;
 }
+
+bool cfg_params_check(const struct cfg *c, const struct cfg_params *live, const char *key, int joint, double value,
+                      char *why, size_t cap)
+{
+	struct cfg_range range = { 0.0, CFG_LEAD_MAX_S, false };
+	bool lead = strcmp(key, "servo_lead_s") == 0;
+	if (!lead && (!cfg_param_range(key, &range) || !cfg_param_commandable(key))) {
+		snprintf(why, cap, "parameter %s cannot be changed while the robot runs", key);
+		return false;
+	}
+	if (!isfinite(value)) {
+		snprintf(why, cap, "parameter %s: value is not finite", key);
+		return false;
+	}
+	bool robot = lead || cfg_param_is_robot(key);
+	if (robot && joint != -1) {
+		snprintf(why, cap, "parameter %s is per robot: joint must be -1, not %d", key, joint);
+		return false;
+	}
+	if (!robot && (joint < -1 || joint >= (int)c->njoints)) {
+		snprintf(why, cap, "parameter %s: joint %d does not exist (0..%zu, or -1 for all)", key, joint,
+		         c->njoints - 1);
+		return false;
+	}
+	if (!range_ok(&range, value)) {
+		snprintf(why, cap, "parameter %s: %g out of range %s%g..%g", key, value, range.min_open ? ">" : "",
+		         range.min, range.max);
+		return false;
+	}
+	if (lead)
+		return true;
+	char inner[200];
+	if (robot) {
+		if (cfg_robot_param_check(c, key, value, inner, sizeof inner))
+			return true;
+		snprintf(why, cap, "parameter %s: %s", key, inner);
+		return false;
+	}
+	/* what the range table cannot express: the joint's parameters together */
+	size_t first = joint < 0 ? 0 : (size_t)joint;
+	size_t last = joint < 0 ? c->njoints : first + 1;
+	for (size_t j = first; j < last; j++) {
+		struct cfg_joint jt = c->joint[j];
+		jt.osc = live->osc[j];
+		*cfg_osc_param(&jt.osc, key) = value;
+		if (!cfg_joint_check(&jt, inner, sizeof inner)) {
+			snprintf(why, cap, "parameter %s: joint %zu: %s", key, j, inner);
+			return false;
+		}
+	}
+	return true;
+}
+
 
 /* ---- defaults ----------------------------------------------------------------------- */
 void cfg_defaults(struct cfg *c)
@@ -386,7 +484,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("rs485", T_RS485, rs485, 0, 0),
 	K("adapter_latency_us", T_LONG, adapter_latency_us, -1, 100000),
 	K("period_ms", T_DOUBLE, period_ms, 2, 100),
-	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, 0.2),
+	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, CFG_LEAD_MAX_S),
 	K("compliance_margin", T_LONG, compliance_margin, -1, 255),
 	K("compliance_slope", T_LONG, compliance_slope, -1, 254),
 	K("actuation", T_ACT, actuation, 0, 0),
@@ -885,25 +983,22 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 	}
 }
 
-void cfg_scale_torque_defaults(struct cfg *c, size_t j, double scale)
+void cfg_params_scale_torque_defaults(struct cfg_params *p, const struct cfg *c, size_t j, double scale)
 {
-	struct cfg_joint *jt = &c->joint[j];
-	unsigned d = jt->torque_defaults;
-	if (d & CFG_TQ_K) jt->osc.k *= scale;
-	if (d & CFG_TQ_C) jt->osc.c *= scale;
-	if (d & CFG_TQ_MU) jt->osc.mu *= scale;
-	if (d & CFG_TQ_INERTIA) jt->osc.inertia *= scale;
-	if (d & CFG_TQ_FRICTION) jt->osc.friction *= scale;
-	jt->torque_defaults = 0;
+	struct osc_joint_params *o = &p->osc[j];
+	unsigned d = c->joint[j].torque_defaults;
+	if (d & CFG_TQ_K) o->k *= scale;
+	if (d & CFG_TQ_C) o->c *= scale;
+	if (d & CFG_TQ_MU) o->mu *= scale;
+	if (d & CFG_TQ_INERTIA) o->inertia *= scale;
+	if (d & CFG_TQ_FRICTION) o->friction *= scale;
 }
 
-bool cfg_position_defaults(struct cfg *c, size_t j, double k, double mu)
+bool cfg_params_position_defaults(struct cfg_params *p, const struct cfg *c, size_t j, double k, double mu)
 {
-	struct cfg_joint *jt = &c->joint[j];
-	unsigned d = jt->position_defaults;
-	if (d & CFG_TQ_K) jt->osc.k = k;
-	if (d & CFG_TQ_MU) jt->osc.mu = mu;
-	jt->position_defaults = 0;
+	unsigned d = c->joint[j].position_defaults;
+	if (d & CFG_TQ_K) p->osc[j].k = k;
+	if (d & CFG_TQ_MU) p->osc[j].mu = mu;
 	return d != 0;
 }
 

@@ -181,7 +181,7 @@ static void test_switches_without_jumps(void **state)
 	if (!(first <= before + 0.01))
 		fail_msg("goal jumped %.4f rad at the switch to SINUSOID (moving %.4f a cycle)", first, before);
 	run(300);
-	const double a = c.cfg->amplitude;
+	const double a = c.p.amplitude;
 	/* once blended, the commanded angle is the sinusoid itself */
 	assert_true(fabs(c.j[0].goal - osc_sinusoid(a, cfg.frequency, cfg.phase, 0, t)) < 1e-9);
 }
@@ -461,13 +461,12 @@ static void test_goal_register_inside_limits(void **state)
 {
 	(void)state;
 	setup_robot(CFG_MODE_SINUSOID);
-	cfg.amplitude = 2.5;
 	cfg.joint[1].limit_min = -0.5;
 	cfg.joint[1].limit_max = 0.5;
 	char why[512];
 	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023 };
 	assert_true(ctl_set_servo(&c, 1, &info, why, sizeof why));
-	ctl_params_changed(&c);
+	assert_true(ctl_set_param(&c, "amplitude", -1, 2.5, why, sizeof why));
 	uint16_t addr;
 	uint8_t width, ids[8], data[64];
 	int at_hi = 0, at_lo = 0;
@@ -494,8 +493,8 @@ static void test_nonfinite_never_reaches_goal(void **state)
 	setup_robot(CFG_MODE_SINUSOID);
 	run(200);
 	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
-	cfg.joint[0].osc.k = NAN;      /* a corrupted parameter */
-	cfg.joint[1].osc.inertia = INFINITY;
+	c.p.osc[0].k = NAN;      /* a corrupted parameter (ctl_set_param refuses one) */
+	c.p.osc[1].inertia = INFINITY;
 	long long before = c.nonfinite;
 	double m = run(50);
 	assert_true(c.nonfinite > before);
@@ -510,11 +509,10 @@ static void test_limits_respected(void **state)
 {
 	(void)state;
 	setup_robot(CFG_MODE_SINUSOID);
-	cfg.amplitude = 2.5;   /* asks beyond ±1.3 */
 	char why[512];
 	struct ctl_servo_info info = { .cw_limit = 400, .ccw_limit = 1023, .max_torque = 1023 };
 	assert_true(ctl_set_servo(&c, 0, &info, why, sizeof why));
-	ctl_params_changed(&c);
+	assert_true(ctl_set_param(&c, "amplitude", -1, 2.5, why, sizeof why));   /* asks beyond ±1.3 */
 	for (int i = 0; i < 400; i++) {
 		cycle();
 		assert_true(c.j[0].goal >= dxl_pos_to_rad(400) - 1e-12 && c.j[0].goal <= 1.3 + 1e-12);
