@@ -364,6 +364,30 @@ static void test_search_stays_inside_the_configuration_ranges(void **state)
 	assert_true(kmax > 9.0);   /* it went to the edge, not past it */
 }
 
+/* The tuner's steps go through the controller's one door: a step it
+ * refuses (here k beyond its range, forced by hand: the search box stays
+ * inside) fails the tuning with the controller's reason and leaves the
+ * controller running what it ran, whole — no joint half-changed. */
+static void test_refused_step_fails_and_changes_nothing(void **state)
+{
+	(void)state;
+	struct run r;
+	start(&r, 2, 0.8, 0.8, false);
+	struct plant p = { .f0 = 1.07, .a0 = { 1.23, 1.30 }, .ef = 0.45, .ea = 0.28 };
+	drive(&r, &p, 12);
+	assert_true(r.applied >= 1);
+	struct cfg_params before = r.ctl.p;
+	r.t.mu[0] *= 1.01;                  /* joint 0 alone would pass ... */
+	r.t.k = 20.0 / r.t.k0[1];           /* ... joint 1's k does not */
+	r.t.changed = true;
+	assert_false(tune_apply(&r.t, &r.ctl));
+	assert_false(r.t.changed);
+	assert_int_equal(r.t.state, TUNE_FAILED);
+	assert_non_null(strstr(r.t.why, "the controller refused the tuner's step: parameter k: "));
+	assert_memory_equal(&r.ctl.p, &before, sizeof before);
+	assert_memory_equal(&r.t.ran, &before, sizeof before);
+}
+
 /* Bad samples (NaN angles, time going backwards) neither crash nor count. */
 static void test_bad_samples(void **state)
 {
@@ -427,6 +451,7 @@ int main(void)
 		cmocka_unit_test(test_starter_again_is_a_stall),
 		cmocka_unit_test(test_targets_checked_against_the_configuration),
 		cmocka_unit_test(test_search_stays_inside_the_configuration_ranges),
+		cmocka_unit_test(test_refused_step_fails_and_changes_nothing),
 		cmocka_unit_test(test_bad_samples),
 		cmocka_unit_test(test_written_configuration_loads),
 	};
