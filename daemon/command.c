@@ -32,7 +32,7 @@ static enum cmd_verdict cmd_check_param(const struct cmd_request *r, const struc
 	const char *name = nz(r->param);
 	char quoted[CMD_QUOTE_MAX];
 	text_sanitize(quoted, sizeof quoted, name);
-	struct cfg_range range;
+	struct param_range range;
 	if (!cfg_param_range(name, &range))
 		return reject(why, cap, "unknown parameter '%s' (%s)", quoted, cfg_param_commandable_list());
 	if (!cfg_param_commandable(name))

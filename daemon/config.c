@@ -16,9 +16,9 @@
 #include "textfile.h"
 #include "udpm.h"
 
-#define CFG_PI 3.14159265358979323846
+#define CFG_PI PARAM_PI
 /* The AX-12 turns 300°: ±150° = ±2.618 rad around its centre. */
-#define CFG_SERVO_HALF_RANGE (150.0 * CFG_PI / 180.0)
+#define CFG_SERVO_HALF_RANGE PARAM_SERVO_HALF_RANGE
 
 static void cfg_error(struct cfg_errors *e, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void cfg_error(struct cfg_errors *e, const char *fmt, ...)
@@ -152,51 +152,10 @@ static bool parse_ids(const char *s, uint8_t *out, size_t *n, char *why, size_t 
 	return true;
 }
 
-/* ---- parameter ranges (documented in daemon/README.md) ------------------------------ */
-struct cfg_param_def {
-	const char *key;
-	struct cfg_range range;
-	bool joint;        /* per joint ([joint.N]) or per robot ([sinusoid]) */
-	bool commandable;  /* a command may change it (never what bounds a joint) */
-};
-/* The ranges are physical: an AX-12 joint's link has an inertia of order
- * 1e-3 kg·m² and a stall torque of 1.5 N·m, so a law's spring of more than
- * 10 N·m/rad or an inertia below 1e-5 (the oscillator then asks for
- * accelerations the servo cannot give and one control period cannot
- * integrate) is a typo, not a tuning. */
-static const struct cfg_param_def cfg_params[] = {
-	{ "k",         { 1e-4, 10.0, false }, true, true },
-	{ "c",         { -1.0, 1.0, false }, true, true },
-	{ "mu",        { 0.0, 100.0, false }, true, true },
-	{ "lambda",    { -10.0, 10.0, false }, true, true },
-	{ "inertia",   { 1e-5, 1.0, false }, true, true },
-	{ "friction",  { 0.0, 1.0, false }, true, true },
-	{ "coupling_phase", { -CFG_PI, CFG_PI, false }, true, true },
-	{ "neutral",   { -CFG_SERVO_HALF_RANGE, CFG_SERVO_HALF_RANGE, false }, true, false },
-	{ "limit_min", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
-	{ "limit_max", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
-	{ "max_step",  { 0.0, 0.5, true }, true, false },
-	{ "amplitude", { 0.0, CFG_SERVO_HALF_RANGE, false }, false, true },
-	{ "frequency", { 0.0, 5.0, false }, false, true },
-	{ "phase",     { -2.0 * CFG_PI, 2.0 * CFG_PI, false }, false, true },
-	/* the clock as a torque law: the paper's 0.015..0.135 N·m/rad and far
-	 * beyond (the position loop's own stiffness is 9.2 N·m/rad); 0 = off */
-	{ "stiffness", { 0.0, 10.0, false }, false, true },
-	{ "damping",   { 0.0, 1.0, false }, false, true },
-};
-#define CFG_NPARAMS (sizeof cfg_params / sizeof cfg_params[0])
-
-static const struct cfg_param_def *cfg_param_find(const char *key)
+/* ---- parameter ranges: common/params.h, one table with the programs that send commands ---- */
+bool cfg_param_range(const char *key, struct param_range *out)
 {
-	for (size_t i = 0; i < CFG_NPARAMS; i++)
-		if (strcmp(key, cfg_params[i].key) == 0)
-			return &cfg_params[i];
-	return NULL;
-}
-
-bool cfg_param_range(const char *key, struct cfg_range *out)
-{
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	if (d == NULL)
 		return false;
 	*out = d->range;
@@ -205,7 +164,7 @@ bool cfg_param_range(const char *key, struct cfg_range *out)
 
 bool cfg_param_commandable(const char *key)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	return d != NULL && d->commandable;
 }
 
@@ -248,13 +207,13 @@ bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap)
 
 bool cfg_param_is_joint(const char *key)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	return d != NULL && d->joint;
 }
 
 bool cfg_param_is_robot(const char *key)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	return d != NULL && !d->joint;
 }
 
@@ -319,17 +278,10 @@ double *cfg_params_field(struct cfg_params *p, const char *key, size_t j)
 	return j < CFG_MAX_JOINTS ? cfg_osc_param(&p->osc[j], key) : NULL;
 }
 
-static bool range_ok(const struct cfg_range *r, double v)
-{
-	if (r->min_open ? !(v > r->min) : !(v >= r->min))
-		return false;
-	return v <= r->max;
-}
-
 bool cfg_params_check(const struct cfg *c, const struct cfg_params *live, const char *key, int joint, double value,
                       char *why, size_t cap)
 {
-	struct cfg_range range = { 0.0, CFG_LEAD_MAX_S, false };
+	struct param_range range = { 0.0, CFG_LEAD_MAX_S, false };
 	bool lead = strcmp(key, "servo_lead_s") == 0;
 	if (!lead && (!cfg_param_range(key, &range) || !cfg_param_commandable(key))) {
 		snprintf(why, cap, "parameter %s cannot be changed while the robot runs", key);
@@ -349,7 +301,7 @@ bool cfg_params_check(const struct cfg *c, const struct cfg_params *live, const 
 		         c->njoints - 1);
 		return false;
 	}
-	if (!range_ok(&range, value)) {
+	if (!param_in_range(&range, value)) {
 		snprintf(why, cap, "parameter %s: %g out of range %s%g..%g", key, value, range.min_open ? ">" : "",
 		         range.min, range.max);
 		return false;
@@ -665,13 +617,13 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 static bool cfg_set_param(double *field, const char *where, const char *section, const char *key,
                           const char *value, struct cfg_errors *e)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	double v;
 	if (!parse_double(value, &v)) {
 		cfg_error(e, "%s: [%s] %s: not a number '%s'", where, section, key, value);
 		return false;
 	}
-	if (!range_ok(&d->range, v)) {
+	if (!param_in_range(&d->range, v)) {
 		cfg_error(e, "%s: [%s] %s: %g out of range %s%g..%g", where, section, key, v,
 		          d->range.min_open ? ">" : "", d->range.min, d->range.max);
 		return false;

@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "osc.h"
+#include "params.h"
 #include "port.h"
 
 #define CFG_MAX_JOINTS   OSC_MAX_JOINTS   /* joints per robot: the oscillator's bound */
@@ -144,10 +145,10 @@ bool cfg_set(struct cfg *c, const char *where, const char *section, const char *
  * (ids present, limits ordered, ...). Call once after all sources. */
 bool cfg_finish(struct cfg *c, struct cfg_errors *errors);
 
-/* Documented ranges of the per-joint and sinusoid parameters; shared with
- * command validation. Returns false for an unknown name. */
-struct cfg_range { double min, max; bool min_open; };
-bool cfg_param_range(const char *key, struct cfg_range *out);
+/* Documented ranges of the per-joint and sinusoid parameters (common/params.h:
+ * one table for the file, commands and the programs that send them). Returns
+ * false for an unknown name. */
+bool cfg_param_range(const char *key, struct param_range *out);
 /* May a command change it? Only the configuration decides where a joint may
  * go: neutral, the limits and max_step are not commandable. */
 bool cfg_param_commandable(const char *key);

@@ -193,7 +193,7 @@ bool tune_init(struct tune *t, const struct tune_opts *o, const struct cfg *cfg,
 	 * natural frequency one period integrates: cfg_joint_check) — the tuner
 	 * sets parameters as a command would, so it is held to what a command
 	 * may set, and the file it writes loads. */
-	struct cfg_range kr, mr;
+	struct param_range kr, mr;
 	cfg_param_range("k", &kr);
 	cfg_param_range("mu", &mr);
 	t->k_lo = 1.0 / TUNE_K_RANGE;

@@ -355,7 +355,7 @@ static void test_search_stays_inside_the_configuration_ranges(void **state)
 			jt.osc = r.ctl.p.osc[j];
 			char jwhy[128];
 			assert_true(cfg_joint_check(&jt, jwhy, sizeof jwhy));
-			struct cfg_range kr;
+			struct param_range kr;
 			assert_true(cfg_param_range("k", &kr) && r.ctl.p.osc[j].k <= kr.max);
 		}
 	}
