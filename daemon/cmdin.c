@@ -53,11 +53,12 @@ bool cin_check_key(const struct cfg *cfg, char *why, size_t cap, char *note, siz
 	return ok;
 }
 
-bool cin_open(struct cin *in, const struct cfg *cfg, const struct cin_hooks *hooks, int64_t fingerprint,
-              char *why, size_t cap)
+bool cin_open(struct cin *in, const struct cfg *cfg, const struct ctl *ctl, const struct cin_hooks *hooks,
+              int64_t fingerprint, char *why, size_t cap)
 {
 	memset(in, 0, sizeof *in);
 	in->cfg = cfg;
+	in->ctl = ctl;
 	in->hooks = *hooks;
 	in->fingerprint = fingerprint;
 	in->local_fd = in->net_fd = -1;
@@ -212,7 +213,8 @@ static void cin_take(struct cin *in, struct cin_cmd *c)
 		cin_reject(in, c, "commands are disabled in this robot's configuration (commands = off)");
 		return;
 	}
-	enum cmd_verdict v = cmd_check(&c->w.req, in->cfg, c->direct, why, sizeof why);
+	enum cmd_verdict v = cmd_check_live(&c->w.req, in->cfg, in->ctl != NULL ? &in->ctl->p : NULL, c->direct, why,
+	                                    sizeof why);
 	if (v == CMD_IGNORE)
 		return;
 	if (v == CMD_REJECT) {
@@ -353,12 +355,12 @@ void cin_on_network(struct cin *in)
 }
 
 /* ---- the cycle boundary ------------------------------------------------------------------------ */
-static bool cin_apply_one(struct cin_cmd *c, struct ctl *ctl, struct cfg *cfg, char *text, size_t cap)
+static bool cin_apply_one(struct cin_cmd *c, struct ctl *ctl, char *text, size_t cap)
 {
 	const struct cmd_request *r = &c->w.req;
 	char reason[sizeof ctl->reason];
 	/* an earlier command of this batch may have changed what is valid */
-	if (cmd_check(r, cfg, c->direct, text, cap) != CMD_ACCEPT)
+	if (cmd_check_live(r, ctl->cfg, &ctl->p, c->direct, text, cap) != CMD_ACCEPT)
 		return false;
 	switch (r->kind) {
 	case CMD_KIND_MODE:
@@ -377,20 +379,20 @@ static bool cin_apply_one(struct cin_cmd *c, struct ctl *ctl, struct cfg *cfg, c
 			return false;
 		break;
 	case CMD_KIND_PARAM:
-		cmd_apply_param(cfg, r);
-		ctl_params_changed(ctl);
+		if (!ctl_set_param(ctl, r->param, r->joint, r->value, text, cap))
+			return false;
 		break;
 	}
 	cmd_describe(r, text, cap);
 	return true;
 }
 
-void cin_apply(struct cin *in, struct ctl *ctl, struct cfg *cfg)
+void cin_apply(struct cin *in, struct ctl *ctl)
 {
 	for (size_t i = 0; i < in->nq; i++) {
 		struct cin_cmd *c = &in->q[i];
 		char text[256];
-		if (cin_apply_one(c, ctl, cfg, text, sizeof text))
+		if (cin_apply_one(c, ctl, text, sizeof text))
 			cin_accepted(in, c, text);
 		else
 			cin_reject(in, c, text);

@@ -64,6 +64,7 @@ struct cin_cmd {
 
 struct cin {
 	const struct cfg *cfg;
+	const struct ctl *ctl;           /* a command's value is judged against its live parameters */
 	struct cin_hooks hooks;
 	int64_t fingerprint;             /* command_t's */
 	int local_fd, net_fd;
@@ -85,10 +86,12 @@ struct cin {
 };
 
 /* Opens the doors the configuration asks for. cfg is read each time (its
- * name, its commands setting). False with *why (a config error, or the socket
- * taken by another daemon for this robot). */
-bool cin_open(struct cin *in, const struct cfg *cfg, const struct cin_hooks *hooks, int64_t fingerprint,
-              char *why, size_t cap);
+ * name, its commands setting), and a parameter's value is judged against
+ * ctl's live parameters when it arrives (NULL: the configuration's). False
+ * with *why (a config error, or the socket taken by another daemon for this
+ * robot). */
+bool cin_open(struct cin *in, const struct cfg *cfg, const struct ctl *ctl, const struct cin_hooks *hooks,
+              int64_t fingerprint, char *why, size_t cap);
 void cin_close(struct cin *in);
 /* --check-config: the command key (with commands = network) judged as
  * cin_open() judges it at start: false with the same refusal in *why. Run
@@ -111,9 +114,9 @@ void cin_network_datagram(struct cin *in, const uint8_t *d, size_t n, bool trunc
  * cycle boundary like any other; answered in the log and on the event
  * channel (the simulator that sent it reads neither). */
 void cin_clock_command(struct cin *in, const char *text);
-/* The cycle boundary: apply the queued commands to the controller and the
- * configuration it reads, answer each. */
-void cin_apply(struct cin *in, struct ctl *ctl, struct cfg *cfg);
+/* The cycle boundary: apply the queued commands to the controller (a
+ * parameter through ctl_set_param), answer each. */
+void cin_apply(struct cin *in, struct ctl *ctl);
 size_t cin_pending(const struct cin *in);
 /* Commands refused so far, for the state message (bad_commands). */
 long long cin_refused(const struct cin *in);

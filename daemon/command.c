@@ -1,7 +1,6 @@
 /* command.c — see command.h. */
 #include "command.h"
 
-#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,52 +26,28 @@ static enum cmd_verdict reject(char *why, size_t cap, const char *fmt, ...)
 	return CMD_REJECT;
 }
 
-static enum cmd_verdict cmd_check_param(const struct cmd_request *r, const struct cfg *cfg, char *why,
-                                        size_t cap)
+static enum cmd_verdict cmd_check_param(const struct cmd_request *r, const struct cfg *cfg,
+                                        const struct cfg_params *live, char *why, size_t cap)
 {
 	const char *name = nz(r->param);
 	char quoted[CMD_QUOTE_MAX];
 	text_sanitize(quoted, sizeof quoted, name);
-	struct cfg_range range;
+	struct param_range range;
 	if (!cfg_param_range(name, &range))
 		return reject(why, cap, "unknown parameter '%s' (%s)", quoted, cfg_param_commandable_list());
 	if (!cfg_param_commandable(name))
 		return reject(why, cap, "parameter %s bounds where a joint may go: only the configuration file sets it "
 		              "(commands may set %s)", name, cfg_param_commandable_list());
-	if (!isfinite(r->value))
-		return reject(why, cap, "parameter %s: value is not finite", name);
-	if (cfg_param_is_robot(name)) {
-		if (r->joint != -1)
-			return reject(why, cap, "parameter %s is per robot: joint must be -1, not %d", name, r->joint);
-	} else if (r->joint < -1 || r->joint >= (int)cfg->njoints) {
-		return reject(why, cap, "parameter %s: joint %d does not exist (0..%zu, or -1 for all)", name,
-		              r->joint, cfg->njoints - 1);
+	struct cfg_params initial;
+	if (live == NULL) {
+		cfg_params_init(&initial, cfg);
+		live = &initial;
 	}
-	bool below = range.min_open ? !(r->value > range.min) : !(r->value >= range.min);
-	if (below || r->value > range.max)
-		return reject(why, cap, "parameter %s: %g out of range %s%g..%g", name, r->value,
-		              range.min_open ? ">" : "", range.min, range.max);
-	if (cfg_param_is_robot(name)) {
-		char inner[200];
-		if (!cfg_robot_param_check(cfg, name, r->value, inner, sizeof inner))
-			return reject(why, cap, "parameter %s: %s", name, inner);
-		return CMD_ACCEPT;
-	}
-	/* what the range table cannot express: the joint's parameters together */
-	size_t first = r->joint < 0 ? 0 : (size_t)r->joint;
-	size_t last = r->joint < 0 ? cfg->njoints : first + 1;
-	for (size_t j = first; j < last; j++) {
-		struct cfg_joint jt = cfg->joint[j];
-		*cfg_joint_param(&jt, name) = r->value;
-		char inner[160];
-		if (!cfg_joint_check(&jt, inner, sizeof inner))
-			return reject(why, cap, "parameter %s: joint %zu: %s", name, j, inner);
-	}
-	return CMD_ACCEPT;
+	return cfg_params_check(cfg, live, name, r->joint, r->value, why, cap) ? CMD_ACCEPT : CMD_REJECT;
 }
 
-enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, bool direct, char *why,
-                           size_t cap)
+enum cmd_verdict cmd_check_live(const struct cmd_request *r, const struct cfg *cfg, const struct cfg_params *live,
+                                bool direct, char *why, size_t cap)
 {
 	const char *robot = nz(r->robot);
 	why[0] = '\0';
@@ -89,13 +64,19 @@ enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, b
 			return reject(why, cap, "unknown mode %d (0 limp, 1 hold, 2 sinusoid, 3 oscillator)", r->mode);
 		return CMD_ACCEPT;
 	case CMD_KIND_PARAM:
-		return cmd_check_param(r, cfg, why, cap);
+		return cmd_check_param(r, cfg, live, why, cap);
 	case CMD_KIND_TORQUE:
 	case CMD_KIND_CLEAR:
 		return CMD_ACCEPT;
 	default:
 		return reject(why, cap, "unknown command kind %d (1 mode, 2 param, 3 torque, 4 clear)", r->kind);
 	}
+}
+
+enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, bool direct, char *why,
+                           size_t cap)
+{
+	return cmd_check_live(r, cfg, NULL, direct, why, cap);
 }
 
 /* ---- command_t on the wire ---------------------------------------------------------------- */
@@ -176,25 +157,6 @@ size_t cmd_encode(const struct cmd_request *r, int64_t fingerprint, const uint8_
 		*signed_len = wr.len;
 	wire_put_bytes(&wr, mac != NULL ? mac : zeros, CMD_MAC_BYTES);
 	return wr.bad ? 0 : wr.len;
-}
-
-void cmd_apply_param(struct cfg *cfg, const struct cmd_request *r)
-{
-	const char *name = nz(r->param);
-	if (!cfg_param_commandable(name))
-		return;   /* cmd_check() refused it; a caller that skipped it changes nothing */
-	double *robot = cfg_robot_param(cfg, name);
-	if (robot != NULL) {
-		*robot = r->value;
-		return;
-	}
-	size_t first = r->joint < 0 ? 0 : (size_t)r->joint;
-	size_t last = r->joint < 0 ? cfg->njoints : first + 1;
-	for (size_t j = first; j < last && j < cfg->njoints; j++) {
-		double *f = cfg_joint_param(&cfg->joint[j], name);
-		if (f != NULL)
-			*f = r->value;
-	}
 }
 
 void cmd_describe(const struct cmd_request *r, char *out, size_t cap)

@@ -83,12 +83,14 @@ size_t cmd_encode(const struct cmd_request *r, int64_t fingerprint, const uint8_
 /* `direct` is true when the command was addressed to this robot's own
  * channel or socket (so another robot name there is a mistake worth
  * answering), false for the shared "UNDULATE.CMD". Names quoted in *why are
- * sanitized (they come from outside). */
+ * sanitized (they come from outside). A parameter's value is judged with
+ * cfg_params_check() against `live`, the values the robot runs with (NULL:
+ * the configuration's own); cmd_check() is cmd_check_live() with NULL.
+ * Applying an accepted parameter is the controller's (ctl_set_param). */
+enum cmd_verdict cmd_check_live(const struct cmd_request *r, const struct cfg *cfg, const struct cfg_params *live,
+                                bool direct, char *why, size_t cap);
 enum cmd_verdict cmd_check(const struct cmd_request *r, const struct cfg *cfg, bool direct,
                            char *why, size_t cap);
-
-/* Apply an accepted KIND_PARAM to cfg (joint -1 = every joint). */
-void cmd_apply_param(struct cfg *cfg, const struct cmd_request *r);
 
 /* Parse the text of `undulated --command`: "mode oscillator", "mode 2",
  * "param k 0.5 [joint]", "torque on|off", "clear". Unchecked values are

@@ -16,9 +16,9 @@
 #include "textfile.h"
 #include "udpm.h"
 
-#define CFG_PI 3.14159265358979323846
+#define CFG_PI PARAM_PI
 /* The AX-12 turns 300°: ±150° = ±2.618 rad around its centre. */
-#define CFG_SERVO_HALF_RANGE (150.0 * CFG_PI / 180.0)
+#define CFG_SERVO_HALF_RANGE PARAM_SERVO_HALF_RANGE
 
 static void cfg_error(struct cfg_errors *e, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void cfg_error(struct cfg_errors *e, const char *fmt, ...)
@@ -152,51 +152,10 @@ static bool parse_ids(const char *s, uint8_t *out, size_t *n, char *why, size_t 
 	return true;
 }
 
-/* ---- parameter ranges (documented in daemon/README.md) ------------------------------ */
-struct cfg_param_def {
-	const char *key;
-	struct cfg_range range;
-	bool joint;        /* per joint ([joint.N]) or per robot ([sinusoid]) */
-	bool commandable;  /* a command may change it (never what bounds a joint) */
-};
-/* The ranges are physical: an AX-12 joint's link has an inertia of order
- * 1e-3 kg·m² and a stall torque of 1.5 N·m, so a law's spring of more than
- * 10 N·m/rad or an inertia below 1e-5 (the oscillator then asks for
- * accelerations the servo cannot give and one control period cannot
- * integrate) is a typo, not a tuning. */
-static const struct cfg_param_def cfg_params[] = {
-	{ "k",         { 1e-4, 10.0, false }, true, true },
-	{ "c",         { -1.0, 1.0, false }, true, true },
-	{ "mu",        { 0.0, 100.0, false }, true, true },
-	{ "lambda",    { -10.0, 10.0, false }, true, true },
-	{ "inertia",   { 1e-5, 1.0, false }, true, true },
-	{ "friction",  { 0.0, 1.0, false }, true, true },
-	{ "coupling_phase", { -CFG_PI, CFG_PI, false }, true, true },
-	{ "neutral",   { -CFG_SERVO_HALF_RANGE, CFG_SERVO_HALF_RANGE, false }, true, false },
-	{ "limit_min", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
-	{ "limit_max", { -2.0 * CFG_SERVO_HALF_RANGE, 2.0 * CFG_SERVO_HALF_RANGE, false }, true, false },
-	{ "max_step",  { 0.0, 0.5, true }, true, false },
-	{ "amplitude", { 0.0, CFG_SERVO_HALF_RANGE, false }, false, true },
-	{ "frequency", { 0.0, 5.0, false }, false, true },
-	{ "phase",     { -2.0 * CFG_PI, 2.0 * CFG_PI, false }, false, true },
-	/* the clock as a torque law: the paper's 0.015..0.135 N·m/rad and far
-	 * beyond (the position loop's own stiffness is 9.2 N·m/rad); 0 = off */
-	{ "stiffness", { 0.0, 10.0, false }, false, true },
-	{ "damping",   { 0.0, 1.0, false }, false, true },
-};
-#define CFG_NPARAMS (sizeof cfg_params / sizeof cfg_params[0])
-
-static const struct cfg_param_def *cfg_param_find(const char *key)
+/* ---- parameter ranges: common/params.h, one table with the programs that send commands ---- */
+bool cfg_param_range(const char *key, struct param_range *out)
 {
-	for (size_t i = 0; i < CFG_NPARAMS; i++)
-		if (strcmp(key, cfg_params[i].key) == 0)
-			return &cfg_params[i];
-	return NULL;
-}
-
-bool cfg_param_range(const char *key, struct cfg_range *out)
-{
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	if (d == NULL)
 		return false;
 	*out = d->range;
@@ -205,7 +164,7 @@ bool cfg_param_range(const char *key, struct cfg_range *out)
 
 bool cfg_param_commandable(const char *key)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	return d != NULL && d->commandable;
 }
 
@@ -248,25 +207,34 @@ bool cfg_joint_check(const struct cfg_joint *j, char *why, size_t cap)
 
 bool cfg_param_is_joint(const char *key)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	return d != NULL && d->joint;
 }
 
 bool cfg_param_is_robot(const char *key)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	return d != NULL && !d->joint;
+}
+
+/* A joint's oscillator parameter by name: the commandable ones. */
+static double *cfg_osc_param(struct osc_joint_params *o, const char *key)
+{
+	if (strcmp(key, "k") == 0) return &o->k;
+	if (strcmp(key, "c") == 0) return &o->c;
+	if (strcmp(key, "mu") == 0) return &o->mu;
+	if (strcmp(key, "lambda") == 0) return &o->lambda;
+	if (strcmp(key, "coupling_phase") == 0) return &o->coupling_phase;
+	if (strcmp(key, "inertia") == 0) return &o->inertia;
+	if (strcmp(key, "friction") == 0) return &o->friction;
+	return NULL;
 }
 
 double *cfg_joint_param(struct cfg_joint *j, const char *key)
 {
-	if (strcmp(key, "k") == 0) return &j->osc.k;
-	if (strcmp(key, "c") == 0) return &j->osc.c;
-	if (strcmp(key, "mu") == 0) return &j->osc.mu;
-	if (strcmp(key, "lambda") == 0) return &j->osc.lambda;
-	if (strcmp(key, "coupling_phase") == 0) return &j->osc.coupling_phase;
-	if (strcmp(key, "inertia") == 0) return &j->osc.inertia;
-	if (strcmp(key, "friction") == 0) return &j->osc.friction;
+	double *osc = cfg_osc_param(&j->osc, key);
+	if (osc != NULL)
+		return osc;
 	if (strcmp(key, "neutral") == 0) return &j->neutral;
 	if (strcmp(key, "limit_min") == 0) return &j->limit_min;
 	if (strcmp(key, "limit_max") == 0) return &j->limit_max;
@@ -274,12 +242,94 @@ double *cfg_joint_param(struct cfg_joint *j, const char *key)
 	return NULL;
 }
 
-static bool range_ok(const struct cfg_range *r, double v)
+void cfg_params_init(struct cfg_params *p, const struct cfg *c)
 {
-	if (r->min_open ? !(v > r->min) : !(v >= r->min))
-		return false;
-	return v <= r->max;
+	memset(p, 0, sizeof *p);
+	for (size_t j = 0; j < c->njoints && j < CFG_MAX_JOINTS; j++)
+		p->osc[j] = c->joint[j].osc;
+	p->servo_lead_s = c->servo_lead_s;
+	p->amplitude = c->amplitude;
+	p->frequency = c->frequency;
+	p->phase = c->phase;
+	p->sin_stiffness = c->sin_stiffness;
+	p->sin_damping = c->sin_damping;
 }
+
+void cfg_params_put(struct cfg *c, const struct cfg_params *p)
+{
+	for (size_t j = 0; j < c->njoints && j < CFG_MAX_JOINTS; j++)
+		c->joint[j].osc = p->osc[j];
+	c->servo_lead_s = p->servo_lead_s;
+	c->amplitude = p->amplitude;
+	c->frequency = p->frequency;
+	c->phase = p->phase;
+	c->sin_stiffness = p->sin_stiffness;
+	c->sin_damping = p->sin_damping;
+}
+
+double *cfg_params_field(struct cfg_params *p, const char *key, size_t j)
+{
+	if (strcmp(key, "amplitude") == 0) return &p->amplitude;
+	if (strcmp(key, "frequency") == 0) return &p->frequency;
+	if (strcmp(key, "phase") == 0) return &p->phase;
+	if (strcmp(key, "stiffness") == 0) return &p->sin_stiffness;
+	if (strcmp(key, "damping") == 0) return &p->sin_damping;
+	if (strcmp(key, "servo_lead_s") == 0) return &p->servo_lead_s;
+	return j < CFG_MAX_JOINTS ? cfg_osc_param(&p->osc[j], key) : NULL;
+}
+
+bool cfg_params_check(const struct cfg *c, const struct cfg_params *live, const char *key, int joint, double value,
+                      char *why, size_t cap)
+{
+	struct param_range range = { 0.0, CFG_LEAD_MAX_S, false };
+	bool lead = strcmp(key, "servo_lead_s") == 0;
+	if (!lead && (!cfg_param_range(key, &range) || !cfg_param_commandable(key))) {
+		snprintf(why, cap, "parameter %s cannot be changed while the robot runs", key);
+		return false;
+	}
+	if (!isfinite(value)) {
+		snprintf(why, cap, "parameter %s: value is not finite", key);
+		return false;
+	}
+	bool robot = lead || cfg_param_is_robot(key);
+	if (robot && joint != -1) {
+		snprintf(why, cap, "parameter %s is per robot: joint must be -1, not %d", key, joint);
+		return false;
+	}
+	if (!robot && (joint < -1 || joint >= (int)c->njoints)) {
+		snprintf(why, cap, "parameter %s: joint %d does not exist (0..%zu, or -1 for all)", key, joint,
+		         c->njoints - 1);
+		return false;
+	}
+	if (!param_in_range(&range, value)) {
+		snprintf(why, cap, "parameter %s: %g out of range %s%g..%g", key, value, range.min_open ? ">" : "",
+		         range.min, range.max);
+		return false;
+	}
+	if (lead)
+		return true;
+	char inner[200];
+	if (robot) {
+		if (cfg_robot_param_check(c, key, value, inner, sizeof inner))
+			return true;
+		snprintf(why, cap, "parameter %s: %s", key, inner);
+		return false;
+	}
+	/* what the range table cannot express: the joint's parameters together */
+	size_t first = joint < 0 ? 0 : (size_t)joint;
+	size_t last = joint < 0 ? c->njoints : first + 1;
+	for (size_t j = first; j < last; j++) {
+		struct cfg_joint jt = c->joint[j];
+		jt.osc = live->osc[j];
+		*cfg_osc_param(&jt.osc, key) = value;
+		if (!cfg_joint_check(&jt, inner, sizeof inner)) {
+			snprintf(why, cap, "parameter %s: joint %zu: %s", key, j, inner);
+			return false;
+		}
+	}
+	return true;
+}
+
 
 /* ---- defaults ----------------------------------------------------------------------- */
 void cfg_defaults(struct cfg *c)
@@ -386,7 +436,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("rs485", T_RS485, rs485, 0, 0),
 	K("adapter_latency_us", T_LONG, adapter_latency_us, -1, 100000),
 	K("period_ms", T_DOUBLE, period_ms, 2, 100),
-	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, 0.2),
+	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, CFG_LEAD_MAX_S),
 	K("compliance_margin", T_LONG, compliance_margin, -1, 255),
 	K("compliance_slope", T_LONG, compliance_slope, -1, 254),
 	K("actuation", T_ACT, actuation, 0, 0),
@@ -567,13 +617,13 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 static bool cfg_set_param(double *field, const char *where, const char *section, const char *key,
                           const char *value, struct cfg_errors *e)
 {
-	const struct cfg_param_def *d = cfg_param_find(key);
+	const struct param_def *d = param_find(key);
 	double v;
 	if (!parse_double(value, &v)) {
 		cfg_error(e, "%s: [%s] %s: not a number '%s'", where, section, key, value);
 		return false;
 	}
-	if (!range_ok(&d->range, v)) {
+	if (!param_in_range(&d->range, v)) {
 		cfg_error(e, "%s: [%s] %s: %g out of range %s%g..%g", where, section, key, v,
 		          d->range.min_open ? ">" : "", d->range.min, d->range.max);
 		return false;
@@ -885,25 +935,22 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 	}
 }
 
-void cfg_scale_torque_defaults(struct cfg *c, size_t j, double scale)
+void cfg_params_scale_torque_defaults(struct cfg_params *p, const struct cfg *c, size_t j, double scale)
 {
-	struct cfg_joint *jt = &c->joint[j];
-	unsigned d = jt->torque_defaults;
-	if (d & CFG_TQ_K) jt->osc.k *= scale;
-	if (d & CFG_TQ_C) jt->osc.c *= scale;
-	if (d & CFG_TQ_MU) jt->osc.mu *= scale;
-	if (d & CFG_TQ_INERTIA) jt->osc.inertia *= scale;
-	if (d & CFG_TQ_FRICTION) jt->osc.friction *= scale;
-	jt->torque_defaults = 0;
+	struct osc_joint_params *o = &p->osc[j];
+	unsigned d = c->joint[j].torque_defaults;
+	if (d & CFG_TQ_K) o->k *= scale;
+	if (d & CFG_TQ_C) o->c *= scale;
+	if (d & CFG_TQ_MU) o->mu *= scale;
+	if (d & CFG_TQ_INERTIA) o->inertia *= scale;
+	if (d & CFG_TQ_FRICTION) o->friction *= scale;
 }
 
-bool cfg_position_defaults(struct cfg *c, size_t j, double k, double mu)
+bool cfg_params_position_defaults(struct cfg_params *p, const struct cfg *c, size_t j, double k, double mu)
 {
-	struct cfg_joint *jt = &c->joint[j];
-	unsigned d = jt->position_defaults;
-	if (d & CFG_TQ_K) jt->osc.k = k;
-	if (d & CFG_TQ_MU) jt->osc.mu = mu;
-	jt->position_defaults = 0;
+	unsigned d = c->joint[j].position_defaults;
+	if (d & CFG_TQ_K) p->osc[j].k = k;
+	if (d & CFG_TQ_MU) p->osc[j].mu = mu;
 	return d != 0;
 }
 

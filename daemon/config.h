@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "osc.h"
+#include "params.h"
 #include "port.h"
 
 #define CFG_MAX_JOINTS   OSC_MAX_JOINTS   /* joints per robot: the oscillator's bound */
@@ -144,10 +145,10 @@ bool cfg_set(struct cfg *c, const char *where, const char *section, const char *
  * (ids present, limits ordered, ...). Call once after all sources. */
 bool cfg_finish(struct cfg *c, struct cfg_errors *errors);
 
-/* Documented ranges of the per-joint and sinusoid parameters; shared with
- * command validation. Returns false for an unknown name. */
-struct cfg_range { double min, max; bool min_open; };
-bool cfg_param_range(const char *key, struct cfg_range *out);
+/* Documented ranges of the per-joint and sinusoid parameters (common/params.h:
+ * one table for the file, commands and the programs that send them). Returns
+ * false for an unknown name. */
+bool cfg_param_range(const char *key, struct param_range *out);
 /* May a command change it? Only the configuration decides where a joint may
  * go: neutral, the limits and max_step are not commandable. */
 bool cfg_param_commandable(const char *key);
@@ -169,22 +170,54 @@ bool cfg_param_is_robot(const char *key);   /* amplitude, frequency, phase, stif
  * range table cannot say it): [sinusoid] stiffness > 0 needs torque
  * actuation. False with *why. */
 bool cfg_robot_param_check(const struct cfg *c, const char *key, double value, char *why, size_t cap);
-/* Value of a per-robot parameter by name (for commands); NULL if unknown. */
+/* Value of a per-robot parameter by name (the file's [sinusoid]); NULL if unknown. */
 double *cfg_robot_param(struct cfg *c, const char *key);
-/* Value of a per-joint parameter by name (for commands); NULL if unknown. */
+/* Value of a per-joint parameter by name (the file's [joint.N]); NULL if unknown. */
 double *cfg_joint_param(struct cfg_joint *j, const char *key);
+
+/* The parameters that may change while the robot runs — by command, or by
+ * the tuner (which also moves the horizon's lead). The configuration gives
+ * their initial values; the controller (control.h) holds the live ones and
+ * is the only one that changes them, so a struct cfg is never written once
+ * the robot runs. */
+struct cfg_params {
+	struct osc_joint_params osc[CFG_MAX_JOINTS];
+	double servo_lead_s;
+	double amplitude, frequency, phase;   /* [sinusoid] */
+	double sin_stiffness, sin_damping;
+};
+/* servo_lead_s's range, one for the file and the tuner (CONTROL.md). */
+#define CFG_LEAD_MAX_S 0.2
+/* The one check of a change to a live parameter, by a command or the tuner:
+ * `key` is a commandable parameter (cfg_param_commandable) or servo_lead_s;
+ * joint -1 is every joint (a robot parameter takes -1 only); the value is
+ * finite, inside the parameter's range (cfg_param_range; servo_lead_s
+ * 0..CFG_LEAD_MAX_S) and passes the cross-checks (cfg_robot_param_check,
+ * cfg_joint_check) with the other parameters' `live` values. False with *why
+ * ("parameter k: 20 out of range 0.0001..10"). */
+bool cfg_params_check(const struct cfg *c, const struct cfg_params *live, const char *key, int joint, double value,
+                      char *why, size_t cap);
+/* The initial values: the configuration's. */
+void cfg_params_init(struct cfg_params *p, const struct cfg *c);
+/* c with the values of p in place of its own (a file of what ran). */
+void cfg_params_put(struct cfg *c, const struct cfg_params *p);
+/* The live value of a commandable parameter by name (amplitude ... for the
+ * robot, k ... of joint j), or of servo_lead_s; NULL if unknown or j is out
+ * of range for a joint's parameter. */
+double *cfg_params_field(struct cfg_params *p, const char *key, size_t joint);
 
 const char *cfg_mode_name(enum cfg_mode m);     /* "OSCILLATOR" */
 bool cfg_mode_parse(const char *s, enum cfg_mode *out);   /* case-insensitive */
 
 /* Torque actuation's defaults are an AX-12A joint's: a joint on another
- * servo has `scale` times its inertia, and the parameters that took the
- * defaults (not those given) scale with it — once. */
-void cfg_scale_torque_defaults(struct cfg *c, size_t joint, double scale);
+ * servo has `scale` times its inertia, and the parameters of p that took the
+ * defaults in c (not those given) scale with it. Once: the caller's
+ * (ctl_model_defaults). */
+void cfg_params_scale_torque_defaults(struct cfg_params *p, const struct cfg *c, size_t joint, double scale);
 /* Position actuation on a servo whose defaults are not osc.h's: k and μ of
- * the joint, where they took the defaults, become these (once: later calls
- * change nothing). True when anything changed. */
-bool cfg_position_defaults(struct cfg *c, size_t joint, double k, double mu);
+ * the joint in p, where they took the defaults in c, become these. True when
+ * anything changed. */
+bool cfg_params_position_defaults(struct cfg_params *p, const struct cfg *c, size_t joint, double k, double mu);
 
 /* Print every key with its current value as INI (for --check-config -v). */
 void cfg_print(const struct cfg *c, void *file);

@@ -285,10 +285,11 @@ size_t ctl_sync(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *id
 }
 
 /* ---- set-up --------------------------------------------------------------------------------- */
-void ctl_init(struct ctl *c, struct cfg *cfg)
+void ctl_init(struct ctl *c, const struct cfg *cfg)
 {
 	memset(c, 0, sizeof *c);
 	c->cfg = cfg;
+	cfg_params_init(&c->p, cfg);
 	c->n = cfg->njoints;
 	c->mode = cfg->mode;
 	c->fade_mode = CFG_NMODES;
@@ -340,6 +341,23 @@ bool ctl_set_servo(struct ctl *c, size_t j, const struct ctl_servo_info *info, c
 		return false;
 	}
 	return true;
+}
+
+bool ctl_torque_defaults(struct ctl *c, size_t j, double scale)
+{
+	if (c->defaults_done[j] & CTL_DEFAULTS_TORQUE)
+		return false;
+	c->defaults_done[j] |= CTL_DEFAULTS_TORQUE;
+	cfg_params_scale_torque_defaults(&c->p, c->cfg, j, scale);
+	return c->cfg->joint[j].torque_defaults != 0;
+}
+
+bool ctl_position_defaults(struct ctl *c, size_t j, double k, double mu)
+{
+	if (c->defaults_done[j] & CTL_DEFAULTS_POSITION)
+		return false;
+	c->defaults_done[j] |= CTL_DEFAULTS_POSITION;
+	return cfg_params_position_defaults(&c->p, c->cfg, j, k, mu);
 }
 
 uint32_t ctl_joint_mode_limits(const struct ctl *c, size_t j)
@@ -397,7 +415,7 @@ static bool ctl_any_still(const struct ctl *c)
 static void ctl_starter(struct ctl *c)
 {
 	c->starter_offset = 0.0;
-	double period = c->cfg->frequency > 0.0 ? 1.0 / c->cfg->frequency : 1.0;
+	double period = c->p.frequency > 0.0 ? 1.0 / c->p.frequency : 1.0;
 	c->starter_until = c->t + c->cfg->ramp_s + period;
 	c->starter_active = true;
 	c->starts++;
@@ -968,12 +986,30 @@ void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason)
 	          cfg_mode_name(old), cfg_mode_name(mode), reason);
 }
 
-void ctl_params_changed(struct ctl *c)
+/* SINUSOID re-blends so that its new phase or frequency cannot jump. */
+static void ctl_params_changed(struct ctl *c)
 {
 	if (c->mode != CFG_MODE_SINUSOID)
 		return;
 	for (size_t j = 0; j < c->n; j++)
 		ctl_blend_joint(c, j, ctl_present_or_goal(&c->j[j]));
+}
+
+bool ctl_check_param(const struct ctl *c, const char *name, int joint, double value, char *why, size_t cap)
+{
+	return cfg_params_check(c->cfg, &c->p, name, joint, value, why, cap);
+}
+
+bool ctl_set_param(struct ctl *c, const char *name, int joint, double value, char *why, size_t cap)
+{
+	if (!ctl_check_param(c, name, joint, value, why, cap))
+		return false;
+	size_t first = joint < 0 ? 0 : (size_t)joint;
+	size_t last = joint < 0 ? c->n : first + 1;
+	for (size_t j = first; j < last; j++)
+		*cfg_params_field(&c->p, name, j) = value;   /* a robot's parameter: the same field every time */
+	ctl_params_changed(c);
+	return true;
 }
 
 void ctl_torque(struct ctl *c, bool on)
@@ -1266,10 +1302,8 @@ static void ctl_check_stale(struct ctl *c, size_t j)
 static void ctl_targets_oscillator(struct ctl *c, double dt, double *target)
 {
 	double x[CFG_MAX_JOINTS], v[CFG_MAX_JOINTS], xn[CFG_MAX_JOINTS];
-	struct osc_joint_params p[CFG_MAX_JOINTS];
 	for (size_t j = 0; j < c->n; j++) {
 		const struct ctl_joint *jt = &c->j[j];
-		p[j] = c->cfg->joint[j].osc;
 		x[j] = jt->angle - c->cfg->joint[j].neutral;
 		v[j] = jt->fresh ? jt->speed : 0.0;
 	}
@@ -1277,8 +1311,8 @@ static void ctl_targets_oscillator(struct ctl *c, double dt, double *target)
 	 * must not leap seconds ahead), plus the servo's lead — the AX-12 lags its
 	 * goal by ~27 ms, so a goal one period ahead damps the loop out (CONTROL.md). */
 	double period = c->cfg->period_ms * 1e-3;
-	double h = fmin(fmax(dt, 0.25 * period), 3.0 * period) + c->cfg->servo_lead_s;
-	if (!osc_step(p, c->n, x, v, h, CTL_OSC_SUBSTEPS, xn, NULL)) {
+	double h = fmin(fmax(dt, 0.25 * period), 3.0 * period) + c->p.servo_lead_s;
+	if (!osc_step(c->p.osc, c->n, x, v, h, CTL_OSC_SUBSTEPS, xn, NULL)) {
 		for (size_t j = 0; j < c->n; j++)
 			target[j] = NAN;
 		return;
@@ -1316,8 +1350,8 @@ static void ctl_targets(struct ctl *c, enum cfg_mode mode, double dt, double t_r
 		 * which after a stall runs at its own offset */
 		for (size_t j = 0; j < c->n; j++)
 			target[j] = c->cfg->joint[j].neutral +
-			            osc_sinusoid(c->cfg->amplitude, c->cfg->frequency,
-			                         c->cfg->phase + (c->mode == CFG_MODE_OSCILLATOR ? c->starter_offset : 0.0),
+			            osc_sinusoid(c->p.amplitude, c->p.frequency,
+			                         c->p.phase + (c->mode == CFG_MODE_OSCILLATOR ? c->starter_offset : 0.0),
 			                         j, t_real);
 		return;
 	}
@@ -1430,7 +1464,7 @@ static void ctl_update_estimates(struct ctl *c, size_t j)
 	phase_estimator_update(&jt->estimator, x, c->t);
 	/* before a frequency is measured, the law's own: sqrt(k / I) */
 	double omega = jt->estimator.frequency > 0.0 ? phase_estimator_omega(&jt->estimator)
-	                                            : sqrt(cj->osc.k / cj->osc.inertia);
+	                                            : sqrt(c->p.osc[j].k / c->p.osc[j].inertia);
 	jt->phase = phase_from_state(x, jt->speed, omega);
 }
 

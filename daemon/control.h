@@ -145,7 +145,9 @@ struct ctl_joint {
 };
 
 struct ctl {
-	struct cfg *cfg;            /* parameters (accepted commands change the documented ones) */
+	const struct cfg *cfg;      /* the configuration; never written (the live parameters are p) */
+	struct cfg_params p;        /* the live parameters: the configuration's at ctl_init, changed
+	                               only by ctl_set_param (commands, the tuner) and the model's defaults */
 	size_t n;
 	struct ctl_joint j[CFG_MAX_JOINTS];
 	enum cfg_mode mode;
@@ -185,15 +187,25 @@ struct ctl {
 	long long resets;               /* servos found reset */
 	long long watchdog_trips;       /* X series: servos found stopped by their bus watchdog */
 	long long reboots;              /* X series: REBOOTs sent */
+	unsigned char defaults_done[CFG_MAX_JOINTS];   /* CTL_DEFAULTS_* given to the joint (once) */
 };
+#define CTL_DEFAULTS_TORQUE   1u
+#define CTL_DEFAULTS_POSITION 2u
 
-void ctl_init(struct ctl *c, struct cfg *cfg);
+void ctl_init(struct ctl *c, const struct cfg *cfg);
 /* The joint's servo model (the AX-12A until ctl_set_servo says otherwise). */
 const struct sm_model *ctl_model(const struct ctl *c, size_t joint);
 /* After start-up checks (again after every reconnect): the servo's limits and
  * settings. False (with *why) if the configured limits and the servo's have
  * no angle in common or the servo is in wheel mode. */
 bool ctl_set_servo(struct ctl *c, size_t joint, const struct ctl_servo_info *info, char *why, size_t cap);
+/* Once the joint's servo model is known (the first connect, before the robot
+ * runs): the live parameters that took the AX-12A's defaults (config.h)
+ * become the model's — under torque actuation scaled by `scale`
+ * (sm_torque_scale), under position actuation k and μ replaced. Once per
+ * joint: later calls change nothing. True when anything changed. */
+bool ctl_torque_defaults(struct ctl *c, size_t joint, double scale);
+bool ctl_position_defaults(struct ctl *c, size_t joint, double k, double mu);
 /* The servo angle limits that put a joint back in joint mode after wheel mode
  * (torque actuation): the servo's own. Packed as the 4 bytes at register 6. */
 uint32_t ctl_joint_mode_limits(const struct ctl *c, size_t joint);
@@ -239,9 +251,17 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real);
 bool ctl_mode_allowed(const struct ctl *c, enum cfg_mode mode, char *why, size_t cap);
 /* Mode change (commands, faults, signals). Continuous in commanded angle. */
 void ctl_set_mode(struct ctl *c, enum cfg_mode mode, const char *reason);
-/* Parameters changed (a command): SINUSOID re-blends so its new phase/frequency
- * cannot jump. */
-void ctl_params_changed(struct ctl *c);
+/* A live parameter: the one door for commands and the tuner. `name` is a
+ * commandable parameter or servo_lead_s, joint -1 every joint (a robot's
+ * parameter takes -1 only). Checked by cfg_params_check() against the values
+ * in force (range, finiteness, joint, natural frequency, stiffness and
+ * actuation): false with *why and nothing changed, else applied at once —
+ * call it at the cycle boundary — and SINUSOID re-blends so that a new phase
+ * or frequency cannot jump. Which names a *command* may set is command.h's
+ * (servo_lead_s is the tuner's alone). */
+bool ctl_set_param(struct ctl *c, const char *name, int joint, double value, char *why, size_t cap);
+/* The same check without the change (a command judged when it arrives). */
+bool ctl_check_param(const struct ctl *c, const char *name, int joint, double value, char *why, size_t cap);
 /* Torque on/off command: off = LIMP; on = HOLD where the joints are. */
 void ctl_torque(struct ctl *c, bool on);
 /* Clear latched faults. False (with *why) if the cause is still there: a

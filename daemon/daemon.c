@@ -85,7 +85,7 @@ struct dmn_clock {
 };
 
 struct dmn {
-	struct cfg *cfg;
+	const struct cfg *cfg;        /* never written: the live parameters are the controller's */
 	struct ctl ctl;
 	struct cyc cyc;
 	struct cin cin;
@@ -332,7 +332,7 @@ static void dmn_torque_defaults(struct dmn *d)
 		if (d->cfg->joint[j].torque_defaults != 0 && scale != 1.0) {
 			log_info("joint %zu: torque actuation's default k, c, mu, inertia, friction scaled x%.3f for the %s's "
 			         "joint (its rotor through the gearbox)", j + 1, scale, ctl_model(&d->ctl, j)->name);
-			cfg_scale_torque_defaults(d->cfg, j, scale);
+			ctl_torque_defaults(&d->ctl, j, scale);
 		}
 	}
 }
@@ -344,7 +344,7 @@ static void dmn_torque_defaults(struct dmn *d)
  * connect, as the torque defaults above. */
 static void dmn_position_defaults(struct dmn *d)
 {
-	struct cfg *cfg = d->cfg;
+	const struct cfg *cfg = d->cfg;
 	if (cfg->actuation != CFG_ACT_POSITION)
 		return;
 	const struct sm_model *first = ctl_model(&d->ctl, 0);
@@ -358,18 +358,20 @@ static void dmn_position_defaults(struct dmn *d)
 			continue;
 		}
 		double k0 = cfg->joint[j].osc.k, mu0 = cfg->joint[j].osc.mu;
-		if (cfg_position_defaults(cfg, j, k, mu))
+		if (ctl_position_defaults(&d->ctl, j, k, mu))
 			log_info("joint %zu: position actuation's default k %.4g, mu %.4g are the %s's (the AX-12A's: "
-			         "k %.4g, mu %.4g; daemon/CONTROL.md, \"X-series servos\")%s", j + 1, cfg->joint[j].osc.k,
-			         cfg->joint[j].osc.mu, m->position_from, k0, mu0,
+			         "k %.4g, mu %.4g; daemon/CONTROL.md, \"X-series servos\")%s", j + 1, d->ctl.p.osc[j].k,
+			         d->ctl.p.osc[j].mu, m->position_from, k0, mu0,
 			         strcmp(m->position_from, m->name) != 0 ? ": nobody tuned them on this model yet, "
 			         "undulated --tune finds its own" : "");
 	}
+	char why[160];
 	if (same && lead > 0.0 && cfg->servo_lead_default) {
-		log_info("servo_lead_s %.3f s, the %s's default (the AX-12A's: %.3f s)", lead, first->position_from,
-		         cfg->servo_lead_s);
-		cfg->servo_lead_s = lead;
-		cfg->servo_lead_default = false;
+		if (ctl_set_param(&d->ctl, "servo_lead_s", -1, lead, why, sizeof why))
+			log_info("servo_lead_s %.3f s, the %s's default (the AX-12A's: %.3f s)", lead, first->position_from,
+			         cfg->servo_lead_s);
+		else
+			log_warn("the %s's default %s: kept the AX-12A's", first->position_from, why);
 	} else if (!same && cfg->servo_lead_default && d->protocol == BUS_PROTOCOL_2) {
 		kept = true;
 	}
@@ -390,7 +392,7 @@ static void dmn_tune_rebase(struct dmn *d)
 		return;
 	struct tune_opts o = d->tune->opts;
 	char why[sizeof d->tune->why];
-	if (!tune_init(d->tune, &o, d->cfg, why, sizeof why)) {
+	if (!tune_init(d->tune, &o, d->cfg, &d->ctl.p, why, sizeof why)) {
 		snprintf(d->tune->why, sizeof d->tune->why, "%s", why);
 		d->tune->state = TUNE_FAILED;
 		d->stop = true;
@@ -511,12 +513,12 @@ static void dmn_arm_deadline(struct dmn *d) { d->clock->arm_deadline(d); }
 static void dmn_control(struct dmn *d)
 {
 	if (cin_pending(&d->cin) > 0) {
-		cin_apply(&d->cin, &d->ctl, d->cfg);
+		cin_apply(&d->cin, &d->ctl);
 		d->params_dirty = true;
 	}
 	if (d->tune && d->tune->changed) {
-		tune_apply(d->tune, d->cfg);
-		ctl_params_changed(&d->ctl);
+		if (!tune_apply(d->tune, &d->ctl))
+			d->stop = true;   /* refused: the tuner failed, and says why */
 		d->params_dirty = true;
 	}
 	double dt = 1e-6 * (double)(d->cycle_start_us - d->last_cycle_start_us);
@@ -548,6 +550,7 @@ static void dmn_tune_cycle(struct dmn *d)
 		if (d->ctl.j[j].voltage > 0 && !(d->ctl.j[j].voltage >= volts))
 			volts = d->ctl.j[j].voltage;   /* the lowest: the weakest servo sets the pace */
 	tune_supply(t, volts);
+	t->ran = d->ctl.p;   /* the file it writes holds what the robot ran with, commands' changes too */
 	tune_sample(t, d->ctl.t, x, v, d->ctl.starter_active);
 	if (t->progress[0]) {
 		fprintf(d->tune_out, "tune: %5.1f s  %s\n", d->ctl.t, t->progress);
@@ -935,12 +938,12 @@ static bool dmn_open(struct dmn *d, int *status)
 	*status = 1;
 	if (!dmn_fds(d))
 		return false;
-	if (!pub_open(&d->pub, d->cfg, why, sizeof why)) {
+	if (!pub_open(&d->pub, d->cfg, &d->ctl.p, why, sizeof why)) {
 		log_error("%s", why);
 		return false;
 	}
 	struct cin_hooks hooks = { .ctx = d, .event = cin_event_hook, .wall_us = cin_wall_hook, .mono_us = cin_mono_hook };
-	if (!cin_open(&d->cin, d->cfg, &hooks, __undulate_command_t_get_hash(), why, sizeof why)) {
+	if (!cin_open(&d->cin, d->cfg, &d->ctl, &hooks, __undulate_command_t_get_hash(), why, sizeof why)) {
 		log_error("%s", why);
 		/* a key file or socket directory that is wrong stays wrong: a
 		 * configuration error, not worth restarting for */
@@ -950,16 +953,16 @@ static bool dmn_open(struct dmn *d, int *status)
 	return true;
 }
 
-static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out);
+static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out);
 
-int dmn_run(struct cfg *cfg) { return dmn_run_with(cfg, NULL, NULL); }
+int dmn_run(const struct cfg *cfg) { return dmn_run_with(cfg, NULL, NULL); }
 
-int dmn_run_tune(struct cfg *cfg, struct tune *t, void *progress)
+int dmn_run_tune(const struct cfg *cfg, struct tune *t, void *progress)
 {
 	return dmn_run_with(cfg, t, progress ? progress : stdout);
 }
 
-static int dmn_run_with(struct cfg *cfg, struct tune *tune, FILE *tune_out)
+static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out)
 {
 	static struct dmn dmn;   /* large (bus stats per ID): not on the stack */
 	struct dmn *d = &dmn;

@@ -14,15 +14,15 @@
  * 0 after a clean safe stop, 1 when start-up failed (the bus, a servo: worth
  * a retry), 2 when the configuration cannot work (not worth one; also a port
  * that refuses the configured rs485 mode). */
-int dmn_run(struct cfg *cfg);
+int dmn_run(const struct cfg *cfg);
 
 /* `undulated --tune`: the same loop in OSCILLATOR, with the tuner (tune.h)
  * fed every cycle and its parameters applied at the cycle boundary, until it
  * is done or has given up (or a signal). Then the usual safe stop. Progress
  * lines go to `progress` (a FILE *). Returns as dmn_run(); what the tuner
- * found is in *t. */
+ * found is in *t, and what the robot ran with in t->ran. */
 struct tune;
-int dmn_run_tune(struct cfg *cfg, struct tune *t, void *progress);
+int dmn_run_tune(const struct cfg *cfg, struct tune *t, void *progress);
 
 /* `undulated --command TEXT`: send one command to robot (or "*") and print
  * the answers within timeout_s. 0 if accepted (by every robot that

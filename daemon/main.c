@@ -278,7 +278,7 @@ static int main_tune(const struct main_args *a, struct cfg *cfg)
 	cfg->mode_given = true;
 	static struct tune t;
 	char why[TUNE_TEXT];
-	if (!tune_init(&t, &a->tune_opts, cfg, why, sizeof why)) {
+	if (!tune_init(&t, &a->tune_opts, cfg, NULL, why, sizeof why)) {
 		fprintf(stderr, "undulated --tune: %s\n", why);
 		return 2;
 	}

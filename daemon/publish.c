@@ -25,10 +25,11 @@
 		}                                                                                \
 	} while (0)
 
-bool pub_open(struct pub *p, const struct cfg *cfg, char *why, size_t cap)
+bool pub_open(struct pub *p, const struct cfg *cfg, const struct cfg_params *live, char *why, size_t cap)
 {
 	memset(p, 0, sizeof *p);
 	p->cfg = cfg;
+	p->live = live;
 	p->lim_encode = (struct log_limit)LOG_LIMIT_INIT(3, 10000000);
 	p->buf = malloc(PUB_ENCODE_CAP);
 	if (p->buf == NULL) {
@@ -107,14 +108,16 @@ void pub_params(struct pub *p)
 {
 	double v[9][CFG_MAX_JOINTS];
 	const struct cfg *c = p->cfg;
+	const struct cfg_params *live = p->live;
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
-		v[0][j] = jt->osc.k;
-		v[1][j] = jt->osc.c;
-		v[2][j] = jt->osc.mu;
-		v[3][j] = jt->osc.lambda;
-		v[4][j] = jt->osc.inertia;
-		v[5][j] = jt->osc.friction;
+		const struct osc_joint_params *o = &live->osc[j];
+		v[0][j] = o->k;
+		v[1][j] = o->c;
+		v[2][j] = o->mu;
+		v[3][j] = o->lambda;
+		v[4][j] = o->inertia;
+		v[5][j] = o->friction;
 		v[6][j] = jt->neutral;
 		v[7][j] = jt->limit_min;
 		v[8][j] = jt->limit_max;
@@ -125,7 +128,7 @@ void pub_params(struct pub *p)
 		.utime = clock_wall_us(), .robot = robot, .njoints = (int32_t)c->njoints,
 		.k = v[0], .c = v[1], .mu = v[2], .lambda = v[3], .inertia = v[4], .friction = v[5],
 		.neutral = v[6], .limit_min = v[7], .limit_max = v[8],
-		.amplitude = c->amplitude, .frequency = c->frequency, .phase = c->phase,
+		.amplitude = live->amplitude, .frequency = live->frequency, .phase = live->phase,
 	};
 	PUB_SEND(p, undulate_osc_params_t, p->ch_params, &m);
 }

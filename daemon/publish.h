@@ -45,6 +45,7 @@ struct pub_bus {
 struct pub {
 	lcm_t *lcm;
 	const struct cfg *cfg;
+	const struct cfg_params *live;   /* the controller's: what .PARAMS reports */
 	uint8_t *buf;
 	char ch_state[PUB_CHANNEL_MAX], ch_bus[PUB_CHANNEL_MAX], ch_params[PUB_CHANNEL_MAX],
 	     ch_event[PUB_CHANNEL_MAX];
@@ -54,8 +55,9 @@ struct pub {
 	long long events, encode_failures;
 };
 
-/* False with *why (LCM could not be created for the URL). */
-bool pub_open(struct pub *p, const struct cfg *cfg, char *why, size_t cap);
+/* False with *why (LCM could not be created for the URL). `live` is the
+ * controller's live parameters (control.h), read at every pub_params(). */
+bool pub_open(struct pub *p, const struct cfg *cfg, const struct cfg_params *live, char *why, size_t cap);
 void pub_close(struct pub *p);
 void pub_event(struct pub *p, int64_t seq, int level, const char *kind, const char *text);
 void pub_state(struct pub *p, const struct ctl *c, const struct pub_cycle *f);

@@ -58,7 +58,7 @@ bool tq_mode_drives(const struct ctl *c, enum cfg_mode mode)
 {
 	if (c->cfg->actuation != CFG_ACT_TORQUE)
 		return false;
-	return mode == CFG_MODE_OSCILLATOR || (mode == CFG_MODE_SINUSOID && c->cfg->sin_stiffness > 0.0);
+	return mode == CFG_MODE_OSCILLATOR || (mode == CFG_MODE_SINUSOID && c->p.sin_stiffness > 0.0);
 }
 
 bool tq_want_wheel(const struct ctl *c)
@@ -188,17 +188,14 @@ static double tq_no_outward(const struct ctl_joint *jt, double u)
  * the SINUSOID's shared time t_real. */
 static bool tq_law(const struct ctl *c, double t_real, const double *x, const double *v, double *tau)
 {
-	const struct cfg *cfg = c->cfg;
+	const struct cfg_params *p = &c->p;
 	if (c->mode == CFG_MODE_SINUSOID) {
-		const struct osc_clock k = { .amplitude = cfg->amplitude, .frequency = cfg->frequency,
-		                             .phase = cfg->phase, .stiffness = cfg->sin_stiffness,
-		                             .damping = cfg->sin_damping };
+		const struct osc_clock k = { .amplitude = p->amplitude, .frequency = p->frequency,
+		                             .phase = p->phase, .stiffness = p->sin_stiffness,
+		                             .damping = p->sin_damping };
 		return osc_clock_torque(&k, c->n, t_real, x, v, tau);
 	}
-	struct osc_joint_params p[CFG_MAX_JOINTS];
-	for (size_t j = 0; j < c->n; j++)
-		p[j] = cfg->joint[j].osc;
-	return osc_torque(p, c->n, x, v, tau);
+	return osc_torque(p->osc, c->n, x, v, tau);
 }
 
 void tq_duties(struct ctl *c, double t_real)

@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "control.h"
+
 /* Starting exponents of the plant's answer, f ∝ k^ef and A ∝ μ^(−ea): through
  * a position servo (CONTROL.md's tables: +10 % k gives +6.5 % f; A ≈ ∝ μ^−0.4),
  * and for the law's own torque (the bare equation: f ∝ √k, A ∝ 1/√μ). The
@@ -128,10 +130,15 @@ static bool tune_solve(const struct tune *t, const double *rhs, double *s)
 	return true;
 }
 
-bool tune_init(struct tune *t, const struct tune_opts *o, const struct cfg *cfg, char *why, size_t cap)
+bool tune_init(struct tune *t, const struct tune_opts *o, const struct cfg *cfg, const struct cfg_params *from,
+               char *why, size_t cap)
 {
 	memset(t, 0, sizeof *t);
 	t->opts = *o;
+	if (from != NULL)
+		t->ran = *from;
+	else
+		cfg_params_init(&t->ran, cfg);
 	if (t->opts.max_s <= 0)
 		t->opts.max_s = TUNE_DEFAULT_MAX_S;
 	t->n = cfg->njoints;
@@ -186,27 +193,27 @@ bool tune_init(struct tune *t, const struct tune_opts *o, const struct cfg *cfg,
 	 * natural frequency one period integrates: cfg_joint_check) — the tuner
 	 * sets parameters as a command would, so it is held to what a command
 	 * may set, and the file it writes loads. */
-	struct cfg_range kr, mr;
+	struct param_range kr, mr;
 	cfg_param_range("k", &kr);
 	cfg_param_range("mu", &mr);
 	t->k_lo = 1.0 / TUNE_K_RANGE;
 	t->k_hi = TUNE_K_RANGE;
 	for (size_t i = 0; i < t->n; i++) {
-		const struct cfg_joint *jt = &cfg->joint[i];
+		const struct osc_joint_params *jo = &t->ran.osc[i];
 		double w = 2.0 * M_PI * CFG_MAX_NATURAL_HZ;
-		t->k0[i] = jt->osc.k;
-		t->k_lo = fmax(t->k_lo, kr.min / jt->osc.k);
-		t->k_hi = fmin(t->k_hi, fmin(kr.max, 0.999 * w * w * jt->osc.inertia) / jt->osc.k);
-		t->mu[i] = t->mu0[i] = jt->osc.mu;
-		t->mu_lo[i] = fmax(jt->osc.mu / TUNE_MU_RANGE, mr.min);
-		t->mu_hi[i] = fmin(jt->osc.mu * TUNE_MU_RANGE, mr.max);
+		t->k0[i] = jo->k;
+		t->k_lo = fmax(t->k_lo, kr.min / jo->k);
+		t->k_hi = fmin(t->k_hi, fmin(kr.max, 0.999 * w * w * jo->inertia) / jo->k);
+		t->mu[i] = t->mu0[i] = jo->mu;
+		t->mu_lo[i] = fmax(jo->mu / TUNE_MU_RANGE, mr.min);
+		t->mu_hi[i] = fmin(jo->mu * TUNE_MU_RANGE, mr.max);
 		t->j[i].cross_t = NAN;
 		t->j[i].hyst = TUNE_HYST_MIN;
 	}
 	t->ef0 = torque ? TUNE_EF_TORQUE : TUNE_EF_POSITION;
 	t->ea0 = torque ? TUNE_EA_TORQUE : TUNE_EA_POSITION;
 	tune_jacobian_init(t);
-	t->lead = cfg->servo_lead_s;
+	t->lead = t->ran.servo_lead_s;
 	t->state = TUNE_STARTING;
 	t->t0 = NAN;
 	t->dead_t = NAN;
@@ -695,14 +702,27 @@ void tune_supply(struct tune *t, double volts)
 		t->supply_v = volts;
 }
 
-void tune_apply(struct tune *t, struct cfg *cfg)
+bool tune_apply(struct tune *t, struct ctl *c)
 {
-	for (size_t i = 0; i < t->n; i++) {
-		cfg->joint[i].osc.k = t->k0[i] * t->k;
-		cfg->joint[i].osc.mu = t->mu[i];
-	}
-	cfg->servo_lead_s = t->lead;
+	char why[256];
+	bool ok = true;
 	t->changed = false;
+	/* all or nothing: checked first, so that a refusal leaves the
+	 * controller running the parameters the last window measured */
+	for (size_t i = 0; i < t->n && ok; i++)
+		ok = ctl_check_param(c, "k", (int)i, t->k0[i] * t->k, why, sizeof why) &&
+		     ctl_check_param(c, "mu", (int)i, t->mu[i], why, sizeof why);
+	ok = ok && ctl_check_param(c, "servo_lead_s", -1, t->lead, why, sizeof why);
+	for (size_t i = 0; i < t->n && ok; i++)
+		ok = ctl_set_param(c, "k", (int)i, t->k0[i] * t->k, why, sizeof why) &&
+		     ctl_set_param(c, "mu", (int)i, t->mu[i], why, sizeof why);
+	ok = ok && ctl_set_param(c, "servo_lead_s", -1, t->lead, why, sizeof why);
+	if (!ok) {
+		snprintf(t->why, sizeof t->why, "the controller refused the tuner's step: %s", why);
+		t->state = TUNE_FAILED;
+	}
+	t->ran = c->p;
+	return ok;
 }
 
 void tune_write_config(const struct tune *t, const struct cfg *cfg, const char *when, double took_s, void *file)
@@ -710,6 +730,7 @@ void tune_write_config(const struct tune *t, const struct cfg *cfg, const char *
 	FILE *f = file;
 	static struct cfg out;
 	out = *cfg;
+	cfg_params_put(&out, &t->ran);   /* what commands changed while it ran, too */
 	const struct tune_window *r = &t->result;
 	for (size_t i = 0; i < t->n; i++) {
 		out.joint[i].osc.k = t->k0[i] * r->k;

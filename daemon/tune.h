@@ -26,6 +26,8 @@
 
 #include "config.h"
 
+struct ctl;
+
 #define TUNE_TOLERANCE 0.05        /* the result: every joint within 5 % of both targets */
 #define TUNE_AIM 0.035             /* a window this close is confirmed by one more */
 #define TUNE_MAX_WINDOW_CYCLES 6   /* cycles a window waits for two that agree */
@@ -111,13 +113,17 @@ struct tune {
 	int pinned;                      /* windows in a row that wanted k or μ beyond the search range */
 	double supply_v;                 /* V the servos report (NaN: not yet) */
 	double no_load_speed;            /* rad/s at 12 V (the configuration's) */
+	struct cfg_params ran;           /* what the controller runs: the start, then after every
+	                                    tune_apply (and what the daemon saw last, commands too) */
 	char why[TUNE_TEXT];             /* TUNE_FAILED: in words, with what can be reached */
 	char progress[TUNE_TEXT];        /* a new line to show ("" when none) */
 };
 
-/* Targets and the parameters of cfg as the start. False with *why when the
- * targets are not plausible or do not fit inside the joints' limits. */
-bool tune_init(struct tune *t, const struct tune_opts *o, const struct cfg *cfg, char *why, size_t cap);
+/* Targets, and `from` (NULL: cfg's own parameters) as the start; cfg for
+ * the joints' limits and the servo. False with *why when the targets are not
+ * plausible or do not fit inside the joints' limits. */
+bool tune_init(struct tune *t, const struct tune_opts *o, const struct cfg *cfg, const struct cfg_params *from,
+               char *why, size_t cap);
 
 /* One control cycle: time (s), each joint's x = angle − neutral (rad) and
  * speed (rad/s), NaN for a joint without a reading this cycle; starter: the
@@ -130,17 +136,20 @@ bool tune_sample(struct tune *t, double time, const double *x, const double *v, 
  * with it, and a target beyond it is called out of reach. */
 void tune_supply(struct tune *t, double volts);
 
-/* Copy the parameters in force into cfg (oscillator k and mu of every joint,
- * servo_lead_s) and clear `changed`. */
-void tune_apply(struct tune *t, struct cfg *cfg);
+/* Hand the parameters in force to the controller (k and mu of every joint,
+ * servo_lead_s) through ctl_set_param, all or none, and clear `changed`.
+ * False when the controller refused one (nothing changed then): the tuning
+ * has failed (TUNE_FAILED, *why says which and why). */
+bool tune_apply(struct tune *t, struct ctl *c);
 
 /* The peak speed a sinusoid of f and A needs, and what a servo with peak
  * speed vmax reaches: the frequency at amplitude a, the amplitude at f. */
 double tune_needed_speed(double f, double a);
 
-/* Write the tuned configuration (cfg with the result's parameters, the
- * SINUSOID baseline set to the measured frequency and mean amplitude, start
- * mode OSCILLATOR) with a header saying how it was measured. */
+/* Write the tuned configuration (cfg with the parameters the robot ran
+ * with, `ran`, and over them the result's k, mu and lead, the SINUSOID
+ * baseline set to the measured frequency and mean amplitude, start mode
+ * OSCILLATOR) with a header saying how it was measured. */
 void tune_write_config(const struct tune *t, const struct cfg *cfg, const char *when, double took_s, void *file);
 
 #endif

@@ -81,6 +81,7 @@ static void setup(void)
 	/* the doors by hand: no sockets, a known key */
 	memset(&in, 0, sizeof in);
 	in.cfg = &cfg;
+	in.ctl = &ctl;
 	in.hooks = (struct cin_hooks){ .event = on_event, .wall_us = wall_us, .mono_us = mono_us };
 	in.fingerprint = __undulate_command_t_get_hash();
 	in.local_fd = in.net_fd = -1;
@@ -100,6 +101,8 @@ static void setup(void)
 
 static void check_limits_unchanged(void)
 {
+	/* nor anything else of it: the live parameters are the controller's */
+	CHECK(memcmp(&cfg, &cfg0, sizeof cfg) == 0);
 	for (size_t j = 0; j < cfg.njoints; j++) {
 		CHECK(memcmp(&cfg.joint[j].neutral, &cfg0.joint[j].neutral, sizeof(double)) == 0);
 		CHECK(memcmp(&cfg.joint[j].limit_min, &cfg0.joint[j].limit_min, sizeof(double)) == 0);
@@ -111,7 +114,7 @@ static void check_limits_unchanged(void)
 static void step(void)
 {
 	double before[2] = { ctl.j[0].goal, ctl.j[1].goal };
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	for (size_t j = 0; j < 2; j++)
 		ctl_measure(&ctl, j, dxl_rad_to_pos(isfinite(ctl.j[j].goal) ? ctl.j[j].goal : 0.0), 0, 0, 0, 0.01);
 	wall += 10000;

@@ -140,7 +140,7 @@ static int setup(void **state)
 	fake_mono = 5000000;
 	nev = ev_checked = 0;
 	char why[300];
-	if (!cin_open(&in, &cfg, &hooks, fp, why, sizeof why)) {
+	if (!cin_open(&in, &cfg, &ctl, &hooks, fp, why, sizeof why)) {
 		print_error("cin_open: %s\n", why);
 		return -1;
 	}
@@ -253,16 +253,19 @@ static void test_queued_then_applied(void **state)
 	/* queued, not applied: nothing changed, nothing answered yet */
 	assert_int_equal(cin_pending(&in), 3);
 	assert_int_equal(nev, 0);
-	assert_true(cfg.amplitude == amp0);
-	assert_true(cfg.joint[0].osc.k == k0);
+	assert_true(ctl.p.amplitude == amp0);
+	assert_true(ctl.p.osc[0].k == k0);
 	assert_int_not_equal(ctl.mode, CFG_MODE_HOLD);
 	/* the intake's stack is gone by the boundary */
 	clobber_stack();
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	assert_int_equal(cin_pending(&in), 0);
-	assert_true(cfg.amplitude == 0.5);
-	assert_true(cfg.joint[0].osc.k == 0.05);
-	assert_true(cfg.joint[1].osc.k == k0);
+	assert_true(ctl.p.amplitude == 0.5);
+	assert_true(ctl.p.osc[0].k == 0.05);
+	assert_true(ctl.p.osc[1].k == k0);
+	/* the controller owns the live values: the configuration keeps the start */
+	assert_true(cfg.amplitude == amp0);
+	assert_true(cfg.joint[0].osc.k == k0);
 	assert_int_equal(ctl.mode, CFG_MODE_HOLD);
 	if (strstr(ctl.reason, "uid 1000 pid 4242 'operator-1'") == NULL)
 		fail_msg("reason '%s'", ctl.reason);
@@ -287,7 +290,7 @@ static void test_source_escaped(void **state)
 	r.source = "op\n<0>forged";
 	send_local(&r);
 	clobber_stack();
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	assert_int_equal(ctl.mode, CFG_MODE_HOLD);
 	assert_null(strchr(ctl.reason, '\n'));
 	assert_non_null(strstr(ctl.reason, "op\\x0a<0>forged"));
@@ -310,7 +313,7 @@ static void test_commands_off(void **state)
 	assert_int_equal(cin_pending(&in), 0);
 	assert_int_equal(in.rejected, 2);
 	expect_last_event("command-rejected", "commands = off");
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	assert_int_not_equal(ctl.mode, CFG_MODE_HOLD);
 	assert_int_equal(count_kind("command-accepted"), 0);
 	assert_int_equal(cin_refused(&in), 2);
@@ -319,7 +322,7 @@ static void test_commands_off(void **state)
 static void test_refused_at_intake(void **state)
 {
 	(void)state;
-	struct cfg before = cfg;
+	struct cfg_params before = ctl.p;
 	struct {
 		const char *param;
 		int joint;
@@ -371,11 +374,9 @@ static void test_refused_at_intake(void **state)
 	assert_int_equal(cin_pending(&in), 0);
 	/* and the boundary has nothing to apply */
 	size_t events = nev;
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	assert_int_equal(nev, events);
-	assert_memory_equal(&cfg.joint, &before.joint, sizeof cfg.joint);
-	assert_true(cfg.amplitude == before.amplitude);
-	assert_true(cfg.frequency == before.frequency);
+	assert_memory_equal(&ctl.p, &before, sizeof before);
 	assert_int_not_equal(ctl.mode, CFG_MODE_HOLD);
 }
 
@@ -398,8 +399,8 @@ static void test_busy(void **state)
 	assert_int_equal(expect_last_event("command-rejected", "busy")->seq, 99);
 	/* the queue is applied in arrival order: the last queued value stays,
 	 * the refused one never lands */
-	cin_apply(&in, &ctl, &cfg);
-	assert_true(fabs(cfg.amplitude - 0.01 * CIN_QUEUE) < 1e-12);
+	cin_apply(&in, &ctl);
+	assert_true(fabs(ctl.p.amplitude - 0.01 * CIN_QUEUE) < 1e-12);
 	assert_int_equal(count_kind("command-accepted"), CIN_QUEUE);
 	for (int i = 0; i < CIN_QUEUE; i++)
 		assert_int_equal(evs[1 + i].seq, i);
@@ -502,7 +503,7 @@ static void test_network_refused(void **state)
 	assert_int_equal(cin_refused(&in), 10);
 	assert_int_equal(cin_pending(&in), 1);
 	/* only the good one reaches the controller */
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	assert_int_equal(count_kind("command-accepted"), 1);
 	expect_last_event("command-accepted", "mode HOLD");
 	assert_int_equal(evs[nev - 1].seq, 44);
@@ -533,10 +534,10 @@ static void test_network_signed_applied(void **state)
 	assert_int_equal(in.unauthenticated, 0);
 	assert_int_equal(nev, 0);
 	clobber_stack();
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	assert_int_equal(count_kind("command-accepted"), 3);
-	assert_true(cfg.amplitude == 0.25);
-	assert_true(cfg.frequency == 0.6);
+	assert_true(ctl.p.amplitude == 0.25);
+	assert_true(ctl.p.frequency == 0.6);
 	assert_int_equal(ctl.mode, CFG_MODE_HOLD);
 	assert_non_null(strstr(ctl.reason, "the network 'operator-2'"));
 	/* the next command of a source must be newer */
@@ -630,7 +631,7 @@ static void test_local_socket_answers(void **state)
 	assert_non_null(strstr(e.text, "unknown mode 9"));
 	undulate_event_t_decode_cleanup(&e);
 	assert_int_equal(recv(c, buf, sizeof buf, MSG_DONTWAIT), -1);
-	cin_apply(&in, &ctl, &cfg);
+	cin_apply(&in, &ctl);
 	got = recv(c, buf, sizeof buf, MSG_DONTWAIT);
 	assert_true(got > 0);
 	assert_true(undulate_event_t_decode(buf, 0, (int)got, &e) > 0);
@@ -652,7 +653,7 @@ static void test_open_failures(void **state)
 	/* a second daemon for this robot: refused, and closing it leaves the
 	 * first one's socket alone */
 	static struct cin second;
-	assert_false(cin_open(&second, &cfg, &hooks, fp, why, sizeof why));
+	assert_false(cin_open(&second, &cfg, &ctl, &hooks, fp, why, sizeof why));
 	assert_non_null(strstr(why, "another undulated"));
 	assert_int_equal(cin_local_fd(&second), -1);
 	cin_close(&second);
@@ -666,7 +667,7 @@ static void test_open_failures(void **state)
 	assert_true(snprintf(other.command_key, sizeof other.command_key, "%s/no-such.key", scratch_dir) <
 	            (int)sizeof other.command_key);
 	why[0] = '\0';
-	assert_false(cin_open(&second, &other, &hooks, fp, why, sizeof why));
+	assert_false(cin_open(&second, &other, NULL, &hooks, fp, why, sizeof why));
 	assert_non_null(strstr(why, "command_key"));
 	char p[CSOCK_PATH_MAX];
 	assert_true(csock_path(p, sizeof p, scratch_dir, "robot9", other.lcm_url));
@@ -681,7 +682,7 @@ static void test_open_failures(void **state)
 	fclose(f);
 	assert_int_equal(chmod(keyp, 0644), 0);
 	memcpy(other.command_key, keyp, sizeof keyp);
-	assert_false(cin_open(&second, &other, &hooks, fp, why, sizeof why));
+	assert_false(cin_open(&second, &other, NULL, &hooks, fp, why, sizeof why));
 	assert_non_null(strstr(why, "chmod 600"));
 	assert_int_equal(stat(p, &st), -1);
 	/* a run_dir too long for any socket in it, and one that leaves no room
@@ -691,11 +692,11 @@ static void test_open_failures(void **state)
 	other.run_dir[0] = '/';
 	other.run_dir[150] = '\0';
 	snprintf(why, sizeof why, "unset");
-	assert_false(cin_open(&second, &other, &hooks, fp, why, sizeof why));
+	assert_false(cin_open(&second, &other, NULL, &hooks, fp, why, sizeof why));
 	if (strstr(why, "too long") == NULL)
 		fail_msg("why '%s'", why);
 	other.run_dir[90] = '\0';
-	assert_false(cin_open(&second, &other, &hooks, fp, why, sizeof why));
+	assert_false(cin_open(&second, &other, NULL, &hooks, fp, why, sizeof why));
 	assert_non_null(strstr(why, "does not fit a socket address"));
 	cin_close(&second);
 }

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "../../daemon/command.h"
+#include "../../daemon/control.h"
 #include "undulate_command_t.h"
 
 static struct cfg cfg;
@@ -157,34 +158,59 @@ static void test_limits_not_commandable(void **state)
 				expect_reject(&r, false, "only the configuration file");
 			}
 		}
-		/* and applied anyway (a caller that skipped the check), nothing changes */
-		struct cfg c = cfg;
-		struct cmd_request r = base(CMD_KIND_PARAM);
-		r.param = names[i];
-		r.value = 0.25;
-		cmd_apply_param(&c, &r);
-		assert_memory_equal(&c, &cfg, sizeof c);
+		/* and given to the controller anyway (a caller that skipped the
+		 * check): refused there too, nothing changes */
+		static struct ctl ctl;
+		ctl_init(&ctl, &cfg);
+		struct cfg_params before = ctl.p;
+		char why[256];
+		for (int joint = -1; joint < 2; joint++)
+			assert_false(ctl_set_param(&ctl, names[i], joint, 0.25, why, sizeof why));
+		assert_memory_equal(&ctl.p, &before, sizeof before);
+		assert_null(cfg_params_field(&ctl.p, names[i], 0));
 	}
 }
 
+/* An accepted parameter is the controller's to apply (ctl_set_param):
+ * joint -1 is every joint; the configuration keeps its start values. */
 static void test_apply(void **state)
 {
 	(void)state;
-	struct cfg c = cfg;
+	static struct ctl ctl;
+	struct cfg saved = cfg;
+	char why[256];
+	ctl_init(&ctl, &cfg);
+	assert_true(ctl_set_param(&ctl, "c", -1, 0.004, why, sizeof why));
+	assert_true(ctl.p.osc[0].c == 0.004 && ctl.p.osc[1].c == 0.004);
+	assert_true(ctl_set_param(&ctl, "c", 1, 0.005, why, sizeof why));
+	assert_true(ctl.p.osc[0].c == 0.004 && ctl.p.osc[1].c == 0.005);
+	assert_true(ctl_set_param(&ctl, "phase", -1, 1.25, why, sizeof why));
+	assert_true(ctl.p.phase == 1.25);
+	assert_memory_equal(&cfg, &saved, sizeof cfg);
+}
+
+/* A value is judged against the values the robot runs with: k that the
+ * configuration's inertia would refuse (natural frequency above 5 Hz) is
+ * accepted once a command raised the inertia, and the other way round. */
+static void test_judged_against_live(void **state)
+{
+	(void)state;
+	static struct ctl ctl;
+	char why[256];
+	ctl_init(&ctl, &cfg);
 	struct cmd_request r = base(CMD_KIND_PARAM);
-	r.param = "c";
-	r.value = 0.004;
-	cmd_apply_param(&c, &r);
-	assert_true(c.joint[0].osc.c == 0.004 && c.joint[1].osc.c == 0.004);
-	r.joint = 1;
-	r.value = 0.005;
-	cmd_apply_param(&c, &r);
-	assert_true(c.joint[0].osc.c == 0.004 && c.joint[1].osc.c == 0.005);
-	r = base(CMD_KIND_PARAM);
-	r.param = "phase";
-	r.value = 1.25;
-	cmd_apply_param(&c, &r);
-	assert_true(c.phase == 1.25);
+	r.joint = 0;
+	r.value = cfg.joint[0].osc.inertia * pow(2.0 * M_PI * 6.0, 2.0);   /* 6 Hz at this inertia */
+	expect_reject(&r, true, "natural frequency");
+	assert_int_equal(cmd_check_live(&r, &cfg, &ctl.p, true, why, sizeof why), CMD_REJECT);
+	assert_true(ctl_set_param(&ctl, "inertia", 0, 4.0 * cfg.joint[0].osc.inertia, why, sizeof why));
+	assert_int_equal(cmd_check_live(&r, &cfg, &ctl.p, true, why, sizeof why), CMD_ACCEPT);
+	assert_true(ctl_set_param(&ctl, "k", 0, r.value, why, sizeof why));
+	/* now the inertia cannot go back under that k */
+	assert_false(ctl_set_param(&ctl, "inertia", 0, cfg.joint[0].osc.inertia, why, sizeof why));
+	if (strstr(why, "parameter inertia: joint 0: ") == NULL)
+		fail_msg("why '%s'", why);
+	assert_true(ctl.p.osc[0].k == r.value);
 }
 
 /* The clock's stiffness (torque actuation's SINUSOID as a torque law) is a
@@ -214,13 +240,12 @@ static void test_sinusoid_stiffness(void **state)
 	expect_accept(&r);
 	r.value = -0.01;
 	expect_reject(&r, true, "out of range 0..1");
-	struct cfg c = cfg;
-	r.value = 0.02;
-	cmd_apply_param(&c, &r);
-	r.param = "stiffness";
-	r.value = 0.015;
-	cmd_apply_param(&c, &r);
-	assert_true(c.sin_stiffness == 0.015 && c.sin_damping == 0.02);
+	static struct ctl ctl;
+	char why[256];
+	ctl_init(&ctl, &cfg);
+	assert_true(ctl_set_param(&ctl, "damping", -1, 0.02, why, sizeof why));
+	assert_true(ctl_set_param(&ctl, "stiffness", -1, 0.015, why, sizeof why));
+	assert_true(ctl.p.sin_stiffness == 0.015 && ctl.p.sin_damping == 0.02);
 	cfg = saved;
 }
 
@@ -376,6 +401,7 @@ int main(void)
 		cmocka_unit_test(test_limits_not_commandable),
 		cmocka_unit_test(test_encode),
 		cmocka_unit_test(test_apply),
+		cmocka_unit_test(test_judged_against_live),
 		cmocka_unit_test(test_sinusoid_stiffness),
 		cmocka_unit_test(test_parse_text),
 		cmocka_unit_test(test_decode),

@@ -645,7 +645,7 @@ static void test_rs485(void **state)
 static void test_param_ranges(void **state)
 {
 	(void)state;
-	struct cfg_range r;
+	struct param_range r;
 	assert_true(cfg_param_range("k", &r));
 	assert_false(r.min_open);
 	assert_true(r.min > 0.0);

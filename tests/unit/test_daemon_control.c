@@ -181,7 +181,7 @@ static void test_switches_without_jumps(void **state)
 	if (!(first <= before + 0.01))
 		fail_msg("goal jumped %.4f rad at the switch to SINUSOID (moving %.4f a cycle)", first, before);
 	run(300);
-	const double a = c.cfg->amplitude;
+	const double a = c.p.amplitude;
 	/* once blended, the commanded angle is the sinusoid itself */
 	assert_true(fabs(c.j[0].goal - osc_sinusoid(a, cfg.frequency, cfg.phase, 0, t)) < 1e-9);
 }
@@ -461,13 +461,12 @@ static void test_goal_register_inside_limits(void **state)
 {
 	(void)state;
 	setup_robot(CFG_MODE_SINUSOID);
-	cfg.amplitude = 2.5;
 	cfg.joint[1].limit_min = -0.5;
 	cfg.joint[1].limit_max = 0.5;
 	char why[512];
 	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023 };
 	assert_true(ctl_set_servo(&c, 1, &info, why, sizeof why));
-	ctl_params_changed(&c);
+	assert_true(ctl_set_param(&c, "amplitude", -1, 2.5, why, sizeof why));
 	uint16_t addr;
 	uint8_t width, ids[8], data[64];
 	int at_hi = 0, at_lo = 0;
@@ -488,14 +487,61 @@ static void test_goal_register_inside_limits(void **state)
 	assert_true(at_hi > 0 && at_lo > 0);   /* it went to each limit */
 }
 
+/* ctl_set_param is the one door for a live parameter: a refused value
+ * (not finite, out of its range, a joint that does not exist, a natural
+ * frequency too high, a bound only the file sets, a name that is none)
+ * changes nothing, says why, and the configuration is never written. */
+static void test_set_param_refused_leaves_controller(void **state)
+{
+	(void)state;
+	setup_robot(CFG_MODE_SINUSOID);
+	run(50);
+	static struct cfg saved;
+	saved = cfg;
+	struct cfg_params before = c.p;
+	double blend_t0 = c.blend_t0[0];
+	static const struct { const char *name; int joint; double value; const char *why; } bad[] = {
+		{ "k", 0, NAN, "parameter k: value is not finite" },
+		{ "mu", -1, INFINITY, "parameter mu: value is not finite" },
+		{ "k", 0, 20.0, "parameter k: 20 out of range 0.0001..10" },
+		{ "amplitude", -1, 2.7, "parameter amplitude: 2.7 out of range 0..2.61799" },
+		{ "amplitude", 0, 0.5, "parameter amplitude is per robot: joint must be -1, not 0" },
+		{ "c", 2, 0.01, "parameter c: joint 2 does not exist (0..1, or -1 for all)" },
+		{ "k", -1, 9.0, "parameter k: joint 0: k 9 and inertia" },
+		{ "stiffness", -1, 0.1, "parameter stiffness: stiffness 0.1 drives the clock as a torque" },
+		{ "servo_lead_s", -1, 0.25, "parameter servo_lead_s: 0.25 out of range 0..0.2" },
+		{ "servo_lead_s", 1, 0.05, "parameter servo_lead_s is per robot" },
+		{ "limit_max", 0, 0.1, "parameter limit_max cannot be changed while the robot runs" },
+		{ "neutral", -1, 0.1, "parameter neutral cannot be changed" },
+		{ "period_ms", -1, 5.0, "parameter period_ms cannot be changed" },
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+		char why[256] = "";
+		if (ctl_set_param(&c, bad[i].name, bad[i].joint, bad[i].value, why, sizeof why))
+			fail_msg("%s %g (joint %d) accepted", bad[i].name, bad[i].value, bad[i].joint);
+		if (strstr(why, bad[i].why) != why)
+			fail_msg("%s: why '%s', expected '%s...'", bad[i].name, why, bad[i].why);
+		assert_memory_equal(&c.p, &before, sizeof before);
+	}
+	assert_true(c.blend_t0[0] == blend_t0);   /* no re-blend for nothing */
+	/* accepted: applied at once, SINUSOID re-blends from where it is */
+	char why[256];
+	run(5);
+	assert_true(ctl_set_param(&c, "frequency", -1, 0.5, why, sizeof why));
+	assert_true(c.p.frequency == 0.5 && c.blend_t0[0] == c.t && isfinite(c.blend_from[0]));
+	assert_true(ctl_set_param(&c, "servo_lead_s", -1, 0.05, why, sizeof why));
+	assert_true(c.p.servo_lead_s == 0.05);
+	assert_memory_equal(&cfg, &saved, sizeof cfg);
+}
+
 static void test_nonfinite_never_reaches_goal(void **state)
 {
 	(void)state;
 	setup_robot(CFG_MODE_SINUSOID);
 	run(200);
 	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
-	cfg.joint[0].osc.k = NAN;      /* a corrupted parameter */
-	cfg.joint[1].osc.inertia = INFINITY;
+	c.p.osc[0].k = NAN;      /* a corrupted parameter (ctl_set_param refuses one) */
+	c.p.osc[1].inertia = INFINITY;
 	long long before = c.nonfinite;
 	double m = run(50);
 	assert_true(c.nonfinite > before);
@@ -510,11 +556,10 @@ static void test_limits_respected(void **state)
 {
 	(void)state;
 	setup_robot(CFG_MODE_SINUSOID);
-	cfg.amplitude = 2.5;   /* asks beyond ±1.3 */
 	char why[512];
 	struct ctl_servo_info info = { .cw_limit = 400, .ccw_limit = 1023, .max_torque = 1023 };
 	assert_true(ctl_set_servo(&c, 0, &info, why, sizeof why));
-	ctl_params_changed(&c);
+	assert_true(ctl_set_param(&c, "amplitude", -1, 2.5, why, sizeof why));   /* asks beyond ±1.3 */
 	for (int i = 0; i < 400; i++) {
 		cycle();
 		assert_true(c.j[0].goal >= dxl_pos_to_rad(400) - 1e-12 && c.j[0].goal <= 1.3 + 1e-12);
@@ -589,6 +634,7 @@ int main(void)
 		cmocka_unit_test(test_fault_while_limp_stays_limp),
 		cmocka_unit_test(test_hold_from_past_limit_inside_limits),
 		cmocka_unit_test(test_goal_register_inside_limits),
+		cmocka_unit_test(test_set_param_refused_leaves_controller),
 		cmocka_unit_test(test_nonfinite_never_reaches_goal),
 		cmocka_unit_test(test_limits_respected),
 	};

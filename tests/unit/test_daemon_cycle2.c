@@ -505,7 +505,7 @@ static void test_clock_in_current_control(void **state)
 		assert_int_equal(sv(id)->mem[11], 0);
 		assert_true(jt->drive_ready);
 		chain[id - 1] = jt->drive_chain;
-		double tau = cfg.sin_stiffness * (osc_sinusoid(cfg.amplitude, cfg.frequency, cfg.phase, id - 1u, c.t) -
+		double tau = c.p.sin_stiffness * (osc_sinusoid(c.p.amplitude, c.p.frequency, c.p.phase, id - 1u, c.t) -
 		                                  (jt->angle - cfg.joint[id - 1].neutral));
 		assert_true(fabs(jt->torque_cmd - tau) < 1e-9);
 		int16_t cur = (int16_t)reg(id, 102, 2);

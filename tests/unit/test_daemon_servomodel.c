@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "../../daemon/config.h"
+#include "../../daemon/control.h"
 #include "../../daemon/servo_model.h"
 #include "dxl.h"
 #include "dxl_table.h"
@@ -264,23 +265,28 @@ static void test_torque_defaults_scale(void **state)
 	assert_true(fabs(xm - (4.39e-3 - 4.6e-8 * 254 * 254 + 5.0e-8 * 353.5 * 353.5) / 4.39e-3) < 1e-9);
 	assert_true(xm > 1.7 && xm < 1.8);
 	assert_true(xl > 1.0 && xl < 1.05);
-	struct cfg c;
+	/* the controller's live parameters take them; the configuration keeps what was configured */
+	static struct cfg c;
+	static struct ctl ctl;
 	cfg_with(&c, "robot.ids=1,2", "robot.actuation=torque", "robot.torque_drive=current", "joint.2.k=0.3", NULL);
+	ctl_init(&ctl, &c);
 	double k1 = c.joint[0].osc.k, mu1 = c.joint[0].osc.mu, i1 = c.joint[0].osc.inertia, mu2 = c.joint[1].osc.mu;
-	cfg_scale_torque_defaults(&c, 0, xm);
-	cfg_scale_torque_defaults(&c, 1, xm);
-	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
-	assert_true(fabs(c.joint[0].osc.mu - mu1 * xm) < 1e-12);
-	assert_true(fabs(c.joint[0].osc.inertia - i1 * xm) < 1e-12);
-	assert_true(fabs(c.joint[1].osc.k - 0.3) < 1e-12);        /* given: kept */
-	assert_true(fabs(c.joint[1].osc.mu - mu2 * xm) < 1e-12);  /* not given: scaled */
-	cfg_scale_torque_defaults(&c, 0, xm);                      /* once */
-	assert_true(fabs(c.joint[0].osc.k - k1 * xm) < 1e-12);
+	assert_true(ctl_torque_defaults(&ctl, 0, xm));
+	assert_true(ctl_torque_defaults(&ctl, 1, xm));
+	assert_true(fabs(ctl.p.osc[0].k - k1 * xm) < 1e-12);
+	assert_true(fabs(ctl.p.osc[0].mu - mu1 * xm) < 1e-12);
+	assert_true(fabs(ctl.p.osc[0].inertia - i1 * xm) < 1e-12);
+	assert_true(fabs(ctl.p.osc[1].k - 0.3) < 1e-12);        /* given: kept */
+	assert_true(fabs(ctl.p.osc[1].mu - mu2 * xm) < 1e-12);  /* not given: scaled */
+	assert_true(c.joint[0].osc.k == k1);
+	assert_false(ctl_torque_defaults(&ctl, 0, xm));          /* once */
+	assert_true(fabs(ctl.p.osc[0].k - k1 * xm) < 1e-12);
 	/* position actuation's parameters are a control law's, not a joint's: none */
 	cfg_with(&c, "robot.ids=1", NULL);
+	ctl_init(&ctl, &c);
 	k1 = c.joint[0].osc.k;
-	cfg_scale_torque_defaults(&c, 0, xm);
-	assert_true(fabs(c.joint[0].osc.k - k1) < 1e-12);
+	assert_false(ctl_torque_defaults(&ctl, 0, xm));
+	assert_true(fabs(ctl.p.osc[0].k - k1) < 1e-12);
 }
 
 /* Position actuation's defaults: the AX-12A has none of its own (osc.h's
@@ -302,26 +308,31 @@ static void test_position_defaults(void **state)
 	assert_true(sm_position_defaults(xl, 0, 1, &k, &mu, &lead));   /* a single joint */
 	assert_true(fabs(k - 0.0105) < 1e-12 && fabs(mu - 0.0360) < 1e-12 && fabs(lead - 0.117) < 1e-12);
 
-	struct cfg c;
+	static struct cfg c;
+	static struct ctl ctl;
 	cfg_with(&c, "robot.ids=1,2", "joint.2.mu=0.5", NULL);
+	ctl_init(&ctl, &c);
 	assert_true(c.servo_lead_default);
-	assert_true(cfg_position_defaults(&c, 0, 0.03, 0.07));
-	assert_true(fabs(c.joint[0].osc.k - 0.03) < 1e-12 && fabs(c.joint[0].osc.mu - 0.07) < 1e-12);
-	assert_true(cfg_position_defaults(&c, 1, 0.03, 0.07));
-	assert_true(fabs(c.joint[1].osc.k - 0.03) < 1e-12);
-	assert_true(fabs(c.joint[1].osc.mu - 0.5) < 1e-12);             /* given: kept */
-	assert_false(cfg_position_defaults(&c, 0, 0.9, 0.9));           /* once */
-	assert_true(fabs(c.joint[0].osc.k - 0.03) < 1e-12);
+	assert_true(ctl_position_defaults(&ctl, 0, 0.03, 0.07));
+	assert_true(fabs(ctl.p.osc[0].k - 0.03) < 1e-12 && fabs(ctl.p.osc[0].mu - 0.07) < 1e-12);
+	assert_true(ctl_position_defaults(&ctl, 1, 0.03, 0.07));
+	assert_true(fabs(ctl.p.osc[1].k - 0.03) < 1e-12);
+	assert_true(fabs(ctl.p.osc[1].mu - 0.5) < 1e-12);             /* given: kept */
+	assert_false(ctl_position_defaults(&ctl, 0, 0.9, 0.9));         /* once */
+	assert_true(fabs(ctl.p.osc[0].k - 0.03) < 1e-12);
+	assert_true(fabs(c.joint[0].osc.k - 0.03) > 1e-3);            /* the configuration's own stays */
 	/* every one given: nothing to replace */
 	cfg_with(&c, "robot.ids=1", "joint.1.k=0.2", "joint.1.mu=0.2", "robot.servo_lead_s=0.03", NULL);
+	ctl_init(&ctl, &c);
 	assert_false(c.servo_lead_default);
-	assert_false(cfg_position_defaults(&c, 0, 0.03, 0.07));
-	assert_true(fabs(c.joint[0].osc.k - 0.2) < 1e-12);
+	assert_false(ctl_position_defaults(&ctl, 0, 0.03, 0.07));
+	assert_true(fabs(ctl.p.osc[0].k - 0.2) < 1e-12);
 	/* torque actuation: its own defaults (scaled), never these */
 	cfg_with(&c, "robot.ids=1", "robot.actuation=torque", NULL);
+	ctl_init(&ctl, &c);
 	k = c.joint[0].osc.k;
-	assert_false(cfg_position_defaults(&c, 0, 0.03, 0.07));
-	assert_true(fabs(c.joint[0].osc.k - k) < 1e-12);
+	assert_false(ctl_position_defaults(&ctl, 0, 0.03, 0.07));
+	assert_true(fabs(ctl.p.osc[0].k - k) < 1e-12);
 }
 
 /* The supply each model can be running at: its e-manual's rated range, 5 %

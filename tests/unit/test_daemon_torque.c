@@ -372,7 +372,7 @@ static void test_two_joint_defaults_inside_limits(void **state)
 		if (c.limit_trips != 0 || c.latched || !c.wheel || !(widest[0] < 1.0 && widest[1] < 1.0) ||
 		    !(widest[0] > 0.5 && widest[1] > 0.5))
 			fail_msg("%s drive, defaults mu %.3f/%.3f: widest %.3f/%.3f rad in 20..40 s, %lld limit trip(s), %s",
-			         drives[d], cfg.joint[0].osc.mu, cfg.joint[1].osc.mu, widest[0], widest[1], c.limit_trips,
+			         drives[d], c.p.osc[0].mu, c.p.osc[1].mu, widest[0], widest[1], c.limit_trips,
 			         c.latched ? c.latch : "no fault");
 		assert_int_equal(c.starts, 0);
 	}
@@ -386,8 +386,8 @@ static void test_start_from_rest_displaced(void **state)
 	start_angle[0] = 0.5;
 	start_angle[1] = -0.5;
 	setup("1,2", "current", CFG_MODE_HOLD);
-	cfg.joint[0].osc.lambda = cfg.joint[1].osc.lambda = 0.0;   /* two independent oscillators */
-	cfg.joint[1].osc.mu = cfg.joint[0].osc.mu;                  /* and alike */
+	c.p.osc[0].lambda = c.p.osc[1].lambda = 0.0;   /* two independent oscillators */
+	c.p.osc[1].mu = c.p.osc[0].mu;                  /* and alike */
 	run(50);
 	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
 	start_angle[0] = 0.2;
@@ -408,7 +408,6 @@ static void test_walls_and_limit_breach(void **state)
 	setup("1", "current", CFG_MODE_OSCILLATOR);
 	cfg.joint[0].limit_min = -1.0;
 	cfg.joint[0].limit_max = 1.0;
-	ctl_params_changed(&c);
 	run_into_wheel();
 	/* near the upper limit and moving out: the wall pushes back whatever
 	 * the law says */
@@ -469,7 +468,7 @@ static void test_stale_and_nonfinite_give_no_drive(void **state)
 	sv[1].answers = true;
 	run(5);
 	long long nonfinite = c.nonfinite;
-	cfg.joint[0].osc.k = NAN;
+	c.p.osc[0].k = NAN;   /* (ctl_set_param refuses one) */
 	cycle();
 	assert_true(c.nonfinite > nonfinite);
 	for (size_t j = 0; j < nj; j++)
@@ -664,9 +663,9 @@ static void test_limits_hold_for_every_reading(void **state)
 /* The clock's torque at time t for a joint at (x, v) rad, rad/s from neutral. */
 static double clock_tau(size_t j, double tt, double x, double v)
 {
-	double target = osc_sinusoid(cfg.amplitude, cfg.frequency, cfg.phase, j, tt);
-	double rate = osc_sinusoid_rate(cfg.amplitude, cfg.frequency, cfg.phase, j, tt);
-	return cfg.sin_stiffness * (target - x) + cfg.sin_damping * (rate - v);
+	double target = osc_sinusoid(c.p.amplitude, c.p.frequency, c.p.phase, j, tt);
+	double rate = osc_sinusoid_rate(c.p.amplitude, c.p.frequency, c.p.phase, j, tt);
+	return c.p.sin_stiffness * (target - x) + c.p.sin_damping * (rate - v);
 }
 
 static void setup_clock(const char *ids, const char *drive, const char *stiffness)
@@ -719,7 +718,7 @@ static void test_clock_drives_the_law(void **state)
 {
 	(void)state;
 	setup_clock("1,2", "current", "0.015");
-	assert_true(cfg.sin_stiffness == CLOCK_K);
+	assert_true(c.p.sin_stiffness == CLOCK_K);
 	run_into_wheel();
 	assert_false(c.starter_active);
 	for (int i = 0; i < 300; i++) {
@@ -741,7 +740,7 @@ static void test_clock_drives_the_law(void **state)
 		}
 	}
 	/* and with damping, against the clock's speed */
-	cfg.sin_damping = 0.01;
+	c.p.sin_damping = 0.01;
 	for (int i = 0; i < 50; i++) {
 		cycle();
 		for (size_t j = 0; j < nj; j++) {
@@ -760,13 +759,13 @@ static void test_clock_drives_the_law(void **state)
 	sv[1].answers = true;
 	run(5);
 	long long nonfinite = c.nonfinite;
-	cfg.amplitude = NAN;   /* (no file or command can set one) */
+	c.p.amplitude = NAN;   /* (no file or command can set one) */
 	cycle();
 	assert_true(c.wheel && c.nonfinite > nonfinite);
 	assert_true(c.j[0].duty == 0.0 && c.j[1].duty == 0.0);
-	cfg.amplitude = 0.8;
+	c.p.amplitude = 0.8;
 	/* nor a stiffness: not a torque law, back to joint mode */
-	cfg.sin_stiffness = NAN;
+	c.p.sin_stiffness = NAN;
 	cycle();
 	assert_false(c.wheel);
 	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);
@@ -780,7 +779,6 @@ static void test_clock_walls_and_breach(void **state)
 	setup_clock("1", "current", "0.135");
 	cfg.joint[0].limit_min = -1.0;
 	cfg.joint[0].limit_max = 1.0;
-	ctl_params_changed(&c);
 	run_into_wheel();
 	double hi = c.j[0].limits.hi;
 	sv[0].angle = hi - 0.05;
@@ -834,7 +832,7 @@ static void test_clock_to_oscillator_stays_in_drive(void **state)
 		for (size_t j = 0; j < nj; j++) {
 			x[j] = c.j[j].angle - cfg.joint[j].neutral;
 			v[j] = c.j[j].speed;
-			p[j] = cfg.joint[j].osc;
+			p[j] = c.p.osc[j];
 		}
 		assert_true(osc_torque(p, nj, x, v, tau));
 		for (size_t j = 0; j < nj; j++) {
@@ -877,18 +875,17 @@ static void test_clock_stiffness_zero_is_joint_mode(void **state)
 {
 	(void)state;
 	setup("1,2", "current", CFG_MODE_SINUSOID);
-	assert_true(cfg.sin_stiffness == 0.0);
+	assert_true(c.p.sin_stiffness == 0.0);
 	run(300);
 	assert_false(c.wheel);
 	assert_int_equal(c.sync, CTL_SYNC_GOAL);
 	assert_true(c.j[0].write_goal);
-	cfg.sin_stiffness = CLOCK_K;
-	ctl_params_changed(&c);
+	char why[256];
+	assert_true(ctl_set_param(&c, "stiffness", -1, CLOCK_K, why, sizeof why));
 	run(3);
 	assert_true(c.wheel);
 	assert_int_equal(c.sync, CTL_SYNC_DUTY);
-	cfg.sin_stiffness = 0.0;
-	ctl_params_changed(&c);
+	assert_true(ctl_set_param(&c, "stiffness", -1, 0.0, why, sizeof why));
 	cycle();
 	assert_false(c.wheel);
 	assert_int_equal(c.sync, CTL_SYNC_GOAL_STOP);

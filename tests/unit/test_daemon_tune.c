@@ -18,6 +18,7 @@
 #include <cmocka.h>
 
 #include "../../daemon/config.h"
+#include "../../daemon/control.h"
 #include "../../daemon/tune.h"
 
 #define PI 3.14159265358979323846
@@ -48,6 +49,7 @@ static struct cfg *base_cfg(size_t njoints)
 struct run {
 	struct tune t;
 	struct cfg *cfg;
+	struct ctl ctl;            /* what runs: the tuner's steps go through ctl_set_param */
 	double k0, mu0[2], lead0;
 	double time;
 	int applied;
@@ -55,13 +57,13 @@ struct run {
 
 static void gait(const struct run *r, const struct plant *p, double *f, double *a)
 {
-	double kr = r->cfg->joint[0].osc.k / r->k0;
-	*f = p->f0 * pow(kr, p->ef) * pow(r->mu0[0] / r->cfg->joint[0].osc.mu, 0.1);
+	double kr = r->ctl.p.osc[0].k / r->k0;
+	*f = p->f0 * pow(kr, p->ef) * pow(r->mu0[0] / r->ctl.p.osc[0].mu, 0.1);
 	for (size_t j = 0; j < r->t.n; j++) {
-		a[j] = p->a0[j] * pow(r->mu0[j] / r->cfg->joint[j].osc.mu, p->ea);
+		a[j] = p->a0[j] * pow(r->mu0[j] / r->ctl.p.osc[j].mu, p->ea);
 		/* the energy the loop gets caps what μ can give */
 		if (j == 1 && p->lead_exp > 0)
-			a[j] = fmin(p->a0[j] * pow(r->cfg->servo_lead_s / r->lead0, p->lead_exp), 1.1 * a[j]);
+			a[j] = fmin(p->a0[j] * pow(r->ctl.p.servo_lead_s / r->lead0, p->lead_exp), 1.1 * a[j]);
 		double v = 2 * PI * *f * a[j];
 		if (p->vmax > 0 && v > p->vmax)
 			a[j] *= p->vmax / v;
@@ -90,7 +92,7 @@ static void drive(struct run *r, struct plant *p, double seconds)
 		if (getenv("TUNE_TRACE") && r->t.progress[0])
 			print_message("%6.1f %s\n", r->time, r->t.progress);
 		if (ch) {
-			tune_apply(&r->t, r->cfg);
+			assert_true(tune_apply(&r->t, &r->ctl));
 			r->applied++;
 		}
 		r->time += DT;
@@ -110,9 +112,10 @@ static void start(struct run *r, size_t njoints, double f, double a, bool torque
 	r->lead0 = r->cfg->servo_lead_s;
 	for (size_t j = 0; j < njoints; j++)
 		r->mu0[j] = r->cfg->joint[j].osc.mu;
+	ctl_init(&r->ctl, r->cfg);
 	struct tune_opts o = { .target_freq = f, .target_amp = a, .max_s = 90 };
 	char why[TUNE_TEXT];
-	assert_true(tune_init(&r->t, &o, r->cfg, why, sizeof why));
+	assert_true(tune_init(&r->t, &o, r->cfg, &r->ctl.p, why, sizeof why));
 }
 
 /* The plant the audit found: the defaults give 1.07 Hz and 1.25 rad, and its
@@ -134,8 +137,13 @@ static void test_converges_on_a_fast_plant(void **state)
 	assert_true(r.time < 60);
 	/* the Jacobian moved towards the plant's exponents (0.45 and -0.28) */
 	assert_true(r.t.jac[0][0] < 0.66 && r.t.jac[1][1] > -0.40);
-	/* the parameters in the configuration are the result's */
-	assert_true(fabs(r.cfg->joint[0].osc.k / r.k0 - r.t.result.k) < 1e-9);
+	/* the parameters the controller runs are the result's; the configuration keeps the start */
+	for (size_t j = 0; j < 2; j++) {
+		assert_true(fabs(r.ctl.p.osc[j].k / r.k0 - r.t.result.k) < 1e-9);
+		assert_true(fabs(r.ctl.p.osc[j].mu - r.t.result.mu[j]) < 1e-12);
+	}
+	assert_true(fabs(r.ctl.p.servo_lead_s - r.t.result.lead) < 1e-12);
+	assert_true(r.cfg->joint[0].osc.k == r.k0 && r.cfg->joint[1].osc.mu == r.mu0[1]);
 	assert_true(fabs(r.t.result.lag_deg - 90) < 3);
 }
 
@@ -248,7 +256,7 @@ static void test_dead_loop_raises_the_lead(void **state)
 	drive(&r, &p, 2.0 + TUNE_DEAD_S + 0.5);
 	assert_true(r.t.lead > lead0 * 1.3 && r.t.lead < lead0 * 1.4);
 	assert_true(r.applied == 1);
-	assert_true(fabs(r.cfg->servo_lead_s - r.t.lead) < 1e-12);
+	assert_true(fabs(r.ctl.p.servo_lead_s - r.t.lead) < 1e-12);
 	/* it keeps dying: the lead grows to its largest, then it gives up */
 	drive(&r, &p, 80);
 	assert_int_equal(r.t.state, TUNE_FAILED);
@@ -293,26 +301,26 @@ static void test_targets_checked_against_the_configuration(void **state)
 	struct tune t;
 	char why[TUNE_TEXT];
 	struct tune_opts o = { .target_freq = 0.8, .target_amp = 0.8 };
-	assert_false(tune_init(&t, &o, c, why, sizeof why));
+	assert_false(tune_init(&t, &o, c, NULL, why, sizeof why));
 	assert_non_null(strstr(why, "joint 2's limits"));
 	/* faster than the servo can move at that amplitude */
 	c = base_cfg(2);
 	o = (struct tune_opts){ .target_freq = 2.0, .target_amp = 0.8 };
-	assert_false(tune_init(&t, &o, c, why, sizeof why));
+	assert_false(tune_init(&t, &o, c, NULL, why, sizeof why));
 	assert_non_null(strstr(why, "no-load speed"));
 	assert_non_null(strstr(why, "reaches"));
 	/* a goal step larger than max_step allows */
 	assert_true(cfg_override(c, "joint.1.max_step=0.02", &e));
 	assert_true(cfg_finish(c, &e));
 	o = (struct tune_opts){ .target_freq = 0.8, .target_amp = 0.8 };
-	assert_false(tune_init(&t, &o, c, why, sizeof why));
+	assert_false(tune_init(&t, &o, c, NULL, why, sizeof why));
 	assert_non_null(strstr(why, "max_step"));
 	/* implausible targets */
 	c = base_cfg(2);
 	o = (struct tune_opts){ .target_freq = 0.0, .target_amp = 0.8 };
-	assert_false(tune_init(&t, &o, c, why, sizeof why));
+	assert_false(tune_init(&t, &o, c, NULL, why, sizeof why));
 	o = (struct tune_opts){ .target_freq = 0.8, .target_amp = NAN };
-	assert_false(tune_init(&t, &o, c, why, sizeof why));
+	assert_false(tune_init(&t, &o, c, NULL, why, sizeof why));
 }
 
 /* The tuner sets parameters as a command would: never past the ranges the
@@ -333,24 +341,51 @@ static void test_search_stays_inside_the_configuration_ranges(void **state)
 	r.mu0[0] = r.cfg->joint[0].osc.mu;
 	r.mu0[1] = r.cfg->joint[1].osc.mu;
 	r.lead0 = r.cfg->servo_lead_s;
+	ctl_init(&r.ctl, r.cfg);
 	struct tune_opts o = { .target_freq = 0.8, .target_amp = 0.8, .max_s = 90 };
 	char why[TUNE_TEXT];
-	assert_true(tune_init(&r.t, &o, r.cfg, why, sizeof why));
+	assert_true(tune_init(&r.t, &o, r.cfg, &r.ctl.p, why, sizeof why));
 	struct plant p = { .f0 = 0.35, .a0 = { 0.8, 0.8 }, .ef = 0.66, .ea = 0.4 };
 	double kmax = 0;
 	while (r.t.state != TUNE_DONE && r.t.state != TUNE_FAILED && r.time < 95) {
 		drive(&r, &p, 0.5);
 		for (int j = 0; j < 2; j++) {
-			kmax = fmax(kmax, r.cfg->joint[j].osc.k);
+			kmax = fmax(kmax, r.ctl.p.osc[j].k);
+			struct cfg_joint jt = r.cfg->joint[j];
+			jt.osc = r.ctl.p.osc[j];
 			char jwhy[128];
-			assert_true(cfg_joint_check(&r.cfg->joint[j], jwhy, sizeof jwhy));
-			struct cfg_range kr;
-			assert_true(cfg_param_range("k", &kr) && r.cfg->joint[j].osc.k <= kr.max);
+			assert_true(cfg_joint_check(&jt, jwhy, sizeof jwhy));
+			struct param_range kr;
+			assert_true(cfg_param_range("k", &kr) && r.ctl.p.osc[j].k <= kr.max);
 		}
 	}
 	assert_int_equal(r.t.state, TUNE_FAILED);
 	assert_non_null(strstr(r.t.why, "out of reach"));
 	assert_true(kmax > 9.0);   /* it went to the edge, not past it */
+}
+
+/* The tuner's steps go through the controller's one door: a step it
+ * refuses (here k beyond its range, forced by hand: the search box stays
+ * inside) fails the tuning with the controller's reason and leaves the
+ * controller running what it ran, whole — no joint half-changed. */
+static void test_refused_step_fails_and_changes_nothing(void **state)
+{
+	(void)state;
+	struct run r;
+	start(&r, 2, 0.8, 0.8, false);
+	struct plant p = { .f0 = 1.07, .a0 = { 1.23, 1.30 }, .ef = 0.45, .ea = 0.28 };
+	drive(&r, &p, 12);
+	assert_true(r.applied >= 1);
+	struct cfg_params before = r.ctl.p;
+	r.t.mu[0] *= 1.01;                  /* joint 0 alone would pass ... */
+	r.t.k = 20.0 / r.t.k0[1];           /* ... joint 1's k does not */
+	r.t.changed = true;
+	assert_false(tune_apply(&r.t, &r.ctl));
+	assert_false(r.t.changed);
+	assert_int_equal(r.t.state, TUNE_FAILED);
+	assert_non_null(strstr(r.t.why, "the controller refused the tuner's step: parameter k: "));
+	assert_memory_equal(&r.ctl.p, &before, sizeof before);
+	assert_memory_equal(&r.t.ran, &before, sizeof before);
 }
 
 /* Bad samples (NaN angles, time going backwards) neither crash nor count. */
@@ -416,6 +451,7 @@ int main(void)
 		cmocka_unit_test(test_starter_again_is_a_stall),
 		cmocka_unit_test(test_targets_checked_against_the_configuration),
 		cmocka_unit_test(test_search_stays_inside_the_configuration_ranges),
+		cmocka_unit_test(test_refused_step_fails_and_changes_nothing),
 		cmocka_unit_test(test_bad_samples),
 		cmocka_unit_test(test_written_configuration_loads),
 	};

@@ -187,8 +187,15 @@ static void test_commands(void **state)
 	assert_int_equal(top_command_nudge(c, r, -1, 60, "me", why, sizeof(why)), 1);
 	assert_string_equal(c[0].msg.param, "amplitude");
 	assert_true(fabs(c[0].msg.value - 0.75) < 1e-12);
-	r->sin_amplitude = TOP_AMPLITUDE_MAX;
+	/* the daemon's range (common/params.h): 2.6 + 0.05 leaves 0..2.618 */
+	r->sin_amplitude = 2.6;
 	assert_int_equal(top_command_nudge(c, r, 1, 61, "me", why, sizeof(why)), -1);
+	assert_non_null(strstr(why, "amplitude 2.650 rad would leave [0, 2.618]"));
+	r->sin_amplitude = 1.5;   /* the old limit of our own, which the daemon never had */
+	assert_int_equal(top_command_nudge(c, r, 1, 61, "me", why, sizeof(why)), 1);
+	assert_true(fabs(c[0].msg.value - 1.55) < 1e-12);
+	r->sin_amplitude = 0.02;
+	assert_int_equal(top_command_nudge(c, r, -1, 61, "me", why, sizeof(why)), -1);
 	feed_state("r2", 0.02, 0, 0, 10, UNDULATE_ROBOT_STATE_T_MODE_LIMP);
 	assert_int_equal(top_command_nudge(c, r, 1, 62, "me", why, sizeof(why)), -1);
 }

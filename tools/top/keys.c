@@ -1,6 +1,7 @@
 /* keys.c — see keys.h. */
 #include "keys.h"
 #include "modes.h"
+#include "params.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -85,11 +86,16 @@ static int nudge_oscillator(struct top_command out[TOP_MAX_JOINTS], const struct
 			    int64_t seq, const char *source, char *why, size_t whylen)
 {
 	int n = r->nparams < r->njoints || r->njoints == 0 ? r->nparams : r->njoints;
+	const struct param_range *range = &param_find("c")->range;   /* the daemon's */
 	int len = snprintf(why, whylen, "%s c:", r->name);
 	for (int k = 0; k < n; k++) {
 		double v = r->c[k] * (1.0 + dir * TOP_NUDGE_FRACTION);
 		if (!isfinite(v) || v <= 0.0) {
 			snprintf(why, whylen, "%s: c[%d] = %g cannot be nudged (must stay > 0)", r->name, k, r->c[k]);
+			return -1;
+		}
+		if (!param_in_range(range, v)) {
+			snprintf(why, whylen, "%s: c[%d] %.4g would leave [%g, %g]", r->name, k, v, range->min, range->max);
 			return -1;
 		}
 		top_command_base(&out[k], r->name, UNDULATE_COMMAND_T_KIND_PARAM, seq + k, source);
@@ -117,9 +123,11 @@ int top_command_nudge(struct top_command out[TOP_MAX_JOINTS], const struct top_r
 			 mode_name(r->mode), mode_name(MODE_OSCILLATOR), mode_name(MODE_SINUSOID));
 		return -1;
 	}
+	/* the daemon's range, not one of our own: a value it accepts is one we may send */
+	const struct param_range *range = &param_find("amplitude")->range;
 	double v = r->sin_amplitude + dir * TOP_NUDGE_AMPLITUDE;
-	if (!(v >= 0.0 && v <= TOP_AMPLITUDE_MAX)) {
-		snprintf(why, whylen, "%s: amplitude %.3f rad would leave [0, %.2f]", r->name, v, TOP_AMPLITUDE_MAX);
+	if (!param_in_range(range, v)) {
+		snprintf(why, whylen, "%s: amplitude %.3f rad would leave [%g, %.3f]", r->name, v, range->min, range->max);
 		return -1;
 	}
 	top_command_base(&out[0], r->name, UNDULATE_COMMAND_T_KIND_PARAM, seq, source);

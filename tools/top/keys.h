@@ -27,7 +27,6 @@ enum top_key top_key_feed(struct top_keyparser *kp, unsigned char byte, int *ch)
 
 #define TOP_NUDGE_FRACTION 0.1   /* +/- scale the oscillator's c by 10 % */
 #define TOP_NUDGE_AMPLITUDE 0.05 /* rad: +/- step of the sinusoid amplitude */
-#define TOP_AMPLITUDE_MAX 1.5    /* rad: the most we ask for; the AX-12 spans +-2.6 rad */
 #define TOP_CHANNEL_MAX 80
 
 /* A command ready to publish. The strings live in the struct. */
@@ -43,7 +42,7 @@ struct top_command {
 int top_command_mode(struct top_command *c, const char *robot, int mode, int64_t seq, const char *source);
 /* +1/-1 nudge of the parameter that drives robot R's current mode: c of
  * every joint (one command per joint) in OSCILLATOR, the amplitude in
- * SINUSOID. Returns the number of commands (<= TOP_MAX_JOINTS), or -1 with
+ * SINUSOID, each kept inside the range the daemon accepts (common/params.h). Returns the number of commands (<= TOP_MAX_JOINTS), or -1 with
  * the reason in WHY (no parameters known yet, nothing to nudge in LIMP/HOLD,
  * out of range). A description of what is sent goes in WHY otherwise. */
 int top_command_nudge(struct top_command out[TOP_MAX_JOINTS], const struct top_robot *r, int dir, int64_t seq,

@@ -1,0 +1,32 @@
+/*
+ * params.h — the documented ranges of a robot's parameters (daemon/README.md,
+ * "Commands"): one table for the daemon, which checks the configuration file
+ * and every command against it, and for the programs that send commands
+ * (undulate-top's nudges), so that what one offers the other never refuses
+ * for a range of its own.
+ */
+#ifndef UNDULATE_COMMON_PARAMS_H
+#define UNDULATE_COMMON_PARAMS_H
+
+#include <stdbool.h>
+
+#define PARAM_PI 3.14159265358979323846
+/* The AX-12's goal spans ±150° around its centre (raw 0..1023 over 300°):
+ * no amplitude or neutral beyond it names an angle the servo can take. */
+#define PARAM_SERVO_HALF_RANGE (150.0 * PARAM_PI / 180.0)
+
+struct param_range { double min, max; bool min_open; };
+
+struct param_def {
+	const char *key;
+	struct param_range range;
+	bool joint;        /* per joint ([joint.N]) or per robot ([sinusoid]) */
+	bool commandable;  /* a command may change it (never what bounds a joint) */
+};
+
+/* The parameter named key (k, c, mu, ..., amplitude, ...); NULL if none. */
+const struct param_def *param_find(const char *key);
+/* v inside r (NaN never is). */
+bool param_in_range(const struct param_range *r, double v);
+
+#endif
