@@ -824,7 +824,10 @@ void bus_abort(struct bus *b)
 	bus_finish(b);
 	/* whatever was half-read belongs to the abandoned request */
 	bus_echo_clear(b);
-	b->proto->parser_reset(&b->parser);
+	/* a bus never given its protocol (a port closed before bus_init: the
+	 * daemon refusing a wiring) has no parser to reset */
+	if (b->proto != NULL)
+		b->proto->parser_reset(&b->parser);
 }
 
 /* ---- blocking calls --------------------------------------------------------------- */

@@ -522,9 +522,22 @@ static void test_reply_lateness(void **state)
 	assert_int_equal(lt.pings, 1);
 }
 
+/* A bus closed before it was given a protocol (the daemon refusing an
+ * RS-485 wiring closes its port before bus_init) is aborted without a
+ * parser to reset: it crashed the daemon once (exit 139). */
+static void test_abort_before_init(void **state)
+{
+	(void)state;
+	struct bus b;
+	memset(&b, 0, sizeof b);
+	bus_abort(&b);
+	assert_false(bus_is_pending(&b));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_abort_before_init),
 		cmocka_unit_test(test_flush_only_when_needed),
 		cmocka_unit_test(test_timeout_formula),
 		cmocka_unit_test(test_ping_ok),
