@@ -86,9 +86,9 @@ const struct sm_model *ctl_model(const struct ctl *c, size_t j)
 	return j < c->n && c->j[j].servo.model != NULL ? c->j[j].servo.model : sm_ax12();
 }
 
-bool ctl_is_x(const struct ctl *c, size_t j)
+bool ctl_has(const struct ctl *c, size_t j, unsigned cap)
 {
-	return ctl_model(c, j)->protocol == 2;
+	return sm_has(ctl_model(c, j), cap);
 }
 
 static size_t ctl_joint_of(const struct ctl *c, uint8_t id)
@@ -103,7 +103,7 @@ static size_t ctl_joint_of(const struct ctl *c, uint8_t id)
  * itself, not a limit, and only the SYNC_WRITE sets it. */
 static bool ctl_limit_is_drive(const struct ctl *c, size_t j)
 {
-	return ctl_is_x(c, j) && c->wheel && c->cfg->torque_drive == CFG_DRIVE_PWM;
+	return sm_limit_is_pwm_drive(ctl_model(c, j)) && c->wheel && c->cfg->torque_drive == CFG_DRIVE_PWM;
 }
 
 uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt)
@@ -146,27 +146,14 @@ const struct wq_write *ctl_take_write(struct ctl *c)
 
 static const char *ctl_register_name(const struct sm_model *m, const struct wq_write *w)
 {
-	if (w->len == 0)
-		return "REBOOT";
-	if (m->protocol == 2) {
-		const struct dxl2_reg *r = dxl2_reg_at(dxl2_model_by_number(m->number), w->addr);
-		return r != NULL ? r->name : "register";
-	}
-	switch (w->addr) {
-	case DXL_AX_TORQUE_ENABLE: return "torque enable";
-	case DXL_AX_TORQUE_LIMIT: return "torque limit";
-	case DXL_AX_CW_ANGLE_LIMIT: return "angle limits";
-	case DXL_AX_CW_COMPLIANCE_MARGIN: return "compliance margins";
-	case DXL_AX_CW_COMPLIANCE_SLOPE: return "compliance slopes";
-	case DXL_AX_MOVING_SPEED: return "moving speed";
-	default: return "register";
-	}
+	return w->len == 0 ? "REBOOT" : sm_register_name(m, w->addr);
 }
 
 static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what, const char *after);
 
-/* X series: what an acknowledged (or given-up) write means to the joint. */
-static void ctl_x_write_done(struct ctl *c, size_t j, const struct wq_write *w, bool ok)
+/* A REBOOT or a write of a chain (SM_CAP_HWERR, SM_CAP_OPMODE): what its
+ * acknowledgement, or its giving up, means to the joint. */
+static void ctl_chain_write_done(struct ctl *c, size_t j, const struct wq_write *w, bool ok)
 {
 	struct ctl_joint *jt = &c->j[j];
 	if (w->len == 0) {
@@ -199,8 +186,9 @@ void ctl_write_result(struct ctl *c, bool ok)
 	struct wq_write w = { 0 };
 	enum wq_outcome o = wq_done(&c->wq, ok, &w);
 	size_t j = ctl_joint_of(c, w.id);
-	if (w.tries > 0 && j < c->n && ctl_is_x(c, j) && (o == WQ_FAILED || (o == WQ_DONE && ok)))
-		ctl_x_write_done(c, j, &w, o == WQ_DONE);
+	/* a REBOOT or a chain's write: what its acknowledgement means to the joint */
+	if (w.tries > 0 && j < c->n && (w.len == 0 || w.chain != 0) && (o == WQ_FAILED || (o == WQ_DONE && ok)))
+		ctl_chain_write_done(c, j, &w, o == WQ_DONE);
 	if (o != WQ_FAILED)
 		return;
 	c->write_failures++;
@@ -239,7 +227,7 @@ static int32_t ctl_goal_pos(const struct ctl_joint *jt, const struct sm_model *m
  * position control would take Goal PWM as its limit. */
 static size_t ctl_sync_drive(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *ids, uint8_t *data)
 {
-	bool current = c->cfg->torque_drive == CFG_DRIVE_CURRENT, x = ctl_is_x(c, 0);
+	bool current = c->cfg->torque_drive == CFG_DRIVE_CURRENT, x = ctl_has(c, 0, SM_CAP_OPMODE);
 	size_t n = 0;
 	*addr = sm_drive_register(ctl_model(c, 0), current);
 	*width = 2;
@@ -261,7 +249,7 @@ size_t ctl_sync(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *id
 {
 	size_t n = 0;
 	const struct sm_model *m = ctl_model(c, 0);
-	if (c->sync == CTL_SYNC_DUTY || (m->protocol == 2 && c->sync == CTL_SYNC_GOAL_STOP))
+	if (c->sync == CTL_SYNC_DUTY || (sm_has(m, SM_CAP_OPMODE) && c->sync == CTL_SYNC_GOAL_STOP))
 		return ctl_sync_drive(c, addr, width, ids, data);
 	*width = c->sync == CTL_SYNC_GOAL_STOP ? 4 : m->goal_size;
 	*addr = m->goal;
@@ -272,13 +260,10 @@ size_t ctl_sync(const struct ctl *c, uint16_t *addr, uint8_t *width, uint8_t *id
 		if (!jt->write_goal || !isfinite(jt->goal))
 			continue;
 		ids[n] = jt->id;
-		if (m->protocol == 2) {
-			ctl_put_le(&data[*width * n], (uint32_t)ctl_goal_pos(jt, ctl_model(c, j), jt->goal), *width);
-		} else {
-			dxl_put_u16(&data[*width * n], (uint16_t)ctl_goal_pos(jt, ctl_model(c, j), jt->goal));
-			if (*width == 4)
-				dxl_put_u16(&data[*width * n + 2], 0);   /* moving speed 0: joint mode's "fastest" */
-		}
+		ctl_put_le(&data[*width * n], (uint32_t)ctl_goal_pos(jt, ctl_model(c, j), jt->goal), m->goal_size);
+		/* the AX-12's stop: Moving Speed 0 after the goal, joint mode's "fastest" */
+		if (*width > m->goal_size)
+			memset(&data[*width * n + m->goal_size], 0, (size_t)(*width - m->goal_size));
 		n++;
 	}
 	return n;
@@ -326,7 +311,7 @@ bool ctl_set_servo(struct ctl *c, size_t j, const struct ctl_servo_info *info, c
 	const struct sm_model *m = info->model != NULL ? info->model : sm_ax12();
 	jt->servo = *info;
 	jt->servo.model = m;
-	if (m->protocol == 1 && dxl_is_wheel_mode(info->cw_limit, info->ccw_limit)) {
+	if (!sm_has(m, SM_CAP_OPMODE) && dxl_is_wheel_mode(info->cw_limit, info->ccw_limit)) {
 		snprintf(why, cap, "servo %u is in wheel mode (both angle limits 0): set its angle limits "
 		         "(dxl --port PATH write %u ccw_angle_limit 1023)", jt->id, jt->id);
 		return false;
@@ -336,7 +321,7 @@ bool ctl_set_servo(struct ctl *c, size_t j, const struct ctl_servo_info *info, c
 	    !safety_limits_make_rad(&jt->limits, cj->neutral, cj->limit_min, cj->limit_max, lo, hi, cj->max_step)) {
 		snprintf(why, cap, "joint %zu (servo %u): configured limits neutral %+.3f + [%.3f, %.3f] rad and the "
 		         "servo's %s limits %u..%u (%.3f..%.3f rad) have no angle in common", j, jt->id,
-		         cj->neutral, cj->limit_min, cj->limit_max, m->protocol == 2 ? "position" : "angle", info->cw_limit,
+		         cj->neutral, cj->limit_min, cj->limit_max, m->limits_name, info->cw_limit,
 		         info->ccw_limit, lo, hi);
 		return false;
 	}
@@ -451,7 +436,7 @@ static double ctl_present_or_goal(const struct ctl_joint *jt)
 static void ctl_servo_setup(struct ctl *c, size_t j, bool torque)
 {
 	struct ctl_joint *jt = &c->j[j];
-	if (ctl_is_x(c, j)) {
+	if (ctl_has(c, j, SM_CAP_OPMODE)) {
 		/* under torque actuation the servo boots in its drive's mode with
 		 * Goal PWM at its limit: every joint goes back to position control
 		 * first (the next cycle may switch them again) */
@@ -596,7 +581,7 @@ void ctl_measure_present(struct ctl *c, size_t j, const struct sm_present *p, ui
 	jt->stale_cycles = 0;
 	jt->angle = p->angle;
 	jt->load = p->load;
-	if (ctl_is_x(c, j))
+	if (ctl_has(c, j, SM_CAP_HWERR))
 		ctl_x_status(c, j, status);
 	else
 		jt->errbits = status;
@@ -898,7 +883,7 @@ void ctl_readback_block(struct ctl *c, size_t j, size_t block, const uint8_t *by
 	sm_state_unknown(&st);
 	if (!sm_decode_readback(m, block, bytes, n, &st))
 		return;
-	if (m->protocol == 2)
+	if (sm_has(m, SM_CAP_OPMODE))
 		ctl_readback_x(c, j, &st, status);
 	else
 		ctl_readback_ax(c, j, &st, status);
@@ -1082,7 +1067,7 @@ bool ctl_clear_faults(struct ctl *c, char *why, size_t cap)
 		jt->retries = 0;
 		jt->resets = 0;
 		jt->reboots = 0;
-		if (ctl_is_x(c, j) && jt->hwerr > 0 && (jt->hwerr & SM_HWERR_FAULTS) && jt->torque_read == 0) {
+		if (ctl_has(c, j, SM_CAP_HWERR) && jt->hwerr > 0 && (jt->hwerr & SM_HWERR_FAULTS) && jt->torque_read == 0) {
 			/* shut down: an X servo takes torque again only after a REBOOT,
 			 * which the operator's 'clear' asks for (not counted against
 			 * fault_reboots); then it is set up as after any */
@@ -1120,14 +1105,14 @@ static void ctl_backoff(struct ctl *c, size_t j)
 static uint8_t ctl_fault_bits(const struct ctl *c, size_t j)
 {
 	const struct ctl_joint *jt = &c->j[j];
-	if (ctl_is_x(c, j))
+	if (ctl_has(c, j, SM_CAP_HWERR))
 		return (uint8_t)(jt->hwerr > 0 ? jt->hwerr & SM_HWERR_FAULTS : 0);
 	return jt->fresh ? (uint8_t)(jt->errbits & (DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT)) : 0;
 }
 
 static void ctl_fault_name(const struct ctl *c, size_t j, uint8_t bits, char *what, size_t cap)
 {
-	if (ctl_is_x(c, j))
+	if (ctl_has(c, j, SM_CAP_HWERR))
 		dxl2_hwerr_format(bits, what, cap);
 	else
 		dxl_errbits_format(bits, what, cap);
@@ -1153,7 +1138,7 @@ static void ctl_fault_persistent(struct ctl *c, size_t j, const char *what, cons
 static void ctl_report_errbits(struct ctl *c, size_t j)
 {
 	struct ctl_joint *jt = &c->j[j];
-	if (!jt->fresh || ctl_is_x(c, j))
+	if (!jt->fresh || ctl_has(c, j, SM_CAP_HWERR))
 		return;
 	uint8_t other = jt->errbits & (uint8_t)~(DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT);
 	uint8_t fresh_bits = other & (uint8_t)~jt->reported_bits;
@@ -1171,7 +1156,7 @@ static void ctl_report_errbits(struct ctl *c, size_t j)
 static bool ctl_x_reboot(struct ctl *c, size_t j, const char *what)
 {
 	struct ctl_joint *jt = &c->j[j];
-	if (!ctl_is_x(c, j) || jt->torque_read != 0)
+	if (!ctl_has(c, j, SM_CAP_HWERR) || jt->torque_read != 0)
 		return false;
 	if (jt->reboots >= c->cfg->fault_reboots) {
 		char after[64];
@@ -1199,7 +1184,7 @@ static bool ctl_x_read_since(const struct ctl_joint *jt, double since)
 static void ctl_fault_step(struct ctl *c, size_t j)
 {
 	struct ctl_joint *jt = &c->j[j];
-	bool x = ctl_is_x(c, j);
+	bool x = ctl_has(c, j, SM_CAP_HWERR);
 	uint8_t bad = ctl_fault_bits(c, j);
 	char what[64];
 	ctl_fault_name(c, j, bad ? bad : (x ? (uint8_t)(jt->hwerr > 0 ? jt->hwerr : 0) : jt->errbits), what, sizeof what);

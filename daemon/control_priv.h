@@ -27,7 +27,9 @@ void ctl_write_chain(struct ctl *c, uint16_t chain, uint8_t id, uint16_t addr, u
  * when it had stopped the servo), and torque on when it is wanted. */
 uint16_t ctl_x_setup(struct ctl *c, size_t j, bool with_mode);
 /* The joint's servo is an X series one. */
-bool ctl_is_x(const struct ctl *c, size_t j);
+/* Joint j's servo has cap (enum sm_cap): what differs between servo
+ * families is asked this way, never by protocol or name. */
+bool ctl_has(const struct ctl *c, size_t j, unsigned cap);
 /* The torque limit a joint should have: the servo's max torque, reduced to
  * backoff_torque while it backs off from a fault or holds after one that
  * persisted. */

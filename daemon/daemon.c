@@ -354,7 +354,7 @@ static void dmn_position_defaults(struct dmn *d)
 		const struct sm_model *m = ctl_model(&d->ctl, j);
 		same = same && m == first;
 		if (!sm_position_defaults(m, j, d->ctl.n, &k, &mu, &lead)) {
-			kept = kept || m->protocol == 2;
+			kept = kept || m != sm_ax12();   /* the AX-12A's own are osc.h's */
 			continue;
 		}
 		double k0 = cfg->joint[j].osc.k, mu0 = cfg->joint[j].osc.mu;
@@ -372,7 +372,7 @@ static void dmn_position_defaults(struct dmn *d)
 			         cfg->servo_lead_s);
 		else
 			log_warn("the %s's default %s: kept the AX-12A's", first->position_from, why);
-	} else if (!same && cfg->servo_lead_default && d->protocol == BUS_PROTOCOL_2) {
+	} else if (!same && cfg->servo_lead_default) {   /* models mixed: whose lead? */
 		kept = true;
 	}
 	if (kept)
@@ -1023,7 +1023,7 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	dmn_position_defaults(d);
 	dmn_tune_rebase(d);
 	log_info("robot %s: %zu joint(s) on %s at %ld bps, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints,
-	         d->port_path, cfg->baud, d->protocol == BUS_PROTOCOL_2 ? "2.0" : "1.0", models,
+	         d->port_path, cfg->baud, bus_proto(&d->bus)->name, models,
 	         cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");
 	log_info("commands: %s (local socket %s%s)", cfg_commands_name(cfg->commands), cin_local_path(&d->cin),
 	         cfg->commands == CFG_CMD_NETWORK ? "; signed commands from the LCM group" : "");

@@ -86,7 +86,7 @@ void pub_state(struct pub *p, const struct ctl *c, const struct pub_cycle *f)
 			.goal = jt->goal - neutral, .drive = jt->duty, .phase = jt->phase,
 			.amplitude = jt->estimator.amplitude, .frequency = jt->estimator.frequency,
 			.voltage = jt->voltage, .temperature = jt->temperature,
-			.error_bits = (int16_t)(jt->errbits | (ctl_model(c, j)->protocol == 2 ? UNDULATE_JOINT_STATE_T_ERROR_BITS_X : 0)),
+			.error_bits = (int16_t)(jt->errbits | (sm_has(ctl_model(c, j), SM_CAP_HWERR) ? UNDULATE_JOINT_STATE_T_ERROR_BITS_X : 0)),
 			.stale_cycles = jt->stale_cycles, .torque = jt->torque, .torque_read = (int8_t)jt->torque_read,
 			.torque_limit = (int16_t)jt->torque_limit_read,
 		};

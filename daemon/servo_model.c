@@ -79,7 +79,8 @@ static const struct sm_model sm_ax = {
 	.ref_voltage = DXL_AX12_REF_VOLTAGE, .stall_torque_nm = DXL_AX12_STALL_TORQUE_NM,
 	.no_load_speed_rad_s = DXL_AX12_NO_LOAD_SPEED_RAD_S, .stall_current_a = 1.5,
 	.rated_min_v = DXL_AX12_RATED_MIN_V, .rated_max_v = DXL_AX12_RATED_MAX_V,
-	.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0), .position_from = "AX-12A",
+	.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0), .position_from = "AX-12A", .caps = 0,
+	.limits_name = "angle",
 };
 
 /* The X models, made once from protocol/dxl2_table.c's descriptors: every
@@ -98,7 +99,8 @@ static const struct sm_model *sm_x_model(size_t i)
 		return &sm_x[i];
 	struct sm_model *m = &sm_x[i];
 	*m = (struct sm_model){
-		.name = d->name, .protocol = 2, .number = d->number, .desc = d,
+		.name = d->name, .protocol = 2, .number = d->number, .desc = d, .caps = SM_CAP_HWERR | SM_CAP_OPMODE,
+		.limits_name = "position",
 		.torque_enable = DXL2_X_TORQUE_ENABLE, .torque_limit = DXL2_X_GOAL_PWM,
 		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
 		/* Present Current where it senses current, Present Load else: 126 */
@@ -171,6 +173,28 @@ void sm_joint_range(const struct sm_model *m, double lo_rad, double hi_rad, int3
 		(*lo)++;
 	if (sm_pos_to_rad(m, *hi) > hi_rad && *hi > 0)
 		(*hi)--;
+}
+
+const char *sm_register_name(const struct sm_model *m, uint16_t addr)
+{
+	if (m->desc != NULL) {
+		const struct dxl2_reg *r = dxl2_reg_at(m->desc, addr);
+		return r != NULL ? r->name : "register";
+	}
+	switch (addr) {
+	case DXL_AX_TORQUE_ENABLE: return "torque enable";
+	case DXL_AX_TORQUE_LIMIT: return "torque limit";
+	case DXL_AX_CW_ANGLE_LIMIT: return "angle limits";
+	case DXL_AX_CW_COMPLIANCE_MARGIN: return "compliance margins";
+	case DXL_AX_CW_COMPLIANCE_SLOPE: return "compliance slopes";
+	case DXL_AX_MOVING_SPEED: return "moving speed";
+	default: return "register";
+	}
+}
+
+bool sm_limit_is_pwm_drive(const struct sm_model *m)
+{
+	return m->torque_limit == sm_drive_register(m, false);
 }
 
 bool sm_decode_present(const struct sm_model *m, const uint8_t *b, size_t n, struct sm_present *out)

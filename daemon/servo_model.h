@@ -41,6 +41,21 @@
 #include "dxl2_table.h"
 
 
+/* What a family has, asked instead of its protocol or its name (sm_has). */
+enum sm_cap {
+	/* Its faults are in a Hardware Error Status register (70), its status
+	 * only raises an alert; a fault shuts it down until a REBOOT (X). An
+	 * AX-12's status byte carries its overload and overheating itself. */
+	SM_CAP_HWERR = 1u << 0,
+	/* It is set up and switched by its Operating Mode (11): position
+	 * control with Min/Max Position Limit and the Bus Watchdog at start,
+	 * each switch of torque actuation a chain of writes acknowledged per
+	 * servo, and leaving it zeroes the drive registers (X). Without it,
+	 * joint mode is angle limits not both 0, wheel mode both 0, and its
+	 * position loop is set by compliance margins and slopes (AX-12). */
+	SM_CAP_OPMODE = 1u << 1,
+};
+
 /* A register block read in one READ. */
 struct sm_block {
 	uint16_t addr, len;
@@ -65,6 +80,8 @@ struct sm_model {
 	int protocol;                   /* 1 or 2 */
 	uint16_t number;                /* model number (register 0) */
 	const struct dxl2_model *desc;  /* Protocol 2.0: its descriptor (control table, datasheet); NULL on 1.0 */
+	unsigned caps;                  /* enum sm_cap */
+	const char *limits_name;        /* what its own limits are called: "angle" | "position" */
 	/* registers the controller writes */
 	uint16_t torque_enable;         /* 24 | 64 */
 	uint16_t torque_limit;          /* Torque Limit 34 | Goal PWM 100, 2 bytes */
@@ -92,6 +109,11 @@ struct sm_model {
 	struct sm_position_defaults position;
 	const char *position_from;      /* the model `position` was tuned on: its own name once tuned on it */
 };
+
+static inline bool sm_has(const struct sm_model *m, unsigned cap)
+{
+	return (m->caps & cap) == cap;
+}
 
 /* The AX-12A (what undulated assumed before it knew of others). */
 const struct sm_model *sm_ax12(void);
@@ -180,6 +202,14 @@ bool sm_write_refused(const struct sm_model *m, uint8_t status);
 bool sm_supply_plausible(const struct sm_model *m, double volts);
 /* The plausible range itself, for messages and bounds. */
 void sm_supply_range(const struct sm_model *m, double *lo, double *hi);
+
+/* A register's name for messages ("torque limit", "goal_pwm"); "register"
+ * when the model's table has none at addr. */
+const char *sm_register_name(const struct sm_model *m, uint16_t addr);
+/* Its torque-limit register is its PWM drive too (X: Goal PWM caps position
+ * control and is PWM control's drive): under the PWM drive only the drive's
+ * SYNC_WRITE may set it. */
+bool sm_limit_is_pwm_drive(const struct sm_model *m);
 
 /* ---- torque actuation ----------------------------------------------------------------------
  * The register torque actuation's SYNC_WRITE carries, 2 bytes: AX-12 Moving

@@ -45,13 +45,14 @@
 double tq_stall_torque(const struct ctl *c, const struct ctl_joint *jt)
 {
 	const struct sm_model *m = jt->servo.model != NULL ? jt->servo.model : sm_ax12();
-	return c->cfg->stall_torque_given || m->protocol == 1 ? c->cfg->stall_torque : m->stall_torque_nm;
+	/* the configuration's unless given is the AX-12A's datasheet: the model's */
+	return c->cfg->stall_torque_given ? c->cfg->stall_torque : m->stall_torque_nm;
 }
 
 double tq_no_load_speed(const struct ctl *c, const struct ctl_joint *jt)
 {
 	const struct sm_model *m = jt->servo.model != NULL ? jt->servo.model : sm_ax12();
-	return c->cfg->no_load_speed_given || m->protocol == 1 ? c->cfg->no_load_speed : m->no_load_speed_rad_s;
+	return c->cfg->no_load_speed_given ? c->cfg->no_load_speed : m->no_load_speed_rad_s;
 }
 
 bool tq_mode_drives(const struct ctl *c, enum cfg_mode mode)
@@ -147,7 +148,7 @@ static double tq_duty(const struct ctl *c, const struct ctl_joint *jt, double ta
 	double ref = m->ref_voltage;
 	/* the AX-12's torque limit and the X's PWM Limit cap the output; an XM430
 	 * keeps its current within Current Limit by itself (sm_drive_raw) */
-	double cap = m->protocol == 2 && cfg->torque_drive == CFG_DRIVE_CURRENT ? 1.0
+	double cap = m->current_control && cfg->torque_drive == CFG_DRIVE_CURRENT ? 1.0
 	           : jt->servo.max_torque / (double)m->torque_full;
 	double u;
 	if (cfg->torque_drive == CFG_DRIVE_CURRENT) {
@@ -267,7 +268,7 @@ static void tq_x_enter(struct ctl *c, size_t j)
 void tq_enter_wheel(struct ctl *c)
 {
 	for (size_t j = 0; j < c->n; j++) {
-		if (ctl_is_x(c, j))
+		if (ctl_has(c, j, SM_CAP_OPMODE))
 			tq_x_enter(c, j);
 		else
 			tq_switch_limits(c, j, 0, true);
@@ -280,7 +281,7 @@ void tq_leave_wheel(struct ctl *c)
 {
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
-		if (ctl_is_x(c, j)) {
+		if (ctl_has(c, j, SM_CAP_OPMODE)) {
 			jt->drive_ready = false;
 			jt->drive_chain = 0;
 			(void)ctl_x_setup(c, j, true);
@@ -304,7 +305,7 @@ void tq_stop_goals(struct ctl *c)
 		jt->duty = NAN;
 		jt->torque_cmd = NAN;
 		/* X series: the SYNC_WRITE stops the drives, the chain sets the goal */
-		if (jt->write_goal || !jt->have_reading || jt->limits.max_step <= 0.0 || ctl_is_x(c, j))
+		if (jt->write_goal || !jt->have_reading || jt->limits.max_step <= 0.0 || ctl_has(c, j, SM_CAP_OPMODE))
 			continue;
 		jt->goal = safety_clamp(&jt->limits, jt->angle, NAN, jt->angle, NULL);
 		jt->write_goal = true;

@@ -22,6 +22,31 @@
 
 #define PI 3.14159265358979323846
 
+/* What differs between families is asked as capabilities: the AX-12A has
+ * neither, every X model (made from its descriptor) both; the register names
+ * come from the model's own table. */
+static void test_capabilities(void **state)
+{
+	(void)state;
+	const struct sm_model *ax = sm_ax12();
+	assert_false(sm_has(ax, SM_CAP_HWERR));
+	assert_false(sm_has(ax, SM_CAP_OPMODE));
+	assert_false(sm_limit_is_pwm_drive(ax));     /* Torque Limit 34, wheel-mode drive Moving Speed 32 */
+	assert_string_equal(ax->limits_name, "angle");
+	assert_string_equal(sm_register_name(ax, 34), "torque limit");
+	const uint16_t xs[] = { 1060, 1020, 1070 };
+	for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++) {
+		const struct sm_model *x = sm_by_number(2, xs[i]);
+		assert_non_null(x);
+		assert_true(sm_has(x, SM_CAP_HWERR | SM_CAP_OPMODE));
+		assert_true(sm_limit_is_pwm_drive(x));   /* Goal PWM 100: the limit and the PWM drive */
+		assert_string_equal(x->limits_name, "position");
+		assert_string_equal(sm_register_name(x, 100), "goal_pwm");
+		assert_string_equal(sm_register_name(x, 101), "register");   /* inside Goal PWM */
+		assert_ptr_equal(x->desc, dxl2_model_by_number(xs[i]));
+	}
+}
+
 static void test_families_by_number(void **state)
 {
 	(void)state;
@@ -367,6 +392,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_families_by_number),
+		cmocka_unit_test(test_capabilities),
 		cmocka_unit_test(test_positions_both_ways),
 		cmocka_unit_test(test_present_block_x),
 		cmocka_unit_test(test_present_block_ax),
