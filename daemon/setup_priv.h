@@ -1,13 +1,15 @@
 /*
- * setup_priv.h — what the two files of the start-up and safe stop share:
- * setup.c (both protocols, the AX-12's registers) and setup_x.c (the X
- * series' registers). Nothing outside them includes this.
+ * setup_priv.h — what the files of the start-up and safe stop share:
+ * setup.c (both protocols, the AX-12's registers), setup_x.c (the X
+ * series' registers) and setup_io.c (the transactions both use, tried
+ * again; it calls neither). Nothing outside them includes this.
  */
 #ifndef UNDULATE_DAEMON_SETUP_PRIV_H
 #define UNDULATE_DAEMON_SETUP_PRIV_H
 
 #include "setup.h"
 
+/* ---- setup_io.c --------------------------------------------------------------------------- */
 /* Before try t of a transaction: wait for a quiet line (setup.h). */
 void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, int last);
 /* A READ or WRITE tried SETUP_TRIES times, on the bus's protocol (2.0: the

@@ -279,6 +279,31 @@ const struct port_latency *port_get_latency(const struct port *p)
 	return p->latency_checked ? &p->latency : NULL;
 }
 
+/* Here, not in port_latency.c: it reads the port, which port_latency.c
+ * (fd and path level, called by port_open) never does. */
+long port_adapter_latency_us(struct port *p, long configured_us, struct port_latency *lat)
+{
+	struct port_latency found;
+
+	memset(&found, 0, sizeof found);
+	if (configured_us >= 0) {
+		snprintf(found.note, sizeof found.note, "adapter latency %ld us as configured", configured_us);
+	} else {
+		/* port_open() checked on the fd it holds: opening the device again
+		 * would fail with EBUSY on an exclusively held real port and lose the
+		 * ASYNC_LOW_LATENCY fallback. */
+		if (p->latency_checked)
+			found = p->latency;
+		else
+			port_latency_check_fd(p->path, p->fd, true, &found);
+	}
+	if (lat != NULL)
+		*lat = found;
+	if (configured_us >= 0)
+		return configured_us;
+	return found.known ? 1000L * found.timer_ms : 0;
+}
+
 int port_set_baud(struct port *p, long baud)
 {
 	if (baud <= 0 || baud > INT_MAX)

@@ -199,27 +199,3 @@ void port_latency_check(const char *path, bool lower, struct port_latency *out)
 	if (fd >= 0)
 		close(fd);
 }
-
-long port_adapter_latency_us(struct port *p, long configured_us, struct port_latency *lat)
-{
-	struct port_latency found;
-
-	memset(&found, 0, sizeof found);
-	if (configured_us >= 0) {
-		port_note(&found, "adapter latency %ld us as configured", configured_us);
-	} else {
-		/* port_open() checked on the fd it holds: opening the device again
-		 * would fail with EBUSY on an exclusively held real port and lose the
-		 * ASYNC_LOW_LATENCY fallback. */
-		const struct port_latency *opened = port_get_latency(p);
-		if (opened != NULL)
-			found = *opened;
-		else
-			port_latency_check_fd(port_path(p), port_fd(p), true, &found);
-	}
-	if (lat != NULL)
-		*lat = found;
-	if (configured_us >= 0)
-		return configured_us;
-	return found.known ? 1000L * found.timer_ms : 0;
-}
