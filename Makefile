@@ -285,6 +285,8 @@ $(BUILD)/fuzz/$(1): tests/fuzz/$(1).c $(foreach c,$(DEPS_$(call fuzz_component,$
 	  $(if $(filter sim,$(call fuzz_component,$(1))),-lchipmunk) -lm
 endef
 $(foreach t,$(patsubst tests/fuzz/%.c,%,$(FUZZ_SRC)),$(eval $(call fuzz_target,$(t))))
+# the body both protocol targets include
+$(BUILD)/fuzz/fuzz_protocol_parser $(BUILD)/fuzz/fuzz_protocol_parser2: tests/fuzz/protocol_fuzz.h
 .PHONY: fuzz-build
 fuzz-build: $(LCM_STAMP) $(FUZZ_BINS)
 fuzz: deps
