@@ -77,8 +77,35 @@ fig_num() {
 		fig_usage "$1: want a number from $3 to $4, got '$2'"
 }
 
-fig_hash() { printf '%s' "$1" | cksum | cut -d' ' -f1; }
-fig_seed() { echo $(( $(fig_hash "$*") % 999999 + 1 )); }
+# fig_hash is POSIX cksum's CRC (the seeds of every recorded run came from
+# `cksum`), computed in the shell: a module lists its jobs with one seed each,
+# hundreds of them, and a pipe of printf, cksum and cut per seed cost seconds
+# on a loaded machine. The table (CRC-32, polynomial 0x04C11DB7, most
+# significant bit first) is made once, when this file is sourced.
+_fig_crc=()
+for ((_i = 0; _i < 256; _i++)); do
+	_c=$(( _i << 24 ))
+	for ((_k = 0; _k < 8; _k++)); do
+		if (( _c & 0x80000000 )); then _c=$(( ((_c << 1) ^ 0x04C11DB7) & 0xFFFFFFFF )); else _c=$(( (_c << 1) & 0xFFFFFFFF )); fi
+	done
+	_fig_crc[_i]=$_c
+done
+unset _i _k _c
+# fig_hash_v VAR TEXT: VAR = TEXT's cksum, without a subshell
+fig_hash_v() {
+	local -n _h=$1
+	local s=$2 crc=0 i c n LC_ALL=C   # bytes, as cksum counts them
+	for ((i = 0; i < ${#s}; i++)); do
+		printf -v c '%d' "'${s:i:1}"
+		crc=$(( ((crc << 8) & 0xFFFFFFFF) ^ _fig_crc[((crc >> 24) ^ c) & 0xFF] ))
+	done
+	for ((n = ${#s}; n > 0; n >>= 8)); do   # then the length, low byte first
+		crc=$(( ((crc << 8) & 0xFFFFFFFF) ^ _fig_crc[((crc >> 24) ^ n) & 0xFF] ))
+	done
+	_h=$(( ~crc & 0xFFFFFFFF ))
+}
+fig_hash() { local h; fig_hash_v h "$1"; echo "$h"; }
+fig_seed() { local h; fig_hash_v h "$*"; echo $(( h % 999999 + 1 )); }
 FIG_GOLDEN=0.6180339887498949
 
 # Ports for the figures' runs: above the tests' (7600-8000 plus their offsets

@@ -49,7 +49,7 @@ _cleanup() {
 	local pid
 	for pid in "${_pids[@]}"; do kill -TERM "$pid" 2>/dev/null; done
 	for pid in "${_pids[@]}"; do
-		for _ in $(seq 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.02; done
+		for _ in $(seq 100); do kill -0 "$pid" 2>/dev/null || break; _nap 0.02; done
 		kill -KILL "$pid" 2>/dev/null
 		wait "$pid" 2>/dev/null
 	done
@@ -119,15 +119,65 @@ stop() {
 }
 alive() { local var="pid_${1//[^A-Za-z0-9_]/_}"; kill -0 "${!var}" 2>/dev/null; }
 
+# Polling costs what its processes cost: a fork and exec is about 10 ms of
+# CPU on a loaded machine, so a poll of `date`, `sleep` and the command every
+# 20 ms kept a core busy while a test only waited. The clock ($EPOCHREALTIME)
+# and the pause (`read -t` on a FIFO nobody writes) are the shell's own; only
+# the command forks, every 20 ms for the first 0.4 s (most waits end there)
+# and every 50 ms after.
+mkfifo "$T/.nap" && exec {_nap_fd}<>"$T/.nap"
+_nap() { read -r -t "$1" -u "$_nap_fd" _ || :; }
 wait_for() {
-	local timeout=$1; shift
-	local deadline=$(( $(date +%s%N) + timeout * 1000000000 ))
+	local timeout=$1 n=0; shift
+	local now=${EPOCHREALTIME/[.,]/}
+	local deadline=$(( now / 1000 + timeout * 1000 ))
 	until "$@" >/dev/null 2>&1; do
-		[ "$(date +%s%N)" -lt "$deadline" ] || return 1
-		sleep 0.02
+		now=${EPOCHREALTIME/[.,]/}
+		[ $(( now / 1000 )) -lt "$deadline" ] || return 1
+		if [ $((n += 1)) -le 20 ]; then _nap 0.02; else _nap 0.05; fi
 	done
 }
 wait_log() { wait_for "${3:-10}" grep -qE "$2" "$T/$1.log"; }
+
+# py_start NAME SCRIPT [VAR...]: one Python interpreter that runs SCRIPT's
+# main(argv) per call (tests/tools/pyserve.py): a Python start-up costs more
+# than most exchanges a test makes with it, hundreds of times a test. The
+# environment variables VAR... are passed on each call as they are then.
+# py_call NAME ARG...: SCRIPT ARG... as if run on its own: its output, its
+# stderr, its exit status. One caller at a time (not from two background
+# jobs at once); a script that is a program of its own (spawn) runs as
+# python3 SCRIPT.
+py_start() {
+	local name=$1 script=$2 fd_in fd_out; shift 2
+	mkfifo "$T/py_$name.in" "$T/py_$name.out" || return 1
+	python3 -S "$top/tests/tools/pyserve.py" "$script" <"$T/py_$name.in" >"$T/py_$name.out" 2>"$T/py_$name.err" &
+	_pids+=("$!")
+	# read-write: never blocks, and the server never sees its input end
+	exec {fd_in}<>"$T/py_$name.in"
+	# read-only: waits for the server's side, and ends (EOF) if it dies
+	exec {fd_out}<"$T/py_$name.out"
+	eval "_py_in_$name=$fd_in _py_out_$name=$fd_out"
+	eval "_py_env_$name=\$*"
+}
+py_call() {
+	local name=$1 in out envs e req="" line rc=""; shift
+	in=_py_in_$name out=_py_out_$name envs=_py_env_$name
+	for e in ${!envs}; do
+		if [ -n "${!e+x}" ]; then req+="$e=${!e};"; else req+="$e;"; fi
+	done
+	local IFS=$'\x1f'   # "$*" joins the arguments with it
+	printf '%s\x1f%s\n' "${req%;}" "$*" >&"${!in}"
+	while IFS= read -r line <&"${!out}"; do
+		case $line in
+		"o "*) printf '%s\n' "${line:2}" ;;
+		"e "*) printf '%s\n' "${line:2}" >&2 ;;
+		"x "*) rc=${line:2}; break ;;
+		esac
+	done
+	[ -n "$rc" ] && return "$rc"
+	echo "py_call: the $name interpreter is gone: $(tail -n 5 "$T/py_$name.err")" >&2
+	return 1
+}
 
 lcm_port() { echo $(( $1 + TEST_PORT_OFFSET )); }
 lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }

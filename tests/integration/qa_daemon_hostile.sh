@@ -24,7 +24,8 @@ PORT=$(lcm_port "${QA_PORT:-7952}")   # the UDP port itself: qa_lcm.py talks to 
 URL=$(lcm_url "${QA_PORT:-7952}")
 R="qa$$"
 LIM=0.5
-ctl() { python3 "$top/tests/integration/sim_client.py" ctl "$T/ctl" "$1"; }
+py_start sim "$top/tests/integration/sim_client.py"   # one interpreter (tests/lib.sh)
+ctl() { py_call sim ctl "$T/ctl" "$1"; }
 
 KEY="$T/command.key"
 "$D" --gen-key "$KEY" >/dev/null || { tap_fail "command key made" "undulated --gen-key failed"; tap_done; exit 1; }

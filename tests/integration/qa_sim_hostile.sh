@@ -11,7 +11,8 @@ S="$B/undulate-sim"; Q="$top/tests/integration/qa_lcm.py"
 [ -x "$S" ] || tap_skip_all "undulate-sim not built"
 PORT=$(lcm_port 7954)   # the UDP port itself: qa_lcm.py talks to it raw
 URL=$(lcm_url 7954)
-ctl() { python3 "$top/tests/integration/sim_client.py" ctl "$T/ctl" "$1"; }
+py_start sim "$top/tests/integration/sim_client.py"   # one interpreter (tests/lib.sh)
+ctl() { py_call sim ctl "$T/ctl" "$1"; }
 
 # a sim_command_t as lcm-gen encodes it, for its fingerprint
 spawn cap python3 "$Q" capture $PORT SIM.CMD 10

@@ -12,6 +12,8 @@
 #  - a parameter far outside physics (inertia 1e-300).
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"; Q="$top/tests/integration/qa_lcm.py"
+# one interpreter for the forging and sending (tests/lib.sh, py_start)
+py_start qa "$Q"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; exit 0; fi
 PORT=$(lcm_port 7710)
 URL=$(lcm_url 7710)
@@ -30,8 +32,8 @@ wait_log cap listening 10
 wait_for 5 grep -qE '^[0-9a-f]{40,}$' "$T/cap.log"
 TEMPLATE=$(grep -E '^[0-9a-f]{40,}$' "$T/cap.log" | head -1)
 [ -n "$TEMPLATE" ] || { tap_fail "capture a command_t" "$(cat "$T/cap.log")"; tap_done; exit 1; }
-forge() { python3 "$Q" forge "$TEMPLATE" "$R" "$@"; }   # KIND MODE PARAM JOINT VALUE [key= age= source=]
-forge_all() { python3 "$Q" forge "$TEMPLATE" '*' "$@"; }
+forge() { py_call qa forge "$TEMPLATE" "$R" "$@"; }   # KIND MODE PARAM JOINT VALUE [key= age= source=]
+forge_all() { py_call qa forge "$TEMPLATE" '*' "$@"; }
 HOSTADDR=$(hostname -I 2>/dev/null | awk '{ print $1 }')
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 4 --return-delay 0
@@ -79,10 +81,10 @@ bad0=$(last_state | field bad_commands)
 acc0=$(events | grep -c "kind=command-accepted")
 for c in "1 2 - -1 0" "2 0 amplitude -1 0.1"; do   # mode sinusoid; amplitude 0.1
 	hex=$(forge $c)
-	python3 "$Q" send "$PORT" "$R.CMD" "$hex" >/dev/null
-	python3 "$Q" send "$PORT" "UNDULATE.CMD" "$(forge_all $c)" >/dev/null
-	python3 "$Q" send "$PORT" "$R.CMD" "$hex" to=127.0.0.1 >/dev/null
-	[ -n "$HOSTADDR" ] && python3 "$Q" send "$PORT" "$R.CMD" "$hex" to="$HOSTADDR" >/dev/null
+	py_call qa send "$PORT" "$R.CMD" "$hex" >/dev/null
+	py_call qa send "$PORT" "UNDULATE.CMD" "$(forge_all $c)" >/dev/null
+	py_call qa send "$PORT" "$R.CMD" "$hex" to=127.0.0.1 >/dev/null
+	[ -n "$HOSTADDR" ] && py_call qa send "$PORT" "$R.CMD" "$hex" to="$HOSTADDR" >/dev/null
 done
 wait_cycles 30
 s=$(last_state)
@@ -97,17 +99,17 @@ else tap_fail "no socket on the LCM port" "$(ss -Hulnp | grep "pid=$pid_d,")"; f
 stop d >/dev/null
 
 # opened to the network: signed commands only
-# command_window_s 10: a command forged by one python3 and sent by another must
-# arrive inside the window, and at load 10-12 on 2 cores python3 took 3 s to
+# command_window_s 10: a command forged by one call and sent by another must
+# arrive inside the window, and at load 10-12 on 2 cores a python3 took 3 s to
 # start: the replayed command's first copy came 'too old' (the stale ones
 # below are 30 s off, outside either window)
 start_daemon d2 --set robot.commands=network --set robot.command_key="$KEY" --set robot.command_window_s=10 ||
 	{ tap_fail "daemon starts with commands = network" "$(cat "$T/d2.log")"; tap_done; exit 1; }
 bad0=$(last_state | field bad_commands)
 for c in "1 2 - -1 0" "2 0 amplitude -1 0.1"; do
-	python3 "$Q" send "$PORT" "$R.CMD" "$(forge $c)" >/dev/null
-	python3 "$Q" send "$PORT" "$R.CMD" "$(forge $c)" to=127.0.0.1 >/dev/null
-	python3 "$Q" send "$PORT" "$R.CMD" "$(forge $c key="$T/other.key")" >/dev/null
+	py_call qa send "$PORT" "$R.CMD" "$(forge $c)" >/dev/null
+	py_call qa send "$PORT" "$R.CMD" "$(forge $c)" to=127.0.0.1 >/dev/null
+	py_call qa send "$PORT" "$R.CMD" "$(forge $c key="$T/other.key")" >/dev/null
 done
 wait_cycles 30
 s=$(last_state)
@@ -120,7 +122,7 @@ if [ $rc = 0 ] && echo "$out" | grep -q "command-accepted: mode SINUSOID" && wai
 	tap_ok "a signed command from another process is accepted"; else tap_fail "signed command accepted" "rc $rc $out"; fi
 hex=$(forge 1 1 - -1 0 key="$KEY" source=replayer)   # mode hold, signed
 bad0=$(last_state | field bad_commands)
-python3 "$Q" send "$PORT" "$R.CMD" "$hex" times=3 >/dev/null
+py_call qa send "$PORT" "$R.CMD" "$hex" times=3 >/dev/null
 wait_cycles 20
 # counted every time; published within the unauthenticated traffic's rate limit
 nrep=$(events | grep -c 'kind=command-rejected text="signed, but replayed')
@@ -131,8 +133,8 @@ else tap_fail "replays refused" "bad_commands $bad0 -> $(last_state | field bad_
 # published 5 at once, then one a second: let the budget refill first
 wait_cycles 300
 bad0=$(last_state | field bad_commands)
-python3 "$Q" send "$PORT" "$R.CMD" "$(forge 1 2 - -1 0 key="$KEY" age=30 source=late)" >/dev/null
-python3 "$Q" send "$PORT" "$R.CMD" "$(forge 1 2 - -1 0 key="$KEY" age=-30 source=early)" >/dev/null
+py_call qa send "$PORT" "$R.CMD" "$(forge 1 2 - -1 0 key="$KEY" age=30 source=late)" >/dev/null
+py_call qa send "$PORT" "$R.CMD" "$(forge 1 2 - -1 0 key="$KEY" age=-30 source=early)" >/dev/null
 wait_cycles 20
 if last_state | grep -q ' mode=1 ' && [ "$(last_state | field bad_commands)" = $((bad0 + 2)) ] &&
 	events | grep -q 'signed, but too old' && events | grep -q 'signed, but from the future'; then
@@ -152,8 +154,8 @@ if ! grep -aqE '^(<[0-7]>)?forged' "$T/d2.log" && [ "$(grep -ac '\\x0a<0>forged-
 else tap_fail "log injection" "$(grep -a -B1 -A1 'forged' "$T/d2.log" | head -6)"; fi
 SOCK=$(ls "$T"/*"$R"@*.cmd)
 lines0=$(wc -l <"$T/d2.log"); ev0=$(events | wc -l)
-python3 "$Q" flood "$SOCK" "$(forge 1 1 - -1 0)" 2000 >"$T/flood1.out"          # mode hold: accepted
-python3 "$Q" flood "$SOCK" "$(forge 2 0 nothing -1 0)" 2000 >"$T/flood2.out"    # unknown parameter: refused
+py_call qa flood "$SOCK" "$(forge 1 1 - -1 0)" 2000 >"$T/flood1.out"          # mode hold: accepted
+py_call qa flood "$SOCK" "$(forge 2 0 nothing -1 0)" 2000 >"$T/flood2.out"    # unknown parameter: refused
 wait_cycles 100
 lines=$(( $(wc -l <"$T/d2.log") - lines0 )); ev=$(( $(events | wc -l) - ev0 ))
 acc=$(events | tail -n "$ev" | grep -c command-accepted); rej=$(events | tail -n "$ev" | grep -c command-rejected)
@@ -166,7 +168,7 @@ else tap_fail "floods rate-limited" "$lines log lines, $ev events ($acc/$rej), $
 # ---- new channel names cost nothing -------------------------------------------------------------
 rss() { awk '/^VmRSS/ { print $2 }' "/proc/$1/status"; }
 r0=$(rss "$pid_d2")
-python3 "$Q" names "$PORT" "grow$$-" 300000 >"$T/names.out" 2>&1
+py_call qa names "$PORT" "grow$$-" 300000 >"$T/names.out" 2>&1
 wait_cycles 50
 r1=$(rss "$pid_d2")
 if [ "$(cat "$T/names.out")" = "sent 300000" ] && [ $((r1 - r0)) -le 512 ] && alive d2; then

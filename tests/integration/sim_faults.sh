@@ -5,7 +5,9 @@
 # error bit, slow reply, power loss and return, disconnect and reconnect at
 # the same path; bad commands get a clear error and never stop the sim.
 . "$(dirname "$0")/../lib.sh"
-C="python3 -S $(dirname "$0")/sim_client.py"
+# one interpreter for the whole test (tests/lib.sh, py_start)
+py_start sim "$top/tests/integration/sim_client.py" SIM_CLIENT_BAUD
+C="py_call sim"
 URL=$(lcm_url 7651)
 link="$T/bus/r1"
 
@@ -123,13 +125,14 @@ answers2() { xfer $PING2 300 6; [ "$reply" = FFFF020200FB ]; }
 if wait_for 3 answers2; then tap_ok "SIM.CMD clear applied"; else tap_fail "SIM.CMD clear applied"; fi
 
 # ---- disconnect / reconnect at the same path ------------------------------------------
-spawn eio $C eio "$link"
+spawn eio python3 -S "$top/tests/integration/sim_client.py" eio "$link"
 wait_log eio '^open' 5
 old=$(readlink "$link")
 ctl_ok "disconnect" "disconnect r1"
 tap_check "disconnect: link removed" test ! -L "$link"
 if wait_log eio '^eio' 5; then tap_ok "disconnect: an open client sees the port go away"; else tap_fail "disconnect: client sees EIO" "$(cat "$T/eio.log")"; fi
-tap_check "disconnect: opening the path fails" bash -c "! $C xfer '$link' $PING1 20 >/dev/null 2>&1"
+xfer_fails() { ! $C xfer "$link" "$PING1" 20 >/dev/null 2>&1; }
+tap_check "disconnect: opening the path fails" xfer_fails
 ctl_ok "reconnect" "reconnect r1"
 tap_check "reconnect: link back at the same path" test -L "$link" -a -c "$(readlink "$link")"
 xfer $PING1 300 6; tap_check "reconnect: servo answers at the same path (was $old, now $(readlink "$link"))" test "$reply" = $OK1

@@ -20,7 +20,9 @@
 # our encoder (STYLE.md: a symmetric bug would pass); replies the manuals do not
 # print are built by pkt() below, an independent few lines of shell.
 . "$(dirname "$0")/../lib.sh"
-C="python3 -S $(dirname "$0")/sim_client.py"
+# one interpreter for the whole test (tests/lib.sh, py_start)
+py_start sim "$top/tests/integration/sim_client.py" SIM_CLIENT_BAUD
+C="py_call sim"
 URL=$(lcm_url 7653)
 link="$T/bus/r1"
 

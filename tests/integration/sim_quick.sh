@@ -4,7 +4,9 @@
 # broadcast PING collision, a wrong-baud bus, --duration and SIGTERM exits
 # with their clean-up, and ground truth on LCM.
 . "$(dirname "$0")/../lib.sh"
-C="python3 -S $(dirname "$0")/sim_client.py"
+# one interpreter for the whole test (tests/lib.sh, py_start)
+py_start sim "$top/tests/integration/sim_client.py" SIM_CLIENT_BAUD
+C="py_call sim"
 URL=$(lcm_url 7650)
 link="$T/bus/r1"
 

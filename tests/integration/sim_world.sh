@@ -5,7 +5,9 @@
 # blocked servo reports load, and the scenario's timed events and --set
 # overrides take effect.
 . "$(dirname "$0")/../lib.sh"
-C="python3 -S $(dirname "$0")/sim_client.py"
+# one interpreter for the whole test (tests/lib.sh, py_start)
+py_start sim "$top/tests/integration/sim_client.py" SIM_CLIENT_BAUD
+C="py_call sim"
 URL=$(lcm_url 7652)
 top=$(cd "$(dirname "$0")/../.." && pwd)
 

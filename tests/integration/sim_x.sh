@@ -10,7 +10,9 @@
 # encoder). The manual's servo is an XM430-W210 (model 1030, firmware 38):
 # the simulated XM430-W350s get those two registers poked.
 . "$(dirname "$0")/../lib.sh"
-C="python3 -S $(dirname "$0")/sim_client.py"
+# one interpreter for the whole test (tests/lib.sh, py_start)
+py_start sim "$top/tests/integration/sim_client.py" SIM_CLIENT_BAUD
+C="py_call sim"
 export SIM_CLIENT_BAUD=57600
 xbus="$T/bus/x" lbus="$T/bus/l"
 
