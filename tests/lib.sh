@@ -262,6 +262,17 @@ run_diag() {
 	return 0
 }
 
+# An end-to-end experiment (e2e_pair, e2e_row) asserts the paper's regimes
+# twice: in lockstep, where the outcome is the same on any machine, and in
+# real time, where a loaded machine changes the timing and so the
+# trajectory. `make test` runs the lockstep half (it must pass on a busy
+# machine); `make test-long` runs the real-time half alone
+# (tests/long/e2e_*_realtime.sh). E2E_PART=lockstep|realtime|all.
+e2e_part=${E2E_PART:-lockstep}
+case $e2e_part in lockstep | realtime | all) ;; *) echo "lib.sh: E2E_PART must be lockstep, realtime or all, not '$e2e_part'" >&2; exit 2 ;; esac
+realtime_part() { [ "$e2e_part" != lockstep ]; }
+lockstep_part() { [ "$e2e_part" != realtime ]; }
+
 # keep_runs DIR...: after a failure, keep the runs' logs and analysis (the
 # test directory is removed on exit) in $BUILD/test-logs/<test>.d/.
 keep_runs() {

@@ -59,7 +59,34 @@ if command -v gnuplot >/dev/null; then
 	drawn "collision_rate.png draws the contact force" "$T/out/collision_rate.png" 1000 b3261e
 	# the anti-phase pair r2:r3 is one band at pi, not two at the edges: its
 	# deltas near -pi were moved up by 2 pi (cut below -2 asin(d~))
-	tap_check "phase_diff.png: anti-phase drawn as one band" grep -q '? (\$9 <= -1.5' "$T/out/plots.gp"
+	tap_check "phase_diff.png: anti-phase drawn as one band" grep -q '1:(\$2 <= -1.5' "$T/out/plots.gp"
+	# Each big CSV is read once, by the analyser, into blocks of the rows each
+	# panel draws (gnuplot filtering states.csv once per joint took two
+	# minutes for a demo): the script reads none of them, and each block holds
+	# exactly its joint's (its pair's) rows.
+	big=$(grep -cE "'(states|phase_diff|collisions)\.csv'" "$T/out/plots.gp")
+	if [ "$big" = 0 ]; then tap_ok "plots.gp filters none of the big CSVs (joints.dat, phase.dat, pair_collisions.dat instead)"
+	else tap_fail "plots.gp filters none of the big CSVs" "$big plot clauses read them"; fi
+	per_key() {   # CSV KEYCOLS...: "key rows" per key, the key's columns named in the header, unquoted
+		awk -F, -v keys="${*:2}" 'NR == 1 { n = split(keys, k, " "); for (i = 1; i <= NF; i++) c[$i] = i; next }
+			{ key = ""; for (i = 1; i <= n; i++) { v = $c[k[i]]; gsub(/"/, "", v); key = key (i > 1 ? ":" : "") v }; rows[key]++ }
+			END { for (key in rows) print key, rows[key] }' "$1" | sort
+	}
+	per_block() {   # DAT: "key rows" per block, the key from its comment line
+		awk '/^# index / { key = $0; next } NF { rows[key]++ } END { for (key in rows) print key, rows[key] }' "$1"
+	}
+	rows=$(awk -F, 'NR > 1 { n++ } END { print n + 0 }' "$T/out/states.csv")
+	got=$(per_block "$T/out/joints.dat" | awk '{ s += $NF; b++ } END { print s + 0, b + 0 }')
+	if [ "${got% *}" = "$rows" ] && [ "${got#* }" -ge 4 ]; then
+		tap_ok "joints.dat holds every row of states.csv, in ${got#* } joints' blocks"
+	else
+		tap_fail "joints.dat holds every row of states.csv" "states.csv: $rows rows; joints.dat: ${got% *} rows in ${got#* } blocks"
+	fi
+	# (phase_diff.csv also holds each robot's own joint pairs, r1/0:1, which no panel draws)
+	got=$(per_block "$T/out/phase.dat" | sed -E 's/^# index [0-9]+: pair ([^:]*:[^:]*): [^ ]* /\1 /' | sort)
+	want=$(per_key "$T/out/phase_diff.csv" pair | join - <(echo "$got" | awk '{ print $1 }'))
+	if [ -n "$got" ] && [ "$want" = "$got" ]; then tap_ok "phase.dat: each pair's rows of phase_diff.csv in its block ($(echo $got))"
+	else tap_fail "phase.dat: each pair's rows of phase_diff.csv" "phase_diff.csv: $(echo $want); phase.dat: $(echo $got)"; fi
 	tap_check "phase_diff.png: compatibility bounds and collisions drawn" \
 		bash -c "grep -q 'compatible bound' '$T/out/plots.gp' && grep -q \"title 'collision'\" '$T/out/plots.gp'"
 	tap_check "return maps: measured points coloured by time" grep -q "lc palette title 'measured (colour: time)'" "$T/out/plots.gp"

@@ -1,5 +1,4 @@
 #!/usr/bin/env bash
-# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
 # e2e_demo.sh — `make demo DEMO_SECONDS=...` end to end, as a new user runs
 # it: the paper's contact-force scene (ten robots crowded in a row, one
 # undulated each), 20 s on the clock, then the oscillator, headless; the
@@ -8,7 +7,11 @@
 # run is kept and the exact command for the plots (run here: its plots must
 # draw data); afterwards nothing is left behind (no process, no pty link, no
 # socket, no temporary directory) — also when the demo is stopped early by
-# SIGTERM, and on a terminal stopped by Ctrl-C.
+# SIGTERM, and on a terminal stopped by Ctrl-C. The paper's effect (the
+# contact force falls after the switch) is asserted on the same scene in
+# lockstep, where the outcome does not depend on the machine's load; in real
+# time, alone, it is make test-long's (tests/long/e2e_force.sh, on the row
+# world's ten robots).
 source "$(dirname "$0")/../lib.sh"
 
 demo="$top/scripts/demo.sh"
@@ -29,8 +32,8 @@ leftovers() {
 	return 1
 }
 
-# ---- a headless run, as `make demo DEMO_SECONDS=45 DEMO_OUT=...` ----------------
-seconds=45
+# ---- a headless run, as `make demo DEMO_SECONDS=35 DEMO_OUT=...` ----------------
+seconds=35
 spawn demo env BUILD="$BUILD" DEMO_SECONDS=$seconds DEMO_LCM_URL="$url" TMPDIR="$T/tmp" \
 	DEMO_OUT="$T/out" "$demo"
 if wait_log demo '^demo: scenario' 40; then
@@ -50,7 +53,7 @@ rc=$?
 if [ "$rc" = 0 ]; then tap_ok "headless demo exits 0"; else tap_fail "headless demo exits 0" "exit $rc; $(tail -n 20 "$T/demo.log")"; fi
 
 out="$T/demo.log"
-if grep -q '^=== undulate demo summary: 10 robots, 45 s, plane-demo.scenario' "$out"; then
+if grep -q "^=== undulate demo summary: 10 robots, $seconds s, plane-demo.scenario" "$out"; then
 	tap_ok "summary printed"
 else
 	tap_fail "summary printed" "$(tail -n 30 "$out")"
@@ -69,7 +72,7 @@ bad=$(awk '$1 ~ /^r[0-9]+:r[0-9]+$/ && $2 ~ /^(in-phase|compatible|anti-phase|gr
 	&& ($3 < -3.1416 || $3 > 3.1416 || $4 <= 0.05 || $4 > 2) { print }' "$out")
 if [ -z "$bad" ]; then tap_ok "phase differences within (-pi, pi], d~ plausible"; else tap_fail "phase differences within (-pi, pi], d~ plausible" "$bad"; fi
 windows=$(awk '/^collisions per 10 s window:/ { on = 1; next } on && /collisions/ { n++ } END { print n + 0 }' "$out")
-if [ "$windows" -ge 4 ]; then
+if [ "$windows" -ge 3 ]; then
 	tap_ok "collision count per 10 s window ($windows windows)"
 else
 	tap_fail "collision count per 10 s window" "$(sed -n '/collisions per 10 s/,$p' "$out")"
@@ -84,32 +87,11 @@ else
 fi
 # In words: the contact force's change, as a ratio, and the collisions.
 words=$(grep -E '^  The mean contact force (fell [0-9.]+x after the switch|fell to zero after the switch|did not fall): [0-9.]+ N on the sinusoid' "$out")
-ratio=$(echo "$words" | sed -n 's/.*fell \([0-9.]*\)x after.*/\1/p')
 if [ -n "$words" ] && grep -qE '^  Collisions between robots per 10 s: [0-9]+ -> [0-9]+; against the walls' "$out"; then
 	tap_ok "summary in words: ${words#  }"
 else
 	tap_fail "summary says in words how the contact force and collisions changed" "$(sed -n '/In words/,+4p' "$out")"
 fi
-# The paper's effect (docs/EXPERIMENTS.md section 4, which this run is: the
-# simulator's total impulse per second, sampled by demo.sh, over the last
-# 10 s on each side of the switch): asserted 3x or more — the least fall
-# recorded is 3.8x; 5x, as the README promises it for the demo, and the
-# paper's order of magnitude are TODOs with their number when short. (This
-# replaced e2e_force in make test: the same experiment run a second time;
-# it runs in make test-long.)
-zero=0; echo "$words" | grep -q 'fell to zero' && zero=1
-if [ "$zero" = 1 ] || { [ -n "$ratio" ] && awk -v r="$ratio" 'BEGIN { exit !(r >= 3) }'; }; then
-	tap_ok "the contact force falls 3x or more after the switch (${ratio:-to zero}x)"
-else
-	tap_fail "the contact force falls 3x or more after the switch" "${words:-no words}"
-fi
-for want in 5 10; do
-	if [ "$zero" = 1 ] || { [ -n "$ratio" ] && awk -v r="$ratio" -v w="$want" 'BEGIN { exit !(r >= w) }'; }; then
-		tap_ok "the contact force falls ${want}x or more after the switch (${ratio:-to zero}x)"
-	else
-		tap_todo "the contact force falls ${want}x or more after the switch" "${words:-no words}"
-	fi
-done
 # Robots that stopped would also stop colliding: every joint must still swing
 # at least 0.6 rad peak-to-peak (a crowded end robot's free joint swings least).
 sg=$(min_swing "$T/out" 2>/dev/null)
@@ -152,6 +134,33 @@ else
 	tap_fail "the analysis takes the restitution from the simulator's SIM.WORLD" "$(grep -i restitution "$T/out/summary.txt")"
 fi
 if why=$(leftovers); then tap_ok "nothing left behind after a full run"; else tap_fail "nothing left behind after a full run" "$why"; fi
+
+# ---- the paper's effect: the same scene in lockstep ----------------------------------------
+# (docs/EXPERIMENTS.md section 4: the simulator's total impulse per second,
+# sampled by demo.sh, over the last 10 s on each side of the switch at 20 s.)
+# Asserted 3x or more; 5x, as the README promises it for the demo, and the
+# paper's order of magnitude are TODOs with their number when short. The
+# robots must still swing: robots that stopped would also stop colliding.
+env BUILD="$BUILD" DEMO_SECONDS=45 TMPDIR="$T/tmp" DEMO_OUT="$T/lout" "$demo" --lockstep --lcm-url "$url" \
+	>"$T/ldemo.log" 2>&1
+lrc=$?
+words=$(grep -E '^  The mean contact force (fell [0-9.]+x after the switch|fell to zero after the switch|did not fall)' "$T/ldemo.log")
+ratio=$(echo "$words" | sed -n 's/.*fell \([0-9.]*\)x after.*/\1/p')
+lsw=$(min_swing "$T/lout" 2>/dev/null)
+zero=0; echo "$words" | grep -q 'fell to zero' && zero=1
+if [ "$lrc" = 0 ] && { [ "$zero" = 1 ] || { [ -n "$ratio" ] && awk -v r="$ratio" 'BEGIN { exit !(r >= 3) }'; }; } &&
+	[ -n "$lsw" ] && awk -v s="${lsw%% *}" 'BEGIN { exit !(s >= 0.6) }'; then
+	tap_ok "in lockstep: the contact force falls 3x or more after the switch (${ratio:-to zero}x), every robot undulates (smallest swing ${lsw%% *} rad)"
+else
+	tap_fail "in lockstep: the contact force falls 3x or more after the switch, every robot undulates" "exit $lrc; ${words:-no words}; swing $lsw; $(tail -n 5 "$T/ldemo.log")"
+fi
+for want in 5 10; do
+	if [ "$zero" = 1 ] || { [ -n "$ratio" ] && awk -v r="$ratio" -v w="$want" 'BEGIN { exit !(r >= w) }'; }; then
+		tap_ok "in lockstep: the contact force falls ${want}x or more after the switch (${ratio:-to zero}x)"
+	else
+		tap_todo "in lockstep: the contact force falls ${want}x or more after the switch" "${words:-no words}"
+	fi
+done
 
 # ---- the row's experiment on XM430-W350 robots (Protocol 2.0), in virtual time --------------
 # (force10.scenario: the row world, as before make demo moved to the plane.)

@@ -8,6 +8,8 @@
 /* Panels per figure at most (robots in angles.png, pairs in phase_diff.png);
  * more are left out of the picture and the title says how many. */
 #define PLOT_MAX_PANELS 12
+/* Pairs drawn in the collision rate at most (the analyser's AN_MAX_PAIRS). */
+#define PLOT_MAX_PAIRS 192
 
 struct plot_pair {
 	const char *name;   /* "a:b", as in phase_diff.csv and return_map.csv */
