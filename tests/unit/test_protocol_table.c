@@ -12,9 +12,75 @@
 #include <cmocka.h>
 
 #include "dxl.h"
+#include "dxl2_table.h"
 #include "dxl_table.h"
 
 #define PI 3.14159265358979323846
+
+/* The AX-12A is a descriptor in the one model list, beside the X series:
+ * protocol 1, its rows those of the dxl_reg view (the same numbers, one
+ * written place), its datasheet the e-manual's, its capabilities asked of
+ * the descriptor. */
+static void test_ax12a_descriptor(void **state)
+{
+	(void)state;
+	const struct dxl2_model *m = dxl2_model_by_number(DXL_AX12_MODEL);
+	assert_non_null(m);
+	assert_ptr_equal(dxl2_model_at(0), m);
+	assert_ptr_equal(dxl2_model_by_name("ax-12a"), m);
+	assert_ptr_equal(dxl2_model_find(1, DXL_AX12_MODEL), m);
+	assert_null(dxl2_model_find(2, DXL_AX12_MODEL));
+	assert_int_equal(m->protocol, 1);
+	assert_string_equal(m->name, "AX-12A");
+	assert_int_equal(m->nregs, dxl_ax12_nregs);
+	for (size_t i = 0; i < m->nregs; i++) {
+		const struct dxl_reg *v = &dxl_ax12_regs[i];
+		const struct dxl2_reg *r = &m->regs[i];
+		assert_string_equal(r->name, v->name);
+		assert_int_equal(r->addr, v->addr);
+		assert_int_equal(r->size, v->size);
+		assert_false(r->is_signed);
+		assert_int_equal(r->min, v->min);
+		assert_int_equal(r->max, v->max);
+		assert_int_equal(r->has_default, v->def >= 0);
+		assert_ptr_equal(dxl2_reg_lookup(m, r->name), r);
+	}
+	/* aliases resolve to the model's own register */
+	assert_int_equal(dxl2_reg_lookup(m, "speed")->addr, DXL_AX_PRESENT_SPEED);
+	assert_int_equal(dxl2_reg_lookup(m, "voltage")->addr, DXL_AX_PRESENT_VOLTAGE);
+	assert_null(dxl2_reg_lookup(m, "hardware_error_status"));
+	/* datasheet: 1.5 N·m and 59 rpm at 12 V, 254:1, rated 9..12 V (11.1) */
+	assert_true(m->sheet.stall_torque_nm == 1.5 && m->sheet.stall_current_a == 1.5);
+	assert_true(m->sheet.no_load_speed_rpm == 59.0 && m->sheet.gear_ratio == 254.0);
+	assert_true(m->sheet.rated_min_v == 9.0 && m->sheet.rated_rec_v == 11.1 && m->sheet.rated_max_v == 12.0);
+	assert_true(fabs(dxl2_sheet_no_load_rad_s(&m->sheet) - 59.0 * 2.0 * PI / 60.0) < 1e-12);
+	assert_int_equal(m->factory_baud, 1000000);
+	/* capabilities: a wheel by its angle limits; no hardware error status,
+	 * watchdog, reboot or operating mode */
+	assert_true(dxl2_model_can(m, DXL2_CAP_WHEEL_BY_ANGLE_LIMITS));
+	assert_false(dxl2_model_can(m, DXL2_CAP_HWERR_STATUS));
+	assert_false(dxl2_model_can(m, DXL2_CAP_WATCHDOG));
+	assert_false(dxl2_model_can(m, DXL2_CAP_REBOOT));
+	assert_false(dxl2_model_can(m, DXL2_CAP_OPMODE));
+	assert_int_equal(m->opmodes, 0);
+	/* units: speed with its direction bit, 300 degrees, baud 2e6/(v+1) */
+	char buf[64];
+	assert_string_equal(dxl2_reg_format(dxl2_reg_at(m, 38), 0x400 | 100, buf, sizeof buf), "1124 (11.1 rpm CW)");
+	assert_string_equal(dxl2_reg_format(dxl2_reg_at(m, 36), 1023, buf, sizeof buf), "1023 (300.0 deg)");
+	assert_string_equal(dxl2_reg_format(dxl2_reg_at(m, 4), 1, buf, sizeof buf), "1 (1000000 bps)");
+	/* Moving Speed: 0..1023 in joint mode, bit 10 allowed in wheel mode */
+	const struct dxl2_reg *ms = dxl2_reg_at(m, DXL_AX_MOVING_SPEED);
+	uint8_t joint[DXL_AX_TABLE_SIZE] = { 0 }, wheel[DXL_AX_TABLE_SIZE] = { 0 };
+	joint[DXL_AX_CCW_ANGLE_LIMIT] = 0xFF;
+	joint[DXL_AX_CCW_ANGLE_LIMIT + 1] = 3;
+	assert_int_equal(dxl2_reg_check_write_live(m, ms, 1500, joint, sizeof joint), DXL_E_ARG);
+	assert_int_equal(dxl2_reg_check_write_live(m, ms, 1023, joint, sizeof joint), DXL_OK);
+	assert_int_equal(dxl2_reg_check_write_live(m, ms, 1500, wheel, sizeof wheel), DXL_OK);
+	/* the X series' names leave it out */
+	char names[128];
+	assert_string_equal(dxl2_model_names(2, names, sizeof names), "XL430-W250, XM430-W350, XC430-W150");
+	assert_string_equal(dxl2_model_names(1, names, sizeof names), "AX-12A");
+}
 
 static void test_lookup(void **state)
 {
@@ -283,6 +349,7 @@ static void test_format(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_ax12a_descriptor),
 		cmocka_unit_test(test_lookup),
 		cmocka_unit_test(test_table_shape),
 		cmocka_unit_test(test_table_values),

@@ -53,7 +53,7 @@ struct dxlt2_reg {
 static const char *dxlt2_known(void)
 {
 	static char names[160];
-	return dxl2_model_names(names, sizeof names);
+	return dxl2_model_names(2, names, sizeof names);
 }
 
 static const char *dxlt2_model_text(const struct dxlt2_servo *s)
