@@ -257,7 +257,7 @@ static int dr_latency(struct dr *d)
 	if (first != NULL) {
 		/* its own return delay is no adapter's doing: read it first */
 		uint8_t rd = 0;
-		int rr = d->t->a.protocol == 2 ? dxlt2_read(d->t, first->id, DXL2_X_RETURN_DELAY_TIME, 1, &rd)
+		int rr = d->t->a.protocol == 2 ? dxlt_read(d->t, first->id, DXL2_X_RETURN_DELAY_TIME, 1, &rd)
 		                               : dxlt_read(d->t, first->id, DXL_AX_RETURN_DELAY_TIME, 1, &rd);
 		if (rr != DXL_OK)
 			rd = 0;
@@ -779,7 +779,7 @@ static int dr2_read_all(struct dr *d, int *status)
 		if (!s->answered)
 			continue;
 		for (int k = 0; k < DR_READ_TRIES && r != DXL_OK && !dr_gone(r); k++)
-			r = dxlt2_read(d->t, s->id, 0, sizeof mem, mem);
+			r = dxlt_read(d->t, s->id, 0, sizeof mem, mem);
 		if (dr_gone(r))
 			return dxlt_bus_fail(d->t, s->id, r);
 		status[j] = r;
