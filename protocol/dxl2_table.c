@@ -256,6 +256,7 @@ static const struct dxl2_reg xm430_regs[] = {
 };
 
 #define OPMODE_BIT(m) (1u << (m))
+#define ROWS(a) .regs = (a), .nregs = sizeof (a) / sizeof (a)[0]
 /* What every X servo here can do beyond its table. */
 #define X_CAPS (DXL2_CAP_HWERR_STATUS | DXL2_CAP_WATCHDOG | DXL2_CAP_REBOOT | DXL2_CAP_OPMODE | \
                 DXL2_CAP_FACTORY_RESET_KEEP)
@@ -264,24 +265,24 @@ static const struct dxl2_model dxl2_models[] = {
 	 * at 12 V, 254:1, 9-12 V (11.1 recommended); rotor 4.6e-8 kg·m², the
 	 * simulator's estimate (sim-bridge/PHYSICS.md §5). Factory 1 Mbps; the
 	 * simulated one reports firmware 24. */
-	{ .protocol = 1, .number = DXL_AX12_MODEL, .name = "AX-12A", .regs = ax12a_regs,
-	  .nregs = sizeof ax12a_regs / sizeof ax12a_regs[0], .caps = DXL2_CAP_WHEEL_BY_ANGLE_LIMITS,
+	{ .protocol = 1, .number = DXL_AX12_MODEL, .name = "AX-12A", ROWS(ax12a_regs),
+	  .caps = DXL2_CAP_WHEEL_BY_ANGLE_LIMITS,
 	  .opmodes = 0, .current_sensing = false,
 	  .sheet = { .stall_torque_nm = 1.5, .stall_current_a = 1.5, .no_load_speed_rpm = 59.0, .gear_ratio = 254.0,
 	             .rotor_inertia = 4.6e-8, .rated_min_v = 9.0, .rated_rec_v = 11.1, .rated_max_v = 12.0 },
 	  .factory_baud = 1000000, .firmware = 24 },
 	/* 1.5 N·m at 12 V (1.4 A), 61 rpm at 12 V, 258.5:1, 6.5-12.0 V (11.1
 	 * recommended); a cored motor: its rotor taken as the AX-12A's */
-	{ .protocol = 2, .number = DXL2_MODEL_XL430_W250, .name = "XL430-W250", .regs = xl430_regs,
-	  .nregs = sizeof xl430_regs / sizeof xl430_regs[0], .caps = X_CAPS,
+	{ .protocol = 2, .number = DXL2_MODEL_XL430_W250, .name = "XL430-W250", ROWS(xl430_regs),
+	  .caps = X_CAPS,
 	  .opmodes = OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
 	  .sheet = { .stall_torque_nm = 1.5, .stall_current_a = 1.4, .no_load_speed_rpm = 61.0, .gear_ratio = 258.5,
 	             .rotor_inertia = 4.6e-8, .rated_min_v = 6.5, .rated_rec_v = 11.1, .rated_max_v = 12.0 },
 	  .factory_baud = 57600, .firmware = 46 },
 	/* 4.1 N·m at 12 V (2.3 A), 46 rpm at 12 V, 353.5:1, 10.0-14.8 V (12.0
 	 * recommended); a coreless (Maxon) motor: 0.5 g·cm² taken for its rotor */
-	{ .protocol = 2, .number = DXL2_MODEL_XM430_W350, .name = "XM430-W350", .regs = xm430_regs,
-	  .nregs = sizeof xm430_regs / sizeof xm430_regs[0], .caps = X_CAPS,
+	{ .protocol = 2, .number = DXL2_MODEL_XM430_W350, .name = "XM430-W350", ROWS(xm430_regs),
+	  .caps = X_CAPS,
 	  .opmodes = OPMODE_BIT(0) | OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(5) | OPMODE_BIT(16),
 	  .current_sensing = true,
 	  .sheet = { .stall_torque_nm = 4.1, .stall_current_a = 2.3, .no_load_speed_rpm = 46.0, .gear_ratio = 353.5,
@@ -291,8 +292,8 @@ static const struct dxl2_model dxl2_models[] = {
 	 * 12 V, 159.59:1, 6.5-14.8 V (12.0 recommended); velocity, position,
 	 * extended position and PWM control, Present Load (no current sensing);
 	 * a coreless motor: its rotor taken as the XM430's */
-	{ .protocol = 2, .number = DXL2_MODEL_XC430_W150, .name = "XC430-W150", .regs = xc430_regs,
-	  .nregs = sizeof xc430_regs / sizeof xc430_regs[0], .caps = X_CAPS,
+	{ .protocol = 2, .number = DXL2_MODEL_XC430_W150, .name = "XC430-W150", ROWS(xc430_regs),
+	  .caps = X_CAPS,
 	  .opmodes = OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
 	  .sheet = { .stall_torque_nm = 1.6, .stall_current_a = 1.4, .no_load_speed_rpm = 106.0, .gear_ratio = 159.59,
 	             .rotor_inertia = 5.0e-8, .rated_min_v = 6.5, .rated_rec_v = 12.0, .rated_max_v = 14.8 },

@@ -64,6 +64,9 @@ void dxlt_apply_timing(struct dxlt *t);
 int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status);
 /* Transactions whose replies' error bits are remembered in t->errseen. */
 int dxlt_ping(struct dxlt *t, uint8_t id);
+/* PING, and the model number where the protocol's PING carries one
+ * (*model untouched where it does not). */
+int dxlt_ping_model(struct dxlt *t, uint8_t id, uint16_t *model);
 /* An error byte a reply carried outside these (a REBOOT's). */
 void dxlt_seen(struct dxlt *t, uint8_t id, uint8_t e);
 int dxlt_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out);

@@ -108,6 +108,19 @@ int dxlt_ping(struct dxlt *t, uint8_t id)
 	return r;
 }
 
+int dxlt_ping_model(struct dxlt *t, uint8_t id, uint16_t *model)
+{
+	uint8_t e = 0;
+	int r = bus_ping_model(&t->bus, id, model, NULL, &e);
+
+	/* a backend whose PING carries no model sends nothing for that */
+	if (r == DXL_E_UNSUPPORTED)
+		return dxlt_ping(t, id);
+	if (r == DXL_OK)
+		*dxlt_errseen(t, id) |= e;
+	return r;
+}
+
 int dxlt_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out)
 {
 	uint8_t e = 0;
