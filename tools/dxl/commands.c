@@ -177,12 +177,18 @@ static const struct dxlt_family dxlt_families[] = {
 	  .settle_us = DXLT_EEPROM_SETTLE_US, .eeprom_needs_torque_off = false,
 	  .no_rate = "dxl: an AX-12 cannot run at '%s' bps (rates are 2000000/(n+1), e.g. 1000000, 500000, 117647, "
 	             "57143)\n",
+	  .reset_form = "reset ID --yes",
+	  .reset_refusal = "dxl: a factory reset sets ID 1, 1000000 bps and every default (including angle limits); "
+	                   "add --yes to do it\n",
 	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
 	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
 	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
 	  .settle_us = 20000, .eeprom_needs_torque_off = true,
 	  .no_rate = "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, 3000000, "
 	             "4000000, 4500000)\n",
+	  .reset_form = "reset ID --yes [--keep id|id-baud]",
+	  .reset_refusal = "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
+	                   "to do it (--keep id or id-baud keeps those)\n",
 	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at },
 };
 #define DXLT_NFAMILIES (sizeof dxlt_families / sizeof dxlt_families[0])
@@ -559,35 +565,46 @@ static int dxlt_cmd_torque(struct dxlt *t)
 	return dxlt_write_checked(t, id, dxl_reg_at(DXL_AX_TORQUE_ENABLE), on ? 1 : 0);
 }
 
+/* What a factory reset keeps: --keep where the models can (their
+ * descriptor's DXL2_CAP_FACTORY_RESET_KEEP), else everything goes. */
+static uint8_t dxlt_reset_keep(const struct dxlt *t, const char **what)
+{
+	uint8_t keep = dxl2_model_can(t->fam_model, DXL2_CAP_FACTORY_RESET_KEEP) ? (uint8_t)t->a.keep : DXL_RESET_ALL;
+	*what = keep == DXL2_RESET_KEEP_ID ? "every default but the ID (57600 bps)"
+	        : keep == DXL2_RESET_KEEP_ID_BAUD ? "every default but the ID and the baud rate"
+	        : "ID 1, 57600 bps and every default";
+	return keep;
+}
+
 static int dxlt_cmd_reset(struct dxlt *t)
 {
 	uint8_t id, e = 0;
-	int rc;
+	const char *what;
+	int rc, r;
 
-	if ((rc = dxlt_need_args(t, 1, "reset ID --yes")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
+	if ((rc = dxlt_need_form(t, 1, t->fam->reset_form)) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)))
 		return rc;
+	uint8_t keep = dxlt_reset_keep(t, &what);
 	if (!t->a.yes) {
-		fprintf(t->err, "dxl: a factory reset sets ID 1, 1000000 bps and every default "
-		        "(including angle limits); add --yes to do it\n");
+		fprintf(t->err, t->fam->reset_refusal, what);
 		return DXLT_EXIT_USAGE;
 	}
-	int r = dxlt_ping(t, id);
-	if (r != DXL_OK)
+	if ((r = dxlt_ping(t, id)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	r = bus_factory_reset(&t->bus, id, DXL_RESET_ALL, false, &e);
-	if (r != DXL_OK)
+	if ((r = bus_factory_reset(&t->bus, id, keep, false, &e)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	if ((rc = dxlt_set_baud(t, DXLT_DEFAULT_BAUD)) != DXLT_EXIT_OK)
+	/* where the servo went: its model's factory ID and rate, or what it kept */
+	uint8_t now_id = keep == DXL_RESET_ALL ? 1 : id;
+	long now_baud = keep == DXL2_RESET_KEEP_ID_BAUD ? port_baud(t->port) : t->fam_model->factory_baud;
+	dxlt_sleep_us(t->fam->settle_us);
+	if ((rc = dxlt_set_baud(t, now_baud)) != DXLT_EXIT_OK)
 		return rc;
-	r = dxlt_verify_ping(t, 1);
-	if (r != DXL_OK) {
-		fprintf(t->err, "dxl: reset sent to ID %u but ID 1 does not answer at 1000000 bps (%s)\n",
-		        id, dxl_strerror(r));
+	if ((r = dxlt_verify_ping(t, now_id)) != DXL_OK) {
+		fprintf(t->err, "dxl: reset sent to ID %u but ID %u does not answer at %ld bps (%s)\n", id, now_id, now_baud,
+		        dxl_strerror(r));
 		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
 	}
-	fprintf(t->out, "ID %u reset to factory defaults: now ID 1 at 1000000 bps\n", id);
+	fprintf(t->out, "ID %u reset to factory defaults: now ID %u at %ld bps\n", id, now_id, now_baud);
 	return DXLT_EXIT_OK;
 }
 
@@ -797,7 +814,7 @@ static const struct dxlt_command dxlt_commands[] = {
 	{ "read", { dxlt_cmd_read, dxlt2_cmd_read } },         { "write", { dxlt_cmd_write, dxlt2_cmd_write } },
 	{ "dump", { dxlt_cmd_dump, dxlt2_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
 	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt2_cmd_torque } },
-	{ "reset", { dxlt_cmd_reset, dxlt2_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt2_cmd_setup } },
+	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt2_cmd_setup } },
 	{ "reboot", { dxlt_cmd_reboot, dxlt_cmd_reboot } },
 };
 

@@ -387,42 +387,6 @@ int dxlt2_cmd_torque(struct dxlt *t)
 	return dxlt2_write_reg(t, &s, &reg, on ? 1 : 0);
 }
 
-/* ---- reset ------------------------------------------------------------------------ */
-
-int dxlt2_cmd_reset(struct dxlt *t)
-{
-	uint8_t id, e = 0;
-	int rc, r;
-
-	if ((rc = dxlt_need_args(t, 1, "--protocol 2 reset ID --yes [--keep id|id-baud]")) ||
-	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)))
-		return rc;
-	const char *what = t->a.keep == DXL2_RESET_KEEP_ID ? "every default but the ID (57600 bps)"
-	                   : t->a.keep == DXL2_RESET_KEEP_ID_BAUD ? "every default but the ID and the baud rate"
-	                   : "ID 1, 57600 bps and every default";
-	if (!t->a.yes) {
-		fprintf(t->err, "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
-		        "to do it (--keep id or id-baud keeps those)\n", what);
-		return DXLT_EXIT_USAGE;
-	}
-	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if ((r = bus_factory_reset(&t->bus, id, (uint8_t)t->a.keep, false, &e)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	uint8_t now_id = t->a.keep == DXL2_RESET_ALL ? 1 : id;
-	long now_baud = t->a.keep == DXL2_RESET_KEEP_ID_BAUD ? port_baud(t->port) : DXLT_DEFAULT_BAUD2;
-	dxlt_sleep_us(t->fam->settle_us);
-	if ((rc = dxlt_set_baud(t, now_baud)) != DXLT_EXIT_OK)
-		return rc;
-	if ((r = dxlt_verify_ping(t, now_id)) != DXL_OK) {
-		fprintf(t->err, "dxl: reset sent to ID %u but ID %u does not answer at %ld bps (%s)\n", id, now_id, now_baud,
-		        dxl_strerror(r));
-		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u reset to factory defaults: now ID %u at %ld bps\n", id, now_id, now_baud);
-	return DXLT_EXIT_OK;
-}
-
 /* ---- setup ------------------------------------------------------------------------------ */
 
 /* Write one byte if it differs, then read it back (writes not waited for:

@@ -29,6 +29,9 @@ struct dxlt_family {
 	 * the tool can name before sending */
 	bool eeprom_needs_torque_off;
 	const char *no_rate;           /* set-baud's refusal, "%s" the rate asked */
+	const char *reset_form;        /* reset's usage */
+	/* reset without --yes: what it would set ("%s": the keep form's words) */
+	const char *reset_refusal;
 	int (*baud_to_reg)(long bps, uint8_t *v);
 	long (*baud_from_reg)(uint8_t v);
 	/* one rate of `scan`: a line per servo found */
@@ -97,7 +100,6 @@ int dxlt2_cmd_read(struct dxlt *t);
 int dxlt2_cmd_write(struct dxlt *t);
 int dxlt2_cmd_dump(struct dxlt *t);
 int dxlt2_cmd_torque(struct dxlt *t);
-int dxlt2_cmd_reset(struct dxlt *t);
 int dxlt2_reboot(struct dxlt *t, uint8_t id);
 int dxlt2_cmd_setup(struct dxlt *t);
 
