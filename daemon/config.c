@@ -11,6 +11,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "dxl2_table.h"
 #include "dxl_table.h"
 #include "text.h"
 #include "textfile.h"
@@ -355,8 +356,9 @@ void cfg_defaults(struct cfg *c)
 	c->actuation = CFG_ACT_POSITION;
 	c->torque_drive = CFG_DRIVE_PWM;
 	/* The AX-12A's datasheet line at 12 V. */
-	c->stall_torque = DXL_AX12_STALL_TORQUE_NM;
-	c->no_load_speed = DXL_AX12_NO_LOAD_SPEED_RAD_S;
+	const struct dxl2_datasheet *ax = &dxl2_model_find(1, DXL_AX12_MODEL)->sheet;
+	c->stall_torque = ax->stall_torque_nm;
+	c->no_load_speed = dxl2_sheet_no_load_rad_s(ax);
 	/* Replies on a loaded 2-core machine (simulator, tests) come up to ~3 ms
 	 * late; a real adapter with return delay 0 needs far less. */
 	c->bus_margin_us = 3000;

@@ -69,19 +69,18 @@ static const struct {
 	{ DXL2_MODEL_XL430_W250, SM_XL430_POSITION },
 };
 
-static const struct sm_model sm_ax = {
+/* The AX-12A: its registers here, its datasheet its descriptor's
+ * (protocol/dxl2_table.c), filled in at the first sm_ax12(). */
+static struct sm_model sm_ax = {
 	.name = "AX-12A", .protocol = 1, .number = DXL_AX12_MODEL,
 	.torque_enable = DXL_AX_TORQUE_ENABLE, .torque_limit = DXL_AX_TORQUE_LIMIT,
 	.goal = DXL_AX_GOAL_POSITION, .goal_size = 2,
 	.present = DXL_AX_PRESENT_POSITION, .present_len = 6, .present_len_slow = 8,
 	.readback = { { SM_AX_READBACK_ADDR, SM_AX_READBACK_LEN, "RAM" } }, .nreadback = 1,
-	.pos_max = DXL_POS_MAX, .torque_full = 1023,
-	.ref_voltage = DXL_AX12_REF_VOLTAGE, .stall_torque_nm = DXL_AX12_STALL_TORQUE_NM,
-	.no_load_speed_rad_s = DXL_AX12_NO_LOAD_SPEED_RAD_S, .stall_current_a = 1.5,
-	.rated_min_v = DXL_AX12_RATED_MIN_V, .rated_max_v = DXL_AX12_RATED_MAX_V,
-	.reflected_inertia = SM_REFLECTED(4.6e-8, 254.0), .position_from = "AX-12A", .caps = 0,
-	.limits_name = "angle",
+	.pos_max = DXL_POS_MAX, .torque_full = 1023, .ref_voltage = DXL2_REF_VOLTAGE,
+	.position_from = "AX-12A", .caps = 0, .limits_name = "angle",
 };
+static bool sm_ax_made;
 
 /* The X models, made once from protocol/dxl2_table.c's descriptors: every
  * X servo is read and driven through the same registers; what differs is
@@ -126,15 +125,25 @@ static const struct sm_model *sm_x_model(size_t i)
 
 const struct sm_model *sm_ax12(void)
 {
+	if (!sm_ax_made) {
+		const struct dxl2_model *d = dxl2_model_find(1, DXL_AX12_MODEL);
+		sm_ax.stall_torque_nm = d->sheet.stall_torque_nm;
+		sm_ax.no_load_speed_rad_s = dxl2_sheet_no_load_rad_s(&d->sheet);
+		sm_ax.stall_current_a = d->sheet.stall_current_a;
+		sm_ax.rated_min_v = d->sheet.rated_min_v;
+		sm_ax.rated_max_v = d->sheet.rated_max_v;
+		sm_ax.reflected_inertia = SM_REFLECTED(d->sheet.rotor_inertia, d->sheet.gear_ratio);
+		sm_ax_made = true;
+	}
 	return &sm_ax;
 }
 
 const struct sm_model *sm_by_number(int protocol, uint16_t number)
 {
 	if (protocol == 1)
-		return number == sm_ax.number ? &sm_ax : NULL;
+		return number == sm_ax.number ? sm_ax12() : NULL;
 	for (size_t i = 0; i < dxl2_model_count(); i++)
-		if (dxl2_model_at(i)->number == number)
+		if (dxl2_model_at(i)->protocol == 2 && dxl2_model_at(i)->number == number)
 			return sm_x_model(i);
 	return NULL;
 }
@@ -330,7 +339,7 @@ uint16_t sm_drive_register(const struct sm_model *m, bool current)
 
 double sm_torque_scale(const struct sm_model *m)
 {
-	double link = OSC_TORQUE_JOINT_INERTIA - sm_ax.reflected_inertia;
+	double link = OSC_TORQUE_JOINT_INERTIA - sm_ax12()->reflected_inertia;
 	return (link + m->reflected_inertia) / OSC_TORQUE_JOINT_INERTIA;
 }
 

@@ -44,7 +44,7 @@ static const struct sm_model *setup_x_model(const uint8_t *t, uint8_t id, const 
 	if (m == NULL) {
 		char known[160];
 		snprintf(err, cap, "servo %u: model number %u is none undulated drives on Protocol 2.0 (%s): its "
-		         "registers may differ", id, number, dxl2_model_names(known, sizeof known));
+		         "registers may differ", id, number, dxl2_model_names(2, known, sizeof known));
 		return NULL;
 	}
 	if (cfg->actuation == CFG_ACT_TORQUE && cfg->torque_drive == CFG_DRIVE_CURRENT && !m->current_control) {

@@ -1,7 +1,8 @@
 /*
- * dxl2_table.c — the XL430-W250, XM430-W350 and XC430-W150 control tables and datasheets as data,
- * lookup, write checks, conversions and formatting. Rows are the ROBOTIS
- * e-manual's (ROBOTIS-GIT/emanual: docs/en/dxl/x/xl430-w250.md and
+ * dxl2_table.c — the AX-12A, XL430-W250, XM430-W350 and XC430-W150 control
+ * tables and datasheets as data, lookup, write checks, conversions and
+ * formatting. The AX-12A's rows are dxl_ax12_rows.h's; the X series' are the
+ * ROBOTIS e-manual's (ROBOTIS-GIT/emanual: docs/en/dxl/x/xl430-w250.md and
  * xm430-w350.md, the revisions with Range and Unit columns). Where the
  * printed range cannot be meant literally the row says what was taken.
  */
@@ -16,6 +17,7 @@
 
 #include "dxl.h"
 #include "dxl2.h"
+#include "dxl_ax12_rows.h"
 
 #define R   DXL_ACCESS_R
 #define RW  DXL_ACCESS_RW
@@ -135,6 +137,29 @@
 	{ "backup_ready",     147, 1, false, R,  RAM, RO_U8, false, 0, U(BOOL), NOLIM, \
 	    "a RAM backup is stored" }
 
+/* The AX-12A's rows: dxl_ax12_rows.h's, in the units of Protocol 1.0's
+ * servo; Moving Speed narrower in joint mode. */
+#define NODEF (-1)
+#define AXU_RAW          U(RAW)
+#define AXU_POSITION     U(AX_POSITION)
+#define AXU_SPEED        U(AX_SPEED)
+#define AXU_MOVING_SPEED U(AX_MOVING_SPEED)
+#define AXU_LOAD         U(AX_LOAD)
+#define AXU_TORQUE       U(AX_TORQUE)
+#define AXU_VOLTAGE      U(VOLTAGE)
+#define AXU_TEMPERATURE  U(TEMPERATURE)
+#define AXU_BAUD         U(AX_BAUD)
+#define AXU_RETURN_DELAY U(RETURN_DELAY)
+#define AXU_BOOL         U(BOOL)
+#define AXU_ERRMASK      U(AX_ERRMASK)
+#define AXU_STATUS_LEVEL U(STATUS_LEVEL)
+#define AX_ROW(name, addr, size, access, area, min, max, def, unit, desc) \
+	{ name, addr, size, false, access, area, min, max, (def) >= 0, (def) >= 0 ? (def) : 0, AXU_##unit, \
+	  (addr) == DXL_AX_MOVING_SPEED ? DXL2_LIMIT_JOINT_MODE : DXL2_LIMIT_NONE, 0, desc },
+static const struct dxl2_reg ax12a_regs[] = {
+	DXL_AX12_ROWS(AX_ROW)
+};
+
 static const struct dxl2_reg xl430_regs[] = {
 	/*                               threshold  temp  volts  velocity  vel I  pos D  pos P */
 	X_PWM_ROWS(DXL2_MODEL_XL430_W250, 10,       72,   140,   265,      1000,  4000,  640),
@@ -231,18 +256,34 @@ static const struct dxl2_reg xm430_regs[] = {
 };
 
 #define OPMODE_BIT(m) (1u << (m))
+#define ROWS(a) .regs = (a), .nregs = sizeof (a) / sizeof (a)[0]
+/* What every X servo here can do beyond its table. */
+#define X_CAPS (DXL2_CAP_HWERR_STATUS | DXL2_CAP_WATCHDOG | DXL2_CAP_REBOOT | DXL2_CAP_OPMODE | \
+                DXL2_CAP_FACTORY_RESET_KEEP)
 static const struct dxl2_model dxl2_models[] = {
+	/* e-manual (docs/en/dxl/ax/ax-12a.md): 1.5 N·m at 12 V (1.5 A), 59 rpm
+	 * at 12 V, 254:1, 9-12 V (11.1 recommended); rotor 4.6e-8 kg·m², the
+	 * simulator's estimate (sim-bridge/PHYSICS.md §5). Factory 1 Mbps; the
+	 * simulated one reports firmware 24. */
+	{ .protocol = 1, .number = DXL_AX12_MODEL, .name = "AX-12A", ROWS(ax12a_regs),
+	  .caps = DXL2_CAP_WHEEL_BY_ANGLE_LIMITS,
+	  .opmodes = 0, .current_sensing = false,
+	  .sheet = { .stall_torque_nm = 1.5, .stall_current_a = 1.5, .no_load_speed_rpm = 59.0, .gear_ratio = 254.0,
+	             .rotor_inertia = 4.6e-8, .rated_min_v = 9.0, .rated_rec_v = 11.1, .rated_max_v = 12.0 },
+	  .factory_baud = 1000000, .firmware = 24 },
 	/* 1.5 N·m at 12 V (1.4 A), 61 rpm at 12 V, 258.5:1, 6.5-12.0 V (11.1
 	 * recommended); a cored motor: its rotor taken as the AX-12A's */
-	{ DXL2_MODEL_XL430_W250, "XL430-W250", xl430_regs, sizeof xl430_regs / sizeof xl430_regs[0],
-	  OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
+	{ .protocol = 2, .number = DXL2_MODEL_XL430_W250, .name = "XL430-W250", ROWS(xl430_regs),
+	  .caps = X_CAPS,
+	  .opmodes = OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
 	  .sheet = { .stall_torque_nm = 1.5, .stall_current_a = 1.4, .no_load_speed_rpm = 61.0, .gear_ratio = 258.5,
 	             .rotor_inertia = 4.6e-8, .rated_min_v = 6.5, .rated_rec_v = 11.1, .rated_max_v = 12.0 },
 	  .factory_baud = 57600, .firmware = 46 },
 	/* 4.1 N·m at 12 V (2.3 A), 46 rpm at 12 V, 353.5:1, 10.0-14.8 V (12.0
 	 * recommended); a coreless (Maxon) motor: 0.5 g·cm² taken for its rotor */
-	{ DXL2_MODEL_XM430_W350, "XM430-W350", xm430_regs, sizeof xm430_regs / sizeof xm430_regs[0],
-	  OPMODE_BIT(0) | OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(5) | OPMODE_BIT(16),
+	{ .protocol = 2, .number = DXL2_MODEL_XM430_W350, .name = "XM430-W350", ROWS(xm430_regs),
+	  .caps = X_CAPS,
+	  .opmodes = OPMODE_BIT(0) | OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(5) | OPMODE_BIT(16),
 	  .current_sensing = true,
 	  .sheet = { .stall_torque_nm = 4.1, .stall_current_a = 2.3, .no_load_speed_rpm = 46.0, .gear_ratio = 353.5,
 	             .rotor_inertia = 5.0e-8, .rated_min_v = 10.0, .rated_rec_v = 12.0, .rated_max_v = 14.8 },
@@ -251,14 +292,18 @@ static const struct dxl2_model dxl2_models[] = {
 	 * 12 V, 159.59:1, 6.5-14.8 V (12.0 recommended); velocity, position,
 	 * extended position and PWM control, Present Load (no current sensing);
 	 * a coreless motor: its rotor taken as the XM430's */
-	{ DXL2_MODEL_XC430_W150, "XC430-W150", xc430_regs, sizeof xc430_regs / sizeof xc430_regs[0],
-	  OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
+	{ .protocol = 2, .number = DXL2_MODEL_XC430_W150, .name = "XC430-W150", ROWS(xc430_regs),
+	  .caps = X_CAPS,
+	  .opmodes = OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
 	  .sheet = { .stall_torque_nm = 1.6, .stall_current_a = 1.4, .no_load_speed_rpm = 106.0, .gear_ratio = 159.59,
 	             .rotor_inertia = 5.0e-8, .rated_min_v = 6.5, .rated_rec_v = 12.0, .rated_max_v = 14.8 },
 	  .factory_baud = 57600, .firmware = 46 },
 };
 #define NMODELS (sizeof dxl2_models / sizeof dxl2_models[0])
 
+/* Short names people type at a prompt; an alias names the first of its
+ * registers the model has ("speed": present_velocity on an X servo,
+ * present_speed on the AX-12A). */
 static const struct {
 	const char *alias, *name;
 } dxl2_aliases[] = {
@@ -266,6 +311,11 @@ static const struct {
 	{ "firmware", "firmware_version" },
 	{ "baud", "baud_rate" },
 	{ "return_delay", "return_delay_time" },
+	{ "cw_limit", "cw_angle_limit" },
+	{ "ccw_limit", "ccw_angle_limit" },
+	{ "max_temperature", "temperature_limit" },
+	{ "min_voltage", "min_voltage_limit" },
+	{ "max_voltage", "max_voltage_limit" },
 	{ "mode", "operating_mode" },
 	{ "torque", "torque_enable" },
 	{ "return_level", "status_return_level" },
@@ -275,9 +325,11 @@ static const struct {
 	{ "position", "present_position" },
 	{ "velocity", "present_velocity" },
 	{ "speed", "present_velocity" },
+	{ "speed", "present_speed" },
 	{ "current", "present_current" },
 	{ "load", "present_load" },
 	{ "voltage", "present_input_voltage" },
+	{ "voltage", "present_voltage" },
 	{ "temperature", "present_temperature" },
 };
 
@@ -349,6 +401,22 @@ const struct dxl2_model *dxl2_model_by_number(uint16_t number)
 	return NULL;
 }
 
+const struct dxl2_model *dxl2_model_find(int protocol, uint16_t number)
+{
+	const struct dxl2_model *m = dxl2_model_by_number(number);
+	return m != NULL && m->protocol == protocol ? m : NULL;
+}
+
+bool dxl2_model_can(const struct dxl2_model *m, enum dxl2_cap cap)
+{
+	return m != NULL && (m->caps & (uint32_t)cap) == (uint32_t)cap;
+}
+
+double dxl2_sheet_no_load_rad_s(const struct dxl2_datasheet *s)
+{
+	return s->no_load_speed_rpm * 2.0 * DXL2_PI / 60.0;
+}
+
 size_t dxl2_model_count(void)
 {
 	return NMODELS;
@@ -359,14 +427,16 @@ const struct dxl2_model *dxl2_model_at(size_t i)
 	return i < NMODELS ? &dxl2_models[i] : NULL;
 }
 
-char *dxl2_model_names(char *buf, size_t cap)
+char *dxl2_model_names(int protocol, char *buf, size_t cap)
 {
 	size_t off = 0;
 	if (cap == 0)
 		return buf;
 	buf[0] = '\0';
 	for (size_t i = 0; i < NMODELS; i++) {
-		int w = snprintf(buf + off, cap - off, "%s%s", i ? ", " : "", dxl2_models[i].name);
+		if (protocol != 0 && dxl2_models[i].protocol != protocol)
+			continue;
+		int w = snprintf(buf + off, cap - off, "%s%s", off ? ", " : "", dxl2_models[i].name);
 		if (w < 0 || (size_t)w >= cap - off)
 			break;
 		off += (size_t)w;
@@ -399,9 +469,13 @@ static const struct dxl2_reg *dxl2_reg_by_name(const struct dxl2_model *m, const
 	for (size_t i = 0; i < m->nregs; i++)
 		if (name_eq(m->regs[i].name, name))
 			return &m->regs[i];
-	for (size_t i = 0; i < sizeof dxl2_aliases / sizeof dxl2_aliases[0]; i++)
-		if (name_eq(dxl2_aliases[i].alias, name))
-			return dxl2_reg_by_name(m, dxl2_aliases[i].name);
+	for (size_t i = 0; i < sizeof dxl2_aliases / sizeof dxl2_aliases[0]; i++) {
+		if (!name_eq(dxl2_aliases[i].alias, name))
+			continue;
+		for (size_t k = 0; k < m->nregs; k++)
+			if (name_eq(m->regs[k].name, dxl2_aliases[i].name))
+				return &m->regs[k];
+	}
 	return NULL;
 }
 
@@ -492,6 +566,11 @@ int dxl2_reg_range(const struct dxl2_model *m, const struct dxl2_reg *r, const u
 			*hi = b;
 		}
 		break;
+	case DXL2_LIMIT_JOINT_MODE:
+		if (image_value(m, DXL_AX_CW_ANGLE_LIMIT, table, len, &a) &&
+		    image_value(m, DXL_AX_CCW_ANGLE_LIMIT, table, len, &b) && !dxl_is_wheel_mode((uint16_t)a, (uint16_t)b))
+			*hi = DXL_POS_MAX;
+		break;
 	case DXL2_LIMIT_NONE:
 	default:
 		break;
@@ -508,6 +587,51 @@ int dxl2_reg_check_write_live(const struct dxl2_model *m, const struct dxl2_reg 
 	if (dxl2_reg_range(m, r, table, len, &lo, &hi) != DXL_OK)
 		return DXL_E_ARG;
 	return (value < lo || value > hi) ? DXL_E_ARG : DXL_OK;
+}
+
+/* Bit 10 of the AX-12A's speed and load: the direction, none at 0. */
+static const char *ax_direction(int32_t raw)
+{
+	if ((raw & 0x3FF) == 0)
+		return "";
+	return (raw & DXL_DIRECTION_BIT) ? " CW" : " CCW";
+}
+
+/* The AX-12A's units; false for another unit. */
+static bool ax_format(enum dxl2_unit unit, int32_t raw, char *buf, size_t cap)
+{
+	char bits[96];
+	unsigned u = (unsigned)raw & 0xFFFFu, mag = u & 0x3FFu;
+	switch (unit) {
+	case DXL2_UNIT_AX_POSITION:
+		snprintf(buf, cap, "%u (%.1f deg)", u, u * DXL_POS_RANGE_DEG / DXL_POS_MAX);
+		return true;
+	case DXL2_UNIT_AX_SPEED:
+		snprintf(buf, cap, "%u (%.1f rpm%s)", u, mag * DXL_SPEED_RPM_PER_UNIT, ax_direction(raw));
+		return true;
+	case DXL2_UNIT_AX_MOVING_SPEED:
+		if (u == 0)
+			snprintf(buf, cap, "0 (maximum)");
+		else if (u > DXL_POS_MAX) /* wheel mode: direction bit */
+			snprintf(buf, cap, "%u (%.1f rpm%s)", u, mag * DXL_SPEED_RPM_PER_UNIT, ax_direction(raw));
+		else
+			snprintf(buf, cap, "%u (%.1f rpm)", u, u * DXL_SPEED_RPM_PER_UNIT);
+		return true;
+	case DXL2_UNIT_AX_LOAD:
+		snprintf(buf, cap, "%u (%.1f %%%s)", u, mag * 0.1, ax_direction(raw));
+		return true;
+	case DXL2_UNIT_AX_TORQUE:
+		snprintf(buf, cap, "%u (%.1f %%)", u, u * 0.1);
+		return true;
+	case DXL2_UNIT_AX_BAUD:
+		snprintf(buf, cap, "%u (%ld bps)", u, dxl_baud_from_reg((uint8_t)u));
+		return true;
+	case DXL2_UNIT_AX_ERRMASK:
+		snprintf(buf, cap, "%u (%s)", u, dxl_errbits_format((uint8_t)u, bits, sizeof bits));
+		return true;
+	default:
+		return false;
+	}
 }
 
 char *dxl2_reg_format(const struct dxl2_reg *r, int32_t raw, char *buf, size_t cap)
@@ -577,7 +701,8 @@ char *dxl2_reg_format(const struct dxl2_reg *r, int32_t raw, char *buf, size_t c
 		break;
 	case DXL2_UNIT_RAW:
 	default:
-		snprintf(buf, cap, "%ld", v);
+		if (!ax_format(r->unit, raw, buf, cap))
+			snprintf(buf, cap, "%ld", v);
 		break;
 	}
 	return buf;

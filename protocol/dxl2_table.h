@@ -1,9 +1,13 @@
 /*
- * dxl2_table.h — control tables of the X-series servos that speak Protocol
- * 2.0 (XL430-W250, XM430-W350) as data, lookup, write checks and unit
- * conversions. Pure code, like dxl_table.h for the AX-12: tools address
- * registers by name, the simulator can build its servo memory from the same
- * rows, the daemon converts raw values to SI.
+ * dxl2_table.h — every servo model undulate knows, as data: the AX-12A
+ * (Protocol 1.0) and the X series (XL430-W250, XM430-W350, XC430-W150;
+ * Protocol 2.0), one descriptor each in one list — protocol, model number,
+ * control-table rows, datasheet, capabilities — with lookup, write checks,
+ * formatting and the X series' unit conversions (the AX-12's are
+ * dxl_table.h's). Pure code: tools address registers by name, the simulator
+ * builds its servo memory from the same rows, the daemon converts raw values
+ * to SI. (The dxl2_ prefix is the module's, older than the AX-12A's place in
+ * it; the types are protocol-neutral.)
  *
  * Values are the ROBOTIS e-manual's control-table pages; where one printed
  * revision disagrees with another, the row's comment in dxl2_table.c says
@@ -130,6 +134,14 @@ enum dxl2_unit {
 	DXL2_UNIT_HWERR,        /* hardware error bits */
 	DXL2_UNIT_STATUS_LEVEL, /* 0 ping, 1 + read, 2 all */
 	DXL2_UNIT_OPMODE,
+	/* The AX-12A's (Protocol 1.0) own units. */
+	DXL2_UNIT_AX_POSITION,  /* 300/1023 deg, 512 = centre */
+	DXL2_UNIT_AX_SPEED,     /* present speed: 0.111 rpm, bit 10 = CW */
+	DXL2_UNIT_AX_MOVING_SPEED, /* goal speed: 0.111 rpm, 0 = maximum; wheel mode bit 10 = CW */
+	DXL2_UNIT_AX_LOAD,      /* 0.1 % of max torque, bit 10 = CW */
+	DXL2_UNIT_AX_TORQUE,    /* 0.1 % of max torque (limits) */
+	DXL2_UNIT_AX_BAUD,      /* bps = 2e6 / (v + 1) */
+	DXL2_UNIT_AX_ERRMASK,   /* Protocol 1.0 error-bit mask: named bits */
 };
 
 /* How a register's range depends on another register's value. */
@@ -137,6 +149,10 @@ enum dxl2_limit {
 	DXL2_LIMIT_NONE,
 	DXL2_LIMIT_SYMMETRIC,  /* -value(lim_addr) .. +value(lim_addr) */
 	DXL2_LIMIT_POSITION,   /* min .. max position limit (52, 48) in position mode */
+	/* The AX-12A's Moving Speed (e-manual): 0..1023 in joint mode; the
+	 * static range, bit 10 the direction, in wheel mode (both angle limits
+	 * 0, the model's DXL2_CAP_WHEEL_BY_ANGLE_LIMITS) */
+	DXL2_LIMIT_JOINT_MODE,
 };
 
 struct dxl2_reg {
@@ -170,16 +186,31 @@ struct dxl2_datasheet {
 	double rated_min_v, rated_rec_v, rated_max_v;   /* the supply it is rated for, and the recommended one */
 };
 
-/* One Protocol 2.0 servo model: everything a program needs to know of it.
- * A new model is one of these and its control table's rows (dxl2_table.c):
- * what differs between models in the code's behaviour is asked of these
- * fields (current_sensing, opmodes, the registers the table has), never of
- * the model number. */
+/* What a model can do beyond reading and writing its table: asked of the
+ * descriptor (dxl2_model_can), never of the protocol or the model number. */
+enum dxl2_cap {
+	DXL2_CAP_HWERR_STATUS = 1u << 0,  /* Hardware Error Status (70), the status packet's alert bit */
+	DXL2_CAP_WATCHDOG     = 1u << 1,  /* Bus Watchdog (98) */
+	DXL2_CAP_REBOOT       = 1u << 2,  /* the REBOOT instruction */
+	DXL2_CAP_OPMODE       = 1u << 3,  /* Operating Mode (11): the opmodes field */
+	/* no operating mode: both angle limits 0 make it a wheel (endless
+	 * rotation, Moving Speed the output), else a joint */
+	DXL2_CAP_WHEEL_BY_ANGLE_LIMITS = 1u << 4,
+	DXL2_CAP_FACTORY_RESET_KEEP = 1u << 5,  /* FACTORY_RESET's keep-ID / keep-ID-and-baud forms */
+};
+
+/* One servo model: everything a program needs to know of it. A new model
+ * is one of these and its control table's rows (dxl2_table.c): what differs
+ * between models in the code's behaviour is asked of these fields
+ * (protocol, caps, current_sensing, opmodes, the registers the table has),
+ * never of the model number. */
 struct dxl2_model {
+	uint8_t protocol;      /* 1: Protocol 1.0 (AX-12A), 2: Protocol 2.0 (X series) */
 	uint16_t number;
 	const char *name;      /* "XL430-W250" */
 	const struct dxl2_reg *regs;
 	size_t nregs;
+	uint32_t caps;         /* enum dxl2_cap bits */
 	uint32_t opmodes;      /* bit n set: Operating Mode n exists */
 	/* Present Current (126), Current Limit (38), Goal Current (102) and
 	 * current control (mode 0): the XM series; without it 126 is Present
@@ -190,15 +221,24 @@ struct dxl2_model {
 	uint8_t firmware;      /* the firmware a simulated one reports */
 };
 
-/* The models known, in a fixed order (0 .. dxl2_model_count() - 1). */
+/* The models known, in a fixed order (0 .. dxl2_model_count() - 1): the
+ * AX-12A first, then the X series. */
 size_t dxl2_model_count(void);
 const struct dxl2_model *dxl2_model_at(size_t i);
-/* Their names for messages, "XL430-W250, XM430-W350, ..." into buf. */
-char *dxl2_model_names(char *buf, size_t cap);
+/* The names of one protocol's models (0: all) for messages,
+ * "XL430-W250, XM430-W350, ..." into buf. */
+char *dxl2_model_names(int protocol, char *buf, size_t cap);
+bool dxl2_model_can(const struct dxl2_model *m, enum dxl2_cap cap);
 
-/* NULL when unknown. Names compare case-insensitively ("xm430-w350"). */
+/* NULL when unknown. Model numbers are unique across ROBOTIS's servos
+ * (register 0 on either protocol); names compare case-insensitively
+ * ("xm430-w350"). dxl2_model_find: the model of that number speaking that
+ * protocol, as a reply on that protocol names it. */
 const struct dxl2_model *dxl2_model_by_number(uint16_t number);
+const struct dxl2_model *dxl2_model_find(int protocol, uint16_t number);
 const struct dxl2_model *dxl2_model_by_name(const char *name);
+/* The no-load speed of a datasheet in rad/s. */
+double dxl2_sheet_no_load_rad_s(const struct dxl2_datasheet *s);
 /* A register by name ('-' = '_', case-insensitive), a short alias
  * ("position", "velocity", "goal", "torque", ...) or an address ("132",
  * "0x84"). NULL if unknown for this model. */

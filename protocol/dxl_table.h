@@ -1,7 +1,9 @@
 /*
- * dxl_table.h — the AX-12(A) control table as data, and unit conversions.
- * Pure code: tools address registers by name, the simulator builds its servo
- * memory from the same description, the daemon converts raw values to SI.
+ * dxl_table.h — the AX-12(A)'s addresses and unit conversions, and a view of
+ * its control table as struct dxl_reg rows (8-bit addresses). The AX-12A's
+ * model descriptor — rows, datasheet, capabilities — is in dxl2_table.h's
+ * model list beside the X series'; the rows are written once, in
+ * dxl_ax12_rows.h, and this view's lookup and checks are the descriptor's.
  */
 #ifndef UNDULATE_DXL_TABLE_H
 #define UNDULATE_DXL_TABLE_H
@@ -49,16 +51,8 @@ enum dxl_ax12_addr {
 #define DXL_AX_TABLE_SIZE   50   /* bytes 0..49 */
 #define DXL_AX_EEPROM_END   24   /* addresses below are EEPROM */
 #define DXL_AX12_MODEL      12   /* model number of AX-12/AX-12+/AX-12A */
-/* The AX-12A's datasheet line at its reference supply (torque and speed scale
- * about linearly with the supply voltage): the daemon's torque actuation
- * defaults and the simulator's motor model start from the same numbers. */
-#define DXL_AX12_REF_VOLTAGE        12.0   /* V */
-#define DXL_AX12_STALL_TORQUE_NM    1.5    /* N·m at 12 V, 1.5 A */
-#define DXL_AX12_NO_LOAD_SPEED_RPM  59.0   /* at 12 V */
-#define DXL_AX12_NO_LOAD_SPEED_RAD_S (DXL_AX12_NO_LOAD_SPEED_RPM * 2.0 * 3.14159265358979323846 / 60.0)
-/* The supply it is rated for (e-manual: 9 ~ 12 V, 11.1 V recommended). */
-#define DXL_AX12_RATED_MIN_V        9.0
-#define DXL_AX12_RATED_MAX_V        12.0
+/* Its datasheet (stall torque, speed, rated supply) is its descriptor's:
+ * dxl2_model_find(1, DXL_AX12_MODEL)->sheet (dxl2_table.c). */
 
 enum dxl_access { DXL_ACCESS_R, DXL_ACCESS_RW };
 enum dxl_area { DXL_AREA_EEPROM, DXL_AREA_RAM };
@@ -101,7 +95,7 @@ const struct dxl_reg *dxl_reg_lookup(const char *name_or_addr);
 /* The register that starts at addr, NULL if none (e.g. the high byte of a word). */
 const struct dxl_reg *dxl_reg_at(uint8_t addr);
 /* DXL_OK if value is writable into reg in some mode, else DXL_E_ARG
- * (read-only or out of range). */
+ * (read-only or out of range): the descriptor's dxl2_reg_check_write. */
 int dxl_reg_check_write(const struct dxl_reg *reg, long value);
 /* The same for a servo known to be in wheel mode (wheel) or joint mode: a few
  * registers have a narrower range in joint mode (moving speed: 0-1023 there,

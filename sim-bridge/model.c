@@ -1,9 +1,8 @@
 /*
  * model.c — the simulated servo models and their datasheet facts (model.h).
- * Numbers: the ROBOTIS e-manual's specification tables, at 12 V: the X
- * series' are protocol/dxl2_table.c's descriptors (the daemon and dxl read
- * the same ones), the AX-12A's dxl_table.h; PHYSICS.md §5 says how each is
- * used.
+ * Numbers: the ROBOTIS e-manual's specification tables, at 12 V, as
+ * protocol/dxl2_table.c's model descriptors have them (the daemon and dxl
+ * read the same ones); PHYSICS.md §5 says how each is used.
  */
 #include "model.h"
 
@@ -15,46 +14,56 @@
 
 #define RPM_TO_RAD_S (2.0 * 3.14159265358979323846 / 60.0)
 
-static const struct sim_model_info ax12a = {
-	.name = "ax12a", .label = "AX-12A", .protocol = 1, .default_baud = 1000000, .firmware = 24,
-	.stall_torque_nm = DXL_AX12_STALL_TORQUE_NM, .no_load_speed_rpm = DXL_AX12_NO_LOAD_SPEED_RPM,
-	.stall_current_a = 1.5, .gear_ratio = 254.0, .rotor_inertia = 4.6e-8,
-	.model_number = DXL_AX12_MODEL,
-};
-
-/* The X models: model m is protocol/dxl2_table.c's descriptor m - 1, its
+/* Model m is protocol/dxl2_table.c's descriptor m (the AX-12A first), its
  * facts taken from there (a new model there is one here). */
-#define SIM_MAX_X 32
-static struct sim_model_info xinfo[SIM_MAX_X];
-static char xname[SIM_MAX_X][24];
-static bool xmade[SIM_MAX_X];
+#define SIM_MAX_MODELS 32
+static struct sim_model_info info[SIM_MAX_MODELS];
+static char lname[SIM_MAX_MODELS][24];
+static bool made[SIM_MAX_MODELS];
 
 int sim_model_count(void)
 {
 	size_t n = dxl2_model_count();
-	return 1 + (int)(n < SIM_MAX_X ? n : SIM_MAX_X);
+	return (int)(n < SIM_MAX_MODELS ? n : SIM_MAX_MODELS);
+}
+
+/* The option's name: the label in lower case, or the name scenarios have
+ * used since before the model list held the X series. */
+static const struct {
+	uint16_t number;
+	const char *name;
+} model_old_names[] = {
+	{ DXL_AX12_MODEL, "ax12a" },
+};
+
+static void model_option_name(const struct dxl2_model *d, char *out, size_t cap)
+{
+	size_t k = 0;
+	for (size_t i = 0; i < sizeof model_old_names / sizeof model_old_names[0]; i++)
+		if (model_old_names[i].number == d->number) {
+			snprintf(out, cap, "%s", model_old_names[i].name);
+			return;
+		}
+	for (const char *c = d->name; *c != '\0' && k + 1 < cap; c++)
+		out[k++] = (char)tolower((unsigned char)*c);
+	out[k] = '\0';
 }
 
 const struct sim_model_info *sim_model_info(enum sim_model m)
 {
-	if ((int)m <= 0 || (int)m >= sim_model_count())
-		return &ax12a;
-	size_t i = (size_t)m - 1;
-	if (!xmade[i]) {
+	size_t i = ((int)m <= 0 || (int)m >= sim_model_count()) ? 0 : (size_t)m;
+	if (!made[i]) {
 		const struct dxl2_model *d = dxl2_model_at(i);
-		size_t k = 0;
-		for (; d->name[k] != '\0' && k + 1 < sizeof xname[i]; k++)
-			xname[i][k] = (char)tolower((unsigned char)d->name[k]);
-		xname[i][k] = '\0';
-		xinfo[i] = (struct sim_model_info){
-			.name = xname[i], .label = d->name, .protocol = 2, .default_baud = d->factory_baud,
+		model_option_name(d, lname[i], sizeof lname[i]);
+		info[i] = (struct sim_model_info){
+			.name = lname[i], .label = d->name, .protocol = d->protocol, .default_baud = d->factory_baud,
 			.firmware = d->firmware, .stall_torque_nm = d->sheet.stall_torque_nm,
 			.no_load_speed_rpm = d->sheet.no_load_speed_rpm, .stall_current_a = d->sheet.stall_current_a,
 			.gear_ratio = d->sheet.gear_ratio, .rotor_inertia = d->sheet.rotor_inertia, .model_number = d->number,
 		};
-		xmade[i] = true;
+		made[i] = true;
 	}
-	return &xinfo[i];
+	return &info[i];
 }
 
 /* Case-insensitive, '-' and '_' ignored: "AX-12A", "ax12a", "XL430_W250". */
@@ -88,7 +97,7 @@ int sim_model_parse(const char *name, enum sim_model *m)
 
 const char *sim_model_names(void)
 {
-	static char names[SIM_MAX_X * 26];
+	static char names[SIM_MAX_MODELS * 26];
 	size_t off = 0;
 	names[0] = '\0';
 	for (int i = 0; i < sim_model_count(); i++) {
@@ -104,7 +113,7 @@ const char *sim_model_names(void)
 const struct dxl2_model *sim_model_table(enum sim_model m)
 {
 	const struct sim_model_info *i = sim_model_info(m);
-	return i->protocol == 2 ? dxl2_model_by_number(i->model_number) : NULL;
+	return i->protocol == 2 ? dxl2_model_find(2, i->model_number) : NULL;
 }
 
 void sim_model_motor_params(enum sim_model m, struct sim_motor_params *p)

@@ -3,8 +3,8 @@
  * that the simulator needs beyond its control table: the protocol it speaks,
  * its default baud rate, and its motor's datasheet line (stall torque and
  * no-load speed at 12 V, stall current, gear ratio). The control tables
- * themselves are protocol/dxl_table.c (AX-12A) and protocol/dxl2_table.c
- * (X series); the sources of every number are in sim-bridge/PHYSICS.md.
+ * and datasheets themselves are protocol/dxl2_table.c's model descriptors
+ * (AX-12A and X series, one list); the sources of every number are in sim-bridge/PHYSICS.md.
  */
 #ifndef UNDULATE_SIM_MODEL_H
 #define UNDULATE_SIM_MODEL_H
@@ -16,7 +16,7 @@
 #include "dxl2_table.h"
 #include "motor.h"
 
-/* 0 is the AX-12A, 1.. the X models of protocol/dxl2_table.c in its order
+/* Model m is protocol/dxl2_table.c's descriptor m: 0 the AX-12A, 1.. the X models
  * (sim_model_count() in all); the two named here are the first two there. */
 enum sim_model {
 	SIM_MODEL_AX12A = 0,

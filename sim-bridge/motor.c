@@ -19,10 +19,11 @@
 
 #include <math.h>
 
+#include "dxl2_table.h"
 #include "dxl_table.h"
 
 /* The datasheet's motor line is given at this supply voltage. */
-#define MOTOR_REF_VOLTAGE    DXL_AX12_REF_VOLTAGE
+#define MOTOR_REF_VOLTAGE    DXL2_REF_VOLTAGE
 /* Full scale of torque limit, punch and wheel-mode speed registers. */
 #define MOTOR_RAW_FULL       1023.0
 #define MOTOR_SPEED_MASK     0x3FFu
@@ -51,9 +52,10 @@ void sim_motor_default_params(struct sim_motor_params *p)
 	 * these are only what the link adds (bearing, drag). */
 	p->viscous = 0.002;
 	p->coulomb = 0.005;
-	p->stall_torque_12v = DXL_AX12_STALL_TORQUE_NM;
-	p->no_load_speed_12v = DXL_AX12_NO_LOAD_SPEED_RAD_S;
-	p->supply_voltage = DXL_AX12_REF_VOLTAGE;
+	const struct dxl2_datasheet *ax = &dxl2_model_find(1, DXL_AX12_MODEL)->sheet;
+	p->stall_torque_12v = ax->stall_torque_nm;
+	p->no_load_speed_12v = dxl2_sheet_no_load_rad_s(ax);
+	p->supply_voltage = DXL2_REF_VOLTAGE;
 	p->ambient_c = 25.0;
 	p->thermal_tau_s = 600.0;
 	p->heat_gain = 0.6;

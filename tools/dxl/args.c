@@ -263,7 +263,7 @@ void dxlt_help(FILE *f)
 {
 	char x[160];
 	fprintf(f, "dxl — talk to Dynamixel servos on a serial bus: AX-12 (Protocol 1.0), %s\n"
-	        "(Protocol 2.0, --protocol 2)\n\n", dxl2_model_names(x, sizeof x));
+	        "(Protocol 2.0, --protocol 2)\n\n", dxl2_model_names(2, x, sizeof x));
 	dxlt_usage(f);
 	fputs("\ncommands:\n"
 	      "  ports                      list serial ports with USB IDs, marking Dynamixel adapters\n"

@@ -6,130 +6,16 @@
  * next, and the exit code tells the kind (dxlt.h). Nothing is written to a
  * servo before its arguments were checked against the control table.
  */
-#include <errno.h>
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "dxl2_table.h"
 #include "dxl_table.h"
 #include "dxlt_priv.h"
 #include "num.h"
 
-/* ---- helpers ------------------------------------------------------------------ */
-
-void dxlt_sleep_us(long us)
-{
-	struct timespec ts = { us / 1000000L, (us % 1000000L) * 1000L };
-
-	while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {
-	}
-}
-
-const char *dxlt_model_name(uint16_t model)
-{
-	switch (model) {
-	case 12: return "AX-12";
-	case 18: return "AX-18";
-	case 300: return "AX-12W";
-	default: return "not an AX-12";
-	}
-}
-
-void dxlt_apply_timing(struct dxlt *t)
-{
-	struct bus_timing timing = { .baud = port_baud(t->port) };
-
-	if (t->a.timeout_ms > 0) {
-		timing.margin_us = (uint32_t)(t->a.timeout_ms * 1000);
-	} else {
-		/* The servo's return delay is unknown until read: allow the largest
-		 * (254 × 2 µs). */
-		timing.return_delay_us = 254u * 2u;
-		timing.margin_us = DXLT_DEFAULT_SLACK_MS * 1000u;
-		if (t->a.latency_us >= 0)
-			timing.adapter_latency_us = (uint32_t)t->a.latency_us;
-		else if (t->latency.known)
-			timing.adapter_latency_us = (uint32_t)t->latency.timer_ms * 1000u;
-	}
-	bus_set_timing(&t->bus, &timing);
-}
-
-int dxlt_set_baud(struct dxlt *t, long baud)
-{
-	if (port_set_baud(t->port, baud) != DXL_OK) {
-		fprintf(t->err, "dxl: cannot set %s to %ld bps\n", port_path(t->port), baud);
-		return DXLT_EXIT_PORT;
-	}
-	dxlt_apply_timing(t);
-	return DXLT_EXIT_OK;
-}
-
-int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
-{
-	switch (status) {
-	case DXL_E_TIMEOUT:
-		fprintf(t->err,
-		        "dxl: no reply from ID %u at %ld bps; wrong baud or ID? try: dxl --port %s "
-		        "scan --bauds all\n", id, port_baud(t->port), port_path(t->port));
-		return DXLT_EXIT_BUS;
-	case DXL_E_DISCONNECTED:
-		fprintf(t->err, "dxl: %s went away (adapter unplugged or simulator stopped)\n",
-		        port_path(t->port));
-		return DXLT_EXIT_PORT;
-	case DXL_E_IO:
-		fprintf(t->err, "dxl: I/O error on %s: %s\n", port_path(t->port), strerror(errno));
-		return DXLT_EXIT_PORT;
-	case DXL_E_ECHO:
-		fprintf(t->err, "dxl: bytes read back differ from those sent (is --echo right for "
-		        "this wiring?)\n");
-		return DXLT_EXIT_BUS;
-	case DXL_E_WRONG_LENGTH:
-		fprintf(t->err, "dxl: bad reply from ID %u: %s%s\n", id, dxl_strerror(status),
-		        t->a.echo ? "" : " (single-wire wiring? try --echo)");
-		return DXLT_EXIT_BUS;
-	default:
-		fprintf(t->err, "dxl: bad reply from ID %u: %s\n", id, dxl_strerror(status));
-		return DXLT_EXIT_BUS;
-	}
-}
-
 /* ---- transactions: every reply's error bits are remembered ------------------- */
-
-int dxlt_ping(struct dxlt *t, uint8_t id)
-{
-	uint8_t e = 0;
-	int r = bus_ping(&t->bus, id, &e);
-
-	/* on a 2.0 bus the byte is the ERR field: kept apart, named apart */
-	if (r == DXL_OK && bus_get_protocol(&t->bus) == BUS_PROTOCOL_2)
-		t->errseen2[id] |= e;
-	else if (r == DXL_OK)
-		t->errseen[id] |= e;
-	return r;
-}
-
-int dxlt_read(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out)
-{
-	uint8_t e = 0;
-	int r = bus_read(&t->bus, id, addr, len, out, &e);
-
-	if (r == DXL_OK)
-		t->errseen[id] |= e;
-	return r;
-}
-
-static int dxlt_write(struct dxlt *t, uint8_t id, uint8_t addr, const uint8_t *data, size_t n,
-                      bool expect_reply)
-{
-	uint8_t e = 0;
-	int r = bus_write(&t->bus, id, addr, data, n, expect_reply, &e);
-
-	if (r == DXL_OK)
-		t->errseen[id] |= e;
-	return r;
-}
 
 /* One line per servo whose replies carried error bits (1.0) or a non-zero
  * ERR field (2.0); exit 5 unless the command already failed in a way that
@@ -160,22 +46,6 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 	if (t->hint[0] != '\0')
 		fprintf(t->err, "dxl: %s\n", t->hint);
 	return rc == DXLT_EXIT_OK ? DXLT_EXIT_SERVO : rc;
-}
-
-int dxlt_need_args(struct dxlt *t, int n, const char *form)
-{
-	if (t->a.npos == n)
-		return DXLT_EXIT_OK;
-	fprintf(t->err, "dxl: usage: dxl --port PATH %s\n", form);
-	return DXLT_EXIT_USAGE;
-}
-
-int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id)
-{
-	if (dxlt_parse_id(s, allow_broadcast, id) == 0)
-		return DXLT_EXIT_OK;
-	fprintf(t->err, "dxl: bad ID '%s' (0-253%s)\n", s, allow_broadcast ? ", 254 broadcast" : "");
-	return DXLT_EXIT_USAGE;
 }
 
 static int dxlt_arg_reg(struct dxlt *t, const char *s, const struct dxl_reg **reg)
@@ -282,23 +152,59 @@ static int dxlt_scan1_at(struct dxlt *t, long baud, unsigned *found)
 /* The rates one protocol is scanned at: `--bauds all` gives each its own
  * list; a list given keeps the rates that protocol's servos can run at
  * (within 3 %); without one, --baud. */
-static size_t dxlt_scan_bauds(const struct dxlt *t, int protocol, long *out, size_t cap)
+static size_t dxlt_scan_bauds(const struct dxlt *t, const struct dxlt_family *f, long *out, size_t cap)
 {
 	size_t n = 0;
 	uint8_t reg;
 
 	if (t->a.bauds_all)
-		return dxlt_bauds_for(protocol, out, cap);
+		return dxlt_bauds_for(f->protocol, out, cap);
 	if (t->a.nbauds == 0) {
 		out[0] = t->a.baud;
 		return 1;
 	}
 	for (size_t i = 0; i < t->a.nbauds && n < cap; i++) {
 		long b = t->a.bauds[i];
-		if (protocol == 2 ? dxl2_baud_to_reg(b, &reg) == DXL_OK : dxl_baud_to_reg(b, &reg) == DXL_OK)
+		if (f->baud_to_reg(b, &reg) == DXL_OK)
 			out[n++] = b;
 	}
 	return n;
+}
+
+/* The two families `dxl` speaks to, in scan order. */
+static const struct dxlt_family dxlt_families[] = {
+	{ .protocol = 1, .bus = BUS_PROTOCOL_1, .label = "Protocol 1.0", .opt = "", .max_id = DXL_MAX_ID,
+	  .settle_us = DXLT_EEPROM_SETTLE_US, .eeprom_needs_torque_off = false,
+	  .no_rate = "dxl: an AX-12 cannot run at '%s' bps (rates are 2000000/(n+1), e.g. 1000000, 500000, 117647, "
+	             "57143)\n",
+	  .reset_form = "reset ID --yes",
+	  .reset_refusal = "dxl: a factory reset sets ID 1, 1000000 bps and every default (including angle limits); "
+	                   "add --yes to do it\n",
+	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
+	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
+	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
+	  .settle_us = 20000, .eeprom_needs_torque_off = true,
+	  .no_rate = "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, 3000000, "
+	             "4000000, 4500000)\n",
+	  .reset_form = "reset ID --yes [--keep id|id-baud]",
+	  .reset_refusal = "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
+	                   "to do it (--keep id or id-baud keeps those)\n",
+	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at },
+};
+#define DXLT_NFAMILIES (sizeof dxlt_families / sizeof dxlt_families[0])
+
+/* --protocol's family (0, not given: Protocol 1.0's), its first model
+ * descriptor found once. */
+static const struct dxlt_family *dxlt_family_for(int protocol, const struct dxl2_model **model)
+{
+	const struct dxlt_family *f = &dxlt_families[0];
+	for (size_t i = 0; i < DXLT_NFAMILIES; i++)
+		if (dxlt_families[i].protocol == protocol)
+			f = &dxlt_families[i];
+	for (size_t i = dxl2_model_count(); i-- > 0;)
+		if (dxl2_model_at(i)->protocol == f->protocol)
+			*model = dxl2_model_at(i);
+	return f;
 }
 
 static int dxlt_cmd_scan(struct dxlt *t)
@@ -310,16 +216,17 @@ static int dxlt_cmd_scan(struct dxlt *t)
 	if (t->a.npos != 0)
 		return dxlt_need_args(t, 0, "scan [--ids A-B] [--bauds LIST|all]");
 	fprintf(t->out, "%-4s %-6s %-13s %-9s %-8s %s\n", "ID", "MODEL", "NAME", "FIRMWARE", "BAUD", "PROTOCOL");
-	for (int protocol = 1; protocol <= 2; protocol++) {
+	for (size_t i = 0; i < DXLT_NFAMILIES; i++) {
+		const struct dxlt_family *f = &dxlt_families[i];
 		long bauds[DXLT_MAX_BAUDS];
-		if (t->a.protocol != 0 && t->a.protocol != protocol)
+		if (t->a.protocol != 0 && t->a.protocol != f->protocol)
 			continue;
-		size_t nbauds = dxlt_scan_bauds(t, protocol, bauds, DXLT_MAX_BAUDS);
-		bus_set_protocol(&t->bus, protocol == 2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1);
+		size_t nbauds = dxlt_scan_bauds(t, f, bauds, DXLT_MAX_BAUDS);
+		bus_set_protocol(&t->bus, f->bus);
 		for (size_t b = 0; b < nbauds; b++, tried++) {
 			if ((rc = dxlt_set_baud(t, bauds[b])) != DXLT_EXIT_OK)
 				return rc;
-			rc = protocol == 2 ? dxlt2_scan_at(t, bauds[b], &found) : dxlt_scan1_at(t, bauds[b], &found);
+			rc = f->scan_at(t, bauds[b], &found);
 			if (rc != DXLT_EXIT_OK)
 				return rc;
 			fflush(t->out);
@@ -328,7 +235,7 @@ static int dxlt_cmd_scan(struct dxlt *t)
 	if (found == 0) {
 		fprintf(t->err, "dxl: no servo answered on %s (IDs %u-%u, %zu baud rate%s on %s)%s\n",
 		        port_path(t->port), t->a.id_lo, t->a.id_hi, tried, tried == 1 ? "" : "s",
-		        t->a.protocol == 1 ? "Protocol 1.0" : t->a.protocol == 2 ? "Protocol 2.0" : "Protocols 1.0 and 2.0",
+		        t->a.protocol != 0 ? t->fam->label : "Protocols 1.0 and 2.0",
 		        t->a.nbauds == 0 ? "; try --bauds all" : "");
 		return DXLT_EXIT_BUS;
 	}
@@ -542,16 +449,30 @@ static int dxlt_cmd_dump(struct dxlt *t)
 
 /* ---- set-id / set-baud / torque / reset --------------------------------------- */
 
-/* After an EEPROM write whose reply we did not wait for (a new ID or baud
- * makes the reply's sender ambiguous), give the servo time, then ask. */
-static int dxlt_verify_ping(struct dxlt *t, uint8_t id)
+/* EEPROM (ID, rate) is refused while torque is on where the family says
+ * so: say it before sending. */
+static int dxlt_need_torque_off(struct dxlt *t, uint8_t id, const char *what)
 {
-	int r = DXL_E_TIMEOUT;
+	uint8_t torque = 0;
+	int r;
 
-	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	for (int attempt = 0; attempt < 3 && r == DXL_E_TIMEOUT; attempt++)
-		r = dxlt_ping(t, id);
-	return r;
+	if (!t->fam->eeprom_needs_torque_off)
+		return DXLT_EXIT_OK;
+	if ((r = dxlt_read(t, id, dxlt_addr(t, "torque_enable"), 1, &torque)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (torque == 0)
+		return DXLT_EXIT_OK;
+	fprintf(t->err, "dxl: ID %u has torque on, and an X-series servo refuses EEPROM writes (%s) then: dxl "
+	        "%s--port %s torque %u off\n", id, what, t->fam->opt, port_path(t->port), id);
+	return DXLT_EXIT_REFUSED;
+}
+
+/* "set-id OLD NEW", with the protocol option a suggestion must carry. */
+static int dxlt_need_form(struct dxlt *t, int n, const char *form)
+{
+	char line[96];
+	snprintf(line, sizeof line, "%s%s", t->fam->opt, form);
+	return dxlt_need_args(t, n, line);
 }
 
 static int dxlt_cmd_set_id(struct dxlt *t)
@@ -559,9 +480,9 @@ static int dxlt_cmd_set_id(struct dxlt *t)
 	uint8_t old_id, new_id;
 	int rc;
 
-	if ((rc = dxlt_need_args(t, 2, "set-id OLD NEW")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &old_id)) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[1], false, &new_id)))
+	if ((rc = dxlt_need_form(t, 2, "set-id OLD NEW")) ||
+	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &old_id)) ||
+	    (rc = dxlt_arg_servo_id(t, t->a.pos[1], &new_id)))
 		return rc;
 	if (old_id == new_id) {
 		fprintf(t->out, "ID %u unchanged\n", old_id);
@@ -575,7 +496,9 @@ static int dxlt_cmd_set_id(struct dxlt *t)
 		fprintf(t->err, "dxl: ID %u is already taken on this bus; pick another\n", new_id);
 		return DXLT_EXIT_REFUSED;
 	}
-	r = dxlt_write_reg(t, old_id, dxl_reg_at(DXL_AX_ID), new_id, false);
+	if ((rc = dxlt_need_torque_off(t, old_id, "id")) != DXLT_EXIT_OK)
+		return rc;
+	r = dxlt_write(t, old_id, dxlt_addr(t, "id"), &new_id, 1, false);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, old_id, r);
 	r = dxlt_verify_ping(t, new_id);
@@ -594,24 +517,25 @@ static int dxlt_cmd_set_baud(struct dxlt *t)
 	long bps;
 	int rc;
 
-	if ((rc = dxlt_need_args(t, 2, "set-baud ID BAUD")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
+	if ((rc = dxlt_need_form(t, 2, "set-baud ID BAUD")) ||
+	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)))
 		return rc;
 	if (num_parse_long(t->a.pos[1], 1, DXLT_MAX_BAUD, &bps) != NUM_OK ||
-	    dxl_baud_to_reg(bps, &reg_value) != DXL_OK) {
-		fprintf(t->err, "dxl: an AX-12 cannot run at '%s' bps (rates are 2000000/(n+1), "
-		        "e.g. 1000000, 500000, 117647, 57143)\n", t->a.pos[1]);
+	    t->fam->baud_to_reg(bps, &reg_value) != DXL_OK) {
+		fprintf(t->err, t->fam->no_rate, t->a.pos[1]);
 		return DXLT_EXIT_USAGE;
 	}
 	int r = dxlt_ping(t, id);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	r = dxlt_write_reg(t, id, dxl_reg_at(DXL_AX_BAUD_RATE), reg_value, false);
+	if ((rc = dxlt_need_torque_off(t, id, "baud_rate")) != DXLT_EXIT_OK)
+		return rc;
+	r = dxlt_write(t, id, dxlt_addr(t, "baud_rate"), &reg_value, 1, false);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	long exact = dxl_baud_from_reg(reg_value);
+	long exact = t->fam->baud_from_reg(reg_value);
 	/* Let the servo take the old-rate packet before the line changes rate. */
-	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
+	dxlt_sleep_us(t->fam->settle_us);
 	if ((rc = dxlt_set_baud(t, exact)) != DXLT_EXIT_OK)
 		return rc;
 	r = dxlt_verify_ping(t, id);
@@ -641,35 +565,46 @@ static int dxlt_cmd_torque(struct dxlt *t)
 	return dxlt_write_checked(t, id, dxl_reg_at(DXL_AX_TORQUE_ENABLE), on ? 1 : 0);
 }
 
+/* What a factory reset keeps: --keep where the models can (their
+ * descriptor's DXL2_CAP_FACTORY_RESET_KEEP), else everything goes. */
+static uint8_t dxlt_reset_keep(const struct dxlt *t, const char **what)
+{
+	uint8_t keep = dxl2_model_can(t->fam_model, DXL2_CAP_FACTORY_RESET_KEEP) ? (uint8_t)t->a.keep : DXL_RESET_ALL;
+	*what = keep == DXL2_RESET_KEEP_ID ? "every default but the ID (57600 bps)"
+	        : keep == DXL2_RESET_KEEP_ID_BAUD ? "every default but the ID and the baud rate"
+	        : "ID 1, 57600 bps and every default";
+	return keep;
+}
+
 static int dxlt_cmd_reset(struct dxlt *t)
 {
 	uint8_t id, e = 0;
-	int rc;
+	const char *what;
+	int rc, r;
 
-	if ((rc = dxlt_need_args(t, 1, "reset ID --yes")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
+	if ((rc = dxlt_need_form(t, 1, t->fam->reset_form)) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)))
 		return rc;
+	uint8_t keep = dxlt_reset_keep(t, &what);
 	if (!t->a.yes) {
-		fprintf(t->err, "dxl: a factory reset sets ID 1, 1000000 bps and every default "
-		        "(including angle limits); add --yes to do it\n");
+		fprintf(t->err, t->fam->reset_refusal, what);
 		return DXLT_EXIT_USAGE;
 	}
-	int r = dxlt_ping(t, id);
-	if (r != DXL_OK)
+	if ((r = dxlt_ping(t, id)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	r = bus_factory_reset(&t->bus, id, DXL_RESET_ALL, false, &e);
-	if (r != DXL_OK)
+	if ((r = bus_factory_reset(&t->bus, id, keep, false, &e)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	if ((rc = dxlt_set_baud(t, DXLT_DEFAULT_BAUD)) != DXLT_EXIT_OK)
+	/* where the servo went: its model's factory ID and rate, or what it kept */
+	uint8_t now_id = keep == DXL_RESET_ALL ? 1 : id;
+	long now_baud = keep == DXL2_RESET_KEEP_ID_BAUD ? port_baud(t->port) : t->fam_model->factory_baud;
+	dxlt_sleep_us(t->fam->settle_us);
+	if ((rc = dxlt_set_baud(t, now_baud)) != DXLT_EXIT_OK)
 		return rc;
-	r = dxlt_verify_ping(t, 1);
-	if (r != DXL_OK) {
-		fprintf(t->err, "dxl: reset sent to ID %u but ID 1 does not answer at 1000000 bps (%s)\n",
-		        id, dxl_strerror(r));
+	if ((r = dxlt_verify_ping(t, now_id)) != DXL_OK) {
+		fprintf(t->err, "dxl: reset sent to ID %u but ID %u does not answer at %ld bps (%s)\n", id, now_id, now_baud,
+		        dxl_strerror(r));
 		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
 	}
-	fprintf(t->out, "ID %u reset to factory defaults: now ID 1 at 1000000 bps\n", id);
+	fprintf(t->out, "ID %u reset to factory defaults: now ID %u at %ld bps\n", id, now_id, now_baud);
 	return DXLT_EXIT_OK;
 }
 
@@ -811,84 +746,77 @@ static int dxlt_cmd_setup(struct dxlt *t)
 	return worst;
 }
 
-/* REBOOT is Protocol 2.0's (and the MX series'): the AX-12 has none. */
+/* A REBOOT takes the servo off the bus while it starts again: the e-manual
+ * gives no figure; PINGs are tried for this long. */
+#define DXLT_REBOOT_WAIT_US 2000000L
+#define DXLT_REBOOT_POLL_US 50000L
+
+/* After a REBOOT: wait until the servo answers, and say whether it came
+ * back with a hardware error (where it has the register). */
+static int dxlt_reboot_wait(struct dxlt *t, uint8_t id)
+{
+	bool hwerr = dxl2_model_can(t->fam_model, DXL2_CAP_HWERR_STATUS);
+
+	for (long waited = 0; waited < DXLT_REBOOT_WAIT_US; waited += DXLT_REBOOT_POLL_US) {
+		dxlt_sleep_us(DXLT_REBOOT_POLL_US);
+		uint8_t hw = 0;
+		if (dxlt_ping(t, id) != DXL_OK)
+			continue;
+		if (hwerr && dxlt_read(t, id, dxlt_addr(t, "hardware_error_status"), 1, &hw) == DXL_OK && hw != 0) {
+			char names[96];
+			fprintf(t->err, "dxl: ID %u restarted with hardware error status %u (%s): the cause is still there\n",
+			        id, hw, dxl2_hwerr_format(hw, names, sizeof names));
+			return DXLT_EXIT_SERVO;
+		}
+		fprintf(t->out, "ID %u rebooted: answers again after %ld ms, torque off\n", id,
+		        (waited + DXLT_REBOOT_POLL_US) / 1000);
+		return DXLT_EXIT_OK;
+	}
+	fprintf(t->err, "dxl: ID %u does not answer %ld ms after REBOOT\n", id, DXLT_REBOOT_WAIT_US / 1000);
+	return DXLT_EXIT_BUS;
+}
+
+/* REBOOT is a capability: the X series' (Protocol 2.0), not the AX-12's. */
 static int dxlt_cmd_reboot(struct dxlt *t)
 {
-	fprintf(t->err, "dxl: the AX-12 has no REBOOT (Protocol 1.0): power-cycle it; an X-series servo: "
-	        "dxl --protocol 2 --port %s reboot ID\n", port_path(t->port));
-	return DXLT_EXIT_USAGE;
+	uint8_t id, e = 0, level = 2;
+	int rc, r;
+
+	if (!dxl2_model_can(t->fam_model, DXL2_CAP_REBOOT)) {
+		fprintf(t->err, "dxl: the AX-12 has no REBOOT (Protocol 1.0): power-cycle it; an X-series servo: "
+		        "dxl --protocol 2 --port %s reboot ID\n", port_path(t->port));
+		return DXLT_EXIT_USAGE;
+	}
+	if ((rc = dxlt_need_form(t, 1, "reboot ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)))
+		return rc;
+	if ((r = dxlt_ping(t, id)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (dxlt_read(t, id, dxlt_addr(t, "status_return_level"), 1, &level) != DXL_OK)
+		level = 0;
+	/* the reply (level 2) comes before the servo restarts */
+	if ((r = bus_reboot(&t->bus, id, level >= 2, &e)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	dxlt_seen(t, id, e);
+	return dxlt_reboot_wait(t, id);
 }
 
 /* ---- main --------------------------------------------------------------------- */
 
+/* A command, and what runs it on each family (dxlt_families' order); one
+ * function where it is written once. */
 struct dxlt_command {
 	const char *name;
-	int (*run)(struct dxlt *t);    /* Protocol 1.0 */
-	int (*run2)(struct dxlt *t);   /* Protocol 2.0 */
+	int (*run[DXLT_NFAMILIES])(struct dxlt *t);
 };
 
 static const struct dxlt_command dxlt_commands[] = {
-	{ "scan", dxlt_cmd_scan, dxlt_cmd_scan },         { "ping", dxlt_cmd_ping, dxlt2_cmd_ping },
-	{ "read", dxlt_cmd_read, dxlt2_cmd_read },        { "write", dxlt_cmd_write, dxlt2_cmd_write },
-	{ "dump", dxlt_cmd_dump, dxlt2_cmd_dump },        { "set-id", dxlt_cmd_set_id, dxlt2_cmd_set_id },
-	{ "set-baud", dxlt_cmd_set_baud, dxlt2_cmd_set_baud }, { "torque", dxlt_cmd_torque, dxlt2_cmd_torque },
-	{ "reset", dxlt_cmd_reset, dxlt2_cmd_reset },     { "setup", dxlt_cmd_setup, dxlt2_cmd_setup },
-	{ "reboot", dxlt_cmd_reboot, dxlt2_cmd_reboot },
+	{ "scan", { dxlt_cmd_scan, dxlt_cmd_scan } },          { "ping", { dxlt_cmd_ping, dxlt2_cmd_ping } },
+	{ "read", { dxlt_cmd_read, dxlt2_cmd_read } },         { "write", { dxlt_cmd_write, dxlt2_cmd_write } },
+	{ "dump", { dxlt_cmd_dump, dxlt2_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
+	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt2_cmd_torque } },
+	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt2_cmd_setup } },
+	{ "reboot", { dxlt_cmd_reboot, dxlt_cmd_reboot } },
 };
-
-/* What to do instead when another program holds the bus: dxl's packets
- * would collide with its own. A robot's daemon is watched through the
- * daemon (read-only, LCM), or stopped first. */
-static void dxlt_held(struct dxlt *t, const char *why, const struct holder *h)
-{
-	const char *robot = h->robot[0] != '\0' ? h->robot : NULL;
-
-	if (strcmp(h->program, "undulated") == 0)
-		fprintf(t->err, "dxl: %s: a robot's daemon drives this bus, and dxl's packets would collide with its cycle; "
-		        "watch its servos (angles, speeds, loads, voltages, temperatures, error bits) through the daemon: "
-		        "undulated --watch %s; or stop the robot first (systemctl stop undulated@%s if that is its service, or "
-		        "kill %ld), then run dxl\n", why, robot != NULL ? robot : "'*'", robot != NULL ? robot : "ROBOT", h->pid);
-	else if (strcmp(h->program, "dxl") == 0)
-		fprintf(t->err, "dxl: %s: another dxl is using this bus; run this one when it is done\n", why);
-	else
-		fprintf(t->err, "dxl: %s: one program drives a bus at a time; stop that one first\n", why);
-}
-
-int dxlt_open(struct dxlt *t, const char *path, bool low_latency)
-{
-	char owner[64];
-	struct holder held;
-	struct port_options opt = { .baud = t->a.baud, .low_latency = low_latency, .owner = owner, .holder = &held };
-	struct bus_io io;
-	char why[512];
-
-	snprintf(owner, sizeof owner, "command %s", t->a.command != NULL ? t->a.command : "?");
-	t->port = port_open(path, &opt, why, sizeof why);
-	if (t->port == NULL) {
-		if (held.pid > 0 || held.program[0] != '\0')
-			dxlt_held(t, why, &held);
-		else
-			fprintf(t->err, "dxl: %s\n", why);
-		return DXLT_EXIT_PORT;
-	}
-	/* A UART behind a half-duplex buffer: the kernel switches the direction
-	 * around every packet, or nothing we send reaches a servo. */
-	if (port_set_rs485(t->port, t->a.rs485, why, sizeof why) != DXL_OK) {
-		fprintf(t->err, "dxl: %s\n", why);
-		return DXLT_EXIT_PORT;
-	}
-	/* Look, do not touch (unless asked): only setup and doctor change the adapter. */
-	const struct port_latency *checked = port_get_latency(t->port);
-	if (checked != NULL)
-		t->latency = *checked;
-	else
-		port_latency_check_fd(path, port_fd(t->port), false, &t->latency);
-	port_bus_io(t->port, &io);
-	bus_init(&t->bus, &io, NULL, t->a.echo);
-	bus_set_protocol(&t->bus, t->a.protocol == 2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1);
-	dxlt_apply_timing(t);
-	return DXLT_EXIT_OK;
-}
 
 static int dxlt_dispatch(struct dxlt *t)
 {
@@ -901,6 +829,7 @@ static int dxlt_dispatch(struct dxlt *t)
 		dxlt_usage(t->err);
 		return DXLT_EXIT_USAGE;
 	}
+	t->fam = dxlt_family_for(t->a.protocol, &t->fam_model);
 	if (strcmp(t->a.command, "ports") == 0)
 		return t->a.npos == 0 ? dxlt_cmd_ports(t) : dxlt_need_args(t, 0, "ports");
 	if (strcmp(t->a.command, "doctor") == 0)
@@ -915,7 +844,7 @@ static int dxlt_dispatch(struct dxlt *t)
 		int rc = dxlt_open(t, t->a.port_path, false);
 		if (rc != DXLT_EXIT_OK)
 			return rc;
-		return dxlt_report_errbits(t, t->a.protocol == 2 ? dxlt_commands[i].run2(t) : dxlt_commands[i].run(t));
+		return dxlt_report_errbits(t, dxlt_commands[i].run[t->fam - dxlt_families](t));
 	}
 	fprintf(t->err, "dxl: unknown command '%s'\n", t->a.command);
 	dxlt_usage(t->err);

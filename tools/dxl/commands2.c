@@ -19,13 +19,6 @@
 #include "dxlt_priv.h"
 #include "num.h"
 
-/* An X servo writes its EEPROM in a few ms; after a write whose reply we do
- * not wait for (a new ID or rate) give it this long before asking. */
-#define DXLT2_SETTLE_US 20000
-/* A REBOOT takes the servo off the bus while it starts again: the e-manual
- * gives no figure; PINGs are tried for this long. */
-#define DXLT2_REBOOT_WAIT_US 2000000L
-#define DXLT2_REBOOT_POLL_US 50000L
 /* The rate `setup` puts a slower bus at: at the factory 57600 bps one cycle
  * of two servos takes more than the 10 ms period on the wire alone. */
 #define DXLT2_SETUP_BAUD 1000000L
@@ -53,7 +46,7 @@ struct dxlt2_reg {
 static const char *dxlt2_known(void)
 {
 	static char names[160];
-	return dxl2_model_names(names, sizeof names);
+	return dxl2_model_names(2, names, sizeof names);
 }
 
 static const char *dxlt2_model_text(const struct dxlt2_servo *s)
@@ -62,45 +55,6 @@ static const char *dxlt2_model_text(const struct dxlt2_servo *s)
 }
 
 /* ---- transactions: every reply's ERR field is remembered -------------------------- */
-
-int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware)
-{
-	uint8_t e = 0;
-	int r = bus_ping_model(&t->bus, id, model, firmware, &e);
-	if (r == DXL_OK)
-		t->errseen2[id] |= e;
-	return r;
-}
-
-int dxlt2_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out)
-{
-	uint8_t e = 0;
-	int r = bus_read(&t->bus, id, addr, len, out, &e);
-	if (r == DXL_OK)
-		t->errseen2[id] |= e;
-	return r;
-}
-
-static int dxlt2_write(struct dxlt *t, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply)
-{
-	uint8_t e = 0;
-	int r = bus_write(&t->bus, id, addr, data, n, expect_reply, &e);
-	if (r == DXL_OK)
-		t->errseen2[id] |= e;
-	return r;
-}
-
-static int dxlt2_arg_id(struct dxlt *t, const char *s, uint8_t *id)
-{
-	int rc = dxlt_arg_id(t, s, false, id);
-	if (rc != DXLT_EXIT_OK)
-		return rc;
-	if (*id > DXL2_MAX_ID) {
-		fprintf(t->err, "dxl: bad ID '%s' (0-%u on Protocol 2.0)\n", s, DXL2_MAX_ID);
-		return DXLT_EXIT_USAGE;
-	}
-	return DXLT_EXIT_OK;
-}
 
 /* PING the servo and pick its table. */
 static int dxlt2_identify(struct dxlt *t, uint8_t id, struct dxlt2_servo *s)
@@ -188,7 +142,7 @@ int dxlt2_cmd_ping(struct dxlt *t)
 	uint8_t id;
 	int rc;
 
-	if ((rc = dxlt_need_args(t, 1, "--protocol 2 ping ID")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) ||
+	if ((rc = dxlt_need_args(t, 1, "--protocol 2 ping ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
 	    (rc = dxlt2_identify(t, id, &s)))
 		return rc;
 	fprintf(t->out, "ID %u answered in %u us: model %u (%s), firmware %u, Protocol 2.0\n", id,
@@ -210,10 +164,10 @@ int dxlt2_cmd_read(struct dxlt *t)
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 2, "--protocol 2 read ID REG [--units]")) ||
-	    (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
+	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
 	    (rc = dxlt2_arg_reg(t, &s, t->a.pos[1], &reg)))
 		return rc;
-	int r = dxlt2_read(t, id, reg.addr, reg.size, raw);
+	int r = dxlt_read(t, id, reg.addr, reg.size, raw);
 	if (r == DXL_E_TIMEOUT) {
 		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0 (raise it: dxl "
 		        "--protocol 2 --port %s write %u status_return_level 2)\n", id, port_path(t->port), id);
@@ -249,10 +203,10 @@ int dxlt2_cmd_dump(struct dxlt *t)
 	char text[96];
 	int rc;
 
-	if ((rc = dxlt_need_args(t, 1, "--protocol 2 dump ID")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) ||
+	if ((rc = dxlt_need_args(t, 1, "--protocol 2 dump ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
 	    (rc = dxlt2_identify(t, id, &s)))
 		return rc;
-	int r = dxlt2_read(t, id, 0, sizeof mem, mem);
+	int r = dxlt_read(t, id, 0, sizeof mem, mem);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (s.m == NULL) {
@@ -342,7 +296,7 @@ static int dxlt2_write_checked(struct dxlt *t, uint8_t id, const struct dxlt2_re
 		dxl2_reg_encode(reg->row, (int32_t)value, raw);
 	else
 		dxl2_put_u32(raw, (uint32_t)value);
-	int r = dxlt2_write(t, id, reg->addr, raw, reg->size, answered);
+	int r = dxlt_write(t, id, reg->addr, raw, reg->size, answered);
 	if (r != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (answered)
@@ -354,8 +308,8 @@ static int dxlt2_write_checked(struct dxlt *t, uint8_t id, const struct dxlt2_re
 		return DXLT_EXIT_OK;
 	}
 	if (reg->row != NULL && reg->row->area == DXL_AREA_EEPROM)
-		dxlt_sleep_us(DXLT2_SETTLE_US);
-	if ((r = dxlt2_read(t, id, reg->addr, reg->size, back)) != DXL_OK)
+		dxlt_sleep_us(t->fam->settle_us);
+	if ((r = dxlt_read(t, id, reg->addr, reg->size, back)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (memcmp(back, raw, reg->size) != 0) {
 		fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld)\n", id, reg->name, (long)dxlt2_decode(reg, back),
@@ -375,7 +329,7 @@ static int dxlt2_write_reg(struct dxlt *t, const struct dxlt2_servo *s, const st
 
 	if (reg->row == NULL)   /* a model we do not know: its level unknown too, a reply expected */
 		return dxlt2_write_checked(t, s->id, reg, value, 2);
-	if ((r = dxlt2_read(t, s->id, 0, sizeof mem, mem)) == DXL_E_TIMEOUT) {
+	if ((r = dxlt_read(t, s->id, 0, sizeof mem, mem)) == DXL_E_TIMEOUT) {
 		/* level 0: PING only; nothing can be checked or confirmed */
 		fprintf(t->err, "dxl: ID %u answers PING but not READ (status return level 0): %s not checked against "
 		        "its limits\n", s->id, reg->name);
@@ -398,7 +352,7 @@ int dxlt2_cmd_write(struct dxlt *t)
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 3, "--protocol 2 write ID REG VALUE")) ||
-	    (rc = dxlt2_arg_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
+	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
 	    (rc = dxlt2_arg_reg(t, &s, t->a.pos[1], &reg)) || (rc = dxlt2_parse_value(t, &reg, t->a.pos[2], &value)))
 		return rc;
 	if (reg.row != NULL && (reg.addr == DXL2_X_ID || reg.addr == DXL2_X_BAUD_RATE)) {
@@ -416,7 +370,7 @@ int dxlt2_cmd_torque(struct dxlt *t)
 	uint8_t id;
 	int rc;
 
-	if ((rc = dxlt_need_args(t, 2, "--protocol 2 torque ID on|off")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
+	if ((rc = dxlt_need_args(t, 2, "--protocol 2 torque ID on|off")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)))
 		return rc;
 	const char *w = t->a.pos[1];
 	bool on = strcmp(w, "on") == 0 || strcmp(w, "1") == 0;
@@ -433,163 +387,6 @@ int dxlt2_cmd_torque(struct dxlt *t)
 	return dxlt2_write_reg(t, &s, &reg, on ? 1 : 0);
 }
 
-/* ---- set-id / set-baud / reset / reboot -------------------------------------------- */
-
-/* After a write whose reply we did not wait for, give the servo time, then ask. */
-static int dxlt2_verify_ping(struct dxlt *t, uint8_t id)
-{
-	int r = DXL_E_TIMEOUT;
-	dxlt_sleep_us(DXLT2_SETTLE_US);
-	for (int attempt = 0; attempt < 3 && r == DXL_E_TIMEOUT; attempt++)
-		r = dxlt2_ping(t, id, NULL, NULL);
-	return r;
-}
-
-/* EEPROM (ID, rate) is refused while torque is on: say so before sending. */
-static int dxlt2_need_torque_off(struct dxlt *t, uint8_t id, const char *what)
-{
-	uint8_t torque = 0;
-	int r = dxlt2_read(t, id, DXL2_X_TORQUE_ENABLE, 1, &torque);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (torque == 0)
-		return DXLT_EXIT_OK;
-	fprintf(t->err, "dxl: ID %u has torque on, and an X-series servo refuses EEPROM writes (%s) then: dxl "
-	        "--protocol 2 --port %s torque %u off\n", id, what, port_path(t->port), id);
-	return DXLT_EXIT_REFUSED;
-}
-
-int dxlt2_cmd_set_id(struct dxlt *t)
-{
-	uint8_t old_id, new_id;
-	int rc, r;
-
-	if ((rc = dxlt_need_args(t, 2, "--protocol 2 set-id OLD NEW")) ||
-	    (rc = dxlt2_arg_id(t, t->a.pos[0], &old_id)) || (rc = dxlt2_arg_id(t, t->a.pos[1], &new_id)))
-		return rc;
-	if (old_id == new_id) {
-		fprintf(t->out, "ID %u unchanged\n", old_id);
-		return DXLT_EXIT_OK;
-	}
-	if ((r = dxlt2_ping(t, old_id, NULL, NULL)) != DXL_OK)
-		return dxlt_bus_fail(t, old_id, r);
-	if (dxlt2_ping(t, new_id, NULL, NULL) == DXL_OK) {
-		fprintf(t->err, "dxl: ID %u is already taken on this bus; pick another\n", new_id);
-		return DXLT_EXIT_REFUSED;
-	}
-	if ((rc = dxlt2_need_torque_off(t, old_id, "id")) != DXLT_EXIT_OK)
-		return rc;
-	if ((r = dxlt2_write(t, old_id, DXL2_X_ID, &new_id, 1, false)) != DXL_OK)
-		return dxlt_bus_fail(t, old_id, r);
-	if ((r = dxlt2_verify_ping(t, new_id)) != DXL_OK) {
-		fprintf(t->err, "dxl: wrote ID %u to servo %u but ID %u does not answer (%s)\n", new_id, old_id, new_id,
-		        dxl_strerror(r));
-		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u is now ID %u\n", old_id, new_id);
-	return DXLT_EXIT_OK;
-}
-
-int dxlt2_cmd_set_baud(struct dxlt *t)
-{
-	uint8_t id, reg_value;
-	long bps;
-	int rc, r;
-
-	if ((rc = dxlt_need_args(t, 2, "--protocol 2 set-baud ID BAUD")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
-		return rc;
-	if (num_parse_long(t->a.pos[1], 1, DXLT_MAX_BAUD, &bps) != NUM_OK || dxl2_baud_to_reg(bps, &reg_value) != DXL_OK) {
-		fprintf(t->err, "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, "
-		        "3000000, 4000000, 4500000)\n", t->a.pos[1]);
-		return DXLT_EXIT_USAGE;
-	}
-	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if ((rc = dxlt2_need_torque_off(t, id, "baud_rate")) != DXLT_EXIT_OK)
-		return rc;
-	if ((r = dxlt2_write(t, id, DXL2_X_BAUD_RATE, &reg_value, 1, false)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	long exact = dxl2_baud_from_reg(reg_value);
-	dxlt_sleep_us(DXLT2_SETTLE_US);
-	if ((rc = dxlt_set_baud(t, exact)) != DXLT_EXIT_OK)
-		return rc;
-	if ((r = dxlt2_verify_ping(t, id)) != DXL_OK) {
-		fprintf(t->err, "dxl: ID %u does not answer at %ld bps after the change (%s); try: dxl --port %s scan "
-		        "--bauds all\n", id, exact, dxl_strerror(r), port_path(t->port));
-		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u now at %ld bps (register value %u)\n", id, exact, reg_value);
-	return DXLT_EXIT_OK;
-}
-
-int dxlt2_cmd_reset(struct dxlt *t)
-{
-	uint8_t id, e = 0;
-	int rc, r;
-
-	if ((rc = dxlt_need_args(t, 1, "--protocol 2 reset ID --yes [--keep id|id-baud]")) ||
-	    (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
-		return rc;
-	const char *what = t->a.keep == DXL2_RESET_KEEP_ID ? "every default but the ID (57600 bps)"
-	                   : t->a.keep == DXL2_RESET_KEEP_ID_BAUD ? "every default but the ID and the baud rate"
-	                   : "ID 1, 57600 bps and every default";
-	if (!t->a.yes) {
-		fprintf(t->err, "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
-		        "to do it (--keep id or id-baud keeps those)\n", what);
-		return DXLT_EXIT_USAGE;
-	}
-	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if ((r = bus_factory_reset(&t->bus, id, (uint8_t)t->a.keep, false, &e)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	uint8_t now_id = t->a.keep == DXL2_RESET_ALL ? 1 : id;
-	long now_baud = t->a.keep == DXL2_RESET_KEEP_ID_BAUD ? port_baud(t->port) : DXLT_DEFAULT_BAUD2;
-	dxlt_sleep_us(DXLT2_SETTLE_US);
-	if ((rc = dxlt_set_baud(t, now_baud)) != DXLT_EXIT_OK)
-		return rc;
-	if ((r = dxlt2_verify_ping(t, now_id)) != DXL_OK) {
-		fprintf(t->err, "dxl: reset sent to ID %u but ID %u does not answer at %ld bps (%s)\n", id, now_id, now_baud,
-		        dxl_strerror(r));
-		return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u reset to factory defaults: now ID %u at %ld bps\n", id, now_id, now_baud);
-	return DXLT_EXIT_OK;
-}
-
-int dxlt2_cmd_reboot(struct dxlt *t)
-{
-	uint8_t id, e = 0, level = 2;
-	int rc, r;
-
-	if ((rc = dxlt_need_args(t, 1, "--protocol 2 reboot ID")) || (rc = dxlt2_arg_id(t, t->a.pos[0], &id)))
-		return rc;
-	if ((r = dxlt2_ping(t, id, NULL, NULL)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (dxlt2_read(t, id, DXL2_X_STATUS_RETURN_LEVEL, 1, &level) != DXL_OK)
-		level = 0;
-	/* the reply (level 2) comes before the servo restarts */
-	if ((r = bus_reboot(&t->bus, id, level >= 2, &e)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	t->errseen2[id] |= e;
-	for (long waited = 0; waited < DXLT2_REBOOT_WAIT_US; waited += DXLT2_REBOOT_POLL_US) {
-		dxlt_sleep_us(DXLT2_REBOOT_POLL_US);
-		uint8_t hw = 0;
-		if (dxlt2_ping(t, id, NULL, NULL) != DXL_OK)
-			continue;
-		if (dxlt2_read(t, id, DXL2_X_HARDWARE_ERROR_STATUS, 1, &hw) == DXL_OK && hw != 0) {
-			char names[96];
-			fprintf(t->err, "dxl: ID %u restarted with hardware error status %u (%s): the cause is still there\n",
-			        id, hw, dxl2_hwerr_format(hw, names, sizeof names));
-			return DXLT_EXIT_SERVO;
-		}
-		fprintf(t->out, "ID %u rebooted: answers again after %ld ms, torque off\n", id,
-		        (waited + DXLT2_REBOOT_POLL_US) / 1000);
-		return DXLT_EXIT_OK;
-	}
-	fprintf(t->err, "dxl: ID %u does not answer %ld ms after REBOOT\n", id, DXLT2_REBOOT_WAIT_US / 1000);
-	return DXLT_EXIT_BUS;
-}
-
 /* ---- setup ------------------------------------------------------------------------------ */
 
 /* Write one byte if it differs, then read it back (writes not waited for:
@@ -603,10 +400,10 @@ static int dxlt2_setup_byte(struct dxlt *t, uint8_t id, uint16_t addr, const cha
 		fprintf(t->out, "ID %u: %s already %u\n", id, name, want);
 		return DXLT_EXIT_OK;
 	}
-	if ((r = dxlt2_write(t, id, addr, &want, 1, false)) != DXL_OK)
+	if ((r = dxlt_write(t, id, addr, &want, 1, false)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	dxlt_sleep_us(DXLT2_SETTLE_US);
-	if ((r = dxlt2_read(t, id, addr, 1, &back)) != DXL_OK)
+	dxlt_sleep_us(t->fam->settle_us);
+	if ((r = dxlt_read(t, id, addr, 1, &back)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (back != want) {
 		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u)\n", id, name, back, want);
@@ -630,7 +427,7 @@ static int dxlt2_setup_one(struct dxlt *t, uint8_t id, bool *current)
 		return DXLT_EXIT_REFUSED;
 	}
 	*current = *current || s.m->current_sensing;
-	if ((r = dxlt2_read(t, id, 0, sizeof mem, mem)) != DXL_OK) {
+	if ((r = dxlt_read(t, id, 0, sizeof mem, mem)) != DXL_OK) {
 		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? (the loop's SYNC_READ "
 		        "needs 1 or 2)\n", id);
 		return r == DXL_E_TIMEOUT ? DXLT_EXIT_BUS : dxlt_bus_fail(t, id, r);
@@ -665,14 +462,14 @@ static int dxlt2_setup_baud(struct dxlt *t, const uint8_t *ids, int n)
 		return DXLT_EXIT_OK;
 	dxl2_baud_to_reg(DXLT2_SETUP_BAUD, &reg);
 	for (int i = 0; i < n; i++)
-		if ((r = dxlt2_write(t, ids[i], DXL2_X_BAUD_RATE, &reg, 1, false)) != DXL_OK)
+		if ((r = dxlt_write(t, ids[i], DXL2_X_BAUD_RATE, &reg, 1, false)) != DXL_OK)
 			return dxlt_bus_fail(t, ids[i], r);
 	long before = port_baud(t->port);
-	dxlt_sleep_us(DXLT2_SETTLE_US);
+	dxlt_sleep_us(t->fam->settle_us);
 	if ((rc = dxlt_set_baud(t, DXLT2_SETUP_BAUD)) != DXLT_EXIT_OK)
 		return rc;
 	for (int i = 0; i < n; i++) {
-		if ((r = dxlt2_verify_ping(t, ids[i])) != DXL_OK) {
+		if ((r = dxlt_verify_ping(t, ids[i])) != DXL_OK) {
 			fprintf(t->err, "dxl: ID %u does not answer at %ld bps after the change (%s); try: dxl --port %s scan "
 			        "--bauds all\n", ids[i], DXLT2_SETUP_BAUD, dxl_strerror(r), port_path(t->port));
 			return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
@@ -692,7 +489,7 @@ int dxlt2_cmd_setup(struct dxlt *t)
 	if (n < 1 || n > DXL2_MAX_ID + 1)
 		return dxlt_need_args(t, -1, "--protocol 2 setup ID... [--status-level N] [--yes]");
 	for (int i = 0; i < n; i++) {
-		int rc = dxlt2_arg_id(t, t->a.pos[i], &ids[i]);
+		int rc = dxlt_arg_servo_id(t, t->a.pos[i], &ids[i]);
 		if (rc != DXLT_EXIT_OK)
 			return rc;
 	}

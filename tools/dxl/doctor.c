@@ -233,8 +233,8 @@ static int dr_find(struct dr *d, unsigned *answered)
 		int r = DXL_E_TIMEOUT;
 		s->id = d->cfg.ids[j];
 		for (int k = 0; k < DR_PING_TRIES && r != DXL_OK; k++) {
-			/* on 2.0 the PING says the model: the baud line prices its cycle */
-			r = d->t->a.protocol == 2 ? dxlt2_ping(d->t, s->id, &d->servo2[j].model, NULL) : dxlt_ping(d->t, s->id);
+			/* where the PING says the model (2.0), the baud line prices its cycle */
+			r = dxlt_ping_model(d->t, s->id, &d->servo2[j].model);
 			if (dr_gone(r))
 				return dxlt_bus_fail(d->t, s->id, r);
 		}
@@ -257,8 +257,7 @@ static int dr_latency(struct dr *d)
 	if (first != NULL) {
 		/* its own return delay is no adapter's doing: read it first */
 		uint8_t rd = 0;
-		int rr = d->t->a.protocol == 2 ? dxlt2_read(d->t, first->id, DXL2_X_RETURN_DELAY_TIME, 1, &rd)
-		                               : dxlt_read(d->t, first->id, DXL_AX_RETURN_DELAY_TIME, 1, &rd);
+		int rr = dxlt_read(d->t, first->id, dxlt_addr(d->t, "return_delay_time"), 1, &rd);
 		if (rr != DXL_OK)
 			rd = 0;
 		int r = bus_reply_lateness(&d->t->bus, first->id, dxl_return_delay_us(rd), DR_LATENESS_PINGS, &l.late);
@@ -318,7 +317,7 @@ static void dr_context(struct dr *d)
 	size_t off = 0;
 	d->setup_ids[0] = '\0';
 	d->ctx = (struct dr_context){ .port = d->cfg.port, .ids = d->setup_ids, .baud = d->cfg.baud,
-	                              .period_ms = d->cfg.period_ms, .protocol = d->t->a.protocol == 2 ? 2 : 1,
+	                              .period_ms = d->cfg.period_ms, .protocol = d->t->fam->protocol,
 	                              .read_len2 = DR2_READ_LEN };
 	for (size_t j = 0; j < d->cfg.njoints; j++) {
 		const struct dr_servo *s = &d->servo[j];
@@ -328,9 +327,9 @@ static void dr_context(struct dr *d)
 		if (w > 0 && (size_t)w < sizeof d->setup_ids - off)
 			off += (size_t)w;
 		d->ctx.any_torque_on = d->ctx.any_torque_on || (s->read && s->torque_enable) ||
-		                       (s->read && d->ctx.protocol == 2 && d->servo2[j].torque_enable);
+		                       (s->read && d->servo2[j].torque_enable);   /* 2.0's image; 0 on 1.0 */
 		/* the loop's SYNC_READ takes the present current too where there is one */
-		const struct dxl2_model *xm = d->ctx.protocol == 2 ? dxl2_model_by_number(d->servo2[j].model) : NULL;
+		const struct dxl2_model *xm = dxl2_model_find(d->ctx.protocol, d->servo2[j].model);
 		if (xm != NULL && xm->current_sensing)
 			d->ctx.read_len2 = DR2_READ_LEN_CURRENT;
 	}
@@ -779,7 +778,7 @@ static int dr2_read_all(struct dr *d, int *status)
 		if (!s->answered)
 			continue;
 		for (int k = 0; k < DR_READ_TRIES && r != DXL_OK && !dr_gone(r); k++)
-			r = dxlt2_read(d->t, s->id, 0, sizeof mem, mem);
+			r = dxlt_read(d->t, s->id, 0, sizeof mem, mem);
 		if (dr_gone(r))
 			return dxlt_bus_fail(d->t, s->id, r);
 		status[j] = r;

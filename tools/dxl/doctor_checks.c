@@ -268,10 +268,10 @@ void dr_check_voltage(const struct dr_servo *s, struct dr_verdict *v)
 	} else if (s->voltage < DR_DECIVOLTS_MIN) {
 		dr_set(v, DR_FAIL, "%.1f V %s, below the AX-12A's 9..12 V: it gives %.0f%% of its 12 V torque and speed, and "
 		       "sags further under load; fix: charge or replace the battery (11.1..12 V), check the supply's cable",
-		       volts, range, 100.0 * volts / DXL_AX12_REF_VOLTAGE);
+		       volts, range, 100.0 * volts / DXL2_REF_VOLTAGE);
 	} else if (s->voltage < DR_DECIVOLTS_LOW) {
 		dr_set(v, DR_WARN, "%.1f V %s: %.0f%% of the 12 V torque and speed, at rest; fix: charge the battery "
-		       "(11.1..12 V)", volts, range, 100.0 * volts / DXL_AX12_REF_VOLTAGE);
+		       "(11.1..12 V)", volts, range, 100.0 * volts / DXL2_REF_VOLTAGE);
 	} else if (s->voltage > DR_DECIVOLTS_MAX) {
 		dr_set(v, DR_WARN, "%.1f V %s, above the AX-12A's 12 V; fix: a 12 V supply or a 3S battery", volts, range);
 	} else {

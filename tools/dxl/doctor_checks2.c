@@ -56,7 +56,7 @@ void dr2_check_model(const struct dr2_servo *s, const struct dr_context *c, stru
 	char known[160];
 	dr_set(v, DR_WARN, "%u, firmware %u: not in dxl's tables (%s); the checks below read it "
 	        "with the X series' addresses, which it may not share; fix: check its control table (dxl --protocol 2 "
-	        "--port %s dump %u prints it raw)", s->model, s->firmware, dxl2_model_names(known, sizeof known), c->port,
+	        "--port %s dump %u prints it raw)", s->model, s->firmware, dxl2_model_names(2, known, sizeof known), c->port,
 	        s->id);
 }
 

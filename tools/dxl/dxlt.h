@@ -31,8 +31,6 @@ enum dxlt_exit {
 /* Largest rate a command line may name, bps: the X series' top rate (4.5
  * Mbps, baud register 7), so a typo's extra digit is caught here. */
 #define DXLT_MAX_BAUD 4500000L
-/* The X series' factory rate (Protocol 2.0). */
-#define DXLT_DEFAULT_BAUD2 57600L
 /* The AX-12 factory rate. */
 #define DXLT_DEFAULT_BAUD 1000000L
 /* Scheduling slack on top of the derived reply timeout (ms): the tool is

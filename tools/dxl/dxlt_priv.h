@@ -1,7 +1,8 @@
 /*
- * dxlt_priv.h — what the `dxl` commands share inside libdxl (commands.c and
- * doctor.c): the tool's state over one bus and the helpers every command
- * uses. Not for the tests: they go through dxlt_main() (dxlt.h).
+ * dxlt_priv.h — what the `dxl` commands share inside libdxl: the tool's
+ * state over one bus and the helpers every command uses (session.c, which
+ * commands.c, commands2.c and doctor.c call down into). Not for the tests:
+ * they go through dxlt_main() (dxlt.h).
  */
 #ifndef UNDULATE_DXLT_PRIV_H
 #define UNDULATE_DXLT_PRIV_H
@@ -10,10 +11,37 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "dxl2_table.h"
 #include "dxlt.h"
+
+struct dxlt;
+/* What a command needs of the protocol it speaks beyond the bus's backend
+ * table (bus.h) and the model descriptors (dxl2_table.h): chosen once at
+ * start from --protocol (dxlt_family_for), then asked, never branched on. */
+struct dxlt_family {
+	int protocol;                  /* 1 or 2 */
+	enum bus_protocol bus;
+	const char *label;             /* "Protocol 1.0" */
+	const char *opt;               /* what a suggested command carries: "" or "--protocol 2 " */
+	uint8_t max_id;
+	long settle_us;                /* after an EEPROM write whose reply is not waited for */
+	/* the servo refuses EEPROM writes while its torque is on, with an error
+	 * the tool can name before sending */
+	bool eeprom_needs_torque_off;
+	const char *no_rate;           /* set-baud's refusal, "%s" the rate asked */
+	const char *reset_form;        /* reset's usage */
+	/* reset without --yes: what it would set ("%s": the keep form's words) */
+	const char *reset_refusal;
+	int (*baud_to_reg)(long bps, uint8_t *v);
+	long (*baud_from_reg)(uint8_t v);
+	/* one rate of `scan`: a line per servo found */
+	int (*scan_at)(struct dxlt *t, long baud, unsigned *found);
+};
 
 struct dxlt {
 	struct dxlt_args a;
+	const struct dxlt_family *fam;   /* set before any command runs */
+	const struct dxl2_model *fam_model;   /* its first model: the addresses its models share */
 	FILE *out, *err;
 	struct port *port;
 	struct port_latency latency;
@@ -26,6 +54,7 @@ struct dxlt {
 	char hint[200];          /* what to do about them, when we know */
 };
 
+/* ---- session.c ---- */
 /* Open path as the bus (t->a.baud, t->a.echo, t->a.rs485) with the derived
  * reply timeouts. low_latency: lower the FTDI latency timer as undulated
  * does at start (only setup and doctor touch the adapter). DXLT_EXIT_OK or
@@ -38,7 +67,20 @@ void dxlt_apply_timing(struct dxlt *t);
 int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status);
 /* Transactions whose replies' error bits are remembered in t->errseen. */
 int dxlt_ping(struct dxlt *t, uint8_t id);
-int dxlt_read(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out);
+/* PING, and the model number where the protocol's PING carries one
+ * (*model untouched where it does not). */
+int dxlt_ping_model(struct dxlt *t, uint8_t id, uint16_t *model);
+/* An error byte a reply carried outside these (a REBOOT's). */
+void dxlt_seen(struct dxlt *t, uint8_t id, uint8_t e);
+int dxlt_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out);
+int dxlt_write(struct dxlt *t, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply);
+/* The address of a register every model of the protocol has at one place
+ * ("id", "baud_rate", "torque_enable", "status_return_level"). */
+uint16_t dxlt_addr(const struct dxlt *t, const char *name);
+/* An ID on the command line, within the protocol's range. */
+int dxlt_arg_servo_id(struct dxlt *t, const char *s, uint8_t *id);
+/* After a write whose reply was not waited for, give the servo time, then PING. */
+int dxlt_verify_ping(struct dxlt *t, uint8_t id);
 const char *dxlt_model_name(uint16_t model);
 /* Switch the port (and the reply timeouts) to baud. */
 int dxlt_set_baud(struct dxlt *t, long baud);
@@ -47,20 +89,18 @@ void dxlt_sleep_us(long us);
 int dxlt_need_args(struct dxlt *t, int n, const char *form);
 int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id);
 
+/* Protocol 2.0's PING, with the model and firmware it answers. */
+int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware);
+
 /* ---- Protocol 2.0 (commands2.c) ---- */
 /* Broadcast PING at the current rate: one scan line per servo in the ID range. */
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found);
-int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware);
-int dxlt2_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out);
 int dxlt2_cmd_ping(struct dxlt *t);
 int dxlt2_cmd_read(struct dxlt *t);
 int dxlt2_cmd_write(struct dxlt *t);
 int dxlt2_cmd_dump(struct dxlt *t);
-int dxlt2_cmd_set_id(struct dxlt *t);
-int dxlt2_cmd_set_baud(struct dxlt *t);
 int dxlt2_cmd_torque(struct dxlt *t);
-int dxlt2_cmd_reset(struct dxlt *t);
-int dxlt2_cmd_reboot(struct dxlt *t);
+int dxlt2_reboot(struct dxlt *t, uint8_t id);
 int dxlt2_cmd_setup(struct dxlt *t);
 
 /* `dxl doctor` (doctor.c): opens the port itself, after reading the
