@@ -78,6 +78,19 @@ static void (*on_write_sent)(void);   /* run when a WRITE goes out (mid-cycle) *
 
 static uint64_t wire_us(size_t bytes) { return bytes * 10; }   /* 1 Mbps, 8N1 */
 
+/* Room for n more bytes of replies on the fake line, either bus's. */
+static void rx_room(size_t n)
+{
+	if (f.tail + n > RX_CAP && f.head > 0) {
+		/* what was read is gone: room for long runs */
+		memmove(f.rx, f.rx + f.head, f.tail - f.head);
+		memmove(f.rx_at, f.rx_at + f.head, (f.tail - f.head) * sizeof f.rx_at[0]);
+		f.tail -= f.head;
+		f.head = 0;
+	}
+	assert_true(f.tail + n <= RX_CAP);
+}
+
 /* ---- the plant: AX-12 control tables ---------------------------------------------------------- */
 struct servo {
 	uint8_t id;
@@ -129,17 +142,9 @@ static void servo_init(struct servo *s, uint8_t id)
 	s->mem[DXL_AX_CW_COMPLIANCE_MARGIN] = s->mem[DXL_AX_CCW_COMPLIANCE_MARGIN] = 0;
 }
 
-
 static void push(const uint8_t *d, size_t n, uint64_t at)
 {
-	if (f.tail + n > RX_CAP && f.head > 0) {
-		/* what was read is gone: room for long runs */
-		memmove(f.rx, f.rx + f.head, f.tail - f.head);
-		memmove(f.rx_at, f.rx_at + f.head, (f.tail - f.head) * sizeof f.rx_at[0]);
-		f.tail -= f.head;
-		f.head = 0;
-	}
-	assert_true(f.tail + n <= RX_CAP);
+	rx_room(n);
 	for (size_t i = 0; i < n; i++) {
 		f.rx[f.tail] = d[i];
 		f.rx_at[f.tail++] = at;
@@ -217,14 +222,7 @@ static void emit(void *ctx, const uint8_t *pkt, size_t n, unsigned delay_us)
 	(void)ctx;
 	uint64_t start = (f.request_end > f.line_free ? f.request_end : f.line_free) + delay_us + f.late_us;
 	f.late_us = 0;
-	if (f.tail + n > RX_CAP && f.head > 0) {
-		/* what was read is gone: room for long runs */
-		memmove(f.rx, f.rx + f.head, f.tail - f.head);
-		memmove(f.rx_at, f.rx_at + f.head, (f.tail - f.head) * sizeof f.rx_at[0]);
-		f.tail -= f.head;
-		f.head = 0;
-	}
-	assert_true(f.tail + n <= RX_CAP);
+	rx_room(n);
 	for (size_t i = 0; i < n; i++) {
 		f.rx[f.tail] = pkt[i];
 		if (f.corrupt > 0 && i == n - 1)
