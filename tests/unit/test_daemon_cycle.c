@@ -877,17 +877,24 @@ static void test_writes_are_the_models_ax(void **state)
 }
 
 /* ---- the X series' bus --------------------------------------------------------------------------- */
+/* Two XM430s holding for 0.2 s, then servo `id` shut down by `cause`
+ * (Hardware Error Status, torque off), backing off 0.2 s. */
+static void x_shut_down(uint8_t id, uint8_t cause)
+{
+	const char *sets[] = { "robot.fault_backoff_s=0.2", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	run(20);
+	xs(id)->mem[70] = cause;
+	xs(id)->mem[64] = 0;
+}
+
 /* An overload shuts servo 2 down: the alert in its status has its RAM block
  * read at once, the fault backs off, one REBOOT (fault_reboots 1) and the
  * set-up chain bring it back. */
 static void test_shutdown_recovered_by_reboot(void **state)
 {
 	(void)state;
-	const char *sets[] = { "robot.fault_backoff_s=0.2", NULL };
-	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
-	run(20);
-	xs(2)->mem[70] = DXL2_HWERR_OVERLOAD;
-	xs(2)->mem[64] = 0;
+	x_shut_down(2, DXL2_HWERR_OVERLOAD);
 	run(3);
 	assert_int_equal(c.j[1].hwerr, DXL2_HWERR_OVERLOAD);
 	assert_non_null(find_event("servo 2: overload (shut down: torque off): backing off"));
@@ -909,11 +916,7 @@ static void test_shutdown_recovered_by_reboot(void **state)
 static void test_shutdown_latches_when_reboot_does_not_help(void **state)
 {
 	(void)state;
-	const char *sets[] = { "robot.fault_backoff_s=0.2", NULL };
-	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
-	run(20);
-	xs(2)->mem[70] = DXL2_HWERR_OVERHEAT;
-	xs(2)->mem[64] = 0;
+	x_shut_down(2, DXL2_HWERR_OVERHEAT);
 	xs(2)->hwerr_after_reboot = DXL2_HWERR_OVERHEAT;
 	for (int i = 0; i < 150; i++) {
 		(void)tick(NULL);
@@ -982,6 +985,18 @@ static void test_operating_mode_changed(void **state)
 	assert_int_equal(c.j[0].opmode_read, 3);
 }
 
+/* Under torque actuation: both joints resting away from neutral (the law
+ * starts them, no starter), then OSCILLATOR for `cycles`: in the drive. */
+static void x_oscillate_in_drive(int cycles)
+{
+	for (uint8_t id = 1; id <= 2; id++)
+		xfake_put(xs(id)->mem, 132, 2048 + 250, 4);
+	run(10);
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	run(cycles);
+	assert_true(c.wheel);
+}
+
 /* Torque actuation on the XM430: into current control and out of it, each
  * a chain per servo; the drive goes only to servos whose switch went
  * through, within Current Limit. */
@@ -990,13 +1005,7 @@ static void test_current_control_switch(void **state)
 	(void)state;
 	const char *sets[] = { "robot.actuation=torque", "robot.torque_drive=current", NULL };
 	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
-	/* resting away from neutral: the law starts it, no starter */
-	for (uint8_t id = 1; id <= 2; id++)
-		xfake_put(xs(id)->mem, 132, 2048 + 250, 4);
-	run(10);
-	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
-	run(5);
-	assert_true(c.wheel);
+	x_oscillate_in_drive(5);
 	for (uint8_t id = 1; id <= 2; id++) {
 		assert_int_equal(xs(id)->mem[11], 0);          /* current control */
 		assert_int_equal(xs(id)->mem[64], 1);
@@ -1212,12 +1221,7 @@ static void test_writes_are_the_models_x(void **state)
 		setup_x(models[k], 2, CFG_MODE_HOLD, drive[k]);
 		xb.on_write = x_check_write;
 		bad_write[0] = '\0';
-		for (uint8_t id = 1; id <= 2; id++)
-			xfake_put(xs(id)->mem, 132, 2048 + 250, 4);
-		run(10);
-		ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
-		run(10);
-		assert_true(c.wheel);
+		x_oscillate_in_drive(10);
 		xs(2)->mem[70] = DXL2_HWERR_OVERLOAD;
 		run(10);
 		xs(2)->mem[70] = 0;
