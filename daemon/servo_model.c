@@ -94,6 +94,9 @@ static const struct sm_setup sm_x_setup = {
 	.watchdog = DXL2_X_BUS_WATCHDOG, .hwerr = DXL2_X_HARDWARE_ERROR_STATUS, .shutdown = DXL2_X_SHUTDOWN,
 };
 
+_Static_assert(DXL_AX_STATUS_RETURN_LEVEL + 1 <= SM_SETTINGS_MAX && DXL2_X_BUS_WATCHDOG + 1 <= SM_SETTINGS_MAX,
+               "start-up's settings READ fits its buffer");
+
 static const struct sm_model sm_ax = {
 	.name = "AX-12A", .protocol = 1, .number = DXL_AX12_MODEL,
 	.torque_enable = DXL_AX_TORQUE_ENABLE, .torque_limit = DXL_AX_TORQUE_LIMIT,

@@ -79,6 +79,7 @@ struct sm_position_defaults {
  * the cycle's registers, and how they judge what they find: one start-up
  * over every family, its differences here. A register 0 is one the family
  * does not have. (AX-12A | X series.) */
+#define SM_SETTINGS_MAX 128
 struct sm_setup {
 	const char *family;             /* what a protocol found at start is said to run: "AX-12" | "X series" */
 	const char *dxl_opt;            /* the `dxl` options that speak to it, for the fixes said: "" | "--protocol 2 " */
@@ -90,7 +91,7 @@ struct sm_setup {
 	 * AX-12A, as undulated always did). */
 	bool strict;
 	uint16_t settings_len;          /* start-up's one READ from register 0: to Status Return Level (17 bytes) |
-	                                   to the Bus Watchdog (99) */
+	                                   to the Bus Watchdog (99); at most SM_SETTINGS_MAX */
 	uint16_t return_delay;          /* 5 | 9, 2 µs a unit on both */
 	uint16_t status_return_level;   /* 16 | 68 */
 	uint16_t output_limit;          /* the torque limit's ceiling, 2 bytes: Max Torque 14 | PWM Limit 36 */

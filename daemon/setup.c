@@ -385,7 +385,7 @@ static bool setup_servo(struct bus *bus, struct ctl *ctl, size_t j, const struct
                         int *max_return_delay_us, char *err, size_t cap)
 {
 	const struct sm_model *family = sm_family(bus_proto(bus)->number);
-	uint8_t id = ctl->j[j].id, eb = 0, t[DXL2_X_TABLE_SIZE];
+	uint8_t id = ctl->j[j].id, eb = 0, t[SM_SETTINGS_MAX];
 	int r = setup_read(bus, id, 0, family->setup->settings_len, t, &eb);
 	if (r != DXL_OK) {
 		snprintf(err, cap, "servo %u: reading its settings failed: %s", id, dxl_strerror(r));
