@@ -314,12 +314,14 @@ _Static_assert((int)CFG_PROTO_1 == (int)BUS_PROTOCOL_1 && (int)CFG_PROTO_2 == (i
  * (setup_protocol) and kept for every reconnect. */
 static bool dmn_protocol(struct dmn *d, char *err, size_t cap)
 {
-	/* Protocol branch 1 of the daemon's 2 (both choose the backend at
-	 * start-up; the other is setup_protocol's probe order): a configured
+	/* The daemon's two branches on the protocol, both choosing the backend
+	 * at start-up; everything after asks the servo's model. 1: a configured
 	 * protocol is the bus's, by its number (config.h's CFG_PROTO_n are
-	 * bus.h's BUS_PROTOCOL_n). Everything after asks the servo's model. */
+	 * bus.h's BUS_PROTOCOL_n). */
 	if (d->protocol == 0 && d->cfg->protocol != CFG_PROTO_AUTO)
 		d->protocol = (enum bus_protocol)d->cfg->protocol;
+	/* 2: protocol = auto, none found yet: PINGs find it (setup_protocol,
+	 * its backends in a table, the AX-12's first) */
 	if (d->protocol == 0 && !setup_protocol(&d->bus, d->cfg, d->port_path, &d->protocol, err, cap))
 		return false;
 	bus_set_protocol(&d->bus, d->protocol);

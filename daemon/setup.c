@@ -51,9 +51,8 @@ static bool setup_find(struct bus *bus, const struct ctl *ctl, const struct cfg 
 bool setup_protocol(struct bus *bus, const struct cfg *cfg, const char *port_path, enum bus_protocol *found,
                     char *err, size_t cap)
 {
-	/* Protocol branch 2 of the daemon's 2 (both choose the backend at
-	 * start-up; the other is dmn_protocol's configured one): which
-	 * backends protocol = auto tries, in order, the AX-12's first. */
+	/* which backends protocol = auto tries, in order, the AX-12's first
+	 * (the daemon's second branch on the protocol: dmn_protocol) */
 	static const enum bus_protocol order[] = { BUS_PROTOCOL_1, BUS_PROTOCOL_2 };
 	int r = DXL_E_TIMEOUT;
 	/* round after round, each ID on each protocol once: a servo that was
