@@ -39,6 +39,8 @@ enum cfg_drive { CFG_DRIVE_PWM, CFG_DRIVE_CURRENT };
 enum cfg_commands { CFG_CMD_OFF, CFG_CMD_LOCAL, CFG_CMD_NETWORK };
 /* The bus's protocol: Dynamixel 1.0 (AX-12), 2.0 (X series), or found at
  * start-up by PINGs (daemon/README.md, "Protocol"). */
+/* CFG_PROTO_n is the bus's protocol number n (bus.h BUS_PROTOCOL_n): the
+ * daemon takes a configured protocol as it is. */
 enum cfg_protocol { CFG_PROTO_AUTO = 0, CFG_PROTO_1 = 1, CFG_PROTO_2 = 2 };
 
 struct cfg_joint {

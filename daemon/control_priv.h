@@ -1,15 +1,17 @@
 /*
- * control_priv.h — the controller's internals shared by its two files:
- * control.c (modes, faults, read-back, the position laws) and torque.c
- * (torque actuation through wheel mode). Nothing outside the controller
- * includes this.
+ * control_priv.h — the controller's internals shared by its files:
+ * control.c (modes, faults, read-back, the position laws), torque.c
+ * (torque actuation through wheel mode) and control_core.c (what both call:
+ * events, writes, a joint's model and limits). The calls go one way:
+ * control.c -> torque.c -> control_core.c; torque.c reports a fault to
+ * latch, control.c latches it. Nothing outside the controller includes this.
  */
 #ifndef UNDULATE_DAEMON_CONTROL_PRIV_H
 #define UNDULATE_DAEMON_CONTROL_PRIV_H
 
 #include "control.h"
 
-/* ---- control.c ------------------------------------------------------------------------ */
+/* ---- control_core.c ------------------------------------------------------------------- */
 void ctl_event(struct ctl *c, int level, const char *kind, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
 /* A register's new value (writeq.h's merge rules). */
@@ -35,6 +37,10 @@ bool ctl_has(const struct ctl *c, size_t j, unsigned cap);
  * persisted. */
 uint16_t ctl_torque_limit(const struct ctl *c, const struct ctl_joint *jt);
 void ctl_blend_joint(struct ctl *c, size_t j, double from);
+/* A goal's register value for rad on model m, never past the joint's limits. */
+int32_t ctl_goal_pos(const struct ctl_joint *jt, const struct sm_model *m, double rad);
+
+/* ---- control.c: torque.c never calls these -------------------------------------------- */
 void ctl_hold_at_present(struct ctl *c);
 /* Put the robot in its fault action and keep it there until cleared. */
 void ctl_latch(struct ctl *c, const char *what);
@@ -46,12 +52,14 @@ bool tq_mode_drives(const struct ctl *c, enum cfg_mode mode);
 /* The servos go into wheel mode only for such a mode running (not the
  * oscillator's starter) whose joints are all healthy, torqued and measured. */
 bool tq_want_wheel(const struct ctl *c);
-/* A joint past its limits under torque: the fault action, latched. */
-void tq_check_limits(struct ctl *c);
+/* A joint past its limits under torque: true with what to latch (the
+ * caller puts the robot in its fault action, ctl_latch), the event said. */
+bool tq_check_limits(struct ctl *c, char *what, size_t cap);
 /* The PWM drive scales with the supply each servo reports: in a mode that
  * drives torque (tq_mode_drives) a reading outside the servo's plausible
- * range (sm_supply_plausible) is a fault, named and latched, never a gain. */
-void tq_check_supply(struct ctl *c);
+ * range (sm_supply_plausible) is a fault, named, never a gain: true with
+ * what to latch. */
+bool tq_check_supply(struct ctl *c, char *what, size_t cap);
 /* This cycle's duties from the mode's law (wheel mode); t_real is the
  * SINUSOID's shared clock (ctl_step). */
 void tq_duties(struct ctl *c, double t_real);
@@ -67,7 +75,9 @@ void tq_stop_goals(struct ctl *c);
 double tq_stall_torque(const struct ctl *c, const struct ctl_joint *jt);
 double tq_no_load_speed(const struct ctl *c, const struct ctl_joint *jt);
 /* X series: a step of a drive switch's chain was acknowledged (ok) or given
- * up; the joint's drive is ready, or the robot goes back to joint mode. */
-void tq_chain_result(struct ctl *c, size_t j, const struct wq_write *w, bool ok);
+ * up; the joint's drive is ready, or (the caller's part) the robot goes
+ * back to joint mode. True with what to latch when the switch failed more
+ * than fault_retries times. */
+bool tq_chain_result(struct ctl *c, size_t j, const struct wq_write *w, bool ok, char *what, size_t cap);
 
 #endif

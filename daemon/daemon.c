@@ -307,12 +307,21 @@ static double dmn_ctl_time(const struct dmn *d, uint64_t t_us)
 	return 1e-6 * (double)(t_us - d->epoch_us);
 }
 
+_Static_assert((int)CFG_PROTO_1 == (int)BUS_PROTOCOL_1 && (int)CFG_PROTO_2 == (int)BUS_PROTOCOL_2,
+               "a configured protocol is the bus's by its number");
+
 /* The bus's protocol: configured, or found by PINGs at the first connect
  * (setup_protocol) and kept for every reconnect. */
 static bool dmn_protocol(struct dmn *d, char *err, size_t cap)
 {
+	/* The daemon's two branches on the protocol, both choosing the backend
+	 * at start-up; everything after asks the servo's model. 1: a configured
+	 * protocol is the bus's, by its number (config.h's CFG_PROTO_n are
+	 * bus.h's BUS_PROTOCOL_n). */
 	if (d->protocol == 0 && d->cfg->protocol != CFG_PROTO_AUTO)
-		d->protocol = d->cfg->protocol == CFG_PROTO_2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1;
+		d->protocol = (enum bus_protocol)d->cfg->protocol;
+	/* 2: protocol = auto, none found yet: PINGs find it (setup_protocol,
+	 * its backends in a table, the AX-12's first) */
 	if (d->protocol == 0 && !setup_protocol(&d->bus, d->cfg, d->port_path, &d->protocol, err, cap))
 		return false;
 	bus_set_protocol(&d->bus, d->protocol);

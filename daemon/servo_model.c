@@ -69,6 +69,34 @@ static const struct {
 	{ DXL2_MODEL_XL430_W250, SM_XL430_POSITION },
 };
 
+static const struct sm_setup sm_ax_setup = {
+	.family = "AX-12", .dxl_opt = "", .factory_baud = 0, .strict = false,
+	.settings_len = DXL_AX_STATUS_RETURN_LEVEL + 1,
+	.return_delay = DXL_AX_RETURN_DELAY_TIME, .status_return_level = DXL_AX_STATUS_RETURN_LEVEL,
+	.output_limit = DXL_AX_MAX_TORQUE, .output_limit_name = "max torque", .position = DXL_AX_PRESENT_POSITION,
+	.angle_limits = DXL_AX_CW_ANGLE_LIMIT,
+	.compliance_margin = DXL_AX_CW_COMPLIANCE_MARGIN, .compliance_slope = DXL_AX_CW_COMPLIANCE_SLOPE,
+	.ramp = DXL_AX_MOVING_SPEED, .ramp_size = 2, .nramp = 1, .ramp_name = "moving speed",
+};
+
+/* The X series' one READ at start-up covers the model (0) to the Bus
+ * Watchdog (98): mode, limits, shutdown, torque, status return level,
+ * hardware error. */
+static const struct sm_setup sm_x_setup = {
+	.family = "X series", .dxl_opt = "--protocol 2 ", .factory_baud = 57600, .strict = true,
+	.settings_len = DXL2_X_BUS_WATCHDOG + 1,
+	.return_delay = DXL2_X_RETURN_DELAY_TIME, .status_return_level = DXL2_X_STATUS_RETURN_LEVEL,
+	.output_limit = DXL2_X_PWM_LIMIT, .output_limit_name = "PWM Limit", .current_limit = DXL2_X_CURRENT_LIMIT,
+	.position = DXL2_X_PRESENT_POSITION,
+	.opmode = DXL2_X_OPERATING_MODE, .pos_limit_min = DXL2_X_MIN_POSITION_LIMIT,
+	.pos_limit_max = DXL2_X_MAX_POSITION_LIMIT,
+	.ramp = DXL2_X_PROFILE_ACCELERATION, .ramp_size = 4, .nramp = 2, .ramp_name = "profile acceleration, velocity",
+	.watchdog = DXL2_X_BUS_WATCHDOG, .hwerr = DXL2_X_HARDWARE_ERROR_STATUS, .shutdown = DXL2_X_SHUTDOWN,
+};
+
+_Static_assert(DXL_AX_STATUS_RETURN_LEVEL + 1 <= SM_SETTINGS_MAX && DXL2_X_BUS_WATCHDOG + 1 <= SM_SETTINGS_MAX,
+               "start-up's settings READ fits its buffer");
+
 /* The AX-12A: its registers here, its datasheet its descriptor's
  * (protocol/dxl2_table.c), filled in at the first sm_ax12(). */
 static struct sm_model sm_ax = {
@@ -78,7 +106,7 @@ static struct sm_model sm_ax = {
 	.present = DXL_AX_PRESENT_POSITION, .present_len = 6, .present_len_slow = 8,
 	.readback = { { SM_AX_READBACK_ADDR, SM_AX_READBACK_LEN, "RAM" } }, .nreadback = 1,
 	.pos_max = DXL_POS_MAX, .torque_full = 1023, .ref_voltage = DXL2_REF_VOLTAGE,
-	.position_from = "AX-12A", .caps = 0, .limits_name = "angle",
+	.position_from = "AX-12A", .caps = 0, .limits_name = "angle", .setup = &sm_ax_setup,
 };
 static bool sm_ax_made;
 
@@ -99,7 +127,7 @@ static const struct sm_model *sm_x_model(size_t i)
 	struct sm_model *m = &sm_x[i];
 	*m = (struct sm_model){
 		.name = d->name, .protocol = 2, .number = d->number, .desc = d, .caps = SM_CAP_HWERR | SM_CAP_OPMODE,
-		.limits_name = "position",
+		.limits_name = "position", .setup = &sm_x_setup,
 		.torque_enable = DXL2_X_TORQUE_ENABLE, .torque_limit = DXL2_X_GOAL_PWM,
 		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
 		/* Present Current where it senses current, Present Load else: 126 */
@@ -145,6 +173,16 @@ const struct sm_model *sm_by_number(int protocol, uint16_t number)
 	for (size_t i = 0; i < dxl2_model_count(); i++)
 		if (dxl2_model_at(i)->protocol == 2 && dxl2_model_at(i)->number == number)
 			return sm_x_model(i);
+	return NULL;
+}
+
+const struct sm_model *sm_family(int protocol)
+{
+	if (protocol == 1)
+		return sm_ax12();
+	for (size_t i = 0; protocol == 2 && i < dxl2_model_count(); i++)
+		if (dxl2_model_at(i)->protocol == 2)
+			return sm_x_model(i);   /* the first X model: the family's registers are every X model's */
 	return NULL;
 }
 

@@ -75,6 +75,46 @@ struct sm_position_defaults {
 	double k_single, mu_single, lead_single;
 };
 
+/* What start-up and the safe stop (daemon/setup.c) read and write besides
+ * the cycle's registers, and how they judge what they find: one start-up
+ * over every family, its differences here. A register 0 is one the family
+ * does not have. (AX-12A | X series.) */
+#define SM_SETTINGS_MAX 128
+struct sm_setup {
+	const char *family;             /* what a protocol found at start is said to run: "AX-12" | "X series" */
+	const char *dxl_opt;            /* the `dxl` options that speak to it, for the fixes said: "" | "--protocol 2 " */
+	long factory_baud;              /* said when servos are missing at another rate; 0: not said (the AX-12's
+	                                   1 Mbps is the rate undulated uses) | 57600 */
+	/* A surprise at start-up — an unknown model number, an output limit of
+	 * 0 — is refused (X: the models' tables differ, and undulated would
+	 * guess), or said and run on the AX-12's table and full output (the
+	 * AX-12A, as undulated always did). */
+	bool strict;
+	uint16_t settings_len;          /* start-up's one READ from register 0: to Status Return Level (17 bytes) |
+	                                   to the Bus Watchdog (99); at most SM_SETTINGS_MAX */
+	uint16_t return_delay;          /* 5 | 9, 2 µs a unit on both */
+	uint16_t status_return_level;   /* 16 | 68 */
+	uint16_t output_limit;          /* the torque limit's ceiling, 2 bytes: Max Torque 14 | PWM Limit 36 */
+	const char *output_limit_name;  /* "max torque" | "PWM Limit" */
+	uint16_t current_limit;         /* 0 | Current Limit 38 (read where current_control) */
+	uint16_t position;              /* Present Position, goal_size bytes: 36 | 132 */
+	/* joint mode: angle limits not both 0 (CW, CCW Angle Limit 6, 8) | Operating
+	 * Mode 11 position control within Min/Max Position Limit 52, 48 (SM_CAP_OPMODE) */
+	uint16_t angle_limits;
+	uint16_t opmode, pos_limit_min, pos_limit_max;
+	/* the position loop's stiffness, each CW register followed by its CCW one:
+	 * Compliance Margin 26, Slope 28 | 0 */
+	uint16_t compliance_margin, compliance_slope;
+	/* What makes every goal a slow ramp when another program left it non-zero,
+	 * set to 0 at start: Moving Speed 32 (one of 2 bytes) | Profile Acceleration
+	 * 108 and Velocity 112 (two of 4). */
+	uint16_t ramp;
+	uint8_t ramp_size, nramp;
+	const char *ramp_name;          /* "moving speed" | "profile acceleration, velocity" */
+	uint16_t watchdog;              /* 0 | Bus Watchdog 98 */
+	uint16_t hwerr, shutdown;       /* Hardware Error Status 70, Shutdown 63 (SM_CAP_HWERR) | 0 */
+};
+
 struct sm_model {
 	const char *name;               /* "XM430-W350" */
 	int protocol;                   /* 1 or 2 */
@@ -82,6 +122,7 @@ struct sm_model {
 	const struct dxl2_model *desc;  /* Protocol 2.0: its descriptor (control table, datasheet); NULL on 1.0 */
 	unsigned caps;                  /* enum sm_cap */
 	const char *limits_name;        /* what its own limits are called: "angle" | "position" */
+	const struct sm_setup *setup;   /* start-up's and the safe stop's registers */
 	/* registers the controller writes */
 	uint16_t torque_enable;         /* 24 | 64 */
 	uint16_t torque_limit;          /* Torque Limit 34 | Goal PWM 100, 2 bytes */
@@ -119,6 +160,10 @@ static inline bool sm_has(const struct sm_model *m, unsigned cap)
 const struct sm_model *sm_ax12(void);
 /* The family a PING's model number names on that protocol; NULL when this
  * daemon does not know it. */
+/* The model start-up reads a servo's settings with before its model number
+ * is known (every model of a protocol shares those registers): the AX-12A
+ * on 1, an X model on 2; NULL on another. */
+const struct sm_model *sm_family(int protocol);
 const struct sm_model *sm_by_number(int protocol, uint16_t number);
 
 /* ---- units ---------------------------------------------------------------------------------- */

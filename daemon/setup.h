@@ -4,25 +4,30 @@
  * has no cycle to keep yet, and the stop is the last thing the daemon does.
  *
  * Start-up: every servo answers a PING (a missing one is named), its
- * settings are read (model, angle limits, max torque, return delay, status
- * return level) and handed to the controller (ctl_set_servo), a servo left in
- * wheel mode by a torque-actuated run is put back in joint mode, the
- * compliance margins and moving speed (RAM: a power loss resets them) are
- * written, and every joint's present position is read. Lost replies are
- * retried (a loaded machine); a port that goes away is not.
+ * settings are read in one READ and judged (model, status return level,
+ * output limit, hardware error, return delay) and handed to the controller
+ * (ctl_set_servo); joint mode is made what the loop expects, the RAM it
+ * relies on written (a power loss resets it), and every joint's present
+ * position is read. Lost replies are retried (a loaded machine); a port
+ * that goes away is not.
  *
- * Safe stop: any wheel-mode drive is stopped and joint mode restored, then
- * the robot is left as configured (safe_stop: holding where it is, or limp),
- * and what matters is read back: a torque-off that did not take is said.
+ * One path for every servo family: what differs is its model's data
+ * (servo_model.h, sm_setup: which registers, how strict) and capabilities.
+ * Joint mode is angle limits (AX-12: a servo a torque-actuated run left in
+ * wheel mode is put back) or Operating Mode 3 with Min/Max Position Limit
+ * made the configuration's (SM_CAP_OPMODE: EEPROM, written with torque off,
+ * only when they differ; a drive mode of ours is put back, another
+ * refused); an unknown model number is refused where the family's models
+ * differ; the compliance margins and slopes are written where the servo has
+ * them, a ramp another program left (Moving Speed, the profiles) set to 0,
+ * a bus watchdog that stopped the servo cleared and the configured one set
+ * (bus_watchdog_ms) where it has one.
  *
- * X series (setup_x.c): the model is identified (an unknown model number is
- * refused), Operating Mode must be position control (a torque-actuated run's
- * current or PWM control is put back), Min/Max Position Limit are made the
- * configuration's (EEPROM: written with torque off, only when they differ),
- * the profiles are set to none, a bus watchdog that stopped the servo is
- * cleared and the configured one set (bus_watchdog_ms); at the safe stop the
- * watchdog is cleared first — a robot left holding by a clean stop is not a
- * silent controller — then the servos hold or go limp.
+ * Safe stop: a bus watchdog is cleared first (a robot left holding by a
+ * clean stop is not a silent controller), any torque-actuation drive is
+ * stopped and joint mode restored, then the robot is left as configured
+ * (safe_stop: holding where it is, or limp), and what matters is read back:
+ * a torque-off that did not take is said.
  */
 #ifndef UNDULATE_DAEMON_SETUP_H
 #define UNDULATE_DAEMON_SETUP_H

@@ -1,9 +1,8 @@
 /*
  * setup_io.c — what the set-up of every servo family uses (setup_priv.h):
  * READ and WRITE tried SETUP_TRIES times after a quiet line, a joint made
- * limp and read back, and the joint limits in a model's units. setup.c (the
- * AX-12 and the dispatch) and setup_x.c (the X series) call these; these
- * call neither, so the two files no longer call each other.
+ * limp and read back, and the joint limits in a model's units. setup.c
+ * calls these; these call nothing of it.
  */
 #include "setup_priv.h"
 

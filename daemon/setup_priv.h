@@ -1,8 +1,8 @@
 /*
  * setup_priv.h — what the files of the start-up and safe stop share:
- * setup.c (both protocols, the AX-12's registers), setup_x.c (the X
- * series' registers) and setup_io.c (the transactions both use, tried
- * again; it calls neither). Nothing outside them includes this.
+ * setup.c (every servo family, through its model: servo_model.h's
+ * sm_setup) and setup_io.c (the transactions it uses, tried again).
+ * Nothing outside them includes this.
  */
 #ifndef UNDULATE_DAEMON_SETUP_PRIV_H
 #define UNDULATE_DAEMON_SETUP_PRIV_H
@@ -17,10 +17,5 @@ void setup_pause(struct bus *bus, int t, uint8_t id, const char *what, int last)
 int setup_read(struct bus *bus, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out, uint8_t *eb);
 int setup_write(struct bus *bus, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply,
                 uint8_t *eb);
-
-/* ---- setup_x.c: the X series --------------------------------------------------------------- */
-bool setup_servo_x(struct bus *bus, struct ctl *ctl, size_t j, const struct cfg *cfg, const char *port_path,
-                   int *max_return_delay_us, char *err, size_t cap);
-void setup_safe_stop_x(struct bus *bus, const struct ctl *ctl, bool limp);
 
 #endif

@@ -33,8 +33,6 @@
 #include <stdio.h>
 
 #include "control_priv.h"
-#include "dxl.h"
-#include "dxl_table.h"
 
 /* A virtual spring pushes a joint back from TQ_WALL_MARGIN inside either
  * limit, reaching the stall torque at the limit itself, with TQ_WALL_DAMPING
@@ -74,32 +72,31 @@ bool tq_want_wheel(const struct ctl *c)
 	return true;
 }
 
-void tq_check_limits(struct ctl *c)
+bool tq_check_limits(struct ctl *c, char *what, size_t cap)
 {
 	if (!c->wheel)
-		return;
+		return false;
 	for (size_t j = 0; j < c->n; j++) {
 		const struct ctl_joint *jt = &c->j[j];
 		if (!jt->fresh || (jt->angle >= jt->limits.lo && jt->angle <= jt->limits.hi))
 			continue;
 		c->limit_trips++;
 		double neutral = c->cfg->joint[j].neutral;
-		char what[CTL_LATCH_TEXT];
-		snprintf(what, sizeof what, "servo %u at %+.3f rad left its limits [%+.3f, %+.3f] under torque actuation",
+		snprintf(what, cap, "servo %u at %+.3f rad left its limits [%+.3f, %+.3f] under torque actuation",
 		         jt->id, jt->angle - neutral, jt->limits.lo - neutral, jt->limits.hi - neutral);
 		ctl_event(c, 2, "limit", "%s: robot %s in joint mode", what,
 		          cfg_mode_name(c->cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD));
 		/* HOLD where it is: the safety clamp puts the goal inside the limits */
-		ctl_latch(c, what);
-		return;
+		return true;
 	}
+	return false;
 }
 
-void tq_check_supply(struct ctl *c)
+bool tq_check_supply(struct ctl *c, char *what, size_t cap)
 {
 	const struct cfg *cfg = c->cfg;
 	if (cfg->torque_drive != CFG_DRIVE_PWM || !tq_mode_drives(c, c->mode))
-		return;
+		return false;
 	for (size_t j = 0; j < c->n; j++) {
 		struct ctl_joint *jt = &c->j[j];
 		const struct sm_model *m = ctl_model(c, j);
@@ -110,16 +107,15 @@ void tq_check_supply(struct ctl *c)
 		sm_supply_range(m, &lo, &hi);
 		jt->faults++;
 		c->faults++;
-		char what[CTL_LATCH_TEXT];
-		snprintf(what, sizeof what, "servo %u reads its supply as %.1f V, outside the %s's %.2f..%.2f V", jt->id,
+		snprintf(what, cap, "servo %u reads its supply as %.1f V, outside the %s's %.2f..%.2f V", jt->id,
 		         jt->voltage, m->name, lo, hi);
 		/* within CTL_EVENT_TEXT for the longest model name and reading */
 		ctl_event(c, 2, "supply", "%s (rated %.1f..%.1f V): not a gain for the PWM drive; robot %s in joint mode",
 		          what, m->rated_min_v, m->rated_max_v,
 		          cfg_mode_name(cfg->fault_action == CFG_SAFE_LIMP ? CFG_MODE_LIMP : CFG_MODE_HOLD));
-		ctl_latch(c, what);
-		return;
+		return true;
 	}
+	return false;
 }
 
 /* The virtual spring near a limit (N·m), on top of the law's torque. */
@@ -237,16 +233,17 @@ void tq_duties(struct ctl *c, double t_real)
 static void tq_switch_limits(struct ctl *c, size_t j, uint32_t limits, bool torque_after)
 {
 	uint8_t id = c->j[j].id;
-	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 0);
-	ctl_write_seq(c, id, DXL_AX_CW_ANGLE_LIMIT, 4, limits);
+	const struct sm_model *m = ctl_model(c, j);
+	ctl_write_seq(c, id, m->torque_enable, 1, 0);
+	ctl_write_seq(c, id, m->setup->angle_limits, 4, limits);
 	if (!torque_after)
 		return;
 	/* Torque on the manual's way, the torque limit first: enabling torque
 	 * clears a latched overload bit, so an alarm shutdown that zeroed the
 	 * torque limit since the last reading would otherwise never be seen, and
 	 * the joint would stay without drive. */
-	ctl_write_seq(c, id, DXL_AX_TORQUE_LIMIT, 2, ctl_torque_limit(c, &c->j[j]));
-	ctl_write_seq(c, id, DXL_AX_TORQUE_ENABLE, 1, 1);
+	ctl_write_seq(c, id, m->torque_limit, 2, ctl_torque_limit(c, &c->j[j]));
+	ctl_write_seq(c, id, m->torque_enable, 1, 1);
 }
 
 /* X series: into the drive's mode, one chain per servo (above). */
@@ -259,7 +256,7 @@ static void tq_x_enter(struct ctl *c, size_t j)
 	jt->drive_ready = false;
 	jt->drive_chain = ch;
 	ctl_write_chain(c, ch, jt->id, m->torque_enable, 1, 0);
-	ctl_write_chain(c, ch, jt->id, DXL2_X_OPERATING_MODE, 1, sm_drive_opmode(current));
+	ctl_write_chain(c, ch, jt->id, m->setup->opmode, 1, sm_drive_opmode(current));
 	/* the new mode put Goal PWM at its limit: in PWM control a full drive */
 	ctl_write_chain(c, ch, jt->id, sm_drive_register(m, current), 2, 0);
 	ctl_write_chain(c, ch, jt->id, m->torque_enable, 1, 1);
@@ -312,14 +309,14 @@ void tq_stop_goals(struct ctl *c)
 	}
 }
 
-void tq_chain_result(struct ctl *c, size_t j, const struct wq_write *w, bool ok)
+bool tq_chain_result(struct ctl *c, size_t j, const struct wq_write *w, bool ok, char *what, size_t cap)
 {
 	struct ctl_joint *jt = &c->j[j];
 	const struct sm_model *m = ctl_model(c, j);
 	if (ok) {
 		if (w->addr == m->torque_enable && w->value == 1)
 			jt->drive_ready = true;
-		return;
+		return false;
 	}
 	jt->drive_ready = false;
 	jt->drive_chain = 0;
@@ -329,12 +326,8 @@ void tq_chain_result(struct ctl *c, size_t j, const struct wq_write *w, bool ok)
 	          "torque actuation ends, servos back in position control (reset %lld of %d)", jt->id,
 	          c->cfg->torque_drive == CFG_DRIVE_CURRENT ? "current" : "PWM", w->addr, jt->resets,
 	          c->cfg->fault_retries);
-	if (jt->resets > c->cfg->fault_retries) {
-		char what[CTL_LATCH_TEXT];
-		snprintf(what, sizeof what, "servo %u: its switch to torque actuation failed %lld times", jt->id,
-		         jt->resets);
-		ctl_latch(c, what);
-	}
-	if (c->wheel)
-		tq_leave_wheel(c);
+	if (jt->resets <= c->cfg->fault_retries)
+		return false;
+	snprintf(what, cap, "servo %u: its switch to torque actuation failed %lld times", jt->id, jt->resets);
+	return true;
 }

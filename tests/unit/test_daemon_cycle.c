@@ -1,13 +1,28 @@
 /*
- * test_daemon_cycle.c — the cycle's bus work (cycle.h) through the seam it was
- * designed with: a fake transport with a fake clock (bus_io), and behind it a
- * small plant of AX-12 control tables that answers READ, WRITE and
- * SYNC_WRITE with the wire time a real bus takes. The loop that drives it is
- * the daemon's, reduced: a tick every 10 ms starts a cycle (cutting one still
- * on the bus), the transport's next byte or the deadline wakes the cycle, and
- * at CYC_CONTROL the controller steps. Faults are the plant's: lost, damaged
- * and late replies, a servo that resets, a bus that goes away, replies so
- * slow that the writes do not fit in the period.
+ * test_daemon_cycle.c — the cycle's bus work (cycle.h) and the controller
+ * through the seam they were designed with: a fake transport with a fake
+ * clock (bus_io), and behind it one of two fake buses, each with the wire
+ * time a real bus takes at 1 Mbps:
+ *  - AX-12A: a small plant of AX-12 control tables on Protocol 1.0 that
+ *    answers READ, WRITE and SYNC_WRITE;
+ *  - X series: the fake X servos of xfake.h (their own CRC and stuffing;
+ *    the e-manual's refusals) on Protocol 2.0.
+ * The loop that drives it is the daemon's, reduced: a tick every 10 ms
+ * starts a cycle (cutting one still on the bus), the transport's next byte
+ * or the deadline wakes the cycle, and at CYC_CONTROL the controller steps.
+ *
+ * What both families must do is one test body run on each bus (struct
+ * backend: the servos' registers and how each bus loses or delays a reply):
+ * normal cycles, a lost and a damaged reply, a reply a period late, LIMP
+ * racing HOLD's writes. What only one family has is tested on its bus: on
+ * the AX-12's, writes that do not fit, a cycle cut off by the tick, writes
+ * that never starve, a servo reset, a write given up, the port going away;
+ * on the X series', a hardware-error shutdown found through the alert and
+ * recovered by one REBOOT or latched, a tripped bus watchdog, a power loss,
+ * an Operating Mode changed behind the controller's back, torque actuation
+ * switching into current control and back, and a switch that stops
+ * half-way. Each model's fault and LIMP paths are checked write by write
+ * against its control table (writes_are_the_models).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -23,11 +38,58 @@
 #include "../../daemon/cycle.h"
 #include "bus.h"
 #include "dxl.h"
+#include "dxl2.h"
+#include "dxl2_table.h"
 #include "dxl_table.h"
+#include "xfake.h"
 
 #define PERIOD_US 10000
 #define NSERVO_MAX 18
-#define RX_CAP 8192
+#define RX_CAP 16384
+#define WATCHDOG_UNITS 5   /* the default 100 ms */
+
+/* ---- the transport and the clock, over either bus --------------------------------------------- */
+struct fake {
+	bool x;                    /* the X series' bus (xfake.h), else the AX-12 plant */
+	uint64_t now;
+	uint8_t rx[RX_CAP];
+	uint64_t rx_at[RX_CAP];
+	size_t head, tail;
+	int write_error;           /* the transport fails: DXL_E_DISCONNECTED */
+	/* the AX-12 plant */
+	struct dxl_parser parser;
+	unsigned sync_writes;
+	/* the X bus */
+	uint64_t request_end;      /* when the request being answered ended on the wire */
+	uint64_t line_free;        /* when the last reply queued ends */
+	uint64_t late_us;          /* the next reply this much later */
+	int corrupt;               /* replies to damage (a bit of their CRC) */
+};
+
+static struct fake f;
+static struct cfg cfg;
+static struct ctl c;
+static struct bus bus;
+static struct cyc y;
+static uint64_t next_tick;
+static unsigned cuts;
+static void (*at_control)(void);   /* run at the cycle boundary, before the step */
+static void (*on_write_sent)(void);   /* run when a WRITE goes out (mid-cycle) */
+
+static uint64_t wire_us(size_t bytes) { return bytes * 10; }   /* 1 Mbps, 8N1 */
+
+/* Room for n more bytes of replies on the fake line, either bus's. */
+static void rx_room(size_t n)
+{
+	if (f.tail + n > RX_CAP && f.head > 0) {
+		/* what was read is gone: room for long runs */
+		memmove(f.rx, f.rx + f.head, f.tail - f.head);
+		memmove(f.rx_at, f.rx_at + f.head, (f.tail - f.head) * sizeof f.rx_at[0]);
+		f.tail -= f.head;
+		f.head = 0;
+	}
+	assert_true(f.tail + n <= RX_CAP);
+}
 
 /* ---- the plant: AX-12 control tables ---------------------------------------------------------- */
 struct servo {
@@ -42,27 +104,8 @@ struct servo {
 	unsigned writes[DXL_AX_TABLE_SIZE];   /* WRITE instructions per start address */
 };
 
-struct fake {
-	uint64_t now;
-	uint8_t rx[RX_CAP];
-	uint64_t rx_at[RX_CAP];
-	size_t head, tail;
-	struct dxl_parser parser;
-	int write_error;       /* the transport fails: DXL_E_DISCONNECTED */
-	unsigned sync_writes;
-};
-
-static struct fake f;
 static struct servo sv[NSERVO_MAX];
 static size_t nsv;
-static struct cfg cfg;
-static struct ctl c;
-static struct bus bus;
-static struct cyc y;
-static uint64_t next_tick;
-static unsigned cuts;
-static void (*at_control)(void);   /* run at the cycle boundary, before the step */
-static void (*on_write_sent)(void);   /* run when a WRITE goes out (mid-cycle) */
 
 static struct servo *servo_by_id(uint8_t id)
 {
@@ -99,18 +142,9 @@ static void servo_init(struct servo *s, uint8_t id)
 	s->mem[DXL_AX_CW_COMPLIANCE_MARGIN] = s->mem[DXL_AX_CCW_COMPLIANCE_MARGIN] = 0;
 }
 
-static uint32_t wire_us(size_t bytes) { return (uint32_t)(bytes * 10); }   /* 1 Mbps, 8N1 */
-
 static void push(const uint8_t *d, size_t n, uint64_t at)
 {
-	if (f.tail + n > RX_CAP && f.head > 0) {
-		/* what was read is gone: room for long runs */
-		memmove(f.rx, f.rx + f.head, f.tail - f.head);
-		memmove(f.rx_at, f.rx_at + f.head, (f.tail - f.head) * sizeof f.rx_at[0]);
-		f.tail -= f.head;
-		f.head = 0;
-	}
-	assert_true(f.tail + n <= RX_CAP);
+	rx_room(n);
 	for (size_t i = 0; i < n; i++) {
 		f.rx[f.tail] = d[i];
 		f.rx_at[f.tail++] = at;
@@ -179,12 +213,30 @@ static void plant(const struct dxl_packet *p, uint64_t done)
 	}
 }
 
-/* ---- the transport ------------------------------------------------------------------------------ */
-static int fake_write(void *ctx, const uint8_t *buf, size_t n)
+/* ---- the X bus: xfake.h's servos ------------------------------------------------------------ */
+static struct xfake xb;
+
+/* Replies follow one another on the line, each after its servo's return delay. */
+static void emit(void *ctx, const uint8_t *pkt, size_t n, unsigned delay_us)
 {
 	(void)ctx;
-	if (f.write_error)
-		return f.write_error;
+	uint64_t start = (f.request_end > f.line_free ? f.request_end : f.line_free) + delay_us + f.late_us;
+	f.late_us = 0;
+	rx_room(n);
+	for (size_t i = 0; i < n; i++) {
+		f.rx[f.tail] = pkt[i];
+		if (f.corrupt > 0 && i == n - 1)
+			f.rx[f.tail] ^= 0x01;
+		f.rx_at[f.tail++] = start + wire_us(i + 1);
+	}
+	if (f.corrupt > 0)
+		f.corrupt--;
+	f.line_free = start + wire_us(n);
+}
+
+/* ---- the transport ------------------------------------------------------------------------------ */
+static void fake_write_ax(const uint8_t *buf, size_t n)
+{
 	uint64_t done = f.now + wire_us(n);
 	size_t off = 0;
 	while (off < n) {
@@ -197,6 +249,27 @@ static int fake_write(void *ctx, const uint8_t *buf, size_t n)
 		else if (r == DXL_NEED_MORE)
 			break;
 	}
+}
+
+static void fake_write_x(const uint8_t *buf, size_t n)
+{
+	f.request_end = f.now + wire_us(n);
+	f.line_free = f.request_end;
+	unsigned writes = atomic_load(&xb.writes) + atomic_load(&xb.reboots);
+	xfake_feed(&xb, buf, n);
+	if (on_write_sent != NULL && atomic_load(&xb.writes) + atomic_load(&xb.reboots) != writes)
+		on_write_sent();
+}
+
+static int fake_write(void *ctx, const uint8_t *buf, size_t n)
+{
+	(void)ctx;
+	if (f.write_error)
+		return f.write_error;
+	if (f.x)
+		fake_write_x(buf, n);
+	else
+		fake_write_ax(buf, n);
 	return DXL_OK;
 }
 
@@ -259,24 +332,44 @@ static void drive(enum cyc_status st)
 	}
 }
 
-/* One tick: a cycle still on the bus is cut off, the events taken (true if
- * one of kind `kind` was among them or comes out of this cycle), a cycle run. */
+/* The controller's events as they come, "kind: text" (the first 64). */
+static char events[64][CTL_EVENT_TEXT + 32];
+static size_t nevents;
+
+/* Takes the events; true if one of kind `kind` was among them. */
+static bool take_events(const char *kind)
+{
+	struct ctl_event e;
+	bool seen = false;
+	while (ctl_next_event(&c, &e)) {
+		seen = seen || (kind != NULL && strcmp(e.kind, kind) == 0);
+		if (nevents < 64)
+			snprintf(events[nevents++], sizeof events[0], "%s: %s", e.kind, e.text);
+	}
+	return seen;
+}
+
+static const char *find_event(const char *needle)
+{
+	for (size_t i = 0; i < nevents; i++)
+		if (strstr(events[i], needle) != NULL)
+			return events[i];
+	return NULL;
+}
+
+/* One tick: a cycle still on the bus is cut off, a cycle run; true if an
+ * event of kind `kind` came since the last tick or out of this cycle. */
 static bool tick(const char *kind)
 {
-	bool seen = false;
 	f.now = next_tick;
 	next_tick += PERIOD_US;
 	if (cyc_busy(&y)) {
 		cyc_cut(&y);
 		cuts++;
 	}
-	struct ctl_event e;
-	while (ctl_next_event(&c, &e))
-		seen = seen || (kind != NULL && strcmp(e.kind, kind) == 0);
+	bool seen = take_events(kind);
 	drive(cyc_start(&y));
-	for (size_t k = 0; k < c.nevents && kind != NULL; k++)
-		seen = seen || strcmp(c.events[k].kind, kind) == 0;
-	return seen;
+	return take_events(kind) || seen;
 }
 
 static void run(int cycles)
@@ -293,89 +386,236 @@ static void run_watching(int cycles, const char *kind)
 		saw_event = tick(kind);
 }
 
-static void setup_n(size_t n, enum cfg_mode mode, uint32_t margin_us)
+/* What both set-ups share: the configuration (with `sets`), the bus over
+ * the fake transport, the cycle, the clock. */
+static void setup_common(size_t n, enum cfg_mode mode, const char *const *sets)
 {
 	struct cfg_errors e = { 0 };
 	char ids[128] = "robot.ids=";
-	memset(&f, 0, sizeof f);
-	dxl_parser_init(&f.parser, DXL_PARSE_INSTRUCTION);
-	nsv = n;
-	for (size_t i = 0; i < n; i++) {
-		servo_init(&sv[i], (uint8_t)(i + 1));
+	for (size_t i = 0; i < n; i++)
 		snprintf(ids + strlen(ids), sizeof ids - strlen(ids), "%s%zu", i ? "," : "", i + 1);
-	}
 	cfg_defaults(&cfg);
 	assert_true(cfg_override(&cfg, "robot.port=/dev/null", &e));
 	assert_true(cfg_override(&cfg, ids, &e));
+	for (size_t i = 0; sets != NULL && sets[i] != NULL; i++)
+		assert_true(cfg_override(&cfg, sets[i], &e));
 	cfg.mode = mode;
 	assert_true(cfg_finish(&cfg, &e));
 	ctl_init(&c, &cfg);
+}
+
+static void setup_start(uint32_t margin_us, enum bus_protocol protocol)
+{
+	struct bus_io io = { .ctx = &f, .write = fake_write, .read = fake_read, .wait = fake_wait, .now_us = fake_now,
+	                     .flush_input = fake_flush };
+	struct bus_timing tm = { .baud = 1000000, .return_delay_us = 0, .adapter_latency_us = 0, .margin_us = margin_us };
+	bus_init(&bus, &io, &tm, false);
+	assert_int_equal(bus_set_protocol(&bus, protocol), DXL_OK);
+	struct cyc_hooks hooks = { .bus_error = on_bus_error };
+	cyc_init(&y, &bus, &c, PERIOD_US, &hooks);
+	next_tick = 1000000;
+	f.now = next_tick - PERIOD_US;
+	cuts = 0;
+	nevents = 0;
+	bus_error_count = 0;
+	at_control = NULL;
+	on_write_sent = NULL;
+	ctl_start(&c, 1e-6 * (double)f.now, "test");
+}
+
+/* n AX-12As as undulated's start-up leaves them. */
+static void setup_n(size_t n, enum cfg_mode mode, uint32_t margin_us)
+{
+	memset(&f, 0, sizeof f);
+	dxl_parser_init(&f.parser, DXL_PARSE_INSTRUCTION);
+	nsv = n;
+	for (size_t i = 0; i < n; i++)
+		servo_init(&sv[i], (uint8_t)(i + 1));
+	on_plant_write = NULL;
+	setup_common(n, mode, NULL);
 	char why[256];
 	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
 	for (size_t j = 0; j < n; j++) {
 		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
 		ctl_measure(&c, j, 512, 0, 0, 0, 0.01);
 	}
-	struct bus_io io = { .ctx = &f, .write = fake_write, .read = fake_read, .wait = fake_wait, .now_us = fake_now,
-	                     .flush_input = fake_flush };
-	struct bus_timing tm = { .baud = 1000000, .return_delay_us = 0, .adapter_latency_us = 0, .margin_us = margin_us };
-	bus_init(&bus, &io, &tm, false);
-	struct cyc_hooks hooks = { .bus_error = on_bus_error };
-	cyc_init(&y, &bus, &c, PERIOD_US, &hooks);
-	next_tick = 1000000;
-	f.now = next_tick - PERIOD_US;
-	cuts = 0;
-	bus_error_count = 0;
-	at_control = NULL;
-	on_write_sent = NULL;
-	on_plant_write = NULL;
-	ctl_start(&c, 1e-6 * (double)f.now, "test");
+	setup_start(margin_us, BUS_PROTOCOL_1);
 }
 
 static void setup(enum cfg_mode mode) { setup_n(2, mode, 500); }
 
-/* ---- tests ------------------------------------------------------------------------------------ */
+static struct xfake_servo *xs(uint8_t id) { return xfake_servo_by_id(&xb, id); }
+static uint32_t xreg(uint8_t id, uint16_t addr, int size) { return xfake_get(xs(id)->mem, addr, size); }
+
+/* Two X servos (or the models given) as undulated's start-up leaves them:
+ * 1 Mbps, return delay 0, position control, the watchdog set, torque off. */
+static void setup_x(const uint16_t *models, size_t n, enum cfg_mode mode, const char *const *sets)
+{
+	memset(&f, 0, sizeof f);
+	f.x = true;
+	memset(&xb, 0, sizeof xb);
+	xb.emit = emit;
+	xb.alert_from_hwerr = true;
+	for (size_t i = 0; i < n; i++) {
+		xfake_servo_defaults(&xb.servo[xb.nservos++], (uint8_t)(i + 1), models[i]);
+		struct xfake_servo *s = &xb.servo[i];
+		s->mem[8] = 3;
+		s->mem[9] = 0;
+		s->mem[98] = WATCHDOG_UNITS;
+		xfake_put(s->mem, 48, 2048 + 1700, 4);
+		xfake_put(s->mem, 52, 2048 - 1700, 4);
+		xfake_put(s->mem, 128, 0, 4);
+	}
+	setup_common(n, mode, sets);
+	char why[256];
+	for (size_t j = 0; j < n; j++) {
+		struct ctl_servo_info info = { .cw_limit = 2048 - 1700, .ccw_limit = 2048 + 1700, .max_torque = 885,
+		                               .status_return_level = 2, .model = sm_by_number(2, models[j]),
+		                               .current_limit = 1193 };
+		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
+		struct sm_present p = { .pos_raw = 2048, .angle = 0, .voltage = NAN, .temperature = NAN };
+		ctl_measure_present(&c, j, &p, 0, 0.01);
+	}
+	setup_start(500, BUS_PROTOCOL_2);
+}
+
+static const uint16_t xm2[] = { DXL2_MODEL_XM430_W350, DXL2_MODEL_XM430_W350 };
+static const uint16_t xl_xm[] = { DXL2_MODEL_XL430_W250, DXL2_MODEL_XM430_W350 };
+
+/* ---- the two buses, as the tests that run on both see them ------------------------------------ */
+struct backend {
+	const char *name;
+	void (*setup)(size_t n, enum cfg_mode mode);
+	uint32_t (*reg)(uint8_t id, uint16_t addr, int size);
+	void (*put)(uint8_t id, uint16_t addr, uint32_t v, int size);
+	uint16_t torque_enable, present_position;
+	int pos_size;
+	int32_t centre;
+	/* a reply a whole period late: how late, and on a bus of how many servos */
+	uint64_t late_us;
+	size_t late_servos;
+	void (*late_next)(uint8_t id, uint64_t us);
+	void (*lose_next)(uint8_t id);       /* the servo's next reply lost ... */
+	void (*found_again)(uint8_t id);     /* ... and it answers again */
+	void (*damage_next)(uint8_t id);     /* its next reply damaged */
+	unsigned (*sync_writes)(void);
+	uint64_t bus_us_min, bus_us_max;     /* a normal cycle's bus time */
+	void (*normal_servo)(uint8_t id);    /* what else normal cycles leave on the family's servo */
+};
+
+static void ax_setup(size_t n, enum cfg_mode mode) { setup_n(n, mode, 500); }
+static uint32_t ax_reg(uint8_t id, uint16_t addr, int size)
+{
+	return size == 1 ? sv[id - 1].mem[addr] : dxl_get_u16(&sv[id - 1].mem[addr]);
+}
+static void ax_put(uint8_t id, uint16_t addr, uint32_t v, int size)
+{
+	if (size == 1)
+		sv[id - 1].mem[addr] = (uint8_t)v;
+	else
+		dxl_put_u16(&sv[id - 1].mem[addr], (uint16_t)v);
+}
+static void ax_late_next(uint8_t id, uint64_t us) { sv[id - 1].late_us = us; }
+static void ax_lose_next(uint8_t id) { sv[id - 1].drop = 1; }
+static void ax_found_again(uint8_t id) { (void)id; }
+static void ax_damage_next(uint8_t id) { sv[id - 1].corrupt = 1; }
+static unsigned ax_sync_writes(void) { return f.sync_writes; }
+static void ax_normal_servo(uint8_t id)
+{
+	/* start-up: torque limit then torque on, each written exactly once */
+	assert_int_equal(sv[id - 1].writes[DXL_AX_TORQUE_ENABLE], 1);
+	assert_int_equal(sv[id - 1].writes[DXL_AX_TORQUE_LIMIT], 1);
+	assert_int_equal(dxl_get_u16(&sv[id - 1].mem[DXL_AX_GOAL_POSITION]), 512);
+	assert_int_equal(c.j[id - 1].torque_limit_read, 1023);
+}
+
+static void x_setup(size_t n, enum cfg_mode mode) { setup_x(xm2, n, mode, NULL); }
+static void x_put(uint8_t id, uint16_t addr, uint32_t v, int size) { xfake_put(xs(id)->mem, addr, v, size); }
+/* the next reply on the line, whichever servo sends it */
+static void x_late_next(uint8_t id, uint64_t us) { (void)id; f.late_us = us; }
+static void x_lose_next(uint8_t id) { xs(id)->powered = false; }
+static void x_found_again(uint8_t id) { xs(id)->powered = true; }
+/* the next reply on the line: servo 1's comes first in the SYNC_READ */
+static void x_damage_next(uint8_t id) { (void)id; f.corrupt = 1; }
+static unsigned x_sync_writes(void) { return atomic_load(&xb.sync_writes); }
+static void x_normal_servo(uint8_t id)
+{
+	assert_int_equal(atomic_load(&xb.sync_reads), 100);   /* one SYNC_READ a cycle */
+	assert_int_equal(xreg(id, 100, 2), 885);              /* Goal PWM at PWM Limit */
+	assert_int_equal(xreg(id, 116, 4), 2048);             /* holding where it stands */
+	const struct ctl_joint *jt = &c.j[id - 1];
+	assert_int_equal(jt->opmode_read, 3);
+	assert_int_equal(jt->watchdog_read, WATCHDOG_UNITS);
+	assert_int_equal(jt->hwerr, 0);
+	/* the slow read every other cycle brings voltage and temperature */
+	assert_true(fabs(jt->voltage - 12.0) < 1e-9 && fabs(jt->temperature - 36) < 1e-9);
+	assert_int_equal(c.readback_mismatches, 0);
+}
+
+/* The AX-12's READ(36) reply 100 µs into the next cycle, before that
+ * cycle's own; on the X bus the SYNC_READ's reply late by as much. */
+static struct backend ax_bus = {
+	.name = "AX-12A", .setup = ax_setup, .reg = ax_reg, .put = ax_put,
+	.torque_enable = DXL_AX_TORQUE_ENABLE, .present_position = DXL_AX_PRESENT_POSITION, .pos_size = 2, .centre = 512,
+	.late_us = PERIOD_US - 220 + 100, .late_servos = 2, .late_next = ax_late_next,
+	.lose_next = ax_lose_next, .found_again = ax_found_again, .damage_next = ax_damage_next,
+	.sync_writes = ax_sync_writes, .bus_us_min = 400, .bus_us_max = 2000, .normal_servo = ax_normal_servo,
+};
+/* SYNC_READ of 21 bytes from two servos and the goals' SYNC_WRITE: 16 + 2 x
+ * 32 + 24 bytes at 1 Mbps, about 1 ms */
+#define X_BUS(bus_name, setup_fn) { \
+	.name = bus_name, .setup = setup_fn, .reg = xreg, .put = x_put, \
+	.torque_enable = 64, .present_position = 132, .pos_size = 4, .centre = 2048, \
+	.late_us = PERIOD_US - 100, .late_servos = 1, .late_next = x_late_next, \
+	.lose_next = x_lose_next, .found_again = x_found_again, .damage_next = x_damage_next, \
+	.sync_writes = x_sync_writes, .bus_us_min = 500, .bus_us_max = 2500, .normal_servo = x_normal_servo, \
+}
+static struct backend x_bus = X_BUS("XM430-W350", x_setup);
+/* an XL430 beside an XM430: two models on one bus */
+static void x_setup_mixed(size_t n, enum cfg_mode mode) { setup_x(xl_xm, n, mode, NULL); }
+static struct backend x_mixed_bus = X_BUS("XL430-W250 + XM430-W350", x_setup_mixed);
+
+/* ---- tests on both buses ---------------------------------------------------------------------- */
 static void test_normal_cycles(void **state)
 {
-	(void)state;
-	setup(CFG_MODE_HOLD);
+	const struct backend *b = *state;
+	b->setup(2, CFG_MODE_HOLD);
 	run(100);
 	assert_int_equal(cuts, 0);
 	assert_int_equal(y.errors, 0);
-	assert_int_equal(f.sync_writes, 100);
-	for (size_t i = 0; i < nsv; i++) {
-		/* start-up: torque limit then torque on, each written exactly once */
-		assert_int_equal(sv[i].mem[DXL_AX_TORQUE_ENABLE], 1);
-		assert_int_equal(sv[i].writes[DXL_AX_TORQUE_ENABLE], 1);
-		assert_int_equal(sv[i].writes[DXL_AX_TORQUE_LIMIT], 1);
-		assert_int_equal(dxl_get_u16(&sv[i].mem[DXL_AX_GOAL_POSITION]), 512);
+	assert_int_equal(b->sync_writes(), 100);
+	for (uint8_t id = 1; id <= 2; id++) {
+		assert_int_equal(b->reg(id, b->torque_enable, 1), 1);
 		/* read back, and seen to be on */
-		assert_int_equal(c.j[i].torque_read, 1);
-		assert_int_equal(c.j[i].torque_limit_read, 1023);
-		assert_int_equal(c.j[i].stale_cycles, 0);
+		assert_int_equal(c.j[id - 1].torque_read, 1);
+		assert_int_equal(c.j[id - 1].stale_cycles, 0);
+		b->normal_servo(id);
 	}
 	/* every 5 cycles one joint read back: 20 in 100 cycles */
 	assert_int_equal(y.readbacks, 20);
 	/* and the cycle's bus time is the wire time, far inside the period */
-	assert_true(y.bus_us > 400 && y.bus_us < 2000);
+	assert_true(y.bus_us > b->bus_us_min && y.bus_us < b->bus_us_max);
 	assert_int_equal(wq_pending(&c.wq), 0);
 }
 
+/* A lost reply (on the X bus: a servo missing from the SYNC_READ, the others
+ * read) and a damaged one: that joint stale for a cycle, the bus names it. */
 static void test_lost_and_damaged_replies(void **state)
 {
-	(void)state;
-	setup(CFG_MODE_HOLD);
+	const struct backend *b = *state;
+	b->setup(2, CFG_MODE_HOLD);
 	run(10);
-	sv[1].drop = 1;
+	b->lose_next(2);
 	run(1);
+	b->found_again(2);
 	assert_int_equal(c.j[1].stale_cycles, 1);   /* this cycle joint 2 had no reading */
 	assert_int_equal(c.j[0].stale_cycles, 0);   /* joint 1 did */
 	assert_int_equal(y.errors, 1);
-	sv[0].corrupt = 1;
+	assert_int_equal(bus.servo[2].timeouts, 1);
+	b->damage_next(1);
 	run(1);
 	assert_int_equal(c.j[0].stale_cycles, 1);
 	assert_int_equal(c.j[1].stale_cycles, 0);
-	assert_int_equal(y.errors, 2);
 	assert_int_equal(bus.servo[1].checksum_errors, 1);
 	run(5);
 	assert_int_equal(c.j[0].stale_cycles + c.j[1].stale_cycles, 0);
@@ -386,23 +626,57 @@ static void test_lost_and_damaged_replies(void **state)
  * reading: the servo has moved since. */
 static void test_reply_one_period_late(void **state)
 {
-	(void)state;
-	setup(CFG_MODE_HOLD);
-	run(11);   /* an odd count: the next READ asks for 6 bytes, the one after for 8 */
-	dxl_put_u16(&sv[0].mem[DXL_AX_PRESENT_POSITION], 600);
-	/* arrives 100 µs into the next cycle, before that cycle's own reply */
-	sv[0].late_us = PERIOD_US - 220 + 100;
+	const struct backend *b = *state;
+	b->setup(b->late_servos, CFG_MODE_HOLD);
+	run(11);   /* an odd count: the next read is the short one */
+	int32_t moved = b->centre + (b->pos_size == 2 ? 88 : 552), on = moved + 100;
+	b->put(1, b->present_position, (uint32_t)moved, b->pos_size);
+	b->late_next(1, b->late_us);
 	run(1);
 	assert_int_equal(c.j[0].stale_cycles, 1);   /* lost to the timeout in its own cycle */
-	/* the servo moves on; the next cycle's READ must see 700, or nothing */
-	dxl_put_u16(&sv[0].mem[DXL_AX_PRESENT_POSITION], 700);
+	/* the servo moves on; the next cycle's read must see it, or nothing */
+	b->put(1, b->present_position, (uint32_t)on, b->pos_size);
 	run(1);
-	if (c.j[0].stale_cycles == 0 && dxl_rad_to_pos(c.j[0].angle) != 700)
-		fail_msg("the late reply (600) was taken as this cycle's reading (%u)", dxl_rad_to_pos(c.j[0].angle));
+	int32_t got = sm_rad_to_pos(ctl_model(&c, 0), c.j[0].angle);
+	if (c.j[0].stale_cycles == 0 && got != on)
+		fail_msg("the late reply (%d) was taken as this cycle's reading (%d)", moved, got);
 	run(2);
-	assert_int_equal(dxl_rad_to_pos(c.j[0].angle), 700);
+	assert_int_equal(sm_rad_to_pos(ctl_model(&c, 0), c.j[0].angle), on);
 	assert_int_equal(c.j[0].stale_cycles, 0);
 }
+
+/* LIMP applied while HOLD's writes are on the wire (as a command applied
+ * mid-cycle once could be): the torque-off is queued behind them, never
+ * merged into one and dropped; whatever was sent, torque ends off. */
+static int limp_after_writes = -1;
+static void limp_mid_write(void)
+{
+	if (limp_after_writes > 0 && --limp_after_writes == 0)
+		ctl_set_mode(&c, CFG_MODE_LIMP, "test: mid-cycle");
+}
+
+static void test_torque_off_never_lost(void **state)
+{
+	const struct backend *b = *state;
+	for (int k = 1; k <= 4; k++) {
+		b->setup(2, CFG_MODE_LIMP);
+		run(5);
+		ctl_set_mode(&c, CFG_MODE_HOLD, "test");   /* queues HOLD's writes per servo */
+		limp_after_writes = k;                      /* LIMP after the k-th of those writes is sent */
+		on_write_sent = limp_mid_write;
+		run(5);
+		on_write_sent = NULL;
+		assert_int_equal(c.mode, CFG_MODE_LIMP);
+		for (uint8_t id = 1; id <= 2; id++)
+			if (b->reg(id, b->torque_enable, 1) != 0)
+				fail_msg("%s, LIMP after write %d: servo %u torque on", b->name, k, id);
+	}
+}
+
+/* ---- the AX-12's bus ---------------------------------------------------------------------------- */
+/* ---- every register written is the model's: what each bus's tests collect -------------------- */
+static char bad_write[160];
+static unsigned writes_seen;
 
 /* 18 servos whose replies are slow: the writes of a start do not fit after
  * the reads; the rest wait for the next cycle and each is sent once. */
@@ -471,34 +745,6 @@ static void test_writes_never_starve(void **state)
 	assert_int_equal(wq_pending(&c.wq), 0);
 }
 
-/* LIMP applied while HOLD's torque-on is on the wire (as a command applied
- * mid-cycle once could be): the torque-off is queued behind it, never
- * merged into it and dropped. */
-static int limp_after_writes = -1;
-static void limp_mid_write(void)
-{
-	if (limp_after_writes > 0 && --limp_after_writes == 0)
-		ctl_set_mode(&c, CFG_MODE_LIMP, "test: mid-cycle");
-}
-
-static void test_torque_off_never_lost(void **state)
-{
-	(void)state;
-	for (int k = 1; k <= 4; k++) {
-		setup(CFG_MODE_LIMP);
-		run(5);
-		ctl_set_mode(&c, CFG_MODE_HOLD, "test");   /* queues torque limit + torque on per servo */
-		limp_after_writes = k;                      /* LIMP after the k-th of those writes is sent */
-		on_write_sent = limp_mid_write;
-		run(5);
-		on_write_sent = NULL;
-		assert_int_equal(c.mode, CFG_MODE_LIMP);
-		for (size_t i = 0; i < nsv; i++)
-			if (sv[i].mem[DXL_AX_TORQUE_ENABLE] != 0)
-				fail_msg("LIMP after write %d: servo %u torque on", k, sv[i].id);
-	}
-}
-
 /* A servo that lost power comes back with torque off and factory RAM: the
  * read-back finds it, it is reported and set up again. */
 static void test_servo_reset_found(void **state)
@@ -565,8 +811,6 @@ static const char *const ax_written[] = {
 	"ccw_compliance_margin", "cw_compliance_slope", "ccw_compliance_slope", "cw_angle_limit", "ccw_angle_limit",
 	NULL,
 };
-static char bad_write[160];
-static unsigned writes_seen;
 
 static bool ax_ours(const struct dxl_reg *r)
 {
@@ -576,7 +820,7 @@ static bool ax_ours(const struct dxl_reg *r)
 	return false;
 }
 
-static void check_write(const struct servo *s, uint8_t addr, size_t n)
+static void ax_check_write(const struct servo *s, uint8_t addr, size_t n)
 {
 	writes_seen++;
 	size_t at = addr;
@@ -589,16 +833,16 @@ static void check_write(const struct servo *s, uint8_t addr, size_t n)
 	         addr, r != NULL ? r->name : "no register", at);
 }
 
-/* The AX-12A through the fault paths and LIMP, as test_daemon_cycle2.c takes
- * each X model: an overload whose back-off ends in LIMP, one that persists
+/* The AX-12A through the fault paths and LIMP, as test_writes_are_the_models_x
+ * takes each X model: an overload whose back-off ends in LIMP, one that persists
  * and latches, 'clear', HOLD and LIMP again; every write checked against
  * the AX-12's table. */
-static void test_writes_are_the_models(void **state)
+static void test_writes_are_the_models_ax(void **state)
 {
 	(void)state;
 	setup(CFG_MODE_HOLD);
 	cfg.fault_backoff_s = 0.205;
-	on_plant_write = check_write;
+	on_plant_write = ax_check_write;
 	bad_write[0] = '\0';
 	writes_seen = 0;
 	run(20);
@@ -632,20 +876,392 @@ static void test_writes_are_the_models(void **state)
 	assert_true(writes_seen > 10);
 }
 
+/* ---- the X series' bus --------------------------------------------------------------------------- */
+/* Two XM430s holding for 0.2 s, then servo `id` shut down by `cause`
+ * (Hardware Error Status, torque off), backing off 0.2 s. */
+static void x_shut_down(uint8_t id, uint8_t cause)
+{
+	const char *sets[] = { "robot.fault_backoff_s=0.2", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	run(20);
+	xs(id)->mem[70] = cause;
+	xs(id)->mem[64] = 0;
+}
+
+/* An overload shuts servo 2 down: the alert in its status has its RAM block
+ * read at once, the fault backs off, one REBOOT (fault_reboots 1) and the
+ * set-up chain bring it back. */
+static void test_shutdown_recovered_by_reboot(void **state)
+{
+	(void)state;
+	x_shut_down(2, DXL2_HWERR_OVERLOAD);
+	run(3);
+	assert_int_equal(c.j[1].hwerr, DXL2_HWERR_OVERLOAD);
+	assert_non_null(find_event("servo 2: overload (shut down: torque off): backing off"));
+	assert_int_equal(atomic_load(&xb.reboots), 0);
+	/* back-off 0.2 s, the boot's 0.3 s, the check's 0.3 s */
+	run(100);
+	assert_non_null(find_event("servo 2: overload shut it down: REBOOT 1 of 1"));
+	assert_int_equal(atomic_load(&xb.reboots), 1);
+	assert_non_null(find_event("servo 2: recovered"));
+	assert_int_equal(xs(2)->mem[64], 1);
+	assert_int_equal(xs(2)->mem[98], WATCHDOG_UNITS);   /* the boot cleared it; set again */
+	assert_int_equal(xreg(2, 100, 2), 885);
+	assert_false(c.latched);
+	assert_int_equal(c.j[1].fault, CTL_FAULT_NONE);
+}
+
+/* The cause is still there after the REBOOT: the fault latches (HOLD), and
+ * the servo's torque is never turned on while its error stands. */
+static void test_shutdown_latches_when_reboot_does_not_help(void **state)
+{
+	(void)state;
+	x_shut_down(2, DXL2_HWERR_OVERHEAT);
+	xs(2)->hwerr_after_reboot = DXL2_HWERR_OVERHEAT;
+	for (int i = 0; i < 150; i++) {
+		(void)tick(NULL);
+		if (xs(2)->mem[70] != 0 && xs(2)->mem[64] != 0)
+			fail_msg("torque on with a hardware error standing");
+	}
+	assert_int_equal(atomic_load(&xb.reboots), 1);
+	assert_true(c.latched);
+	assert_non_null(strstr(c.latch, "servo 2 overheating"));
+	assert_int_equal(c.mode, CFG_MODE_HOLD);
+	/* the other joint holds on */
+	assert_int_equal(xs(1)->mem[64], 1);
+	/* 'clear' is the operator's REBOOT; cooled down, it comes back */
+	xs(2)->hwerr_after_reboot = 0;
+	char why[128];
+	assert_true(ctl_clear_faults(&c, why, sizeof why));
+	run(60);
+	assert_int_equal(atomic_load(&xb.reboots), 2);
+	assert_int_equal(xs(2)->mem[64], 1);
+	assert_false(c.latched);
+}
+
+/* The servo's bus watchdog stopped it (this controller was late): found by
+ * the read-back, cleared (0 first: only 0 is taken), set again, counted. */
+static void test_watchdog_trip_recovered(void **state)
+{
+	(void)state;
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	run(20);
+	xs(1)->mem[98] = SM_WATCHDOG_TRIPPED;
+	run(25);
+	assert_non_null(find_event("servo 1: its bus watchdog stopped it"));
+	assert_int_equal(xs(1)->mem[98], WATCHDOG_UNITS);
+	assert_int_equal(xs(1)->mem[64], 1);
+	assert_int_equal(c.watchdog_trips, 1);
+	assert_int_equal(c.j[0].resets, 1);
+	assert_false(c.latched);
+}
+
+/* A power loss: the servo boots, torque off, RAM at its defaults. */
+static void test_power_loss_set_up_again(void **state)
+{
+	(void)state;
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	run(20);
+	xfake_boot(xs(2));
+	run(25);
+	assert_non_null(find_event("servo-reset: servo 2 found with torque off"));
+	assert_int_equal(xs(2)->mem[64], 1);
+	assert_int_equal(xs(2)->mem[98], WATCHDOG_UNITS);
+	assert_int_equal(c.j[1].resets, 1);
+}
+
+/* Another program switched servo 1 to velocity control (EEPROM, torque off
+ * for it): found in the EEPROM block, put back in position control. */
+static void test_operating_mode_changed(void **state)
+{
+	(void)state;
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	run(20);
+	xs(1)->mem[11] = 1;
+	run(45);
+	assert_non_null(find_event("servo 1: operating mode changed"));
+	assert_int_equal(xs(1)->mem[11], 3);
+	assert_int_equal(xs(1)->mem[64], 1);
+	assert_int_equal(c.j[0].opmode_read, 3);
+}
+
+/* Under torque actuation: both joints resting away from neutral (the law
+ * starts them, no starter), then OSCILLATOR for `cycles`: in the drive. */
+static void x_oscillate_in_drive(int cycles)
+{
+	for (uint8_t id = 1; id <= 2; id++)
+		xfake_put(xs(id)->mem, 132, 2048 + 250, 4);
+	run(10);
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	run(cycles);
+	assert_true(c.wheel);
+}
+
+/* Torque actuation on the XM430: into current control and out of it, each
+ * a chain per servo; the drive goes only to servos whose switch went
+ * through, within Current Limit. */
+static void test_current_control_switch(void **state)
+{
+	(void)state;
+	const char *sets[] = { "robot.actuation=torque", "robot.torque_drive=current", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	x_oscillate_in_drive(5);
+	for (uint8_t id = 1; id <= 2; id++) {
+		assert_int_equal(xs(id)->mem[11], 0);          /* current control */
+		assert_int_equal(xs(id)->mem[64], 1);
+		assert_true(c.j[id - 1].drive_ready);
+		int16_t cur = (int16_t)xreg(id, 102, 2);
+		/* -k x at 0.37 rad out: a pull back towards neutral */
+		assert_true(cur < 0 && cur >= -1193);
+	}
+	ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+	run(5);
+	assert_false(c.wheel);
+	for (uint8_t id = 1; id <= 2; id++) {
+		assert_int_equal(xs(id)->mem[11], 3);          /* back in position control */
+		assert_int_equal(xs(id)->mem[64], 0);          /* and limp */
+		assert_int_equal(xreg(id, 102, 2), 0);          /* the drive stopped */
+		assert_false(c.j[id - 1].drive_ready);
+	}
+}
+
+/* The clock as a torque law ([sinusoid] stiffness) on the XM430: SINUSOID
+ * switches the servos into current control as OSCILLATOR does, the drive is
+ * the clock's torque, and at the switch to OSCILLATOR (the experiment: the
+ * clock, then the oscillator) they stay there: no new chain, no torque off,
+ * Operating Mode 0 all along. HOLD brings them back to position control. */
+static void test_clock_in_current_control(void **state)
+{
+	(void)state;
+	const char *sets[] = { "robot.actuation=torque", "robot.torque_drive=current", "sinusoid.stiffness=0.135",
+	                       NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	run(10);
+	ctl_set_mode(&c, CFG_MODE_SINUSOID, "test");
+	run(5);
+	assert_true(c.wheel);
+	uint16_t chain[2];
+	for (uint8_t id = 1; id <= 2; id++) {
+		const struct ctl_joint *jt = &c.j[id - 1];
+		assert_int_equal(xs(id)->mem[11], 0);
+		assert_true(jt->drive_ready);
+		chain[id - 1] = jt->drive_chain;
+		double tau = c.p.sin_stiffness * (osc_sinusoid(c.p.amplitude, c.p.frequency, c.p.phase, id - 1u, c.t) -
+		                                  (jt->angle - cfg.joint[id - 1].neutral));
+		assert_true(fabs(jt->torque_cmd - tau) < 1e-9);
+		int16_t cur = (int16_t)xreg(id, 102, 2);
+		assert_true(cur != 0 && (cur > 0) == (tau > 0.0));
+	}
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	for (int i = 0; i < 50; i++) {
+		(void)tick(NULL);
+		for (uint8_t id = 1; id <= 2; id++)
+			if (!c.wheel || xs(id)->mem[11] != 0 || xs(id)->mem[64] != 1 || !c.j[id - 1].drive_ready ||
+			    c.j[id - 1].drive_chain != chain[id - 1])
+				fail_msg("cycle %d after the switch, servo %u: wheel %d, mode %u, torque %u, chain %u (was %u)", i,
+				         id, c.wheel, xs(id)->mem[11], xs(id)->mem[64], c.j[id - 1].drive_chain, chain[id - 1]);
+	}
+	assert_null(find_event("back in joint mode"));
+	ctl_set_mode(&c, CFG_MODE_HOLD, "test");
+	run(5);
+	assert_false(c.wheel);
+	for (uint8_t id = 1; id <= 2; id++) {
+		assert_int_equal(xs(id)->mem[11], 3);
+		assert_int_equal(xs(id)->mem[64], 1);
+	}
+}
+
+/* Servo 2 refuses every write (the access error, nothing written): its
+ * switch stops at the first step, it is never sent a drive, and the robot
+ * goes back to joint mode. */
+static void test_switch_stops_half_way(void **state)
+{
+	(void)state;
+	const char *sets[] = { "robot.actuation=torque", "robot.torque_drive=current", "robot.fault_retries=0", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	for (uint8_t id = 1; id <= 2; id++)
+		xfake_put(xs(id)->mem, 132, 2048 + 250, 4);
+	run(10);
+	xs(2)->refuse_writes = true;
+	ctl_set_mode(&c, CFG_MODE_OSCILLATOR, "test");
+	run(20);
+	assert_non_null(find_event("servo 2: the switch to current control stopped"));
+	assert_int_equal(xs(2)->drive_parts, 0);
+	assert_int_equal(xs(2)->mem[11], 3);
+	assert_false(c.j[1].drive_ready);
+	assert_true(c.latched);                /* fault_retries 0: the first failed switch latches */
+	assert_false(c.wheel);
+	assert_int_equal(xs(1)->mem[11], 3);   /* servo 1 back in position control too */
+	assert_int_equal(xs(1)->mem[64], 1);
+}
+
+/* The guard itself: under torque actuation a SYNC_WRITE carries the drive of
+ * the joints whose switch went through, and of no other. */
+static void test_drive_only_where_ready(void **state)
+{
+	(void)state;
+	const char *sets[] = { "robot.actuation=torque", "robot.torque_drive=current", NULL };
+	setup_x(xm2, 2, CFG_MODE_OSCILLATOR, sets);
+	c.wheel = true;
+	c.sync = CTL_SYNC_DUTY;
+	c.j[0].duty = 0.5;
+	c.j[1].duty = -0.5;
+	c.j[0].drive_ready = true;
+	c.j[1].drive_ready = false;
+	uint16_t addr;
+	uint8_t width, ids[CFG_MAX_JOINTS], data[CTL_SYNC_MAX_WIDTH * CFG_MAX_JOINTS];
+	assert_int_equal(ctl_sync(&c, &addr, &width, ids, data), 1);
+	assert_int_equal(addr, 102);
+	assert_int_equal(width, 2);
+	assert_int_equal(ids[0], 1);
+	assert_int_equal((int16_t)(data[0] | data[1] << 8), 428);   /* half the stall current, 2.69 mA a unit */
+	/* leaving it: every drive 0 */
+	c.sync = CTL_SYNC_GOAL_STOP;
+	assert_int_equal(ctl_sync(&c, &addr, &width, ids, data), 2);
+	assert_int_equal(addr, 102);
+	assert_int_equal(data[0] | data[1] | data[2] | data[3], 0);
+}
+
+/* ---- every register written is the model's ---------------------------------------------------
+ * What undulated writes on an X servo, by the e-manual's names (dxl2_table.c,
+ * not our constants): torque, the output limit (Goal PWM), the drives, the
+ * goal, the watchdog, the profiles, and with torque off the Operating Mode
+ * and position limits the configuration decides. Any other address is
+ * another model's register on this one: the AX-12's Torque Limit (34) is an
+ * X servo's Min Voltage Limit, EEPROM, which it takes once torque is off. */
+static const char *const x_written[] = {
+	"torque_enable", "goal_pwm", "goal_current", "goal_position", "bus_watchdog", "profile_acceleration",
+	"profile_velocity", "operating_mode", "min_position_limit", "max_position_limit", NULL,
+};
+
+static void x_check_write(void *ctx, const struct xfake_servo *s, uint16_t addr, size_t len)
+{
+	(void)ctx;
+	const struct dxl2_model *m = dxl2_model_by_number((uint16_t)xfake_get(s->mem, 0, 2));
+	const struct dxl2_reg *r = dxl2_reg_at(m, addr);
+	bool ours = false;
+	for (size_t i = 0; r != NULL && x_written[i] != NULL; i++)
+		ours = ours || strcmp(r->name, x_written[i]) == 0;
+	writes_seen++;
+	if (ours && r->access == DXL_ACCESS_RW && r->size == len)
+		return;
+	if (bad_write[0] == '\0')
+		snprintf(bad_write, sizeof bad_write, "servo %u (%s): %zu byte(s) written at %u (%s%s)", s->mem[7],
+		         m != NULL ? m->name : "?", len, addr, r != NULL ? r->name : "no register",
+		         r != NULL && r->area == DXL_AREA_EEPROM ? ", EEPROM" : "");
+}
+
+/* Each model through the fault paths and LIMP: a fault that leaves torque on
+ * (the servo's Shutdown without its bit) whose back-off ends in LIMP, a
+ * shutdown recovered by REBOOT, one that latches and 'clear', LIMP and HOLD
+ * again; every write the servos heard is checked against their table. */
+static void test_writes_are_the_models_x(void **state)
+{
+	(void)state;
+	static const uint16_t models[][2] = {
+		{ DXL2_MODEL_XL430_W250, DXL2_MODEL_XL430_W250 },
+		{ DXL2_MODEL_XM430_W350, DXL2_MODEL_XM430_W350 },
+	};
+	/* 20.5 periods: the back-off ends at the 21st step after the one that
+	 * found the fault, 5 ms from either step */
+	const char *sets[] = { "robot.fault_backoff_s=0.205", "robot.fault_reboots=1", NULL };
+	for (size_t k = 0; k < sizeof models / sizeof models[0]; k++) {
+		setup_x(models[k], 2, CFG_MODE_HOLD, sets);
+		xb.on_write = x_check_write;
+		bad_write[0] = '\0';
+		writes_seen = 0;
+		run(20);
+		/* an overload the servo does not shut down for: torque stays on */
+		xs(2)->mem[70] = DXL2_HWERR_OVERLOAD;
+		for (int i = 0; i < 20 && c.j[1].fault == CTL_FAULT_NONE; i++)
+			(void)tick(NULL);
+		assert_int_equal(c.j[1].fault, CTL_FAULT_BACKOFF);
+		run(20);
+		xs(2)->mem[70] = 0;
+		/* LIMP at the cycle whose step ends the back-off: the recovery is
+		 * LIMP's (the output limit back, torque off), not a REBOOT */
+		ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+		run(60);
+		assert_int_equal(atomic_load(&xb.reboots), 0);
+		assert_non_null(find_event("servo 2: recovered"));
+		for (uint8_t id = 1; id <= 2; id++)
+			assert_int_equal(xs(id)->mem[64], 0);
+		/* a shutdown in HOLD: REBOOT and set-up */
+		ctl_set_mode(&c, CFG_MODE_HOLD, "test");
+		run(20);
+		xs(1)->mem[70] = DXL2_HWERR_OVERHEAT;
+		xs(1)->mem[64] = 0;
+		xs(1)->hwerr_after_reboot = DXL2_HWERR_OVERHEAT;
+		run(150);
+		assert_true(c.latched);
+		/* LIMP while latched, then 'clear' (the operator's REBOOT) and HOLD */
+		ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+		run(20);
+		xs(1)->hwerr_after_reboot = 0;
+		char why[128];
+		assert_true(ctl_clear_faults(&c, why, sizeof why));
+		run(60);
+		ctl_set_mode(&c, CFG_MODE_HOLD, "test");
+		run(60);
+		assert_int_equal(xs(1)->mem[64], 1);
+		if (bad_write[0] != '\0')
+			fail_msg("%s", bad_write);
+		assert_true(writes_seen > 20);
+		/* nothing written where the X servos keep their supply limits */
+		for (uint8_t id = 1; id <= 2; id++)
+			assert_int_equal(xreg(id, 34, 2), dxl2_reg_at(dxl2_model_by_number(models[k][0]), 34)->def);
+	}
+	/* torque actuation (XL430: PWM control, XM430: current control): into
+	 * the drive, a fault there, LIMP out of it */
+	const char *drive[][4] = {
+		{ "robot.actuation=torque", "robot.torque_drive=pwm", "robot.fault_backoff_s=0.2", NULL },
+		{ "robot.actuation=torque", "robot.torque_drive=current", "robot.fault_backoff_s=0.2", NULL },
+	};
+	for (size_t k = 0; k < sizeof models / sizeof models[0]; k++) {
+		setup_x(models[k], 2, CFG_MODE_HOLD, drive[k]);
+		xb.on_write = x_check_write;
+		bad_write[0] = '\0';
+		x_oscillate_in_drive(10);
+		xs(2)->mem[70] = DXL2_HWERR_OVERLOAD;
+		run(10);
+		xs(2)->mem[70] = 0;
+		run(60);
+		ctl_set_mode(&c, CFG_MODE_LIMP, "test");
+		run(20);
+		assert_false(c.wheel);
+		if (bad_write[0] != '\0')
+			fail_msg("%s", bad_write);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_normal_cycles),
-		cmocka_unit_test(test_lost_and_damaged_replies),
-		cmocka_unit_test(test_reply_one_period_late),
+		{ "normal_cycles (AX-12A)", test_normal_cycles, NULL, NULL, (void *)&ax_bus },
+		{ "normal_cycles (XL430-W250 + XM430-W350)", test_normal_cycles, NULL, NULL, (void *)&x_mixed_bus },
+		{ "lost_and_damaged_replies (AX-12A)", test_lost_and_damaged_replies, NULL, NULL, (void *)&ax_bus },
+		{ "lost_and_damaged_replies (XM430-W350)", test_lost_and_damaged_replies, NULL, NULL, (void *)&x_bus },
+		{ "reply_one_period_late (AX-12A)", test_reply_one_period_late, NULL, NULL, (void *)&ax_bus },
+		{ "reply_one_period_late (XM430-W350)", test_reply_one_period_late, NULL, NULL, (void *)&x_bus },
+		{ "torque_off_never_lost (AX-12A)", test_torque_off_never_lost, NULL, NULL, (void *)&ax_bus },
+		{ "torque_off_never_lost (XM430-W350)", test_torque_off_never_lost, NULL, NULL, (void *)&x_bus },
 		cmocka_unit_test(test_writes_that_do_not_fit),
 		cmocka_unit_test(test_overrun_cut_off),
 		cmocka_unit_test(test_writes_never_starve),
-		cmocka_unit_test(test_torque_off_never_lost),
 		cmocka_unit_test(test_servo_reset_found),
 		cmocka_unit_test(test_write_given_up),
 		cmocka_unit_test(test_bus_lost),
-		cmocka_unit_test(test_writes_are_the_models),
+		cmocka_unit_test(test_writes_are_the_models_ax),
+		cmocka_unit_test(test_shutdown_recovered_by_reboot),
+		cmocka_unit_test(test_shutdown_latches_when_reboot_does_not_help),
+		cmocka_unit_test(test_watchdog_trip_recovered),
+		cmocka_unit_test(test_power_loss_set_up_again),
+		cmocka_unit_test(test_operating_mode_changed),
+		cmocka_unit_test(test_clock_in_current_control),
+		cmocka_unit_test(test_current_control_switch),
+		cmocka_unit_test(test_switch_stops_half_way),
+		cmocka_unit_test(test_drive_only_where_ready),
+		cmocka_unit_test(test_writes_are_the_models_x),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -3,7 +3,7 @@
  * pty, and the `dxl --protocol 2` commands against it, in-process
  * (dxlt_main), as test_dxl_fakeservo.c does for the AX-12.
  *
- * The fake (xfake.h, shared with test_daemon_cycle2.c) frames packets with
+ * The fake (xfake.h, shared with test_daemon_cycle.c) frames packets with
  * its own few lines — CRC, stuffing — not protocol/dxl2.c, and is checked
  * against the e-manual's packets first, so a bug shared by our encoder and
  * parser cannot pass through it unseen. Its control table is dxl2_table's

@@ -1,7 +1,7 @@
 /*
  * xfake.h — a fake bus of X-series servos (Protocol 2.0) for tests, whatever
  * carries its bytes: test_dxl_fakeservo2.c serves it on a pty from a thread,
- * test_daemon_cycle2.c in memory against a fake clock. The transport feeds
+ * test_daemon_cycle.c in memory against a fake clock. The transport feeds
  * it the controller's bytes (xfake_feed) and takes its status packets
  * through `emit`, with the servo's return delay to apply.
  *
