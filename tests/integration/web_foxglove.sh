@@ -50,8 +50,9 @@ rss() { awk '/^VmRSS/ { print $2 }' "/proc/$pid_web/status"; }
 fox watch "$WS" left.STATE 4 >"$T/watch.json" 2>"$T/watch.err"
 o="$T/watch.json"
 jqo() { jq -e "$@" "$o" >/dev/null 2>&1; }
+jqf() { jq -e "$@" >/dev/null 2>&1; }   # jqf FILTER [ARGS] FILE
 tap_check "serverInfo: a name, no clientPublish ($(jq -c '.serverInfo // .error' "$o" 2>/dev/null | head -c 300))" \
-	jqo '.serverInfo.name | test("undulate")' -e '(.serverInfo.capabilities // []) | index("clientPublish") | not'
+	jqo '(.serverInfo.name | test("undulate")) and ((.serverInfo.capabilities // []) | index("clientPublish") | not)'
 tap_check "channels advertised as heard: left.STATE, right.STATE, left.BUS, left.PARAMS ($(jq -c '[.channels[]?.topic]' "$o" 2>/dev/null))" \
 	jqo '[.channels[].topic] as $t | all(("left.STATE", "right.STATE", "left.BUS", "left.PARAMS"); . as $x | $t | index($x))'
 tap_check "every channel: encoding json, a JSON Schema (jsonschema) that parses, an object of its fields" \
@@ -80,8 +81,10 @@ for what in "bad JSON" "unknown op" "client advertise (no clientPublish)" "binar
 	"a subscription id that is not a number" "a 1 MB message" "3000 subscriptions" \
 	"3000 subscriptions in one message"; do
 	tap_check "$what: an error status ($(jq -r --arg w "$what" '.cases[]? | select(.what == $w) | "\(.level) \(.message)"' "$o" 2>/dev/null | head -c 200))" \
-		jq -e --arg w "$what" '.cases[] | select(.what == $w) | .level == 2 and (.message | length) > 10' "$o"
+		jqf --arg w "$what" '.cases[] | select(.what == $w) | .level == 2 and (.message | length) > 10' "$o"
 done
+tap_check "the 1 MB message and the one with 3000 subscriptions: refused for their length" \
+	jqo '[.cases[] | select(.what | test("1 MB|in one message")) | .message | test("longer than 4096 bytes")] == [true, true]'
 tap_check "after them the connection is open and serves at most 64 subscriptions ($(jq -r '.subscriptionsServed // "?"' "$o"))" \
 	jqo '.stillOpen and .subscriptionsServed >= 1 and .subscriptionsServed <= 64'
 for i in 1 2 3; do fox hostile "$WS" left.STATE >/dev/null 2>&1; done
@@ -90,7 +93,7 @@ tap_check "memory after four hostile clients: VmRSS ${rss0} kB -> ${rss1} kB (le
 	[ "$((rss1 - rss0))" -lt 16384 ]
 fox watch "$WS" left.STATE 1 >"$T/watch2.json" 2>&1
 tap_check "the server lives on: a new client still subscribes ($(jq -r '.rate // .error' "$T/watch2.json" | head -c 200) per second)" \
-	jq -e '.rate > 30' "$T/watch2.json"
+	jqf '.rate > 30' "$T/watch2.json"
 
 # ---- the same gate as every WebSocket --------------------------------------------------------
 python3 - "$port" >"$T/rebind.out" 2>&1 <<EOF
@@ -107,9 +110,9 @@ tap_check "Host evil.example (DNS rebinding): the Foxglove WebSocket is refused 
 	grep -q '^REFUSED' "$T/rebind.out"
 fox crowd "$WS" 30 >"$T/crowd.json" 2>&1
 tap_check "30 Foxglove clients without the token: 24 taken, the rest refused ($(jq -c . "$T/crowd.json" | head -c 200))" \
-	jq -e '.taken == 24' "$T/crowd.json"
+	jqf '.taken == 24' "$T/crowd.json"
 
 stop web >/dev/null
-tap_check "at exit the refusals are counted ($(grep -o '[0-9]* Foxglove[^,]*' "$T/web.log" | tr '\n' ' '))" \
+tap_check "at exit the refusals are counted ($(grep -o '[0-9]* Foxglove messages refused' "$T/web.log"))" \
 	grep -Eq '[1-9][0-9]* Foxglove messages refused' "$T/web.log"
 tap_done
