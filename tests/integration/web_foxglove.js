@@ -7,6 +7,7 @@
 //                                                   count messages, unsubscribe, count again
 //   node web_foxglove.js hostile URL TOPIC         bad JSON, unknown ops, huge and binary
 //                                                   frames, unknown and too many subscriptions
+//   node web_foxglove.js quiet URL TOPIC SECONDS   subscribe, then wait for TOPIC's unadvertise
 //   node web_foxglove.js crowd URL N               open N connections: how many were taken
 "use strict";
 const { FoxgloveClient } = require("@foxglove/ws-protocol");
@@ -146,6 +147,27 @@ async function hostile() {
 	done(0);
 }
 
+// Subscribes to TOPIC, says so on stderr, then waits (up to SECONDS) for
+// the channel to be unadvertised once its source stops.
+async function quiet() {
+	const s = connect();
+	await until(() => s.info !== null && topicChannel(s, arg) !== null, 10000, "serverInfo and " + arg);
+	const ch = topicChannel(s, arg);
+	s.c.subscribe(ch.id);
+	await until(() => s.msgs.length > 0, 5000, "a first message");
+	console.error("subscribed to " + arg);
+	const t0 = Date.now();
+	await until(() => s.removed.includes(ch.id), Number(arg2 || 30) * 1000, "the unadvertise of " + arg).catch(() => {});
+	out.unadvertised = s.removed.includes(ch.id);
+	out.afterSeconds = (Date.now() - t0) / 1000;
+	const n = s.msgs.length;
+	await sleep(500);
+	out.messagesAfter = s.msgs.length - n;
+	out.othersLive = [...s.channels.values()].map((c) => c.topic);
+	s.c.close();
+	done(0);
+}
+
 async function crowd() {
 	const n = Number(arg);
 	const socks = [];
@@ -158,7 +180,7 @@ async function crowd() {
 	done(0);
 }
 
-const modes = { watch, hostile, crowd };
+const modes = { watch, hostile, quiet, crowd };
 if (!modes[mode]) {
 	console.error("usage: web_foxglove.js watch|hostile|crowd URL ARG");
 	process.exit(2);

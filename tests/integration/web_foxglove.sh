@@ -9,7 +9,8 @@
 # Hostile clients (bad JSON, unknown and publishing ops, binary and 1 MB
 # frames, unknown channels and subscriptions, thousands of subscriptions) get
 # an error status each, are counted, and the server's memory stays flat; a
-# foreign Host is refused and the crowd limit holds for Foxglove too.
+# foreign Host is refused and the crowd limit holds for Foxglove too; a
+# robot that stops is unadvertised after 10 s of silence.
 . "$(dirname "$0")/../lib.sh"
 W="$B/undulate-web" D="$B/undulated" S="$B/undulate-sim"
 JS="$top/tests/integration/web_foxglove.js"
@@ -111,6 +112,16 @@ tap_check "Host evil.example (DNS rebinding): the Foxglove WebSocket is refused 
 fox crowd "$WS" 30 >"$T/crowd.json" 2>&1
 tap_check "30 Foxglove clients without the token: 24 taken, the rest refused ($(jq -c . "$T/crowd.json" | head -c 200))" \
 	jqf '.taken == 24' "$T/crowd.json"
+
+# ---- a source that goes quiet is unadvertised ------------------------------------------------
+spawn quiet env NODE_PATH="$NPM_CACHE/node_modules" node --experimental-websocket --no-warnings "$JS" quiet "$WS" right.STATE 30
+if wait_log quiet 'subscribed to right.STATE' 15; then
+	stop d_right >/dev/null
+	wait_for 40 bash -c "grep -q '^{' '$T/quiet.log'"
+fi
+q=$(grep '^{' "$T/quiet.log")
+tap_check "right's daemon stopped: right.STATE unadvertised $(jq -r '.afterSeconds // "?"' <<<"$q") s later (10 s of silence), left.STATE still advertised" \
+	jqf '.unadvertised and (.othersLive | index("left.STATE")) and (.othersLive | index("right.STATE") | not)' <<<"${q:-null}"
 
 stop web >/dev/null
 tap_check "at exit the refusals are counted ($(grep -o '[0-9]* Foxglove messages refused' "$T/web.log"))" \
