@@ -97,18 +97,35 @@ tap_check "the server lives on: a new client still subscribes ($(jq -r '.rate //
 	jqf '.rate > 30' "$T/watch2.json"
 
 # ---- the same gate as every WebSocket --------------------------------------------------------
-python3 - "$port" >"$T/rebind.out" 2>&1 <<EOF
+# ws_try PORT PROTOCOL [host=H] [origin=O]: OPEN or REFUSED, as a browser's handshake would end
+ws_try() {
+	python3 - "$@" 2>&1 <<EOF
 import sys
 sys.path.insert(0, '$top/tests/integration')
 import web_cdp
+port, proto = int(sys.argv[1]), sys.argv[2]
+kw = dict(a.split('=', 1) for a in sys.argv[3:])
 try:
-    web_cdp.WS('127.0.0.1', int(sys.argv[1]), '/', 'foxglove.websocket.v1', host_header='evil.example:' + sys.argv[1])
+    web_cdp.WS('127.0.0.1', port, '/', proto, host_header=kw.get('host'), origin=kw.get('origin'))
     print('OPEN')
 except Exception as e:
     print('REFUSED', e)
 EOF
-tap_check "Host evil.example (DNS rebinding): the Foxglove WebSocket is refused ($(head -c 120 "$T/rebind.out"))" \
-	grep -q '^REFUSED' "$T/rebind.out"
+}
+r=$(ws_try "$port" foxglove.websocket.v1 "host=evil.example:$port")
+tap_check "Host evil.example (DNS rebinding): the Foxglove WebSocket is refused ($r)" grep -q '^REFUSED' <<<"$r"
+FG=https://app.foxglove.dev
+r1=$(ws_try "$port" foxglove.websocket.v1 "origin=$FG") r2=$(ws_try "$port" foxglove.websocket.v1 "origin=http://127.0.0.1:$port")
+tap_check "Origin $FG: refused by default ($r1); the server's own origin: open ($r2)" \
+	bash -c "grep -q '^REFUSED' <<<'$r1' && grep -q '^OPEN' <<<'$r2'"
+spawn web2 "$W" --listen 127.0.0.1:0 --lcm-url "$URL" --read-only --allow-origin "$FG"
+wait_log web2 'listening on http://' 10
+port2=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/web2.log")
+r1=$(ws_try "$port2" foxglove.websocket.v1 "origin=$FG") r2=$(ws_try "$port2" undulate "origin=$FG")
+r3=$(ws_try "$port2" foxglove.websocket.v1 "origin=$FG" "host=evil.example:$port2")
+tap_check "--allow-origin $FG: its Foxglove WebSocket opens ($r1), the page's protocol stays refused to it ($r2), and a foreign Host still is ($r3)" \
+	bash -c "grep -q '^OPEN' <<<'$r1' && grep -q '^REFUSED' <<<'$r2' && grep -q '^REFUSED' <<<'$r3'"
+stop web2 >/dev/null
 fox crowd "$WS" 30 >"$T/crowd.json" 2>&1
 tap_check "30 Foxglove clients without the token: 24 taken, the rest refused ($(jq -c . "$T/crowd.json" | head -c 200))" \
 	jqf '.taken == 24' "$T/crowd.json"

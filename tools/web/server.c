@@ -463,7 +463,17 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 
 /* ---- WebSocket -------------------------------------------------------------------- */
 
-static bool web_ws_allowed(struct lws *wsi)
+/* An origin given with --allow-origin (the Foxglove protocol only). */
+static bool web_fox_origin_ok(const char *origin)
+{
+	for (int i = 0; i < app.o.nfox_origins; i++)
+		if (strcmp(origin, app.o.fox_origins[i]) == 0)
+			return true;
+	return false;
+}
+
+/* fox: a Foxglove client, which may also come from an --allow-origin page */
+static bool web_ws_allowed(struct lws *wsi, bool fox)
 {
 	char origin[256] = "", host[256], qo[80], qh[80];
 	if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) >= (int)sizeof origin) {
@@ -477,7 +487,7 @@ static bool web_ws_allowed(struct lws *wsi)
 		        "rebinding?)", text_sanitize(qh, sizeof qh, host));
 		return false;
 	}
-	if (!req_origin_ok(origin, host)) {
+	if (!req_origin_ok(origin, host) && !(fox && web_fox_origin_ok(origin))) {
 		web_log(++app.n.ws_refused, "refused a WebSocket from origin '%s' (this is http://%s)",
 		        text_sanitize(qo, sizeof qo, origin), text_sanitize(qh, sizeof qh, host));
 		return false;
@@ -676,7 +686,7 @@ static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
 	switch (reason) {
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
 		web_conn_set(wsi, WEB_CONN_BUSY);
-		if (!web_ws_allowed(wsi))
+		if (!web_ws_allowed(wsi, false))
 			return 1;
 		web_ws_token(wsi, c);
 		return web_ws_room(c->authed) ? 0 : 1;
@@ -741,7 +751,7 @@ static int web_fox_cb(struct lws *wsi, enum lws_callback_reasons reason, void *u
 	switch (reason) {
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
 		web_conn_set(wsi, WEB_CONN_BUSY);
-		return web_ws_allowed(wsi) && web_ws_room(false) ? 0 : 1;
+		return web_ws_allowed(wsi, true) && web_ws_room(false) ? 0 : 1;
 	case LWS_CALLBACK_ESTABLISHED:
 		if (web_fox_bad(wsi, c, wsr_upgraded(fd)))
 			return -1;
