@@ -17,18 +17,6 @@ struct foxsrv_chan {
 	double heard;
 };
 
-/* every top-level type a channel may carry, decoded into one place */
-union foxsrv_msg {
-	undulate_robot_state_t state;
-	undulate_bus_stats_t bus;
-	undulate_osc_params_t params;
-	undulate_event_t event;
-	undulate_sim_truth_t truth;
-	undulate_sim_collision_t collision;
-	undulate_sim_world_t world;
-	undulate_sim_reply_t reply;
-};
-
 static struct {
 	struct foxsrv_chan chan[FOXSRV_CHANNELS];
 	uint32_t next_id;
@@ -157,7 +145,7 @@ static void foxsrv_enqueue(struct fox_client *c, const unsigned char *frame, siz
 /* The message as JSON after its header's room; 0 if it does not decode or fit. */
 static size_t foxsrv_encode(const struct fox_type *t, const void *data, size_t len)
 {
-	static union foxsrv_msg u;
+	static union lcmdec_any u;
 	if (t->size > sizeof u || lcmdec_decode(t->dec, data, len, &u) != LCMDEC_OK)
 		return 0; /* the monitors' model counts and says what does not decode */
 	FILE *f = fmemopen(fs.msg + FOX_DATA_HEADER, FOXSRV_MSG_MAX, "w");

@@ -645,24 +645,30 @@ static void web_ws_receive(struct lws *wsi, struct web_client *c, const char *in
 	web_command(c, &m);
 }
 
-/* What its client sent breaks RFC 6455 where libwebsockets 4.1 lets it
- * through (wsguard.h): close with 1002 before acting on anything. */
-static bool web_ws_bad(struct lws *wsi, struct web_client *c, enum wsg_verdict v)
+/* What a client sent breaks RFC 6455 where libwebsockets 4.1 lets it
+ * through (wsguard.h): close with 1002 before acting on anything. who and
+ * id name it in the log ("browser 3", "Foxglove client 4"). */
+static bool web_guard(struct lws *wsi, bool *failed, const char *who, unsigned id, enum wsg_verdict v)
 {
-	if (c->failed)
+	if (*failed)
 		return true;
 	if (v == WSG_OK)
 		return false;
-	c->failed = true;
+	*failed = true;
 	app.n.ws_bad_frames++;
 	if (!wsr_interposed())
 		web_log(app.n.ws_bad_frames, "cannot see what browsers send (recv() is not this program's): "
 		        "every WebSocket is refused");
 	else
-		web_log(app.n.ws_bad_frames, "browser %u: closed: %s", c->id, wsg_why(v));
+		web_log(app.n.ws_bad_frames, "%s %u: closed: %s", who, id, wsg_why(v));
 	const char *why = wsg_why(v);
 	lws_close_reason(wsi, LWS_CLOSE_STATUS_PROTOCOL_ERR, (unsigned char *)(uintptr_t)why, strlen(why));
 	return true;
+}
+
+static bool web_ws_bad(struct lws *wsi, struct web_client *c, enum wsg_verdict v)
+{
+	return web_guard(wsi, &c->failed, "browser", c->id, v);
 }
 
 /* The protocol is text (JSON out, "cmd ..." in): a binary frame is not ours
@@ -728,22 +734,6 @@ static void web_fox_receive(struct lws *wsi, struct fox_client *c, const char *i
 		web_log(foxsrv_counters()->refused, "Foxglove client %u: refused: %s", c->id, why);
 }
 
-/* What its client sent breaks RFC 6455 (wsguard.h): closed with 1002, as
- * a browser would be. */
-static bool web_fox_bad(struct lws *wsi, struct fox_client *c, enum wsg_verdict v)
-{
-	if (c->failed)
-		return true;
-	if (v == WSG_OK)
-		return false;
-	c->failed = true;
-	app.n.ws_bad_frames++;
-	web_log(app.n.ws_bad_frames, "Foxglove client %u: closed: %s", c->id, wsg_why(v));
-	const char *why = wsg_why(v);
-	lws_close_reason(wsi, LWS_CLOSE_STATUS_PROTOCOL_ERR, (unsigned char *)(uintptr_t)why, strlen(why));
-	return true;
-}
-
 static int web_fox_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
 {
 	struct fox_client *c = user;
@@ -752,21 +742,23 @@ static int web_fox_cb(struct lws *wsi, enum lws_callback_reasons reason, void *u
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
 		web_conn_set(wsi, WEB_CONN_BUSY);
 		return web_ws_allowed(wsi, true) && web_ws_room(false) ? 0 : 1;
-	case LWS_CALLBACK_ESTABLISHED:
-		if (web_fox_bad(wsi, c, wsr_upgraded(fd)))
+	case LWS_CALLBACK_ESTABLISHED: {
+		unsigned id = ++app.next_client;
+		if (web_guard(wsi, &c->failed, "Foxglove client", id, wsr_upgraded(fd)))
 			return -1;
-		if (!foxsrv_open(c, wsi, ++app.next_client, clock_mono_s())) {
+		if (!foxsrv_open(c, wsi, id, clock_mono_s())) {
 			web_log(++app.n.ws_refused, "refused a Foxglove client: no memory for its queue");
 			return -1;
 		}
 		web_conn_set(wsi, WEB_CONN_WS);
 		return 0;
+	}
 	case LWS_CALLBACK_SERVER_WRITEABLE:
-		if (web_fox_bad(wsi, c, wsr_verdict(fd)))
+		if (web_guard(wsi, &c->failed, "Foxglove client", c->id, wsr_verdict(fd)))
 			return -1;
 		return foxsrv_write(c, clock_mono_s());
 	case LWS_CALLBACK_RECEIVE:
-		if (web_fox_bad(wsi, c, wsr_verdict(fd)))
+		if (web_guard(wsi, &c->failed, "Foxglove client", c->id, wsr_verdict(fd)))
 			return -1;
 		web_fox_receive(wsi, c, in, len);
 		return 0;
