@@ -139,9 +139,11 @@ static void test_kinds(void **state)
 		assert_null(fox_kind_of(none[i]));
 }
 
-/* The field names of lcmtypes/NAME.lcm, in order ("a b c "). The test runs
- * from the source tree (tests/run.sh) or its build directory's parent. */
-static void lcm_fields(const char *name, char *out, size_t cap)
+/* The field names of lcmtypes/NAME.lcm, in order ("a b c "), with typed
+ * each one's type before it ("int64_t utime double[] k joint_state_t[]
+ * joints "). The test runs from the source tree (tests/run.sh) or its build
+ * directory's parent. */
+static void lcm_fields(const char *name, bool typed, char *out, size_t cap)
 {
 	char path[256];
 	FILE *f = NULL;
@@ -161,6 +163,10 @@ static void lcm_fields(const char *name, char *out, size_t cap)
 		if (strstr(line, "const ") || strstr(line, "struct ") || strstr(line, "package "))
 			continue;
 		if (sscanf(line, " %63s %63[A-Za-z0-9_]", type, field) == 2 && strchr(line, ';')) {
+			if (typed) {
+				strncat(out, type, cap - strlen(out) - 4);
+				strncat(out, strchr(line, '[') ? "[] " : " ", cap - strlen(out) - 1);
+			}
 			strncat(out, field, cap - strlen(out) - 2);
 			strncat(out, " ", cap - strlen(out) - 1);
 		}
@@ -202,11 +208,52 @@ static void test_schemas_name_every_field(void **state)
 		char *s = schema(rows[i].channel);
 		char want[1024], got[1024];
 		assert_true(parses(s));
-		lcm_fields(rows[i].lcm, want, sizeof want);
+		lcm_fields(rows[i].lcm, false, want, sizeof want);
 		schema_fields(s, got, sizeof got);
 		assert_string_equal(got, want);
 		free(s);
 	}
+}
+
+/* The table's fields as lcm_fields writes them typed. */
+static void table_fields(const struct fox_type *t, char *out, size_t cap)
+{
+	static const char *const lcm[] = { [FOX_I8] = "int8_t", [FOX_I16] = "int16_t", [FOX_I32] = "int32_t",
+	                                   [FOX_I64] = "int64_t", [FOX_F64] = "double", [FOX_BOOL] = "boolean",
+	                                   [FOX_STRING] = "string", [FOX_F64_ARRAY] = "double[]" };
+	out[0] = '\0';
+	for (size_t i = 0; i < t->nfields; i++) {
+		const struct fox_field *f = &t->fields[i];
+		char type[80];
+		if (f->kind == FOX_STRUCT_ARRAY)
+			snprintf(type, sizeof type, "%s[]", f->item->name + strlen("undulate."));
+		else
+			snprintf(type, sizeof type, "%s", lcm[f->kind]);
+		size_t n = strlen(out);
+		snprintf(out + n, cap - n, "%s %s ", type, f->name);
+	}
+}
+
+/* Each table (and the tables of its arrays' elements) is its .lcm file:
+ * names, order and C types, so no field is read at a wrong width. */
+static void check_table(const struct fox_type *t)
+{
+	char want[1024], got[1024];
+	lcm_fields(t->name + strlen("undulate."), true, want, sizeof want);
+	table_fields(t, got, sizeof got);
+	assert_string_equal(got, want);
+	for (size_t i = 0; i < t->nfields; i++)
+		if (t->fields[i].kind == FOX_STRUCT_ARRAY)
+			check_table(t->fields[i].item);
+}
+
+static void test_tables_are_the_lcm_files(void **state)
+{
+	(void)state;
+	static const char *const channels[] = { "x.STATE", "x.BUS", "x.PARAMS", "x.EVENT",
+	                                        "SIM.TRUTH", "SIM.COLLISION", "SIM.WORLD", "SIM.REPLY" };
+	for (size_t i = 0; i < sizeof channels / sizeof channels[0]; i++)
+		check_table(fox_kind_of(channels[i]));
 }
 
 static void test_schema_text(void **state)
@@ -418,6 +465,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_kinds),           cmocka_unit_test(test_schemas_name_every_field),
+		cmocka_unit_test(test_tables_are_the_lcm_files),
 		cmocka_unit_test(test_schema_text),     cmocka_unit_test(test_encode_state),
 		cmocka_unit_test(test_encode_others),   cmocka_unit_test(test_encode_truth),
 		cmocka_unit_test(test_data_header),     cmocka_unit_test(test_ops),
