@@ -196,6 +196,8 @@ $(BUILD)/tests/tools/%: $(OBJ)/tests/tools/%.o $(call libs_of,daemon) $(LIB)/lib
 # undulate-web serves HTTP and WebSocket with libwebsockets (Debian's
 # libwebsockets-dev); only it links it.
 $(BIN)/undulate-web: LDLIBS += -lwebsockets
+# ... and the Foxglove op parser's test (libwebsockets' lejp, tools/web/fox.h)
+$(BUILD)/tests/test_web_fox: LDLIBS += -lwebsockets
 # The simulator's plane world steps Chipmunk2D (Debian's libchipmunk-dev):
 # the simulator and its tests link it.
 $(BIN)/undulate-sim: LDLIBS += -lchipmunk

@@ -59,6 +59,21 @@ extern const struct lcmdec_type lcmdec_robot_state_t, lcmdec_bus_stats_t, lcmdec
 	lcmdec_event_t, lcmdec_command_t, lcmdec_sim_truth_t, lcmdec_sim_collision_t, lcmdec_sim_world_t,
 	lcmdec_sim_command_t, lcmdec_sim_reply_t;
 
+/* Room for any one decoded message, whatever its type (a program that
+ * decodes by channel decodes into one of these). */
+union lcmdec_any {
+	undulate_robot_state_t state;
+	undulate_bus_stats_t bus;
+	undulate_osc_params_t params;
+	undulate_event_t event;
+	undulate_command_t command;
+	undulate_sim_truth_t truth;
+	undulate_sim_collision_t collision;
+	undulate_sim_world_t world;
+	undulate_sim_command_t sim_command;
+	undulate_sim_reply_t reply;
+};
+
 enum lcmdec_status {
 	LCMDEC_OK = 0,
 	LCMDEC_TOO_LONG,     /* longer than the type's maximum */

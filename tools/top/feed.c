@@ -17,16 +17,6 @@ static bool feed_ends_with(const char *s, const char *suffix)
 	return n > k && strcmp(s + n - k, suffix) == 0;
 }
 
-/* every type the monitors take, decoded into one place */
-union feed_msg {
-	undulate_robot_state_t state;
-	undulate_bus_stats_t bus;
-	undulate_osc_params_t params;
-	undulate_event_t event;
-	undulate_sim_truth_t truth;
-	undulate_sim_collision_t collision;
-};
-
 static const struct lcmdec_type *feed_type(const char *channel)
 {
 	if (strcmp(channel, "SIM.TRUTH") == 0)
@@ -44,7 +34,7 @@ static const struct lcmdec_type *feed_type(const char *channel)
 	return NULL;
 }
 
-static void feed_apply(struct top_model *m, const struct lcmdec_type *t, const union feed_msg *u, double now,
+static void feed_apply(struct top_model *m, const struct lcmdec_type *t, const union lcmdec_any *u, double now,
                        const struct top_feed_hooks *h)
 {
 	if (t == &lcmdec_robot_state_t) {
@@ -76,7 +66,7 @@ bool top_feed(struct top_model *m, const char *channel, const void *data, size_t
 	const struct lcmdec_type *t = feed_type(channel);
 	if (t == NULL)
 		return false;
-	union feed_msg u;
+	union lcmdec_any u;
 	enum lcmdec_status s = lcmdec_decode(t, data, len, &u);
 	if (s != LCMDEC_OK) {
 		m->decode_errors++;

@@ -21,7 +21,8 @@
 static void usage(FILE *f)
 {
 	fputs("usage: undulate-web [--listen ADDR:PORT] [--lcm-url URL] [--read-only] [--allow-remote]\n"
-	      "                    [--allow-host NAME]... [--token-file FILE] [--key FILE] [--page-dir DIR]\n"
+	      "                    [--allow-host NAME]... [--allow-origin URL]... [--token-file FILE]\n"
+	      "                    [--key FILE] [--page-dir DIR]\n"
 	      "                    [--chartjs FILE] [-v]\n"
 	      "A live dashboard of every robot on the LCM network, at http://ADDR:PORT/.\n"
 	      "  --listen ADDR:PORT  where to listen (default 127.0.0.1:8080; port 0: any free port, printed)\n"
@@ -29,6 +30,8 @@ static void usage(FILE *f)
 	      "                      need --token-file, or use --read-only\n"
 	      "  --allow-host NAME   a name by which browsers reach this server (repeatable); always allowed:\n"
 	      "                      localhost, its address, and beyond loopback this computer's name\n"
+	      "  --allow-origin URL  a web page of another origin that may open the read-only Foxglove\n"
+	      "                      WebSocket, e.g. https://app.foxglove.dev (repeatable)\n"
 	      "  --token-file FILE   commands need this secret (the file's first line; mode 0600):\n"
 	      "                      open the page as http://ADDR:PORT/#token=SECRET. Without it\n"
 	      "                      (on loopback) a token is made at start, written to the run\n"
@@ -87,6 +90,14 @@ static bool host_name_ok(const char *s)
 	return n > 0 && n < 254 && strspn(s, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789.-") == n;
 }
 
+/* An origin as a browser sends it: scheme and host[:port], no path. */
+static bool origin_ok(const char *s)
+{
+	const char *rest = strncmp(s, "https://", 8) == 0 ? s + 8 : strncmp(s, "http://", 7) == 0 ? s + 7 : NULL;
+	size_t n = rest != NULL ? strlen(rest) : 0;
+	return n > 0 && n < 200 && strspn(rest, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789.-:[]") == n;
+}
+
 /* Beyond loopback, this computer's own name reaches it (http://labpc:8080/):
  * as gethostname says, and its first label. */
 static void add_own_names(struct req_hosts *h)
@@ -132,11 +143,11 @@ static const char *find_page_dir(void)
 
 int main(int argc, char **argv)
 {
-	enum { O_LISTEN = 256, O_URL, O_RO, O_REMOTE, O_TOKEN, O_KEY, O_PAGE, O_CHARTJS, O_HOST };
+	enum { O_LISTEN = 256, O_URL, O_RO, O_REMOTE, O_TOKEN, O_KEY, O_PAGE, O_CHARTJS, O_HOST, O_ORIGIN };
 	static const struct option opts[] = {
 		{ "listen", required_argument, NULL, O_LISTEN },   { "lcm-url", required_argument, NULL, O_URL },
 		{ "read-only", no_argument, NULL, O_RO },          { "allow-remote", no_argument, NULL, O_REMOTE },
-		{ "allow-host", required_argument, NULL, O_HOST },
+		{ "allow-host", required_argument, NULL, O_HOST }, { "allow-origin", required_argument, NULL, O_ORIGIN },
 		{ "token-file", required_argument, NULL, O_TOKEN }, { "key", required_argument, NULL, O_KEY },
 		{ "page-dir", required_argument, NULL, O_PAGE },   { "chartjs", required_argument, NULL, O_CHARTJS },
 		{ "help", no_argument, NULL, 'h' },                { "verbose", no_argument, NULL, 'v' },
@@ -161,6 +172,14 @@ int main(int argc, char **argv)
 				return 2;
 			}
 			o.hosts.names[o.hosts.nnames++] = optarg;
+			break;
+		case O_ORIGIN:
+			if (!origin_ok(optarg) || o.nfox_origins >= WEB_FOX_ORIGINS) {
+				fprintf(stderr, "undulate-web: --allow-origin \"%s\": want http:// or https:// and a host "
+				        "(e.g. https://app.foxglove.dev), at most %d of them\n", optarg, WEB_FOX_ORIGINS);
+				return 2;
+			}
+			o.fox_origins[o.nfox_origins++] = optarg;
 			break;
 		case O_TOKEN: token_file = optarg; break;
 		case O_KEY: o.key_file = optarg; break;

@@ -17,6 +17,7 @@
 #include "clock.h"
 #include "csock.h"
 #include "tools/top/feed.h"
+#include "foxsrv.h"
 #include "frame.h"
 #include "hist.h"
 #include "req.h"
@@ -198,6 +199,7 @@ static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *us
 	static double last_said;
 	double now = clock_mono_s();
 	char why[160];
+	foxsrv_heard(channel, rbuf->data, rbuf->data_size, (uint64_t)clock_wall_us() * 1000u, now);
 	if (top_feed(&app.model, channel, rbuf->data, rbuf->data_size, now, &hooks, why, sizeof why) || !why[0])
 		return;
 	if (app.model.decode_errors <= WEB_DECODE_LOG_N || now - last_said >= WEB_DECODE_LOG_EVERY_S) {
@@ -208,10 +210,20 @@ static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *us
 	}
 }
 
+/* the channels only Foxglove clients are served (foxsrv.h) */
+static void web_on_lcm_fox(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+	(void)user;
+	foxsrv_heard(channel, rbuf->data, rbuf->data_size, (uint64_t)clock_wall_us() * 1000u, clock_mono_s());
+}
+
 static int web_subscribe(void)
 {
 	for (size_t i = 0; i < top_feed_nchannels; i++)
 		if (!lcm_subscribe(app.lcm, top_feed_channels[i], web_on_lcm, NULL))
+			return -1;
+	for (size_t i = 0; i < fox_extra_nchannels; i++)
+		if (!lcm_subscribe(app.lcm, fox_extra_channels[i], web_on_lcm_fox, NULL))
 			return -1;
 	return 0;
 }
@@ -431,7 +443,7 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
 		/* a WebSocket that named no protocol, or "http": libwebsockets
 		 * would give it to this callback, past every check of "undulate" */
-		web_log(++app.n.ws_refused, "refused a WebSocket without the protocol 'undulate'");
+		web_log(++app.n.ws_refused, "refused a WebSocket without the protocol 'undulate' or '" FOX_SUBPROTOCOL "'");
 		return 1;
 	case LWS_CALLBACK_HTTP_BODY:
 		return 0; /* no request has a body worth reading: it was answered already */
@@ -451,7 +463,17 @@ static int web_http_cb(struct lws *wsi, enum lws_callback_reasons reason, void *
 
 /* ---- WebSocket -------------------------------------------------------------------- */
 
-static bool web_ws_allowed(struct lws *wsi)
+/* An origin given with --allow-origin (the Foxglove protocol only). */
+static bool web_fox_origin_ok(const char *origin)
+{
+	for (int i = 0; i < app.o.nfox_origins; i++)
+		if (strcmp(origin, app.o.fox_origins[i]) == 0)
+			return true;
+	return false;
+}
+
+/* fox: a Foxglove client, which may also come from an --allow-origin page */
+static bool web_ws_allowed(struct lws *wsi, bool fox)
 {
 	char origin[256] = "", host[256], qo[80], qh[80];
 	if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) >= (int)sizeof origin) {
@@ -465,7 +487,7 @@ static bool web_ws_allowed(struct lws *wsi)
 		        "rebinding?)", text_sanitize(qh, sizeof qh, host));
 		return false;
 	}
-	if (!req_origin_ok(origin, host)) {
+	if (!req_origin_ok(origin, host) && !(fox && web_fox_origin_ok(origin))) {
 		web_log(++app.n.ws_refused, "refused a WebSocket from origin '%s' (this is http://%s)",
 		        text_sanitize(qo, sizeof qo, origin), text_sanitize(qh, sizeof qh, host));
 		return false;
@@ -494,14 +516,17 @@ static void web_ws_token(struct lws *wsi, struct web_client *c)
 	c->wrong_token = !c->authed;
 }
 
-/* Room for it: watchers may not take the places kept for the token's holders. */
-static bool web_ws_room(const struct web_client *c)
+/* Room for it: watchers may not take the places kept for the token's
+ * holders. Foxglove clients are watchers (they never command) and count
+ * among the browsers. */
+static bool web_ws_room(bool authed)
 {
-	if (req_ws_room(app.nclients, app.nwatchers, c->authed, WEB_MAX_CLIENTS, WEB_MAX_WATCHERS))
+	int nfox = (int)foxsrv_counters()->clients;
+	if (req_ws_room(app.nclients + nfox, app.nwatchers + nfox, authed, WEB_MAX_CLIENTS, WEB_MAX_WATCHERS))
 		return true;
-	web_log(++app.n.ws_refused, "refused a WebSocket%s: %d browsers connected, %d of them without the token "
-	        "(at most %d; the rest is kept for the token's holders)", c->authed ? " with the token" : "",
-	        app.nclients, app.nwatchers, WEB_MAX_WATCHERS);
+	web_log(++app.n.ws_refused, "refused a WebSocket%s: %d browsers connected (%d of them Foxglove), %d of them "
+	        "without the token (at most %d; the rest is kept for the token's holders)",
+	        authed ? " with the token" : "", app.nclients + nfox, nfox, app.nwatchers + nfox, WEB_MAX_WATCHERS);
 	return false;
 }
 
@@ -620,24 +645,30 @@ static void web_ws_receive(struct lws *wsi, struct web_client *c, const char *in
 	web_command(c, &m);
 }
 
-/* What its client sent breaks RFC 6455 where libwebsockets 4.1 lets it
- * through (wsguard.h): close with 1002 before acting on anything. */
-static bool web_ws_bad(struct lws *wsi, struct web_client *c, enum wsg_verdict v)
+/* What a client sent breaks RFC 6455 where libwebsockets 4.1 lets it
+ * through (wsguard.h): close with 1002 before acting on anything. who and
+ * id name it in the log ("browser 3", "Foxglove client 4"). */
+static bool web_guard(struct lws *wsi, bool *failed, const char *who, unsigned id, enum wsg_verdict v)
 {
-	if (c->failed)
+	if (*failed)
 		return true;
 	if (v == WSG_OK)
 		return false;
-	c->failed = true;
+	*failed = true;
 	app.n.ws_bad_frames++;
 	if (!wsr_interposed())
 		web_log(app.n.ws_bad_frames, "cannot see what browsers send (recv() is not this program's): "
 		        "every WebSocket is refused");
 	else
-		web_log(app.n.ws_bad_frames, "browser %u: closed: %s", c->id, wsg_why(v));
+		web_log(app.n.ws_bad_frames, "%s %u: closed: %s", who, id, wsg_why(v));
 	const char *why = wsg_why(v);
 	lws_close_reason(wsi, LWS_CLOSE_STATUS_PROTOCOL_ERR, (unsigned char *)(uintptr_t)why, strlen(why));
 	return true;
+}
+
+static bool web_ws_bad(struct lws *wsi, struct web_client *c, enum wsg_verdict v)
+{
+	return web_guard(wsi, &c->failed, "browser", c->id, v);
 }
 
 /* The protocol is text (JSON out, "cmd ..." in): a binary frame is not ours
@@ -661,10 +692,10 @@ static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
 	switch (reason) {
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
 		web_conn_set(wsi, WEB_CONN_BUSY);
-		if (!web_ws_allowed(wsi))
+		if (!web_ws_allowed(wsi, false))
 			return 1;
 		web_ws_token(wsi, c);
-		return web_ws_room(c) ? 0 : 1;
+		return web_ws_room(c->authed) ? 0 : 1;
 	case LWS_CALLBACK_ESTABLISHED:
 		c->id = ++app.next_client;
 		if (web_ws_bad(wsi, c, wsr_upgraded(fd)))
@@ -685,6 +716,56 @@ static int web_ws_cb(struct lws *wsi, enum lws_callback_reasons reason, void *us
 	case LWS_CALLBACK_CLOSED:
 		wsr_forget(fd);
 		web_ws_close(c);
+		return 0;
+	default:
+		return 0;
+	}
+}
+
+/* ---- Foxglove's WebSocket protocol (foxsrv.h), through the same gate ---------------- */
+
+static void web_fox_receive(struct lws *wsi, struct fox_client *c, const char *in, size_t len)
+{
+	char why[256];
+	bool first = lws_is_first_fragment(wsi);
+	bool last = lws_is_final_fragment(wsi) && lws_remaining_packet_payload(wsi) == 0;
+	foxsrv_receive(c, in, len, lws_frame_is_binary(wsi), first, last, why, sizeof why);
+	if (why[0] != '\0')
+		web_log(foxsrv_counters()->refused, "Foxglove client %u: refused: %s", c->id, why);
+}
+
+static int web_fox_cb(struct lws *wsi, enum lws_callback_reasons reason, void *user, void *in, size_t len)
+{
+	struct fox_client *c = user;
+	int fd = lws_get_socket_fd(wsi);
+	switch (reason) {
+	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+		web_conn_set(wsi, WEB_CONN_BUSY);
+		return web_ws_allowed(wsi, true) && web_ws_room(false) ? 0 : 1;
+	case LWS_CALLBACK_ESTABLISHED: {
+		unsigned id = ++app.next_client;
+		if (web_guard(wsi, &c->failed, "Foxglove client", id, wsr_upgraded(fd)))
+			return -1;
+		if (!foxsrv_open(c, wsi, id, clock_mono_s())) {
+			web_log(++app.n.ws_refused, "refused a Foxglove client: no memory for its queue");
+			return -1;
+		}
+		web_conn_set(wsi, WEB_CONN_WS);
+		return 0;
+	}
+	case LWS_CALLBACK_SERVER_WRITEABLE:
+		if (web_guard(wsi, &c->failed, "Foxglove client", c->id, wsr_verdict(fd)))
+			return -1;
+		return foxsrv_write(c, clock_mono_s());
+	case LWS_CALLBACK_RECEIVE:
+		if (web_guard(wsi, &c->failed, "Foxglove client", c->id, wsr_verdict(fd)))
+			return -1;
+		web_fox_receive(wsi, c, in, len);
+		return 0;
+	case LWS_CALLBACK_CLOSED:
+		wsr_forget(fd);
+		if (c->queue != NULL)
+			foxsrv_close(c);
 		return 0;
 	default:
 		return 0;
@@ -774,6 +855,7 @@ static void web_tick(lws_sorted_usec_list_t *sul)
 		hist_close_contacts(&app.hist, now);
 		web_world_refusals();
 		web_frames_due(now);
+		foxsrv_tick(now);
 	}
 	lws_sul_schedule(app.ctx, 0, sul, web_tick, LWS_US_PER_SEC / HIST_HZ);
 }
@@ -783,6 +865,7 @@ static void web_tick(lws_sorted_usec_list_t *sul)
 static const struct lws_protocols web_protocols[] = {
 	{ "http", web_http_cb, sizeof(struct web_http), 0, 0, NULL, 0 },
 	{ "undulate", web_ws_cb, sizeof(struct web_client), REQ_MSG_MAX, 0, NULL, 0 },
+	{ FOX_SUBPROTOCOL, web_fox_cb, sizeof(struct fox_client), FOXSRV_OP_MAX, 0, NULL, 0 },
 	{ "undulate-raw", web_raw_cb, 0, 0, 0, NULL, 0 },
 	{ NULL, NULL, 0, 0, 0, NULL, 0 },
 };
@@ -844,7 +927,7 @@ int web_run(const struct web_opts *o)
 	hist_init(&app.hist, clock_mono_s());
 	app.frame = malloc(LWS_PRE + WEB_FRAME_MAX);
 	app.lcm = lcm_create(o->lcm_url);
-	if (app.frame == NULL || app.lcm == NULL || web_subscribe() != 0) {
+	if (app.frame == NULL || !foxsrv_init() || app.lcm == NULL || web_subscribe() != 0) {
 		fprintf(stderr, "undulate-web: cannot start LCM on %s\n", o->lcm_url ? o->lcm_url : "the default URL");
 		return 1;
 	}
@@ -892,7 +975,13 @@ int web_run(const struct web_opts *o)
 	        app.n.http_requests, app.n.http_refused, app.n.ws_refused, app.n.msgs_refused, app.n.commands_sent,
 	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled,
 	        app.n.ws_bad_frames, app.n.conns_evicted);
+	const struct foxsrv_counters *fx = foxsrv_counters();
+	fprintf(stderr, "undulate-web: exit: Foxglove: %lld messages sent, %lld dropped for clients behind, %lld "
+	        "Foxglove messages refused, %lld channels not advertised, %lld messages too large, %lld clients "
+	        "closed for taking nothing\n", fx->sent, fx->dropped, fx->refused, fx->channels_refused,
+	        fx->too_large, fx->stalled);
 	lws_context_destroy(app.ctx);
+	foxsrv_fini();
 	if (app.token_path[0] != '\0')
 		unlink(app.token_path);
 	sodium_memzero(app.token, sizeof app.token);

@@ -32,6 +32,7 @@
  * frame of 20 robots is ~6 kB; a browser that reads keeps it nearly empty. */
 #define WEB_SNDBUF (16 * 1024)
 #define WEB_NOTES 16                /* answers waiting for a browser's next frame */
+#define WEB_FOX_ORIGINS 8           /* --allow-origin, at most */
 
 struct web_opts {
 	const char *addr;           /* "127.0.0.1" */
@@ -44,6 +45,10 @@ struct web_opts {
 	const char *key_file;       /* signed LCM commands instead of local sockets */
 	const char *page_dir;       /* index.html, app.js, style.css */
 	const char *chartjs;        /* Chart.js from libjs-chart.js */
+	/* --allow-origin: pages of other origins that may open the read-only
+	 * Foxglove WebSocket (https://app.foxglove.dev); never the page's own */
+	const char *fox_origins[WEB_FOX_ORIGINS];
+	int nfox_origins;
 	bool verbose;
 };
 
