@@ -4,6 +4,7 @@
 #include <ftw.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,6 +15,24 @@ int scratch_make(const char *tag)
 	const char *base = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
 	snprintf(scratch_dir, sizeof scratch_dir, "%s/undulate-%s-XXXXXX", base, tag);
 	return mkdtemp(scratch_dir) ? 0 : -1;
+}
+
+int scratch_group_setup(void **state)
+{
+	(void)state;
+	char exe[256];
+	ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+	if (n <= 0)
+		return scratch_make("unit");
+	exe[n] = '\0';
+	const char *slash = strrchr(exe, '/');
+	return scratch_make(slash ? slash + 1 : exe);
+}
+
+int scratch_group_teardown(void **state)
+{
+	(void)state;
+	return scratch_remove();
 }
 
 static int scratch_unlink(const char *path, const struct stat *st, int type, struct FTW *ftw)

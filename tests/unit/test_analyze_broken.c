@@ -35,18 +35,6 @@ ALOG_DEFINE_WRITER(sim_truth_t)
 #define T_FREQ 0.8
 #define T_SWITCH_S 10.0
 
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("broken");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 struct run {
 	double force_n;           /* the pair's contact force, every truth period */
 	double clock_force_n;     /* before the switch */
@@ -223,5 +211,5 @@ int main(void)
 		cmocka_unit_test(test_a_few_late_steps_are_not_broken),
 		cmocka_unit_test(test_broken_runs),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

@@ -43,18 +43,6 @@ struct motion {
 	double amplitude, phase, offset, stop_s, freq_zero_s;
 };
 
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("endstate");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 static void motion_at(const struct motion *m, int64_t cycle, double *angle, double *speed)
 {
 	double w = 2.0 * M_PI * T_FREQ_HZ, t = (double)cycle * T_DT;
@@ -291,5 +279,5 @@ int main(void)
 		cmocka_unit_test(test_min_swing_option),
 		cmocka_unit_test(test_stop_inside_window),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

@@ -22,18 +22,6 @@
 /* Largest file the tests read whole (summary.json, return_map.csv). */
 #define T_FILE_MAX (1 << 20)
 
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("analyze");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 static void path_of(char *out, size_t n, const char *a, const char *b)
 {
 	snprintf(out, n, "%s/%s%s%s", scratch_dir, a, b ? "/" : "", b ? b : "");
@@ -576,5 +564,5 @@ int main(void)
 		cmocka_unit_test(test_plots),
 		cmocka_unit_test(test_plane_csv),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

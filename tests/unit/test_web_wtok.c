@@ -16,18 +16,6 @@
 #include "../../tools/web/wtok.h"
 #include "scratch.h"
 
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("wtok");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 static void put(const char *name, const char *text, mode_t mode)
 {
 	char path[512];
@@ -119,5 +107,5 @@ int main(void)
 		cmocka_unit_test(test_write_no_follow),
 		cmocka_unit_test(test_read),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }
