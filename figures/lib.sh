@@ -2,6 +2,12 @@
 # scripts/figures.sh, the driver of `make figures`. Source it; bash, set -u.
 #
 #   fig_init NAME               the module's name, which starts its messages
+#   fig_main USAGE CMD ARG...   runs the module's subcommand CMD (jobs, run, merge,
+#                               seconds, or one in FIG_MORE_COMMANDS), else the usage
+#   fig_grid ID VALUES N SEED_WORDS ARG...  job lines: each value x runs 1..N, with
+#                               {v}, {i} and {seed} filled in (fig_seed SEED_WORDS V I)
+#   fig_run_start OUTDIR        a run's folder checked (fig_run_dir); FIG_RUN its
+#                               absolute path, FIG_T0 the start; fig_wall: seconds since
 #   fig_die MSG... / fig_usage MSG...   "NAME: MSG" on stderr, exit 1 / exit 2
 #   fig_uint NAME VALUE MIN MAX a whole number in range, else fig_usage naming NAME
 #   fig_num NAME VALUE MIN MAX  a decimal number in range, else fig_usage
@@ -30,10 +36,13 @@
 #   fig_results DIR [sorted]    every DIR/*/result.csv as one CSV (one header; the
 #                               rows sorted with `sorted`); exit 1 when there is none
 #   fig_median / fig_quantile Q of the numbers on stdin, one a line
+#   fig_spread LIST             "MEDIAN MIN MAX" of the numbers in LIST (blank-separated)
 #   fig_merge_begin FIGDIR      for a merge: gnuplot present, FIGDIR checked as a
 #                               run's folder, FIG_TMP (a temporary folder) and
 #                               FIG_OUT (a private folder inside FIGDIR, where
 #                               the merge writes its files), removed at exit
+#   fig_merge_runs RUNS FIGDIR  merge's arguments checked, fig_merge_begin FIGDIR,
+#                               and the runs' rows (sorted) in FIG_OUT/NAME.csv
 #   fig_merge_end               FIG_OUT's files moved into FIGDIR, replacing
 #                               what has their names (never written through)
 #   fig_need_gnuplot            exit 1 with a message when gnuplot is missing
@@ -67,6 +76,40 @@ FIG_NAME=fig
 fig_init() { FIG_NAME=$1; }
 fig_die() { echo "$FIG_NAME: $*" >&2; exit 1; }
 fig_usage() { echo "$FIG_NAME: $*" >&2; exit 2; }
+
+# fig_main USAGE CMD ARG...: a module's last line. Every module answers the
+# same four subcommands (README.md, "A module"), each a function of the same
+# name; a module with more names them in FIG_MORE_COMMANDS. Anything else:
+# "NAME: usage: fig.sh USAGE", exit 2.
+fig_main() {
+	local usage=$1 cmd=${2:-}
+	case " jobs run merge seconds ${FIG_MORE_COMMANDS:-} " in
+	*" $cmd "*) [ -n "$cmd" ] && { shift 2; "$cmd" "$@"; return; } ;;
+	esac
+	fig_usage "usage: fig.sh $usage"
+}
+
+# fig_grid ID VALUES N SEED_WORDS ARG...: the job lines of a sweep, N runs at
+# each value: "ID ARG..." with {v} the value and {i} the run's number (1..N)
+# in ID and the ARGs, and {seed} (an ARG) fig_seed SEED_WORDS V I: the same
+# lines, names and seeds every time (README.md, "A module": jobs).
+fig_grid() {
+	local id=$1 values=$2 count=$3 words=$4 v i a line seed
+	shift 4
+	for v in $values; do
+		for i in $(seq "$count"); do
+			seed=$(fig_seed "$words" "$v" "$i")
+			line=${id//\{v\}/$v}
+			line=${line//\{i\}/$i}
+			for a in "$@"; do
+				a=${a//\{v\}/$v}
+				a=${a//\{i\}/$i}
+				line+=" ${a//\{seed\}/$seed}"
+			done
+			echo "$line"
+		done
+	done
+}
 
 fig_uint() {
 	[[ "$2" =~ ^[0-9]{1,9}$ ]] && [ "$((10#$2))" -ge "$3" ] && [ "$((10#$2))" -le "$4" ] ||
@@ -130,6 +173,17 @@ fig_run_dir() {
 	[ -d "$parent" ] || mkdir -p -- "$parent" || fig_die "cannot create $parent"
 	outdir_check "$1" "$FIG_NAME:" || exit 1
 }
+
+# fig_run_start OUTDIR: what every run does first: its folder checked or made
+# (fig_run_dir), FIG_RUN its absolute path (the run's programs start in other
+# folders) and FIG_T0 the moment, for fig_wall: the run's wall seconds so
+# far, one decimal, for its result row.
+fig_run_start() {
+	fig_run_dir "$1"
+	FIG_RUN=$(cd "$1" && pwd) || fig_die "cannot enter $1"
+	FIG_T0=$(date +%s.%N)
+}
+fig_wall() { awk -v a="$FIG_T0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }'; }
 
 # Attempts of one run when it heard another run on its port.
 FIG_PORT_TRIES=3
@@ -236,6 +290,18 @@ fig_quantile() {
 		printf "%.6g\n", (i < NR ? v[i] + f * (v[i + 1] - v[i]) : v[NR]) }'
 }
 
+# fig_spread LIST: the median, the least and the greatest of the numbers in
+# LIST (separated by blanks: the lists a merge's awk gathers per setting), on
+# one line with a space between; an empty LIST gives "nan" and two empty
+# fields (three words for printf's %s, or read's three names, all the same).
+fig_spread() {
+	local med lo hi
+	med=$(tr ' ' '\n' <<<"$1" | grep . | fig_median)
+	lo=$(tr ' ' '\n' <<<"$1" | grep . | sort -g | head -1)
+	hi=$(tr ' ' '\n' <<<"$1" | grep . | sort -g | tail -1)
+	echo "$med $lo $hi"
+}
+
 fig_need_gnuplot() {
 	command -v "${GNUPLOT:-gnuplot}" >/dev/null 2>&1 ||
 		fig_die "gnuplot is not installed: no figure can be drawn (Debian: apt-get install gnuplot-nox; or scripts/deps.sh)"
@@ -254,6 +320,14 @@ fig_merge_begin() {
 	FIG_OUT=$(mktemp -d "$1/.merge-$FIG_NAME.XXXXXX") || fig_die "cannot write in $1"
 	if [ "${FIG_KEEP:-0}" = 1 ]; then trap 'rm -rf "$FIG_OUT"' EXIT
 	else trap 'rm -rf "$FIG_TMP" "$FIG_OUT"' EXIT; fi
+}
+# fig_merge_runs RUNS_DIR FIGDIR: a merge's beginning where the module
+# merges all its runs' rows into one table: the arguments checked,
+# fig_merge_begin FIGDIR, and FIG_OUT/NAME.csv the rows (fig_results, sorted).
+fig_merge_runs() {
+	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
+	fig_merge_begin "$2"
+	fig_results "$1" sorted >"$FIG_OUT/$FIG_NAME.csv"
 }
 fig_merge_end() {
 	outdir_publish "$FIG_OUT" "$FIG_MERGE_DIR" || fig_die "could not move the figure into $FIG_MERGE_DIR"

@@ -66,20 +66,12 @@ LINK_WIDTH_M=0.032
 FRAMES="2 5 15 32"
 
 jobs() {
-	local trials=$TRIALS w t
+	local trials=$TRIALS
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel-plane tiny) ends"; return; fi
-	for w in $WIDTHS_CM; do
-		for t in $(seq "$trials"); do
-			echo "w${w}cm-t$t $w $(fig_seed channel-plane "$w" "$t") ends"
-		done
-	done
+	fig_grid 'w{v}cm-t{i}' "$WIDTHS_CM" "$trials" channel-plane '{v}' '{seed}' ends
 	[ "${1:-}" = --quick ] && return
-	for w in $WIDTHS_CM; do
-		for t in $(seq "$CONTROL_TRIALS"); do
-			echo "noends-w${w}cm-t$t $w $(fig_seed channel-plane none "$w" "$t") none"
-		done
-	done
+	fig_grid 'noends-w{v}cm-t{i}' "$WIDTHS_CM" "$CONTROL_TRIALS" 'channel-plane none' '{v}' '{seed}' none
 }
 
 # robot_stats PLANE_CSV FROM: per robot over t >= FROM, from the analyser's
@@ -106,10 +98,9 @@ run() {
 	case "$ends" in ends) ;; none) ends_set=(--set world.ends=none) ;; *) fig_usage "ENDS: want ends or none, got '$ends'" ;; esac
 	local sets
 	mapfile -t sets < <(fig_plane_sets) && [ ${#sets[@]} -gt 0 ] || exit 1
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0 spacing nominal r="$out/demo"
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
+	local spacing nominal r="$out/demo"
 	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
 	nominal=$(awk -v d="$spacing" -v s="$SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/plane-channel4.scenario" --seconds "$SECONDS_TOTAL" \
@@ -135,7 +126,7 @@ run() {
 	{ echo "moment,kind,index,x,y,angle_or_bx,length_or_by,robot_index"; cat "$out/frames.tmp"; } >"$out/frames.csv"
 	rm -f "$out/frames.tmp"
 	swing=$(fig_min_swing "$r/summary.json")
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	{
 		echo "width_cm,nominal_dsep,seed,$fig_pairs_header,dy_m,sweep_a_m,sweep_b_m,min_swing_rad,wall_s,ends"
 		awk -v p="$width,$nominal,$seed," -v q=",$swing,$wall,$ends" 'NR == FNR { cy[$1] = $3; sw[$1] = $4; next }
@@ -149,11 +140,8 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
-	fig_results "$runs" sorted >"$fig/channel-plane.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # channel-plane.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	# the channel with end walls (the figure), and the control runs without
 	awk -F, 'NR == 1 || $22 != "none"' "$fig/channel-plane.csv" >"$FIG_TMP/main.csv"
 	awk -F, 'NR == 1 || $22 == "none"' "$fig/channel-plane.csv" >"$FIG_TMP/control.csv"
@@ -336,10 +324,4 @@ seconds() {
 	echo 20
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR WIDTH_CM SEED [ENDS] | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
-esac
+fig_main "jobs [--quick] | run OUTDIR WIDTH_CM SEED [ENDS] | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

@@ -41,15 +41,11 @@ WINDOW=5
 SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
 
 jobs() {
-	local trials=$TRIALS w t
+	local trials=$TRIALS
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
 	# FIG_TINY=1 (the tests): one run at the middle width
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel tiny)"; return; fi
-	for w in $WIDTHS_CM; do
-		for t in $(seq "$trials"); do
-			echo "w${w}cm-t$t $w $(fig_seed channel "$w" "$t")"
-		done
-	done
+	fig_grid 'w{v}cm-t{i}' "$WIDTHS_CM" "$trials" channel '{v}' '{seed}'
 }
 
 run() {
@@ -57,17 +53,16 @@ run() {
 	local out=$1 width=$2 seed=$3
 	fig_num WIDTH_CM "$width" 5 60
 	fig_uint SEED "$seed" 1 999999999
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0 spacing nominal
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
+	local spacing nominal
 	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
 	nominal=$(awk -v d="$spacing" -v s="$SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/channel4.scenario" --seconds "$SECONDS_TOTAL" \
 		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.spacing=$spacing" || exit 1
 	local r="$out/demo" wall swing
 	swing=$(fig_min_swing "$r/summary.json")
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	outdir_new "$out/pairs.csv" "$out/result.csv" || fig_die "cannot write in $out"
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
 	[ -s "$out/pairs.csv" ] || fig_die "the analysis has no neighbouring pairs"
@@ -80,11 +75,8 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
-	fig_results "$runs" sorted >"$fig/channel.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # channel.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	draw "$fig" "$FIG_TMP" || fig_die "channel.png could not be drawn"
 	fragment "$fig"
 	fig_merge_end
@@ -181,10 +173,4 @@ seconds() {
 	echo 5
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR WIDTH_CM SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
-esac
+fig_main "jobs [--quick] | run OUTDIR WIDTH_CM SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"
