@@ -126,15 +126,10 @@ merge() {
 		local -a more
 		IFS='|' read -r -a more <<<"${f}"
 		med() { tr ' ' '\n' <<<"$1" | grep . | fig_median; }
-		printf '%s %s %s %s %s %s %s %s %s %s %s %s %s\n' "$k" "$n" "$b" \
-			"$(med "$cs")" "$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | tail -1)" \
-			"$(med "$os")" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)" \
+		printf '%s %s %s %s %s %s %s %s %s\n' "$k" "$n" "$b" "$(fig_spread "$cs")" "$(fig_spread "$os")" \
 			"$(med "${more[0]:-}")" "$(med "${more[1]:-}")" "$(med "${more[2]:-}")" "$(med "${more[3]:-}")"
 	done >"$t/summary"
-	[ -s "$t/summary" ] || fig_die "no runs to summarize in $csv"
-	{ echo "k,runs,broken,clock,clock_min,clock_max,osc,osc_min,osc_max,mean_clock,mean_osc,contacts_clock,contacts_osc"; tr ' ' ',' <"$t/summary"; } >"$t/summary.csv"
+	fig_summary_csv "$t/summary" "$csv" k,runs,broken,clock,clock_min,clock_max,osc,osc_min,osc_max,mean_clock,mean_osc,contacts_clock,contacts_osc
 	force_plot "$fig" "$t" || fig_die "forces-plane.png could not be drawn"
 	time_plot "$runs" "$fig" "$t" || fig_die "forces-plane_time.png could not be drawn"
 	fragment "$fig"
@@ -165,18 +160,13 @@ force_plot() {
 }
 
 time_plot() {
-	local runs=$1 fig=$2 t=$3 series=() k d colors=('#9467bd' '#1f77b4' '#2ca02c' '#ff7f0e' '#d62728') i=0 end
+	local runs=$1 fig=$2 t=$3 series=() k colors=('#9467bd' '#1f77b4' '#2ca02c' '#ff7f0e' '#d62728') i=0 end
 	end=$(awk -F, 'NR == 2 { print $3; exit }' "$fig/forces-plane.csv")
 	for k in $(cut -d' ' -f1 "$t/summary"); do
-		for d in "$runs"/*/; do
-			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
-			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$k" ] || continue
-			awk -F, -v e="$end" 'NR == 1 || ($2 != "" && $2 > 0 && $1 + 1 <= e)' "$d/series.csv" >"$t/time.k$k.csv"
-			fig_has "$t/time.k$k.csv" 1 && series+=(
-				"'$t/time.k$k.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 5))]}' title 'k = $k N·m/rad'")
-			i=$((i + 1))
-			break
-		done
+		fig_force_series "$runs" "$k" "$end" "$t/time.k$k.csv" || continue
+		fig_has "$t/time.k$k.csv" 1 && series+=(
+			"'$t/time.k$k.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 5))]}' title 'k = $k N·m/rad'")
+		i=$((i + 1))
 	done
 	[ ${#series[@]} -gt 0 ] || { echo "forces-plane: no series.csv in the runs: no time plot" >&2; return 0; }
 	{

@@ -161,14 +161,9 @@ merge() {
 		for (s in n) print s, k[s], n[s], c[s] "|" o[s] }' "$csv" | sort -n |
 	while read -r s k n rest; do
 		local cs=${rest%%|*} os=${rest#*|}
-		printf '%s %s %s %s %s %s %s %s %s\n' "$s" "$k" "$n" \
-			"$(tr ' ' '\n' <<<"$cs" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | tail -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)"
+		printf '%s %s %s %s %s\n' "$s" "$k" "$n" "$(fig_spread "$cs")" "$(fig_spread "$os")"
 	done >"$t/summary"
-	[ -s "$t/summary" ] || fig_die "no runs to summarize in $csv"
-	{ echo "slope,k,runs,clock,clock_min,clock_max,osc,osc_min,osc_max"; tr ' ' ',' <"$t/summary"; } >"$t/summary.csv"
+	fig_summary_csv "$t/summary" "$csv" slope,k,runs,clock,clock_min,clock_max,osc,osc_min,osc_max
 	force_plot "$fig" "$t" || fig_die "forces.png could not be drawn"
 	time_plot "$runs" "$fig" "$t" || fig_die "forces_time.png could not be drawn"
 	fragment "$fig"
@@ -205,19 +200,13 @@ force_plot() {
 # through the whole run, one run per slope (its first replicate that has a
 # series).
 time_plot() {
-	local runs=$1 fig=$2 t=$3 series=() s d colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 end
+	local runs=$1 fig=$2 t=$3 series=() s colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 end
 	end=$(run_end "$fig/forces.csv")
 	for s in $(cut -d' ' -f1 "$t/summary"); do
-		for d in "$runs"/*/; do
-			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
-			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$s" ] || continue
-			# whole seconds of the run (the last bin holds the final message alone)
-			awk -F, -v e="$end" 'NR == 1 || ($2 != "" && $2 > 0 && $1 + 1 <= e)' "$d/series.csv" >"$t/time.s$s.csv"
-			fig_has "$t/time.s$s.csv" 1 && series+=(
-				"'$t/time.s$s.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'")
-			i=$((i + 1))
-			break
-		done
+		fig_force_series "$runs" "$s" "$end" "$t/time.s$s.csv" || continue
+		fig_has "$t/time.s$s.csv" 1 && series+=(
+			"'$t/time.s$s.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'")
+		i=$((i + 1))
 	done
 	[ ${#series[@]} -gt 0 ] || { echo "forces: no series.csv in the runs: no time plot" >&2; return 0; }
 	{
