@@ -22,6 +22,7 @@
 
 #include "../../tools/analyze/alog.h"
 #include "../../tools/analyze/analyze.h"
+#include "anrun.h"
 #include "scratch.h"
 #include "undulate_robot_state_t.h"
 #include "undulate_sim_truth_t.h"
@@ -112,11 +113,7 @@ static char *analyse(const char *name, const struct run *r)
 	}
 	assert_int_equal(alog_writer_close(&w), 0);
 	struct an_options o;
-	an_options_default(&o);
-	o.logs[0] = logp;
-	o.nlogs = 1;
-	o.out_dir = outp;
-	o.quiet = true;
+	anrun_options(&o, logp, outp);
 	FILE *null = fopen("/dev/null", "w");
 	o.msg = null;
 	assert_int_equal(an_run(&o), AN_EXIT_OK);

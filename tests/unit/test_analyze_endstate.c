@@ -18,6 +18,7 @@
 
 #include "../../tools/analyze/alog.h"
 #include "../../tools/analyze/analyze.h"
+#include "anrun.h"
 #include "scratch.h"
 
 #include "undulate_robot_state_t.h"
@@ -98,11 +99,7 @@ static void analyse(const char *name, double min_swing)
 	snprintf(logp, sizeof(logp), "%s/%s.log", scratch_dir, name);
 	snprintf(outp, sizeof(outp), "%s/%s", scratch_dir, name);
 	struct an_options o;
-	an_options_default(&o);
-	o.logs[0] = logp;
-	o.nlogs = 1;
-	o.out_dir = outp;
-	o.quiet = true;
+	anrun_options(&o, logp, outp);
 	if (!isnan(min_swing))
 		o.min_swing = min_swing;
 	assert_int_equal(an_run(&o), AN_EXIT_OK);

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "../../tools/analyze/analyze.h"
+#include "anrun.h"
 #include "../../tools/analyze/theory.h"
 #include "../../tools/analyze/synth.h"
 #include "scratch.h"
@@ -80,14 +81,10 @@ static int pair_has(const char *json, const char *pair, const char *text)
 static int run(const char *log, const char *out, void (*tweak)(struct an_options *))
 {
 	static char logp[AN_MAX_LOGS][512], outp[512];
-	struct an_options o;
-	an_options_default(&o);
 	path_of(logp[0], sizeof(logp[0]), log, NULL);
 	path_of(outp, sizeof(outp), out, NULL);
-	o.logs[0] = logp[0];
-	o.nlogs = 1;
-	o.out_dir = outp;
-	o.quiet = true;
+	struct an_options o;
+	anrun_options(&o, logp[0], outp);
 	if (tweak)
 		tweak(&o);
 	return an_run(&o);

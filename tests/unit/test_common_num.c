@@ -36,19 +36,6 @@ static void expect_long(const char *s, long min, long max, enum num_status st, l
 	assert_int_equal(v, st == NUM_OK ? want : -77);
 }
 
-/* A row of the tables below: expect_long's arguments. */
-struct long_case {
-	const char *s;
-	long min, max;
-	enum num_status st;
-	long want;
-};
-
-static void expect_long_case(const struct long_case *c)
-{
-	expect_long(c->s, c->min, c->max, c->st, c->want);
-}
-
 static void test_double_accepts(void **state)
 {
 	(void)state;
@@ -132,67 +119,59 @@ static void test_double_range(void **state)
 static void test_long_accepts(void **state)
 {
 	(void)state;
-	static const struct long_case cases[] = {
-		{ "0", LONG_MIN, LONG_MAX, NUM_OK, 0 },
-		{ "42", LONG_MIN, LONG_MAX, NUM_OK, 42 },
-		{ "-42", LONG_MIN, LONG_MAX, NUM_OK, -42 },
-		{ "+42", LONG_MIN, LONG_MAX, NUM_OK, 42 },
-		/* leading zeros are decimal, not octal */
-		{ "010", LONG_MIN, LONG_MAX, NUM_OK, 10 },
-		{ "-010", LONG_MIN, LONG_MAX, NUM_OK, -10 },
-		{ "08", LONG_MIN, LONG_MAX, NUM_OK, 8 },
-		{ "0x10", LONG_MIN, LONG_MAX, NUM_OK, 16 },
-		{ "0X1f", LONG_MIN, LONG_MAX, NUM_OK, 31 },
-		{ "0xFF", LONG_MIN, LONG_MAX, NUM_OK, 255 },
-		{ "-0x10", LONG_MIN, LONG_MAX, NUM_OK, -16 },
-		{ "0x0", LONG_MIN, LONG_MAX, NUM_OK, 0 },
-		{ "9223372036854775807", LONG_MIN, LONG_MAX, NUM_OK, LONG_MAX },
-		{ "-9223372036854775808", LONG_MIN, LONG_MAX, NUM_OK, LONG_MIN },
-		{ "0x7fffffffffffffff", LONG_MIN, LONG_MAX, NUM_OK, LONG_MAX },
-		{ "-0x8000000000000000", LONG_MIN, LONG_MAX, NUM_OK, LONG_MIN },
-	};
-	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-		expect_long_case(&cases[i]);
+	expect_long("0", LONG_MIN, LONG_MAX, NUM_OK, 0);
+	expect_long("42", LONG_MIN, LONG_MAX, NUM_OK, 42);
+	expect_long("-42", LONG_MIN, LONG_MAX, NUM_OK, -42);
+	expect_long("+42", LONG_MIN, LONG_MAX, NUM_OK, 42);
+	/* leading zeros are decimal, not octal */
+	expect_long("010", LONG_MIN, LONG_MAX, NUM_OK, 10);
+	expect_long("-010", LONG_MIN, LONG_MAX, NUM_OK, -10);
+	expect_long("08", LONG_MIN, LONG_MAX, NUM_OK, 8);
+	expect_long("0x10", LONG_MIN, LONG_MAX, NUM_OK, 16);
+	expect_long("0X1f", LONG_MIN, LONG_MAX, NUM_OK, 31);
+	expect_long("0xFF", LONG_MIN, LONG_MAX, NUM_OK, 255);
+	expect_long("-0x10", LONG_MIN, LONG_MAX, NUM_OK, -16);
+	expect_long("0x0", LONG_MIN, LONG_MAX, NUM_OK, 0);
+	expect_long("9223372036854775807", LONG_MIN, LONG_MAX, NUM_OK, LONG_MAX);
+	expect_long("-9223372036854775808", LONG_MIN, LONG_MAX, NUM_OK, LONG_MIN);
+	expect_long("0x7fffffffffffffff", LONG_MIN, LONG_MAX, NUM_OK, LONG_MAX);
+	expect_long("-0x8000000000000000", LONG_MIN, LONG_MAX, NUM_OK, LONG_MIN);
 }
 
 static void test_long_refuses(void **state)
 {
 	(void)state;
-	static const struct long_case cases[] = {
-		{ NULL, 0, 10, NUM_EMPTY, 0 },
-		{ "", 0, 10, NUM_EMPTY, 0 },
-		{ " 1", 0, 10, NUM_SYNTAX, 0 },
-		{ "1 ", 0, 10, NUM_SYNTAX, 0 },
-		{ "1\n", 0, 10, NUM_SYNTAX, 0 },
-		{ "- 1", -10, 10, NUM_SYNTAX, 0 },
-		{ "-", -10, 10, NUM_SYNTAX, 0 },
-		{ "+", -10, 10, NUM_SYNTAX, 0 },
-		{ "--1", -10, 10, NUM_SYNTAX, 0 },
-		{ "+-1", -10, 10, NUM_SYNTAX, 0 },
-		{ "1x", 0, 10, NUM_SYNTAX, 0 },
-		{ "1.0", 0, 10, NUM_SYNTAX, 0 },
-		{ "1e3", 0, 10000, NUM_SYNTAX, 0 },
-		{ "0x", 0, 10, NUM_SYNTAX, 0 },
-		{ "0x-5", -10, 10, NUM_SYNTAX, 0 },
-		{ "0x 5", -10, 10, NUM_SYNTAX, 0 },
-		{ "0x+5", -10, 10, NUM_SYNTAX, 0 },
-		{ "0xg", 0, 10, NUM_SYNTAX, 0 },
-		{ "0b101", 0, 10, NUM_SYNTAX, 0 },
-		{ "x10", 0, 100, NUM_SYNTAX, 0 },
-		/* beyond the type: NUM_RANGE, whatever min and max say */
-		{ "9223372036854775808", LONG_MIN, LONG_MAX, NUM_RANGE, 0 },
-		{ "-9223372036854775809", LONG_MIN, LONG_MAX, NUM_RANGE, 0 },
-		{ "99999999999999999999999", LONG_MIN, LONG_MAX, NUM_RANGE, 0 },
-		{ "0x8000000000000000", LONG_MIN, LONG_MAX, NUM_RANGE, 0 },
-		/* outside the caller's range */
-		{ "254", 0, 253, NUM_RANGE, 0 },
-		{ "-1", 0, 253, NUM_RANGE, 0 },
-		{ "253", 0, 253, NUM_OK, 253 },
-		{ "0", 0, 253, NUM_OK, 0 },
-		{ "0", 1, 99, NUM_RANGE, 0 },
-	};
-	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
-		expect_long_case(&cases[i]);
+	expect_long(NULL, 0, 10, NUM_EMPTY, 0);
+	expect_long("", 0, 10, NUM_EMPTY, 0);
+	expect_long(" 1", 0, 10, NUM_SYNTAX, 0);
+	expect_long("1 ", 0, 10, NUM_SYNTAX, 0);
+	expect_long("1\n", 0, 10, NUM_SYNTAX, 0);
+	expect_long("- 1", -10, 10, NUM_SYNTAX, 0);
+	expect_long("-", -10, 10, NUM_SYNTAX, 0);
+	expect_long("+", -10, 10, NUM_SYNTAX, 0);
+	expect_long("--1", -10, 10, NUM_SYNTAX, 0);
+	expect_long("+-1", -10, 10, NUM_SYNTAX, 0);
+	expect_long("1x", 0, 10, NUM_SYNTAX, 0);
+	expect_long("1.0", 0, 10, NUM_SYNTAX, 0);
+	expect_long("1e3", 0, 10000, NUM_SYNTAX, 0);
+	expect_long("0x", 0, 10, NUM_SYNTAX, 0);
+	expect_long("0x-5", -10, 10, NUM_SYNTAX, 0);
+	expect_long("0x 5", -10, 10, NUM_SYNTAX, 0);
+	expect_long("0x+5", -10, 10, NUM_SYNTAX, 0);
+	expect_long("0xg", 0, 10, NUM_SYNTAX, 0);
+	expect_long("0b101", 0, 10, NUM_SYNTAX, 0);
+	expect_long("x10", 0, 100, NUM_SYNTAX, 0);
+	/* beyond the type: NUM_RANGE, whatever min and max say */
+	expect_long("9223372036854775808", LONG_MIN, LONG_MAX, NUM_RANGE, 0);
+	expect_long("-9223372036854775809", LONG_MIN, LONG_MAX, NUM_RANGE, 0);
+	expect_long("99999999999999999999999", LONG_MIN, LONG_MAX, NUM_RANGE, 0);
+	expect_long("0x8000000000000000", LONG_MIN, LONG_MAX, NUM_RANGE, 0);
+	/* outside the caller's range */
+	expect_long("254", 0, 253, NUM_RANGE, 0);
+	expect_long("-1", 0, 253, NUM_RANGE, 0);
+	expect_long("253", 0, 253, NUM_OK, 253);
+	expect_long("0", 0, 253, NUM_OK, 0);
+	expect_long("0", 1, 99, NUM_RANGE, 0);
 }
 
 static void test_int(void **state)
