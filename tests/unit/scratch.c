@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,6 +34,21 @@ int scratch_group_teardown(void **state)
 {
 	(void)state;
 	return scratch_remove();
+}
+
+bool scratch_private_file(const char *path, unsigned mode)
+{
+	struct stat st;
+	if (lstat(path, &st) != 0) {
+		fprintf(stderr, "%s: cannot lstat\n", path);
+		return false;
+	}
+	if (!S_ISREG(st.st_mode) || (st.st_mode & 07777) != mode || st.st_uid != geteuid()) {
+		fprintf(stderr, "%s: type/mode %06o, owner %u; want a regular file, %04o, %u\n", path,
+		        (unsigned)st.st_mode, (unsigned)st.st_uid, mode, (unsigned)geteuid());
+		return false;
+	}
+	return true;
 }
 
 static int scratch_unlink(const char *path, const struct stat *st, int type, struct FTW *ftw)

@@ -6,6 +6,7 @@
 #ifndef UNDULATE_SCRATCH_H
 #define UNDULATE_SCRATCH_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 /* The directory made by scratch_make(), "" before. */
@@ -24,6 +25,10 @@ int scratch_group_teardown(void **state);
 /* A file under the scratch directory, NUL-terminated, at most cap bytes read
  * (free() it); NULL if it cannot be opened. `rel` is relative to scratch_dir. */
 char *scratch_slurp(const char *rel, size_t cap);
+/* PATH itself (a link not followed) is a regular file of ours whose mode
+ * bits (07777) are MODE: a private file as written. Else false, saying
+ * what it is on stderr. */
+bool scratch_private_file(const char *path, unsigned mode);
 /* A pid nobody has: a child that exited and was reaped (-1 if fork failed). */
 long scratch_dead_pid(void);
 

@@ -234,11 +234,7 @@ static void test_key_generate(void **state)
 	umask(old);
 	assert_true(ok);
 	assert_true(auth_key_generate(p2, why, sizeof why));
-	struct stat st;
-	assert_int_equal(lstat(p1, &st), 0);
-	assert_true(S_ISREG(st.st_mode));
-	assert_int_equal(st.st_mode & 07777, 0600);
-	assert_int_equal(st.st_uid, geteuid());
+	assert_true(scratch_private_file(p1, 0600));
 	/* 64 hex digits and a newline, and it loads as a private key */
 	char *text = scratch_slurp("gen1.key", 300);
 	assert_non_null(text);

@@ -53,11 +53,7 @@ static void test_write_no_follow(void **state)
 	char *v = scratch_slurp("victim", 100);
 	assert_string_equal(v, "keep\n");
 	free(v);
-	struct stat st;
-	assert_int_equal(lstat(path, &st), 0);
-	assert_true(S_ISREG(st.st_mode));
-	assert_int_equal(st.st_mode & 0777, 0600);
-	assert_int_equal(st.st_uid, geteuid());
+	assert_true(scratch_private_file(path, 0600));
 	char *t = scratch_slurp("undulate-web-8080.token", 100);
 	assert_string_equal(t, "s3cret-token\n");
 	free(t);
