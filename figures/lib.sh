@@ -2,6 +2,12 @@
 # scripts/figures.sh, the driver of `make figures`. Source it; bash, set -u.
 #
 #   fig_init NAME               the module's name, which starts its messages
+#   fig_main USAGE CMD ARG...   runs the module's subcommand CMD (jobs, run, merge,
+#                               seconds, or one in FIG_MORE_COMMANDS), else the usage
+#   fig_grid ID VALUES N SEED_WORDS ARG...  job lines: each value x runs 1..N, with
+#                               {v}, {i} and {seed} filled in (fig_seed SEED_WORDS V I)
+#   fig_run_start OUTDIR        a run's folder checked (fig_run_dir); FIG_RUN its
+#                               absolute path, FIG_T0 the start; fig_wall: seconds since
 #   fig_die MSG... / fig_usage MSG...   "NAME: MSG" on stderr, exit 1 / exit 2
 #   fig_uint NAME VALUE MIN MAX a whole number in range, else fig_usage naming NAME
 #   fig_num NAME VALUE MIN MAX  a decimal number in range, else fig_usage
@@ -30,10 +36,17 @@
 #   fig_results DIR [sorted]    every DIR/*/result.csv as one CSV (one header; the
 #                               rows sorted with `sorted`); exit 1 when there is none
 #   fig_median / fig_quantile Q of the numbers on stdin, one a line
+#   fig_force_series RUNS V END OUT  the per-second contact force of the first run
+#                               whose setting (result.csv's first field) is V
+#   fig_summary_csv SUMMARY CSV HEADER  SUMMARY's blank-separated rows as SUMMARY.csv
+#                               under HEADER; none: exit 1 (nothing in CSV to summarize)
+#   fig_spread LIST             "MEDIAN MIN MAX" of the numbers in LIST (blank-separated)
 #   fig_merge_begin FIGDIR      for a merge: gnuplot present, FIGDIR checked as a
 #                               run's folder, FIG_TMP (a temporary folder) and
 #                               FIG_OUT (a private folder inside FIGDIR, where
 #                               the merge writes its files), removed at exit
+#   fig_merge_runs RUNS FIGDIR  merge's arguments checked, fig_merge_begin FIGDIR,
+#                               and the runs' rows (sorted) in FIG_OUT/NAME.csv
 #   fig_merge_end               FIG_OUT's files moved into FIGDIR, replacing
 #                               what has their names (never written through)
 #   fig_need_gnuplot            exit 1 with a message when gnuplot is missing
@@ -43,8 +56,14 @@
 #   fig_has CSV CONDITION      a row of CSV where the awk CONDITION holds
 #   fig_plot SPEC...            a gnuplot plot command of the series (empty ones left out)
 #   fig_theory ARG...           undulate-analyze --theory ARG... (tools/analyze/theory.c)
+#   FIG_PAIR_SCENARIO, FIG_PAIR_DRIVE  the pair rig's scenario and its robots' drive
+#                               (demo.sh --daemon-set words), shared by pair and returnmap
 #   fig_pair_switch DSEP DELTA0 when to switch a pair started on the full sinusoid to the
 #                               oscillator: just after the clock last pressed them together
+#   fig_channel_series CSV TMP WORD PS SWEPT_M, fig_channel_axes WINDOW,
+#   fig_channel_widths CSV, fig_channel_table CSV LAST [above], fig_channel_counts CSV,
+#   fig_channel_trials CSV      the channel modules' figure
+#                               (the paper's Fig. 9) and table, the same for both
 #   FIG_PLANE_CONF              the oscillator tuned for the plane world's robot
 #                               (figures/plane-oscillator.conf, made by fig_plane_tune)
 #   fig_plane_sets [CONF]       its parameters as demo.sh --daemon-set words, one a line
@@ -67,6 +86,40 @@ FIG_NAME=fig
 fig_init() { FIG_NAME=$1; }
 fig_die() { echo "$FIG_NAME: $*" >&2; exit 1; }
 fig_usage() { echo "$FIG_NAME: $*" >&2; exit 2; }
+
+# fig_main USAGE CMD ARG...: a module's last line. Every module answers the
+# same four subcommands (README.md, "A module"), each a function of the same
+# name; a module with more names them in FIG_MORE_COMMANDS. Anything else:
+# "NAME: usage: fig.sh USAGE", exit 2.
+fig_main() {
+	local usage=$1 cmd=${2:-}
+	case " jobs run merge seconds ${FIG_MORE_COMMANDS:-} " in
+	*" $cmd "*) [ -n "$cmd" ] && { shift 2; "$cmd" "$@"; return; } ;;
+	esac
+	fig_usage "usage: fig.sh $usage"
+}
+
+# fig_grid ID VALUES N SEED_WORDS ARG...: the job lines of a sweep, N runs at
+# each value: "ID ARG..." with {v} the value and {i} the run's number (1..N)
+# in ID and the ARGs, and {seed} (an ARG) fig_seed SEED_WORDS V I: the same
+# lines, names and seeds every time (README.md, "A module": jobs).
+fig_grid() {
+	local id=$1 values=$2 count=$3 words=$4 v i a line seed
+	shift 4
+	for v in $values; do
+		for i in $(seq "$count"); do
+			seed=$(fig_seed "$words" "$v" "$i")
+			line=${id//\{v\}/$v}
+			line=${line//\{i\}/$i}
+			for a in "$@"; do
+				a=${a//\{v\}/$v}
+				a=${a//\{i\}/$i}
+				line+=" ${a//\{seed\}/$seed}"
+			done
+			echo "$line"
+		done
+	done
+}
 
 fig_uint() {
 	[[ "$2" =~ ^[0-9]{1,9}$ ]] && [ "$((10#$2))" -ge "$3" ] && [ "$((10#$2))" -le "$4" ] ||
@@ -157,6 +210,17 @@ fig_run_dir() {
 	[ -d "$parent" ] || mkdir -p -- "$parent" || fig_die "cannot create $parent"
 	outdir_check "$1" "$FIG_NAME:" || exit 1
 }
+
+# fig_run_start OUTDIR: what every run does first: its folder checked or made
+# (fig_run_dir), FIG_RUN its absolute path (the run's programs start in other
+# folders) and FIG_T0 the moment, for fig_wall: the run's wall seconds so
+# far, one decimal, for its result row.
+fig_run_start() {
+	fig_run_dir "$1"
+	FIG_RUN=$(cd "$1" && pwd) || fig_die "cannot enter $1"
+	FIG_T0=$(date +%s.%N)
+}
+fig_wall() { awk -v a="$FIG_T0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }'; }
 
 # Attempts of one run when it heard another run on its port.
 FIG_PORT_TRIES=3
@@ -263,6 +327,43 @@ fig_quantile() {
 		printf "%.6g\n", (i < NR ? v[i] + f * (v[i + 1] - v[i]) : v[NR]) }'
 }
 
+# fig_spread LIST: the median, the least and the greatest of the numbers in
+# LIST (separated by blanks: the lists a merge's awk gathers per setting), on
+# one line with a space between; an empty LIST gives "nan" and two empty
+# fields (three words for printf's %s, or read's three names, all the same).
+fig_spread() {
+	local med lo hi
+	med=$(tr ' ' '\n' <<<"$1" | grep . | fig_median)
+	lo=$(tr ' ' '\n' <<<"$1" | grep . | sort -g | head -1)
+	hi=$(tr ' ' '\n' <<<"$1" | grep . | sort -g | tail -1)
+	echo "$med $lo $hi"
+}
+
+# fig_force_series RUNS_DIR VALUE END OUT: the forces modules' picture of
+# force against time draws one run per setting: the first run folder (in
+# name order) with a series.csv whose result.csv row has VALUE first. OUT:
+# that series' header and its whole seconds up to END with a force (the
+# last bin holds the final message alone). 1 when no run has one.
+fig_force_series() {
+	local d
+	for d in "$1"/*/; do
+		[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
+		[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$2" ] || continue
+		awk -F, -v e="$3" 'NR == 1 || ($2 != "" && $2 > 0 && $1 + 1 <= e)' "$d/series.csv" >"$4"
+		return 0
+	done
+	return 1
+}
+
+# fig_summary_csv SUMMARY CSV HEADER: a merge's table of one row per setting,
+# written by the shell's printf (blank-separated, so fig_spread's empty fields
+# stay in their columns), made a CSV for gnuplot: SUMMARY.csv under HEADER.
+# An empty SUMMARY: no run of CSV to summarize, exit 1 saying so.
+fig_summary_csv() {
+	[ -s "$1" ] || fig_die "no runs to summarize in $2"
+	{ echo "$3"; tr ' ' ',' <"$1"; } >"$1.csv"
+}
+
 fig_need_gnuplot() {
 	command -v "${GNUPLOT:-gnuplot}" >/dev/null 2>&1 ||
 		fig_die "gnuplot is not installed: no figure can be drawn (Debian: apt-get install gnuplot-nox; or scripts/deps.sh)"
@@ -281,6 +382,14 @@ fig_merge_begin() {
 	FIG_OUT=$(mktemp -d "$1/.merge-$FIG_NAME.XXXXXX") || fig_die "cannot write in $1"
 	if [ "${FIG_KEEP:-0}" = 1 ]; then trap 'rm -rf "$FIG_OUT"' EXIT
 	else trap 'rm -rf "$FIG_TMP" "$FIG_OUT"' EXIT; fi
+}
+# fig_merge_runs RUNS_DIR FIGDIR: a merge's beginning where the module
+# merges all its runs' rows into one table: the arguments checked,
+# fig_merge_begin FIGDIR, and FIG_OUT/NAME.csv the rows (fig_results, sorted).
+fig_merge_runs() {
+	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
+	fig_merge_begin "$2"
+	fig_results "$1" sorted >"$FIG_OUT/$FIG_NAME.csv"
 }
 fig_merge_end() {
 	outdir_publish "$FIG_OUT" "$FIG_MERGE_DIR" || fig_die "could not move the figure into $FIG_MERGE_DIR"
@@ -325,6 +434,14 @@ fig_plot() {
 }
 
 fig_theory() { "$FIG_BIN/undulate-analyze" --theory "$@"; }
+# ---- the pair rig (pair, returnmap) ---------------------------------------------------
+# Its scenario, and its robots' drive in every run of both modules: torque
+# actuation through the current drive, as the paper's rig drove each joint
+# with a motor current (docs/EXPERIMENTS.md); each module adds its own clock
+# (sinusoid.*) to these.
+FIG_PAIR_SCENARIO="$fig_top/sim-bridge/scenarios/pair-rig.scenario"
+FIG_PAIR_DRIVE=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current)
+
 # ---- a pair started at full amplitude, released by the clock -------------------------
 # Where the clock would press the bodies together at once (d~ = 0: for half
 # of every period), a phase difference cannot be set by a sinusoid that runs
@@ -357,6 +474,85 @@ fig_pair_switch() {
 			if (te >= tmin) { printf "%.3f\n", te + after; exit }
 		}
 	}'
+}
+
+# ---- four robots in a channel (channel, channel-plane: the paper's Fig. 9) ------------
+# Both modules' rows are "width_cm,nominal_dsep,seed," and then fig_pairs'
+# fields: $5 the class, $6 the mean Δ, $9 the collisions in the final window,
+# $13 the analyser's d̃, $14 its bound 2 asin(d̃). The row world's robots and
+# the plane's are drawn and tabled alike, so that the two pages compare.
+
+# fig_channel_series CSV TMP WORD PS SWEPT_M: the figure's series, one a line
+# (for mapfile): the compatibility curve from the theory's own code
+# (tools/analyze/theory.c, the analyser's per-pair compat_limit: "2 asin(d̃):
+# the compatibility WORD"), anti-phase, then each width's pairs, final |Δ|
+# against their d̃, points of size PS, a colour a width, titled with the
+# nominal d̃ (width / SWEPT_M). 1 when the theory failed.
+fig_channel_series() {
+	local csv=$1 t=$2 w i=0 colors=('#1f77b4' '#2ca02c' '#ff7f0e' '#d62728' '#9467bd')
+	fig_theory curves --points 401 >"$t/curves.csv" || return 1
+	echo "'$t/curves.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title '2 asin(d̃): the compatibility $3'"
+	echo "pi with lines dt 2 lc rgb 'gray' title 'anti-phase'"
+	for w in $(awk -F, 'NR > 1 { print $1 }' "$csv" | sort -gu); do
+		fig_has "$csv" "\$1 == $w && \$13 != \"nan\"" &&
+			echo "'$csv' every ::1 using (\$1 == $w ? \$13 : 1/0):(abs(\$6)) with points pt 7 ps $4 lc rgb '${colors[$((i % 5))]}' title '$w cm (d̃ $(awk -v w="$w" -v s="$5" 'BEGIN { printf "%.2f", w / 100 / s }') nominal)'"
+		i=$((i + 1))
+	done
+}
+
+# fig_channel_axes WINDOW: the figure's axes, after its title and labels:
+# final |Δ| (the mean over the last WINDOW s) from 0 to π, d̃ from 0.
+fig_channel_axes() {
+	echo "set ylabel 'final |Δ| (rad), mean over the last $1 s'"
+	echo "set key top left"
+	echo "set yrange [0:3.3]"
+	echo "set xrange [0:*]"
+	echo "set ytics ('0' 0, 'π/4' pi/4, 'π/2' pi/2, '3π/4' 3*pi/4, 'π' pi)"
+}
+
+# fig_channel_widths CSV: the table's numbers, a line per width (sorted):
+# width, nominal d̃, pairs, pairs at or below the bound + 0.1 rad (the
+# analyser's margin), above it, anti-phase, still colliding in the final
+# window, the d̃ at the end (median, least, greatest) and the final |Δ|'s median.
+fig_channel_widths() {
+	awk -F, 'NR > 1 {
+			w = $1; n[w]++; nom[w] = $2; d = $6 < 0 ? -$6 : $6
+			dd[w] = dd[w] " " $13; ad[w] = ad[w] " " d
+			if ($14 != "nan" && d <= $14 + 0.1) below[w]++
+			else above[w]++
+			if ($5 == "anti-phase") anti[w]++
+			if ($9 > 0) coll[w]++
+		}
+		END { for (w in n) printf "%s %s %d %d %d %d %d|%s|%s\n", w, nom[w], n[w], below[w], above[w], anti[w], coll[w], dd[w], ad[w] }' "$1" |
+		sort -g | while IFS='|' read -r head dlist alist; do
+			echo "$head $(fig_spread "$dlist") $(tr ' ' '\n' <<<"$alist" | grep . | fig_median)"
+		done
+}
+
+# fig_channel_table CSV LAST [above]: the page's table of fig_channel_widths,
+# a row per width; LAST heads the column of pairs still colliding in the
+# final window; with `above`, a column of the pairs above the bound too.
+fig_channel_table() {
+	local above=${3:-} w nom n below nabove anti coll dmed dmin dmax amed
+	echo "| width | d̃ nominal | pairs | d̃ at the end, median (range) | final \|Δ\| median | at or below 2 asin(d̃) + 0.1 |${above:+ above it |} anti-phase | $2 |"
+	echo "|---|---|---|---|---|---|${above:+---|}---|---|"
+	fig_channel_widths "$1" | while read -r w nom n below nabove anti coll dmed dmin dmax amed; do
+		printf '| %s cm | %.2f | %d | %.2f (%.2f-%.2f) | %.2f rad | %d of %d |' "$w" "$nom" "$n" "$dmed" "$dmin" "$dmax" "$amed" "$below" "$n"
+		[ -n "$above" ] && printf ' %d |' "$nabove"
+		printf ' %d | %d |\n' "$anti" "$coll"
+	done
+}
+
+# fig_channel_counts CSV: the runs (a width and a seed each) and the
+# neighbouring pairs (its rows) in CSV.
+fig_channel_counts() {
+	echo "$(awk -F, 'NR > 1 { print $1 " " $3 }' "$1" | sort -u | wc -l) $(($(wc -l <"$1") - 1))"
+}
+
+# fig_channel_trials CSV: the most runs (width and seed) at any one width:
+# at most the quick set's trials a width, the page says it is the quick set.
+fig_channel_trials() {
+	awk -F, 'NR > 1 { t[$1 " " $3] = 1 } END { for (k in t) { split(k, a, " "); n[a[1]]++ } for (w in n) if (n[w] > m) m = n[w]; print m + 0 }' "$1"
 }
 
 # ---- the oscillator tuned for the plane world's robot -------------------------------

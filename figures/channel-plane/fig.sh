@@ -66,20 +66,12 @@ LINK_WIDTH_M=0.032
 FRAMES="2 5 15 32"
 
 jobs() {
-	local trials=$TRIALS w t
+	local trials=$TRIALS
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel-plane tiny) ends"; return; fi
-	for w in $WIDTHS_CM; do
-		for t in $(seq "$trials"); do
-			echo "w${w}cm-t$t $w $(fig_seed channel-plane "$w" "$t") ends"
-		done
-	done
+	fig_grid 'w{v}cm-t{i}' "$WIDTHS_CM" "$trials" channel-plane '{v}' '{seed}' ends
 	[ "${1:-}" = --quick ] && return
-	for w in $WIDTHS_CM; do
-		for t in $(seq "$CONTROL_TRIALS"); do
-			echo "noends-w${w}cm-t$t $w $(fig_seed channel-plane none "$w" "$t") none"
-		done
-	done
+	fig_grid 'noends-w{v}cm-t{i}' "$WIDTHS_CM" "$CONTROL_TRIALS" 'channel-plane none' '{v}' '{seed}' none
 }
 
 # robot_stats PLANE_CSV FROM: per robot over t >= FROM, from the analyser's
@@ -106,10 +98,9 @@ run() {
 	case "$ends" in ends) ;; none) ends_set=(--set world.ends=none) ;; *) fig_usage "ENDS: want ends or none, got '$ends'" ;; esac
 	local sets
 	mapfile -t sets < <(fig_plane_sets) && [ ${#sets[@]} -gt 0 ] || exit 1
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0 spacing nominal r="$out/demo"
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
+	local spacing nominal r="$out/demo"
 	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
 	nominal=$(awk -v d="$spacing" -v s="$SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/plane-channel4.scenario" --seconds "$SECONDS_TOTAL" \
@@ -135,7 +126,7 @@ run() {
 	{ echo "moment,kind,index,x,y,angle_or_bx,length_or_by,robot_index"; cat "$out/frames.tmp"; } >"$out/frames.csv"
 	rm -f "$out/frames.tmp"
 	swing=$(fig_min_swing "$r/summary.json")
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	{
 		echo "width_cm,nominal_dsep,seed,$fig_pairs_header,dy_m,sweep_a_m,sweep_b_m,min_swing_rad,wall_s,ends"
 		awk -v p="$width,$nominal,$seed," -v q=",$swing,$wall,$ends" 'NR == FNR { cy[$1] = $3; sw[$1] = $4; next }
@@ -149,11 +140,8 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
-	fig_results "$runs" sorted >"$fig/channel-plane.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # channel-plane.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	# the channel with end walls (the figure), and the control runs without
 	awk -F, 'NR == 1 || $22 != "none"' "$fig/channel-plane.csv" >"$FIG_TMP/main.csv"
 	awk -F, 'NR == 1 || $22 == "none"' "$fig/channel-plane.csv" >"$FIG_TMP/control.csv"
@@ -167,15 +155,9 @@ merge() {
 # draw FIGDIR TMP: channel-plane.png, each pair's final |Δ| against its d̃,
 # one colour per width, beside the compatibility curve (the paper's Fig. 9).
 draw() {
-	local fig=$1 t=$2 csv="$1/channel-plane.csv" w i=0 series=() colors=('#1f77b4' '#2ca02c' '#ff7f0e' '#d62728' '#9467bd')
-	fig_theory curves --points 401 >"$t/curves.csv" || return 1
-	series+=("'$t/curves.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title '2 asin(d̃): the compatibility curve'"
-		"pi with lines dt 2 lc rgb 'gray' title 'anti-phase'")
-	for w in $(awk -F, 'NR > 1 { print $1 }' "$t/main.csv" | sort -gu); do
-		fig_has "$t/main.csv" "\$1 == $w && \$13 != \"nan\"" && series+=(
-			"'$t/main.csv' every ::1 using (\$1 == $w ? \$13 : 1/0):(abs(\$6)) with points pt 7 ps 1.0 lc rgb '${colors[$((i % 5))]}' title '$w cm (d̃ $(awk -v w="$w" -v s="$SWEPT_M" 'BEGIN { printf "%.2f", w / 100 / s }') nominal)'")
-		i=$((i + 1))
-	done
+	local fig=$1 t=$2 series
+	fig_channel_series "$t/main.csv" "$t" curve 1.0 "$SWEPT_M" >"$t/series" || return 1
+	mapfile -t series <"$t/series"
 	fig_has "$t/control.csv" "\$13 != \"nan\"" && series+=(
 		"'$t/control.csv' every ::1 using 13:(abs(\$6)) with points pt 6 ps 0.9 lc rgb '#888888' title 'control: no end walls, all widths'")
 	{
@@ -183,12 +165,8 @@ draw() {
 		echo "set output '$fig/channel-plane.png'"
 		echo "set termoption noenhanced"
 		echo "set xlabel 'd̃ of the pair at the end (analyser: final centres, measured amplitude)'"
-		echo "set ylabel 'final |Δ| (rad), mean over the last $WINDOW s'"
 		echo "set title 'Four three-link robots in a channel (plane world), 30 s on the oscillator from random phases'"
-		echo "set key top left"
-		echo "set yrange [0:3.3]"
-		echo "set xrange [0:*]"
-		echo "set ytics ('0' 0, 'π/4' pi/4, 'π/2' pi/2, '3π/4' 3*pi/4, 'π' pi)"
+		fig_channel_axes "$WINDOW"
 		fig_plot "${series[@]}"
 	} >"$t/channel-plane.gp"
 	fig_gnuplot "$t/channel-plane.gp"
@@ -245,8 +223,7 @@ frames() {
 fragment() {
 	local fig=$1 csv="$2/main.csv" control="$2/control.csv"
 	local runs pairs
-	runs=$(awk -F, 'NR > 1 { print $1 " " $3 }' "$csv" | sort -u | wc -l)
-	pairs=$(($(wc -l <"$csv") - 1))
+	read -r runs pairs <<<"$(fig_channel_counts "$csv")"
 	{
 		echo "## Four three-link robots in a channel, in the plane (the paper's Figs. 8c-f and 9)"
 		echo
@@ -266,28 +243,11 @@ fragment() {
 		echo "the clock at random phases, then $((SECONDS_TOTAL - SWITCH)) s on the oscillator; $pairs neighbouring pairs. Final Δ: the"
 		echo "pair's mean over the last $WINDOW s; d̃ and 2 asin(d̃): the analyser's per pair (final centres,"
 		echo "lever 0.1865 m/rad, measured amplitude)."
-		if [ "$(awk -F, 'NR > 1 { t[$1 " " $3] = 1 } END { for (k in t) { split(k, a, " "); n[a[1]]++ } for (w in n) if (n[w] > m) m = n[w]; print m + 0 }' "$csv")" -le "$QUICK_TRIALS" ]; then
+		if [ "$(fig_channel_trials "$csv")" -le "$QUICK_TRIALS" ]; then
 			echo "(\`make figures QUICK=1\`: $QUICK_TRIALS trials a width; the full set runs $TRIALS, the paper's 210 simulated trials.)"
 		fi
 		echo
-		echo "| width | d̃ nominal | pairs | d̃ at the end, median (range) | final \|Δ\| median | at or below 2 asin(d̃) + 0.1 | above it | anti-phase | still touching in the last $WINDOW s |"
-		echo "|---|---|---|---|---|---|---|---|---|"
-		awk -F, 'NR > 1 {
-				w = $1; n[w]++; nom[w] = $2; d = $6 < 0 ? -$6 : $6
-				dd[w] = dd[w] " " $13; ad[w] = ad[w] " " d
-				if ($14 != "nan" && d <= $14 + 0.1) below[w]++
-				else above[w]++
-				if ($5 == "anti-phase") anti[w]++
-				if ($9 > 0) coll[w]++
-			}
-			END { for (w in n) printf "%s %s %d %d %d %d %d|%s|%s\n", w, nom[w], n[w], below[w], above[w], anti[w], coll[w], dd[w], ad[w] }' "$csv" |
-			sort -g | while IFS='|' read -r head dlist alist; do
-				read -r w nom n below above anti coll <<<"$head"
-				printf '| %s cm | %.2f | %d | %.2f (%.2f-%.2f) | %.2f rad | %d of %d | %d | %d | %d |\n' "$w" "$nom" "$n" \
-					"$(tr ' ' '\n' <<<"$dlist" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$dlist" | grep . | sort -g | head -1)" \
-					"$(tr ' ' '\n' <<<"$dlist" | grep . | sort -g | tail -1)" "$(tr ' ' '\n' <<<"$alist" | grep . | fig_median)" \
-					"$below" "$n" "$above" "$anti" "$coll"
-			done
+		fig_channel_table "$csv" "still touching in the last $WINDOW s" above
 		echo
 		local sweep dy
 		sweep=$(awk -F, 'NR > 1 { print $18; print $19 }' "$csv" | grep -v nan | fig_median)
@@ -336,10 +296,4 @@ seconds() {
 	echo 20
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR WIDTH_CM SEED [ENDS] | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
-esac
+fig_main "jobs [--quick] | run OUTDIR WIDTH_CM SEED [ENDS] | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

@@ -41,15 +41,11 @@ WINDOW=5
 SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
 
 jobs() {
-	local trials=$TRIALS w t
+	local trials=$TRIALS
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
 	# FIG_TINY=1 (the tests): one run at the middle width
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel tiny)"; return; fi
-	for w in $WIDTHS_CM; do
-		for t in $(seq "$trials"); do
-			echo "w${w}cm-t$t $w $(fig_seed channel "$w" "$t")"
-		done
-	done
+	fig_grid 'w{v}cm-t{i}' "$WIDTHS_CM" "$trials" channel '{v}' '{seed}'
 }
 
 run() {
@@ -57,17 +53,16 @@ run() {
 	local out=$1 width=$2 seed=$3
 	fig_num WIDTH_CM "$width" 5 60
 	fig_uint SEED "$seed" 1 999999999
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0 spacing nominal
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
+	local spacing nominal
 	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
 	nominal=$(awk -v d="$spacing" -v s="$SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/channel4.scenario" --seconds "$SECONDS_TOTAL" \
 		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.spacing=$spacing" || exit 1
 	local r="$out/demo" wall swing
 	swing=$(fig_min_swing "$r/summary.json")
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	outdir_new "$out/pairs.csv" "$out/result.csv" || fig_die "cannot write in $out"
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
 	[ -s "$out/pairs.csv" ] || fig_die "the analysis has no neighbouring pairs"
@@ -80,11 +75,8 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
-	fig_results "$runs" sorted >"$fig/channel.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # channel.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	draw "$fig" "$FIG_TMP" || fig_die "channel.png could not be drawn"
 	fragment "$fig"
 	fig_merge_end
@@ -93,28 +85,16 @@ merge() {
 # draw FIGDIR TMP: channel.png, each pair's final |Δ| against its d̃, one
 # colour per width, beside the compatibility bound.
 draw() {
-	local fig=$1 t=$2 csv="$1/channel.csv" w i=0 series=() colors=('#1f77b4' '#2ca02c' '#ff7f0e' '#d62728' '#9467bd')
-	# the bound from the theory's own code (tools/analyze/theory.c), as the
-	# analyser's per-pair compat_limit in channel.csv
-	fig_theory curves --points 401 >"$t/curves.csv" || return 1
-	series+=("'$t/curves.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title '2 asin(d̃): the compatibility bound'"
-		"pi with lines dt 2 lc rgb 'gray' title 'anti-phase'")
-	for w in $(awk -F, 'NR > 1 { print $1 }' "$csv" | sort -gu); do
-		fig_has "$csv" "\$1 == $w && \$13 != \"nan\"" && series+=(
-			"'$csv' every ::1 using (\$1 == $w ? \$13 : 1/0):(abs(\$6)) with points pt 7 ps 1.1 lc rgb '${colors[$((i % 5))]}' title '$w cm (d̃ $(awk -v w="$w" -v s="$SWEPT_M" 'BEGIN { printf "%.2f", w / 100 / s }') nominal)'")
-		i=$((i + 1))
-	done
+	local fig=$1 t=$2 series
+	fig_channel_series "$fig/channel.csv" "$t" bound 1.1 "$SWEPT_M" >"$t/series" || return 1
+	mapfile -t series <"$t/series"
 	{
 		fig_gp_head 900 600
 		echo "set output '$fig/channel.png'"
 		echo "set termoption noenhanced"
 		echo "set xlabel 'd̃ of the pair at the end (analyser: final neutral positions, measured amplitude)'"
-		echo "set ylabel 'final |Δ| (rad), mean over the last $WINDOW s'"
 		echo "set title 'Four robots in a channel, 30 s on the oscillator from random phases'"
-		echo "set key top left"
-		echo "set yrange [0:3.3]"
-		echo "set xrange [0:*]"
-		echo "set ytics ('0' 0, 'π/4' pi/4, 'π/2' pi/2, '3π/4' 3*pi/4, 'π' pi)"
+		fig_channel_axes "$WINDOW"
 		fig_plot "${series[@]}"
 	} >"$t/channel.gp"
 	fig_gnuplot "$t/channel.gp"
@@ -123,8 +103,7 @@ draw() {
 fragment() {
 	local fig=$1 csv="$1/channel.csv"
 	local runs pairs
-	runs=$(awk -F, 'NR > 1 { print $1 " " $3 }' "$csv" | sort -u | wc -l)
-	pairs=$(($(wc -l <"$csv") - 1))
+	read -r runs pairs <<<"$(fig_channel_counts "$csv")"
 	{
 		echo "## Four robots in a channel, in the row world (the paper's Figs. 8 and 9)"
 		echo
@@ -136,27 +115,11 @@ fragment() {
 		echo "neighbouring pairs. Channel width = the distance between neighbouring robots (d̃ ="
 		echo "width / 0.298 m, the swept width of a contact body). Final Δ: the pair's mean over the"
 		echo "last $WINDOW s; d̃ and 2 asin(d̃): the analyser's, per pair."
-		if [ "$(awk -F, 'NR > 1 { t[$1 " " $3] = 1 } END { for (k in t) { split(k, a, " "); n[a[1]]++ } for (w in n) if (n[w] > m) m = n[w]; print m + 0 }' "$csv")" -le "$QUICK_TRIALS" ]; then
+		if [ "$(fig_channel_trials "$csv")" -le "$QUICK_TRIALS" ]; then
 			echo "(\`make figures QUICK=1\`: $QUICK_TRIALS trials a width; the full set runs $TRIALS.)"
 		fi
 		echo
-		echo "| width | d̃ nominal | pairs | d̃ at the end, median (range) | final \|Δ\| median | at or below 2 asin(d̃) + 0.1 | anti-phase | still colliding in the last $WINDOW s |"
-		echo "|---|---|---|---|---|---|---|---|"
-		awk -F, 'NR > 1 {
-				w = $1; n[w]++; nom[w] = $2; d = $6 < 0 ? -$6 : $6
-				dd[w] = dd[w] " " $13; ad[w] = ad[w] " " d
-				if ($14 != "nan" && d <= $14 + 0.1) below[w]++
-				if ($5 == "anti-phase") anti[w]++
-				if ($9 > 0) coll[w]++
-			}
-			END { for (w in n) printf "%s %s %d %d %d %d|%s|%s\n", w, nom[w], n[w], below[w], anti[w], coll[w], dd[w], ad[w] }' "$csv" |
-			sort -g | while IFS='|' read -r head dlist alist; do
-				read -r w nom n below anti coll <<<"$head"
-				printf '| %s cm | %.2f | %d | %.2f (%.2f-%.2f) | %.2f rad | %d of %d | %d | %d |\n' "$w" "$nom" "$n" \
-					"$(tr ' ' '\n' <<<"$dlist" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$dlist" | grep . | sort -g | head -1)" \
-					"$(tr ' ' '\n' <<<"$dlist" | grep . | sort -g | tail -1)" "$(tr ' ' '\n' <<<"$alist" | grep . | fig_median)" \
-					"$below" "$n" "$anti" "$coll"
-			done
+		fig_channel_table "$csv" "still colliding in the last $WINDOW s"
 		echo
 		awk -F, 'NR > 1 { n++; d = $6 < 0 ? -$6 : $6; if ($5 == "anti-phase") a++; if ($14 != "nan" && d <= $14 + 0.1) b++
 				if ($15 < 0.2 || $16 < 0.2) s++; t += $18 } END {
@@ -181,10 +144,4 @@ seconds() {
 	echo 5
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR WIDTH_CM SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
-esac
+fig_main "jobs [--quick] | run OUTDIR WIDTH_CM SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

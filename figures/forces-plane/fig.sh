@@ -47,14 +47,10 @@ OSC_MU2=0.088
 OSC_PHASE=0.05
 
 jobs() {
-	local ks=$KS seeds=$SEEDS end=$END_FULL k s
+	local ks=$KS seeds=$SEEDS end=$END_FULL
 	[ "${1:-}" = --quick ] && ks=$QUICK_KS seeds=$QUICK_SEEDS end=$END_QUICK
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "k0.135-t0 0.135 $(fig_seed forces-plane tiny) $END_TINY $WALLS"; return; fi
-	for k in $ks; do
-		for s in $(seq "$seeds"); do
-			echo "k$k-s$s $k $(fig_seed forces-plane "$k" "$s") $end $WALLS"
-		done
-	done
+	fig_grid 'k{v}-s{i}' "$ks" "$seeds" forces-plane '{v}' '{seed}' "$end" "$WALLS"
 }
 
 # force_stat RUN_DIR FROM TO median|mean: of the per-second contact force
@@ -73,10 +69,8 @@ run() {
 	fig_num WALLS "$walls" 0.3 2
 	local closed=$((end / 3)) switch=$((2 * end / 3)) half
 	half=$(awk -v w="$walls" 'BEGIN { printf "%g", w / 2 }')
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/plane-arena10.scenario" --seconds "$end" \
 		--switch-at "$switch" --seed "$seed" --window "$closed" --set motor.drive=current \
 		--set "events.10=walls -$half $half over $((closed - 10))" \
@@ -103,7 +97,7 @@ run() {
 	# where the walls stood at the end (a crowd may hold them short of WALLS)
 	width=$(fig_json "$r" '(.walls.right_m // null) as $r | (.walls.left_m // null) as $l |
 		if $r == null or $l == null then "nan" else ($r - $l) end')
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	outdir_new "$out/result.csv" || fig_die "cannot write $out/result.csv"
 	{
 		echo "k_nm_rad,seed,end_s,walls_m,damping,median_clock_n,median_osc_n,contacts_clock,contacts_osc,mean_clock_n,mean_osc_n,broken,min_swing_rad,wall_s,walls_end_m"
@@ -114,11 +108,8 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT
-	fig_results "$runs" sorted >"$fig/forces-plane.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # forces-plane.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	local csv="$fig/forces-plane.csv" t=$FIG_TMP
 	# per k, over the runs that did not break: the median of the runs' medians and their range
 	# fields: k runs broken, the medians of all contacts (clock: median of the runs'
@@ -135,15 +126,10 @@ merge() {
 		local -a more
 		IFS='|' read -r -a more <<<"${f}"
 		med() { tr ' ' '\n' <<<"$1" | grep . | fig_median; }
-		printf '%s %s %s %s %s %s %s %s %s %s %s %s %s\n' "$k" "$n" "$b" \
-			"$(med "$cs")" "$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | tail -1)" \
-			"$(med "$os")" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)" \
+		printf '%s %s %s %s %s %s %s %s %s\n' "$k" "$n" "$b" "$(fig_spread "$cs")" "$(fig_spread "$os")" \
 			"$(med "${more[0]:-}")" "$(med "${more[1]:-}")" "$(med "${more[2]:-}")" "$(med "${more[3]:-}")"
 	done >"$t/summary"
-	[ -s "$t/summary" ] || fig_die "no runs to summarize in $csv"
-	{ echo "k,runs,broken,clock,clock_min,clock_max,osc,osc_min,osc_max,mean_clock,mean_osc,contacts_clock,contacts_osc"; tr ' ' ',' <"$t/summary"; } >"$t/summary.csv"
+	fig_summary_csv "$t/summary" "$csv" k,runs,broken,clock,clock_min,clock_max,osc,osc_min,osc_max,mean_clock,mean_osc,contacts_clock,contacts_osc
 	force_plot "$fig" "$t" || fig_die "forces-plane.png could not be drawn"
 	time_plot "$runs" "$fig" "$t" || fig_die "forces-plane_time.png could not be drawn"
 	fragment "$fig"
@@ -174,18 +160,13 @@ force_plot() {
 }
 
 time_plot() {
-	local runs=$1 fig=$2 t=$3 series=() k d colors=('#9467bd' '#1f77b4' '#2ca02c' '#ff7f0e' '#d62728') i=0 end
+	local runs=$1 fig=$2 t=$3 series=() k colors=('#9467bd' '#1f77b4' '#2ca02c' '#ff7f0e' '#d62728') i=0 end
 	end=$(awk -F, 'NR == 2 { print $3; exit }' "$fig/forces-plane.csv")
 	for k in $(cut -d' ' -f1 "$t/summary"); do
-		for d in "$runs"/*/; do
-			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
-			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$k" ] || continue
-			awk -F, -v e="$end" 'NR == 1 || ($2 != "" && $2 > 0 && $1 + 1 <= e)' "$d/series.csv" >"$t/time.k$k.csv"
-			fig_has "$t/time.k$k.csv" 1 && series+=(
-				"'$t/time.k$k.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 5))]}' title 'k = $k N·m/rad'")
-			i=$((i + 1))
-			break
-		done
+		fig_force_series "$runs" "$k" "$end" "$t/time.k$k.csv" || continue
+		fig_has "$t/time.k$k.csv" 1 && series+=(
+			"'$t/time.k$k.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 5))]}' title 'k = $k N·m/rad'")
+		i=$((i + 1))
 	done
 	[ ${#series[@]} -gt 0 ] || { echo "forces-plane: no series.csv in the runs: no time plot" >&2; return 0; }
 	{
@@ -286,10 +267,4 @@ seconds() {
 	if [ "${1:-}" = --quick ]; then echo 480; else echo 960; fi
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR K SEED [END [WALLS]] | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
-esac
+fig_main "jobs [--quick] | run OUTDIR K SEED [END [WALLS]] | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

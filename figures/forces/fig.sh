@@ -52,15 +52,11 @@ stiffness() { # SLOPE -> N·m/rad (see the header)
 }
 
 jobs() {
-	local slopes=$SLOPES reps=$REPLICATES end=$END_FULL s r
+	local slopes=$SLOPES reps=$REPLICATES end=$END_FULL
 	[ "${1:-}" = --quick ] && slopes=$QUICK_SLOPES reps=$QUICK_REPLICATES end=$END_QUICK
 	# FIG_TINY=1 (the tests): one run at the shortest timeline a run takes
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "slope64-t0 64 $(fig_seed forces tiny) $END_TINY"; return; fi
-	for s in $slopes; do
-		for r in $(seq "$reps"); do
-			echo "slope$s-rep$r $s $(fig_seed forces "$s" "$r") $end"
-		done
-	done
+	fig_grid 'slope{v}-rep{i}' "$slopes" "$reps" forces '{v}' '{seed}' "$end"
 }
 
 # tune OUTDIR SLOPE SEED: one robot on its own simulated bus, the tuner in
@@ -115,10 +111,8 @@ run() {
 	fig_uint SEED "$seed" 1 999999999
 	fig_uint END "$end" "$END_TINY" 3600
 	local closed=$((end / 3)) switch=$((2 * end / 3))
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
 	tune "$out" "$slope" "$seed" || exit 1
 	local conf="$out/tuned.conf" sets=() key j
 	sets+=(--daemon-set "robot.compliance_slope=$slope" --daemon-set "robot.servo_lead_s=$(ini "$conf" robot servo_lead_s)")
@@ -149,7 +143,7 @@ run() {
 	swing=$(fig_min_swing "$r/summary.json")
 	[ "$fc" != nan ] && [ "$fo" != nan ] || fig_die "no contact force in the run's analysis (no SIM.TRUTH?)"
 	local wall
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	outdir_new "$out/result.csv" || fig_die "cannot write $out/result.csv"
 	{
 		echo "slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s,end_s"
@@ -159,25 +153,17 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
-	fig_results "$runs" sorted >"$fig/forces.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # forces.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	local csv="$fig/forces.csv" t=$FIG_TMP
 	# per slope: the median over replicates of each run's median, and the range
 	awk -F, 'NR > 1 { n[$1]++; k[$1] = $2; c[$1] = c[$1] " " $8; o[$1] = o[$1] " " $9 } END {
 		for (s in n) print s, k[s], n[s], c[s] "|" o[s] }' "$csv" | sort -n |
 	while read -r s k n rest; do
 		local cs=${rest%%|*} os=${rest#*|}
-		printf '%s %s %s %s %s %s %s %s %s\n' "$s" "$k" "$n" \
-			"$(tr ' ' '\n' <<<"$cs" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$cs" | grep . | sort -g | tail -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | fig_median)" "$(tr ' ' '\n' <<<"$os" | grep . | sort -g | head -1)" \
-			"$(tr ' ' '\n' <<<"$os" | grep . | sort -g | tail -1)"
+		printf '%s %s %s %s %s\n' "$s" "$k" "$n" "$(fig_spread "$cs")" "$(fig_spread "$os")"
 	done >"$t/summary"
-	[ -s "$t/summary" ] || fig_die "no runs to summarize in $csv"
-	{ echo "slope,k,runs,clock,clock_min,clock_max,osc,osc_min,osc_max"; tr ' ' ',' <"$t/summary"; } >"$t/summary.csv"
+	fig_summary_csv "$t/summary" "$csv" slope,k,runs,clock,clock_min,clock_max,osc,osc_min,osc_max
 	force_plot "$fig" "$t" || fig_die "forces.png could not be drawn"
 	time_plot "$runs" "$fig" "$t" || fig_die "forces_time.png could not be drawn"
 	fragment "$fig"
@@ -214,19 +200,13 @@ force_plot() {
 # through the whole run, one run per slope (its first replicate that has a
 # series).
 time_plot() {
-	local runs=$1 fig=$2 t=$3 series=() s d colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 end
+	local runs=$1 fig=$2 t=$3 series=() s colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 end
 	end=$(run_end "$fig/forces.csv")
 	for s in $(cut -d' ' -f1 "$t/summary"); do
-		for d in "$runs"/*/; do
-			[ -f "$d/series.csv" ] && [ -f "$d/result.csv" ] || continue
-			[ "$(awk -F, 'NR == 2 { print $1 }' "$d/result.csv")" = "$s" ] || continue
-			# whole seconds of the run (the last bin holds the final message alone)
-			awk -F, -v e="$end" 'NR == 1 || ($2 != "" && $2 > 0 && $1 + 1 <= e)' "$d/series.csv" >"$t/time.s$s.csv"
-			fig_has "$t/time.s$s.csv" 1 && series+=(
-				"'$t/time.s$s.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'")
-			i=$((i + 1))
-			break
-		done
+		fig_force_series "$runs" "$s" "$end" "$t/time.s$s.csv" || continue
+		fig_has "$t/time.s$s.csv" 1 && series+=(
+			"'$t/time.s$s.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'")
+		i=$((i + 1))
 	done
 	[ ${#series[@]} -gt 0 ] || { echo "forces: no series.csv in the runs: no time plot" >&2; return 0; }
 	{
@@ -332,10 +312,4 @@ seconds() {
 	if [ "${1:-}" = --quick ]; then echo 45; else echo 90; fi
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR SLOPE SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
-esac
+fig_main "jobs [--quick] | run OUTDIR SLOPE SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

@@ -30,9 +30,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 source "$here/../lib.sh"
 fig_init pair
 
-SCENARIO="$fig_top/sim-bridge/scenarios/pair-rig.scenario"
-RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current
-     --daemon-set sinusoid.amplitude=0.25)
+SCENARIO=$FIG_PAIR_SCENARIO
+RIG=("${FIG_PAIR_DRIVE[@]}" --daemon-set sinusoid.amplitude=0.25)
 # The switch: as e2e_pair (the phase difference is the clock's until then).
 SWITCH_S=3
 # Run length. Measured on 32 runs of 90 s near d~_c (2026-11-27): the last

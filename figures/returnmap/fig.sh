@@ -27,9 +27,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 source "$here/../lib.sh"
 fig_init returnmap
 
-SCENARIO="$fig_top/sim-bridge/scenarios/pair-rig.scenario"
-RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current
-     --daemon-set "sinusoid.amplitude=$FIG_SIN_AMP" --daemon-set "sinusoid.frequency=$FIG_SIN_HZ"
+SCENARIO=$FIG_PAIR_SCENARIO
+RIG=("${FIG_PAIR_DRIVE[@]}" --daemon-set "sinusoid.amplitude=$FIG_SIN_AMP" --daemon-set "sinusoid.frequency=$FIG_SIN_HZ"
      --set sim.initial_spread=0)
 # Measured: in phase (|Delta| < 0.05) 8-10 collisions after the switch,
 # two collisions a period, at r = 0.67; r = 0.9 takes longer.

@@ -67,7 +67,7 @@ TINY_RELAX_SECONDS=16
 RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current)
 
 jobs() {
-	local d b s seeds=$SWEEP_SEEDS rseeds=$RELAX_SEEDS dseps=$SWEEP_DSEPS secs=$SWEEP_SECONDS
+	local d seeds=$SWEEP_SEEDS rseeds=$RELAX_SEEDS dseps=$SWEEP_DSEPS secs=$SWEEP_SECONDS
 	local rbetas=$RELAX_BETAS rsecs=$RELAX_SECONDS
 	if [ "${FIG_TINY:-0}" = 1 ]; then
 		echo "sweep-t0 $RELAX_DSEP 0 $TINY_SWEEP_SECONDS $(fig_seed rows tiny sweep)"
@@ -79,17 +79,9 @@ jobs() {
 		rbetas=$QUICK_RELAX_BETAS rsecs=$QUICK_RELAX_SECONDS
 	fi
 	for d in $dseps; do
-		for b in $SWEEP_BETAS; do
-			for s in $(seq "$seeds"); do
-				echo "sweep-d$d-b$b-s$s $d $b $secs $(fig_seed rows sweep "$d" "$b" "$s")"
-			done
-		done
+		fig_grid "sweep-d$d-b{v}-s{i}" "$SWEEP_BETAS" "$seeds" "rows sweep $d" "$d" '{v}' "$secs" '{seed}'
 	done
-	for b in $rbetas; do
-		for s in $(seq "$rseeds"); do
-			echo "relax-b$b-s$s $RELAX_DSEP $b $rsecs $(fig_seed rows relax "$b" "$s")"
-		done
-	done
+	fig_grid 'relax-b{v}-s{i}' "$rbetas" "$rseeds" 'rows relax' "$RELAX_DSEP" '{v}' "$rsecs" '{seed}'
 }
 
 run() {
@@ -99,10 +91,8 @@ run() {
 	fig_num BETA "$beta" 0 1
 	fig_uint SECONDS "$secs" $((SWITCH + WINDOW + 1)) 3600
 	fig_uint SEED "$seed" 1 999999999
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
 	# the ends: walls an amplitude and a quarter beyond the end robots
 	# (see the header), the row centred on 0
 	local wall_x
@@ -135,7 +125,7 @@ run() {
 	local relax censored
 	relax=$(awk -v l="$last" -v sw="$SWITCH" 'BEGIN { r = l - sw; if (r < 0) r = 0; printf "%.0f", r }')
 	censored=$(awk -v l="$last" -v s="$secs" -v c="$CENSOR_S" 'BEGIN { print (l > s - c) ? 1 : 0 }')
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	{
 		echo "dsep,beta,seconds,seed,pairs,colliding_pairs,pair_collisions_hz,compat_error_rad,compat_error_max_rad,compatible_pairs,antiphase_pairs,stopped_pairs,wall_collisions_hz,relax_s,censored,min_swing_rad,wall_s"
 		echo "$dsep,$beta,$secs,$seed,$ends,$walls,$relax,$censored,$swing,$wall"
@@ -145,11 +135,8 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
-	fig_results "$runs" sorted >"$fig/rows.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # rows.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	local csv="$fig/rows.csv" t=$FIG_TMP
 	# the sweep's runs: β in SWEEP_BETAS and a sweep's length (a relaxation
 	# run at β = 0.1 is not one of them)
@@ -345,10 +332,4 @@ seconds() {
 	if [ "${1:-}" = --quick ]; then echo 18; else echo 25; fi
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR DSEP BETA SECONDS SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" ;;
-esac
+fig_main "jobs [--quick] | run OUTDIR DSEP BETA SECONDS SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

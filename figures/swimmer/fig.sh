@@ -44,14 +44,10 @@ SHOW=5
 BODY_EVERY=5
 
 jobs() {
-	local secs=$SECONDS_FULL seeds=$SEEDS m s
+	local secs=$SECONDS_FULL seeds=$SEEDS
 	[ "${1:-}" = --quick ] && secs=$SECONDS_QUICK seeds=1
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "oscillator-t0 oscillator $SECONDS_TINY $(fig_seed swimmer tiny)"; return; fi
-	for m in $MODES; do
-		for s in $(seq "$seeds"); do
-			echo "$m-s$s $m $secs $(fig_seed swimmer "$m" "$s")"
-		done
-	done
+	fig_grid '{v}-s{i}' "$MODES" "$seeds" swimmer '{v}' "$secs" '{seed}'
 }
 
 # json_joint SUMMARY J KEY: a joint's number in the analyser's summary.json
@@ -65,10 +61,9 @@ run() {
 	fig_uint SEED "$seed" 1 999999999
 	local sets
 	mapfile -t sets < <(fig_plane_sets) && [ ${#sets[@]} -gt 0 ] || exit 1
-	fig_run_dir "$out"
-	out=$(cd "$out" && pwd) || fig_die "cannot enter $out"
-	local t0 r="$out/demo"
-	t0=$(date +%s.%N)
+	fig_run_start "$out"
+	out=$FIG_RUN
+	local r="$out/demo"
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/plane-swimmer.scenario" --seconds "$secs" \
 		--start-mode "$mode" --switch-at never --seed "$seed" --window $((secs - SETTLE)) "${sets[@]}" || exit 1
 	[ -s "$r/plane.csv" ] || fig_die "the run's analysis has no plane.csv (a plane world's log gives one)"
@@ -92,7 +87,7 @@ run() {
 	lag=$(jq -r '[.pairs[] | select(.kind == "joints")][0].mean_delta // "nan" | if type == "number" then -. else . end' "$r/summary.json")
 	spread=$(jq -r '[.pairs[] | select(.kind == "joints")][0].spread // "nan"' "$r/summary.json")
 	swing=$(fig_min_swing "$r/summary.json")
-	wall=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+	wall=$(fig_wall)
 	# the swim from SETTLE s to the end: the centre's displacement along the
 	# mean heading and across it, per period of the joints' mean frequency
 	# how wide the swimming body is: per period from SETTLE s, the span of
@@ -133,11 +128,8 @@ run() {
 }
 
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
-	fig_results "$runs" sorted >"$fig/swimmer.csv"
+	fig_merge_runs "$@"
+	local runs=$1 fig=$FIG_OUT   # swimmer.csv (the runs' rows) there; all moved into FIGDIR by fig_merge_end
 	draw "$runs" "$fig" "$FIG_TMP" || fig_die "swimmer.png could not be drawn"
 	fragment "$fig"
 	fig_merge_end
@@ -264,11 +256,11 @@ seconds() {
 	if [ "${1:-}" = --quick ]; then echo 8; else echo 11; fi
 }
 
-case "${1:-}" in
-jobs) shift; jobs "$@" ;;
-run) shift; run "$@" ;;
-merge) shift; merge "$@" ;;
-seconds) shift; seconds "$@" ;;
-tune) shift; [ $# -ge 1 ] || fig_usage "tune OUT.conf [SEED]"; fig_plane_tune "$@" ;;
-*) fig_usage "usage: fig.sh jobs [--quick] | run OUTDIR MODE SECONDS SEED | merge RUNS_DIR FIGDIR | seconds [--quick] | tune OUT.conf [SEED]" ;;
-esac
+# tune OUT.conf [SEED]: figures/plane-oscillator.conf made again (fig_plane_tune)
+tune() {
+	[ $# -ge 1 ] || fig_usage "tune OUT.conf [SEED]"
+	fig_plane_tune "$@"
+}
+FIG_MORE_COMMANDS=tune
+
+fig_main "jobs [--quick] | run OUTDIR MODE SECONDS SEED | merge RUNS_DIR FIGDIR | seconds [--quick] | tune OUT.conf [SEED]" "$@"

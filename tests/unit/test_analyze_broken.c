@@ -22,6 +22,7 @@
 
 #include "../../tools/analyze/alog.h"
 #include "../../tools/analyze/analyze.h"
+#include "anrun.h"
 #include "scratch.h"
 #include "undulate_robot_state_t.h"
 #include "undulate_sim_truth_t.h"
@@ -34,18 +35,6 @@ ALOG_DEFINE_WRITER(sim_truth_t)
 #define T_SECONDS 30.0
 #define T_FREQ 0.8
 #define T_SWITCH_S 10.0
-
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("broken");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
 
 struct run {
 	double force_n;           /* the pair's contact force, every truth period */
@@ -124,11 +113,7 @@ static char *analyse(const char *name, const struct run *r)
 	}
 	assert_int_equal(alog_writer_close(&w), 0);
 	struct an_options o;
-	an_options_default(&o);
-	o.logs[0] = logp;
-	o.nlogs = 1;
-	o.out_dir = outp;
-	o.quiet = true;
+	anrun_options(&o, logp, outp);
 	FILE *null = fopen("/dev/null", "w");
 	o.msg = null;
 	assert_int_equal(an_run(&o), AN_EXIT_OK);
@@ -223,5 +208,5 @@ int main(void)
 		cmocka_unit_test(test_a_few_late_steps_are_not_broken),
 		cmocka_unit_test(test_broken_runs),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

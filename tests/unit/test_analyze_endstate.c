@@ -18,6 +18,7 @@
 
 #include "../../tools/analyze/alog.h"
 #include "../../tools/analyze/analyze.h"
+#include "anrun.h"
 #include "scratch.h"
 
 #include "undulate_robot_state_t.h"
@@ -42,18 +43,6 @@ ALOG_DEFINE_WRITER(robot_state_t)
 struct motion {
 	double amplitude, phase, offset, stop_s, freq_zero_s;
 };
-
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("endstate");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
 
 static void motion_at(const struct motion *m, int64_t cycle, double *angle, double *speed)
 {
@@ -110,11 +99,7 @@ static void analyse(const char *name, double min_swing)
 	snprintf(logp, sizeof(logp), "%s/%s.log", scratch_dir, name);
 	snprintf(outp, sizeof(outp), "%s/%s", scratch_dir, name);
 	struct an_options o;
-	an_options_default(&o);
-	o.logs[0] = logp;
-	o.nlogs = 1;
-	o.out_dir = outp;
-	o.quiet = true;
+	anrun_options(&o, logp, outp);
 	if (!isnan(min_swing))
 		o.min_swing = min_swing;
 	assert_int_equal(an_run(&o), AN_EXIT_OK);
@@ -291,5 +276,5 @@ int main(void)
 		cmocka_unit_test(test_min_swing_option),
 		cmocka_unit_test(test_stop_inside_window),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

@@ -15,24 +15,13 @@
 #include <unistd.h>
 
 #include "../../tools/analyze/analyze.h"
+#include "anrun.h"
 #include "../../tools/analyze/theory.h"
 #include "../../tools/analyze/synth.h"
 #include "scratch.h"
 
 /* Largest file the tests read whole (summary.json, return_map.csv). */
 #define T_FILE_MAX (1 << 20)
-
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("analyze");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
 
 static void path_of(char *out, size_t n, const char *a, const char *b)
 {
@@ -92,14 +81,10 @@ static int pair_has(const char *json, const char *pair, const char *text)
 static int run(const char *log, const char *out, void (*tweak)(struct an_options *))
 {
 	static char logp[AN_MAX_LOGS][512], outp[512];
-	struct an_options o;
-	an_options_default(&o);
 	path_of(logp[0], sizeof(logp[0]), log, NULL);
 	path_of(outp, sizeof(outp), out, NULL);
-	o.logs[0] = logp[0];
-	o.nlogs = 1;
-	o.out_dir = outp;
-	o.quiet = true;
+	struct an_options o;
+	anrun_options(&o, logp[0], outp);
 	if (tweak)
 		tweak(&o);
 	return an_run(&o);
@@ -576,5 +561,5 @@ int main(void)
 		cmocka_unit_test(test_plots),
 		cmocka_unit_test(test_plane_csv),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

@@ -24,18 +24,6 @@
 
 #define KEY_HEX "000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f"
 
-static int group_setup(void **state)
-{
-	(void)state;
-	return scratch_make("auth");
-}
-
-static int group_teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 static void expect_key_bytes_0_to_31(const struct auth_key *k)
 {
 	for (size_t i = 0; i < AUTH_KEY_BYTES; i++)
@@ -246,11 +234,7 @@ static void test_key_generate(void **state)
 	umask(old);
 	assert_true(ok);
 	assert_true(auth_key_generate(p2, why, sizeof why));
-	struct stat st;
-	assert_int_equal(lstat(p1, &st), 0);
-	assert_true(S_ISREG(st.st_mode));
-	assert_int_equal(st.st_mode & 07777, 0600);
-	assert_int_equal(st.st_uid, geteuid());
+	assert_true(scratch_private_file(p1, 0600));
 	/* 64 hex digits and a newline, and it loads as a private key */
 	char *text = scratch_slurp("gen1.key", 300);
 	assert_non_null(text);
@@ -522,5 +506,5 @@ int main(void)
 		cmocka_unit_test(test_replay_eviction),
 		cmocka_unit_test(test_replay_property),
 	};
-	return cmocka_run_group_tests(tests, group_setup, group_teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

@@ -25,18 +25,6 @@
 #include "holder.h"
 #include "scratch.h"
 
-static int group_setup(void **state)
-{
-	(void)state;
-	return scratch_make("holder");
-}
-
-static int group_teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 static void scratch_path(char *out, size_t cap, const char *rel)
 {
 	snprintf(out, cap, "%s/%s", scratch_dir, rel);
@@ -277,5 +265,5 @@ int main(void)
 		cmocka_unit_test(test_lockfile),
 		cmocka_unit_test(test_lockfile_refuses_other_files),
 	};
-	return cmocka_run_group_tests(tests, group_setup, group_teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

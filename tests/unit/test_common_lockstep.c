@@ -25,18 +25,6 @@
 #include "lockstep.h"
 #include "scratch.h"
 
-static int group_setup(void **state)
-{
-	(void)state;
-	return scratch_make("lockstep");
-}
-
-static int group_teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 /* A client on one end of a SOCK_SEQPACKET pair; the test holds the other. */
 static int client_pair(struct lks_client *c, int *sim)
 {
@@ -296,5 +284,5 @@ int main(void)
 		cmocka_unit_test(test_block),
 		cmocka_unit_test(test_join),
 	};
-	return cmocka_run_group_tests(tests, group_setup, group_teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

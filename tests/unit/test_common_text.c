@@ -49,50 +49,75 @@ static const char *sanitize(size_t cap, const char *src)
 	return dst;
 }
 
+/* One call of text_sanitize and the line it must give: the tests below are
+ * tables of these, checked one by one (a failure names its row). */
+struct sanitize_case {
+	size_t cap;
+	const char *src;
+	const char *want;
+};
+
+static void check_cases(const struct sanitize_case *cases, size_t n)
+{
+	for (size_t i = 0; i < n; i++) {
+		const char *got = sanitize(cases[i].cap, cases[i].src);
+		if (strcmp(got, cases[i].want) != 0)
+			fail_msg("row %zu (cap %zu): got \"%s\", want \"%s\"", i, cases[i].cap, got, cases[i].want);
+	}
+}
+
 static void test_sanitize_plain(void **state)
 {
 	(void)state;
-	assert_string_equal(sanitize(64, "robot1"), "robot1");
-	assert_string_equal(sanitize(64, " ~!\"#$%&'()*+,-./09:;<=>?@AZ[]^_`az{|}"),
-	                    " ~!\"#$%&'()*+,-./09:;<=>?@AZ[]^_`az{|}");
-	assert_string_equal(sanitize(64, ""), "");
-	assert_string_equal(sanitize(64, NULL), "");
-	assert_string_equal(sanitize(8, NULL), "");
+	static const struct sanitize_case cases[] = {
+		{ 64, "robot1", "robot1" },
+		{ 64, " ~!\"#$%&'()*+,-./09:;<=>?@AZ[]^_`az{|}", " ~!\"#$%&'()*+,-./09:;<=>?@AZ[]^_`az{|}" },
+		{ 64, "", "" },
+		{ 64, NULL, "" },
+		{ 8, NULL, "" },
+	};
+	check_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
 static void test_sanitize_escapes(void **state)
 {
 	(void)state;
-	assert_string_equal(sanitize(64, "a\nb"), "a\\x0ab");
-	/* the journal forgery text.h names: a newline, then a priority prefix */
-	assert_string_equal(sanitize(64, "ok\n<0>emergency"), "ok\\x0a<0>emergency");
-	assert_string_equal(sanitize(64, "\r\t\x1b[2J"), "\\x0d\\x09\\x1b[2J");
-	/* the backslash itself, so an escape in the output is always ours */
-	assert_string_equal(sanitize(64, "\\x0a"), "\\x5cx0a");
-	assert_string_equal(sanitize(64, "\x1f\x7f\x80\xff"), "\\x1f\\x7f\\x80\\xff");
-	assert_string_equal(sanitize(64, "caf\xc3\xa9"), "caf\\xc3\\xa9");
-	/* nothing after the first NUL exists for a C string */
-	assert_string_equal(sanitize(64, "ab\0cd"), "ab");
+	static const struct sanitize_case cases[] = {
+		{ 64, "a\nb", "a\\x0ab" },
+		/* the journal forgery text.h names: a newline, then a priority prefix */
+		{ 64, "ok\n<0>emergency", "ok\\x0a<0>emergency" },
+		{ 64, "\r\t\x1b[2J", "\\x0d\\x09\\x1b[2J" },
+		/* the backslash itself, so an escape in the output is always ours */
+		{ 64, "\\x0a", "\\x5cx0a" },
+		{ 64, "\x1f\x7f\x80\xff", "\\x1f\\x7f\\x80\\xff" },
+		{ 64, "caf\xc3\xa9", "caf\\xc3\\xa9" },
+		/* nothing after the first NUL exists for a C string */
+		{ 64, "ab\0cd", "ab" },
+	};
+	check_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
 static void test_sanitize_cut(void **state)
 {
 	(void)state;
-	/* does not fit: cut, and says so */
-	assert_string_equal(sanitize(8, "abcdefgh"), "abcd...");
-	assert_string_equal(sanitize(10, "abcdefghijklmnop"), "abcdef...");
-	/* an escape is never split: "ab" + "\x0a" would need 6 + 3 > 7 */
-	assert_string_equal(sanitize(8, "ab\ncdefgh"), "ab...");
-	assert_string_equal(sanitize(8, "abc\n\n"), "abc...");
-	/* fits exactly (cap - 1 bytes): not cut */
-	assert_string_equal(sanitize(8, "abcdefg"), "abcdefg");
-	assert_string_equal(sanitize(8, "abc\n"), "abc\\x0a");
-	assert_string_equal(sanitize(9, "\n\\"), "\\x0a\\x5c");
-	assert_string_equal(sanitize(8, "\n\\"), "\\x0a...");
-	assert_string_equal(sanitize(12, "0123456789a"), "0123456789a");
-	/* one byte more than fits */
-	assert_string_equal(sanitize(8, "abc\nd"), "abc...");
-	assert_string_equal(sanitize(12, "0123456789ab"), "01234567...");
+	static const struct sanitize_case cases[] = {
+		/* does not fit: cut, and says so */
+		{ 8, "abcdefgh", "abcd..." },
+		{ 10, "abcdefghijklmnop", "abcdef..." },
+		/* an escape is never split: "ab" + "\x0a" would need 6 + 3 > 7 */
+		{ 8, "ab\ncdefgh", "ab..." },
+		{ 8, "abc\n\n", "abc..." },
+		/* fits exactly (cap - 1 bytes): not cut */
+		{ 8, "abcdefg", "abcdefg" },
+		{ 8, "abc\n", "abc\\x0a" },
+		{ 9, "\n\\", "\\x0a\\x5c" },
+		{ 8, "\n\\", "\\x0a..." },
+		{ 12, "0123456789a", "0123456789a" },
+		/* one byte more than fits */
+		{ 8, "abc\nd", "abc..." },
+		{ 12, "0123456789ab", "01234567..." },
+	};
+	check_cases(cases, sizeof cases / sizeof cases[0]);
 }
 
 static void test_sanitize_small_caps(void **state)

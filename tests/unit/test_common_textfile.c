@@ -22,18 +22,6 @@
 static char path[512];
 static char err[512];
 
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("textfile");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 static const char *in_scratch(const char *name)
 {
 	snprintf(path, sizeof path, "%s/%s", scratch_dir, name);
@@ -148,5 +136,5 @@ int main(void)
 		cmocka_unit_test(test_size_limit),
 		cmocka_unit_test(test_nul_bytes),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

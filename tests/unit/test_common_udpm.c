@@ -155,24 +155,23 @@ static void test_net_name(void **state)
 {
 	(void)state;
 	char out[96];
-	udpm_net_name("udpm://239.255.76.67:7667?ttl=0", out, sizeof out);
-	assert_string_equal(out, "239.255.76.67-7667");
-	/* the same network, however it is written */
-	udpm_net_name("udpm://239.255.76.67?ttl=1&recv_buf_size=4096", out, sizeof out);
-	assert_string_equal(out, "239.255.76.67-7667");
-	udpm_net_name("udpm://239.255.76.67:07667", out, sizeof out);
-	assert_string_equal(out, "239.255.76.67-7667");
-	udpm_net_name("udpm://224.0.0.1:1", out, sizeof out);
-	assert_string_equal(out, "224.0.0.1-1");
-	udpm_net_name(NULL, out, sizeof out);
-	assert_string_equal(out, "239.255.76.67-7667");
-	/* others: the URL, every character but [A-Za-z0-9.-] made '_' */
-	udpm_net_name("memq://", out, sizeof out);
-	assert_string_equal(out, "memq___");
-	udpm_net_name("file:///tmp/a b.log", out, sizeof out);
-	assert_string_equal(out, "file____tmp_a_b.log");
-	udpm_net_name("udpm://10.0.0.1:7667?ttl=0", out, sizeof out);
-	assert_string_equal(out, "udpm___10.0.0.1_7667_ttl_0");
+	static const struct { const char *url, *want; } names[] = {
+		{ "udpm://239.255.76.67:7667?ttl=0", "239.255.76.67-7667" },
+		/* the same network, however it is written */
+		{ "udpm://239.255.76.67?ttl=1&recv_buf_size=4096", "239.255.76.67-7667" },
+		{ "udpm://239.255.76.67:07667", "239.255.76.67-7667" },
+		{ "udpm://224.0.0.1:1", "224.0.0.1-1" },
+		{ NULL, "239.255.76.67-7667" },
+		/* others: the URL, every character but [A-Za-z0-9.-] made '_' */
+		{ "memq://", "memq___" },
+		{ "file:///tmp/a b.log", "file____tmp_a_b.log" },
+		{ "udpm://10.0.0.1:7667?ttl=0", "udpm___10.0.0.1_7667_ttl_0" },
+	};
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+		udpm_net_name(names[i].url, out, sizeof out);
+		if (strcmp(out, names[i].want) != 0)
+			fail_msg("%s: got \"%s\", want \"%s\"", names[i].url ? names[i].url : "(null)", out, names[i].want);
+	}
 	/* no '/' or '@' ever, so it is one path component after the robot's '@' */
 	udpm_net_name("tcpq://user@host:1/x/../y", out, sizeof out);
 	assert_null(strchr(out, '/'));

@@ -77,6 +77,19 @@ static const char *load_error(const char *text, char *buf, size_t cap)
 	return buf;
 }
 
+/* What --check-config -v prints for c (cfg_print), to search; the caller frees it. */
+static char *printed(const struct cfg *c)
+{
+	char *text = NULL;
+	size_t len = 0;
+	FILE *f = open_memstream(&text, &len);
+	assert_non_null(f);
+	cfg_print(c, f);
+	fclose(f);
+	assert_non_null(text);
+	return text;
+}
+
 static void test_good_file(void **state)
 {
 	(void)state;
@@ -268,12 +281,7 @@ static void test_sinusoid_stiffness(void **state)
 	assert_false(cfg_robot_param_check(&c, "stiffness", 0.5, why, sizeof why));
 	assert_true(cfg_robot_param_check(&c, "stiffness", 0.0, why, sizeof why));
 	c.actuation = CFG_ACT_TORQUE;
-	char *text = NULL;
-	size_t len = 0;
-	FILE *f = open_memstream(&text, &len);
-	assert_non_null(f);
-	cfg_print(&c, f);
-	fclose(f);
+	char *text = printed(&c);
 	assert_non_null(strstr(text, "\n[sinusoid]\namplitude = 0.8\nfrequency = 0.8\nphase = 0\nstiffness = 0.135\n"
 	                             "damping = 0.01\n"));
 	free(text);
@@ -566,12 +574,9 @@ static void test_compliance_slope(void **state)
 	assert_false(cfg_override(&c, "robot.compliance_slope=-2", &e));
 	assert_false(cfg_override(&c, "robot.compliance_slope=64.5", &e));
 	assert_int_equal(c.compliance_slope, 128);
-	char text[4096];
-	FILE *f = fmemopen(text, sizeof text, "w");
-	assert_non_null(f);
-	cfg_print(&c, f);
-	fclose(f);
+	char *text = printed(&c);
 	assert_non_null(strstr(text, "\ncompliance_slope = 128\n"));
+	free(text);
 }
 
 static void test_command_line_only(void **state)
@@ -602,9 +607,9 @@ static void test_refused_ids_change_nothing(void **state)
 	struct cfg_errors e = { 0 };
 	cfg_defaults(&c);
 	assert_true(cfg_override(&c, "robot.ids=1,2", &e));
-	assert_false(cfg_override(&c, "robot.ids=5,j", &e));
-	assert_false(cfg_override(&c, "robot.ids=7,7", &e));
-	assert_false(cfg_override(&c, "robot.ids=9,300", &e));
+	static const char *const refused[] = { "robot.ids=5,j", "robot.ids=7,7", "robot.ids=9,300" };
+	for (size_t i = 0; i < sizeof refused / sizeof refused[0]; i++)
+		assert_false(cfg_override(&c, refused[i], &e));
 	assert_int_equal(c.njoints, 2);
 	assert_int_equal(c.ids[0], 1);
 	assert_int_equal(c.ids[1], 2);
@@ -632,12 +637,7 @@ static void test_rs485(void **state)
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1\nrs485=\n", err, sizeof err),
 	                    "robot1.conf:4: [robot] rs485: '' is not off, rts-on-send (or rts) or rts-after-send");
 	/* --check-config -v prints it back in a form the parser takes */
-	char *text = NULL;
-	size_t len = 0;
-	FILE *f = open_memstream(&text, &len);
-	assert_non_null(f);
-	cfg_print(&c, f);
-	fclose(f);
+	char *text = printed(&c);
 	assert_non_null(strstr(text, "\nrs485 = rts-on-send\n"));
 	free(text);
 }

@@ -402,15 +402,14 @@ static void test_start_from_rest_displaced(void **state)
 	assert_true(fabs(sv[0].angle) > 0.3 || fabs(sv[0].speed) > 1.0);
 }
 
-static void test_walls_and_limit_breach(void **state)
+/* Limits at -1..1 rad, into wheel mode, then one cycle 0.05 rad inside the
+ * upper limit moving out at 2 rad/s: the wall pushes back whatever the law
+ * says (the torque law and the clock alike). Returns the upper limit. */
+static double pushed_back_near_the_wall(void)
 {
-	(void)state;
-	setup("1", "current", CFG_MODE_OSCILLATOR);
 	cfg.joint[0].limit_min = -1.0;
 	cfg.joint[0].limit_max = 1.0;
 	run_into_wheel();
-	/* near the upper limit and moving out: the wall pushes back whatever
-	 * the law says */
 	double hi = c.j[0].limits.hi;
 	sv[0].angle = hi - 0.05;
 	sv[0].speed = 2.0;
@@ -418,6 +417,14 @@ static void test_walls_and_limit_breach(void **state)
 	assert_true(c.wheel);
 	assert_true(c.j[0].torque_cmd < 0.0);
 	assert_true(c.j[0].clamp_flags & SAFETY_LIMIT);
+	return hi;
+}
+
+static void test_walls_and_limit_breach(void **state)
+{
+	(void)state;
+	setup("1", "current", CFG_MODE_OSCILLATOR);
+	double hi = pushed_back_near_the_wall();
 	/* past it: back to joint mode, fault_action (HOLD), the goal inside the limits */
 	long long trips = c.limit_trips;
 	sv[0].angle = hi + 0.05;
@@ -777,16 +784,7 @@ static void test_clock_walls_and_breach(void **state)
 {
 	(void)state;
 	setup_clock("1", "current", "0.135");
-	cfg.joint[0].limit_min = -1.0;
-	cfg.joint[0].limit_max = 1.0;
-	run_into_wheel();
-	double hi = c.j[0].limits.hi;
-	sv[0].angle = hi - 0.05;
-	sv[0].speed = 2.0;
-	cycle();
-	assert_true(c.wheel);
-	assert_true(c.j[0].clamp_flags & SAFETY_LIMIT);
-	assert_true(c.j[0].torque_cmd < 0.0);
+	double hi = pushed_back_near_the_wall();
 	assert_true(c.j[0].duty <= 0.0);   /* moving out near the wall: never driven outwards */
 	sv[0].angle = hi + 0.05;
 	sv[0].speed = 0.0;

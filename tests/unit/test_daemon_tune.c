@@ -118,15 +118,25 @@ static void start(struct run *r, size_t njoints, double f, double a, bool torque
 	assert_true(tune_init(&r->t, &o, r->cfg, &r->ctl.p, why, sizeof why));
 }
 
+/* The usual run: two joints on position actuation, targets 0.8 Hz and
+ * 0.8 rad, the plant fed for 90 s (the tuner's own limit); the servos
+ * report SUPPLY_V volts first when it is above 0. */
+static void tune_on(struct run *r, struct plant *p, double supply_v)
+{
+	start(r, 2, 0.8, 0.8, false);
+	if (supply_v > 0)
+		tune_supply(&r->t, supply_v);
+	drive(r, p, 90);
+}
+
 /* The plant the audit found: the defaults give 1.07 Hz and 1.25 rad, and its
  * exponents are not the simulator's. */
 static void test_converges_on_a_fast_plant(void **state)
 {
 	(void)state;
 	struct run r;
-	start(&r, 2, 0.8, 0.8, false);
 	struct plant p = { .f0 = 1.07, .a0 = { 1.23, 1.30 }, .ef = 0.45, .ea = 0.28 };
-	drive(&r, &p, 90);
+	tune_on(&r, &p, 0);
 	assert_int_equal(r.t.state, TUNE_DONE);
 	assert_true(fabs(r.t.result.freq / 0.8 - 1) <= TUNE_TOLERANCE);
 	for (int j = 0; j < 2; j++)
@@ -153,9 +163,8 @@ static void test_double_hump_reads_the_fundamental(void **state)
 {
 	(void)state;
 	struct run r;
-	start(&r, 2, 0.8, 0.8, false);
 	struct plant p = { .f0 = 1.0, .a0 = { 0.6, 1.2 }, .ef = 0.6, .ea = 0.4, .harmonic = 0.8 };
-	drive(&r, &p, 90);
+	tune_on(&r, &p, 0);
 	assert_true(r.t.have_first);
 	assert_true(fabs(r.t.first.freq / 1.0 - 1) < 0.03);
 	double hi = -1e9, lo = 1e9;
@@ -173,9 +182,8 @@ static void test_on_target_confirms_without_change(void **state)
 {
 	(void)state;
 	struct run r;
-	start(&r, 2, 0.8, 0.8, false);
 	struct plant p = { .f0 = 0.805, .a0 = { 0.81, 0.79 }, .ef = 0.66, .ea = 0.4 };
-	drive(&r, &p, 90);
+	tune_on(&r, &p, 0);
 	assert_int_equal(r.t.state, TUNE_DONE);
 	assert_int_equal(r.applied, 0);
 	assert_int_equal(r.t.iterations, 2);
@@ -202,10 +210,8 @@ static void test_speed_limit_says_what_is_reachable(void **state)
 {
 	(void)state;
 	struct run r;
-	start(&r, 2, 0.8, 0.8, false);
 	struct plant p = { .f0 = 0.7, .a0 = { 0.7, 0.7 }, .ef = 0.6, .ea = 0.4, .vmax = 3.2 };
-	tune_supply(&r.t, 12.0);
-	drive(&r, &p, 90);
+	tune_on(&r, &p, 12.0);
 	assert_int_equal(r.t.state, TUNE_FAILED);
 	assert_non_null(strstr(r.t.why, "out of reach"));
 	assert_non_null(strstr(r.t.why, "Reachable"));
@@ -218,10 +224,8 @@ static void test_amplitude_short_with_mu_at_floor_raises_the_lead(void **state)
 {
 	(void)state;
 	struct run r;
-	start(&r, 2, 0.8, 0.8, false);
 	struct plant p = { .f0 = 0.8, .a0 = { 0.8, 0.55 }, .ef = 0.6, .ea = 0.4, .lead_exp = 1.5 };
-	tune_supply(&r.t, 12.0);
-	drive(&r, &p, 90);
+	tune_on(&r, &p, 12.0);
 	if (r.t.state != TUNE_DONE)
 		print_message("%s\n", r.t.why);
 	assert_int_equal(r.t.state, TUNE_DONE);
@@ -234,10 +238,8 @@ static void test_low_supply_is_out_of_reach(void **state)
 {
 	(void)state;
 	struct run r;
-	start(&r, 2, 0.8, 0.8, false);
 	struct plant p = { .f0 = 0.8, .a0 = { 0.5, 0.4 }, .ef = 0.6, .ea = 0.4 };
-	tune_supply(&r.t, 7.0);
-	drive(&r, &p, 90);
+	tune_on(&r, &p, 7.0);
 	assert_int_equal(r.t.state, TUNE_FAILED);
 	assert_int_equal(r.t.iterations, 0);
 	assert_true(r.time < 2.5);
@@ -407,9 +409,8 @@ static void test_written_configuration_loads(void **state)
 {
 	(void)state;
 	struct run r;
-	start(&r, 2, 0.8, 0.8, false);
 	struct plant p = { .f0 = 1.07, .a0 = { 1.23, 1.30 }, .ef = 0.45, .ea = 0.28 };
-	drive(&r, &p, 90);
+	tune_on(&r, &p, 0);
 	assert_int_equal(r.t.state, TUNE_DONE);
 	char *buf = NULL;
 	size_t len = 0;

@@ -38,6 +38,19 @@ static struct plane_drive drives[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
 static struct plane_joint joints[PLANE_MAX_ROBOTS * PLANE_MAX_JOINTS];
 
 /* no drive, joints free: the zero line */
+/* The piston (a wall along x from -1 to 1 m, at Y) pushes for 40 steps of
+ * DT at V m/s, then falls BACK m out of the way for one step more. */
+static void push_and_drop(struct plane *pl, int piston, double y, double v, double back, double dt)
+{
+	for (int k = 0; k < 40; k++) {
+		y += v * dt;
+		plane_move_wall(pl, piston, -1, y, 1, y, dt);
+		plane_step(pl, dt, drives, joints);
+	}
+	plane_move_wall(pl, piston, -1, y - back, 1, y - back, dt);
+	plane_step(pl, dt, drives, joints);
+}
+
 static void free_joints(void)
 {
 	memset(drives, 0, sizeof drives);
@@ -64,16 +77,8 @@ static void test_wall_restitution(void **state)
 		int top = plane_add_wall(pl, -1, 0.2, 1, 0.2, err, sizeof err);
 		assert_true(piston >= 0 && top >= 0);
 		free_joints();
-		double dt = 0.001, y = -0.03, v = 0.5;
-		/* 40 ms of pushing at 0.5 m/s */
-		for (int k = 0; k < 40; k++) {
-			y += v * dt;
-			plane_move_wall(pl, piston, -1, y, 1, y, dt);
-			plane_step(pl, dt, drives, joints);
-		}
-		/* the piston falls back out of the way */
-		plane_move_wall(pl, piston, -1, y - 0.1, 1, y - 0.1, dt);
-		plane_step(pl, dt, drives, joints);
+		double dt = 0.001, v = 0.5;
+		push_and_drop(pl, piston, -0.03, v, 0.1, dt);
 		double x0, y0, vx, vy;
 		plane_robot_centre(pl, 0, &x0, &y0, &vx, &vy);
 		/* the piston's own impact launched it at (1 + r) x 0.5 m/s */
@@ -225,13 +230,7 @@ static void test_drag_decay(void **state)
 		int piston = plane_add_wall(pl, -1, y, 1, y, err, sizeof err);
 		free_joints();
 		double dt = 0.001;
-		for (int k = 0; k < 40; k++) {
-			y += 0.4 * dt;
-			plane_move_wall(pl, piston, -1, y, 1, y, dt);
-			plane_step(pl, dt, drives, joints);
-		}
-		plane_move_wall(pl, piston, -1, y - 0.2, 1, y - 0.2, dt);
-		plane_step(pl, dt, drives, joints);
+		push_and_drop(pl, piston, y, 0.4, 0.2, dt);
 		double x0, y0, vx, v0;
 		plane_robot_centre(pl, 0, &x0, &y0, &vx, &v0);
 		for (int k = 0; k < 500; k++)

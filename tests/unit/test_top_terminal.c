@@ -361,25 +361,54 @@ static int press_none(struct child *c, const char *keys)
 	return ngot - before;
 }
 
-static void test_commands_and_answer(void **state)
+/* The two command tests' session: our LCM listener for commands (LCM_URL),
+ * the robot's local socket (robot_open), undulate-top started with ARG (or
+ * none) and read without blocking. session_close quits it with q and
+ * undoes the rest. */
+static struct child *session_open(const char *arg, lcm_t **lcm, undulate_command_t_subscription_t **sub)
 {
-	(void)state;
-	lcm_t *lcm = lcm_create(lcm_url);
-	assert_non_null(lcm);
-	undulate_command_t_subscription_t *sub = undulate_command_t_subscribe(lcm, ".*CMD", on_command, NULL);
+	*lcm = lcm_create(lcm_url);
+	assert_non_null(*lcm);
+	*sub = undulate_command_t_subscribe(*lcm, ".*CMD", on_command, NULL);
 	ngot = 0;
 	nlcm = 0;
 	robot_open();
 	struct child *c = calloc(1, sizeof(*c));
-	start(c, NULL);
+	start(c, arg);
 	fcntl(c->master, F_SETFL, O_NONBLOCK);
-	assert_true(read_until(c, "undulate-top"));
+	return c;
+}
+
+/* The robot's state published until its row ("r1 ") is on the screen. */
+static void wait_for_robot(struct child *c, lcm_t *lcm)
+{
 	int seen = 0;
 	for (int i = 0; i < 100 && !seen; i++) {
 		publish_robot(lcm);
 		seen = read_until_ms(c, "r1 ", 50);
 	}
 	assert_true(seen);
+}
+
+static void session_close(struct child *c, lcm_t *lcm, undulate_command_t_subscription_t *sub)
+{
+	robot_close();
+	assert_int_equal(write(c->master, "q", 1), 1);
+	assert_int_equal(wait_exit(c), 0);
+	close(c->master);
+	free(c);
+	undulate_command_t_unsubscribe(lcm, sub);
+	lcm_destroy(lcm);
+}
+
+static void test_commands_and_answer(void **state)
+{
+	(void)state;
+	lcm_t *lcm;
+	undulate_command_t_subscription_t *sub;
+	struct child *c = session_open(NULL, &lcm, &sub);
+	assert_true(read_until(c, "undulate-top"));
+	wait_for_robot(c, lcm);
 	/* navigating as vi does (h j k l), and the old one-key mode letters,
 	 * send nothing: a mode change takes two keys */
 	assert_int_equal(press_none(c, "hjkllhsoLHSO"), 0);
@@ -425,34 +454,17 @@ static void test_commands_and_answer(void **state)
 	answer(NULL, got[3].seq, "command-rejected", "mode OSCILLATOR refused: torque off");
 	assert_true(read_until(c, "command-rejected: mode OSCILLATOR refused"));
 	assert_int_equal(nlcm, 0);   /* and nothing went out on LCM */
-	robot_close();
-	assert_int_equal(write(c->master, "q", 1), 1);
-	assert_int_equal(wait_exit(c), 0);
-	close(c->master);
-	free(c);
-	undulate_command_t_unsubscribe(lcm, sub);
-	lcm_destroy(lcm);
+	session_close(c, lcm, sub);
 }
 
 /* --read-only: the same keys send nothing and say so. */
 static void test_read_only_sends_nothing(void **state)
 {
 	(void)state;
-	lcm_t *lcm = lcm_create(lcm_url);
-	assert_non_null(lcm);
-	undulate_command_t_subscription_t *sub = undulate_command_t_subscribe(lcm, ".*CMD", on_command, NULL);
-	ngot = 0;
-	nlcm = 0;
-	robot_open();
-	struct child *c = calloc(1, sizeof(*c));
-	start(c, "--read-only");
-	fcntl(c->master, F_SETFL, O_NONBLOCK);
-	int seen = 0;
-	for (int i = 0; i < 100 && !seen; i++) {
-		publish_robot(lcm);
-		seen = read_until_ms(c, "r1 ", 50);
-	}
-	assert_true(seen);
+	lcm_t *lcm;
+	undulate_command_t_subscription_t *sub;
+	struct child *c = session_open("--read-only", &lcm, &sub);
+	wait_for_robot(c, lcm);
 	c->len = 0;
 	assert_int_equal(write(c->master, "moMl+", 5), 5);
 	assert_true(read_until(c, "read-only: commands are disabled"));
@@ -461,13 +473,7 @@ static void test_read_only_sends_nothing(void **state)
 	robot_receive(1);
 	assert_int_equal(ngot, 0);
 	assert_int_equal(nlcm, 0);
-	robot_close();
-	assert_int_equal(write(c->master, "q", 1), 1);
-	assert_int_equal(wait_exit(c), 0);
-	close(c->master);
-	free(c);
-	undulate_command_t_unsubscribe(lcm, sub);
-	lcm_destroy(lcm);
+	session_close(c, lcm, sub);
 }
 
 /* After every test, passed or not: no program and no socket left behind. */

@@ -395,6 +395,38 @@ static void test_world_hostile(void **state)
 	assert_non_null(strstr(buf, "\"marks\":256}"));
 }
 
+/* The simulator's per-second bins: three arrays of the same bins, oldest
+ * first; past HIST_BINS the ring has overwritten the oldest, and a frame
+ * starts at the oldest still held, across the ring's end. */
+static void test_bins(void **state)
+{
+	(void)state;
+	hist.nbins = HIST_BINS + 2;    /* bins 2 .. HIST_BINS + 1 held: slots 2 .. end, then 0, 1 */
+	for (uint64_t i = 2; i < hist.nbins; i++) {
+		int s = (int)(i % HIST_BINS);
+		hist.bin_t_ms[s] = (int64_t)i * 1000;
+		hist.bin_coll[s] = (int32_t)(i % 7);
+		hist.bin_force[s] = (float)i * 0.5f;
+	}
+	struct frame_cursor c;
+	frame_cursor_init(&c, &hist);
+	c.bin = 0;
+	size_t n = frame_write(&hist, &model, 1.0, &c, NULL, NULL, 0, buf, sizeof buf);
+	assert_true(n > 0);
+	buf[n] = '\0';
+	assert_whole(buf, n);
+	assert_int_equal(count_after(buf, "\"bins\":{\"t\":"), HIST_BINS);
+	assert_non_null(strstr(buf, "\"bins\":{\"t\":[2000,3000,4000,"));
+	assert_non_null(strstr(buf, ",300000,301000],\"coll\":[2,3,4,5,6,0,1,"));
+	assert_non_null(strstr(buf, ",6,0],\"force\":[1,1.5,2,2.5,"));
+	assert_non_null(strstr(buf, ",150,150.5]}"));
+	/* a cursor past them: three empty arrays */
+	c.bin = hist.nbins;
+	n = frame_write(&hist, &model, 1.0, &c, NULL, NULL, 0, buf, sizeof buf);
+	buf[n] = '\0';
+	assert_non_null(strstr(buf, "\"bins\":{\"t\":[],\"coll\":[],\"force\":[]}"));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -404,6 +436,7 @@ int main(void)
 		cmocka_unit_test_setup(test_marks_and_notes, setup),
 		cmocka_unit_test_setup(test_world, setup),
 		cmocka_unit_test_setup(test_world_hostile, setup),
+		cmocka_unit_test_setup(test_bins, setup),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -16,18 +16,6 @@
 #include "../../tools/web/wtok.h"
 #include "scratch.h"
 
-static int setup(void **state)
-{
-	(void)state;
-	return scratch_make("wtok");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	return scratch_remove();
-}
-
 static void put(const char *name, const char *text, mode_t mode)
 {
 	char path[512];
@@ -65,11 +53,7 @@ static void test_write_no_follow(void **state)
 	char *v = scratch_slurp("victim", 100);
 	assert_string_equal(v, "keep\n");
 	free(v);
-	struct stat st;
-	assert_int_equal(lstat(path, &st), 0);
-	assert_true(S_ISREG(st.st_mode));
-	assert_int_equal(st.st_mode & 0777, 0600);
-	assert_int_equal(st.st_uid, geteuid());
+	assert_true(scratch_private_file(path, 0600));
 	char *t = scratch_slurp("undulate-web-8080.token", 100);
 	assert_string_equal(t, "s3cret-token\n");
 	free(t);
@@ -119,5 +103,5 @@ int main(void)
 		cmocka_unit_test(test_write_no_follow),
 		cmocka_unit_test(test_read),
 	};
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

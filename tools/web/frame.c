@@ -190,25 +190,33 @@ static void frame_marks(struct json *j, const struct hist *h, const struct top_m
 	json_array_end(j);
 }
 
+/* The per-second bins' three columns, each sent as an array of its own. */
+enum frame_bin_column { FRAME_BIN_T, FRAME_BIN_COLL, FRAME_BIN_FORCE };
+
+/* One column of the bins from `from` on: the ring (HIST_BINS, oldest
+ * overwritten) walked once here, in the order the bins were closed. */
+static void frame_bin_column(struct json *j, const char *key, const struct hist *h, uint64_t from,
+                             enum frame_bin_column col)
+{
+	json_key(j, key);
+	json_array_begin(j);
+	for (uint64_t i = from; i < h->nbins; i++) {
+		uint64_t b = i % HIST_BINS;
+		if (col == FRAME_BIN_FORCE)
+			json_number(j, h->bin_force[b]);
+		else
+			json_int(j, col == FRAME_BIN_T ? h->bin_t_ms[b] : h->bin_coll[b]);
+	}
+	json_array_end(j);
+}
+
 static void frame_bins(struct json *j, const struct hist *h, uint64_t from)
 {
 	json_key(j, "bins");
 	json_object_begin(j);
-	json_key(j, "t");
-	json_array_begin(j);
-	for (uint64_t i = from; i < h->nbins; i++)
-		json_int(j, h->bin_t_ms[i % HIST_BINS]);
-	json_array_end(j);
-	json_key(j, "coll");
-	json_array_begin(j);
-	for (uint64_t i = from; i < h->nbins; i++)
-		json_int(j, h->bin_coll[i % HIST_BINS]);
-	json_array_end(j);
-	json_key(j, "force");
-	json_array_begin(j);
-	for (uint64_t i = from; i < h->nbins; i++)
-		json_number(j, h->bin_force[i % HIST_BINS]);
-	json_array_end(j);
+	frame_bin_column(j, "t", h, from, FRAME_BIN_T);
+	frame_bin_column(j, "coll", h, from, FRAME_BIN_COLL);
+	frame_bin_column(j, "force", h, from, FRAME_BIN_FORCE);
 	json_object_end(j);
 }
 
