@@ -633,11 +633,15 @@ static int finish_models(const struct sim_config *c, struct sim_robot_config *r,
 	}
 	memcpy(r->models, all, sizeof(all[0]) * r->nids);
 	r->nmodels = r->nids;
-	for (size_t k = 0; k < r->nids && sim_model_info(all[0])->protocol == 2; k++)
-		if (r->ids[k] > DXL2_MAX_ID)
-			return ERR("robot %s: ID %u: Protocol 2.0 IDs are 0..%d", r->name, r->ids[k], DXL2_MAX_ID);
-	if (r->servo_baud_reg > 7 && sim_model_info(all[0])->protocol == 2)
-		return ERR("robot %s: servo_baud %d: the X series' Baud Rate register is 0..7", r->name, r->servo_baud_reg);
+	/* the parser took IDs 0..253 and registers 0..254: a family's own limits */
+	const struct sim_joint_ops *ops = sim_joint_ops_of(all[0]);
+	for (size_t k = 0; k < r->nids; k++)
+		if (r->ids[k] > ops->max_id)
+			return ERR("robot %s: ID %u: Protocol %s IDs are 0..%d", r->name, r->ids[k], ops->proto->name,
+			           ops->max_id);
+	if (r->servo_baud_reg > ops->max_baud_reg)
+		return ERR("robot %s: servo_baud %d: the %s' Baud Rate register is 0..%d", r->name, r->servo_baud_reg,
+		           ops->family, ops->max_baud_reg);
 	return 0;
 }
 
@@ -649,7 +653,7 @@ int sim_config_robot_protocol(const struct sim_robot_config *r)
 void sim_config_motor_params(const struct sim_config *c, enum sim_model m, struct sim_motor_params *p)
 {
 	const struct sim_motor_params *g = &c->motor;
-	if (m == SIM_MODEL_AX12A) {
+	if (sim_joint_ops_of(m)->motor_from_config) {
 		*p = *g;
 		return;
 	}
