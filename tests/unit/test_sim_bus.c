@@ -290,21 +290,26 @@ static void test_bad_checksum_reply(void **state)
 	assert_int_equal(c->servo_checksum_errors(&b.joints[1]), 1);
 }
 
-/* Apply a fault to servo 1 and return what the controller reads for a PING. */
-static size_t ping_with_fault(const struct family_case *c, struct sim_bus *b, const char *fault, uint8_t *out,
-                              int64_t *first)
+static void set_fault(struct sim_bus *b, const char *text)
 {
-	char buf[64], err[128], *argv[8];
+	char buf[128], err[128], *argv[8];
 	int argc = 0;
 	enum sim_fault_kind kind;
 	struct sim_fault f;
-	int64_t last;
-	snprintf(buf, sizeof(buf), "%s", fault);
+	snprintf(buf, sizeof(buf), "%s", text);
 	for (char *save = NULL, *w = strtok_r(buf, " ", &save); w && argc < 8; w = strtok_r(NULL, " ", &save))
 		argv[argc++] = w;
 	assert_int_equal(sim_fault_parse(argc, argv, &kind, &f, err, sizeof(err)), 0);
-	sim_faults_clear(&b->joints[0].faults);
 	b->joints[0].faults.f[kind] = f;
+}
+
+/* Apply a fault to servo 1 alone and return what the controller reads for a PING. */
+static size_t ping_with_fault(const struct family_case *c, struct sim_bus *b, const char *fault, uint8_t *out,
+                              int64_t *first)
+{
+	int64_t last;
+	sim_faults_clear(&b->joints[0].faults);
+	set_fault(b, fault);
 	sim_bus_feed(b, c->ping.p, c->ping.n, 0);
 	b->rx_free_at = 0;
 	return drain(b, out, 128, first, &last);
@@ -378,19 +383,6 @@ static size_t ping1(struct sim_bus *b, int64_t t, uint8_t *out)
 	int64_t first, last;
 	sim_bus_feed(b, ping, sizeof(ping), t);
 	return drain(b, out, 128, &first, &last);
-}
-
-static void set_fault(struct sim_bus *b, const char *text)
-{
-	char buf[128], err[128], *argv[8];
-	int argc = 0;
-	enum sim_fault_kind kind;
-	struct sim_fault f;
-	snprintf(buf, sizeof(buf), "%s", text);
-	for (char *save = NULL, *w = strtok_r(buf, " ", &save); w && argc < 8; w = strtok_r(NULL, " ", &save))
-		argv[argc++] = w;
-	assert_int_equal(sim_fault_parse(argc, argv, &kind, &f, err, sizeof(err)), 0);
-	b->joints[0].faults.f[kind] = f;
 }
 
 static void test_v1_broadcast_ping_collides(void **state)
