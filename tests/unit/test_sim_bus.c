@@ -290,6 +290,7 @@ static void test_bad_checksum_reply(void **state)
 	assert_int_equal(c->servo_checksum_errors(&b.joints[1]), 1);
 }
 
+/* Set a fault on servo 1 from its text form, beside those it has. */
 static void set_fault(struct sim_bus *b, const char *text)
 {
 	char buf[128], err[128], *argv[8];
