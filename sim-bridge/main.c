@@ -226,6 +226,18 @@ static const struct {
 
 static char set_store[MAIN_MAX_KEYS][SIM_CMD_MAX + SIM_PATH_MAX];
 
+/* An option's number in lo..hi; else what it takes (`what`) on stderr. */
+static bool opt_number(const char *arg, double lo, double hi, double *out, const char *what)
+{
+	char *end;
+	*out = strtod(arg, &end);
+	if (end == arg || *end != '\0' || !(*out >= lo && *out <= hi)) {
+		fprintf(stderr, "undulate-sim: %s\n", what);
+		return false;
+	}
+	return true;
+}
+
 static int parse_args(int argc, char **argv, struct options *o)
 {
 	static const struct option longopts[] = {
@@ -280,11 +292,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 		case OPT_SET: o->sets[o->nsets++] = optarg; break;
 		case OPT_ECHO: o->sets[o->nsets++] = "sim.echo=true"; break;
 		case OPT_TX_SLICE:
-			o->tx_slice_us = strtod(optarg, &end);
-			if (end == optarg || *end != '\0' || !(o->tx_slice_us >= 0 && o->tx_slice_us <= 10000)) {
-				fprintf(stderr, "undulate-sim: --tx-slice-us: 0..10000\n");
+			if (!opt_number(optarg, 0, 10000, &o->tx_slice_us, "--tx-slice-us: 0..10000"))
 				return -1;
-			}
 			break;
 		case OPT_BENCH: o->bench = true; break;
 		case OPT_CMD: o->send_cmd = optarg; break;
@@ -306,11 +315,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 			o->lockstep = optarg;
 			break;
 		case OPT_LOCKSTEP_GRACE:
-			o->lockstep_grace_s = strtod(optarg, &end);
-			if (end == optarg || *end != '\0' || !(o->lockstep_grace_s >= 0.1 && o->lockstep_grace_s <= 3600)) {
-				fprintf(stderr, "undulate-sim: --lockstep-grace: seconds, 0.1..3600\n");
+			if (!opt_number(optarg, 0.1, 3600, &o->lockstep_grace_s, "--lockstep-grace: seconds, 0.1..3600"))
 				return -1;
-			}
 			break;
 		case OPT_HELP: case 'h': usage(stdout); exit(0);
 		default: usage(stderr); return -1;
