@@ -143,10 +143,6 @@ static int bc_parse(int argc, char **argv, struct bc_opts *o)
 		else
 			return -1;
 	}
-	if (o->protocol != 1 && o->protocol != 2)
-		return -1;
-	if (o->protocol == 2 && o->read_len != 8 && o->read_len != 10)
-		return -1;
 	return o->port && o->nids && o->baud > 0 && o->cycles > 0 && o->period_us > 0 ? 0 : -1;
 }
 
@@ -157,25 +153,6 @@ static void bc_timing(struct bc_run *r, const struct bc_opts *o, unsigned return
 		.adapter_latency_us = (uint32_t)o->latency_us, .margin_us = (uint32_t)margin_us,
 	};
 	bus_set_timing(&r->bus, &t);
-}
-
-/* PING every ID; read the present servos' return delay, as the daemon does
- * at start-up, so the READ timeout is derived from the real value. */
-static void bc_discover(struct bc_run *r, const struct bc_opts *o)
-{
-	bc_timing(r, o, BC_MAX_RETURN_DELAY_US, o->margin_us > BC_DISCOVERY_MARGIN_US ? o->margin_us : BC_DISCOVERY_MARGIN_US);
-	r->return_delay_us = 0;
-	for (size_t i = 0; i < o->nids; i++) {
-		uint8_t eb = 0, rd = 0;
-		r->present[i] = bus_ping(&r->bus, o->ids[i], &eb) == DXL_OK ||
-		                bus_ping(&r->bus, o->ids[i], &eb) == DXL_OK;
-		if (r->present[i] && bus_read_u8(&r->bus, o->ids[i], DXL_AX_RETURN_DELAY_TIME, &rd, &eb) == DXL_OK &&
-		    dxl_return_delay_us(rd) > r->return_delay_us)
-			r->return_delay_us = dxl_return_delay_us(rd);
-		if (r->present[i])
-			bus_read_u16(&r->bus, o->ids[i], DXL_AX_PRESENT_POSITION, &r->position[i], &eb);
-	}
-	bc_timing(r, o, r->return_delay_us, o->margin_us);
 }
 
 static void bc_read_one(struct bc_run *r, const struct bc_opts *o, size_t i)
@@ -225,24 +202,6 @@ static uint16_t bc2_read_addr(const struct bc_opts *o)
 	return o->read_len == 10 ? DXL2_X_PRESENT_CURRENT : DXL2_X_PRESENT_VELOCITY;
 }
 
-static void bc2_discover(struct bc_run *r, const struct bc_opts *o)
-{
-	bc_timing(r, o, BC_MAX_RETURN_DELAY_US, o->margin_us > BC_DISCOVERY_MARGIN_US ? o->margin_us : BC_DISCOVERY_MARGIN_US);
-	r->return_delay_us = 0;
-	for (size_t i = 0; i < o->nids; i++) {
-		uint8_t rd = 0, err = 0;
-		uint32_t pos = 0;
-		r->present[i] = bus_ping_model(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK ||
-		                bus_ping_model(&r->bus, o->ids[i], NULL, NULL, &err) == DXL_OK;
-		if (r->present[i] && bus_read_u8(&r->bus, o->ids[i], DXL2_X_RETURN_DELAY_TIME, &rd, &err) == DXL_OK &&
-		    dxl2_return_delay_us(rd) > r->return_delay_us)
-			r->return_delay_us = dxl2_return_delay_us(rd);
-		if (r->present[i] && bus_read_u32(&r->bus, o->ids[i], DXL2_X_PRESENT_POSITION, &pos, &err) == DXL_OK)
-			r->position[i] = (uint16_t)pos;
-	}
-	bc_timing(r, o, r->return_delay_us, o->margin_us);
-}
-
 /* One cycle: every servo's state in one SYNC_READ, every goal in one SYNC_WRITE. */
 static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
 {
@@ -269,6 +228,103 @@ static void bc2_floor(const struct bc_run *r, const struct bc_opts *o, size_t n,
 {
 	*reads = bus_wire_time_us(&r->bus, 14 + n + n * (11 + o->read_len)) + (uint32_t)n * r->return_delay_us;
 	*sync = bus_wire_time_us(&r->bus, 14 + 5 * n);
+}
+
+/* ---- what differs by protocol ---------------------------------------------------- */
+
+/* One protocol's cycle and the registers the bench reads at start: the
+ * bench's one choice of protocol, made from --protocol (bc_proto_of). */
+struct bc_proto {
+	enum bus_protocol bus;
+	bool fake;                                /* the in-process fake serves it */
+	bool (*read_len_ok)(unsigned len);        /* --read-len */
+	uint16_t return_delay_reg, position_reg;
+	unsigned (*return_delay_us)(uint8_t v);
+	void (*cycle)(struct bc_run *r, const struct bc_opts *o);
+	/* the wire-time floor of the cycle's reads and SYNC_WRITE, the reads' timeout */
+	void (*floor)(const struct bc_run *r, const struct bc_opts *o, size_t npresent, uint32_t *reads,
+	              uint32_t *sync, uint32_t *timeout);
+};
+
+static bool bc_any_read_len(unsigned len)
+{
+	(void)len;   /* 1.0 reads READ(36, 6) whatever --read-len says */
+	return true;
+}
+
+/* One READ per servo, then one SYNC_WRITE. */
+static void bc_cycle(struct bc_run *r, const struct bc_opts *o)
+{
+	for (size_t i = 0; i < o->nids; i++)
+		bc_read_one(r, o, i);
+	bc_sync_write(r, o);
+}
+
+static void bc_floor(const struct bc_run *r, const struct bc_opts *o, size_t npresent, uint32_t *reads,
+                     uint32_t *sync, uint32_t *timeout)
+{
+	(void)o;
+	/* SYNC_WRITE: LEN = (L + 1)·N + 4, on the wire LEN + 4 bytes. */
+	size_t sync_bytes = npresent ? (BC_GOAL_BYTES + 1) * npresent + 4 + 4 : 0;
+	*reads = (uint32_t)npresent * (bus_wire_time_us(&r->bus, BC_READ_REQ_BYTES + BC_READ_REPLY_BYTES) +
+	                               r->return_delay_us);
+	*sync = bus_wire_time_us(&r->bus, sync_bytes);
+	*timeout = bus_timeout_us(&r->bus, BC_READ_REQ_BYTES, BC_READ_REPLY_BYTES);
+}
+
+/* present velocity + position (8 bytes), or with the present current before them (10) */
+static bool bc2_read_len_ok(unsigned len)
+{
+	return len == 8 || len == 10;
+}
+
+static void bc2_floor_timeout(const struct bc_run *r, const struct bc_opts *o, size_t npresent, uint32_t *reads,
+                              uint32_t *sync, uint32_t *timeout)
+{
+	uint16_t lens[BC_MAX_IDS];
+	for (size_t i = 0; i < o->nids; i++)
+		lens[i] = (uint16_t)o->read_len;
+	bc2_floor(r, o, npresent, reads, sync);
+	*timeout = bus_multi_timeout_us(&r->bus, 14 + o->nids, lens, o->nids);
+}
+
+static const struct bc_proto bc_v1 = {
+	.bus = BUS_PROTOCOL_1, .fake = false, .read_len_ok = bc_any_read_len,
+	.return_delay_reg = DXL_AX_RETURN_DELAY_TIME, .position_reg = DXL_AX_PRESENT_POSITION,
+	.return_delay_us = dxl_return_delay_us, .cycle = bc_cycle, .floor = bc_floor,
+};
+
+static const struct bc_proto bc_v2 = {
+	.bus = BUS_PROTOCOL_2, .fake = true, .read_len_ok = bc2_read_len_ok,
+	.return_delay_reg = DXL2_X_RETURN_DELAY_TIME, .position_reg = DXL2_X_PRESENT_POSITION,
+	.return_delay_us = dxl2_return_delay_us, .cycle = bc2_cycle, .floor = bc2_floor_timeout,
+};
+
+/* The table for --protocol N; NULL for a protocol the bench does not run. */
+static const struct bc_proto *bc_proto_of(int protocol)
+{
+	const struct bc_proto *all[] = { NULL, &bc_v1, &bc_v2 };
+	return protocol >= 1 && protocol <= 2 ? all[protocol] : NULL;
+}
+
+/* PING every ID; read the present servos' return delay, as the daemon does
+ * at start-up, so the READ timeout is derived from the real value, and
+ * their present position (its low 16 bits: the goal written back). */
+static void bc_discover(struct bc_run *r, const struct bc_opts *o, const struct bc_proto *bp)
+{
+	bc_timing(r, o, BC_MAX_RETURN_DELAY_US, o->margin_us > BC_DISCOVERY_MARGIN_US ? o->margin_us : BC_DISCOVERY_MARGIN_US);
+	r->return_delay_us = 0;
+	for (size_t i = 0; i < o->nids; i++) {
+		uint8_t eb = 0, rd = 0, pos[2];
+		r->present[i] = bus_ping(&r->bus, o->ids[i], &eb) == DXL_OK ||
+		                bus_ping(&r->bus, o->ids[i], &eb) == DXL_OK;
+		if (r->present[i] && bus_read_u8(&r->bus, o->ids[i], bp->return_delay_reg, &rd, &eb) == DXL_OK &&
+		    bp->return_delay_us(rd) > r->return_delay_us)
+			r->return_delay_us = bp->return_delay_us(rd);
+		if (r->present[i] && bus_read(&r->bus, o->ids[i], bp->position_reg, sizeof pos, pos, &eb) == DXL_OK)
+			r->position[i] = dxl_get_u16(pos);
+	}
+	bc_timing(r, o, r->return_delay_us, o->margin_us);
 }
 
 /* The in-process fake X bus: the pty's master end, served by a thread. */
@@ -418,42 +474,25 @@ static void bc_sleep_until(struct timespec *next, long period_us, long *overruns
 	}
 }
 
-static void bc_cycles(struct bc_run *r, const struct bc_opts *o)
+static void bc_cycles(struct bc_run *r, const struct bc_opts *o, const struct bc_proto *bp)
 {
 	struct timespec next;
 	clock_gettime(CLOCK_MONOTONIC, &next);
 	for (long c = 0; c < o->cycles; c++) {
 		uint64_t t0 = port_now_us();
-		if (o->protocol == 2) {
-			bc2_cycle(r, o);
-		} else {
-			for (size_t i = 0; i < o->nids; i++)
-				bc_read_one(r, o, i);
-			bc_sync_write(r, o);
-		}
+		bp->cycle(r, o);
 		r->cycle_us[c] = (double)(port_now_us() - t0);
 		bc_sleep_until(&next, o->period_us, &r->overruns);
 	}
 }
 
-static void bc_report(struct bc_run *r, const struct bc_opts *o)
+static void bc_report(struct bc_run *r, const struct bc_opts *o, const struct bc_proto *bp)
 {
 	size_t npresent = 0;
 	for (size_t i = 0; i < o->nids; i++)
 		npresent += r->present[i];
-	/* SYNC_WRITE: LEN = (L + 1)·N + 4, on the wire LEN + 4 bytes. */
-	size_t sync_bytes = npresent ? (BC_GOAL_BYTES + 1) * npresent + 4 + 4 : 0;
-	uint32_t reads = (uint32_t)npresent * (bus_wire_time_us(&r->bus, BC_READ_REQ_BYTES + BC_READ_REPLY_BYTES) +
-	                                       r->return_delay_us);
-	uint32_t sync = bus_wire_time_us(&r->bus, sync_bytes);
-	uint32_t timeout = bus_timeout_us(&r->bus, BC_READ_REQ_BYTES, BC_READ_REPLY_BYTES);
-	if (o->protocol == 2) {
-		uint16_t lens[BC_MAX_IDS];
-		for (size_t i = 0; i < o->nids; i++)
-			lens[i] = (uint16_t)o->read_len;
-		bc2_floor(r, o, npresent, &reads, &sync);
-		timeout = bus_multi_timeout_us(&r->bus, 14 + o->nids, lens, o->nids);
-	}
+	uint32_t reads, sync, timeout;
+	bp->floor(r, o, npresent, &reads, &sync, &timeout);
 	printf("protocol %d\n", o->protocol);
 	qsort(r->cycle_us, (size_t)o->cycles, sizeof(double), bc_cmp);
 	printf("servos %zu\npresent %zu\nabsent %zu\n", o->nids, npresent, o->nids - npresent);
@@ -477,13 +516,14 @@ int main(int argc, char **argv)
 	static struct bc_fake fake;
 	struct bc_opts o;
 	char err[256], fake_path[64];
-	if (bc_parse(argc, argv, &o) != 0) {
+	const struct bc_proto *bp = NULL;
+	if (bc_parse(argc, argv, &o) != 0 || (bp = bc_proto_of(o.protocol)) == NULL || !bp->read_len_ok(o.read_len)) {
 		fprintf(stderr, "usage: buscycle --port PATH|fake --ids 1,2 [--protocol 1|2] [--read-len 8|10] [--baud BPS] "
 		                "[--cycles N] [--period-us P] [--latency-us L] [--margin-us M]\n");
 		return 2;
 	}
 	bool fake_bus = strcmp(o.port, "fake") == 0;
-	if (fake_bus && (o.protocol != 2 || bc_fake_start(&fake, &o, fake_path, sizeof fake_path) != 0)) {
+	if (fake_bus && (!bp->fake || bc_fake_start(&fake, &o, fake_path, sizeof fake_path) != 0)) {
 		fprintf(stderr, "buscycle: the in-process fake serves Protocol 2.0 only (--protocol 2)\n");
 		return 1;
 	}
@@ -497,18 +537,15 @@ int main(int argc, char **argv)
 	struct bus_timing t = { .baud = o.baud };
 	port_bus_io(p, &io);
 	bus_init(&r.bus, &io, &t, false);
-	bus_set_protocol(&r.bus, o.protocol == 2 ? BUS_PROTOCOL_2 : BUS_PROTOCOL_1);
+	bus_set_protocol(&r.bus, bp->bus);
 	r.cycle_us = calloc((size_t)o.cycles, sizeof(double));
 	if (!r.cycle_us) {
 		port_close(p);
 		return 1;
 	}
-	if (o.protocol == 2)
-		bc2_discover(&r, &o);
-	else
-		bc_discover(&r, &o);
-	bc_cycles(&r, &o);
-	bc_report(&r, &o);
+	bc_discover(&r, &o, bp);
+	bc_cycles(&r, &o, bp);
+	bc_report(&r, &o, bp);
 	free(r.cycle_us);
 	port_close(p);
 	if (fake_bus)

@@ -84,6 +84,35 @@ static int v1_parser_feed(union dxl_proto_parser *p, const uint8_t *data, size_t
 	return r;
 }
 
+static void v1_parser_counts(const union dxl_proto_parser *p, struct dxl_parser_counts *out)
+{
+	*out = (struct dxl_parser_counts){ p->v1.frames, p->v1.checksum_errors, p->v1.header_errors, 0,
+	                                   p->v1.bytes_dropped, p->v1.have };
+}
+
+/* FF FF ID LEN INSTR ... CHK, LEN counting from INSTR to CHK. */
+static bool v1_damaged_packet(const uint8_t *h, size_t n, uint8_t *id, uint8_t *instr)
+{
+	for (size_t p = n >= 6 ? n - 6 + 1 : 0; p-- > 0;) {
+		if (h[p] != 0xFF || h[p + 1] != 0xFF || p + 4 >= n)
+			continue;
+		if ((size_t)h[p + 3] + 4 != n - p)
+			continue;
+		*id = h[p + 2];
+		*instr = h[p + 4];
+		return true;
+	}
+	return false;
+}
+
+/* 1.0 servos answer a broadcast PING all at once (they collide). */
+static int v1_reply_order(const struct dxl_frame *req, uint8_t id)
+{
+	(void)req;
+	(void)id;
+	return -1;
+}
+
 /* The AX-12, the 1.0 servo driven here, has no REBOOT, SYNC_READ or
  * BULK_READ (ax12.md): the MX series' REBOOT and BULK_READ are left out
  * until a 1.0 servo that has them is driven. */
@@ -115,6 +144,10 @@ const struct dxl_proto dxl_proto_v1 = {
 	.parser_init = v1_parser_init,
 	.parser_reset = v1_parser_reset,
 	.parser_feed = v1_parser_feed,
+	.parser_counts = v1_parser_counts,
+	.damaged_packet = v1_damaged_packet,
+	.reply_order = v1_reply_order,
+	.check_name = "checksum",
 	.instruction_name = dxl_instruction_name,
 	.err_format = dxl_errbits_format,
 };
@@ -184,6 +217,48 @@ static int v2_parser_feed(union dxl_proto_parser *p, const uint8_t *data, size_t
 	return r;
 }
 
+static void v2_parser_counts(const union dxl_proto_parser *p, struct dxl_parser_counts *out)
+{
+	*out = (struct dxl_parser_counts){ p->v2.frames, p->v2.checksum_errors, p->v2.header_errors,
+	                                   p->v2.stuffing_errors, p->v2.bytes_dropped, p->v2.have };
+}
+
+/* FF FF FD 00 ID LEN_L LEN_H INSTR ..., LEN counting from INSTR to the CRC. */
+static bool v2_damaged_packet(const uint8_t *bytes, size_t n, uint8_t *id, uint8_t *instr)
+{
+	for (size_t p = n >= 10 ? n - 9 : 0; p-- > 0;) {
+		const uint8_t *h = &bytes[p];
+		if (h[0] != 0xFF || h[1] != 0xFF || h[2] != 0xFD || h[3] != 0x00)
+			continue;
+		size_t len = (size_t)h[5] | ((size_t)h[6] << 8);
+		if (p + DXL2_HEADER_BYTES + len != n)
+			continue;
+		*id = h[4];
+		*instr = h[7];
+		return true;
+	}
+	return false;
+}
+
+/* SYNC_READ and BULK_READ are answered in the order the request lists the
+ * servos, a broadcast PING in the order of their IDs (e-manual, Protocol
+ * 2.0): a servo's slot in the list, or its ID. */
+static int v2_reply_order(const struct dxl_frame *req, uint8_t id)
+{
+	if (req->instr == DXL2_INST_SYNC_READ) {
+		for (size_t k = 4; k < req->nparams; k++)
+			if (req->params[k] == id)
+				return (int)k;
+	} else if (req->instr == DXL2_INST_BULK_READ) {
+		for (size_t k = 0; k + 5 <= req->nparams; k += 5)
+			if (req->params[k] == id)
+				return (int)k;
+	} else if (req->instr != DXL2_INST_PING || req->id != DXL2_BROADCAST_ID) {
+		return -1;
+	}
+	return id;
+}
+
 const struct dxl_proto dxl_proto_v2 = {
 	.name = "2.0",
 	.number = 2,
@@ -218,6 +293,10 @@ const struct dxl_proto dxl_proto_v2 = {
 	.parser_init = v2_parser_init,
 	.parser_reset = v2_parser_reset,
 	.parser_feed = v2_parser_feed,
+	.parser_counts = v2_parser_counts,
+	.damaged_packet = v2_damaged_packet,
+	.reply_order = v2_reply_order,
+	.check_name = "CRC",
 	.instruction_name = dxl2_instruction_name,
 	.err_format = dxl2_err_format,
 };

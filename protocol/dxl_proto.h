@@ -68,6 +68,13 @@ union dxl_proto_parser {
 	struct dxl2_parser v2;
 };
 
+/* A parser's counters and its buffered bytes, either protocol's
+ * (stuffing_errors: 2.0 only, 0 on 1.0). */
+struct dxl_parser_counts {
+	uint32_t frames, checksum_errors, header_errors, stuffing_errors, bytes_dropped;
+	size_t have;
+};
+
 /* Every encoder writes into buf (cap bytes) and returns the bytes written or
  * a negative dxl_status (DXL_E_ARG, DXL_E_BUFFER); nothing past cap. */
 struct dxl_proto {
@@ -127,8 +134,20 @@ struct dxl_proto {
 	void (*parser_reset)(union dxl_proto_parser *p);
 	int (*parser_feed)(union dxl_proto_parser *p, const uint8_t *data, size_t n, size_t *used,
 	                   struct dxl_frame *out);
+	void (*parser_counts)(const union dxl_proto_parser *p, struct dxl_parser_counts *out);
+
+	/* The simulator's side: a packet that just failed its checksum ends at
+	 * bytes[n - 1] (the bytes the parser consumed last). Its ID and
+	 * instruction from its header, so the addressed servo can answer with
+	 * its checksum error; false when no header's LEN spans exactly to there. */
+	bool (*damaged_packet)(const uint8_t *bytes, size_t n, uint8_t *id, uint8_t *instr);
+	/* Several servos answering one request: the place of servo id's reply
+	 * among them (each follows the one before, in this order), or -1 when
+	 * every reply to req starts at the request's end (and two collide). */
+	int (*reply_order)(const struct dxl_frame *req, uint8_t id);
 
 	/* texts */
+	const char *check_name;      /* what a damaged packet failed: "checksum", "CRC" */
 	const char *(*instruction_name)(uint8_t instr);
 	/* The servo's error byte / ERR field as text ("overheating|overload",
 	 * "alert|data range", "none"); returns buf. */

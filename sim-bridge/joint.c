@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "dxl.h"
 #include "dxl2.h"
@@ -119,11 +120,43 @@ static bool ax_error_fits(const struct sim_fault *f, const char **why)
 	return f->arg >= 0;
 }
 
+static int ax_handle(struct sim_joint *j, const struct dxl_frame *req, uint8_t *out, size_t cap)
+{
+	/* a 1.0 frame (its parser's) always fits the 1.0 packet */
+	struct dxl_packet pkt;
+	pkt.id = req->id;
+	pkt.code = req->instr;
+	pkt.nparams = (uint8_t)req->nparams;
+	memcpy(pkt.params, req->params, pkt.nparams);
+	return sim_servo_handle(&j->servo, &pkt, out, cap);
+}
+
+static int ax_handle_damaged(struct sim_joint *j, uint8_t id, uint8_t instr, uint8_t *out, size_t cap)
+{
+	return sim_servo_handle_bad_checksum(&j->servo, id, instr, out, cap);
+}
+
+static bool ax_reply_faults(struct sim_joint *j, uint64_t *rng, uint8_t *pkt, size_t *len, size_t cap,
+                            uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns)
+{
+	(void)cap;   /* a 1.0 fault never lengthens the packet */
+	return sim_faults_apply(&j->faults, rng, pkt, len, garbage, ngarbage, extra_delay_ns);
+}
+
+static int64_t ax_return_delay_ns(const struct sim_joint *j)
+{
+	return (int64_t)dxl_return_delay_us(j->servo.mem[DXL_AX_RETURN_DELAY_TIME]) * 1000;
+}
+
 static const struct sim_joint_ops ax_ops = {
-	.protocol = 1, .place = ax_place, .id = ax_id, .powered = ax_powered, .torque = ax_torque, .baud = ax_baud,
+	.proto = &dxl_proto_v1, .family = "AX-12A", .place = ax_place, .id = ax_id, .powered = ax_powered, .torque = ax_torque, .baud = ax_baud,
 	.sense = ax_sense, .step = ax_step, .drive = ax_drive, .power_up = ax_power_up, .power_on = ax_power_on,
 	.power_off = ax_power_off, .reg = ax_reg, .poke = ax_poke, .peek = ax_peek, .describe = ax_describe,
 	.error_fits = ax_error_fits,
+	.handle = ax_handle, .handle_damaged = ax_handle_damaged, .reply_faults = ax_reply_faults,
+	.return_delay_ns = ax_return_delay_ns,
+	.baud_reg = dxl_baud_to_reg, .rate_names = "AX-12 rate", .max_id = DXL_MAX_ID, .max_baud_reg = 254,
+	.motor_from_config = true, .says_family = false,
 };
 
 /* ---- the X series on Protocol 2.0 ---------------------------------------------------- */
@@ -238,13 +271,48 @@ static bool x_error_fits(const struct sim_fault *f, const char **why)
 	return f->err2 >= 0;
 }
 
+static int x_handle(struct sim_joint *j, const struct dxl_frame *req, uint8_t *out, size_t cap)
+{
+	struct dxl2_packet pkt;   /* fields assigned, not the whole kilobyte zeroed */
+	pkt.id = req->id;
+	pkt.instr = req->instr;
+	pkt.err = req->err;
+	pkt.nparams = req->nparams;
+	pkt.wire_bytes = req->wire_bytes;
+	memcpy(pkt.params, req->params, req->nparams);
+	return sim_xservo_handle(&j->xservo, &pkt, out, cap);
+}
+
+static int x_handle_damaged(struct sim_joint *j, uint8_t id, uint8_t instr, uint8_t *out, size_t cap)
+{
+	return sim_xservo_handle_bad_crc(&j->xservo, id, instr, out, cap);
+}
+
+static bool x_reply_faults(struct sim_joint *j, uint64_t *rng, uint8_t *pkt, size_t *len, size_t cap,
+                           uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns)
+{
+	return sim_faults_apply2(&j->faults, rng, pkt, len, cap, garbage, ngarbage, extra_delay_ns);
+}
+
+static int64_t x_return_delay_ns(const struct sim_joint *j)
+{
+	return (int64_t)dxl2_return_delay_us(j->xservo.mem[DXL2_X_RETURN_DELAY_TIME]) * 1000;
+}
+
 static const struct sim_joint_ops x_ops = {
-	.protocol = 2, .place = x_place, .id = x_id, .powered = x_powered, .torque = x_torque, .baud = x_baud,
+	.proto = &dxl_proto_v2, .family = "X series", .place = x_place, .id = x_id, .powered = x_powered, .torque = x_torque, .baud = x_baud,
 	.sense = x_sense, .step = x_step, .drive = x_drive, .power_up = x_power_up, .power_on = x_power_up,
 	.power_off = x_power_off, .reg = x_reg, .poke = x_poke, .peek = x_peek, .describe = x_describe,
 	.error_fits = x_error_fits,
+	.handle = x_handle, .handle_damaged = x_handle_damaged, .reply_faults = x_reply_faults,
+	.return_delay_ns = x_return_delay_ns,
+	.baud_reg = dxl2_baud_to_reg,
+	.rate_names = "X-series rate (9600, 57600, 115200, 1000000, 2000000, 3000000, 4000000, 4500000)",
+	.max_id = DXL2_MAX_ID, .max_baud_reg = 7, .motor_from_config = false, .says_family = true,
 };
 
+/* The one place a model's family is chosen: by the protocol its model
+ * speaks, one family per protocol so far. */
 const struct sim_joint_ops *sim_joint_ops_of(enum sim_model m)
 {
 	return sim_model_info(m)->protocol == 2 ? &x_ops : &ax_ops;

@@ -14,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "dxl_proto.h"
 #include "fault.h"
 #include "model.h"
 #include "motor.h"
@@ -39,7 +40,8 @@ struct sim_joint_reg {
 };
 
 struct sim_joint_ops {
-	int protocol;                                      /* 1 or 2 */
+	const struct dxl_proto *proto;                     /* the protocol it speaks */
+	const char *family;                                /* "AX-12A", "X series" */
 	void (*place)(struct sim_joint *j, enum sim_model m, const struct sim_joint_place *p);
 	uint8_t (*id)(const struct sim_joint *j);
 	bool (*powered)(const struct sim_joint *j);
@@ -64,6 +66,31 @@ struct sim_joint_ops {
 	int (*describe)(const struct sim_joint *j, char *buf, size_t cap);
 	/* a stuck-error fault this servo's status can carry; else why not */
 	bool (*error_fits)(const struct sim_fault *f, const char **why);
+
+	/* On the bus: a request of its protocol answered, the status packet in
+	 * out (its length; 0: no reply); a damaged request's ID and instruction
+	 * answered with the checksum error if it was addressed. */
+	int (*handle)(struct sim_joint *j, const struct dxl_frame *req, uint8_t *out, size_t cap);
+	int (*handle_damaged)(struct sim_joint *j, uint8_t id, uint8_t instr, uint8_t *out, size_t cap);
+	/* the reply faults (fault.h) on one of its status packets, cap bytes of room */
+	bool (*reply_faults)(struct sim_joint *j, uint64_t *rng, uint8_t *pkt, size_t *len, size_t cap,
+	                     uint8_t *garbage, size_t *ngarbage, int64_t *extra_delay_ns);
+	int64_t (*return_delay_ns)(const struct sim_joint *j);
+
+	/* Configuration: the Baud Rate register for bps (DXL_OK, or not one of
+	 * rate_names); the largest ID and Baud Rate register value. */
+	int (*baud_reg)(long bps, uint8_t *reg);
+	const char *rate_names;
+	uint8_t max_id;
+	int max_baud_reg;
+	/* The configuration's [motor] section is its motor as given (the
+	 * AX-12A's, measured first); else its model's datasheet, overridden by
+	 * what the section sets. */
+	bool motor_from_config;
+	/* Its bus's summary names the protocol and its word is followed by
+	 * NAME.model=: the AX-12A's outputs predate the other families and stay
+	 * as they were. */
+	bool says_family;
 };
 
 /* The table of model m's family. */

@@ -226,6 +226,18 @@ static const struct {
 
 static char set_store[MAIN_MAX_KEYS][SIM_CMD_MAX + SIM_PATH_MAX];
 
+/* An option's number in lo..hi; else what it takes (`what`) on stderr. */
+static bool opt_number(const char *arg, double lo, double hi, double *out, const char *what)
+{
+	char *end;
+	*out = strtod(arg, &end);
+	if (end == arg || *end != '\0' || !(*out >= lo && *out <= hi)) {
+		fprintf(stderr, "undulate-sim: %s\n", what);
+		return false;
+	}
+	return true;
+}
+
 static int parse_args(int argc, char **argv, struct options *o)
 {
 	static const struct option longopts[] = {
@@ -280,11 +292,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 		case OPT_SET: o->sets[o->nsets++] = optarg; break;
 		case OPT_ECHO: o->sets[o->nsets++] = "sim.echo=true"; break;
 		case OPT_TX_SLICE:
-			o->tx_slice_us = strtod(optarg, &end);
-			if (end == optarg || *end != '\0' || !(o->tx_slice_us >= 0 && o->tx_slice_us <= 10000)) {
-				fprintf(stderr, "undulate-sim: --tx-slice-us: 0..10000\n");
+			if (!opt_number(optarg, 0, 10000, &o->tx_slice_us, "--tx-slice-us: 0..10000"))
 				return -1;
-			}
 			break;
 		case OPT_BENCH: o->bench = true; break;
 		case OPT_CMD: o->send_cmd = optarg; break;
@@ -306,11 +315,8 @@ static int parse_args(int argc, char **argv, struct options *o)
 			o->lockstep = optarg;
 			break;
 		case OPT_LOCKSTEP_GRACE:
-			o->lockstep_grace_s = strtod(optarg, &end);
-			if (end == optarg || *end != '\0' || !(o->lockstep_grace_s >= 0.1 && o->lockstep_grace_s <= 3600)) {
-				fprintf(stderr, "undulate-sim: --lockstep-grace: seconds, 0.1..3600\n");
+			if (!opt_number(optarg, 0.1, 3600, &o->lockstep_grace_s, "--lockstep-grace: seconds, 0.1..3600"))
 				return -1;
-			}
 			break;
 		case OPT_HELP: case 'h': usage(stdout); exit(0);
 		default: usage(stderr); return -1;
@@ -916,6 +922,14 @@ static void bench_line(struct app *a, int64_t now, double *cpu_prev, int64_t *be
 	*bench_prev = now;
 }
 
+/* Whether a bus's lines name its protocol and models: the AX-12A's lines
+ * predate the other families and stay as they were (no protocol named, no
+ * stuffing column: 1.0 has none, no NAME.model= word). */
+static bool bus_says_family(const struct sim_bus *b)
+{
+	return b->njoints > 0 && b->joints[0].ops->says_family;
+}
+
 /* Bad bytes from a controller are counted by the bus; tell people about them
  * at most once a second per bus, as a sum since the last report. */
 static void report_bad_input(struct app *a)
@@ -927,18 +941,15 @@ static void report_bad_input(struct app *a)
 		if (bad == a->reported_bad[i])
 			continue;
 		a->reported_bad[i] = bad;
-		if (b->protocol == 2) {
-			fprintf(stderr, "undulate-sim: bus %s: bad input so far: %llu bad CRCs, %llu bad stuffing, "
-			                "%llu bad headers (%llu bytes skipped); %llu reply bytes nobody read\n",
-			        b->name, (unsigned long long)c->checksum_errors, (unsigned long long)c->stuffing_errors,
-			        (unsigned long long)c->header_errors, (unsigned long long)b->parser2.bytes_dropped,
-			        (unsigned long long)c->tx_dropped);
-			continue;
-		}
-		fprintf(stderr, "undulate-sim: bus %s: bad input so far: %llu bad checksums, %llu bad headers "
-		                "(%llu bytes skipped); %llu reply bytes nobody read\n",
-		        b->name, (unsigned long long)c->checksum_errors, (unsigned long long)c->header_errors,
-		        (unsigned long long)b->parser.bytes_dropped, (unsigned long long)c->tx_dropped);
+		struct dxl_parser_counts pc;
+		b->proto->parser_counts(&b->parser, &pc);
+		fprintf(stderr, "undulate-sim: bus %s: bad input so far: %llu bad %ss, ", b->name,
+		        (unsigned long long)c->checksum_errors, b->proto->check_name);
+		if (bus_says_family(b))
+			fprintf(stderr, "%llu bad stuffing, ", (unsigned long long)c->stuffing_errors);
+		fprintf(stderr, "%llu bad headers (%llu bytes skipped); %llu reply bytes nobody read\n",
+		        (unsigned long long)c->header_errors, (unsigned long long)pc.bytes_dropped,
+		        (unsigned long long)c->tx_dropped);
 	}
 }
 
@@ -1191,7 +1202,7 @@ static const struct sim_clock clock_lockstep = {
  * model, or one per ID); an AX-12A bus's word stands alone, as before. */
 static void print_models(const struct sim_bus *b)
 {
-	if (b->protocol != 2)
+	if (!bus_says_family(b))
 		return;
 	bool same = true;
 	for (size_t k = 1; k < b->njoints; k++)
@@ -1267,23 +1278,18 @@ static void print_bus_summary(const struct app *a)
 {
 	const struct sim *s = a->sim;
 	for (size_t i = 0; i < s->nbuses && !a->quiet; i++) {
-		const struct sim_bus_counters *c = &s->buses[i].count;
-		if (s->buses[i].protocol == 2) {
-			printf("undulate-sim: bus %s (Protocol 2.0): %llu packets, %llu replies, %llu bad CRCs, "
-			       "%llu bad stuffing, %llu header errors, %llu wrong-baud, %llu bytes dropped, "
-			       "%llu collisions on the line\n",
-			       s->buses[i].name, (unsigned long long)c->packets, (unsigned long long)c->replies,
-			       (unsigned long long)c->checksum_errors, (unsigned long long)c->stuffing_errors,
-			       (unsigned long long)c->header_errors, (unsigned long long)c->wrong_baud,
-			       (unsigned long long)c->tx_dropped, (unsigned long long)s->buses[i].line.collisions);
-			continue;
-		}
-		printf("undulate-sim: bus %s: %llu packets, %llu replies, %llu bad checksums, %llu header errors, "
-		       "%llu wrong-baud, %llu bytes dropped, %llu collisions on the line\n",
-		       s->buses[i].name, (unsigned long long)c->packets, (unsigned long long)c->replies,
-		       (unsigned long long)c->checksum_errors, (unsigned long long)c->header_errors,
-		       (unsigned long long)c->wrong_baud, (unsigned long long)c->tx_dropped,
-		       (unsigned long long)s->buses[i].line.collisions);
+		const struct sim_bus *b = &s->buses[i];
+		const struct sim_bus_counters *c = &b->count;
+		bool says = bus_says_family(b);
+		printf("undulate-sim: bus %s%s%s%s: %llu packets, %llu replies, %llu bad %ss, ", b->name,
+		       says ? " (Protocol " : "", says ? b->proto->name : "", says ? ")" : "",
+		       (unsigned long long)c->packets, (unsigned long long)c->replies,
+		       (unsigned long long)c->checksum_errors, b->proto->check_name);
+		if (says)
+			printf("%llu bad stuffing, ", (unsigned long long)c->stuffing_errors);
+		printf("%llu header errors, %llu wrong-baud, %llu bytes dropped, %llu collisions on the line\n",
+		       (unsigned long long)c->header_errors, (unsigned long long)c->wrong_baud,
+		       (unsigned long long)c->tx_dropped, (unsigned long long)b->line.collisions);
 	}
 	fflush(stdout);
 }

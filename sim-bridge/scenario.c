@@ -217,6 +217,19 @@ static int set_sim(struct sim_config *c, const char *k, const char *v, char *err
 	return ERR("unknown key sim.%s", k);
 }
 
+/* LO,HI: two finite numbers, LO < HI (sscanf's %lf used to take "-inf"). */
+static bool parse_range(const char *v, double *lo, double *hi)
+{
+	char first[64];
+	const char *comma = strchr(v, ',');
+	size_t n = comma ? (size_t)(comma - v) : sizeof(first);
+	if (n >= sizeof(first))
+		return false;
+	memcpy(first, v, n);
+	first[n] = '\0';
+	return parse_num(first, lo) && parse_num(comma + 1, hi) && *lo < *hi;
+}
+
 static int set_walls(struct sim_config *c, const char *v, char *err, size_t errcap)
 {
 	if (!strcasecmp(v, "none")) {
@@ -227,16 +240,8 @@ static int set_walls(struct sim_config *c, const char *v, char *err, size_t errc
 		c->walls = SIM_WALLS_AUTO;
 		return 0;
 	}
-	/* LEFT,RIGHT: both finite (sscanf's %lf used to take "-inf") */
 	double l, r;
-	char left[64];
-	const char *comma = strchr(v, ',');
-	size_t n = comma ? (size_t)(comma - v) : sizeof(left);
-	if (n < sizeof(left)) {
-		memcpy(left, v, n);
-		left[n] = '\0';
-	}
-	if (n >= sizeof(left) || !parse_num(left, &l) || !parse_num(comma + 1, &r) || !(l < r))
+	if (!parse_range(v, &l, &r))
 		return ERR("walls: none, auto or LEFT,RIGHT (m, LEFT < RIGHT)");
 	c->walls = SIM_WALLS_FIXED;
 	c->world.wall_left = l;
@@ -252,14 +257,7 @@ static int set_ends(struct sim_config *c, const char *v, char *err, size_t errca
 		return 0;
 	}
 	double b, f;
-	char back[64];
-	const char *comma = strchr(v, ',');
-	size_t n = comma ? (size_t)(comma - v) : sizeof(back);
-	if (n < sizeof(back)) {
-		memcpy(back, v, n);
-		back[n] = '\0';
-	}
-	if (n >= sizeof(back) || !parse_num(back, &b) || !parse_num(comma + 1, &f) || !(b < f))
+	if (!parse_range(v, &b, &f))
 		return ERR("ends: none or BACK,FRONT (m along y, BACK < FRONT)");
 	c->ends_set = true;
 	c->ends_back = b;
@@ -633,11 +631,15 @@ static int finish_models(const struct sim_config *c, struct sim_robot_config *r,
 	}
 	memcpy(r->models, all, sizeof(all[0]) * r->nids);
 	r->nmodels = r->nids;
-	for (size_t k = 0; k < r->nids && sim_model_info(all[0])->protocol == 2; k++)
-		if (r->ids[k] > DXL2_MAX_ID)
-			return ERR("robot %s: ID %u: Protocol 2.0 IDs are 0..%d", r->name, r->ids[k], DXL2_MAX_ID);
-	if (r->servo_baud_reg > 7 && sim_model_info(all[0])->protocol == 2)
-		return ERR("robot %s: servo_baud %d: the X series' Baud Rate register is 0..7", r->name, r->servo_baud_reg);
+	/* the parser took IDs 0..253 and registers 0..254: a family's own limits */
+	const struct sim_joint_ops *ops = sim_joint_ops_of(all[0]);
+	for (size_t k = 0; k < r->nids; k++)
+		if (r->ids[k] > ops->max_id)
+			return ERR("robot %s: ID %u: Protocol %s IDs are 0..%d", r->name, r->ids[k], ops->proto->name,
+			           ops->max_id);
+	if (r->servo_baud_reg > ops->max_baud_reg)
+		return ERR("robot %s: servo_baud %d: the %s' Baud Rate register is 0..%d", r->name, r->servo_baud_reg,
+		           ops->family, ops->max_baud_reg);
 	return 0;
 }
 
@@ -649,7 +651,7 @@ int sim_config_robot_protocol(const struct sim_robot_config *r)
 void sim_config_motor_params(const struct sim_config *c, enum sim_model m, struct sim_motor_params *p)
 {
 	const struct sim_motor_params *g = &c->motor;
-	if (m == SIM_MODEL_AX12A) {
+	if (sim_joint_ops_of(m)->motor_from_config) {
 		*p = *g;
 		return;
 	}

@@ -68,19 +68,17 @@ static enum sim_model robot_model(const struct sim_robot_config *rc, size_t k)
 	return rc->models[rc->nmodels == rc->nids ? k : 0];
 }
 
-/* The Baud Rate register value of the robot's servos. */
-static int robot_baud_reg(const struct sim_robot_config *rc, long baud, int protocol, uint8_t *reg, char *err,
-                          size_t errcap)
+/* The Baud Rate register value of the robot's servos (ops: their family's). */
+static int robot_baud_reg(const struct sim_robot_config *rc, long baud, const struct sim_joint_ops *ops,
+                          uint8_t *reg, char *err, size_t errcap)
 {
 	if (rc->servo_baud_reg >= 0) {
 		*reg = (uint8_t)rc->servo_baud_reg;
 		return 0;
 	}
-	if (protocol == 2 && dxl2_baud_to_reg(baud, reg) != DXL_OK)
-		return snprintf(err, errcap, "robot %s: %ld bps is no X-series rate (9600, 57600, 115200, 1000000, "
-		                "2000000, 3000000, 4000000, 4500000); set servo_baud", rc->name, baud), -1;
-	if (protocol == 1 && dxl_baud_to_reg(baud, reg) != DXL_OK)
-		return snprintf(err, errcap, "robot %s: %ld bps is no AX-12 rate; set servo_baud", rc->name, baud), -1;
+	if (ops->baud_reg(baud, reg) != DXL_OK)
+		return snprintf(err, errcap, "robot %s: %ld bps is no %s; set servo_baud", rc->name, baud,
+		                ops->rate_names), -1;
 	return 0;
 }
 
@@ -94,10 +92,10 @@ static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char 
 	bool echo = rc->echo >= 0 ? rc->echo != 0 : c->echo;
 	sim_bus_init(b, rc->name, rc->link, baud, latency_ms / 1000.0, echo, c->seed * 1000003u + s->nbuses + 1);
 	b->follow_tty = c->baud_follows_tty;
-	if (mi->protocol == 2)
-		sim_bus_set_protocol(b, 2);
+	/* the bus speaks its servos' protocol: the choice made here, once */
+	sim_bus_set_protocol(b, mi->protocol);
 	uint8_t baud_reg;
-	if (robot_baud_reg(rc, baud, mi->protocol, &baud_reg, err, errcap) != 0)
+	if (robot_baud_reg(rc, baud, sim_joint_ops_of(robot_model(rc, 0)), &baud_reg, err, errcap) != 0)
 		return -1;
 	int delay_us = rc->return_delay_us >= 0 ? rc->return_delay_us : c->return_delay_us;
 	for (size_t k = 0; k < rc->nids; k++) {

@@ -38,17 +38,17 @@ void sim_bus_init(struct sim_bus *b, const char *name, const char *link, long ba
 	b->echo = echo;
 	b->master = b->slave = -1;
 	b->link_lock = -1;
-	dxl_parser_init(&b->parser, DXL_PARSE_INSTRUCTION);
-	b->protocol = 1;
-	dxl2_parser_init(&b->parser2, DXL2_PARSE_INSTRUCTION);
+	b->proto = &dxl_proto_v1;
+	b->proto->parser_init(&b->parser, true);
 	sim_line_init(&b->line);
 	b->rng = seed ? seed : 1;
 }
 
 void sim_bus_set_protocol(struct sim_bus *b, int protocol)
 {
-	b->protocol = protocol == 2 ? 2 : 1;
-	dxl2_parser_init(&b->parser2, DXL2_PARSE_INSTRUCTION);
+	const struct dxl_proto *p = dxl_proto_by_number(protocol);
+	b->proto = p ? p : &dxl_proto_v1;
+	b->proto->parser_init(&b->parser, true);
 }
 
 void sim_bus_set_baud(struct sim_bus *b, long bps)
@@ -109,88 +109,32 @@ static void bus_hist_push(struct sim_bus *b, const uint8_t *data, size_t n)
 	hist_push(b->hist, sizeof(b->hist), &b->hist_n, data, n);
 }
 
-/* Schedule one servo's status packet: it starts after the request's end on
- * the wire plus the servo's return delay, then goes out at the baud rate. */
-static void bus_send_reply(struct sim_bus *b, struct sim_joint *j, uint8_t *pkt, size_t len, int64_t req_end)
-{
-	uint8_t garbage[SIM_FAULT_MAX_GARBAGE];
-	size_t ngarbage = 0;
-	int64_t extra = 0;
-	sim_faults_apply(&j->faults, &b->rng, pkt, &len, garbage, &ngarbage, &extra);
-	int64_t start = req_end + (int64_t)dxl_return_delay_us(j->servo.mem[DXL_AX_RETURN_DELAY_TIME]) * 1000 + extra;
-	int64_t first = start + b->byte_ns + b->latency_ns;
-	if (ngarbage) {
-		sim_line_put(&b->line, first, b->byte_ns, garbage, ngarbage);
-		first += (int64_t)ngarbage * b->byte_ns;
-	}
-	if (len) {
-		sim_line_put(&b->line, first, b->byte_ns, pkt, len);
-		b->count.replies++;
-	}
-}
-
-static void bus_dispatch(struct sim_bus *b, const struct dxl_packet *pkt, int64_t req_end)
-{
-	b->count.packets++;
-	for (size_t i = 0; i < b->njoints; i++) {
-		struct sim_joint *j = &b->joints[i];
-		if (!j->servo.powered)
-			continue;
-		if (!sim_bus_baud_matches(b, j->servo.mem[DXL_AX_BAUD_RATE])) {
-			b->count.wrong_baud++;
-			continue;  /* at another rate the servo sees only framing noise */
-		}
-		uint8_t reply[DXL_MAX_PACKET];
-		int len = sim_servo_handle(&j->servo, pkt, reply, sizeof(reply));
-		if (len > 0)
-			bus_send_reply(b, j, reply, (size_t)len, req_end);
-	}
-}
-
-/* The parser dropped a packet for its checksum: find it in the bytes just
- * consumed (it ends there) so the addressed servo can answer with bit 4. */
-static void bus_bad_checksum(struct sim_bus *b, int64_t req_end)
-{
-	b->count.checksum_errors++;
-	for (size_t p = b->hist_n >= 6 ? b->hist_n - 6 + 1 : 0; p-- > 0;) {
-		if (b->hist[p] != 0xFF || b->hist[p + 1] != 0xFF || p + 4 >= b->hist_n)
-			continue;
-		if ((size_t)b->hist[p + 3] + 4 != b->hist_n - p)
-			continue;
-		uint8_t id = b->hist[p + 2], instr = b->hist[p + 4];
-		for (size_t i = 0; i < b->njoints; i++) {
-			struct sim_joint *j = &b->joints[i];
-			if (!j->servo.powered || !sim_bus_baud_matches(b, j->servo.mem[DXL_AX_BAUD_RATE]))
-				continue;
-			uint8_t reply[DXL_MAX_PACKET];
-			int len = sim_servo_handle_bad_checksum(&j->servo, id, instr, reply, sizeof(reply));
-			if (len > 0)
-				bus_send_reply(b, j, reply, (size_t)len, req_end);
-		}
-		return;
-	}
-}
-
-/* ---- Protocol 2.0 ------------------------------------------------------------- */
-
-/* The longest status packet an X servo sends: a READ of its whole table
+/* The longest status packet a servo sends, with room for a fault's changes:
+ * 1.0's largest packet (259 bytes); an X servo's READ of its whole table
  * (148 bytes), stuffed at worst (dxl2_status_bytes_max(148) = 209), with
  * room for a stuck-error fault's re-stuffing. */
-#define BUS_REPLY2_MAX 256
+#define BUS_REPLY_MAX 260
 
-/* Schedule one X servo's status packet: it starts `after` (the request's
+/* A servo hears the bus's protocol only: the configuration gives a bus one
+ * family, a test may not. */
+static bool bus_speaks(const struct sim_bus *b, const struct sim_joint *j)
+{
+	return j->ops->proto == b->proto;
+}
+
+/* Schedule one servo's status packet: it starts `after` (the request's
  * end, or the previous reply's in an ordered answer) plus the servo's return
  * delay, then goes out at the baud rate. Returns when its last byte has left
  * the wire (`after` if nothing went out). */
-static int64_t bus_send_reply2(struct sim_bus *b, struct sim_joint *j, uint8_t *pkt, size_t len, int64_t after)
+static int64_t bus_send_reply(struct sim_bus *b, struct sim_joint *j, uint8_t *pkt, size_t len, int64_t after)
 {
 	uint8_t garbage[SIM_FAULT_MAX_GARBAGE];
 	size_t ngarbage = 0;
 	int64_t extra = 0;
-	sim_faults_apply2(&j->faults, &b->rng, pkt, &len, BUS_REPLY2_MAX, garbage, &ngarbage, &extra);
+	j->ops->reply_faults(j, &b->rng, pkt, &len, BUS_REPLY_MAX, garbage, &ngarbage, &extra);
 	if (len == 0 && ngarbage == 0)
 		return after;
-	int64_t start = after + (int64_t)dxl2_return_delay_us(j->xservo.mem[DXL2_X_RETURN_DELAY_TIME]) * 1000 + extra;
+	int64_t start = after + j->ops->return_delay_ns(j) + extra;
 	int64_t first = start + b->byte_ns;
 	if (ngarbage) {
 		sim_line_put(&b->line, first + b->latency_ns, b->byte_ns, garbage, ngarbage);
@@ -205,45 +149,19 @@ static int64_t bus_send_reply2(struct sim_bus *b, struct sim_joint *j, uint8_t *
 
 struct bus_reply {
 	size_t joint;
-	int rank;
+	int rank;      /* its place among the replies (the protocol's reply_order); -1 none */
 	size_t len;
-	uint8_t bytes[BUS_REPLY2_MAX];
+	uint8_t bytes[BUS_REPLY_MAX];
 };
 
-/* Whether several replies to pkt follow one another instead of colliding:
- * SYNC_READ and BULK_READ answer in the order the request lists the servos,
- * a broadcast PING in the order of their IDs (e-manual, Protocol 2.0). */
-static bool bus_ordered(const struct dxl2_packet *pkt)
+/* Replies of several servos to one request: where the protocol orders them,
+ * in that order, each after the one before it has ended plus its own return
+ * delay; a servo that stays silent leaves no gap (README: the manual does not
+ * say how long the others wait for it). Otherwise every reply starts from the
+ * request's end, and two servos answering one request collide. */
+static void bus_send_replies(struct sim_bus *b, struct bus_reply *r, size_t n, int64_t req_end)
 {
-	return pkt->instr == DXL2_INST_SYNC_READ || pkt->instr == DXL2_INST_BULK_READ ||
-	       (pkt->instr == DXL2_INST_PING && pkt->id == DXL2_BROADCAST_ID);
-}
-
-/* A servo's place among the replies to pkt: its slot in the request's list,
- * or its ID for a broadcast PING. */
-static int bus_rank(const struct dxl2_packet *pkt, uint8_t id)
-{
-	if (pkt->instr == DXL2_INST_SYNC_READ) {
-		for (size_t k = 4; k < pkt->nparams; k++)
-			if (pkt->params[k] == id)
-				return (int)k;
-	} else if (pkt->instr == DXL2_INST_BULK_READ) {
-		for (size_t k = 0; k + 5 <= pkt->nparams; k += 5)
-			if (pkt->params[k] == id)
-				return (int)k;
-	}
-	return id;
-}
-
-/* Replies of several servos to one request: in their order, each after the
- * one before it has ended plus its own return delay. A servo that stays
- * silent leaves no gap (README: the manual does not say how long the others
- * wait for it). Otherwise every reply starts from the request's end, and two
- * servos answering one unicast request (a duplicated ID) collide. */
-static void bus_send_replies2(struct sim_bus *b, const struct dxl2_packet *pkt, struct bus_reply *r, size_t n,
-                              int64_t req_end)
-{
-	bool ordered = bus_ordered(pkt);
+	bool ordered = n > 0 && r[0].rank >= 0;
 	for (size_t i = 1; ordered && i < n; i++)  /* insertion sort: a few replies */
 		for (size_t k = i; k > 0 && r[k - 1].rank > r[k].rank; k--) {
 			struct bus_reply t = r[k];
@@ -252,84 +170,54 @@ static void bus_send_replies2(struct sim_bus *b, const struct dxl2_packet *pkt, 
 		}
 	int64_t t = req_end;
 	for (size_t i = 0; i < n; i++) {
-		int64_t end = bus_send_reply2(b, &b->joints[r[i].joint], r[i].bytes, r[i].len, ordered ? t : req_end);
+		int64_t end = bus_send_reply(b, &b->joints[r[i].joint], r[i].bytes, r[i].len, ordered ? t : req_end);
 		if (ordered)
 			t = end;
 	}
 }
 
-static void bus_dispatch2(struct sim_bus *b, const struct dxl2_packet *pkt, int64_t req_end)
+static void bus_dispatch(struct sim_bus *b, const struct dxl_frame *req, int64_t req_end)
 {
 	struct bus_reply r[SIM_BUS_MAX_SERVOS];
 	size_t n = 0;
 	b->count.packets++;
 	for (size_t i = 0; i < b->njoints; i++) {
 		struct sim_joint *j = &b->joints[i];
-		if (j->ops->protocol != 2 || !j->xservo.powered)
+		if (!bus_speaks(b, j) || !j->ops->powered(j))
 			continue;
 		if (!sim_joint_hears(b, j)) {
 			b->count.wrong_baud++;
 			continue;  /* at another rate the servo sees only framing noise */
 		}
-		uint8_t id = sim_xservo_id(&j->xservo);
-		int len = sim_xservo_handle(&j->xservo, pkt, r[n].bytes, sizeof r[n].bytes);
+		uint8_t id = j->ops->id(j);
+		int len = j->ops->handle(j, req, r[n].bytes, sizeof r[n].bytes);
 		if (len > 0) {
 			r[n].joint = i;
-			r[n].rank = bus_rank(pkt, id);
+			r[n].rank = b->proto->reply_order(req, id);
 			r[n].len = (size_t)len;
 			n++;
 		}
 	}
-	bus_send_replies2(b, pkt, r, n, req_end);
+	bus_send_replies(b, r, n, req_end);
 }
 
-/* The parser dropped a packet for its CRC: find it in the bytes just
- * consumed (header, LEN spanning exactly to here) so the addressed servo can
- * answer with the CRC error. */
-static void bus_bad_crc(struct sim_bus *b, int64_t req_end)
+/* The parser dropped a packet for its checksum: find it in the bytes just
+ * consumed (it ends there) so the addressed servo can answer with its
+ * checksum error. */
+static void bus_bad_checksum(struct sim_bus *b, int64_t req_end)
 {
+	uint8_t id, instr;
 	b->count.checksum_errors++;
-	for (size_t p = b->hist2_n >= 10 ? b->hist2_n - 9 : 0; p-- > 0;) {
-		const uint8_t *h = &b->hist2[p];
-		if (h[0] != 0xFF || h[1] != 0xFF || h[2] != 0xFD || h[3] != 0x00)
-			continue;
-		size_t len = (size_t)h[5] | ((size_t)h[6] << 8);
-		if (p + DXL2_HEADER_BYTES + len != b->hist2_n)
-			continue;
-		for (size_t i = 0; i < b->njoints; i++) {
-			struct sim_joint *j = &b->joints[i];
-			if (j->ops->protocol != 2 || !sim_joint_hears(b, j))
-				continue;
-			uint8_t reply[BUS_REPLY2_MAX];
-			int n = sim_xservo_handle_bad_crc(&j->xservo, h[4], h[7], reply, sizeof(reply));
-			if (n > 0)
-				bus_send_reply2(b, j, reply, (size_t)n, req_end);
-		}
+	if (!b->proto->damaged_packet(b->hist, b->hist_n, &id, &instr))
 		return;
-	}
-}
-
-/* As bus 1.0's loop below: until the parser needs more input. */
-static void bus_feed2(struct sim_bus *b, const uint8_t *data, size_t n, int64_t start)
-{
-	size_t off = 0;
-	for (size_t rounds = 0; rounds < n + DXL2_MAX_PACKET + 1; rounds++) {
-		size_t used = 0;
-		struct dxl2_packet pkt;
-		int r = dxl2_parser_feed(&b->parser2, data + off, n - off, &used, &pkt);
-		hist_push(b->hist2, sizeof(b->hist2), &b->hist2_n, data + off, used);
-		off += used;
-		int64_t end = start + (int64_t)off * b->byte_ns;
-		if (r == DXL_FRAME)
-			bus_dispatch2(b, &pkt, end);
-		else if (r == DXL_E_CHECKSUM)
-			bus_bad_crc(b, end);
-		else if (r == DXL_E_STUFFING)
-			b->count.stuffing_errors++;
-		else if (r < 0)
-			b->count.header_errors++;
-		else
-			break;
+	for (size_t i = 0; i < b->njoints; i++) {
+		struct sim_joint *j = &b->joints[i];
+		if (!bus_speaks(b, j) || !sim_joint_hears(b, j))
+			continue;
+		uint8_t reply[BUS_REPLY_MAX];
+		int n = j->ops->handle_damaged(j, id, instr, reply, sizeof(reply));
+		if (n > 0)
+			bus_send_reply(b, j, reply, (size_t)n, req_end);
 	}
 }
 
@@ -337,12 +225,10 @@ static void bus_feed2(struct sim_bus *b, const uint8_t *data, size_t n, int64_t 
 
 void sim_bus_feed(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now)
 {
-	size_t partial = b->protocol == 2 ? b->parser2.have : b->parser.have;
-	if (partial > 0 && now - b->last_rx > BUS_PACKET_GAP_NS) {
-		if (b->protocol == 2)
-			dxl2_parser_reset(&b->parser2);
-		else
-			dxl_parser_reset(&b->parser);
+	struct dxl_parser_counts pc;
+	b->proto->parser_counts(&b->parser, &pc);
+	if (pc.have > 0 && now - b->last_rx > BUS_PACKET_GAP_NS) {
+		b->proto->parser_reset(&b->parser);
 		b->count.stale_drops++;
 	}
 	b->last_rx = now;
@@ -351,26 +237,23 @@ void sim_bus_feed(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now)
 	b->count.rx_bytes += n;
 	if (b->echo)
 		sim_line_put(&b->line, start + b->byte_ns + b->latency_ns, b->byte_ns, data, n);
-	if (b->protocol == 2) {
-		bus_feed2(b, data, n, start);
-		return;
-	}
 	size_t off = 0;
 	/* Until the parser needs more input, even when all of it is consumed:
 	 * after an error the bytes it still holds may be a whole packet (one
 	 * inside a damaged packet), due now, not at the controller's next byte.
 	 * Each round consumes bytes or drops one buffered byte: bounded. */
-	for (size_t rounds = 0; rounds < n + DXL_MAX_PACKET + 1; rounds++) {
+	for (size_t rounds = 0; rounds < n + b->proto->max_packet + 1; rounds++) {
 		size_t used = 0;
-		struct dxl_packet pkt;
-		int r = dxl_parser_feed(&b->parser, data + off, n - off, &used, &pkt);
+		int r = b->proto->parser_feed(&b->parser, data + off, n - off, &used, &b->frame);
 		bus_hist_push(b, data + off, used);
 		off += used;
 		int64_t end = start + (int64_t)off * b->byte_ns;
 		if (r == DXL_FRAME)
-			bus_dispatch(b, &pkt, end);
+			bus_dispatch(b, &b->frame, end);
 		else if (r == DXL_E_CHECKSUM)
 			bus_bad_checksum(b, end);
+		else if (r == DXL_E_STUFFING)
+			b->count.stuffing_errors++;
 		else if (r < 0)
 			b->count.header_errors++;
 		else
@@ -507,8 +390,7 @@ int sim_bus_open(struct sim_bus *b, char *err, size_t errcap)
 		sim_bus_close(b);
 		return -1;
 	}
-	dxl_parser_reset(&b->parser);
-	dxl2_parser_reset(&b->parser2);
+	b->proto->parser_reset(&b->parser);
 	sim_line_clear(&b->line);
 	return 0;
 }
@@ -528,8 +410,7 @@ void sim_bus_close(struct sim_bus *b)
 	close(b->slave);
 	b->master = b->slave = -1;
 	sim_line_clear(&b->line);
-	dxl_parser_reset(&b->parser);
-	dxl2_parser_reset(&b->parser2);
+	b->proto->parser_reset(&b->parser);
 }
 
 void sim_bus_release(struct sim_bus *b)

@@ -66,19 +66,18 @@ struct sim_bus {
 	int64_t byte_ns;           /* 10 bits a byte at baud */
 	int64_t latency_ns;        /* USB adapter hold time toward the controller */
 	bool echo;                 /* single-wire adapter: the request comes back */
-	int protocol;              /* 1 (AX-12A) or 2 (X series): what the bus speaks */
+	const struct dxl_proto *proto;   /* what the bus speaks: 1.0 (AX-12A) or 2.0 (X series) */
 	int master, slave;         /* -1 when disconnected */
 	int link_lock;             /* the lock on the link (LINK.lock), held from the first open to release; -1 none */
-	struct dxl_parser parser;
-	struct dxl2_parser parser2;
+	union dxl_proto_parser parser;   /* proto's, instruction side */
+	struct dxl_frame frame;          /* the request parsed last */
 	struct sim_line line;
 	int64_t rx_free_at;        /* ns: when the request bytes so far end on the wire */
 	int64_t last_rx;           /* ns: when the last byte came in */
-	/* The last bytes the parser consumed, to find a bad packet's ID. */
-	uint8_t hist[DXL_MAX_PACKET];
+	/* The last bytes the parser consumed, to find a bad packet's ID: the
+	 * longest packet of either protocol. */
+	uint8_t hist[DXL2_MAX_PACKET];
 	size_t hist_n;
-	uint8_t hist2[DXL2_MAX_PACKET];   /* the same on a 2.0 bus */
-	size_t hist2_n;
 	struct sim_joint joints[SIM_BUS_MAX_SERVOS];
 	size_t njoints;
 	uint64_t rng;
@@ -88,8 +87,11 @@ struct sim_bus {
 /* Set up the bus (no I/O): name, link path, baud, latency (s), echo. */
 void sim_bus_init(struct sim_bus *b, const char *name, const char *link, long baud, double latency_s,
                   bool echo, uint64_t seed);
-/* Protocol 2.0 (X-series servos) instead of 1.0: the bus parses and answers
- * 2.0 packets. Its joints must all be X servos (the configuration checks). */
+/* The bus's protocol by number (1 or 2; 1 for anything else): the one
+ * choice of protocol, made when the bus is set up; the bus parses and
+ * answers that protocol's packets through its table (dxl_proto.h) and its
+ * servos through their family's (joint.h). Its joints must all speak it
+ * (the configuration checks). */
 void sim_bus_set_protocol(struct sim_bus *b, int protocol);
 /* The controller now talks at bps (byte time and pacing follow). */
 void sim_bus_set_baud(struct sim_bus *b, long bps);

@@ -552,7 +552,7 @@ static int run_x(const uint8_t *data, size_t size)
 		CHECK(bus.count.checksum_errors == mc.crc_errors);
 		CHECK(bus.count.header_errors == mc.header_errors);
 		CHECK(bus.count.stuffing_errors == mc.stuffing_errors);
-		CHECK(bus.parser2.have == mp.have);
+		CHECK(bus.parser.v2.have == mp.have);
 		for (int k = 0; k < NSERVOS; k++) {
 			const struct sim_xservo *s = &bus.joints[k].xservo;
 			CHECK(memcmp(s->mem, xmodel[k].mem, DXL2_X_TABLE_SIZE) == 0);
@@ -614,7 +614,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 		CHECK(bus.count.packets == mc.frames);
 		CHECK(bus.count.checksum_errors == mc.checksum_errors);
 		CHECK(bus.count.header_errors == mc.header_errors);
-		CHECK(bus.parser.have == mp.have);
+		CHECK(bus.parser.v1.have == mp.have);
 		for (int k = 0; k < NSERVOS; k++) {
 			const struct sim_servo *s = &bus.joints[k].servo;
 			CHECK(memcmp(s->mem, model[k].mem, DXL_AX_TABLE_SIZE) == 0);

@@ -1,6 +1,6 @@
 /*
- * busfake.h — a fake transport for the bus tests (test_protocol_bus.c,
- * test_protocol_bus2.c): an in-memory peer that answers each request with
+ * busfake.h — a fake transport for the bus tests (test_protocol_bus.c, both
+ * protocols): an in-memory peer that answers each request with
  * scripted literal bytes after a scripted delay, and a fake clock that only
  * io->wait advances, so timeouts are checked to the microsecond. Sized for
  * Protocol 2.0's packets (1024 bytes) and a SYNC_READ's replies.

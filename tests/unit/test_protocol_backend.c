@@ -2,7 +2,7 @@
  * test_protocol_backend.c — both protocol tables (dxl_proto.h) driven
  * through the table alone, as the bus drives them. Every expected packet is
  * typed from the manuals (ax12.md's worked examples; the e-manual's
- * Protocol 2.0 page, the rows of test_protocol_packet2.c), never produced by
+ * Protocol 2.0 page, the 2.0 rows of test_protocol_packet.c), never produced by
  * our encoder.
  */
 #include <setjmp.h>

@@ -9,7 +9,7 @@
  *
  * Packets are literal bytes (1.0: checksums computed by hand; 2.0: the
  * e-manual's, or derived by hand with a separate CRC: see
- * test_protocol_packet2.c); the random runs use the encoder only to build
+ * test_protocol_packet.c); the random runs use the encoder only to build
  * streams whose decoding is then compared field by field with what was
  * generated.
  */

@@ -439,10 +439,10 @@ static void test_models(void **state)
 	assert_int_equal(sim_config_robot_protocol(&cfg.robots[3]), 1);
 	assert_int_equal(sim_init(&sim, &cfg, err, sizeof err), 0);
 	/* X buses start at 57600 (the factory Baud Rate 1), the AX-12A's at 1 Mbps */
-	assert_int_equal(sim.buses[0].protocol, 2);
+	assert_int_equal(sim.buses[0].proto->number, 2);
 	assert_int_equal(sim.buses[0].baud, 57600);
 	assert_int_equal(sim.buses[0].joints[0].xservo.mem[DXL2_X_BAUD_RATE], 1);
-	assert_int_equal(sim.buses[3].protocol, 1);
+	assert_int_equal(sim.buses[3].proto->number, 1);
 	assert_int_equal(sim.buses[3].baud, 1000000);
 	assert_int_equal(sim_joint_id(&sim.buses[2].joints[1]), 5);
 	/* each model its own motor line (e-manual, 12 V) */

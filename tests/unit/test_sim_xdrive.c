@@ -37,7 +37,7 @@ static struct sim_joint *rig(const char *model, const char *extra)
 	assert_int_equal(sim_config_load_text(&cfg, "rig", text, strlen(text), err, sizeof err), 0);
 	assert_int_equal(sim_config_finish(&cfg, err, sizeof err), 0);
 	assert_int_equal(sim_init(&sim, &cfg, err, sizeof err), 0);
-	assert_int_equal(sim.buses[0].protocol, 2);
+	assert_int_equal(sim.buses[0].proto->number, 2);
 	return &sim.buses[0].joints[0];
 }
 
