@@ -167,13 +167,18 @@ py_call() {
 	done
 	local IFS=$'\x1f'   # "$*" joins the arguments with it
 	printf '%s\x1f%s\n' "${req%;}" "$*" >&"${!in}"
+	# The whole reply first, then print it: a reader that stops early (`| grep -q`)
+	# must not leave the rest in the FIFO for the next call.
+	local -a o=() e=()
 	while IFS= read -r line <&"${!out}"; do
 		case $line in
-		"o "*) printf '%s\n' "${line:2}" ;;
-		"e "*) printf '%s\n' "${line:2}" >&2 ;;
+		"o "*) o+=("${line:2}") ;;
+		"e "*) e+=("${line:2}") ;;
 		"x "*) rc=${line:2}; break ;;
 		esac
 	done
+	[ ${#e[@]} -eq 0 ] || printf '%s\n' "${e[@]}" >&2
+	[ ${#o[@]} -eq 0 ] || printf '%s\n' "${o[@]}"
 	[ -n "$rc" ] && return "$rc"
 	echo "py_call: the $name interpreter is gone: $(tail -n 5 "$T/py_$name.err")" >&2
 	return 1
@@ -195,13 +200,26 @@ lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }
 #                         published N cycles (its counter starts at 0 again, and
 #                         the watcher may still print the old one's last states)
 #   events                robot $R's EVENT lines
+#   event / state_is REGEX [TIMEOUT_S]  wait until an EVENT / the last STATE matches
 ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 states() { grep -a "^STATE $R " "$T/watch.log"; }
-last_state() { states | tail -1; }
-cycle_at_least() { [ "$(last_state | field cycle)" -ge "$1" ] 2>/dev/null; }
+# The watcher prints 100 lines a second, and these run in every poll: read
+# the log from its end (tac), not all of it each time.
+last_state() { tac "$T/watch.log" 2>/dev/null | grep -a -m1 "^STATE $R "; }
+cycle_at_least() {
+	local c
+	c=$(tac "$T/watch.log" 2>/dev/null | awk -v r="$R" '$1 == "STATE" && $2 == r { sub("cycle=", "", $3); print $3 + 0; exit }')
+	[ "${c:-0}" -ge "$1" ] 2>/dev/null
+}
 wait_cycles() { local c; c=$(last_state | field cycle); wait_for 10 cycle_at_least $((${c:-0} + $1)); }
 events() { grep -a "^EVENT $R " "$T/watch.log"; }
+# event REGEX [TIMEOUT_S]: wait (default 5 s) until one of $R's EVENT lines matches;
+# state_is REGEX [TIMEOUT_S]: until its last STATE line matches
+_event_has() { events | grep -qE "$1"; }
+_state_has() { last_state | grep -qE "$1"; }
+event() { wait_for "${2:-5}" _event_has "$1"; }
+state_is() { wait_for "${2:-5}" _state_has "$1"; }
 _mark=0
 mark_states() { _mark=$(states | wc -l); }
 restarted_at_least() {
@@ -261,6 +279,23 @@ run_diag() {
 		"$d/bus.csv" | sort
 	return 0
 }
+
+# run_wait NAME TIMEOUT_S: wait for a spawned scripts/demo.sh run NAME (its
+# --out in $T/NAME) to end, stopped if it overran; its exit status in $run_rc.
+# Returns 0 when it ran and was analysed, 2 when another program published on
+# its LCM URL (its results would mix two runs), 1 otherwise.
+run_rc=
+_gone() { ! kill -0 "$1" 2>/dev/null; }
+run_wait() {
+	local var="pid_${1//[^A-Za-z0-9_]/_}"
+	wait_for "$2" _gone "${!var}"
+	kill -TERM "${!var}" 2>/dev/null   # only if it overran
+	run_rc=0
+	wait "${!var}" || run_rc=$?
+	[ -f "$T/$1/crosstalk" ] && return 2
+	[ "$run_rc" = 0 ] && [ -f "$T/$1/summary.txt" ]
+}
+CROSSTALK="another program published on the run's LCM URL; its results mix two runs"
 
 # An end-to-end experiment (e2e_pair, e2e_row) asserts the paper's regimes
 # twice: in lockstep, where the outcome is the same on any machine, and in
