@@ -216,7 +216,7 @@ wait_cycles() { local c; c=$(last_state | field cycle); wait_for 10 cycle_at_lea
 events() { grep -a "^EVENT $R " "$T/watch.log"; }
 # event REGEX [TIMEOUT_S]: wait (default 5 s) until one of $R's EVENT lines matches;
 # state_is REGEX [TIMEOUT_S]: until its last STATE line matches
-_event_has() { events | grep -qE "$1"; }
+_event_has() { grep -qaE "^EVENT $R .*$1" "$T/watch.log"; }   # one process a poll
 _state_has() { last_state | grep -qE "$1"; }
 event() { wait_for "${2:-5}" _event_has "$1"; }
 state_is() { wait_for "${2:-5}" _state_has "$1"; }
@@ -227,6 +227,32 @@ restarted_at_least() {
 		END { exit !(low && last >= n) }'
 }
 wait_restarted() { wait_for 10 restarted_at_least "$1"; }
+
+# ---- a raw client on a simulated bus (the sim_* tests) --------------------------------------
+# pkt ID INSTR|ERR PARAM...: a Protocol 1.0 packet in hex with its checksum
+# (instruction and status packets share the layout); written here, not by
+# our encoder (a symmetric bug would pass), and in the shell without a
+# subshell: a test builds hundreds.
+pkt() {
+	local id=$(($1)) code=$(($2)) p sum out
+	shift 2
+	sum=$(( id + $# + 2 + code ))
+	printf -v out 'FFFF%02X%02X%02X' "$id" $(( $# + 2 )) "$code"
+	for p; do p=$((p)); sum=$(( sum + p )); printf -v out '%s%02X' "$out" "$p"; done
+	printf '%s%02X\n' "$out" $(( ~sum & 0xFF ))
+}
+status() { pkt "$@"; }
+# expect_reply NAME REQUEST WANT / expect_silence NAME REQUEST: one exchange
+# through the script's own `xfer HEX TIMEOUT_MS [EXPECT_BYTES]`, which sets
+# $reply (the reply in hex, "-" for none).
+expect_reply() {
+	xfer "$2" 300 $(( ${#3} / 2 ))
+	if [ "$reply" = "$3" ]; then tap_ok "$1"; else tap_fail "$1" "sent $2, want $3, got $reply"; fi
+}
+expect_silence() {
+	xfer "$2" 30
+	if [ "$reply" = "-" ]; then tap_ok "$1"; else tap_fail "$1" "sent $2, want no reply, got $reply"; fi
+}
 
 # ---- reading an experiment's analysis (scripts/demo.sh --out DIR) -------------------
 # min_swing DIR: the smallest peak-to-peak angle (rad) of any robot's joint

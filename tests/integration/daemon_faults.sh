@@ -12,7 +12,6 @@ fi
 # multicast port (another build directory) cannot answer for it
 R="u$$"
 URL=$(lcm_url 7701)
-event() { wait_for "${2:-5}" grep -qE "^EVENT $R .*$1" "$T/watch.log"; }
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
@@ -38,7 +37,7 @@ r=$(ctl fault r1 2 stuck-error overload)
 [ "${r%% *}" = ok ] || tap_fail "inject overload" "$r"
 if event 'kind=fault text="servo 2: overload: backing off'; then tap_ok "overload reported as a fault event"
 else tap_fail "fault event" "$(grep EVENT "$T/watch.log" | tail -3)"; fi
-if wait_for 3 sh -c "grep '^STATE $R ' '$T/watch.log' | tail -1 | grep -q ' e1=32 '"; then
+if wait_for 3 _state_has ' e1=32 '; then
 	tap_ok "error bits published in robot_state_t (e1=32)"; else tap_fail "error bits published" "$(last_state | cut -c1-300)"; fi
 # backing off: the joint holds where it is (the servo's alarm shutdown has
 # zeroed its torque limit meanwhile, as on a real AX-12)
@@ -59,7 +58,7 @@ ctl fault r1 1 stuck-error overheating >/dev/null
 if event 'kind=fault-persistent text="servo 1: overheating persists after 3 recovery attempts: robot LIMP' 10; then
 	tap_ok "persistent fault reported after bounded retries"
 else tap_fail "persistent fault" "$(grep EVENT "$T/watch.log" | tail -4)"; fi
-if wait_for 3 sh -c "grep '^STATE $R ' '$T/watch.log' | tail -1 | grep -q ' mode=0 reason=\"fault: servo 1 overheating persists\"'"; then
+if wait_for 3 _state_has ' mode=0 reason="fault: servo 1 overheating persists"'; then
 	tap_ok "robot LIMP with the fault as its mode reason"; else tap_fail "robot LIMP" "$(last_state | cut -c1-160)"; fi
 t1=$(ctl peek r1 1 torque_enable); t2=$(ctl peek r1 2 torque_enable)
 if [ "$t1" = "ok 0" ] && [ "$t2" = "ok 0" ]; then tap_ok "torque off on both servos"; else
@@ -75,7 +74,7 @@ if [ $rc -eq 1 ] && echo "$out" | grep -q "fault latched (servo 1 overheating pe
 	tap_ok "HOLD refused while the fault is latched"; else tap_fail "HOLD refused while latched" "rc $rc $out"; fi
 "$D" --command clear --robot "$R" --lcm-url "$URL" --timeout 2 >/dev/null
 out=$("$D" --command "mode hold" --robot "$R" --lcm-url "$URL" --timeout 2); rc=$?
-if [ $rc -eq 0 ] && wait_for 3 sh -c "grep '^STATE $R ' '$T/watch.log' | tail -1 | grep -q ' mode=1 .* tq0=1 .* tq1=1 '"; then
+if [ $rc -eq 0 ] && wait_for 3 _state_has ' mode=1 .* tq0=1 .* tq1=1 '; then
 	tap_ok "HOLD by command after the fault: torque back on"; else tap_fail "HOLD after fault" "rc $rc $out; $(last_state | cut -c1-200)"; fi
 if alive d; then tap_ok "daemon alive throughout"; else tap_fail "daemon alive"; fi
 tap_done

@@ -110,7 +110,7 @@ reject "param bogus 1" "unknown parameter 'bogus'"
 reject "kind 9" "unknown command kind 9"
 out=$("$D" --command "mode hold" --robot "x$R" --lcm-url "$URL" --timeout 0.5); rc=$?
 if [ $rc -eq 1 ]; then tap_ok "a command for another robot is not answered"; else tap_fail "other robot" "$out"; fi
-wait_for 3 sh -c "grep '^STATE $R ' '$T/watch.log' | tail -1 | grep -q ' bad_commands=6 '"
+wait_for 3 _state_has ' bad_commands=6 '
 if last_state | grep -q ' bad_commands=6 '; then tap_ok "6 rejected commands counted in robot_state_t"; else
 	tap_fail "bad_commands counted" "$(last_state | cut -c1-200)"; fi
 if grep -q 'command .* rejected: unknown mode 7' "$T/d.log"; then tap_ok "rejection logged"; else

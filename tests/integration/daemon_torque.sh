@@ -18,7 +18,6 @@ if [ ! -x "$S" ] || [ ! -x "$D" ]; then
 fi
 R="t$$"
 URL=$(lcm_url 7704)
-event() { wait_for "${2:-5}" grep -qE "^EVENT $R .*$1" "$T/watch.log"; }
 peek() { local v; v=$(ctl peek r1 "$1" "$2"); echo "${v#ok }"; }
 num() { awk "BEGIN { exit !($*) }"; }
 
@@ -115,7 +114,7 @@ spawn d2 "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold 
 wait_log d2 "ready: $R.STATE" 10 || { tap_fail "daemon with +-0.6 rad starts" "$(cat "$T/d2.log")"; tap_done; exit 1; }
 cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2 >/dev/null; }
 # reads VOLTS: the daemon publishes the supply as read (v0, one decimal)
-reads() { wait_for 5 sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -q ' v0=$1 '"; }
+reads() { wait_for 5 _state_has " v0=$1 "; }
 # widest_since N: the farthest the published angle got from neutral after line N
 widest_since() { grep -a "^STATE $R " "$T/watch.log" | tail -n +"$1" | field a0 |
 	awk '{ a = $1 < 0 ? -$1 : $1; if (a > m) m = a } END { printf "%.4f", m }'; }
@@ -125,7 +124,7 @@ for v in 1.5 0.0 25.0; do
 	from=$(grep -ac "^STATE $R " "$T/watch.log")
 	cmd 'mode oscillator'
 	if event "kind=supply text=\"servo 1 reads its supply as $v V, outside the AX-12A's 8.55..12.60 V" 5 &&
-		wait_for 5 sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -q 'mode=1 .*fault=\"servo 1 reads its supply as $v V'"; then
+		wait_for 5 _state_has "mode=1 .*fault=\"servo 1 reads its supply as $v V"; then
 		sleep_until 1
 		w=$(widest_since "$from"); lim="$(peek 1 cw_angle_limit)/$(peek 1 ccw_angle_limit)"
 		if num "$w <= 0.6" && [ "$lim" != 0/0 ]; then

@@ -16,8 +16,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
 URL=$(lcm_url 7730)
 R="dx$$"
-event() { wait_for "${2:-5}" sh -c "grep -a '^EVENT $R ' '$T/watch.log' | grep -qE '$1'"; }
-state_is() { wait_for "${2:-5}" sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -qE '$1'"; }
 cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2; }
 peek() { local v; v=$(ctl peek "$1" "$2" "$3"); echo "${v#ok }"; }
 swing() {   # peak-to-peak of joint $1's angle over the last $2 states

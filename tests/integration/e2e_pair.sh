@@ -65,14 +65,10 @@ if realtime_part; then
 	run compat $((port + 1)) 0.3 0,2.0
 	run anti $((port + 2)) 0.7 0,3.1416
 	for name in inphase compat anti; do
-		var="pid_$name"
-		wait_for $((seconds + 60)) bash -c "! kill -0 ${!var}"
-		kill -TERM "${!var}" 2>/dev/null  # only if it overran
-		wait "${!var}"
-		rc=$?
-		if [ -f "$T/$name/crosstalk" ]; then
-			tap_fail "$name: nobody else on its LCM port" "another program published on the run's LCM URL; its results mix two runs"
-		elif [ "$rc" = 0 ] && [ -f "$T/$name/summary.txt" ]; then
+		run_wait "$name" $((seconds + 60)); ran=$?
+		if [ "$ran" = 2 ]; then
+			tap_fail "$name: nobody else on its LCM port" "$CROSSTALK"
+		elif [ "$ran" = 0 ]; then
 			tap_ok "$name: rig ran ${seconds} s through sim + 2 daemons, log analysed"
 			sw=$(min_swing "$T/$name")
 			if num "${sw%% *} >= $MIN_SWING"; then
@@ -82,7 +78,7 @@ if realtime_part; then
 				tap_fail "$name: both robots still swing at the end" "smallest peak-to-peak over the last 10 s: $sw rad (< $MIN_SWING): a stopped pair proves nothing"
 			fi
 		else
-			tap_fail "$name: rig ran ${seconds} s through sim + 2 daemons, log analysed" "exit $rc: $(tail -n 20 "$T/$name.log")"
+			tap_fail "$name: rig ran ${seconds} s through sim + 2 daemons, log analysed" "exit $run_rc: $(tail -n 20 "$T/$name.log")"
 		fi
 	done
 fi

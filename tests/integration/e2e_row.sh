@@ -58,14 +58,10 @@ if realtime_part; then
 	run mobile mobile 11 $((port + 1))
 	run mobile_b mobile 12 $((port + 2))
 	for name in immobile mobile mobile_b; do
-		var="pid_$name"
-		wait_for $((seconds + 60)) bash -c "! kill -0 ${!var}"
-		kill -TERM "${!var}" 2>/dev/null  # only if it overran
-		wait "${!var}"
-		rc=$?
-		if [ -f "$T/$name/crosstalk" ]; then
-			tap_fail "$name row: nobody else on its LCM port" "another program published on the run's LCM URL; its results mix two runs"
-		elif [ "$rc" = 0 ] && [ -f "$T/$name/summary.txt" ]; then
+		run_wait "$name" $((seconds + 60)); ran=$?
+		if [ "$ran" = 2 ]; then
+			tap_fail "$name row: nobody else on its LCM port" "$CROSSTALK"
+		elif [ "$ran" = 0 ]; then
 			tap_ok "$name row: ${seconds} s through sim + 5 daemons, log analysed"
 			# the switch is one command to every robot; a robot left on the clock
 			# would keep colliding whatever its base does
@@ -83,7 +79,7 @@ if realtime_part; then
 				tap_fail "$name row: every robot still swings at the end" "smallest peak-to-peak over the last 10 s: $sw rad (< $MIN_SWING)"
 			fi
 		else
-			tap_fail "$name row: ${seconds} s through sim + 5 daemons, log analysed" "exit $rc: $(tail -n 20 "$T/$name.log")"
+			tap_fail "$name row: ${seconds} s through sim + 5 daemons, log analysed" "exit $run_rc: $(tail -n 20 "$T/$name.log")"
 		fi
 	done
 fi

@@ -17,8 +17,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; exit 0; fi
 URL=$(lcm_url 7711)
 R="ss$$"
-event() { wait_for "${2:-5}" sh -c "grep -a '^EVENT $R ' '$T/watch.log' | grep -qE '$1'"; }
-state_is() { wait_for "${2:-5}" sh -c "grep -a '^STATE $R ' '$T/watch.log' | tail -1 | grep -qE '$1'"; }
 cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2; }
 torque() { local a b; a=$(ctl peek r1 1 torque_enable); b=$(ctl peek r1 2 torque_enable); echo "${a#ok } ${b#ok }"; }
 

@@ -20,17 +20,6 @@ ctl_ok() {  # NAME COMMAND
 	local r; r=$(ctl "$2")
 	case "$r" in ok*) tap_ok "$1";; *) tap_fail "$1" "'$2' -> $r";; esac
 }
-# pkt ID INSTR|ERR PARAM...: a packet in hex with its checksum (instruction and
-# status packets share the layout); done in the shell, it is called often.
-pkt() {
-	local id=$(($1)) code=$(($2)); shift 2
-	local len=$(( $# + 2 )) sum out p
-	sum=$(( id + len + code ))
-	out=$(printf 'FFFF%02X%02X%02X' "$id" "$len" "$code")
-	for p; do p=$((p)); sum=$(( sum + p )); out+=$(printf '%02X' "$p"); done
-	printf '%s%02X\n' "$out" $(( ~sum & 0xFF ))
-}
-status() { pkt "$@"; }
 PING1=FFFF010201FB
 PING2=FFFF020201FA
 OK1=FFFF010200FC

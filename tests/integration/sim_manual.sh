@@ -35,25 +35,6 @@ wait_log sim 'ready:' 5 || { tap_fail "sim ready" "$(cat "$T/sim.log")"; tap_don
 
 xfer() { read -r reply rtt < <($C xfer "$link" "$@"); }
 ctl() { $C ctl "$T/ctl" "$1"; }
-expect_reply() {  # NAME REQUEST WANT
-	xfer "$2" 300 $(( ${#3} / 2 ))
-	if [ "$reply" = "$3" ]; then tap_ok "$1"; else tap_fail "$1" "sent $2, want $3, got $reply"; fi
-}
-expect_silence() {  # NAME REQUEST
-	xfer "$2" 30
-	if [ "$reply" = "-" ]; then tap_ok "$1"; else tap_fail "$1" "sent $2, want no reply, got $reply"; fi
-}
-# pkt ID INSTR|ERR PARAM...: a packet in hex with its checksum (instruction and
-# status packets share the layout).
-pkt() {
-	local id=$(($1)) code=$(($2)); shift 2
-	local len=$(( $# + 2 )) sum out p
-	sum=$(( id + len + code ))
-	out=$(printf 'FFFF%02X%02X%02X' "$id" "$len" "$code")
-	for p; do p=$((p)); sum=$(( sum + p )); out+=$(printf '%02X' "$p"); done
-	printf '%s%02X\n' "$out" $(( ~sum & 0xFF ))
-}
-status() { pkt "$@"; }
 # expect_regs NAME ID ADDR BYTE...: READ(ADDR, n) of servo ID answers BYTE...
 expect_regs() {
 	local name=$1 id=$2 addr=$3; shift 3

@@ -23,25 +23,6 @@ tap_check "link is a symlink to a pty" test -L "$link" -a -c "$(readlink "$link"
 
 # xfer HEX [timeout_ms] [expect_bytes] -> $reply, $rtt
 xfer() { read -r reply rtt < <($C xfer "$link" "$@"); }
-expect_reply() {  # NAME REQUEST WANT
-	xfer "$2" 300 $(( ${#3} / 2 ))
-	if [ "$reply" = "$3" ]; then tap_ok "$1"; else tap_fail "$1" "sent $2, want $3, got $reply"; fi
-}
-expect_silence() {  # NAME REQUEST
-	xfer "$2" 30
-	if [ "$reply" = "-" ]; then tap_ok "$1"; else tap_fail "$1" "sent $2, want no reply, got $reply"; fi
-}
-# pkt ID INSTR|ERR PARAM...: a packet in hex with its checksum (instruction and
-# status packets share the layout); done in the shell, it is called often.
-pkt() {
-	local id=$(($1)) code=$(($2)); shift 2
-	local len=$(( $# + 2 )) sum out p
-	sum=$(( id + len + code ))
-	out=$(printf 'FFFF%02X%02X%02X' "$id" "$len" "$code")
-	for p; do p=$((p)); sum=$(( sum + p )); out+=$(printf '%02X' "$p"); done
-	printf '%s%02X\n' "$out" $(( ~sum & 0xFF ))
-}
-status() { pkt "$@"; }
 
 # ---- the manual's examples, byte for byte --------------------------------------
 expect_reply "golden PING id 1" FFFF010201FB FFFF010200FC

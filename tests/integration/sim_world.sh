@@ -28,16 +28,6 @@ else tap_fail "pair scenario ready" "$(cat "$T/sim.log")"; tap_done; exit; fi
 
 # a reply is waited for up to 300 ms (done as soon as the expected bytes are in)
 xfer() { read -r reply rtt < <($C xfer "$T/links/$1" "$2" $([ -n "${3:-}" ] && echo 300 || echo 40) "${3:-}"); }
-# pkt ID INSTR|ERR PARAM...: a packet in hex with its checksum (instruction and
-# status packets share the layout); done in the shell, it is called often.
-pkt() {
-	local id=$(($1)) code=$(($2)); shift 2
-	local len=$(( $# + 2 )) sum out p
-	sum=$(( id + len + code ))
-	out=$(printf 'FFFF%02X%02X%02X' "$id" "$len" "$code")
-	for p; do p=$((p)); sum=$(( sum + p )); out+=$(printf '%02X' "$p"); done
-	printf '%s%02X\n' "$out" $(( ~sum & 0xFF ))
-}
 
 # Left swings to +0.6 rad (towards the right), right to −0.6 rad (towards the
 # left): at d̃ = 0.2 the bodies meet on the way.
