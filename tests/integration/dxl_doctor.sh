@@ -55,9 +55,10 @@ if sim_up clean 7760 --return-delay 0 --control "$T/ctl"; then
 	# the period. The timed cycles share the machine with whatever else runs:
 	# beside CPU-bound work (make test-busy) the simulator's replies came late
 	# and 10-15 of 664 transactions timed out, run after run — the doctor said
-	# so (budget WARN, exit 1), and rightly: that bus was not clean then. So the
-	# budget is OK, or a WARN whose only cause is failed transactions below the
-	# FAIL share (printed); any other verdict fails.
+	# so (budget WARN, exit 1), and rightly: that bus was not clean then; at
+	# load 20 cycles were cut off by the next tick as well. So the budget is
+	# OK, or a WARN whose only causes are failed transactions below the FAIL
+	# share and cycles cut off (printed); any other verdict fails.
 	doctor clean --config "$T/clean.conf"
 	budget_ok() {
 		line clean "$1" budget 'p50 [0-9.]+ / p99 [0-9.]+ / max [0-9.]+ ms' && line clean "$1" budget 'wire floor [0-9.]+ ms' \
@@ -66,9 +67,12 @@ if sim_up clean 7760 --return-delay 0 --control "$T/ctl"; then
 	if budget_ok OK && [ "$rc" -eq 0 ]; then
 		tap_ok "clean bus: the budget line gives p50/p99/max, the wire floor and the period (OK)"
 	elif budget_ok WARN && [ "$rc" -eq 1 ] && [ "$(grep -cE '^(WARN|FAIL) ' "$T/clean.out")" = 1 ] &&
-		grep -qE '^WARN +budget .*: [0-9]+ of [0-9]+ transactions failed, 0 cycle\(s\) cut off' "$T/clean.out"; then
-		echo "# the timed cycles saw failed transactions on this machine: $(grep -oE '[0-9]+ of [0-9]+ transactions failed' "$T/clean.out")"
-		tap_ok "clean bus: the budget line gives p50/p99/max, the wire floor and the period (WARN: failed transactions on a busy machine)"
+		grep -qE '^WARN +budget .*: [0-9]+ of [0-9]+ transactions failed, [0-9]+ cycle\(s\) cut off' "$T/clean.out"; then
+		# a busy machine delays the simulated servos' replies and the loop's
+		# ticks alike: failed transactions and cycles cut off by the next tick
+		# are what the doctor must say then (a WARN, never a FAIL here)
+		echo "# the timed cycles met a busy machine: $(grep -oE '[0-9]+ of [0-9]+ transactions failed, [0-9]+ cycle\(s\) cut off' "$T/clean.out")"
+		tap_ok "clean bus: the budget line gives p50/p99/max, the wire floor and the period (WARN: a busy machine)"
 	else
 		tap_fail "clean bus: the budget line gives p50/p99/max, the wire floor and the period" "$(show clean)"
 	fi
