@@ -191,6 +191,7 @@ lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }
 # For scripts that run `undulated --watch $R` into $T/watch.log and a simulator
 # with its control socket at $T/ctl (a script may define its own to replace one):
 #   ctl CMD...            one command to the simulator; prints its answer line
+#   cmd COMMAND [OPT...]  one command to the robot $R over $URL; prints the answers
 #   field NAME            the value of NAME=... in the line on stdin
 #   states / last_state   robot $R's STATE lines / the last one
 #   cycle_at_least N      its last published cycle is >= N
@@ -202,6 +203,8 @@ lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }
 #   events                robot $R's EVENT lines
 #   event / state_is REGEX [TIMEOUT_S]  wait until an EVENT / the last STATE matches
 ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
+# cmd COMMAND [OPTION...]: one command to robot $R over $URL (undulated --command)
+cmd() { "$B/undulated" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2 "${@:2}"; }
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 states() { grep -a "^STATE $R " "$T/watch.log"; }
 # The watcher prints 100 lines a second, and these run in every poll: read
@@ -227,6 +230,21 @@ restarted_at_least() {
 		END { exit !(low && last >= n) }'
 }
 wait_restarted() { wait_for 10 restarted_at_least "$1"; }
+
+# start_pair: the simulated pair (sim-bridge/scenarios/pair.scenario, links
+# $T/left and $T/right) on $URL with a daemon each on the oscillator and
+# a watcher of left ($T/watch.log); ends the test when they do not start.
+start_pair() {
+	spawn sim "$B/undulate-sim" --scenario "$top/sim-bridge/scenarios/pair.scenario" --link-dir "$T" --lcm-url "$URL" --seed 5
+	wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
+	spawn watch "$B/undulated" --watch left --lcm-url "$URL"
+	local r
+	for r in left right; do
+		spawn "d_$r" "$B/undulated" --port "$T/$r" --ids 1 --robot "$r" --lcm-url "$URL" --mode oscillator
+	done
+	wait_log d_left 'ready:' 10 && wait_log d_right 'ready:' 10 ||
+		{ tap_fail "daemons ready" "$(cat "$T/d_left.log" "$T/d_right.log")"; tap_done; exit 1; }
+}
 
 # ---- a raw client on a simulated bus (the sim_* tests) --------------------------------------
 # pkt ID INSTR|ERR PARAM...: a Protocol 1.0 packet in hex with its checksum

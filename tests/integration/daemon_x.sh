@@ -16,7 +16,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
 URL=$(lcm_url 7730)
 R="dx$$"
-cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2; }
 peek() { local v; v=$(ctl peek "$1" "$2" "$3"); echo "${v#ok }"; }
 swing() {   # peak-to-peak of joint $1's angle over the last $2 states
 	states | tail -"$2" | awk -v k="a$1=" '{ for (i = 1; i <= NF; i++) if (index($i, k) == 1) { v = substr($i, 4) + 0

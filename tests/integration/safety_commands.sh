@@ -19,7 +19,6 @@ PORT=$(lcm_port 7710)
 URL=$(lcm_url 7710)
 R="sc$$"
 LIM=1.3
-cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2 "${@:2}"; }
 
 KEY="$T/command.key"
 "$D" --gen-key "$KEY" >/dev/null || { tap_fail "command key made" "undulated --gen-key failed"; tap_done; exit 1; }

@@ -17,7 +17,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; exit 0; fi
 URL=$(lcm_url 7711)
 R="ss$$"
-cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2; }
 torque() { local a b; a=$(ctl peek r1 1 torque_enable); b=$(ctl peek r1 2 torque_enable); echo "${a#ok } ${b#ok }"; }
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 6 --return-delay 0

@@ -24,14 +24,7 @@ ATK="$(dirname "$0")/web_attack.py" Q="$(dirname "$0")/qa_lcm.py"
 for t in curl jq python3; do command -v $t >/dev/null || tap_skip_all "$t missing"; done
 URL=$(lcm_url 7792) LPORT=$(lcm_port 7792)
 
-spawn sim "$S" --scenario "$top/sim-bridge/scenarios/pair.scenario" --link-dir "$T" --lcm-url "$URL" --seed 5
-wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch left --lcm-url "$URL"
-for r in left right; do
-	spawn "d_$r" "$D" --port "$T/$r" --ids 1 --robot "$r" --lcm-url "$URL" --mode oscillator
-done
-wait_log d_left 'ready:' 10 && wait_log d_right 'ready:' 10 ||
-	{ tap_fail "daemons ready" "$(cat "$T/d_left.log" "$T/d_right.log")"; tap_done; exit 1; }
+start_pair
 
 spawn web "$W" --listen 127.0.0.1:0 --lcm-url "$URL"
 wait_log web 'listening on http://' 10 || { tap_fail "undulate-web listening" "$(cat "$T/web.log")"; tap_done; exit 1; }

@@ -21,7 +21,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
 URL=$(lcm_url 7731)
 R="sx$$"
-cmd() { "$D" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2; }
 peek() { local v; v=$(ctl peek r1 "$1" "$2"); echo "${v#ok }"; }
 torque() { echo "$(peek 1 torque_enable) $(peek 2 torque_enable)"; }
 swing() {   # peak-to-peak of joint $1's angle over the last $2 states (150)
