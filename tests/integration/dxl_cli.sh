@@ -37,7 +37,7 @@ run noargs
 	&& tap_ok "no command: usage on stderr, exit 2" || tap_fail "no command: usage on stderr, exit 2" "rc=$rc"
 
 run ping --port "$bus" ping 1
-[ "$rc" -eq 0 ] && grep -q '^ID 1 answered in [0-9]* us: model 12 (AX-12), firmware 24$' "$T/ping.out" \
+[ "$rc" -eq 0 ] && grep -q '^ID 1 answered in [0-9]* us: model 12 (AX-12A), firmware 24, Protocol 1.0$' "$T/ping.out" \
 	&& tap_ok "ping 1" || tap_fail "ping 1" "rc=$rc $(cat "$T/ping.out" "$T/ping.err")"
 
 run temp --port "$bus" read 1 present_temperature

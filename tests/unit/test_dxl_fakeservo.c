@@ -461,7 +461,7 @@ static void test_dxl_ping_and_scan(void **state)
 
 	assert_int_equal(run_dxl(f, "ping", "2", NULL), 0);
 	assert_non_null(strstr(f->out, "ID 2 answered"));
-	assert_non_null(strstr(f->out, "model 12 (AX-12), firmware 24"));
+	assert_non_null(strstr(f->out, "model 12 (AX-12A), firmware 24, Protocol 1.0"));
 	assert_int_equal(run_dxl(f, "scan", "--ids", "0-5", NULL), 0);
 	/* header + exactly the two servos, with model, firmware, baud */
 	assert_non_null(strstr(f->out, "\n1    12     AX-12         24        1000000  1.0\n"));

@@ -48,7 +48,7 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 	return rc == DXLT_EXIT_OK ? DXLT_EXIT_SERVO : rc;
 }
 
-static int dxlt_arg_reg(struct dxlt *t, const char *s, const struct dxl_reg **reg)
+static int dxlt_ax_arg_reg(struct dxlt *t, const char *s, const struct dxl_reg **reg)
 {
 	*reg = dxl_reg_lookup(s);
 	if (*reg != NULL)
@@ -183,7 +183,7 @@ static const struct dxlt_family dxlt_families[] = {
 	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
 	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
 	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
-	  .settle_us = 20000, .eeprom_needs_torque_off = true,
+	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true,
 	  .no_rate = "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, 3000000, "
 	             "4000000, 4500000)\n",
 	  .reset_form = "reset ID --yes [--keep id|id-baud]",
@@ -242,56 +242,7 @@ static int dxlt_cmd_scan(struct dxlt *t)
 	return DXLT_EXIT_OK;
 }
 
-static int dxlt_cmd_ping(struct dxlt *t)
-{
-	uint8_t id, raw[2], fw = 0;
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 1, "ping ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
-		return rc;
-	int r = dxlt_ping(t, id);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	uint32_t rtt = t->bus.servo[id].rtt_last_us;
-	fprintf(t->out, "ID %u answered in %u us", id, (unsigned)rtt);
-	if (dxlt_read(t, id, DXL_AX_MODEL_NUMBER, 2, raw) == DXL_OK)
-		fprintf(t->out, ": model %u (%s)", dxl_get_u16(raw), dxlt_model_name(dxl_get_u16(raw)));
-	else
-		fprintf(t->out, ": answers PING only (status return level 0)");
-	if (dxlt_read(t, id, DXL_AX_FIRMWARE_VERSION, 1, &fw) == DXL_OK)
-		fprintf(t->out, ", firmware %u", fw);
-	fputc('\n', t->out);
-	return DXLT_EXIT_OK;
-}
-
 /* ---- read / write / dump ------------------------------------------------------ */
-
-static int dxlt_cmd_read(struct dxlt *t)
-{
-	const struct dxl_reg *reg;
-	uint8_t id;
-	uint16_t v;
-	char text[96];
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 2, "read ID REG [--units]")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)) || (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)))
-		return rc;
-	int r = dxlt_read_reg(t, id, reg, &v);
-	if (r == DXL_E_TIMEOUT && dxlt_ping(t, id) == DXL_OK) {
-		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0 "
-		        "(raise it: dxl --port %s write %u status_return_level 2)\n", id,
-		        port_path(t->port), id);
-		return DXLT_EXIT_BUS;
-	}
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (t->a.units)
-		fprintf(t->out, "%s\n", dxl_reg_format(reg, v, text, sizeof text));
-	else
-		fprintf(t->out, "%u\n", v);
-	return DXLT_EXIT_OK;
-}
 
 static int dxlt_check_value(struct dxlt *t, const struct dxl_reg *reg, const char *s, uint16_t *v)
 {
@@ -412,7 +363,7 @@ static int dxlt_cmd_write(struct dxlt *t)
 
 	if ((rc = dxlt_need_args(t, 3, "write ID REG VALUE")) ||
 	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)) ||
-	    (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)) || (rc = dxlt_check_value(t, reg, t->a.pos[2], &v)))
+	    (rc = dxlt_ax_arg_reg(t, t->a.pos[1], &reg)) || (rc = dxlt_check_value(t, reg, t->a.pos[2], &v)))
 		return rc;
 	/* After a new ID or baud the servo answers elsewhere: only the commands
 	 * made for it know where to look for the answer. */
@@ -422,29 +373,6 @@ static int dxlt_cmd_write(struct dxlt *t)
 		return DXLT_EXIT_USAGE;
 	}
 	return dxlt_write_checked(t, id, reg, v);
-}
-
-static int dxlt_cmd_dump(struct dxlt *t)
-{
-	uint8_t id;
-	uint8_t mem[DXL_AX_TABLE_SIZE];
-	char text[96];
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 1, "dump ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
-		return rc;
-	int r = dxlt_read(t, id, 0, DXL_AX_TABLE_SIZE, mem);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	fprintf(t->out, "%-4s %-22s %-24s %s\n", "ADDR", "NAME", "VALUE", "DESCRIPTION");
-	for (size_t i = 0; i < dxl_ax12_nregs; i++) {
-		const struct dxl_reg *reg = &dxl_ax12_regs[i];
-		uint16_t v = reg->size == 2 ? dxl_get_u16(&mem[reg->addr]) : mem[reg->addr];
-		fprintf(t->out, "%-4u %-22s %-24s %s%s\n", reg->addr, reg->name,
-		        dxl_reg_format(reg, v, text, sizeof text), reg->desc,
-		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
-	}
-	return DXLT_EXIT_OK;
 }
 
 /* ---- set-id / set-baud / torque / reset --------------------------------------- */
@@ -810,9 +738,9 @@ struct dxlt_command {
 };
 
 static const struct dxlt_command dxlt_commands[] = {
-	{ "scan", { dxlt_cmd_scan, dxlt_cmd_scan } },          { "ping", { dxlt_cmd_ping, dxlt2_cmd_ping } },
-	{ "read", { dxlt_cmd_read, dxlt2_cmd_read } },         { "write", { dxlt_cmd_write, dxlt2_cmd_write } },
-	{ "dump", { dxlt_cmd_dump, dxlt2_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
+	{ "scan", { dxlt_cmd_scan, dxlt_cmd_scan } },          { "ping", { dxlt_cmd_ping, dxlt_cmd_ping } },
+	{ "read", { dxlt_cmd_read, dxlt_cmd_read } },         { "write", { dxlt_cmd_write, dxlt2_cmd_write } },
+	{ "dump", { dxlt_cmd_dump, dxlt_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
 	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt2_cmd_torque } },
 	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt2_cmd_setup } },
 	{ "reboot", { dxlt_cmd_reboot, dxlt_cmd_reboot } },

@@ -24,94 +24,9 @@
 #define DXLT2_SETUP_BAUD 1000000L
 /* The first bytes of the X tables, read in one READ for `dump`, `write`'s
  * checks and `setup` (0..147: model number .. present temperature). */
-#define DXLT2_IMAGE_LEN DXL2_X_TABLE_SIZE
+#define DXLT2_IMAGE_LEN DXLT_IMAGE_MAX
 
-/* What a servo answered to PING. */
-struct dxlt2_servo {
-	uint8_t id;
-	uint16_t model;
-	uint8_t firmware;
-	const struct dxl2_model *m;   /* NULL: not in our tables, raw addresses only */
-};
-
-/* A register named on the command line: the table's row, or a raw address. */
-struct dxlt2_reg {
-	const struct dxl2_reg *row;   /* NULL for a raw address */
-	uint16_t addr;
-	uint8_t size;
-	const char *name;
-};
-
-/* The models dxl knows on Protocol 2.0, for messages: protocol/dxl2_table.c's. */
-static const char *dxlt2_known(void)
-{
-	static char names[160];
-	return dxl2_model_names(2, names, sizeof names);
-}
-
-static const char *dxlt2_model_text(const struct dxlt2_servo *s)
-{
-	return s->m != NULL ? s->m->name : "not in dxl's tables";
-}
-
-/* ---- transactions: every reply's ERR field is remembered -------------------------- */
-
-/* PING the servo and pick its table. */
-static int dxlt2_identify(struct dxlt *t, uint8_t id, struct dxlt2_servo *s)
-{
-	memset(s, 0, sizeof *s);
-	s->id = id;
-	int r = dxlt2_ping(t, id, &s->model, &s->firmware);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	s->m = dxl2_model_by_number(s->model);
-	return DXLT_EXIT_OK;
-}
-
-static void dxlt2_raw_note(struct dxlt *t, const struct dxlt2_servo *s, uint16_t addr, uint8_t size)
-{
-	fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): address %u taken as "
-	        "%u raw byte%s, unchecked (--size 1|2|4)\n", s->id, s->model, dxlt2_known(), addr, size, size == 1 ? "" : "s");
-}
-
-/* The register REG names on this servo. */
-static int dxlt2_arg_reg(struct dxlt *t, const struct dxlt2_servo *s, const char *text, struct dxlt2_reg *out)
-{
-	long addr;
-
-	if (s->m != NULL) {
-		out->row = dxl2_reg_lookup(s->m, text);
-		if (out->row == NULL) {
-			fprintf(t->err, "dxl: unknown register '%s' for the %s (names and addresses: dxl --protocol 2 "
-			        "--port %s dump %u)\n", text, s->m->name, port_path(t->port), s->id);
-			return DXLT_EXIT_USAGE;
-		}
-		out->addr = out->row->addr;
-		out->size = out->row->size;
-		out->name = out->row->name;
-		return DXLT_EXIT_OK;
-	}
-	if (num_parse_long(text, 0, UINT16_MAX, &addr) != NUM_OK) {
-		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): registers by "
-		        "address only, not '%s'\n", s->id, s->model, dxlt2_known(), text);
-		return DXLT_EXIT_USAGE;
-	}
-	out->row = NULL;
-	out->addr = (uint16_t)addr;
-	out->size = (uint8_t)(t->a.size > 0 ? t->a.size : 1);
-	out->name = "address";
-	dxlt2_raw_note(t, s, out->addr, out->size);
-	return DXLT_EXIT_OK;
-}
-
-static int32_t dxlt2_decode(const struct dxlt2_reg *reg, const uint8_t *raw)
-{
-	if (reg->row != NULL)
-		return dxl2_reg_decode(reg->row, raw);
-	return reg->size == 4 ? (int32_t)dxl2_get_u32(raw) : reg->size == 2 ? dxl_get_u16(raw) : raw[0];
-}
-
-/* ---- scan / ping ------------------------------------------------------------------ */
+/* ---- scan ------------------------------------------------------------------ */
 
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found)
 {
@@ -136,101 +51,9 @@ int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found)
 	return DXLT_EXIT_OK;
 }
 
-int dxlt2_cmd_ping(struct dxlt *t)
-{
-	struct dxlt2_servo s;
-	uint8_t id;
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 1, "--protocol 2 ping ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
-	    (rc = dxlt2_identify(t, id, &s)))
-		return rc;
-	fprintf(t->out, "ID %u answered in %u us: model %u (%s), firmware %u, Protocol 2.0\n", id,
-	        (unsigned)t->bus.servo[id].rtt_last_us, s.model, dxlt2_model_text(&s), s.firmware);
-	if (s.m == NULL)
-		fprintf(t->err, "dxl: model %u is not in dxl's tables (%s): read and write it by "
-		        "address (--size 1|2|4)\n", s.model, dxlt2_known());
-	return DXLT_EXIT_OK;
-}
-
-/* ---- read / dump ------------------------------------------------------------------ */
-
-int dxlt2_cmd_read(struct dxlt *t)
-{
-	struct dxlt2_servo s;
-	struct dxlt2_reg reg;
-	uint8_t id, raw[4] = { 0 };
-	char text[96];
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 2, "--protocol 2 read ID REG [--units]")) ||
-	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
-	    (rc = dxlt2_arg_reg(t, &s, t->a.pos[1], &reg)))
-		return rc;
-	int r = dxlt_read(t, id, reg.addr, reg.size, raw);
-	if (r == DXL_E_TIMEOUT) {
-		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0 (raise it: dxl "
-		        "--protocol 2 --port %s write %u status_return_level 2)\n", id, port_path(t->port), id);
-		return DXLT_EXIT_BUS;
-	}
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	int32_t v = dxlt2_decode(&reg, raw);
-	if (t->a.units && reg.row != NULL)
-		fprintf(t->out, "%s\n", dxl2_reg_format(reg.row, v, text, sizeof text));
-	else if (reg.row == NULL || !reg.row->is_signed)
-		fprintf(t->out, "%lu\n", (unsigned long)(uint32_t)v);
-	else
-		fprintf(t->out, "%ld\n", (long)v);
-	return DXLT_EXIT_OK;
-}
-
-static void dxlt2_dump_raw(struct dxlt *t, const uint8_t *mem, size_t len)
-{
-	fprintf(t->out, "ADDR  BYTES (model not in dxl's tables: raw, little-endian)\n");
-	for (size_t a = 0; a < len; a += 16) {
-		fprintf(t->out, "%-5zu", a);
-		for (size_t k = a; k < a + 16 && k < len; k++)
-			fprintf(t->out, " %02X", mem[k]);
-		fputc('\n', t->out);
-	}
-}
-
-int dxlt2_cmd_dump(struct dxlt *t)
-{
-	struct dxlt2_servo s;
-	uint8_t id, mem[DXLT2_IMAGE_LEN];
-	char text[96];
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 1, "--protocol 2 dump ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
-	    (rc = dxlt2_identify(t, id, &s)))
-		return rc;
-	int r = dxlt_read(t, id, 0, sizeof mem, mem);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (s.m == NULL) {
-		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): bytes 0-%zu "
-		        "raw\n", id, s.model, dxlt2_known(), sizeof mem - 1);
-		dxlt2_dump_raw(t, mem, sizeof mem);
-		return DXLT_EXIT_OK;
-	}
-	fprintf(t->out, "%s (model %u), firmware %u\n", s.m->name, s.model, s.firmware);
-	fprintf(t->out, "%-4s %-24s %-26s %s\n", "ADDR", "NAME", "VALUE", "DESCRIPTION");
-	for (size_t i = 0; i < s.m->nregs; i++) {
-		const struct dxl2_reg *reg = &s.m->regs[i];
-		if (reg->addr + reg->size > sizeof mem)
-			continue;
-		fprintf(t->out, "%-4u %-24s %-26s %s%s\n", reg->addr, reg->name,
-		        dxl2_reg_format(reg, dxl2_reg_decode(reg, &mem[reg->addr]), text, sizeof text), reg->desc,
-		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
-	}
-	return DXLT_EXIT_OK;
-}
-
 /* ---- write / torque ------------------------------------------------------------------ */
 
-static int dxlt2_parse_value(struct dxlt *t, const struct dxlt2_reg *reg, const char *text, long *value)
+static int dxlt2_parse_value(struct dxlt *t, const struct dxlt_reg *reg, const char *text, long *value)
 {
 	enum num_status st = num_parse_long(text, LONG_MIN, LONG_MAX, value);
 	if (st != NUM_OK && st != NUM_RANGE) {
@@ -259,7 +82,7 @@ static int dxlt2_parse_value(struct dxlt *t, const struct dxlt2_reg *reg, const 
 
 /* What the servo holds now decides what it takes: limits, operating modes,
  * torque for EEPROM. The servo would answer an error; say why first. */
-static int dxlt2_check_live(struct dxlt *t, const struct dxlt2_servo *s, const struct dxlt2_reg *reg, long value,
+static int dxlt2_check_live(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg, long value,
                             const uint8_t *mem)
 {
 	int32_t lo, hi;
@@ -287,7 +110,7 @@ static int dxlt2_check_live(struct dxlt *t, const struct dxlt2_servo *s, const s
 /* Write and know whether it took, as far as the status return level lets
  * us (68: 0 PING only, 1 PING and READ, 2 everything): as commands.c's
  * dxlt_write_checked. */
-static int dxlt2_write_checked(struct dxlt *t, uint8_t id, const struct dxlt2_reg *reg, long value, uint8_t level)
+static int dxlt2_write_checked(struct dxlt *t, uint8_t id, const struct dxlt_reg *reg, long value, uint8_t level)
 {
 	uint8_t raw[4], back[4];
 	bool answered = level >= 2 && reg->addr != DXL2_X_STATUS_RETURN_LEVEL;
@@ -312,7 +135,7 @@ static int dxlt2_write_checked(struct dxlt *t, uint8_t id, const struct dxlt2_re
 	if ((r = dxlt_read(t, id, reg->addr, reg->size, back)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (memcmp(back, raw, reg->size) != 0) {
-		fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld)\n", id, reg->name, (long)dxlt2_decode(reg, back),
+		fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld)\n", id, reg->name, (long)dxlt_decode(reg, back),
 		        value);
 		return t->errseen2[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
 	}
@@ -322,7 +145,7 @@ static int dxlt2_write_checked(struct dxlt *t, uint8_t id, const struct dxlt2_re
 }
 
 /* The whole write: checked against the table and the servo's image first. */
-static int dxlt2_write_reg(struct dxlt *t, const struct dxlt2_servo *s, const struct dxlt2_reg *reg, long value)
+static int dxlt2_write_reg(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg, long value)
 {
 	uint8_t mem[DXLT2_IMAGE_LEN];
 	int rc, r;
@@ -345,15 +168,15 @@ static int dxlt2_write_reg(struct dxlt *t, const struct dxlt2_servo *s, const st
 
 int dxlt2_cmd_write(struct dxlt *t)
 {
-	struct dxlt2_servo s;
-	struct dxlt2_reg reg;
+	struct dxlt_servo s;
+	struct dxlt_reg reg;
 	uint8_t id;
 	long value;
 	int rc;
 
 	if ((rc = dxlt_need_args(t, 3, "--protocol 2 write ID REG VALUE")) ||
-	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) || (rc = dxlt2_identify(t, id, &s)) ||
-	    (rc = dxlt2_arg_reg(t, &s, t->a.pos[1], &reg)) || (rc = dxlt2_parse_value(t, &reg, t->a.pos[2], &value)))
+	    (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) || (rc = dxlt_identify(t, id, &s)) ||
+	    (rc = dxlt_arg_reg(t, &s, t->a.pos[1], &reg)) || (rc = dxlt2_parse_value(t, &reg, t->a.pos[2], &value)))
 		return rc;
 	if (reg.row != NULL && (reg.addr == DXL2_X_ID || reg.addr == DXL2_X_BAUD_RATE)) {
 		fprintf(t->err, "dxl: %s moves the servo away from this ID/rate: use dxl --protocol 2 --port %s %s\n",
@@ -365,8 +188,8 @@ int dxlt2_cmd_write(struct dxlt *t)
 
 int dxlt2_cmd_torque(struct dxlt *t)
 {
-	struct dxlt2_servo s;
-	struct dxlt2_reg reg = { NULL, DXL2_X_TORQUE_ENABLE, 1, "torque_enable" };
+	struct dxlt_servo s;
+	struct dxlt_reg reg = { NULL, DXL2_X_TORQUE_ENABLE, 1, "torque_enable" };
 	uint8_t id;
 	int rc;
 
@@ -378,12 +201,12 @@ int dxlt2_cmd_torque(struct dxlt *t)
 		fprintf(t->err, "dxl: torque takes on or off, not '%s'\n", w);
 		return DXLT_EXIT_USAGE;
 	}
-	if ((rc = dxlt2_identify(t, id, &s)) != DXLT_EXIT_OK)
+	if ((rc = dxlt_identify(t, id, &s)) != DXLT_EXIT_OK)
 		return rc;
 	if (s.m != NULL)
 		reg.row = dxl2_reg_at(s.m, DXL2_X_TORQUE_ENABLE);
 	else
-		dxlt2_raw_note(t, &s, reg.addr, reg.size);
+		dxlt_raw_note(t, &s, reg.addr, reg.size);
 	return dxlt2_write_reg(t, &s, &reg, on ? 1 : 0);
 }
 
@@ -416,14 +239,15 @@ static int dxlt2_setup_byte(struct dxlt *t, uint8_t id, uint16_t addr, const cha
 static int dxlt2_setup_one(struct dxlt *t, uint8_t id, bool *current)
 {
 	uint8_t mem[DXLT2_IMAGE_LEN];
-	struct dxlt2_servo s;
+	struct dxlt_servo s;
+	char names[160];
 	int rc, r;
 
-	if ((rc = dxlt2_identify(t, id, &s)) != DXLT_EXIT_OK)
+	if ((rc = dxlt_identify(t, id, &s)) != DXLT_EXIT_OK)
 		return rc;
 	if (s.m == NULL) {
 		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): setup does not "
-		        "know its registers\n", id, s.model, dxlt2_known());
+		        "know its registers\n", id, s.model, dxl2_model_names(2, names, sizeof names));
 		return DXLT_EXIT_REFUSED;
 	}
 	*current = *current || s.m->current_sensing;

@@ -1,0 +1,239 @@
+/*
+ * registers.c — the `dxl` commands that go by a servo's control table
+ * (ping, read, dump), written once over every model: registers by name
+ * through the model descriptor's rows (dxl2_table.h), values through the one
+ * row type. Where the family's PING names the model (Protocol 2.0) the
+ * servo is identified first and a model not in the tables still answers
+ * raw addresses (--size bytes), saying so; where it does not (Protocol 1.0)
+ * the family's first model is taken, as its servos all share one table.
+ * The output contract is commands.c's.
+ */
+#include <string.h>
+
+#include "dxl2.h"
+#include "dxl2_table.h"
+#include "dxlt_priv.h"
+#include "num.h"
+
+/* The models dxl knows on this family's protocol, for messages. */
+static const char *dxlt_known(const struct dxlt *t)
+{
+	static char names[160];
+	return dxl2_model_names(t->fam->protocol, names, sizeof names);
+}
+
+static const char *dxlt_servo_model_text(const struct dxlt_servo *s)
+{
+	return s->m != NULL ? s->m->name : "not in dxl's tables";
+}
+
+size_t dxlt_image_len(const struct dxl2_model *m)
+{
+	size_t end = 0;
+
+	if (m == NULL)
+		return DXLT_IMAGE_MAX;
+	for (size_t i = 0; i < m->nregs; i++)
+		if ((size_t)m->regs[i].addr + m->regs[i].size > end)
+			end = (size_t)m->regs[i].addr + m->regs[i].size;
+	return end < DXLT_IMAGE_MAX ? end : DXLT_IMAGE_MAX;
+}
+
+int dxlt_identify(struct dxlt *t, uint8_t id, struct dxlt_servo *s)
+{
+	memset(s, 0, sizeof *s);
+	s->id = id;
+	if (!t->fam->ping_names_model) {
+		s->m = t->fam_model;
+		return DXLT_EXIT_OK;
+	}
+	int r = dxlt2_ping(t, id, &s->model, &s->firmware);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	s->pinged = true;
+	s->m = dxl2_model_find(t->fam->protocol, s->model);
+	return DXLT_EXIT_OK;
+}
+
+void dxlt_raw_note(struct dxlt *t, const struct dxlt_servo *s, uint16_t addr, uint8_t size)
+{
+	fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): address %u taken as "
+	        "%u raw byte%s, unchecked (--size 1|2|4)\n", s->id, s->model, dxlt_known(t), addr, size,
+	        size == 1 ? "" : "s");
+}
+
+int dxlt_arg_reg(struct dxlt *t, const struct dxlt_servo *s, const char *text, struct dxlt_reg *out)
+{
+	long addr;
+
+	if (s->m != NULL) {
+		out->row = dxl2_reg_lookup(s->m, text);
+		if (out->row == NULL) {
+			fprintf(t->err, "dxl: unknown register '%s' for the %s (names and addresses: dxl %s--port %s "
+			        "dump %u)\n", text, s->m->name, t->fam->opt, port_path(t->port), s->id);
+			return DXLT_EXIT_USAGE;
+		}
+		out->addr = out->row->addr;
+		out->size = out->row->size;
+		out->name = out->row->name;
+		return DXLT_EXIT_OK;
+	}
+	if (num_parse_long(text, 0, UINT16_MAX, &addr) != NUM_OK) {
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): registers by "
+		        "address only, not '%s'\n", s->id, s->model, dxlt_known(t), text);
+		return DXLT_EXIT_USAGE;
+	}
+	out->row = NULL;
+	out->addr = (uint16_t)addr;
+	out->size = (uint8_t)(t->a.size > 0 ? t->a.size : 1);
+	out->name = "address";
+	dxlt_raw_note(t, s, out->addr, out->size);
+	return DXLT_EXIT_OK;
+}
+
+int32_t dxlt_decode(const struct dxlt_reg *reg, const uint8_t *raw)
+{
+	if (reg->row != NULL)
+		return dxl2_reg_decode(reg->row, raw);
+	return reg->size == 4 ? (int32_t)dxl2_get_u32(raw) : reg->size == 2 ? dxl_get_u16(raw) : raw[0];
+}
+
+/* "ping ID" with the family's option a suggestion must carry. */
+static int dxlt_need_cmd(struct dxlt *t, int n, const char *form)
+{
+	char line[96];
+	snprintf(line, sizeof line, "%s%s", t->fam->opt, form);
+	return dxlt_need_args(t, n, line);
+}
+
+/* ---- ping ----------------------------------------------------------------------- */
+
+/* Where the PING does not name the model, READ it (status return level 0
+ * answers PING only: then the ID is all there is to say). */
+static bool dxlt_ping_identity(struct dxlt *t, struct dxlt_servo *s)
+{
+	uint8_t raw[2], fw = 0;
+	const struct dxl2_reg *model = dxl2_reg_lookup(t->fam_model, "model_number");
+	const struct dxl2_reg *firmware = dxl2_reg_lookup(t->fam_model, "firmware_version");
+
+	if (s->pinged)
+		return true;
+	if (dxlt_read(t, s->id, model->addr, model->size, raw) != DXL_OK)
+		return false;
+	s->model = dxl_get_u16(raw);
+	s->m = dxl2_model_find(t->fam->protocol, s->model);
+	if (dxlt_read(t, s->id, firmware->addr, 1, &fw) == DXL_OK)
+		s->firmware = fw;
+	return true;
+}
+
+int dxlt_cmd_ping(struct dxlt *t)
+{
+	struct dxlt_servo s;
+	uint8_t id;
+	int rc, r;
+
+	if ((rc = dxlt_need_cmd(t, 1, "ping ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
+	    (rc = dxlt_identify(t, id, &s)))
+		return rc;
+	if (!s.pinged && (r = dxlt_ping(t, id)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	fprintf(t->out, "ID %u answered in %u us", id, (unsigned)t->bus.servo[id].rtt_last_us);
+	if (dxlt_ping_identity(t, &s))
+		fprintf(t->out, ": model %u (%s), firmware %u, %s\n", s.model, dxlt_servo_model_text(&s), s.firmware,
+		        t->fam->label);
+	else
+		fprintf(t->out, ": answers PING only (status return level 0), %s\n", t->fam->label);
+	/* only where the model picks the table does an unknown one change what dxl can do */
+	if (s.pinged && s.m == NULL)
+		fprintf(t->err, "dxl: model %u is not in dxl's tables (%s): read and write it by "
+		        "address (--size 1|2|4)\n", s.model, dxlt_known(t));
+	return DXLT_EXIT_OK;
+}
+
+/* ---- read / dump ------------------------------------------------------------------ */
+
+int dxlt_cmd_read(struct dxlt *t)
+{
+	struct dxlt_servo s;
+	struct dxlt_reg reg;
+	uint8_t id, raw[4] = { 0 };
+	char text[96];
+	int rc;
+
+	if ((rc = dxlt_need_cmd(t, 2, "read ID REG [--units]")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
+	    (rc = dxlt_identify(t, id, &s)) || (rc = dxlt_arg_reg(t, &s, t->a.pos[1], &reg)))
+		return rc;
+	int r = dxlt_read(t, id, reg.addr, reg.size, raw);
+	if (r == DXL_E_TIMEOUT && (s.pinged || dxlt_ping(t, id) == DXL_OK)) {
+		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0 (raise it: dxl %s--port %s "
+		        "write %u status_return_level 2)\n", id, t->fam->opt, port_path(t->port), id);
+		return DXLT_EXIT_BUS;
+	}
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	int32_t v = dxlt_decode(&reg, raw);
+	if (t->a.units && reg.row != NULL)
+		fprintf(t->out, "%s\n", dxl2_reg_format(reg.row, v, text, sizeof text));
+	else if (reg.row == NULL || !reg.row->is_signed)
+		fprintf(t->out, "%lu\n", (unsigned long)(uint32_t)v);
+	else
+		fprintf(t->out, "%ld\n", (long)v);
+	return DXLT_EXIT_OK;
+}
+
+static void dxlt_dump_raw(struct dxlt *t, const uint8_t *mem, size_t len)
+{
+	fprintf(t->out, "ADDR  BYTES (model not in dxl's tables: raw, little-endian)\n");
+	for (size_t a = 0; a < len; a += 16) {
+		fprintf(t->out, "%-5zu", a);
+		for (size_t k = a; k < a + 16 && k < len; k++)
+			fprintf(t->out, " %02X", mem[k]);
+		fputc('\n', t->out);
+	}
+}
+
+/* The title line: the model and firmware as the image holds them. */
+static void dxlt_dump_title(struct dxlt *t, const struct dxl2_model *m, const uint8_t *mem, size_t len)
+{
+	const struct dxl2_reg *model = dxl2_reg_lookup(m, "model_number");
+	const struct dxl2_reg *firmware = dxl2_reg_lookup(m, "firmware_version");
+
+	if (model == NULL || firmware == NULL || firmware->addr >= len)
+		return;
+	fprintf(t->out, "%s (model %ld), firmware %ld\n", m->name, (long)dxl2_reg_decode(model, &mem[model->addr]),
+	        (long)dxl2_reg_decode(firmware, &mem[firmware->addr]));
+}
+
+int dxlt_cmd_dump(struct dxlt *t)
+{
+	struct dxlt_servo s;
+	uint8_t id, mem[DXLT_IMAGE_MAX];
+	char text[96];
+	int rc;
+
+	if ((rc = dxlt_need_cmd(t, 1, "dump ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
+	    (rc = dxlt_identify(t, id, &s)))
+		return rc;
+	size_t len = dxlt_image_len(s.m);
+	int r = dxlt_read(t, id, 0, (uint16_t)len, mem);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (s.m == NULL) {
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): bytes 0-%zu "
+		        "raw\n", id, s.model, dxlt_known(t), len - 1);
+		dxlt_dump_raw(t, mem, len);
+		return DXLT_EXIT_OK;
+	}
+	dxlt_dump_title(t, s.m, mem, len);
+	fprintf(t->out, "%-4s %-24s %-26s %s\n", "ADDR", "NAME", "VALUE", "DESCRIPTION");
+	for (size_t i = 0; i < s.m->nregs; i++) {
+		const struct dxl2_reg *reg = &s.m->regs[i];
+		if (reg->addr + reg->size > len)
+			continue;
+		fprintf(t->out, "%-4u %-24s %-26s %s%s\n", reg->addr, reg->name,
+		        dxl2_reg_format(reg, dxl2_reg_decode(reg, &mem[reg->addr]), text, sizeof text), reg->desc,
+		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
+	}
+	return DXLT_EXIT_OK;
+}
