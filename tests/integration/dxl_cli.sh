@@ -55,7 +55,7 @@ run readback --port "$bus" read 1 goal_position
 run range --port "$bus" write 1 goal_position 5000
 run after --port "$bus" read 1 goal_position
 [ "$rc" -eq 0 ] && [ "$(cat "$T/after.out")" = "300" ] && [ "$(lines "$T/range.err")" = 1 ] \
-	&& grep -q 'out of range for goal_position (0-1023)' "$T/range.err" \
+	&& grep -q 'out of range for goal_position (0..1023)' "$T/range.err" \
 	&& tap_ok "out-of-range write: one line, nothing written" \
 	|| tap_fail "out-of-range write: one line, nothing written" "$(cat "$T/range.err" "$T/after.out")"
 run range2 --port "$bus" write 1 goal_position 5000

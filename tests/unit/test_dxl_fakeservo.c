@@ -493,7 +493,7 @@ static void test_dxl_write_validates_first(void **state)
 	unsigned packets = atomic_load(&f->bus.packets);
 	/* out of range, read-only, unknown, not a number: nothing goes on the wire */
 	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "1024", NULL), DXLT_EXIT_USAGE);
-	assert_non_null(strstr(f->err, "out of range for goal_position (0-1023)"));
+	assert_non_null(strstr(f->err, "out of range for goal_position (0..1023)"));
 	assert_int_equal(run_dxl(f, "write", "1", "present_position", "10", NULL), DXLT_EXIT_USAGE);
 	assert_non_null(strstr(f->err, "read-only"));
 	assert_int_equal(run_dxl(f, "write", "1", "warp_drive", "1", NULL), DXLT_EXIT_USAGE);

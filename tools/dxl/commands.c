@@ -48,37 +48,6 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 	return rc == DXLT_EXIT_OK ? DXLT_EXIT_SERVO : rc;
 }
 
-static int dxlt_ax_arg_reg(struct dxlt *t, const char *s, const struct dxl_reg **reg)
-{
-	*reg = dxl_reg_lookup(s);
-	if (*reg != NULL)
-		return DXLT_EXIT_OK;
-	fprintf(t->err, "dxl: unknown register '%s' (names and addresses: dxl dump ID)\n", s);
-	return DXLT_EXIT_USAGE;
-}
-
-static int dxlt_read_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t *v)
-{
-	uint8_t raw[2] = { 0, 0 };
-	int r = dxlt_read(t, id, reg->addr, reg->size, raw);
-
-	*v = reg->size == 2 ? dxl_get_u16(raw) : raw[0];
-	return r;
-}
-
-static int dxlt_write_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t v,
-                          bool expect_reply)
-{
-	uint8_t raw[2];
-
-	/* 16-bit values go in one packet: the servo must never act on half. */
-	if (reg->size == 2)
-		dxl_put_u16(raw, v);
-	else
-		raw[0] = (uint8_t)v;
-	return dxlt_write(t, id, reg->addr, raw, reg->size, expect_reply);
-}
-
 /* ---- ports -------------------------------------------------------------------- */
 
 /* Enumeration beyond this many ports is truncated (a robot has one or two). */
@@ -244,137 +213,6 @@ static int dxlt_cmd_scan(struct dxlt *t)
 
 /* ---- read / write / dump ------------------------------------------------------ */
 
-static int dxlt_check_value(struct dxlt *t, const struct dxl_reg *reg, const char *s, uint16_t *v)
-{
-	long value;
-
-	if (reg->access != DXL_ACCESS_RW) {
-		fprintf(t->err, "dxl: %s (address %u) is read-only\n", reg->name, reg->addr);
-		return DXLT_EXIT_USAGE;
-	}
-	enum num_status st = num_parse_long(s, LONG_MIN, LONG_MAX, &value);
-	if (st != NUM_OK && st != NUM_RANGE) {
-		fprintf(t->err, "dxl: value '%s' for %s is %s\n", s, reg->name, num_strerror(st));
-		return DXLT_EXIT_USAGE;
-	}
-	if (st != NUM_OK || dxl_reg_check_write(reg, value) != DXL_OK) {
-		fprintf(t->err, "dxl: value '%s' out of range for %s (%u-%u)\n", s, reg->name, reg->min,
-		        reg->max);
-		return DXLT_EXIT_USAGE;
-	}
-	*v = (uint16_t)value;
-	return DXLT_EXIT_OK;
-}
-
-/* The servo's status return level decides which instructions it answers (0:
- * PING only, 1: READ too, 2: everything): ask it rather than assume 2, or a
- * write that took effect reads as "no reply". */
-static int dxlt_status_level(struct dxlt *t, uint8_t id, uint8_t *level)
-{
-	uint8_t v = 0;
-	int r = dxlt_read(t, id, DXL_AX_STATUS_RETURN_LEVEL, 1, &v);
-
-	if (r == DXL_OK) {
-		*level = v > 2 ? 2 : v;
-		return DXL_OK;
-	}
-	if (r != DXL_E_TIMEOUT)
-		return r;
-	r = dxlt_ping(t, id);
-	if (r == DXL_OK)
-		*level = 0;
-	return r;
-}
-
-/* Why the servo refused a write, when its error bits say (the bits alone
- * name the symptom, not the remedy). */
-static void dxlt_write_hint(struct dxlt *t, uint8_t id, const struct dxl_reg *reg)
-{
-	uint8_t e = t->errseen[id];
-
-	if ((e & DXL_ERRBIT_RANGE) && reg->area == DXL_AREA_EEPROM)
-		snprintf(t->hint, sizeof t->hint, "the AX-12A refuses EEPROM writes (%s) while torque "
-		         "is on or the lock is set: dxl --port %s torque %u off", reg->name,
-		         port_path(t->port), id);
-	else if ((e & DXL_ERRBIT_ANGLE_LIMIT) && reg->addr == DXL_AX_GOAL_POSITION)
-		snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's angle limits: dxl "
-		         "--port %s read %u cw_angle_limit (and ccw_angle_limit)", port_path(t->port), id);
-}
-
-/* Write one register and know whether it took, as far as the servo's status
- * return level lets us: level 2 answers the WRITE; level 1 answers only a
- * READ, so read the value back; level 0 answers nothing but PING, so the
- * write goes out unconfirmed and the output says so. A write to the status
- * return level itself is never waited for: which level answers it is the
- * servo's choice. */
-static int dxlt_write_checked(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t v)
-{
-	uint8_t level = 2;
-	int r;
-
-	if (id == DXL_BROADCAST_ID) {
-		r = dxlt_write_reg(t, id, reg, v, false);
-		if (r != DXL_OK)
-			return dxlt_bus_fail(t, id, r);
-		fprintf(t->out, "broadcast: %s = %u sent (servos do not answer a broadcast)\n",
-		        reg->name, v);
-		return DXLT_EXIT_OK;
-	}
-	if ((r = dxlt_status_level(t, id, &level)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	bool answered = level >= 2 && reg->addr != DXL_AX_STATUS_RETURN_LEVEL;
-	r = dxlt_write_reg(t, id, reg, v, answered);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	dxlt_write_hint(t, id, reg);
-	if (answered)
-		return DXLT_EXIT_OK;
-	uint8_t now_level = reg->addr == DXL_AX_STATUS_RETURN_LEVEL ? (uint8_t)v : level;
-	if (now_level == 0) {
-		if ((r = dxlt_ping(t, id)) != DXL_OK)
-			return dxlt_bus_fail(t, id, r);
-		fprintf(t->out, "ID %u: %s = %u sent, not confirmed: the servo answers PING only "
-		        "(status return level 0)\n", id, reg->name, v);
-		return DXLT_EXIT_OK;
-	}
-	/* A READ right after a WRITE to EEPROM may find the servo busy writing. */
-	if (reg->area == DXL_AREA_EEPROM)
-		dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	uint16_t have = 0;
-	if ((r = dxlt_read_reg(t, id, reg, &have)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (have != v) {
-		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u; status return level %u: the "
-		        "WRITE itself is not answered, its read-back is)\n", id, reg->name, have, v,
-		        level);
-		return t->errseen[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u: %s = %u (read back: status return level %u does not answer "
-	        "WRITE)\n", id, reg->name, v, level);
-	return DXLT_EXIT_OK;
-}
-
-static int dxlt_cmd_write(struct dxlt *t)
-{
-	const struct dxl_reg *reg;
-	uint8_t id;
-	uint16_t v;
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 3, "write ID REG VALUE")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)) ||
-	    (rc = dxlt_ax_arg_reg(t, t->a.pos[1], &reg)) || (rc = dxlt_check_value(t, reg, t->a.pos[2], &v)))
-		return rc;
-	/* After a new ID or baud the servo answers elsewhere: only the commands
-	 * made for it know where to look for the answer. */
-	if (reg->addr == DXL_AX_ID || reg->addr == DXL_AX_BAUD_RATE) {
-		fprintf(t->err, "dxl: %s moves the servo away from this ID/rate: use dxl --port %s %s\n", reg->name,
-		        port_path(t->port), reg->addr == DXL_AX_ID ? "set-id OLD NEW" : "set-baud ID BAUD");
-		return DXLT_EXIT_USAGE;
-	}
-	return dxlt_write_checked(t, id, reg, v);
-}
-
 /* ---- set-id / set-baud / torque / reset --------------------------------------- */
 
 /* EEPROM (ID, rate) is refused while torque is on where the family says
@@ -474,23 +312,6 @@ static int dxlt_cmd_set_baud(struct dxlt *t)
 	}
 	fprintf(t->out, "ID %u now at %ld bps (register value %u)\n", id, exact, reg_value);
 	return DXLT_EXIT_OK;
-}
-
-static int dxlt_cmd_torque(struct dxlt *t)
-{
-	uint8_t id;
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 2, "torque ID on|off")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)))
-		return rc;
-	const char *s = t->a.pos[1];
-	bool on = strcmp(s, "on") == 0 || strcmp(s, "1") == 0;
-	if (!on && strcmp(s, "off") != 0 && strcmp(s, "0") != 0) {
-		fprintf(t->err, "dxl: torque takes on or off, not '%s'\n", s);
-		return DXLT_EXIT_USAGE;
-	}
-	return dxlt_write_checked(t, id, dxl_reg_at(DXL_AX_TORQUE_ENABLE), on ? 1 : 0);
 }
 
 /* What a factory reset keeps: --keep where the models can (their
@@ -739,9 +560,9 @@ struct dxlt_command {
 
 static const struct dxlt_command dxlt_commands[] = {
 	{ "scan", { dxlt_cmd_scan, dxlt_cmd_scan } },          { "ping", { dxlt_cmd_ping, dxlt_cmd_ping } },
-	{ "read", { dxlt_cmd_read, dxlt_cmd_read } },         { "write", { dxlt_cmd_write, dxlt2_cmd_write } },
+	{ "read", { dxlt_cmd_read, dxlt_cmd_read } },         { "write", { dxlt_cmd_write, dxlt_cmd_write } },
 	{ "dump", { dxlt_cmd_dump, dxlt_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
-	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt2_cmd_torque } },
+	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt_cmd_torque } },
 	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt2_cmd_setup } },
 	{ "reboot", { dxlt_cmd_reboot, dxlt_cmd_reboot } },
 };

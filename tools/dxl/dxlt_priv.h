@@ -129,12 +129,12 @@ size_t dxlt_image_len(const struct dxl2_model *m);
 int dxlt_cmd_ping(struct dxlt *t);
 int dxlt_cmd_read(struct dxlt *t);
 int dxlt_cmd_dump(struct dxlt *t);
+int dxlt_cmd_write(struct dxlt *t);
+int dxlt_cmd_torque(struct dxlt *t);
 
 /* ---- Protocol 2.0 (commands2.c) ---- */
 /* Broadcast PING at the current rate: one scan line per servo in the ID range. */
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found);
-int dxlt2_cmd_write(struct dxlt *t);
-int dxlt2_cmd_torque(struct dxlt *t);
 int dxlt2_reboot(struct dxlt *t, uint8_t id);
 int dxlt2_cmd_setup(struct dxlt *t);
 

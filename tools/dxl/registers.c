@@ -1,6 +1,6 @@
 /*
  * registers.c — the `dxl` commands that go by a servo's control table
- * (ping, read, dump), written once over every model: registers by name
+ * (ping, read, dump, write, torque), written once over every model: registers by name
  * through the model descriptor's rows (dxl2_table.h), values through the one
  * row type. Where the family's PING names the model (Protocol 2.0) the
  * servo is identified first and a model not in the tables still answers
@@ -8,6 +8,7 @@
  * the family's first model is taken, as its servos all share one table.
  * The output contract is commands.c's.
  */
+#include <limits.h>
 #include <string.h>
 
 #include "dxl2.h"
@@ -236,4 +237,219 @@ int dxlt_cmd_dump(struct dxlt *t)
 		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
 	}
 	return DXLT_EXIT_OK;
+}
+
+/* ---- write / torque ------------------------------------------------------------------ */
+
+/* The servo a write goes to: the broadcast ID too where the family's
+ * models share one table (its PING does not pick one), as no reply says
+ * which table a servo has. */
+static int dxlt_arg_write_id(struct dxlt *t, const char *text, uint8_t *id)
+{
+	if (t->fam->ping_names_model)
+		return dxlt_arg_servo_id(t, text, id);
+	return dxlt_arg_id(t, text, true, id);
+}
+
+static int dxlt_parse_value(struct dxlt *t, const struct dxlt_reg *reg, const char *text, long *value)
+{
+	enum num_status st = num_parse_long(text, LONG_MIN, LONG_MAX, value);
+	if (st != NUM_OK && st != NUM_RANGE) {
+		fprintf(t->err, "dxl: value '%s' for %s is %s\n", text, reg->name, num_strerror(st));
+		return DXLT_EXIT_USAGE;
+	}
+	if (reg->row == NULL) {
+		long lo = reg->size == 4 ? INT32_MIN : 0, hi = reg->size == 4 ? (long)UINT32_MAX : (1L << (8 * reg->size)) - 1;
+		if (st != NUM_OK || *value < lo || *value > hi) {
+			fprintf(t->err, "dxl: value '%s' does not fit %u byte(s)\n", text, reg->size);
+			return DXLT_EXIT_USAGE;
+		}
+		return DXLT_EXIT_OK;
+	}
+	if (reg->row->access != DXL_ACCESS_RW) {
+		fprintf(t->err, "dxl: %s (address %u) is read-only\n", reg->name, reg->addr);
+		return DXLT_EXIT_USAGE;
+	}
+	if (st != NUM_OK || *value < reg->row->min || *value > reg->row->max) {
+		fprintf(t->err, "dxl: value '%s' out of range for %s (%ld..%ld)\n", text, reg->name, (long)reg->row->min,
+		        (long)reg->row->max);
+		return DXLT_EXIT_USAGE;
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* What the servo holds now decides what it takes: limits, operating modes,
+ * wheel or joint, torque for EEPROM where the family refuses it. The servo
+ * would answer an error; say why first. */
+static int dxlt_check_live(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg, long value,
+                           const uint8_t *mem, size_t len)
+{
+	int32_t lo, hi;
+
+	if (dxl2_reg_check_write(s->m, reg->row, value) != DXL_OK) {
+		fprintf(t->err, "dxl: the %s has no %s %ld (operating modes: dxl %sdump %u)\n", s->m->name, reg->name,
+		        value, t->fam->opt, s->id);
+		return DXLT_EXIT_USAGE;
+	}
+	if (dxl2_reg_check_write_live(s->m, reg->row, value, mem, len) != DXL_OK &&
+	    dxl2_reg_range(s->m, reg->row, mem, len, &lo, &hi) == DXL_OK) {
+		fprintf(t->err, "dxl: value %ld outside %s's range on ID %u now (%ld..%ld, from its limit registers; "
+		        "the servo would answer a data limit error)\n", value, reg->name, s->id, (long)lo, (long)hi);
+		return DXLT_EXIT_USAGE;
+	}
+	if (t->fam->eeprom_needs_torque_off && reg->row->area == DXL_AREA_EEPROM &&
+	    mem[dxlt_addr(t, "torque_enable")] != 0) {
+		fprintf(t->err, "dxl: ID %u has torque on, and an X-series servo refuses EEPROM writes (%s) then with "
+		        "an access error: dxl %s--port %s torque %u off\n", s->id, reg->name, t->fam->opt,
+		        port_path(t->port), s->id);
+		return DXLT_EXIT_REFUSED;
+	}
+	return DXLT_EXIT_OK;
+}
+
+/* Why the servo refused a write, when its error bits say (the bits alone
+ * name the symptom, not the remedy): Protocol 1.0's bits, kept per ID. */
+static void dxlt_write_hint(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg)
+{
+	uint8_t e = t->errseen[s->id];
+
+	if (reg->row == NULL || s->m == NULL)
+		return;
+	if ((e & DXL_ERRBIT_RANGE) && reg->row->area == DXL_AREA_EEPROM)
+		snprintf(t->hint, sizeof t->hint, "the %s refuses EEPROM writes (%s) while torque "
+		         "is on or the lock is set: dxl %s--port %s torque %u off", s->m->name, reg->name, t->fam->opt,
+		         port_path(t->port), s->id);
+	else if ((e & DXL_ERRBIT_ANGLE_LIMIT) && strcmp(reg->name, "goal_position") == 0)
+		snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's angle limits: dxl "
+		         "%s--port %s read %u cw_angle_limit (and ccw_angle_limit)", t->fam->opt, port_path(t->port), s->id);
+}
+
+static bool dxlt_is_level_reg(const struct dxlt_reg *reg)
+{
+	return reg->row != NULL && strcmp(reg->name, "status_return_level") == 0;
+}
+
+/* Write one register and know whether it took, as far as the servo's status
+ * return level lets us: level 2 answers the WRITE; level 1 answers only a
+ * READ, so read the value back; level 0 answers nothing but PING, so the
+ * write goes out unconfirmed and the output says so. A write to the status
+ * return level itself is never waited for: which level answers it is the
+ * servo's choice. */
+static int dxlt_write_checked(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg, long value,
+                              uint8_t level)
+{
+	uint8_t raw[4], back[4];
+	uint8_t id = s->id;
+	bool answered = id != DXL_BROADCAST_ID && level >= 2 && !dxlt_is_level_reg(reg);
+
+	/* multi-byte values go in one packet: the servo must never act on half */
+	if (reg->row != NULL)
+		dxl2_reg_encode(reg->row, (int32_t)value, raw);
+	else
+		dxl2_put_u32(raw, (uint32_t)value);
+	int r = dxlt_write(t, id, reg->addr, raw, reg->size, answered);
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (id == DXL_BROADCAST_ID) {
+		fprintf(t->out, "broadcast: %s = %ld sent (servos do not answer a broadcast)\n", reg->name, value);
+		return DXLT_EXIT_OK;
+	}
+	dxlt_write_hint(t, s, reg);
+	if (answered)
+		return DXLT_EXIT_OK;
+	uint8_t now_level = dxlt_is_level_reg(reg) ? (uint8_t)value : level;
+	if (now_level == 0) {
+		if ((r = dxlt_ping(t, id)) != DXL_OK)
+			return dxlt_bus_fail(t, id, r);
+		fprintf(t->out, "ID %u: %s = %ld sent, not confirmed: the servo answers PING only (status return level "
+		        "0)\n", id, reg->name, value);
+		return DXLT_EXIT_OK;
+	}
+	/* A READ right after a WRITE to EEPROM may find the servo busy writing. */
+	if (reg->row != NULL && reg->row->area == DXL_AREA_EEPROM)
+		dxlt_sleep_us(t->fam->settle_us);
+	if ((r = dxlt_read(t, id, reg->addr, reg->size, back)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (memcmp(back, raw, reg->size) != 0) {
+		fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld; status return level %u: the WRITE itself is not "
+		        "answered, its read-back is)\n", id, reg->name, (long)dxlt_decode(reg, back), value, level);
+		return t->errseen[id] != 0 || t->errseen2[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u: %s = %ld (read back: status return level %u does not answer WRITE)\n", id, reg->name,
+	        value, level);
+	return DXLT_EXIT_OK;
+}
+
+/* The whole write: checked against the table and the servo's image first. */
+static int dxlt_write_reg(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg, long value)
+{
+	uint8_t mem[DXLT_IMAGE_MAX];
+	size_t len = dxlt_image_len(s->m);
+	int rc, r;
+
+	/* a model we do not know: its level unknown too, a reply expected;
+	 * a broadcast: nobody answers */
+	if (reg->row == NULL || s->id == DXL_BROADCAST_ID)
+		return dxlt_write_checked(t, s, reg, value, 2);
+	if ((r = dxlt_read(t, s->id, 0, (uint16_t)len, mem)) == DXL_E_TIMEOUT) {
+		/* level 0 (PING only), or nobody there */
+		if (!s->pinged && (r = dxlt_ping(t, s->id)) != DXL_OK)
+			return dxlt_bus_fail(t, s->id, r);
+		fprintf(t->err, "dxl: ID %u answers PING but not READ (status return level 0): %s not checked against "
+		        "its limits\n", s->id, reg->name);
+		return dxlt_write_checked(t, s, reg, value, 0);
+	}
+	if (r != DXL_OK)
+		return dxlt_bus_fail(t, s->id, r);
+	if ((rc = dxlt_check_live(t, s, reg, value, mem, len)) != DXLT_EXIT_OK)
+		return rc;
+	uint8_t level = mem[dxlt_addr(t, "status_return_level")];
+	return dxlt_write_checked(t, s, reg, value, level > 2 ? 2 : level);
+}
+
+int dxlt_cmd_write(struct dxlt *t)
+{
+	struct dxlt_servo s;
+	struct dxlt_reg reg;
+	uint8_t id;
+	long value;
+	int rc;
+
+	if ((rc = dxlt_need_cmd(t, 3, "write ID REG VALUE")) || (rc = dxlt_arg_write_id(t, t->a.pos[0], &id)) ||
+	    (rc = dxlt_identify(t, id, &s)) || (rc = dxlt_arg_reg(t, &s, t->a.pos[1], &reg)) ||
+	    (rc = dxlt_parse_value(t, &reg, t->a.pos[2], &value)))
+		return rc;
+	/* After a new ID or baud the servo answers elsewhere: only the commands
+	 * made for it know where to look for the answer. */
+	bool is_id = reg.row != NULL && strcmp(reg.name, "id") == 0;
+	if (is_id || (reg.row != NULL && strcmp(reg.name, "baud_rate") == 0)) {
+		fprintf(t->err, "dxl: %s moves the servo away from this ID/rate: use dxl %s--port %s %s\n", reg.name,
+		        t->fam->opt, port_path(t->port), is_id ? "set-id OLD NEW" : "set-baud ID BAUD");
+		return DXLT_EXIT_USAGE;
+	}
+	return dxlt_write_reg(t, &s, &reg, value);
+}
+
+int dxlt_cmd_torque(struct dxlt *t)
+{
+	struct dxlt_servo s;
+	struct dxlt_reg reg = { NULL, dxlt_addr(t, "torque_enable"), 1, "torque_enable" };
+	uint8_t id;
+	int rc;
+
+	if ((rc = dxlt_need_cmd(t, 2, "torque ID on|off")) || (rc = dxlt_arg_write_id(t, t->a.pos[0], &id)))
+		return rc;
+	const char *w = t->a.pos[1];
+	bool on = strcmp(w, "on") == 0 || strcmp(w, "1") == 0;
+	if (!on && strcmp(w, "off") != 0 && strcmp(w, "0") != 0) {
+		fprintf(t->err, "dxl: torque takes on or off, not '%s'\n", w);
+		return DXLT_EXIT_USAGE;
+	}
+	if ((rc = dxlt_identify(t, id, &s)) != DXLT_EXIT_OK)
+		return rc;
+	if (s.m != NULL)
+		reg.row = dxl2_reg_lookup(s.m, "torque_enable");
+	else
+		dxlt_raw_note(t, &s, reg.addr, reg.size);
+	return dxlt_write_reg(t, &s, &reg, on ? 1 : 0);
 }
