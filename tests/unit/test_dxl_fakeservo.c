@@ -685,7 +685,7 @@ static void test_dxl_setup(void **state)
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_RETURN_DELAY_TIME], 250);
 	servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL] = 1;
 	assert_int_equal(run_dxl(f, "setup", "1", "2", "--yes", NULL), 0);
-	assert_non_null(strstr(f->out, "ID 1: torque turned off (--yes)"));
+	assert_non_null(strstr(f->out, "ID 1: torque_enable set to 0"));
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_TORQUE_ENABLE], 0);
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_RETURN_DELAY_TIME], 0);
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL], 2);

@@ -140,6 +140,21 @@ static size_t dxlt_scan_bauds(const struct dxlt *t, const struct dxlt_family *f,
 	return n;
 }
 
+/* setup's bus time of one 100 Hz cycle on Protocol 1.0: one READ(36, 6) per servo and one SYNC_WRITE
+ * of goal + speed for all, plus the adapter's hold time per READ. */
+static void dxlt_setup_budget(struct dxlt *t, unsigned nservos, bool current, int latency_ms)
+{
+	(void)current;   /* the AX-12A senses none */
+	double byte_us = 10.0 * 1e6 / (double)port_baud(t->port);
+	double wire_ms = (nservos * 20.0 + 5.0 * nservos + 8.0) * byte_us / 1000.0;
+	double total_ms = wire_ms + nservos * (double)latency_ms;
+
+	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire + %d ms "
+	        "adapter latency per read = %.2f ms of the 10 ms period%s\n", nservos,
+	        nservos == 1 ? "" : "s", port_baud(t->port), wire_ms, latency_ms, total_ms,
+	        total_ms > 5.0 ? " (too much for 100 Hz)" : "");
+}
+
 /* The two families `dxl` speaks to, in scan order. */
 static const struct dxlt_family dxlt_families[] = {
 	{ .protocol = 1, .bus = BUS_PROTOCOL_1, .label = "Protocol 1.0", .opt = "", .max_id = DXL_MAX_ID,
@@ -149,7 +164,8 @@ static const struct dxlt_family dxlt_families[] = {
 	  .reset_form = "reset ID --yes",
 	  .reset_refusal = "dxl: a factory reset sets ID 1, 1000000 bps and every default (including angle limits); "
 	                   "add --yes to do it\n",
-	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
+	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at,
+	  .setup_budget = dxlt_setup_budget },
 	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
 	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
 	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true,
@@ -158,7 +174,8 @@ static const struct dxlt_family dxlt_families[] = {
 	  .reset_form = "reset ID --yes [--keep id|id-baud]",
 	  .reset_refusal = "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
 	                   "to do it (--keep id or id-baud keeps those)\n",
-	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at },
+	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at,
+	  .setup_budget = dxlt2_setup_budget },
 };
 #define DXLT_NFAMILIES (sizeof dxlt_families / sizeof dxlt_families[0])
 
@@ -357,143 +374,7 @@ static int dxlt_cmd_reset(struct dxlt *t)
 	return DXLT_EXIT_OK;
 }
 
-/* ---- setup -------------------------------------------------------------------- */
-
-/* Write one EEPROM byte if it differs, then read it back. */
-static int dxlt_setup_byte(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t want, bool replies)
-{
-	const struct dxl_reg *reg = dxl_reg_at(addr);
-	uint8_t have = 0;
-	int r = dxlt_read(t, id, addr, 1, &have);
-
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (have == want) {
-		fprintf(t->out, "ID %u: %s already %u\n", id, reg->name, want);
-		return DXLT_EXIT_OK;
-	}
-	uint8_t before = t->errseen[id];
-	r = dxlt_write(t, id, addr, &want, 1, replies);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (t->errseen[id] & ~before)
-		return DXLT_EXIT_SERVO; /* refused: reported with the others at the end */
-	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	r = dxlt_read(t, id, addr, 1, &have);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (have != want) {
-		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u): EEPROM locked? (lock register; "
-		        "power-cycle)\n", id, reg->name, have, want);
-		return DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u: %s set to %u\n", id, reg->name, want);
-	return DXLT_EXIT_OK;
-}
-
-/* The AX-12A ignores EEPROM writes while torque is on, and a robot just
- * stopped by the daemon holds its pose. Turning torque off lets the joint
- * fall, so it is done only when asked (--yes). */
-static int dxlt_setup_torque_off(struct dxlt *t, uint8_t id, bool replies)
-{
-	uint8_t torque = 0;
-	int r;
-
-	if ((r = dxlt_read(t, id, DXL_AX_TORQUE_ENABLE, 1, &torque)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (!torque)
-		return DXLT_EXIT_OK;
-	if (!t->a.yes) {
-		fprintf(t->err, "dxl: ID %u has torque on, and the AX-12A ignores EEPROM writes then; "
-		        "add --yes to turn it off first (the joint goes limp: support the robot), or "
-		        "dxl --port %s torque %u off\n", id, port_path(t->port), id);
-		return DXLT_EXIT_REFUSED;
-	}
-	uint8_t off = 0;
-	if ((r = dxlt_write(t, id, DXL_AX_TORQUE_ENABLE, &off, 1, replies)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if ((r = dxlt_read(t, id, DXL_AX_TORQUE_ENABLE, 1, &torque)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (torque) {
-		fprintf(t->err, "dxl: ID %u kept torque on after torque off\n", id);
-		return DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u: torque turned off (--yes)\n", id);
-	return DXLT_EXIT_OK;
-}
-
-static int dxlt_setup_one(struct dxlt *t, uint8_t id)
-{
-	uint8_t level = 0;
-	int r, rc;
-
-	if ((r = dxlt_ping(t, id)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	/* The loop READs every cycle, so level 0 (PING only) cannot work; level
-	 * 2 costs nothing per cycle (goals go by SYNC_WRITE, never answered) and
-	 * lets start-up and tools verify their writes. */
-	int want_level = t->a.status_level >= 0 ? t->a.status_level : 2;
-	r = dxlt_read(t, id, DXL_AX_STATUS_RETURN_LEVEL, 1, &level);
-	if (r != DXL_OK) {
-		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? "
-		        "(dxl write %u status_return_level 2 cannot be verified either)\n", id, id);
-		return DXLT_EXIT_BUS;
-	}
-	if ((rc = dxlt_setup_torque_off(t, id, level >= 2)) != DXLT_EXIT_OK)
-		return rc;
-	/* 0: the reply follows the request after ≈22 µs instead of 500 µs. */
-	if ((rc = dxlt_setup_byte(t, id, DXL_AX_RETURN_DELAY_TIME, 0, level >= 2)) != DXLT_EXIT_OK)
-		return rc;
-	/* Which level answers a write to the level is the servo's choice: never
-	 * wait for that reply, read the value back instead. */
-	return dxlt_setup_byte(t, id, DXL_AX_STATUS_RETURN_LEVEL, (uint8_t)want_level, false);
-}
-
-/* Bus time of one 100 Hz cycle: one READ(36, 6) per servo and one SYNC_WRITE
- * of goal + speed for all, plus the adapter's hold time per READ. */
-static void dxlt_setup_budget(struct dxlt *t, unsigned nservos, int latency_ms)
-{
-	double byte_us = 10.0 * 1e6 / (double)port_baud(t->port);
-	double wire_ms = (nservos * 20.0 + 5.0 * nservos + 8.0) * byte_us / 1000.0;
-	double total_ms = wire_ms + nservos * (double)latency_ms;
-
-	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire + %d ms "
-	        "adapter latency per read = %.2f ms of the 10 ms period%s\n", nservos,
-	        nservos == 1 ? "" : "s", port_baud(t->port), wire_ms, latency_ms, total_ms,
-	        total_ms > 5.0 ? " (too much for 100 Hz)" : "");
-}
-
-static int dxlt_cmd_setup(struct dxlt *t)
-{
-	uint8_t ids[DXLT_MAX_IDS];
-	int worst = DXLT_EXIT_OK;
-
-	if (t->a.npos < 1 || t->a.npos > DXLT_MAX_IDS)
-		return dxlt_need_args(t, -1, "setup ID... [--status-level N]");
-	for (int i = 0; i < t->a.npos; i++) {
-		int rc = dxlt_arg_id(t, t->a.pos[i], false, &ids[i]);
-		if (rc != DXLT_EXIT_OK)
-			return rc;
-	}
-	for (int i = 0; i < t->a.npos; i++) {
-		int rc = dxlt_setup_one(t, ids[i]);
-		if (rc == DXLT_EXIT_PORT)
-			return rc;
-		if (rc > worst)
-			worst = rc;
-	}
-	/* The adapter: lower the FTDI latency timer now that the servos are done. */
-	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
-	fprintf(t->out, "adapter: %s\n", t->latency.note);
-	int latency_ms = t->latency.known ? t->latency.timer_ms : 0;
-	dxlt_setup_budget(t, (unsigned)t->a.npos, latency_ms);
-	if (t->latency.known && t->latency.timer_ms > 1) {
-		fprintf(t->err, "dxl: %s\n", t->latency.note);
-		if (worst == DXLT_EXIT_OK)
-			worst = DXLT_EXIT_PORT;
-	}
-	return worst;
-}
+/* ---- reboot ------------------------------------------------------------------- */
 
 /* A REBOOT takes the servo off the bus while it starts again: the e-manual
  * gives no figure; PINGs are tried for this long. */
@@ -563,7 +444,7 @@ static const struct dxlt_command dxlt_commands[] = {
 	{ "read", { dxlt_cmd_read, dxlt_cmd_read } },         { "write", { dxlt_cmd_write, dxlt_cmd_write } },
 	{ "dump", { dxlt_cmd_dump, dxlt_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
 	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt_cmd_torque } },
-	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt2_cmd_setup } },
+	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt_cmd_setup } },
 	{ "reboot", { dxlt_cmd_reboot, dxlt_cmd_reboot } },
 };
 

@@ -39,6 +39,9 @@ struct dxlt_family {
 	long (*baud_from_reg)(uint8_t v);
 	/* one rate of `scan`: a line per servo found */
 	int (*scan_at)(struct dxlt *t, long baud, unsigned *found);
+	/* `setup`'s last line: the bus time of one cycle of the daemon's loop
+	 * for n servos (current: one senses its current) */
+	void (*setup_budget)(struct dxlt *t, unsigned n, bool current, int latency_ms);
 };
 
 struct dxlt {
@@ -131,12 +134,12 @@ int dxlt_cmd_read(struct dxlt *t);
 int dxlt_cmd_dump(struct dxlt *t);
 int dxlt_cmd_write(struct dxlt *t);
 int dxlt_cmd_torque(struct dxlt *t);
+int dxlt_cmd_setup(struct dxlt *t);
 
 /* ---- Protocol 2.0 (commands2.c) ---- */
 /* Broadcast PING at the current rate: one scan line per servo in the ID range. */
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found);
-int dxlt2_reboot(struct dxlt *t, uint8_t id);
-int dxlt2_cmd_setup(struct dxlt *t);
+void dxlt2_setup_budget(struct dxlt *t, unsigned n, bool current, int latency_ms);
 
 /* `dxl doctor` (doctor.c): opens the port itself, after reading the
  * configuration that may name it. */

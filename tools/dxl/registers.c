@@ -1,6 +1,6 @@
 /*
  * registers.c — the `dxl` commands that go by a servo's control table
- * (ping, read, dump, write, torque), written once over every model: registers by name
+ * (ping, read, dump, write, torque, setup), written once over every model: registers by name
  * through the model descriptor's rows (dxl2_table.h), values through the one
  * row type. Where the family's PING names the model (Protocol 2.0) the
  * servo is identified first and a model not in the tables still answers
@@ -452,4 +452,147 @@ int dxlt_cmd_torque(struct dxlt *t)
 	else
 		dxlt_raw_note(t, &s, reg.addr, reg.size);
 	return dxlt_write_reg(t, &s, &reg, on ? 1 : 0);
+}
+
+/* ---- setup ------------------------------------------------------------------------------ */
+
+/* The rate `setup` puts a slower bus at: at the X series' factory 57600 bps
+ * one cycle of two servos takes more than the 10 ms period on the wire alone. */
+#define DXLT_SETUP_BAUD 1000000L
+
+/* Write one EEPROM byte if it differs from what the image holds, then read
+ * it back. A write to the status return level is never waited for. */
+static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const char *name, uint8_t want,
+                           const uint8_t *mem, uint8_t level)
+{
+	const struct dxl2_reg *reg = dxl2_reg_lookup(s->m, name);
+	uint8_t id = s->id, have = mem[reg->addr], before = t->errseen[id] | t->errseen2[id];
+	int r;
+
+	if (have == want) {
+		fprintf(t->out, "ID %u: %s already %u\n", id, name, want);
+		return DXLT_EXIT_OK;
+	}
+	if ((r = dxlt_write(t, id, reg->addr, &want, 1, level >= 2 && strcmp(name, "status_return_level") != 0)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if ((t->errseen[id] | t->errseen2[id]) & ~before)
+		return DXLT_EXIT_SERVO;   /* refused: reported with the others at the end */
+	dxlt_sleep_us(t->fam->settle_us);
+	if ((r = dxlt_read(t, id, reg->addr, 1, &have)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (have != want) {
+		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u)%s\n", id, name, have, want,
+		        dxl2_reg_lookup(s->m, "lock") != NULL ? ": EEPROM locked? (lock register; power-cycle)" : "");
+		return t->errseen[id] | t->errseen2[id] ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+	}
+	fprintf(t->out, "ID %u: %s set to %u\n", id, name, want);
+	return DXLT_EXIT_OK;
+}
+
+static int dxlt_setup_one(struct dxlt *t, uint8_t id, bool *current)
+{
+	uint8_t mem[DXLT_IMAGE_MAX];
+	struct dxlt_servo s;
+	int rc, r;
+
+	if ((rc = dxlt_identify(t, id, &s)) != DXLT_EXIT_OK)
+		return rc;
+	if (!s.pinged && (r = dxlt_ping(t, id)) != DXL_OK)
+		return dxlt_bus_fail(t, id, r);
+	if (s.m == NULL) {
+		fprintf(t->err, "dxl: ID %u is model %u, not in dxl's tables (%s): setup does not "
+		        "know its registers\n", id, s.model, dxlt_known(t));
+		return DXLT_EXIT_REFUSED;
+	}
+	*current = *current || s.m->current_sensing;
+	/* The loop READs every cycle, so level 0 (PING only) cannot work. */
+	if ((r = dxlt_read(t, id, 0, (uint16_t)dxlt_image_len(s.m), mem)) != DXL_OK) {
+		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? (the loop's reads need 1 "
+		        "or 2; dxl %swrite %u status_return_level 2 cannot be verified either)\n", id, t->fam->opt, id);
+		return r == DXL_E_TIMEOUT ? DXLT_EXIT_BUS : dxlt_bus_fail(t, id, r);
+	}
+	uint8_t level = mem[dxlt_addr(t, "status_return_level")];
+	/* A servo refuses EEPROM writes while its torque is on, and a robot just
+	 * stopped by the daemon holds its pose. Turning torque off lets the
+	 * joint fall, so it is done only when asked (--yes). */
+	if (mem[dxlt_addr(t, "torque_enable")]) {
+		if (!t->a.yes) {
+			fprintf(t->err, "dxl: ID %u has torque on, and the %s refuses EEPROM writes then; add --yes to turn it "
+			        "off first (the joint goes limp: support the robot), or dxl %s--port %s torque %u off\n", id,
+			        s.m->name, t->fam->opt, port_path(t->port), id);
+			return DXLT_EXIT_REFUSED;
+		}
+		if ((rc = dxlt_setup_byte(t, &s, "torque_enable", 0, mem, level)) != DXLT_EXIT_OK)
+			return rc;
+	}
+	/* 0: the reply follows the request at once instead of after 500 µs */
+	if ((rc = dxlt_setup_byte(t, &s, "return_delay_time", 0, mem, level)) != DXLT_EXIT_OK)
+		return rc;
+	/* level 2 costs nothing per cycle (goals go unanswered) and lets
+	 * start-up and tools verify their writes */
+	uint8_t want_level = (uint8_t)(t->a.status_level >= 0 ? t->a.status_level : 2);
+	return dxlt_setup_byte(t, &s, "status_return_level", want_level, mem, level);
+}
+
+/* A bus slower than 1 Mbps cannot carry a 100 Hz cycle (57600 bps, the X
+ * series' factory rate, needs 16 ms for two servos' SYNC_READ and
+ * SYNC_WRITE): every servo goes to 1 Mbps, then the port, then each must
+ * answer there. */
+static int dxlt_setup_baud(struct dxlt *t, const uint8_t *ids, int n)
+{
+	uint8_t reg;
+	int r, rc;
+
+	if (port_baud(t->port) >= DXLT_SETUP_BAUD || t->fam->baud_to_reg(DXLT_SETUP_BAUD, &reg) != DXL_OK)
+		return DXLT_EXIT_OK;
+	for (int i = 0; i < n; i++)
+		if ((r = dxlt_write(t, ids[i], dxlt_addr(t, "baud_rate"), &reg, 1, false)) != DXL_OK)
+			return dxlt_bus_fail(t, ids[i], r);
+	long before = port_baud(t->port);
+	dxlt_sleep_us(t->fam->settle_us);
+	if ((rc = dxlt_set_baud(t, DXLT_SETUP_BAUD)) != DXLT_EXIT_OK)
+		return rc;
+	for (int i = 0; i < n; i++) {
+		if ((r = dxlt_verify_ping(t, ids[i])) != DXL_OK) {
+			fprintf(t->err, "dxl: ID %u does not answer at %ld bps after the change (%s); try: dxl %s--port %s scan "
+			        "--bauds all\n", ids[i], DXLT_SETUP_BAUD, dxl_strerror(r), t->fam->opt, port_path(t->port));
+			return r == DXL_E_DISCONNECTED ? DXLT_EXIT_PORT : DXLT_EXIT_BUS;
+		}
+		fprintf(t->out, "ID %u: baud_rate %ld -> %ld bps (a 100 Hz cycle does not fit the period below 1 Mbps; "
+		        "undulated's configuration needs baud = %ld)\n", ids[i], before, DXLT_SETUP_BAUD, DXLT_SETUP_BAUD);
+	}
+	return DXLT_EXIT_OK;
+}
+
+int dxlt_cmd_setup(struct dxlt *t)
+{
+	uint8_t ids[DXLT_MAX_IDS];
+	int worst = DXLT_EXIT_OK, n = t->a.npos;
+	bool current = false;   /* a servo senses its current: the loop reads it too */
+
+	if (n < 1 || n > t->fam->max_id + 1)
+		return dxlt_need_cmd(t, -1, "setup ID... [--status-level N] [--yes]");
+	for (int i = 0; i < n; i++) {
+		int rc = dxlt_arg_servo_id(t, t->a.pos[i], &ids[i]);
+		if (rc != DXLT_EXIT_OK)
+			return rc;
+	}
+	for (int i = 0; i < n; i++) {
+		int rc = dxlt_setup_one(t, ids[i], &current);
+		if (rc == DXLT_EXIT_PORT)
+			return rc;
+		worst = rc > worst ? rc : worst;
+	}
+	if (worst == DXLT_EXIT_OK && (worst = dxlt_setup_baud(t, ids, n)) == DXLT_EXIT_PORT)
+		return worst;
+	/* The adapter: lower the FTDI latency timer now that the servos are done. */
+	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
+	fprintf(t->out, "adapter: %s\n", t->latency.note);
+	t->fam->setup_budget(t, (unsigned)n, current, t->latency.known ? t->latency.timer_ms : 0);
+	if (t->latency.known && t->latency.timer_ms > 1) {
+		fprintf(t->err, "dxl: %s\n", t->latency.note);
+		if (worst == DXLT_EXIT_OK)
+			worst = DXLT_EXIT_PORT;
+	}
+	return worst;
 }

@@ -1,7 +1,7 @@
 /*
  * session.c — what every `dxl` command stands on: the port opened as one
  * bus, its reply timeouts, the transactions that remember each reply's
- * error bits, and the argument helpers. commands.c, commands2.c and
+ * error bits, and the argument helpers. commands.c, registers.c, commands2.c and
  * doctor.c call down into it; it calls none of them.
  */
 #include <errno.h>
