@@ -79,7 +79,7 @@ run noport --port "$T/no-such-port" ping 1
 	&& tap_ok "no such port: exit 3" || tap_fail "no such port: exit 3" "rc=$rc $(cat "$T/noport.err")"
 
 run scan --port "$bus" scan --ids 0-5
-found=$(grep -cE '^[0-9]+ +12 +AX-12 +24 +1000000 +1\.0$' "$T/scan.out")
+found=$(grep -cE '^[0-9]+ +12 +AX-12A +24 +1000000 +1\.0$' "$T/scan.out")
 [ "$found" = 2 ] && tap_ok "scan finds both servos" || tap_fail "scan finds both servos" "$(cat "$T/scan.out" "$T/scan.err")"
 
 run wrongbaud --port "$bus" --baud 57600 ping 1

@@ -464,8 +464,8 @@ static void test_dxl_ping_and_scan(void **state)
 	assert_non_null(strstr(f->out, "model 12 (AX-12A), firmware 24, Protocol 1.0"));
 	assert_int_equal(run_dxl(f, "scan", "--ids", "0-5", NULL), 0);
 	/* header + exactly the two servos, with model, firmware, baud */
-	assert_non_null(strstr(f->out, "\n1    12     AX-12         24        1000000  1.0\n"));
-	assert_non_null(strstr(f->out, "\n2    12     AX-12         24        1000000  1.0\n"));
+	assert_non_null(strstr(f->out, "\n1    12     AX-12A        24        1000000  1.0\n"));
+	assert_non_null(strstr(f->out, "\n2    12     AX-12A        24        1000000  1.0\n"));
 	assert_null(strstr(f->out, "\n3 "));
 	assert_string_equal(f->err, "");
 }

@@ -92,7 +92,7 @@ static void dxlt_print_identity(struct dxlt *t, uint8_t id, long baud)
 	/* Status return level 0 answers PING only: the ID is real, the rest unknown. */
 	fprintf(t->out, "%-4u ", id);
 	if (have_model)
-		fprintf(t->out, "%-6u %-13s ", model, dxlt_model_name(model));
+		fprintf(t->out, "%-6u %-13s ", model, dxlt_model_name(1, model));
 	else
 		fprintf(t->out, "%-6s %-13s ", "?", "?");
 	if (have_fw)

@@ -23,12 +23,11 @@ int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found)
 		return dxlt_bus_fail(t, DXL2_BROADCAST_ID, r);
 	for (size_t i = 0; i < n; i++) {
 		const struct bus_found *f = &servo[i];
-		const struct dxl2_model *m = dxl2_model_by_number(f->model);
 		if (f->id < t->a.id_lo || f->id > t->a.id_hi)
 			continue;
 		t->errseen2[f->id] |= f->err;
 		(*found)++;
-		fprintf(t->out, "%-4u %-6u %-13s %-9u %-8ld 2.0\n", f->id, f->model, m != NULL ? m->name : "unknown",
+		fprintf(t->out, "%-4u %-6u %-13s %-9u %-8ld 2.0\n", f->id, f->model, dxlt_model_name(2, f->model),
 		        f->firmware, baud);
 	}
 	return DXLT_EXIT_OK;

@@ -87,7 +87,9 @@ uint16_t dxlt_addr(const struct dxlt *t, const char *name);
 int dxlt_arg_servo_id(struct dxlt *t, const char *s, uint8_t *id);
 /* After a write whose reply was not waited for, give the servo time, then PING. */
 int dxlt_verify_ping(struct dxlt *t, uint8_t id);
-const char *dxlt_model_name(uint16_t model);
+/* A model's name as a reply on that protocol numbers it: its descriptor's,
+ * or "not in dxl's tables". */
+const char *dxlt_model_name(int protocol, uint16_t model);
 /* Switch the port (and the reply timeouts) to baud. */
 int dxlt_set_baud(struct dxlt *t, long baud);
 void dxlt_sleep_us(long us);

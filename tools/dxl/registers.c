@@ -23,11 +23,6 @@ static const char *dxlt_known(const struct dxlt *t)
 	return dxl2_model_names(t->fam->protocol, names, sizeof names);
 }
 
-static const char *dxlt_servo_model_text(const struct dxlt_servo *s)
-{
-	return s->m != NULL ? s->m->name : "not in dxl's tables";
-}
-
 size_t dxlt_image_len(const struct dxl2_model *m)
 {
 	size_t end = 0;
@@ -141,7 +136,7 @@ int dxlt_cmd_ping(struct dxlt *t)
 		return dxlt_bus_fail(t, id, r);
 	fprintf(t->out, "ID %u answered in %u us", id, (unsigned)t->bus.servo[id].rtt_last_us);
 	if (dxlt_ping_identity(t, &s))
-		fprintf(t->out, ": model %u (%s), firmware %u, %s\n", s.model, dxlt_servo_model_text(&s), s.firmware,
+		fprintf(t->out, ": model %u (%s), firmware %u, %s\n", s.model, dxlt_model_name(t->fam->protocol, s.model), s.firmware,
 		        t->fam->label);
 	else
 		fprintf(t->out, ": answers PING only (status return level 0), %s\n", t->fam->label);

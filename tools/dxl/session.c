@@ -18,13 +18,17 @@ void dxlt_sleep_us(long us)
 	}
 }
 
-const char *dxlt_model_name(uint16_t model)
+const char *dxlt_model_name(int protocol, uint16_t model)
 {
-	switch (model) {
-	case 12: return "AX-12";
+	const struct dxl2_model *m = dxl2_model_find(protocol, model);
+
+	if (m != NULL)
+		return m->name;
+	/* Protocol 1.0 servos dxl names but has no table of (their own differ) */
+	switch (protocol == 1 ? model : 0) {
 	case 18: return "AX-18";
 	case 300: return "AX-12W";
-	default: return "not an AX-12";
+	default: return "not in dxl's tables";
 	}
 }
 
