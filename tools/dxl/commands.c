@@ -250,14 +250,6 @@ static int dxlt_need_torque_off(struct dxlt *t, uint8_t id, const char *what)
 	return DXLT_EXIT_REFUSED;
 }
 
-/* "set-id OLD NEW", with the protocol option a suggestion must carry. */
-static int dxlt_need_form(struct dxlt *t, int n, const char *form)
-{
-	char line[96];
-	snprintf(line, sizeof line, "%s%s", t->fam->opt, form);
-	return dxlt_need_args(t, n, line);
-}
-
 static int dxlt_cmd_set_id(struct dxlt *t)
 {
 	uint8_t old_id, new_id;

@@ -95,6 +95,9 @@ int dxlt_set_baud(struct dxlt *t, long baud);
 void dxlt_sleep_us(long us);
 /* The command's positional count, or a usage line (form) and exit 2. */
 int dxlt_need_args(struct dxlt *t, int n, const char *form);
+/* dxlt_need_args with the family's option a suggestion must carry
+ * ("--protocol 2 " + "set-id OLD NEW"). */
+int dxlt_need_form(struct dxlt *t, int n, const char *form);
 int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id);
 
 /* Protocol 2.0's PING, with the model and firmware it answers. */

@@ -94,14 +94,6 @@ int32_t dxlt_decode(const struct dxlt_reg *reg, const uint8_t *raw)
 	return reg->size == 4 ? (int32_t)dxl2_get_u32(raw) : reg->size == 2 ? dxl_get_u16(raw) : raw[0];
 }
 
-/* "ping ID" with the family's option a suggestion must carry. */
-static int dxlt_need_cmd(struct dxlt *t, int n, const char *form)
-{
-	char line[96];
-	snprintf(line, sizeof line, "%s%s", t->fam->opt, form);
-	return dxlt_need_args(t, n, line);
-}
-
 /* ---- ping ----------------------------------------------------------------------- */
 
 /* Where the PING does not name the model, READ it (status return level 0
@@ -129,7 +121,7 @@ int dxlt_cmd_ping(struct dxlt *t)
 	uint8_t id;
 	int rc, r;
 
-	if ((rc = dxlt_need_cmd(t, 1, "ping ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
+	if ((rc = dxlt_need_form(t, 1, "ping ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
 	    (rc = dxlt_identify(t, id, &s)))
 		return rc;
 	if (!s.pinged && (r = dxlt_ping(t, id)) != DXL_OK)
@@ -157,7 +149,7 @@ int dxlt_cmd_read(struct dxlt *t)
 	char text[96];
 	int rc;
 
-	if ((rc = dxlt_need_cmd(t, 2, "read ID REG [--units]")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
+	if ((rc = dxlt_need_form(t, 2, "read ID REG [--units]")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
 	    (rc = dxlt_identify(t, id, &s)) || (rc = dxlt_arg_reg(t, &s, t->a.pos[1], &reg)))
 		return rc;
 	int r = dxlt_read(t, id, reg.addr, reg.size, raw);
@@ -208,7 +200,7 @@ int dxlt_cmd_dump(struct dxlt *t)
 	char text[96];
 	int rc;
 
-	if ((rc = dxlt_need_cmd(t, 1, "dump ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
+	if ((rc = dxlt_need_form(t, 1, "dump ID")) || (rc = dxlt_arg_servo_id(t, t->a.pos[0], &id)) ||
 	    (rc = dxlt_identify(t, id, &s)))
 		return rc;
 	size_t len = dxlt_image_len(s.m);
@@ -410,7 +402,7 @@ int dxlt_cmd_write(struct dxlt *t)
 	long value;
 	int rc;
 
-	if ((rc = dxlt_need_cmd(t, 3, "write ID REG VALUE")) || (rc = dxlt_arg_write_id(t, t->a.pos[0], &id)) ||
+	if ((rc = dxlt_need_form(t, 3, "write ID REG VALUE")) || (rc = dxlt_arg_write_id(t, t->a.pos[0], &id)) ||
 	    (rc = dxlt_identify(t, id, &s)) || (rc = dxlt_arg_reg(t, &s, t->a.pos[1], &reg)) ||
 	    (rc = dxlt_parse_value(t, &reg, t->a.pos[2], &value)))
 		return rc;
@@ -432,7 +424,7 @@ int dxlt_cmd_torque(struct dxlt *t)
 	uint8_t id;
 	int rc;
 
-	if ((rc = dxlt_need_cmd(t, 2, "torque ID on|off")) || (rc = dxlt_arg_write_id(t, t->a.pos[0], &id)))
+	if ((rc = dxlt_need_form(t, 2, "torque ID on|off")) || (rc = dxlt_arg_write_id(t, t->a.pos[0], &id)))
 		return rc;
 	const char *w = t->a.pos[1];
 	bool on = strcmp(w, "on") == 0 || strcmp(w, "1") == 0;
@@ -566,7 +558,7 @@ int dxlt_cmd_setup(struct dxlt *t)
 	bool current = false;   /* a servo senses its current: the loop reads it too */
 
 	if (n < 1 || n > t->fam->max_id + 1)
-		return dxlt_need_cmd(t, -1, "setup ID... [--status-level N] [--yes]");
+		return dxlt_need_form(t, -1, "setup ID... [--status-level N] [--yes]");
 	for (int i = 0; i < n; i++) {
 		int rc = dxlt_arg_servo_id(t, t->a.pos[i], &ids[i]);
 		if (rc != DXLT_EXIT_OK)

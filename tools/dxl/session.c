@@ -180,6 +180,13 @@ int dxlt_need_args(struct dxlt *t, int n, const char *form)
 	return DXLT_EXIT_USAGE;
 }
 
+int dxlt_need_form(struct dxlt *t, int n, const char *form)
+{
+	char line[96];
+	snprintf(line, sizeof line, "%s%s", t->fam->opt, form);
+	return dxlt_need_args(t, n, line);
+}
+
 int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id)
 {
 	if (dxlt_parse_id(s, allow_broadcast, id) == 0)
