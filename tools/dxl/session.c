@@ -18,18 +18,23 @@ void dxlt_sleep_us(long us)
 	}
 }
 
+/* Servos dxl names but has no table of (their tables differ from the AX-12A's). */
+static const struct {
+	int protocol;
+	uint16_t number;
+	const char *name;
+} dxlt_untabled[] = { { 1, 18, "AX-18" }, { 1, 300, "AX-12W" } };
+
 const char *dxlt_model_name(int protocol, uint16_t model)
 {
 	const struct dxl2_model *m = dxl2_model_find(protocol, model);
 
 	if (m != NULL)
 		return m->name;
-	/* Protocol 1.0 servos dxl names but has no table of (their own differ) */
-	switch (protocol == 1 ? model : 0) {
-	case 18: return "AX-18";
-	case 300: return "AX-12W";
-	default: return "not in dxl's tables";
-	}
+	for (size_t i = 0; i < sizeof dxlt_untabled / sizeof dxlt_untabled[0]; i++)
+		if (dxlt_untabled[i].protocol == protocol && dxlt_untabled[i].number == model)
+			return dxlt_untabled[i].name;
+	return "not in dxl's tables";
 }
 
 void dxlt_apply_timing(struct dxlt *t)
