@@ -37,7 +37,7 @@ run noargs
 	&& tap_ok "no command: usage on stderr, exit 2" || tap_fail "no command: usage on stderr, exit 2" "rc=$rc"
 
 run ping --port "$bus" ping 1
-[ "$rc" -eq 0 ] && grep -q '^ID 1 answered in [0-9]* us: model 12 (AX-12), firmware 24$' "$T/ping.out" \
+[ "$rc" -eq 0 ] && grep -q '^ID 1 answered in [0-9]* us: model 12 (AX-12A), firmware 24, Protocol 1.0$' "$T/ping.out" \
 	&& tap_ok "ping 1" || tap_fail "ping 1" "rc=$rc $(cat "$T/ping.out" "$T/ping.err")"
 
 run temp --port "$bus" read 1 present_temperature
@@ -55,7 +55,7 @@ run readback --port "$bus" read 1 goal_position
 run range --port "$bus" write 1 goal_position 5000
 run after --port "$bus" read 1 goal_position
 [ "$rc" -eq 0 ] && [ "$(cat "$T/after.out")" = "300" ] && [ "$(lines "$T/range.err")" = 1 ] \
-	&& grep -q 'out of range for goal_position (0-1023)' "$T/range.err" \
+	&& grep -q 'out of range for goal_position (0..1023)' "$T/range.err" \
 	&& tap_ok "out-of-range write: one line, nothing written" \
 	|| tap_fail "out-of-range write: one line, nothing written" "$(cat "$T/range.err" "$T/after.out")"
 run range2 --port "$bus" write 1 goal_position 5000
@@ -79,7 +79,7 @@ run noport --port "$T/no-such-port" ping 1
 	&& tap_ok "no such port: exit 3" || tap_fail "no such port: exit 3" "rc=$rc $(cat "$T/noport.err")"
 
 run scan --port "$bus" scan --ids 0-5
-found=$(grep -cE '^[0-9]+ +12 +AX-12 +24 +1000000 +1\.0$' "$T/scan.out")
+found=$(grep -cE '^[0-9]+ +12 +AX-12A +24 +1000000 +1\.0$' "$T/scan.out")
 [ "$found" = 2 ] && tap_ok "scan finds both servos" || tap_fail "scan finds both servos" "$(cat "$T/scan.out" "$T/scan.err")"
 
 run wrongbaud --port "$bus" --baud 57600 ping 1

@@ -26,7 +26,7 @@ spawn sim "$sim" --link "$bus" --ids 1,2 --lcm-url "$url" --quiet
 if wait_log sim 'ready' 10; then tap_ok "simulator ready"; else tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit; fi
 
 run scan --port "$bus" scan --ids 0-4
-found=$(grep -cE '^[12] +12 +AX-12 +[0-9]+ +1000000 +1\.0$' "$T/scan.out")
+found=$(grep -cE '^[12] +12 +AX-12A +[0-9]+ +1000000 +1\.0$' "$T/scan.out")
 [ "$rc" -eq 0 ] && [ "$found" = 2 ] && [ "$(wc -l <"$T/scan.out")" -eq 3 ] \
 	&& tap_ok "scan finds exactly IDs 1 and 2" || tap_fail "scan finds exactly IDs 1 and 2" "rc=$rc $(cat "$T/scan.out" "$T/scan.err")"
 

@@ -461,11 +461,11 @@ static void test_dxl_ping_and_scan(void **state)
 
 	assert_int_equal(run_dxl(f, "ping", "2", NULL), 0);
 	assert_non_null(strstr(f->out, "ID 2 answered"));
-	assert_non_null(strstr(f->out, "model 12 (AX-12), firmware 24"));
+	assert_non_null(strstr(f->out, "model 12 (AX-12A), firmware 24, Protocol 1.0"));
 	assert_int_equal(run_dxl(f, "scan", "--ids", "0-5", NULL), 0);
 	/* header + exactly the two servos, with model, firmware, baud */
-	assert_non_null(strstr(f->out, "\n1    12     AX-12         24        1000000  1.0\n"));
-	assert_non_null(strstr(f->out, "\n2    12     AX-12         24        1000000  1.0\n"));
+	assert_non_null(strstr(f->out, "\n1    12     AX-12A        24        1000000  1.0\n"));
+	assert_non_null(strstr(f->out, "\n2    12     AX-12A        24        1000000  1.0\n"));
 	assert_null(strstr(f->out, "\n3 "));
 	assert_string_equal(f->err, "");
 }
@@ -493,7 +493,7 @@ static void test_dxl_write_validates_first(void **state)
 	unsigned packets = atomic_load(&f->bus.packets);
 	/* out of range, read-only, unknown, not a number: nothing goes on the wire */
 	assert_int_equal(run_dxl(f, "write", "1", "goal_position", "1024", NULL), DXLT_EXIT_USAGE);
-	assert_non_null(strstr(f->err, "out of range for goal_position (0-1023)"));
+	assert_non_null(strstr(f->err, "out of range for goal_position (0..1023)"));
 	assert_int_equal(run_dxl(f, "write", "1", "present_position", "10", NULL), DXLT_EXIT_USAGE);
 	assert_non_null(strstr(f->err, "read-only"));
 	assert_int_equal(run_dxl(f, "write", "1", "warp_drive", "1", NULL), DXLT_EXIT_USAGE);
@@ -685,7 +685,7 @@ static void test_dxl_setup(void **state)
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_RETURN_DELAY_TIME], 250);
 	servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL] = 1;
 	assert_int_equal(run_dxl(f, "setup", "1", "2", "--yes", NULL), 0);
-	assert_non_null(strstr(f->out, "ID 1: torque turned off (--yes)"));
+	assert_non_null(strstr(f->out, "ID 1: torque_enable set to 0"));
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_TORQUE_ENABLE], 0);
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_RETURN_DELAY_TIME], 0);
 	assert_int_equal(servo_by_id(f, 1)->mem[DXL_AX_STATUS_RETURN_LEVEL], 2);

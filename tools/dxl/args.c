@@ -16,15 +16,25 @@ static const uint8_t dxlt_ax12_baud_regs[] = { 1, 3, 4, 7, 9, 16, 34, 103, 207 }
 /* The X series' baud register, factory rate (57600) first: 1, 3 (1 M), ... */
 static const uint8_t dxlt_x_baud_regs[] = { 1, 3, 2, 4, 5, 6, 7, 0 };
 
+/* Each protocol's rates, as its register values and their meaning. */
+static const struct {
+	int protocol;
+	const uint8_t *regs;
+	size_t nregs;
+	long (*from_reg)(uint8_t v);
+} dxlt_rate_lists[] = {
+	{ 1, dxlt_ax12_baud_regs, sizeof dxlt_ax12_baud_regs, dxl_baud_from_reg },
+	{ 2, dxlt_x_baud_regs, sizeof dxlt_x_baud_regs, dxl2_baud_from_reg },
+};
+
 size_t dxlt_bauds_for(int protocol, long *out, size_t cap)
 {
 	size_t n = 0;
-	if (protocol == 2) {
-		for (size_t i = 0; i < sizeof dxlt_x_baud_regs && n < cap; i++)
-			out[n++] = dxl2_baud_from_reg(dxlt_x_baud_regs[i]);
-	} else {
-		for (size_t i = 0; i < sizeof dxlt_ax12_baud_regs && n < cap; i++)
-			out[n++] = dxl_baud_from_reg(dxlt_ax12_baud_regs[i]);
+	for (size_t l = 0; l < sizeof dxlt_rate_lists / sizeof dxlt_rate_lists[0]; l++) {
+		if (dxlt_rate_lists[l].protocol != protocol)
+			continue;
+		for (size_t i = 0; i < dxlt_rate_lists[l].nregs && n < cap; i++)
+			out[n++] = dxlt_rate_lists[l].from_reg(dxlt_rate_lists[l].regs[i]);
 	}
 	return n;
 }

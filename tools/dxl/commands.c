@@ -48,37 +48,6 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 	return rc == DXLT_EXIT_OK ? DXLT_EXIT_SERVO : rc;
 }
 
-static int dxlt_arg_reg(struct dxlt *t, const char *s, const struct dxl_reg **reg)
-{
-	*reg = dxl_reg_lookup(s);
-	if (*reg != NULL)
-		return DXLT_EXIT_OK;
-	fprintf(t->err, "dxl: unknown register '%s' (names and addresses: dxl dump ID)\n", s);
-	return DXLT_EXIT_USAGE;
-}
-
-static int dxlt_read_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t *v)
-{
-	uint8_t raw[2] = { 0, 0 };
-	int r = dxlt_read(t, id, reg->addr, reg->size, raw);
-
-	*v = reg->size == 2 ? dxl_get_u16(raw) : raw[0];
-	return r;
-}
-
-static int dxlt_write_reg(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t v,
-                          bool expect_reply)
-{
-	uint8_t raw[2];
-
-	/* 16-bit values go in one packet: the servo must never act on half. */
-	if (reg->size == 2)
-		dxl_put_u16(raw, v);
-	else
-		raw[0] = (uint8_t)v;
-	return dxlt_write(t, id, reg->addr, raw, reg->size, expect_reply);
-}
-
 /* ---- ports -------------------------------------------------------------------- */
 
 /* Enumeration beyond this many ports is truncated (a robot has one or two). */
@@ -123,7 +92,7 @@ static void dxlt_print_identity(struct dxlt *t, uint8_t id, long baud)
 	/* Status return level 0 answers PING only: the ID is real, the rest unknown. */
 	fprintf(t->out, "%-4u ", id);
 	if (have_model)
-		fprintf(t->out, "%-6u %-13s ", model, dxlt_model_name(model));
+		fprintf(t->out, "%-6u %-13s ", model, dxlt_model_name(1, model));
 	else
 		fprintf(t->out, "%-6s %-13s ", "?", "?");
 	if (have_fw)
@@ -171,6 +140,21 @@ static size_t dxlt_scan_bauds(const struct dxlt *t, const struct dxlt_family *f,
 	return n;
 }
 
+/* setup's bus time of one 100 Hz cycle on Protocol 1.0: one READ(36, 6) per servo and one SYNC_WRITE
+ * of goal + speed for all, plus the adapter's hold time per READ. */
+static void dxlt_setup_budget(struct dxlt *t, unsigned nservos, bool current, int latency_ms)
+{
+	(void)current;   /* the AX-12A senses none */
+	double byte_us = 10.0 * 1e6 / (double)port_baud(t->port);
+	double wire_ms = (nservos * 20.0 + 5.0 * nservos + 8.0) * byte_us / 1000.0;
+	double total_ms = wire_ms + nservos * (double)latency_ms;
+
+	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire + %d ms "
+	        "adapter latency per read = %.2f ms of the 10 ms period%s\n", nservos,
+	        nservos == 1 ? "" : "s", port_baud(t->port), wire_ms, latency_ms, total_ms,
+	        total_ms > 5.0 ? " (too much for 100 Hz)" : "");
+}
+
 /* The two families `dxl` speaks to, in scan order. */
 static const struct dxlt_family dxlt_families[] = {
 	{ .protocol = 1, .bus = BUS_PROTOCOL_1, .label = "Protocol 1.0", .opt = "", .max_id = DXL_MAX_ID,
@@ -180,16 +164,18 @@ static const struct dxlt_family dxlt_families[] = {
 	  .reset_form = "reset ID --yes",
 	  .reset_refusal = "dxl: a factory reset sets ID 1, 1000000 bps and every default (including angle limits); "
 	                   "add --yes to do it\n",
-	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
+	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at,
+	  .setup_budget = dxlt_setup_budget },
 	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
 	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
-	  .settle_us = 20000, .eeprom_needs_torque_off = true,
+	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true,
 	  .no_rate = "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, 3000000, "
 	             "4000000, 4500000)\n",
 	  .reset_form = "reset ID --yes [--keep id|id-baud]",
 	  .reset_refusal = "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
 	                   "to do it (--keep id or id-baud keeps those)\n",
-	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at },
+	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at,
+	  .setup_budget = dxlt2_setup_budget },
 };
 #define DXLT_NFAMILIES (sizeof dxlt_families / sizeof dxlt_families[0])
 
@@ -242,210 +228,7 @@ static int dxlt_cmd_scan(struct dxlt *t)
 	return DXLT_EXIT_OK;
 }
 
-static int dxlt_cmd_ping(struct dxlt *t)
-{
-	uint8_t id, raw[2], fw = 0;
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 1, "ping ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
-		return rc;
-	int r = dxlt_ping(t, id);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	uint32_t rtt = t->bus.servo[id].rtt_last_us;
-	fprintf(t->out, "ID %u answered in %u us", id, (unsigned)rtt);
-	if (dxlt_read(t, id, DXL_AX_MODEL_NUMBER, 2, raw) == DXL_OK)
-		fprintf(t->out, ": model %u (%s)", dxl_get_u16(raw), dxlt_model_name(dxl_get_u16(raw)));
-	else
-		fprintf(t->out, ": answers PING only (status return level 0)");
-	if (dxlt_read(t, id, DXL_AX_FIRMWARE_VERSION, 1, &fw) == DXL_OK)
-		fprintf(t->out, ", firmware %u", fw);
-	fputc('\n', t->out);
-	return DXLT_EXIT_OK;
-}
-
 /* ---- read / write / dump ------------------------------------------------------ */
-
-static int dxlt_cmd_read(struct dxlt *t)
-{
-	const struct dxl_reg *reg;
-	uint8_t id;
-	uint16_t v;
-	char text[96];
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 2, "read ID REG [--units]")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)) || (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)))
-		return rc;
-	int r = dxlt_read_reg(t, id, reg, &v);
-	if (r == DXL_E_TIMEOUT && dxlt_ping(t, id) == DXL_OK) {
-		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0 "
-		        "(raise it: dxl --port %s write %u status_return_level 2)\n", id,
-		        port_path(t->port), id);
-		return DXLT_EXIT_BUS;
-	}
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (t->a.units)
-		fprintf(t->out, "%s\n", dxl_reg_format(reg, v, text, sizeof text));
-	else
-		fprintf(t->out, "%u\n", v);
-	return DXLT_EXIT_OK;
-}
-
-static int dxlt_check_value(struct dxlt *t, const struct dxl_reg *reg, const char *s, uint16_t *v)
-{
-	long value;
-
-	if (reg->access != DXL_ACCESS_RW) {
-		fprintf(t->err, "dxl: %s (address %u) is read-only\n", reg->name, reg->addr);
-		return DXLT_EXIT_USAGE;
-	}
-	enum num_status st = num_parse_long(s, LONG_MIN, LONG_MAX, &value);
-	if (st != NUM_OK && st != NUM_RANGE) {
-		fprintf(t->err, "dxl: value '%s' for %s is %s\n", s, reg->name, num_strerror(st));
-		return DXLT_EXIT_USAGE;
-	}
-	if (st != NUM_OK || dxl_reg_check_write(reg, value) != DXL_OK) {
-		fprintf(t->err, "dxl: value '%s' out of range for %s (%u-%u)\n", s, reg->name, reg->min,
-		        reg->max);
-		return DXLT_EXIT_USAGE;
-	}
-	*v = (uint16_t)value;
-	return DXLT_EXIT_OK;
-}
-
-/* The servo's status return level decides which instructions it answers (0:
- * PING only, 1: READ too, 2: everything): ask it rather than assume 2, or a
- * write that took effect reads as "no reply". */
-static int dxlt_status_level(struct dxlt *t, uint8_t id, uint8_t *level)
-{
-	uint8_t v = 0;
-	int r = dxlt_read(t, id, DXL_AX_STATUS_RETURN_LEVEL, 1, &v);
-
-	if (r == DXL_OK) {
-		*level = v > 2 ? 2 : v;
-		return DXL_OK;
-	}
-	if (r != DXL_E_TIMEOUT)
-		return r;
-	r = dxlt_ping(t, id);
-	if (r == DXL_OK)
-		*level = 0;
-	return r;
-}
-
-/* Why the servo refused a write, when its error bits say (the bits alone
- * name the symptom, not the remedy). */
-static void dxlt_write_hint(struct dxlt *t, uint8_t id, const struct dxl_reg *reg)
-{
-	uint8_t e = t->errseen[id];
-
-	if ((e & DXL_ERRBIT_RANGE) && reg->area == DXL_AREA_EEPROM)
-		snprintf(t->hint, sizeof t->hint, "the AX-12A refuses EEPROM writes (%s) while torque "
-		         "is on or the lock is set: dxl --port %s torque %u off", reg->name,
-		         port_path(t->port), id);
-	else if ((e & DXL_ERRBIT_ANGLE_LIMIT) && reg->addr == DXL_AX_GOAL_POSITION)
-		snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's angle limits: dxl "
-		         "--port %s read %u cw_angle_limit (and ccw_angle_limit)", port_path(t->port), id);
-}
-
-/* Write one register and know whether it took, as far as the servo's status
- * return level lets us: level 2 answers the WRITE; level 1 answers only a
- * READ, so read the value back; level 0 answers nothing but PING, so the
- * write goes out unconfirmed and the output says so. A write to the status
- * return level itself is never waited for: which level answers it is the
- * servo's choice. */
-static int dxlt_write_checked(struct dxlt *t, uint8_t id, const struct dxl_reg *reg, uint16_t v)
-{
-	uint8_t level = 2;
-	int r;
-
-	if (id == DXL_BROADCAST_ID) {
-		r = dxlt_write_reg(t, id, reg, v, false);
-		if (r != DXL_OK)
-			return dxlt_bus_fail(t, id, r);
-		fprintf(t->out, "broadcast: %s = %u sent (servos do not answer a broadcast)\n",
-		        reg->name, v);
-		return DXLT_EXIT_OK;
-	}
-	if ((r = dxlt_status_level(t, id, &level)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	bool answered = level >= 2 && reg->addr != DXL_AX_STATUS_RETURN_LEVEL;
-	r = dxlt_write_reg(t, id, reg, v, answered);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	dxlt_write_hint(t, id, reg);
-	if (answered)
-		return DXLT_EXIT_OK;
-	uint8_t now_level = reg->addr == DXL_AX_STATUS_RETURN_LEVEL ? (uint8_t)v : level;
-	if (now_level == 0) {
-		if ((r = dxlt_ping(t, id)) != DXL_OK)
-			return dxlt_bus_fail(t, id, r);
-		fprintf(t->out, "ID %u: %s = %u sent, not confirmed: the servo answers PING only "
-		        "(status return level 0)\n", id, reg->name, v);
-		return DXLT_EXIT_OK;
-	}
-	/* A READ right after a WRITE to EEPROM may find the servo busy writing. */
-	if (reg->area == DXL_AREA_EEPROM)
-		dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	uint16_t have = 0;
-	if ((r = dxlt_read_reg(t, id, reg, &have)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (have != v) {
-		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u; status return level %u: the "
-		        "WRITE itself is not answered, its read-back is)\n", id, reg->name, have, v,
-		        level);
-		return t->errseen[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u: %s = %u (read back: status return level %u does not answer "
-	        "WRITE)\n", id, reg->name, v, level);
-	return DXLT_EXIT_OK;
-}
-
-static int dxlt_cmd_write(struct dxlt *t)
-{
-	const struct dxl_reg *reg;
-	uint8_t id;
-	uint16_t v;
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 3, "write ID REG VALUE")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)) ||
-	    (rc = dxlt_arg_reg(t, t->a.pos[1], &reg)) || (rc = dxlt_check_value(t, reg, t->a.pos[2], &v)))
-		return rc;
-	/* After a new ID or baud the servo answers elsewhere: only the commands
-	 * made for it know where to look for the answer. */
-	if (reg->addr == DXL_AX_ID || reg->addr == DXL_AX_BAUD_RATE) {
-		fprintf(t->err, "dxl: %s moves the servo away from this ID/rate: use dxl --port %s %s\n", reg->name,
-		        port_path(t->port), reg->addr == DXL_AX_ID ? "set-id OLD NEW" : "set-baud ID BAUD");
-		return DXLT_EXIT_USAGE;
-	}
-	return dxlt_write_checked(t, id, reg, v);
-}
-
-static int dxlt_cmd_dump(struct dxlt *t)
-{
-	uint8_t id;
-	uint8_t mem[DXL_AX_TABLE_SIZE];
-	char text[96];
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 1, "dump ID")) || (rc = dxlt_arg_id(t, t->a.pos[0], false, &id)))
-		return rc;
-	int r = dxlt_read(t, id, 0, DXL_AX_TABLE_SIZE, mem);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	fprintf(t->out, "%-4s %-22s %-24s %s\n", "ADDR", "NAME", "VALUE", "DESCRIPTION");
-	for (size_t i = 0; i < dxl_ax12_nregs; i++) {
-		const struct dxl_reg *reg = &dxl_ax12_regs[i];
-		uint16_t v = reg->size == 2 ? dxl_get_u16(&mem[reg->addr]) : mem[reg->addr];
-		fprintf(t->out, "%-4u %-22s %-24s %s%s\n", reg->addr, reg->name,
-		        dxl_reg_format(reg, v, text, sizeof text), reg->desc,
-		        reg->area == DXL_AREA_EEPROM ? " [EEPROM]" : "");
-	}
-	return DXLT_EXIT_OK;
-}
 
 /* ---- set-id / set-baud / torque / reset --------------------------------------- */
 
@@ -465,14 +248,6 @@ static int dxlt_need_torque_off(struct dxlt *t, uint8_t id, const char *what)
 	fprintf(t->err, "dxl: ID %u has torque on, and an X-series servo refuses EEPROM writes (%s) then: dxl "
 	        "%s--port %s torque %u off\n", id, what, t->fam->opt, port_path(t->port), id);
 	return DXLT_EXIT_REFUSED;
-}
-
-/* "set-id OLD NEW", with the protocol option a suggestion must carry. */
-static int dxlt_need_form(struct dxlt *t, int n, const char *form)
-{
-	char line[96];
-	snprintf(line, sizeof line, "%s%s", t->fam->opt, form);
-	return dxlt_need_args(t, n, line);
 }
 
 static int dxlt_cmd_set_id(struct dxlt *t)
@@ -548,23 +323,6 @@ static int dxlt_cmd_set_baud(struct dxlt *t)
 	return DXLT_EXIT_OK;
 }
 
-static int dxlt_cmd_torque(struct dxlt *t)
-{
-	uint8_t id;
-	int rc;
-
-	if ((rc = dxlt_need_args(t, 2, "torque ID on|off")) ||
-	    (rc = dxlt_arg_id(t, t->a.pos[0], true, &id)))
-		return rc;
-	const char *s = t->a.pos[1];
-	bool on = strcmp(s, "on") == 0 || strcmp(s, "1") == 0;
-	if (!on && strcmp(s, "off") != 0 && strcmp(s, "0") != 0) {
-		fprintf(t->err, "dxl: torque takes on or off, not '%s'\n", s);
-		return DXLT_EXIT_USAGE;
-	}
-	return dxlt_write_checked(t, id, dxl_reg_at(DXL_AX_TORQUE_ENABLE), on ? 1 : 0);
-}
-
 /* What a factory reset keeps: --keep where the models can (their
  * descriptor's DXL2_CAP_FACTORY_RESET_KEEP), else everything goes. */
 static uint8_t dxlt_reset_keep(const struct dxlt *t, const char **what)
@@ -608,143 +366,7 @@ static int dxlt_cmd_reset(struct dxlt *t)
 	return DXLT_EXIT_OK;
 }
 
-/* ---- setup -------------------------------------------------------------------- */
-
-/* Write one EEPROM byte if it differs, then read it back. */
-static int dxlt_setup_byte(struct dxlt *t, uint8_t id, uint8_t addr, uint8_t want, bool replies)
-{
-	const struct dxl_reg *reg = dxl_reg_at(addr);
-	uint8_t have = 0;
-	int r = dxlt_read(t, id, addr, 1, &have);
-
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (have == want) {
-		fprintf(t->out, "ID %u: %s already %u\n", id, reg->name, want);
-		return DXLT_EXIT_OK;
-	}
-	uint8_t before = t->errseen[id];
-	r = dxlt_write(t, id, addr, &want, 1, replies);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (t->errseen[id] & ~before)
-		return DXLT_EXIT_SERVO; /* refused: reported with the others at the end */
-	dxlt_sleep_us(DXLT_EEPROM_SETTLE_US);
-	r = dxlt_read(t, id, addr, 1, &have);
-	if (r != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (have != want) {
-		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u): EEPROM locked? (lock register; "
-		        "power-cycle)\n", id, reg->name, have, want);
-		return DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u: %s set to %u\n", id, reg->name, want);
-	return DXLT_EXIT_OK;
-}
-
-/* The AX-12A ignores EEPROM writes while torque is on, and a robot just
- * stopped by the daemon holds its pose. Turning torque off lets the joint
- * fall, so it is done only when asked (--yes). */
-static int dxlt_setup_torque_off(struct dxlt *t, uint8_t id, bool replies)
-{
-	uint8_t torque = 0;
-	int r;
-
-	if ((r = dxlt_read(t, id, DXL_AX_TORQUE_ENABLE, 1, &torque)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (!torque)
-		return DXLT_EXIT_OK;
-	if (!t->a.yes) {
-		fprintf(t->err, "dxl: ID %u has torque on, and the AX-12A ignores EEPROM writes then; "
-		        "add --yes to turn it off first (the joint goes limp: support the robot), or "
-		        "dxl --port %s torque %u off\n", id, port_path(t->port), id);
-		return DXLT_EXIT_REFUSED;
-	}
-	uint8_t off = 0;
-	if ((r = dxlt_write(t, id, DXL_AX_TORQUE_ENABLE, &off, 1, replies)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if ((r = dxlt_read(t, id, DXL_AX_TORQUE_ENABLE, 1, &torque)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	if (torque) {
-		fprintf(t->err, "dxl: ID %u kept torque on after torque off\n", id);
-		return DXLT_EXIT_BUS;
-	}
-	fprintf(t->out, "ID %u: torque turned off (--yes)\n", id);
-	return DXLT_EXIT_OK;
-}
-
-static int dxlt_setup_one(struct dxlt *t, uint8_t id)
-{
-	uint8_t level = 0;
-	int r, rc;
-
-	if ((r = dxlt_ping(t, id)) != DXL_OK)
-		return dxlt_bus_fail(t, id, r);
-	/* The loop READs every cycle, so level 0 (PING only) cannot work; level
-	 * 2 costs nothing per cycle (goals go by SYNC_WRITE, never answered) and
-	 * lets start-up and tools verify their writes. */
-	int want_level = t->a.status_level >= 0 ? t->a.status_level : 2;
-	r = dxlt_read(t, id, DXL_AX_STATUS_RETURN_LEVEL, 1, &level);
-	if (r != DXL_OK) {
-		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? "
-		        "(dxl write %u status_return_level 2 cannot be verified either)\n", id, id);
-		return DXLT_EXIT_BUS;
-	}
-	if ((rc = dxlt_setup_torque_off(t, id, level >= 2)) != DXLT_EXIT_OK)
-		return rc;
-	/* 0: the reply follows the request after ≈22 µs instead of 500 µs. */
-	if ((rc = dxlt_setup_byte(t, id, DXL_AX_RETURN_DELAY_TIME, 0, level >= 2)) != DXLT_EXIT_OK)
-		return rc;
-	/* Which level answers a write to the level is the servo's choice: never
-	 * wait for that reply, read the value back instead. */
-	return dxlt_setup_byte(t, id, DXL_AX_STATUS_RETURN_LEVEL, (uint8_t)want_level, false);
-}
-
-/* Bus time of one 100 Hz cycle: one READ(36, 6) per servo and one SYNC_WRITE
- * of goal + speed for all, plus the adapter's hold time per READ. */
-static void dxlt_setup_budget(struct dxlt *t, unsigned nservos, int latency_ms)
-{
-	double byte_us = 10.0 * 1e6 / (double)port_baud(t->port);
-	double wire_ms = (nservos * 20.0 + 5.0 * nservos + 8.0) * byte_us / 1000.0;
-	double total_ms = wire_ms + nservos * (double)latency_ms;
-
-	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire + %d ms "
-	        "adapter latency per read = %.2f ms of the 10 ms period%s\n", nservos,
-	        nservos == 1 ? "" : "s", port_baud(t->port), wire_ms, latency_ms, total_ms,
-	        total_ms > 5.0 ? " (too much for 100 Hz)" : "");
-}
-
-static int dxlt_cmd_setup(struct dxlt *t)
-{
-	uint8_t ids[DXLT_MAX_IDS];
-	int worst = DXLT_EXIT_OK;
-
-	if (t->a.npos < 1 || t->a.npos > DXLT_MAX_IDS)
-		return dxlt_need_args(t, -1, "setup ID... [--status-level N]");
-	for (int i = 0; i < t->a.npos; i++) {
-		int rc = dxlt_arg_id(t, t->a.pos[i], false, &ids[i]);
-		if (rc != DXLT_EXIT_OK)
-			return rc;
-	}
-	for (int i = 0; i < t->a.npos; i++) {
-		int rc = dxlt_setup_one(t, ids[i]);
-		if (rc == DXLT_EXIT_PORT)
-			return rc;
-		if (rc > worst)
-			worst = rc;
-	}
-	/* The adapter: lower the FTDI latency timer now that the servos are done. */
-	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
-	fprintf(t->out, "adapter: %s\n", t->latency.note);
-	int latency_ms = t->latency.known ? t->latency.timer_ms : 0;
-	dxlt_setup_budget(t, (unsigned)t->a.npos, latency_ms);
-	if (t->latency.known && t->latency.timer_ms > 1) {
-		fprintf(t->err, "dxl: %s\n", t->latency.note);
-		if (worst == DXLT_EXIT_OK)
-			worst = DXLT_EXIT_PORT;
-	}
-	return worst;
-}
+/* ---- reboot ------------------------------------------------------------------- */
 
 /* A REBOOT takes the servo off the bus while it starts again: the e-manual
  * gives no figure; PINGs are tried for this long. */
@@ -810,11 +432,11 @@ struct dxlt_command {
 };
 
 static const struct dxlt_command dxlt_commands[] = {
-	{ "scan", { dxlt_cmd_scan, dxlt_cmd_scan } },          { "ping", { dxlt_cmd_ping, dxlt2_cmd_ping } },
-	{ "read", { dxlt_cmd_read, dxlt2_cmd_read } },         { "write", { dxlt_cmd_write, dxlt2_cmd_write } },
-	{ "dump", { dxlt_cmd_dump, dxlt2_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
-	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt2_cmd_torque } },
-	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt2_cmd_setup } },
+	{ "scan", { dxlt_cmd_scan, dxlt_cmd_scan } },          { "ping", { dxlt_cmd_ping, dxlt_cmd_ping } },
+	{ "read", { dxlt_cmd_read, dxlt_cmd_read } },         { "write", { dxlt_cmd_write, dxlt_cmd_write } },
+	{ "dump", { dxlt_cmd_dump, dxlt_cmd_dump } },         { "set-id", { dxlt_cmd_set_id, dxlt_cmd_set_id } },
+	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt_cmd_torque } },
+	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt_cmd_setup } },
 	{ "reboot", { dxlt_cmd_reboot, dxlt_cmd_reboot } },
 };
 

@@ -56,8 +56,21 @@
 /* Width of the check-name column. */
 #define DR_NAME_WIDTH 19
 
+struct dr;
+/* What the doctor does differently per protocol: how a servo's table is
+ * read and judged, and what the controller would make of it. Chosen once
+ * from the family (dr_family_for), then asked. */
+struct dr_family {
+	int protocol;
+	/* every answering servo's table; DXLT_EXIT_OK or the port's failure */
+	int (*read_all)(struct dr *d, int *status);
+	void (*servo_lines)(struct dr *d, size_t j, int read_status);
+	bool (*servo_info)(const struct dr *d, size_t j, struct ctl_servo_info *info);
+};
+
 struct dr {
 	struct dxlt *t;
+	const struct dr_family *fam;         /* dr_family_for(the tool's family) */
 	struct cfg cfg;
 	char source[CFG_PATH_MAX + 32];      /* where the robot came from, for the header */
 	struct dr_servo servo[CFG_MAX_JOINTS];
@@ -418,25 +431,29 @@ static double dr_pct(const double *v, size_t n, double p)
 }
 
 /* What start-up hands the controller (setup.c's setup_servo, setup_x.c's
- * setup_servo_x), from the checks' reads. */
-static void dr_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
+ * setup_servo_x), from the checks' reads; false: undulated would not drive
+ * it (an X model it does not know, or no PWM to move with). */
+static bool dr1_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
 {
 	const struct dr_servo *s = &d->servo[j];
-	if (d->t->a.protocol == 2) {
-		const struct dr2_servo *x = &d->servo2[j];
-		bool in_turn = x->min_position >= 0 && x->max_position <= DXL2_POS_MAX;
-		*info = (struct ctl_servo_info){
-			.cw_limit = in_turn ? (uint16_t)x->min_position : 1, .ccw_limit = in_turn ? (uint16_t)x->max_position : 0,
-			.max_torque = x->pwm_limit, .return_delay = x->return_delay,
-			.status_return_level = x->status_return_level, .model = sm_by_number(2, x->model),
-		};
-		return;
-	}
 	*info = (struct ctl_servo_info){
 		.cw_limit = s->cw_limit, .ccw_limit = s->ccw_limit,
 		.max_torque = s->max_torque ? s->max_torque : 1023,   /* as setup.c does */
 		.return_delay = s->return_delay, .status_return_level = s->status_return_level,
 	};
+	return true;
+}
+
+static bool dr2_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
+{
+	const struct dr2_servo *x = &d->servo2[j];
+	bool in_turn = x->min_position >= 0 && x->max_position <= DXL2_POS_MAX;
+	*info = (struct ctl_servo_info){
+		.cw_limit = in_turn ? (uint16_t)x->min_position : 1, .ccw_limit = in_turn ? (uint16_t)x->max_position : 0,
+		.max_torque = x->pwm_limit, .return_delay = x->return_delay,
+		.status_return_level = x->status_return_level, .model = sm_by_number(2, x->model),
+	};
+	return info->model != NULL && info->max_torque != 0;
 }
 
 /* Give the controller the joints r->from[0..n) lists; keep those it takes
@@ -451,10 +468,7 @@ static size_t dr_set_servos(struct dr *d, struct dr_run *r, size_t n)
 	r->cfg.njoints = n;
 	ctl_init(&r->ctl, &r->cfg);
 	for (size_t k = 0; k < n; k++) {
-		dr_servo_info(d, r->from[k], &info);
-		/* an X model undulated does not know, or no PWM to move with: not driven */
-		if ((d->t->a.protocol == 2 && (info.model == NULL || info.max_torque == 0)) ||
-		    !ctl_set_servo(&r->ctl, k, &info, why, sizeof why))
+		if (!d->fam->servo_info(d, r->from[k], &info) || !ctl_set_servo(&r->ctl, k, &info, why, sizeof why))
 			continue;   /* its angle-limits line says why */
 		r->cfg.ids[kept] = r->cfg.ids[k];
 		r->cfg.joint[kept] = r->cfg.joint[k];
@@ -482,8 +496,7 @@ static unsigned dr_pick_joints(struct dr *d, struct dr_run *r)
 	r->cfg.fault_reboots = 0;
 	for (size_t j = 0; j < d->cfg.njoints; j++) {
 		const struct dr_servo *s = &d->servo[j];
-		uint8_t level = d->t->a.protocol == 2 ? d->servo2[j].status_return_level : s->status_return_level;
-		if (!s->read || level == 0)
+		if (!s->read || s->status_return_level == 0)
 			continue;
 		r->cfg.ids[n] = s->id;
 		r->cfg.joint[n] = d->cfg.joint[j];
@@ -787,6 +800,7 @@ static int dr2_read_all(struct dr *d, int *status)
 		dr2_servo_decode(&d->servo2[j], mem);
 		d->servo2[j].id = s->id;
 		d->servo2[j].err = d->t->errseen2[s->id];
+		s->status_return_level = d->servo2[j].status_return_level;   /* what dr_pick_joints asks */
 		s->read = true;
 	}
 	return DXLT_EXIT_OK;
@@ -797,6 +811,10 @@ static void dr2_servo_lines(struct dr *d, size_t j, int read_status)
 	const struct dr2_servo *s = &d->servo2[j];
 	struct dr_verdict v = { DR_FAIL, "" };
 
+	if (!d->servo[j].answered) {
+		dr_servo_lines(d, j, read_status);
+		return;
+	}
 	if (!d->servo[j].read) {
 		if (read_status == DXL_E_TIMEOUT)
 			snprintf(v.text, sizeof v.text, "answers PING but not READ: status return level 0, and the loop's "
@@ -832,24 +850,17 @@ static void dr2_servo_lines(struct dr *d, size_t j, int read_status)
 		dr_servo_line(d, s->id, "error field", &v);
 }
 
-/* The servos' lines on 2.0, then the timed cycles: undulated's own (one
- * SYNC_READ, one SYNC_WRITE a cycle, daemon/cycle.c), holding. */
-static int dr2_check_servos(struct dr *d)
-{
-	struct dr_verdict v;
-	int rc, status[CFG_MAX_JOINTS];
+static const struct dr_family dr_families[] = {
+	{ 1, dr_read_all, dr_servo_lines, dr1_servo_info },
+	{ 2, dr2_read_all, dr2_servo_lines, dr2_servo_info },
+};
 
-	if ((rc = dr2_read_all(d, status)) != DXLT_EXIT_OK)
-		return rc;
-	dr_context(d);
-	for (size_t j = 0; j < d->cfg.njoints; j++)
-		if (d->servo[j].answered)
-			dr2_servo_lines(d, j, status[j]);
-		else
-			dr_servo_lines(d, j, status[j]);
-	if (dr_check_echo(d->t->a.echo, d->t->bus.unexpected_echoes, d->t->bus.echo_errors, &v))
-		dr_line(d, "echo", &v);
-	return dr_budget(d);
+static const struct dr_family *dr_family_for(int protocol)
+{
+	for (size_t i = 0; i < sizeof dr_families / sizeof dr_families[0]; i++)
+		if (dr_families[i].protocol == protocol)
+			return &dr_families[i];
+	return &dr_families[0];
 }
 
 /* ---- the command --------------------------------------------------------------------------------- */
@@ -879,13 +890,12 @@ static int dr_check(struct dr *d)
 	dr_context(d);
 	dr_check_baud(&d->ctx, (unsigned)d->cfg.njoints, answered, &v);
 	dr_line(d, "baud", &v);
-	if (t->a.protocol == 2)
-		return dr2_check_servos(d);
-	if ((rc = dr_read_all(d, status)) != DXLT_EXIT_OK)
+	/* the servos' lines, then the timed cycles: undulated's own, holding */
+	if ((rc = d->fam->read_all(d, status)) != DXLT_EXIT_OK)
 		return rc;
 	dr_context(d);
 	for (size_t j = 0; j < d->cfg.njoints; j++)
-		dr_servo_lines(d, j, status[j]);
+		d->fam->servo_lines(d, j, status[j]);
 	if (dr_check_echo(t->a.echo, t->bus.unexpected_echoes, t->bus.echo_errors, &v))
 		dr_line(d, "echo", &v);
 	return dr_budget(d);
@@ -901,6 +911,7 @@ int dxlt_cmd_doctor(struct dxlt *t)
 		return DXLT_EXIT_PORT;
 	}
 	d->t = t;
+	d->fam = dr_family_for(t->fam->protocol);
 	log_set_program("dxl");
 	rc = dr_configure(d);
 	if (rc == DXLT_EXIT_OK)

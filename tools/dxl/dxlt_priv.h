@@ -1,7 +1,7 @@
 /*
  * dxlt_priv.h — what the `dxl` commands share inside libdxl: the tool's
  * state over one bus and the helpers every command uses (session.c, which
- * commands.c, commands2.c and doctor.c call down into). Not for the tests:
+ * commands.c, registers.c, commands2.c and doctor.c call down into). Not for the tests:
  * they go through dxlt_main() (dxlt.h).
  */
 #ifndef UNDULATE_DXLT_PRIV_H
@@ -28,6 +28,9 @@ struct dxlt_family {
 	/* the servo refuses EEPROM writes while its torque is on, with an error
 	 * the tool can name before sending */
 	bool eeprom_needs_torque_off;
+	/* its PING answers the model number: commands identify the servo
+	 * first and take that model's table (else the family's first model's) */
+	bool ping_names_model;
 	const char *no_rate;           /* set-baud's refusal, "%s" the rate asked */
 	const char *reset_form;        /* reset's usage */
 	/* reset without --yes: what it would set ("%s": the keep form's words) */
@@ -36,6 +39,9 @@ struct dxlt_family {
 	long (*baud_from_reg)(uint8_t v);
 	/* one rate of `scan`: a line per servo found */
 	int (*scan_at)(struct dxlt *t, long baud, unsigned *found);
+	/* `setup`'s last line: the bus time of one cycle of the daemon's loop
+	 * for n servos (current: one senses its current) */
+	void (*setup_budget)(struct dxlt *t, unsigned n, bool current, int latency_ms);
 };
 
 struct dxlt {
@@ -81,27 +87,64 @@ uint16_t dxlt_addr(const struct dxlt *t, const char *name);
 int dxlt_arg_servo_id(struct dxlt *t, const char *s, uint8_t *id);
 /* After a write whose reply was not waited for, give the servo time, then PING. */
 int dxlt_verify_ping(struct dxlt *t, uint8_t id);
-const char *dxlt_model_name(uint16_t model);
+/* A model's name as a reply on that protocol numbers it: its descriptor's,
+ * or "not in dxl's tables". */
+const char *dxlt_model_name(int protocol, uint16_t model);
 /* Switch the port (and the reply timeouts) to baud. */
 int dxlt_set_baud(struct dxlt *t, long baud);
 void dxlt_sleep_us(long us);
 /* The command's positional count, or a usage line (form) and exit 2. */
 int dxlt_need_args(struct dxlt *t, int n, const char *form);
+/* dxlt_need_args with the family's option a suggestion must carry
+ * ("--protocol 2 " + "set-id OLD NEW"). */
+int dxlt_need_form(struct dxlt *t, int n, const char *form);
 int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id);
 
 /* Protocol 2.0's PING, with the model and firmware it answers. */
 int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware);
 
+/* ---- registers.c: the commands that go by the control table ---- */
+/* The longest image of a control table read in one READ (`dump`, `write`'s
+ * checks, `setup`): the X series' 0..147, model number .. present temperature. */
+#define DXLT_IMAGE_MAX DXL2_X_TABLE_SIZE
+
+/* A servo a command addresses, and the model whose table it goes by. */
+struct dxlt_servo {
+	uint8_t id;
+	uint16_t model;
+	uint8_t firmware;
+	bool pinged;                  /* identified by PING (the family's PING names the model) */
+	const struct dxl2_model *m;   /* NULL: not in our tables, raw addresses only */
+};
+
+/* A register named on the command line: the table's row, or a raw address. */
+struct dxlt_reg {
+	const struct dxl2_reg *row;   /* NULL for a raw address */
+	uint16_t addr;
+	uint8_t size;
+	const char *name;
+};
+
+/* The model's table: identified by PING where the family's PING names it. */
+int dxlt_identify(struct dxlt *t, uint8_t id, struct dxlt_servo *s);
+/* The register REG names on this servo. */
+int dxlt_arg_reg(struct dxlt *t, const struct dxlt_servo *s, const char *text, struct dxlt_reg *out);
+/* A raw address on a model not in the tables: said once on err. */
+void dxlt_raw_note(struct dxlt *t, const struct dxlt_servo *s, uint16_t addr, uint8_t size);
+int32_t dxlt_decode(const struct dxlt_reg *reg, const uint8_t *raw);
+/* Bytes from address 0 that hold every row of m (DXLT_IMAGE_MAX at most; NULL: that). */
+size_t dxlt_image_len(const struct dxl2_model *m);
+int dxlt_cmd_ping(struct dxlt *t);
+int dxlt_cmd_read(struct dxlt *t);
+int dxlt_cmd_dump(struct dxlt *t);
+int dxlt_cmd_write(struct dxlt *t);
+int dxlt_cmd_torque(struct dxlt *t);
+int dxlt_cmd_setup(struct dxlt *t);
+
 /* ---- Protocol 2.0 (commands2.c) ---- */
 /* Broadcast PING at the current rate: one scan line per servo in the ID range. */
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found);
-int dxlt2_cmd_ping(struct dxlt *t);
-int dxlt2_cmd_read(struct dxlt *t);
-int dxlt2_cmd_write(struct dxlt *t);
-int dxlt2_cmd_dump(struct dxlt *t);
-int dxlt2_cmd_torque(struct dxlt *t);
-int dxlt2_reboot(struct dxlt *t, uint8_t id);
-int dxlt2_cmd_setup(struct dxlt *t);
+void dxlt2_setup_budget(struct dxlt *t, unsigned n, bool current, int latency_ms);
 
 /* `dxl doctor` (doctor.c): opens the port itself, after reading the
  * configuration that may name it. */

@@ -1,7 +1,7 @@
 /*
  * session.c — what every `dxl` command stands on: the port opened as one
  * bus, its reply timeouts, the transactions that remember each reply's
- * error bits, and the argument helpers. commands.c, commands2.c and
+ * error bits, and the argument helpers. commands.c, registers.c, commands2.c and
  * doctor.c call down into it; it calls none of them.
  */
 #include <errno.h>
@@ -18,14 +18,23 @@ void dxlt_sleep_us(long us)
 	}
 }
 
-const char *dxlt_model_name(uint16_t model)
+/* Servos dxl names but has no table of (their tables differ from the AX-12A's). */
+static const struct {
+	int protocol;
+	uint16_t number;
+	const char *name;
+} dxlt_untabled[] = { { 1, 18, "AX-18" }, { 1, 300, "AX-12W" } };
+
+const char *dxlt_model_name(int protocol, uint16_t model)
 {
-	switch (model) {
-	case 12: return "AX-12";
-	case 18: return "AX-18";
-	case 300: return "AX-12W";
-	default: return "not an AX-12";
-	}
+	const struct dxl2_model *m = dxl2_model_find(protocol, model);
+
+	if (m != NULL)
+		return m->name;
+	for (size_t i = 0; i < sizeof dxlt_untabled / sizeof dxlt_untabled[0]; i++)
+		if (dxlt_untabled[i].protocol == protocol && dxlt_untabled[i].number == model)
+			return dxlt_untabled[i].name;
+	return "not in dxl's tables";
 }
 
 void dxlt_apply_timing(struct dxlt *t)
@@ -174,6 +183,13 @@ int dxlt_need_args(struct dxlt *t, int n, const char *form)
 		return DXLT_EXIT_OK;
 	fprintf(t->err, "dxl: usage: dxl --port PATH %s\n", form);
 	return DXLT_EXIT_USAGE;
+}
+
+int dxlt_need_form(struct dxlt *t, int n, const char *form)
+{
+	char line[96];
+	snprintf(line, sizeof line, "%s%s", t->fam->opt, form);
+	return dxlt_need_args(t, n, line);
 }
 
 int dxlt_arg_id(struct dxlt *t, const char *s, bool allow_broadcast, uint8_t *id)
