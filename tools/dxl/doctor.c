@@ -430,8 +430,8 @@ static double dr_pct(const double *v, size_t n, double p)
 	return n ? v[rank ? rank - 1 : 0] : 0.0;
 }
 
-/* What start-up hands the controller (setup.c's setup_servo, setup_x.c's
- * setup_servo_x), from the checks' reads; false: undulated would not drive
+/* What start-up hands the controller (daemon/setup.c's setup_servo, one for
+ * every model), from the checks' reads; false: undulated would not drive
  * it (an X model it does not know, or no PWM to move with). */
 static bool dr1_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
 {
