@@ -75,12 +75,18 @@ if command -v gnuplot >/dev/null; then
 	per_block() {   # DAT: "key rows" per block, the key from its comment line
 		awk '/^# index / { key = $0; next } NF { rows[key]++ } END { for (key in rows) print key, rows[key] }' "$1"
 	}
-	rows=$(awk -F, 'NR > 1 { n++ } END { print n + 0 }' "$T/out/states.csv")
-	got=$(per_block "$T/out/joints.dat" | awk '{ s += $NF; b++ } END { print s + 0, b + 0 }')
-	if [ "${got% *}" = "$rows" ] && [ "${got#* }" -ge 4 ]; then
-		tap_ok "joints.dat holds every row of states.csv, in ${got#* } joints' blocks"
+	# each joint's rows (t, angle, speed as states.csv has them, in its order),
+	# by robot name and joint, in its own block
+	awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+		{ r = $c["robot"]; gsub(/"/, "", r); print r ":" $c["joint"] "\t" $c["t"] "," $c["angle"] "," $c["speed"] }' \
+		"$T/out/states.csv" | sort -s -t "$(printf '\t')" -k1,1 >"$T/joints.want"
+	awk '/^# index / { r = $5; sub(/,$/, "", r); j = $7; sub(/:$/, "", j); key = r ":" j; next }   # "# index K: robot R, joint J: ..."
+		NF { print key "\t" $0 }' "$T/out/joints.dat" | sort -s -t "$(printf '\t')" -k1,1 >"$T/joints.got"
+	nj=$(cut -f1 "$T/joints.got" | sort -u | grep -c .)
+	if [ "$nj" -ge 4 ] && cmp -s "$T/joints.want" "$T/joints.got"; then
+		tap_ok "joints.dat: each joint's rows of states.csv, as written, in its own block ($nj joints)"
 	else
-		tap_fail "joints.dat holds every row of states.csv" "states.csv: $rows rows; joints.dat: ${got% *} rows in ${got#* } blocks"
+		tap_fail "joints.dat: each joint's rows of states.csv in its own block" "$nj blocks; first difference: $(diff "$T/joints.want" "$T/joints.got" | head -3 | tr '\n' ' ')"
 	fi
 	# (phase_diff.csv also holds each robot's own joint pairs, r1/0:1, which no panel draws)
 	got=$(per_block "$T/out/phase.dat" | sed -E 's/^# index [0-9]+: pair ([^:]*:[^:]*): [^ ]* /\1 /' | sort)

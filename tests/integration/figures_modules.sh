@@ -44,6 +44,18 @@ for m in rows channel forces forces-plane swimmer channel-plane; do
 	else tap_fail "$m: jobs" "$(head -3 <<<"$a"); duplicate ids '$ids', bad '$bad', duplicate seeds '$seeds'"; fi
 done
 
+# ---- seeds: cksum's CRC, computed in the shell ------------------------------------------
+# Every recorded run's seed came from `cksum`; figures/lib.sh computes the
+# same CRC itself (no pipe per seed). Any other number would make the
+# recorded runs irreproducible by their seeds.
+diff=$(bash -c '. "$1/lib.sh"; for s in "" a "channel-plane 20 3" "rows 0.5 0 60 12" "forces-plane none 0.25 7" \
+	"$(printf "caf\303\251 \001\377 %0300d" 0)"; do
+	mine=$(fig_hash "$s") ref=$(printf "%s" "$s" | cksum | cut -d" " -f1)
+	[ "$mine" = "$ref" ] || echo "\"$s\": $mine, cksum $ref"
+done' _ "$F")
+if [ -z "$diff" ]; then tap_ok "fig_hash is cksum's CRC (empty, ASCII, bytes above 127, 300+ bytes)"
+else tap_fail "fig_hash is cksum's CRC" "$diff"; fi
+
 # ---- bad arguments: one line, exit 2, nothing run --------------------------------
 refused() { # NAME WANT CMD...
 	local name=$1 want=$2 rc; shift 2
