@@ -208,9 +208,12 @@ def servos(devtools_port, url, png, robot, want, torque=None):
         return t ? [...t.querySelectorAll('tr')].slice(1)
             .map(r => [...r.children].map(c => c.textContent)) : []; }})()"""
     also = f" && r[5] === {json.dumps(torque)}" if torque else ""
-    found = cdp.wait(f"{rows_js}.some(r => r[4] === {json.dumps(want)}{also})", 15)
+    # the rows from the one evaluation that matched: read again a moment later, a
+    # busy machine's page may already show the next frame (a bus silent for three
+    # cycles reads "SILENT x3" in every row)
+    found = cdp.wait(f"(rows => rows.some(r => r[4] === {json.dumps(want)}{also}) && rows)({rows_js})", 15)
     print(f"FOUND {bool(found)}", flush=True)
-    for r in cdp.js(rows_js) or []:  # tab-separated: a status may hold '|'
+    for r in found or cdp.js(rows_js) or []:  # tab-separated: a status may hold '|'
         print("ROW\t" + "\t".join(r), flush=True)
     shot = cdp.call("Page.captureScreenshot", format="png")
     with open(png, "wb") as f:
