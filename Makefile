@@ -218,8 +218,11 @@ test-deps: deps
 # DXL_SDK=DIR: a DynamixelSDK checkout; with it `make test` also runs
 # tests/integration/sdk_client.sh (without it that test skips and says how).
 DXL_SDK ?=
+# The build before the tests uses every core unless make was given its own -j
+# (then the jobserver it handed down decides).
+BUILD_JOBS = $(if $(findstring j,$(filter-out --%,$(MAKEFLAGS))),,-j$(shell nproc 2>/dev/null || echo 2))
 test: test-deps
-	@$(MAKE) --no-print-directory check-pure check-lcmdec all
+	@$(MAKE) --no-print-directory $(BUILD_JOBS) check-pure check-lcmdec all
 	@BUILD=$(BUILD) DXL_SDK=$(DXL_SDK) tests/run.sh
 
 test-sdk: deps

@@ -7,7 +7,7 @@
 # Environment: TEST_FILTER (run the programs whose name contains it),
 # TEST_TIMEOUT (seconds one program may run, default 300; a hang is a failure;
 # a script that says "# run.sh: timeout SECONDS" may run that long if longer:
-# a soak of minutes), # TEST_JOBS (integration tests run side by side, default 2; see below).
+# a soak of minutes), TEST_JOBS (slots for programs side by side, default 4; see below).
 # Logs: $BUILD/test-logs/<program>.log.
 #
 # What counts (TAP):
@@ -121,14 +121,6 @@ execute() {
 	echo "$rc $(( ($(date +%s%N) - start) / 1000000 )) $limit"
 }
 
-run_one() {
-	local name=$1; shift
-	[ -n "$filter" ] && [[ "$name" != *$filter* ]] && return
-	local rc ms limit
-	read -r rc ms limit < <(execute "$name" "$per_test_timeout" "$@")
-	account "$name" "$rc" "$ms" "$limit"
-}
-
 # account NAME RC MS LIMIT: count a finished program's results and show its line.
 account() {
 	local name=$1 rc=$2 ms=$3 limit=$4
@@ -181,68 +173,102 @@ UNDULATE_LOCK_DIR=$(mktemp -d "${TMPDIR:-/tmp}/undulate-locks.XXXXXX")
 export UNDULATE_LOCK_DIR
 trap 'rm -rf "$UNDULATE_LOCK_DIR"' EXIT
 
+# ---- every program, TEST_JOBS slots at a time ----------------------------------------
+# Most tests spend their time waiting: on simulated buses, on timeouts, on runs
+# in real time. They run side by side, each on its own LCM ports and in its own
+# temporary directory (tests/lib.sh), in TEST_JOBS slots (default 4). A program
+# takes one slot, or says otherwise in a line of its own:
+#   "# run.sh: heavy" — it keeps a core busy (runs in lockstep, the virtual
+#     clock as fast as the machine goes): two slots, so that with the default
+#     four, two of them at once have nothing beside them, and one has two
+#     light ones at most;
+#   "# run.sh: alone" — it measures a gait or an experiment in real time: every
+#     slot, nothing beside it.
+# Order: the alone ones first (started on an idle machine, so no slot waits for
+# the others to drain), then the ones that say "# run.sh: long" (started early,
+# the run does not end waiting on one of them), the other scripts, and the unit
+# tests last (short: they fill the end). Whatever fits in the free slots starts,
+# the first in this order first; results are counted and shown in the order the
+# programs started. TEST_JOBS=1 runs them one by one, in this order.
+jobs_max=${TEST_JOBS:-4}
+[[ "$jobs_max" =~ ^[1-9][0-9]?$ ]] || { echo "run.sh: TEST_JOBS must be 1..99, not '$jobs_max'" >&2; exit 2; }
+says() { grep -q "^# run.sh: $2" "$1"; }
+names=() cmds=() weights=()
+# add NAME WEIGHT CMD...: one program into the queue (unless the filter leaves it out)
+add() {
+	[ -n "$filter" ] && [[ "$1" != *$filter* ]] && return
+	local w=$2
+	[ "$w" -gt "$jobs_max" ] && w=$jobs_max
+	names+=("$1") weights+=("$w")
+	shift 2
+	cmds+=("$(printf '%q ' "$@")")
+}
+scripts=()
+for t in "$integration_dir"/*.sh; do [ -f "$t" ] && scripts+=("$t"); done
+if [ -n "${TEST_LONG:-}" ]; then
+	for t in "$long_dir"/*.sh; do [ -f "$t" ] && scripts+=("$t"); done
+fi
+for t in ${scripts[@]+"${scripts[@]}"}; do says "$t" alone && add "$(basename "$t" .sh)" "$jobs_max" bash "$t"; done
+for pass in long other; do
+	for t in ${scripts[@]+"${scripts[@]}"}; do
+		says "$t" alone && continue
+		if says "$t" long; then [ "$pass" = long ] || continue; else [ "$pass" = other ] || continue; fi
+		w=1; says "$t" heavy && w=2
+		add "$(basename "$t" .sh)" "$w" bash "$t"
+	done
+done
 for t in "$unit_dir"/test_*; do
-	[ -f "$t" ] && [ -x "$t" ] || continue
-	run_one "$(basename "$t")" "$t"
+	[ -f "$t" ] && [ -x "$t" ] && add "$(basename "$t")" 1 "$t"
 done
 
-# ---- integration tests, TEST_JOBS at a time ------------------------------------------
-# Most integration tests spend their time waiting: on simulated buses, on
-# timeouts, on runs in real time. TEST_JOBS of them (default 2) run side by
-# side, each on its own LCM ports and in its own temporary directory
-# (tests/lib.sh); they are counted and shown in their own order, as when run
-# one by one. A test that needs the machine to itself — it measures a gait or
-# an experiment in real time — says so with a line "# run.sh: alone" and runs
-# with nothing beside it. TEST_JOBS=1 runs them one by one.
-jobs_max=${TEST_JOBS:-2}
-[[ "$jobs_max" =~ ^[1-9][0-9]?$ ]] || { echo "run.sh: TEST_JOBS must be 1..99, not '$jobs_max'" >&2; exit 2; }
-names=() scripts=()
-for t in "$integration_dir"/*.sh; do
-	[ -f "$t" ] || continue
-	n=$(basename "$t" .sh)
-	[ -n "$filter" ] && [[ "$n" != *$filter* ]] && continue
-	names+=("$n"); scripts+=("$t")
-done
-if [ -n "${TEST_LONG:-}" ]; then
-	for t in "$long_dir"/*.sh; do
-		[ -f "$t" ] || continue
-		n=$(basename "$t" .sh)
-		[ -n "$filter" ] && [[ "$n" != *$filter* ]] && continue
-		names+=("$n"); scripts+=("$t")
-	done
-fi
-is_alone() { grep -q '^# run.sh: alone' "$1"; }
-# A started program is over when its .rc file ("RC MS") is there.
+# A started program is over when its .rc file ("RC MS LIMIT") is there; its
+# slots are free from then on, counted or not. Each one that ends also writes a
+# line into a pipe the loop sleeps on (wait -n would miss one that ended
+# before it was called).
 over() { [ -f "$logs/${names[$1]}.rc" ]; }
-started=0 reported=0
+ends="$logs/.ends.$$"
+rm -f "$ends"; mkfifo "$ends" && exec 9<>"$ends" && rm -f "$ends" || { echo "run.sh: cannot make a pipe in $logs" >&2; exit 2; }
+# limit_of I: the seconds program I may run (a script may ask for more)
+limit_of() { case "${cmds[$1]}" in bash\ *) eval "set -- ${cmds[$1]}"; timeout_of "$2" ;; *) echo "$per_test_timeout" ;; esac; }
+queued=(${names[@]+"${!names[@]}"}) order=() running=() used=0 reported=0
 while [ "$reported" -lt "${#names[@]}" ]; do
-	# how many run now, and whether one of them wants the machine alone
-	active=0 alone_now=0
-	for ((i = reported; i < started; i++)); do
-		over "$i" && continue
-		active=$((active + 1))
-		is_alone "${scripts[$i]}" && alone_now=1
+	# free the slots of the ones that are over
+	still=()
+	for i in ${running[@]+"${running[@]}"}; do
+		if over "$i"; then used=$((used - weights[i])); else still+=("$i"); fi
 	done
-	while [ "$started" -lt "${#names[@]}" ] && [ "$alone_now" -eq 0 ] && [ "$active" -lt "$jobs_max" ]; do
-		if is_alone "${scripts[$started]}"; then
-			[ "$active" -eq 0 ] || break
-			alone_now=1
+	running=(${still[@]+"${still[@]}"})
+	# start, in the queue's order, whatever fits in the free slots; nothing
+	# passes an alone program that waits for the machine
+	rest=() k=0
+	for i in ${queued[@]+"${queued[@]}"}; do
+		k=$((k + 1))
+		if [ $((used + weights[i])) -le "$jobs_max" ]; then
+			n=${names[$i]}
+			rm -f "$logs/$n.rc"
+			( eval "execute \"\$n\" \"\$(limit_of $i)\" ${cmds[$i]}" >"$logs/$n.rc.tmp" 9>&-
+			  mv "$logs/$n.rc.tmp" "$logs/$n.rc"; echo >&9 ) &
+			order+=("$i") running+=("$i") used=$((used + weights[i]))
+		elif [ "${weights[$i]}" -eq "$jobs_max" ]; then
+			rest+=("${queued[@]:k-1}")
+			break
+		else
+			rest+=("$i")
 		fi
-		n=${names[$started]}
-		rm -f "$logs/$n.rc"
-		( execute "$n" "$(timeout_of "${scripts[$started]}")" bash "${scripts[$started]}" >"$logs/$n.rc.tmp"
-		  mv "$logs/$n.rc.tmp" "$logs/$n.rc" ) &
-		started=$((started + 1)) active=$((active + 1))
 	done
-	# the finished ones, in order
-	while [ "$reported" -lt "$started" ] && over "$reported"; do
-		read -r rc ms limit <"$logs/${names[$reported]}.rc"
-		rm -f "$logs/${names[$reported]}.rc"
-		account "${names[$reported]}" "$rc" "$ms" "$limit"
+	queued=(${rest[@]+"${rest[@]}"})
+	# the finished ones, in the order they started
+	while [ "$reported" -lt "${#order[@]}" ] && over "${order[$reported]}"; do
+		i=${order[$reported]}
+		read -r rc ms limit <"$logs/${names[$i]}.rc"
+		account "${names[$i]}" "$rc" "$ms" "$limit"
 		reported=$((reported + 1))
 	done
-	[ "$reported" -lt "${#names[@]}" ] && ! over "$reported" && wait -n 2>/dev/null
+	# sleep until the next one ends
+	[ "$reported" -lt "${#names[@]}" ] && read -r -u 9 _
 done
+exec 9>&-
+for n in ${names[@]+"${names[@]}"}; do rm -f "$logs/$n.rc"; done
 wait
 
 echo

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
 # undulated on X-series servos (Protocol 2.0) against undulate-sim --model:
 #  - the protocol: --protocol 1 on an X bus finds nobody and says so; auto
 #    (the default) finds Protocol 2.0 by PING and names the model;

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
+# run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # e2e_demo.sh — `make demo DEMO_SECONDS=...` end to end, as a new user runs
 # it: the paper's contact-force scene (ten robots crowded in a row, one
 # undulated each), 20 s on the clock, then the oscillator, headless; the

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
+# run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # e2e_pair.sh — the paper's pair rig through the real daemon on the simulated
 # bus (theory.md, "Two phase oscillators that touch"): two single-joint robots
 # on immobile bases, restitution r = 0.67, joints driven by torque as on the

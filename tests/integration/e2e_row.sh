@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
+# run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # e2e_row.sh — a row of five single-joint robots at large separation
 # (d~ = 0.7 at 0.8 rad), restitution 0.67, each end closed by a wall where a
 # mirrored neighbour would stand (the paper's lattice has fixed ends), through

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
+# run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # figures_driver.sh — `make figures`'s driver (scripts/figures.sh): its
 # modules in the page's order, each with a tiny set of runs (FIG_TINY=1; the
 # rows, channel and forces ones run in figures_modules.sh); and on a tiny

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
+# run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # figures_modules.sh — the rows, channel, forces, forces-plane, swimmer and
 # channel-plane modules of `make figures`
 # (figures/<name>/fig.sh): their job lists are the same every time, with

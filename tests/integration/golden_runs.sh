@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # golden_runs.sh — the golden runs (tests/golden/README.md): each
 # tests/golden/NAME.run in lockstep (scripts/golden.sh --run), and what it gave
 # compared with the committed tests/golden/NAME.chk (scripts/golden.sh

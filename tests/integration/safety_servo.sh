@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
 # What a servo and a race may do to a robot, tried on the simulated bus (the
 # reproductions of an audit, each of which succeeded once):
 #  - HOLD followed within milliseconds by LIMP, 40 times: every servo ends

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
 # safety_servo's reproductions on X-series servos (Protocol 2.0: undulate-sim
 # --model xm430-w350 at 1 Mbps), and what only the X series has:
 #  - HOLD followed within milliseconds by LIMP, 20 times: every servo ends

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # sim_lockstep.sh — the same simulator and daemons in virtual time
 # (undulate-sim --lockstep, undulated --lockstep, scripts/demo.sh --lockstep):
 #  - a pair-rig run ends by itself after its simulated seconds, and the

@@ -226,4 +226,46 @@ expect "TEST_FILTER runs the programs whose name holds it" "2 passed, 0 failed, 
 suite mixed TEST_FILTER=nosuchtest
 expect "a filter that matches nothing ran no test: exit 1" "0 passed, 0 failed, 0 skipped" 1 'no test program ran'
 
+# ---- side by side: slots, heavy and alone programs ------------------------------------
+# Each fake program writes "+ NAME" when it starts and "- NAME" when it ends
+# into one file; the most that ran at once, and who ran beside whom, are read
+# from it.
+spans="$T/spans"
+slotted() { # CASE NAME [RUNSH-LINE]: a program that runs half a second
+	fake "$1" integration "$2" <<EOF
+${3:-}
+echo "+ $2" >>"$spans"; sleep 0.5; echo "- $2" >>"$spans"
+echo "ok 1 - $2"; echo "1..1"
+EOF
+}
+# most_at_once [NAME...]: the most programs running at one time (of NAMEs, all if none)
+most_at_once() { awk -v only=" $* " 'only == "  " || index(only, " " $2 " ") { n += ($1 == "+") ? 1 : -1; if (n > m) m = n } END { print m + 0 }' "$spans"; }
+# beside NAME: the programs that ran at some time while NAME ran
+beside() { awk -v me="$1" '
+	$1 == "+" { run[$2] = 1; if ($2 == me) { on = 1; for (r in run) if (r != me) seen[r] = 1 } else if (on) seen[$2] = 1 }
+	$1 == "-" { delete run[$2]; if ($2 == me) on = 0 }
+	END { for (s in seen) printf "%s ", s }' "$spans"; }
+for n in l1 l2 l3 l4 l5 l6; do slotted slots "$n"; done
+slotted slots h1 '# run.sh: heavy'
+slotted slots h2 '# run.sh: heavy'
+slotted slots solo '# run.sh: alone'
+slotted slots late '# run.sh: long'
+: >"$spans"
+suite slots TEST_JOBS=3
+most=$(most_at_once) heavy=$(most_at_once h1 h2) solo=$(beside solo)
+first=$(awk '$1 == "+" { print $2; exit }' "$spans") second=$(awk '$1 == "+" { if (++k == 2) { print $2; exit } }' "$spans")
+if [ "$closing" = "10 passed, 0 failed, 0 skipped" ] && [ "$most" = 3 ] && [ "$heavy" = 1 ] && [ -z "$solo" ] &&
+	[ "$first" = solo ] && [ "$second" = late ]; then
+	tap_ok "TEST_JOBS=3: three at once at most, the two heavy ones never together, the alone one first with none beside it, then the long one"
+else tap_fail "slots" "closing '$closing'; at once $most (want 3), heavy together $heavy (want 1), beside solo '$solo', first $first, second $second"$'\n'"$(cat "$spans")"; fi
+: >"$spans"
+suite slots TEST_JOBS=1
+if [ "$closing" = "10 passed, 0 failed, 0 skipped" ] && [ "$(most_at_once)" = 1 ]; then
+	tap_ok "TEST_JOBS=1: one at a time"
+else tap_fail "TEST_JOBS=1" "closing '$closing', at once $(most_at_once)"; fi
+: >"$spans"
+suite slots TEST_JOBS=x
+if [ "$rc" = 2 ] && grep -q "TEST_JOBS must be" "$out" && [ ! -s "$spans" ]; then tap_ok "TEST_JOBS=x: refused, nothing run"
+else tap_fail "TEST_JOBS=x" "exit $rc: $(tail -2 "$out")"; fi
+
 tap_done

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
 # undulate-web against two daemons on the simulated bus: GET /api/snapshot is
 # undulate-top --once --json's object; other methods, oversized and garbage
 # requests are refused and the server lives on; a browser that stops reading

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
 # undulate-web speaks Foxglove's WebSocket protocol (foxglove.websocket.v1)
 # to a client written with the published client library @foxglove/ws-protocol
 # (0.8.x, installed at set-up into a cache directory outside the repository,
