@@ -205,6 +205,9 @@ struct port *port_open(const char *path, const struct port_options *opt, char *e
 	char real[PATH_MAX];
 	struct port *p;
 
+	/* who holds the port, when that is why it fails: nobody, on every other path */
+	if (opt != NULL && opt->holder != NULL)
+		memset(opt->holder, 0, sizeof *opt->holder);
 	if (path == NULL || path[0] == '\0' || strlen(path) >= PORT_PATH_MAX) {
 		port_errf(err, errcap, "bad port path '%s'%s", path != NULL ? path : "", " (empty or too long)");
 		return NULL;
