@@ -73,7 +73,7 @@
 #
 # Programs come from $BUILD/bin (BUILD: default build/ of this checkout); the
 # modules use nothing else outside their OUTDIR, so a run goes to any machine
-# with the same checkout built (README.md, "A sweep on a cluster").
+# with the same checkout built (docs/CLUSTER.md).
 
 fig_top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 source "$fig_top/scripts/outdir.sh"

@@ -6,7 +6,7 @@
 #   make test-busy      is   scripts/busy.sh make test
 #
 # What it checks: that the daemons and the simulator keep their timing when
-# the machine has no idle core (README: Known limits). The busy loops run at
+# the machine has no idle core (docs/LIMITS.md, "Under load"). The busy loops run at
 # the caller's priority; the exit status is COMMAND's.
 set -u
 [ $# -gt 0 ] || { echo "usage: scripts/busy.sh COMMAND [ARGS...]" >&2; exit 2; }

@@ -247,7 +247,7 @@ trap cleanup EXIT
 # in a cgroup of its own. With the kernel's autogroups everything started from
 # one session shares one scheduling group: started from a shell that also runs
 # CPU-bound work, the kernel worker that carries the simulated buses' bytes was
-# seen waiting over half a second to run (README: Known limits). A background
+# seen waiting over half a second to run (docs/LIMITS.md, "Under load"). A background
 # job of a script is not a process group leader, so setsid execs and the PID
 # kept below is the program's; stopping by PID does not depend on the session.
 own_session=()

@@ -49,7 +49,8 @@ PROGRAMS=(undulated undulate-sim dxl undulate-top undulate-analyze undulate-web)
 UNITS=(undulated@.service undulate-sim.service undulate-web.service)
 DOCS=(README.md daemon/README.md daemon/CONTROL.md sim-bridge/README.md sim-bridge/PHYSICS.md
       protocol/README.md lcmtypes/README.md systemd/README.md tools/dxl/README.md tools/top/README.md
-      tools/analyze/README.md tools/web/README.md docs/EXPERIMENTS.md)
+      tools/analyze/README.md tools/web/README.md docs/EXPERIMENTS.md docs/ROBOT.md docs/SAFETY.md
+      docs/MEASUREMENTS.md docs/LIMITS.md docs/LAYOUT.md docs/CLUSTER.md docs/img/dashboard.png)
 SERVICE_USER=undulate
 
 die() { echo "install.sh: $*" >&2; exit 1; }
