@@ -107,8 +107,8 @@ fig_grid() {
 	local id=$1 values=$2 count=$3 words=$4 v i a line seed
 	shift 4
 	for v in $values; do
-		for i in $(seq "$count"); do
-			seed=$(fig_seed "$words" "$v" "$i")
+		for ((i = 1; i <= count; i++)); do
+			fig_seed_v seed "$words" "$v" "$i"   # no subshell: hundreds of lines
 			line=${id//\{v\}/$v}
 			line=${line//\{i\}/$i}
 			for a in "$@"; do
@@ -159,6 +159,8 @@ fig_hash_v() {
 }
 fig_hash() { local h; fig_hash_v h "$1"; echo "$h"; }
 fig_seed() { local h; fig_hash_v h "$*"; echo $(( h % 999999 + 1 )); }
+# fig_seed_v VAR WORDS...: the same into VAR
+fig_seed_v() { local -n _s=$1; shift; local h; fig_hash_v h "$*"; _s=$(( h % 999999 + 1 )); }
 FIG_GOLDEN=0.6180339887498949
 
 # Ports for the figures' runs: above the tests' (7600-8000 plus their offsets
