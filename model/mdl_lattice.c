@@ -217,6 +217,8 @@ static void lat_collide(struct lat *l, int k, struct lat_event *ev)
 	ev->t = l->t;
 	ev->contact = k;
 	ev->delta_before = ev->delta_after = ev->dsep_before = NAN;
+	ev->x_left = k > 0 ? l->amp * cos(l->phi[k - 1]) : NAN;
+	ev->x_right = k < l->n ? l->amp * cos(l->phi[k]) : NAN;
 	if (k == 0 || k == l->n) {
 		int i = k == 0 ? 0 : l->n - 1;
 		double v = lat_v(l, l->phi, i), w = collide_wall(l->r, v);

@@ -54,6 +54,7 @@ struct lat_event {
 	int left, right;                /* oscillator indices; -1 for a wall */
 	double pre_left, pre_right;
 	double post_left, post_right;
+	double x_left, x_right;         /* displacements A cos(phi) at the impact; a wall's NAN */
 	double impulse;                 /* unit mass: the left body's change of speed (a wall's body's) */
 	double delta_before;            /* phi_right - phi_left in (-pi, pi]; NAN at a wall */
 	double delta_after;
