@@ -264,7 +264,10 @@ static int lat_pending(struct lat *l, struct lat_event *ev)
 		if (!l->pending[k])
 			continue;
 		l->pending[k] = false;
-		if (!(lat_gap(l, l->phi, k) < 0))
+		/* <= 0: a neighbour that reached contact at the very instant of
+		 * this impact (a symmetric row) would otherwise pass unseen, its
+		 * gap not > 0 at the next step's start */
+		if (!(lat_gap(l, l->phi, k) <= 0))
 			continue;
 		if (lat_gap_rate(l, l->phi, k) < 0) {
 			lat_collide(l, k, ev);
