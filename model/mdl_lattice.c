@@ -20,6 +20,10 @@
 /* Brent iterations at most when locating a time; it converges in ~10-40. */
 #define LAT_ROOT_ITER 200
 #define LAT_TOL_DEFAULT 1e-12
+/* Immediate collisions at one instant at most, per oscillator: each can
+ * leave its neighbours overlapping again (the new phases jump the bodies),
+ * and a chain that did not die out would hold the row at one instant. */
+#define LAT_IMMEDIATE_PER_OSC 4
 
 struct lat {
 	int n;
@@ -34,6 +38,8 @@ struct lat {
 	double *ytmp;            /* scratch: the state at a time inside the step */
 	bool *pending;           /* contacts to look at after a jump */
 	bool any_pending;
+	double immediate_t;      /* the instant of the last immediate collisions */
+	int immediate_n;         /* how many at that instant */
 	double h, hmax, tol;
 	gsl_odeiv2_system sys;
 	gsl_odeiv2_step *step;
@@ -269,7 +275,12 @@ static int lat_pending(struct lat *l, struct lat_event *ev)
 		 * gap not > 0 at the next step's start */
 		if (!(lat_gap(l, l->phi, k) <= 0))
 			continue;
-		if (lat_gap_rate(l, l->phi, k) < 0) {
+		if (l->t != l->immediate_t) {
+			l->immediate_t = l->t;
+			l->immediate_n = 0;
+		}
+		if (lat_gap_rate(l, l->phi, k) < 0 && l->immediate_n < LAT_IMMEDIATE_PER_OSC * l->n) {
+			l->immediate_n++;
 			lat_collide(l, k, ev);
 			ev->immediate = true;
 			return 1;
@@ -391,6 +402,7 @@ struct lat *lat_new(const struct lat_params *p, const double *phase0, char *err,
 	l->tol = p->tolerance > 0 ? p->tolerance : LAT_TOL_DEFAULT;
 	l->hmax = 1.0 / (p->frequency_hz * LAT_STEPS_PER_PERIOD);
 	l->h = l->hmax;
+	l->immediate_t = NAN;
 	if (lat_alloc(l, err, errcap) != 0) {
 		lat_free(l);
 		return NULL;

@@ -21,7 +21,9 @@
  * A collision's jump (the new phases on the cycle of amplitude A, a
  * mobility shift) can leave a neighbouring pair overlapping. Such a pair
  * collides at once when it is approaching (`immediate` in the event), and is
- * let through until it separates when it is not (counted in lat_overlaps).
+ * let through until it separates when it is not (counted in lat_overlaps);
+ * so is one still approaching after 4 n immediate collisions at one instant
+ * (a chain that does not die out).
  * The pair that just collided is never collided again before its next
  * approach: that is theory.md's return map. */
 #ifndef UNDULATE_MODEL_LATTICE_H
