@@ -269,9 +269,12 @@ static const char *mrun_class(const struct mrun *m, int k)
 }
 
 /* The time the row stopped colliding: the last collision between
- * oscillators when none came in the final window, else NAN (censored). */
+ * oscillators when none came in the final window, else NAN (censored); 0
+ * for a row that never collided. */
 static double mrun_t_relax(const struct mrun *m)
 {
+	if (isnan(m->last_pair_collision))
+		return 0;   /* never touched: relaxed from the start */
 	if (m->last_pair_collision >= m->window_start)
 		return NAN;
 	return m->last_pair_collision;

@@ -52,8 +52,8 @@ tap_check "d~ = 0 ends in phase (|delta| < 0.01), grazing" \
 	jq -e '.pairs[0].class == "grazing" and .pairs[0].mean_abs_delta < 0.01' "$T/p0/summary.json"
 
 "$M" pair --dsep 0.3 --delta0 0.5 --duration 30 --out "$T/p3" --quiet >/dev/null 2>&1
-tap_check "d~ = 0.3 from 0.5 rad (below 2 asin(0.3) = 0.61): compatible, no contact" \
-	jq -e '.pairs[0].class == "compatible" and .pairs[0].collisions == 0' "$T/p3/summary.json"
+tap_check "d~ = 0.3 from 0.5 rad (below 2 asin(0.3) = 0.61): compatible, no contact, relaxed at 0" \
+	jq -e '.pairs[0].class == "compatible" and .pairs[0].collisions == 0 and .model.t_relax_s == 0' "$T/p3/summary.json"
 "$M" pair --dsep 0.3 --delta0 1.0 --duration 30 --out "$T/p3b" --quiet >/dev/null 2>&1
 tap_check "d~ = 0.3 from 1.0 rad: one collision, then no more" \
 	jq -e '.pairs[0].collisions == 1 and .model.t_relax_s < 1.25' "$T/p3b/summary.json"
