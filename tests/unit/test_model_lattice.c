@@ -141,6 +141,24 @@ static void test_random_phases(void **state)
 	assert_true(a[0] > -M_PI && a[0] <= M_PI);
 }
 
+/* Three bodies on one spot (d~ = 0) at phases 1, -1, 1: every gap exactly 0
+ * at the start, the right pair approaching. It collides at once; a gap of 0
+ * is not "apart", and the pair passed through each other before (the first
+ * impact came at 0.5 s, between the left pair). */
+static void test_contact_at_zero_gap(void **state)
+{
+	(void)state;
+	struct lat_params p = { .n = 3, .frequency_hz = 1, .amplitude = 1, .restitution = 0.5, .dsep = 0 };
+	double ph[3] = { 1.0, -1.0, 1.0 };
+	char err[200];
+	struct lat *l = lat_new(&p, ph, err, sizeof err);
+	assert_non_null(l);
+	struct lat_event ev;
+	assert_int_equal(lat_advance(l, 3, &ev, err, sizeof err), LAT_COLLISION);
+	assert_true(ev.t == 0 && ev.contact == 2 && ev.immediate);
+	lat_free(l);
+}
+
 static void test_bad_parameters(void **state)
 {
 	(void)state;
@@ -176,6 +194,7 @@ int main(void)
 		cmocka_unit_test(test_impact_books),
 		cmocka_unit_test(test_mobile_row_relaxes),
 		cmocka_unit_test(test_random_phases),
+		cmocka_unit_test(test_contact_at_zero_gap),
 		cmocka_unit_test(test_bad_parameters),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
