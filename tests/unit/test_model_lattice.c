@@ -159,6 +159,34 @@ static void test_contact_at_zero_gap(void **state)
 	lat_free(l);
 }
 
+/* Ten bodies on one spot (d~ = 0), r = 0.9, seed 8: each impact's new
+ * phases leave a neighbour overlapping and approaching again, and without a
+ * bound the immediate impacts at one instant never ended (past 2e6 of them
+ * at one instant before the bound of 4 n). */
+static void test_immediate_chain_ends(void **state)
+{
+	(void)state;
+	struct lat_params p = { .n = N, .frequency_hz = 0.8, .amplitude = 0.8, .restitution = 0.9, .dsep = 0 };
+	double ph[N];
+	char err[200];
+	lat_random_phases(&p, 8, ph);
+	struct lat *l = lat_new(&p, ph, err, sizeof err);
+	assert_non_null(l);
+	struct lat_event ev;
+	long n = 0, run = 0, longest = 0;
+	double last = -1;
+	enum lat_status st;
+	while ((st = lat_advance(l, 30, &ev, err, sizeof err)) == LAT_COLLISION && n < 100000) {
+		run = ev.t == last ? run + 1 : 1;
+		longest = run > longest ? run : longest;
+		last = ev.t;
+		n++;
+	}
+	assert_int_equal(st, LAT_REACHED);
+	assert_true(longest <= 4 * N + 1);
+	lat_free(l);
+}
+
 static void test_bad_parameters(void **state)
 {
 	(void)state;
@@ -195,6 +223,7 @@ int main(void)
 		cmocka_unit_test(test_mobile_row_relaxes),
 		cmocka_unit_test(test_random_phases),
 		cmocka_unit_test(test_contact_at_zero_gap),
+		cmocka_unit_test(test_immediate_chain_ends),
 		cmocka_unit_test(test_bad_parameters),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
