@@ -63,7 +63,7 @@ GEN_WARN := -w
 # ---- components -------------------------------------------------------------
 # name : directory
 # bench/ holds standalone programs compiled by bench/run.sh, not a library.
-COMPONENTS := common protocol daemon sim dxl top analyze web
+COMPONENTS := common protocol daemon sim dxl top analyze web model
 DIR_common   := common
 DIR_protocol := protocol protocol/io
 DIR_daemon   := daemon
@@ -72,6 +72,7 @@ DIR_dxl      := tools/dxl
 DIR_top      := tools/top
 DIR_analyze  := tools/analyze
 DIR_web      := tools/web
+DIR_model    := model
 
 # programs: binary name -> component, and the libraries each links (in order)
 PROG_undulated        := daemon
@@ -80,7 +81,8 @@ PROG_dxl              := dxl
 PROG_undulate-top     := top
 PROG_undulate-analyze := analyze
 PROG_undulate-web     := web
-ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze undulate-web
+PROG_undulate-model   := model
+ALL_PROGRAMS := undulated undulate-sim dxl undulate-top undulate-analyze undulate-web undulate-model
 # Build only programs whose main.c exists (keeps partial trees buildable).
 PROGRAMS := $(foreach p,$(ALL_PROGRAMS),$(if $(wildcard $(firstword $(DIR_$(PROG_$(p))))/main.c),$(p)))
 DEPS_daemon   := daemon protocol common
@@ -92,6 +94,9 @@ DEPS_analyze  := analyze protocol common
 # undulate-web: top's model (the LCM picture, top_json), analyze's end-state
 # rules, the daemon's command validation
 DEPS_web      := web top analyze daemon protocol common
+# undulate-model: the analyser's end-state rules (classify.c) and theory
+# (theory.c) for its summary, so that its pairs are named as a log's are
+DEPS_model    := model analyze common
 DEPS_protocol := protocol common
 DEPS_common   := common
 
@@ -202,6 +207,11 @@ $(BUILD)/tests/test_web_fox: LDLIBS += -lwebsockets
 # the simulator and its tests link it.
 $(BIN)/undulate-sim: LDLIBS += -lchipmunk
 $(patsubst tests/unit/%.c,$(BUILD)/tests/%,$(wildcard tests/unit/test_sim_*.c)): LDLIBS += -lchipmunk
+# undulate-model integrates the paper's equations with GSL's odeiv2 and finds
+# its collisions with GSL's root finders (Debian's libgsl-dev): it and its
+# tests link GSL.
+$(BIN)/undulate-model: LDLIBS += -lgsl -lgslcblas
+$(patsubst tests/unit/%.c,$(BUILD)/tests/%,$(wildcard tests/unit/test_model_*.c)): LDLIBS += -lgsl -lgslcblas
 # pngdata reads the plots' PNGs (libpng, from Debian's libpng-dev).
 $(BUILD)/tests/tools/pngdata: LDLIBS += -lpng
 unit-tests: $(TOOL_BINS)

@@ -13,7 +13,8 @@
 # runs, 8), BENCH_FLEET_S (20 robots with 20 daemons, 15), BENCH_CG_S (the
 # daemon under callgrind, 3), BENCH_LOCK_REPS (lockstep runs per scenario, 3),
 # BENCH_ONLY (a list of sections to run, e.g.
-# "loop bus"; default all: loop bus missing cap plane codec cg web lockstep),
+# "loop bus"; default all: loop bus missing cap plane codec cg web lockstep model),
+# BENCH_MODEL_REPS (undulate-model runs per setting, 3),
 # KEEP_BENCH_DIR=1 keeps the logs.
 set -u
 top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -32,7 +33,8 @@ CYCLES=${BENCH_CYCLES:-300}
 CAP_S=${BENCH_CAP_S:-8}
 CG_S=${BENCH_CG_S:-3}
 FLEET_S=${BENCH_FLEET_S:-15}
-ONLY=${BENCH_ONLY:-loop bus missing cap plane codec cg web lockstep}
+ONLY=${BENCH_ONLY:-loop bus missing cap plane codec cg web lockstep model}
+MODEL_REPS=${BENCH_MODEL_REPS:-3}
 LOCK_REPS=${BENCH_LOCK_REPS:-3}
 WEB_S=${BENCH_WEB_S:-15}
 WEB_ROBOTS=20
@@ -940,6 +942,76 @@ section_lockstep() {
 	say ""
 }
 
+# ---- 9: the paper's model (undulate-model) ---------------------------------------
+# model_run NAME ARGS...: one 50-oscillator, 600 s lattice on one core (CPU 0
+# when taskset exists); "wall user+sys collisions steps root_evals" to
+# $T/model/NAME.res, or "nan ..." when it failed.
+model_run() {
+	local name=$1 d=$T/model pin=() t rc
+	shift
+	mkdir -p "$d"
+	command -v taskset >/dev/null && pin=(taskset -c 0)
+	t=$( { TIMEFORMAT='%R %U %S'; time "${pin[@]}" "$BIN/undulate-model" lattice --n 50 --duration 600 \
+		--seed 3 --out "$d/$name.out" --quiet "$@" >"$d/$name.log" 2>&1; } 2>&1)
+	rc=$?
+	if [ "$rc" != 0 ] || [ ! -s "$d/$name.out/summary.json" ]; then
+		echo "nan nan nan nan nan" >"$d/$name.res"
+		return 1
+	fi
+	echo "$t $(jq -r '[.collisions, .model.steps, .model.root_evals] | map(tostring) | join(" ")' \
+		"$d/$name.out/summary.json")" | awk '{ printf "%s %.2f %s %s %s\n", $1, $2 + $3, $4, $5, $6 }' >"$d/$name.res"
+	rm -rf "$d/$name.out"
+}
+section_model() {
+	if [ ! -x "$BIN/undulate-model" ]; then
+		sum "undulate-model: 50 oscillators, 600 s" "< 10 s on one core" "not measured: not built"
+		return 0
+	fi
+	progress "model: undulate-model, 50 oscillators for 600 s, $MODEL_REPS runs a setting"
+	local i set worst=nan label
+	local -A args=(
+		[d014]="--dsep 0.14"
+		[d07]="--dsep 0.7"
+		[d07ns]="--dsep 0.7 --no-samples"
+		[mob]="--dsep 0.78 --beta 0.01 --fixed-ends"
+	)
+	local -A labels=(
+		[d014]="d~ 0.14, immobile (relaxes within seconds), 20 samples/s written"
+		[d07]="d~ 0.7, immobile (collides to the end), 20 samples/s written"
+		[d07ns]="d~ 0.7, immobile, no sample rows"
+		[mob]="d~ 0.78, beta 0.01 s, fixed ends, 20 samples/s written"
+	)
+	for set in d014 d07 d07ns mob; do
+		for i in $(seq "$MODEL_REPS"); do
+			# shellcheck disable=SC2086 # the settings are words
+			model_run "$set.$i" ${args[$set]}
+		done
+	done
+	say "## 9. The paper's model (undulate-model)"
+	say ""
+	say "\`undulate-model lattice --n 50 --duration 600 --seed 3\` on one core (taskset -c 0), $MODEL_REPS runs each:"
+	say "the phase oscillators integrated with GSL's odeiv2, every collision located as an event (model/README.md)."
+	say "Budget: under 10 s on one core. Wall and CPU (user + sys) seconds: the median and the range."
+	say ""
+	say "| setting | wall s | CPU s | collisions | steps | root evaluations |"
+	say "|---|---|---|---|---|---|"
+	for set in d014 d07 d07ns mob; do
+		local walls cpus med cmed crange wrange one
+		walls=$(cat "$T/model/$set".*.res | awk '{ print $1 }' | sort -n)
+		cpus=$(cat "$T/model/$set".*.res | awk '{ print $2 }' | sort -n)
+		med=$(echo "$walls" | awk '{ x[NR] = $1 } END { print x[int((NR + 1) / 2)] }')
+		cmed=$(echo "$cpus" | awk '{ x[NR] = $1 } END { print x[int((NR + 1) / 2)] }')
+		wrange=$(echo "$walls" | awk 'NR == 1 { lo = $1 } { hi = $1 } END { printf "%s–%s", lo, hi }')
+		crange=$(echo "$cpus" | awk 'NR == 1 { lo = $1 } { hi = $1 } END { printf "%s–%s", lo, hi }')
+		one=$(head -n1 "$T/model/$set.1.res")
+		say "| ${labels[$set]} | $med ($wrange) | $cmed ($crange) | $(echo "$one" | awk '{ print $3 }') |" \
+			"$(echo "$one" | awk '{ print $4 }') | $(echo "$one" | awk '{ print $5 }') |"
+		[ "$set" = d07 ] && worst="$med s wall, $cmed s CPU (${labels[$set]})"
+	done
+	say ""
+	sum "undulate-model: 50 oscillators, 600 s lattice" "< 10 s on one core" "$worst"
+}
+
 # ---- main -------------------------------------------------------------------------
 main() {
 	local missing=()
@@ -980,6 +1052,7 @@ main() {
 	wants cg && section_cg
 	wants web && section_web
 	wants lockstep && section_lockstep
+	wants model && section_model
 	{
 		echo "# undulate benchmarks"
 		echo

@@ -11,12 +11,13 @@ set -eu
 # scripts/figures.sh), cyclictest for the jitter benchmark; systemd and man-db
 # for checking the units (systemd-analyze verify) and the man pages;
 # libwebsockets and Chart.js for undulate-web (its page's plots, served from
-# the installed path); Chipmunk2D for the simulator's plane world. Chromium (headless: web_dashboard's browser test) is
+# the installed path); Chipmunk2D for the simulator's plane world; GSL for
+# undulate-model (the paper's equations: odeiv2, root finding). Chromium (headless: web_dashboard's browser test) is
 # installed by `make test` when it can be (`scripts/deps.sh chromium`);
 # without it that test says so and skips.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
       libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox parallel rt-tests procps iproute2 jq python3 socat systemd man-db curl
-      libwebsockets-dev libjs-chart.js libchipmunk-dev)
+      libwebsockets-dev libjs-chart.js libchipmunk-dev libgsl-dev)
 [ $# -gt 0 ] && need=("$@")
 missing=()
 for p in "${need[@]}"; do

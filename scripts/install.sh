@@ -45,12 +45,12 @@ SYSUSERSDIR=${SYSUSERSDIR:-${sys_lib:-$sys_etc}/sysusers.d}
 CONFDIR="$SYSCONFDIR/undulate"
 MANIFEST="$DATADIR/install-manifest"
 
-PROGRAMS=(undulated undulate-sim dxl undulate-top undulate-analyze undulate-web)
+PROGRAMS=(undulated undulate-sim dxl undulate-top undulate-analyze undulate-web undulate-model)
 UNITS=(undulated@.service undulate-sim.service undulate-web.service)
 DOCS=(README.md daemon/README.md daemon/CONTROL.md sim-bridge/README.md sim-bridge/PHYSICS.md
       protocol/README.md lcmtypes/README.md systemd/README.md tools/dxl/README.md tools/top/README.md
-      tools/analyze/README.md tools/web/README.md docs/EXPERIMENTS.md docs/ROBOT.md docs/SAFETY.md
-      docs/MEASUREMENTS.md docs/LIMITS.md docs/LAYOUT.md docs/CLUSTER.md docs/img/dashboard.png)
+      tools/analyze/README.md tools/web/README.md model/README.md docs/EXPERIMENTS.md docs/ROBOT.md
+      docs/SAFETY.md docs/MEASUREMENTS.md docs/LIMITS.md docs/LAYOUT.md docs/CLUSTER.md docs/img/dashboard.png)
 SERVICE_USER=undulate
 
 die() { echo "install.sh: $*" >&2; exit 1; }

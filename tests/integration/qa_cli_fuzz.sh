@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Seeded random command lines for every program (undulated, undulate-sim, dxl,
-# undulate-top --once, undulate-analyze). Each command line holds at least one
+# undulate-top --once, undulate-analyze, undulate-model). Each command line holds at least one
 # bad element — an unknown option, a missing or non-numeric value (abc, nan,
 # inf, 1e999, '', '1x'), stray words — among random valid options and hostile
 # strings (format directives, 4 kB, control bytes, UTF-8). Every program must
 # answer with a message on stderr and a non-zero exit: never a signal, never a
 # sanitizer report, never a hang. A few valid but extreme command lines run too.
 . "$(dirname "$0")/../lib.sh"
-for p in undulated undulate-sim dxl undulate-top undulate-analyze; do
+for p in undulated undulate-sim dxl undulate-top undulate-analyze undulate-model; do
 	[ -x "$B/$p" ] || tap_skip_all "$p not built"
 done
 # anything that talks LCM stays on this test's own port
@@ -46,6 +46,12 @@ progs = {
                          ['--from', '--to', '--window', '--separation', '--restitution', '--merge', '--duration',
                           '--min-swing', '--synth-stop-after'],
                          ['--plots', '--zero-crossings', '--quiet'], []),
+    'undulate-model': (['--n', '--dsep', '--restitution', '--beta', '--walls', '--seed', '--phases', '--delta0',
+                        '--duration', '--frequency', '--amplitude', '--sample-hz', '--window', '--tolerance',
+                        '--out', '--dsep-from', '--dsep-to', '--dsep-points', '--delta-points'],
+                       ['--n', '--dsep', '--restitution', '--walls', '--seed', '--delta0', '--duration',
+                        '--frequency', '--amplitude', '--sample-hz', '--window', '--tolerance', '--dsep-points'],
+                       ['--fixed-ends', '--no-samples', '--quiet'], []),
 }
 
 def value():
@@ -54,6 +60,8 @@ def value():
 def argv(prog):
     opts, nums, flags, words = progs[prog]
     groups = [['--once', '--wait', '0.2']] if prog == 'undulate-top' else []
+    # undulate-model's subcommand comes first
+    head = [rng.choice(['pair', 'lattice', 'map'])] if prog == 'undulate-model' else []
     for _ in range(rng.randrange(0, 5)):
         r = rng.random()
         if r < 0.4:
@@ -71,7 +79,7 @@ def argv(prog):
         groups.insert(rng.randrange(0, len(groups) + 1), bad)
     else:
         groups.append([rng.choice(opts)])
-    return [x for g in groups for x in g]
+    return head + [x for g in groups for x in g]
 
 def run(prog, args, timeout=3):
     env = dict(os.environ, ASAN_OPTIONS='detect_leaks=1:abort_on_error=0')
@@ -118,6 +126,10 @@ extreme = [
                           '--merge', '0', '--pairs', 'a:a,:,b:', '--quiet']),
     ('undulated', ['--watch', '*', '--timeout', '0.2']),
     ('undulated', ['--command', 'param k 1e308 -32768', '--robot', '*', '--timeout', '0.2']),
+    ('undulate-model', ['lattice', '--n', '1000', '--dsep', '0.5', '--restitution', '1', '--duration', '2',
+                        '--seed', '18446744073709551615', '--out', T + '/m', '--quiet', '--no-samples']),
+    ('undulate-model', ['map', '--dsep-points', '2', '--delta-points', '3600', '--restitution', '0',
+                        '--tolerance', '1e-4']),
     ('dxl', ['--port', '/dev/null', 'ports']),
     ('dxl', ['--protocol', '2', '--port', T + '/nothing', '--size', '4', 'read', '252', '0xFFFF']),
     ('dxl', ['--protocol', '2', '--port', T + '/nothing', 'reset', '252', '--keep', 'id-baud', '--yes']),

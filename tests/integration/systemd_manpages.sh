@@ -8,7 +8,7 @@
 # A program that is not built is skipped (TAP SKIP), its page still rendered.
 . "$(dirname "$0")/../lib.sh"
 
-pages=(undulated.8 undulate-sim.1 dxl.1 undulate-top.1 undulate-analyze.1 undulate-web.1)
+pages=(undulated.8 undulate-sim.1 dxl.1 undulate-top.1 undulate-analyze.1 undulate-web.1 undulate-model.1)
 
 render() { LC_ALL=C.UTF-8 MANWIDTH=2000 man --warnings -E UTF-8 -l "$1"; }
 long_opts() { grep -oE -- '(^|[^A-Za-z0-9-])--[a-z][a-z0-9-]*' | grep -oE -- '--[a-z][a-z0-9-]*' | sort -u; }
