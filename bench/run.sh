@@ -171,7 +171,7 @@ build_helpers() {
 # $T/web-WORLD/result, or the reason it could not measure (status 1). Not in
 # a subshell: the processes it starts stay in PID for the cleanup.
 web_run() {
-	local world=$1 u d=$T/web-$1 port wpid t0 c0 t1 c1 pct frames bytes secs
+	local world=$1 fox=${2:-} u d=$T/web-$1${2:+-fox} port wpid t0 c0 t1 c1 pct frames bytes secs fpid=
 	u=$(url "$PORT_WEB")
 	mkdir -p "$d"
 	start webpub "$HB/webpub" "$u" "$WEB_ROBOTS" $((WEB_S + 10)) $([ "$world" = plane ] && echo plane)
@@ -184,9 +184,12 @@ web_run() {
 	port=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$T/web.log")
 	sleep 2  # every robot heard, the first (whole-history) frame out of the way
 	wpid=${PID[web]}
+	# with fox: a Foxglove client subscribed to every channel beside the page's
+	[ -n "$fox" ] && { python3 tests/integration/web_cdp.py fox 127.0.0.1 "$port" "$WEB_S" >"$d/fox" 2>&1 & fpid=$!; }
 	t0=$(now_us) c0=$(cpu_ticks "$wpid")
 	python3 tests/integration/web_cdp.py frames 127.0.0.1 "$port" "$WEB_S" >"$d/frames" 2>&1
 	t1=$(now_us) c1=$(cpu_ticks "$wpid")
+	[ -n "$fpid" ] && wait "$fpid"
 	pct=$(cpu_pct "$c0" "$c1" "$t0" "$t1")
 	frames=$(awk '/^FRAMES/ { print $2 }' "$d/frames")
 	bytes=$(awk '/^FRAMES/ { print $4 }' "$d/frames")
@@ -205,19 +208,23 @@ section_web() {
 	fi
 	say "## undulate-web"
 	say ""
-	for world in row plane; do
-		progress "web: undulate-web with $WEB_ROBOTS robots at 100 Hz ($world) and one browser, ${WEB_S} s"
-		if ! web_run "$world"; then
-			sum "undulate-web CPU, 20 robots at 100 Hz ($world), one browser" "≤ 5 % of a core" \
-				"$(cat "$T/web-$world/result")"
+	local run fox what
+	for run in row plane plane+fox; do
+		world=${run%+fox} fox=; [ "$run" != "$world" ] && fox=fox
+		what="one browser"; [ -n "$fox" ] && what="one browser and one Foxglove client on every channel"
+		progress "web: undulate-web with $WEB_ROBOTS robots at 100 Hz ($world), $what, ${WEB_S} s"
+		if ! web_run "$world" $fox; then
+			sum "undulate-web CPU, 20 robots at 100 Hz ($world), $what" "≤ 5 % of a core" \
+				"$(cat "$T/web-$world${fox:+-fox}/result")"
 			continue
 		fi
-		read -r pct rate kbs per <"$T/web-$world/result"
-		sum "undulate-web CPU, 20 robots at 100 Hz ($world), one browser" "≤ 5 % of a core" \
+		read -r pct rate kbs per <"$T/web-$world${fox:+-fox}/result"
+		sum "undulate-web CPU, 20 robots at 100 Hz ($world), $what" "≤ 5 % of a core" \
 			"$(fmt "$pct" 2) % ($(fmt "$rate" 1) frames/s, $(fmt "$kbs") kB/s)"
 		say "$WEB_ROBOTS robots' STATE and SIM.TRUTH of the $world at 100 Hz (bench/webpub.c), one WebSocket client"
 		say "reading every frame for ${WEB_S} s: server CPU $(fmt "$pct" 2) % of one core, $(fmt "$rate" 1) frames/s,"
 		say "$(fmt "$kbs") kB/s, $(fmt "$per") bytes a frame."
+		[ -n "$fox" ] && say "Beside it a Foxglove client (foxglove.websocket.v1, web_cdp.py fox): $(cat "$T/web-$world-fox/fox")."
 		say ""
 	done
 }

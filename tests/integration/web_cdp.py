@@ -103,7 +103,9 @@ class WS:
         return out
 
     def recv(self):
+        """The next message: str for a text one, bytes for a binary one."""
         msg = b""
+        kind = None
         while True:
             b0, b1 = self._need(2)
             n = b1 & 0x7F
@@ -118,9 +120,11 @@ class WS:
                 raise Closed(code, payload[2:].decode(errors="replace"))
             if op in (9, 10):
                 continue
+            if kind is None:
+                kind = op
             msg += payload
             if b0 & 0x80:
-                return msg.decode()
+                return msg if kind == 2 else msg.decode()
 
 
 class CDP:
@@ -298,6 +302,36 @@ def frames(host, port, seconds):
     print("SERVER " + json.dumps(server), flush=True)
 
 
+def fox(host, port, seconds):
+    """A Foxglove client (foxglove.websocket.v1) that subscribes to every
+    channel the server advertises and counts the messages for SECONDS:
+    "FOX CHANNELS n MESSAGES n BYTES n SECONDS s"."""
+    ws = WS(host, int(port), "/", "foxglove.websocket.v1")
+    channels, n, total, sub = {}, 0, 0, 0
+    end = time.time() + float(seconds)
+    first = None
+    while time.time() < end:
+        m = ws.recv()
+        if isinstance(m, str):
+            msg = json.loads(m)
+            if msg.get("op") == "advertise":
+                new = [c["id"] for c in msg.get("channels", []) if c["id"] not in channels]
+                subs = []
+                for c in new:
+                    sub += 1
+                    channels[c] = sub
+                    subs.append({"id": sub, "channelId": c})
+                if subs:
+                    ws.send(json.dumps({"op": "subscribe", "subscriptions": subs}))
+            continue
+        if first is None:
+            first = time.time()
+        n += 1
+        total += len(m)
+    print(f"FOX CHANNELS {len(channels)} MESSAGES {n} BYTES {total} SECONDS {time.time() - (first or end):.2f}",
+          flush=True)
+
+
 def say(host, port, message, until=None):
     """Send one message; print the first note (not the hello), or with
     `until` every note until one of that kind (the robot's answer)."""
@@ -325,4 +359,4 @@ def freeport():
 
 if __name__ == "__main__":
     cmd = sys.argv[1]
-    {"page": page, "view": view, "servos": servos, "world": world, "slow": slow, "frames": frames, "say": say, "freeport": freeport}[cmd](*sys.argv[2:])
+    {"page": page, "view": view, "servos": servos, "world": world, "slow": slow, "frames": frames, "fox": fox, "say": say, "freeport": freeport}[cmd](*sys.argv[2:])
