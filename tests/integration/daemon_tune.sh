@@ -47,7 +47,12 @@ out=$("$D" --tune --port "$T/none" --ids 1,2 --set joint.1.limit_max=0.9 --targe
 # ---- the simulator and the test plant, tuned at the same time ---------------------------
 spawn sim "$S" --link "$T/sim" --ids 1,2 --lcm-url "$URL_SIM" --seed 21 --return-delay 0
 # the plant the audit described: joints that reach the goal at once up to the rated speed
-spawn plant python3 "$PLANT" --link "$T/plant" --ids 1,2 --gain 300 --tau 0.003
+# A servo is hardware: the CPU around it never makes it late. The Python plant
+# is a process, and on a loaded machine it missed replies (READ timeouts) and
+# the tuner's windows wandered (0.66..0.97 Hz at load 10-13, no result): it
+# runs ahead of the rest where that is allowed (root; GNU nice runs it anyway,
+# with a warning, where it is not).
+spawn plant nice -n -10 python3 "$PLANT" --link "$T/plant" --ids 1,2 --gain 300 --tau 0.003
 wait_log sim 'ready' 10 && wait_log plant 'ready' 10 ||
 	{ tap_fail "simulator and plant ready" "$(cat "$T/sim.log" "$T/plant.log")"; tap_done; exit 1; }
 spawn tsim "$D" --tune --port "$T/sim" --ids 1,2 --robot tsim --lcm-url "$URL_SIM" --out "$T/tsim.conf" -q
