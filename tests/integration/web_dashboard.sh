@@ -124,7 +124,7 @@ URLN=$(lcm_url 7791)
 "$D" --gen-key "$T/wrong.key" >/dev/null
 spawn simn "$S" --link "$T/net" --ids 1 --lcm-url "$URLN" --seed 6
 wait_log simn 'ready' 10
-spawn watchn "$D" --watch net --lcm-url "$URLN"
+spawn watchn "$D" --watch net --raw --lcm-url "$URLN"
 spawn d_net "$D" --port "$T/net" --ids 1 --robot net --lcm-url "$URLN" --mode oscillator \
 	--set robot.commands=network --set "robot.command_key=$T/net.key"
 wait_log d_net 'ready: net.STATE' 10
