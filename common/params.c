@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "json.h"
+
 /* The ranges are physical: an AX-12 joint's link has an inertia of order
  * 1e-3 kg·m² and a stall torque of 1.5 N·m, so a law's spring of more than
  * 10 N·m/rad or an inertia below 1e-5 (the oscillator then asks for
@@ -60,4 +62,38 @@ char *param_range_format(const struct param_range *r, char *buf, size_t cap)
 {
 	snprintf(buf, cap, "%s%.4g..%.4g", r->min_open ? ">" : "", r->min, r->max);
 	return buf;
+}
+
+bool param_table_json(FILE *f)
+{
+	struct json j;
+	char range[48];
+	json_init(&j, f, 0);
+	json_array_begin(&j);
+	for (size_t i = 0; i < PARAM_NDEFS; i++) {
+		const struct param_def *d = &param_defs[i];
+		if (!d->commandable)
+			continue;
+		json_object_begin(&j);
+		json_key(&j, "name");
+		json_string(&j, d->key);
+		json_key(&j, "min");
+		json_number(&j, d->range.min);
+		json_key(&j, "max");
+		json_number(&j, d->range.max);
+		json_key(&j, "min_open");
+		json_bool(&j, d->range.min_open);
+		json_key(&j, "range");
+		json_string(&j, param_range_format(&d->range, range, sizeof range));
+		json_key(&j, "unit");
+		json_string(&j, d->unit);
+		json_key(&j, "step");
+		json_number(&j, d->step);
+		json_key(&j, "per_joint");
+		json_bool(&j, d->joint);
+		json_object_end(&j);
+	}
+	json_array_end(&j);
+	fputc('\n', f);
+	return json_end(&j) && !ferror(f);
 }

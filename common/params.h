@@ -10,6 +10,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #define PARAM_PI 3.14159265358979323846
 /* The AX-12's goal spans ±150° around its centre (raw 0..1023 over 300°):
@@ -36,5 +37,11 @@ bool param_in_range(const struct param_range *r, double v);
 const struct param_def *param_at(size_t i);
 /* "[0, 2.618]" or "(0, 0.5]": the range as every program's messages say it. */
 char *param_range_format(const struct param_range *r, char *buf, size_t cap);
+/* The parameters a command may change, as one JSON array of
+ * {name, min, max, min_open, range, unit, step, per_joint}: what undulate-web
+ * serves its page at /api/params, so that the page offers the daemon's names,
+ * ranges, units and steps rather than a copy of its own. False on a write
+ * error. */
+bool param_table_json(FILE *f);
 
 #endif
