@@ -107,7 +107,7 @@ else
 fi
 # Where the run is kept, and the next command, which works as printed.
 next=$(sed -n 's/^Next, the plots:  //p' "$out")
-if grep -qF "The run is kept in $T/out: demo.lcmlog" "$out" && [ "$next" = "$B/undulate-analyze $T/out/demo.lcmlog --out $T/out/plots --plots" ] &&
+if grep -qF "The run is kept in $T/out: demo.lcmlog" "$out" && [ "$next" = "$B/undulate-analyze $T/out/demo.lcmlog --out $T/out/plots --plots-only" ] &&
 	grep -qF "log: $T/out/demo.lcmlog" "$T/out/summary.txt"; then
 	tap_ok "summary ends with the kept folder and the next command; summary.txt names the kept log"
 else
