@@ -587,6 +587,8 @@ if [ "$interactive" -eq 1 ]; then
 	# the run unanalysed and say what ran
 	if [ "$top_rc" -ne 0 ]; then
 		date +%s%N >"$run/t_end"
+		# undulate-top leaves the cursor at the end of its last line
+		[ -t 2 ] && echo >&2
 		stop_children
 		early_keep "$run" "$([ "$top_rc" -eq 130 ] && echo Ctrl-C || echo "undulate-top exit $top_rc")"
 		exit "$top_rc"
