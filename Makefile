@@ -42,7 +42,8 @@ OBJ      := $(BUILD)/obj
 LIB      := $(BUILD)/lib
 GEN      := $(BUILD)/lcmgen
 
-PKGS     := lcm libserialport inih libsodium
+# liblzma: undulate-analyze reads the xz-compressed logs make demo keeps
+PKGS     := lcm libserialport inih libsodium liblzma
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 
@@ -256,7 +257,7 @@ DEMO_SECONDS ?=
 DEMO_OUT ?=
 demo: deps
 	@$(MAKE) --no-print-directory all
-	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) DEMO_OUT=$(DEMO_OUT) scripts/demo.sh
+	@BUILD=$(BUILD) DEMO_SECONDS=$(DEMO_SECONDS) DEMO_OUT=$(DEMO_OUT) DEMO_COMPRESS=1 scripts/demo.sh
 
 # The paper's figures (scripts/figures.sh, README.md "Figures"): every run
 # through GNU parallel here, then docs/FIGURES.md. QUICK=1: the quick set.

@@ -58,7 +58,7 @@ wait_line() {
 	>"$dir/sim.log" 2>&1 &
 pids+=($!)
 wait_line "$dir/sim.log" ready || { echo "tune.sh: simulator did not start" >&2; cat "$dir/sim.log" >&2; exit 1; }
-"$DMN" --watch "$robot" --lcm-url "$url" >"$dir/watch.log" 2>&1 &
+"$DMN" --watch "$robot" --raw --lcm-url "$url" >"$dir/watch.log" 2>&1 &
 pids+=($!)
 "$DMN" --port "$dir/bus" --ids "$ids" --robot "$robot" --lcm-url "$url" --mode oscillator "$@" >"$dir/d.log" 2>&1 &
 pids+=($!)

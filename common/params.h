@@ -9,6 +9,8 @@
 #define UNDULATE_COMMON_PARAMS_H
 
 #include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
 
 #define PARAM_PI 3.14159265358979323846
 /* The AX-12's goal spans ±150° around its centre (raw 0..1023 over 300°):
@@ -22,11 +24,24 @@ struct param_def {
 	struct param_range range;
 	bool joint;        /* per joint ([joint.N]) or per robot ([sinusoid]) */
 	bool commandable;  /* a command may change it (never what bounds a joint) */
+	const char *unit;  /* ASCII, as printed after a value ("N m/rad"); "" when none */
+	double step;       /* what a monitor's +/- or a form's arrows change it by */
 };
 
 /* The parameter named key (k, c, mu, ..., amplitude, ...); NULL if none. */
 const struct param_def *param_find(const char *key);
 /* v inside r (NaN never is). */
 bool param_in_range(const struct param_range *r, double v);
+/* The i-th parameter of the table (0 ..), NULL past its end: for the
+ * programs that list them (undulate-web serves them to its page). */
+const struct param_def *param_at(size_t i);
+/* "[0, 2.618]" or "(0, 0.5]": the range as every program's messages say it. */
+char *param_range_format(const struct param_range *r, char *buf, size_t cap);
+/* The parameters a command may change, as one JSON array of
+ * {name, min, max, min_open, range, unit, step, per_joint}: what undulate-web
+ * serves its page at /api/params, so that the page offers the daemon's names,
+ * ranges, units and steps rather than a copy of its own. False on a write
+ * error. */
+bool param_table_json(FILE *f);
 
 #endif

@@ -303,8 +303,9 @@ bool cfg_params_check(const struct cfg *c, const struct cfg_params *live, const 
 		return false;
 	}
 	if (!param_in_range(&range, value)) {
-		snprintf(why, cap, "parameter %s: %g out of range %s%g..%g", key, value, range.min_open ? ">" : "",
-		         range.min, range.max);
+		char shown[48];
+		snprintf(why, cap, "parameter %s: %g out of range %s", key, value,
+		         param_range_format(&range, shown, sizeof shown));
 		return false;
 	}
 	if (lead)
@@ -626,8 +627,9 @@ static bool cfg_set_param(double *field, const char *where, const char *section,
 		return false;
 	}
 	if (!param_in_range(&d->range, v)) {
-		cfg_error(e, "%s: [%s] %s: %g out of range %s%g..%g", where, section, key, v,
-		          d->range.min_open ? ">" : "", d->range.min, d->range.max);
+		char shown[48];
+		cfg_error(e, "%s: [%s] %s: %g out of range %s", where, section, key, v,
+		          param_range_format(&d->range, shown, sizeof shown));
 		return false;
 	}
 	*field = v;

@@ -38,8 +38,20 @@ struct send_opts {
 int dmn_send_command(const struct send_opts *o);
 
 /* `undulated --watch ROBOT`: print the robot's STATE/EVENT/BUS/PARAMS
- * messages as text lines (robot "*": every robot) until a signal or for
- * duration_s seconds (0: until a signal). */
-int dmn_watch(const char *lcm_url, const char *robot, double duration_s);
+ * messages (robot "*": every robot) until a signal or for duration_s
+ * seconds (0: until a signal). In words for a person: at most rate_hz
+ * states a second per robot, every event, the bus once a second and the
+ * parameters when they change; raw: every message as one key=value line
+ * (the format scripts parse), rate_hz 0 meaning every state. */
+struct watch_opts {
+	const char *lcm_url;
+	const char *robot;
+	double duration_s;
+	double rate_hz;   /* 0: every state */
+	bool raw;
+};
+#define WATCH_RATE_DEFAULT_HZ 4.0
+#define WATCH_RATE_MAX_HZ 1000.0
+int dmn_watch(const struct watch_opts *o);
 
 #endif

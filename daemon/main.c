@@ -30,7 +30,7 @@ static void main_usage(FILE *f)
 	        "       undulated --command 'TEXT' --robot NAME|'*' [--lcm-url URL] [--timeout S]\n"
 	        "                 [--key FILE] [--source NAME]\n"
 	        "       undulated --gen-key FILE\n"
-	        "       undulated --watch NAME|'*' [--lcm-url URL] [--timeout S]\n"
+	        "       undulated --watch NAME|'*' [--rate HZ] [--raw] [--lcm-url URL] [--timeout S]\n"
 	        "       undulated --tune [CONFIG.conf] --port PATH --ids 1,2 [--robot NAME]\n"
 	        "                 [--target-freq HZ] [--target-amp RAD] [--out FILE]\n"
 	        "\n"
@@ -63,8 +63,14 @@ static void main_usage(FILE *f)
 	        "      --source NAME      who sends, as the robot logs it (default undulated@HOST:PID)\n"
 	        "      --gen-key FILE     write a new random command key (mode 600) and exit\n"
 	        "      --timeout S        how long --command waits for answers (default 1)\n"
-	        "      --watch NAME|'*'   print a robot's STATE/EVENT/BUS/PARAMS messages as text\n"
-	        "                         lines (with --timeout S: for S seconds)\n"
+	        "      --watch NAME|'*'   print what a robot publishes, in words: its state a few times\n"
+	        "                         a second (mode by name, each joint's values with units),\n"
+	        "                         every event, the bus once a second, the parameters when they\n"
+	        "                         change (with --timeout S: for S seconds)\n"
+	        "      --rate HZ          --watch: at most HZ states a second per robot (default 4;\n"
+	        "                         a change of mode or fault is shown at once)\n"
+	        "      --raw              --watch: every message as one key=value line, for scripts\n"
+	        "                         (every state, 100 a second, unless --rate is given)\n"
 	        "      --tune             run the oscillator on the connected robot and adjust k and mu until\n"
 	        "                         every joint is within 5 %% of the target frequency and amplitude;\n"
 	        "                         then write a complete configuration (with the SINUSOID baseline\n"
@@ -79,7 +85,7 @@ static void main_usage(FILE *f)
 enum {
 	OPT_SET = 256, OPT_PORT, OPT_IDS, OPT_BAUD, OPT_ROBOT, OPT_MODE, OPT_LCM, OPT_CHECK, OPT_LOGLEVEL,
 	OPT_COMMAND, OPT_TIMEOUT, OPT_WATCH, OPT_KEY, OPT_SOURCE, OPT_GENKEY, OPT_TUNE, OPT_TFREQ, OPT_TAMP,
-	OPT_TTIME, OPT_OUT, OPT_LOCKSTEP, OPT_PROTOCOL,
+	OPT_TTIME, OPT_OUT, OPT_LOCKSTEP, OPT_PROTOCOL, OPT_RATE, OPT_RAW,
 };
 
 struct main_args {
@@ -90,6 +96,8 @@ struct main_args {
 	bool check;
 	const char *command;
 	const char *watch;
+	double watch_rate_hz;   /* 0: not given */
+	bool watch_raw;
 	bool timeout_set;
 	const char *robot;
 	const char *lcm_url;
@@ -160,7 +168,8 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 		{ "check-config", no_argument, NULL, OPT_CHECK }, { "verbose", no_argument, NULL, 'v' },
 		{ "quiet", no_argument, NULL, 'q' }, { "log-level", required_argument, NULL, OPT_LOGLEVEL },
 		{ "command", required_argument, NULL, OPT_COMMAND }, { "timeout", required_argument, NULL, OPT_TIMEOUT },
-		{ "watch", required_argument, NULL, OPT_WATCH }, { "key", required_argument, NULL, OPT_KEY },
+		{ "watch", required_argument, NULL, OPT_WATCH }, { "rate", required_argument, NULL, OPT_RATE },
+		{ "raw", no_argument, NULL, OPT_RAW }, { "key", required_argument, NULL, OPT_KEY },
 		{ "source", required_argument, NULL, OPT_SOURCE }, { "gen-key", required_argument, NULL, OPT_GENKEY },
 		{ "tune", no_argument, NULL, OPT_TUNE }, { "target-freq", required_argument, NULL, OPT_TFREQ },
 		{ "target-amp", required_argument, NULL, OPT_TAMP }, { "tune-time", required_argument, NULL, OPT_TTIME },
@@ -201,6 +210,11 @@ static int main_parse(int argc, char **argv, struct main_args *a)
 			a->timeout_set = true;
 			break;
 		case OPT_WATCH: a->watch = optarg; break;
+		case OPT_RATE:
+			if (!main_number("--rate", optarg, 0.1, WATCH_RATE_MAX_HZ, "Hz", &a->watch_rate_hz))
+				return 2;
+			break;
+		case OPT_RAW: a->watch_raw = true; break;
 		case OPT_KEY: a->key_file = optarg; break;
 		case OPT_SOURCE: a->source = optarg; break;
 		case OPT_GENKEY: a->gen_key = optarg; break;
@@ -379,8 +393,15 @@ int main(int argc, char **argv)
 		       "commands it over the network (--key)\n", a.gen_key, a.gen_key);
 		return 0;
 	}
-	if (a.watch != NULL)
-		return dmn_watch(a.lcm_url, a.watch, a.timeout_set ? a.timeout_s : 0.0);
+	if (a.watch != NULL) {
+		struct watch_opts w = {
+			.lcm_url = a.lcm_url, .robot = a.watch, .duration_s = a.timeout_set ? a.timeout_s : 0.0,
+			.raw = a.watch_raw,
+			/* words: a few a second by default; raw: every state unless asked */
+			.rate_hz = a.watch_rate_hz > 0 ? a.watch_rate_hz : a.watch_raw ? 0.0 : WATCH_RATE_DEFAULT_HZ,
+		};
+		return dmn_watch(&w);
+	}
 	if (a.command != NULL) {
 		if (a.robot == NULL) {
 			fprintf(stderr, "undulated: --command needs --robot NAME (or '*' for every robot)\n");

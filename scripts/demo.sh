@@ -25,7 +25,7 @@
 #                   [--daemon-set SEC.KEY=VAL]... [--start-mode MODE]
 #                   [--switch-at S|never] [--switch-to MODE] [--phases random|LIST]
 #                   [--seed N] [--window S] [--out DIR] [--lcm-url URL]
-#                   [--no-realtime] [--lockstep]
+#                   [--no-realtime] [--lockstep] [--compress]
 #
 # The robots start in --start-mode (default SINUSOID, each with its own phase:
 # random, or the comma-separated radians of --phases in scenario order) and are
@@ -50,14 +50,112 @@
 # the simulator delivers to every daemon at that simulated time, and the same
 # --seed gives the same run.
 #
+# --compress (or DEMO_COMPRESS=1; make demo sets it) keeps the run in a
+# third of the space, everything in it: the LCM log as demo.lcmlog.xz (every
+# message; undulate-analyze reads it as it is) and the per-sample CSVs
+# (states, phase_diff, collisions, plane) as .csv.xz (every row; xz -dc,
+# pandas and R read them). Measured on the default scene in lockstep, 30 s:
+# 32 MB plain (64 MB a minute: the log 40, states.csv 15, phase_diff.csv 6),
+# 8.6 MB compressed (17 MB a minute); xz -1 takes about 4 s per 20 MB of log.
+# The experiments' scripts and the tests read the plain files: off by default.
+#
 # Everything runs in a private temporary directory on a private LCM port
 # (printed at start), so two demos, or a demo and the tests, never hear each
-# other. Ctrl-C (or SIGTERM) stops the daemons, the simulator and the logger by
-# PID, waits for them, and removes the pty links and the directory.
+# other. Ctrl-C (or SIGTERM, SIGHUP) stops the daemons, the simulator and the
+# logger by PID, waits for them, and removes the pty links and the directory.
+# A run that ends early — a signal, Ctrl-C in undulate-top, a program that
+# stopped during the run (a daemon killed) — says what ran (the start mode
+# and for how long, the switch mode if it came) and what did not, and keeps
+# what it has in the run's folder: the LCM log so far, every program's log,
+# early-stop.txt with those lines, unanalysed, and the command that analyses it.
 set -u
 
 top=$(cd "$(dirname "$0")/.." && pwd)
 source "$top/scripts/outdir.sh"
+
+BUILD=${BUILD:-build}
+case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
+B="$BUILD/bin"
+
+# ---- a run that ends early ------------------------------------------------------
+# early_keep RUN WHY [VERB]: the run in RUN stopped before its end, its
+# programs already stopped (WHY: "SIGTERM", "Ctrl-C", "undulated-r2 stopped
+# during the run: killed by SIGKILL"; VERB: "stopped early", or "ended" for a
+# run that broke). Says on stderr what ran and what did not, keeps
+# the LCM log so far and every program's log in the run's folder (RUN/out,
+# written by the worker once it is known), and prints the command that
+# analyses the log. The worker's record of the run (RUN/plan, RUN/t_ready,
+# RUN/switch.time) says what ran; in lockstep the simulator's log does (its
+# samples every 5 simulated seconds, and the switch it delivered).
+early_keep() {
+	local run=$1 why=$2 verb=${3:-stopped early} out k v start_mode="" switch_at="" switch_to="" lockstep=0 seconds="" el="" sw="" of
+	[ -d "$run" ] || return 0   # the worker ended and cleaned up: nothing was cut short
+	if [ ! -f "$run/out" ] || [ ! -f "$run/plan" ]; then
+		echo "demo: stopped early ($why) before the robots started: nothing ran, nothing kept" >&2
+		return 0
+	fi
+	out=$(cat "$run/out")
+	while IFS='=' read -r k v; do
+		case $k in
+		start_mode) start_mode=$v ;; switch_at) switch_at=$v ;; switch_to) switch_to=$v ;;
+		lockstep) lockstep=$v ;; seconds) seconds=$v ;;
+		esac
+	done <"$run/plan"
+	if [ -f "$run/analysing" ]; then
+		echo "demo: stopped ($why) while the run was being analysed; its LCM log is kept: $out/demo.lcmlog" >&2
+		echo "demo: to analyse it: $B/undulate-analyze $out/demo.lcmlog --out $out/analysis" >&2
+		return 0
+	fi
+	if [ "$lockstep" = 1 ]; then
+		# the simulator's exit line (it was stopped), else its last sample
+		el=$(sed -n "s/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time.*/\1/p" "$run/sim.log" 2>/dev/null)
+		[ -n "$el" ] || el=$(sed -n "s/^undulate-sim: t=\([0-9.]*\) event .*/\1/p" "$run/sim.log" 2>/dev/null | tail -n 1)
+		el=$(awk -v t="${el:-0}" 'BEGIN { printf "%.1f", t }')
+		of="of $seconds s of simulated time"
+		grep -q "event 'command \* mode $switch_to': ok" "$run/sim.log" 2>/dev/null && sw=$switch_at
+	elif [ -f "$run/t_ready" ]; then
+		local t0
+		t0=$(cat "$run/t_ready")
+		# when it was found stopped (RUN/t_end), not after its programs were
+		el=$(( ($(cat "$run/t_end" 2>/dev/null || date +%s%N) - t0) / 1000000000 ))
+		of=${seconds:+of $seconds s}
+		of=${of:-on the terminal}
+		[ -f "$run/switch.time" ] && sw=$(( ($(cat "$run/switch.time") - t0) / 1000000000 ))
+	fi
+	local report=()
+	if [ -z "$el" ]; then
+		report+=("demo: $verb ($why) while the robots were starting: nothing ran")
+	else
+		report+=("demo: $verb ($why) after $el s $of")
+		if [ -n "$sw" ]; then
+			report+=("demo: ran: $start_mode (the clock) for $sw s, then $switch_to for $(awk -v e="$el" -v s="$sw" 'BEGIN { printf "%.0f", e > s ? e - s : 0 }') s")
+		elif [ "$switch_at" = never ]; then
+			report+=("demo: ran: $start_mode for $el s (no switch planned)")
+		else
+			report+=("demo: ran: $start_mode (the clock) for $el s; did not run: $switch_to (due at $switch_at s): THE ${switch_to^^} NEVER RAN")
+		fi
+	fi
+	printf '%s\n' "${report[@]}" >&2
+	local parent keep
+	parent=$(dirname "$out")
+	{ [ -d "$parent" ] || mkdir -p -- "$parent"; } && outdir_check "$out" "demo: --out" ||
+		{ echo "demo: the run could not be kept (above)" >&2; return 1; }
+	keep="$run/keep"
+	rm -rf -- "$keep"
+	mkdir -m 700 "$keep" "$keep/logs" || { echo "demo: cannot create $keep: the run is not kept" >&2; return 1; }
+	cp "$run"/*.log "$keep/logs/" 2>/dev/null
+	printf '%s\n' "${report[@]}" >"$keep/early-stop.txt"
+	[ -f "$run/seed" ] && cp "$run/seed" "$keep/seed"
+	local what="logs/ (every program's log), early-stop.txt (these lines); not analysed"
+	if [ -s "$run/demo.lcmlog" ]; then
+		outdir_mv "$run/demo.lcmlog" "$out/demo.lcmlog" || { echo "demo: cannot move the LCM log into $out" >&2; return 1; }
+		what="demo.lcmlog ($(du -k "$out/demo.lcmlog" | cut -f1) kB, the LCM log so far), $what"
+	fi
+	outdir_publish "$keep" "$out" || { echo "demo: could not move everything into $out (above)" >&2; return 1; }
+	echo "demo: the run so far is kept in $out: $what" >&2
+	[ -f "$out/demo.lcmlog" ] && echo "demo: to analyse it: $B/undulate-analyze $out/demo.lcmlog --out $out/analysis" >&2
+	return 0
+}
 
 # ---- supervisor ---------------------------------------------------------------
 # The demo runs as two processes: this one only waits, and a worker (this
@@ -95,6 +193,7 @@ if [ -z "${UNDULATE_DEMO_RUN:-}" ]; then
 	sv_worker=$!
 	sv_stop() {
 		trap '' INT TERM HUP
+		[ -d "$sv_run" ] && date +%s%N >"$sv_run/t_end"
 		kill -KILL "$sv_worker" 2>/dev/null
 		wait "$sv_worker" 2>/dev/null
 		local pid name first=() rest=()
@@ -105,21 +204,21 @@ if [ -z "${UNDULATE_DEMO_RUN:-}" ]; then
 		fi
 		stop_pids ${first[@]+"${first[@]}"}
 		stop_pids ${rest[@]+"${rest[@]}"}
+		# the worker is gone (SIGKILL): whatever it was doing, its record says what ran
+		# (after the terminal's "^C", on a line of its own)
+		[ "$2" = Ctrl-C ] && [ -t 2 ] && echo >&2
+		[ -f "$sv_run/done" ] || early_keep "$sv_run" "$2"
 		rm -rf "$sv_run"
 		exit "$1"
 	}
-	trap 'sv_stop 130' INT
-	trap 'sv_stop 143' TERM
-	trap 'sv_stop 129' HUP
+	trap 'sv_stop 130 Ctrl-C' INT
+	trap 'sv_stop 143 SIGTERM' TERM
+	trap 'sv_stop 129 "SIGHUP: the terminal closed"' HUP
 	sv_rc=0
 	wait "$sv_worker" || sv_rc=$?
 	rm -rf "$sv_run"   # normally gone already: the worker removes it
 	exit "$sv_rc"
 fi
-BUILD=${BUILD:-build}
-case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
-B="$BUILD/bin"
-
 scenario="$top/sim-bridge/scenarios/plane-demo.scenario"
 default_scenario=1
 seconds=${DEMO_SECONDS:-}
@@ -150,6 +249,7 @@ RT_SIM=30
 RT_DAEMON=20
 realtime=${DEMO_REALTIME:-1}
 lockstep=${DEMO_LOCKSTEP:-0}
+compress=${DEMO_COMPRESS:-0}
 # How long a program may take to say it is ready (s).
 READY_TIMEOUT_S=10
 
@@ -174,6 +274,7 @@ while [ $# -gt 0 ]; do
 	--lcm-url) url=$2; shift 2 ;;
 	--no-realtime) realtime=0; shift ;;
 	--lockstep) lockstep=1; shift ;;
+	--compress) compress=1; shift ;;
 	-h|--help) usage ;;
 	*) echo "demo: unknown argument '$1' (--help)" >&2; exit 2 ;;
 	esac
@@ -210,6 +311,11 @@ if [ -e "$out" ] || [ -L "$out" ]; then outdir_check "$out" "demo: --out" || exi
 run=$UNDULATE_DEMO_RUN
 links="$run/links"
 mkdir -p "$links"
+# what an early stop (early_keep, above) needs to say what ran and to keep it
+echo "$out" >"$run/out"
+echo "$seed" >"$run/seed"
+printf '%s\n' "start_mode=$start_mode" "switch_at=$switch_at" "switch_to=$switch_to" "lockstep=$lockstep" \
+	"seconds=$seconds" >"$run/plan"
 
 pids=()       # everything we started, in start order
 names=()
@@ -388,6 +494,7 @@ for i in "${!robots[@]}"; do
 	exit 1
 done
 t_ready=$(date +%s%N)
+echo "$t_ready" >"$run/t_ready"
 
 # ---- the web dashboard, beside the terminal view --------------------------------
 # undulate-web on loopback (DEMO_WEB_PORT, default 8080; any free port when
@@ -476,8 +583,16 @@ if [ "$interactive" -eq 1 ]; then
 	record "$!" top
 	top_rc=0
 	wait "$!" || top_rc=$?
-	# 130: Ctrl-C (a key to undulate-top's raw terminal): stop, keep nothing
-	[ "$top_rc" -eq 0 ] || exit "$top_rc"
+	# 130: Ctrl-C (a key to undulate-top's raw terminal): stop at once, keep
+	# the run unanalysed and say what ran
+	if [ "$top_rc" -ne 0 ]; then
+		date +%s%N >"$run/t_end"
+		# undulate-top leaves the cursor at the end of its last line
+		[ -t 2 ] && echo >&2
+		stop_children
+		early_keep "$run" "$([ "$top_rc" -eq 130 ] && echo Ctrl-C || echo "undulate-top exit $top_rc")"
+		exit "$top_rc"
+	fi
 	seconds=$(awk -v n="$(( $(date +%s%N) - t_ready ))" 'BEGIN { printf "%.0f", n / 1e9 }')
 fi
 
@@ -487,11 +602,41 @@ if [ "$lockstep" = 1 ]; then
 	wait "$(pid_of sim)" || sim_rc=$?
 	for i in "${!robots[@]}"; do wait "$(pid_of "undulated-${robots[$i]}")" 2>/dev/null; done
 	ended=$(sed -n 's/^undulate-sim: lockstep: .*; ended: //p' "$run/sim.log")
-	[ "$sim_rc" -eq 0 ] || die "the lockstep run failed (undulate-sim exit $sim_rc): ${ended:-see its log}; its log:
-$(tail -n 15 "$run/sim.log")"
+	if [ "$sim_rc" -ne 0 ]; then
+		# a daemon killed stalls the lockstep clock: the simulator ends the run
+		echo "demo: the lockstep run failed (undulate-sim exit $sim_rc): ${ended:-see its log}; its log ends:" >&2
+		tail -n 8 "$run/sim.log" | sed 's/^/    /' >&2
+		stop_children
+		early_keep "$run" "the lockstep run failed: ${ended:-undulate-sim exit $sim_rc}"
+		exit 1
+	fi
 	grep -q "event 'command \* mode $switch_to': ok" "$run/sim.log" && echo lockstep >"$run/switch.time"
 	say "lockstep: $(sed -n 's/^undulate-sim: lockstep: \([0-9.]* s of simulated time in [0-9.]* s ([0-9.]*x real time\).*/\1)/p' "$run/sim.log")"
 fi
+
+# check_alive: a program that stopped during the run (a daemon killed, the
+# simulator crashed) makes it another experiment: say which, keep what there
+# is (early_keep) and end with exit 1. Checked at every contact sample and at
+# the end (in lockstep the simulator ends a run whose daemon is gone).
+check_alive() {
+	local i gone gone_rc how
+	for i in "${!pids[@]}"; do
+		[ "$lockstep" = 1 ] && return 0
+		case "${names[$i]}" in "switch timer"|banner|top|web|analyze) continue ;; esac
+		kill -0 "${pids[$i]}" 2>/dev/null && continue
+		gone=${names[$i]}
+		gone_rc=0
+		wait "${pids[$i]}" 2>/dev/null || gone_rc=$?
+		how="exit $gone_rc"
+		[ "$gone_rc" -gt 128 ] && how="killed by SIG$(kill -l $((gone_rc - 128)) 2>/dev/null || echo $((gone_rc - 128)))"
+		date +%s%N >"$run/t_end"
+		echo "demo: $gone stopped during the run ($how); its log ends:" >&2
+		tail -n 8 "$run/$gone.log" | sed 's/^/    /' >&2
+		stop_children
+		early_keep "$run" "$gone stopped during the run: $how" "ended"
+		exit 1
+	done
+}
 
 # ---- headless -------------------------------------------------------------------
 if [ "$interactive" -eq 0 ] && [ "$lockstep" != 1 ]; then
@@ -521,14 +666,10 @@ while :; do
 	sample) sample_contact; next_sample=$(awk -v a="$next_sample" -v d=$CONTACT_SAMPLE_S 'BEGIN { print a + d }') ;;
 	end) sample_contact; break ;;
 	esac
+	check_alive
 done
 fi
-for i in "${!pids[@]}"; do
-	[ "$lockstep" = 1 ] && break   # they ended with the run, checked above
-	case "${names[$i]}" in "switch timer"|banner|top|web) continue ;; esac
-	kill -0 "${pids[$i]}" 2>/dev/null || die "${names[$i]} stopped during the run; its log:
-$(tail -n 15 "$run/${names[$i]}.log")"
-done
+check_alive
 
 # Stop the robots and the simulator, then the logger, so the log is complete.
 stop_children
@@ -543,6 +684,7 @@ parent=$(dirname "$out")
 outdir_check "$out" "demo: --out" || exit 1
 keep="$run/keep"
 mkdir -m 700 "$keep" || die "cannot create $keep"
+: >"$run/analysing"   # a stop from now on finds the log in $out (early_keep)
 outdir_mv "$log" "$out/demo.lcmlog" || die "cannot move the LCM log into $out"
 log="$out/demo.lcmlog"
 analysis="$keep"
@@ -573,6 +715,11 @@ if [ -n "$broken" ]; then
 	sed 's/^/  - /' <<<"$broken"
 fi
 [ -n "$switch_t" ] && echo "switched $start_mode -> $switch_to at t = $switch_t s"
+# q (or --seconds) before the switch: a run of the clock alone, and said so
+# before its numbers are taken for the experiment's
+if [ -z "$switch_t" ] && [ "$switch_at" != never ]; then
+	echo "THE ${switch_to^^} NEVER RAN: the run ended after $seconds s, before the switch due at $switch_at s: what follows is $start_mode (the clock) alone"
+fi
 
 # In words: the contact force and the collisions between robots in the last
 # $window s before the switch and in the last $window s of the run, from the
@@ -677,10 +824,27 @@ truth=$(grep -m1 '^undulate-sim: exit:' "$run/sim.log" | sed 's/^undulate-sim: e
 summary | tee "$keep/demo-summary.txt"
 mkdir "$keep/logs"
 cp "$run"/*.log "$keep/logs/" 2>/dev/null
+kept_log="$out/demo.lcmlog"
+kept_what="demo.lcmlog (the LCM log), demo-summary.txt, the analysis (summary.txt, CSV files), logs/"
+if [ "$compress" = 1 ]; then
+	# xz -1: a third of the size in seconds (-6 saves 4 % more in three times as long)
+	if xz -1 -T0 -c "$out/demo.lcmlog" >"$keep/demo.lcmlog.xz" &&
+		xz -1 -T0 -f -- "$keep/states.csv" "$keep/phase_diff.csv" "$keep/collisions.csv" $( [ -f "$keep/plane.csv" ] && echo "$keep/plane.csv"); then
+		rm -f -- "$out/demo.lcmlog"
+		kept_log="$out/demo.lcmlog.xz"
+		sed -i "s|^log: $out/demo.lcmlog\b|log: $kept_log|" "$keep/summary.txt"
+		kept_what="demo.lcmlog.xz (the LCM log, xz), demo-summary.txt, the analysis (summary.txt, CSV files; the per-sample ones .csv.xz), logs/"
+	else
+		rm -f -- "$keep/demo.lcmlog.xz"
+		echo "demo: xz failed: the run is kept uncompressed" >&2
+	fi
+fi
 [ -n "$switch_t" ] && echo "$switch_t" >"$keep/switch_t"
 echo "$seed" >"$keep/seed"
 outdir_publish "$keep" "$out" || die "could not move everything into $out (above)"
 echo
-echo "The run is kept in $out: demo.lcmlog (the LCM log), demo-summary.txt, the analysis (summary.txt, CSV files), logs/."
-echo "Next, the plots:  $B/undulate-analyze $out/demo.lcmlog --out $out/plots --plots"
+echo "The run is kept in $out: $kept_what."
+# --plots-only: the plots without a second copy of the analysis's CSVs
+echo "Next, the plots:  $B/undulate-analyze $kept_log --out $out/plots --plots-only"
+: >"$run/done"   # kept and said: a signal now has nothing more to keep
 exit 0

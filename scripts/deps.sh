@@ -17,7 +17,7 @@ set -eu
 # without it that test says so and skips.
 need=(build-essential pkg-config liblcm-dev liblcm-bin libglib2.0-dev libserialport-dev
       libinih-dev libsodium-dev libcmocka-dev libpng-dev gnuplot-nox parallel rt-tests procps iproute2 jq python3 socat systemd man-db curl
-      libwebsockets-dev libjs-chart.js libchipmunk-dev libgsl-dev)
+      libwebsockets-dev libjs-chart.js libchipmunk-dev libgsl-dev liblzma-dev xz-utils)
 [ $# -gt 0 ] && need=("$@")
 missing=()
 for p in "${need[@]}"; do

@@ -237,7 +237,7 @@ wait_restarted() { wait_for 10 restarted_at_least "$1"; }
 start_pair() {
 	spawn sim "$B/undulate-sim" --scenario "$top/sim-bridge/scenarios/pair.scenario" --link-dir "$T" --lcm-url "$URL" --seed 5
 	wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-	spawn watch "$B/undulated" --watch left --lcm-url "$URL"
+	spawn watch "$B/undulated" --watch left --raw --lcm-url "$URL"
 	local r
 	for r in left right; do
 		spawn "d_$r" "$B/undulated" --port "$T/$r" --ids 1 --robot "$r" --lcm-url "$URL" --mode oscillator

@@ -197,6 +197,24 @@ head -c 300000 "$T/s.log" >"$T/cut.log"
 tap_check "truncated log: exit 3 with a warning saying where it stopped" \
 	bash -c "[ $rc = 3 ] && grep -q 'truncated or damaged at byte' '$T/e3.err'"
 tap_check "truncated log: everything before the damage is written" test "$(wc -l <"$T/e3/states.csv")" -gt 100
+# an xz-compressed log (as make demo keeps it) reads as the log it holds; one
+# whose xz stream was cut short is a truncated log; an xz of something else is foreign
+xz -1 -c "$T/s.log" >"$T/s.log.xz"
+"$A" "$T/s.log" --out "$T/x0" --quiet 2>/dev/null; "$A" "$T/s.log.xz" --out "$T/x1" --quiet 2>"$T/x1.err"; rc=$?
+tap_check "an xz-compressed log: the same states.csv and summary as the log" bash -c "[ $rc = 0 ] &&
+	cmp -s '$T/x0/states.csv' '$T/x1/states.csv' && diff <(grep -v '^log:' '$T/x0/summary.txt') <(grep -v '^log:' '$T/x1/summary.txt') >/dev/null"
+head -c $(( $(stat -c %s "$T/s.log.xz") / 2 )) "$T/s.log.xz" >"$T/cut.log.xz"
+"$A" "$T/cut.log.xz" --out "$T/x2" --quiet 2>"$T/x2.err"; rc=$?
+tap_check "an xz log cut short: exit 3, truncated, what came before written" \
+	bash -c "[ $rc = 3 ] && grep -q 'truncated or damaged at byte' '$T/x2.err' && [ \$(wc -l <'$T/x2/states.csv') -gt 100 ]"
+xz -1 -c "$T/foreign.log" >"$T/foreign.log.xz"
+"$A" "$T/foreign.log.xz" --out "$T/x3" 2>"$T/x3.err"; rc=$?
+tap_check "an xz of something else: exit 2, not an LCM log inside the xz stream" \
+	bash -c "[ $rc = 2 ] && grep -q 'not an LCM log inside the xz stream' '$T/x3.err'"
+# --plots-only: the plots without the per-sample CSVs (the plot command make demo prints)
+"$A" "$T/s.log.xz" --out "$T/x4" --plots-only --quiet 2>"$T/x4.err"; rc=$?
+tap_check "--plots-only: plots and summary, no states.csv or phase_diff.csv" bash -c "[ $rc = 0 ] &&
+	[ -f '$T/x4/angles.png' ] && [ -f '$T/x4/summary.txt' ] && [ ! -e '$T/x4/states.csv' ] && [ ! -e '$T/x4/phase_diff.csv' ]"
 "$A" "$T/s.log" --window -1 2>/dev/null; rc=$?
 tap_check "bad option: exit 1" [ "$rc" = 1 ]
 tap_done

@@ -21,7 +21,7 @@ start_sim() {
 	wait_log "$1" 'ready' 10
 }
 start_sim sim || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 # silent_s 2: the short outage below resumes by itself, the long one latches;
 # compliance slope 16 (factory 32): written at start-up like the margin
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode sinusoid --set robot.safe_stop=limp \

@@ -15,7 +15,7 @@ URL=$(lcm_url 7701)
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 # a moving speed left behind by another program: reset at start-up, with a warning
 ctl poke r1 1 moving_speed 100 >/dev/null
 # servo 2's first three replies 20 ms late (a busy machine, a slow adapter):

@@ -32,9 +32,9 @@ spawn sim1 "$S" --link "$T/bus1" --ids 1 --lcm-url "$URL1" --seed 12
 spawn sim3 "$S" --link "$T/bus3" --ids 1 --lcm-url "$URL3" --seed 13 --set motor.drive=current
 wait_log sim2 'ready' 10 && wait_log sim1 'ready' 10 ||
 	{ tap_fail "simulators ready" "$(cat "$T/sim2.log" "$T/sim1.log")"; tap_done; exit 1; }
-spawn watch2 "$D" --watch "$R2" --lcm-url "$URL2"
-spawn watch1 "$D" --watch "$R1" --lcm-url "$URL1"
-spawn watch3 "$D" --watch "$R3" --lcm-url "$URL3"
+spawn watch2 "$D" --watch "$R2" --raw --lcm-url "$URL2"
+spawn watch1 "$D" --watch "$R1" --raw --lcm-url "$URL1"
+spawn watch3 "$D" --watch "$R3" --raw --lcm-url "$URL3"
 # start-up is not what this test is about: on a heavily loaded machine the
 # first settings read can time out and the daemon exits (status 1, "a service
 # manager should retry"); retry once, as the service would, and say so

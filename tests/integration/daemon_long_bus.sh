@@ -20,7 +20,7 @@ ids=$(seq -s, 1 18)
 
 spawn sim "$S" --link "$T/bus" --ids "$ids" --name r1 --return-delay 0 --lcm-url "$URL" --control "$T/ctl"
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids "$ids" --robot "$R" --lcm-url "$URL" --mode hold
 wait_log d "ready: $R.STATE" 10 || { tap_fail "daemon starts with 18 servos" "$(cat "$T/d.log")"; tap_done; exit 1; }
 torque() { # VALUE: how many of the 18 servos have torque enable = VALUE

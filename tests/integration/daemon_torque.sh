@@ -23,7 +23,7 @@ num() { awk "BEGIN { exit !($*) }"; }
 
 spawn sim "$S" --link "$T/bus" --ids 1 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 3
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 
 # ---- a servo left in wheel mode, spinning
 ctl poke r1 1 torque_enable 0 >/dev/null

@@ -110,7 +110,7 @@ fi
 # ---- the plant's file, run as it is --------------------------------------------------------
 out=$("$D" "$T/tplant.conf" --check-config 2>&1)
 tap_check "the written file passes --check-config ($out)" grep -q "mode OSCILLATOR" <<<"$out"
-spawn watch "$D" --watch tplant --lcm-url "$URL_PLANT"
+spawn watch "$D" --watch tplant --raw --lcm-url "$URL_PLANT"
 spawn run "$D" "$T/tplant.conf" -q
 # ---- Ctrl-C ---------------------------------------------------------------------------------
 spawn simint "$S" --link "$T/int" --ids 1,2 --lcm-url "$URL_INT" --seed 23 --return-delay 0

@@ -42,7 +42,7 @@ contact = none
 EOF
 spawn sim "$S" --scenario "$T/x.scenario" --lcm-url "$URL" --control "$T/ctl"
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 
 # ---- the protocol -------------------------------------------------------------------------------
 out=$(timeout 20 "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --protocol 1 2>&1); rc=$?

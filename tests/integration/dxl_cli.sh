@@ -51,6 +51,18 @@ run units --port "$bus" read 1 43 --units
 run write --port "$bus" write 1 goal_position 300
 run readback --port "$bus" read 1 goal_position
 [ "$(cat "$T/readback.out")" = "300" ] && tap_ok "write then read back" || tap_fail "write then read back" "$(cat "$T/readback.out" "$T/write.err")"
+# a write says what the servo holds now (it printed nothing)
+[ "$(cat "$T/write.out")" = "ID 1: goal_position = 300 (read back)" ] && [ ! -s "$T/write.err" ] \
+	&& tap_ok "write confirms: $(cat "$T/write.out")" || tap_fail "write confirms what the servo holds" "out '$(cat "$T/write.out")' err '$(cat "$T/write.err")'"
+
+# a negative value is a value, not an option: an unsigned register refuses it
+# with its range (it said "unknown option '-3'"), after -- as well
+run neg --port "$bus" write 1 cw_angle_limit -3
+run neg2 --port "$bus" write -- 1 cw_angle_limit -3
+[ "$rc" -eq 2 ] && [ ! -s "$T/neg.out" ] && [ "$(lines "$T/neg.err")" = 1 ] \
+	&& grep -q "^dxl: value '-3' out of range for cw_angle_limit (0..1023)$" "$T/neg.err" && cmp -s "$T/neg.err" "$T/neg2.err" \
+	&& tap_ok "write 1 cw_angle_limit -3: $(cat "$T/neg.err")" \
+	|| tap_fail "a negative value refused with the register's range" "rc=$rc $(cat "$T/neg.err" "$T/neg2.err")"
 
 run range --port "$bus" write 1 goal_position 5000
 run after --port "$bus" read 1 goal_position

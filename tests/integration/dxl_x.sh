@@ -66,6 +66,10 @@ at_goal() { run pos --port "$xl" --baud 1000000 read 1 present_position; [ "$rc"
 if wait_for 10 at_goal; then tap_ok "write goal_position moves the simulated X joint"
 else tap_fail "write goal_position moves the simulated X joint" "present $(cat "$T/pos.out" "$T/pos.err")"; fi
 
+run pwm --port "$xl" --baud 1000000 write 1 goal_pwm -300
+check "a signed register takes a negative value and says what it holds" pwm \
+	test "$rc" -eq 0 -a "$(cat "$T/pwm.out")" = "ID 1: goal_pwm = -300 (read back)"
+run pwm0 --port "$xl" --baud 1000000 write 1 goal_pwm 885
 run big --port "$xl" --baud 1000000 write 1 goal_position 5000
 check "goal outside the position limits refused before the bus (exit 2)" big \
 	test "$rc" -eq 2 -a -n "$(grep "outside goal_position's range on ID 1 now (0..4095" "$T/big.err")"

@@ -109,7 +109,7 @@ else
 fi
 # Where the run is kept, and the next command, which works as printed.
 next=$(sed -n 's/^Next, the plots:  //p' "$out")
-if grep -qF "The run is kept in $T/out: demo.lcmlog" "$out" && [ "$next" = "$B/undulate-analyze $T/out/demo.lcmlog --out $T/out/plots --plots" ] &&
+if grep -qF "The run is kept in $T/out: demo.lcmlog" "$out" && [ "$next" = "$B/undulate-analyze $T/out/demo.lcmlog --out $T/out/plots --plots-only" ] &&
 	grep -qF "log: $T/out/demo.lcmlog" "$T/out/summary.txt"; then
 	tap_ok "summary ends with the kept folder and the next command; summary.txt names the kept log"
 else
@@ -196,10 +196,10 @@ if why=$(leftovers); then tap_ok "nothing left behind after the lockstep run"; e
 
 # ---- stopped early ---------------------------------------------------------------
 # SIGTERM (what `timeout`, a service manager or a closing terminal sends)
-# must stop every child and remove the links. (Ctrl-C in a terminal goes to
+# must stop every child and remove the links, and keep the run so far. (Ctrl-C in a terminal goes to
 # the whole foreground process group; a background job here ignores SIGINT.)
 # (the four robots of the channel: what is tested is the stopping)
-spawn demo2 env BUILD="$BUILD" DEMO_SECONDS=60 DEMO_LCM_URL="$url" TMPDIR="$T/tmp" "$demo" \
+spawn demo2 env BUILD="$BUILD" DEMO_SECONDS=60 DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/out2" "$demo" \
 	--scenario "$top/sim-bridge/scenarios/channel4.scenario"
 if wait_log demo2 '^demo: phases' 40; then
 	links=$(find "$T/tmp" -type l | wc -l)
@@ -207,8 +207,8 @@ if wait_log demo2 '^demo: phases' 40; then
 	kill -TERM "$pid_demo2"
 	wait "$pid_demo2"
 	rc=$?
-	if [ "$links" -eq 4 ] && [ "$rc" = 143 ]; then
-		tap_ok "SIGTERM stops the demo (exit 143) after it made 4 pty links"
+	if [ "$links" -eq 4 ] && [ "$rc" = 143 ] && grep -q '^demo: stopped early (SIGTERM)' "$T/demo2.log" && [ -f "$T/out2/early-stop.txt" ]; then
+		tap_ok "SIGTERM stops the demo (exit 143) after it made 4 pty links, says so and keeps the run"
 	else
 		tap_fail "SIGTERM stops the demo (exit 143) after it made 4 pty links" "links $links, exit $rc; its log: $(tail -n 12 "$T/demo2.log")"
 	fi
@@ -220,8 +220,9 @@ fi
 # ---- interactive, on a terminal: q, then Ctrl-C ------------------------------------
 # `script` gives the demo a pseudo-terminal: undulate-top runs in the
 # foreground. q ends it and the demo summarizes and keeps the run; the 0x03
-# written to the terminal is the user's Ctrl-C (the line discipline turns it
-# into SIGINT for the foreground process group): everything stops at once.
+# written to the terminal is the user's Ctrl-C (a key to undulate-top's raw
+# terminal): everything stops at once, and the demo says what ran and keeps
+# the run unanalysed (e2e_demo_stop: the other ways a run ends early).
 # The switch comes after 3 s here, not 20, to see both phases of the banner.
 clean() { tr -d '\r' <"$1" | sed 's/\x1b\[[0-9;?]*[A-Za-z]//g'; }
 if command -v script >/dev/null; then
@@ -251,8 +252,10 @@ if command -v script >/dev/null; then
 		env BUILD="$BUILD" DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/iout2" \
 		timeout 60 script -qec "$demo --scenario $top/sim-bridge/scenarios/channel4.scenario" /dev/null >"$T/tty2.out" 2>&1
 	rc=$?
-	if [ "$rc" = 130 ] && clean "$T/tty2.out" | grep -qE '^. *[0-9]+ r4 +SIN' && [ ! -e "$T/iout2" ]; then
-		tap_ok "interactive: Ctrl-C ends the demo at once (exit 130, nothing kept)"
+	if [ "$rc" = 130 ] && clean "$T/tty2.out" | grep -qE '^. *[0-9]+ r4 +SIN' &&
+		clean "$T/tty2.out" | grep -qE '^demo: stopped early \(Ctrl-C\) after [0-9]+ s on the terminal' &&
+		clean "$T/tty2.out" | grep -qF "demo: the run so far is kept in $T/iout2" && [ -s "$T/iout2/demo.lcmlog" ]; then
+		tap_ok "interactive: Ctrl-C ends the demo at once (exit 130), says what ran and keeps the run unanalysed"
 	else
 		tap_fail "interactive: Ctrl-C ends the demo" "exit $rc; $(clean "$T/tty2.out" | tail -n 10)"
 	fi

@@ -48,7 +48,7 @@ if [ "$rc" != 0 ] && echo "$out" | grep -q "servo 1 is an XC430-W150, which has 
 	tap_ok "torque_drive = current refused: the XC430-W150 has no current control (exit $rc)"
 else tap_fail "current drive refused on the XC430" "rc $rc: $(echo "$out" | tail -3)"; fi
 
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator
 wait_log d "ready: $R.STATE" 15 || { tap_fail "undulated starts on the XC430 bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
 if grep -q "Protocol 2.0 (XC430-W150), mode OSCILLATOR" "$T/d.log" &&

@@ -42,7 +42,7 @@ model=()
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5 --return-delay 0 \
 	${model[@]+"${model[@]}"}
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator \
 	--set robot.commands=network --set robot.command_key="$KEY" \
 	--set joint.1.limit_min=-$LIM --set joint.1.limit_max=$LIM \

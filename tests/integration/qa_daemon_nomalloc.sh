@@ -207,7 +207,7 @@ TEMPLATE=$(grep -E '^[0-9a-f]{40,}$' "$T/cap.log" | head -1)
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --seed 2 --return-delay 0
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-QA_MALLOC_OUT="$T/watch.count" LD_PRELOAD="$T/shim.so" spawn watch "$D" --watch "$R" --lcm-url "$URL"
+QA_MALLOC_OUT="$T/watch.count" LD_PRELOAD="$T/shim.so" spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 # a short ramp: the oscillator takes over from the starter within ~1.5 s
 QA_MALLOC_OUT="$T/d.count" LD_PRELOAD="$T/shim.so" spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --mode oscillator \
 	--lcm-url "$URL" --set robot.ramp_s=0.3 --set robot.commands=network --set robot.command_key="$KEY"
@@ -279,7 +279,7 @@ spawn simx "$S" --model xm430-w350 --link "$T/xbus" --ids 1,2 --name x1 --baud 1
 	--return-delay 0 --control "$T/ctlx"
 wait_log simx 'ready' 10 || { tap_fail "X simulator ready" "$(cat "$T/simx.log")"; tap_done; exit 1; }
 RX="qx$$"
-spawn watchx "$D" --watch "$RX" --lcm-url "$URL"
+spawn watchx "$D" --watch "$RX" --raw --lcm-url "$URL"
 xcycle() { grep -a "^STATE $RX " "$T/watchx.log" | tail -1 | field cycle; }
 xcycle_at_least() { [ "$(xcycle)" -ge "$1" ] 2>/dev/null; }
 QA_MALLOC_OUT="$T/dx.count" LD_PRELOAD="$T/shim.so" spawn dx "$D" --port "$T/xbus" --ids 1,2 --robot "$RX" \

@@ -42,7 +42,7 @@ if diff <(grep -v '^log:\|^undecodable' "$T/out/summary.txt") <(grep -v '^log:\|
 else tap_fail "analysis unchanged by the bad messages" "$(head "$T/an.diff")"; fi
 
 # ---- on the network ---------------------------------------------------------------------------
-spawn watch "$D" --watch '*' --lcm-url "$URL"
+spawn watch "$D" --watch '*' --raw --lcm-url "$URL"
 spawn top env LCM_DEFAULT_URL="$URL" "$TOP" --json --interval 0.5
 spawn web "$W" --listen 127.0.0.1:0 --lcm-url "$URL" --read-only
 wait_log web 'listening on http://' 10 || { tap_fail "undulate-web listening" "$(cat "$T/web.log")"; tap_done; exit 1; }

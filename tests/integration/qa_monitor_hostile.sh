@@ -38,7 +38,7 @@ print(template.hex())
 EOF
 TEMPLATE=$(cat "$T/template")
 
-spawn watch "$D" --watch '*' --lcm-url "$URL"
+spawn watch "$D" --watch '*' --raw --lcm-url "$URL"
 spawn top env LCM_DEFAULT_URL="$URL" "$TOP" --once --wait 6 --json   # long enough on a loaded machine
 # both have joined the group once two sockets are bound to the port
 bound() { [ "$(grep -c ":$(printf '%04X' $PORT) " /proc/net/udp)" -ge 2 ]; }

@@ -43,7 +43,7 @@ heard3() { ctl servo r1 3 | sed -n 's/.* instructions=\([0-9]*\).*/\1/p'; }
 spawn sim "$S" --link "$bus" --ids 1,2,3 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 3
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 pts=$(readlink "$bus")
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 spawn d1 "$D" --port "$bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode sinusoid
 wait_log d1 "ready: $R.STATE" 10 || { tap_fail "daemon starts" "$(cat "$T/d1.log")"; tap_done; exit 1; }
 wait_for 10 cycle_at_least 100

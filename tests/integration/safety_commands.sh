@@ -37,7 +37,7 @@ HOSTADDR=$(hostname -I 2>/dev/null | awk '{ print $1 }')
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 4 --return-delay 0
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 start_daemon() { # NAME ARGS...: the robot, default limits +-1.3 rad, in HOLD
 	local name=$1; shift
 	mark_states   # the daemon before it (stopped) published under the same name

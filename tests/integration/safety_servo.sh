@@ -22,7 +22,7 @@ torque() { local a b; a=$(ctl peek r1 1 torque_enable); b=$(ctl peek r1 2 torque
 
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 6 --return-delay 0
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode limp \
 	--set robot.fault_action=hold --set robot.fault_backoff_s=0.2 --set robot.fault_retries=1
 wait_log d "ready: $R.STATE" 10 && wait_for 10 cycle_at_least 50 ||

@@ -32,7 +32,7 @@ swing() {   # peak-to-peak of joint $1's angle over the last $2 states (150)
 spawn sim "$S" --model xm430-w350 --link "$T/bus" --ids 1,2 --name r1 --baud 1000000 --return-delay 0 \
 	--lcm-url "$URL" --control "$T/ctl" --seed 6
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 # the oscillator on the XM430's own defaults (daemon/CONTROL.md, "X-series servos"): with the
 # AX-12A's it would run down between restarts there, and "it swings again" would mean little
 # silent_s 5 (as safety_servo): the power loss below lasts two control-socket

@@ -198,6 +198,18 @@ def page(devtools_port, url, png, robot, mode):
     mode_shown = cdp.wait(f"""(() => {{ const c = document.getElementById('robot-{robot}');
         return c && c.dataset.mode === '{mode.upper()}' ? c.dataset.mode : ''; }})()""", 5)
     print(f"MODE_SHOWN {mode_shown}", flush=True)
+    # the parameter form: the names and ranges the server lists (/api/params),
+    # and a value outside its range refused with the daemon's words
+    listed = cdp.wait("""(() => { const s = document.getElementById('p-name');
+        if (![...s.options].some(o => o.value === 'amplitude')) return '';
+        s.value = 'amplitude'; s.dispatchEvent(new Event('change'));
+        return [...s.options].map(o => o.value).join(',') + ' ' + document.getElementById('p-range').textContent; })()""", 5)
+    print(f"PARAM_RANGE {listed}", flush=True)
+    cdp.js("""(() => { document.getElementById('p-value').value = '2.65'; document.getElementById('p-joint').value = '-1';
+        document.querySelector('#paramform button[type=submit]').click(); })()""")
+    refused = cdp.wait("""(() => { const a = document.querySelector('#answers .answer.refused');
+        return a ? a.textContent : ''; })()""", 5)
+    print(f"PARAM_REFUSED {refused}", flush=True)
 
 
 def servos(devtools_port, url, png, robot, want, torque=None):

@@ -89,6 +89,14 @@ python3 "$CDP" say 127.0.0.1 "$port" "cmd 2 left param k 50 0" >"$T/bad.out" 2>&
 tap_check "a command out of range is refused before it is sent: $(cat "$T/bad.out")" \
 	grep -q '^NOTE refused parameter k: 50 out of range' "$T/bad.out"
 tap_check "no LIMP reached the robot" bash -c "! grep -q '^STATE left .* mode=0' '$T/watch.log'"
+# one range per parameter (common/params.h): the daemon's words, here and on the page
+python3 "$CDP" say 127.0.0.1 "$port" "cmd 3 left param amplitude 2.65" >"$T/amp.out" 2>&1
+tap_check "amplitude 2.65 refused with the daemon's range: $(cat "$T/amp.out")" \
+	grep -q '^NOTE refused parameter amplitude: 2.65 out of range 0..2.618$' "$T/amp.out"
+curl -s "$H/api/params" >"$T/params.json"
+tap_check "/api/params serves the table: amplitude $(jq -c '.[] | select(.name == "amplitude")' "$T/params.json")" \
+	jq -e '(.[] | select(.name == "amplitude") | .range == "0..2.618" and .unit == "rad" and .step == 0.05)
+		and ([.[].name] | index("stiffness") != null and index("neutral") == null)' "$T/params.json"
 
 # ---- headless chromium: the page draws, a click commands a robot -------------------------------
 browser=$(command -v chromium || command -v chromium-browser || true)
@@ -113,6 +121,10 @@ else
 	tap_check "the robot's answer is on the page: $(grep '^ANSWER' "$T/page.out")" \
 		grep -q '^ANSWER command-accepted .*left command-accepted: mode HOLD' "$T/page.out"
 	tap_check "the page shows left in HOLD" grep -q '^MODE_SHOWN HOLD' "$T/page.out"
+	tap_check "the page's parameters and ranges are the server's: $(grep '^PARAM_RANGE' "$T/page.out")" \
+		grep -qE '^PARAM_RANGE k,c,.*amplitude,.*stiffness,damping range 0\.\.2\.618 rad, step 0\.05' "$T/page.out"
+	tap_check "the page's amplitude 2.65 refused with the same range: $(grep '^PARAM_REFUSED' "$T/page.out")" \
+		grep -q '^PARAM_REFUSED .*refused: parameter amplitude: 2.65 out of range 0..2.618$' "$T/page.out"
 	python3 "$CDP" view "$dport" "$H/" "$T/watch.png" >"$T/view.out" 2>&1
 	tap_check "without the token the page watches: no command buttons, and says how to get them ($(cat "$T/view.out"))" \
 		grep -q '^VIEW commands=False watching=True buttons=0$' "$T/view.out"
@@ -125,7 +137,7 @@ URLN=$(lcm_url 7791)
 "$D" --gen-key "$T/wrong.key" >/dev/null
 spawn simn "$S" --link "$T/net" --ids 1 --lcm-url "$URLN" --seed 6
 wait_log simn 'ready' 10
-spawn watchn "$D" --watch net --lcm-url "$URLN"
+spawn watchn "$D" --watch net --raw --lcm-url "$URLN"
 spawn d_net "$D" --port "$T/net" --ids 1 --robot net --lcm-url "$URLN" --mode oscillator \
 	--set robot.commands=network --set "robot.command_key=$T/net.key"
 wait_log d_net 'ready: net.STATE' 10

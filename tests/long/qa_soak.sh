@@ -77,7 +77,7 @@ sim_torque_off() {
 load0=$(load)
 spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed "$SEED" --return-delay 0
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --lcm-url "$URL"
+spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator \
 	--set joint.1.limit_min=-$LIM --set joint.1.limit_max=$LIM \
 	--set joint.2.limit_min=-$LIM --set joint.2.limit_max=$LIM

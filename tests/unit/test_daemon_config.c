@@ -265,7 +265,7 @@ static void test_sinusoid_stiffness(void **state)
 	                            "[joint.2]\ncoupling_phase = -0.6\n", &e) && cfg_finish(&c, &e));
 	assert_true(c.joint[0].osc.coupling_phase == 0.6 && c.joint[1].osc.coupling_phase == -0.6);
 	assert_false(cfg_load_string(&c, "r.conf", "[joint.1]\ncoupling_phase = 4\n", &e));
-	assert_non_null(strstr(e.line[e.count - 1], "[joint.1] coupling_phase: 4 out of range -3.14159..3.14159"));
+	assert_non_null(strstr(e.line[e.count - 1], "[joint.1] coupling_phase: 4 out of range -3.142..3.142"));
 	e.count = 0;
 	cfg_defaults(&c);
 	assert_true(cfg_load_string(&c, "r.conf", "[sinusoid]\nstiffness = 0.135\ndamping = 0.01\n[robot]\n"

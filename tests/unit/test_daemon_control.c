@@ -504,7 +504,7 @@ static void test_set_param_refused_leaves_controller(void **state)
 		{ "k", 0, NAN, "parameter k: value is not finite" },
 		{ "mu", -1, INFINITY, "parameter mu: value is not finite" },
 		{ "k", 0, 20.0, "parameter k: 20 out of range 0.0001..10" },
-		{ "amplitude", -1, 2.7, "parameter amplitude: 2.7 out of range 0..2.61799" },
+		{ "amplitude", -1, 2.7, "parameter amplitude: 2.7 out of range 0..2.618" },
 		{ "amplitude", 0, 0.5, "parameter amplitude is per robot: joint must be -1, not 0" },
 		{ "c", 2, 0.01, "parameter c: joint 2 does not exist (0..1, or -1 for all)" },
 		{ "k", -1, 9.0, "parameter k: joint 0: k 9 and inertia" },

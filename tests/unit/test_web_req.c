@@ -21,6 +21,8 @@ static void test_routes(void **state)
 	assert_int_equal(req_route("GET", "/chart.js"), REQ_CHARTJS);
 	assert_int_equal(req_route("GET", "/api/snapshot"), REQ_SNAPSHOT);
 	assert_int_equal(req_route("GET", "/api/snapshot?pretty"), REQ_SNAPSHOT);
+	assert_int_equal(req_route("GET", "/api/params"), REQ_PARAMS);
+	assert_int_equal(req_route("POST", "/api/params"), REQ_BAD_METHOD);
 	/* the snapshot takes GET only; the page GET and HEAD */
 	assert_int_equal(req_route("POST", "/api/snapshot"), REQ_BAD_METHOD);
 	assert_int_equal(req_route("HEAD", "/api/snapshot"), REQ_BAD_METHOD);

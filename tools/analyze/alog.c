@@ -1,21 +1,166 @@
 /* alog.c — see alog.h. */
+#define _GNU_SOURCE   /* fopencookie: an xz log read as a stream */
 #include "alog.h"
 
 #include "outdir.h"
 
 #include <errno.h>
 #include <limits.h>
+#include <lzma.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+/* xz's stream header magic (its file format, section 2.1.1.1). */
+static const uint8_t alog_xz_magic[6] = { 0xFD, '7', 'z', 'X', 'Z', 0x00 };
+/* Bytes read from the compressed file at a time. */
+#define ALOG_XZ_CHUNK 65536
+/* Decompressed bytes kept behind the position: liblcm 1.3.1's reader seeks
+ * back once per event (by up to its stdio buffer, 8 KiB, and a few bytes). */
+#define ALOG_XZ_BACK (64 * 1024)
+
+/* An xz-compressed log, read through a stdio stream of its decompressed
+ * bytes (fopencookie), so that liblcm's reader takes it as it takes a file:
+ * make demo keeps its logs compressed (a third of the size). The stream
+ * goes forward, and back as far as ALOG_XZ_BACK. */
+struct alog_xz {
+	FILE *raw;
+	lzma_stream s;
+	bool raw_end;
+	bool stream_end;
+	int64_t decoded;   /* decompressed bytes so far: the end of back[] */
+	int64_t pos;       /* where the reader is (<= decoded) */
+	uint8_t in[ALOG_XZ_CHUNK];
+	uint8_t back[ALOG_XZ_BACK];   /* the last bytes decoded, a ring indexed by offset */
+};
+
+/* Decodes up to n more bytes into out, kept in back[] too; 0 at the end. */
+static size_t alog_xz_decode(struct alog_xz *x, uint8_t *out, size_t n)
+{
+	x->s.next_out = out;
+	x->s.avail_out = n;
+	while (x->s.avail_out > 0 && !x->stream_end) {
+		if (x->s.avail_in == 0 && !x->raw_end) {
+			size_t got = fread(x->in, 1, sizeof x->in, x->raw);
+			x->raw_end = got == 0;
+			x->s.next_in = x->in;
+			x->s.avail_in = got;
+		}
+		lzma_ret r = lzma_code(&x->s, x->raw_end ? LZMA_FINISH : LZMA_RUN);
+		if (r == LZMA_STREAM_END)
+			x->stream_end = true;
+		else if (r != LZMA_OK)
+			break;   /* damaged or cut short: what came before is the log's */
+	}
+	size_t got = n - x->s.avail_out;
+	for (size_t k = 0; k < got;) {
+		size_t at = (size_t)(x->decoded % ALOG_XZ_BACK), m = ALOG_XZ_BACK - at < got - k ? ALOG_XZ_BACK - at : got - k;
+		memcpy(x->back + at, out + k, m);
+		k += m;
+		x->decoded += (int64_t)m;
+	}
+	return got;
+}
+
+static ssize_t alog_xz_read(void *cookie, char *buf, size_t size)
+{
+	struct alog_xz *x = cookie;
+	size_t done = 0;
+	while (done < size) {
+		if (x->pos < x->decoded) {   /* after a seek back: from the ring */
+			size_t at = (size_t)(x->pos % ALOG_XZ_BACK);
+			size_t m = size - done;
+			if (m > (size_t)(x->decoded - x->pos))
+				m = (size_t)(x->decoded - x->pos);
+			if (m > ALOG_XZ_BACK - at)
+				m = ALOG_XZ_BACK - at;
+			memcpy(buf + done, x->back + at, m);
+			done += m;
+			x->pos += (int64_t)m;
+			continue;
+		}
+		size_t got = alog_xz_decode(x, (uint8_t *)buf + done, size - done);
+		if (got == 0)
+			break;
+		done += got;
+		x->pos += (int64_t)got;
+	}
+	return (ssize_t)done;
+}
+
+static int alog_xz_seek(void *cookie, off64_t *off, int whence)
+{
+	struct alog_xz *x = cookie;
+	int64_t to = whence == SEEK_SET ? (int64_t)*off : whence == SEEK_CUR ? x->pos + (int64_t)*off : -1;
+	int64_t oldest = x->decoded > ALOG_XZ_BACK ? x->decoded - ALOG_XZ_BACK : 0;
+	uint8_t skip[4096];
+	while (to > x->decoded && alog_xz_decode(x, skip, to - x->decoded < (int64_t)sizeof skip
+	                                                    ? (size_t)(to - x->decoded) : sizeof skip) > 0)
+		;
+	if (to < oldest || to > x->decoded) {
+		errno = ESPIPE;
+		return -1;
+	}
+	x->pos = to;
+	*off = to;
+	return 0;
+}
+
+static int alog_xz_close(void *cookie)
+{
+	struct alog_xz *x = cookie;
+	lzma_end(&x->s);
+	int rc = fclose(x->raw);
+	free(x);
+	return rc;
+}
+
+/* PATH for reading: the file itself, or its decompressed bytes when it is an
+ * xz file (*xz set). NULL with errno on failure. */
+static FILE *alog_fopen(const char *path, bool *xz, void **state)
+{
+	FILE *f = fopen(path, "rb");
+	uint8_t head[sizeof alog_xz_magic];
+	*xz = false;
+	if (f == NULL)
+		return NULL;
+	size_t n = fread(head, 1, sizeof head, f);
+	*xz = n == sizeof head && memcmp(head, alog_xz_magic, sizeof head) == 0;
+	rewind(f);
+	if (!*xz)
+		return f;
+	struct alog_xz *x = calloc(1, sizeof *x);
+	lzma_stream init = LZMA_STREAM_INIT;
+	if (x == NULL) {
+		fclose(f);
+		return NULL;
+	}
+	x->raw = f;
+	x->s = init;
+	/* no memory limit of our own: a log's dictionary is what xz -1..-9 makes (<= 64 MiB) */
+	if (lzma_stream_decoder(&x->s, UINT64_MAX, 0) != LZMA_OK) {
+		fclose(f);
+		free(x);
+		errno = ENOMEM;
+		return NULL;
+	}
+	cookie_io_functions_t io = { .read = alog_xz_read, .seek = alog_xz_seek, .close = alog_xz_close };
+	FILE *z = fopencookie(x, "rb", io);
+	if (z == NULL)
+		alog_xz_close(x);
+	else if (state != NULL)
+		*state = x;
+	return z;
+}
 
 /* Checks the file's first word before handing it to liblcm: its reader scans
  * for a sync word byte by byte and would call any foreign file "0 events". */
 static int alog_check_header(const char *path, char *err, size_t errlen)
 {
 	unsigned char head[4];
-	FILE *f = fopen(path, "rb");
+	bool xz;
+	FILE *f = alog_fopen(path, &xz, NULL);
 	if (!f) {
 		snprintf(err, errlen, "%s: %s", path, strerror(errno));
 		return -1;
@@ -23,15 +168,15 @@ static int alog_check_header(const char *path, char *err, size_t errlen)
 	size_t n = fread(head, 1, sizeof(head), f);
 	fclose(f);
 	if (n == 0) {
-		snprintf(err, errlen, "%s: empty file, not an LCM log", path);
+		snprintf(err, errlen, "%s: empty %s, not an LCM log", path, xz ? "xz stream" : "file");
 		return -1;
 	}
 	uint32_t magic = (uint32_t)head[0] << 24 | (uint32_t)head[1] << 16 |
 			 (uint32_t)head[2] << 8 | (uint32_t)head[3];
 	if (n < sizeof(head) || magic != ALOG_MAGIC) {
 		snprintf(err, errlen,
-			 "%s: not an LCM log (no lcm_eventlog sync word 0x%08X at the start)",
-			 path, ALOG_MAGIC);
+			 "%s: not an LCM log%s (no lcm_eventlog sync word 0x%08X at the start)",
+			 path, xz ? " inside the xz stream" : "", ALOG_MAGIC);
 		return -1;
 	}
 	return 0;
@@ -53,11 +198,18 @@ int alog_open(struct alog_reader *r, const char *path, char *err, size_t errlen)
 	if (alog_check_header(path, err, errlen) != 0)
 		return -1;
 	r->file_size = (int64_t)st.st_size;
-	r->log = lcm_eventlog_create(path, "r");
+	/* liblcm's lcm_eventlog_create() can only fopen() a path: its handle is
+	 * the public {FILE *f; eventcount}, which lcm_eventlog_destroy() fcloses
+	 * and frees; one is made here around the stream (the writer's way) */
+	FILE *f = alog_fopen(path, &r->xz, &r->xz_state);
+	r->log = f ? calloc(1, sizeof(*r->log)) : NULL;
 	if (!r->log) {
 		snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+		if (f)
+			fclose(f);
 		return -1;
 	}
+	r->log->f = f;
 	return 0;
 }
 
@@ -68,6 +220,20 @@ lcm_eventlog_event_t *alog_next(struct alog_reader *r)
 	lcm_eventlog_event_t *ev = lcm_eventlog_read_next_event(r->log);
 	if (!ev) {
 		r->ended = true;
+		/* an xz log's decompressed size is known at its end: what follows
+		 * the last complete event, counted */
+		if (r->xz) {
+			int64_t at = (int64_t)ftello(r->log->f), rest = 0;
+			char skip[4096];
+			size_t n;
+			while ((n = fread(skip, 1, sizeof skip, r->log->f)) > 0)
+				rest += (int64_t)n;
+			r->file_size = (at > r->good_end ? at : r->good_end) + rest;
+			/* an xz stream cut short (a recording stopped mid-write) is
+			 * a damaged log even where it ends between two events */
+			if (!((const struct alog_xz *)r->xz_state)->stream_end)
+				r->file_size++;
+		}
 		return NULL;
 	}
 	r->events++;

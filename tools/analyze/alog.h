@@ -16,14 +16,17 @@
 struct alog_reader {
 	lcm_eventlog_t *log;
 	const char *path;
-	int64_t file_size;  /* bytes */
+	bool xz;            /* an xz-compressed log (PATH.xz, as make demo keeps it) */
+	void *xz_state;     /* its decoder (alog.c), owned by the stream */
+	int64_t file_size;  /* bytes (of the decompressed log, for xz: known at its end) */
 	int64_t good_end;   /* offset just past the last complete event */
 	int64_t events;     /* complete events read so far */
 	bool ended;
 };
 
-/* Opens PATH for reading. Returns 0, or -1 with a one-line reason in ERR
- * (missing, unreadable, empty, not an LCM log). */
+/* Opens PATH for reading: an LCM log, or one compressed by xz (read as it
+ * is decompressed, never written out). Returns 0, or -1 with a one-line
+ * reason in ERR (missing, unreadable, empty, not an LCM log). */
 int alog_open(struct alog_reader *r, const char *path, char *err, size_t errlen);
 /* The next complete event (free with lcm_eventlog_free_event), or NULL at the
  * end of the file or at the first damaged/incomplete event. */

@@ -1207,6 +1207,18 @@ static int an_open_dir(struct an_ctx *c)
 	return 0;
 }
 
+/* --plots-only: the CSV files the plots' script (plots.gp) does not read —
+ * the per-sample ones, hundreds of MB for a long demo — are not published:
+ * they are the analysis's, kept where it was written. The plots drew from
+ * them already (joints.dat, phase.dat, pair_collisions.dat). */
+static void an_drop_csvs(struct an_ctx *c)
+{
+	static const char *const unread[] = { "states.csv", "phase_diff.csv", "collisions.csv", "plane.csv",
+	                                      "plane_walls.csv", "bus.csv", "events.csv", "params.csv" };
+	for (size_t i = 0; i < sizeof unread / sizeof unread[0]; i++)
+		unlinkat(c->stagefd, unread[i], 0);   /* absent (no plane world): nothing to drop */
+}
+
 /* Moves what was written into --out, replacing what is there by name. */
 static int an_publish(struct an_ctx *c)
 {
@@ -1794,6 +1806,8 @@ int an_run(const struct an_options *o)
 	 * results, CSV files without their plots), as when it was written in place */
 	if (c->stagefd >= 0) {
 		an_close_outputs(c);
+		if (o->plots_only)
+			an_drop_csvs(c);
 		if (an_publish(c) != 0)
 			rc = AN_EXIT_OUTPUT;
 	}

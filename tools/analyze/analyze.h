@@ -30,6 +30,9 @@ struct an_options {
 	const char *out_dir;   /* default "." */
 	const char *pairs;     /* "a:b,c:d" or NULL for neighbours */
 	bool plots;
+	bool plots_only;       /* --plots-only: the plots and what their script reads; the
+	                        * per-sample CSVs are left out (they are the analysis's, in
+	                        * its own folder: no second copy) */
 	double from_s, to_s;   /* seconds from the first event; NAN = open */
 	double window_s;       /* final window for the classification */
 	double separation;     /* d~ for every pair; NAN = from SIM.TRUTH */

@@ -14,7 +14,7 @@
 
 static void usage(FILE *f)
 {
-	fputs("usage: undulate-analyze LOG... [--out DIR] [--pairs a:b,...] [--plots]\n"
+	fputs("usage: undulate-analyze LOG... [--out DIR] [--pairs a:b,...] [--plots|--plots-only]\n"
 	      "                        [--from S] [--to S] [--window S] [--separation D]\n"
 	      "                        [--restitution R] [--merge S] [--min-swing RAD] [--zero-crossings]\n"
 	      "                        [--frequency HZ] [--plane-every S]\n"
@@ -26,7 +26,9 @@ static void usage(FILE *f)
 	      "Reads lcm-logger logs and writes states.csv, collisions.csv, bus.csv, events.csv,\n"
 	      "phase_diff.csv, return_map.csv, collision_rate.csv, summary.txt, summary.json\n"
 	      "(plane.csv and plane_walls.csv for a plane world's log; PNG plots with --plots)\n"
-	      "into DIR (default: current directory).\n"
+	      "into DIR (default: current directory). A LOG may be xz-compressed (LOG.xz).\n"
+	      "  --plots-only      the plots, the summary and the files the plots' script reads,\n"
+	      "                    without the per-sample CSVs (states.csv, phase_diff.csv, ...)\n"
 	      "  --pairs a:b,...   pairs to follow (default: neighbours by SIM.TRUTH position, else name)\n"
 	      "  --from/--to S     only events between S seconds after the log start\n"
 	      "  --window S        final window for the end-state classification (default 10)\n"
@@ -65,13 +67,13 @@ static int parse_double(const char *opt, const char *s, double *out)
 	return 0;
 }
 
-enum { OPT_OUT = 256, OPT_PAIRS, OPT_PLOTS, OPT_FROM, OPT_TO, OPT_WINDOW, OPT_SEP, OPT_REST,
+enum { OPT_OUT = 256, OPT_PAIRS, OPT_PLOTS, OPT_PLOTS_ONLY, OPT_FROM, OPT_TO, OPT_WINDOW, OPT_SEP, OPT_REST,
        OPT_SYNTH, OPT_DURATION, OPT_QUIET, OPT_ZC, OPT_MERGE, OPT_MIN_SWING, OPT_STOP_AFTER, OPT_HELP,
        OPT_RECORD, OPT_LCM_URL, OPT_FREQ, OPT_THEORY, OPT_DELTA0, OPT_STEPS, OPT_POINTS, OPT_PLANE_EVERY };
 
 static const struct option long_opts[] = {
 	{ "out", required_argument, NULL, OPT_OUT },       { "pairs", required_argument, NULL, OPT_PAIRS },
-	{ "plots", no_argument, NULL, OPT_PLOTS },         { "from", required_argument, NULL, OPT_FROM },
+	{ "plots", no_argument, NULL, OPT_PLOTS },         { "plots-only", no_argument, NULL, OPT_PLOTS_ONLY },         { "from", required_argument, NULL, OPT_FROM },
 	{ "to", required_argument, NULL, OPT_TO },         { "window", required_argument, NULL, OPT_WINDOW },
 	{ "separation", required_argument, NULL, OPT_SEP }, { "restitution", required_argument, NULL, OPT_REST },
 	{ "synth", required_argument, NULL, OPT_SYNTH },   { "duration", required_argument, NULL, OPT_DURATION },
@@ -115,6 +117,7 @@ static int parse_option(int c, struct an_options *o, struct synth_args *sa)
 	case OPT_OUT: o->out_dir = optarg; return 0;
 	case OPT_PAIRS: o->pairs = optarg; return 0;
 	case OPT_PLOTS: o->plots = true; return 0;
+	case OPT_PLOTS_ONLY: o->plots = o->plots_only = true; return 0;
 	case OPT_QUIET: o->quiet = true; return 0;
 	case OPT_ZC: o->zero_crossings = true; return 0;
 	case OPT_MERGE: return parse_double("--merge", optarg, &o->merge_s);

@@ -3,6 +3,7 @@
  * so that options may follow the command (`dxl read 1 goal --units`) and the
  * parser holds no global state (the tests call it many times).
  */
+#include <ctype.h>
 #include <string.h>
 
 #include "dxl2.h"
@@ -233,7 +234,10 @@ int dxlt_parse_args(int argc, char **argv, struct dxlt_args *a, FILE *err)
 			options_done = true;
 			continue;
 		}
-		if (options_done || arg[0] != '-' || arg[1] == '\0') {
+		/* A negative number is a value (write 1 goal_pwm -300), never an
+		 * option: no option starts with a digit or a point. */
+		bool negative = arg[0] == '-' && (isdigit((unsigned char)arg[1]) || arg[1] == '.');
+		if (options_done || negative || arg[0] != '-' || arg[1] == '\0') {
 			if (a->command == NULL)
 				a->command = arg;
 			else
@@ -281,7 +285,8 @@ void dxlt_help(FILE *f)
 	      "                             unless --protocol says one; each line names its protocol\n"
 	      "  ping ID                    ping one servo: model, firmware, round-trip time\n"
 	      "  read ID REG [--units]      print a register's raw value (REG: name or address)\n"
-	      "  write ID REG VALUE         write a register (checked against the table first)\n"
+	      "  write ID REG VALUE         write a register (checked against the table first; a negative\n"
+	      "                             VALUE is a value) and print what the servo holds, read back\n"
 	      "  dump ID                    the whole control table, named, with units\n"
 	      "  set-id OLD NEW             change a servo's ID (refused if NEW answers)\n"
 	      "  set-baud ID BAUD           change a servo's baud rate (bps) and verify it\n"

@@ -318,10 +318,12 @@ static bool dxlt_is_level_reg(const struct dxlt_reg *reg)
 
 /* Write one register and know whether it took, as far as the servo's status
  * return level lets us: level 2 answers the WRITE; level 1 answers only a
- * READ, so read the value back; level 0 answers nothing but PING, so the
- * write goes out unconfirmed and the output says so. A write to the status
- * return level itself is never waited for: which level answers it is the
- * servo's choice. */
+ * READ; at both, the value is read back and what the servo holds is what
+ * the output says ("ID 1: goal_position = 512 (read back)"), so a write that
+ * printed nothing is never mistaken for one that took. Level 0 answers
+ * nothing but PING, so the write goes out unconfirmed and the output says
+ * so. A write to the status return level itself is never waited for: which
+ * level answers it is the servo's choice. */
 static int dxlt_write_checked(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg, long value,
                               uint8_t level)
 {
@@ -342,8 +344,6 @@ static int dxlt_write_checked(struct dxlt *t, const struct dxlt_servo *s, const 
 		return DXLT_EXIT_OK;
 	}
 	dxlt_write_hint(t, s, reg);
-	if (answered)
-		return DXLT_EXIT_OK;
 	uint8_t now_level = dxlt_is_level_reg(reg) ? (uint8_t)value : level;
 	if (now_level == 0) {
 		if ((r = dxlt_ping(t, id)) != DXL_OK)
@@ -358,12 +358,23 @@ static int dxlt_write_checked(struct dxlt *t, const struct dxlt_servo *s, const 
 	if ((r = dxlt_read(t, id, reg->addr, reg->size, back)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
 	if (memcmp(back, raw, reg->size) != 0) {
-		fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld; status return level %u: the WRITE itself is not "
-		        "answered, its read-back is)\n", id, reg->name, (long)dxlt_decode(reg, back), value, level);
+		if (answered)
+			fprintf(t->err, "dxl: ID %u holds %s = %ld, not the %ld written\n", id, reg->name,
+			        (long)dxlt_decode(reg, back), value);
+		else
+			fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld; status return level %u: the WRITE itself is "
+			        "not answered, its read-back is)\n", id, reg->name, (long)dxlt_decode(reg, back), value, level);
 		return t->errseen[id] != 0 || t->errseen2[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
 	}
-	fprintf(t->out, "ID %u: %s = %ld (read back: status return level %u does not answer WRITE)\n", id, reg->name,
-	        value, level);
+	/* what the servo holds, in the register's own signedness */
+	long held = (long)dxlt_decode(reg, back);
+	if (reg->row == NULL || !reg->row->is_signed)
+		held = (long)(uint32_t)dxlt_decode(reg, back);
+	if (answered)
+		fprintf(t->out, "ID %u: %s = %ld (read back)\n", id, reg->name, held);
+	else
+		fprintf(t->out, "ID %u: %s = %ld (read back: status return level %u does not answer WRITE)\n", id,
+		        reg->name, held, level);
 	return DXLT_EXIT_OK;
 }
 

@@ -87,6 +87,7 @@ static int nudge_oscillator(struct top_command out[TOP_MAX_JOINTS], const struct
 {
 	int n = r->nparams < r->njoints || r->njoints == 0 ? r->nparams : r->njoints;
 	const struct param_range *range = &param_find("c")->range;   /* the daemon's */
+	/* the daemon's words too: "out of range 0..2.618" in every program */
 	int len = snprintf(why, whylen, "%s c:", r->name);
 	for (int k = 0; k < n; k++) {
 		double v = r->c[k] * (1.0 + dir * TOP_NUDGE_FRACTION);
@@ -95,7 +96,9 @@ static int nudge_oscillator(struct top_command out[TOP_MAX_JOINTS], const struct
 			return -1;
 		}
 		if (!param_in_range(range, v)) {
-			snprintf(why, whylen, "%s: c[%d] %.4g would leave [%g, %g]", r->name, k, v, range->min, range->max);
+			char shown[48];
+			snprintf(why, whylen, "%s: c[%d] %.4g out of range %s: not sent", r->name, k, v,
+				 param_range_format(range, shown, sizeof shown));
 			return -1;
 		}
 		top_command_base(&out[k], r->name, UNDULATE_COMMAND_T_KIND_PARAM, seq + k, source);
@@ -124,10 +127,12 @@ int top_command_nudge(struct top_command out[TOP_MAX_JOINTS], const struct top_r
 		return -1;
 	}
 	/* the daemon's range, not one of our own: a value it accepts is one we may send */
-	const struct param_range *range = &param_find("amplitude")->range;
-	double v = r->sin_amplitude + dir * TOP_NUDGE_AMPLITUDE;
-	if (!param_in_range(range, v)) {
-		snprintf(why, whylen, "%s: amplitude %.3f rad would leave [%g, %.3f]", r->name, v, range->min, range->max);
+	const struct param_def *amp = param_find("amplitude");
+	double v = r->sin_amplitude + dir * amp->step;
+	if (!param_in_range(&amp->range, v)) {
+		char shown[48];
+		snprintf(why, whylen, "%s: amplitude %.3f %s out of range %s %s: not sent", r->name, v, amp->unit,
+			 param_range_format(&amp->range, shown, sizeof shown), amp->unit);
 		return -1;
 	}
 	top_command_base(&out[0], r->name, UNDULATE_COMMAND_T_KIND_PARAM, seq, source);

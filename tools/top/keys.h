@@ -26,7 +26,6 @@ struct top_keyparser {
 enum top_key top_key_feed(struct top_keyparser *kp, unsigned char byte, int *ch);
 
 #define TOP_NUDGE_FRACTION 0.1   /* +/- scale the oscillator's c by 10 % */
-#define TOP_NUDGE_AMPLITUDE 0.05 /* rad: +/- step of the sinusoid amplitude */
 #define TOP_CHANNEL_MAX 80
 
 /* A command ready to publish. The strings live in the struct. */

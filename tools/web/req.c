@@ -26,6 +26,8 @@ enum req_route req_route(const char *method, const char *path)
 	bool get = strcmp(method, "GET") == 0, head = strcmp(method, "HEAD") == 0;
 	if (req_path_is(path, "/api/snapshot"))
 		return get ? REQ_SNAPSHOT : REQ_BAD_METHOD;
+	if (req_path_is(path, "/api/params"))
+		return get ? REQ_PARAMS : REQ_BAD_METHOD;
 	for (size_t i = 0; i < sizeof assets / sizeof assets[0]; i++)
 		if (req_path_is(path, assets[i].path))
 			return get || head ? assets[i].route : REQ_BAD_METHOD;

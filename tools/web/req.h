@@ -24,6 +24,7 @@ enum req_route {
 	REQ_ASSET_CSS,     /* GET/HEAD /style.css */
 	REQ_CHARTJS,       /* GET/HEAD /chart.js: Debian's libjs-chart.js */
 	REQ_SNAPSHOT,      /* GET /api/snapshot */
+	REQ_PARAMS,        /* GET /api/params: the commandable parameters (common/params.h) */
 	REQ_NOT_FOUND,     /* 404 */
 	REQ_BAD_METHOD,    /* 405: a path we serve, another method */
 };

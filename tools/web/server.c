@@ -21,6 +21,7 @@
 #include "frame.h"
 #include "hist.h"
 #include "req.h"
+#include "params.h"
 #include "text.h"
 #include "wcmd.h"
 #include "wsrecv.h"
@@ -342,12 +343,18 @@ static int web_serve_file(struct lws *wsi, const char *dir, const char *name, co
 	return n > 0 ? web_http_done(wsi) : 0;
 }
 
-static int web_snapshot(struct lws *wsi, struct web_http *h)
+/* A JSON answer: the body written by what (the snapshot, the parameters). */
+enum web_json_kind { WEB_JSON_SNAPSHOT, WEB_JSON_PARAMS };
+
+static int web_json(struct lws *wsi, struct web_http *h, enum web_json_kind what)
 {
 	FILE *f = open_memstream(&h->body, &h->len);
 	if (f == NULL)
 		return web_http_status(wsi, HTTP_STATUS_INTERNAL_SERVER_ERROR, "out of memory");
-	top_json(&app.model, clock_mono_s(), clock_wall_us(), f);
+	if (what == WEB_JSON_PARAMS)
+		param_table_json(f);
+	else
+		top_json(&app.model, clock_mono_s(), clock_wall_us(), f);
 	fclose(f);
 	h->off = 0;
 	unsigned char hdr[LWS_PRE + 512], *start = hdr + LWS_PRE, *p = start, *end = hdr + sizeof hdr - 1;
@@ -413,7 +420,8 @@ static int web_http(struct lws *wsi, struct web_http *h, const char *uri)
 	case REQ_ASSET_JS: return web_serve_file(wsi, app.o.page_dir, "app.js", "application/javascript");
 	case REQ_ASSET_CSS: return web_serve_file(wsi, app.o.page_dir, "style.css", "text/css");
 	case REQ_CHARTJS: return web_serve_file(wsi, NULL, app.o.chartjs, "application/javascript");
-	case REQ_SNAPSHOT: return web_snapshot(wsi, h);
+	case REQ_SNAPSHOT: return web_json(wsi, h, WEB_JSON_SNAPSHOT);
+	case REQ_PARAMS: return web_json(wsi, h, WEB_JSON_PARAMS);
 	case REQ_BAD_METHOD:
 		web_log(app.n.http_refused + 1, "refused %s %s: method not allowed", method, quoted);
 		return web_http_status(wsi, HTTP_STATUS_METHOD_NOT_ALLOWED, "method not allowed");

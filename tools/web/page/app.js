@@ -525,6 +525,38 @@ function connect() {
                        setTimeout(connect, 1000); };
 }
 
+// The parameters, their ranges, units and steps: the server's table
+// (common/params.h, served at /api/params), the one the daemon and
+// undulate-top check against, never a copy of our own. A value outside its
+// range is sent all the same: the server refuses it with the daemon's words.
+const params = new Map();
+function showRange() {
+  const p = params.get(document.getElementById('p-name').value);
+  const hint = document.getElementById('p-range');
+  if (!p) { hint.textContent = ''; return; }
+  const unit = p.unit ? ' ' + p.unit : '';
+  hint.textContent = `range ${p.range}${unit}, step ${p.step}` + (p.per_joint ? '' : ' (per robot: joint -1)');
+  document.getElementById('p-value').title = `${p.name}: ${p.range}${unit}`;
+}
+async function loadParams() {
+  const select = document.getElementById('p-name');
+  try {
+    const r = await fetch('/api/params', { cache: 'no-store' });
+    for (const p of await r.json()) {
+      params.set(p.name, p);
+      const o = document.createElement('option');
+      o.value = o.textContent = p.name;
+      select.appendChild(o);
+    }
+    select.value = params.has('c') ? 'c' : select.value;
+  } catch (e) {
+    document.getElementById('p-range').textContent = 'parameter list not loaded: ' + e;
+  }
+  showRange();
+}
+document.getElementById('p-name').addEventListener('change', showRange);
+loadParams();
+
 document.getElementById('paramform').addEventListener('submit', (ev) => {
   ev.preventDefault();
   const v = (id) => document.getElementById(id).value.trim();
