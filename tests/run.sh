@@ -184,10 +184,10 @@ trap 'rm -rf "$UNDULATE_LOCK_DIR"' EXIT
 #     light ones at most;
 #   "# run.sh: alone" — it measures a gait or an experiment in real time: every
 #     slot, nothing beside it.
-# Order: the alone ones first (started on an idle machine, so no slot waits for
-# the others to drain), then the ones that say "# run.sh: long" (started early,
-# the run does not end waiting on one of them), the other scripts, and the unit
-# tests last (short: they fill the end). Whatever fits in the free slots starts,
+# Order: the unit tests and the alone scripts first, one at a time (started on
+# an idle machine, so no slot waits for the others to drain), then the
+# scripts that say "# run.sh: long" (started early, the run does not end
+# waiting on one of them) and the other scripts. Whatever fits in the free slots starts,
 # the first in this order first; results are counted and shown in the order the
 # programs started. TEST_JOBS=1 runs them one by one, in this order.
 jobs_max=${TEST_JOBS:-4}
@@ -208,6 +208,11 @@ for t in "$integration_dir"/*.sh; do [ -f "$t" ] && scripts+=("$t"); done
 if [ -n "${TEST_LONG:-}" ]; then
 	for t in "$long_dir"/*.sh; do [ -f "$t" ] && scripts+=("$t"); done
 fi
+# the unit tests time ptys and fake servos to the millisecond (a missing
+# servo's timeout, the doctor's latency): one at a time, nothing beside them
+for t in "$unit_dir"/test_*; do
+	[ -f "$t" ] && [ -x "$t" ] && add "$(basename "$t")" "$jobs_max" "$t"
+done
 for t in ${scripts[@]+"${scripts[@]}"}; do says "$t" alone && add "$(basename "$t" .sh)" "$jobs_max" bash "$t"; done
 for pass in long other; do
 	for t in ${scripts[@]+"${scripts[@]}"}; do
@@ -216,9 +221,6 @@ for pass in long other; do
 		w=1; says "$t" heavy && w=2
 		add "$(basename "$t" .sh)" "$w" bash "$t"
 	done
-done
-for t in "$unit_dir"/test_*; do
-	[ -f "$t" ] && [ -x "$t" ] && add "$(basename "$t")" 1 "$t"
 done
 
 # A started program is over when its .rc file ("RC MS LIMIT") is there; its

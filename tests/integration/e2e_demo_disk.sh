@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
+# run.sh: heavy — its demos keep a core busy (tests/run.sh)
 # e2e_demo_disk.sh — what `make demo` keeps: under 20 MB a minute for its ten
 # robots, and nothing the analysis needs lost. make demo passes
 # DEMO_COMPRESS=1: the LCM log is kept xz-compressed (every message) and

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
+# run.sh: heavy — its demos keep a core busy (tests/run.sh)
 # e2e_demo_stop.sh — a demo that ends before its end says what ran, what did
 # not and where the run is kept, and keeps it (the LCM log so far and every
 # program's log), whatever ended it: SIGTERM, Ctrl-C of a lockstep run, a
