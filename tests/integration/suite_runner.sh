@@ -231,10 +231,11 @@ expect "a filter that matches nothing ran no test: exit 1" "0 passed, 0 failed, 
 # into one file; the most that ran at once, and who ran beside whom, are read
 # from it.
 spans="$T/spans"
-slotted() { # CASE NAME [RUNSH-LINE]: a program that runs half a second
+slotted() { # CASE NAME [RUNSH-LINE]: a program that runs SLOT_S seconds (2: long
+	# enough that a loaded machine starts three while the first still runs)
 	fake "$1" integration "$2" <<EOF
 ${3:-}
-echo "+ $2" >>"$spans"; sleep 0.5; echo "- $2" >>"$spans"
+echo "+ $2" >>"$spans"; sleep \${SLOT_S:-2}; echo "- $2" >>"$spans"
 echo "ok 1 - $2"; echo "1..1"
 EOF
 }
@@ -259,7 +260,7 @@ if [ "$closing" = "10 passed, 0 failed, 0 skipped" ] && [ "$most" = 3 ] && [ "$h
 	tap_ok "TEST_JOBS=3: three at once at most, the two heavy ones never together, the alone one first with none beside it, then the long one"
 else tap_fail "slots" "closing '$closing'; at once $most (want 3), heavy together $heavy (want 1), beside solo '$solo', first $first, second $second"$'\n'"$(cat "$spans")"; fi
 : >"$spans"
-suite slots TEST_JOBS=1
+suite slots TEST_JOBS=1 SLOT_S=0.2
 if [ "$closing" = "10 passed, 0 failed, 0 skipped" ] && [ "$(most_at_once)" = 1 ]; then
 	tap_ok "TEST_JOBS=1: one at a time"
 else tap_fail "TEST_JOBS=1" "closing '$closing', at once $(most_at_once)"; fi
