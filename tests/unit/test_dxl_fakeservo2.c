@@ -475,7 +475,7 @@ static void test_doctor(void **state)
 		"\nOK    ID 2 model          1020 (XM430-W350), firmware 46\n",
 		"\nWARN  ID 1 return delay   500 us before every reply",
 		"\nOK    ID 1 voltage        12.0 V (servo's limits 6.0..14.0 V)\n",
-		"\nFAIL  ID 2 voltage        9.5 V (servo's limits 9.5..16.0 V), outside the XM430-W350's 10.0..14.8 V",
+		"\nFAIL  ID 2 voltage        9.5 V (servo's limits 9.5..16.0 V), below the XM430-W350's 10..14.8 V",
 		"\nOK    ID 1 operating mode 3 (position)\n",
 		"\nOK    ID 1 position limits 0..4095, around the configuration's",
 		"\nFAIL  ID 2 hardware error 32 (overload): the servo switched its torque off",

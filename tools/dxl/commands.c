@@ -12,6 +12,8 @@
 
 #include "dxl2_table.h"
 #include "dxl_table.h"
+#include "daemon/servo_model.h"
+#include "doctor.h"
 #include "dxlt_priv.h"
 #include "num.h"
 
@@ -140,19 +142,21 @@ static size_t dxlt_scan_bauds(const struct dxlt *t, const struct dxlt_family *f,
 	return n;
 }
 
-/* setup's bus time of one 100 Hz cycle on Protocol 1.0: one READ(36, 6) per servo and one SYNC_WRITE
- * of goal + speed for all, plus the adapter's hold time per READ. */
-static void dxlt_setup_budget(struct dxlt *t, unsigned nservos, bool current, int latency_ms)
+/* setup's last line: the bus time of one 100 Hz cycle of undulated's for n
+ * servos (doctor.h's dr_cycle_wire_us: the model's present block read, one
+ * READ a servo or one SYNC_READ as the protocol can, and one SYNC_WRITE of
+ * goals), plus the adapter's hold time for each read. */
+void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int latency_ms)
 {
-	(void)current;   /* the AX-12A senses none */
-	double byte_us = 10.0 * 1e6 / (double)port_baud(t->port);
-	double wire_ms = (nservos * 20.0 + 5.0 * nservos + 8.0) * byte_us / 1000.0;
-	double total_ms = wire_ms + nservos * (double)latency_ms;
+	const struct dxl_proto *p = bus_proto(&t->bus);
+	bool sync = dxl_proto_can(p, DXL_CAP_SYNC_READ);
+	double wire_ms = 1e-3 * dr_cycle_wire_us(p, n, m->present_len, m->goal_size, port_baud(t->port));
+	double total_ms = wire_ms + (sync ? 1.0 : (double)n) * latency_ms;
 
-	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire + %d ms "
-	        "adapter latency per read = %.2f ms of the 10 ms period%s\n", nservos,
-	        nservos == 1 ? "" : "s", port_baud(t->port), wire_ms, latency_ms, total_ms,
-	        total_ms > 5.0 ? " (too much for 100 Hz)" : "");
+	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire (%s of %u bytes each, one "
+	        "SYNC_WRITE) + %d ms adapter latency %s = %.2f ms of the 10 ms period%s\n", n, n == 1 ? "" : "s",
+	        port_baud(t->port), wire_ms, sync ? "one SYNC_READ" : "a READ", m->present_len, latency_ms,
+	        sync ? "for it" : "per read", total_ms, total_ms > 5.0 ? " (too much for 100 Hz)" : "");
 }
 
 /* The two families `dxl` speaks to, in scan order. */
@@ -164,8 +168,7 @@ static const struct dxlt_family dxlt_families[] = {
 	  .reset_form = "reset ID --yes",
 	  .reset_refusal = "dxl: a factory reset sets ID 1, 1000000 bps and every default (including angle limits); "
 	                   "add --yes to do it\n",
-	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at,
-	  .setup_budget = dxlt_setup_budget },
+	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
 	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
 	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
 	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true,
@@ -174,8 +177,7 @@ static const struct dxlt_family dxlt_families[] = {
 	  .reset_form = "reset ID --yes [--keep id|id-baud]",
 	  .reset_refusal = "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
 	                   "to do it (--keep id or id-baud keeps those)\n",
-	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at,
-	  .setup_budget = dxlt2_setup_budget },
+	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at },
 };
 #define DXLT_NFAMILIES (sizeof dxlt_families / sizeof dxlt_families[0])
 

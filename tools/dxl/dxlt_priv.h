@@ -39,9 +39,6 @@ struct dxlt_family {
 	long (*baud_from_reg)(uint8_t v);
 	/* one rate of `scan`: a line per servo found */
 	int (*scan_at)(struct dxlt *t, long baud, unsigned *found);
-	/* `setup`'s last line: the bus time of one cycle of the daemon's loop
-	 * for n servos (current: one senses its current) */
-	void (*setup_budget)(struct dxlt *t, unsigned n, bool current, int latency_ms);
 };
 
 struct dxlt {
@@ -140,11 +137,15 @@ int dxlt_cmd_dump(struct dxlt *t);
 int dxlt_cmd_write(struct dxlt *t);
 int dxlt_cmd_torque(struct dxlt *t);
 int dxlt_cmd_setup(struct dxlt *t);
+/* ---- commands.c ---- */
+struct sm_model;
+/* setup's last line: the bus time of one cycle of undulated's loop for n
+ * servos of model m (the one whose cycle reads the most). */
+void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int latency_ms);
 
 /* ---- Protocol 2.0 (commands2.c) ---- */
 /* Broadcast PING at the current rate: one scan line per servo in the ID range. */
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found);
-void dxlt2_setup_budget(struct dxlt *t, unsigned n, bool current, int latency_ms);
 
 /* `dxl doctor` (doctor.c): opens the port itself, after reading the
  * configuration that may name it. */

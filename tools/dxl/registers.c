@@ -13,6 +13,7 @@
 
 #include "dxl2.h"
 #include "dxl2_table.h"
+#include "daemon/servo_model.h"
 #include "dxlt_priv.h"
 #include "num.h"
 
@@ -476,7 +477,8 @@ static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const cha
 	return DXLT_EXIT_OK;
 }
 
-static int dxlt_setup_one(struct dxlt *t, uint8_t id, bool *current)
+/* *loop: the model whose cycle reads the most bytes, for setup's budget line. */
+static int dxlt_setup_one(struct dxlt *t, uint8_t id, const struct sm_model **loop)
 {
 	uint8_t mem[DXLT_IMAGE_MAX];
 	struct dxlt_servo s;
@@ -491,7 +493,9 @@ static int dxlt_setup_one(struct dxlt *t, uint8_t id, bool *current)
 		        "know its registers\n", id, s.model, dxlt_known(t));
 		return DXLT_EXIT_REFUSED;
 	}
-	*current = *current || s.m->current_sensing;
+	const struct sm_model *sm = sm_by_number(t->fam->protocol, s.m->number);
+	if (sm != NULL && (*loop == NULL || sm->present_len > (*loop)->present_len))
+		*loop = sm;
 	/* The loop READs every cycle, so level 0 (PING only) cannot work. */
 	if ((r = dxlt_read(t, id, 0, (uint16_t)dxlt_image_len(s.m), mem)) != DXL_OK) {
 		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? (the loop's reads need 1 "
@@ -555,7 +559,7 @@ int dxlt_cmd_setup(struct dxlt *t)
 {
 	uint8_t ids[DXLT_MAX_IDS];
 	int worst = DXLT_EXIT_OK, n = t->a.npos;
-	bool current = false;   /* a servo senses its current: the loop reads it too */
+	const struct sm_model *loop = NULL;   /* the servo whose cycle reads the most */
 
 	if (n < 1 || n > t->fam->max_id + 1)
 		return dxlt_need_form(t, -1, "setup ID... [--status-level N] [--yes]");
@@ -565,7 +569,7 @@ int dxlt_cmd_setup(struct dxlt *t)
 			return rc;
 	}
 	for (int i = 0; i < n; i++) {
-		int rc = dxlt_setup_one(t, ids[i], &current);
+		int rc = dxlt_setup_one(t, ids[i], &loop);
 		if (rc == DXLT_EXIT_PORT)
 			return rc;
 		worst = rc > worst ? rc : worst;
@@ -575,7 +579,8 @@ int dxlt_cmd_setup(struct dxlt *t)
 	/* The adapter: lower the FTDI latency timer now that the servos are done. */
 	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
 	fprintf(t->out, "adapter: %s\n", t->latency.note);
-	t->fam->setup_budget(t, (unsigned)n, current, t->latency.known ? t->latency.timer_ms : 0);
+	dxlt_setup_budget(t, (unsigned)n, loop != NULL ? loop : sm_family(t->fam->protocol),
+	                  t->latency.known ? t->latency.timer_ms : 0);
 	if (t->latency.known && t->latency.timer_ms > 1) {
 		fprintf(t->err, "dxl: %s\n", t->latency.note);
 		if (worst == DXLT_EXIT_OK)
