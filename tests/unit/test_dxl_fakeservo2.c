@@ -390,6 +390,19 @@ static void test_err_field(void **state)
 	 * the tool's back) is named too */
 	assert_int_equal(run_dxl(f, "--protocol", "2", "read", "1", "led", NULL), 0);
 	assert_string_equal(f->err, "");
+	/* a refused write's error number gets its remedy, as 1.0's bits do
+	 * (the hints were 1.0's alone; the error fields of both protocols are
+	 * one table of refusals now) */
+	servo_by_id(f, 1)->err = DXL2_ERRNUM_ACCESS;
+	assert_int_equal(run_dxl(f, "--protocol", "2", "write", "1", "return_delay_time", "0", NULL), DXLT_EXIT_SERVO);
+	assert_non_null(strstr(f->err, "ID 1 reports error 0x07: access"));
+	assert_non_null(strstr(f->err, "refuses EEPROM writes (return_delay_time)"));
+	assert_non_null(strstr(f->err, "dxl --protocol 2 --port "));
+	servo_by_id(f, 1)->err = DXL2_ERRNUM_DATA_LIMIT;
+	assert_int_equal(run_dxl(f, "--protocol", "2", "write", "1", "goal_position", "2100", NULL), DXLT_EXIT_SERVO);
+	assert_non_null(strstr(f->err, "outside the servo's position limits"));
+	assert_non_null(strstr(f->err, "read 1 min_position_limit (and max_position_limit)"));
+	servo_by_id(f, 1)->err = 0;
 }
 
 static void test_set_id_baud_reset_reboot(void **state)

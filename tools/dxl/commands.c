@@ -19,6 +19,8 @@
 
 /* ---- transactions: every reply's error bits are remembered ------------------- */
 
+static const struct dxlt_family *dxlt_family_for(int protocol, const struct dxl2_model **model);
+
 /* One line per servo whose replies carried error bits (1.0) or a non-zero
  * ERR field (2.0); exit 5 unless the command already failed in a way that
  * says more (a lost bus, bad usage). */
@@ -27,21 +29,24 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 	char names[128];
 	bool any = false;
 
-	for (size_t id = 0; id < sizeof t->errseen; id++) {
-		if (t->errseen[id] == 0)
-			continue;
-		fprintf(t->err, "dxl: ID %zu reports error bits 0x%02X: %s\n", id, t->errseen[id],
-		        dxl_errbits_format(t->errseen[id], names, sizeof names));
-		any = true;
-	}
-	for (size_t id = 0; id < sizeof t->errseen2; id++) {
-		if (t->errseen2[id] == 0)
-			continue;
-		fprintf(t->err, "dxl: ID %zu reports error 0x%02X: %s%s\n", id, t->errseen2[id],
-		        dxl2_err_format(t->errseen2[id], names, sizeof names),
-		        dxl2_err_alert(t->errseen2[id]) ? " (the alert bit: a hardware error; see dxl --protocol 2 "
-		        "read ID hardware_error_status --units, and reboot ID to clear it)" : "");
-		any = true;
+	for (size_t i = 0; i < DXLT_PROTOCOLS; i++) {
+		const struct dxl_proto *p = dxl_proto_by_number((int)i + 1);
+		const struct dxl2_model *unused;
+		const struct dxlt_family *f = dxlt_family_for((int)i + 1, &unused);
+		for (size_t id = 0; id < sizeof t->errseen[i]; id++) {
+			uint8_t e = t->errseen[i][id];
+			if (e == 0)
+				continue;
+			fprintf(t->err, "dxl: ID %zu reports %s 0x%02X: %s", id, f->err_field, e,
+			        p->err_format(e, names, sizeof names));
+			if ((e & p->err_alert) && f->alert_fix != NULL) {
+				fputs(" (", t->err);
+				fprintf(t->err, f->alert_fix, f->opt, f->opt);
+				fputc(')', t->err);
+			}
+			fputc('\n', t->err);
+			any = true;
+		}
 	}
 	if (!any)
 		return rc;
@@ -162,7 +167,7 @@ void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int
 /* The two families `dxl` speaks to, in scan order. */
 static const struct dxlt_family dxlt_families[] = {
 	{ .protocol = 1, .bus = BUS_PROTOCOL_1, .label = "Protocol 1.0", .opt = "", .max_id = DXL_MAX_ID,
-	  .settle_us = DXLT_EEPROM_SETTLE_US, .eeprom_needs_torque_off = false,
+	  .settle_us = DXLT_EEPROM_SETTLE_US, .eeprom_needs_torque_off = false, .err_field = "error bits",
 	  .no_rate = "dxl: an AX-12 cannot run at '%s' bps (rates are 2000000/(n+1), e.g. 1000000, 500000, 117647, "
 	             "57143)\n",
 	  .reset_form = "reset ID --yes",
@@ -171,7 +176,9 @@ static const struct dxlt_family dxlt_families[] = {
 	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
 	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
 	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
-	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true,
+	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true, .err_field = "error",
+	  .alert_fix = "the alert bit: a hardware error; see dxl %sread ID hardware_error_status --units, and dxl %sreboot "
+	               "ID to clear it",
 	  .no_rate = "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, 3000000, "
 	             "4000000, 4500000)\n",
 	  .reset_form = "reset ID --yes [--keep id|id-baud]",

@@ -23,7 +23,7 @@ int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found)
 		const struct bus_found *f = &servo[i];
 		if (f->id < t->a.id_lo || f->id > t->a.id_hi)
 			continue;
-		t->errseen2[f->id] |= f->err;
+		dxlt_seen(t, f->id, f->err);
 		(*found)++;
 		fprintf(t->out, "%-4u %-6u %-13s %-9u %-8ld 2.0\n", f->id, f->model, dxlt_model_name(2, f->model),
 		        f->firmware, baud);

@@ -335,7 +335,7 @@ static int dr_read_all(struct dr *d, int *status)
 		if (r != DXL_OK)
 			continue;
 		s->read = true;
-		s->errbits = d->t->errseen[s->id] | d->t->errseen2[s->id];
+		s->errbits = dxlt_errors(d->t, s->id);
 	}
 	return DXLT_EXIT_OK;
 }

@@ -13,6 +13,7 @@
 
 #include "dxl2.h"
 #include "dxl2_table.h"
+#include "dxl_proto.h"
 #include "daemon/servo_model.h"
 #include "dxlt_priv.h"
 #include "num.h"
@@ -295,21 +296,56 @@ static int dxlt_check_live(struct dxlt *t, const struct dxlt_servo *s, const str
 	return DXLT_EXIT_OK;
 }
 
-/* Why the servo refused a write, when its error bits say (the bits alone
- * name the symptom, not the remedy): Protocol 1.0's bits, kept per ID. */
+/* What a refused write's error field says, per protocol (the field names the
+ * symptom, not the remedy): (err & mask) == value, for a write to EEPROM or
+ * to the goal position. 2.0's field is an error number, 1.0's a set of bits;
+ * `dxl` refuses most of the 2.0 cases before sending (the family's
+ * eeprom_needs_torque_off, dxl2_reg_check_write_live), the servo has the
+ * last word. */
+static const struct dxlt_refusal {
+	const struct dxl_proto *proto;
+	uint8_t mask, value;
+	bool eeprom;                  /* else the goal position */
+} dxlt_refusals[] = {
+	{ &dxl_proto_v1, DXL_ERRBIT_RANGE, DXL_ERRBIT_RANGE, true },
+	{ &dxl_proto_v1, DXL_ERRBIT_ANGLE_LIMIT, DXL_ERRBIT_ANGLE_LIMIT, false },
+	{ &dxl_proto_v2, (uint8_t)~DXL2_ERR_ALERT, DXL2_ERRNUM_ACCESS, true },
+	{ &dxl_proto_v2, (uint8_t)~DXL2_ERR_ALERT, DXL2_ERRNUM_DATA_LIMIT, false },
+};
+
+/* The registers that bound a goal position: the model's pair. */
+static const char *const *dxlt_limit_rows(const struct dxl2_model *m)
+{
+	static const char *const pairs[][2] = {
+		{ "cw_angle_limit", "ccw_angle_limit" }, { "min_position_limit", "max_position_limit" },
+	};
+	for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++)
+		if (dxl2_reg_lookup(m, pairs[i][0]) != NULL)
+			return pairs[i];
+	return NULL;
+}
+
 static void dxlt_write_hint(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg)
 {
-	uint8_t e = t->errseen[s->id];
+	uint8_t e = dxlt_errors(t, s->id);
+	const struct dxl_proto *p = bus_proto(&t->bus);
 
 	if (reg->row == NULL || s->m == NULL)
 		return;
-	if ((e & DXL_ERRBIT_RANGE) && reg->row->area == DXL_AREA_EEPROM)
-		snprintf(t->hint, sizeof t->hint, "the %s refuses EEPROM writes (%s) while torque "
-		         "is on or the lock is set: dxl %s--port %s torque %u off", s->m->name, reg->name, t->fam->opt,
-		         port_path(t->port), s->id);
-	else if ((e & DXL_ERRBIT_ANGLE_LIMIT) && strcmp(reg->name, "goal_position") == 0)
-		snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's angle limits: dxl "
-		         "%s--port %s read %u cw_angle_limit (and ccw_angle_limit)", t->fam->opt, port_path(t->port), s->id);
+	for (size_t i = 0; i < sizeof dxlt_refusals / sizeof dxlt_refusals[0]; i++) {
+		const struct dxlt_refusal *r = &dxlt_refusals[i];
+		if (r->proto != p || (e & r->mask) != r->value)
+			continue;
+		const char *const *lim = dxlt_limit_rows(s->m);
+		if (r->eeprom && reg->row->area == DXL_AREA_EEPROM)
+			snprintf(t->hint, sizeof t->hint, "the %s refuses EEPROM writes (%s) while torque is on or the lock "
+			         "is set: dxl %s--port %s torque %u off", s->m->name, reg->name, t->fam->opt,
+			         port_path(t->port), s->id);
+		else if (!r->eeprom && strcmp(reg->name, "goal_position") == 0 && lim != NULL)
+			snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's %s limits: dxl %s--port %s read %u "
+			         "%s (and %s)", sm_family(t->fam->protocol)->limits_name, t->fam->opt, port_path(t->port), s->id,
+			         lim[0], lim[1]);
+	}
 }
 
 static bool dxlt_is_level_reg(const struct dxlt_reg *reg)
@@ -361,7 +397,7 @@ static int dxlt_write_checked(struct dxlt *t, const struct dxlt_servo *s, const 
 	if (memcmp(back, raw, reg->size) != 0) {
 		fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld; status return level %u: the WRITE itself is not "
 		        "answered, its read-back is)\n", id, reg->name, (long)dxlt_decode(reg, back), value, level);
-		return t->errseen[id] != 0 || t->errseen2[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+		return dxlt_errors(t, id) != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
 	}
 	fprintf(t->out, "ID %u: %s = %ld (read back: status return level %u does not answer WRITE)\n", id, reg->name,
 	        value, level);
@@ -454,7 +490,7 @@ static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const cha
                            const uint8_t *mem, uint8_t level)
 {
 	const struct dxl2_reg *reg = dxl2_reg_lookup(s->m, name);
-	uint8_t id = s->id, have = mem[reg->addr], before = t->errseen[id] | t->errseen2[id];
+	uint8_t id = s->id, have = mem[reg->addr], before = dxlt_errors(t, id);
 	int r;
 
 	if (have == want) {
@@ -463,7 +499,7 @@ static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const cha
 	}
 	if ((r = dxlt_write(t, id, reg->addr, &want, 1, level >= 2 && strcmp(name, "status_return_level") != 0)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	if ((t->errseen[id] | t->errseen2[id]) & ~before)
+	if ((dxlt_errors(t, id)) & ~before)
 		return DXLT_EXIT_SERVO;   /* refused: reported with the others at the end */
 	dxlt_sleep_us(t->fam->settle_us);
 	if ((r = dxlt_read(t, id, reg->addr, 1, &have)) != DXL_OK)
@@ -471,7 +507,7 @@ static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const cha
 	if (have != want) {
 		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u)%s\n", id, name, have, want,
 		        dxl2_reg_lookup(s->m, "lock") != NULL ? ": EEPROM locked? (lock register; power-cycle)" : "");
-		return t->errseen[id] | t->errseen2[id] ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+		return dxlt_errors(t, id) ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
 	}
 	fprintf(t->out, "ID %u: %s set to %u\n", id, name, want);
 	return DXLT_EXIT_OK;
