@@ -407,6 +407,14 @@ const struct dxl2_model *dxl2_model_find(int protocol, uint16_t number)
 	return m != NULL && m->protocol == protocol ? m : NULL;
 }
 
+const struct dxl2_model *dxl2_model_first(int protocol)
+{
+	for (size_t i = 0; i < dxl2_model_count(); i++)
+		if (dxl2_model_at(i)->protocol == protocol)
+			return dxl2_model_at(i);
+	return NULL;
+}
+
 bool dxl2_model_can(const struct dxl2_model *m, enum dxl2_cap cap)
 {
 	return m != NULL && (m->caps & (uint32_t)cap) == (uint32_t)cap;

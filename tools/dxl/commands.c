@@ -196,9 +196,7 @@ static const struct dxlt_family *dxlt_family_for(int protocol, const struct dxl2
 	for (size_t i = 0; i < DXLT_NFAMILIES; i++)
 		if (dxlt_families[i].protocol == protocol)
 			f = &dxlt_families[i];
-	for (size_t i = dxl2_model_count(); i-- > 0;)
-		if (dxl2_model_at(i)->protocol == f->protocol)
-			*model = dxl2_model_at(i);
+	*model = dxl2_model_first(f->protocol);
 	return f;
 }
 
