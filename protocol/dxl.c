@@ -45,7 +45,7 @@ const char *dxl_errbit_name(uint8_t bit)
 	}
 }
 
-char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
+char *dxl_bits_format(uint8_t bits, const char *(*name_of)(uint8_t bit), char *buf, size_t cap)
 {
 	if (buf == NULL || cap == 0)
 		return buf;
@@ -59,8 +59,8 @@ char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
 		uint8_t bit = (uint8_t)(1u << i);
 		if (!(bits & bit))
 			continue;
-		const char *name = dxl_errbit_name(bit);
-		/* bit 7 is never sent by a servo: show it rather than hide it */
+		const char *name = name_of(bit);
+		/* a bit no servo sends (1.0's bit 7): show it rather than hide it */
 		int w = name ? snprintf(buf + off, cap - off, "%s%s", off ? "|" : "", name)
 		             : snprintf(buf + off, cap - off, "%sbit%u", off ? "|" : "", i);
 		if (w < 0 || (size_t)w >= cap - off)
@@ -68,6 +68,11 @@ char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
 		off += (size_t)w;
 	}
 	return buf;
+}
+
+char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
+{
+	return dxl_bits_format(bits, dxl_errbit_name, buf, cap);
 }
 
 const char *dxl_strerror(int status)
