@@ -231,6 +231,22 @@ restarted_at_least() {
 }
 wait_restarted() { wait_for 10 restarted_at_least "$1"; }
 
+# rig_up LCM_PORT SEED: the daemon and simulator binaries ($D, $S; the test
+# skipped when either is not built), a robot name of its own ($R: a
+# concurrent run on the same multicast port from another build directory
+# cannot answer for it), $URL, the simulator (servos 1 and 2 on $T/bus,
+# robot r1, its control socket $T/ctl) ready, and a watcher of $R
+# ($T/watch.log). Ends the test when the simulator does not start.
+rig_up() {
+	D="$B/undulated"; S="$B/undulate-sim"
+	[ -x "$S" ] && [ -x "$D" ] || tap_skip_all "undulate-sim or undulated not built"
+	R="u$$"
+	URL=$(lcm_url "$1")
+	spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed "$2"
+	wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
+	spawn watch "$D" --watch "$R" --lcm-url "$URL"
+}
+
 # start_retried: the script's start_daemon, and once more as a unit's
 # Restart=on-failure would when that start-up failed (exit 1, e.g. a servo
 # read timing out on a loaded machine) before the script's `ready`; the
