@@ -303,6 +303,7 @@ endef
 $(foreach t,$(patsubst tests/fuzz/%.c,%,$(FUZZ_SRC)),$(eval $(call fuzz_target,$(t))))
 # the body both protocol targets include
 $(BUILD)/fuzz/fuzz_protocol_parser $(BUILD)/fuzz/fuzz_protocol_parser2: tests/fuzz/protocol_fuzz.h
+$(BUILD)/fuzz/fuzz_daemon_commands $(BUILD)/fuzz/fuzz_web_feed: tests/fuzz/fuzz_records.h
 .PHONY: fuzz-build
 fuzz-build: $(LCM_STAMP) $(FUZZ_BINS)
 fuzz: deps

@@ -237,6 +237,23 @@ SUMMARY=$T/summary.md
 say() { printf '%s\n' "$*" >>"$REPORT"; }
 sum() { printf '| %s | %s | %s |\n' "$1" "$2" "$3" >>"$SUMMARY"; }
 
+# sim_logged NAME INFO WHAT LCM SIM_ARG...: undulate-sim (SIM_ARG..., on $u,
+# quiet, the caller's model options) and an lcm-logger of its LCM into LCM;
+# when the simulator does not start, "status not measured: WHAT (why)" into
+# INFO and 1. ($u and $model are the caller's locals.)
+sim_logged() {
+	local name=$1 info=$2 what=$3 log=$4
+	shift 4
+	start "sim-$name" "$SIM" "$@" --lcm-url "$u" --quiet ${model[@]+"${model[@]}"}
+	if ! wait_ready "sim-$name" 'ready:' 10; then
+		echo "status not measured: $what ($(why "sim-$name"))" >"$info"
+		stop "sim-$name"
+		return 1
+	fi
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$log"
+	wait_file "$log" 10
+}
+
 # ---- 1 + 4: loop timing against cyclictest, daemon CPU and memory ------------------
 # loop_run RUN MCAST_PORT [MODEL]: one robot (2 servos, return delay 0) on the
 # simulated bus, its daemon at RUN's policy (fifo, else SCHED_OTHER), cyclictest
@@ -249,14 +266,8 @@ loop_run() {
 	u=$(url "$2")
 	mkdir -p "$d"
 	echo "status ok" >"$d/info"
-	start "sim-$run" "$SIM" --link "$d/r1" --ids 1,2 --return-delay 0 --lcm-url "$u" --quiet ${model[@]+"${model[@]}"}
-	if ! wait_ready "sim-$run" 'ready:' 10; then
-		echo "status not measured: undulate-sim did not start ($(why "sim-$run"))" >"$d/info"
-		stop "sim-$run"
+	sim_logged "$run" "$d/info" "undulate-sim did not start" "$d/run.lcm" --link "$d/r1" --ids 1,2 --return-delay 0 ||
 		return 1
-	fi
-	start "log-$run" lcm-logger --lcm-url="$u" -f "$d/run.lcm"
-	wait_file "$d/run.lcm" 10
 	local extra=()
 	[ "$pol" = fifo ] && extra=(--set "robot.priority=$FIFO_PRIORITY" --set robot.mlockall=true)
 	if ! start_daemon "dmn-$run" "$DMN" --port "$d/r1" --ids 1,2 --robot r1 --lcm-url "$u" --mode oscillator "${extra[@]}"; then
@@ -402,15 +413,8 @@ daemon_bus_run() {
 	[ -n "${3:-}" ] && { name="db2-$1-$2"; model=(--model "$3" --baud 1000000); }
 	u=$(url $PORT_BUS)
 	mkdir -p "$d"
-	start "sim-$name" "$SIM" --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay "$rd" --lcm-url "$u" \
-		${model[@]+"${model[@]}"} --quiet
-	if ! wait_ready "sim-$name" 'ready:' 10; then
-		echo "status not measured: the simulator refused $n servos on one bus ($(why "sim-$name"))" >"$d/$name"
-		stop "sim-$name"
-		return 1
-	fi
-	start "log-$name" lcm-logger --lcm-url="$u" -f "$d/$name.lcm"
-	wait_file "$d/$name.lcm" 10
+	sim_logged "$name" "$d/$name" "the simulator refused $n servos on one bus" "$d/$name.lcm" --link "$d/$name.pty" \
+		--ids "$(ids_upto "$n")" --return-delay "$rd" || return 1
 	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --robot "r$n" --lcm-url "$u" --mode oscillator; then
 		sleep "$RAMP_S"
 		local t0 t1

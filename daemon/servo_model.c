@@ -97,6 +97,28 @@ static const struct sm_setup sm_x_setup = {
 _Static_assert(DXL_AX_STATUS_RETURN_LEVEL + 1 <= SM_SETTINGS_MAX && DXL2_X_BUS_WATCHDOG + 1 <= SM_SETTINGS_MAX,
                "start-up's settings READ fits its buffer");
 
+/* Each family's decoders and drive units (below): the model table names
+ * them, the calls never ask which family. */
+static void sm_ax_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out);
+static void sm_x_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out);
+static void sm_ax_readback(const struct sm_model *m, const uint8_t *ram, struct sm_state *s);
+static void sm_x_ram(const struct sm_model *m, const uint8_t *b, struct sm_state *s);
+static void sm_x_eeprom(const struct sm_model *m, const uint8_t *b, struct sm_state *s);
+static uint16_t sm_ax_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit);
+static uint16_t sm_x_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit);
+
+/* The AX-12A's positions are 0..1023: a raw value outside is taken as the
+ * nearest end. */
+static double sm_ax_pos_to_rad(int32_t raw)
+{
+	return dxl_pos_to_rad((uint16_t)(raw < 0 ? 0 : raw > DXL_POS_MAX ? DXL_POS_MAX : raw));
+}
+
+static int32_t sm_ax_rad_to_pos(double rad)
+{
+	return dxl_rad_to_pos(rad);
+}
+
 /* The AX-12A: its registers here, its datasheet its descriptor's
  * (protocol/dxl2_table.c), filled in at the first sm_ax12(). */
 static struct sm_model sm_ax = {
@@ -104,9 +126,13 @@ static struct sm_model sm_ax = {
 	.torque_enable = DXL_AX_TORQUE_ENABLE, .torque_limit = DXL_AX_TORQUE_LIMIT,
 	.goal = DXL_AX_GOAL_POSITION, .goal_size = 2,
 	.present = DXL_AX_PRESENT_POSITION, .present_len = 6, .present_len_slow = 8,
-	.readback = { { SM_AX_READBACK_ADDR, SM_AX_READBACK_LEN, "RAM" } }, .nreadback = 1,
-	.pos_max = DXL_POS_MAX, .torque_full = 1023, .ref_voltage = DXL2_REF_VOLTAGE,
-	.position_from = "AX-12A", .caps = 0, .limits_name = "angle", .setup = &sm_ax_setup,
+	.readback = { { SM_AX_READBACK_ADDR, SM_AX_READBACK_LEN, "RAM", sm_ax_readback } }, .nreadback = 1,
+	.decode_present = sm_ax_present, .drive_raw = sm_ax_drive_raw,
+	.pos_max = DXL_POS_MAX, .pos_to_rad = sm_ax_pos_to_rad, .rad_to_pos = sm_ax_rad_to_pos,
+	.status_faults = DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT, .status_alert = 0,
+	.status_refused = DXL_ERRBIT_RANGE | DXL_ERRBIT_INSTRUCTION | DXL_ERRBIT_CHECKSUM,
+	.drive = DXL_AX_MOVING_SPEED, .drive_current = DXL_AX_MOVING_SPEED,
+	.torque_full = 1023, .ref_voltage = DXL2_REF_VOLTAGE, .position_from = "AX-12A", .caps = 0, .limits_name = "angle", .setup = &sm_ax_setup,
 };
 static bool sm_ax_made;
 
@@ -132,8 +158,12 @@ static const struct sm_model *sm_x_model(size_t i)
 		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
 		/* Present Current where it senses current, Present Load else: 126 */
 		.present = DXL2_X_PRESENT_LOAD, .present_len = SM_X_PRESENT_LEN, .present_len_slow = SM_X_PRESENT_LEN_SLOW,
-		.readback = { { SM_X_RAM_ADDR, SM_X_RAM_LEN, "RAM" }, { SM_X_EEPROM_ADDR, SM_X_EEPROM_LEN, "EEPROM" } },
-		.nreadback = 2, .pos_max = DXL2_POS_MAX, .torque_full = SM_X_PWM_FULL,
+		.readback = { { SM_X_RAM_ADDR, SM_X_RAM_LEN, "RAM", sm_x_ram },
+		              { SM_X_EEPROM_ADDR, SM_X_EEPROM_LEN, "EEPROM", sm_x_eeprom } },
+		.decode_present = sm_x_present, .drive_raw = sm_x_drive_raw,
+		.nreadback = 2, .pos_max = DXL2_POS_MAX, .pos_to_rad = dxl2_pos_to_rad, .rad_to_pos = dxl2_rad_to_pos,
+		.status_faults = 0, .status_alert = DXL2_ERR_ALERT, .status_refused = DXL2_ERR_NUMBER_MASK,
+		.drive = DXL2_X_GOAL_PWM, .drive_current = DXL2_X_GOAL_CURRENT, .torque_full = SM_X_PWM_FULL,
 		.ref_voltage = DXL2_REF_VOLTAGE, .stall_torque_nm = d->sheet.stall_torque_nm,
 		.no_load_speed_rad_s = d->sheet.no_load_speed_rpm * SM_RPM_TO_RAD_S,
 		.stall_current_a = d->sheet.stall_current_a, .current_control = d->current_sensing,
@@ -186,11 +216,6 @@ const struct sm_model *sm_family(int protocol)
 	return NULL;
 }
 
-static bool sm_is_x(const struct sm_model *m)
-{
-	return m->protocol == 2;
-}
-
 /* The table's row: the X series' registers are read with dxl2_table's sizes
  * and signs, never restated here. */
 static int32_t sm_x_get(const struct sm_model *m, const uint8_t *block, uint16_t block_addr, uint16_t addr)
@@ -202,14 +227,12 @@ static int32_t sm_x_get(const struct sm_model *m, const uint8_t *block, uint16_t
 /* ---- units ------------------------------------------------------------------------------------- */
 double sm_pos_to_rad(const struct sm_model *m, int32_t raw)
 {
-	if (sm_is_x(m))
-		return dxl2_pos_to_rad(raw);
-	return dxl_pos_to_rad((uint16_t)(raw < 0 ? 0 : raw > DXL_POS_MAX ? DXL_POS_MAX : raw));
+	return m->pos_to_rad(raw);
 }
 
 int32_t sm_rad_to_pos(const struct sm_model *m, double rad)
 {
-	return sm_is_x(m) ? dxl2_rad_to_pos(rad) : dxl_rad_to_pos(rad);
+	return m->rad_to_pos(rad);
 }
 
 void sm_joint_range(const struct sm_model *m, double lo_rad, double hi_rad, int32_t *lo, int32_t *hi)
@@ -244,23 +267,21 @@ bool sm_limit_is_pwm_drive(const struct sm_model *m)
 	return m->torque_limit == sm_drive_register(m, false);
 }
 
-bool sm_decode_present(const struct sm_model *m, const uint8_t *b, size_t n, struct sm_present *out)
+static void sm_ax_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out)
 {
-	if (n != m->present_len && n != m->present_len_slow)
-		return false;
-	out->slow = n == m->present_len_slow;
-	out->voltage = out->temperature = NAN;
-	if (!sm_is_x(m)) {
-		out->pos_raw = dxl_get_u16(b);
-		out->angle = dxl_pos_to_rad(dxl_get_u16(b));
-		out->speed = dxl_speed_to_rad_s(dxl_get_u16(b + 2));
-		out->load = dxl_load_to_fraction(dxl_get_u16(b + 4));
-		if (out->slow) {
-			out->voltage = dxl_voltage_to_volts(b[6]);
-			out->temperature = b[7];
-		}
-		return true;
+	(void)m;
+	out->pos_raw = dxl_get_u16(b);
+	out->angle = dxl_pos_to_rad(dxl_get_u16(b));
+	out->speed = dxl_speed_to_rad_s(dxl_get_u16(b + 2));
+	out->load = dxl_load_to_fraction(dxl_get_u16(b + 4));
+	if (out->slow) {
+		out->voltage = dxl_voltage_to_volts(b[6]);
+		out->temperature = b[7];
 	}
+}
+
+static void sm_x_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out)
+{
 	int32_t load = sm_x_get(m, b, m->present, DXL2_X_PRESENT_LOAD);
 	out->pos_raw = sm_x_get(m, b, m->present, DXL2_X_PRESENT_POSITION);
 	out->angle = dxl2_pos_to_rad(out->pos_raw);
@@ -270,6 +291,15 @@ bool sm_decode_present(const struct sm_model *m, const uint8_t *b, size_t n, str
 		out->voltage = dxl2_voltage_to_volts(sm_x_get(m, b, m->present, DXL2_X_PRESENT_INPUT_VOLTAGE));
 		out->temperature = sm_x_get(m, b, m->present, DXL2_X_PRESENT_TEMPERATURE);
 	}
+}
+
+bool sm_decode_present(const struct sm_model *m, const uint8_t *b, size_t n, struct sm_present *out)
+{
+	if (n != m->present_len && n != m->present_len_slow)
+		return false;
+	out->slow = n == m->present_len_slow;
+	out->voltage = out->temperature = NAN;
+	m->decode_present(m, b, out);
 	return true;
 }
 
@@ -283,8 +313,9 @@ void sm_state_unknown(struct sm_state *s)
 	};
 }
 
-static void sm_ax_readback(const uint8_t *ram, struct sm_state *s)
+static void sm_ax_readback(const struct sm_model *m, const uint8_t *ram, struct sm_state *s)
 {
+	(void)m;
 #define REG(addr) ram[(addr) - SM_AX_READBACK_ADDR]
 	s->torque = REG(DXL_AX_TORQUE_ENABLE);
 	s->torque_limit = dxl_get_u16(&REG(DXL_AX_TORQUE_LIMIT));
@@ -325,31 +356,24 @@ bool sm_decode_readback(const struct sm_model *m, size_t block, const uint8_t *b
 {
 	if (block >= m->nreadback || n != m->readback[block].len)
 		return false;
-	if (!sm_is_x(m))
-		sm_ax_readback(bytes, s);
-	else if (m->readback[block].addr == SM_X_RAM_ADDR)
-		sm_x_ram(m, bytes, s);
-	else
-		sm_x_eeprom(m, bytes, s);
+	m->readback[block].decode(m, bytes, s);
 	return true;
 }
 
 /* ---- status ----------------------------------------------------------------------------------- */
 uint8_t sm_status_faults(const struct sm_model *m, uint8_t status)
 {
-	return sm_is_x(m) ? 0 : (uint8_t)(status & (DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT));
+	return (uint8_t)(status & m->status_faults);
 }
 
 bool sm_alert(const struct sm_model *m, uint8_t status)
 {
-	return sm_is_x(m) && dxl2_err_alert(status);
+	return (status & m->status_alert) != 0;
 }
 
 bool sm_write_refused(const struct sm_model *m, uint8_t status)
 {
-	if (sm_is_x(m))
-		return dxl2_err_number(status) != DXL2_ERRNUM_NONE;
-	return (status & (DXL_ERRBIT_RANGE | DXL_ERRBIT_INSTRUCTION | DXL_ERRBIT_CHECKSUM)) != 0;
+	return (status & m->status_refused) != 0;
 }
 
 /* ---- the supply ------------------------------------------------------------------------------- */
@@ -370,9 +394,7 @@ bool sm_supply_plausible(const struct sm_model *m, double volts)
 /* ---- torque actuation --------------------------------------------------------------------------- */
 uint16_t sm_drive_register(const struct sm_model *m, bool current)
 {
-	if (!sm_is_x(m))
-		return DXL_AX_MOVING_SPEED;
-	return current ? DXL2_X_GOAL_CURRENT : DXL2_X_GOAL_PWM;
+	return current ? m->drive_current : m->drive;
 }
 
 double sm_torque_scale(const struct sm_model *m)
@@ -400,8 +422,18 @@ uint8_t sm_drive_opmode(bool current)
 
 uint16_t sm_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit)
 {
-	if (!sm_is_x(m))
-		return dxl_duty_to_wheel(ratio);
+	return m->drive_raw(m, current, ratio, limit);
+}
+
+/* The AX-12A's wheel mode: Moving Speed as a PWM duty, bit 10 the direction. */
+static uint16_t sm_ax_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit)
+{
+	(void)m, (void)current, (void)limit;
+	return dxl_duty_to_wheel(ratio);
+}
+
+static uint16_t sm_x_drive_raw(const struct sm_model *m, bool current, double ratio, int32_t limit)
+{
 	if (!isfinite(ratio))
 		return 0;
 	if (limit < 0)

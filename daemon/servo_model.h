@@ -56,10 +56,14 @@ enum sm_cap {
 	SM_CAP_OPMODE = 1u << 1,
 };
 
-/* A register block read in one READ. */
+struct sm_model;
+struct sm_state;
+struct sm_present;
+/* A register block read in one READ, and what fills sm_state from it. */
 struct sm_block {
 	uint16_t addr, len;
 	const char *what;          /* "RAM", for messages */
+	void (*decode)(const struct sm_model *m, const uint8_t *b, struct sm_state *s);
 };
 /* Read-back blocks of one family (the AX-12 has one, the X series two). */
 #define SM_MAX_BLOCKS 2
@@ -135,6 +139,22 @@ struct sm_model {
 	struct sm_block readback[SM_MAX_BLOCKS];
 	size_t nreadback;
 	int32_t pos_max;                /* 1023 | 4095 */
+	/* raw position <-> radians from its centre (512 | 2048), the servo's units */
+	double (*pos_to_rad)(int32_t raw);
+	int32_t (*rad_to_pos)(double rad);
+	/* What a status packet's error field says of it (the field is its
+	 * protocol's): the bits that are a fault of its own (overload and
+	 * overheating | none: the X series raises the alert and Hardware Error
+	 * Status names the cause), the alert bit (0 | 0x80), and what says a write
+	 * was refused (range, instruction, checksum bits | any error number). */
+	uint8_t status_faults, status_alert, status_refused;
+	/* torque actuation's drive register: Moving Speed 32 (wheel mode) | Goal
+	 * PWM 100, or Goal Current 102 where current-controlled */
+	uint16_t drive, drive_current;
+	/* the family's decoders and the drive's units (sm_decode_present,
+	 * sm_drive_raw: their contracts) */
+	void (*decode_present)(const struct sm_model *m, const uint8_t *b, struct sm_present *out);
+	uint16_t (*drive_raw)(const struct sm_model *m, bool current, double ratio, int32_t limit);
 	uint32_t torque_full;           /* full output in torque-limit units: 1023 | 885 */
 	/* the datasheet's line at ref_voltage (the simulator's motors use the same) */
 	double ref_voltage, stall_torque_nm, no_load_speed_rad_s, stall_current_a;

@@ -45,7 +45,7 @@ const char *dxl_errbit_name(uint8_t bit)
 	}
 }
 
-char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
+char *dxl_bits_format(uint8_t bits, const char *(*name_of)(uint8_t bit), char *buf, size_t cap)
 {
 	if (buf == NULL || cap == 0)
 		return buf;
@@ -59,8 +59,8 @@ char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
 		uint8_t bit = (uint8_t)(1u << i);
 		if (!(bits & bit))
 			continue;
-		const char *name = dxl_errbit_name(bit);
-		/* bit 7 is never sent by a servo: show it rather than hide it */
+		const char *name = name_of(bit);
+		/* a bit no servo sends (1.0's bit 7): show it rather than hide it */
 		int w = name ? snprintf(buf + off, cap - off, "%s%s", off ? "|" : "", name)
 		             : snprintf(buf + off, cap - off, "%sbit%u", off ? "|" : "", i);
 		if (w < 0 || (size_t)w >= cap - off)
@@ -68,6 +68,11 @@ char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
 		off += (size_t)w;
 	}
 	return buf;
+}
+
+char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap)
+{
+	return dxl_bits_format(bits, dxl_errbit_name, buf, cap);
 }
 
 const char *dxl_strerror(int status)
@@ -101,6 +106,27 @@ uint8_t dxl_checksum(const uint8_t *from_id, size_t n)
 	return (uint8_t)(~sum & 0xFFu);
 }
 
+/* A packet of nparams parameters: its header into buf (the parameters go at
+ * buf + 5, written by the caller), or why it does not fit. */
+static int dxl_frame_begin(uint8_t *buf, size_t cap, uint8_t id, uint8_t code, size_t nparams)
+{
+	if (nparams > DXL_MAX_TX_PARAMS || cap < nparams + DXL_OVERHEAD)
+		return DXL_E_BUFFER;
+	buf[0] = DXL_LEAD;
+	buf[1] = DXL_LEAD;
+	buf[2] = id;
+	buf[3] = (uint8_t)(nparams + 2);
+	buf[4] = code;
+	return DXL_OK;
+}
+
+/* Its checksum after the parameters; the packet's length. */
+static int dxl_frame_end(uint8_t *buf, size_t nparams)
+{
+	buf[5 + nparams] = dxl_checksum(buf + 2, nparams + 3);
+	return (int)(nparams + DXL_OVERHEAD);
+}
+
 /* Frame `code` and the parameters (given as up to two pieces, so encoders can
  * prepend an address without a scratch buffer). */
 static int dxl_frame(uint8_t *buf, size_t cap, uint8_t id, uint8_t code, const uint8_t *head,
@@ -109,21 +135,14 @@ static int dxl_frame(uint8_t *buf, size_t cap, uint8_t id, uint8_t code, const u
 	size_t nparams = nhead + ntail;
 	if (buf == NULL || (nhead && head == NULL) || (ntail && tail == NULL))
 		return DXL_E_ARG;
-	if (nparams > DXL_MAX_TX_PARAMS)
-		return DXL_E_BUFFER;
-	if (cap < nparams + DXL_OVERHEAD)
-		return DXL_E_BUFFER;
-	buf[0] = DXL_LEAD;
-	buf[1] = DXL_LEAD;
-	buf[2] = id;
-	buf[3] = (uint8_t)(nparams + 2);
-	buf[4] = code;
+	int r = dxl_frame_begin(buf, cap, id, code, nparams);
+	if (r != DXL_OK)
+		return r;
 	if (nhead)
 		memcpy(buf + 5, head, nhead);
 	if (ntail)
 		memcpy(buf + 5 + nhead, tail, ntail);
-	buf[5 + nparams] = dxl_checksum(buf + 2, nparams + 3);
-	return (int)(nparams + DXL_OVERHEAD);
+	return dxl_frame_end(buf, nparams);
 }
 
 int dxl_encode_instruction(uint8_t *buf, size_t cap, uint8_t id, uint8_t instr,
@@ -185,18 +204,12 @@ int dxl_encode_sync_write(uint8_t *buf, size_t cap, uint8_t addr, uint8_t len,
 		return DXL_E_ARG;
 	/* params: addr, L, then (ID + L bytes) per servo */
 	size_t nparams = 2 + n * ((size_t)len + 1);
-	if (nparams > DXL_MAX_TX_PARAMS)
-		return DXL_E_BUFFER;
-	if (cap < nparams + DXL_OVERHEAD)
+	if (nparams > DXL_MAX_TX_PARAMS || cap < nparams + DXL_OVERHEAD)
 		return DXL_E_BUFFER;
 	for (size_t i = 0; i < n; i++)
 		if (ids[i] > DXL_MAX_ID)
 			return DXL_E_ARG;
-	buf[0] = DXL_LEAD;
-	buf[1] = DXL_LEAD;
-	buf[2] = DXL_BROADCAST_ID;
-	buf[3] = (uint8_t)(nparams + 2);
-	buf[4] = DXL_INST_SYNC_WRITE;
+	(void)dxl_frame_begin(buf, cap, DXL_BROADCAST_ID, DXL_INST_SYNC_WRITE, nparams);
 	buf[5] = addr;
 	buf[6] = len;
 	uint8_t *p = buf + 7;
@@ -205,8 +218,7 @@ int dxl_encode_sync_write(uint8_t *buf, size_t cap, uint8_t addr, uint8_t len,
 		memcpy(p, data + i * len, len);
 		p += len;
 	}
-	*p = dxl_checksum(buf + 2, nparams + 3);
-	return (int)(nparams + DXL_OVERHEAD);
+	return dxl_frame_end(buf, nparams);
 }
 
 int dxl_encode_bulk_read(uint8_t *buf, size_t cap, const struct dxl_bulk_item *items, size_t n)
@@ -215,18 +227,12 @@ int dxl_encode_bulk_read(uint8_t *buf, size_t cap, const struct dxl_bulk_item *i
 		return DXL_E_ARG;
 	/* params: 0x00, then (L, ID, addr) per item (MX manual order) */
 	size_t nparams = 1 + 3 * n;
-	if (nparams > DXL_MAX_TX_PARAMS)
-		return DXL_E_BUFFER;
-	if (cap < nparams + DXL_OVERHEAD)
+	if (nparams > DXL_MAX_TX_PARAMS || cap < nparams + DXL_OVERHEAD)
 		return DXL_E_BUFFER;
 	for (size_t i = 0; i < n; i++)
 		if (items[i].id > DXL_MAX_ID || items[i].len == 0)
 			return DXL_E_ARG;
-	buf[0] = DXL_LEAD;
-	buf[1] = DXL_LEAD;
-	buf[2] = DXL_BROADCAST_ID;
-	buf[3] = (uint8_t)(nparams + 2);
-	buf[4] = DXL_INST_BULK_READ;
+	(void)dxl_frame_begin(buf, cap, DXL_BROADCAST_ID, DXL_INST_BULK_READ, nparams);
 	buf[5] = 0x00;
 	uint8_t *p = buf + 6;
 	for (size_t i = 0; i < n; i++) {
@@ -234,8 +240,7 @@ int dxl_encode_bulk_read(uint8_t *buf, size_t cap, const struct dxl_bulk_item *i
 		*p++ = items[i].id;
 		*p++ = items[i].addr;
 	}
-	*p = dxl_checksum(buf + 2, nparams + 3);
-	return (int)(nparams + DXL_OVERHEAD);
+	return dxl_frame_end(buf, nparams);
 }
 
 int dxl_encode_status(uint8_t *buf, size_t cap, uint8_t id, uint8_t err,

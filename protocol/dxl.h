@@ -62,6 +62,9 @@ enum dxl_errbit {
 const char *dxl_errbit_name(uint8_t bit);
 /* Writes "overload|overheating" (or "none") into buf; returns buf. */
 char *dxl_errbits_format(uint8_t bits, char *buf, size_t cap);
+/* Any register of bits as "a|b|bitN" ("none" for 0), each set bit named by
+ * name_of (NULL: "bitN"); buf always terminated. Returns buf. */
+char *dxl_bits_format(uint8_t bits, const char *(*name_of)(uint8_t bit), char *buf, size_t cap);
 
 /* Our own status codes (control flow). 0 is success; errors are negative. */
 enum dxl_status {

@@ -346,9 +346,9 @@ const char *dxl2_opmode_name(uint8_t mode)
 	}
 }
 
-static const char *dxl2_hwerr_name(unsigned bit)
+static const char *dxl2_hwerr_name(uint8_t bit)
 {
-	switch (1u << bit) {
+	switch (bit) {
 	case DXL2_HWERR_VOLTAGE:  return "input voltage";
 	case DXL2_HWERR_OVERHEAT: return "overheating";
 	case DXL2_HWERR_ENCODER:  return "motor encoder";
@@ -360,25 +360,7 @@ static const char *dxl2_hwerr_name(unsigned bit)
 
 char *dxl2_hwerr_format(uint8_t bits, char *buf, size_t cap)
 {
-	if (buf == NULL || cap == 0)
-		return buf;
-	buf[0] = '\0';
-	if (bits == 0) {
-		snprintf(buf, cap, "none");
-		return buf;
-	}
-	size_t off = 0;
-	for (unsigned i = 0; i < 8; i++) {
-		if (!(bits & (1u << i)))
-			continue;
-		const char *name = dxl2_hwerr_name(i);
-		int w = name ? snprintf(buf + off, cap - off, "%s%s", off ? "|" : "", name)
-		             : snprintf(buf + off, cap - off, "%sbit%u", off ? "|" : "", i);
-		if (w < 0 || (size_t)w >= cap - off)
-			break;
-		off += (size_t)w;
-	}
-	return buf;
+	return dxl_bits_format(bits, dxl2_hwerr_name, buf, cap);
 }
 
 static bool name_eq(const char *a, const char *b)
@@ -405,6 +387,14 @@ const struct dxl2_model *dxl2_model_find(int protocol, uint16_t number)
 {
 	const struct dxl2_model *m = dxl2_model_by_number(number);
 	return m != NULL && m->protocol == protocol ? m : NULL;
+}
+
+const struct dxl2_model *dxl2_model_first(int protocol)
+{
+	for (size_t i = 0; i < dxl2_model_count(); i++)
+		if (dxl2_model_at(i)->protocol == protocol)
+			return dxl2_model_at(i);
+	return NULL;
 }
 
 bool dxl2_model_can(const struct dxl2_model *m, enum dxl2_cap cap)

@@ -237,6 +237,9 @@ bool dxl2_model_can(const struct dxl2_model *m, enum dxl2_cap cap);
 const struct dxl2_model *dxl2_model_by_number(uint16_t number);
 const struct dxl2_model *dxl2_model_find(int protocol, uint16_t number);
 const struct dxl2_model *dxl2_model_by_name(const char *name);
+/* The protocol's first model in the list: the addresses every model of it
+ * shares (what a tool reads before it knows the model); NULL for none. */
+const struct dxl2_model *dxl2_model_first(int protocol);
 /* The no-load speed of a datasheet in rad/s. */
 double dxl2_sheet_no_load_rad_s(const struct dxl2_datasheet *s);
 /* A register by name ('-' = '_', case-insensitive), a short alias

@@ -309,3 +309,13 @@ const struct dxl_proto *dxl_proto_by_number(int number)
 	default: return NULL;
 	}
 }
+
+void dxl_frame_to_packet2(const struct dxl_frame *f, struct dxl2_packet *out)
+{
+	out->id = f->id;
+	out->instr = f->instr;
+	out->err = f->err;
+	out->nparams = f->nparams;
+	out->wire_bytes = f->wire_bytes;
+	memcpy(out->params, f->params, f->nparams);
+}

@@ -154,6 +154,10 @@ struct dxl_proto {
 	char *(*err_format)(uint8_t err, char *buf, size_t cap);
 };
 
+/* A frame as 2.0's own packet (what dxl2_* calls take): its fields and its
+ * nparams parameters copied, the rest of out's kilobyte left alone. */
+void dxl_frame_to_packet2(const struct dxl_frame *f, struct dxl2_packet *out);
+
 extern const struct dxl_proto dxl_proto_v1;
 extern const struct dxl_proto dxl_proto_v2;
 

@@ -274,12 +274,7 @@ static bool x_error_fits(const struct sim_fault *f, const char **why)
 static int x_handle(struct sim_joint *j, const struct dxl_frame *req, uint8_t *out, size_t cap)
 {
 	struct dxl2_packet pkt;   /* fields assigned, not the whole kilobyte zeroed */
-	pkt.id = req->id;
-	pkt.instr = req->instr;
-	pkt.err = req->err;
-	pkt.nparams = req->nparams;
-	pkt.wire_bytes = req->wire_bytes;
-	memcpy(pkt.params, req->params, req->nparams);
+	dxl_frame_to_packet2(req, &pkt);
 	return sim_xservo_handle(&j->xservo, &pkt, out, cap);
 }
 

@@ -231,6 +231,67 @@ restarted_at_least() {
 }
 wait_restarted() { wait_for 10 restarted_at_least "$1"; }
 
+# rig_up LCM_PORT SEED: the daemon and simulator binaries ($D, $S; the test
+# skipped when either is not built), a robot name of its own ($R: a
+# concurrent run on the same multicast port from another build directory
+# cannot answer for it), $URL, the simulator (servos 1 and 2 on $T/bus,
+# robot r1, its control socket $T/ctl) ready, and a watcher of $R
+# ($T/watch.log). Ends the test when the simulator does not start.
+rig_up() {
+	D="$B/undulated"; S="$B/undulate-sim"
+	[ -x "$S" ] && [ -x "$D" ] || tap_skip_all "undulate-sim or undulated not built"
+	R="u$$"
+	URL=$(lcm_url "$1")
+	spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed "$2"
+	wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
+	spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
+}
+
+# start_retried: the script's start_daemon, and once more as a unit's
+# Restart=on-failure would when that start-up failed (exit 1, e.g. a servo
+# read timing out on a loaded machine) before the script's `ready`; the
+# failed run's errors are shown (daemon_errors: its log's error lines unless
+# the script says otherwise). The daemon is spawned as "daemon".
+daemon_errors() { grep -a error "$T/daemon.log"; }
+_ready_or_exit() { ready || ! alive daemon; }
+start_retried() {
+	start_daemon
+	wait_for 15 _ready_or_exit
+	if ! ready && ! alive daemon; then
+		stop daemon >"$T/daemon.rc"
+		echo "# daemon start-up failed (exit $(cat "$T/daemon.rc")), restarted as Restart=on-failure would:"
+		daemon_errors | sed 's/^/#   /'
+		start_daemon
+	fi
+}
+
+# torque_race N: HOLD then LIMP to robot $R, the second command leaving 0-4 ms
+# after the first (process start-up jitter), N times; after each, whichever
+# was applied last, the robot's mode and its servos' torque (the script's
+# `torque`: "0 0" or "1 1") must agree once the writes are out. One TAP line.
+# (A torque-off merged into a write already sent was once dropped.)
+torque_race() {
+	local n=$1 lost=0 wrong=0 i h s t
+	for i in $(seq "$n"); do
+		"$B/undulated" --command 'mode hold' --robot "$R" --lcm-url "$URL" --timeout 0.5 >/dev/null 2>&1 &
+		h=$!
+		sleep "0.00$((i % 5))"
+		"$B/undulated" --command 'mode limp' --robot "$R" --lcm-url "$URL" --timeout 0.5 >/dev/null 2>&1
+		wait "$h"
+		wait_cycles 12
+		s=$(last_state); t=$(torque)
+		case "$(echo "$s" | field mode):$t" in
+			0:"0 0") ;;
+			1:"1 1") wrong=$((wrong + 1)) ;;   # HOLD applied after LIMP: consistent, but not the order sent
+			*) lost=$((lost + 1)); echo "# trial $i: robot mode $(echo "$s" | field mode), servos torque '$t'" ;;
+		esac
+		cmd 'mode limp' >/dev/null; wait_cycles 5
+	done
+	if [ "$lost" = 0 ]; then
+		tap_ok "HOLD then LIMP 0-4 ms apart, $n times: robot and servos agree every time ($wrong applied in the other order)"
+	else tap_fail "torque-off race" "$lost of $n trials: the robot's mode and the servos' torque disagree"; fi
+}
+
 # start_pair: the simulated pair (sim-bridge/scenarios/pair.scenario, links
 # $T/left and $T/right) on $URL with a daemon each on the oscillator and
 # a watcher of left ($T/watch.log); ends the test when they do not start.

@@ -32,6 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz_records.h"
 #include "../../daemon/cmdin.h"
 #include "../../daemon/control.h"
 #include "auth.h"
@@ -167,26 +168,23 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	setup();
 	size_t off = 0;
 	long long accepted_net_unsigned = 0;
-	while (off + 3 <= size) {
-		uint8_t door = data[off];
-		size_t n = (size_t)data[off + 1] << 8 | data[off + 2];
-		off += 3;
-		if (n > size - off)
-			n = size - off;
+	uint8_t door;
+	const uint8_t *rec;
+	size_t n;
+	while (fuzz_next_record(data, size, &off, &door, &rec, &n)) {
 		long long acc = in.accepted;
 		size_t q = in.nq;
 		if (door & 1) {
-			network(data + off, n, (door & 2) != 0);
+			network(rec, n, (door & 2) != 0);
 			/* a network command queued unsigned would be a hole */
 			if (in.nq > q && !(door & 2))
 				accepted_net_unsigned++;
 		} else {
 			struct csock_peer peer = { 0 };
-			cin_local_datagram(&in, data + off, n, false, &peer);
+			cin_local_datagram(&in, rec, n, false, &peer);
 		}
 		(void)acc;
 		CHECK(in.nq <= CIN_QUEUE);
-		off += n;
 		if (door & 4)
 			step();
 		check_limits_unchanged();

@@ -30,12 +30,7 @@ static void v2_tracker_begin(void)
 static void v2_tracker_frame(const struct dxl_frame *f)
 {
 	static struct dxl2_packet pkt;
-	pkt.id = f->id;
-	pkt.instr = f->instr;
-	pkt.err = f->err;
-	pkt.nparams = f->nparams;
-	pkt.wire_bytes = f->wire_bytes;
-	memcpy(pkt.params, f->params, f->nparams);
+	dxl_frame_to_packet2(f, &pkt);
 	size_t slot = 99;
 	int a = dxl2_multi_read_accept(&tracker, &pkt, &slot);
 	CHECK(a == DXL_OK || a == DXL_E_WRONG_ID || a == DXL_E_WRONG_LENGTH);

@@ -220,19 +220,22 @@ struct model_counts {
 	uint64_t frames, checksum_errors, header_errors;
 };
 
-/* The bytes the model consumed, the last DXL_MAX_PACKET of them: where a
+/* The bytes a model consumed, the last packet's worth (cap) of them: where a
  * packet with a bad checksum ended, to find whom it was for. */
-static uint8_t mhist[DXL_MAX_PACKET];
-static size_t mhist_n;
+struct byte_hist {
+	uint8_t b[DXL2_MAX_PACKET];
+	size_t n, cap;
+};
+static struct byte_hist hist1 = { .cap = DXL_MAX_PACKET }, hist2 = { .cap = DXL2_MAX_PACKET };
 
-static void mhist_push(const uint8_t *d, size_t n)
+static void hist_push(struct byte_hist *h, const uint8_t *d, size_t n)
 {
 	for (size_t i = 0; i < n; i++) {
-		if (mhist_n == sizeof(mhist)) {
-			memmove(mhist, mhist + 1, sizeof(mhist) - 1);
-			mhist_n--;
+		if (h->n == h->cap) {
+			memmove(h->b, h->b + 1, h->cap - 1);
+			h->n--;
 		}
-		mhist[mhist_n++] = d[i];
+		h->b[h->n++] = d[i];
 	}
 }
 
@@ -242,6 +245,8 @@ static void mhist_push(const uint8_t *d, size_t n)
  * allows, and cuts its torque if bit 4 is in its Alarm Shutdown. */
 static void model_bad_checksum(void)
 {
+	const uint8_t *mhist = hist1.b;
+	size_t mhist_n = hist1.n;
 	for (size_t p = mhist_n >= 6 ? mhist_n - 5 : 0; p-- > 0;) {
 		if (mhist[p] != 0xFF || mhist[p + 1] != 0xFF || p + 4 >= mhist_n ||
 		    (size_t)mhist[p + 3] + 4 != mhist_n - p)
@@ -274,7 +279,7 @@ static void model_feed(struct dxl_parser *p, const uint8_t *d, size_t n, struct 
 		struct dxl_packet pkt;
 		int r = dxl_parser_feed(p, d + off, n - off, &used, &pkt);
 		CHECK(used <= n - off);
-		mhist_push(d + off, used);
+		hist_push(&hist1, d + off, used);
 		off += used;
 		if (r == DXL_FRAME) {
 			mc->frames++;
@@ -391,24 +396,12 @@ static void model_handle2(int k, const struct dxl2_packet *req)
 		CHECK(memcmp(before.mem, s->mem, DXL2_X_EEPROM_END) == 0);
 }
 
-static uint8_t mhist2[DXL2_MAX_PACKET];
-static size_t mhist2_n;
-
-static void mhist2_push(const uint8_t *d, size_t n)
-{
-	for (size_t i = 0; i < n; i++) {
-		if (mhist2_n == sizeof(mhist2)) {
-			memmove(mhist2, mhist2 + 1, sizeof(mhist2) - 1);
-			mhist2_n--;
-		}
-		mhist2[mhist2_n++] = d[i];
-	}
-}
-
 /* A packet with a bad CRC just ended: its header and LEN span the bytes up
  * to here; its servo answers with the CRC error where it would answer. */
 static void model_bad_crc2(void)
 {
+	const uint8_t *mhist2 = hist2.b;
+	size_t mhist2_n = hist2.n;
 	for (size_t p = mhist2_n >= 10 ? mhist2_n - 9 : 0; p-- > 0;) {
 		const uint8_t *h = &mhist2[p];
 		if (h[0] != 0xFF || h[1] != 0xFF || h[2] != 0xFD || h[3] != 0 ||
@@ -445,7 +438,7 @@ static void model_feed2(struct dxl2_parser *p, const uint8_t *d, size_t n, struc
 		static struct dxl2_packet pkt;
 		int r = dxl2_parser_feed(p, d + off, n - off, &used, &pkt);
 		CHECK(used <= n - off);
-		mhist2_push(d + off, used);
+		hist_push(&hist2, d + off, used);
 		off += used;
 		if (r == DXL_FRAME) {
 			mc->frames++;
@@ -524,16 +517,27 @@ static void setup(uint8_t flags, const uint8_t *fault)
 }
 
 /* The stream on a 2.0 bus, the model beside it (as the 1.0 loop below). */
-static int run_x(const uint8_t *data, size_t size)
+/* One protocol's side of a run: its model's parser (pending bytes, dropped
+ * after a long gap as the bus does), one byte into the model, and the bus
+ * held against the model before and after each chunk. */
+struct run_side {
+	size_t (*have)(void);
+	void (*reset)(void);
+	void (*feed)(const uint8_t *byte);
+	void (*before)(void);
+	void (*after)(unsigned chunk);
+};
+
+/* The input after its header, in chunks of 1..16 bytes at times that are
+ * mostly back to back, sometimes a pause, now and then a long one; each
+ * chunk into the bus and, byte by byte, into the model. */
+static int run(const uint8_t *data, size_t size, const struct run_side *side)
 {
-	static struct dxl2_parser mp;
-	dxl2_parser_init(&mp, DXL2_PARSE_INSTRUCTION);
-	mhist2_n = 0;
-	struct model_counts2 mc = { 0, 0, 0, 0 };
 	uint32_t seed = (uint32_t)data[0] << 24 | (uint32_t)data[1] << 16 | (uint32_t)data[2] << 8 | data[3];
 	int64_t now = MS, last_rx = 0;
 	uint8_t drained[SIM_LINE_CAP];
 	size_t off = HEADER;
+	unsigned chunks = 0;
 	while (off < size) {
 		uint32_t r = next_rand(&seed);
 		size_t n = 1 + r % 16;
@@ -541,34 +545,94 @@ static int run_x(const uint8_t *data, size_t size)
 			n = size - off;
 		r = next_rand(&seed);
 		now += (r & 7) == 0 ? 150 * MS : (r & 7) == 1 ? 2 * MS : 20000;
-		if (mp.have > 0 && now - last_rx > GAP_NS)
-			dxl2_parser_reset(&mp);
+		if (side->have() > 0 && now - last_rx > GAP_NS)
+			side->reset();
 		last_rx = now;
+		side->before();
 		sim_bus_feed(&bus, data + off, n, now);
 		for (size_t i = 0; i < n; i++)
-			model_feed2(&mp, data + off + i, 1, &mc);
+			side->feed(data + off + i);
 		off += n;
-		CHECK(bus.count.packets == mc.frames);
-		CHECK(bus.count.checksum_errors == mc.crc_errors);
-		CHECK(bus.count.header_errors == mc.header_errors);
-		CHECK(bus.count.stuffing_errors == mc.stuffing_errors);
-		CHECK(bus.parser.v2.have == mp.have);
-		for (int k = 0; k < NSERVOS; k++) {
-			const struct sim_xservo *s = &bus.joints[k].xservo;
-			CHECK(memcmp(s->mem, xmodel[k].mem, DXL2_X_TABLE_SIZE) == 0);
-			CHECK(s->reg_pending == xmodel[k].reg_pending);
-		}
+		side->after(++chunks);
 		CHECK(bus.line.n <= SIM_LINE_CAP && bus.line.head + bus.line.n <= SIM_LINE_CAP);
-		check_line(&bus.line);
+		/* what is due goes to the controller */
 		sim_line_take(&bus.line, now, drained, sizeof(drained));
 	}
+	check_line(&bus.line);
 	CHECK(bus.count.rx_bytes == size - HEADER);
 	return 0;
 }
 
+/* ---- Protocol 1.0's side ---- */
+static struct dxl_parser mp1;
+static struct model_counts mc1;
+static uint8_t mem_before[NSERVOS][DXL_AX_TABLE_SIZE];
+static uint32_t shutdowns_before[NSERVOS];
+static uint64_t packets_before;
+
+static size_t v1_have(void) { return mp1.have; }
+static void v1_reset(void) { dxl_parser_reset(&mp1); }
+static void v1_feed(const uint8_t *b) { model_feed(&mp1, b, 1, &mc1); }
+static void v1_before(void)
+{
+	for (int k = 0; k < NSERVOS; k++) {
+		memcpy(mem_before[k], bus.joints[k].servo.mem, DXL_AX_TABLE_SIZE);
+		shutdowns_before[k] = bus.joints[k].servo.count.shutdowns;
+	}
+	packets_before = bus.count.packets;
+}
+
+/* the bus saw what the model saw, and its servos agree */
+static void v1_after(unsigned chunk)
+{
+	CHECK(bus.count.packets == mc1.frames);
+	CHECK(bus.count.checksum_errors == mc1.checksum_errors);
+	CHECK(bus.count.header_errors == mc1.header_errors);
+	CHECK(bus.parser.v1.have == mp1.have);
+	for (int k = 0; k < NSERVOS; k++) {
+		const struct sim_servo *s = &bus.joints[k].servo;
+		CHECK(memcmp(s->mem, model[k].mem, DXL_AX_TABLE_SIZE) == 0);
+		CHECK(s->reg_pending == model[k].reg_pending);
+		if (bus.count.packets == packets_before)
+			check_only_shutdown(mem_before[k], s->mem, s->count.shutdowns != shutdowns_before[k]);
+	}
+	/* the whole queue now and then (it holds up to 4096 bytes: every read
+	 * would make long inputs slow), its bounds always (run) */
+	if ((chunk & 7) == 0)
+		check_line(&bus.line);
+}
+
+static const struct run_side side_v1 = { v1_have, v1_reset, v1_feed, v1_before, v1_after };
+
+/* ---- Protocol 2.0's side ---- */
+static struct dxl2_parser mp2;
+static struct model_counts2 mc2;
+
+static size_t v2_have(void) { return mp2.have; }
+static void v2_reset(void) { dxl2_parser_reset(&mp2); }
+static void v2_feed(const uint8_t *b) { model_feed2(&mp2, b, 1, &mc2); }
+static void v2_before(void) {}
+
+static void v2_after(unsigned chunk)
+{
+	(void)chunk;
+	CHECK(bus.count.packets == mc2.frames);
+	CHECK(bus.count.checksum_errors == mc2.crc_errors);
+	CHECK(bus.count.header_errors == mc2.header_errors);
+	CHECK(bus.count.stuffing_errors == mc2.stuffing_errors);
+	CHECK(bus.parser.v2.have == mp2.have);
+	for (int k = 0; k < NSERVOS; k++) {
+		const struct sim_xservo *s = &bus.joints[k].xservo;
+		CHECK(memcmp(s->mem, xmodel[k].mem, DXL2_X_TABLE_SIZE) == 0);
+		CHECK(s->reg_pending == xmodel[k].reg_pending);
+	}
+	check_line(&bus.line);
+}
+
+static const struct run_side side_v2 = { v2_have, v2_reset, v2_feed, v2_before, v2_after };
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-	static struct dxl_parser mp;
 	static bool once;
 	if (!once) {
 		find_reserved();
@@ -577,60 +641,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (size < HEADER)
 		return 0;
 	setup(data[0], data + 1);
-	if (data[0] & 16)
-		return run_x(data, size);
-	dxl_parser_init(&mp, DXL_PARSE_INSTRUCTION);
-	mhist_n = 0;
-	struct model_counts mc = { 0, 0, 0 };
-	uint32_t seed = (uint32_t)data[0] << 24 | (uint32_t)data[1] << 16 | (uint32_t)data[2] << 8 | data[3];
-	int64_t now = MS, last_rx = 0;
-	uint8_t drained[SIM_LINE_CAP];
-	size_t off = HEADER;
-	unsigned reads = 0;
-	while (off < size) {
-		uint32_t r = next_rand(&seed);
-		size_t n = 1 + r % 16;
-		if (n > size - off)
-			n = size - off;
-		/* mostly back to back, sometimes a pause, now and then a long one */
-		r = next_rand(&seed);
-		now += (r & 7) == 0 ? 150 * MS : (r & 7) == 1 ? 2 * MS : 20000;
-		/* the model drops a half-read packet after a long gap, as the bus does */
-		if (mp.have > 0 && now - last_rx > GAP_NS)
-			dxl_parser_reset(&mp);
-		last_rx = now;
-		uint8_t mem_before[NSERVOS][DXL_AX_TABLE_SIZE];
-		uint32_t shutdowns_before[NSERVOS];
-		for (int k = 0; k < NSERVOS; k++) {
-			memcpy(mem_before[k], bus.joints[k].servo.mem, DXL_AX_TABLE_SIZE);
-			shutdowns_before[k] = bus.joints[k].servo.count.shutdowns;
-		}
-		uint64_t packets = bus.count.packets;
-		sim_bus_feed(&bus, data + off, n, now);
-		for (size_t i = 0; i < n; i++)
-			model_feed(&mp, data + off + i, 1, &mc);
-		off += n;
-		/* the bus saw what the model saw, and its servos agree */
-		CHECK(bus.count.packets == mc.frames);
-		CHECK(bus.count.checksum_errors == mc.checksum_errors);
-		CHECK(bus.count.header_errors == mc.header_errors);
-		CHECK(bus.parser.v1.have == mp.have);
-		for (int k = 0; k < NSERVOS; k++) {
-			const struct sim_servo *s = &bus.joints[k].servo;
-			CHECK(memcmp(s->mem, model[k].mem, DXL_AX_TABLE_SIZE) == 0);
-			CHECK(s->reg_pending == model[k].reg_pending);
-			if (bus.count.packets == packets)
-				check_only_shutdown(mem_before[k], s->mem, s->count.shutdowns != shutdowns_before[k]);
-		}
-		/* the whole queue now and then (it holds up to 4096 bytes: every
-		 * read would make long inputs slow), its bounds always */
-		CHECK(bus.line.n <= SIM_LINE_CAP && bus.line.head + bus.line.n <= SIM_LINE_CAP);
-		if ((++reads & 7) == 0)
-			check_line(&bus.line);
-		/* what is due goes to the controller */
-		sim_line_take(&bus.line, now, drained, sizeof(drained));
+	if (data[0] & 16) {
+		dxl2_parser_init(&mp2, DXL2_PARSE_INSTRUCTION);
+		hist2.n = 0;
+		mc2 = (struct model_counts2){ 0, 0, 0, 0 };
+		return run(data, size, &side_v2);
 	}
-	check_line(&bus.line);
-	CHECK(bus.count.rx_bytes == size - HEADER);
-	return 0;
+	dxl_parser_init(&mp1, DXL_PARSE_INSTRUCTION);
+	hist1.n = 0;
+	mc1 = (struct model_counts){ 0, 0, 0 };
+	return run(data, size, &side_v1);
 }

@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz_records.h"
 #include "tools/top/feed.h"
 #include "tools/web/frame.h"
 #include "tools/web/hist.h"
@@ -66,19 +67,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	const struct top_feed_hooks hooks = { .on_truth = fuzz_on_truth, .user = web ? &hist : NULL };
 	int64_t records = 0, taken = 0;
 	size_t pos = 1;
-	while (pos + 3 <= size) {
-		uint8_t sel = data[pos];
-		size_t len = (size_t)data[pos + 1] << 8 | data[pos + 2];
-		pos += 3;
-		if (len > size - pos)
-			len = size - pos;
+	uint8_t sel;
+	const uint8_t *rec;
+	size_t len;
+	while (fuzz_next_record(data, size, &pos, &sel, &rec, &len)) {
 		char why[160];
 		records++;
-		if (top_feed(&model, channels[sel >> 7][(sel & 0x7f) % 6], data + pos, len, now, &hooks, why, sizeof why))
+		if (top_feed(&model, channels[sel >> 7][(sel & 0x7f) % 6], rec, len, now, &hooks, why, sizeof why))
 			taken++;
 		else
 			CHECK(why[0] != '\0');
-		pos += len;
 		now += 0.01;
 		for (int i = 0; i < model.world.ncontacts; i++) {
 			const struct top_contact *c = &model.world.contacts[i];

@@ -4,18 +4,7 @@
 # a fault that persists puts the robot in its configured fault state (LIMP
 # here: torque off on the simulated servos) and says so.
 . "$(dirname "$0")/../lib.sh"
-D="$B/undulated"; S="$B/undulate-sim"
-if [ ! -x "$S" ] || [ ! -x "$D" ]; then
-	tap_skip_all "undulate-sim or undulated not built"
-fi
-# a robot name of its own: a concurrent run of this test on the same
-# multicast port (another build directory) cannot answer for it
-R="u$$"
-URL=$(lcm_url 7701)
-
-spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 5
-wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
+rig_up 7701 5
 # a moving speed left behind by another program: reset at start-up, with a warning
 ctl poke r1 1 moving_speed 100 >/dev/null
 # servo 2's first three replies 20 ms late (a busy machine, a slow adapter):

@@ -3,19 +3,7 @@
 # commands (accepted and rejected, with events), and SIGTERM leaving HOLD
 # (torque on, goal = present position, read from the simulated servo).
 . "$(dirname "$0")/../lib.sh"
-D="$B/undulated"; S="$B/undulate-sim"
-if [ ! -x "$S" ] || [ ! -x "$D" ]; then
-	tap_skip_all "undulate-sim or undulated not built"
-fi
-# a robot name of its own: a concurrent run of this test on the same
-# multicast port (another build directory) cannot answer for it
-R="u$$"
-URL=$(lcm_url 7700)
-# value of key=... in a watch line
-
-spawn sim "$S" --link "$T/bus" --ids 1,2 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 3
-wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
-spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
+rig_up 7700 3
 # max_step 0.5 rad: the clamp must not be what makes the switches smooth
 spawn d "$D" --port "$T/bus" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode oscillator \
 	--set joint.1.max_step=0.5 --set joint.2.max_step=0.5

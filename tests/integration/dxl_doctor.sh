@@ -140,7 +140,7 @@ if sim_up missing 7764 --return-delay 0; then
 	robot_conf missing 1,2,3
 	doctor missing --config "$T/missing.conf" --cycles 0
 	[ "$rc" -eq 7 ] && line missing FAIL 'ID 3' 'no reply' && line missing FAIL 'ID 3' 'scan --bauds all' \
-		&& line missing OK 'ID 1 model' '12 \(AX-12\)' && line missing OK 'ID 2 model' '12 \(AX-12\)' \
+		&& line missing OK 'ID 1 model' '12 \(AX-12A\)' && line missing OK 'ID 2 model' '12 \(AX-12A\)' \
 		&& tap_ok "missing ID 3: FAIL naming it and the scan, the others checked, exit 7" \
 		|| tap_fail "missing ID 3: FAIL naming it and the scan, the others checked, exit 7" "$(show missing)"
 	stop missing >/dev/null
@@ -173,7 +173,7 @@ fi
 if sim_up echo 7766 --return-delay 0 --echo; then
 	doctor echo --port "$T/echo.bus" --cycles 0 1 2
 	[ "$rc" -eq 1 ] && line echo WARN echo 'our own request came back' && line echo WARN echo 'fix: echo = true' \
-		&& line echo OK 'ID 2 model' '12 \(AX-12\)' \
+		&& line echo OK 'ID 2 model' '12 \(AX-12A\)' \
 		&& tap_ok "an echoing wiring without echo: WARN with the fix, exit 1" \
 		|| tap_fail "an echoing wiring without echo: WARN with the fix, exit 1" "$(show echo)"
 	doctor echoon --port "$T/echo.bus" --echo --cycles 0 1 2

@@ -90,6 +90,17 @@ check "doctor on 2.0: the servos' lines, and 300 of undulated's own 2.0 cycles t
 	-a -n "$(grep -E '^OK +ID 2 return delay +0 us' "$T/doctor.out")" \
 	-a -n "$(grep -E '^(OK|WARN) +budget +bus time per cycle p50 .* 300 cycles of undulated.s own loop on 2 joint\(s\), holding' "$T/doctor.out")"
 
+# Torque is put back as the doctor found it, on 2.0 as on 1.0: ID 1 found on
+# stays on (the X doctor once kept the found torque in a record of its own
+# and made every joint limp after the timed cycles), ID 2 found off is off.
+run ton --port "$xl" --baud 1000000 torque 1 on
+run tdoc --port "$xl" --baud 1000000 doctor 1 2 --cycles 20
+run tq1 --port "$xl" --baud 1000000 read 1 torque_enable
+run tq2 --port "$xl" --baud 1000000 read 2 torque_enable
+check "doctor on 2.0 puts torque back as found: ID 1 on, ID 2 off" tdoc \
+	test -n "$(grep -E '^OK +ID 1 torque +on' "$T/tdoc.out")" -a "$(cat "$T/tq1.out")" = 1 -a "$(cat "$T/tq2.out")" = 0
+run toff --port "$xl" --baud 1000000 torque 1 off
+
 # undulated sets the joints' limits up, the doctor expects what it wrote: one
 # rule (whole units inside the limits) for both; at +-0.5 rad the doctor once
 # rounded to the nearest unit and warned about the servos undulated had just

@@ -29,27 +29,7 @@ wait_log d "ready: $R.STATE" 10 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
 
 # ---- the torque-off race ------------------------------------------------------------------------
-lost=0; wrong=0
-for i in $(seq 40); do
-	"$D" --command 'mode hold' --robot "$R" --lcm-url "$URL" --timeout 0.5 >/dev/null 2>&1 &
-	h=$!
-	# the second command leaves 0-4 ms after the first (process start-up jitter)
-	sleep "0.00$((i % 5))"
-	"$D" --command 'mode limp' --robot "$R" --lcm-url "$URL" --timeout 0.5 >/dev/null 2>&1
-	wait "$h"
-	# whichever was applied last, robot and servos must agree once the writes are out
-	wait_cycles 12
-	s=$(last_state); t=$(torque)
-	case "$(echo "$s" | field mode):$t" in
-		0:"0 0") ;;
-		1:"1 1") wrong=$((wrong + 1)) ;;   # HOLD applied after LIMP: consistent, but not the order sent
-		0:*) lost=$((lost + 1)); echo "# trial $i: robot LIMP, servos torque '$t'" ;;
-		*) lost=$((lost + 1)); echo "# trial $i: robot mode $(echo "$s" | field mode), servos torque '$t'" ;;
-	esac
-	cmd 'mode limp' >/dev/null; wait_cycles 5
-done
-if [ "$lost" = 0 ]; then tap_ok "HOLD then LIMP 0-4 ms apart, 40 times: robot and servos agree every time ($wrong applied in the other order)"
-else tap_fail "torque-off race" "$lost of 40 trials: the robot's mode and the servos' torque disagree"; fi
+torque_race 40
 s=$(last_state); t=$(torque)
 if [ "$t" = "0 0" ] && [ "$(echo "$s" | field tq0)$(echo "$s" | field tr0)$(echo "$s" | field tr1)" = "000" ]; then
 	tap_ok "LIMP: torque off on the servos, reported and read back"; else tap_fail "LIMP read back" "servos '$t'; $(echo "$s" | cut -c1-200)"; fi

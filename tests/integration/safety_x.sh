@@ -44,24 +44,7 @@ wait_log d "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts on the X bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
 
 # ---- the torque-off race ------------------------------------------------------------------------
-lost=0; wrong=0
-for i in $(seq 20); do
-	"$D" --command 'mode hold' --robot "$R" --lcm-url "$URL" --timeout 0.5 >/dev/null 2>&1 &
-	h=$!
-	sleep "0.00$((i % 5))"
-	"$D" --command 'mode limp' --robot "$R" --lcm-url "$URL" --timeout 0.5 >/dev/null 2>&1
-	wait "$h"
-	wait_cycles 12
-	s=$(last_state); t=$(torque)
-	case "$(echo "$s" | field mode):$t" in
-		0:"0 0") ;;
-		1:"1 1") wrong=$((wrong + 1)) ;;
-		*) lost=$((lost + 1)); echo "# trial $i: robot mode $(echo "$s" | field mode), servos torque '$t'" ;;
-	esac
-	cmd 'mode limp' >/dev/null; wait_cycles 5
-done
-if [ "$lost" = 0 ]; then tap_ok "HOLD then LIMP 0-4 ms apart, 20 times: robot and servos agree every time ($wrong applied in the other order)"
-else tap_fail "torque-off race" "$lost of 20 trials: the robot's mode and the servos' torque disagree"; fi
+torque_race 20
 
 # ---- limits: the configuration's, on the servo too; none from the network -------------------------
 out=$(cmd 'param limit_max 2.5 0' 2>&1)

@@ -120,19 +120,23 @@ start_rig() {
 	wait_log d_left 'ready:' 10 && wait_log d_right 'ready:' 10
 }
 exited() { ! alive "$1"; }
+# sim_ends_run SECONDS PATTERN NAME: within SECONDS the simulator ends the
+# run, exits 1 and its log says PATTERN (grep -q). One TAP line, NAME.
+sim_ends_run() {
+	local rc
+	if ! wait_for "$1" exited sim; then
+		tap_fail "$3" "still running after $1 s: $(tail -n 3 "$T/sim.log")"
+		return
+	fi
+	rc=$(stop sim)
+	if [ "$rc" = 1 ] && grep -q "$2" "$T/sim.log"; then tap_ok "$3"
+	else tap_fail "$3" "exit $rc: $(tail -n 4 "$T/sim.log")"; fi
+}
 
 start_rig || tap_fail "rig started in lockstep" "$(tail -n 5 "$T/sim.log" "$T/d_left.log")"
 kill -KILL "$pid_d_left"
-if wait_for 15 exited sim; then
-	rc=$(stop sim)
-	if [ "$rc" = 1 ] && grep -q "robot left's daemon (pid $pid_d_left) left the run at t=" "$T/sim.log"; then
-		tap_ok "a daemon killed: the simulator ends the run, naming it (exit 1)"
-	else
-		tap_fail "a daemon killed: the simulator ends the run, naming it (exit 1)" "exit $rc: $(tail -n 4 "$T/sim.log")"
-	fi
-else
-	tap_fail "a daemon killed: the simulator ends the run" "still running after 15 s: $(tail -n 3 "$T/sim.log")"
-fi
+sim_ends_run 15 "robot left's daemon (pid $pid_d_left) left the run at t=" \
+	"a daemon killed: the simulator ends the run, naming it (exit 1)"
 if wait_for 15 exited d_right && [ "$(stop d_right)" = 0 ] && grep -q 'ended the run' "$T/d_right.log"; then
 	tap_ok "... and the other daemon is told, makes its safe stop and exits 0"
 else
@@ -142,16 +146,8 @@ stop d_left >/dev/null
 
 start_rig || tap_fail "rig started in lockstep (2)" "$(tail -n 5 "$T/sim.log")"
 kill -STOP "$pid_d_left"
-if wait_for 20 exited sim; then
-	rc=$(stop sim)
-	if [ "$rc" = 1 ] && grep -q "robot left's daemon (pid $pid_d_left) has not waited for 2 s" "$T/sim.log"; then
-		tap_ok "a daemon stopped (SIGSTOP): the simulator calls it stalled after its grace and ends the run (exit 1)"
-	else
-		tap_fail "a daemon stopped: the simulator calls it stalled" "exit $rc: $(tail -n 4 "$T/sim.log")"
-	fi
-else
-	tap_fail "a daemon stopped: the simulator calls it stalled" "still running after 20 s: $(tail -n 3 "$T/sim.log")"
-fi
+sim_ends_run 20 "robot left's daemon (pid $pid_d_left) has not waited for 2 s" \
+	"a daemon stopped (SIGSTOP): the simulator calls it stalled after its grace and ends the run (exit 1)"
 kill -CONT "$pid_d_left"
 if wait_for 15 exited d_left && [ "$(stop d_left)" = 1 ] && grep -qE 'lockstep: the simulator (closed the clock|is gone)' "$T/d_left.log"; then
 	tap_ok "... and when it runs again it finds the simulator gone, says so, exits 1"

@@ -89,16 +89,7 @@ wait_for 10 grep -q listening "$T/notify.msgs"
 read -r -a d_cmd <<<"$(exec_of undulated@.service r1)"
 start_daemon() { spawn daemon env NOTIFY_SOCKET="$T/notify.sock" WATCHDOG_USEC=2000000 "${d_cmd[@]}"; }
 ready() { grep -q '^READY=1$' "$T/notify.msgs"; }
-ready_or_exit() { ready || ! alive daemon; }
-# As Restart=on-failure would: a failed start-up (exit 1) is retried once.
-start_daemon
-wait_for 15 ready_or_exit
-if ! ready && ! alive daemon; then
-	stop daemon >"$T/daemon.rc"
-	echo "# daemon start-up failed (exit $(cat "$T/daemon.rc")), restarted as Restart=on-failure would:"
-	grep error "$T/daemon.log" | sed 's/^/#   /'
-	start_daemon
-fi
+start_retried
 if wait_for 15 ready &&
 	wait_for 5 grep -qE '^STATUS=.* 2 joints, bus ok' "$T/notify.msgs"; then
 	tap_ok "undulated@r1's command line (--config /etc/undulate/r1.conf) reaches READY=1, bus ok"

@@ -87,18 +87,8 @@ start_daemon() {
 }
 daemon_log() { cat "$T/relay.log" "$T/daemon.log" 2>/dev/null | grep -v '^####'; }
 ready() { grep -q ' READY=1$' "$T/notify.msgs"; }
-ready_or_exit() { ready || ! alive daemon; }
-
-# As the unit's Restart=on-failure would: a start-up that fails (exit 1, e.g.
-# a servo read timing out on a loaded machine) is retried once.
-start_daemon
-wait_for 15 ready_or_exit
-if ! ready && ! alive daemon; then
-	stop daemon >"$T/daemon.rc"
-	echo "# daemon start-up failed (exit $(cat "$T/daemon.rc")), restarted as Restart=on-failure would:"
-	daemon_log | grep -E 'error' | sed 's/^/#   /'
-	start_daemon
-fi
+daemon_errors() { daemon_log | grep -E 'error'; }
+start_retried
 daemon_pid=$pid_daemon
 
 if wait_for 15 ready; then

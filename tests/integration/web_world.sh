@@ -35,14 +35,21 @@ if [ -n "$browser" ]; then
 		--user-data-dir="$T/chromium" --remote-debugging-port="$dport" about:blank
 fi
 
+# world_up SIM WEB SCENARIO LCM_PORT WHAT: the simulator on the scenario and a
+# read-only undulate-web on it, both ready (else the test ends), its ten
+# robots in the snapshot; the page's address in $H.
+world_up() {
+	URL=$(lcm_url "$4")
+	spawn "$1" "$S" --scenario "$T/$3.scenario" --link-dir "$T" --lcm-url "$URL" --seed 5 --quiet
+	spawn "$2" "$W" --listen 127.0.0.1:0 --lcm-url "$URL" --read-only
+	wait_log "$1" 'ready' 10 && wait_log "$2" 'listening on http://' 10 ||
+		{ tap_fail "${5}simulator and undulate-web ready" "$(cat "$T/$1.log" "$T/$2.log")"; tap_done; exit 1; }
+	H="http://127.0.0.1:$(port_of "$2")"
+	wait_for 10 bash -c "curl -s '$H/api/snapshot' | jq -e '.nrobots == 10' "
+}
+
 # ---- the plane ---------------------------------------------------------------------
-URL=$(lcm_url 7794)
-spawn sim "$S" --scenario "$T/plane.scenario" --link-dir "$T" --lcm-url "$URL" --seed 5 --quiet
-spawn web "$W" --listen 127.0.0.1:0 --lcm-url "$URL" --read-only
-wait_log sim 'ready' 10 && wait_log web 'listening on http://' 10 ||
-	{ tap_fail "simulator and undulate-web ready" "$(cat "$T/sim.log" "$T/web.log")"; tap_done; exit 1; }
-H="http://127.0.0.1:$(port_of web)"
-wait_for 10 bash -c "curl -s '$H/api/snapshot' | jq -e '.nrobots == 10' "
+world_up sim web plane 7794 ""
 # the walls meet the outer robots about 4 s after they start moving (at 1 s)
 # and push them together until 11 s: contacts go on while the frames are read
 # (walls that stopped at 5 s left none by the time a loaded machine read them)
@@ -129,13 +136,8 @@ stop web >/dev/null
 stop sim >/dev/null
 
 # ---- the row ------------------------------------------------------------------------------
-URL=$(lcm_url 7795)
-spawn simr "$S" --scenario "$T/row.scenario" --link-dir "$T" --lcm-url "$URL" --seed 5 --quiet
-spawn webr "$W" --listen 127.0.0.1:0 --lcm-url "$URL" --read-only
-wait_log simr 'ready' 10 && wait_log webr 'listening on http://' 10 ||
-	{ tap_fail "row: simulator and undulate-web ready" "$(cat "$T/simr.log" "$T/webr.log")"; tap_done; exit 1; }
-HR="http://127.0.0.1:$(port_of webr)"
-wait_for 10 bash -c "curl -s '$HR/api/snapshot' | jq -e '.nrobots == 10' "
+world_up simr webr row 7795 "row: "
+HR=$H
 if [ -n "$browser" ]; then
 	python3 "$CDP" world "$dport" "$HR/" "$T/row.png" row 10 >"$T/row.out" 2>&1
 	sed 's/^/# /' "$T/row.out"

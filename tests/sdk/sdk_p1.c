@@ -23,6 +23,9 @@
 #include "protocol1_packet_handler.h"
 
 #define P1 1
+#define SDK_PROTOCOL P1
+#define SDK_ERR_NAME "error byte"
+#include "sdk_common.h"
 /* AX-12A addresses (e-manual). */
 #define A_MODEL        0
 #define A_ID           3
@@ -43,35 +46,7 @@
 #define E_RANGE        0x08
 #define E_INSTRUCTION  0x40
 
-static int port;
 static uint8_t id1, id2;
-
-static void result(bool ok, const char *what, const char *fmt, ...)
-{
-	char why[300] = "";
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(why, sizeof why, fmt, ap);
-	va_end(ap);
-	if (ok)
-		printf("ok %s\n", what);
-	else
-		printf("not ok %s: %s\n", what, why);
-	fflush(stdout);
-}
-
-static int comm(void) { return getLastTxRxResult(port, P1); }
-static uint8_t err(void) { return getLastRxPacketError(port, P1); }
-static bool good(void) { return comm() == COMM_SUCCESS && err() == 0; }
-static const char *said(void)
-{
-	static char buf[300];
-	snprintf(buf, sizeof buf, "%s %s (error byte 0x%02x)", getTxRxResult(P1, comm()),
-	         comm() == COMM_SUCCESS ? getRxPacketError(P1, err()) : "", err());
-	return buf;
-}
-
-static void ms(int n) { usleep((useconds_t)n * 1000); }
 
 static void basics(void)
 {

@@ -28,6 +28,9 @@
 #include "protocol2_packet_handler.h"
 
 #define P2 2
+#define SDK_PROTOCOL P2
+#define SDK_ERR_NAME "ERR"
+#include "sdk_common.h"
 /* X-series addresses (e-manual; the same on both models). */
 #define A_MODEL        0
 #define A_ID           7
@@ -51,36 +54,7 @@
 #define A_VOLTAGE      144
 #define A_TEMPERATURE  146
 
-static int port;
 static uint8_t xl, xm;
-
-static void result(bool ok, const char *what, const char *fmt, ...)
-{
-	char why[300] = "";
-	va_list ap;
-	va_start(ap, fmt);
-	vsnprintf(why, sizeof why, fmt, ap);
-	va_end(ap);
-	if (ok)
-		printf("ok %s\n", what);
-	else
-		printf("not ok %s: %s\n", what, why);
-	fflush(stdout);
-}
-
-/* The last transaction: the SDK's result and the servo's ERR field. */
-static int comm(void) { return getLastTxRxResult(port, P2); }
-static uint8_t err(void) { return getLastRxPacketError(port, P2); }
-static bool good(void) { return comm() == COMM_SUCCESS && err() == 0; }
-static const char *said(void)
-{
-	static char buf[300];
-	snprintf(buf, sizeof buf, "%s %s (ERR 0x%02x)", getTxRxResult(P2, comm()),
-	         comm() == COMM_SUCCESS ? getRxPacketError(P2, err()) : "", err());
-	return buf;
-}
-
-static void ms(int n) { usleep((useconds_t)n * 1000); }
 
 static void ping_and_models(void)
 {

@@ -1,9 +1,9 @@
 /*
  * test_dxl_doctor.c — the verdicts of `dxl doctor` (tools/dxl/doctor.h): each
  * check's thresholds on both sides, the level, the value shown and the fix
- * named, for the AX-12A (doctor_checks.c) and the X series (Protocol 2.0,
- * doctor_checks2.c: still a check set of its own, so its tests are their
- * own functions here). The bus work around them is
+ * named, for the AX-12A and the X series (Protocol 2.0): one set of checks
+ * (doctor_checks.c) over the record dr_servo_decode fills through each
+ * model's descriptor, run here on both families. The bus work around them is
  * tests/integration/dxl_doctor.sh's, on the simulator, and
  * test_dxl_fakeservo*.c's on fake buses.
  */
@@ -21,10 +21,14 @@
 #include "dxl.h"
 #include "dxl2.h"
 #include "dxl2_table.h"
+#include "dxl_proto.h"
 
 #define PORT "/dev/ttyUSB0"
 
-static const struct dr_context ctx = { .port = PORT, .ids = "1 2", .baud = 1000000, .period_ms = 10.0 };
+/* The AX-12A's bus: a READ of 8 bytes a servo, 2-byte goals (ax12.md's
+ * budget table prices that cycle). */
+static const struct dr_context ctx = { .port = PORT, .ids = "1 2", .baud = 1000000, .period_ms = 10.0,
+                                       .proto = &dxl_proto_v1, .read_len = 8, .write_len = 2 };
 
 /* The line has level lv and contains every string given (NULL-terminated). */
 static void expect(const struct dr_verdict *v, enum dr_level lv, ...)
@@ -48,40 +52,49 @@ static void lacks(const struct dr_verdict *v, const char *what)
 /* An AX-12A as it leaves the factory, set up for 100 Hz (return delay 0). */
 static struct dr_servo factory(uint8_t id)
 {
+	const struct dxl2_model *ax = dxl2_model_find(1, 12);
 	struct dr_servo s = {
-		.id = id, .answered = true, .read = true, .model = 12, .firmware = 24, .return_delay = 0,
-		.cw_limit = 0, .ccw_limit = 1023, .temperature_limit = 70, .min_voltage = 60, .max_voltage = 140,
-		.max_torque = 1023, .status_return_level = 2, .alarm_led = 36, .alarm_shutdown = 36, .torque_enable = 0,
-		.torque_limit = 1023, .voltage = 120, .temperature = 32,
+		.id = id, .answered = true, .read = true, .model = 12, .m = ax, .table = ax, .firmware = 24,
+		.return_delay = 0, .min_limit = 0, .max_limit = 1023, .temperature_limit = 70, .min_voltage = 60,
+		.max_voltage = 140, .max_output = 1023, .status_return_level = 2, .has_alarm_led = true, .alarm_led = 36,
+		.shutdown = 36, .torque_enable = 0, .has_torque_limit = true, .torque_limit = 1023, .voltage = 120,
+		.temperature = 32,
 	};
 	return s;
 }
 
-/* The two blocks as the manual lays them out (ax12.md), not through our own
- * encoder: EEPROM 0..18 and RAM 24..43 of a factory AX-12A at 12 V, 32 °C. */
+/* The table as the manual lays it out (ax12.md), not through our own
+ * encoder: EEPROM 0..18 and RAM 24..43 of a factory AX-12A at 12 V, 32 °C,
+ * read in one READ from address 0. */
 static void test_decode(void **state)
 {
 	(void)state;
-	const uint8_t eeprom[DR_EEPROM_LEN] = { 12, 0, 24, 1, 1, 250, 0, 0, 0xFF, 0x03, 0, 70, 60, 140, 0xFF, 0x03, 2, 36, 4 };
-	uint8_t ram[DR_RAM_LEN] = { 0 };
-	ram[0] = 1;                    /* 24 torque enable */
-	ram[10] = 0x00, ram[11] = 0x02; /* 34 torque limit 512 */
-	ram[18] = 111;                 /* 42 present voltage */
-	ram[19] = 32;                  /* 43 present temperature */
+	const struct dxl2_model *ax = dxl2_model_find(1, 12);
+	uint8_t image[44] = { 12, 0, 24, 1, 1, 250, 0, 0, 0xFF, 0x03, 0, 70, 60, 140, 0xFF, 0x03, 2, 36, 4 };
+	assert_int_equal(dr_image_len(ax), sizeof image);
+	image[24] = 1;                       /* torque enable */
+	image[34] = 0x00, image[35] = 0x02;  /* torque limit 512 */
+	image[42] = 111;                     /* present voltage */
+	image[43] = 32;                      /* present temperature */
 	struct dr_servo s = { 0 };
-	dr_servo_decode(&s, eeprom, ram);
+	dr_servo_decode(&s, ax, ax, image, sizeof image);
+	assert_ptr_equal(s.m, ax);
+	assert_true(s.has_alarm_led);
+	assert_true(s.has_torque_limit);
+	assert_int_equal(s.hwerr, 0);        /* no such register: 0, and no line (doctor.c asks the caps) */
+	assert_int_equal(s.operating_mode, 0);
 	assert_int_equal(s.model, 12);
 	assert_int_equal(s.firmware, 24);
 	assert_int_equal(s.return_delay, 250);
-	assert_int_equal(s.cw_limit, 0);
-	assert_int_equal(s.ccw_limit, 1023);
+	assert_int_equal(s.min_limit, 0);
+	assert_int_equal(s.max_limit, 1023);
 	assert_int_equal(s.temperature_limit, 70);
 	assert_int_equal(s.min_voltage, 60);
 	assert_int_equal(s.max_voltage, 140);
-	assert_int_equal(s.max_torque, 1023);
+	assert_int_equal(s.max_output, 1023);
 	assert_int_equal(s.status_return_level, 2);
 	assert_int_equal(s.alarm_led, 36);
-	assert_int_equal(s.alarm_shutdown, 4);
+	assert_int_equal(s.shutdown, 4);
 	assert_int_equal(s.torque_enable, 1);
 	assert_int_equal(s.torque_limit, 512);
 	assert_int_equal(s.voltage, 111);
@@ -94,10 +107,11 @@ static void test_model(void **state)
 	struct dr_verdict v;
 	struct dr_servo s = factory(1);
 	dr_check_model(&s, &ctx, &v);
-	expect(&v, DR_OK, "12 (AX-12)", "firmware 24", NULL);
-	s.model = 18;
+	expect(&v, DR_OK, "12 (AX-12A)", "firmware 24", NULL);
+	s.model = 18, s.m = NULL;   /* an AX-18: not in the tables, read with the AX-12A's */
 	dr_check_model(&s, &ctx, &v);
-	expect(&v, DR_WARN, "18 (AX-18)", "dxl --port " PORT " dump 1", NULL);
+	expect(&v, DR_WARN, "18, firmware 24: not in dxl's tables (AX-12A)", "with the AX-12A's addresses",
+	       "undulated drives it with that table", "dxl --port " PORT " dump 1", NULL);
 }
 
 static void test_return_delay(void **state)
@@ -129,10 +143,11 @@ static void test_status_level(void **state)
 	expect(&v, DR_OK, "2", NULL);
 	s.status_return_level = 1;
 	dr_check_status_level(&s, &ctx, &v);
-	expect(&v, DR_WARN, "1: WRITEs are not answered", "setup 1 2 --yes (writes status return level 2)", NULL);
+	expect(&v, DR_WARN, "1: READ answered, WRITEs not", "setup 1 2 --yes (writes status return level 2)", NULL);
 	s.status_return_level = 0;
 	dr_check_status_level(&s, &ctx, &v);
-	expect(&v, DR_FAIL, "answers PING only", "fix: dxl --port " PORT " write 4 status_return_level 2", NULL);
+	expect(&v, DR_FAIL, "answers PING only", "READ of every joint", "refuses to start",
+	       "fix: dxl --port " PORT " write 4 status_return_level 2", NULL);
 }
 
 static void test_voltage(void **state)
@@ -142,9 +157,12 @@ static void test_voltage(void **state)
 	struct dr_servo s = factory(1);
 	dr_check_voltage(&s, &v);
 	expect(&v, DR_OK, "12.0 V", "(servo's limits 6.0..14.0 V)", NULL);
-	s.voltage = 100;         /* 10.0 V: the lowest that is not a warning */
+	s.voltage = 101;         /* 10.1 V, the recommended 11.1 V less 1 V: the lowest that is not a warning */
 	dr_check_voltage(&s, &v);
-	expect(&v, DR_OK, "10.0 V", NULL);
+	expect(&v, DR_OK, "10.1 V", NULL);
+	s.voltage = 100;         /* the X series' rule, one for every model (the AX-12A's own said OK here) */
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_WARN, "10.0 V", "recommended 11.1 V", NULL);
 	s.voltage = 99;
 	dr_check_voltage(&s, &v);
 	expect(&v, DR_WARN, "9.9 V", "fix: charge the battery", NULL);
@@ -187,10 +205,10 @@ static void test_temperature(void **state)
 	expect(&v, DR_WARN, "60 C, within 10 C of its limit 70 C", "fix: let it cool", NULL);
 	s.temperature = 70;
 	dr_check_temperature(&s, &v);
-	expect(&v, DR_FAIL, "70 C, at or above its limit", "the alarm switches its torque off", "20 minutes", NULL);
-	s.alarm_shutdown = DXL_ERRBIT_OVERLOAD;
+	expect(&v, DR_FAIL, "70 C, at or above its limit", "its shutdown switches torque off", "20 minutes", NULL);
+	s.shutdown = DXL_ERRBIT_OVERLOAD;
 	dr_check_temperature(&s, &v);
-	expect(&v, DR_FAIL, "no alarm switches its torque off", NULL);
+	expect(&v, DR_FAIL, "nothing switches its torque off", NULL);
 }
 
 /* The configured joint: neutral 0, ±1.3 rad, i.e. raw 259..765 (whole units
@@ -212,24 +230,24 @@ static void test_limits(void **state)
 	struct dr_servo s = factory(1);
 	dr_check_limits(&s, &c, 0, &ctx, &v);
 	expect(&v, DR_OK, "0..1023", "259..765", "joint 1", NULL);
-	s.cw_limit = 259, s.ccw_limit = 765;     /* exactly the configuration's */
+	s.min_limit = 259, s.max_limit = 765;     /* exactly the configuration's */
 	dr_check_limits(&s, &c, 0, &ctx, &v);
 	expect(&v, DR_OK, "259..765", NULL);
-	s.cw_limit = 350, s.ccw_limit = 700;
+	s.min_limit = 350, s.max_limit = 700;
 	dr_check_limits(&s, &c, 0, &ctx, &v);
 	expect(&v, DR_WARN, "350..700, narrower than the configuration's 259..765", "write 1 cw_angle_limit 259",
 	       "write 1 ccw_angle_limit 765", NULL);
 	lacks(&v, "torque 1 off");
-	s.ccw_limit = 1023;                      /* one side only: one write */
+	s.max_limit = 1023;                      /* one side only: one write */
 	s.torque_enable = 1;
 	dr_check_limits(&s, &c, 1, &ctx, &v);
 	expect(&v, DR_WARN, "350..1023", "joint 2", "dxl --port " PORT " torque 1 off; dxl --port " PORT
 	       " write 1 cw_angle_limit 259", NULL);
 	lacks(&v, "ccw_angle_limit");
-	s.cw_limit = 800, s.ccw_limit = 1023;    /* no angle in common */
+	s.min_limit = 800, s.max_limit = 1023;    /* no angle in common */
 	dr_check_limits(&s, &c, 0, &ctx, &v);
 	expect(&v, DR_FAIL, "800..1023 have no angle in common", "refuses to start", NULL);
-	s.cw_limit = 0, s.ccw_limit = 0;         /* wheel mode */
+	s.min_limit = 0, s.max_limit = 0;         /* wheel mode */
 	s.torque_enable = 0;
 	dr_check_limits(&s, &c, 0, &ctx, &v);
 	expect(&v, DR_FAIL, "wheel mode", "write 1 cw_angle_limit 259; dxl --port " PORT " write 1 ccw_angle_limit 765",
@@ -246,11 +264,11 @@ static void test_alarms(void **state)
 	struct dr_servo s = factory(2);
 	dr_check_alarms(&s, &ctx, &v);
 	expect(&v, DR_OK, "shutdown 36 (overheating|overload)", "LED 36", NULL);
-	s.alarm_shutdown = DXL_ERRBIT_OVERHEAT;  /* the old manual's default 4 */
+	s.shutdown = DXL_ERRBIT_OVERHEAT;  /* the old manual's default 4 */
 	dr_check_alarms(&s, &ctx, &v);
 	expect(&v, DR_WARN, "overload does not switch torque off", "fix: dxl --port " PORT " write 2 alarm_shutdown 36",
 	       NULL);
-	s.alarm_shutdown = 36 | DXL_ERRBIT_CHECKSUM;
+	s.shutdown = 36 | DXL_ERRBIT_CHECKSUM;
 	dr_check_alarms(&s, &ctx, &v);
 	expect(&v, DR_WARN, "checksum switches torque off", "one damaged packet", NULL);
 	lacks(&v, "does not switch");
@@ -272,7 +290,7 @@ static void test_torque(void **state)
 	s.torque_limit = 0;
 	dr_check_torque(&s, &ctx, &v);
 	expect(&v, DR_WARN, "torque limit 0: an alarm shut it down", "write 1 torque_limit 1023", NULL);
-	s.max_torque = 0;
+	s.max_output = 0;
 	dr_check_torque(&s, &ctx, &v);
 	expect(&v, DR_WARN, "max torque 0", "write 1 max_torque 1023", NULL);
 }
@@ -367,17 +385,24 @@ static void test_baud(void **state)
 	(void)state;
 	struct dr_verdict v;
 	/* ax12.md's budget table: 2 servos 0.58 ms, 6 servos 1.58 ms at 1 Mbps */
-	assert_true(dr_cycle_wire_us(2, 1000000) > 579.9 && dr_cycle_wire_us(2, 1000000) < 580.1);
-	assert_true(dr_cycle_wire_us(6, 1000000) > 1579.9 && dr_cycle_wire_us(6, 1000000) < 1580.1);
-	assert_true(dr_cycle_wire_us(0, 1000000) == 0.0);
+	assert_float_equal(dr_cycle_wire_us(&dxl_proto_v1, 2, 8, 2, 1000000), 580.0, 1e-9);
+	assert_float_equal(dr_cycle_wire_us(&dxl_proto_v1, 6, 8, 2, 1000000), 1580.0, 1e-9);
+	assert_float_equal(dr_cycle_wire_us(&dxl_proto_v1, 0, 8, 2, 1000000), 0.0, 1e-9);
+	/* undulated's own AX-12A cycle: READ(36, 6), 2-byte goals: 2·(8 + 12) + 14 bytes */
+	assert_float_equal(dr_cycle_wire_us(&dxl_proto_v1, 2, sm_ax12()->present_len, sm_ax12()->goal_size, 1000000),
+	                   540.0, 1e-9);
 	dr_check_baud(&ctx, 2, 2, &v);
 	expect(&v, DR_OK, "1000000 bps: 2 of 2", "0.58 ms on the wire", NULL);
 	dr_check_baud(&ctx, 3, 0, &v);
 	expect(&v, DR_FAIL, "none of the 3 servo(s) answered", "dxl --port " PORT " scan --bauds all", NULL);
 	struct dr_context slow = ctx;
 	slow.baud = 57143;
-	dr_check_baud(&slow, 6, 6, &v);   /* 158 bytes: 27.6 ms */
-	expect(&v, DR_WARN, "57143 bps", "more than half", "set-baud ID 1000000", NULL);
+	dr_check_baud(&slow, 6, 6, &v);   /* 158 bytes: 27.6 ms, longer than the period (a WARN on 1.0 once) */
+	expect(&v, DR_FAIL, "57143 bps", "(a READ a servo, a SYNC_WRITE) take 27.65 ms", "more than the 10 ms period",
+	       "fix: dxl --port " PORT " setup 1 2", NULL);
+	slow.baud = 200000;
+	dr_check_baud(&slow, 6, 6, &v);   /* 7.9 ms */
+	expect(&v, DR_WARN, "200000 bps", "7.90 ms", "more than half", "dxl --port " PORT " set-baud ID 1000000", NULL);
 }
 
 static void test_budget(void **state)
@@ -416,19 +441,21 @@ static void test_budget(void **state)
 
 /* ---- the X series (Protocol 2.0) ---- */
 
-/* The X series' (Protocol 2.0, doctor_checks2.c): the same bus, the cycle's
- * SYNC_READ of 8 bytes a servo. */
+/* The X series' (Protocol 2.0): the same bus, the cycle's SYNC_READ of 8
+ * bytes a servo, 4-byte goals. */
 static const struct dr_context ctx2 = { .port = PORT, .ids = "1 2", .baud = 1000000, .period_ms = 10.0,
-                                        .protocol = 2, .read_len2 = DR2_READ_LEN };
+                                        .proto = &dxl_proto_v2, .read_len = 8, .write_len = 4 };
 
 /* An XL430-W250 at its factory settings, return delay 0, at 11.1 V. */
-static struct dr2_servo xl430(uint8_t id)
+static struct dr_servo xl430(uint8_t id)
 {
-	struct dr2_servo s = {
-		.id = id, .model = DXL2_MODEL_XL430_W250, .firmware = 46, .return_delay = 0, .operating_mode = 3,
-		.temperature_limit = 72, .temperature = 30, .max_voltage = 140, .min_voltage = 60, .voltage = 111,
-		.max_position = 4095, .min_position = 0, .shutdown = 52, .torque_enable = 0, .status_return_level = 2,
-		.hwerr = 0, .bus_watchdog = 0, .err = 0,
+	const struct dxl2_model *xl = dxl2_model_find(2, DXL2_MODEL_XL430_W250);
+	struct dr_servo s = {
+		.id = id, .answered = true, .read = true, .model = DXL2_MODEL_XL430_W250, .m = xl, .table = xl,
+		.firmware = 46, .return_delay = 0, .operating_mode = 3, .temperature_limit = 72, .temperature = 30,
+		.max_voltage = 140, .min_voltage = 60, .voltage = 111, .max_limit = 4095, .min_limit = 0, .shutdown = 52,
+		.max_output = 885, .torque_enable = 0, .status_return_level = 2, .hwerr = 0, .bus_watchdog = 0,
+		.errbits = 0,
 	};
 	return s;
 }
@@ -437,7 +464,9 @@ static struct dr2_servo xl430(uint8_t id)
 static void test_x_decode(void **state)
 {
 	(void)state;
-	uint8_t mem[DR2_IMAGE_LEN] = { 0 };
+	const struct dxl2_model *xl = dxl2_model_find(2, DXL2_MODEL_XL430_W250);
+	uint8_t mem[147] = { 0 };
+	assert_int_equal(dr_image_len(xl), sizeof mem);
 	mem[0] = 0x24, mem[1] = 0x04;          /* model number 1060 */
 	mem[6] = 46, mem[9] = 250, mem[11] = 3, mem[31] = 72;
 	mem[32] = 140, mem[34] = 60;           /* max / min voltage limit */
@@ -445,12 +474,18 @@ static void test_x_decode(void **state)
 	mem[52] = 0x00;                        /* min position limit 0 */
 	mem[63] = 52, mem[64] = 1, mem[68] = 2, mem[70] = 0x20, mem[98] = 0xFF;
 	mem[144] = 119, mem[146] = 37;
-	struct dr2_servo s;
-	dr2_servo_decode(&s, mem);
+	mem[36] = 0x75, mem[37] = 0x03;        /* PWM Limit 885 */
+	struct dr_servo s = { 0 };
+	dr_servo_decode(&s, xl, xl, mem, sizeof mem);
+	assert_false(s.has_alarm_led);
+	assert_false(s.has_torque_limit);
+	assert_int_equal(s.max_output, 885);
+	assert_int_equal(s.shutdown, 52);
+	assert_int_equal(s.operating_mode, 3);
 	assert_int_equal(s.model, 1060);
 	assert_int_equal(s.return_delay, 250);
 	assert_int_equal(s.max_voltage, 140);
-	assert_int_equal(s.max_position, 4095);
+	assert_int_equal(s.max_limit, 4095);
 	assert_int_equal(s.torque_enable, 1);
 	assert_int_equal(s.hwerr, DXL2_HWERR_OVERLOAD);
 	assert_int_equal(s.bus_watchdog, 0xFF);
@@ -461,86 +496,98 @@ static void test_x_decode(void **state)
 static void test_x_model_delay_level(void **state)
 {
 	(void)state;
-	struct dr2_servo s = xl430(1);
+	struct dr_servo s = xl430(1);
 	struct dr_verdict v;
-	dr2_check_model(&s, &ctx2, &v);
+	dr_check_model(&s, &ctx2, &v);
 	expect(&v, DR_OK, "1060 (XL430-W250), firmware 46", NULL);
-	s.model = 1200;
-	dr2_check_model(&s, &ctx2, &v);
-	expect(&v, DR_WARN, "not in dxl's tables", "dump 1", NULL);
+	s.model = 1200, s.m = NULL;
+	dr_check_model(&s, &ctx2, &v);
+	expect(&v, DR_WARN, "not in dxl's tables", "with the XL430-W250's addresses", "refuses to start with it",
+	       "dxl --protocol 2 --port " PORT " dump 1", NULL);
 	s = xl430(1);
-	dr2_check_return_delay(&s, &ctx2, &v);
+	dr_check_return_delay(&s, &ctx2, &v);
 	expect(&v, DR_OK, "0 us", NULL);
 	s.return_delay = 1;
-	dr2_check_return_delay(&s, &ctx2, &v);
+	dr_check_return_delay(&s, &ctx2, &v);
 	expect(&v, DR_WARN, "2 us before every reply", "dxl --protocol 2 --port " PORT " setup 1 2 --yes", NULL);
-	dr2_check_status_level(&s, &ctx2, &v);
+	dr_check_status_level(&s, &ctx2, &v);
 	expect(&v, DR_OK, "2", NULL);
 	s.status_return_level = 1;
-	dr2_check_status_level(&s, &ctx2, &v);
-	expect(&v, DR_WARN, "WRITEs not", NULL);
+	dr_check_status_level(&s, &ctx2, &v);
+	expect(&v, DR_WARN, "SYNC_READ and READ answered, WRITEs not", "dxl --protocol 2 --port " PORT " setup", NULL);
 	s.status_return_level = 0;
-	dr2_check_status_level(&s, &ctx2, &v);
+	dr_check_status_level(&s, &ctx2, &v);
 	expect(&v, DR_FAIL, "SYNC_READ goes unanswered", "status_return_level 2", NULL);
 }
 
 static void test_x_voltage(void **state)
 {
 	(void)state;
-	struct dr2_servo s = xl430(1);
+	struct dr_servo s = xl430(1);
 	struct dr_verdict v;
-	dr2_check_voltage(&s, &v);
+	dr_check_voltage(&s, &v);
 	expect(&v, DR_OK, "11.1 V (servo's limits 6.0..14.0 V)", NULL);
 	s.voltage = 101;          /* the recommended 11.1 V less 1 V: still OK */
-	dr2_check_voltage(&s, &v);
+	dr_check_voltage(&s, &v);
 	expect(&v, DR_OK, "10.1 V", NULL);
 	s.voltage = 100;
-	dr2_check_voltage(&s, &v);
+	dr_check_voltage(&s, &v);
 	expect(&v, DR_WARN, "10.0 V", "recommended 11.1 V", NULL);
 	s.voltage = 65;           /* the XL430's lowest */
-	dr2_check_voltage(&s, &v);
+	dr_check_voltage(&s, &v);
 	expect(&v, DR_WARN, "6.5 V", NULL);
 	s.voltage = 64;
-	dr2_check_voltage(&s, &v);
-	expect(&v, DR_FAIL, "outside the XL430-W250's 6.5..12.0 V", NULL);
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_FAIL, "below the XL430-W250's 6.5..12 V", NULL);
 	s.voltage = 59;           /* below its own limit register */
-	dr2_check_voltage(&s, &v);
-	expect(&v, DR_FAIL, "raises an input voltage error", "charge", NULL);
-	s.voltage = 121;
-	dr2_check_voltage(&s, &v);
-	expect(&v, DR_FAIL, "outside the XL430-W250's", NULL);
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_FAIL, "flags every reply with its voltage error", "charge", NULL);
+	/* above the rated 12 V: a full 3S battery (12.6 V) is what robots run
+	 * on, OK as on the AX-12A (the X rule alone said FAIL at 12.1 V) */
+	s.voltage = 126;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_OK, "12.6 V", NULL);
+	s.voltage = 127;
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_WARN, "12.7 V", "above the XL430-W250's 12 V", NULL);
 	s.model = DXL2_MODEL_XM430_W350;
+	s.m = s.table = dxl2_model_find(2, DXL2_MODEL_XM430_W350);
 	s.max_voltage = 160, s.min_voltage = 95, s.voltage = 120;
-	dr2_check_voltage(&s, &v);
+	dr_check_voltage(&s, &v);
 	expect(&v, DR_OK, "12.0 V", NULL);
 	s.voltage = 99;
-	dr2_check_voltage(&s, &v);
-	expect(&v, DR_FAIL, "outside the XM430-W350's 10.0..14.8 V", NULL);
+	dr_check_voltage(&s, &v);
+	expect(&v, DR_FAIL, "below the XM430-W350's 10..14.8 V", NULL);
 }
 
 static void test_x_temperature_mode_torque(void **state)
 {
 	(void)state;
-	struct dr2_servo s = xl430(1);
+	struct dr_servo s = xl430(1);
 	struct dr_verdict v;
-	dr2_check_temperature(&s, &v);
+	dr_check_temperature(&s, &v);
 	expect(&v, DR_OK, "30 C (limit 72 C)", NULL);
 	s.temperature = 62;
-	dr2_check_temperature(&s, &v);
+	dr_check_temperature(&s, &v);
 	expect(&v, DR_WARN, "within 10 C", NULL);
 	s.temperature = 61;
-	dr2_check_temperature(&s, &v);
+	dr_check_temperature(&s, &v);
 	expect(&v, DR_OK, NULL);
 	s.temperature = 72;
-	dr2_check_temperature(&s, &v);
+	dr_check_temperature(&s, &v);
 	expect(&v, DR_FAIL, "its shutdown switches torque off", NULL);
-	dr2_check_mode(&s, &ctx2, &v);
+	dr_check_mode(&s, &ctx2, &v);
 	expect(&v, DR_OK, "3 (position)", NULL);
 	s.operating_mode = 1;
-	dr2_check_mode(&s, &ctx2, &v);
+	dr_check_mode(&s, &ctx2, &v);
 	expect(&v, DR_WARN, "1 (velocity)", "write 1 operating_mode 3", NULL);
-	dr2_check_torque(&s, &v);
-	expect(&v, DR_OK, "off", NULL);
+	dr_check_torque(&s, &ctx2, &v);
+	expect(&v, DR_OK, "off, PWM Limit 885", "turns it on at start", NULL);
+	lacks(&v, "torque limit");
+	s.max_output = 0;         /* the X series' start-up refuses a servo that cannot move */
+	dr_check_torque(&s, &ctx2, &v);
+	expect(&v, DR_WARN, "PWM Limit 0", "refuses to start", "dxl --protocol 2 --port " PORT " write 1 pwm_limit 885",
+	       NULL);
 }
 
 static void test_x_limits(void **state)
@@ -552,21 +599,23 @@ static void test_x_limits(void **state)
 	cfg.joint[0].neutral = 0.0;
 	cfg.joint[0].limit_min = -1.3;
 	cfg.joint[0].limit_max = 1.3;
-	struct dr2_servo s = xl430(1);
+	cfg.joint[0].max_step = 0.2;   /* cfg_finish insists on one */
+	struct dr_servo s = xl430(1);
 	struct dr_verdict v;
 	/* ±1.3 rad at 4096 a turn around 2048: 1201..2895 */
-	dr2_check_limits(&s, &cfg, 0, &ctx2, &v);
+	dr_check_limits(&s, &cfg, 0, &ctx2, &v);
 	expect(&v, DR_OK, "0..4095, around the configuration's 1201..2895", NULL);
-	s.min_position = 1201, s.max_position = 2895;
-	dr2_check_limits(&s, &cfg, 0, &ctx2, &v);
+	s.min_limit = 1201, s.max_limit = 2895;
+	dr_check_limits(&s, &cfg, 0, &ctx2, &v);
 	expect(&v, DR_OK, NULL);
-	s.min_position = 1500;
-	dr2_check_limits(&s, &cfg, 0, &ctx2, &v);
+	s.min_limit = 1500;
+	dr_check_limits(&s, &cfg, 0, &ctx2, &v);
 	expect(&v, DR_WARN, "narrower", "write 1 min_position_limit 1201", NULL);
-	s.min_position = 3000, s.max_position = 4095;
+	s.min_limit = 3000, s.max_limit = 4095;
 	s.torque_enable = 1;
-	dr2_check_limits(&s, &cfg, 0, &ctx2, &v);
-	expect(&v, DR_FAIL, "no position in common", "torque off first", NULL);
+	dr_check_limits(&s, &cfg, 0, &ctx2, &v);
+	expect(&v, DR_FAIL, "no position in common", "dxl --protocol 2 --port " PORT " torque 1 off; ",
+	       "write 1 min_position_limit 1201", "write 1 max_position_limit 2895", NULL);
 	/* What undulated writes is what the doctor expects: the joint limits
 	 * rounded inward to whole units (setup rounds +-0.5 rad to 1723..2373;
 	 * rounding to the nearest unit made the doctor expect 1722..2374 and
@@ -577,47 +626,47 @@ static void test_x_limits(void **state)
 		cfg.joint[0].limit_max = lims[i];
 		int32_t lo, hi;
 		setup_joint_limits_model(sm_by_number(2, DXL2_MODEL_XL430_W250), &cfg.joint[0], &lo, &hi);
-		s.min_position = lo, s.max_position = hi;
+		s.min_limit = lo, s.max_limit = hi;
 		s.torque_enable = 0;
-		dr2_check_limits(&s, &cfg, 0, &ctx2, &v);
+		dr_check_limits(&s, &cfg, 0, &ctx2, &v);
 		expect(&v, DR_OK, NULL);
 	}
-	s.min_position = 1723, s.max_position = 2373;
+	s.min_limit = 1723, s.max_limit = 2373;
 	cfg.joint[0].limit_min = -0.5, cfg.joint[0].limit_max = 0.5;
-	dr2_check_limits(&s, &cfg, 0, &ctx2, &v);
+	dr_check_limits(&s, &cfg, 0, &ctx2, &v);
 	expect(&v, DR_OK, "1723..2373, around the configuration's 1723..2373", NULL);
 }
 
 static void test_x_hwerr_watchdog_err(void **state)
 {
 	(void)state;
-	struct dr2_servo s = xl430(2);
+	struct dr_servo s = xl430(2);
 	struct dr_verdict v;
-	dr2_check_hwerr(&s, &ctx2, &v);
+	dr_check_hwerr(&s, &ctx2, &v);
 	expect(&v, DR_OK, "none", NULL);
 	s.hwerr = DXL2_HWERR_OVERHEAT;
-	dr2_check_hwerr(&s, &ctx2, &v);
+	dr_check_hwerr(&s, &ctx2, &v);
 	expect(&v, DR_FAIL, "4 (overheating)", "switched its torque off", "reboot 2", NULL);
 	s.hwerr = DXL2_HWERR_ENCODER;   /* not in the factory shutdown mask 52 */
-	dr2_check_hwerr(&s, &ctx2, &v);
+	dr_check_hwerr(&s, &ctx2, &v);
 	expect(&v, DR_FAIL, "flags every reply with the alert", NULL);
-	dr2_check_watchdog(&s, &ctx2, &v);
+	dr_check_watchdog(&s, &ctx2, &v);
 	expect(&v, DR_OK, "off", NULL);
 	s.bus_watchdog = 1;            /* 20 ms: two 10 ms periods is the line */
-	dr2_check_watchdog(&s, &ctx2, &v);
+	dr_check_watchdog(&s, &ctx2, &v);
 	expect(&v, DR_OK, "20 ms", NULL);
 	const struct dr_context slow = { .port = PORT, .ids = "2", .period_ms = 20.0 };
-	dr2_check_watchdog(&s, &slow, &v);
+	dr_check_watchdog(&s, &slow, &v);
 	expect(&v, DR_WARN, "20 ms, less than two 20 ms periods", "bus_watchdog 5 (100 ms)", NULL);
 	s.bus_watchdog = 0xFF;
-	dr2_check_watchdog(&s, &ctx2, &v);
+	dr_check_watchdog(&s, &ctx2, &v);
 	expect(&v, DR_FAIL, "fired", "bus_watchdog 0", NULL);
-	assert_false(dr2_check_err(&s, &v));
-	s.err = DXL2_ERRNUM_DATA_RANGE;
-	assert_true(dr2_check_err(&s, &v));
+	assert_false(dr_check_errbits(&s, &ctx2, &v));
+	s.errbits = DXL2_ERRNUM_DATA_RANGE;
+	assert_true(dr_check_errbits(&s, &ctx2, &v));
 	expect(&v, DR_WARN, "0x04 (data range)", NULL);
-	s.err = 0x80;
-	assert_true(dr2_check_err(&s, &v));
+	s.errbits = 0x80;
+	assert_true(dr_check_errbits(&s, &ctx2, &v));
 	expect(&v, DR_FAIL, "0x80 (alert)", NULL);
 }
 
@@ -627,9 +676,9 @@ static void test_x_cycle_and_baud(void **state)
 	(void)state;
 	struct dr_verdict v;
 	/* 2 servos, 8 bytes: (14+2) + 2·19 + (14+10) = 78 bytes = 780 µs at 1 Mbps */
-	assert_float_equal(dr2_cycle_wire_us(2, DR2_READ_LEN, 1000000), 780.0, 1e-9);
-	assert_float_equal(dr2_cycle_wire_us(2, DR2_READ_LEN_CURRENT, 1000000), 820.0, 1e-9);
-	assert_float_equal(dr2_cycle_wire_us(0, DR2_READ_LEN, 1000000), 0.0, 1e-9);
+	assert_float_equal(dr_cycle_wire_us(&dxl_proto_v2, 2, 8, 4, 1000000), 780.0, 1e-9);
+	assert_float_equal(dr_cycle_wire_us(&dxl_proto_v2, 2, 10, 4, 1000000), 820.0, 1e-9);
+	assert_float_equal(dr_cycle_wire_us(&dxl_proto_v2, 0, 8, 4, 1000000), 0.0, 1e-9);
 	dr_check_baud(&ctx2, 2, 2, &v);
 	expect(&v, DR_OK, "0.78 ms on the wire", NULL);
 	struct dr_context c = ctx2;

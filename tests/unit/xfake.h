@@ -1,13 +1,13 @@
 /*
  * xfake.h — a fake bus of X-series servos (Protocol 2.0) for tests, whatever
- * carries its bytes: test_dxl_fakeservo2.c serves it on a pty from a thread,
+ * carries its bytes: test_dxl_fakeservo.c serves it on a pty from a thread,
  * test_daemon_cycle.c in memory against a fake clock. The transport feeds
  * it the controller's bytes (xfake_feed) and takes its status packets
  * through `emit`, with the servo's return delay to apply.
  *
  * It frames packets with its own few lines: a bit-by-bit CRC-16 (polynomial
  * 0x8005), its own stuffing and unstuffing — not protocol/dxl2.c — checked
- * against the e-manual's packets (test_dxl_fakeservo2.c), so a bug shared by
+ * against the e-manual's packets (test_dxl_fakeservo.c), so a bug shared by
  * our encoder and parser cannot pass through it unseen. Its control table
  * is dxl2_table's defaults; what a real servo refuses (EEPROM with torque
  * on: access error 7; torque on after a shutdown: result fail 1) it refuses
@@ -53,7 +53,7 @@ struct xfake {
 	void (*emit)(void *ctx, const uint8_t *pkt, size_t n, unsigned delay_us);
 	void *ctx;
 	/* the alert bit (7) in every status while Hardware Error Status (70) is
-	 * not 0, as the e-manual has it (off: test_dxl_fakeservo2's fake, which
+	 * not 0, as the e-manual has it (off: test_dxl_fakeservo.c's X fake, which
 	 * injects the ERR field itself) */
 	bool alert_from_hwerr;
 	/* every WRITE and SYNC_WRITE part addressed to a servo that hears, before

@@ -12,10 +12,14 @@
 
 #include "dxl2_table.h"
 #include "dxl_table.h"
+#include "daemon/servo_model.h"
+#include "doctor.h"
 #include "dxlt_priv.h"
 #include "num.h"
 
 /* ---- transactions: every reply's error bits are remembered ------------------- */
+
+static const struct dxlt_family *dxlt_family_for(int protocol, const struct dxl2_model **model);
 
 /* One line per servo whose replies carried error bits (1.0) or a non-zero
  * ERR field (2.0); exit 5 unless the command already failed in a way that
@@ -25,21 +29,24 @@ static int dxlt_report_errbits(struct dxlt *t, int rc)
 	char names[128];
 	bool any = false;
 
-	for (size_t id = 0; id < sizeof t->errseen; id++) {
-		if (t->errseen[id] == 0)
-			continue;
-		fprintf(t->err, "dxl: ID %zu reports error bits 0x%02X: %s\n", id, t->errseen[id],
-		        dxl_errbits_format(t->errseen[id], names, sizeof names));
-		any = true;
-	}
-	for (size_t id = 0; id < sizeof t->errseen2; id++) {
-		if (t->errseen2[id] == 0)
-			continue;
-		fprintf(t->err, "dxl: ID %zu reports error 0x%02X: %s%s\n", id, t->errseen2[id],
-		        dxl2_err_format(t->errseen2[id], names, sizeof names),
-		        dxl2_err_alert(t->errseen2[id]) ? " (the alert bit: a hardware error; see dxl --protocol 2 "
-		        "read ID hardware_error_status --units, and reboot ID to clear it)" : "");
-		any = true;
+	for (size_t i = 0; i < DXLT_PROTOCOLS; i++) {
+		const struct dxl_proto *p = dxl_proto_by_number((int)i + 1);
+		const struct dxl2_model *unused;
+		const struct dxlt_family *f = dxlt_family_for((int)i + 1, &unused);
+		for (size_t id = 0; id < sizeof t->errseen[i]; id++) {
+			uint8_t e = t->errseen[i][id];
+			if (e == 0)
+				continue;
+			fprintf(t->err, "dxl: ID %zu reports %s 0x%02X: %s", id, f->err_field, e,
+			        p->err_format(e, names, sizeof names));
+			if ((e & p->err_alert) && f->alert_fix != NULL) {
+				fputs(" (", t->err);
+				fprintf(t->err, f->alert_fix, f->opt, f->opt);
+				fputc(')', t->err);
+			}
+			fputc('\n', t->err);
+			any = true;
+		}
 	}
 	if (!any)
 		return rc;
@@ -140,42 +147,44 @@ static size_t dxlt_scan_bauds(const struct dxlt *t, const struct dxlt_family *f,
 	return n;
 }
 
-/* setup's bus time of one 100 Hz cycle on Protocol 1.0: one READ(36, 6) per servo and one SYNC_WRITE
- * of goal + speed for all, plus the adapter's hold time per READ. */
-static void dxlt_setup_budget(struct dxlt *t, unsigned nservos, bool current, int latency_ms)
+/* setup's last line: the bus time of one 100 Hz cycle of undulated's for n
+ * servos (doctor.h's dr_cycle_wire_us: the model's present block read, one
+ * READ a servo or one SYNC_READ as the protocol can, and one SYNC_WRITE of
+ * goals), plus the adapter's hold time for each read. */
+void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int latency_ms)
 {
-	(void)current;   /* the AX-12A senses none */
-	double byte_us = 10.0 * 1e6 / (double)port_baud(t->port);
-	double wire_ms = (nservos * 20.0 + 5.0 * nservos + 8.0) * byte_us / 1000.0;
-	double total_ms = wire_ms + nservos * (double)latency_ms;
+	const struct dxl_proto *p = bus_proto(&t->bus);
+	bool sync = dxl_proto_can(p, DXL_CAP_SYNC_READ);
+	double wire_ms = 1e-3 * dr_cycle_wire_us(p, n, m->present_len, m->goal_size, port_baud(t->port));
+	double total_ms = wire_ms + (sync ? 1.0 : (double)n) * latency_ms;
 
-	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire + %d ms "
-	        "adapter latency per read = %.2f ms of the 10 ms period%s\n", nservos,
-	        nservos == 1 ? "" : "s", port_baud(t->port), wire_ms, latency_ms, total_ms,
-	        total_ms > 5.0 ? " (too much for 100 Hz)" : "");
+	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire (%s of %u bytes each, one "
+	        "SYNC_WRITE) + %d ms adapter latency %s = %.2f ms of the 10 ms period%s\n", n, n == 1 ? "" : "s",
+	        port_baud(t->port), wire_ms, sync ? "one SYNC_READ" : "a READ", m->present_len, latency_ms,
+	        sync ? "for it" : "per read", total_ms, total_ms > 5.0 ? " (too much for 100 Hz)" : "");
 }
 
 /* The two families `dxl` speaks to, in scan order. */
 static const struct dxlt_family dxlt_families[] = {
 	{ .protocol = 1, .bus = BUS_PROTOCOL_1, .label = "Protocol 1.0", .opt = "", .max_id = DXL_MAX_ID,
-	  .settle_us = DXLT_EEPROM_SETTLE_US, .eeprom_needs_torque_off = false,
+	  .settle_us = DXLT_EEPROM_SETTLE_US, .eeprom_needs_torque_off = false, .err_field = "error bits",
 	  .no_rate = "dxl: an AX-12 cannot run at '%s' bps (rates are 2000000/(n+1), e.g. 1000000, 500000, 117647, "
 	             "57143)\n",
 	  .reset_form = "reset ID --yes",
 	  .reset_refusal = "dxl: a factory reset sets ID 1, 1000000 bps and every default (including angle limits); "
 	                   "add --yes to do it\n",
-	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at,
-	  .setup_budget = dxlt_setup_budget },
+	  .baud_to_reg = dxl_baud_to_reg, .baud_from_reg = dxl_baud_from_reg, .scan_at = dxlt_scan1_at },
 	/* An X servo writes its EEPROM in a few ms; 20 ms before asking. */
 	{ .protocol = 2, .bus = BUS_PROTOCOL_2, .label = "Protocol 2.0", .opt = "--protocol 2 ", .max_id = DXL2_MAX_ID,
-	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true,
+	  .settle_us = 20000, .eeprom_needs_torque_off = true, .ping_names_model = true, .err_field = "error",
+	  .alert_fix = "the alert bit: a hardware error; see dxl %sread ID hardware_error_status --units, and dxl %sreboot "
+	               "ID to clear it",
 	  .no_rate = "dxl: an X-series servo cannot run at '%s' bps (9600, 57600, 115200, 1000000, 2000000, 3000000, "
 	             "4000000, 4500000)\n",
 	  .reset_form = "reset ID --yes [--keep id|id-baud]",
 	  .reset_refusal = "dxl: a factory reset sets %s (position limits and operating mode included); add --yes "
 	                   "to do it (--keep id or id-baud keeps those)\n",
-	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at,
-	  .setup_budget = dxlt2_setup_budget },
+	  .baud_to_reg = dxl2_baud_to_reg, .baud_from_reg = dxl2_baud_from_reg, .scan_at = dxlt2_scan_at },
 };
 #define DXLT_NFAMILIES (sizeof dxlt_families / sizeof dxlt_families[0])
 
@@ -187,9 +196,7 @@ static const struct dxlt_family *dxlt_family_for(int protocol, const struct dxl2
 	for (size_t i = 0; i < DXLT_NFAMILIES; i++)
 		if (dxlt_families[i].protocol == protocol)
 			f = &dxlt_families[i];
-	for (size_t i = dxl2_model_count(); i-- > 0;)
-		if (dxl2_model_at(i)->protocol == f->protocol)
-			*model = dxl2_model_at(i);
+	*model = dxl2_model_first(f->protocol);
 	return f;
 }
 

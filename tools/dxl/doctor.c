@@ -9,7 +9,10 @@
  *  3. every servo PINGed with a timeout long enough for any adapter (the
  *     largest FTDI latency timer is 255 ms), then the replies' lateness
  *     measured (bus_reply_lateness): the latency and baud lines;
- *  4. two READs per servo (EEPROM 0..18, RAM 24..43): a line per setting;
+ *  4. one READ per servo of its control table, model number .. present
+ *     temperature, read through its model's descriptor: a line per setting
+ *     (doctor_checks.c; a model's own lines where its descriptor says it
+ *     has the register or the capability);
  *  5. a few hundred of undulated's own cycles (daemon/cycle.c driving
  *     daemon/control.c, with the daemon's bus timeouts) holding every joint
  *     where it stands, timed as the daemon times them: the budget line.
@@ -56,25 +59,11 @@
 /* Width of the check-name column. */
 #define DR_NAME_WIDTH 19
 
-struct dr;
-/* What the doctor does differently per protocol: how a servo's table is
- * read and judged, and what the controller would make of it. Chosen once
- * from the family (dr_family_for), then asked. */
-struct dr_family {
-	int protocol;
-	/* every answering servo's table; DXLT_EXIT_OK or the port's failure */
-	int (*read_all)(struct dr *d, int *status);
-	void (*servo_lines)(struct dr *d, size_t j, int read_status);
-	bool (*servo_info)(const struct dr *d, size_t j, struct ctl_servo_info *info);
-};
-
 struct dr {
 	struct dxlt *t;
-	const struct dr_family *fam;         /* dr_family_for(the tool's family) */
 	struct cfg cfg;
 	char source[CFG_PATH_MAX + 32];      /* where the robot came from, for the header */
 	struct dr_servo servo[CFG_MAX_JOINTS];
-	struct dr2_servo servo2[CFG_MAX_JOINTS];   /* Protocol 2.0: what each servo's table holds */
 	char setup_ids[CFG_MAX_JOINTS * 4 + 1];
 	struct dr_context ctx;
 	unsigned count[DR_SKIP + 1];
@@ -246,8 +235,9 @@ static int dr_find(struct dr *d, unsigned *answered)
 		int r = DXL_E_TIMEOUT;
 		s->id = d->cfg.ids[j];
 		for (int k = 0; k < DR_PING_TRIES && r != DXL_OK; k++) {
-			/* where the PING says the model (2.0), the baud line prices its cycle */
-			r = dxlt_ping_model(d->t, s->id, &d->servo2[j].model);
+			/* where the PING says the model (2.0), the baud line prices its
+			 * cycle and the READ takes its table */
+			r = dxlt_ping_model(d->t, s->id, &s->model);
 			if (dr_gone(r))
 				return dxlt_bus_fail(d->t, s->id, r);
 		}
@@ -273,7 +263,7 @@ static int dr_latency(struct dr *d)
 		int rr = dxlt_read(d->t, first->id, dxlt_addr(d->t, "return_delay_time"), 1, &rd);
 		if (rr != DXL_OK)
 			rd = 0;
-		int r = bus_reply_lateness(&d->t->bus, first->id, dxl_return_delay_us(rd), DR_LATENESS_PINGS, &l.late);
+		int r = bus_reply_lateness(&d->t->bus, first->id, dxl2_return_delay_us(rd), DR_LATENESS_PINGS, &l.late);
 		if (dr_gone(r))
 			return dxlt_bus_fail(d->t, first->id, r);
 		l.measured = r == DXL_OK;
@@ -292,37 +282,72 @@ static int dr_latency(struct dr *d)
 
 /* ---- 4. each servo's settings -------------------------------------------------------------- */
 
-static int dr_read(struct dr *d, uint8_t id, uint8_t addr, uint8_t len, uint8_t *out)
+static int dr_read(struct dr *d, uint8_t id, uint16_t len, uint8_t *out)
 {
 	int r = DXL_E_TIMEOUT;
 	for (int k = 0; k < DR_READ_TRIES && r != DXL_OK && !dr_gone(r); k++)
-		r = dxlt_read(d->t, id, addr, len, out);
+		r = dxlt_read(d->t, id, 0, len, out);
 	return r;
 }
 
-/* Read both blocks of every servo that answered. DXLT_EXIT_OK or the port's
- * failure; a servo that does not answer READ keeps s->read false and *why. */
+/* One servo's table from address 0: its model's, where the PING named it,
+ * else the protocol's first model's (every model of a protocol has the model
+ * number at 0); read again through its own model's table when the number
+ * names another model whose table reaches further. */
+static int dr_read_one(struct dr *d, struct dr_servo *s)
+{
+	int protocol = d->t->fam->protocol;
+	const struct dxl2_model *table = dxl2_model_find(protocol, s->model), *m;
+	uint8_t image[DXLT_IMAGE_MAX];
+
+	if (table == NULL)
+		table = d->t->fam_model;
+	size_t len = dr_image_len(table);
+	int r = dr_read(d, s->id, (uint16_t)len, image);
+	if (r != DXL_OK)
+		return r;
+	dr_servo_decode(s, NULL, table, image, len);
+	if ((m = dxl2_model_find(protocol, s->model)) != NULL && m != table) {
+		table = m;
+		if (dr_image_len(m) > len) {
+			len = dr_image_len(m);
+			if ((r = dr_read(d, s->id, (uint16_t)len, image)) != DXL_OK)
+				return r;
+		}
+	}
+	dr_servo_decode(s, m, table, image, len);
+	return DXL_OK;
+}
+
+/* Read every servo that answered. DXLT_EXIT_OK or the port's failure; a
+ * servo that does not answer READ keeps s->read false and its status. */
 static int dr_read_all(struct dr *d, int *status)
 {
 	for (size_t j = 0; j < d->cfg.njoints; j++) {
 		struct dr_servo *s = &d->servo[j];
-		uint8_t eeprom[DR_EEPROM_LEN], ram[DR_RAM_LEN];
 		status[j] = DXL_OK;
 		if (!s->answered)
 			continue;
-		int r = dr_read(d, s->id, 0, DR_EEPROM_LEN, eeprom);
-		if (r == DXL_OK)
-			r = dr_read(d, s->id, DR_RAM_ADDR, DR_RAM_LEN, ram);
+		int r = dr_read_one(d, s);
 		if (dr_gone(r))
 			return dxlt_bus_fail(d->t, s->id, r);
 		status[j] = r;
 		if (r != DXL_OK)
 			continue;
-		dr_servo_decode(s, eeprom, ram);
 		s->read = true;
-		s->errbits = d->t->errseen[s->id];
+		s->errbits = dxlt_errors(d->t, s->id);
 	}
 	return DXLT_EXIT_OK;
+}
+
+/* The servo model undulated's start-up would drive a servo as (its own, or
+ * where its family runs an unknown model on its first model's table, that
+ * one); NULL where it would refuse it. */
+static const struct sm_model *dr_sm_model(const struct dr *d, const struct dr_servo *s)
+{
+	int protocol = d->t->fam->protocol;
+	const struct sm_model *m = sm_by_number(protocol, s->model);
+	return m != NULL || sm_family(protocol)->setup->strict ? m : sm_family(protocol);
 }
 
 static void dr_context(struct dr *d)
@@ -330,8 +355,7 @@ static void dr_context(struct dr *d)
 	size_t off = 0;
 	d->setup_ids[0] = '\0';
 	d->ctx = (struct dr_context){ .port = d->cfg.port, .ids = d->setup_ids, .baud = d->cfg.baud,
-	                              .period_ms = d->cfg.period_ms, .protocol = d->t->fam->protocol,
-	                              .read_len2 = DR2_READ_LEN };
+	                              .period_ms = d->cfg.period_ms, .proto = bus_proto(&d->t->bus) };
 	for (size_t j = 0; j < d->cfg.njoints; j++) {
 		const struct dr_servo *s = &d->servo[j];
 		if (!s->answered)
@@ -339,25 +363,30 @@ static void dr_context(struct dr *d)
 		int w = snprintf(d->setup_ids + off, sizeof d->setup_ids - off, "%s%u", off ? " " : "", s->id);
 		if (w > 0 && (size_t)w < sizeof d->setup_ids - off)
 			off += (size_t)w;
-		d->ctx.any_torque_on = d->ctx.any_torque_on || (s->read && s->torque_enable) ||
-		                       (s->read && d->servo2[j].torque_enable);   /* 2.0's image; 0 on 1.0 */
-		/* the loop's SYNC_READ takes the present current too where there is one */
-		const struct dxl2_model *xm = dxl2_model_find(d->ctx.protocol, d->servo2[j].model);
-		if (xm != NULL && xm->current_sensing)
-			d->ctx.read_len2 = DR2_READ_LEN_CURRENT;
+		d->ctx.any_torque_on = d->ctx.any_torque_on || (s->read && s->torque_enable);
+		/* the loop's bytes a servo: the most any of them takes */
+		const struct sm_model *m = dr_sm_model(d, s);
+		if (m == NULL)
+			m = sm_family(d->t->fam->protocol);
+		if (m->present_len > d->ctx.read_len)
+			d->ctx.read_len = m->present_len;
+		if (m->goal_size > d->ctx.write_len)
+			d->ctx.write_len = m->goal_size;
 	}
 }
 
 static void dr_servo_lines(struct dr *d, size_t j, int read_status)
 {
 	const struct dr_servo *s = &d->servo[j];
+	const char *opt = d->t->fam->opt;
 	struct dr_verdict v = { DR_OK, "" };
+	char what[32];
 
 	if (!s->answered) {
 		if (s->ping_status == DXL_E_TIMEOUT)
 			snprintf(v.text, sizeof v.text, "no reply to %d PINGs at %ld bps (%u ms each); fix: its power and "
-			         "cable, or its ID and rate: dxl --port %s scan --bauds all", DR_PING_TRIES, d->cfg.baud,
-			         DR_PROBE_MARGIN_US / 1000u, d->cfg.port);
+			         "cable, or its ID and rate: dxl %s--port %s scan --bauds all", DR_PING_TRIES, d->cfg.baud,
+			         DR_PROBE_MARGIN_US / 1000u, opt, d->cfg.port);
 		else
 			snprintf(v.text, sizeof v.text, "its PING replies are bad (%s)%s", dxl_strerror(s->ping_status),
 			         s->ping_status == DXL_E_ECHO ? ": see the echo line" : "; fix: the cable, a second master on "
@@ -369,8 +398,9 @@ static void dr_servo_lines(struct dr *d, size_t j, int read_status)
 	if (!s->read) {
 		v.level = DR_FAIL;
 		if (read_status == DXL_E_TIMEOUT)
-			snprintf(v.text, sizeof v.text, "answers PING but not READ: status return level 0, and undulated "
-			         "READs every joint every cycle; fix: dxl --port %s write %u status_return_level 2",
+			snprintf(v.text, sizeof v.text, "answers PING but not READ: status return level 0, so the loop's %s "
+			         "goes unanswered; fix: dxl %s--port %s write %u status_return_level 2",
+			         dxl_proto_can(d->ctx.proto, DXL_CAP_SYNC_READ) ? "SYNC_READ" : "READ of every joint", opt,
 			         d->cfg.port, s->id);
 		else
 			snprintf(v.text, sizeof v.text, "answers PING, but its READ replies are bad (%s)%s",
@@ -388,12 +418,27 @@ static void dr_servo_lines(struct dr *d, size_t j, int read_status)
 	dr_servo_line(d, s->id, "voltage", &v);
 	dr_check_temperature(s, &v);
 	dr_servo_line(d, s->id, "temperature", &v);
+	if (dxl2_model_can(s->table, DXL2_CAP_OPMODE)) {
+		dr_check_mode(s, &d->ctx, &v);
+		dr_servo_line(d, s->id, "operating mode", &v);
+	}
 	dr_check_limits(s, &d->cfg, j, &d->ctx, &v);
-	dr_servo_line(d, s->id, "angle limits", &v);
-	dr_check_alarms(s, &d->ctx, &v);
-	dr_servo_line(d, s->id, "alarms", &v);
+	snprintf(what, sizeof what, "%s limits", sm_family(s->table->protocol)->limits_name);
+	dr_servo_line(d, s->id, what, &v);
+	if (s->has_alarm_led) {
+		dr_check_alarms(s, &d->ctx, &v);
+		dr_servo_line(d, s->id, "alarms", &v);
+	}
+	if (dxl2_model_can(s->table, DXL2_CAP_HWERR_STATUS)) {
+		dr_check_hwerr(s, &d->ctx, &v);
+		dr_servo_line(d, s->id, "hardware error", &v);
+	}
 	dr_check_torque(s, &d->ctx, &v);
 	dr_servo_line(d, s->id, "torque", &v);
+	if (dxl2_model_can(s->table, DXL2_CAP_WATCHDOG)) {
+		dr_check_watchdog(s, &d->ctx, &v);
+		dr_servo_line(d, s->id, "bus watchdog", &v);
+	}
 	if (dr_check_errbits(s, &d->ctx, &v))
 		dr_servo_line(d, s->id, "error bits", &v);
 }
@@ -432,28 +477,21 @@ static double dr_pct(const double *v, size_t n, double p)
 
 /* What start-up hands the controller (daemon/setup.c's setup_servo, one for
  * every model), from the checks' reads; false: undulated would not drive
- * it (an X model it does not know, or no PWM to move with). */
-static bool dr1_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
+ * it (a model its family refuses, or no output to move with). */
+static bool dr_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
 {
 	const struct dr_servo *s = &d->servo[j];
+	const struct sm_model *m = dr_sm_model(d, s);
+	if (m == NULL)
+		return false;
+	bool in_turn = s->min_limit >= 0 && s->max_limit <= m->pos_max;
 	*info = (struct ctl_servo_info){
-		.cw_limit = s->cw_limit, .ccw_limit = s->ccw_limit,
-		.max_torque = s->max_torque ? s->max_torque : 1023,   /* as setup.c does */
-		.return_delay = s->return_delay, .status_return_level = s->status_return_level,
+		.cw_limit = in_turn ? (uint16_t)s->min_limit : 1, .ccw_limit = in_turn ? (uint16_t)s->max_limit : 0,
+		/* an output limit of 0: refused, or run at full output (as setup.c does) */
+		.max_torque = s->max_output ? s->max_output : m->setup->strict ? 0 : (uint16_t)m->torque_full,
+		.return_delay = s->return_delay, .status_return_level = s->status_return_level, .model = m,
 	};
-	return true;
-}
-
-static bool dr2_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *info)
-{
-	const struct dr2_servo *x = &d->servo2[j];
-	bool in_turn = x->min_position >= 0 && x->max_position <= DXL2_POS_MAX;
-	*info = (struct ctl_servo_info){
-		.cw_limit = in_turn ? (uint16_t)x->min_position : 1, .ccw_limit = in_turn ? (uint16_t)x->max_position : 0,
-		.max_torque = x->pwm_limit, .return_delay = x->return_delay,
-		.status_return_level = x->status_return_level, .model = sm_by_number(2, x->model),
-	};
-	return info->model != NULL && info->max_torque != 0;
+	return info->max_torque != 0;
 }
 
 /* Give the controller the joints r->from[0..n) lists; keep those it takes
@@ -468,12 +506,12 @@ static size_t dr_set_servos(struct dr *d, struct dr_run *r, size_t n)
 	r->cfg.njoints = n;
 	ctl_init(&r->ctl, &r->cfg);
 	for (size_t k = 0; k < n; k++) {
-		if (!d->fam->servo_info(d, r->from[k], &info) || !ctl_set_servo(&r->ctl, k, &info, why, sizeof why))
+		if (!dr_servo_info(d, r->from[k], &info) || !ctl_set_servo(&r->ctl, k, &info, why, sizeof why))
 			continue;   /* its angle-limits line says why */
 		r->cfg.ids[kept] = r->cfg.ids[k];
 		r->cfg.joint[kept] = r->cfg.joint[k];
 		r->from[kept] = r->from[k];
-		r->rd_us[kept] = dxl_return_delay_us(info.return_delay);
+		r->rd_us[kept] = dxl2_return_delay_us(info.return_delay);
 		kept++;
 	}
 	return kept;
@@ -778,91 +816,6 @@ out:
 	return rc;
 }
 
-/* ---- Protocol 2.0: the checks that need no cycle ------------------------------------------------ */
-
-/* One READ of the table's first DR2_IMAGE_LEN bytes per servo that answered. */
-static int dr2_read_all(struct dr *d, int *status)
-{
-	for (size_t j = 0; j < d->cfg.njoints; j++) {
-		struct dr_servo *s = &d->servo[j];
-		uint8_t mem[DR2_IMAGE_LEN];
-		int r = DXL_E_TIMEOUT;
-		status[j] = DXL_OK;
-		if (!s->answered)
-			continue;
-		for (int k = 0; k < DR_READ_TRIES && r != DXL_OK && !dr_gone(r); k++)
-			r = dxlt_read(d->t, s->id, 0, sizeof mem, mem);
-		if (dr_gone(r))
-			return dxlt_bus_fail(d->t, s->id, r);
-		status[j] = r;
-		if (r != DXL_OK)
-			continue;
-		dr2_servo_decode(&d->servo2[j], mem);
-		d->servo2[j].id = s->id;
-		d->servo2[j].err = d->t->errseen2[s->id];
-		s->status_return_level = d->servo2[j].status_return_level;   /* what dr_pick_joints asks */
-		s->read = true;
-	}
-	return DXLT_EXIT_OK;
-}
-
-static void dr2_servo_lines(struct dr *d, size_t j, int read_status)
-{
-	const struct dr2_servo *s = &d->servo2[j];
-	struct dr_verdict v = { DR_FAIL, "" };
-
-	if (!d->servo[j].answered) {
-		dr_servo_lines(d, j, read_status);
-		return;
-	}
-	if (!d->servo[j].read) {
-		if (read_status == DXL_E_TIMEOUT)
-			snprintf(v.text, sizeof v.text, "answers PING but not READ: status return level 0, and the loop's "
-			         "SYNC_READ needs 1 or 2; fix: dxl --protocol 2 --port %s write %u status_return_level 2",
-			         d->cfg.port, d->servo[j].id);
-		else
-			snprintf(v.text, sizeof v.text, "answers PING, but its READ replies are bad (%s)%s",
-			         dxl_strerror(read_status), d->t->a.echo ? "" : "; a single-wire wiring? try --echo");
-		dr_servo_line(d, d->servo[j].id, "status level", &v);
-		return;
-	}
-	dr2_check_model(s, &d->ctx, &v);
-	dr_servo_line(d, s->id, "model", &v);
-	dr2_check_return_delay(s, &d->ctx, &v);
-	dr_servo_line(d, s->id, "return delay", &v);
-	dr2_check_status_level(s, &d->ctx, &v);
-	dr_servo_line(d, s->id, "status level", &v);
-	dr2_check_voltage(s, &v);
-	dr_servo_line(d, s->id, "voltage", &v);
-	dr2_check_temperature(s, &v);
-	dr_servo_line(d, s->id, "temperature", &v);
-	dr2_check_mode(s, &d->ctx, &v);
-	dr_servo_line(d, s->id, "operating mode", &v);
-	dr2_check_limits(s, &d->cfg, j, &d->ctx, &v);
-	dr_servo_line(d, s->id, "position limits", &v);
-	dr2_check_hwerr(s, &d->ctx, &v);
-	dr_servo_line(d, s->id, "hardware error", &v);
-	dr2_check_torque(s, &v);
-	dr_servo_line(d, s->id, "torque", &v);
-	dr2_check_watchdog(s, &d->ctx, &v);
-	dr_servo_line(d, s->id, "bus watchdog", &v);
-	if (dr2_check_err(s, &v))
-		dr_servo_line(d, s->id, "error field", &v);
-}
-
-static const struct dr_family dr_families[] = {
-	{ 1, dr_read_all, dr_servo_lines, dr1_servo_info },
-	{ 2, dr2_read_all, dr2_servo_lines, dr2_servo_info },
-};
-
-static const struct dr_family *dr_family_for(int protocol)
-{
-	for (size_t i = 0; i < sizeof dr_families / sizeof dr_families[0]; i++)
-		if (dr_families[i].protocol == protocol)
-			return &dr_families[i];
-	return &dr_families[0];
-}
-
 /* ---- the command --------------------------------------------------------------------------------- */
 
 static int dr_check(struct dr *d)
@@ -891,11 +844,11 @@ static int dr_check(struct dr *d)
 	dr_check_baud(&d->ctx, (unsigned)d->cfg.njoints, answered, &v);
 	dr_line(d, "baud", &v);
 	/* the servos' lines, then the timed cycles: undulated's own, holding */
-	if ((rc = d->fam->read_all(d, status)) != DXLT_EXIT_OK)
+	if ((rc = dr_read_all(d, status)) != DXLT_EXIT_OK)
 		return rc;
 	dr_context(d);
 	for (size_t j = 0; j < d->cfg.njoints; j++)
-		d->fam->servo_lines(d, j, status[j]);
+		dr_servo_lines(d, j, status[j]);
 	if (dr_check_echo(t->a.echo, t->bus.unexpected_echoes, t->bus.echo_errors, &v))
 		dr_line(d, "echo", &v);
 	return dr_budget(d);
@@ -911,7 +864,6 @@ int dxlt_cmd_doctor(struct dxlt *t)
 		return DXLT_EXIT_PORT;
 	}
 	d->t = t;
-	d->fam = dr_family_for(t->fam->protocol);
 	log_set_program("dxl");
 	rc = dr_configure(d);
 	if (rc == DXLT_EXIT_OK)

@@ -15,6 +15,8 @@
 #include <stdint.h>
 
 #include "bus.h"
+#include "dxl2_table.h"
+#include "dxl_proto.h"
 #include "daemon/config.h"
 #include "port.h"
 
@@ -30,41 +32,56 @@ struct dr_verdict {
 	char text[DR_TEXT_MAX];
 };
 /* Set a verdict; dr_add appends (a line cut at DR_TEXT_MAX stays terminated).
- * The checks of both protocols (doctor_checks.c, doctor_checks2.c) use them. */
+ * (doctor.c adds to a line the checks set.) */
 __attribute__((format(printf, 3, 4)))
 void dr_set(struct dr_verdict *v, enum dr_level level, const char *fmt, ...);
 __attribute__((format(printf, 2, 3)))
 void dr_add(struct dr_verdict *v, const char *fmt, ...);
 
-/* The two blocks read from every servo: EEPROM 0..18 (model .. alarm
- * shutdown) and RAM 24..43 (torque enable .. present temperature; the same
- * block undulated reads back in its slow round-robin). */
-#define DR_EEPROM_LEN 19
-#define DR_RAM_ADDR 24
-#define DR_RAM_LEN 20
-
-/* What one servo reported. */
+/* What one servo reported, whatever its model: its control table read
+ * from address 0 in one READ and decoded by register name through its model
+ * descriptor (dxl2_table.h), so a check asks the descriptor what the servo
+ * has (dxl2_model_can, or whether its table has the register), never which
+ * protocol it speaks. Where two models name one setting differently (the
+ * AX-12A's angle limits, the X series' position limits) the record has one
+ * field. */
 struct dr_servo {
 	uint8_t id;
 	bool answered;               /* a PING */
 	int ping_status;             /* the last PING's dxl_status (DXL_OK when answered) */
-	bool read;                   /* both blocks (status return level >= 1) */
+	bool read;                   /* its table (status return level >= 1) */
 	uint16_t model;
+	/* its descriptor; NULL when not in the tables, and then `table` is the
+	 * protocol's first model, whose addresses the checks read it with */
+	const struct dxl2_model *m, *table;
 	uint8_t firmware;
-	uint8_t return_delay;        /* register value, 2 us a unit */
-	uint16_t cw_limit, ccw_limit;
-	uint8_t temperature_limit;   /* °C */
-	uint8_t min_voltage, max_voltage;   /* 0.1 V */
-	uint16_t max_torque;
+	uint8_t return_delay;        /* register value, 2 us a unit on every model */
 	uint8_t status_return_level;
-	uint8_t alarm_led, alarm_shutdown;
-	uint8_t torque_enable;
+	uint8_t temperature_limit, temperature;      /* °C */
+	uint16_t min_voltage, max_voltage, voltage;  /* 0.1 V: limits, present */
+	int32_t min_limit, max_limit;   /* CW/CCW angle limits | min/max position limits, raw */
+	/* what switches torque off: Alarm Shutdown | Shutdown. Overheating and
+	 * overload are the same bits in both (doctor_checks.c asserts it) */
+	uint8_t shutdown;
+	bool has_alarm_led;          /* the table has Alarm LED (the AX-12A's alarm pair) */
+	uint8_t alarm_led;
+	uint16_t max_output;         /* Max Torque | PWM Limit: the torque limit's ceiling */
+	bool has_torque_limit;       /* the table has Torque Limit (RAM): an alarm zeroes it */
 	uint16_t torque_limit;
-	uint8_t voltage;             /* present, 0.1 V */
-	uint8_t temperature;         /* present, °C */
-	uint8_t errbits;             /* OR of the error bytes of its replies */
+	uint8_t torque_enable;
+	uint8_t operating_mode;      /* DXL2_CAP_OPMODE */
+	uint8_t hwerr;               /* DXL2_CAP_HWERR_STATUS: Hardware Error Status */
+	uint8_t bus_watchdog;        /* DXL2_CAP_WATCHDOG: 20 ms a unit; 0 off; 255 (-1): it fired */
+	uint8_t errbits;             /* OR of the error fields of its replies (the protocol's) */
 };
-void dr_servo_decode(struct dr_servo *s, const uint8_t eeprom[DR_EEPROM_LEN], const uint8_t ram[DR_RAM_LEN]);
+/* The bytes from address 0 the checks read of a model: every row the
+ * record takes (model number .. present temperature). */
+size_t dr_image_len(const struct dxl2_model *table);
+/* Fill s from table's image (len bytes from address 0): m is the model the
+ * image's model number names (NULL: not in the tables), table the one read
+ * with. Fields whose register the table lacks stay 0. */
+void dr_servo_decode(struct dr_servo *s, const struct dxl2_model *m, const struct dxl2_model *table,
+                     const uint8_t *image, size_t len);
 
 /* What the fixes name. */
 struct dr_context {
@@ -73,8 +90,14 @@ struct dr_context {
 	bool any_torque_on;          /* a servo had torque on (setup --yes makes it limp) */
 	long baud;
 	double period_ms;
-	int protocol;                /* 1 or 2: which cycle the baud line prices */
-	unsigned read_len2;          /* 2.0: the SYNC_READ's bytes a servo (DR2_READ_LEN...) */
+	/* the bus's protocol (its backend table): how undulated's loop reads
+	 * (one SYNC_READ where it can, else a READ a servo), what its replies'
+	 * error field means; its family's start-up rules (sm_family) name the
+	 * option a fix carries and whether an unknown model is refused */
+	const struct dxl_proto *proto;
+	/* the cycle's bytes a servo (daemon/servo_model.h): the present block
+	 * read, the goal written */
+	unsigned read_len, write_len;
 };
 
 /* ---- the bus ------------------------------------------------------------------------ */
@@ -113,92 +136,58 @@ void dr_check_latency(const struct dr_latency *l, struct dr_verdict *v);
  * not our request where an echo is expected. False (no line) when neither. */
 bool dr_check_echo(bool echo, uint32_t unexpected_echoes, uint32_t echo_errors, struct dr_verdict *v);
 
-/* The wire time of one cycle of undulated's for n servos at baud: a READ of
- * 8 bytes (answered by 14) per servo and a SYNC_WRITE of the goals, in µs. */
-double dr_cycle_wire_us(unsigned nservos, long baud);
-/* Protocol 2.0's cycle (the X series): one SYNC_READ of read_len bytes from
- * every servo — present velocity and position (128, 8 bytes), with the
- * present current before them on the XM430 (126, 10 bytes) — and one
- * SYNC_WRITE of 4-byte goal positions: (14 + N) + N·(11 + read_len) +
- * (14 + 5·N) bytes, stuffing not counted (the floor). In µs. */
-#define DR2_READ_LEN 8
-#define DR2_READ_LEN_CURRENT 10
-double dr2_cycle_wire_us(unsigned nservos, unsigned read_len, long baud);
+/* The wire time of one cycle of undulated's for n servos at baud, in µs:
+ * the present block of read_len bytes read (one SYNC_READ where the protocol
+ * has it, else a READ per servo) and one SYNC_WRITE of write_len bytes a
+ * servo, each packet's length from the protocol's own encoders, 10 bits a
+ * byte, 2.0's byte stuffing not counted (the floor). */
+double dr_cycle_wire_us(const struct dxl_proto *p, unsigned nservos, unsigned read_len, unsigned write_len,
+                        long baud);
 void dr_check_baud(const struct dr_context *c, unsigned asked, unsigned answered, struct dr_verdict *v);
 
 /* ---- each servo ------------------------------------------------------------------------ */
 void dr_check_model(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
-/* Appends the fix `dxl [PROTOCOL_OPT]--port P setup IDS --yes (WHAT)`:
- * PROTOCOL_OPT "" for the AX-12, "--protocol 2 " for the X series. */
-void dr_setup_fix(struct dr_verdict *v, const struct dr_context *c, const char *protocol_opt, const char *what);
+/* Appends the fix `dxl [OPT]--port P setup IDS --yes (WHAT)`, OPT the
+ * family's (sm_setup.dxl_opt: "" | "--protocol 2 "). */
+void dr_setup_fix(struct dr_verdict *v, const struct dr_context *c, const char *what);
 void dr_check_return_delay(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
 void dr_check_status_level(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
-/* The AX-12A runs on 9..12 V (ROBOTIS: recommended 11.1 V); torque and speed
- * scale with it. In the register's 0.1 V, so that 12.6 V is 126, not a
- * rounding away from a warning. A full 3S battery is 12.6 V. */
-#define DR_DECIVOLTS_MIN 90
-#define DR_DECIVOLTS_LOW 100
-#define DR_DECIVOLTS_MAX 126
+/* Against the servo's own limit registers, then its model's datasheet
+ * (rated_min_v .. rated_max_v, recommended rated_rec_v): below the rated
+ * minimum a FAIL, more than DR_VOLTS_BELOW_REC under the recommended
+ * supply a WARN (torque and speed scale with it), above the rated maximum
+ * by more than DR_VOLTS_OVER_SHARE a WARN: a full 3S battery (12.6 V) on a
+ * 12 V servo is 5 % over and is what the robots run on. */
+#define DR_VOLTS_BELOW_REC 1.0
+#define DR_VOLTS_OVER_SHARE 1.05
 void dr_check_voltage(const struct dr_servo *s, struct dr_verdict *v);
 /* Within this many °C of its limit a servo is warned about: a gait heats it
  * further, and at the limit it shuts down (if the alarm says so). */
 #define DR_TEMP_MARGIN_C 10
 void dr_check_temperature(const struct dr_servo *s, struct dr_verdict *v);
-/* The servo's angle limits against the configured joint's (neutral + limits,
- * as setup_joint_limits converts them). */
+/* The servo's angle (AX-12A) or position (X) limits against the configured
+ * joint's, converted as undulated's start-up writes them
+ * (setup_joint_limits_model: one rule for every model). */
 void dr_check_limits(const struct dr_servo *s, const struct cfg *cfg, size_t joint, const struct dr_context *c,
                      struct dr_verdict *v);
-/* Alarm shutdown: overheating and overload protect the motor (the factory's
- * 36); voltage, angle-limit, range, checksum or instruction switch torque
- * off for a sagging battery or one damaged packet. */
+/* Alarm Shutdown and Alarm LED, where the table has the pair (the
+ * AX-12A): overheating and overload protect the motor (the factory's 36);
+ * voltage, angle-limit, range, checksum or instruction switch torque off
+ * for a sagging battery or one damaged packet. (The X series' Shutdown is
+ * judged with its Hardware Error Status, dr_check_hwerr.) */
 #define DR_SHUTDOWN_WANT (DXL_ERRBIT_OVERHEAT | DXL_ERRBIT_OVERLOAD)
 void dr_check_alarms(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
+/* Operating Mode (DXL2_CAP_OPMODE): position control (3) holds its limits
+ * and takes goal positions. */
+void dr_check_mode(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
+/* Hardware Error Status (DXL2_CAP_HWERR_STATUS). */
+void dr_check_hwerr(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
 void dr_check_torque(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
-/* False (no line) when its replies carried no error bit. */
+/* Bus Watchdog (DXL2_CAP_WATCHDOG): shorter than two periods fires at the
+ * first late cycle. */
+void dr_check_watchdog(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
+/* False (no line) when its replies carried no error. */
 bool dr_check_errbits(const struct dr_servo *s, const struct dr_context *c, struct dr_verdict *v);
-
-/* ---- each servo, Protocol 2.0 (doctor_checks2.c) -------------------------------------------
- * One READ of addresses 0..147 (model number .. present temperature) per servo. */
-#define DR2_IMAGE_LEN 148
-struct dr2_servo {
-	uint8_t id;
-	uint16_t model;
-	uint8_t firmware;
-	uint8_t return_delay;        /* 2 us a unit */
-	uint8_t operating_mode;
-	uint8_t temperature_limit, temperature;   /* °C */
-	uint16_t max_voltage, min_voltage, voltage;   /* 0.1 V */
-	int32_t max_position, min_position;
-	uint8_t shutdown;            /* hardware error bits that switch torque off */
-	uint8_t torque_enable;
-	uint8_t status_return_level;
-	uint8_t hwerr;               /* Hardware Error Status (70) */
-	uint8_t bus_watchdog;        /* 20 ms a unit; 0 off; 255 (-1): it fired */
-	uint16_t pwm_limit;          /* PWM Limit (36): Goal PWM's ceiling, undulated's torque limit */
-	uint8_t err;                 /* OR of the ERR fields of its replies */
-};
-void dr2_servo_decode(struct dr2_servo *s, const uint8_t mem[DR2_IMAGE_LEN]);
-/* The supply each model is made for (e-manual, "Specifications"): the
- * XL430-W250 6.5..12.0 V (recommended 11.1 V), the XM430-W350 10.0..14.8 V
- * (recommended 12.0 V). False for a model not in the tables. */
-bool dr2_model_volts(uint16_t model, double *lo, double *rec, double *hi);
-void dr2_check_model(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
-void dr2_check_return_delay(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
-void dr2_check_status_level(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
-void dr2_check_voltage(const struct dr2_servo *s, struct dr_verdict *v);
-void dr2_check_temperature(const struct dr2_servo *s, struct dr_verdict *v);
-/* Operating mode 3 (position): the servo holds its limits and takes goal positions. */
-void dr2_check_mode(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
-/* Position limits (52, 48) against the configured joint's, in the X
- * series' 4096 a turn. */
-void dr2_check_limits(const struct dr2_servo *s, const struct cfg *cfg, size_t joint, const struct dr_context *c,
-                      struct dr_verdict *v);
-void dr2_check_hwerr(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
-void dr2_check_torque(const struct dr2_servo *s, struct dr_verdict *v);
-/* A watchdog shorter than two periods fires at the first late cycle. */
-void dr2_check_watchdog(const struct dr2_servo *s, const struct dr_context *c, struct dr_verdict *v);
-/* False (no line) when its replies carried no ERR field. */
-bool dr2_check_err(const struct dr2_servo *s, struct dr_verdict *v);
 
 /* ---- undulated's cycle, timed ------------------------------------------------------------- */
 struct dr_budget {

@@ -15,6 +15,8 @@
 #include "dxlt.h"
 
 struct dxlt;
+/* The protocols `dxl` speaks, numbered 1 .. DXLT_PROTOCOLS. */
+#define DXLT_PROTOCOLS 2
 /* What a command needs of the protocol it speaks beyond the bus's backend
  * table (bus.h) and the model descriptors (dxl2_table.h): chosen once at
  * start from --protocol (dxlt_family_for), then asked, never branched on. */
@@ -31,6 +33,10 @@ struct dxlt_family {
 	/* its PING answers the model number: commands identify the servo
 	 * first and take that model's table (else the family's first model's) */
 	bool ping_names_model;
+	const char *err_field;         /* what its replies' error field is called: "error bits" | "error" */
+	/* what to do about the protocol's alert bit (bus_proto's err_alert), "%s"
+	 * twice the family's option; NULL where it has none */
+	const char *alert_fix;
 	const char *no_rate;           /* set-baud's refusal, "%s" the rate asked */
 	const char *reset_form;        /* reset's usage */
 	/* reset without --yes: what it would set ("%s": the keep form's words) */
@@ -39,9 +45,6 @@ struct dxlt_family {
 	long (*baud_from_reg)(uint8_t v);
 	/* one rate of `scan`: a line per servo found */
 	int (*scan_at)(struct dxlt *t, long baud, unsigned *found);
-	/* `setup`'s last line: the bus time of one cycle of the daemon's loop
-	 * for n servos (current: one senses its current) */
-	void (*setup_budget)(struct dxlt *t, unsigned n, bool current, int latency_ms);
 };
 
 struct dxlt {
@@ -52,11 +55,13 @@ struct dxlt {
 	struct port *port;
 	struct port_latency latency;
 	struct bus bus;
-	/* Error bits any reply carried, per ID: the servo's news, reported once
-	 * when the command ends (dxlt_report_errbits), whichever call saw them. */
-	uint8_t errseen[DXL_BROADCAST_ID + 1];
-	/* Protocol 2.0: the ERR fields (alert bit, error number), per ID. */
-	uint8_t errseen2[DXL2_BROADCAST_ID + 1];
+	/* The error field any reply carried, per protocol and ID: the servo's
+	 * news, reported once when the command ends (dxlt_report_errbits),
+	 * whichever call saw them. A row per protocol (number - 1): scan speaks
+	 * both, and a field means what its protocol says (1.0's error bits,
+	 * 2.0's alert bit and error number; the protocol table's err_format
+	 * names it). dxlt_errors: the bus's protocol's. */
+	uint8_t errseen[DXLT_PROTOCOLS][DXL2_BROADCAST_ID + 1];
 	char hint[200];          /* what to do about them, when we know */
 };
 
@@ -71,13 +76,15 @@ int dxlt_open(struct dxlt *t, const char *path, bool low_latency);
 void dxlt_apply_timing(struct dxlt *t);
 /* One line for a failed transaction, and its exit code. */
 int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status);
-/* Transactions whose replies' error bits are remembered in t->errseen. */
+/* Transactions whose replies' error fields are remembered in t->errseen. */
 int dxlt_ping(struct dxlt *t, uint8_t id);
 /* PING, and the model number where the protocol's PING carries one
  * (*model untouched where it does not). */
 int dxlt_ping_model(struct dxlt *t, uint8_t id, uint16_t *model);
 /* An error byte a reply carried outside these (a REBOOT's). */
 void dxlt_seen(struct dxlt *t, uint8_t id, uint8_t e);
+/* The error fields remembered of id's replies on the bus's protocol. */
+uint8_t dxlt_errors(const struct dxlt *t, uint8_t id);
 int dxlt_read(struct dxlt *t, uint8_t id, uint16_t addr, uint16_t len, uint8_t *out);
 int dxlt_write(struct dxlt *t, uint8_t id, uint16_t addr, const uint8_t *data, size_t n, bool expect_reply);
 /* The address of a register every model of the protocol has at one place
@@ -140,11 +147,15 @@ int dxlt_cmd_dump(struct dxlt *t);
 int dxlt_cmd_write(struct dxlt *t);
 int dxlt_cmd_torque(struct dxlt *t);
 int dxlt_cmd_setup(struct dxlt *t);
+/* ---- commands.c ---- */
+struct sm_model;
+/* setup's last line: the bus time of one cycle of undulated's loop for n
+ * servos of model m (the one whose cycle reads the most). */
+void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int latency_ms);
 
 /* ---- Protocol 2.0 (commands2.c) ---- */
 /* Broadcast PING at the current rate: one scan line per servo in the ID range. */
 int dxlt2_scan_at(struct dxlt *t, long baud, unsigned *found);
-void dxlt2_setup_budget(struct dxlt *t, unsigned n, bool current, int latency_ms);
 
 /* `dxl doctor` (doctor.c): opens the port itself, after reading the
  * configuration that may name it. */

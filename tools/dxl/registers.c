@@ -13,6 +13,8 @@
 
 #include "dxl2.h"
 #include "dxl2_table.h"
+#include "dxl_proto.h"
+#include "daemon/servo_model.h"
 #include "dxlt_priv.h"
 #include "num.h"
 
@@ -294,21 +296,56 @@ static int dxlt_check_live(struct dxlt *t, const struct dxlt_servo *s, const str
 	return DXLT_EXIT_OK;
 }
 
-/* Why the servo refused a write, when its error bits say (the bits alone
- * name the symptom, not the remedy): Protocol 1.0's bits, kept per ID. */
+/* What a refused write's error field says, per protocol (the field names the
+ * symptom, not the remedy): (err & mask) == value, for a write to EEPROM or
+ * to the goal position. 2.0's field is an error number, 1.0's a set of bits;
+ * `dxl` refuses most of the 2.0 cases before sending (the family's
+ * eeprom_needs_torque_off, dxl2_reg_check_write_live), the servo has the
+ * last word. */
+static const struct dxlt_refusal {
+	const struct dxl_proto *proto;
+	uint8_t mask, value;
+	bool eeprom;                  /* else the goal position */
+} dxlt_refusals[] = {
+	{ &dxl_proto_v1, DXL_ERRBIT_RANGE, DXL_ERRBIT_RANGE, true },
+	{ &dxl_proto_v1, DXL_ERRBIT_ANGLE_LIMIT, DXL_ERRBIT_ANGLE_LIMIT, false },
+	{ &dxl_proto_v2, (uint8_t)~DXL2_ERR_ALERT, DXL2_ERRNUM_ACCESS, true },
+	{ &dxl_proto_v2, (uint8_t)~DXL2_ERR_ALERT, DXL2_ERRNUM_DATA_LIMIT, false },
+};
+
+/* The registers that bound a goal position: the model's pair. */
+static const char *const *dxlt_limit_rows(const struct dxl2_model *m)
+{
+	static const char *const pairs[][2] = {
+		{ "cw_angle_limit", "ccw_angle_limit" }, { "min_position_limit", "max_position_limit" },
+	};
+	for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++)
+		if (dxl2_reg_lookup(m, pairs[i][0]) != NULL)
+			return pairs[i];
+	return NULL;
+}
+
 static void dxlt_write_hint(struct dxlt *t, const struct dxlt_servo *s, const struct dxlt_reg *reg)
 {
-	uint8_t e = t->errseen[s->id];
+	uint8_t e = dxlt_errors(t, s->id);
+	const struct dxl_proto *p = bus_proto(&t->bus);
 
 	if (reg->row == NULL || s->m == NULL)
 		return;
-	if ((e & DXL_ERRBIT_RANGE) && reg->row->area == DXL_AREA_EEPROM)
-		snprintf(t->hint, sizeof t->hint, "the %s refuses EEPROM writes (%s) while torque "
-		         "is on or the lock is set: dxl %s--port %s torque %u off", s->m->name, reg->name, t->fam->opt,
-		         port_path(t->port), s->id);
-	else if ((e & DXL_ERRBIT_ANGLE_LIMIT) && strcmp(reg->name, "goal_position") == 0)
-		snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's angle limits: dxl "
-		         "%s--port %s read %u cw_angle_limit (and ccw_angle_limit)", t->fam->opt, port_path(t->port), s->id);
+	for (size_t i = 0; i < sizeof dxlt_refusals / sizeof dxlt_refusals[0]; i++) {
+		const struct dxlt_refusal *r = &dxlt_refusals[i];
+		if (r->proto != p || (e & r->mask) != r->value)
+			continue;
+		const char *const *lim = dxlt_limit_rows(s->m);
+		if (r->eeprom && reg->row->area == DXL_AREA_EEPROM)
+			snprintf(t->hint, sizeof t->hint, "the %s refuses EEPROM writes (%s) while torque is on or the lock "
+			         "is set: dxl %s--port %s torque %u off", s->m->name, reg->name, t->fam->opt,
+			         port_path(t->port), s->id);
+		else if (!r->eeprom && strcmp(reg->name, "goal_position") == 0 && lim != NULL)
+			snprintf(t->hint, sizeof t->hint, "the goal is outside the servo's %s limits: dxl %s--port %s read %u "
+			         "%s (and %s)", sm_family(t->fam->protocol)->limits_name, t->fam->opt, port_path(t->port), s->id,
+			         lim[0], lim[1]);
+	}
 }
 
 static bool dxlt_is_level_reg(const struct dxlt_reg *reg)
@@ -364,7 +401,7 @@ static int dxlt_write_checked(struct dxlt *t, const struct dxlt_servo *s, const 
 		else
 			fprintf(t->err, "dxl: ID %u kept %s at %ld (wrote %ld; status return level %u: the WRITE itself is "
 			        "not answered, its read-back is)\n", id, reg->name, (long)dxlt_decode(reg, back), value, level);
-		return t->errseen[id] != 0 || t->errseen2[id] != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+		return dxlt_errors(t, id) != 0 ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
 	}
 	/* what the servo holds, in the register's own signedness */
 	long held = (long)dxlt_decode(reg, back);
@@ -464,7 +501,7 @@ static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const cha
                            const uint8_t *mem, uint8_t level)
 {
 	const struct dxl2_reg *reg = dxl2_reg_lookup(s->m, name);
-	uint8_t id = s->id, have = mem[reg->addr], before = t->errseen[id] | t->errseen2[id];
+	uint8_t id = s->id, have = mem[reg->addr], before = dxlt_errors(t, id);
 	int r;
 
 	if (have == want) {
@@ -473,7 +510,7 @@ static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const cha
 	}
 	if ((r = dxlt_write(t, id, reg->addr, &want, 1, level >= 2 && strcmp(name, "status_return_level") != 0)) != DXL_OK)
 		return dxlt_bus_fail(t, id, r);
-	if ((t->errseen[id] | t->errseen2[id]) & ~before)
+	if ((dxlt_errors(t, id)) & ~before)
 		return DXLT_EXIT_SERVO;   /* refused: reported with the others at the end */
 	dxlt_sleep_us(t->fam->settle_us);
 	if ((r = dxlt_read(t, id, reg->addr, 1, &have)) != DXL_OK)
@@ -481,13 +518,14 @@ static int dxlt_setup_byte(struct dxlt *t, const struct dxlt_servo *s, const cha
 	if (have != want) {
 		fprintf(t->err, "dxl: ID %u kept %s at %u (wrote %u)%s\n", id, name, have, want,
 		        dxl2_reg_lookup(s->m, "lock") != NULL ? ": EEPROM locked? (lock register; power-cycle)" : "");
-		return t->errseen[id] | t->errseen2[id] ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
+		return dxlt_errors(t, id) ? DXLT_EXIT_SERVO : DXLT_EXIT_BUS;
 	}
 	fprintf(t->out, "ID %u: %s set to %u\n", id, name, want);
 	return DXLT_EXIT_OK;
 }
 
-static int dxlt_setup_one(struct dxlt *t, uint8_t id, bool *current)
+/* *loop: the model whose cycle reads the most bytes, for setup's budget line. */
+static int dxlt_setup_one(struct dxlt *t, uint8_t id, const struct sm_model **loop)
 {
 	uint8_t mem[DXLT_IMAGE_MAX];
 	struct dxlt_servo s;
@@ -502,7 +540,9 @@ static int dxlt_setup_one(struct dxlt *t, uint8_t id, bool *current)
 		        "know its registers\n", id, s.model, dxlt_known(t));
 		return DXLT_EXIT_REFUSED;
 	}
-	*current = *current || s.m->current_sensing;
+	const struct sm_model *sm = sm_by_number(t->fam->protocol, s.m->number);
+	if (sm != NULL && (*loop == NULL || sm->present_len > (*loop)->present_len))
+		*loop = sm;
 	/* The loop READs every cycle, so level 0 (PING only) cannot work. */
 	if ((r = dxlt_read(t, id, 0, (uint16_t)dxlt_image_len(s.m), mem)) != DXL_OK) {
 		fprintf(t->err, "dxl: ID %u answers PING but not READ: status return level 0? (the loop's reads need 1 "
@@ -566,7 +606,7 @@ int dxlt_cmd_setup(struct dxlt *t)
 {
 	uint8_t ids[DXLT_MAX_IDS];
 	int worst = DXLT_EXIT_OK, n = t->a.npos;
-	bool current = false;   /* a servo senses its current: the loop reads it too */
+	const struct sm_model *loop = NULL;   /* the servo whose cycle reads the most */
 
 	if (n < 1 || n > t->fam->max_id + 1)
 		return dxlt_need_form(t, -1, "setup ID... [--status-level N] [--yes]");
@@ -576,7 +616,7 @@ int dxlt_cmd_setup(struct dxlt *t)
 			return rc;
 	}
 	for (int i = 0; i < n; i++) {
-		int rc = dxlt_setup_one(t, ids[i], &current);
+		int rc = dxlt_setup_one(t, ids[i], &loop);
 		if (rc == DXLT_EXIT_PORT)
 			return rc;
 		worst = rc > worst ? rc : worst;
@@ -586,7 +626,8 @@ int dxlt_cmd_setup(struct dxlt *t)
 	/* The adapter: lower the FTDI latency timer now that the servos are done. */
 	port_latency_check_fd(port_path(t->port), port_fd(t->port), true, &t->latency);
 	fprintf(t->out, "adapter: %s\n", t->latency.note);
-	t->fam->setup_budget(t, (unsigned)n, current, t->latency.known ? t->latency.timer_ms : 0);
+	dxlt_setup_budget(t, (unsigned)n, loop != NULL ? loop : sm_family(t->fam->protocol),
+	                  t->latency.known ? t->latency.timer_ms : 0);
 	if (t->latency.known && t->latency.timer_ms > 1) {
 		fprintf(t->err, "dxl: %s\n", t->latency.note);
 		if (worst == DXLT_EXIT_OK)

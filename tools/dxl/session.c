@@ -95,11 +95,15 @@ int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
 	}
 }
 
-/* Where a reply's error byte is remembered: on a 2.0 bus the byte is the
- * ERR field, kept apart and named apart (dxlt_report_errbits). */
+/* Where a reply's error field is remembered: the bus's protocol's row. */
 static uint8_t *dxlt_errseen(struct dxlt *t, uint8_t id)
 {
-	return bus_get_protocol(&t->bus) == BUS_PROTOCOL_2 ? &t->errseen2[id] : &t->errseen[id];
+	return &t->errseen[bus_proto(&t->bus)->number - 1][id];
+}
+
+uint8_t dxlt_errors(const struct dxlt *t, uint8_t id)
+{
+	return t->errseen[bus_proto(&t->bus)->number - 1][id];
 }
 
 void dxlt_seen(struct dxlt *t, uint8_t id, uint8_t e)
@@ -259,6 +263,6 @@ int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware)
 	uint8_t e = 0;
 	int r = bus_ping_model(&t->bus, id, model, firmware, &e);
 	if (r == DXL_OK)
-		t->errseen2[id] |= e;
+		*dxlt_errseen(t, id) |= e;
 	return r;
 }
