@@ -247,6 +247,17 @@ rig_up() {
 	spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 }
 
+# demo_leftovers: what a demo run left behind under $T/tmp (its TMPDIR):
+# processes whose command line names it, and files in it; nothing: status 0.
+demo_leftovers() {
+	local procs files
+	procs=$(pgrep -af -- "$T/tmp" | grep -v pgrep)
+	files=$(find "$T/tmp" -mindepth 1 2>/dev/null)
+	[ -z "$procs$files" ] && return 0
+	echo "processes: ${procs:-none}; files: ${files:-none}"
+	return 1
+}
+
 # start_retried: the script's start_daemon, and once more as a unit's
 # Restart=on-failure would when that start-up failed (exit 1, e.g. a servo
 # read timing out on a loaded machine) before the script's `ready`; the

@@ -24,16 +24,6 @@ mkdir -p "$T/tmp"
 # 7850-7854 so that two copies of this test running at once rarely meet.
 url=$(lcm_url $((7850 + $$ % 5)))
 
-# leftovers: processes whose command line names the demo's directory, and files in it.
-leftovers() {
-	local procs files
-	procs=$(pgrep -af -- "$T/tmp" | grep -v pgrep)
-	files=$(find "$T/tmp" -mindepth 1 2>/dev/null)
-	[ -z "$procs$files" ] && return 0
-	echo "processes: ${procs:-none}; files: ${files:-none}"
-	return 1
-}
-
 # ---- a headless run, as `make demo DEMO_SECONDS=35 DEMO_OUT=...` ----------------
 seconds=35
 spawn demo env BUILD="$BUILD" DEMO_SECONDS=$seconds DEMO_LCM_URL="$url" TMPDIR="$T/tmp" \
@@ -135,7 +125,7 @@ if grep -q '^restitution for theory: 0.670 (the simulator.s, SIM.WORLD)' "$T/out
 else
 	tap_fail "the analysis takes the restitution from the simulator's SIM.WORLD" "$(grep -i restitution "$T/out/summary.txt")"
 fi
-if why=$(leftovers); then tap_ok "nothing left behind after a full run"; else tap_fail "nothing left behind after a full run" "$why"; fi
+if why=$(demo_leftovers); then tap_ok "nothing left behind after a full run"; else tap_fail "nothing left behind after a full run" "$why"; fi
 
 # ---- the paper's effect: the same scene in lockstep ----------------------------------------
 # (docs/EXPERIMENTS.md section 4: the simulator's total impulse per second,
@@ -192,7 +182,7 @@ if [ -n "$xratio" ] && awk -v r="$xratio" 'BEGIN { exit !(r >= 10) }' || echo "$
 else
 	tap_todo "XM430 robots: the contact force falls 10x or more" "${xwords:-no words}"
 fi
-if why=$(leftovers); then tap_ok "nothing left behind after the lockstep run"; else tap_fail "nothing left behind after the lockstep run" "$why"; fi
+if why=$(demo_leftovers); then tap_ok "nothing left behind after the lockstep run"; else tap_fail "nothing left behind after the lockstep run" "$why"; fi
 
 # ---- stopped early ---------------------------------------------------------------
 # SIGTERM (what `timeout`, a service manager or a closing terminal sends)
@@ -212,7 +202,7 @@ if wait_log demo2 '^demo: phases' 40; then
 	else
 		tap_fail "SIGTERM stops the demo (exit 143) after it made 4 pty links" "links $links, exit $rc; its log: $(tail -n 12 "$T/demo2.log")"
 	fi
-	if why=$(leftovers); then tap_ok "nothing left behind after SIGTERM"; else tap_fail "nothing left behind after SIGTERM" "$why"; fi
+	if why=$(demo_leftovers); then tap_ok "nothing left behind after SIGTERM"; else tap_fail "nothing left behind after SIGTERM" "$why"; fi
 else
 	tap_fail "second demo starts" "$(tail -n 20 "$T/demo2.log")"
 fi
@@ -246,7 +236,7 @@ if command -v script >/dev/null; then
 	else
 		tap_fail "interactive: q prints the summary and keeps the run" "$(echo "$screen" | tail -n 15; ls "$T/iout" 2>&1)"
 	fi
-	if why=$(leftovers); then tap_ok "nothing left behind after q"; else tap_fail "nothing left behind after q" "$why"; fi
+	if why=$(demo_leftovers); then tap_ok "nothing left behind after q"; else tap_fail "nothing left behind after q" "$why"; fi
 
 	( wait_for 40 grep -q 'r4 ' "$T/tty2.out"; sleep 2; printf '\003'; sleep 5 ) |
 		env BUILD="$BUILD" DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/iout2" \
@@ -259,13 +249,13 @@ if command -v script >/dev/null; then
 	else
 		tap_fail "interactive: Ctrl-C ends the demo" "exit $rc; $(clean "$T/tty2.out" | tail -n 10)"
 	fi
-	if why=$(leftovers); then tap_ok "nothing left behind after Ctrl-C"; else tap_fail "nothing left behind after Ctrl-C" "$why"; fi
+	if why=$(demo_leftovers); then tap_ok "nothing left behind after Ctrl-C"; else tap_fail "nothing left behind after Ctrl-C" "$why"; fi
 fi
 
 # ---- bad input --------------------------------------------------------------------
 out=$(BUILD="$BUILD" DEMO_SECONDS=abc TMPDIR="$T/tmp" "$demo" 2>&1)
 rc=$?
-if [ "$rc" -ne 0 ] && [[ "$out" == *"DEMO_SECONDS"* ]] && why=$(leftovers); then
+if [ "$rc" -ne 0 ] && [[ "$out" == *"DEMO_SECONDS"* ]] && why=$(demo_leftovers); then
 	tap_ok "bad DEMO_SECONDS: clear message, nothing started"
 else
 	tap_fail "bad DEMO_SECONDS: clear message, nothing started" "exit $rc: $out"

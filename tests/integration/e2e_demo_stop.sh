@@ -14,14 +14,6 @@ scen="$top/sim-bridge/scenarios/channel4.scenario"
 mkdir -p "$T/tmp"
 url=$(lcm_url $((7862 + $$ % 3)))
 
-leftovers() {
-	local procs files
-	procs=$(pgrep -af -- "$T/tmp" | grep -v pgrep)
-	files=$(find "$T/tmp" -mindepth 1 2>/dev/null)
-	[ -z "$procs$files" ] && return 0
-	echo "processes: ${procs:-none}; files: ${files:-none}"
-	return 1
-}
 # kept DIR: the run so far is there: a log with messages in it, every program's log, the report
 kept() {
 	[ -s "$1/demo.lcmlog" ] && [ -f "$1/logs/sim.log" ] && [ -f "$1/logs/undulated-r1.log" ] && [ -s "$1/early-stop.txt" ]
@@ -48,7 +40,7 @@ if wait_log d1 '^demo: phases' 40; then
 	else
 		tap_fail "the kept log analyses with the command printed" "'$next': $(tail -n 3 "$T/next1.out")"
 	fi
-	if why=$(leftovers); then tap_ok "nothing left behind after SIGTERM"; else tap_fail "nothing left behind after SIGTERM" "$why"; fi
+	if why=$(demo_leftovers); then tap_ok "nothing left behind after SIGTERM"; else tap_fail "nothing left behind after SIGTERM" "$why"; fi
 else
 	tap_fail "demo starts" "$(tail -n 20 "$T/d1.log")"
 fi
@@ -68,7 +60,7 @@ if wait_log d2 '^demo: phases' 40; then
 	else
 		tap_fail "a daemon killed during the run: named, the run kept" "exit $rc; $(tail -n 12 "$T/d2.log"); $(ls "$T/out2" 2>&1)"
 	fi
-	if why=$(leftovers); then tap_ok "nothing left behind after a killed daemon"; else tap_fail "nothing left behind after a killed daemon" "$why"; fi
+	if why=$(demo_leftovers); then tap_ok "nothing left behind after a killed daemon"; else tap_fail "nothing left behind after a killed daemon" "$why"; fi
 else
 	tap_fail "demo starts" "$(tail -n 20 "$T/d2.log")"
 fi
@@ -92,7 +84,7 @@ if [ "$rc" = 130 ] && echo "$screen" | grep -qE '^demo: stopped early \(Ctrl-C\)
 else
 	tap_fail "Ctrl-C of a lockstep run says what ran and keeps the run" "exit $rc; $(echo "$screen" | tail -n 8); $(ls "$T/out3" 2>&1)"
 fi
-if why=$(leftovers); then tap_ok "nothing left behind after Ctrl-C in lockstep"; else tap_fail "nothing left behind after Ctrl-C in lockstep" "$why"; fi
+if why=$(demo_leftovers); then tap_ok "nothing left behind after Ctrl-C in lockstep"; else tap_fail "nothing left behind after Ctrl-C in lockstep" "$why"; fi
 
 # ---- q before the switch: the summary says the oscillator never ran ------------------------
 ( wait_for 40 grep -q 'r4 ' "$T/tty2.out"; sleep 2; printf 'q'; wait_for 60 grep -q 'Next, the plots' "$T/tty2.out" ) |
@@ -106,5 +98,5 @@ if [ "$rc" = 0 ] && echo "$screen" | grep -qE '^THE OSCILLATOR NEVER RAN: the ru
 else
 	tap_fail "q before the switch: the summary says the oscillator never ran" "exit $rc; $(echo "$screen" | sed -n '/=== undulate demo/,+4p')"
 fi
-if why=$(leftovers); then tap_ok "nothing left behind after q"; else tap_fail "nothing left behind after q" "$why"; fi
+if why=$(demo_leftovers); then tap_ok "nothing left behind after q"; else tap_fail "nothing left behind after q" "$why"; fi
 tap_done
