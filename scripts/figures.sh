@@ -302,7 +302,7 @@ if [ -n "$export_file" ]; then
 	write_jobs "$runs" $mods >"$export_file" || exit 1
 	echo "figures: $(wc -l <"$export_file") runs in $export_file; from the top of the checkout ($top):"
 	echo "  parallel --joblog runs.joblog < $export_file                    (here, or --sshloginfile HOSTS)"
-	echo "  sbatch --array=1-$(wc -l <"$export_file")%50 scripts/figures-slurm.sh $export_file   (Slurm)"
+	echo "  sbatch --array=1-$(wc -l <"$export_file")%50 --output=$runs/slurm-%A_%a.out scripts/figures-slurm.sh $export_file   (Slurm)"
 	echo "then: scripts/figures.sh --merge $runs"
 	exit 0
 fi
