@@ -58,7 +58,7 @@ run() {
 	fig_uint DELTA0_POINTS "$na" 1 360
 	fig_uint SECONDS "$secs" 20 3600
 	fig_run_start "$out"
-	outdir_new "$out/model.csv" "$out/grid.csv" "$out/theory.csv" "$out/result.csv" ||
+	outdir_new "$out/model.csv" "$out/grid.csv" "$out/theory.csv" "$out/pair.log" "$out/result.csv" ||
 		{ echo "$FIG_NAME: cannot write in $out" >&2; return 1; }
 	awk -v nd="$nd" -v na="$na" 'BEGIN { pi = atan2(0, -1)
 		for (i = 0; i < nd; i++) for (j = 0; j < na; j++) printf "%.6f,%.6f\n", i / (nd - 1), -pi + 2 * pi * (j + 0.5) / na }' >"$out/grid.csv"
