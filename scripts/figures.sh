@@ -33,7 +33,7 @@ fig_init figures
 self="$top/scripts/figures.sh"
 
 # The page's order: the paper's. Modules not named here follow by name.
-ORDER="heatmap pair returnmap rows channel swimmer channel-plane forces forces-plane"
+ORDER="heatmap steady pair returnmap rows channel swimmer channel-plane forces forces-plane"
 # Progress: a new line this often when stdout is not a terminal (s).
 PROGRESS_EVERY_S=30
 
@@ -302,7 +302,7 @@ if [ -n "$export_file" ]; then
 	write_jobs "$runs" $mods >"$export_file" || exit 1
 	echo "figures: $(wc -l <"$export_file") runs in $export_file; from the top of the checkout ($top):"
 	echo "  parallel --joblog runs.joblog < $export_file                    (here, or --sshloginfile HOSTS)"
-	echo "  sbatch --array=1-$(wc -l <"$export_file")%50 scripts/figures-slurm.sh $export_file   (Slurm)"
+	echo "  sbatch --array=1-$(wc -l <"$export_file")%50 --output=$runs/slurm-%A_%a.out scripts/figures-slurm.sh $export_file   (Slurm)"
 	echo "then: scripts/figures.sh --merge $runs"
 	exit 0
 fi

@@ -61,6 +61,34 @@ tap_check "d~ = 0.3 from 1.0 rad: one collision, then no more" \
 tap_check "d~ = 0.6 from 2.5 rad: anti-phase, colliding every period" \
 	jq -e '.pairs[0].class == "anti-phase" and .pairs[0].window_collisions >= 7' "$T/p6/summary.json"
 
+# Anti-phase kicked: a pair locked at pi stays there collision after
+# collision; kicked by 0.05 rad it comes back where pi is stable (d~ 0.5 > d~_c
+# 0.316 at r 0.67), the kick shrinking by |f'(pi)| per collision, and leaves
+# where it is not (d~ 0.25), the kick growing by |f'(pi)| — the theory's
+# slopes from undulate-analyze --theory curves (0.430 and 1.170).
+fp() { "$B/undulate-analyze" --theory curves --restitution 0.67 --points 5 | awk -F, -v d="$1" -v c="${2:-4}" '$1 == d { print $c }'; }
+"$M" pair --dsep 0.5 --delta0 3.14159265358979 --duration 20 --no-samples --out "$T/a0" --quiet >/dev/null 2>&1
+tap_check "anti-phase at d~ 0.5, locked: |delta| = pi (1e-8) at every collision" awk -F, '
+	function abs(x) { return x < 0 ? -x : x }
+	NR > 1 { n++; if (3.14159265358979 - abs($6) > 1e-8) bad++ } END { exit !(n >= 20 && !bad) }' "$T/a0/return_map.csv"
+# kicked RUN: the kick pi - |delta| before each of the first collisions, and its
+# ratio collision to collision (the first four)
+kicks() { awk -F, 'function abs(x) { return x < 0 ? -x : x }
+	NR > 1 && NR <= 6 { k[NR - 1] = 3.14159265358979 - abs($5) }
+	END { for (i = 2; i <= 5; i++) printf "%.4f ", k[i] / k[i - 1] }' "$1/return_map.csv"; }
+"$M" pair --dsep 0.5 --delta0 3.09159265358979 --duration 30 --no-samples --out "$T/a1" --quiet >/dev/null 2>&1
+f=$(fp 0.5) k=$(kicks "$T/a1")
+tap_check "kicked by 0.05 rad at d~ 0.5: back at pi (1e-6), the kick times $k per collision, |f'(pi)| = $f (1 %)" bash -c "
+	jq -e '.pairs[0].class == \"anti-phase\" and 3.14159265 - .pairs[0].mean_abs_delta < 1e-6' '$T/a1/summary.json' >/dev/null &&
+	awk -v k='$k' -v f='$f' 'BEGIN { n = split(k, a, \" \"); if (n != 4 || f == \"\") exit 1
+		for (i = 1; i <= n; i++) if ((a[i] - f)^2 > (0.01 * f)^2) exit 1 }'"
+"$M" pair --dsep 0.25 --delta0 3.09159265358979 --duration 30 --no-samples --out "$T/a2" --quiet >/dev/null 2>&1
+f=$(fp 0.25) k=$(kicks "$T/a2") lim=$(fp 0.25 2)
+tap_check "kicked by 0.05 rad at d~ 0.25: leaves pi for the compatible set (below 2 asin(d~) = $lim), the kick times $k per collision, |f'(pi)| = $f (2 %)" bash -c "
+	jq -e '.pairs[0].class == \"compatible\" and .pairs[0].mean_abs_delta < ${lim:-0}' '$T/a2/summary.json' >/dev/null &&
+	awk -v k='$k' -v f='$f' 'BEGIN { n = split(k, a, \" \"); if (n != 4 || f == \"\") exit 1
+		for (i = 1; i <= n; i++) if ((a[i] - f)^2 > (0.02 * f)^2) exit 1 }'"
+
 # ---- a lattice: per-oscillator beta, fixed ends, walls, one seed one run ----
 run_lat() { "$M" lattice --n 8 --dsep 0.4 --beta 0.02 --fixed-ends --walls 0.1 --seed 7 --duration 60 \
 	--sample-hz 10 --out "$1" --quiet; }
