@@ -187,9 +187,9 @@ trap 'rm -rf "$UNDULATE_LOCK_DIR"' EXIT
 # Order: the unit tests and the alone scripts first, one at a time (started on
 # an idle machine, so no slot waits for the others to drain), then the
 # scripts that say "# run.sh: long" (started early, the run does not end
-# waiting on one of them) and the other scripts. Whatever fits in the free slots starts,
-# the first in this order first; results are counted and shown in the order the
-# programs started. TEST_JOBS=1 runs them one by one, in this order.
+# waiting on one of them) and the other scripts. They start in this order, each
+# as soon as its slots are free; results are counted and shown in that order.
+# TEST_JOBS=1 runs them one by one.
 jobs_max=${TEST_JOBS:-4}
 [[ "$jobs_max" =~ ^[1-9][0-9]?$ ]] || { echo "run.sh: TEST_JOBS must be 1..99, not '$jobs_max'" >&2; exit 2; }
 says() { grep -q "^# run.sh: $2" "$1"; }
@@ -240,25 +240,18 @@ while [ "$reported" -lt "${#names[@]}" ]; do
 		if over "$i"; then used=$((used - weights[i])); else still+=("$i"); fi
 	done
 	running=(${still[@]+"${still[@]}"})
-	# start, in the queue's order, whatever fits in the free slots; nothing
-	# passes an alone program that waits for the machine
-	rest=() k=0
-	for i in ${queued[@]+"${queued[@]}"}; do
-		k=$((k + 1))
-		if [ $((used + weights[i])) -le "$jobs_max" ]; then
-			n=${names[$i]}
-			rm -f "$logs/$n.rc"
-			( eval "execute \"\$n\" \"\$(limit_of $i)\" ${cmds[$i]}" >"$logs/$n.rc.tmp" 9>&-
-			  mv "$logs/$n.rc.tmp" "$logs/$n.rc"; echo >&9 ) &
-			order+=("$i") running+=("$i") used=$((used + weights[i]))
-		elif [ "${weights[$i]}" -eq "$jobs_max" ]; then
-			rest+=("${queued[@]:k-1}")
-			break
-		else
-			rest+=("$i")
-		fi
+	# start, in the queue's order, while the next one fits in the free slots:
+	# nothing passes a program that waits for slots (light ones passing a
+	# heavy one kept it waiting to the end of the run)
+	while [ "${#queued[@]}" -gt 0 ] && [ $((used + weights[queued[0]])) -le "$jobs_max" ]; do
+		i=${queued[0]}
+		queued=("${queued[@]:1}")
+		n=${names[$i]}
+		rm -f "$logs/$n.rc"
+		( eval "execute \"\$n\" \"\$(limit_of $i)\" ${cmds[$i]}" >"$logs/$n.rc.tmp" 9>&-
+		  mv "$logs/$n.rc.tmp" "$logs/$n.rc"; echo >&9 ) &
+		order+=("$i") running+=("$i") used=$((used + weights[i]))
 	done
-	queued=(${rest[@]+"${rest[@]}"})
 	# the finished ones, in the order they started
 	while [ "$reported" -lt "${#order[@]}" ] && over "${order[$reported]}"; do
 		i=${order[$reported]}
