@@ -275,10 +275,7 @@ static int dxlt_check_live(struct dxlt *t, const struct dxlt_servo *s, const str
 {
 	int32_t lo, hi;
 
-	/* a goal beyond its limit register is refused as the limit, even past
-	 * the largest value that register takes (dxl2_reg_limit_binds) */
-	bool limited = dxl2_reg_limit_binds(s->m, reg->row, mem, len);
-	if (!limited && dxl2_reg_check_write(s->m, reg->row, value) != DXL_OK) {
+	if (dxl2_reg_check_write(s->m, reg->row, value) != DXL_OK) {
 		fprintf(t->err, "dxl: the %s has no %s %ld (operating modes: dxl %sdump %u)\n", s->m->name, reg->name,
 		        value, t->fam->opt, s->id);
 		return DXLT_EXIT_USAGE;
