@@ -888,6 +888,62 @@ int bus_settle(struct bus *b, uint32_t quiet_us, uint32_t max_us)
 	return dropped > INT32_MAX ? INT32_MAX : (int)dropped;
 }
 
+/* Feed late bytes to the parser: the first whole packet's ID, or -1. */
+static int bus_late_feed(struct bus *b, const uint8_t *data, size_t n)
+{
+	size_t off = 0;
+	for (;;) {
+		struct dxl_frame pkt;
+		size_t used = 0;
+		int r = b->proto->parser_feed(&b->parser, data + off, n - off, &used, &pkt);
+		off += used;
+		if (r == DXL_FRAME)
+			return pkt.id;
+		if (r == DXL_NEED_MORE)
+			return -1;
+	}
+}
+
+int bus_listen_late(struct bus *b, uint32_t max_us, struct bus_late *out)
+{
+	if (b->pending)
+		return DXL_E_BUSY;
+	*out = (struct bus_late){ .id = -1 };
+	out->waited_us = b->deadline_us > b->started_us ? (uint32_t)(b->deadline_us - b->started_us) : 0;
+	b->proto->parser_reset(&b->parser);
+	uint64_t start = b->io.now_us(b->io.ctx);
+	int rc = DXL_OK;
+	while (out->id < 0) {
+		uint8_t chunk[BUS_READ_CHUNK];
+		long got = b->io.read(b->io.ctx, chunk, sizeof chunk);
+		uint64_t now = b->io.now_us(b->io.ctx);
+		if (got < 0) {
+			b->io_errors++;
+			rc = (int)got;
+			break;
+		}
+		if (got > 0) {
+			if (out->bytes == 0)
+				out->after_us = now > b->deadline_us ? (uint32_t)(now - b->deadline_us) : 0;
+			out->bytes += got;
+			b->bytes_in += (uint64_t)got;
+			out->id = bus_late_feed(b, chunk, (size_t)got);
+			continue;
+		}
+		if (now - start >= max_us)
+			break;
+		int w = b->io.wait(b->io.ctx, (uint32_t)(start + max_us - now));
+		if (w < 0) {
+			b->io_errors++;
+			rc = w;
+			break;
+		}
+	}
+	b->line_dirty = true;
+	b->proto->parser_reset(&b->parser);
+	return rc;
+}
+
 /* One encoded request (n bytes, or the encoder's negative status), its
  * reply if one is expected, and the reply's error byte / ERR field. The
  * reply stays in the bus (bus_reply) for the caller to copy out. */

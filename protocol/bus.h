@@ -331,4 +331,18 @@ int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsi
  * while a transaction is pending, or an I/O error. */
 int bus_settle(struct bus *b, uint32_t quiet_us, uint32_t max_us);
 
+/* After a single request timed out (DXL_E_TIMEOUT), whether its reply was
+ * late or never came: listen up to max_us more, and parse what comes as
+ * status packets. Stops at the first whole packet. What came is dropped
+ * (the next request flushes the line). */
+struct bus_late {
+	long bytes;              /* bytes that came after the deadline */
+	uint32_t waited_us;      /* the deadline the request had, from its start */
+	uint32_t after_us;       /* from the deadline to the first of them */
+	int id;                  /* the first whole packet's ID, or -1 */
+};
+/* DXL_OK (*out filled: bytes 0 = nothing came), DXL_E_BUSY while a
+ * transaction is pending, or an I/O error. */
+int bus_listen_late(struct bus *b, uint32_t max_us, struct bus_late *out);
+
 #endif

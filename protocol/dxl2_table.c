@@ -568,6 +568,25 @@ int dxl2_reg_range(const struct dxl2_model *m, const struct dxl2_reg *r, const u
 	return DXL_OK;
 }
 
+bool dxl2_reg_limit_binds(const struct dxl2_model *m, const struct dxl2_reg *r, const uint8_t *table, size_t len)
+{
+	int32_t v;
+	if (m == NULL || r == NULL)
+		return false;
+	switch (r->limit) {
+	case DXL2_LIMIT_SYMMETRIC:
+		return image_value(m, r->lim_addr, table, len, &v);
+	case DXL2_LIMIT_POSITION:
+		return image_value(m, DXL2_X_OPERATING_MODE, table, len, &v) && v == DXL2_OPMODE_POSITION &&
+		       image_value(m, DXL2_X_MIN_POSITION_LIMIT, table, len, &v) &&
+		       image_value(m, DXL2_X_MAX_POSITION_LIMIT, table, len, &v);
+	case DXL2_LIMIT_JOINT_MODE:   /* Protocol 1.0 has no data limit error */
+	case DXL2_LIMIT_NONE:
+	default:
+		return false;
+	}
+}
+
 int dxl2_reg_check_write_live(const struct dxl2_model *m, const struct dxl2_reg *r, long value,
                               const uint8_t *table, size_t len)
 {

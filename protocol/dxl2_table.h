@@ -263,8 +263,17 @@ int dxl2_reg_check_write(const struct dxl2_model *m, const struct dxl2_reg *r, l
  * range when the image does not reach the limit register. */
 int dxl2_reg_range(const struct dxl2_model *m, const struct dxl2_reg *r, const uint8_t *table,
                    size_t len, int32_t *lo, int32_t *hi);
+/* Whether the range that applies now is set by a limit register (Goal
+ * PWM/Current/Velocity always, Goal Position in position mode), read from
+ * the image: the e-manual's control table prints these ranges as "-PWM
+ * Limit(36) ~ PWM Limit(36)" and so on, so a value outside them, even one
+ * beyond the largest value the limit register takes, "exceeds the limit
+ * value": the data limit error (6). A register whose range is printed as
+ * numbers answers the data range error (4) instead. */
+bool dxl2_reg_limit_binds(const struct dxl2_model *m, const struct dxl2_reg *r, const uint8_t *table, size_t len);
 /* dxl2_reg_check_write and that range: the servo would answer a data limit
- * error (6) for a value this refuses. */
+ * error (6) for a value this refuses where dxl2_reg_limit_binds, else the
+ * data range error (4). */
 int dxl2_reg_check_write_live(const struct dxl2_model *m, const struct dxl2_reg *r, long value,
                               const uint8_t *table, size_t len);
 /* "2048 (180.0 deg)"-style text with units. Returns buf. */

@@ -311,7 +311,16 @@ static uint8_t xservo_length_error(const struct sim_xservo *s, uint16_t addr, si
 
 /* The values of every register written, checked against the new image: its
  * row's range (data range), its limit register (data limit), and the states
- * that refuse a value (the watchdog's error, a shutdown). */
+ * that refuse a value (the watchdog's error, a shutdown). One mistake, one
+ * number: the e-manual defines 0x04 as a value outside the range of the
+ * control table and 0x06 as one that "exceeds the limit value", and its
+ * table prints a goal's range as its limit register's (Goal PWM: -PWM
+ * Limit(36) ~ PWM Limit(36)). So a goal outside the range its limit register
+ * sets is the data limit error even when it is also beyond the largest
+ * value that register takes (Goal PWM 886 exceeds every PWM Limit, as 600
+ * exceeds a PWM Limit of 500); the data range error is for a register whose
+ * range is printed as numbers (PWM Limit itself, Operating Mode, Goal
+ * Position in Extended Position Control Mode). */
 static uint8_t xservo_value_error(const struct sim_xservo *s, uint16_t addr, size_t n, const uint8_t *img)
 {
 	uint8_t err = 0;
@@ -324,9 +333,10 @@ static uint8_t xservo_value_error(const struct sim_xservo *s, uint16_t addr, siz
 		 * takes only 0 (e-manual, Bus Watchdog): the data range error */
 		if (s->mem[A_WATCHDOG] == SIM_XSERVO_WATCHDOG_ERROR && (is_goal(r->addr) || (a == A_WATCHDOG && v != 0)))
 			return DXL2_ERRNUM_DATA_RANGE;
-		if (dxl2_reg_check_write(s->table, r, v) != DXL_OK)
+		bool limited = dxl2_reg_limit_binds(s->table, r, img, DXL2_X_TABLE_SIZE);
+		if (!limited && dxl2_reg_check_write(s->table, r, v) != DXL_OK)
 			return DXL2_ERRNUM_DATA_RANGE;
-		if (!err && dxl2_reg_check_write_live(s->table, r, v, img, DXL2_X_TABLE_SIZE) != DXL_OK)
+		if (!err && limited && dxl2_reg_check_write_live(s->table, r, v, img, DXL2_X_TABLE_SIZE) != DXL_OK)
 			err = DXL2_ERRNUM_DATA_LIMIT;
 		if (!err && a == A_TORQUE && v && s->latched)
 			err = DXL2_ERRNUM_RESULT_FAIL;   /* only REBOOT turns it on again */

@@ -105,6 +105,13 @@ expect "a PING with a bad CRC: the CRC error (3)" "$lbus" "$bad" "$(s2 1 3)"
 expect "temperature limit 101: data range (4)" "$lbus" "$(p2 1 3 31 0 101)" "$(s2 1 4)"
 expect "two bytes of the four-byte Goal Position: data length (5)" "$lbus" "$(p2 1 3 116 0 0 8)" "$(s2 1 5)"
 expect "goal position 5000 (limits 0..4095): data limit (6)" "$lbus" "$(p2 1 3 116 0 0x88 0x13 0 0)" "$(s2 1 6)"
+# one mistake, one number: a goal beyond its limit register is the data limit
+# error whether or not it is also beyond the largest value that register takes
+expect "goal PWM 886 (above every PWM limit): data limit (6)" "$lbus" "$(p2 1 3 100 0 0x76 3)" "$(s2 1 6)"
+expect "PWM limit 500" "$lbus" "$(p2 1 3 36 0 0xF4 1)" "$(s2 1 0)"
+expect "goal PWM 600 (PWM limit 500): data limit (6)" "$lbus" "$(p2 1 3 100 0 0x58 2)" "$(s2 1 6)"
+expect "PWM limit 886: data range (4), a fixed range" "$lbus" "$(p2 1 3 36 0 0x76 3)" "$(s2 1 4)"
+expect "PWM limit 885 again" "$lbus" "$(p2 1 3 36 0 0x75 3)" "$(s2 1 0)"
 expect "a write of Present Position: access (7)" "$lbus" "$(p2 1 3 132 0 0 0 0 0)" "$(s2 1 7)"
 expect "an instruction the servo lacks: instruction (2)" "$lbus" "$(p2 1 7)" "$(s2 1 2)"
 expect "ACTION with nothing registered: instruction (2)" "$lbus" "$(p2 1 5)" "$(s2 1 2)"

@@ -464,6 +464,47 @@ static void test_settle(void **state)
 	bus_abort(&bus);
 }
 
+/* After a timeout, a late reply is told from none (`dxl`'s message): bytes
+ * after the deadline, how late the first came, the ID of the packet. */
+static void test_listen_late(void **state)
+{
+	const struct backend_case *c = case_of(state);
+	setup_bus(c, false);
+	struct bus_late late;
+	/* nothing comes: the whole window, nothing seen */
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_E_TIMEOUT);
+	uint64_t start = fk.now;
+	assert_int_equal(bus_listen_late(&bus, 30000, &late), DXL_OK);
+	assert_int_equal(late.bytes, 0);
+	assert_int_equal(late.id, -1);
+	assert_int_equal(fk.now - start, 30000);
+	assert_int_equal(late.waited_us, c->ping_timeout_us);
+
+	/* a reply 7 ms after the deadline: named, and how late; the wait ends with it */
+	script_bytes(c->ping_reply, c->ping_timeout_us + 7000);
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_E_TIMEOUT);
+	start = fk.now;
+	assert_int_equal(bus_listen_late(&bus, 30000, &late), DXL_OK);
+	assert_int_equal(late.bytes, (long)c->ping_reply.n);
+	assert_int_equal(late.id, 1);
+	assert_true(late.after_us >= 7000 && late.after_us < 8000);
+	assert_true(fk.now - start < 8000);
+	assert_true(bus.line_dirty);   /* the next request flushes */
+
+	/* bytes that are no packet: counted, no ID */
+	static const uint8_t noise[] = { 0x55, 0x00, 0x13 };
+	assert_int_equal(bus_ping(&bus, 1, NULL), DXL_E_TIMEOUT);
+	fake_push(&fk, noise, sizeof noise, fk.now + 1000);
+	assert_int_equal(bus_listen_late(&bus, 30000, &late), DXL_OK);
+	assert_int_equal(late.bytes, 3);
+	assert_int_equal(late.id, -1);
+
+	/* not while a transaction is pending */
+	assert_int_equal(bus_begin(&bus, 1, DXL_INST_PING, NULL, 0, 0), DXL_OK);
+	assert_int_equal(bus_listen_late(&bus, 30000, &late), DXL_E_BUSY);
+	bus_abort(&bus);
+}
+
 static void test_io_errors_and_args(void **state)
 {
 	const struct backend_case *c = case_of(state);
@@ -1141,6 +1182,7 @@ int main(void)
 		BOTH(test_echo),
 		BOTH(test_stale_input_and_strays),
 		BOTH(test_settle),
+		BOTH(test_listen_late),
 		BOTH(test_io_errors_and_args),
 		BOTH(test_reply_lateness),
 		ONE(test_v1_timeout_formula),

@@ -599,6 +599,14 @@ static void test_x_write_checks(void **state)
 	/* an image too short for the limit: the static range */
 	assert_int_equal(dxl2_reg_check_write_live(xm, gcur, 1193, table, 38), DXL_OK);
 	assert_int_equal(dxl2_reg_check_write_live(xm, gcur, 1194, table, 38), DXL_E_ARG);
+	/* which refusals are the limit's (data limit) and which the row's own
+	 * range (data range): a goal whose limit register is in the image */
+	assert_true(dxl2_reg_limit_binds(xm, gcur, table, sizeof table));
+	assert_false(dxl2_reg_limit_binds(xm, gcur, table, 38));
+	assert_false(dxl2_reg_limit_binds(xm, goal, table, sizeof table));   /* extended mode */
+	table[DXL2_X_OPERATING_MODE] = DXL2_OPMODE_POSITION;
+	assert_true(dxl2_reg_limit_binds(xm, goal, table, sizeof table));
+	assert_false(dxl2_reg_limit_binds(xm, dxl2_reg_at(xm, DXL2_X_CURRENT_LIMIT), table, sizeof table));
 }
 
 static void test_x_conversions(void **state)

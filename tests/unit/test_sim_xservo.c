@@ -307,6 +307,8 @@ static void test_error_numbers(void **state)
 	assert_int_equal(wr(&s, 1, DXL2_X_MIN_POSITION_LIMIT, 1000, 4), 0);
 	assert_int_equal(wr(&s, 1, DXL2_X_GOAL_POSITION, 999, 4), DXL2_ERRNUM_DATA_LIMIT);
 	assert_int_equal(wr(&s, 1, DXL2_X_GOAL_POSITION, 1000, 4), 0);
+	/* ... also beyond the register's widest range: the limits bind here */
+	assert_int_equal(wr(&s, 1, DXL2_X_GOAL_POSITION, 1048576, 4), DXL2_ERRNUM_DATA_LIMIT);
 	/* ... in Extended Position Control Mode the limits do not bind */
 	assert_int_equal(wr(&s, 1, DXL2_X_OPERATING_MODE, DXL2_OPMODE_EXTENDED_POSITION, 1), 0);
 	assert_int_equal(wr(&s, 1, DXL2_X_GOAL_POSITION, 100000, 4), 0);
@@ -335,7 +337,7 @@ static void test_error_numbers(void **state)
 	static const uint8_t wrong_key[5] = { 0x01, 0x44, 0x58, 0x4C, 0x23 };
 	assert_int_equal(status(out, req(&s, 1, DXL2_INST_CLEAR, wrong_key, 5, out), 1, &st), DXL2_ERRNUM_DATA_RANGE);
 	assert_int_equal(s.count.result_fail, 1);
-	assert_true(s.count.access_errors >= 5 && s.count.data_limit_errors == 4 && s.count.data_length_errors == 2);
+	assert_true(s.count.access_errors >= 5 && s.count.data_limit_errors == 5 && s.count.data_length_errors == 2);
 }
 
 static void test_status_return_level_and_broadcast(void **state)
@@ -498,7 +500,11 @@ static void test_operating_modes(void **state)
 	assert_int_equal(wr(&xl, 1, DXL2_X_PROFILE_ACCELERATION, 10, 4), 0);
 	assert_int_equal(wr(&xl, 1, DXL2_X_GOAL_PWM, 300, 2), 0);
 	assert_int_equal(wr(&xl, 1, DXL2_X_POSITION_P_GAIN, 100, 2), 0);
-	assert_int_equal(wr(&xl, 1, DXL2_X_GOAL_PWM, 886, 2), DXL2_ERRNUM_DATA_RANGE);
+	/* beyond +-885 is beyond every PWM Limit: the same mistake as 401 with
+	 * limit 400 below, the same error number (data limit, the e-manual's
+	 * range of Goal PWM is -PWM Limit..PWM Limit) */
+	assert_int_equal(wr(&xl, 1, DXL2_X_GOAL_PWM, 886, 2), DXL2_ERRNUM_DATA_LIMIT);
+	assert_int_equal(wr(&xl, 1, DXL2_X_GOAL_PWM, (uint32_t)-886, 2), DXL2_ERRNUM_DATA_LIMIT);
 	assert_int_equal(wr(&xl, 1, DXL2_X_OPERATING_MODE, DXL2_OPMODE_VELOCITY, 1), 0);
 	assert_int_equal(peek(&xl, DXL2_X_PROFILE_VELOCITY), 0);
 	assert_int_equal(peek(&xl, DXL2_X_PROFILE_ACCELERATION), 0);
@@ -512,6 +518,9 @@ static void test_operating_modes(void **state)
 	assert_int_equal(wr(&xm, 1, DXL2_X_GOAL_CURRENT, 1193, 2), 0);
 	assert_int_equal(wr(&xm, 1, DXL2_X_CURRENT_LIMIT, 500, 2), 0);
 	assert_int_equal(wr(&xm, 1, DXL2_X_GOAL_CURRENT, 501, 2), DXL2_ERRNUM_DATA_LIMIT);
+	assert_int_equal(wr(&xm, 1, DXL2_X_GOAL_CURRENT, 1194, 2), DXL2_ERRNUM_DATA_LIMIT);
+	/* the limit registers themselves have fixed ranges: data range */
+	assert_int_equal(wr(&xm, 1, DXL2_X_CURRENT_LIMIT, 1194, 2), DXL2_ERRNUM_DATA_RANGE);
 	struct sim_xdrive_cmd c;
 	sim_xservo_drive_cmd(&xm, &c);
 	assert_int_equal(c.current_limit, 500);

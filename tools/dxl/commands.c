@@ -208,6 +208,10 @@ static int dxlt_cmd_scan(struct dxlt *t)
 
 	if (t->a.npos != 0)
 		return dxlt_need_args(t, 0, "scan [--ids A-B] [--bauds LIST|all]");
+	/* absent IDs are most of a scan: each keeps the derived deadline, not a
+	 * one-shot command's DXLT_ONESHOT_WAIT_MS */
+	t->scanning = true;
+	dxlt_apply_timing(t);
 	fprintf(t->out, "%-4s %-6s %-13s %-9s %-8s %s\n", "ID", "MODEL", "NAME", "FIRMWARE", "BAUD", "PROTOCOL");
 	for (size_t i = 0; i < DXLT_NFAMILIES; i++) {
 		const struct dxlt_family *f = &dxlt_families[i];

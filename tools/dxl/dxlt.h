@@ -37,6 +37,18 @@ enum dxlt_exit {
  * interactive, a few ms more per missing servo cost nothing, a false "no
  * reply" on a loaded machine costs the user's trust. */
 #define DXLT_DEFAULT_SLACK_MS 5
+/* The least a one-shot command (ping, read, write, dump ...) waits for its
+ * reply, ms: a person asked one servo once, and 50 ms is nothing to them,
+ * while a reply held by an adapter (16 ms on an FTDI chip at its default)
+ * or by a loaded machine's scheduler (a pty's reader woken late) is still
+ * taken. `scan` keeps the derived deadline + DXLT_DEFAULT_SLACK_MS: it asks
+ * up to 253 IDs at up to 12 rates, and absent IDs are most of them. */
+#define DXLT_ONESHOT_WAIT_MS 50
+/* After a one-shot command's reply timed out, how long dxl listens on to
+ * tell a late reply (bytes after the deadline: said, with how late) from
+ * none (ms): a quarter of a second more before "no reply" costs a person
+ * little. */
+#define DXLT_LATE_LISTEN_MS 250
 /* Cycles `dxl doctor` times by default: 300 at 10 ms are 3 s, enough for a
  * p99 that means something (3 cycles above it). */
 #define DXLT_DOCTOR_CYCLES 300
@@ -57,7 +69,8 @@ struct dxlt_args {
 	enum port_rs485 rs485;   /* --rs485: a UART's half-duplex buffer on RTS (port.h) */
 	bool rs485_given;
 	long latency_us;         /* --latency-us; -1: from the adapter's latency timer */
-	long timeout_ms;         /* --timeout-ms; -1: derived + DXLT_DEFAULT_SLACK_MS */
+	long timeout_ms;         /* --timeout-ms; -1: derived + DXLT_DEFAULT_SLACK_MS, at least
+	                          * DXLT_ONESHOT_WAIT_MS outside scan */
 	bool units;              /* --units */
 	bool yes;                /* --yes */
 	int status_level;        /* --status-level for setup; -1: default */

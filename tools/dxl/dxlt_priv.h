@@ -63,6 +63,7 @@ struct dxlt {
 	 * names it). dxlt_errors: the bus's protocol's. */
 	uint8_t errseen[DXLT_PROTOCOLS][DXL2_BROADCAST_ID + 1];
 	char hint[200];          /* what to do about them, when we know */
+	bool scanning;           /* scan: the fast per-ID deadline (dxlt_apply_timing) */
 };
 
 /* ---- session.c ---- */

@@ -52,6 +52,11 @@ void dxlt_apply_timing(struct dxlt *t)
 			timing.adapter_latency_us = (uint32_t)t->a.latency_us;
 		else if (t->latency.known)
 			timing.adapter_latency_us = (uint32_t)t->latency.timer_ms * 1000u;
+		/* one-shot commands: at least DXLT_ONESHOT_WAIT_MS, or what the
+		 * adapter needs if that is longer (dxlt.h) */
+		uint32_t derived = timing.return_delay_us + timing.adapter_latency_us + timing.margin_us;
+		if (!t->scanning && derived < DXLT_ONESHOT_WAIT_MS * 1000u)
+			timing.margin_us += DXLT_ONESHOT_WAIT_MS * 1000u - derived;
 	}
 	bus_set_timing(&t->bus, &timing);
 }
@@ -66,13 +71,44 @@ int dxlt_set_baud(struct dxlt *t, long baud)
 	return DXLT_EXIT_OK;
 }
 
+/* A --timeout-ms that would have taken a reply that came after_us after a
+ * deadline of waited_us: twice that, in whole 10 ms, within --timeout-ms's
+ * bounds. */
+static long dxlt_timeout_hint_ms(const struct bus_late *late)
+{
+	long ms = ((long)late->waited_us + (long)late->after_us) * 2 / 1000;
+	ms = (ms + 9) / 10 * 10;
+	return ms < 10 ? 10 : ms > 10000 ? 10000 : ms;
+}
+
+/* A request to id timed out: listen on a moment (DXLT_LATE_LISTEN_MS) and
+ * say whether its reply came late — the servo is there, the wait was too
+ * short — or nothing came (wrong baud, wrong ID, no power, wiring). */
+static void dxlt_timeout_fail(struct dxlt *t, uint8_t id)
+{
+	struct bus_late late = { .id = -1 };
+
+	if (id == DXL_BROADCAST_ID || bus_listen_late(&t->bus, DXLT_LATE_LISTEN_MS * 1000u, &late) != DXL_OK)
+		late.bytes = 0;
+	if (late.bytes > 0 && late.id == id) {
+		fprintf(t->err,
+		        "dxl: a reply from ID %u came %.1f ms after dxl stopped waiting (%.1f ms): it is late, not missing "
+		        "(a loaded machine, or an adapter holding bytes); wait longer: dxl --port %s --timeout-ms %ld ...\n",
+		        id, late.after_us / 1000.0, late.waited_us / 1000.0, port_path(t->port), dxlt_timeout_hint_ms(&late));
+		return;
+	}
+	fprintf(t->err, "dxl: no reply from ID %u at %ld bps", id, port_baud(t->port));
+	if (late.bytes > 0)
+		fprintf(t->err, " (%ld byte%s came %.1f ms after dxl stopped waiting, no status packet from ID %u among them)",
+		        late.bytes, late.bytes == 1 ? "" : "s", late.after_us / 1000.0, id);
+	fprintf(t->err, "; wrong baud or ID? try: dxl --port %s scan --bauds all\n", port_path(t->port));
+}
+
 int dxlt_bus_fail(struct dxlt *t, uint8_t id, int status)
 {
 	switch (status) {
 	case DXL_E_TIMEOUT:
-		fprintf(t->err,
-		        "dxl: no reply from ID %u at %ld bps; wrong baud or ID? try: dxl --port %s "
-		        "scan --bauds all\n", id, port_baud(t->port), port_path(t->port));
+		dxlt_timeout_fail(t, id);
 		return DXLT_EXIT_BUS;
 	case DXL_E_DISCONNECTED:
 		fprintf(t->err, "dxl: %s went away (adapter unplugged or simulator stopped)\n",
