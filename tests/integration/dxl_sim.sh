@@ -10,7 +10,8 @@ bus="$T/bus"
 url=$(lcm_url 7610)
 
 # Replies get 100 ms: the simulator is a process a loaded machine may not
-# schedule within the tool's default 5 ms of slack.
+# schedule within even the one-shot commands' 50 ms (scan's deadline is shorter).
+
 run() {
 	local name=$1; shift
 	rc=0
