@@ -11,7 +11,6 @@ url=$(lcm_url 7610)
 
 # Replies get 100 ms: the simulator is a process a loaded machine may not
 # schedule within even the one-shot commands' 50 ms (scan's deadline is shorter).
-
 run() {
 	local name=$1; shift
 	rc=0
