@@ -15,7 +15,7 @@
 # is a simulator and a few daemons in lockstep, about 1 s of two cores.
 # The default output file below is relative to the job's working directory,
 # the checkout's top: give --output (above) to keep it beside the runs.
-# Run for real on a one-node Slurm 22.05 by tests/integration/figures_slurm.sh.
+# Run for real on a one-node Slurm 22.05 by tests/long/figures_slurm.sh.
 #SBATCH --job-name=undulate-figures
 #SBATCH --cpus-per-task=2
 #SBATCH --time=00:10:00

@@ -2,6 +2,8 @@
 # run.sh: long — started early, so that the run does not end waiting for it (tests/run.sh)
 # run.sh: heavy — its lockstep runs keep a core busy (tests/run.sh)
 # run.sh: timeout 900
+# In make test-long, not make test: its Slurm daemons, sshd and lockstep runs
+# took 113 s of a 15-minute suite (and it installs Slurm where it may).
 # figures_slurm.sh — docs/CLUSTER.md's two ways of running a sweep elsewhere,
 # for real, on this machine: a one-node Slurm (munged with its own key,
 # slurmctld and slurmd on a slurm.conf of this test's, all in its folder and
@@ -98,7 +100,7 @@ slurm_start() {
 	wait_for 10 test -S "$S/sock/munge.sock" || { why="munged did not start: $(tail -n 1 "$T/munged.log")"; return 1; }
 	host=$(hostname -s)
 	cat >"$S/slurm.conf" <<-EOF
-		# a one-node Slurm for tests/integration/figures_slurm.sh
+		# a one-node Slurm for tests/long/figures_slurm.sh
 		ClusterName=undulatetest
 		SlurmctldHost=$host(127.0.0.1)
 		SlurmctldPort=$CTLD_PORT
