@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "mdl_collide.h"
+#include "phase.h"
 
 /* Steps per period at most: g_k is a sinusoid at omega between impacts, so
  * a step of an eighth of a period holds at most one of its extrema and a dip
@@ -61,15 +62,6 @@ static int lat_err(char *err, size_t cap, const char *fmt, ...)
 	return -1;
 }
 
-static double lat_wrap(double a)
-{
-	a = fmod(a, 2 * M_PI);
-	if (a > M_PI)
-		a -= 2 * M_PI;
-	else if (a <= -M_PI)
-		a += 2 * M_PI;
-	return a;
-}
 
 /* phi_i' = omega: the phase model. (Kept an ODE so that the oscillator's
  * law is one function, and the event machinery does not depend on it.) */
@@ -321,7 +313,7 @@ static void lat_collide(struct lat *l, int k, struct lat_event *ev)
 	} else {
 		int i = k - 1, j = k;
 		double vi = lat_v(l, l->phi, i), vj = lat_v(l, l->phi, j), pi_, pj;
-		ev->delta_before = lat_wrap(l->phi[j] - l->phi[i]);
+		ev->delta_before = phase_wrap(l->phi[j] - l->phi[i]);
 		ev->dsep_before = (l->neutral[j] - l->neutral[i]) / (2 * l->amp);
 		collide_pair(l->r, vi, vj, &pi_, &pj);
 		l->neutral[i] += l->beta[i] * (vj - vi);
@@ -335,7 +327,7 @@ static void lat_collide(struct lat *l, int k, struct lat_event *ev)
 		ev->post_left = pi_;
 		ev->post_right = pj;
 		ev->impulse = fabs(pi_ - vi);
-		ev->delta_after = lat_wrap(l->phi[j] - l->phi[i]);
+		ev->delta_after = phase_wrap(l->phi[j] - l->phi[i]);
 	}
 	lat_jumped(l);
 	lat_mark_neighbours(l, k);
@@ -497,7 +489,7 @@ struct lat *lat_new(const struct lat_params *p, const double *phase0, char *err,
 	}
 	double d = 2 * p->amplitude * p->dsep;
 	for (int i = 0; i < l->n; i++) {
-		l->phi[i] = lat_wrap(phase0[i]);
+		l->phi[i] = phase_wrap(phase0[i]);
 		l->neutral[i] = i * d;
 		l->beta[i] = p->beta ? p->beta[i] : 0;
 	}
@@ -539,7 +531,7 @@ void lat_free(struct lat *l)
 double lat_time(const struct lat *l) { return l->t; }
 int lat_count(const struct lat *l) { return l->n; }
 double lat_omega(const struct lat *l) { return l->omega; }
-double lat_phase(const struct lat *l, int i) { return lat_wrap(l->phi[i]); }
+double lat_phase(const struct lat *l, int i) { return phase_wrap(l->phi[i]); }
 double lat_displacement(const struct lat *l, int i) { return l->amp * cos(l->phi[i]); }
 double lat_speed(const struct lat *l, int i) { return lat_v(l, l->phi, i); }
 double lat_neutral(const struct lat *l, int i) { return l->neutral[i]; }

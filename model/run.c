@@ -19,6 +19,7 @@
 #include "mdl_lattice.h"
 #include "mdl_pairmap.h"
 #include "outdir.h"
+#include "phase.h"
 
 /* summary.json's significant digits: the analyser's (AN_JSON_DIGITS). */
 #define MRUN_JSON_DIGITS 9
@@ -57,11 +58,6 @@ struct mrun {
 	double cpu_s;
 };
 
-static double mrun_wrap(double a)
-{
-	a = fmod(a, 2 * M_PI);
-	return a > M_PI ? a - 2 * M_PI : a <= -M_PI ? a + 2 * M_PI : a;
-}
 
 static void mrun_num(FILE *f, double v)
 {
@@ -130,7 +126,7 @@ static void mrun_sample(struct mrun *m, double t)
 		fprintf(m->states, ",%d\n", i);
 	}
 	for (int k = 0; k + 1 < m->n; k++) {
-		double delta = mrun_wrap(lat_phase(m->lat, k + 1) - lat_phase(m->lat, k));
+		double delta = phase_wrap(lat_phase(m->lat, k + 1) - lat_phase(m->lat, k));
 		if (in_window)
 			win_circ_add(&m->pairs[k].win, delta);
 		if (o->write_samples) {

@@ -247,6 +247,16 @@ rig_up() {
 	spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 }
 
+# dxl_sim_built: $dxl and $sim, the dxl tests' two programs; a test without
+# them fails at once (one result, the plan) rather than skipping unseen.
+dxl_sim_built() {
+	dxl="$B/dxl" sim="$B/undulate-sim"
+	if [ ! -x "$dxl" ] || [ ! -x "$sim" ]; then
+		tap_fail "dxl and undulate-sim are built" "missing $dxl or $sim"
+		tap_done; exit
+	fi
+}
+
 # demo_leftovers: what a demo run left behind under $T/tmp (its TMPDIR):
 # processes whose command line names it, and files in it; nothing: status 0.
 demo_leftovers() {

@@ -9,13 +9,8 @@
 # and an echo setting that does not match the wiring is named.
 . "$(dirname "$0")/../lib.sh"
 
-dxl="$B/dxl"
-sim="$B/undulate-sim"
 
-if [ ! -x "$dxl" ] || [ ! -x "$sim" ]; then
-	tap_fail "dxl and undulate-sim are built" "missing $dxl or $sim"
-	tap_done; exit
-fi
+dxl_sim_built
 
 # sim_up NAME PORT ARGS...: a simulator with servos 1 and 2 at $T/NAME.
 sim_up() {

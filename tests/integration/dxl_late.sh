@@ -7,13 +7,8 @@
 # `scan` keeps its fast deadline per ID and rate.
 . "$(dirname "$0")/../lib.sh"
 
-dxl="$B/dxl"
-sim="$B/undulate-sim"
 
-if [ ! -x "$dxl" ] || [ ! -x "$sim" ]; then
-	tap_fail "dxl and undulate-sim are built" "missing $dxl or $sim"
-	tap_done; exit
-fi
+dxl_sim_built
 
 # No --timeout-ms here: the defaults are what is tested.
 run() {

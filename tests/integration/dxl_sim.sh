@@ -4,8 +4,6 @@
 # vanishing mid-command (the simulator stopping) as a lost port, exit 3.
 . "$(dirname "$0")/../lib.sh"
 
-dxl="$B/dxl"
-sim="$B/undulate-sim"
 bus="$T/bus"
 url=$(lcm_url 7610)
 
@@ -17,10 +15,7 @@ run() {
 	timeout 30 "$dxl" --timeout-ms 100 "$@" >"$T/$name.out" 2>"$T/$name.err" || rc=$?
 }
 
-if [ ! -x "$dxl" ] || [ ! -x "$sim" ]; then
-	tap_fail "dxl and undulate-sim are built" "missing $dxl or $sim"
-	tap_done; exit
-fi
+dxl_sim_built
 
 spawn sim "$sim" --link "$bus" --ids 1,2 --lcm-url "$url" --quiet
 if wait_log sim 'ready' 10; then tap_ok "simulator ready"; else tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit; fi

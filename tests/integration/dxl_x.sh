@@ -8,14 +8,9 @@
 # simulator has --model the whole script is skipped (its plan line says why).
 . "$(dirname "$0")/../lib.sh"
 
-dxl="$B/dxl"
-sim="$B/undulate-sim"
 url=$(lcm_url 7640)
 
-if [ ! -x "$dxl" ] || [ ! -x "$sim" ]; then
-	tap_fail "dxl and undulate-sim are built" "missing $dxl or $sim"
-	tap_done; exit
-fi
+dxl_sim_built
 if "$sim" --model xl430-w250 --help 2>&1 | grep -q "unrecognized option '--model'"; then
 	echo "1..0 # SKIP undulate-sim has no --model yet"
 	exit 0
