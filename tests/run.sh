@@ -37,7 +37,7 @@ mkdir -p "$logs"
 per_test_timeout=${TEST_TIMEOUT:-300}
 filter=${TEST_FILTER:-}
 
-passed=0 failed=0 skipped=0 todo=0 programs=0
+passed=0 failed=0 skipped=0 todo=0 programs=0 cpu_total=0 run_start=$(date +%s%N)
 failures=()
 todos=()
 skips=()
@@ -111,19 +111,33 @@ timeout_of() {
 	if [ -n "$n" ] && [ "$((10#$n))" -gt "$per_test_timeout" ]; then echo "$((10#$n))"; else echo "$per_test_timeout"; fi
 }
 
+# cpu_ms: the CPU time (user + system, ms) of this shell's finished children,
+# from bash's `times` (its second line); called in a subshell that ran one
+# program, it is that program's and of every process it waited for. (A process
+# left to init is not counted; the tests' traps wait for theirs.)
+# (`times` itself, not in $( ): a subshell has no children of its own yet.)
+cpu_ms() {
+	times >"$1"
+	# the children's line, "1m2.345s 0m0.678s": minutes, seconds
+	awk 'function ms(t) { split(t, a, /[ms]/); return int((a[1] * 60 + a[2]) * 1000 + 0.5) }
+		NR == 2 { print ms($1) + ms($2) }' "$1"
+}
+
 # execute NAME LIMIT CMD...: run one program into its log, for at most LIMIT
-# seconds; print "RC MS LIMIT".
+# seconds; print "RC MS LIMIT CPU_MS".
 execute() {
 	local name=$1 limit=$2; shift 2
 	local start=$(date +%s%N) rc
 	CMOCKA_MESSAGE_OUTPUT=TAP timeout --kill-after=10 "$limit" "$@" >"$logs/$name.log" 2>&1
 	rc=$?
-	echo "$rc $(( ($(date +%s%N) - start) / 1000000 )) $limit"
+	cpu_ms "$logs/$name.times" >"$logs/$name.cpu"
+	echo "$rc $(( ($(date +%s%N) - start) / 1000000 )) $limit $(cat "$logs/$name.cpu")"
+	rm -f "$logs/$name.times" "$logs/$name.cpu"
 }
 
-# account NAME RC MS LIMIT: count a finished program's results and show its line.
+# account NAME RC MS LIMIT CPU_MS: count a finished program's results and show its line.
 account() {
-	local name=$1 rc=$2 ms=$3 limit=$4
+	local name=$1 rc=$2 ms=$3 limit=$4 cpu=$5
 	local log="$logs/$name.log"
 	programs=$((programs + 1))
 	local p f s t plans planned plan_skip
@@ -147,14 +161,19 @@ account() {
 	while IFS= read -r line; do skips+=("$line"); done \
 		< <(tap_lines "$log" "$name" '^(not )?ok([[:space:]]|$).*#[[:space:]]*[Ss][Kk][Ii][Pp]')
 	[ "$f" -gt 0 ] && failures+=("$name${reason:+: $reason}")
-	show "$name" "$log" "$ms" "$p" "$f" "$s" "$t"
+	cpu_total=$((cpu_total + cpu))
+	show "$name" "$log" "$ms" "$cpu" "$p" "$f" "$s" "$t"
 }
 
-# show NAME LOG MS PASSED FAILED SKIPPED TODO: the program's line, and on a
-# failure its "not ok" and comment lines.
+# tenths MS: MS as seconds with one decimal
+tenths() { echo "$(($1 / 1000)).$(( ($1 % 1000) / 100 ))"; }
+
+# show NAME LOG MS CPU_MS PASSED FAILED SKIPPED TODO: the program's line (its
+# time, and the CPU its processes used: what it costs the others beside it),
+# and on a failure its "not ok" and comment lines.
 show() {
-	local name=$1 log=$2 ms=$3 p=$4 f=$5 s=$6 t=$7 extra=""
-	local secs="$((ms / 1000)).$(( (ms % 1000) / 100 ))"
+	local name=$1 log=$2 ms=$3 cpu=$4 p=$5 f=$6 s=$7 t=$8 extra=""
+	local secs="$(tenths "$ms")s, cpu $(tenths "$cpu")"
 	[ "$s" -gt 0 ] && extra+=", $s skipped"
 	[ "$t" -gt 0 ] && extra+=", $t todo"
 	if [ "$f" -gt 0 ]; then
@@ -192,7 +211,13 @@ trap 'rm -rf "$UNDULATE_LOCK_DIR"' EXIT
 # TEST_JOBS=1 runs them one by one.
 jobs_max=${TEST_JOBS:-4}
 [[ "$jobs_max" =~ ^[1-9][0-9]?$ ]] || { echo "run.sh: TEST_JOBS must be 1..99, not '$jobs_max'" >&2; exit 2; }
-says() { grep -q "^# run.sh: $2" "$1"; }
+# every script's "# run.sh:" lines, read with one grep (one per script and
+# question cost seconds of forks before the first test started)
+declare -A directives=()
+while IFS= read -r line; do
+	directives["${line%%:*}"]+=" ${line#*:# run.sh: }"
+done < <(grep -H '^# run\.sh: ' "$integration_dir"/*.sh ${TEST_LONG:+"$long_dir"/*.sh} 2>/dev/null)
+says() { [[ " ${directives[$1]:-}" == *" $2"* ]]; }
 names=() cmds=() weights=()
 # add NAME WEIGHT CMD...: one program into the queue (unless the filter leaves it out)
 add() {
@@ -211,15 +236,16 @@ fi
 # the unit tests time ptys and fake servos to the millisecond (a missing
 # servo's timeout, the doctor's latency): one at a time, nothing beside them
 for t in "$unit_dir"/test_*; do
-	[ -f "$t" ] && [ -x "$t" ] && add "$(basename "$t")" "$jobs_max" "$t"
+	[ -f "$t" ] && [ -x "$t" ] && add "${t##*/}" "$jobs_max" "$t"
 done
-for t in ${scripts[@]+"${scripts[@]}"}; do says "$t" alone && add "$(basename "$t" .sh)" "$jobs_max" bash "$t"; done
+for t in ${scripts[@]+"${scripts[@]}"}; do says "$t" alone && { n=${t##*/}; add "${n%.sh}" "$jobs_max" bash "$t"; }; done
 for pass in long other; do
 	for t in ${scripts[@]+"${scripts[@]}"}; do
 		says "$t" alone && continue
 		if says "$t" long; then [ "$pass" = long ] || continue; else [ "$pass" = other ] || continue; fi
 		w=1; says "$t" heavy && w=2
-		add "$(basename "$t" .sh)" "$w" bash "$t"
+		n=${t##*/}
+		add "${n%.sh}" "$w" bash "$t"
 	done
 done
 
@@ -255,8 +281,8 @@ while [ "$reported" -lt "${#names[@]}" ]; do
 	# the finished ones, in the order they started
 	while [ "$reported" -lt "${#order[@]}" ] && over "${order[$reported]}"; do
 		i=${order[$reported]}
-		read -r rc ms limit <"$logs/${names[$i]}.rc"
-		account "${names[$i]}" "$rc" "$ms" "$limit"
+		read -r rc ms limit cpu <"$logs/${names[$i]}.rc"
+		account "${names[$i]}" "$rc" "$ms" "$limit" "${cpu:-0}"
 		reported=$((reported + 1))
 	done
 	# sleep until the next one ends
@@ -282,5 +308,6 @@ fi
 if [ "$programs" -eq 0 ]; then
 	echo "no test program ran (TEST_FILTER='$filter'; unit tests from $unit_dir, integration tests from $integration_dir)"
 fi
+echo "$programs programs in $(tenths $(( ($(date +%s%N) - run_start) / 1000000 )))s, their CPU $(tenths "$cpu_total")s"
 echo "$passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ] && [ "$programs" -gt 0 ]
