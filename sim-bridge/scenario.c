@@ -438,6 +438,8 @@ static int robot_key(struct sim_robot_config *r, const char *name, const char *k
 		                      : ERR("heading: -360..360 degrees");
 	if (!strcmp(k, "latency_ms"))
 		return d >= 0 && d <= 1000 ? (r->latency_ms = d, 0) : ERR("latency_ms: 0..1000");
+	if (!strcmp(k, "beta"))
+		return d >= 0 ? (r->beta_set = true, r->beta = d, 0) : ERR("beta: >= 0 s (0: this robot's base does not move)");
 	return ERR("unknown key %s.%s", name, k);
 }
 

@@ -41,6 +41,8 @@ struct sim_robot_config {
 	int return_delay_us;         /* < 0: the [sim] value */
 	int servo_baud_reg;          /* < 0: the register matching the bus baud */
 	bool mirror;                 /* the body moves left for a positive angle (facing rigs) */
+	bool beta_set;               /* the robot's own mobility, in place of world.beta */
+	double beta;                 /* s */
 	/* the plane world: where the robot's chain is centred and where its head
 	 * points (unset: in a row along x, heads towards +y) */
 	bool position_set, heading_set;

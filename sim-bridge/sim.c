@@ -113,6 +113,7 @@ static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char 
 			.motor = &j->motor, .lever = rc->mirror ? -c->lever : c->lever, .half_width = c->half_width, .robot = (int)s->nbuses,
 			.effective_mass = c->effective_mass > 0 ? c->effective_mass : j->params.inertia / (c->lever * c->lever),
 			.neutral = rc->neutral_set ? rc->neutral : 0,
+			.own_beta = rc->beta_set, .beta = rc->beta,
 		};
 		if (sim_world_add_body(&s->world, &sb) < 0)
 			return snprintf(err, errcap, "robot %s: the world refused its contact body", rc->name), -1;
@@ -224,6 +225,10 @@ static int sim_plane_build(struct sim *s, char *err, size_t errcap)
 	if (c->world.beta > 0)
 		return snprintf(err, errcap, "world.beta = %g: beta is the row world's mobility; in the plane the "
 		                "robots' bases move by contact and drag (remove it)", c->world.beta), -1;
+	for (size_t i = 0; i < c->nrobots; i++)
+		if (c->robots[i].beta_set)
+			return snprintf(err, errcap, "robot %s: beta is the row world's mobility; in the plane the "
+			                "robots' bases move by contact and drag (remove it)", c->robots[i].name), -1;
 	if (s->nbuses > PLANE_MAX_ROBOTS || s->world.nbodies != s->nbuses)
 		return snprintf(err, errcap, "world.kind = plane: at most %d robots, each with a contact joint "
 		                "(contact = none has no meaning: any link touches)", PLANE_MAX_ROBOTS), -1;

@@ -119,7 +119,8 @@ int sim_world_add_body(struct sim_world *w, const struct sim_body *b)
 	}
 	if (!b->motor || !isfinite(b->lever) || b->lever == 0 || !isfinite(b->neutral)
 	    || !(b->half_width >= 0) || !isfinite(b->half_width)
-	    || !(b->effective_mass > 0) || !isfinite(b->effective_mass)) {
+	    || !(b->effective_mass > 0) || !isfinite(b->effective_mass)
+	    || (b->own_beta && !(b->beta >= 0 && isfinite(b->beta)))) {
 		world_warn(w, "invalid contact body rejected");
 		return -1;
 	}
@@ -236,6 +237,12 @@ static void world_record(struct world_scratch *s, size_t k, double pre_l, double
 	s->impulse[k] += impulse;
 }
 
+/* Body i's mobility: its own, or the world's. */
+static double world_beta(const struct sim_world *w, size_t i)
+{
+	return w->bodies[i].own_beta ? w->bodies[i].beta : w->params.beta;
+}
+
 static void world_shift(struct sim_world *w, struct world_scratch *s, size_t i, double delta)
 {
 	if (delta == 0)
@@ -259,7 +266,7 @@ static bool world_resting(const struct sim_world *w, const struct world_scratch 
 /* Body i hits body i+1 (pair k = i+1). */
 static void world_collide_pair(struct sim_world *w, struct world_scratch *s, size_t i)
 {
-	double beta = w->params.beta;
+	double bi = world_beta(w, i), bj = world_beta(w, i + 1);
 	double r = w->params.restitution;
 	double vi = s->v[i], vj = s->v[i + 1];
 	double vi_post = 0.5 * ((1 - r) * vi + (1 + r) * vj);
@@ -271,9 +278,9 @@ static void world_collide_pair(struct sim_world *w, struct world_scratch *s, siz
 	s->dv[i + 1] += vj_post - vj;
 	s->touched[i] = s->touched[i + 1] = true;
 	world_record(s, i + 1, vi, vj, vi_post, vj_post, mass * fabs(vi_post - vi), false);
-	world_shift(w, s, i, beta * (vj - vi));
-	world_shift(w, s, i + 1, beta * (vi - vj));
-	s->spread[i + 1] += 2 * beta * fabs(vi - vj);
+	world_shift(w, s, i, bi * (vj - vi));
+	world_shift(w, s, i + 1, bj * (vi - vj));
+	s->spread[i + 1] += (bi + bj) * fabs(vi - vj);
 }
 
 /* Body i hits a wall (pair k: 0 left, N right); the wall does not move. */
@@ -289,8 +296,8 @@ static void world_collide_wall(struct sim_world *w, struct world_scratch *s, siz
 		world_record(s, k, 0, v, 0, v_post, impulse, false);
 	else
 		world_record(s, k, v, 0, v_post, 0, impulse, false);
-	world_shift(w, s, i, w->params.beta * (0 - v));
-	s->spread[k] += w->params.beta * fabs(v);
+	world_shift(w, s, i, world_beta(w, i) * (0 - v));
+	s->spread[k] += world_beta(w, i) * fabs(v);
 }
 
 /* Closing speed of pair k (positive: approaching; walls stand still). */
@@ -364,14 +371,14 @@ static void world_plastic_cluster(struct sim_world *w, struct world_scratch *s,
 			double pl = k > a ? before[k - 1] : 0, pr = k <= b ? before[k] : 0;
 			double ql = k > a ? s->v[k - 1] : 0, qr = k <= b ? s->v[k] : 0;
 			world_record(s, k, pl, pr, ql, qr, J, true);
-			if (pl > pr && w->params.beta > 0) {
+			if (pl > pr) {
 				/* mobility, on the pre-contact closing speed */
-				double d = w->params.beta * (pl - pr);
+				double bl = k > a ? world_beta(w, k - 1) : 0, br = k <= b ? world_beta(w, k) : 0;
 				if (k > a)
-					world_shift(w, s, k - 1, -d);
+					world_shift(w, s, k - 1, -bl * (pl - pr));
 				if (k <= b)
-					world_shift(w, s, k, d);
-				s->spread[k] += (k > a && k <= b ? 2 : 1) * d;
+					world_shift(w, s, k, br * (pl - pr));
+				s->spread[k] += (bl + br) * (pl - pr);
 			}
 		}
 		if (k <= b)

@@ -32,6 +32,10 @@ struct sim_body {
 	double half_width;         /* m, the body's extent on each side of X (bumper) */
 	double effective_mass;     /* kg, for the impulse (equal for all, per the model) */
 	int robot;                 /* index of the robot, for reports */
+	/* The body's own mobility (s), in place of the world's β: the paper's
+	 * lattices hold their end oscillators (β = 0 for them). */
+	bool own_beta;
+	double beta;
 };
 
 struct sim_world_params {

@@ -213,6 +213,19 @@ static void test_scenario_files(void **state)
 	assert_int_equal(cfg.seed, 9);
 	assert_int_equal(sim_config_load_text(&cfg, "mem", "[world]\nbeta = -1\n", 18, err, sizeof(err)), -1);
 	assert_string_equal(err, "mem:2: beta: >= 0");
+	/* a robot's own mobility (the paper's fixed ends: beta = 0 for them) */
+	static const char own[] = "[world]\nbeta = 0.05\n[robot a]\nids = 1,2\nbeta = 0\n[robot b]\nids = 1,2\n"
+	                          "[robot c]\nids = 1,2\nbeta = 0.2\n";
+	assert_int_equal(sim_config_load_text(&cfg, "mem", own, sizeof(own) - 1, err, sizeof(err)), 0);
+	assert_int_equal(sim_config_finish(&cfg, err, sizeof(err)), 0);
+	assert_int_equal(sim_init(&sim, &cfg, err, sizeof(err)), 0);
+	assert_true(sim.world.bodies[0].own_beta && sim.world.bodies[0].beta == 0);
+	assert_false(sim.world.bodies[1].own_beta);
+	assert_true(sim.world.bodies[2].own_beta && sim.world.bodies[2].beta == 0.2);
+	sim_free(&sim);
+	static const char neg[] = "[robot a]\nids = 1,2\nbeta = -0.1\n";
+	assert_int_equal(sim_config_load_text(&cfg, "mem", neg, sizeof(neg) - 1, err, sizeof(err)), -1);
+	assert_string_equal(err, "mem:3: beta: >= 0 s (0: this robot's base does not move)");
 }
 
 /* Numbers that end up in integers are parsed as integers, in range: a double

@@ -199,6 +199,47 @@ static void test_mobility_moves_neutrals(void **state)
 	assert_true(late == 0);
 }
 
+/* Mobility per body (the paper's lattices hold their end oscillators): a
+ * body with a mobility of its own moves by it, whatever the world's; the
+ * others by the world's. */
+static void test_mobility_per_body(void **state)
+{
+	(void)state;
+	struct sim_world_params p = world_params(0.67, 0.05);
+	struct sim_world w;
+	world_row(&w, &p, 3, 0.3);
+	w.bodies[0].own_beta = true;   /* a fixed end */
+	w.bodies[0].beta = 0;
+	w.bodies[2].own_beta = true;   /* more mobile than the world */
+	w.bodies[2].beta = 0.2;
+	double vi = 1.5, vj = -0.5;
+	put(&w, 0, 0.105, vi);
+	put(&w, 1, 0.2, vj);
+	put(&w, 2, 0.6, 0);
+	assert_int_equal(resolve(&w, 0.001), 1);
+	assert_true(w.bodies[0].neutral == 0);
+	assert_true(fabs(w.bodies[1].neutral - (0.3 + 0.05 * (vi - vj))) < 1e-15);
+	assert_true(w.bodies[2].neutral == 0.6);
+	/* the other pair: body 2's own β against body 1's, the world's */
+	double n1 = w.bodies[1].neutral;
+	put(&w, 1, n1 + 0.105, 0.8);
+	put(&w, 2, n1 + 0.2, -0.4);
+	assert_int_equal(resolve(&w, 0.001), 1);
+	assert_true(fabs(w.bodies[1].neutral - (n1 + 0.05 * (-0.4 - 0.8))) < 1e-15);
+	assert_true(fabs(w.bodies[2].neutral - (0.6 + 0.2 * (0.8 + 0.4))) < 1e-15);
+	/* a fixed end against a wall does not move either */
+	p = world_params(0.67, 0.05);
+	p.wall_left = -0.5;
+	p.wall_right = 0.8;
+	world_row(&w, &p, 2, 0.3);
+	w.bodies[0].own_beta = true;
+	w.bodies[0].beta = 0;
+	put(&w, 0, -0.46, -2);
+	put(&w, 1, 0.3, 0);
+	assert_int_equal(resolve(&w, 0.001), 1);
+	assert_true(w.bodies[0].neutral == 0);
+}
+
 static void test_walls(void **state)
 {
 	(void)state;
@@ -579,6 +620,7 @@ int main(void)
 		cmocka_unit_test(test_collision_law),
 		cmocka_unit_test(test_no_collision_when_separating_or_apart),
 		cmocka_unit_test(test_mobility_moves_neutrals),
+		cmocka_unit_test(test_mobility_per_body),
 		cmocka_unit_test(test_walls),
 		cmocka_unit_test(test_no_tunnelling),
 		cmocka_unit_test(test_chains),
