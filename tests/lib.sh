@@ -105,6 +105,21 @@ spawn() {
 	_pids+=("$pid")
 	eval "pid_${name//[^A-Za-z0-9_]/_}=$pid"
 }
+# spawn_rt NAME CMD...: spawn, under SCHED_FIFO (chrt, priority
+# TEST_RT_PRIORITY, default 40) where this user may (root, or an rtprio
+# limit), as a robot's daemon runs (its `priority` key, the systemd unit) and
+# as a servo answers (hardware: the CPU beside it never makes it late). For
+# the simulators, plants and daemons of the tests that measure a gait in real
+# time: with them on FIFO those tests pass beside a full machine (at load 20,
+# daemon_limit_cycle; without, it failed at load 14), and the runner lets them
+# run beside the others ("# run.sh: realtime"). Where FIFO is not allowed,
+# a plain spawn, and the runner runs them alone.
+_rt=
+spawn_rt() {
+	[ -n "$_rt" ] || { chrt -f 1 true 2>/dev/null && _rt=yes || _rt=no; }
+	local name=$1; shift
+	if [ "$_rt" = yes ]; then spawn "$name" chrt -f "${TEST_RT_PRIORITY:-40}" "$@"; else spawn "$name" "$@"; fi
+}
 # stop NAME [SIGNAL]: signal a spawned process and wait for it. Its exit status
 # is left in $stop_rc and printed. Call it in this shell (`stop d >file` is fine):
 # inside $(...) the process is not a child of the subshell and cannot be waited.

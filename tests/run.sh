@@ -202,7 +202,10 @@ trap 'rm -rf "$UNDULATE_LOCK_DIR"' EXIT
 #     four, two of them at once have nothing beside them, and one has two
 #     light ones at most;
 #   "# run.sh: alone" — it measures a gait or an experiment in real time: every
-#     slot, nothing beside it.
+#     slot, nothing beside it;
+#   "# run.sh: realtime" — it measures in real time, with its simulators and
+#     daemons under SCHED_FIFO (tests/lib.sh spawn_rt): where this user may
+#     use FIFO, one slot, started early as the long ones; elsewhere alone.
 # Order: the unit tests and the alone scripts first, one at a time (started on
 # an idle machine, so no slot waits for the others to drain), then the
 # scripts that say "# run.sh: long" (started early, the run does not end
@@ -218,6 +221,11 @@ while IFS= read -r line; do
 	directives["${line%%:*}"]+=" ${line#*:# run.sh: }"
 done < <(grep -H '^# run\.sh: ' "$integration_dir"/*.sh ${TEST_LONG:+"$long_dir"/*.sh} 2>/dev/null)
 says() { [[ " ${directives[$1]:-}" == *" $2"* ]]; }
+# SCHED_FIFO allowed (root, or an rtprio limit): "realtime" scripts need not run alone
+rt_ok=0
+chrt -f 1 true 2>/dev/null && rt_ok=1
+# alone SCRIPT: nothing may run beside it
+alone() { says "$1" alone || { [ "$rt_ok" = 0 ] && says "$1" realtime; }; }
 names=() cmds=() weights=()
 # add NAME WEIGHT CMD...: one program into the queue (unless the filter leaves it out)
 add() {
@@ -238,11 +246,11 @@ fi
 for t in "$unit_dir"/test_*; do
 	[ -f "$t" ] && [ -x "$t" ] && add "${t##*/}" "$jobs_max" "$t"
 done
-for t in ${scripts[@]+"${scripts[@]}"}; do says "$t" alone && { n=${t##*/}; add "${n%.sh}" "$jobs_max" bash "$t"; }; done
+for t in ${scripts[@]+"${scripts[@]}"}; do alone "$t" && { n=${t##*/}; add "${n%.sh}" "$jobs_max" bash "$t"; }; done
 for pass in long other; do
 	for t in ${scripts[@]+"${scripts[@]}"}; do
-		says "$t" alone && continue
-		if says "$t" long; then [ "$pass" = long ] || continue; else [ "$pass" = other ] || continue; fi
+		alone "$t" && continue
+		if says "$t" long || says "$t" realtime; then [ "$pass" = long ] || continue; else [ "$pass" = other ] || continue; fi
 		w=1; says "$t" heavy && w=2
 		n=${t##*/}
 		add "${n%.sh}" "$w" bash "$t"

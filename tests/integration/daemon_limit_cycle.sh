@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
+# run.sh: realtime — it measures a gait in real time: its simulators and daemons under SCHED_FIFO where allowed, else alone (tests/run.sh)
 # The oscillator's defaults on the simulated robot, through the real daemon:
 # undulate-sim + undulated with no oscillator settings at all, from rest (the
 # daemon's starter), settle, then measure the joints' own angles as published
@@ -27,9 +27,9 @@ R3="lct_$$"
 SETTLE_CYCLES=800      # 8 s: starter (ramp 1.5 s + one period), then the cycle settles
 MEASURE_CYCLES=1000    # 10 s: eight periods (a disturbed window: one more)
 
-spawn sim2 "$S" --link "$T/bus2" --ids 1,2 --lcm-url "$URL2" --seed 11 --return-delay 0
-spawn sim1 "$S" --link "$T/bus1" --ids 1 --lcm-url "$URL1" --seed 12
-spawn sim3 "$S" --link "$T/bus3" --ids 1 --lcm-url "$URL3" --seed 13 --set motor.drive=current
+spawn_rt sim2 "$S" --link "$T/bus2" --ids 1,2 --lcm-url "$URL2" --seed 11 --return-delay 0
+spawn_rt sim1 "$S" --link "$T/bus1" --ids 1 --lcm-url "$URL1" --seed 12
+spawn_rt sim3 "$S" --link "$T/bus3" --ids 1 --lcm-url "$URL3" --seed 13 --set motor.drive=current
 wait_log sim2 'ready' 10 && wait_log sim1 'ready' 10 ||
 	{ tap_fail "simulators ready" "$(cat "$T/sim2.log" "$T/sim1.log")"; tap_done; exit 1; }
 spawn watch2 "$D" --watch "$R2" --raw --lcm-url "$URL2"
@@ -41,7 +41,7 @@ spawn watch3 "$D" --watch "$R3" --raw --lcm-url "$URL3"
 start_daemon() {   # NAME ROBOT BUS IDS URL [DAEMON OPTIONS...]
 	local try
 	for try in 1 2; do
-		spawn "$1" "$D" --port "$T/$3" --ids "$4" --robot "$2" --lcm-url "$5" --mode oscillator "${@:6}"
+		spawn_rt "$1" "$D" --port "$T/$3" --ids "$4" --robot "$2" --lcm-url "$5" --mode oscillator "${@:6}"
 		wait_log "$1" "ready: $2.STATE" 10 && return 0
 		alive "$1" && return 1
 		echo "# $1 exited at start-up (try $try): $(tail -1 "$T/$1.log")"

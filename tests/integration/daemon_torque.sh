@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
+# run.sh: realtime — it measures a gait in real time: its simulators and daemons under SCHED_FIFO where allowed, else alone (tests/run.sh)
 # undulated with torque actuation against undulate-sim (daemon/README.md,
 # "Torque actuation"): OSCILLATOR puts the servos in wheel mode and drives their
 # output; the register traffic is read back from the simulator. Checked: a
@@ -21,7 +21,7 @@ URL=$(lcm_url 7704)
 peek() { local v; v=$(ctl peek r1 "$1" "$2"); echo "${v#ok }"; }
 num() { awk "BEGIN { exit !($*) }"; }
 
-spawn sim "$S" --link "$T/bus" --ids 1 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 3
+spawn_rt sim "$S" --link "$T/bus" --ids 1 --name r1 --lcm-url "$URL" --control "$T/ctl" --seed 3
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 
@@ -31,13 +31,13 @@ ctl poke r1 1 cw_angle_limit 0 >/dev/null
 ctl poke r1 1 ccw_angle_limit 0 >/dev/null
 ctl poke r1 1 torque_enable 1 >/dev/null
 ctl poke r1 1 moving_speed 200 >/dev/null
-spawn pos "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode oscillator
+spawn_rt pos "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode oscillator
 wait_for 10 bash -c "! kill -0 $pid_pos" && stop pos
 if [ "$stop_rc" != 0 ] && grep -q 'servo 1 is in wheel mode' "$T/pos.log"; then
 	tap_ok "position actuation refuses a servo in wheel mode, saying so (exit $stop_rc)"
 else tap_fail "position actuation refuses wheel mode" "exit $stop_rc: $(tail -3 "$T/pos.log")"; fi
 
-spawn d "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold \
+spawn_rt d "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold \
 	--set robot.actuation=torque --set robot.torque_drive=pwm \
 	--set joint.1.limit_min=-1.2 --set joint.1.limit_max=1.2
 wait_log d "ready: $R.STATE" 10 || { tap_fail "daemon starts" "$(cat "$T/d.log")"; tap_done; exit 1; }
@@ -108,7 +108,7 @@ fi
 # at (1.5 V, 0, 25 V) is a fault that names it, latched before the drive
 # starts; one it may run at (8.6 V: its rated 9..12 V less 5 %) drives; the
 # joint stays inside +-0.6 rad either way.
-spawn d2 "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold \
+spawn_rt d2 "$D" --port "$T/bus" --ids 1 --robot "$R" --lcm-url "$URL" --mode hold \
 	--set robot.actuation=torque --set robot.torque_drive=pwm \
 	--set joint.1.limit_min=-0.6 --set joint.1.limit_max=0.6
 wait_log d2 "ready: $R.STATE" 10 || { tap_fail "daemon with +-0.6 rad starts" "$(cat "$T/d2.log")"; tap_done; exit 1; }

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# run.sh: alone — it measures a gait or an experiment in real time: nothing beside it (tests/run.sh)
+# run.sh: realtime — it measures a gait in real time: its simulators and daemons under SCHED_FIFO where allowed, else alone (tests/run.sh)
 # run.sh: timeout 420 (the test plant may take the tuner its 180 s)
 # undulated --tune, through real processes:
 #   - on the simulated robot and, at the same time, on a test plant unlike the
@@ -45,22 +45,22 @@ out=$("$D" --tune --port "$T/none" --ids 1,2 --set joint.1.limit_max=0.9 --targe
 	tap_fail "an amplitude outside the joint limits: exit 2" "exit $rc: $out"
 
 # ---- the simulator and the test plant, tuned at the same time ---------------------------
-spawn sim "$S" --link "$T/sim" --ids 1,2 --lcm-url "$URL_SIM" --seed 21 --return-delay 0
+spawn_rt sim "$S" --link "$T/sim" --ids 1,2 --lcm-url "$URL_SIM" --seed 21 --return-delay 0
 # the plant the audit described: joints that reach the goal at once up to the rated speed
 # A servo is hardware: the CPU around it never makes it late. The Python plant
 # is a process, and on a loaded machine it missed replies (READ timeouts) and
 # the tuner's windows wandered (0.66..0.97 Hz at load 10-13, no result): it
-# runs ahead of the rest where that is allowed (root; GNU nice runs it anyway,
-# with a warning, where it is not).
-spawn plant nice -n -10 python3 "$PLANT" --link "$T/plant" --ids 1,2 --gain 300 --tau 0.003
+# runs ahead of the rest where that is allowed (spawn_rt: SCHED_FIFO, as the
+# simulator and the daemons; where it is not, the runner runs this test alone).
+spawn_rt plant python3 "$PLANT" --link "$T/plant" --ids 1,2 --gain 300 --tau 0.003
 wait_log sim 'ready' 10 && wait_log plant 'ready' 10 ||
 	{ tap_fail "simulator and plant ready" "$(cat "$T/sim.log" "$T/plant.log")"; tap_done; exit 1; }
-spawn tsim "$D" --tune --port "$T/sim" --ids 1,2 --robot tsim --lcm-url "$URL_SIM" --out "$T/tsim.conf" -q
+spawn_rt tsim "$D" --tune --port "$T/sim" --ids 1,2 --robot tsim --lcm-url "$URL_SIM" --out "$T/tsim.conf" -q
 # The plant gets more than the default 90 s: its Python loop misses replies
 # now and then (READ timeouts), a disturbed window (0.51 Hz once) costs two
 # more, and one make test run ended "no result in 90 s (11 windows); closest:
 # 0.800 Hz, A 0.798/0.798 rad", on target but not yet confirmed.
-spawn tplant "$D" --tune --port "$T/plant" --ids 1,2 --robot tplant --lcm-url "$URL_PLANT" --out "$T/tplant.conf" -q \
+spawn_rt tplant "$D" --tune --port "$T/plant" --ids 1,2 --robot tplant --lcm-url "$URL_PLANT" --out "$T/tplant.conf" -q \
 	--tune-time 180
 wait_for 240 bash -c "! kill -0 $pid_tsim 2>/dev/null && ! kill -0 $pid_tplant 2>/dev/null"
 wait "$pid_tsim"; rc_sim=$?
@@ -111,11 +111,11 @@ fi
 out=$("$D" "$T/tplant.conf" --check-config 2>&1)
 tap_check "the written file passes --check-config ($out)" grep -q "mode OSCILLATOR" <<<"$out"
 spawn watch "$D" --watch tplant --raw --lcm-url "$URL_PLANT"
-spawn run "$D" "$T/tplant.conf" -q
+spawn_rt run "$D" "$T/tplant.conf" -q
 # ---- Ctrl-C ---------------------------------------------------------------------------------
-spawn simint "$S" --link "$T/int" --ids 1,2 --lcm-url "$URL_INT" --seed 23 --return-delay 0
+spawn_rt simint "$S" --link "$T/int" --ids 1,2 --lcm-url "$URL_INT" --seed 23 --return-delay 0
 wait_log simint 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/simint.log")"; tap_done; exit 1; }
-spawn tint "$D" --tune --port "$T/int" --ids 1,2 --robot tint --lcm-url "$URL_INT" --out "$T/tint.conf" -q
+spawn_rt tint "$D" --tune --port "$T/int" --ids 1,2 --robot tint --lcm-url "$URL_INT" --out "$T/tint.conf" -q
 # Ctrl-C once it has measured a window
 if wait_log tint '^tune: .* window 1' 40; then
 	kill -INT "$pid_tint"

@@ -272,4 +272,26 @@ suite slots TEST_JOBS=x
 if [ "$rc" = 2 ] && grep -q "TEST_JOBS must be" "$out" && [ ! -s "$spans" ]; then tap_ok "TEST_JOBS=x: refused, nothing run"
 else tap_fail "TEST_JOBS=x" "exit $rc: $(tail -2 "$out")"; fi
 
+# "realtime": beside the others where SCHED_FIFO is allowed, alone where it is
+# not (a chrt that refuses, first in PATH, plays the user who may not)
+for n in r1 r2 r3; do slotted rt "$n"; done
+slotted rt rtime '# run.sh: realtime'
+mkdir -p "$T/nort"
+printf '#!/bin/sh\necho "chrt: failed to set pid 0'"'"'s policy: Operation not permitted" >&2\nexit 1\n' >"$T/nort/chrt"
+chmod +x "$T/nort/chrt"
+: >"$spans"
+suite rt TEST_JOBS=3 PATH="$T/nort:$PATH"
+if [ "$closing" = "4 passed, 0 failed, 0 skipped" ] && [ -z "$(beside rtime)" ]; then
+	tap_ok "realtime, without SCHED_FIFO: runs alone"
+else tap_fail "realtime without SCHED_FIFO" "closing '$closing', beside it '$(beside rtime)'"$'\n'"$(cat "$spans")"; fi
+if chrt -f 1 true 2>/dev/null; then
+	: >"$spans"
+	suite rt TEST_JOBS=3
+	if [ "$closing" = "4 passed, 0 failed, 0 skipped" ] && [ -n "$(beside rtime)" ]; then
+		tap_ok "realtime, with SCHED_FIFO: runs beside the others ($(beside rtime))"
+	else tap_fail "realtime with SCHED_FIFO" "closing '$closing', beside it '$(beside rtime)'"$'\n'"$(cat "$spans")"; fi
+else
+	tap_skip "realtime, with SCHED_FIFO: runs beside the others" "this user may not use SCHED_FIFO"
+fi
+
 tap_done
