@@ -86,6 +86,22 @@ tap_skip() {
 tap_skip_all() { tap_skip "$(basename "$0" .sh)" "$1"; tap_done; exit 0; }
 tap_check() { local name=$1; shift; if "$@"; then tap_ok "$name"; else tap_fail "$name" "command failed: $*"; fi; }
 tap_done() { echo "1..$_tap_n"; [ "$_tap_failed" -eq 0 ]; }
+# needs_plotting: a test of pictures needs gnuplot to draw them and
+# tests/tools/pngdata (PNG) to count their pixels; without either, the whole
+# script is skipped.
+needs_plotting() {
+	PNG="$BUILD/tests/tools/pngdata"
+	command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
+	[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+}
+# tap_refused PREFIX NAME CMD...: a usage refusal: CMD exits 2 and what it
+# says (stdout and stderr) begins with PREFIX, e.g. a figure module's "name:".
+tap_refused() {
+	local prefix=$1 name=$2 out rc
+	shift 2
+	out=$("$@" 2>&1); rc=$?
+	if [ "$rc" = 2 ] && [[ "$out" == "$prefix"* ]]; then tap_ok "refused: $name"; else tap_fail "refused: $name" "rc=$rc: $out"; fi
+}
 
 # Each spawned program runs in a session of its own (setsid), as a service runs
 # in a cgroup of its own: with the kernel's autogroups, programs in the session

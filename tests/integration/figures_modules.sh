@@ -17,9 +17,7 @@
 # run.sh: timeout 600
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures"
-PNG="$BUILD/tests/tools/pngdata"
-command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
-[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+needs_plotting
 
 # pixels COLOUR PNG: how many pixels of that colour (RRGGBB)
 pixels() { "$PNG" --rgb "$1" "$2" 2>/dev/null | sed -n 's/.*matching=//p'; }
