@@ -74,12 +74,9 @@ static long long mrun_utime(double t)
 
 static FILE *mrun_create(struct mrun *m, const char *name, const char *header)
 {
-	int fd = openat(m->stagefd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	FILE *f = outdir_stage_fopen(m->stagefd, name);
 	if (!f) {
 		fprintf(m->msg, "undulate-model: %s/%s: %s\n", m->o->out_dir, name, strerror(errno));
-		if (fd >= 0)
-			close(fd);
 		return NULL;
 	}
 	if (header)
@@ -89,13 +86,10 @@ static FILE *mrun_create(struct mrun *m, const char *name, const char *header)
 
 static int mrun_close(struct mrun *m, FILE **f, const char *name)
 {
-	if (!*f)
+	if (outdir_stage_fclose(f) == 0)
 		return 0;
-	int bad = ferror(*f) | fclose(*f);
-	*f = NULL;
-	if (bad)
-		fprintf(m->msg, "undulate-model: writing %s/%s failed\n", m->o->out_dir, name);
-	return bad ? -1 : 0;
+	fprintf(m->msg, "undulate-model: writing %s/%s failed\n", m->o->out_dir, name);
+	return -1;
 }
 
 /* ---- recording --------------------------------------------------------- */

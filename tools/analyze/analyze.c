@@ -1158,13 +1158,9 @@ static void an_process_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
  * and private). */
 static FILE *an_create(struct an_ctx *c, const char *name)
 {
-	int fd = openat(c->stagefd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-	if (!f) {
+	FILE *f = outdir_stage_fopen(c->stagefd, name);
+	if (!f)
 		fprintf(c->o->msg, "undulate-analyze: %s/%s: %s\n", c->o->out_dir, name, strerror(errno));
-		if (fd >= 0)
-			close(fd);
-	}
 	return f;
 }
 
@@ -1178,15 +1174,10 @@ static FILE *an_open_out(struct an_ctx *c, const char *name, const char *header)
 
 static int an_close_out(struct an_ctx *c, FILE **f, const char *name)
 {
-	if (!*f)
+	if (outdir_stage_fclose(f) == 0)
 		return 0;
-	int bad = ferror(*f) | fclose(*f);
-	*f = NULL;
-	if (bad) {
-		fprintf(c->o->msg, "undulate-analyze: writing %s/%s failed\n", c->o->out_dir, name);
-		return -1;
-	}
-	return 0;
+	fprintf(c->o->msg, "undulate-analyze: writing %s/%s failed\n", c->o->out_dir, name);
+	return -1;
 }
 
 /* --out: a directory of ours that no one else can write (outdir_open), and
