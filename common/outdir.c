@@ -418,3 +418,24 @@ void outdir_file_abandon(struct outdir_file *f, bool closed)
 	f->fd = -1;
 	unlinkat(f->dirfd, f->tmp, 0);
 }
+
+FILE *outdir_stage_fopen(int stagefd, const char *name)
+{
+	int fd = openat(stagefd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	if (!f && fd >= 0) {
+		int e = errno;   /* fdopen's reason, for the caller's message */
+		close(fd);
+		errno = e;
+	}
+	return f;
+}
+
+int outdir_stage_fclose(FILE **f)
+{
+	if (!*f)
+		return 0;
+	int bad = ferror(*f) | fclose(*f);
+	*f = NULL;
+	return bad ? -1 : 0;
+}

@@ -23,6 +23,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 /* Symbolic links followed on the way to a directory at most (the kernel's
  * own limit, MAXSYMLINKS, is 40). */
@@ -80,6 +81,14 @@ int outdir_publish(int dirfd, int stagefd, const char *stagename, char *err, siz
 
 /* Removes the stage and what it holds, without publishing any of it. */
 void outdir_discard(int dirfd, int stagefd, const char *stagename);
+
+/* Creates NAME new in a stage (outdir_stage: only we can write there, so
+ * nothing can be there before us; O_CREAT|O_EXCL|O_NOFOLLOW, 0666 less the
+ * umask) and opens it to write. NULL with errno set. */
+FILE *outdir_stage_fopen(int stagefd, const char *name);
+/* Closes *f and sets it NULL (a NULL *f: nothing to do, 0). -1 when a
+ * write to it or the close failed: a full disk shows only here. */
+int outdir_stage_fclose(FILE **f);
 
 /* One file written into a directory: created under a temporary name
  * ".NAME.XXXXXX" (O_CREAT|O_EXCL|O_NOFOLLOW, mode 0666 less the umask),

@@ -486,6 +486,20 @@ void ctl_hold_at_present(struct ctl *c)
 		c->hold[j] = ctl_hold_point(&c->j[j], isfinite(c->j[j].angle) ? c->j[j].angle : c->j[j].goal);
 }
 
+/* A servo that lost its set-up (its RAM back at the factory values, or
+ * stopped by its watchdog): what was queued for it is dropped, it is set up
+ * again with torque on and ramps in from goal, unless a fault holds it. */
+static void ctl_set_up_again(struct ctl *c, size_t j, double goal)
+{
+	struct ctl_joint *jt = &c->j[j];
+	wq_drop_id(&c->wq, jt->id);
+	ctl_servo_setup(c, j, true);
+	jt->goal = goal;
+	c->hold[j] = goal;
+	if (jt->fault == CTL_FAULT_NONE)
+		ctl_blend_joint(c, j, goal);
+}
+
 /* A servo found with torque off that should be on: it lost power (or browned
  * out) and came back with its RAM at the factory values. It is set up again
  * and ramps in from where it is now; one that keeps resetting latches. */
@@ -495,11 +509,9 @@ static void ctl_servo_reset(struct ctl *c, size_t j)
 	jt->resets++;
 	c->resets++;
 	if (jt->resets > c->cfg->fault_retries) {
-		char what[CTL_LATCH_TEXT];
-		snprintf(what, sizeof what, "servo %u reset %lld times (power?)", jt->id, jt->resets);
 		ctl_event(c, 2, "servo-reset", "servo %u found with torque off again (reset %lld): giving up", jt->id,
 		          jt->resets);
-		ctl_latch(c, what);
+		ctl_latchf(c, "servo %u reset %lld times (power?)", jt->id, jt->resets);
 		if (c->mode == CFG_MODE_LIMP)
 			return;
 	} else {
@@ -507,13 +519,8 @@ static void ctl_servo_reset(struct ctl *c, size_t j)
 		          "brown-out: its RAM is back at the factory values): setting it up again, reset %lld of %d",
 		          jt->id, cfg_mode_name(c->mode), jt->resets, c->cfg->fault_retries);
 	}
-	wq_drop_id(&c->wq, jt->id);
-	ctl_servo_setup(c, j, true);
 	/* it may have been moved while limp: start where it is (inside the limits) */
-	jt->goal = ctl_hold_point(jt, jt->angle);
-	c->hold[j] = jt->goal;
-	if (jt->fault == CTL_FAULT_NONE)
-		ctl_blend_joint(c, j, jt->goal);
+	ctl_set_up_again(c, j, ctl_hold_point(jt, jt->angle));
 }
 
 static void ctl_mismatch(struct ctl *c, size_t j, const char *what, unsigned read, unsigned want)
@@ -602,39 +609,40 @@ static void ctl_watchdog_tripped(struct ctl *c, size_t j)
 	c->watchdog_trips++;
 	unsigned ms = 20u * cfg_watchdog_units(c->cfg);
 	if (jt->resets > c->cfg->fault_retries) {
-		char what[CTL_LATCH_TEXT];
-		snprintf(what, sizeof what, "servo %u stopped by its bus watchdog %lld times", jt->id, jt->resets);
 		ctl_event(c, 2, "watchdog", "servo %u: its bus watchdog stopped it again (%lld): giving up", jt->id,
 		          jt->resets);
-		ctl_latch(c, what);
+		ctl_latchf(c, "servo %u stopped by its bus watchdog %lld times", jt->id, jt->resets);
 	} else {
 		ctl_event(c, 2, "watchdog", "servo %u: its bus watchdog stopped it (nothing reached it for %u ms: "
 		          "this controller was late or the line was lost): cleared and set up again, reset %lld of %d",
 		          jt->id, ms, jt->resets, c->cfg->fault_retries);
 	}
-	wq_drop_id(&c->wq, jt->id);
-	jt->watchdog_cleared = true;
-	ctl_servo_setup(c, j, true);
-	jt->goal = jt->angle;
-	c->hold[j] = jt->angle;
-	if (jt->fault == CTL_FAULT_NONE)
-		ctl_blend_joint(c, j, jt->angle);
+	jt->watchdog_cleared = true;   /* read by the set-up: the watchdog written 0 first */
+	ctl_set_up_again(c, j, jt->angle);
 }
 
-/* X series: hardware errors that are no fault (the input voltage outside the
- * servo's limits) are reported once when they appear. */
-static void ctl_x_report_hwerr(struct ctl *c, size_t j)
+/* Error bits that are no fault (other) are reported once, when they appear:
+ * those not set at the last report, named by format, with the register
+ * (reg, its value) they came in. */
+static void ctl_report_new_bits(struct ctl *c, struct ctl_joint *jt, uint8_t other,
+                                char *(*format)(uint8_t, char *, size_t), const char *reg, unsigned value)
 {
-	struct ctl_joint *jt = &c->j[j];
-	uint8_t other = (uint8_t)(jt->hwerr > 0 ? jt->hwerr & ~SM_HWERR_FAULTS : 0);
 	uint8_t fresh_bits = other & (uint8_t)~jt->reported_bits;
 	jt->reported_bits = other;
 	if (fresh_bits == 0)
 		return;
 	char what[96];
-	dxl2_hwerr_format(fresh_bits, what, sizeof what);
-	ctl_event(c, 1, "servo-error", "servo %u reports %s (Hardware Error Status 0x%02x)", jt->id, what,
-	          (unsigned)jt->hwerr);
+	format(fresh_bits, what, sizeof what);
+	ctl_event(c, 1, "servo-error", "servo %u reports %s (%s 0x%02x)", jt->id, what, reg, value);
+}
+
+/* X series: hardware errors that are no fault (the input voltage outside the
+ * servo's limits). */
+static void ctl_x_report_hwerr(struct ctl *c, size_t j)
+{
+	struct ctl_joint *jt = &c->j[j];
+	uint8_t other = (uint8_t)(jt->hwerr > 0 ? jt->hwerr & ~SM_HWERR_FAULTS : 0);
+	ctl_report_new_bits(c, jt, other, dxl2_hwerr_format, "Hardware Error Status", (unsigned)jt->hwerr);
 }
 
 /* X series, the RAM block: torque, the watchdog, Goal PWM, the profiles. */
@@ -705,11 +713,8 @@ static void ctl_readback_x_eeprom(struct ctl *c, size_t j, const struct sm_state
 	          jt->limits_wrong ? "position limits changed" : "", st->opmode, mode != NULL ? mode : "unknown",
 	          (long)st->pos_min, (long)st->pos_max, want_mode, jt->servo.cw_limit, jt->servo.ccw_limit, jt->resets,
 	          c->cfg->fault_retries);
-	if (jt->resets > c->cfg->fault_retries) {
-		char what[CTL_LATCH_TEXT];
-		snprintf(what, sizeof what, "servo %u keeps being changed behind this controller's back", jt->id);
-		ctl_latch(c, what);
-	}
+	if (jt->resets > c->cfg->fault_retries)
+		ctl_latchf(c, "servo %u keeps being changed behind this controller's back", jt->id);
 	wq_drop_id(&c->wq, jt->id);
 	if (c->wheel)
 		tq_leave_wheel(c);
@@ -910,6 +915,16 @@ void ctl_latch(struct ctl *c, const char *what)
 	ctl_hold_at_present(c);
 }
 
+void ctl_latchf(struct ctl *c, const char *fmt, ...)
+{
+	char what[CTL_LATCH_TEXT];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(what, sizeof what, fmt, ap);
+	va_end(ap);
+	ctl_latch(c, what);
+}
+
 bool ctl_clear_faults(struct ctl *c, char *why, size_t cap)
 {
 	for (size_t j = 0; j < c->n; j++) {
@@ -1008,13 +1023,7 @@ static void ctl_report_errbits(struct ctl *c, size_t j)
 	if (!jt->fresh || ctl_has(c, j, SM_CAP_HWERR))
 		return;
 	uint8_t other = jt->errbits & (uint8_t)~(DXL_ERRBIT_OVERLOAD | DXL_ERRBIT_OVERHEAT);
-	uint8_t fresh_bits = other & (uint8_t)~jt->reported_bits;
-	jt->reported_bits = other;
-	if (fresh_bits == 0)
-		return;
-	char what[96];
-	dxl_errbits_format(fresh_bits, what, sizeof what);
-	ctl_event(c, 1, "servo-error", "servo %u reports %s (error byte 0x%02x)", jt->id, what, jt->errbits);
+	ctl_report_new_bits(c, jt, other, dxl_errbits_format, "error byte", jt->errbits);
 }
 
 /* X series: a servo its hardware error shut down (torque off) recovers only
@@ -1143,11 +1152,8 @@ static void ctl_check_stale(struct ctl *c, size_t j)
 		          jt->stale_cycles);
 	double silent = jt->stale_cycles * c->cfg->period_ms * 1e-3;
 	double previous = (jt->stale_cycles - 1) * c->cfg->period_ms * 1e-3;
-	if (silent >= c->cfg->silent_s && previous < c->cfg->silent_s) {
-		char what[CTL_LATCH_TEXT];
-		snprintf(what, sizeof what, "servo %u silent for %.2f s", jt->id, silent);
-		ctl_latch(c, what);
-	}
+	if (silent >= c->cfg->silent_s && previous < c->cfg->silent_s)
+		ctl_latchf(c, "servo %u silent for %.2f s", jt->id, silent);
 }
 
 /* ---- the step ------------------------------------------------------------------------------ */

@@ -44,6 +44,8 @@ int32_t ctl_goal_pos(const struct ctl_joint *jt, const struct sm_model *m, doubl
 void ctl_hold_at_present(struct ctl *c);
 /* Put the robot in its fault action and keep it there until cleared. */
 void ctl_latch(struct ctl *c, const char *what);
+/* ctl_latch with its text formatted (cut at CTL_LATCH_TEXT bytes). */
+void ctl_latchf(struct ctl *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* ---- torque.c ------------------------------------------------------------------------- */
 /* Under torque actuation `mode` drives the servos' torque: OSCILLATOR, and

@@ -357,6 +357,41 @@ fig_force_series() {
 	return 1
 }
 
+# fig_force_time_plot RUNS_DIR TMP END PNG YLABEL TITLE_END TAG LABEL COLOURS
+# [AT...]: the forces modules' second picture, PNG: the force per second
+# through a whole run of END s, one run per setting (the first column of
+# TMP/summary; fig_force_series into TMP/time.TAG<setting>.csv), each titled
+# by the function LABEL given the setting, in the COLOURS (a blank-separated
+# list, in turn); a dotted line at each AT s and at END/3 (the walls closed),
+# a solid one at 2 END/3 (the switch to the oscillator). No run with a
+# series: said, and no picture.
+fig_force_time_plot() {
+	local runs=$1 t=$2 end=$3 png=$4 ylabel=$5 title=$6 tag=$7 label=$8 colours series=() v x i=0
+	read -r -a colours <<<"$9"
+	shift 9
+	for v in $(cut -d' ' -f1 "$t/summary"); do
+		fig_force_series "$runs" "$v" "$end" "$t/time.$tag$v.csv" || continue
+		fig_has "$t/time.$tag$v.csv" 1 && series+=(
+			"'$t/time.$tag$v.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colours[$((i % ${#colours[@]}))]}' title '$("$label" "$v")'")
+		i=$((i + 1))
+	done
+	[ ${#series[@]} -gt 0 ] || { echo "$FIG_NAME: no series.csv in the runs: no time plot" >&2; return 0; }
+	{
+		fig_gp_head 900 600
+		echo "set output '$png'"
+		echo "set termoption noenhanced"
+		echo "set logscale y"
+		echo "set xlabel 'simulated time (s)'"
+		echo "set ylabel '$ylabel'"
+		echo "set title 'Walls close 10-$((end / 3)) s; clock until $((2 * end / 3)) s, oscillator after$title'"
+		echo "set key bottom left"
+		for x in "$@" $((end / 3)); do echo "set arrow from $x, graph 0 to $x, graph 1 nohead dt 3 lc rgb 'gray'"; done
+		echo "set arrow from $((2 * end / 3)), graph 0 to $((2 * end / 3)), graph 1 nohead lw 2 lc rgb 'black'"
+		fig_plot "${series[@]}"
+	} >"$t/time.gp"
+	fig_gnuplot "$t/time.gp"
+}
+
 # fig_summary_csv SUMMARY CSV HEADER: a merge's table of one row per setting,
 # written by the shell's printf (blank-separated, so fig_spread's empty fields
 # stay in their columns), made a CSV for gnuplot: SUMMARY.csv under HEADER.
@@ -385,12 +420,16 @@ fig_merge_begin() {
 	if [ "${FIG_KEEP:-0}" = 1 ]; then trap 'rm -rf "$FIG_OUT"' EXIT
 	else trap 'rm -rf "$FIG_TMP" "$FIG_OUT"' EXIT; fi
 }
-# fig_merge_runs RUNS_DIR FIGDIR: a merge's beginning where the module
-# merges all its runs' rows into one table: the arguments checked,
-# fig_merge_begin FIGDIR, and FIG_OUT/NAME.csv the rows (fig_results, sorted).
-fig_merge_runs() {
+# fig_merge_args RUNS_DIR FIGDIR: a merge's beginning: its two arguments
+# checked (else the usage line, exit 2), then fig_merge_begin FIGDIR.
+fig_merge_args() {
 	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
 	fig_merge_begin "$2"
+}
+# fig_merge_runs RUNS_DIR FIGDIR: the same where the module merges all its
+# runs' rows into one table: FIG_OUT/NAME.csv the rows (fig_results, sorted).
+fig_merge_runs() {
+	fig_merge_args "$@"
 	fig_results "$1" sorted >"$FIG_OUT/$FIG_NAME.csv"
 }
 fig_merge_end() {

@@ -13,6 +13,8 @@
 #include <unistd.h>
 
 #include "../tools/analyze/classify.h"
+#include "../tools/analyze/csvrow.h"
+#include "../tools/analyze/pairsum.h"
 #include "../tools/analyze/theory.h"
 #include "../tools/analyze/window.h"
 #include "json.h"
@@ -59,14 +61,6 @@ struct mrun {
 };
 
 
-static void mrun_num(FILE *f, double v)
-{
-	if (isfinite(v))
-		fprintf(f, ",%.9g", v);
-	else
-		fputs(",", f);
-}
-
 static long long mrun_utime(double t)
 {
 	return llround(t * 1e6);
@@ -74,12 +68,9 @@ static long long mrun_utime(double t)
 
 static FILE *mrun_create(struct mrun *m, const char *name, const char *header)
 {
-	int fd = openat(m->stagefd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+	FILE *f = outdir_stage_fopen(m->stagefd, name);
 	if (!f) {
 		fprintf(m->msg, "undulate-model: %s/%s: %s\n", m->o->out_dir, name, strerror(errno));
-		if (fd >= 0)
-			close(fd);
 		return NULL;
 	}
 	if (header)
@@ -89,13 +80,10 @@ static FILE *mrun_create(struct mrun *m, const char *name, const char *header)
 
 static int mrun_close(struct mrun *m, FILE **f, const char *name)
 {
-	if (!*f)
+	if (outdir_stage_fclose(f) == 0)
 		return 0;
-	int bad = ferror(*f) | fclose(*f);
-	*f = NULL;
-	if (bad)
-		fprintf(m->msg, "undulate-model: writing %s/%s failed\n", m->o->out_dir, name);
-	return bad ? -1 : 0;
+	fprintf(m->msg, "undulate-model: writing %s/%s failed\n", m->o->out_dir, name);
+	return -1;
 }
 
 /* ---- recording --------------------------------------------------------- */
@@ -114,15 +102,15 @@ static void mrun_sample(struct mrun *m, double t)
 		/* the columns of undulate-analyze's states.csv; mode 3 is
 		 * OSCILLATOR, goal and load do not exist in the model */
 		fprintf(m->states, "%lld,%.6f,\"r%d\",0,1", mrun_utime(t), t, i + 1);
-		mrun_num(m->states, x);
-		mrun_num(m->states, lat_speed(m->lat, i));
+		csvrow_num(m->states, x);
+		csvrow_num(m->states, lat_speed(m->lat, i));
 		fputs(",,,3", m->states);
-		mrun_num(m->states, phi);
-		mrun_num(m->states, o->amplitude);
-		mrun_num(m->states, o->frequency_hz);
+		csvrow_num(m->states, phi);
+		csvrow_num(m->states, o->amplitude);
+		csvrow_num(m->states, o->frequency_hz);
 		fputs(",0", m->states);
-		mrun_num(m->states, phi);
-		mrun_num(m->states, o->frequency_hz);
+		csvrow_num(m->states, phi);
+		csvrow_num(m->states, o->frequency_hz);
 		fprintf(m->states, ",%d\n", i);
 	}
 	for (int k = 0; k + 1 < m->n; k++) {
@@ -132,7 +120,7 @@ static void mrun_sample(struct mrun *m, double t)
 		if (o->write_samples) {
 			fprintf(m->pdiff, "%lld,%.6f,\"r%d:r%d\",neighbour,\"r%d\",0,\"r%d\",0", mrun_utime(t), t, k + 1,
 				k + 2, k + 1, k + 2);
-			mrun_num(m->pdiff, delta);
+			csvrow_num(m->pdiff, delta);
 			fputc('\n', m->pdiff);
 		}
 	}
@@ -152,12 +140,13 @@ static int mrun_hit_add(struct mrun_pair *p, const struct lat_event *ev)
 	return 0;
 }
 
-static void mrun_robot(FILE *f, int i)
+/* A robot's name in the files ("r1", ...; -1: "wall"), into buf. */
+static const char *mrun_robot(char *buf, size_t cap, int i)
 {
 	if (i < 0)
-		fputs("\"wall\"", f);
-	else
-		fprintf(f, "\"r%d\"", i + 1);
+		return "wall";
+	snprintf(buf, cap, "r%d", i + 1);
+	return buf;
 }
 
 static int mrun_collision(struct mrun *m, const struct lat_event *ev)
@@ -189,21 +178,15 @@ static int mrun_collision(struct mrun *m, const struct lat_event *ev)
 			return -1;
 		}
 	}
-	FILE *f = m->coll;
-	fprintf(f, "%lld,%.6f,%d,%d,", mrun_utime(ev->t), ev->t, ev->left, ev->right);
-	mrun_robot(f, ev->left);
-	fputc(',', f);
-	mrun_robot(f, ev->right);
-	mrun_num(f, ev->pre_left);
-	mrun_num(f, ev->pre_right);
-	mrun_num(f, ev->post_left);
-	mrun_num(f, ev->post_right);
-	mrun_num(f, ev->impulse);
-	fputc(',', f);
-	if (!wall)
-		fprintf(f, "\"r%d:r%d\"", ev->left + 1, ev->right + 1);
-	mrun_num(f, ev->delta_before);
-	fputs(",1\n", f);
+	char left[16], right[16], pair[32];
+	snprintf(pair, sizeof pair, "r%d:r%d", ev->left + 1, ev->right + 1);
+	/* every collision of the model is a new contact */
+	csvrow_collision(m->coll, &(struct csvrow_collision){
+		.utime = mrun_utime(ev->t), .t = ev->t, .left = ev->left, .right = ev->right,
+		.left_robot = mrun_robot(left, sizeof left, ev->left),
+		.right_robot = mrun_robot(right, sizeof right, ev->right),
+		.pre_left = ev->pre_left, .pre_right = ev->pre_right, .post_left = ev->post_left, .post_right = ev->post_right,
+		.impulse = ev->impulse, .pair = wall ? NULL : pair, .delta = ev->delta_before, .new_contact = true });
 	return 0;
 }
 
@@ -282,28 +265,14 @@ static void mrun_json_pair(const struct mrun *m, struct json *j, int k)
 	char name[32];
 	double amp = m->o->amplitude, dist = lat_neutral(m->lat, k + 1) - lat_neutral(m->lat, k);
 	snprintf(name, sizeof name, "r%d:r%d", k + 1, k + 2);
-	json_object_begin(j);
-	json_field_string(j, "pair", name);
-	json_field_string(j, "kind", "neighbour");
-	json_field_string(j, "class", mrun_class(m, k));
-	json_field_number(j, "mean_abs_delta", win_circ_mean_abs(&p->win));
-	json_field_number(j, "mean_delta", win_circ_mean(&p->win));
-	json_field_number(j, "spread", win_circ_spread(&p->win));
-	json_field_int(j, "window_samples", p->win.n);
-	json_field_int(j, "collisions", p->collisions);
-	json_field_int(j, "contacts", p->collisions);
-	json_field_int(j, "window_collisions", p->win_collisions);
-	json_field_number(j, "window_impulse", p->win_impulse);
-	json_field_number(j, "window_contact_impulse", p->win_impulse);
-	json_field_number(j, "impulse", p->impulse);
-	json_field_number(j, "distance_m", dist);
-	json_field_number(j, "amplitude_m", amp);
-	json_field_number(j, "dsep", dist / (2 * amp));
-	json_field_number(j, "compat_limit", theory_compat_limit(dist / (2 * amp)));
-	json_field_int(j, "return_map_points", p->nhits > 0 ? (long long)p->nhits - 1 : 0);
-	json_field_number(j, "swing_a", win_swing_pp(&m->swing[k]));
-	json_field_number(j, "swing_b", win_swing_pp(&m->swing[k + 1]));
-	json_object_end(j);
+	/* every contact of the model is a pair's collision */
+	pairsum_json(j, &(struct pairsum){
+		.name = name, .kind = "neighbour", .cls = mrun_class(m, k), .win = &p->win,
+		.collisions = p->collisions, .contacts = p->collisions, .win_collisions = p->win_collisions,
+		.win_impulse = p->win_impulse, .win_contact_impulse = p->win_impulse, .impulse = p->impulse,
+		.distance = dist, .amplitude = amp, .dsep = dist / (2 * amp),
+		.return_map_points = p->nhits > 0 ? (int64_t)p->nhits - 1 : 0,
+		.swing_a = win_swing_pp(&m->swing[k]), .swing_b = win_swing_pp(&m->swing[k + 1]) });
 }
 
 static void mrun_json_model(const struct mrun *m, struct json *j)
@@ -454,11 +423,11 @@ static int mrun_write_maps(struct mrun *m)
 		for (size_t i = 0; i + 1 < p->nhits; i++) {
 			const struct mrun_hit *h = &p->hits[i];
 			fprintf(f, "\"r%d:r%d\",%zu,%lld,%.6f", k + 1, k + 2, i, mrun_utime(h->t), h->t);
-			mrun_num(f, h->delta);
-			mrun_num(f, p->hits[i + 1].delta);
-			mrun_num(f, theory_return_map(h->delta, h->dsep, m->o->restitution));
-			mrun_num(f, h->dsep);
-			mrun_num(f, h->delta_after);
+			csvrow_num(f, h->delta);
+			csvrow_num(f, p->hits[i + 1].delta);
+			csvrow_num(f, theory_return_map(h->delta, h->dsep, m->o->restitution));
+			csvrow_num(f, h->dsep);
+			csvrow_num(f, h->delta_after);
 			fputc('\n', f);
 		}
 	}
@@ -503,13 +472,9 @@ static int mrun_open_dir(struct mrun *m)
 		fprintf(m->msg, "undulate-model: --out %s: %s\n", m->o->out_dir, err);
 		return -1;
 	}
-	m->states = mrun_create(m, "states.csv",
-		"utime,t,robot,joint,servo_id,angle,speed,goal,load,mode,phase,amplitude,frequency,error_bits,"
-		"phase_daemon,frequency_est,robot_index");
-	m->pdiff = mrun_create(m, "phase_diff.csv", "utime,t,pair,kind,robot_a,joint_a,robot_b,joint_b,delta");
-	m->coll = mrun_create(m, "collisions.csv",
-		"utime,t,left,right,left_robot,right_robot,pre_left,pre_right,post_left,post_right,impulse,pair,"
-		"delta_before,new_contact");
+	m->states = mrun_create(m, "states.csv", CSVROW_STATES_HEADER);
+	m->pdiff = mrun_create(m, "phase_diff.csv", CSVROW_PDIFF_HEADER);
+	m->coll = mrun_create(m, "collisions.csv", CSVROW_COLLISIONS_HEADER);
 	return m->states && m->pdiff && m->coll ? 0 : -1;
 }
 
@@ -630,7 +595,7 @@ int mrun_map(const struct cli_opts *o, FILE *out, FILE *msg)
 			}
 			double next = r.collided ? r.delta_after : delta;
 			fprintf(out, "%.6g,%.9g,%.9g,%.9g,%d", d, delta, next, fabs(next) - fabs(delta), r.collided);
-			mrun_num(out, theory_return_map(delta, d, o->restitution));
+			csvrow_num(out, theory_return_map(delta, d, o->restitution));
 			fputc('\n', out);
 		}
 	}

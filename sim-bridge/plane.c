@@ -89,21 +89,16 @@ static bool plane_check(const struct plane_params *p, char *err, size_t cap)
 }
 
 /* Restitution and friction by the kind of pair (Chipmunk would multiply the
- * two shapes' values, which cannot give a wall its own r). */
-static cpBool plane_presolve_links(cpArbiter *arb, cpSpace *space, cpDataPointer data)
+ * two shapes' values, which cannot give a wall its own r): a link against a
+ * wall (the handler's second shape) bounces with the wall's. */
+static cpBool plane_presolve(cpArbiter *arb, cpSpace *space, cpDataPointer data)
 {
 	(void)space;
 	const struct plane *pl = data;
-	cpArbiterSetRestitution(arb, pl->p.restitution);
-	cpArbiterSetFriction(arb, pl->p.friction);
-	return cpTrue;
-}
-
-static cpBool plane_presolve_wall(cpArbiter *arb, cpSpace *space, cpDataPointer data)
-{
-	(void)space;
-	const struct plane *pl = data;
-	cpArbiterSetRestitution(arb, pl->p.wall_restitution);
+	CP_ARBITER_GET_SHAPES(arb, link, other);
+	(void)link;
+	bool wall = cpShapeGetCollisionType(other) == PLANE_CT_WALL;
+	cpArbiterSetRestitution(arb, wall ? pl->p.wall_restitution : pl->p.restitution);
 	cpArbiterSetFriction(arb, pl->p.friction);
 	return cpTrue;
 }
@@ -151,10 +146,10 @@ struct plane *plane_new(const struct plane_params *p, char *err, size_t cap)
 	cpSpaceSetCollisionSlop(pl->space, PLANE_SLOP_M);
 	cpSpaceSetCollisionBias(pl->space, PLANE_BIAS_LEFT_AFTER_1S);
 	cpCollisionHandler *h = cpSpaceAddCollisionHandler(pl->space, PLANE_CT_LINK, PLANE_CT_LINK);
-	h->preSolveFunc = plane_presolve_links;
+	h->preSolveFunc = plane_presolve;
 	h->userData = pl;
 	h = cpSpaceAddCollisionHandler(pl->space, PLANE_CT_LINK, PLANE_CT_WALL);
-	h->preSolveFunc = plane_presolve_wall;
+	h->preSolveFunc = plane_presolve;
 	h->userData = pl;
 	return pl;
 }

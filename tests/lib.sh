@@ -86,6 +86,22 @@ tap_skip() {
 tap_skip_all() { tap_skip "$(basename "$0" .sh)" "$1"; tap_done; exit 0; }
 tap_check() { local name=$1; shift; if "$@"; then tap_ok "$name"; else tap_fail "$name" "command failed: $*"; fi; }
 tap_done() { echo "1..$_tap_n"; [ "$_tap_failed" -eq 0 ]; }
+# needs_plotting: a test of pictures needs gnuplot to draw them and
+# tests/tools/pngdata (PNG) to count their pixels; without either, the whole
+# script is skipped.
+needs_plotting() {
+	PNG="$BUILD/tests/tools/pngdata"
+	command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
+	[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+}
+# tap_refused PREFIX NAME CMD...: a usage refusal: CMD exits 2 and what it
+# says (stdout and stderr) begins with PREFIX, e.g. a figure module's "name:".
+tap_refused() {
+	local prefix=$1 name=$2 out rc
+	shift 2
+	out=$("$@" 2>&1); rc=$?
+	if [ "$rc" = 2 ] && [[ "$out" == "$prefix"* ]]; then tap_ok "refused: $name"; else tap_fail "refused: $name" "rc=$rc: $out"; fi
+}
 
 # Each spawned program runs in a session of its own (setsid), as a service runs
 # in a cgroup of its own: with the kernel's autogroups, programs in the session
@@ -283,6 +299,20 @@ demo_leftovers() {
 	return 1
 }
 
+# left_nothing WHEN: one TAP line, "nothing left behind after WHEN"
+# (demo_leftovers, what it found if anything).
+left_nothing() {
+	local why
+	if why=$(demo_leftovers); then tap_ok "nothing left behind after $1"; else tap_fail "nothing left behind after $1" "$why"; fi
+}
+# demo_up NAME CLAIM: the spawned scripts/demo.sh NAME printed its phases (its
+# programs are up) within 40 s; if not, CLAIM fails with its log's tail.
+demo_up() {
+	wait_log "$1" '^demo: phases' 40 && return 0
+	tap_fail "$2" "$(tail -n 20 "$T/$1.log")"
+	return 1
+}
+
 # start_retried: the script's start_daemon, and once more as a unit's
 # Restart=on-failure would when that start-up failed (exit 1, e.g. a servo
 # read timing out on a loaded machine) before the script's `ready`; the
@@ -437,6 +467,43 @@ run_wait() {
 	[ "$run_rc" = 0 ] && [ -f "$T/$1/summary.txt" ]
 }
 CROSSTALK="another program published on the run's LCM URL; its results mix two runs"
+# run_ran NAME TIMEOUT_S LABEL CLAIM: run_wait, then one TAP line: CLAIM
+# passed when it ran and was analysed; "LABEL: nobody else on its LCM port"
+# failed on crosstalk. Returns 0 when it ran.
+run_ran() {
+	local ran
+	run_wait "$1" "$2"; ran=$?
+	if [ "$ran" = 2 ]; then
+		tap_fail "$3: nobody else on its LCM port" "$CROSSTALK"
+	elif [ "$ran" = 0 ]; then
+		tap_ok "$4"
+	else
+		tap_fail "$4" "exit $run_rc: $(tail -n 20 "$T/$1.log")"
+	fi
+	[ "$ran" = 0 ]
+}
+# still_swings NAME CLAIM [WHY]: every robot of run NAME kept a peak-to-peak of
+# at least MIN_SWING rad over the last 10 s (min_swing); marks the run
+# $T/NAME/moving for judged. WHY follows the failure's numbers.
+still_swings() {
+	local sw
+	sw=$(min_swing "$T/$1")
+	if awk -v s="${sw%% *}" -v m="$MIN_SWING" 'BEGIN { exit !(s >= m) }'; then
+		tap_ok "$2 (smallest peak-to-peak $sw rad)"
+		: >"$T/$1/moving"
+	else
+		tap_fail "$2" "smallest peak-to-peak over the last 10 s: $sw rad (< $MIN_SWING)${3:+: $3}"
+	fi
+}
+# judged NAME SKIP_NAME SKIP_WHY: run NAME's regime can be judged: it ran and
+# its robots still swing (still_swings); a run that stopped gets one skip,
+# the stop being a failure of its own.
+judged() {
+	[ -f "$T/$1/summary.txt" ] || return 1
+	[ -f "$T/$1/moving" ] && return 0
+	tap_skip "$2" "$3"
+	return 1
+}
 
 # An end-to-end experiment (e2e_pair, e2e_row) asserts the paper's regimes
 # twice: in lockstep, where the outcome is the same on any machine, and in

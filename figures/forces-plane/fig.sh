@@ -160,30 +160,12 @@ force_plot() {
 }
 
 time_plot() {
-	local runs=$1 fig=$2 t=$3 series=() k colors=('#9467bd' '#1f77b4' '#2ca02c' '#ff7f0e' '#d62728') i=0 end
-	end=$(awk -F, 'NR == 2 { print $3; exit }' "$fig/forces-plane.csv")
-	for k in $(cut -d' ' -f1 "$t/summary"); do
-		fig_force_series "$runs" "$k" "$end" "$t/time.k$k.csv" || continue
-		fig_has "$t/time.k$k.csv" 1 && series+=(
-			"'$t/time.k$k.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 5))]}' title 'k = $k N·m/rad'")
-		i=$((i + 1))
-	done
-	[ ${#series[@]} -gt 0 ] || { echo "forces-plane: no series.csv in the runs: no time plot" >&2; return 0; }
-	{
-		fig_gp_head 900 600
-		echo "set output '$fig/forces-plane_time.png'"
-		echo "set termoption noenhanced"
-		echo "set logscale y"
-		echo "set xlabel 'simulated time (s)'"
-		echo "set ylabel 'contact force (N), mean per second, all contacts'"
-		echo "set title 'Walls close 10-$((end / 3)) s; clock until $((2 * end / 3)) s, oscillator after (one run per k)'"
-		echo "set key bottom left"
-		echo "set arrow from $((end / 3)), graph 0 to $((end / 3)), graph 1 nohead dt 3 lc rgb 'gray'"
-		echo "set arrow from $((2 * end / 3)), graph 0 to $((2 * end / 3)), graph 1 nohead lw 2 lc rgb 'black'"
-		fig_plot "${series[@]}"
-	} >"$t/time.gp"
-	fig_gnuplot "$t/time.gp"
+	local end
+	end=$(awk -F, 'NR == 2 { print $3; exit }' "$2/forces-plane.csv")
+	fig_force_time_plot "$1" "$3" "$end" "$2/forces-plane_time.png" 'contact force (N), mean per second, all contacts' \
+		' (one run per k)' k k_label '#9467bd #1f77b4 #2ca02c #ff7f0e #d62728'
 }
+k_label() { echo "k = $1 N·m/rad"; }
 
 fragment() {
 	local fig=$1 csv="$1/forces-plane.csv" n end walls broken

@@ -200,31 +200,12 @@ force_plot() {
 # through the whole run, one run per slope (its first replicate that has a
 # series).
 time_plot() {
-	local runs=$1 fig=$2 t=$3 series=() s colors=('#9467bd' '#1f77b4' '#ff7f0e' '#d62728') i=0 end
-	end=$(run_end "$fig/forces.csv")
-	for s in $(cut -d' ' -f1 "$t/summary"); do
-		fig_force_series "$runs" "$s" "$end" "$t/time.s$s.csv" || continue
-		fig_has "$t/time.s$s.csv" 1 && series+=(
-			"'$t/time.s$s.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colors[$((i % 4))]}' title 'slope $s ($(stiffness "$s") N·m/rad)'")
-		i=$((i + 1))
-	done
-	[ ${#series[@]} -gt 0 ] || { echo "forces: no series.csv in the runs: no time plot" >&2; return 0; }
-	{
-		fig_gp_head 900 600
-		echo "set output '$fig/forces_time.png'"
-		echo "set termoption noenhanced"
-		echo "set logscale y"
-		echo "set xlabel 'simulated time (s)'"
-		echo "set ylabel 'contact force (N), per second'"
-		echo "set title 'Walls close 10-$((end / 3)) s; clock until $((2 * end / 3)) s, oscillator after'"
-		echo "set key bottom left"
-		echo "set arrow from 10, graph 0 to 10, graph 1 nohead dt 3 lc rgb 'gray'"
-		echo "set arrow from $((end / 3)), graph 0 to $((end / 3)), graph 1 nohead dt 3 lc rgb 'gray'"
-		echo "set arrow from $((2 * end / 3)), graph 0 to $((2 * end / 3)), graph 1 nohead lw 2 lc rgb 'black'"
-		fig_plot "${series[@]}"
-	} >"$t/time.gp"
-	fig_gnuplot "$t/time.gp"
+	local end
+	end=$(run_end "$2/forces.csv")
+	fig_force_time_plot "$1" "$3" "$end" "$2/forces_time.png" 'contact force (N), per second' '' s slope_label \
+		'#9467bd #1f77b4 #ff7f0e #d62728' 10
 }
+slope_label() { echo "slope $1 ($(stiffness "$1") N·m/rad)"; }
 
 # run_end CSV: the runs' END (the first run's; a merge of mixed timelines
 # says so in its fragment).

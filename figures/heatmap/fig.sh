@@ -64,10 +64,8 @@ run() {
 
 # ---- merge -----------------------------------------------------------------------
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 r
-	fig_merge_begin "$2"
-	local fig=$FIG_OUT tmp=$FIG_TMP
+	fig_merge_args "$@"
+	local runs=$1 r fig=$FIG_OUT tmp=$FIG_TMP
 	fig_results "$runs" >"$fig/heatmap.csv"
 	for r in $(rs "$fig/heatmap.csv"); do
 		fig_theory curves --restitution "$r" >"$tmp/curves-$r.csv" || fig_die "undulate-analyze --theory failed"

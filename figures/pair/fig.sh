@@ -136,9 +136,8 @@ free_amplitude() {
 }
 
 merge() {
-	local runs=$1 fig=$2
-	fig_merge_begin "$fig"
-	fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
+	fig_merge_args "$@"
+	local runs=$1 fig=$FIG_OUT   # written here, moved into FIGDIR by fig_merge_end
 	tmp=$FIG_TMP
 	fig_results "$runs" >"$tmp/runs.csv"
 	amp=$(free_amplitude "$tmp/runs.csv")

@@ -87,11 +87,8 @@ run() {
 # Columns of steady.csv.
 C_R=1 C_D=2 C_D0=3 C_CLASS=4 C_FINAL=5 C_THEORY=8
 merge() {
-	[ $# -eq 2 ] || fig_usage "merge RUNS_DIR FIGDIR"
-	local runs=$1 r
-	fig_merge_begin "$2"
-	local fig=$FIG_OUT tmp=$FIG_TMP
-	fig_results "$runs" sorted >"$fig/steady.csv"
+	fig_merge_runs "$@"
+	local r fig=$FIG_OUT tmp=$FIG_TMP
 	cells "$fig/steady.csv" >"$tmp/cells.csv"
 	# d~_c(r) over the whole range of r, for the curve
 	for r in $(awk 'BEGIN { for (i = 1; i < 100; i++) printf "%.2f\n", i / 100 }'); do

@@ -125,7 +125,7 @@ if grep -q '^restitution for theory: 0.670 (the simulator.s, SIM.WORLD)' "$T/out
 else
 	tap_fail "the analysis takes the restitution from the simulator's SIM.WORLD" "$(grep -i restitution "$T/out/summary.txt")"
 fi
-if why=$(demo_leftovers); then tap_ok "nothing left behind after a full run"; else tap_fail "nothing left behind after a full run" "$why"; fi
+left_nothing "a full run"
 
 # ---- the paper's effect: the same scene in lockstep ----------------------------------------
 # (docs/EXPERIMENTS.md section 4: the simulator's total impulse per second,
@@ -182,7 +182,7 @@ if [ -n "$xratio" ] && awk -v r="$xratio" 'BEGIN { exit !(r >= 10) }' || echo "$
 else
 	tap_todo "XM430 robots: the contact force falls 10x or more" "${xwords:-no words}"
 fi
-if why=$(demo_leftovers); then tap_ok "nothing left behind after the lockstep run"; else tap_fail "nothing left behind after the lockstep run" "$why"; fi
+left_nothing "the lockstep run"
 
 # ---- stopped early ---------------------------------------------------------------
 # SIGTERM (what `timeout`, a service manager or a closing terminal sends)
@@ -191,7 +191,7 @@ if why=$(demo_leftovers); then tap_ok "nothing left behind after the lockstep ru
 # (the four robots of the channel: what is tested is the stopping)
 spawn demo2 env BUILD="$BUILD" DEMO_SECONDS=60 DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/out2" "$demo" \
 	--scenario "$top/sim-bridge/scenarios/channel4.scenario"
-if wait_log demo2 '^demo: phases' 40; then
+if demo_up demo2 "second demo starts"; then
 	links=$(find "$T/tmp" -type l | wc -l)
 	# (not $(stop ...): a subshell cannot wait for a child of this shell)
 	kill -TERM "$pid_demo2"
@@ -202,9 +202,7 @@ if wait_log demo2 '^demo: phases' 40; then
 	else
 		tap_fail "SIGTERM stops the demo (exit 143) after it made 4 pty links" "links $links, exit $rc; its log: $(tail -n 12 "$T/demo2.log")"
 	fi
-	if why=$(demo_leftovers); then tap_ok "nothing left behind after SIGTERM"; else tap_fail "nothing left behind after SIGTERM" "$why"; fi
-else
-	tap_fail "second demo starts" "$(tail -n 20 "$T/demo2.log")"
+	left_nothing "SIGTERM"
 fi
 
 # ---- interactive, on a terminal: q, then Ctrl-C ------------------------------------
@@ -236,7 +234,7 @@ if command -v script >/dev/null; then
 	else
 		tap_fail "interactive: q prints the summary and keeps the run" "$(echo "$screen" | tail -n 15; ls "$T/iout" 2>&1)"
 	fi
-	if why=$(demo_leftovers); then tap_ok "nothing left behind after q"; else tap_fail "nothing left behind after q" "$why"; fi
+	left_nothing "q"
 
 	( wait_for 40 grep -q 'r4 ' "$T/tty2.out"; sleep 2; printf '\003'; sleep 5 ) |
 		env BUILD="$BUILD" DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/iout2" \
@@ -249,7 +247,7 @@ if command -v script >/dev/null; then
 	else
 		tap_fail "interactive: Ctrl-C ends the demo" "exit $rc; $(clean "$T/tty2.out" | tail -n 10)"
 	fi
-	if why=$(demo_leftovers); then tap_ok "nothing left behind after Ctrl-C"; else tap_fail "nothing left behind after Ctrl-C" "$why"; fi
+	left_nothing "Ctrl-C"
 fi
 
 # ---- bad input --------------------------------------------------------------------

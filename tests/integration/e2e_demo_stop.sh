@@ -22,7 +22,7 @@ clean() { tr -d '\r' <"$1" | sed 's/\x1b\[[0-9;?]*[A-Za-z]//g'; }
 
 # ---- SIGTERM before the switch ------------------------------------------------------
 spawn d1 env BUILD="$BUILD" DEMO_SECONDS=60 DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/out1" "$demo" --scenario "$scen"
-if wait_log d1 '^demo: phases' 40; then
+if demo_up d1 "demo starts"; then
 	wait_for 10 bash -c "[ \$(stat -c %s $T/tmp/undulate-demo.*/demo.lcmlog 2>/dev/null || echo 0) -gt 100000 ]"
 	kill -TERM "$pid_d1"
 	wait "$pid_d1"; rc=$?
@@ -40,14 +40,12 @@ if wait_log d1 '^demo: phases' 40; then
 	else
 		tap_fail "the kept log analyses with the command printed" "'$next': $(tail -n 3 "$T/next1.out")"
 	fi
-	if why=$(demo_leftovers); then tap_ok "nothing left behind after SIGTERM"; else tap_fail "nothing left behind after SIGTERM" "$why"; fi
-else
-	tap_fail "demo starts" "$(tail -n 20 "$T/d1.log")"
+	left_nothing "SIGTERM"
 fi
 
 # ---- a daemon killed during the run ----------------------------------------------------
 spawn d2 env BUILD="$BUILD" DEMO_SECONDS=8 DEMO_LCM_URL="$url" TMPDIR="$T/tmp" DEMO_OUT="$T/out2" "$demo" --scenario "$scen"
-if wait_log d2 '^demo: phases' 40; then
+if demo_up d2 "demo starts"; then
 	victim=$(awk '$2 == "undulated-r2" { print $1 }' "$T"/tmp/undulate-demo.*/pids)
 	kill -KILL "$victim"
 	wait_for 40 bash -c "! kill -0 $pid_d2"
@@ -60,9 +58,7 @@ if wait_log d2 '^demo: phases' 40; then
 	else
 		tap_fail "a daemon killed during the run: named, the run kept" "exit $rc; $(tail -n 12 "$T/d2.log"); $(ls "$T/out2" 2>&1)"
 	fi
-	if why=$(demo_leftovers); then tap_ok "nothing left behind after a killed daemon"; else tap_fail "nothing left behind after a killed daemon" "$why"; fi
-else
-	tap_fail "demo starts" "$(tail -n 20 "$T/d2.log")"
+	left_nothing "a killed daemon"
 fi
 
 if ! command -v script >/dev/null; then
@@ -84,7 +80,7 @@ if [ "$rc" = 130 ] && echo "$screen" | grep -qE '^demo: stopped early \(Ctrl-C\)
 else
 	tap_fail "Ctrl-C of a lockstep run says what ran and keeps the run" "exit $rc; $(echo "$screen" | tail -n 8); $(ls "$T/out3" 2>&1)"
 fi
-if why=$(demo_leftovers); then tap_ok "nothing left behind after Ctrl-C in lockstep"; else tap_fail "nothing left behind after Ctrl-C in lockstep" "$why"; fi
+left_nothing "Ctrl-C in lockstep"
 
 # ---- q before the switch: the summary says the oscillator never ran ------------------------
 ( wait_for 40 grep -q 'r4 ' "$T/tty2.out"; sleep 2; printf 'q'; wait_for 60 grep -q 'Next, the plots' "$T/tty2.out" ) |
@@ -98,5 +94,5 @@ if [ "$rc" = 0 ] && echo "$screen" | grep -qE '^THE OSCILLATOR NEVER RAN: the ru
 else
 	tap_fail "q before the switch: the summary says the oscillator never ran" "exit $rc; $(echo "$screen" | sed -n '/=== undulate demo/,+4p')"
 fi
-if why=$(demo_leftovers); then tap_ok "nothing left behind after q"; else tap_fail "nothing left behind after q" "$why"; fi
+left_nothing "q"
 tap_done

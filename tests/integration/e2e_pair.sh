@@ -54,6 +54,12 @@ col() { summary_col "$T/$1" left:right "$2"; }
 collisions() {
 	awk -F, -v a="$2" -v b="$3" 'NR > 1 && $1 >= a && $1 < b { n += $2 } END { print n + 0 }' "$T/$1/collision_rate.csv"
 }
+# after_switch NAME: collisions in the 10 s after the switch to the oscillator.
+after_switch() {
+	local sw
+	sw=$(cat "$T/$1/switch_t")
+	collisions "$1" "$sw" "$(awk "BEGIN { print $sw + 10 }")"
+}
 span() { awk -F, 'NR > 1 { t = $1 } END { print t + 1 }' "$T/$1/collision_rate.csv"; }
 num() { awk "BEGIN { exit !($*) }"; }
 # Peak-to-peak (rad) both robots must keep: half the rig's 2 x 0.8 rad.
@@ -67,44 +73,31 @@ if realtime_part; then
 	run compat $((port + 1)) 0.3 0,2.0
 	run anti $((port + 2)) 0.7 0,3.1416
 	for name in inphase compat anti; do
-		run_wait "$name" $((seconds + 60)); ran=$?
-		if [ "$ran" = 2 ]; then
-			tap_fail "$name: nobody else on its LCM port" "$CROSSTALK"
-		elif [ "$ran" = 0 ]; then
-			tap_ok "$name: rig ran ${seconds} s through sim + 2 daemons, log analysed"
-			sw=$(min_swing "$T/$name")
-			if num "${sw%% *} >= $MIN_SWING"; then
-				tap_ok "$name: both robots still swing at the end (smallest peak-to-peak $sw rad)"
-				: >"$T/$name/moving"
-			else
-				tap_fail "$name: both robots still swing at the end" "smallest peak-to-peak over the last 10 s: $sw rad (< $MIN_SWING): a stopped pair proves nothing"
-			fi
-		else
-			tap_fail "$name: rig ran ${seconds} s through sim + 2 daemons, log analysed" "exit $run_rc: $(tail -n 20 "$T/$name.log")"
-		fi
+		run_ran "$name" $((seconds + 60)) "$name" "$name: rig ran ${seconds} s through sim + 2 daemons, log analysed" &&
+			still_swings "$name" "$name: both robots still swing at the end" "a stopped pair proves nothing"
 	done
 fi
 
 # regime NAME: the run's regime can be judged (it ran, and both robots still swing)
-regime() {
-	[ -f "$T/$1/summary.txt" ] || return 1
-	[ -f "$T/$1/moving" ] && return 0
-	tap_skip "$1: the regime's checks" "the robots stopped swinging: nothing to judge"
-	return 1
+regime() { judged "$1" "$1: the regime's checks" "the robots stopped swinging: nothing to judge"; }
+# collided LABEL SIZE COND D AFTER: the run's d~ (D) is SIZE (the num
+# condition COND) and the robots collided after the switch (AFTER times): the
+# separation that makes the regime, and contact the oscillator must resolve.
+collided() {
+	if num "$3" && [ "$5" -gt 0 ]; then
+		tap_ok "$1: $2 d~ ($4); the robots collided after the switch ($5)"
+	else
+		tap_fail "$1: $2 d~; the robots collided after the switch" "d~ $4, collisions $5"
+	fi
 }
 
 if realtime_part; then
 	# ---- small separation: in phase --------------------------------------------------
 	n=inphase
 	if regime $n; then
-		d=$(col $n d~); D=$(col $n meanD); sw=$(cat "$T/$n/switch_t")
-		after=$(collisions $n "$sw" "$(awk "BEGIN { print $sw + 10 }")")
+		d=$(col $n d~); D=$(col $n meanD); after=$(after_switch $n)
 		echo "# in phase: d~ $d, final D $D, collisions in the 10 s after the switch $after"
-		if num "$d < 0.15" && [ "$after" -gt 0 ]; then
-			tap_ok "in phase: small d~ ($d); the robots collided after the switch ($after)"
-		else
-			tap_fail "in phase: small d~; the robots collided after the switch" "d~ $d, collisions $after"
-		fi
+		collided "in phase" small "$d < 0.15" "$d" "$after"
 		if num "${D#-} < 0.3"; then
 			tap_ok "in phase: final |D| = ${D#-} < 0.3 rad (d~ = $d)"
 		else
@@ -116,15 +109,10 @@ if realtime_part; then
 	n=compat
 	if regime $n; then
 		d=$(col $n d~); D=$(col $n meanD); lim=$(col $n "2asin(d~)"); end=$(span $n)
-		sw=$(cat "$T/$n/switch_t")
-		after=$(collisions $n "$sw" "$(awk "BEGIN { print $sw + 10 }")")
+		sw=$(cat "$T/$n/switch_t"); after=$(after_switch $n)
 		last=$(collisions $n "$(awk "BEGIN { print $end - 10 }")" "$end")
 		echo "# compatible: d~ $d (2 asin $lim), final D $D, collisions in the 10 s after the switch $after, in the last 10 s $last"
-		if num "$d > 0.15 && $d < 0.45" && [ "$after" -gt 0 ]; then
-			tap_ok "compatible: intermediate d~ ($d); the robots collided after the switch ($after)"
-		else
-			tap_fail "compatible: intermediate d~; the robots collided after the switch" "d~ $d, collisions $after"
-		fi
+		collided compatible intermediate "$d > 0.15 && $d < 0.45" "$d" "$after"
 		# Two separate claims: the phase difference ends inside the compatible
 		# set (at most the grazing value 2 asin(d~), the map's fixed point), and
 		# the contact stops there.

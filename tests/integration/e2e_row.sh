@@ -60,40 +60,22 @@ if realtime_part; then
 	run mobile mobile 11 $((port + 1))
 	run mobile_b mobile 12 $((port + 2))
 	for name in immobile mobile mobile_b; do
-		run_wait "$name" $((seconds + 60)); ran=$?
-		if [ "$ran" = 2 ]; then
-			tap_fail "$name row: nobody else on its LCM port" "$CROSSTALK"
-		elif [ "$ran" = 0 ]; then
-			tap_ok "$name row: ${seconds} s through sim + 5 daemons, log analysed"
-			# the switch is one command to every robot; a robot left on the clock
-			# would keep colliding whatever its base does
-			modes=$(end_modes "$T/$name")
-			if [ "$(echo "$modes" | grep -o '=OSCILLATOR' | wc -l)" = 5 ]; then
-				tap_ok "$name row: every robot took the switch (5 on OSCILLATOR at the end)"
-			else
-				tap_fail "$name row: every robot took the switch" "at the end: $modes; $(cat "$T/$name/logs/switch.log" 2>/dev/null | tr '\n' ';')"
-			fi
-			sw=$(min_swing "$T/$name")
-			if awk -v s="${sw%% *}" -v m=$MIN_SWING 'BEGIN { exit !(s >= m) }'; then
-				tap_ok "$name row: every robot still swings at the end (smallest peak-to-peak $sw rad)"
-				: >"$T/$name/moving"
-			else
-				tap_fail "$name row: every robot still swings at the end" "smallest peak-to-peak over the last 10 s: $sw rad (< $MIN_SWING)"
-			fi
+		run_ran "$name" $((seconds + 60)) "$name row" "$name row: ${seconds} s through sim + 5 daemons, log analysed" || continue
+		# the switch is one command to every robot; a robot left on the clock
+		# would keep colliding whatever its base does
+		modes=$(end_modes "$T/$name")
+		if [ "$(echo "$modes" | grep -o '=OSCILLATOR' | wc -l)" = 5 ]; then
+			tap_ok "$name row: every robot took the switch (5 on OSCILLATOR at the end)"
 		else
-			tap_fail "$name row: ${seconds} s through sim + 5 daemons, log analysed" "exit $run_rc: $(tail -n 20 "$T/$name.log")"
+			tap_fail "$name row: every robot took the switch" "at the end: $modes; $(cat "$T/$name/logs/switch.log" 2>/dev/null | tr '\n' ';')"
 		fi
+		still_swings "$name" "$name row: every robot still swings at the end"
 	done
 fi
 
 # regime NAME: the row can be judged (it ran, and every robot still swings:
 # a stopped robot neither collides nor relaxes; the stop is a failure of its own)
-regime() {
-	[ -f "$T/$1/summary.txt" ] || return 1
-	[ -f "$T/$1/moving" ] && return 0
-	tap_skip "$1 row: the regime's check" "a robot stopped swinging: nothing to judge"
-	return 1
-}
+regime() { judged "$1" "$1 row: the regime's check" "a robot stopped swinging: nothing to judge"; }
 
 if realtime_part; then
 	if regime immobile; then

@@ -7,21 +7,14 @@
 # colour bars alone hold about 1000 of each), the section with its numbers.
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures/heatmap/fig.sh"
-PNG="$BUILD/tests/tools/pngdata"
-command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
-[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+needs_plotting
 [ -x "$B/undulate-model" ] || tap_skip_all "undulate-model is not built"
 
 a=$("$F" jobs) b=$("$F" jobs) q=$("$F" jobs --quick)
 tap_check "jobs: four restitutions, the same twice, unique names" \
 	bash -c "[ '$a' = '$b' ] && [ \$(wc -l <<<'$a') = 4 ] && [ -z \"\$(awk '{ print \$1 }' <<<'$a' | sort | uniq -d)\" ] && [ \$(wc -l <<<'$q') = 4 ]"
 
-refused() {
-	local name=$1 out rc
-	shift
-	out=$("$F" "$@" 2>&1); rc=$?
-	if [ "$rc" = 2 ] && [[ "$out" == heatmap:* ]]; then tap_ok "refused: $name"; else tap_fail "refused: $name" "rc=$rc: $out"; fi
-}
+refused() { tap_refused heatmap: "$1" "$F" "${@:2}"; }
 refused "no subcommand"
 refused "run: r above 1" run "$T/x" 1.5 11 12
 refused "run: too few points" run "$T/x" 0.5 1 12

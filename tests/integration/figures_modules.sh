@@ -17,13 +17,45 @@
 # run.sh: timeout 600
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures"
-PNG="$BUILD/tests/tools/pngdata"
-command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
-[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+needs_plotting
 
 # pixels COLOUR PNG: how many pixels of that colour (RRGGBB)
 pixels() { "$PNG" --rgb "$1" "$2" 2>/dev/null | sed -n 's/.*matching=//p'; }
 coloured() { "$PNG" "$1" 2>/dev/null | sed -n 's/.*coloured=//p'; }
+# drawn CLAIM PNG COLOUR:MIN...: the picture shows its data: at least MIN
+# pixels of each COLOUR (RRGGBB; "any": every coloured pixel), counted in
+# the claim's TAP line.
+drawn() {
+	local claim=$1 png=$2 spec n got=() ok=1
+	shift 2
+	for spec in "$@"; do
+		if [ "${spec%%:*}" = any ]; then n=$(coloured "$png"); else n=$(pixels "${spec%%:*}" "$png"); fi
+		got+=("${n:-0}")
+		[ "${n:-0}" -ge "${spec#*:}" ] || ok=0
+	done
+	if [ "$ok" = 1 ]; then tap_ok "$claim (${got[*]} pixels)"
+	else tap_fail "$claim" "pixels of ${*%%:*}: ${got[*]}; at least ${*#*:} wanted"; fi
+}
+# merged MODULE: its merge of $T/runs/MODULE into $T/fig exits 0.
+merged() {
+	if "$F/$1/fig.sh" merge "$T/runs/$1" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "$1: merge"
+	else tap_fail "$1: merge" "$(cat "$T/merge.out")"; fi
+}
+# section_has CLAIM MD SHOW LINE...: the section MD holds every LINE (a
+# table row, "| ...", as it stands; anything else a grep pattern); if not,
+# the failure shows MD's lines that match the extended pattern SHOW.
+section_has() {
+	local claim=$1 md=$2 show=$3 line
+	shift 3
+	for line in "$@"; do
+		if [[ "$line" == "|"* ]]; then grep -qF -- "$line" "$md"; else grep -q -- "$line" "$md"; fi && continue
+		tap_fail "$claim" "no line '$line' in: $(grep -E "$show" "$md")"
+		return
+	done
+	tap_ok "$claim"
+}
+# csv_rows CSV N: the merge's CSV holds N rows under its header.
+csv_rows() { tap_check "${1##*/}: $2 rows" test "$(wc -l <"$1")" = $(($2 + 1)); }
 # result NAME DIR LINES...: a run folder with its result.csv
 result() {
 	local mod=$1 id=$2; shift 2
@@ -92,21 +124,16 @@ for row in "16,17.7,1,0.02,0.07,0.8,0.8,30,4" "16,17.7,2,0.02,0.07,0.8,0.8,34,6"
 		for (t = 0; t < 300; t++) { f = t < 10 ? 1 : (t < 100 ? 1 + (v[1] - 1) * (t - 10) / 90 : (t < 200 ? v[1] : v[2]))
 			printf "%d,%g,10,8,2\n", t, f } }' >"$T/runs/forces/r$i/series.csv"
 done
-if "$F/forces/fig.sh" merge "$T/runs/forces" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "forces: merge"
-else tap_fail "forces: merge" "$(cat "$T/merge.out")"; fi
-red=$(pixels d62728 "$T/fig/forces.png") blue=$(pixels 1f77b4 "$T/fig/forces.png")
-if [ "${red:-0}" -ge 400 ] && [ "${blue:-0}" -ge 400 ]; then tap_ok "forces.png: both series drawn ($red clock, $blue oscillator pixels)"
-else tap_fail "forces.png shows its data" "clock $red, oscillator $blue pixels of their colours"; fi
-n=$(coloured "$T/fig/forces_time.png")
-if [ "${n:-0}" -ge 3000 ]; then tap_ok "forces_time.png: four runs' forces drawn ($n coloured pixels)"
-else tap_fail "forces_time.png shows its data" "$n coloured pixels"; fi
+merged forces
+drawn "forces.png: both series drawn (clock, oscillator)" "$T/fig/forces.png" d62728:400 1f77b4:400
+drawn "forces_time.png: four runs' forces drawn (coloured)" "$T/fig/forces_time.png" any:3000
 # slope 16: clock 30, 34, 40 -> median 34 (30-40); oscillator 4, 6, 5 -> 5; 6.8x
-if grep -qF '| 16 | 17.7 | 3 | 0.02, 0.07 | 34 (30-40) | 5 (4-6) | 6.8x |' "$T/fig/forces.md" &&
-	grep -qF '| 128 | 2.22 | 2 | 0.11, 0.017 | 21 (20-22) | 4.2 (4-4.4) | 5.0x |' "$T/fig/forces.md" &&
-	grep -q '^!\[.*\](figures/forces.png)' "$T/fig/forces.md" && [ "$(wc -l <"$T/fig/forces.csv")" = 9 ] &&
-	grep -q 'median over 100-200 s (clock)' "$T/fig/forces.md"; then
-	tap_ok "forces.md: the medians per slope with their ranges and ratios, the picture linked; forces.csv 8 rows"
-else tap_fail "forces.md numbers" "$(grep '^|' "$T/fig/forces.md")"; fi
+section_has "forces.md: the medians per slope with their ranges and ratios, the picture linked" "$T/fig/forces.md" '^\|' \
+	'| 16 | 17.7 | 3 | 0.02, 0.07 | 34 (30-40) | 5 (4-6) | 6.8x |' \
+	'| 128 | 2.22 | 2 | 0.11, 0.017 | 21 (20-22) | 4.2 (4-4.4) | 5.0x |' \
+	'^!\[.*\](figures/forces.png)' \
+	'median over 100-200 s (clock)'
+csv_rows "$T/fig/forces.csv" 8
 
 # ---- forces-plane: merge on fixed rows ---------------------------------------------------
 # Two k, two whole runs each and one broken run (left out of the medians, counted).
@@ -122,21 +149,16 @@ for row in "0.015,1,150,0.6,0.01,0.8,0.4,5000,3000,3.0,1.4,0,1.2,400,0.6" "0.015
 		for (t = 0; t < 150; t++) { f = t < 50 ? 0.5 + v[10] * t / 50 : (t < 100 ? v[10] : v[11])
 			printf "%d,%g,8,2\n", t, f } }' >"$T/runs/forces-plane/p$i/series.csv"
 done
-if "$F/forces-plane/fig.sh" merge "$T/runs/forces-plane" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "forces-plane: merge"
-else tap_fail "forces-plane: merge" "$(cat "$T/merge.out")"; fi
-red=$(pixels d62728 "$T/fig/forces-plane.png") blue=$(pixels 1f77b4 "$T/fig/forces-plane.png")
-if [ "${red:-0}" -ge 400 ] && [ "${blue:-0}" -ge 400 ]; then tap_ok "forces-plane.png: both series drawn ($red clock, $blue oscillator pixels)"
-else tap_fail "forces-plane.png shows its data" "clock $red, oscillator $blue pixels of their colours"; fi
-a=$(pixels 9467bd "$T/fig/forces-plane_time.png") b=$(pixels 1f77b4 "$T/fig/forces-plane_time.png")
-if [ "${a:-0}" -ge 300 ] && [ "${b:-0}" -ge 300 ]; then tap_ok "forces-plane_time.png: a run per k drawn ($a and $b pixels)"
-else tap_fail "forces-plane_time.png shows its data" "k 0.015: $a, k 0.135: $b pixels of their colours"; fi
-if grep -qF '| 0.015 | 2 | 0 | 0.85 (0.8-0.9) | 0.45 (0.4-0.5) | 1.9x | 3.05 → 1.45 (2.1x) | 5050 → 2950 (1.7x) |' "$T/fig/forces-plane.md" &&
-	grep -q 'a simulator behind): 1, left out of the medians' "$T/fig/forces-plane.md" &&
-	grep -q '(1 of 2 k above 0.1 N); the clock.s median goes from 0.85 N at k 0.015 to 0.55 N at k 0.135' "$T/fig/forces-plane.md" &&
-	grep -qF '| 0.135 | 2 | 1 | 0.55 (0.5-0.6) | 0.06 (0.05-0.07) | 9.2x | 13.5 → 3.35 (4.0x) | 6050 → 850 (7.1x) |' "$T/fig/forces-plane.md" &&
-	grep -q '^!\[.*\](figures/forces-plane.png)' "$T/fig/forces-plane.md" && [ "$(wc -l <"$T/fig/forces-plane.csv")" = 6 ]; then
-	tap_ok "forces-plane.md: per k the runs' medians with their ranges and ratios, the broken run left out and counted; forces-plane.csv 5 rows"
-else tap_fail "forces-plane.md numbers" "$(grep -E '^\||broken|above' "$T/fig/forces-plane.md")"; fi
+merged forces-plane
+drawn "forces-plane.png: both series drawn (clock, oscillator)" "$T/fig/forces-plane.png" d62728:400 1f77b4:400
+drawn "forces-plane_time.png: a run per k drawn (k 0.015, k 0.135)" "$T/fig/forces-plane_time.png" 9467bd:300 1f77b4:300
+section_has "forces-plane.md: per k the runs' medians with their ranges and ratios, the broken run left out and counted" "$T/fig/forces-plane.md" '^\||broken|above' \
+	'| 0.015 | 2 | 0 | 0.85 (0.8-0.9) | 0.45 (0.4-0.5) | 1.9x | 3.05 → 1.45 (2.1x) | 5050 → 2950 (1.7x) |' \
+	'a simulator behind): 1, left out of the medians' \
+	'(1 of 2 k above 0.1 N); the clock.s median goes from 0.85 N at k 0.015 to 0.55 N at k 0.135' \
+	'| 0.135 | 2 | 1 | 0.55 (0.5-0.6) | 0.06 (0.05-0.07) | 9.2x | 13.5 → 3.35 (4.0x) | 6050 → 850 (7.1x) |' \
+	'^!\[.*\](figures/forces-plane.png)'
+csv_rows "$T/fig/forces-plane.csv" 5
 
 # ---- rows: merge on fixed rows ---------------------------------------------------------
 H="dsep,beta,seconds,seed,pairs,colliding_pairs,pair_collisions_hz,compat_error_rad,compat_error_max_rad,compatible_pairs,antiphase_pairs,stopped_pairs,wall_collisions_hz,relax_s,censored,min_swing_rad,wall_s"
@@ -150,19 +172,14 @@ for row in "0.1,0,60,1,9,0,0,0,0,9,0,0,0,20,0,1.6,14" "0.5,0,60,1,9,5,0.8,0.3,1.
 	i=$((i + 1))
 	result rows "r$i" "$H" "$row"
 done
-if "$F/rows/fig.sh" merge "$T/runs/rows" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "rows: merge"
-else tap_fail "rows: merge" "$(cat "$T/merge.out")"; fi
-red=$(pixels d62728 "$T/fig/rows.png") blue=$(pixels 1f77b4 "$T/fig/rows.png")
-if [ "${red:-0}" -ge 600 ] && [ "${blue:-0}" -ge 400 ]; then tap_ok "rows.png: immobile and mobile drawn ($red, $blue pixels)"
-else tap_fail "rows.png shows its data" "immobile $red, mobile $blue pixels of their colours"; fi
-blue=$(pixels 1f77b4 "$T/fig/rows_relax.png") red=$(pixels d62728 "$T/fig/rows_relax.png")
-if [ "${blue:-0}" -ge 300 ] && [ "${red:-0}" -ge 60 ]; then tap_ok "rows_relax.png: relaxed runs and the censored one drawn ($blue, $red pixels)"
-else tap_fail "rows_relax.png shows its data" "relaxed $blue, censored $red pixels"; fi
-if grep -qF '| 0.5 | 0 | 2 | 0.7 | 0.2 | 8 of 18 | 10 of 18 | 4 |' "$T/fig/rows.md" &&
-	grep -qF '| 0.005 | 2 | 1 of 2 | 90, > 237 | > 237 |' "$T/fig/rows.md" && grep -qF '| 0.1 | 1 | 1 of 1 | 8 | 8 |' "$T/fig/rows.md" &&
-	grep -q 'immobile 0.1: 0 of 9, 0.5: 8 of 18, 0.9: 6 of 9; mobile 0.1: 0 of 9' "$T/fig/rows.md"; then
-	tap_ok "rows.md: means per d~ and beta, relaxation per beta with the censored run counted as the longest, pairs colliding per d~ beside the paper"
-else tap_fail "rows.md numbers" "$(grep '^|' "$T/fig/rows.md")"; fi
+merged rows
+drawn "rows.png: immobile and mobile drawn" "$T/fig/rows.png" d62728:600 1f77b4:400
+drawn "rows_relax.png: relaxed runs and the censored one drawn" "$T/fig/rows_relax.png" 1f77b4:300 d62728:60
+section_has "rows.md: means per d~ and beta, relaxation per beta with the censored run counted as the longest, pairs colliding per d~ beside the paper" "$T/fig/rows.md" '^\|' \
+	'| 0.5 | 0 | 2 | 0.7 | 0.2 | 8 of 18 | 10 of 18 | 4 |' \
+	'| 0.005 | 2 | 1 of 2 | 90, > 237 | > 237 |' \
+	'| 0.1 | 1 | 1 of 1 | 8 | 8 |' \
+	'immobile 0.1: 0 of 9, 0.5: 8 of 18, 0.9: 6 of 9; mobile 0.1: 0 of 9'
 
 # ---- channel: merge on fixed rows ----------------------------------------------------
 H="width_cm,nominal_dsep,seed,pair,class,mean_delta,mean_abs_delta,spread,window_collisions,collisions,impulse,distance_m,dsep,compat_limit,swing_a,swing_b,min_swing_rad,wall_s"
@@ -175,15 +192,11 @@ result channel b "$H" "16,0.5362,2,r1:r2,compatible,0.8,0.8,0.1,0,30,3,0.16,0.52
 result channel c "$H" "24,0.8043,1,r1:r2,compatible,1.5,1.5,0.1,0,30,3,0.24,0.80,1.8546,1.6,1.6,1.5,6" \
 	"24,0.8043,1,r2:r3,compatible,1.7,1.7,0.1,0,40,3,0.25,0.84,1.9736,1.6,1.6,1.5,6" \
 	"24,0.8043,1,r3:r4,compatible,-1.6,1.6,0.1,0,20,2,0.23,0.78,1.7926,1.6,1.6,1.5,6"
-if "$F/channel/fig.sh" merge "$T/runs/channel" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "channel: merge"
-else tap_fail "channel: merge" "$(cat "$T/merge.out")"; fi
-blue=$(pixels 1f77b4 "$T/fig/channel.png") other=$(pixels 2ca02c "$T/fig/channel.png")
-if [ "${blue:-0}" -ge 150 ] && [ "${other:-0}" -ge 80 ]; then tap_ok "channel.png: both widths' pairs drawn ($blue, $other pixels)"
-else tap_fail "channel.png shows its data" "16 cm $blue, 24 cm $other pixels of their colours"; fi
-if grep -qF '| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 2 |' "$T/fig/channel.md" &&
-	grep -q 'In all: 8 of 9 pairs ended at or below the compatibility bound .*, 1 in anti-phase' "$T/fig/channel.md"; then
-	tap_ok "channel.md: per width the pairs at or below 2 asin(d~), anti-phase counted"
-else tap_fail "channel.md numbers" "$(grep -E '^\||In all' "$T/fig/channel.md")"; fi
+merged channel
+drawn "channel.png: both widths' pairs drawn (16 cm, 24 cm)" "$T/fig/channel.png" 1f77b4:150 2ca02c:80
+section_has "channel.md: per width the pairs at or below 2 asin(d~), anti-phase counted" "$T/fig/channel.md" '^\||In all' \
+	'| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 2 |' \
+	'In all: 8 of 9 pairs ended at or below the compatibility bound .*, 1 in anti-phase'
 
 # ---- channel-plane: merge on fixed rows --------------------------------------------------
 H="width_cm,nominal_dsep,seed,pair,class,mean_delta,mean_abs_delta,spread,window_collisions,collisions,impulse,distance_m,dsep,compat_limit,swing_a,swing_b,dy_m,sweep_a_m,sweep_b_m,min_swing_rad,wall_s,ends"
@@ -211,21 +224,18 @@ for id in w16cm-t1 w24cm-t1; do
 			printf "%s,wall,1,%.3f,-0.305,%.3f,0.305,-1\n", m[i], 2 * d, 2 * d
 		} }' >"$T/runs/channel-plane/$id/frames.csv"
 done
-if "$F/channel-plane/fig.sh" merge "$T/runs/channel-plane" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "channel-plane: merge"
-else tap_fail "channel-plane: merge" "$(cat "$T/merge.out")"; fi
-blue=$(pixels 1f77b4 "$T/fig/channel-plane.png") green=$(pixels 2ca02c "$T/fig/channel-plane.png") grey=$(pixels 888888 "$T/fig/channel-plane.png")
-if [ "${blue:-0}" -ge 150 ] && [ "${green:-0}" -ge 80 ] && [ "${grey:-0}" -ge 40 ]; then tap_ok "channel-plane.png: both widths' pairs and the control drawn ($blue, $green, $grey pixels)"
-else tap_fail "channel-plane.png shows its data" "16 cm $blue, 24 cm $green, control $grey pixels of their colours"; fi
+merged channel-plane
+drawn "channel-plane.png: both widths' pairs and the control drawn (16 cm, 24 cm, control)" "$T/fig/channel-plane.png" \
+	1f77b4:150 2ca02c:80 888888:40
 # gnuplot's first four line colours: one robot each
-r1=$(pixels 9400d3 "$T/fig/channel-plane-frames.png") r4=$(pixels e69f00 "$T/fig/channel-plane-frames.png")
-if [ "${r1:-0}" -ge 400 ] && [ "${r4:-0}" -ge 400 ]; then tap_ok "channel-plane-frames.png: the robots drawn in eight panels ($r1, $r4 pixels of two robots' colours)"
-else tap_fail "channel-plane-frames.png shows the robots" "robot 1 $r1, robot 4 $r4 pixels of their colours"; fi
-if grep -qF '| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 1 | 2 |' "$T/fig/channel-plane.md" &&
-	grep -q 'In all: 8 of 9 pairs ended at or below the compatibility curve .*, 1 in anti-phase, 1 more than 2π/3 apart' "$T/fig/channel-plane.md" &&
-	grep -q 'Without end walls.* 2 of 3 pairs ended at or below the curve, 0 in anti-phase, 1 still touched.* 0.100 m apart along the channel (median; up to 0.200 m), against 0.010 m with the ends' "$T/fig/channel-plane.md" &&
-	grep -q '^!\[.*\](figures/channel-plane-frames.png)' "$T/fig/channel-plane.md" && [ "$(wc -l <"$T/fig/channel-plane.csv")" = 13 ]; then
-	tap_ok "channel-plane.md: per width the pairs at or below 2 asin(d~), anti-phase counted, the control apart"
-else tap_fail "channel-plane.md numbers" "$(grep -E '^\||In all|Without' "$T/fig/channel-plane.md")"; fi
+drawn "channel-plane-frames.png: the robots drawn in eight panels (robots 1 and 4)" "$T/fig/channel-plane-frames.png" \
+	9400d3:400 e69f00:400
+section_has "channel-plane.md: per width the pairs at or below 2 asin(d~), anti-phase counted, the control apart" "$T/fig/channel-plane.md" '^\||In all|Without' \
+	'| 16 cm | 0.54 | 6 | 0.56 (0.50-0.60) | 0.95 rad | 5 of 6 | 1 | 1 | 2 |' \
+	'In all: 8 of 9 pairs ended at or below the compatibility curve .*, 1 in anti-phase, 1 more than 2π/3 apart' \
+	'Without end walls.* 2 of 3 pairs ended at or below the curve, 0 in anti-phase, 1 still touched.* 0.100 m apart along the channel (median; up to 0.200 m), against 0.010 m with the ends' \
+	'^!\[.*\](figures/channel-plane-frames.png)'
+csv_rows "$T/fig/channel-plane.csv" 12
 
 # ---- swimmer: merge on fixed rows ---------------------------------------------------------
 H="mode,seed,seconds,freq1_hz,freq2_hz,amp1_rad,amp2_rad,lag_rad,lag_spread_rad,along_per_period_m,across_per_period_m,speed_m_s,turn_rad,periods,min_swing_rad,wall_s,sweep_m"
@@ -241,18 +251,15 @@ for id in oscillator-s1 oscillator-s2 sinusoid-s1; do
 		for (t = 0; t <= 30; t += 5) for (k = 0; k < 3; k++)
 			printf "0,%d,\"r1\",0,%d,0,%.4f,1.5708,0.1865,0.032,0,%.4f,1.5708\n", t, k, 0.012 * t + 0.1865 * (1 - k), 0.012 * t }' >"$d/body.csv"
 done
-if "$F/swimmer/fig.sh" merge "$T/runs/swimmer" "$T/fig" >"$T/merge.out" 2>&1; then tap_ok "swimmer: merge"
-else tap_fail "swimmer: merge" "$(cat "$T/merge.out")"; fi
-blue=$(pixels 1f77b4 "$T/fig/swimmer.png") orange=$(pixels ff7f0e "$T/fig/swimmer.png") red=$(pixels d62728 "$T/fig/swimmer.png")
-if [ "${blue:-0}" -ge 1000 ] && [ "${orange:-0}" -ge 1000 ] && [ "${red:-0}" -ge 100 ]; then
-	tap_ok "swimmer.png: both joints' angles and the centre's path drawn ($blue, $orange, $red pixels)"
-else tap_fail "swimmer.png shows its data" "joint 1 $blue, joint 2 $orange, path $red pixels of their colours"; fi
-if grep -qF '| oscillator | 2 | 0.820 / 0.820 | 0.800 / 0.810 | 1.79 rad (103°) | 1.43 cm (1.40-1.46) | 0.00 cm | 1.18 cm/s | 0.25 rad | 0.190 m |' "$T/fig/swimmer.md" &&
-	grep -qF '| clock | 1 | 0.824 / 0.824 | 0.800 / 0.800 | 2.09 rad (120°) | 1.16 cm (1.16-1.16) | 0.00 cm | 0.95 cm/s | 0.25 rad | 0.170 m |' "$T/fig/swimmer.md" &&
-	grep -q 'with joint 2 1.79 rad (103°) behind joint 1 (2π/3: 2.09 rad)' "$T/fig/swimmer.md" &&
-	grep -q 'sweeps 0.190 m across its heading per period (.*0.222 m with' "$T/fig/swimmer.md" && [ "$(wc -l <"$T/fig/swimmer.csv")" = 4 ]; then
-	tap_ok "swimmer.md: per mode the gait, the lag and the swim per period, the lag beside the paper's 2 pi / 3"
-else tap_fail "swimmer.md numbers" "$(grep -E '^\||Beside' "$T/fig/swimmer.md")"; fi
+merged swimmer
+drawn "swimmer.png: both joints' angles and the centre's path drawn (joint 1, joint 2, path)" "$T/fig/swimmer.png" \
+	1f77b4:1000 ff7f0e:1000 d62728:100
+section_has "swimmer.md: per mode the gait, the lag and the swim per period, the lag beside the paper's 2 pi / 3" "$T/fig/swimmer.md" '^\||Beside' \
+	'| oscillator | 2 | 0.820 / 0.820 | 0.800 / 0.810 | 1.79 rad (103°) | 1.43 cm (1.40-1.46) | 0.00 cm | 1.18 cm/s | 0.25 rad | 0.190 m |' \
+	'| clock | 1 | 0.824 / 0.824 | 0.800 / 0.800 | 2.09 rad (120°) | 1.16 cm (1.16-1.16) | 0.00 cm | 0.95 cm/s | 0.25 rad | 0.170 m |' \
+	'with joint 2 1.79 rad (103°) behind joint 1 (2π/3: 2.09 rad)' \
+	'sweeps 0.190 m across its heading per period (.*0.222 m with'
+csv_rows "$T/fig/swimmer.csv" 3
 
 # ---- no results, no gnuplot ----------------------------------------------------------------
 mkdir -p "$T/empty"
@@ -304,25 +311,21 @@ if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyz
 	red=$(pixels d62728 "$G/rows.png") blue=$(pixels 1f77b4 "$G/rows.png")
 	if [ "${red:-0}" -ge 60 ] && [ "${blue:-0}" = 0 ]; then tap_ok "rows.png: the immobile run drawn ($red pixels), the empty mobile series left out"
 	else tap_fail "rows.png: immobile drawn, mobile left out" "immobile $red, mobile $blue pixels"; fi
-	red=$(pixels d62728 "$G/rows_relax.png")
-	tap_check "rows_relax.png: the censored relaxation run drawn ($red pixels)" test "${red:-0}" -ge 60
-	n=$(coloured "$G/forces_time.png")
-	tap_check "forces_time.png: the run's force per second drawn ($n coloured pixels)" test "${n:-0}" -ge 500
+	drawn "rows_relax.png: the censored relaxation run drawn" "$G/rows_relax.png" d62728:60
+	drawn "forces_time.png: the run's force per second drawn (coloured)" "$G/forces_time.png" any:500
 	# the plane modules' real runs: a gait near the tuned 0.8 Hz and 0.8 rad, the robot
 	# swimming head first; four robots drawn from the run's own frames
 	s="$R/swimmer/oscillator-t0/result.csv"
 	if awk -F, 'NR == 2 { exit !($4 > 0.7 && $4 < 0.95 && $6 > 0.7 && $6 < 0.9 && $8 > 1.2 && $8 < 2.4 && $10 > 0.005 && $17 > 0.1 && $17 < 0.3) }' "$s" 2>/dev/null; then
 		tap_ok "swimmer: a real run: $(awk -F, 'NR == 2 { printf "%.2f Hz, %.2f rad, joint 2 %.0f deg behind, %.2f cm a period, %.3f m wide", $4, $6, $8 * 57.2958, 100 * $10, $17 }' "$s")"
 	else tap_fail "swimmer: a real run's gait and swim" "$(cat "$s" 2>&1)"; fi
-	blue=$(pixels 1f77b4 "$G/swimmer.png") red=$(pixels d62728 "$G/swimmer.png")
-	tap_check "swimmer.png: the run's joints and path drawn ($blue, $red pixels)" test "${blue:-0}" -ge 1000 -a "${red:-0}" -ge 20
+	drawn "swimmer.png: the run's joints and path drawn" "$G/swimmer.png" 1f77b4:1000 d62728:20
 	c="$R/channel-plane/w20cm-t0"
 	if [ "$(wc -l <"$c/result.csv" 2>/dev/null)" = 4 ] && awk -F, 'NR > 1 && !($13 > 0.05 && $13 < 2 && $15 > 0.2 && $16 > 0.2 && $18 > 0.1 && $22 == "ends") { bad = 1 } END { exit bad }' "$c/result.csv" &&
 		[ "$(grep -c ',link,' "$c/frames.csv")" = 48 ] && [ ! -e "$c/demo/plane.csv" ]; then
 		tap_ok "channel-plane: a real run: three pairs with d~, bound, swings and sweeps; 48 links in its frames; plane.csv removed"
 	else tap_fail "channel-plane: a real run" "$(cat "$c/result.csv" 2>&1 | head -4); $(grep -c ',link,' "$c/frames.csv" 2>&1) links"; fi
-	r1=$(pixels 9400d3 "$G/channel-plane-frames.png")
-	tap_check "channel-plane-frames.png: the run's robots drawn ($r1 pixels of one robot's colour)" test "${r1:-0}" -ge 100
+	drawn "channel-plane-frames.png: the run's robots drawn (one robot's colour)" "$G/channel-plane-frames.png" 9400d3:100
 else
 	tap_skip "the tiny set through the driver" "the programs or GNU parallel are missing"
 fi

@@ -46,4 +46,9 @@ tap_check "the series' two runs set at 0.9625-0.9875 that read above 1 are named
 	grep -q '2 runs of the series, set at d̃ = 0.9625–0.9875, read 1.013–1.039 and are left out (0 collisions)' "$T/fig/pair.md"
 tap_check "the table counts the 38 runs at r = 0.67 with d̃ ≤ 1 and the 10 at r = 0.9" \
 	grep -q '^| runs (d̃ ≤ 1) | 38 | 10 |$' "$T/fig/pair.md"
+# merge without its two folders: the module's usage line and exit 2, as every
+# module's (pair and returnmap once stopped on bash's "unbound variable", exit 1)
+for m in pair returnmap heatmap steady rows; do
+	tap_refused "$m:" "$m merge without RUNS_DIR FIGDIR" "$top/figures/$m/fig.sh" merge
+done
 tap_done

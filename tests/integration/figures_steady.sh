@@ -7,9 +7,7 @@
 # the picture drawn, the section with its numbers.
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures/steady/fig.sh"
-PNG="$BUILD/tests/tools/pngdata"
-command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
-[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+needs_plotting
 [ -x "$B/undulate-model" ] || tap_skip_all "undulate-model is not built"
 
 a=$("$F" jobs) b=$("$F" jobs) q=$("$F" jobs --quick) t=$(FIG_TINY=1 "$F" jobs)
@@ -17,12 +15,7 @@ tap_check "jobs: nine restitutions, the same twice, unique names; quick five, ti
 	bash -c "[ '$a' = '$b' ] && [ \$(wc -l <<<'$a') = 9 ] && [ -z \"\$(awk '{ print \$1 }' <<<'$a' | sort | uniq -d)\" ] &&
 		[ \$(wc -l <<<'$q') = 5 ] && [ \$(wc -l <<<'$t') = 2 ]"
 
-refused() {
-	local name=$1 out rc
-	shift
-	out=$("$F" "$@" 2>&1); rc=$?
-	if [ "$rc" = 2 ] && [[ "$out" == steady:* ]]; then tap_ok "refused: $name"; else tap_fail "refused: $name" "rc=$rc: $out"; fi
-}
+refused() { tap_refused steady: "$1" "$F" "${@:2}"; }
 refused "no subcommand"
 refused "run: r above 1" run "$T/x" 1.5 6 4 120
 refused "run: one d~ point" run "$T/x" 0.5 1 4 120

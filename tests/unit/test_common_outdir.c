@@ -380,6 +380,40 @@ static void test_stage_and_publish(void **state)
 	close(dirfd);
 }
 
+/* outdir_stage_fopen: a new file only (a name taken: NULL, EEXIST, and what
+ * is there untouched); outdir_stage_fclose: a write that failed shows at the
+ * close, and the stream is NULL after. */
+static void test_stage_fopen_fclose(void **state)
+{
+	(void)state;
+	assert_int_equal(mkdir(at("st"), 0700), 0);
+	int stage = open(at("st"), O_RDONLY | O_DIRECTORY);
+	assert_true(stage >= 0);
+	FILE *f = outdir_stage_fopen(stage, "a.csv");
+	assert_non_null(f);
+	fputs("t,x\n", f);
+	assert_int_equal(outdir_stage_fclose(&f), 0);
+	assert_null(f);
+	assert_int_equal(outdir_stage_fclose(&f), 0);   /* nothing open: nothing to do */
+	expect_text(at("st/a.csv"), "t,x\n");
+
+	errno = 0;
+	assert_null(outdir_stage_fopen(stage, "a.csv"));
+	assert_int_equal(errno, EEXIST);
+	expect_text(at("st/a.csv"), "t,x\n");
+	assert_int_equal(symlink(at("st/a.csv"), at("st/link.csv")), 0);
+	assert_null(outdir_stage_fopen(stage, "link.csv"));
+	expect_text(at("st/a.csv"), "t,x\n");
+
+	f = fopen("/dev/full", "w");
+	if (f != NULL) {   /* a full disk: the write fails at the flush, in the close */
+		fputs("lost", f);
+		assert_int_equal(outdir_stage_fclose(&f), -1);
+		assert_null(f);
+	}
+	close(stage);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -391,6 +425,7 @@ int main(void)
 		cmocka_unit_test(test_file_replaces_links_and_fifos),
 		cmocka_unit_test(test_parent_and_in_place),
 		cmocka_unit_test(test_stage_and_publish),
+		cmocka_unit_test(test_stage_fopen_fclose),
 	};
 	return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -8,12 +8,14 @@
  * differences (the return map) and the collision-rate bins are kept. */
 #include "analyze.h"
 #include "classify.h"
+#include "csvrow.h"
 #include "alog.h"
 #include "json.h"
 #include "phase.h"
 #include "modes.h"
 #include "num.h"
 #include "outdir.h"
+#include "pairsum.h"
 #include "planecsv.h"
 #include "plot.h"
 #include "text.h"
@@ -654,26 +656,6 @@ static int an_make_pairs(struct an_ctx *c)
 /* ---- pass 2: CSV output ------------------------------------------------------- */
 
 /* A CSV field: quoted, inner quotes doubled (names and event text are free text). */
-static void an_csv_str(FILE *f, const char *s)
-{
-	fputc('"', f);
-	for (; s && *s; s++) {
-		if (*s == '"')
-			fputc('"', f);
-		fputc(*s == '\n' || *s == '\r' ? ' ' : *s, f);
-	}
-	fputc('"', f);
-}
-
-/* %.9g keeps full double-ish precision for the numbers people trust. */
-static void an_csv_num(FILE *f, double v)
-{
-	if (isfinite(v))
-		fprintf(f, ",%.9g", v);
-	else
-		fputs(",", f);
-}
-
 static void an_hist_push(struct an_joint *j, int64_t utime, double t, double phase, double omega)
 {
 	j->hist[j->hnext] = (struct an_sample){ .utime = utime, .t = t, .phase = phase, .omega = omega };
@@ -704,13 +686,13 @@ static double an_phase_at(const struct an_sample *s, double t)
 static void an_pair_row(struct an_ctx *c, struct an_pair *p, int64_t utime, double t, double delta)
 {
 	fprintf(c->pdiff, "%lld,%.6f,", (long long)utime, t);
-	an_csv_str(c->pdiff, p->name);
+	csvrow_str(c->pdiff, p->name);
 	fprintf(c->pdiff, ",%s,", an_pair_kind_name(p->kind));
-	an_csv_str(c->pdiff, c->robots[p->a].name);
+	csvrow_str(c->pdiff, c->robots[p->a].name);
 	fprintf(c->pdiff, ",%d,", p->ja);
-	an_csv_str(c->pdiff, c->robots[p->b].name);
+	csvrow_str(c->pdiff, c->robots[p->b].name);
 	fprintf(c->pdiff, ",%d", p->jb);
-	an_csv_num(c->pdiff, delta);
+	csvrow_num(c->pdiff, delta);
 	fputc('\n', c->pdiff);
 	p->rows++;
 	if (isfinite(delta))
@@ -799,19 +781,19 @@ static void an_on_state(struct an_ctx *c, const undulate_robot_state_t *m)
 
 		FILE *f = c->states;
 		fprintf(f, "%lld,%.6f,", (long long)m->utime, t);
-		an_csv_str(f, r->name);
+		csvrow_str(f, r->name);
 		fprintf(f, ",%d,%d", j, js->servo_id);
-		an_csv_num(f, js->angle);
-		an_csv_num(f, js->speed);
-		an_csv_num(f, js->goal);
-		an_csv_num(f, js->load);
+		csvrow_num(f, js->angle);
+		csvrow_num(f, js->speed);
+		csvrow_num(f, js->goal);
+		csvrow_num(f, js->load);
 		fprintf(f, ",%d", m->mode);
-		an_csv_num(f, phase);
-		an_csv_num(f, js->amplitude);
-		an_csv_num(f, js->frequency);
+		csvrow_num(f, phase);
+		csvrow_num(f, js->amplitude);
+		csvrow_num(f, js->frequency);
 		fprintf(f, ",%d", js->error_bits);
-		an_csv_num(f, js->phase);
-		an_csv_num(f, aj->est.frequency);
+		csvrow_num(f, js->phase);
+		csvrow_num(f, aj->est.frequency);
 		/* the robot as a number: plots select rows by it (a name may hold
 		 * quotes or commas that a gnuplot filter cannot match) */
 		fprintf(f, ",%d\n", ri);
@@ -906,21 +888,11 @@ static void an_on_collision(struct an_ctx *c, const undulate_sim_collision_t *m)
 				an_pair_store_delta(p, m->utime, delta);
 		}
 	}
-	FILE *f = c->coll;
-	fprintf(f, "%lld,%.6f,%d,%d,", (long long)m->utime, t, m->left, m->right);
-	an_csv_str(f, m->left_robot);
-	fputc(',', f);
-	an_csv_str(f, m->right_robot);
-	an_csv_num(f, m->pre_left);
-	an_csv_num(f, m->pre_right);
-	an_csv_num(f, m->post_left);
-	an_csv_num(f, m->post_right);
-	an_csv_num(f, m->impulse);
-	fputc(',', f);
-	if (p)
-		an_csv_str(f, p->name);
-	an_csv_num(f, delta);
-	fprintf(f, ",%d\n", new_contact ? 1 : 0);
+	csvrow_collision(c->coll, &(struct csvrow_collision){
+		.utime = m->utime, .t = t, .left = m->left, .right = m->right, .left_robot = m->left_robot,
+		.right_robot = m->right_robot, .pre_left = m->pre_left, .pre_right = m->pre_right,
+		.post_left = m->post_left, .post_right = m->post_right, .impulse = m->impulse,
+		.pair = p ? p->name : NULL, .delta = delta, .new_contact = new_contact });
 }
 
 static void an_on_bus(struct an_ctx *c, const undulate_bus_stats_t *m)
@@ -933,18 +905,14 @@ static void an_on_bus(struct an_ctx *c, const undulate_bus_stats_t *m)
 	}
 	FILE *f = c->bus;
 	fprintf(f, "%lld,%.6f,", (long long)m->utime, an_t(c, m->utime));
-	an_csv_str(f, m->robot);
+	csvrow_str(f, m->robot);
 	fputc(',', f);
-	an_csv_str(f, m->port);
+	csvrow_str(f, m->port);
 	fprintf(f, ",%d,%d,%lld", m->baud, m->connected ? 1 : 0, (long long)m->reconnects);
-	an_csv_num(f, m->adapter_latency_ms);
+	csvrow_num(f, m->adapter_latency_ms);
 	fprintf(f, ",%d", m->return_delay_us);
-	an_csv_num(f, m->period_p50_us);
-	an_csv_num(f, m->period_p99_us);
-	an_csv_num(f, m->period_max_us);
-	an_csv_num(f, m->jitter_p99_us);
-	an_csv_num(f, m->bus_p99_us);
-	an_csv_num(f, m->cpu_percent);
+	csvrow_nums(f, (const double[]){ m->period_p50_us, m->period_p99_us, m->period_max_us, m->jitter_p99_us,
+	                                 m->bus_p99_us, m->cpu_percent }, 6);
 	fprintf(f, ",%lld,%lld,%lld,%lld,%lld,%lld\n", (long long)m->overruns, (long long)m->stray_packets,
 		(long long)m->io_errors, (long long)timeouts, (long long)checksum, (long long)errrep);
 }
@@ -953,11 +921,11 @@ static void an_on_event(struct an_ctx *c, const undulate_event_t *m)
 {
 	FILE *f = c->evt;
 	fprintf(f, "%lld,%.6f,", (long long)m->utime, an_t(c, m->utime));
-	an_csv_str(f, m->robot);
+	csvrow_str(f, m->robot);
 	fprintf(f, ",%lld,%d,", (long long)m->seq, m->level);
-	an_csv_str(f, m->kind);
+	csvrow_str(f, m->kind);
 	fputc(',', f);
-	an_csv_str(f, m->text);
+	csvrow_str(f, m->text);
 	fputc('\n', f);
 }
 
@@ -966,20 +934,20 @@ static void an_on_params(struct an_ctx *c, const undulate_osc_params_t *m)
 	FILE *f = c->params;
 	for (int j = 0; j < m->njoints; j++) {
 		fprintf(f, "%lld,%.6f,", (long long)m->utime, an_t(c, m->utime));
-		an_csv_str(f, m->robot);
+		csvrow_str(f, m->robot);
 		fprintf(f, ",%d", j);
-		an_csv_num(f, m->k[j]);
-		an_csv_num(f, m->c[j]);
-		an_csv_num(f, m->mu[j]);
-		an_csv_num(f, m->lambda[j]);
-		an_csv_num(f, m->inertia[j]);
-		an_csv_num(f, m->friction[j]);
-		an_csv_num(f, m->neutral[j]);
-		an_csv_num(f, m->limit_min[j]);
-		an_csv_num(f, m->limit_max[j]);
-		an_csv_num(f, m->amplitude);
-		an_csv_num(f, m->frequency);
-		an_csv_num(f, m->phase);
+		csvrow_num(f, m->k[j]);
+		csvrow_num(f, m->c[j]);
+		csvrow_num(f, m->mu[j]);
+		csvrow_num(f, m->lambda[j]);
+		csvrow_num(f, m->inertia[j]);
+		csvrow_num(f, m->friction[j]);
+		csvrow_num(f, m->neutral[j]);
+		csvrow_num(f, m->limit_min[j]);
+		csvrow_num(f, m->limit_max[j]);
+		csvrow_num(f, m->amplitude);
+		csvrow_num(f, m->frequency);
+		csvrow_num(f, m->phase);
 		fputc('\n', f);
 	}
 }
@@ -1009,25 +977,25 @@ static void an_on_plane(struct an_ctx *c, const undulate_sim_truth_t *m)
 			continue;
 		const char *name = m->bodies[l->robot].robot;
 		fprintf(c->plane_csv, "%lld,%.6f,", (long long)m->utime, t);
-		an_csv_str(c->plane_csv, name);
+		csvrow_str(c->plane_csv, name);
 		fprintf(c->plane_csv, ",%d,%d", an_robot_find(c, name, false), l->link);
-		an_csv_num(c->plane_csv, l->x);
-		an_csv_num(c->plane_csv, l->y);
-		an_csv_num(c->plane_csv, l->angle);
-		an_csv_num(c->plane_csv, l->length);
-		an_csv_num(c->plane_csv, l->width);
-		an_csv_num(c->plane_csv, cx);
-		an_csv_num(c->plane_csv, cy);
-		an_csv_num(c->plane_csv, heading);
+		csvrow_num(c->plane_csv, l->x);
+		csvrow_num(c->plane_csv, l->y);
+		csvrow_num(c->plane_csv, l->angle);
+		csvrow_num(c->plane_csv, l->length);
+		csvrow_num(c->plane_csv, l->width);
+		csvrow_num(c->plane_csv, cx);
+		csvrow_num(c->plane_csv, cy);
+		csvrow_num(c->plane_csv, heading);
 		fputc('\n', c->plane_csv);
 	}
 	for (int i = 0; i < m->nwalls; i++) {
 		const undulate_sim_wall_t *w = &m->walls[i];
 		fprintf(c->plane_walls_csv, "%lld,%.6f,%d", (long long)m->utime, t, i);
-		an_csv_num(c->plane_walls_csv, w->ax);
-		an_csv_num(c->plane_walls_csv, w->ay);
-		an_csv_num(c->plane_walls_csv, w->bx);
-		an_csv_num(c->plane_walls_csv, w->by);
+		csvrow_num(c->plane_walls_csv, w->ax);
+		csvrow_num(c->plane_walls_csv, w->ay);
+		csvrow_num(c->plane_walls_csv, w->bx);
+		csvrow_num(c->plane_walls_csv, w->by);
 		fputc('\n', c->plane_walls_csv);
 	}
 }
@@ -1158,13 +1126,9 @@ static void an_process_event(struct an_ctx *c, const lcm_eventlog_event_t *ev)
  * and private). */
 static FILE *an_create(struct an_ctx *c, const char *name)
 {
-	int fd = openat(c->stagefd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-	if (!f) {
+	FILE *f = outdir_stage_fopen(c->stagefd, name);
+	if (!f)
 		fprintf(c->o->msg, "undulate-analyze: %s/%s: %s\n", c->o->out_dir, name, strerror(errno));
-		if (fd >= 0)
-			close(fd);
-	}
 	return f;
 }
 
@@ -1178,15 +1142,10 @@ static FILE *an_open_out(struct an_ctx *c, const char *name, const char *header)
 
 static int an_close_out(struct an_ctx *c, FILE **f, const char *name)
 {
-	if (!*f)
+	if (outdir_stage_fclose(f) == 0)
 		return 0;
-	int bad = ferror(*f) | fclose(*f);
-	*f = NULL;
-	if (bad) {
-		fprintf(c->o->msg, "undulate-analyze: writing %s/%s failed\n", c->o->out_dir, name);
-		return -1;
-	}
-	return 0;
+	fprintf(c->o->msg, "undulate-analyze: writing %s/%s failed\n", c->o->out_dir, name);
+	return -1;
 }
 
 /* --out: a directory of ours that no one else can write (outdir_open), and
@@ -1235,18 +1194,14 @@ static int an_open_outputs(struct an_ctx *c)
 {
 	if (an_open_dir(c) != 0)
 		return -1;
-	c->states = an_open_out(c, "states.csv",
-		"utime,t,robot,joint,servo_id,angle,speed,goal,load,mode,phase,amplitude,frequency,error_bits,phase_daemon,frequency_est,"
-		"robot_index");
-	c->coll = an_open_out(c, "collisions.csv",
-		"utime,t,left,right,left_robot,right_robot,pre_left,pre_right,post_left,post_right,impulse,pair,delta_before,"
-		"new_contact");
+	c->states = an_open_out(c, "states.csv", CSVROW_STATES_HEADER);
+	c->coll = an_open_out(c, "collisions.csv", CSVROW_COLLISIONS_HEADER);
 	c->bus = an_open_out(c, "bus.csv",
 		"utime,t,robot,port,baud,connected,reconnects,adapter_latency_ms,return_delay_us,period_p50_us,"
 		"period_p99_us,period_max_us,jitter_p99_us,bus_p99_us,cpu_percent,overruns,stray_packets,io_errors,"
 		"timeouts,checksum_errors,error_replies");
 	c->evt = an_open_out(c, "events.csv", "utime,t,robot,seq,level,kind,text");
-	c->pdiff = an_open_out(c, "phase_diff.csv", "utime,t,pair,kind,robot_a,joint_a,robot_b,joint_b,delta");
+	c->pdiff = an_open_out(c, "phase_diff.csv", CSVROW_PDIFF_HEADER);
 	c->params = an_open_out(c, "params.csv",
 		"utime,t,robot,joint,k,c,mu,lambda,inertia,friction,neutral,limit_min,limit_max,"
 		"sin_amplitude,sin_frequency,sin_phase");
@@ -1283,13 +1238,13 @@ static int an_write_return_map(struct an_ctx *c)
 	for (int k = 0; k < c->npairs; k++) {
 		struct an_pair *p = &c->pairs[k];
 		for (size_t n = 0; n + 1 < p->ndeltas; n++) {
-			an_csv_str(f, p->name);
+			csvrow_str(f, p->name);
 			double dsep = isfinite(p->dsep) ? p->dsep : 0.0;
 			fprintf(f, ",%zu,%lld,%.6f", n, (long long)p->delta_utime[n], an_t(c, p->delta_utime[n]));
-			an_csv_num(f, p->deltas[n]);
-			an_csv_num(f, p->deltas[n + 1]);
-			an_csv_num(f, theory_return_map(p->deltas[n], dsep, c->restitution));
-			an_csv_num(f, p->dsep);
+			csvrow_num(f, p->deltas[n]);
+			csvrow_num(f, p->deltas[n + 1]);
+			csvrow_num(f, theory_return_map(p->deltas[n], dsep, c->restitution));
+			csvrow_num(f, p->dsep);
 			fputc('\n', f);
 		}
 	}
@@ -1529,28 +1484,13 @@ static void an_json_robot(struct json *j, const struct an_robot *r)
 
 static void an_json_pair(struct json *j, const struct an_pair *p)
 {
-	json_object_begin(j);
-	json_field_string(j, "pair", p->name);
-	json_field_string(j, "kind", an_pair_kind_name(p->kind));
-	json_field_string(j, "class", p->cls);
-	json_field_number(j, "mean_abs_delta", win_circ_mean_abs(&p->win));
-	json_field_number(j, "mean_delta", win_circ_mean(&p->win));
-	json_field_number(j, "spread", win_circ_spread(&p->win));
-	json_field_int(j, "window_samples", p->win.n);
-	json_field_int(j, "collisions", p->collisions);
-	json_field_int(j, "contacts", p->contacts);
-	json_field_int(j, "window_collisions", p->win_collisions);
-	json_field_number(j, "window_impulse", p->win_impulse);
-	json_field_number(j, "window_contact_impulse", p->win_contact_impulse);
-	json_field_number(j, "impulse", p->impulse);
-	json_field_number(j, "distance_m", p->distance);
-	json_field_number(j, "amplitude_m", p->amp_lateral);
-	json_field_number(j, "dsep", p->dsep);
-	json_field_number(j, "compat_limit", theory_compat_limit(p->dsep));
-	json_field_int(j, "return_map_points", p->ndeltas > 0 ? (long long)p->ndeltas - 1 : 0);
-	json_field_number(j, "swing_a", p->swing_a);
-	json_field_number(j, "swing_b", p->swing_b);
-	json_object_end(j);
+	pairsum_json(j, &(struct pairsum){
+		.name = p->name, .kind = an_pair_kind_name(p->kind), .cls = p->cls, .win = &p->win,
+		.collisions = p->collisions, .contacts = p->contacts, .win_collisions = p->win_collisions,
+		.win_impulse = p->win_impulse, .win_contact_impulse = p->win_contact_impulse, .impulse = p->impulse,
+		.distance = p->distance, .amplitude = p->amp_lateral, .dsep = p->dsep,
+		.return_map_points = p->ndeltas > 0 ? (int64_t)p->ndeltas - 1 : 0,
+		.swing_a = p->swing_a, .swing_b = p->swing_b });
 }
 
 static void an_summary_json(struct an_ctx *c, FILE *f, int rc)

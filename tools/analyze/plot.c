@@ -5,6 +5,7 @@
  * wrote, and its `set output` can meet no link or FIFO another user put
  * there (tools/analyze/README.md, "Where the files go"). */
 #include "plot.h"
+#include "outdir.h"
 #include "theory.h"
 
 #include <errno.h>
@@ -17,15 +18,6 @@
 
 /* Points of the theory curve over (-pi, pi]. */
 #define PLOT_THEORY_POINTS 721
-/* A new file in the private directory (nothing can be there before us). */
-static FILE *plot_create(const struct plot_input *in, const char *name)
-{
-	int fd = openat(in->dirfd, name, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-	FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-	if (!f && fd >= 0)
-		close(fd);
-	return f;
-}
 
 /* Exit status of the child when exec failed (as the shell's "not found"). */
 #define PLOT_EXEC_FAILED 127
@@ -221,7 +213,7 @@ static int plot_split_csv(const struct plot_input *in, const struct plot_split *
 	}
 	free(line);
 	fclose(src);
-	FILE *f = ok ? plot_create(in, sp->dst) : NULL;
+	FILE *f = ok ? outdir_stage_fopen(in->dirfd, sp->dst) : NULL;
 	for (int b = 0; f && b < sp->nblocks; b++) {
 		fprintf(f, "# index %d: %s\n", b, sp->labels[b]);
 		if (text[b].len > 0)
@@ -429,7 +421,7 @@ static int plot_theory_file(const struct plot_input *in, int k, double dsep)
 {
 	char name[64];
 	snprintf(name, sizeof(name), "theory_%d.csv", k);
-	FILE *t = plot_create(in, name);
+	FILE *t = outdir_stage_fopen(in->dirfd, name);
 	if (!t)
 		return -1;
 	fputs("delta_n,delta_next\n", t);
@@ -556,7 +548,7 @@ int plot_all(const struct plot_input *all, FILE *msg)
 	if (clip.npairs > PLOT_MAX_PAIRS)
 		clip.npairs = PLOT_MAX_PAIRS;
 	const struct plot_input *in = &clip;
-	FILE *f = plot_create(in, "plots.gp");
+	FILE *f = outdir_stage_fopen(in->dirfd, "plots.gp");
 	if (!f) {
 		fprintf(msg, "undulate-analyze: %s/plots.gp: %s\n", in->dir, strerror(errno));
 		return -1;
