@@ -372,7 +372,7 @@ void cfg_defaults(struct cfg *c)
 	 * periods of 10 ms, longer than a late cycle on a loaded machine (tens of
 	 * ms), short enough that a joint at the gait's peak speed (≈ 4 rad/s)
 	 * moves at most about 0.4 rad under a controller that went quiet. */
-	c->bus_watchdog_ms = 100;
+	c->bus_watchdog_ms = CFG_WATCHDOG_DEFAULT;
 	/* One REBOOT after a hardware-error shutdown: a transient (a collision's
 	 * overload, a supply dip) recovers without the operator; a second
 	 * shutdown means the cause is still there, and the fault latches. */
@@ -438,7 +438,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("echo", T_BOOL, echo, 0, 0),
 	K("rs485", T_RS485, rs485, 0, 0),
 	K("adapter_latency_us", T_LONG, adapter_latency_us, -1, 100000),
-	K("period_ms", T_DOUBLE, period_ms, 2, 100),
+	K("period_ms", T_DOUBLE, period_ms, 1, 100),
 	K("servo_lead_s", T_DOUBLE, servo_lead_s, 0, CFG_LEAD_MAX_S),
 	K("compliance_margin", T_LONG, compliance_margin, -1, 255),
 	K("compliance_slope", T_LONG, compliance_slope, -1, 254),
@@ -933,9 +933,11 @@ static void cfg_fill_joint_defaults(struct cfg *c)
 		 * of links folding onto each other on the paper's robot. */
 		if (isnan(jt->limit_min)) jt->limit_min = -1.3;
 		if (isnan(jt->limit_max)) jt->limit_max = 1.3;
-		/* 0.1 rad a cycle = 10 rad/s: above what an AX-12 can follow (≈6 rad/s),
-		 * so it never limits a healthy gait, only jumps. */
-		if (isnan(jt->max_step)) jt->max_step = 0.1;
+		/* 10 rad/s (0.1 rad a cycle at 10 ms): above what an AX-12 can follow
+		 * (≈6 rad/s), so it never limits a healthy gait, only jumps; the
+		 * same speed at every period_ms (a set max_step is per cycle), within
+		 * the key's range (0.5 rad: 5 rad/s at 100 ms, still above the gait's). */
+		if (isnan(jt->max_step)) jt->max_step = fmin(CFG_MAX_STEP_SPEED * c->period_ms * 1e-3, 0.5);
 	}
 }
 
@@ -958,6 +960,23 @@ bool cfg_params_position_defaults(struct cfg_params *p, const struct cfg *c, siz
 	return d != 0;
 }
 
+/* What is counted in time must span a few periods (CFG_MIN_PERIODS): the bus
+ * watchdog (the default, 100 ms, stretched to ten periods above 10 ms) and
+ * silent_s. At 1 ms both keep their times: safety is said in seconds. */
+static void cfg_check_rate(struct cfg *c, struct cfg_errors *e)
+{
+	const char *src = c->source[0] ? c->source : "command line";
+	if (c->bus_watchdog_ms == CFG_WATCHDOG_DEFAULT && c->period_ms * 10 > CFG_WATCHDOG_DEFAULT)
+		c->bus_watchdog_ms = (long)ceil(c->period_ms * 10);
+	if (c->bus_watchdog_ms > 0 && c->bus_watchdog_ms < CFG_MIN_PERIODS * c->period_ms)
+		cfg_error(e, "%s: [robot] bus_watchdog_ms = %ld is shorter than %d periods of %g ms: one late cycle "
+		          "would stop the servos (raise it, or 0 to leave the watchdog off)", src, c->bus_watchdog_ms,
+		          CFG_MIN_PERIODS, c->period_ms);
+	if (c->silent_s < CFG_MIN_PERIODS * c->period_ms * 1e-3)
+		cfg_error(e, "%s: [robot] silent_s = %g is shorter than %d periods of %g ms: one missed reply would "
+		          "latch a fault", src, c->silent_s, CFG_MIN_PERIODS, c->period_ms);
+}
+
 bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 {
 	size_t before = e->count;
@@ -977,6 +996,7 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 			          c->source[0] ? c->source : "command line", j + 1, c->njoints);
 	}
 	cfg_fill_joint_defaults(c);
+	cfg_check_rate(c, e);
 	c->servo_lead_default = isnan(c->servo_lead_s);
 	if (isnan(c->servo_lead_s))
 		c->servo_lead_s = c->compliance_margin == 0 ? OSC_SERVO_LEAD_MARGIN0_S : OSC_SERVO_LEAD_S;

@@ -190,6 +190,14 @@ struct cfg_params {
 };
 /* servo_lead_s's range, one for the file and the tuner (CONTROL.md). */
 #define CFG_LEAD_MAX_S 0.2
+/* A joint's default step limit as a speed (rad/s): max_step's default is
+ * this times period_ms, 0.1 rad at 10 ms. */
+#define CFG_MAX_STEP_SPEED 10.0
+/* The bus watchdog and silent_s against the period: each at least this many
+ * periods, or one late cycle trips them (CONTROL.md, "Other rates"). */
+#define CFG_MIN_PERIODS 3
+/* bus_watchdog_ms when not set (ms); above a period of 10 ms, ten periods. */
+#define CFG_WATCHDOG_DEFAULT 100
 /* The one check of a change to a live parameter, by a command or the tuner:
  * `key` is a commandable parameter (cfg_param_commandable) or servo_lead_s;
  * joint -1 is every joint (a robot parameter takes -1 only); the value is

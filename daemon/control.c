@@ -23,13 +23,14 @@
  * switched: the baseline sinusoid ([sinusoid] amplitude and frequency) drives
  * the joints for ramp_s plus one period, then the oscillator takes over from
  * the measured, moving state. A joint counts as still below CTL_REST_V; an
- * oscillator with a joint still for CTL_STALL_CYCLES (1 s, far longer than a
- * turning point of a running gait) is started again the same way. */
+ * oscillator with a joint still for CTL_STALL_S (far longer than a turning
+ * point of a running gait; a time, not a count of cycles, so that it means the
+ * same at every period_ms) is started again the same way. */
 #define CTL_REST_V 0.1
 /* A joint back after this many stale cycles is blended in again (its goal was
  * held while the mode's target moved on). */
 #define CTL_RESUME_STALE 3
-#define CTL_STALL_CYCLES 100
+#define CTL_STALL_S 1.0
 
 static size_t ctl_joint_of(const struct ctl *c, uint8_t id)
 {
@@ -1242,7 +1243,7 @@ static void ctl_check_stall(struct ctl *c)
 		fresh = fresh && c->j[j].fresh;
 	bool running = c->mode == CFG_MODE_OSCILLATOR && !c->starter_active;
 	c->rest_cycles = running && fresh && ctl_any_still(c) ? c->rest_cycles + 1 : 0;
-	if (c->rest_cycles < CTL_STALL_CYCLES)
+	if (c->rest_cycles * c->cfg->period_ms * 1e-3 < CTL_STALL_S - 1e-9)
 		return;
 	c->rest_cycles = 0;
 	for (size_t j = 0; j < c->n; j++)
@@ -1250,7 +1251,7 @@ static void ctl_check_stall(struct ctl *c)
 	ctl_starter(c);
 	c->starter_offset = ctl_restart_offset(c);
 	ctl_event(c, 1, "stall", "oscillator at rest for %.1f s: restarting it with the sinusoid starter, "
-	          "phase %+.2f rad from its own", CTL_STALL_CYCLES * c->cfg->period_ms * 1e-3, c->starter_offset);
+	          "phase %+.2f rad from its own", CTL_STALL_S, c->starter_offset);
 }
 
 /* Between two moving modes (SINUSOID <-> OSCILLATOR) the old mode's target

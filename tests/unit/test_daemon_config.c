@@ -598,6 +598,45 @@ static void test_command_line_only(void **state)
 	assert_true(c.mode_given);
 }
 
+/* Other rates (period_ms 1..100): what is counted in time keeps its time, the
+ * default step limit its speed, and the watchdog and silent_s must span three
+ * periods (CONTROL.md, "Other rates"). */
+static bool rate_config(const char *period, const char *extra, struct cfg *c, struct cfg_errors *e)
+{
+	char set[64];
+	cfg_defaults(c);
+	*e = (struct cfg_errors){ 0 };
+	snprintf(set, sizeof set, "robot.period_ms=%s", period);
+	bool ok = cfg_override(c, "robot.port=/dev/pts/9", e) && cfg_override(c, "robot.ids=1,2", e) &&
+	          cfg_override(c, set, e) && (extra == NULL || cfg_override(c, extra, e));
+	return ok && cfg_finish(c, e);
+}
+
+static void test_other_rates(void **state)
+{
+	(void)state;
+	struct cfg c;
+	struct cfg_errors e;
+	assert_true(rate_config("1", NULL, &c, &e));
+	assert_true(fabs(c.joint[0].max_step - 0.01) < 1e-12);   /* 10 rad/s */
+	assert_int_equal(c.bus_watchdog_ms, 100);
+	assert_true(c.silent_s == 0.5);
+	assert_false(rate_config("0.5", NULL, &c, &e));
+	assert_true(rate_config("50", NULL, &c, &e));
+	assert_true(fabs(c.joint[1].max_step - 0.5) < 1e-12);
+	assert_int_equal(c.bus_watchdog_ms, 500);    /* ten periods above 10 ms */
+	assert_true(rate_config("50", "joint.1.max_step=0.2", &c, &e));
+	assert_true(c.joint[0].max_step == 0.2);     /* a set one is per cycle */
+	assert_false(rate_config("50", "robot.bus_watchdog_ms=120", &c, &e));
+	assert_non_null(strstr(e.line[0], "bus_watchdog_ms = 120 is shorter than 3 periods of 50 ms"));
+	assert_true(rate_config("50", "robot.bus_watchdog_ms=0", &c, &e));   /* off */
+	assert_true(rate_config("100", NULL, &c, &e));
+	assert_true(c.joint[0].max_step == 0.5);     /* the key's range */
+	assert_false(rate_config("100", "robot.silent_s=0.2", &c, &e));
+	assert_non_null(strstr(e.line[0], "silent_s = 0.2 is shorter than 3 periods of 100 ms"));
+	assert_true(rate_config("2", "robot.silent_s=0.05", &c, &e));
+}
+
 /* A refused ID list leaves the configured one as it was (it was half
  * overwritten once: "5,j" wrote the 5 before failing). */
 static void test_refused_ids_change_nothing(void **state)
@@ -692,6 +731,7 @@ int main(void)
 		cmocka_unit_test(test_only_regular_files),
 		cmocka_unit_test(test_overrides),
 		cmocka_unit_test(test_command_line_only),
+		cmocka_unit_test(test_other_rates),
 		cmocka_unit_test(test_compliance_slope),
 		cmocka_unit_test(test_param_ranges),
 		cmocka_unit_test(test_rs485),

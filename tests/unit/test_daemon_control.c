@@ -16,7 +16,9 @@
 #include "dxl.h"
 #include "dxl_table.h"
 
-#define DT 0.01
+/* the control period (s): the daemon's default, 10 ms, unless a test runs
+ * another rate (set before setup_config) */
+static double dt_s = 0.01;
 
 static struct cfg cfg;
 static struct ctl c;
@@ -37,6 +39,7 @@ static void setup_config(enum cfg_mode mode)
 	cfg_override(&cfg, "robot.port=/dev/null", &e);
 	cfg_override(&cfg, "robot.ids=1,2", &e);
 	cfg.mode = mode;
+	cfg.period_ms = dt_s * 1e3;
 	cfg.fault_backoff_s = 0.2;
 	cfg.fault_retries = 2;
 	assert_true(cfg_finish(&cfg, &e));
@@ -58,7 +61,7 @@ static void setup_robot(enum cfg_mode mode)
 	servo_angle[1] = -0.2;
 	t = 0.0;
 	for (size_t j = 0; j < 2; j++)
-		ctl_measure(&c, j, dxl_rad_to_pos(servo_angle[j]), 0, 0, 0, DT);
+		ctl_measure(&c, j, dxl_rad_to_pos(servo_angle[j]), 0, 0, 0, dt_s);
 	ctl_start(&c, t, "test");
 }
 
@@ -94,20 +97,20 @@ static const struct ctl_event *find_event(const char *kind)
 static double cycle(void)
 {
 	double before[2] = { c.j[0].goal, c.j[1].goal };
-	t += DT;
+	t += dt_s;
 	for (size_t j = 0; j < 2; j++) {
 		if (c.j[j].torque && isfinite(c.j[j].goal) && !servo_blocked) {
-			double d = (c.j[j].goal - servo_angle[j]) * (DT / SERVO_TAU);
-			if (DT > SERVO_TAU)
+			double d = (c.j[j].goal - servo_angle[j]) * (dt_s / SERVO_TAU);
+			if (dt_s > SERVO_TAU)
 				d = c.j[j].goal - servo_angle[j];
-			double lim = 6.0 * DT;
+			double lim = 6.0 * dt_s;
 			servo_angle[j] += d > lim ? lim : d < -lim ? -lim : d;
 		}
 		if (servo_answers[j])
-			ctl_measure(&c, j, dxl_rad_to_pos(servo_angle[j]), 0, 0, servo_err[j], DT);
+			ctl_measure(&c, j, dxl_rad_to_pos(servo_angle[j]), 0, 0, servo_err[j], dt_s);
 	}
 	drain_outputs();
-	ctl_step(&c, t, DT, t);
+	ctl_step(&c, t, dt_s, t);
 	double m = 0.0;
 	for (size_t j = 0; j < 2; j++) {
 		assert_true(isfinite(c.j[j].goal));
@@ -240,7 +243,7 @@ static double stall_offset(const char *name)
 	assert_non_null(strstr(stall->text, "phase"));
 	servo_blocked = false;
 	/* the starter drives the sinusoid at the offset phase once blended in */
-	run((int)(cfg.ramp_s / DT) + 2);
+	run((int)(cfg.ramp_s / dt_s) + 2);
 	assert_true(c.starter_active);
 	double want = cfg.joint[0].neutral + osc_sinusoid(cfg.amplitude, cfg.frequency, cfg.phase + c.starter_offset, 0, t);
 	assert_true(fabs(c.j[0].goal - want) < 1e-9);
@@ -248,6 +251,43 @@ static double stall_offset(const char *name)
 	double m = run(300);
 	assert_true(m <= cfg.joint[0].max_step + 1e-12);
 	return c.starter_offset;
+}
+
+/* At other rates the stall restart comes after the same time at rest (1 s),
+ * not the same number of cycles (100 were 0.1 s at 1 kHz: a turning point of
+ * the gait), and the default step limit is the same speed (10 rad/s). */
+static void test_stall_time_at_other_rates(void **state)
+{
+	(void)state;
+	const double periods[] = { 0.001, 0.002, 0.02 };
+	for (size_t k = 0; k < sizeof periods / sizeof periods[0]; k++) {
+		dt_s = periods[k];
+		setup_robot(CFG_MODE_OSCILLATOR);
+		assert_true(fabs(cfg.joint[0].max_step - 10.0 * dt_s) < 1e-12);
+		run((int)lround(4.0 / dt_s));
+		assert_false(c.starter_active);
+		servo_blocked = true;
+		double t0 = t;
+		const struct ctl_event *stall = NULL;
+		while (stall == NULL && t - t0 < 3.0) {
+			cycle();
+			stall = find_event("stall");
+		}
+		if (stall == NULL)
+			fail_msg("period %g s: no stall restart within 3 s at rest", dt_s);
+		/* the joints come to rest within a few cycles of the block, then 1 s */
+		if (!(t - t0 >= 1.0 && t - t0 < 1.1))
+			fail_msg("period %g s: stall restart %.3f s after the block, want 1.0 s", dt_s, t - t0);
+		assert_non_null(strstr(stall->text, "at rest for 1.0 s"));
+		servo_blocked = false;
+	}
+}
+
+static int rate_back(void **state)
+{
+	(void)state;
+	dt_s = 0.01;
+	return 0;
 }
 
 /* A stall restart draws a phase offset from the robot's name: two robots
@@ -626,6 +666,7 @@ int main(void)
 		cmocka_unit_test(test_switches_without_jumps),
 		cmocka_unit_test(test_oscillator_starts_from_rest),
 		cmocka_unit_test(test_stall_restart_offset),
+		cmocka_unit_test_teardown(test_stall_time_at_other_rates, rate_back),
 		cmocka_unit_test(test_stale_joint_holds),
 		cmocka_unit_test(test_fault_recovery),
 		cmocka_unit_test(test_fault_persistent),

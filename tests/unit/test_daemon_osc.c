@@ -306,8 +306,10 @@ static void test_independent_of_step_size(void **state)
 	struct cycle one = run_ideal(p, TWO_JOINTS, x0, v0, 0.01, 1, 30.0, 45.0);
 	struct cycle d5 = run_ideal(p, TWO_JOINTS, x0, v0, 0.005, 4, 30.0, 45.0);
 	struct cycle d20 = run_ideal(p, TWO_JOINTS, x0, v0, 0.02, 4, 30.0, 45.0);
-	const struct cycle *all[] = { &one, &d5, &d20 };
-	for (size_t i = 0; i < 3; i++) {
+	/* period_ms = 1 (rates above 100 Hz on X servos) */
+	struct cycle d1 = run_ideal(p, TWO_JOINTS, x0, v0, 0.001, 4, 30.0, 45.0);
+	const struct cycle *all[] = { &one, &d5, &d20, &d1 };
+	for (size_t i = 0; i < 4; i++) {
 		print_message("variant %zu: A0 %.5f A1 %.5f f %.5f lag %.2f\n", i, all[i]->amp[0],
 		              all[i]->amp[1], all[i]->freq, all[i]->lag_deg);
 		assert_true(fabs(all[i]->freq - ref.freq) < 2e-3 * ref.freq);
