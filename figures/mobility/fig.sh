@@ -312,7 +312,7 @@ fragment() {
 	awk -F, 'NR > 1 { printf "| %s | %d | %d | %d | %d | %s | %s | %d | %d (%.2f) |\n", $1, $2, $3, $4, $8,
 		($5 ~ />/) ? "> " substr($5, 2) : sprintf("%.3g", $5), ($3 > 0) ? sprintf("%.3g - %.3g", $6, $7) : "-", $9, $10, $11 }' "$t/betas.csv"
 	echo
-	relax_words "$t"
+	relax_words "$t" "$csv"
 	echo
 	drift_words "$csv"
 	echo
@@ -338,8 +338,13 @@ relax_words() {
 			printf ": steep as β → 0, as the paper says. "
 			if (flo != "") printf "From β = 0.05 s up the medians lie between %.3g and %.3g s (a period is 1.25 s). ", flo, fhi
 			printf "Every run relaxed at β = %s s. ", full
-			if (cen != "") printf "Censored: %s. Below about 0.006 s the model'"'"'s row does not relax in the runs'"'"' time: it settles into a steady state of about 18 collisions a second in which the pushes on each base from its two sides balance (the paper: mobile bases always relax; its β is in its own units, which theory.md does not give).", cen
+			if (cen != "") printf "Censored: %s. Below 0.007 s the row mostly does not relax in the runs'"'"' time: it keeps colliding at a steady rate (the paper: mobile bases always relax; its β is in its own units, which theory.md does not give). ", cen
 			printf "\n" }' "$1/betas.csv"
+	awk -F, -v k=$C_KIND -v cb=$C_B -v ctr=$C_TR -v cc=$C_COLL -v cs=$C_SECS '$k == "run" && $ctr == "" { r[$cb] += $cc / $cs; n[$cb]++ }
+		END { for (b in n) printf "%s,%.1f,%d\n", b, r[b] / n[b], n[b] }' "$2" | sort -t, -k1,1g |
+		awk -F, '{ s = s sprintf("%s%.1f at β = %s s (%d runs)", s == "" ? "" : ", ", $2, $1, $3) }
+			END { if (s != "") printf "The censored runs'"'"' collisions per second over the whole run: %s.\n", s }'
+
 	awk -F, 'NR > 1 && $10 > 0 && (c == "" || $1 + 0 < c) { c = $1 } NR > 1 && $10 == 0 && $1 + 0 > ok { ok = $1 }
 		END { if (c != "") printf "From β = %s s two bases passed each other in some runs (a pair'"'"'s d̃ below 0 after an impact; the model moves a base by β·Δv, up to 8β, and does not forbid it): there the decades are the model'"'"'s formal continuation, not a row of bodies. ", c
 			if (ok != "") printf "Up to β = %s s no base passed a neighbour.\n", ok }' "$1/betas.csv"
@@ -357,11 +362,13 @@ drift_words() {
 			if (!length(bs)) { print "**7a.** No drift runs."; exit }
 			printf "**What it shows (7a).** The row'"'"'s mean d̃ cannot drift: its ends are held and its gaps add up to the distance between them (it stays %s within %s). ", d0, dev < 1e-6 ? "10⁻⁶" : sprintf("%.1g", dev)
 			printf "What drifts is each pair: an impact pushes its two bases apart, so the pairs that collide move to larger d̃ and the ones beside them close up, until every pair is compatible. At the end, by β (each drift run: the largest d̃ / the least / the sd):"
-			for (key in tl) { split(key, kk, SUBSEP); s[kk[1]] = s[kk[1]] sprintf(" %.2f / %.2f / %.3f;", hi[key], lo[key], sd[key]) }
-			for (b in bs) printf " β = %s s:%s", b, s[b]
-			printf " The mean d̃ of the pairs at their collisions, over the whole run:"
-			for (b in bs) printf " %.3f at β = %s s;", cw[b] / cn[b], b
-			printf " the bases rebuilt from the impacts alone (each δ = β(ẋ_other − ẋ_self)) end within %.1g of the model'"'"'s own (%d runs): the mobility'"'"'s books add up.\n", err, ne }' "$1"
+			nb = 0; for (b in bs) ob[++nb] = b + 0
+			for (i = 2; i <= nb; i++) for (j = i; j > 1 && ob[j - 1] > ob[j]; j--) { x = ob[j]; ob[j] = ob[j - 1]; ob[j - 1] = x }
+			for (key in tl) { split(key, kk, SUBSEP); s[kk[1] + 0] = s[kk[1] + 0] sprintf(" %.2f / %.2f / %.3f;", hi[key], lo[key], sd[key]) }
+			for (i = 1; i <= nb; i++) printf " β = %s s:%s", ob[i], s[ob[i]]
+			printf " The d̃ at which collisions happen does not grow with them (the mean over each run'"'"'s collisions:"
+			for (i = 1; i <= nb; i++) for (b in bs) if (b + 0 == ob[i]) printf "%s %.3f at β = %s s", (i > 1 ? "," : ""), cw[b] / cn[b], b
+			printf "): the row spreads, the colliding pairs moving apart and their neighbours closing up. The bases rebuilt from the impacts alone (each δ = β(ẋ_other − ẋ_self)) end within %.1g of the model'"'"'s own (%d runs): the mobility'"'"'s books add up.\n", err, ne }' "$1"
 }
 
 daemon_words() {
