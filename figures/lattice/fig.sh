@@ -67,9 +67,10 @@ jobs() {
 	done
 }
 
-# Wall seconds of one run (2026-11-28, load 5-6: 0.1-0.4 s of model, the
-# rest the shell's bookkeeping).
-seconds() { echo 1.5; }
+# Wall seconds of one run (2026-11-28: 2-3 s at load 5-13 for 0.1-0.4 s of
+# the model, the rest the shell's bookkeeping; the full set niced at load
+# 9-22, two at once: 9.2 s a run on average).
+seconds() { echo 3; }
 
 RESULT_HEADER="kind,dsep,seed,seconds,i,t,phase,abs_delta,pair_dsep,compat_limit,collisions,window_collisions,class,t_relax_s,last_collision_s"
 

@@ -88,9 +88,11 @@ jobs() {
 	done
 }
 
-# Wall seconds of one run (2026-11-28, load 5-6): 0.3 s for 200 s, 7-15 s for
-# 40 000 s, 8 s for 20 000 s still colliding; the average over the full set
-seconds() { [ "${1:-}" = --quick ] && echo 2 || echo 5; }
+# Wall seconds of one run (2026-11-28, load 5-6): 0.3 s of the model for
+# 200 s, 7-15 s for 40 000 s, 8 s for 20 000 s still colliding; the full set
+# niced at load 9-22, two at once: 12.4 s a run on average (173 s of the
+# model's CPU in all); the quick set 2-3 s a run
+seconds() { [ "${1:-}" = --quick ] && echo 3 || echo 8; }
 
 RESULT_HEADER="kind,dsep,beta,seed,seconds,t,collisions,mean_dsep_colliding,dsep_mean,dsep_sd,dsep_min,dsep_max,incompatible_pairs,colliding_pairs,t_relax_s,last_collision_s,neutral_error,dsep_min_run"
 
