@@ -33,7 +33,7 @@ fig_init figures
 self="$top/scripts/figures.sh"
 
 # The page's order: the paper's. Modules not named here follow by name.
-ORDER="heatmap steady pair returnmap rows channel swimmer channel-plane forces forces-plane"
+ORDER="heatmap steady pair returnmap rows lattice mobility channel swimmer channel-plane forces forces-plane"
 # Progress: a new line this often when stdout is not a terminal (s).
 PROGRESS_EVERY_S=30
 

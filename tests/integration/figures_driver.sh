@@ -32,12 +32,12 @@ FIG_PORT_LO=$(lcm_port 7780)
 
 # ---- every module: the page's order, a tiny set each -------------------------------------
 order=$("$F" list 2>&1 | awk '{ printf "%s ", $1 }')
-tap_check "list: the ten modules in the page's order (heatmap steady pair returnmap rows channel swimmer channel-plane forces forces-plane)" \
-	test "$order" = "heatmap steady pair returnmap rows channel swimmer channel-plane forces forces-plane "
+tap_check "list: the twelve modules in the page's order (heatmap steady pair returnmap rows lattice mobility channel swimmer channel-plane forces forces-plane)" \
+	test "$order" = "heatmap steady pair returnmap rows lattice mobility channel swimmer channel-plane forces forces-plane "
 "$F" --export-jobs "$T/tiny.txt" --runs "$T/tinyruns" >"$T/tiny.out" 2>&1
 counts=$(awk '{ n[$3]++ } END { for (m in n) printf "%s %d\n", m, n[m] }' "$T/tiny.txt" 2>/dev/null | sort | tr '\n' ' ')
 tap_check "FIG_TINY=1: every module a tiny set, 1-3 runs ($counts)" awk -v c="$counts" 'BEGIN {
-	n = split(c, f, " "); if (n != 20) exit 1
+	n = split(c, f, " "); if (n != 24) exit 1
 	for (i = 2; i <= n; i += 2) if (f[i] < 1 || f[i] > 3) exit 1 }'
 
 # ---- exported jobs, run by GNU parallel as on a cluster --------------------------------
