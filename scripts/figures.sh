@@ -218,12 +218,15 @@ page() {
 	local dir=$1 m f
 	local figdir="$dir/figures"
 	{
-		echo "# The paper's figures, from the real daemons"
+		echo "# The paper's figures, from the real daemons and from the paper's own model"
 		echo
-		echo "Every figure below comes from runs of the unchanged programs — \`undulate-sim\` and one"
-		echo "\`undulated\` per robot on the simulated Dynamixel bus — in lockstep (the simulator owns"
+		echo "Two sources. Most figures below come from runs of the unchanged programs — \`undulate-sim\`"
+		echo "and one \`undulated\` per robot on the simulated Dynamixel bus — in lockstep (the simulator owns"
 		echo "the clock: sim-bridge/README.md, \"Lockstep\"), each run analysed by \`undulate-analyze\`,"
 		echo "the theory's curves from \`undulate-analyze --theory\` (theory.md's formulas, tools/analyze/theory.c)."
+		echo "Those the paper draws from its own equations (heatmap, steady, lattice, mobility) come from"
+		echo "\`undulate-model\` (model/README.md: the phase oscillators and the lattice, integrated with"
+		echo "GSL, nothing of ours in between), with the daemons' runs laid over them where we have them."
 		echo "The numbers of every figure are in the CSV beside its picture (\`figures/\`)."
 		echo
 		echo "Made by \`make figures\` (\`scripts/figures.sh\`) on $(machine). Per figure: its runs,"
@@ -246,6 +249,11 @@ page() {
 		echo "\`scripts/figures.sh --only pair\` (the page keeps the other figures' sections). A sweep larger"
 		echo "than one machine: README.md, \"A sweep on a cluster\" (\`--export-jobs\`, GNU parallel over ssh"
 		echo "or a Slurm array, then \`--merge\`)."
+		# the comparison, kept by hand beside the modules (its numbers from their CSVs)
+		if [ -f "$fig_top/figures/model-vs-daemons.md" ]; then
+			echo
+			cat "$fig_top/figures/model-vs-daemons.md"
+		fi
 		for m in $(modules); do
 			f="$figdir/$m.md"
 			[ -f "$f" ] || continue
