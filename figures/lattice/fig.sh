@@ -147,7 +147,7 @@ per_dsep() {
 		sort -t, -k1,1g | { echo "dsep,runs,pairs,colliding,share,t_relax_median,t_relax_min,t_relax_max,censored"; cat; }
 }
 
-# The daemons' rows (figures/rows: ten robots, walls 0.19 m beyond the ends):
+# The daemons' rows (figures/rows: ten robots, the paper's ends: no walls, end bases held):
 # the merged rows.csv of this invocation's figures when there is one, else
 # the project's docs/figures/rows.csv; FIG_ROWS_CSV names another.
 rows_csv() {
@@ -181,7 +181,7 @@ pairs_plot() {
 	series+=("'$t/curves.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title 'compatibility limit 2 asin(d̃)'")
 	local share=("'$t/dseps.csv' every ::1 using 1:5 with linespoints lw 2 pt 7 lc rgb '#d62728' title 'model: 50 oscillators, no walls'")
 	fig_has "$t/daemons.csv" 1 && share+=(
-		"'$t/daemons.csv' every ::1 using 1:5 with linespoints lw 2 dt 2 pt 5 ps 1.2 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, walls 0.19 m beyond the ends'")
+		"'$t/daemons.csv' every ::1 using 1:5 with linespoints lw 2 dt 2 pt 5 ps 1.2 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, no walls'")
 	{
 		fig_gp_head 1000 900
 		echo "set encoding utf8"
@@ -349,7 +349,7 @@ verdict() {
 	echo
 	if src=$(rows_csv) && fig_has "$t/daemons.csv" 1; then
 		echo "**Beside the daemons.** The grey line: figures/rows' immobile rows of ten single-joint robots"
-		echo "through the daemons and the simulated servos ($(awk -F, 'NR > 1 { n += $2 } END { print n }' "$t/daemons.csv") runs, $(src_name "$src")), with walls 0.19 m beyond the end robots"
+		echo "through the daemons and the simulated servos ($(awk -F, 'NR > 1 { n += $2 } END { print n }' "$t/daemons.csv") runs, $(src_name "$src")), no walls as here,"
 		echo "and the oscillator from 3 s; their pairs' |Δ| are not in rows.csv, so only the share still"
 		echo "colliding is overlaid, not the per-pair points. $(compare "$t")"
 	else
@@ -365,7 +365,7 @@ compare() {
 			if ($1 + 0 >= 0.5 && $1 + 0 < 1 && $5 - dm[$1 + 0] > 0.3) low = low sprintf("%s%s", low == "" ? "" : ", ", $1) }
 		END { if (!n) { print "They share no d̃ with the model."; exit }
 			printf "Share of pairs colliding at the end, model / daemons, at the d̃ both ran: %s.", s
-			if (low != "") printf " At d̃ %s the daemons'"'"' rows stop colliding far more often than the model'"'"'s. Not measured here, two candidates: their oscillators lose amplitude at each collision, which the phase model does not (issue 25: 0.79 -> 0.64 rad at the pair rig), and ten robots between walls are not fifty in a free row.", low
+			if (low != "") printf " At d̃ %s the daemons'"'"' rows stop colliding far more often than the model'"'"'s. Not measured here, two candidates: their oscillators lose amplitude at each collision, which the phase model does not (issue 25: 0.79 -> 0.64 rad at the pair rig), and ten robots are not fifty.", low
 			printf "\n" }' "$t/daemons.csv" "$t/dseps.csv"
 }
 

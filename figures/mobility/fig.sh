@@ -11,7 +11,7 @@
 #    the others';
 #  - 7b: t_relax (the time of the last collision) against β over three
 #    decades, every seed drawn, with the daemons' mobile rows (figures/rows,
-#    ten robots at d̃ 0.7) over it, and below the decades two β at which
+#    ten robots at d̃ 0.78) over it, and below the decades two β at which
 #    the row never relaxes in its run (censored).
 #
 #   fig.sh jobs [--quick]                 one line per run: RUN_ID BETA SECONDS SEED DRIFT
@@ -199,8 +199,8 @@ per_beta() {
 		sort -t, -k1,1g | { echo "beta,runs,relaxed,censored,median_s,min_s,max_s,seconds,incompatible_pairs,crossed,least_dsep"; cat; }
 }
 
-# The daemons' mobile rows (figures/rows: ten robots, d̃ 0.7, walls 0.19 m
-# beyond the end robots, t from the switch to the oscillator at 3 s): this
+# The daemons' mobile rows (figures/rows: ten robots, d̃ 0.78, the paper's ends:
+# no walls, the end bases held; t from the switch to the oscillator at 3 s): this
 # invocation's rows.csv, else docs/figures/rows.csv; FIG_ROWS_CSV names another.
 rows_csv() {
 	local c
@@ -209,13 +209,13 @@ rows_csv() {
 	done
 	return 1
 }
-# daemon_relax: beta,relax_s,censored,run_s of every mobile run at d̃ 0.7
+# daemon_relax: beta,relax_s,censored,run_s of every mobile run at d̃ 0.78 (figures/rows' RELAX_DSEP)
 daemon_relax() {
 	local c
 	echo "beta,relax_s,censored,run_s"
 	c=$(rows_csv) || return 0
 	awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
-		$1 == 0.7 && $2 > 0 { printf "%s,%s,%s,%s\n", $2, $col["relax_s"], $col["censored"], $3 - 3 }' "$c" | sort -t, -k1,1g
+		$1 == 0.78 && $2 > 0 { printf "%s,%s,%s,%s\n", $2, $col["relax_s"], $col["censored"], $3 - 3 }' "$c" | sort -t, -k1,1g
 }
 
 relax_plot() {
@@ -233,7 +233,7 @@ relax_plot() {
 	fig_has "$t/runs.csv" '$4 != ""' && series+=(
 		"'$t/runs.csv' every ::1 using 2:4 with points pt 8 ps 1.4 lw 1.5 lc rgb '#d62728' title 'model: censored, still colliding at the end of its run (drawn there)'")
 	fig_has "$t/daemons.csv" '$3 == 0' && series+=(
-		"'$t/daemons.csv' every ::1 using (\$3 == 0 ? \$1 : 1/0):(\$2 > 0.05 ? \$2 : 0.05) with points pt 5 ps 1.1 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, d̃ 0.7, walls (0 s drawn at 0.05)'")
+		"'$t/daemons.csv' every ::1 using (\$3 == 0 ? \$1 : 1/0):(\$2 > 0.05 ? \$2 : 0.05) with points pt 5 ps 1.1 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, ends held (0 s drawn at 0.05)'")
 	fig_has "$t/daemons.csv" '$3 == 1' && series+=(
 		"'$t/daemons.csv' every ::1 using (\$3 == 1 ? \$1 : 1/0):4 with points pt 4 ps 1.3 lw 1.5 lc rgb '#555555' title 'daemons: censored (drawn at the length of the run)'")
 	lo=$(awk -F, 'NR > 1 { if (m == "" || $1 < m) m = $1 } END { print m / 2 }' "$t/runs.csv")
@@ -320,8 +320,8 @@ fragment() {
 	echo
 	if src=$(rows_csv) && fig_has "$t/daemons.csv" 1; then
 		echo "**Beside the daemons.** Grey: figures/rows' mobile rows through the daemons and the simulated"
-		echo "servos ($(awk 'END { print NR - 1 }' "$t/daemons.csv") runs from $(case "$src" in "$fig_top/docs/figures/rows.csv") echo "docs/figures/rows.csv" ;; *) echo "this invocation's rows.csv" ;; esac)): ten single-joint robots at d̃ 0.7 (not 0.78),"
-		echo "one β for every robot (the end ones move too) and walls 0.19 m beyond the end robots, time"
+		echo "servos ($(awk 'END { print NR - 1 }' "$t/daemons.csv") runs from $(case "$src" in "$fig_top/docs/figures/rows.csv") echo "docs/figures/rows.csv" ;; *) echo "this invocation's rows.csv" ;; esac)): ten single-joint robots at d̃ 0.78,"
+		echo "the ends as here (no walls, the two end robots' bases held, β for the others), time"
 		echo "from the switch to the oscillator at 3 s. $(daemon_words "$t") rows.csv keeps no"
 		echo "positions over time, so 7a has no daemons' curve."
 	else

@@ -8,8 +8,8 @@
 #  - immobile (β = 0) against mobile (β = 0.1 s) bases over d̃ 0.1-1.1: at the
 #    end (last 10 s), collisions per pair per second and the compatibility
 #    error, how far each pair's |Δ| lies beyond 2 asin(d̃);
-#  - the mobile row at d̃ = 0.7 for β from 0.1 s down to 0.005 s: the
-#    relaxation time, from the switch to the last collision (robots or walls);
+#  - the mobile row at d̃ = 0.78 for β from 0.1 s down to 0.002 s: the
+#    relaxation time, from the switch to the last collision;
 #    a run still colliding in its last 20 s is censored (relaxed later, if
 #    at all).
 #
@@ -18,15 +18,14 @@
 #   fig.sh merge RUNS_DIR FIGDIR          FIGDIR/rows.csv, rows.png, rows_relax.png, rows.md
 #   fig.sh seconds [--quick]              wall seconds of one run on the 2-core machine
 #
-# The ends: the paper's lattice fixes its ends; here walls stand an
-# amplitude and a quarter (1.25 x 0.1865 m/rad x 0.8 rad = 0.19 m) beyond the
-# end robots' neutral positions, out of reach of a swing at rest, so that an
-# immobile row is only its pairs, and a mobile row cannot spread further than
-# that (its nine gaps grow by 4 cm at most: d̃ + 0.14). Walls where a mirrored
-# neighbour would stand (the scenario's own walls = auto, as e2e_row's rows)
-# are hit by the end robots every cycle at any d̃ < 1 on immobile bases, and
-# at d̃ = 0.1 they left ten robots 0.3 m, one swept width, in which they
-# jammed (swings of 0.24 rad).
+# The ends, as the paper's lattice has them: no walls, and the two end robots'
+# bases held (`[robot NAME] beta = 0`) while the others move by world.beta; an
+# immobile row is then only its pairs, and a mobile row spreads between its
+# held ends (its mean d̃ cannot change). Until 2026-11-28 walls stood an
+# amplitude and a quarter beyond the end robots instead, and every base moved
+# (the scenarios could not hold one robot's base): the model beside it
+# (figures/lattice, figures/mobility) is the paper's row. The relaxation runs at
+# the paper's d̃ = 0.78 (0.7 before).
 #
 # Ten robots: a row of 5 runs at 9.7x real time here, 10 at 3.8x, 20 at 2.9x
 # (30 s lockstep runs on this 2-core machine with other work beside them,
@@ -52,7 +51,7 @@ SWEEP_DSEPS="0.1 0.3 0.5 0.7 0.9 1.1"
 SWEEP_BETAS="0 0.1"
 SWEEP_SECONDS=60
 SWEEP_SEEDS=3
-RELAX_DSEP=0.7
+RELAX_DSEP=0.78
 RELAX_BETAS="0.1 0.05 0.02 0.01 0.005 0.002"
 RELAX_SECONDS=240
 RELAX_SEEDS=3
@@ -93,14 +92,11 @@ run() {
 	fig_uint SEED "$seed" 1 999999999
 	fig_run_start "$out"
 	out=$FIG_RUN
-	# the ends: walls an amplitude and a quarter beyond the end robots
-	# (see the header), the row centred on 0
-	local wall_x
-	wall_x=$(awk -v d="$dsep" -v n="$ROBOTS" -v l="$LEVER_M" -v a="$AMPLITUDE_RAD" \
-		'BEGIN { printf "%.4f", (n - 1) / 2 * d * 2 * l * a + 1.25 * l * a }')
+	# the ends: no walls, the end robots' bases held (see the header)
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/lattice10.scenario" --seconds "$secs" \
 		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.separation=$dsep" \
-		--set "world.beta=$beta" --set "world.walls=-$wall_x,$wall_x" "${RIG[@]}" || exit 1
+		--set "world.beta=$beta" --set "world.walls=none" --set "robot r1.beta=0" --set "robot r$ROBOTS.beta=0" \
+		"${RIG[@]}" || exit 1
 	local r="$out/demo" swing wall
 	outdir_new "$out/pairs.csv" "$out/result.csv" || fig_die "cannot write in $out"
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
@@ -249,11 +245,10 @@ fragment() {
 		echo "![Fig. 7b: relaxation time against mobility](figures/rows_relax.png)"
 		echo
 		echo "What ran: $n lockstep runs of \`sim-bridge/scenarios/lattice10.scenario\`: ten single-joint"
-		echo "robots in a row with walls at both ends, r = 0.67, joints driven by the oscillator's torque"
+		echo "robots in a row, r = 0.67, joints driven by the oscillator's torque"
 		echo "(torque actuation on the simulator's current drive), random phases on the clock, the"
-		echo "oscillator from $SWITCH s; walls an amplitude and a quarter (0.19 m) beyond the end robots, out"
-		echo "of reach of their swing, bounding how far a mobile row can spread (its gaps grow by 4 cm at"
-		echo "most). The end is the last $WINDOW s. Compatibility error: the mean over a row's"
+		echo "oscillator from $SWITCH s; the paper's ends: no walls, the two end robots' bases held (β = 0 for"
+		echo "them), the others moving by β. The end is the last $WINDOW s. Compatibility error: the mean over a row's"
 		echo "nine pairs of max(0, |Δ| − 2 asin(d̃)), each pair with its own d̃ as the analyser"
 		echo "measures it (d̃ ≥ 1: no contact possible, error 0)."
 		if awk -F, -v q="$QUICK_SWEEP_SECONDS" -v r="$QUICK_RELAX_SECONDS" 'NR > 1 && ($3 == q || $3 == r) { found = 1 } END { exit !found }' "$csv"; then
@@ -270,7 +265,7 @@ fragment() {
 			sort -t'|' -k1,1g -k2,2g | awk -F'|' '{ printf "| %s | %s | %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, $8 }'
 		echo
 		echo "Relaxation of the mobile row at d̃ = $RELAX_DSEP (time from the switch to the oscillator until"
-		echo "the last collision, walls included; censored: a collision in the run's last $CENSOR_S s):"
+		echo "the last collision; censored: a collision in the run's last $CENSOR_S s):"
 		echo
 		echo "| β (s) | runs | relaxed | each run (s; > censored) | median (s; censored runs counted as longest) |"
 		echo "|---|---|---|---|---|"

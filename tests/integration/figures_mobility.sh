@@ -37,7 +37,13 @@ refused "run: missing argument" run "$T/x" 0.07 200 1
 while read -r id beta s seed drift; do
 	"$F" run "$T/runs/$id" "$beta" "$s" "$seed" "$drift" >"$T/run-$id.log" 2>&1 || tap_fail "run $id" "$(tail -n 1 "$T/run-$id.log")"
 done <<<"$q"
-"$F" merge "$T/runs" "$T/fig" >"$T/merge.log" 2>&1
+# the daemons' rows beside it: a rows.csv of our own (figures/rows' columns),
+# its relaxation runs at d̃ 0.78 and one sweep run at 0.7 that must not count
+H="dsep,beta,seconds,seed,pairs,colliding_pairs,pair_collisions_hz,compat_error_rad,compat_error_max_rad,compatible_pairs,antiphase_pairs,stopped_pairs,wall_collisions_hz,relax_s,censored,min_swing_rad,wall_s"
+printf '%s\n' "$H" "0.78,0.1,240,1,9,0,0,0,0,9,0,0,0,3,0,1.6,50" "0.78,0.02,240,1,9,0,0,0,0,9,0,0,0,40,0,1.6,50" \
+	"0.78,0.005,240,1,9,0,0,0,0,9,0,0,0,150,0,1.6,50" "0.78,0.002,240,1,9,1,0.1,0,0,8,0,0,0,236,1,1.6,50" \
+	"0.78,0.01,240,2,9,0,0,0,0,9,0,0,0,60,0,1.6,50" "0.7,0.1,60,1,9,0,0,0,0,9,0,0,0,99,0,1.6,14" >"$T/rows.csv"
+FIG_ROWS_CSV="$T/rows.csv" "$F" merge "$T/runs" "$T/fig" >"$T/merge.log" 2>&1
 rc=$?
 if [ "$rc" = 0 ]; then tap_ok "merge of the quick set exits 0"; else tap_fail "merge exits 0" "$(tail -n 3 "$T/merge.log")"; fi
 C="$T/fig/mobility.csv"
@@ -69,4 +75,6 @@ tap_check "mobility-drift.png: the second β's curves drawn (${orange:-no} pixel
 tap_check "the section: a row per β, the books and the daemons" \
 	bash -c "grep -qE '^\\| 0.7 \\| 2 \\| 2 \\| 0 \\| 200 \\| [0-9.]+ \\| ' '$T/fig/mobility.md' && grep -q 'the mobility.s books add up' '$T/fig/mobility.md' &&
 		grep -q \"The daemons' runs by β: \" '$T/fig/mobility.md'"
+tap_check "the daemons' runs are figures/rows' relaxation runs at d̃ 0.78 (5), not its sweep at 0.7" \
+	grep -q "(5 runs from this invocation's rows.csv)" "$T/fig/mobility.md"
 tap_done
