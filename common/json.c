@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 /* Length of the well-formed UTF-8 sequence at p (RFC 3629: no overlong forms,
  * no surrogates, nothing above U+10FFFF), or 0 if there is none. */
@@ -37,36 +38,95 @@ static size_t json_utf8_len(const unsigned char *p)
 	return n;
 }
 
-void json_write_string(FILE *f, const char *s)
+/* Every byte goes through here: into the FILE, or into the buffer while it
+ * has room (one byte kept for the NUL). A buffer that was once too small
+ * stays full: it holds the document's start, never a later piece after a
+ * missing one. */
+static void json_put(struct json *j, const char *s, size_t n)
 {
-	fputc('"', f);
+	if (j->f != NULL) {
+		fwrite(s, 1, n, j->f);
+		return;
+	}
+	if (j->full || n >= j->cap - j->len) {
+		j->full = true;
+		return;
+	}
+	memcpy(j->buf + j->len, s, n);
+	j->len += n;
+	j->buf[j->len] = '\0';
+}
+
+static void json_putc(struct json *j, char c)
+{
+	if (j->f != NULL)
+		fputc(c, j->f);
+	else
+		json_put(j, &c, 1);
+}
+
+static void json_put_string(struct json *j, const char *s)
+{
+	static const char hex[] = "0123456789abcdef";
 	const unsigned char *p = (const unsigned char *)(s != NULL ? s : "");
+	const unsigned char *run = p;   /* bytes that go out as they are, from here to p */
+	json_putc(j, '"');
 	while (*p) {
 		size_t n = json_utf8_len(p);
+		if (n != 0 && *p != '"' && *p != '\\' && *p >= 0x20) {
+			p += n;
+			continue;
+		}
+		json_put(j, (const char *)run, (size_t)(p - run));
 		if (n == 0) {
-			fputs("\\ufffd", f);
+			json_put(j, "\\ufffd", 6);
 			n = 1;
 		} else if (*p == '"' || *p == '\\') {
-			fprintf(f, "\\%c", *p);
-		} else if (*p < 0x20) {
-			fprintf(f, "\\u%04x", *p);
+			char esc[2] = { '\\', (char)*p };
+			json_put(j, esc, 2);
 		} else {
-			fwrite(p, 1, n, f);
+			char esc[6] = { '\\', 'u', '0', '0', hex[*p >> 4], hex[*p & 0xf] };
+			json_put(j, esc, 6);
 		}
 		p += n;
+		run = p;
 	}
-	fputc('"', f);
+	json_put(j, (const char *)run, (size_t)(p - run));
+	json_putc(j, '"');
+}
+
+void json_write_string(FILE *f, const char *s)
+{
+	struct json j = { .f = f };
+	json_put_string(&j, s);
+}
+
+static int json_digits(int digits)
+{
+	return digits > 0 && digits <= 17 ? digits : JSON_DEFAULT_DIGITS;
 }
 
 void json_init(struct json *j, FILE *f, int digits)
 {
-	*j = (struct json){ .f = f, .digits = digits > 0 && digits <= 17 ? digits : JSON_DEFAULT_DIGITS,
-	                    .ok = true };
+	*j = (struct json){ .f = f, .digits = json_digits(digits), .ok = true };
+}
+
+void json_init_buf(struct json *j, char *buf, size_t cap, int digits)
+{
+	*j = (struct json){ .buf = buf, .cap = cap, .full = cap == 0, .digits = json_digits(digits), .ok = true };
+	if (cap > 0)
+		buf[0] = '\0';
+}
+
+size_t json_len(const struct json *j)
+{
+	return j->len;
 }
 
 bool json_end(const struct json *j)
 {
-	return j->ok && j->depth == 0 && j->has_items[0] && !j->after_key && !ferror(j->f);
+	bool written = j->f != NULL ? !ferror(j->f) : !j->full;
+	return j->ok && j->depth == 0 && j->has_items[0] && !j->after_key && written;
 }
 
 /* Before any value: the comma it needs, or false (and the writer stopped)
@@ -84,7 +144,7 @@ static bool json_value_prefix(struct json *j)
 		return false;
 	}
 	if (j->has_items[j->depth])
-		fputc(',', j->f);
+		json_putc(j, ',');
 	j->has_items[j->depth] = true;
 	return true;
 }
@@ -98,10 +158,10 @@ void json_key(struct json *j, const char *key)
 		return;
 	}
 	if (j->has_items[j->depth])
-		fputc(',', j->f);
+		json_putc(j, ',');
 	j->has_items[j->depth] = true;
-	json_write_string(j->f, key);
-	fputc(':', j->f);
+	json_put_string(j, key);
+	json_putc(j, ':');
 	j->after_key = true;
 }
 
@@ -113,7 +173,7 @@ static void json_open(struct json *j, bool object)
 		j->ok = false;
 		return;
 	}
-	fputc(object ? '{' : '[', j->f);
+	json_putc(j, object ? '{' : '[');
 	j->depth++;
 	j->in_object[j->depth] = object;
 	j->has_items[j->depth] = false;
@@ -127,7 +187,7 @@ static void json_close(struct json *j, bool object)
 		j->ok = false;
 		return;
 	}
-	fputc(object ? '}' : ']', j->f);
+	json_putc(j, object ? '}' : ']');
 	j->depth--;
 }
 
@@ -154,35 +214,49 @@ void json_array_end(struct json *j)
 void json_string(struct json *j, const char *s)
 {
 	if (json_value_prefix(j))
-		json_write_string(j->f, s);
+		json_put_string(j, s);
 }
 
 void json_number(struct json *j, double v)
 {
 	if (!json_value_prefix(j))
 		return;
-	if (isfinite(v))
-		fprintf(j->f, "%.*g", j->digits, v);
-	else
-		fputs("null", j->f);
+	if (!isfinite(v)) {
+		json_put(j, "null", 4);
+		return;
+	}
+	char text[32];   /* "%.17g" of any double: at most 24 bytes */
+	int n = snprintf(text, sizeof text, "%.*g", j->digits, v);
+	json_put(j, text, (size_t)n);
 }
 
 void json_int(struct json *j, long long v)
 {
-	if (json_value_prefix(j))
-		fprintf(j->f, "%lld", v);
+	if (!json_value_prefix(j))
+		return;
+	/* by hand: printf's machinery costs more than the digits (undulate-web
+	 * writes tens of thousands of integers a second) */
+	char text[24], *p = text + sizeof text;
+	unsigned long long u = v < 0 ? 0ULL - (unsigned long long)v : (unsigned long long)v;
+	do {
+		*--p = (char)('0' + u % 10);
+		u /= 10;
+	} while (u != 0);
+	if (v < 0)
+		*--p = '-';
+	json_put(j, p, (size_t)(text + sizeof text - p));
 }
 
 void json_bool(struct json *j, bool v)
 {
 	if (json_value_prefix(j))
-		fputs(v ? "true" : "false", j->f);
+		json_put(j, v ? "true" : "false", v ? 4 : 5);
 }
 
 void json_null(struct json *j)
 {
 	if (json_value_prefix(j))
-		fputs("null", j->f);
+		json_put(j, "null", 4);
 }
 
 void json_field_string(struct json *j, const char *key, const char *s)

@@ -1,6 +1,8 @@
 /* test_common_json.c — the JSON writer: escaping of quotes, backslashes,
  * control bytes and broken UTF-8; non-finite numbers as null; commas and
- * nesting; misuse reported by json_end instead of a broken document. */
+ * nesting; misuse reported by json_end instead of a broken document. Every
+ * case runs twice, once over each sink (a FILE, a memory buffer): the same
+ * calls must give the same bytes. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +17,9 @@
 
 #define T_BUF 4096
 
+/* The sink the cases run over: the group runs once with each. */
+static bool buffer_sink;
+
 struct out {
 	char buf[T_BUF];
 	FILE *f;
@@ -24,6 +29,11 @@ struct out {
 static void out_open(struct out *o, int digits)
 {
 	memset(o->buf, 0, sizeof o->buf);
+	if (buffer_sink) {
+		o->f = NULL;
+		json_init_buf(&o->j, o->buf, sizeof o->buf, digits);
+		return;
+	}
 	o->f = fmemopen(o->buf, sizeof o->buf, "w");
 	assert_non_null(o->f);
 	json_init(&o->j, o->f, digits);
@@ -32,7 +42,10 @@ static void out_open(struct out *o, int digits)
 /* Closes the stream and returns what was written. */
 static const char *out_text(struct out *o)
 {
-	fclose(o->f);
+	if (o->f != NULL)
+		fclose(o->f);
+	else
+		assert_int_equal(json_len(&o->j), strlen(o->buf));
 	return o->buf;
 }
 
@@ -216,14 +229,64 @@ static void test_write_error(void **state)
 {
 	(void)state;
 	char small[8];
-	FILE *f = fmemopen(small, sizeof small, "w");
-	assert_non_null(f);
-	setvbuf(f, NULL, _IONBF, 0);
 	struct json j;
-	json_init(&j, f, 0);
+	FILE *f = NULL;
+	if (buffer_sink) {
+		json_init_buf(&j, small, sizeof small, 0);
+	} else {
+		f = fmemopen(small, sizeof small, "w");
+		assert_non_null(f);
+		setvbuf(f, NULL, _IONBF, 0);
+		json_init(&j, f, 0);
+	}
 	json_string(&j, "longer than eight bytes");
 	assert_false(json_end(&j));
-	fclose(f);
+	if (f != NULL)
+		fclose(f);
+}
+
+/* The buffer's edge: a document of cap - 1 bytes fits (NUL after it); one of
+ * cap bytes does not: the buffer holds a NUL-terminated start of it, no byte
+ * beyond cap is touched, and json_end says false. */
+static void test_buffer_edge(void **state)
+{
+	(void)state;
+	char b[8];
+	struct json j;
+	json_init_buf(&j, b, 8, 0);
+	json_string(&j, "abcde");   /* 7 bytes with its quotes */
+	assert_true(json_end(&j));
+	assert_int_equal(json_len(&j), 7);
+	assert_string_equal(b, "\"abcde\"");
+	char big[16];
+	memset(big, 'x', sizeof big);
+	json_init_buf(&j, big, 8, 0);
+	json_array_begin(&j);
+	json_string(&j, "abcde");   /* 1 + 7 bytes: the closing quote does not fit */
+	json_array_end(&j);
+	assert_false(json_end(&j));
+	assert_true(json_len(&j) < 8);
+	assert_int_equal(strlen(big), json_len(&j));
+	assert_memory_equal(big, "[\"abcde\"]", json_len(&j));
+	for (size_t k = 8; k < sizeof big; k++)
+		assert_int_equal(big[k], 'x');
+	json_init_buf(&j, b, 0, 0);
+	json_null(&j);
+	assert_false(json_end(&j));
+}
+
+static int over_file(void **state)
+{
+	(void)state;
+	buffer_sink = false;
+	return 0;
+}
+
+static int over_buffer(void **state)
+{
+	(void)state;
+	buffer_sink = true;
+	return 0;
 }
 
 int main(void)
@@ -233,5 +296,10 @@ int main(void)
 		cmocka_unit_test(test_numbers),            cmocka_unit_test(test_nesting_and_commas),
 		cmocka_unit_test(test_misuse),             cmocka_unit_test(test_write_error),
 	};
-	return cmocka_run_group_tests(tests, NULL, NULL);
+	const struct CMUnitTest buffer_only[] = {
+		cmocka_unit_test(test_buffer_edge),
+	};
+	int failed = cmocka_run_group_tests_name("over a FILE", tests, over_file, NULL);
+	failed += cmocka_run_group_tests_name("over a buffer", tests, over_buffer, NULL);
+	return failed + cmocka_run_group_tests_name("buffer only", buffer_only, NULL, NULL);
 }
