@@ -224,6 +224,68 @@ static void test_misuse(void **state)
 	out_text(&o);
 }
 
+/* The number as the writer writes it, and as printf would. */
+static void number_is_printf(double v, int digits)
+{
+	static struct out o;
+	out_open(&o, digits);
+	json_number(&o.j, v);
+	assert_true(json_end(&o.j));
+	char want[40];
+	snprintf(want, sizeof want, "%.*g", digits, v);
+	if (strcmp(out_text(&o), want) != 0)
+		fail_msg("%.17g with %d digits: wrote %s, printf %s", v, digits, o.buf, want);
+}
+
+/* xorshift64: the same values every run */
+static uint64_t rnd(void)
+{
+	static uint64_t x = 88172645463325252ull;
+	x ^= x << 13;
+	x ^= x >> 7;
+	x ^= x << 17;
+	return x;
+}
+
+/* Numbers are written without printf where that is safe: whatever the
+ * value and the digits, the bytes are printf's "%.*g" (values drawn at
+ * random over every scale, decimal fractions with their exact ties, and
+ * the neighbours of powers of ten, where the exponent changes). */
+static void test_numbers_are_printf(void **state)
+{
+	(void)state;
+	static const double edge[] = { 0.0, -0.0, 1, -1, 0.1, 0.5, 1.5, 2.5, 0.125, 1e-4, 9.99999e-5, 1e-5,
+	                               999999999999.5, 99999.5, 9.9999999999995, 0.30000000000000004,
+	                               123456789012.49, 1e12, 1e15, 1e16, 1e22, 1e23, 5e-324, 1.7976931348623157e308 };
+	for (int d = 1; d <= 17; d++) {
+		for (size_t i = 0; i < sizeof edge / sizeof edge[0]; i++) {
+			number_is_printf(edge[i], d);
+			number_is_printf(-edge[i], d);
+		}
+		for (int e = -12; e <= 22; e++) {
+			double t = pow(10, e);
+			number_is_printf(t, d);
+			number_is_printf(nextafter(t, 0), d);
+			number_is_printf(nextafter(t, INFINITY), d);
+		}
+	}
+	for (int i = 0; i < 150000; i++) {
+		int d = 1 + (int)(rnd() % 17);
+		/* any bit pattern (NaN and infinities: null, not printf's) */
+		uint64_t bits = rnd();
+		double v;
+		memcpy(&v, &bits, sizeof v);
+		if (isfinite(v))
+			number_is_printf(v, d);
+		/* every scale from 1e-7 to 1e17 */
+		v = pow(10, -7 + (double)(rnd() % 2400000) / 100000.0) * (rnd() & 1 ? 1 : -1);
+		number_is_printf(v, d);
+		/* short decimal fractions, where rounding meets exact halves */
+		v = (double)(int64_t)(rnd() % 2000001 - 1000000) / pow(10, (double)(rnd() % 9));
+		number_is_printf(v, d);
+	}
+}
+
 /* A stream that cannot take the document: json_end says so. */
 static void test_write_error(void **state)
 {
@@ -295,6 +357,7 @@ int main(void)
 		cmocka_unit_test(test_escaping),           cmocka_unit_test(test_utf8),
 		cmocka_unit_test(test_numbers),            cmocka_unit_test(test_nesting_and_commas),
 		cmocka_unit_test(test_misuse),             cmocka_unit_test(test_write_error),
+		cmocka_unit_test(test_numbers_are_printf),
 	};
 	const struct CMUnitTest buffer_only[] = {
 		cmocka_unit_test(test_buffer_edge),
