@@ -13,6 +13,12 @@
  *            JSON has no spelling for, are written as null.
  *   layout   one line, no spaces; the caller adds a newline after the value.
  *
+ * Two sinks, the same bytes: a FILE (json_init), or a caller's buffer
+ * (json_init_buf), which spares stdio's per-call cost where a document is
+ * written thousands of times a second (undulate-web's Foxglove messages and
+ * frames). A buffer too small for the document stops the output there, and
+ * json_end says so, as a FILE's write error does.
+ *
  * No allocation: nesting is tracked in a fixed array (JSON_MAX_DEPTH). Misuse
  * (a value in an object without a key, a key in an array, closing what is not
  * open, nesting too deep) stops all further output and is reported by
@@ -31,7 +37,10 @@
 #define JSON_DEFAULT_DIGITS 12
 
 struct json {
-	FILE *f;
+	FILE *f;                                /* NULL: the buffer below */
+	char *buf;
+	size_t cap, len;                        /* the buffer's size, the bytes in it */
+	bool full;                              /* something did not fit in the buffer */
 	int digits;
 	int depth;                              /* open containers */
 	bool ok;                                /* false after a misuse */
@@ -44,8 +53,16 @@ struct json {
  * 0: JSON_DEFAULT_DIGITS). */
 void json_init(struct json *j, FILE *f, int digits);
 
+/* Starts one document in buf (cap bytes), kept NUL-terminated: it holds at
+ * most cap - 1 bytes of the document (what fmemopen's "w" mode holds). */
+void json_init_buf(struct json *j, char *buf, size_t cap, int digits);
+
+/* Bytes written into the buffer so far (0 for a FILE). */
+size_t json_len(const struct json *j);
+
 /* True when exactly one complete value was written, every container was
- * closed, nothing was misused and f reports no write error. Writes nothing. */
+ * closed, nothing was misused and the sink took all of it (no write error on
+ * f, nothing left out of the buffer). Writes nothing. */
 bool json_end(const struct json *j);
 
 void json_object_begin(struct json *j);

@@ -1,6 +1,8 @@
 /* test_common_json.c — the JSON writer: escaping of quotes, backslashes,
  * control bytes and broken UTF-8; non-finite numbers as null; commas and
- * nesting; misuse reported by json_end instead of a broken document. */
+ * nesting; misuse reported by json_end instead of a broken document. Every
+ * case runs twice, once over each sink (a FILE, a memory buffer): the same
+ * calls must give the same bytes. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +17,9 @@
 
 #define T_BUF 4096
 
+/* The sink the cases run over: the group runs once with each. */
+static bool buffer_sink;
+
 struct out {
 	char buf[T_BUF];
 	FILE *f;
@@ -24,6 +29,11 @@ struct out {
 static void out_open(struct out *o, int digits)
 {
 	memset(o->buf, 0, sizeof o->buf);
+	if (buffer_sink) {
+		o->f = NULL;
+		json_init_buf(&o->j, o->buf, sizeof o->buf, digits);
+		return;
+	}
 	o->f = fmemopen(o->buf, sizeof o->buf, "w");
 	assert_non_null(o->f);
 	json_init(&o->j, o->f, digits);
@@ -32,7 +42,10 @@ static void out_open(struct out *o, int digits)
 /* Closes the stream and returns what was written. */
 static const char *out_text(struct out *o)
 {
-	fclose(o->f);
+	if (o->f != NULL)
+		fclose(o->f);
+	else
+		assert_int_equal(json_len(&o->j), strlen(o->buf));
 	return o->buf;
 }
 
@@ -211,19 +224,131 @@ static void test_misuse(void **state)
 	out_text(&o);
 }
 
+/* The number as the writer writes it, and as printf would. */
+static void number_is_printf(double v, int digits)
+{
+	static struct out o;
+	out_open(&o, digits);
+	json_number(&o.j, v);
+	assert_true(json_end(&o.j));
+	char want[40];
+	snprintf(want, sizeof want, "%.*g", digits, v);
+	if (strcmp(out_text(&o), want) != 0)
+		fail_msg("%.17g with %d digits: wrote %s, printf %s", v, digits, o.buf, want);
+}
+
+/* xorshift64: the same values every run */
+static uint64_t rnd(void)
+{
+	static uint64_t x = 88172645463325252ull;
+	x ^= x << 13;
+	x ^= x >> 7;
+	x ^= x << 17;
+	return x;
+}
+
+/* Numbers are written without printf where that is safe: whatever the
+ * value and the digits, the bytes are printf's "%.*g" (values drawn at
+ * random over every scale, decimal fractions with their exact ties, and
+ * the neighbours of powers of ten, where the exponent changes). */
+static void test_numbers_are_printf(void **state)
+{
+	(void)state;
+	static const double edge[] = { 0.0, -0.0, 1, -1, 0.1, 0.5, 1.5, 2.5, 0.125, 1e-4, 9.99999e-5, 1e-5,
+	                               999999999999.5, 99999.5, 9.9999999999995, 0.30000000000000004,
+	                               123456789012.49, 1e12, 1e15, 1e16, 1e22, 1e23, 5e-324, 1.7976931348623157e308 };
+	for (int d = 1; d <= 17; d++) {
+		for (size_t i = 0; i < sizeof edge / sizeof edge[0]; i++) {
+			number_is_printf(edge[i], d);
+			number_is_printf(-edge[i], d);
+		}
+		for (int e = -12; e <= 22; e++) {
+			double t = pow(10, e);
+			number_is_printf(t, d);
+			number_is_printf(nextafter(t, 0), d);
+			number_is_printf(nextafter(t, INFINITY), d);
+		}
+	}
+	for (int i = 0; i < 150000; i++) {
+		int d = 1 + (int)(rnd() % 17);
+		/* any bit pattern (NaN and infinities: null, not printf's) */
+		uint64_t bits = rnd();
+		double v;
+		memcpy(&v, &bits, sizeof v);
+		if (isfinite(v))
+			number_is_printf(v, d);
+		/* every scale from 1e-7 to 1e17 */
+		v = pow(10, -7 + (double)(rnd() % 2400000) / 100000.0) * (rnd() & 1 ? 1 : -1);
+		number_is_printf(v, d);
+		/* short decimal fractions, where rounding meets exact halves */
+		v = (double)(int64_t)(rnd() % 2000001 - 1000000) / pow(10, (double)(rnd() % 9));
+		number_is_printf(v, d);
+	}
+}
+
 /* A stream that cannot take the document: json_end says so. */
 static void test_write_error(void **state)
 {
 	(void)state;
 	char small[8];
-	FILE *f = fmemopen(small, sizeof small, "w");
-	assert_non_null(f);
-	setvbuf(f, NULL, _IONBF, 0);
 	struct json j;
-	json_init(&j, f, 0);
+	FILE *f = NULL;
+	if (buffer_sink) {
+		json_init_buf(&j, small, sizeof small, 0);
+	} else {
+		f = fmemopen(small, sizeof small, "w");
+		assert_non_null(f);
+		setvbuf(f, NULL, _IONBF, 0);
+		json_init(&j, f, 0);
+	}
 	json_string(&j, "longer than eight bytes");
 	assert_false(json_end(&j));
-	fclose(f);
+	if (f != NULL)
+		fclose(f);
+}
+
+/* The buffer's edge: a document of cap - 1 bytes fits (NUL after it); one of
+ * cap bytes does not: the buffer holds a NUL-terminated start of it, no byte
+ * beyond cap is touched, and json_end says false. */
+static void test_buffer_edge(void **state)
+{
+	(void)state;
+	char b[8];
+	struct json j;
+	json_init_buf(&j, b, 8, 0);
+	json_string(&j, "abcde");   /* 7 bytes with its quotes */
+	assert_true(json_end(&j));
+	assert_int_equal(json_len(&j), 7);
+	assert_string_equal(b, "\"abcde\"");
+	char big[16];
+	memset(big, 'x', sizeof big);
+	json_init_buf(&j, big, 8, 0);
+	json_array_begin(&j);
+	json_string(&j, "abcde");   /* 1 + 7 bytes: the closing quote does not fit */
+	json_array_end(&j);
+	assert_false(json_end(&j));
+	assert_true(json_len(&j) < 8);
+	assert_int_equal(strlen(big), json_len(&j));
+	assert_memory_equal(big, "[\"abcde\"]", json_len(&j));
+	for (size_t k = 8; k < sizeof big; k++)
+		assert_int_equal(big[k], 'x');
+	json_init_buf(&j, b, 0, 0);
+	json_null(&j);
+	assert_false(json_end(&j));
+}
+
+static int over_file(void **state)
+{
+	(void)state;
+	buffer_sink = false;
+	return 0;
+}
+
+static int over_buffer(void **state)
+{
+	(void)state;
+	buffer_sink = true;
+	return 0;
 }
 
 int main(void)
@@ -232,6 +357,12 @@ int main(void)
 		cmocka_unit_test(test_escaping),           cmocka_unit_test(test_utf8),
 		cmocka_unit_test(test_numbers),            cmocka_unit_test(test_nesting_and_commas),
 		cmocka_unit_test(test_misuse),             cmocka_unit_test(test_write_error),
+		cmocka_unit_test(test_numbers_are_printf),
 	};
-	return cmocka_run_group_tests(tests, NULL, NULL);
+	const struct CMUnitTest buffer_only[] = {
+		cmocka_unit_test(test_buffer_edge),
+	};
+	int failed = cmocka_run_group_tests_name("over a FILE", tests, over_file, NULL);
+	failed += cmocka_run_group_tests_name("over a buffer", tests, over_buffer, NULL);
+	return failed + cmocka_run_group_tests_name("buffer only", buffer_only, NULL, NULL);
 }

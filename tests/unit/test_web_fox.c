@@ -41,11 +41,20 @@ static char *schema(const char *channel)
 	assert_non_null(t);
 	return written(schema_of, t, NULL);
 }
+/* Through the FILE; the server's buffer sink must give the same bytes, and
+ * 0 (not a cut document) when the buffer is one byte short. */
 static char *encode(const char *channel, const void *msg)
 {
 	const struct fox_type *t = fox_kind_of(channel);
 	assert_non_null(t);
-	return written(fox_encode, t, msg);
+	char *s = written(fox_encode, t, msg);
+	static char buf[8192];
+	size_t n = fox_encode_buf(t, msg, buf, sizeof buf);
+	assert_int_equal(n, strlen(s));
+	assert_string_equal(buf, s);
+	assert_int_equal(fox_encode_buf(t, msg, buf, n), 0);
+	assert_int_equal(fox_encode_buf(t, msg, buf, n + 1), n);
+	return s;
 }
 
 /* A document is one JSON value, whole (RFC 8259's grammar; a checker of
@@ -386,6 +395,30 @@ static void test_data_header(void **state)
 	assert_true(ts == 1764000000123456789ull);
 }
 
+/* RFC 6455 5.7's examples of unmasked binary frames (256 bytes, 64 KiB),
+ * and each length encoding's edges. */
+static void test_ws_header(void **state)
+{
+	(void)state;
+	unsigned char h[FOX_WS_HEADER_MAX];
+	static const unsigned char b256[] = { 0x82, 0x7e, 0x01, 0x00 };
+	assert_int_equal(fox_ws_header(h, 256), 4);
+	assert_memory_equal(h, b256, sizeof b256);
+	static const unsigned char b64k[] = { 0x82, 0x7f, 0, 0, 0, 0, 0, 0x01, 0x00, 0x00 };
+	assert_int_equal(fox_ws_header(h, 65536), 10);
+	assert_memory_equal(h, b64k, sizeof b64k);
+	static const unsigned char b0[] = { 0x82, 0x00 }, b125[] = { 0x82, 0x7d }, b126[] = { 0x82, 0x7e, 0x00, 0x7e };
+	static const unsigned char b65535[] = { 0x82, 0x7e, 0xff, 0xff };
+	assert_int_equal(fox_ws_header(h, 0), 2);
+	assert_memory_equal(h, b0, sizeof b0);
+	assert_int_equal(fox_ws_header(h, 125), 2);
+	assert_memory_equal(h, b125, sizeof b125);
+	assert_int_equal(fox_ws_header(h, 126), 4);
+	assert_memory_equal(h, b126, sizeof b126);
+	assert_int_equal(fox_ws_header(h, 65535), 4);
+	assert_memory_equal(h, b65535, sizeof b65535);
+}
+
 static void test_ops(void **state)
 {
 	(void)state;
@@ -468,6 +501,7 @@ int main(void)
 		cmocka_unit_test(test_tables_are_the_lcm_files),
 		cmocka_unit_test(test_schema_text),     cmocka_unit_test(test_encode_state),
 		cmocka_unit_test(test_encode_others),   cmocka_unit_test(test_encode_truth),
+		cmocka_unit_test(test_ws_header),
 		cmocka_unit_test(test_data_header),     cmocka_unit_test(test_ops),
 		cmocka_unit_test(test_bad_ops),
 	};

@@ -299,6 +299,14 @@ bool fox_encode(const struct fox_type *t, const void *msg, FILE *f)
 	return json_end(&j);
 }
 
+size_t fox_encode_buf(const struct fox_type *t, const void *msg, char *buf, size_t cap)
+{
+	struct json j;
+	json_init_buf(&j, buf, cap, 0);
+	fox_encode_object(&j, t, msg);
+	return json_end(&j) ? json_len(&j) : 0;
+}
+
 void fox_data_header(unsigned char out[FOX_DATA_HEADER], uint32_t subscription, uint64_t receive_ns)
 {
 	/* the spec's integers are little-endian whatever this machine is */
@@ -307,6 +315,26 @@ void fox_data_header(unsigned char out[FOX_DATA_HEADER], uint32_t subscription, 
 		out[1 + i] = (unsigned char)(subscription >> (8 * i));
 	for (int i = 0; i < 8; i++)
 		out[5 + i] = (unsigned char)(receive_ns >> (8 * i));
+}
+
+size_t fox_ws_header(unsigned char out[FOX_WS_HEADER_MAX], size_t len)
+{
+	out[0] = 0x80 | 0x2;   /* FIN, binary */
+	if (len < 126) {
+		out[1] = (unsigned char)len;
+		return 2;
+	}
+	if (len <= 0xffff) {
+		out[1] = 126;
+		out[2] = (unsigned char)(len >> 8);
+		out[3] = (unsigned char)len;
+		return 4;
+	}
+	/* network byte order; the most significant bit must be 0 (and is: len < 2^63) */
+	out[1] = 127;
+	for (int i = 0; i < 8; i++)
+		out[2 + i] = (unsigned char)((uint64_t)len >> (8 * (7 - i)));
+	return 10;
 }
 
 /* ---- the client's operations ------------------------------------------------------------ */

@@ -68,9 +68,22 @@ bool fox_schema(const struct fox_type *t, FILE *f);
  * from the network: json.h escapes them and replaces bytes that are not
  * UTF-8. false on a write error. */
 bool fox_encode(const struct fox_type *t, const void *msg, FILE *f);
+/* The same bytes into buf (cap bytes, NUL-terminated, json.h's buffer sink,
+ * what the server uses: no stdio per message): their count, or 0 if they do
+ * not fit. */
+size_t fox_encode_buf(const struct fox_type *t, const void *msg, char *buf, size_t cap);
 
 /* The 13 bytes before a message's payload in a messageData frame. */
 void fox_data_header(unsigned char out[FOX_DATA_HEADER], uint32_t subscription, uint64_t receive_ns);
+
+/* A server's WebSocket frame header (RFC 6455 5.2) for one whole binary
+ * message of len bytes: FIN, opcode 2, no mask, the length in 7, 16 or 64
+ * bits. Its size (2, 4 or 10). The server writes several messageData frames
+ * into one buffer and hands it to libwebsockets as raw bytes: one send for
+ * what is queued instead of one per message (libwebsockets 4.1 frames one
+ * message per lws_write and has no batch call). */
+#define FOX_WS_HEADER_MAX 10
+size_t fox_ws_header(unsigned char out[FOX_WS_HEADER_MAX], size_t len);
 
 /* A client operation. */
 enum fox_op_kind {

@@ -40,6 +40,10 @@
 #define FOXSRV_STATUS 8               /* status messages waiting per client; the oldest goes */
 #define FOXSRV_STATUS_TEXT 200
 #define FOXSRV_ADVERTISE_BATCH 8      /* channels per advertise message */
+/* Bytes of queued messages sent in one go (foxsrv_write): about a burst of
+ * 20 robots' STATE and a SIM.TRUTH; the protocol's tx_packet_size
+ * (server.c) lets it out in one send(). */
+#define FOXSRV_BATCH (64 * 1024)
 
 struct foxsrv_sub {
 	uint32_t id, channel;
@@ -67,6 +71,7 @@ struct foxsrv_counters {
 	long long clients,          /* connected now */
 	          refused,          /* operations and frames refused (each answered with a status) */
 	          sent,             /* messageData frames sent */
+	          batches,          /* sends that carried them (several frames each) */
 	          dropped,          /* messages not queued: the client was behind */
 	          channels_refused, /* channels not advertised: too many, or a name not printable */
 	          too_large,        /* messages whose JSON exceeded FOXSRV_MSG_MAX */
@@ -90,7 +95,9 @@ void foxsrv_close(struct fox_client *c);
 void foxsrv_receive(struct fox_client *c, const char *in, size_t len, bool binary, bool first, bool last,
                     char *why, size_t cap);
 
-/* The socket can take one message: the next one due. -1: close it. */
+/* The socket can take more: the next thing due (serverInfo, unadvertise,
+ * advertise, status, in that order, one a call), else the queued messages,
+ * up to FOXSRV_BATCH bytes at once. -1: close it. */
 int foxsrv_write(struct fox_client *c, double now);
 
 /* Unadvertises quiet channels, closes clients that take nothing. */

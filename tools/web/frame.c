@@ -347,12 +347,8 @@ static size_t frame_try(const struct hist *h, const struct top_model *m, double 
                         uint64_t from, const struct frame_counters *srv, const struct frame_note *notes, int nnotes,
                         char *buf, size_t cap)
 {
-	FILE *f = fmemopen(buf, cap, "w");
-	if (f == NULL)
-		return 0;
-	setvbuf(f, NULL, _IONBF, 0);
 	struct json j;
-	json_init(&j, f, FRAME_DIGITS);
+	json_init_buf(&j, buf, cap, FRAME_DIGITS);
 	json_object_begin(&j);
 	json_field_string(&j, "type", "frame");
 	int64_t now_ms = llround((now - h->t0) * 1000.0);
@@ -367,12 +363,8 @@ static size_t frame_try(const struct hist *h, const struct top_model *m, double 
 	if (m->world.truths > 0 && (m->world.truths != c->truths || marks < h->contacts.n))
 		frame_world(&j, h, m, marks);
 	json_object_end(&j);
-	bool ok = json_end(&j);
-	long len = ftell(f);
-	fclose(f);
-	/* fmemopen in "w" mode keeps a NUL after the data: a full buffer
-	 * holds cap - 1 bytes of it */
-	return ok && len > 0 && (size_t)len < cap ? (size_t)len : 0;
+	/* a frame that does not fit leaves json_end false */
+	return json_end(&j) ? json_len(&j) : 0;
 }
 
 size_t frame_write(const struct hist *h, const struct top_model *m, double now, struct frame_cursor *c,

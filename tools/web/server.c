@@ -794,8 +794,12 @@ static int web_raw_cb(struct lws *wsi, enum lws_callback_reasons reason, void *u
 	if (reason != LWS_CALLBACK_RAW_RX_FILE)
 		return 0;
 	void *tag = lws_get_opaque_user_data(wsi);
-	if (tag == WEB_TAG_LCM)
-		lcm_handle_timeout(app.lcm, 0);
+	if (tag == WEB_TAG_LCM) {
+		/* what has come, not one message a wakeup: the Foxglove clients'
+		 * frames of a burst then go out in one send (foxsrv_write) */
+		for (int i = 0; i < WEB_LCM_DRAIN && lcm_handle_timeout(app.lcm, 0) > 0; i++)
+			;
+	}
 	else if (tag == WEB_TAG_CMD)
 		wcmd_read_local(&app.cmd, web_on_answer, NULL);
 	return 0;
@@ -872,8 +876,11 @@ static void web_tick(lws_sorted_usec_list_t *sul)
 
 static const struct lws_protocols web_protocols[] = {
 	{ "http", web_http_cb, sizeof(struct web_http), 0, 0, NULL, 0 },
-	{ "undulate", web_ws_cb, sizeof(struct web_client), REQ_MSG_MAX, 0, NULL, 0 },
-	{ FOX_SUBPROTOCOL, web_fox_cb, sizeof(struct fox_client), FOXSRV_OP_MAX, 0, NULL, 0 },
+	/* tx_packet_size: without it libwebsockets 4.1 sends at most rx_buffer_size
+	 * (+ LWS_PRE + 4) bytes a send() and copies the rest aside, a poll round
+	 * each: a 10 kB frame took twenty sends of 532 bytes */
+	{ "undulate", web_ws_cb, sizeof(struct web_client), REQ_MSG_MAX, 0, NULL, WEB_TX_PACKET },
+	{ FOX_SUBPROTOCOL, web_fox_cb, sizeof(struct fox_client), FOXSRV_OP_MAX, 0, NULL, WEB_TX_PACKET },
 	{ "undulate-raw", web_raw_cb, 0, 0, 0, NULL, 0 },
 	{ NULL, NULL, 0, 0, 0, NULL, 0 },
 };
@@ -984,10 +991,10 @@ int web_run(const struct web_opts *o)
 	        app.n.commands_refused, app.n.frames_sent, app.n.frames_skipped, app.n.clients_stalled,
 	        app.n.ws_bad_frames, app.n.conns_evicted);
 	const struct foxsrv_counters *fx = foxsrv_counters();
-	fprintf(stderr, "undulate-web: exit: Foxglove: %lld messages sent, %lld dropped for clients behind, %lld "
-	        "Foxglove messages refused, %lld channels not advertised, %lld messages too large, %lld clients "
-	        "closed for taking nothing\n", fx->sent, fx->dropped, fx->refused, fx->channels_refused,
-	        fx->too_large, fx->stalled);
+	fprintf(stderr, "undulate-web: exit: Foxglove: %lld messages sent (in %lld sends), %lld dropped for clients "
+	        "behind, %lld Foxglove messages refused, %lld channels not advertised, %lld messages too large, %lld "
+	        "clients closed for taking nothing\n", fx->sent, fx->batches, fx->dropped, fx->refused,
+	        fx->channels_refused, fx->too_large, fx->stalled);
 	lws_context_destroy(app.ctx);
 	foxsrv_fini();
 	if (app.token_path[0] != '\0')

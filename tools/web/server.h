@@ -31,6 +31,12 @@
  * one partial frame, all a browser that stops reading can hold of ours. A
  * frame of 20 robots is ~6 kB; a browser that reads keeps it nearly empty. */
 #define WEB_SNDBUF (16 * 1024)
+/* Bytes a WebSocket hands the kernel in one send(): a frame of the page
+ * (~11 kB for 20 robots) or a Foxglove batch (FOXSRV_BATCH) at once. */
+#define WEB_TX_PACKET (64 * 1024 + 16)
+/* LCM messages handled a wakeup at most, so a flood cannot starve HTTP:
+ * three bursts of 20 robots' STATE and a SIM.TRUTH. */
+#define WEB_LCM_DRAIN 64
 #define WEB_NOTES 16                /* answers waiting for a browser's next frame */
 #define WEB_FOX_ORIGINS 8           /* --allow-origin, at most */
 
