@@ -204,6 +204,7 @@ $(BUILD)/tests/tools/%: $(OBJ)/tests/tools/%.o $(call libs_of,daemon) $(LIB)/lib
 $(BIN)/undulate-web: LDLIBS += -lwebsockets
 # ... and the Foxglove op parser's test (libwebsockets' lejp, tools/web/fox.h)
 $(BUILD)/tests/test_web_fox: LDLIBS += -lwebsockets
+$(BUILD)/tests/test_web_wlcm: LDLIBS += -lwebsockets
 # The simulator's plane world steps Chipmunk2D (Debian's libchipmunk-dev):
 # the simulator and its tests link it.
 $(BIN)/undulate-sim: LDLIBS += -lchipmunk

@@ -24,6 +24,7 @@
 #include "params.h"
 #include "text.h"
 #include "wcmd.h"
+#include "wlcm.h"
 #include "wsrecv.h"
 #include "wtok.h"
 
@@ -70,7 +71,9 @@ static struct web_app {
 	struct web_opts o;
 	struct lws_context *ctx;
 	struct lws_vhost *vh;
-	lcm_t *lcm;
+	lcm_t *lcm;                 /* publishing; receiving too when wlcm cannot (not udpm) */
+	struct wlcm rx;             /* the group read in this loop (wlcm.h) */
+	bool own_rx;
 	struct top_model model;
 	struct hist hist;
 	struct wcmd cmd;
@@ -192,16 +195,15 @@ static void web_feed_truth(const struct top_model *m, double now, void *user)
  * and said, at most WEB_DECODE_LOG_N times, then once a minute. */
 #define WEB_DECODE_LOG_N 5
 #define WEB_DECODE_LOG_EVERY_S 60.0
-static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+static void web_heard(const char *channel, const uint8_t *data, size_t n)
 {
-	(void)user;
 	static const struct top_feed_hooks hooks = { .on_event = web_feed_event, .on_collision = web_feed_collision,
 	                                             .on_truth = web_feed_truth };
 	static double last_said;
 	double now = clock_mono_s();
 	char why[160];
-	foxsrv_heard(channel, rbuf->data, rbuf->data_size, (uint64_t)clock_wall_us() * 1000u, now);
-	if (top_feed(&app.model, channel, rbuf->data, rbuf->data_size, now, &hooks, why, sizeof why) || !why[0])
+	foxsrv_heard(channel, data, n, (uint64_t)clock_wall_us() * 1000u, now);
+	if (top_feed(&app.model, channel, data, n, now, &hooks, why, sizeof why) || !why[0])
 		return;
 	if (app.model.decode_errors <= WEB_DECODE_LOG_N || now - last_said >= WEB_DECODE_LOG_EVERY_S) {
 		char ch[64];
@@ -212,19 +214,37 @@ static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *us
 }
 
 /* the channels only Foxglove clients are served (foxsrv.h) */
+static void web_heard_fox(const char *channel, const uint8_t *data, size_t n)
+{
+	foxsrv_heard(channel, data, n, (uint64_t)clock_wall_us() * 1000u, clock_mono_s());
+}
+
+/* LCM's own path, where the URL is not a multicast group (memq://, file://) */
+static void web_on_lcm(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+	(void)user;
+	web_heard(channel, rbuf->data, rbuf->data_size);
+}
+
 static void web_on_lcm_fox(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
 	(void)user;
-	foxsrv_heard(channel, rbuf->data, rbuf->data_size, (uint64_t)clock_wall_us() * 1000u, clock_mono_s());
+	web_heard_fox(channel, rbuf->data, rbuf->data_size);
 }
 
+/* The feeds: read in this loop where the URL is a udpm group (wlcm.h), else
+ * through LCM. */
 static int web_subscribe(void)
 {
+	char why[200];
+	app.own_rx = wlcm_open(&app.rx, app.o.lcm_url, why, sizeof why);
 	for (size_t i = 0; i < top_feed_nchannels; i++)
-		if (!lcm_subscribe(app.lcm, top_feed_channels[i], web_on_lcm, NULL))
+		if (app.own_rx ? !wlcm_subscribe(&app.rx, top_feed_channels[i], web_heard)
+		               : !lcm_subscribe(app.lcm, top_feed_channels[i], web_on_lcm, NULL))
 			return -1;
 	for (size_t i = 0; i < fox_extra_nchannels; i++)
-		if (!lcm_subscribe(app.lcm, fox_extra_channels[i], web_on_lcm_fox, NULL))
+		if (app.own_rx ? !wlcm_subscribe(&app.rx, fox_extra_channels[i], web_heard_fox)
+		               : !lcm_subscribe(app.lcm, fox_extra_channels[i], web_on_lcm_fox, NULL))
 			return -1;
 	return 0;
 }
@@ -797,8 +817,11 @@ static int web_raw_cb(struct lws *wsi, enum lws_callback_reasons reason, void *u
 	if (tag == WEB_TAG_LCM) {
 		/* what has come, not one message a wakeup: the Foxglove clients'
 		 * frames of a burst then go out in one send (foxsrv_write) */
-		for (int i = 0; i < WEB_LCM_DRAIN && lcm_handle_timeout(app.lcm, 0) > 0; i++)
-			;
+		if (app.own_rx)
+			wlcm_drain(&app.rx, WEB_LCM_DRAIN / WLCM_BATCH);
+		else
+			for (int i = 0; i < WEB_LCM_DRAIN && lcm_handle_timeout(app.lcm, 0) > 0; i++)
+				;
 	}
 	else if (tag == WEB_TAG_CMD)
 		wcmd_read_local(&app.cmd, web_on_answer, NULL);
@@ -963,7 +986,7 @@ int web_run(const struct web_opts *o)
 		        o->addr, o->port);
 		return 1;
 	}
-	if (web_adopt(lcm_get_fileno(app.lcm), WEB_TAG_LCM) != 0 ||
+	if (web_adopt(app.own_rx ? app.rx.fd : lcm_get_fileno(app.lcm), WEB_TAG_LCM) != 0 ||
 	    (app.cmd.fd >= 0 && web_adopt(app.cmd.fd, WEB_TAG_CMD) != 0)) {
 		fprintf(stderr, "undulate-web: cannot watch the LCM socket\n");
 		return 1;
@@ -995,7 +1018,12 @@ int web_run(const struct web_opts *o)
 	        "behind, %lld Foxglove messages refused, %lld channels not advertised, %lld messages too large, %lld "
 	        "clients closed for taking nothing\n", fx->sent, fx->batches, fx->dropped, fx->refused,
 	        fx->channels_refused, fx->too_large, fx->stalled);
+	if (app.own_rx)
+		fprintf(stderr, "undulate-web: exit: LCM group read in the loop: %lld datagrams, %lld messages taken, "
+		        "%lld not LCM small messages (fragments included), %lld over %d bytes\n", app.rx.n.datagrams,
+		        app.rx.n.messages, app.rx.n.not_lcm, app.rx.n.truncated, WLCM_DGRAM_MAX);
 	lws_context_destroy(app.ctx);
+	wlcm_close(&app.rx);
 	foxsrv_fini();
 	if (app.token_path[0] != '\0')
 		unlink(app.token_path);
