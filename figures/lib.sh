@@ -76,6 +76,18 @@
 # with the same checkout built (docs/CLUSTER.md).
 
 fig_top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+# fig_rows_csv HEADER_REGEX: the daemons' rows (figures/rows' rows.csv) for a
+# module that draws the model beside them: FIG_ROWS_CSV, else the rows.csv of
+# this invocation's merge, else the project's docs/figures/rows.csv — the
+# first that is there and whose header matches; status 1 if none.
+fig_rows_csv() {
+	local c
+	for c in "${FIG_ROWS_CSV:-}" "${FIG_MERGE_DIR:-}/rows.csv" "$fig_top/docs/figures/rows.csv"; do
+		[ -n "$c" ] && [ -s "$c" ] && head -n 1 "$c" | grep -q "$1" && { echo "$c"; return 0; }
+	done
+	return 1
+}
 source "$fig_top/scripts/outdir.sh"
 BUILD=${BUILD:-build}
 case "$BUILD" in /*) ;; *) BUILD="$fig_top/$BUILD" ;; esac

@@ -150,13 +150,7 @@ per_dsep() {
 # The daemons' rows (figures/rows: ten robots, the paper's ends: no walls, end bases held):
 # the merged rows.csv of this invocation's figures when there is one, else
 # the project's docs/figures/rows.csv; FIG_ROWS_CSV names another.
-rows_csv() {
-	local c
-	for c in "${FIG_ROWS_CSV:-}" "$FIG_MERGE_DIR/rows.csv" "$fig_top/docs/figures/rows.csv"; do
-		[ -n "$c" ] && [ -s "$c" ] && head -n 1 "$c" | grep -q '^dsep,beta,seconds,seed,pairs,colliding_pairs,' && { echo "$c"; return 0; }
-	done
-	return 1
-}
+rows_csv() { fig_rows_csv '^dsep,beta,seconds,seed,pairs,colliding_pairs,'; }
 # daemon_rows: per d̃ of the immobile (β = 0) sweep runs: runs, pairs, pairs
 # colliding at the end, share
 daemon_rows() {

@@ -202,13 +202,7 @@ per_beta() {
 # The daemons' mobile rows (figures/rows: ten robots, d̃ 0.78, the paper's ends:
 # no walls, the end bases held; t from the switch to the oscillator at 3 s): this
 # invocation's rows.csv, else docs/figures/rows.csv; FIG_ROWS_CSV names another.
-rows_csv() {
-	local c
-	for c in "${FIG_ROWS_CSV:-}" "$FIG_MERGE_DIR/rows.csv" "$fig_top/docs/figures/rows.csv"; do
-		[ -n "$c" ] && [ -s "$c" ] && head -n 1 "$c" | grep -q '^dsep,beta,seconds,seed,pairs,colliding_pairs,.*,relax_s,censored,' && { echo "$c"; return 0; }
-	done
-	return 1
-}
+rows_csv() { fig_rows_csv '^dsep,beta,seconds,seed,pairs,colliding_pairs,.*,relax_s,censored,'; }
 # daemon_relax: beta,relax_s,censored,run_s of every mobile run at d̃ 0.78 (figures/rows' RELAX_DSEP)
 daemon_relax() {
 	local c

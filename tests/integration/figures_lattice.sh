@@ -20,12 +20,7 @@ tap_check "jobs: 14 d̃ x 5 seeds, the same twice, unique names, one 6b run; qui
 	bash -c "[ '$a' = '$b' ] && [ \$(wc -l <<<'$a') = 70 ] && [ -z \"\$(awk '{ print \$1 }' <<<'$a' | sort | uniq -d)\" ] &&
 		[ \$(awk '\$5 > 0' <<<'$a' | wc -l) = 1 ] && [ \$(wc -l <<<'$q') = 6 ] && [ \$(wc -l <<<'$t') = 2 ]"
 
-refused() {
-	local name=$1 out rc
-	shift
-	out=$("$F" "$@" 2>&1); rc=$?
-	if [ "$rc" = 2 ] && [[ "$out" == lattice:* ]]; then tap_ok "refused: $name"; else tap_fail "refused: $name" "rc=$rc: $out"; fi
-}
+refused() { tap_refused lattice: "$1" "$F" "${@:2}"; }
 refused "no subcommand"
 refused "run: negative d~" run "$T/x" -0.1 120 1 0
 refused "run: too short" run "$T/x" 0.5 5 1 0

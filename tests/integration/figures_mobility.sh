@@ -22,12 +22,7 @@ tap_check "jobs: 10 β x 10 seeds and 2 x 5 below, the same twice, unique names,
 		awk '{ if (\$2 >= 0.007) { if (lo == \"\" || \$2 < lo) lo = \$2; if (\$2 > hi) hi = \$2 } } END { exit !(hi / lo >= 999) }' <<<'$a' &&
 		[ \$(wc -l <<<'$q') = 6 ] && [ \$(wc -l <<<'$t') = 2 ]"
 
-refused() {
-	local name=$1 out rc
-	shift
-	out=$("$F" "$@" 2>&1); rc=$?
-	if [ "$rc" = 2 ] && [[ "$out" == mobility:* ]]; then tap_ok "refused: $name"; else tap_fail "refused: $name" "rc=$rc: $out"; fi
-}
+refused() { tap_refused mobility: "$1" "$F" "${@:2}"; }
 refused "no subcommand"
 refused "run: negative beta" run "$T/x" -0.1 200 1 0
 refused "run: too short" run "$T/x" 0.07 5 1 0
