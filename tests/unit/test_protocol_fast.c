@@ -28,6 +28,7 @@
 
 #include "busfake.h"
 #include "dxl2.h"
+#include "dxl2_table.h"
 #include "dxl_proto.h"
 
 #define HDR 0xFF, 0xFF, 0xFD, 0x00
@@ -313,6 +314,22 @@ static void test_split_rejects(void **state)
 	assert_true(p.header_errors >= 1);
 }
 
+/* Which servos answer: the X430s from firmware 45 (the manual), the AX-12A
+ * never; unknown models never. */
+static void test_model_firmware(void **state)
+{
+	(void)state;
+	const struct dxl2_model *xm = dxl2_model_by_name("XM430-W350"), *xl = dxl2_model_by_name("XL430-W250");
+	const struct dxl2_model *xc = dxl2_model_by_name("XC430-W150"), *ax = dxl2_model_by_name("AX-12A");
+	assert_false(dxl2_model_fast_read(xm, 44));
+	assert_true(dxl2_model_fast_read(xm, 45));
+	assert_true(dxl2_model_fast_read(xl, 46));
+	assert_true(dxl2_model_fast_read(xc, 45));
+	assert_false(dxl2_model_fast_read(xc, 0));
+	assert_false(dxl2_model_fast_read(ax, 255));
+	assert_false(dxl2_model_fast_read(NULL, 46));
+}
+
 /* ---- the bus: one transaction, one packet, every servo's slot ------------------- */
 
 static struct fake fk;
@@ -469,6 +486,7 @@ int main(void)
 		cmocka_unit_test(test_parse_and_split),
 		cmocka_unit_test(test_no_stuffing),
 		cmocka_unit_test(test_split_rejects),
+		cmocka_unit_test(test_model_firmware),
 		cmocka_unit_test(test_bus_fast_sync_read),
 		cmocka_unit_test(test_bus_fast_bulk_read),
 		cmocka_unit_test(test_bus_fast_cut_short),
