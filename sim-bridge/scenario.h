@@ -74,6 +74,7 @@ struct sim_config {
 	double latency_ms;
 	bool echo;
 	int return_delay_us;         /* initial EEPROM value of every servo; < 0 = factory 500 µs */
+	int firmware;                /* X series' firmware version of every servo; 0: the model's (46) */
 	double ambient_c;
 	double initial_spread;       /* rad: initial angles uniform in ±spread (seeded) */
 	bool eeprom_needs_torque_off;
