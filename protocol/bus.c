@@ -527,19 +527,22 @@ static void bus_multi_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t
 	}
 }
 
-/* A slot that failed with the fast read's packet, counted against its servo. */
-static void bus_fast_fail(struct bus *b, size_t slot, int why)
+/* A slot that failed with the fast read's packet; counted against its servo
+ * when its own part was at fault (culprit), not when an earlier one was. */
+static void bus_fast_fail(struct bus *b, size_t slot, int why, bool culprit)
 {
 	struct bus_multi *m = b->multi;
 	struct bus_servo_stats *st = &b->servo[m->id[slot]];
 	m->status[slot] = why;
+	b->line_dirty = true;
+	if (!culprit)
+		return;
 	if (why == DXL_E_CHECKSUM)
 		st->checksum_errors++;
 	else if (why == DXL_E_WRONG_LENGTH)
 		st->wrong_length++;
 	else
 		st->wrong_id++;
-	b->line_dirty = true;
 }
 
 /* The one status packet of a Fast Sync/Bulk Read: every slot at once. A
@@ -562,7 +565,7 @@ static bool bus_fast_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t 
 		if (i >= good) {
 			/* a part's failure is the packet's from there on: the
 			 * parts after it cannot be placed with certainty */
-			bus_fast_fail(b, i, i == good || r != DXL_E_CHECKSUM ? r : DXL_E_CHECKSUM);
+			bus_fast_fail(b, i, r, i == good || r == DXL_E_WRONG_LENGTH);
 			continue;
 		}
 		memcpy(m->data + m->off[i], parts[i].data, m->len[i]);

@@ -457,6 +457,7 @@ static void test_bus_fast_damaged(void **state)
 	assert_int_equal(m.status[1], DXL_E_CHECKSUM);
 	assert_int_equal(m.status[2], DXL_E_CHECKSUM);
 	assert_int_equal(bus.servo[7].checksum_errors, 1);
+	assert_int_equal(bus.servo[4].checksum_errors, 0);   /* its part came after the damage */
 }
 
 /* Servos that do not know the instruction (firmware below 45) stay silent:
