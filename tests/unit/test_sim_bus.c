@@ -726,6 +726,27 @@ static void test_v2_fast_read(void **state)
 	n = dxl2_encode_sync_read(req, sizeof req, DXL2_X_PRESENT_POSITION, 4, ids, 3);
 	sim_bus_feed(&b, req, (size_t)n, 40 * MS);
 	assert_int_equal(drain(&b, out, sizeof out, &first, &last), 3 * 15);
+
+	/* a bad-checksum fault on ID 7's part: its CRC goes out wrong, and ID
+	 * 4's (the packet's), computed over what it heard, checks: the
+	 * controller finds the damage at ID 7's part, ID 3's part sound */
+	sim_xservo_poke(&b.joints[0].xservo, DXL2_X_FIRMWARE_VERSION, 46);
+	set_fault(&b, "bad-checksum count=1");
+	b.joints[1].faults = b.joints[0].faults;
+	sim_faults_clear(&b.joints[0].faults);
+	n = dxl2_encode_fast_sync_read(req, sizeof req, DXL2_X_PRESENT_POSITION, 4, ids, 3);
+	sim_bus_feed(&b, req, (size_t)n, 50 * MS);
+	got = drain(&b, out, sizeof out, &first, &last);
+	assert_int_equal(got, sizeof manual);
+	assert_memory_equal(out, manual, 22);
+	assert_int_equal(out[22], manual[22] ^ 0xFF);
+	assert_int_equal(out[23], manual[23] ^ 0xFF);
+	assert_memory_equal(out + 24, manual + 24, 6);
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	dxl2_parser_expect_fast(&p, true);
+	assert_int_equal(dxl2_parser_feed(&p, out, got, &used, &st), DXL_FRAME);
+	assert_int_equal(dxl2_fast_status_split(&st, &m, parts, &good), DXL_E_CHECKSUM);
+	assert_int_equal(good, 1);
 }
 
 /* A broadcast PING: every servo answers, lowest ID first (e-manual: "in
