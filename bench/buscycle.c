@@ -7,11 +7,15 @@
  *
  *   buscycle --port PATH|fake --ids 1,2,3 [--protocol 1|2] [--read-len 8|10]
  *            [--baud BPS] [--cycles N] [--period-us P] [--latency-us L] [--margin-us M]
+ *            [--read sync|fast]
  *
  * --protocol 2: the X series' cycle instead — one SYNC_READ of read_len
  * bytes from every servo (present velocity + position at 128, 8 bytes; with
  * the present current at 126, 10 bytes, on the XM430) and one SYNC_WRITE
- * of 4-byte goal positions. --port fake serves that bus in-process: a pty
+ * of 4-byte goal positions. --read fast: the SYNC_READ is a Fast Sync Read
+ * (one status packet for all servos: one header and one return delay for the
+ * lot; its floor: a request of 14 + N bytes, one reply of 8 + N (4 +
+ * read_len), one return delay). --port fake serves that bus in-process: a pty
  * whose other end answers as X servos with return delay 0, holding each
  * reply until the wire time of the request and the replies at the baud has
  * passed (what undulate-sim does for the AX-12; its X servos come with the
@@ -72,6 +76,7 @@ struct bc_opts {
 	long latency_us, margin_us;
 	int protocol;
 	unsigned read_len;                  /* 2.0: bytes a servo in the SYNC_READ */
+	bool fast;                          /* 2.0: --read fast, a Fast Sync Read */
 };
 
 struct bc_run {
@@ -140,6 +145,8 @@ static int bc_parse(int argc, char **argv, struct bc_opts *o)
 			o->protocol = atoi(v);
 		else if (!strcmp(k, "--read-len"))
 			o->read_len = (unsigned)atoi(v);
+		else if (!strcmp(k, "--read") && (!strcmp(v, "fast") || !strcmp(v, "sync")))
+			o->fast = !strcmp(v, "fast");
 		else
 			return -1;
 	}
@@ -207,7 +214,8 @@ static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
 {
 	uint8_t data[BC_MAX_IDS * 10], goals[BC_MAX_IDS * 4];
 	struct bus_multi m = { .data = data, .cap = sizeof data };
-	int rc = bus_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m);
+	int rc = o->fast ? bus_fast_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m)
+	                 : bus_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m);
 	if (rc != DXL_OK && rc != DXL_E_TIMEOUT)
 		r->errors++;
 	for (size_t i = 0; i < m.n; i++) {
@@ -223,10 +231,14 @@ static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
 }
 
 /* Wire bytes of the 2.0 cycle: SYNC_READ request 14 + N, each reply
- * 11 + read_len, SYNC_WRITE 14 + 5 N (no byte stuffed: the floor). */
+ * 11 + read_len, SYNC_WRITE 14 + 5 N (no byte stuffed: the floor); a Fast
+ * Sync Read's one reply 8 + N (4 + read_len), one return delay. */
 static void bc2_floor(const struct bc_run *r, const struct bc_opts *o, size_t n, uint32_t *reads, uint32_t *sync)
 {
-	*reads = bus_wire_time_us(&r->bus, 14 + n + n * (11 + o->read_len)) + (uint32_t)n * r->return_delay_us;
+	if (o->fast)
+		*reads = bus_wire_time_us(&r->bus, 14 + n + 8 + n * (4 + o->read_len)) + (n ? r->return_delay_us : 0);
+	else
+		*reads = bus_wire_time_us(&r->bus, 14 + n + n * (11 + o->read_len)) + (uint32_t)n * r->return_delay_us;
 	*sync = bus_wire_time_us(&r->bus, 14 + 5 * n);
 }
 
@@ -285,7 +297,8 @@ static void bc2_floor_timeout(const struct bc_run *r, const struct bc_opts *o, s
 	for (size_t i = 0; i < o->nids; i++)
 		lens[i] = (uint16_t)o->read_len;
 	bc2_floor(r, o, npresent, reads, sync);
-	*timeout = bus_multi_timeout_us(&r->bus, 14 + o->nids, lens, o->nids);
+	*timeout = o->fast ? bus_fast_timeout_us(&r->bus, 14 + o->nids, lens, o->nids)
+	                   : bus_multi_timeout_us(&r->bus, 14 + o->nids, lens, o->nids);
 }
 
 static const struct bc_proto bc_v1 = {
@@ -367,7 +380,19 @@ static void bc_fake_answer(struct bc_fake *f, const struct dxl2_packet *pkt, uin
 				memcpy(&f->mem[k][addr], &pkt->params[i + 1], n);
 		return;
 	}
-	if (pkt->instr == DXL2_INST_SYNC_READ && addr + n <= DXL2_X_TABLE_SIZE) {
+	if (pkt->instr == DXL2_INST_FAST_SYNC_READ && addr + n <= DXL2_X_TABLE_SIZE && n > 0) {
+		/* one packet, each servo's part in turn; a missing one ends it */
+		struct dxl2_fast_part parts[BC_MAX_IDS];
+		size_t ends[BC_MAX_IDS], np = 0, asked = pkt->nparams > 4 ? pkt->nparams - 4u : 0u;
+		for (size_t i = 0; i < asked && i < BC_MAX_IDS; i++) {
+			uint8_t id = pkt->params[4 + i];
+			k = bc_fake_servo(f, id);
+			parts[i] = (struct dxl2_fast_part){ id, 0, n, k >= 0 ? &f->mem[k][addr] : f->mem[0] };
+			np += k >= 0 && np == i;
+		}
+		int w = asked && asked <= BC_MAX_IDS ? dxl2_encode_fast_status(out, sizeof out, parts, asked, ends) : -1;
+		len = w > 0 && np > 0 ? ends[np - 1] : 0;
+	} else if (pkt->instr == DXL2_INST_SYNC_READ && addr + n <= DXL2_X_TABLE_SIZE) {
 		for (size_t i = 4; i < pkt->nparams; i++) {
 			if ((k = bc_fake_servo(f, pkt->params[i])) < 0)
 				continue;   /* a missing servo: the rest still answer */
@@ -494,6 +519,7 @@ static void bc_report(struct bc_run *r, const struct bc_opts *o, const struct bc
 	uint32_t reads, sync, timeout;
 	bp->floor(r, o, npresent, &reads, &sync, &timeout);
 	printf("protocol %d\n", o->protocol);
+	printf("read %s\n", o->fast ? "fast" : "sync");
 	qsort(r->cycle_us, (size_t)o->cycles, sizeof(double), bc_cmp);
 	printf("servos %zu\npresent %zu\nabsent %zu\n", o->nids, npresent, o->nids - npresent);
 	printf("return_delay_us %u\n", r->return_delay_us);

@@ -500,10 +500,11 @@ section_bus() {
 # simulator's XM430-W350 servos when it has them (--model), else on
 # buscycle's in-process fake X bus. Return delay 0, 1 Mbps.
 bus2_run() {
-	local n=$1 d=$T/bus out=$T/bus/bc2-$1.txt
+	local n=$1 read=${2:-sync} d=$T/bus out=$T/bus/bc2-$1.txt
+	[ "$read" = fast ] && out=$T/bus/bc2f-$1.txt
 	mkdir -p "$d"
 	if "$SIM" --model xm430-w350 --help 2>&1 | grep -q "unrecognized option '--model'"; then
-		"$HB/buscycle" --port fake --protocol 2 --read-len 10 --ids "$(ids_upto "$n")" --cycles "$CYCLES" \
+		"$HB/buscycle" --port fake --protocol 2 --read-len 10 --read "$read" --ids "$(ids_upto "$n")" --cycles "$CYCLES" \
 			--margin-us "$MARGIN_US" >"$out" 2>"$d/bc2-$n.err" || echo "status not measured: buscycle failed ($(tail -n1 "$d/bc2-$n.err"))" >"$out"
 		echo "bus fake" >>"$out"
 		return 0
@@ -513,7 +514,7 @@ bus2_run() {
 		--baud 1000000 --quiet
 	if ! wait_ready "sim-bc2-$n" 'ready:' 10; then
 		echo "status not measured: the simulator refused $n X servos on one bus ($(why "sim-bc2-$n"))" >"$out"
-	elif ! "$HB/buscycle" --port "$d/bc2-$n.pty" --protocol 2 --read-len 10 --ids "$(ids_upto "$n")" \
+	elif ! "$HB/buscycle" --port "$d/bc2-$n.pty" --protocol 2 --read-len 10 --read "$read" --ids "$(ids_upto "$n")" \
 		--cycles "$CYCLES" --margin-us "$MARGIN_US" >"$out" 2>"$d/bc2-$n.err"; then
 		echo "status not measured: buscycle failed ($(tail -n1 "$d/bc2-$n.err"))" >"$out"
 	fi
@@ -553,6 +554,34 @@ bus2_table() {
 		say "| $n | $floor1 | $(v "$b" floor_us) | $(v "$b" floor_reads_us) | $(v "$b" bus) | $(v "$b" bus_p50) | $(v "$b" bus_p99) |" \
 			"$(v "$b" bus_max) | $(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_us)") |" \
 			"$(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_reads_us)") | $(v "$b" timeouts) of $((n * CYCLES)) | $dcells |"
+	done
+	say ""
+	bus2_fast_table
+}
+
+# The same cycle with the SYNC_READ a Fast Sync Read (0x8A): one status packet
+# for all servos (8 + N (4 + 10) bytes), one return delay; the servos' firmware
+# 46 answers it. Beside the SYNC_READ's figures above.
+bus2_fast_table() {
+	local n b s
+	progress "2/5 bus time per cycle: the Protocol 2.0 cycle with Fast Sync Read, 2/6/18 servos"
+	for n in 2 6 18; do bus2_run $n fast; done
+	say "#### The same with one Fast Sync Read in place of the SYNC_READ"
+	say ""
+	say "One status packet for all servos (8 + 14N bytes), one return delay; what undulated reads with when"
+	say "every servo has it (X430/X540 from firmware 45). Floor as above, with that reply."
+	say ""
+	say "| servos | floor (µs) | of it the read | SYNC_READ's floor | bus | p50 | p99 | max | p50/floor | SYNC_READ p50 | slots missed |"
+	say "|---|---|---|---|---|---|---|---|---|---|---|"
+	for n in 2 6 18; do
+		b=$T/bus/bc2f-$n.txt; s=$T/bus/bc2-$n.txt
+		if [ "$(v "$b" status)" = not ]; then
+			say "| $n | – | – | $(v "$s" floor_us) | – | $(sed -n 's/^status //p' "$b") | – | – | – | $(v "$s" bus_p50) | – |"
+			continue
+		fi
+		say "| $n | $(v "$b" floor_us) | $(v "$b" floor_reads_us) | $(v "$s" floor_us) | $(v "$b" bus) | $(v "$b" bus_p50) |" \
+			"$(v "$b" bus_p99) | $(v "$b" bus_max) | $(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_us)") |" \
+			"$(v "$s" bus_p50) | $(v "$b" timeouts) of $((n * CYCLES)) |"
 	done
 	say ""
 }

@@ -90,6 +90,7 @@ struct ctl_servo_info {
 	uint8_t status_return_level;
 	const struct sm_model *model;   /* NULL: the AX-12A */
 	uint16_t current_limit;         /* XM430: Current Limit (38) */
+	uint8_t firmware;               /* Version of Firmware (2 | 6), as read at start-up */
 };
 
 struct ctl_joint {

@@ -9,6 +9,10 @@
 #include "dxl_table.h"
 #include "servo_model.h"
 
+#define CYC_STR(x) #x
+#define CYC_XSTR(x) CYC_STR(x)
+#define CYC_FAST_FAILS_TEXT CYC_XSTR(CYC_FAST_FAILS_MAX)
+
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks)
 {
 	*y = (struct cyc){ .bus = bus, .ctl = ctl, .period_us = period_us, .phase = CYC_IDLE };
@@ -26,6 +30,12 @@ static uint64_t cyc_now(const struct cyc *y)
 static bool cyc_sync_reads(const struct cyc *y)
 {
 	return dxl_proto_can(bus_proto(y->bus), DXL_CAP_SYNC_READ);
+}
+
+void cyc_set_fast_read(struct cyc *y, bool on)
+{
+	y->fast_read = on && dxl_proto_can(bus_proto(y->bus), DXL_CAP_FAST_READ);
+	y->fast_fails = 0;
 }
 
 bool cyc_busy(const struct cyc *y)
@@ -120,7 +130,28 @@ static int cyc_begin_sync_read(struct cyc *y)
 		ids[j] = y->ctl->j[j].id;
 	y->multi.data = y->multi_buf;
 	y->multi.cap = sizeof y->multi_buf;
+	if (y->fast_read)
+		return bus_fast_sync_read_begin(y->bus, ctl_model(y->ctl, 0)->present, y->read_len, ids, y->ctl->n,
+		                                &y->multi);
 	return bus_sync_read_begin(y->bus, ctl_model(y->ctl, 0)->present, y->read_len, ids, y->ctl->n, &y->multi);
+}
+
+/* A Fast Sync Read that read nobody, CYC_FAST_FAILS_MAX times in a row: a
+ * servo no longer takes its turn, and with it go the others' parts; the
+ * plain SYNC_READ reads those again. */
+static void cyc_fast_outcome(struct cyc *y)
+{
+	if (!y->fast_read)
+		return;
+	y->fast_fails = y->multi.answered == 0 ? y->fast_fails + 1 : 0;
+	if (y->fast_fails < CYC_FAST_FAILS_MAX)
+		return;
+	y->fast_read = false;
+	y->fast_fallbacks++;
+	if (y->hooks.notice != NULL)
+		y->hooks.notice(y->hooks.ctx, "bus: Fast Sync Read read nobody " CYC_FAST_FAILS_TEXT " cycles in a row: "
+		                "reading by SYNC_READ from now on, each servo's own status packet (until the next "
+		                "start or reconnect)");
 }
 
 /* This cycle's read-back, if any: a joint the controller asks for now (its
@@ -253,8 +284,8 @@ static void cyc_readings2(struct cyc *y)
 		const uint8_t *bytes = bus_multi_data(&y->multi, j);
 		struct sm_present p;
 		if (bytes == NULL || !sm_decode_present(ctl_model(y->ctl, j), bytes, y->multi.len[j], &p)) {
-			cyc_error(y, y->multi.id[j], "SYNC_READ", y->multi.status[j] != DXL_OK ? y->multi.status[j]
-			                                                                       : DXL_E_WRONG_LENGTH);
+			cyc_error(y, y->multi.id[j], y->multi.fast ? "Fast Sync Read" : "SYNC_READ",
+			          y->multi.status[j] != DXL_OK ? y->multi.status[j] : DXL_E_WRONG_LENGTH);
 			continue;
 		}
 		uint64_t last = y->read_at_us[j];
@@ -292,6 +323,7 @@ enum cyc_status cyc_step(struct cyc *y)
 	case CYC_READ:
 		if (cyc_sync_reads(y)) {
 			cyc_readings2(y);
+			cyc_fast_outcome(y);
 			y->idx = y->ctl->n;
 			break;
 		}

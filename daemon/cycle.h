@@ -32,6 +32,15 @@
  * one SYNC_WRITE, the controller's writes (and REBOOTs) one at a time, and
  * the read-back alternates the model's blocks (RAM, EEPROM); a joint whose
  * status raised the alert has its RAM block read at once (ctl_readback_due).
+ *
+ * Where every servo answers it (cyc_set_fast_read, decided at start-up from
+ * the servos' models and firmware: setup_fast_read), the read is one Fast
+ * Sync Read instead: one status packet for all servos, one return delay and
+ * one header for the lot. Its parts are read as the SYNC_READ's slots. A
+ * servo that stops answering takes the whole packet with it (the chain stops
+ * at its part): after CYC_FAST_FAILS_MAX cycles in a row without a single
+ * reading the cycle goes back to SYNC_READ, so the other servos are read
+ * again, and says so (the notice hook).
  */
 #ifndef UNDULATE_DAEMON_CYCLE_H
 #define UNDULATE_DAEMON_CYCLE_H
@@ -65,12 +74,19 @@ enum cyc_phase { CYC_IDLE, CYC_WRITE_FIRST, CYC_READ, CYC_CONTROL_STEP, CYC_WRIT
  * in a row ended with writes waiting, the next cycle sends one write before
  * its reads. */
 #define CYC_STARVED_CYCLES 2
+/* Fast Sync Reads in a row that read nobody before the plain SYNC_READ is
+ * used again: a lost servo then costs the others 30 ms at 100 Hz, and a
+ * single damaged packet (every joint stale for one cycle) changes nothing. */
+#define CYC_FAST_FAILS_MAX 3
 
 struct cyc_hooks {
 	void *ctx;
 	/* a failed transaction (counted here too); the daemon logs it, rate-limited.
 	 * status is DXL_OK when the servo answered but refused (`what` says so). */
 	void (*bus_error)(void *ctx, uint8_t id, const char *what, int status);
+	/* a change of how the cycle reads (Fast Sync Read given up), once: not
+	 * rate-limited with the errors (NULL: none) */
+	void (*notice)(void *ctx, const char *text);
 };
 
 struct cyc {
@@ -86,7 +102,9 @@ struct cyc {
 	size_t readback_now_joint, readback_now_block;   /* the read-back on the wire */
 	uint64_t count;               /* cycles started */
 	uint8_t read_len;             /* this cycle's READ length, 6 or 8 (2.0: the model's, 10 or 21) */
-	/* Protocol 2.0: this cycle's SYNC_READ and its replies */
+	/* Protocol 2.0: this cycle's SYNC_READ (or Fast Sync Read) and its replies */
+	bool fast_read;               /* the read is a Fast Sync Read (cyc_set_fast_read) */
+	int fast_fails;               /* Fast Sync Reads in a row that read nobody */
 	struct bus_multi multi;
 	uint8_t multi_buf[CFG_MAX_JOINTS * 32];
 	uint64_t start_us;            /* this cycle's start (the tick) */
@@ -97,7 +115,7 @@ struct cyc {
 	double bus_us, control_us;
 	int starved;                  /* cycles in a row that ended with writes waiting */
 	/* counters */
-	long long errors, cut_off, deferred, readbacks, writes_first;
+	long long errors, cut_off, deferred, readbacks, writes_first, fast_fallbacks;
 };
 
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks);
@@ -109,6 +127,9 @@ enum cyc_status cyc_start(struct cyc *y);
 enum cyc_status cyc_step(struct cyc *y);
 /* After CYC_CONTROL, once the control step ran: send its outputs. */
 enum cyc_status cyc_resume(struct cyc *y);
+/* Read by Fast Sync Read (on: every servo answers it, and the protocol has
+ * it) or by SYNC_READ, from the next cycle on. */
+void cyc_set_fast_read(struct cyc *y, bool on);
 /* A cycle is under way (not idle). */
 bool cyc_busy(const struct cyc *y);
 /* End the cycle under way now: the next tick came first, or the daemon stops

@@ -178,6 +178,12 @@ static void dmn_bus_error_hook(void *ctx, uint8_t id, const char *what, int stat
 	            status != DXL_OK ? dxl_strerror(status) : "");
 }
 
+static void dmn_notice_hook(void *ctx, const char *text)
+{
+	(void)ctx;
+	log_warn("%s", text);
+}
+
 /* ---- publishing --------------------------------------------------------------------------------- */
 static long long dmn_bus_errors(const struct dmn *d)
 {
@@ -423,6 +429,22 @@ static void dmn_models(const struct dmn *d, char *out, size_t cap)
 }
 
 /* Open the port and run every start-up check. On failure *err says why. */
+/* The cycle's read on a bus that can read every servo with one request:
+ * a Fast Sync Read when every servo answers it (model and firmware, read
+ * at start-up), the plain SYNC_READ otherwise; said either way. */
+static void dmn_fast_read(struct dmn *d)
+{
+	char why[CFG_MAX_JOINTS * 48 + 160];
+	if (!dxl_proto_can(bus_proto(&d->bus), DXL_CAP_SYNC_READ))
+		return;
+	bool fast = setup_fast_read(&d->bus, &d->ctl, why, sizeof why);
+	cyc_set_fast_read(&d->cyc, fast);
+	if (fast)
+		log_info("bus: the cycle reads by Fast Sync Read, one status packet for all servos (%s)", why);
+	else
+		log_info("bus: the cycle reads by SYNC_READ, a status packet per servo: no Fast Sync Read, as %s", why);
+}
+
 static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap)
 {
 	if (!dmn_find_port(d, err, cap))
@@ -476,6 +498,7 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 	}
 	d->connected = true;
 	d->backoff_ms = DMN_BACKOFF_MIN_MS;
+	dmn_fast_read(d);
 	ctl_start(&d->ctl, dmn_ctl_time(d, now_us()), reason);
 	return true;
 }
@@ -988,7 +1011,7 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	d->clock = &dmn_clock_real;
 	snprintf(d->port_path, sizeof d->port_path, "%s", cfg->port);
 	ctl_init(&d->ctl, cfg);
-	struct cyc_hooks ch = { .ctx = d, .bus_error = dmn_bus_error_hook };
+	struct cyc_hooks ch = { .ctx = d, .bus_error = dmn_bus_error_hook, .notice = dmn_notice_hook };
 	cyc_init(&d->cyc, &d->bus, &d->ctl, d->period_us, &ch);
 	notify_init(&d->notify);
 	d->watchdog_interval_us = notify_watchdog_interval_us(&d->notify);

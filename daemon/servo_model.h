@@ -98,6 +98,7 @@ struct sm_setup {
 	                                   to the Bus Watchdog (99); at most SM_SETTINGS_MAX */
 	uint16_t return_delay;          /* 5 | 9, 2 µs a unit on both */
 	uint16_t status_return_level;   /* 16 | 68 */
+	uint16_t firmware;              /* Version of Firmware: 2 | 6 */
 	uint16_t output_limit;          /* the torque limit's ceiling, 2 bytes: Max Torque 14 | PWM Limit 36 */
 	const char *output_limit_name;  /* "max torque" | "PWM Limit" */
 	uint16_t current_limit;         /* 0 | Current Limit 38 (read where current_control) */

@@ -402,6 +402,7 @@ static bool setup_servo(struct bus *bus, struct ctl *ctl, size_t j, const struct
 		.return_delay = t[s->return_delay],
 		.status_return_level = t[s->status_return_level],
 		.model = m,
+		.firmware = t[s->firmware],
 	};
 	bool reply = info.status_return_level >= 2;
 	if (!setup_judge(m, id, t, cfg, port_path, &info, err, cap) ||
@@ -416,6 +417,28 @@ static bool setup_servo(struct bus *bus, struct ctl *ctl, size_t j, const struct
 	if ((int)delay_us > *max_return_delay_us)
 		*max_return_delay_us = (int)delay_us;
 	return ctl_set_servo(ctl, j, &info, err, cap);
+}
+
+bool setup_fast_read(const struct bus *bus, const struct ctl *ctl, char *why, size_t cap)
+{
+	if (!dxl_proto_can(bus_proto(bus), DXL_CAP_FAST_READ)) {
+		snprintf(why, cap, "Protocol %s has none", bus_proto(bus)->name);
+		return false;
+	}
+	size_t at = 0;
+	for (size_t j = 0; j < ctl->n; j++) {
+		const struct ctl_servo_info *s = &ctl->j[j].servo;
+		const char *name = s->model != NULL ? s->model->name : "?";
+		if (!dxl2_model_fast_read(s->model != NULL ? s->model->desc : NULL, s->firmware)) {
+			snprintf(why, cap, "servo %u (%s, firmware %u) does not answer it (the e-manual: X430/X540 from "
+			         "firmware 45)", ctl->j[j].id, name, s->firmware);
+			return false;
+		}
+		int w = snprintf(why + at, at < cap ? cap - at : 0, "%sservo %u %s firmware %u", j ? ", " : "",
+		                 ctl->j[j].id, name, s->firmware);
+		at += w > 0 ? (size_t)w : 0;
+	}
+	return ctl->n > 0;
 }
 
 bool setup_servos(struct bus *bus, struct ctl *ctl, const struct cfg *cfg, const char *port_path,

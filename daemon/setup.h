@@ -77,4 +77,10 @@ void setup_joint_limits(const struct cfg_joint *cj, uint16_t *cw, uint16_t *ccw)
  * sm_joint_range, the one rule. */
 void setup_joint_limits_model(const struct sm_model *m, const struct cfg_joint *cj, int32_t *lo, int32_t *hi);
 
+/* Whether every joint's servo answers Fast Sync Read (its model from
+ * firmware dxl2_model_fast_read says, on a protocol that has it), for the
+ * cycle's read (cyc_set_fast_read); why says which servos, or which one
+ * does not and why, for the log. */
+bool setup_fast_read(const struct bus *bus, const struct ctl *ctl, char *why, size_t cap);
+
 #endif

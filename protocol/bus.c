@@ -102,6 +102,13 @@ uint32_t bus_multi_timeout_us(const struct bus *b, size_t req_bytes, const uint1
 	return us > UINT32_MAX ? UINT32_MAX : (uint32_t)us;
 }
 
+uint32_t bus_fast_timeout_us(const struct bus *b, size_t req_bytes, const uint16_t *lens, size_t n)
+{
+	uint64_t us = (uint64_t)bus_wire_time_us(b, req_bytes + dxl2_fast_status_bytes(lens, n)) +
+	              b->timing.return_delay_us + b->timing.adapter_latency_us + b->timing.margin_us;
+	return us > UINT32_MAX ? UINT32_MAX : (uint32_t)us;
+}
+
 /* A broadcast PING's deadline: a slot for every ID that might answer. */
 static uint32_t bus_ping_all_timeout_us(const struct bus *b, size_t req_bytes)
 {
@@ -332,8 +339,17 @@ int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n)
 
 /* ---- receiving ------------------------------------------------------------------ */
 
+/* Whether the parser takes a fast read's one status packet (only while one
+ * is awaited: dxl2_parser_expect_fast says why). */
+static void bus_parser_fast(struct bus *b, bool on)
+{
+	if (b->proto != NULL && b->proto->parser_expect_fast != NULL)
+		b->proto->parser_expect_fast(&b->parser, on);
+}
+
 static void bus_finish(struct bus *b)
 {
+	bus_parser_fast(b, false);
 	b->pending = false;
 	b->expect_params = -1;
 	b->reply_held = false;
@@ -511,6 +527,56 @@ static void bus_multi_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t
 	}
 }
 
+/* A slot that failed with the fast read's packet; counted against its servo
+ * when its own part was at fault (culprit), not when an earlier one was. */
+static void bus_fast_fail(struct bus *b, size_t slot, int why, bool culprit)
+{
+	struct bus_multi *m = b->multi;
+	struct bus_servo_stats *st = &b->servo[m->id[slot]];
+	m->status[slot] = why;
+	b->line_dirty = true;
+	if (!culprit)
+		return;
+	if (why == DXL_E_CHECKSUM)
+		st->checksum_errors++;
+	else if (why == DXL_E_WRONG_LENGTH)
+		st->wrong_length++;
+	else
+		st->wrong_id++;
+}
+
+/* The one status packet of a Fast Sync/Bulk Read: every slot at once. A
+ * status from a single servo is not part of it (a stray). Returns whether
+ * the packet was the fast read's. */
+static bool bus_fast_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t now)
+{
+	struct bus_multi *m = b->multi;
+	struct dxl2_packet whole;
+	struct dxl2_fast_part parts[BUS_MULTI_MAX];
+	size_t good = 0;
+	if (pkt->id != b->proto->broadcast_id) {
+		b->stray_packets++;
+		b->line_dirty = true;
+		return false;
+	}
+	dxl_frame_to_packet2(pkt, &whole);
+	int r = dxl2_fast_status_split(&whole, &m->track, parts, &good);
+	for (size_t i = 0; i < m->n; i++) {
+		if (i >= good) {
+			/* a part's failure is the packet's from there on: the
+			 * parts after it cannot be placed with certainty */
+			bus_fast_fail(b, i, r, i == good || r == DXL_E_WRONG_LENGTH);
+			continue;
+		}
+		memcpy(m->data + m->off[i], parts[i].data, m->len[i]);
+		m->err[i] = parts[i].err;
+		m->status[i] = DXL_OK;
+		m->answered++;
+		bus_count_reply(b, &b->servo[m->id[i]], now, parts[i].err);
+	}
+	return true;
+}
+
 /* ---- feeding the parser ---------------------------------------------------------- */
 
 /* A reply was damaged (or bytes were dropped) while waiting. */
@@ -533,6 +599,14 @@ static int bus_damage(struct bus *b, int why)
 	/* the reply is damaged; waiting longer cannot repair it */
 	st->checksum_errors++;
 	b->line_dirty = true;
+	if (b->multi != NULL && b->multi->fast) {
+		/* the one packet that held every slot */
+		for (size_t i = 0; i < b->multi->n; i++)
+			if (bus_slot_open(b->multi->status[i]))
+				b->multi->status[i] = DXL_E_CHECKSUM;
+		bus_finish(b);
+		return DXL_E_CHECKSUM;
+	}
 	if (b->multi != NULL) {
 		/* the servo expected next: the others may still answer */
 		b->multi->status[next] = DXL_E_CHECKSUM;
@@ -559,6 +633,13 @@ static int bus_frame(struct bus *b, const struct dxl_frame *pkt, uint64_t now, s
 		if (b->reply_held)
 			b->unexpected_echoes++;
 		return bus_match(b, pkt, now, reply);
+	}
+	if (b->multi->fast) {
+		if (!bus_fast_frame(b, pkt, now))
+			return BUS_PENDING;
+		int outcome = bus_multi_outcome(b->multi);
+		bus_finish(b);
+		return outcome;
 	}
 	if (b->multi->ping_all)
 		bus_ping_all_frame(b, pkt, now);
@@ -672,6 +753,7 @@ static int bus_multi_layout(struct bus_multi *m)
 	m->n = m->track.n;
 	m->answered = 0;
 	m->ping_all = false;
+	m->fast = false;
 	for (size_t i = 0; i < m->n; i++) {
 		m->id[i] = m->track.ids[i];
 		m->len[i] = m->track.len[i];
@@ -691,9 +773,11 @@ static int bus_multi_send(struct bus *b, const uint8_t *pkt, int n, struct bus_m
 	if (r < 0)
 		return r;
 	uint32_t timeout = m->ping_all ? bus_ping_all_timeout_us(b, (size_t)n)
-	                   : bus_multi_timeout_us(b, (size_t)n, m->len, m->n);
+	                   : m->fast   ? bus_fast_timeout_us(b, (size_t)n, m->len, m->n)
+	                               : bus_multi_timeout_us(b, (size_t)n, m->len, m->n);
 	bus_pend(b, pkt, (size_t)n, b->proto->broadcast_id, instr, 0, now, timeout);
 	b->multi = m;
+	bus_parser_fast(b, m->fast);
 	for (size_t i = 0; i < m->n; i++)
 		b->servo[m->id[i]].transactions++;
 	return DXL_OK;
@@ -740,6 +824,42 @@ int bus_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, s
 	return bus_multi_send(b, pkt, b->proto->encode_bulk_read(pkt, sizeof pkt, items, n), m, DXL2_INST_BULK_READ);
 }
 
+int bus_fast_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
+                             struct bus_multi *m)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	if (m == NULL || dxl2_multi_read_sync(&m->track, len, ids, n) != DXL_OK)
+		return DXL_E_ARG;
+	int r = bus_multi_layout(m);
+	if (r == DXL_OK)
+		r = bus_multi_ready(b, DXL_CAP_FAST_READ);
+	if (r < 0)
+		return r;
+	m->fast = true;
+	return bus_multi_send(b, pkt, b->proto->encode_fast_sync_read(pkt, sizeof pkt, addr, len, ids, n), m,
+	                      DXL2_INST_FAST_SYNC_READ);
+}
+
+int bus_fast_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
+{
+	uint8_t pkt[BUS_MAX_PACKET];
+	struct dxl2_bulk_item asked[DXL2_MULTI_MAX];
+	if (m == NULL || items == NULL || n == 0 || n > DXL2_MULTI_MAX)
+		return DXL_E_ARG;
+	for (size_t i = 0; i < n; i++)
+		asked[i] = (struct dxl2_bulk_item){ items[i].id, items[i].addr, items[i].len, NULL };
+	if (dxl2_multi_read_bulk(&m->track, asked, n) != DXL_OK)
+		return DXL_E_ARG;
+	int r = bus_multi_layout(m);
+	if (r == DXL_OK)
+		r = bus_multi_ready(b, DXL_CAP_FAST_READ);
+	if (r < 0)
+		return r;
+	m->fast = true;
+	return bus_multi_send(b, pkt, b->proto->encode_fast_bulk_read(pkt, sizeof pkt, items, n), m,
+	                      DXL2_INST_FAST_BULK_READ);
+}
+
 int bus_ping_all_begin(struct bus *b, struct bus_multi *m)
 {
 	uint8_t pkt[BUS_MAX_PACKET];
@@ -748,6 +868,7 @@ int bus_ping_all_begin(struct bus *b, struct bus_multi *m)
 	m->n = 0;
 	m->answered = 0;
 	m->ping_all = true;
+	m->fast = false;
 	int r = bus_multi_ready(b, DXL_CAP_BROADCAST_PING);
 	if (r < 0)
 		return r;
@@ -1168,6 +1289,17 @@ int bus_sync_read(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids
 int bus_bulk_read(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
 {
 	return bus_multi_wait(b, bus_bulk_read_begin(b, items, n, m));
+}
+
+int bus_fast_sync_read(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
+                       struct bus_multi *m)
+{
+	return bus_multi_wait(b, bus_fast_sync_read_begin(b, addr, len, ids, n, m));
+}
+
+int bus_fast_bulk_read(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
+{
+	return bus_multi_wait(b, bus_fast_bulk_read_begin(b, items, n, m));
 }
 
 int bus_reply_lateness(struct bus *b, uint8_t id, uint32_t return_delay_us, unsigned n, struct bus_lateness *out)

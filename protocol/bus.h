@@ -128,6 +128,7 @@ struct bus_multi {
 	uint8_t err[BUS_MULTI_MAX];  /* the reply's ERR field (data: alert bit, error number) */
 	size_t answered;             /* slots with DXL_OK */
 	bool ping_all;               /* a broadcast PING: any servo, each once */
+	bool fast;                   /* a Fast Sync/Bulk Read: one packet holds every slot */
 	struct dxl2_multi_read track;
 };
 /* Slot's bytes, or NULL when it has none (status[slot] != DXL_OK). */
@@ -204,6 +205,10 @@ uint32_t bus_timeout_us(const struct bus *b, size_t req_bytes, size_t reply_byte
  * reply at its largest (proto->status_bytes_max: 2.0's worst-case
  * stuffing), one return delay per reply, the adapter latency and the margin. */
 uint32_t bus_multi_timeout_us(const struct bus *b, size_t req_bytes, const uint16_t *reply_params, size_t nreplies);
+/* A Fast Sync/Bulk Read of parts of these lengths: the request and the one
+ * status packet on the wire (never stuffed), ONE return delay (each next
+ * servo's part follows the one before at once), the latency and the margin. */
+uint32_t bus_fast_timeout_us(const struct bus *b, size_t req_bytes, const uint16_t *lens, size_t n);
 void bus_reset_stats(struct bus *b);
 
 /* ---- asynchronous core ------------------------------------------------------ */
@@ -235,6 +240,17 @@ int bus_send_raw(struct bus *b, const uint8_t *pkt, size_t n);
 int bus_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
                         struct bus_multi *m);
 int bus_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m);
+/* The same as Fast Sync Read / Fast Bulk Read (DXL_CAP_FAST_READ; whether
+ * the servos answer is their firmware's: X430/X540 from 45). The one status
+ * packet fills every slot when it arrives whole (dxl2_fast_status_split):
+ * a part whose CRC fails is DXL_E_CHECKSUM with every slot after it (the
+ * parts before it are delivered), a packet whose own CRC fails makes every
+ * slot DXL_E_CHECKSUM, another servo in a part's place DXL_E_WRONG_ID. A
+ * packet that never completes (a servo that did not send its part stops
+ * the chain) leaves every slot DXL_E_TIMEOUT at bus_fast_timeout_us. */
+int bus_fast_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
+                             struct bus_multi *m);
+int bus_fast_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m);
 /* A broadcast PING (DXL_CAP_BROADCAST_PING). Every servo answers, in ID order, each
  * after its return delay; the deadline allows for every ID (the wire time
  * of a PING reply and a return delay each, at least 3 ms), and each reply found becomes a
@@ -309,6 +325,9 @@ int bus_bulk_write(struct bus *b, const struct dxl_item *items, size_t n);      
  * bus_step's for them. */
 int bus_sync_read(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n, struct bus_multi *m);
 int bus_bulk_read(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m);
+int bus_fast_sync_read(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
+                       struct bus_multi *m);
+int bus_fast_bulk_read(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m);
 
 /* How late replies come: n PINGs to id (at most BUS_LATENESS_MAX), each round
  * trip less the wire time of the PING and its reply

@@ -24,9 +24,14 @@
 #define OFF_LEN_H    6
 #define OFF_INST     7
 #define OFF_ERR      8
-/* LEN of the shortest packets: INST + CRC, and INST + ERR + CRC. */
+/* LEN of the shortest packets: INST + CRC, and INST + ERR + CRC; a fast
+ * read's status holds at least one part: INST + ERR ID 1 byte + CRC. */
 #define MIN_LEN_INSTRUCTION 3
 #define MIN_LEN_STATUS      4
+#define MIN_LEN_FAST_STATUS 6
+/* A fast read's status: header and INST, then per part ERR ID data CRC. */
+#define FAST_HEAD_BYTES     (DXL2_HEADER_BYTES + 1)
+#define FAST_PART_EXTRA     4
 /* CLEAR option 0x01 must carry these four bytes ("DXL\"") to act. */
 static const uint8_t clear_multi_turn_params[5] = { 0x01, 0x44, 0x58, 0x4C, 0x22 };
 
@@ -46,6 +51,8 @@ const char *dxl2_instruction_name(uint8_t instr)
 	case DXL2_INST_SYNC_WRITE:    return "SYNC_WRITE";
 	case DXL2_INST_BULK_READ:     return "BULK_READ";
 	case DXL2_INST_BULK_WRITE:    return "BULK_WRITE";
+	case DXL2_INST_FAST_SYNC_READ: return "FAST_SYNC_READ";
+	case DXL2_INST_FAST_BULK_READ: return "FAST_BULK_READ";
 	default:                      return "UNKNOWN";
 	}
 }
@@ -334,6 +341,26 @@ int dxl2_encode_sync_read(uint8_t *buf, size_t cap, uint16_t addr, uint16_t len,
 	return dxl2_encode_pieces(buf, cap, DXL2_BROADCAST_ID, DXL2_INST_SYNC_READ, p, sizeof p, ids, n);
 }
 
+size_t dxl2_fast_status_bytes(const uint16_t *lens, size_t n)
+{
+	size_t bytes = FAST_HEAD_BYTES;
+	for (size_t i = 0; lens != NULL && i < n; i++)
+		bytes += (size_t)lens[i] + FAST_PART_EXTRA;
+	return bytes;
+}
+
+int dxl2_encode_fast_sync_read(uint8_t *buf, size_t cap, uint16_t addr, uint16_t len,
+                               const uint8_t *ids, size_t n)
+{
+	if (!dxl2_read_len_ok(len) || !dxl2_ids_ok(ids, n))
+		return DXL_E_ARG;
+	/* n <= 253, len <= 759: no overflow */
+	if (FAST_HEAD_BYTES + n * ((size_t)len + FAST_PART_EXTRA) > DXL2_MAX_PACKET)
+		return DXL_E_ARG;   /* the one reply could not be received */
+	const uint8_t p[4] = { (uint8_t)addr, (uint8_t)(addr >> 8), (uint8_t)len, (uint8_t)(len >> 8) };
+	return dxl2_encode_pieces(buf, cap, DXL2_BROADCAST_ID, DXL2_INST_FAST_SYNC_READ, p, sizeof p, ids, n);
+}
+
 struct sync_write_args {
 	uint16_t addr, len;
 	const uint8_t *ids, *data;
@@ -384,8 +411,10 @@ static void emit_bulk(struct dxl2_out *o, const void *args)
 }
 
 static int dxl2_encode_bulk(uint8_t *buf, size_t cap, const struct dxl2_bulk_item *items, size_t n,
-                            bool write)
+                            uint8_t instr)
 {
+	bool write = instr == DXL2_INST_BULK_WRITE;
+	size_t reply = FAST_HEAD_BYTES;
 	uint8_t ids[DXL2_MULTI_MAX];
 	size_t bytes = 0;
 	if (items == NULL || n == 0 || n > DXL2_MULTI_MAX)
@@ -395,7 +424,10 @@ static int dxl2_encode_bulk(uint8_t *buf, size_t cap, const struct dxl2_bulk_ite
 		if (write ? (items[i].len == 0 || items[i].data == NULL) : !dxl2_read_len_ok(items[i].len))
 			return DXL_E_ARG;
 		bytes += 5 + (write ? items[i].len : 0);
+		reply += (size_t)items[i].len + FAST_PART_EXTRA;
 	}
+	if (instr == DXL2_INST_FAST_BULK_READ && reply > DXL2_MAX_PACKET)
+		return DXL_E_ARG;   /* the one reply could not be received */
 	/* e-manual: "the same ID cannot be used multiple times" */
 	if (!dxl2_ids_ok(ids, n))
 		return DXL_E_ARG;
@@ -403,17 +435,67 @@ static int dxl2_encode_bulk(uint8_t *buf, size_t cap, const struct dxl2_bulk_ite
 		return DXL_E_BUFFER;
 	const struct bulk_args a = { items, n, write };
 	const struct dxl2_body b = { NULL, 0, NULL, 0, emit_bulk, &a };
-	return dxl2_frame(buf, cap, DXL2_BROADCAST_ID, write ? DXL2_INST_BULK_WRITE : DXL2_INST_BULK_READ, &b);
+	return dxl2_frame(buf, cap, DXL2_BROADCAST_ID, instr, &b);
 }
 
 int dxl2_encode_bulk_read(uint8_t *buf, size_t cap, const struct dxl2_bulk_item *items, size_t n)
 {
-	return dxl2_encode_bulk(buf, cap, items, n, false);
+	return dxl2_encode_bulk(buf, cap, items, n, DXL2_INST_BULK_READ);
+}
+
+int dxl2_encode_fast_bulk_read(uint8_t *buf, size_t cap, const struct dxl2_bulk_item *items, size_t n)
+{
+	return dxl2_encode_bulk(buf, cap, items, n, DXL2_INST_FAST_BULK_READ);
 }
 
 int dxl2_encode_bulk_write(uint8_t *buf, size_t cap, const struct dxl2_bulk_item *items, size_t n)
 {
-	return dxl2_encode_bulk(buf, cap, items, n, true);
+	return dxl2_encode_bulk(buf, cap, items, n, DXL2_INST_BULK_WRITE);
+}
+
+/* The fast status is never stuffed: written byte by byte, each part's CRC
+ * continuing over everything before it. */
+static int dxl2_fast_parts_ok(const struct dxl2_fast_part *parts, size_t n, size_t *total)
+{
+	uint8_t ids[DXL2_MULTI_MAX];
+	if (parts == NULL || n == 0 || n > DXL2_MULTI_MAX)
+		return DXL_E_ARG;
+	*total = FAST_HEAD_BYTES;
+	for (size_t i = 0; i < n; i++) {
+		if (parts[i].len == 0 || parts[i].data == NULL)
+			return DXL_E_ARG;
+		ids[i] = parts[i].id;
+		*total += (size_t)parts[i].len + FAST_PART_EXTRA;
+	}
+	return dxl2_ids_ok(ids, n) ? DXL_OK : DXL_E_ARG;
+}
+
+int dxl2_encode_fast_status(uint8_t *buf, size_t cap, const struct dxl2_fast_part *parts, size_t n,
+                            size_t *ends)
+{
+	size_t total = 0;
+	int r = dxl2_fast_parts_ok(parts, n, &total);
+	if (r != DXL_OK || buf == NULL)
+		return DXL_E_ARG;
+	if (total > DXL2_MAX_PACKET || total > cap)
+		return DXL_E_BUFFER;
+	size_t len = total - DXL2_HEADER_BYTES, at = 0;
+	const uint8_t head[FAST_HEAD_BYTES] = { H1, H2, H3, RESERVED, DXL2_BROADCAST_ID, (uint8_t)(len & 0xFF),
+		                                (uint8_t)(len >> 8), DXL2_INST_STATUS };
+	memcpy(buf, head, sizeof head);
+	at = sizeof head;
+	for (size_t i = 0; i < n; i++) {
+		buf[at++] = parts[i].err;
+		buf[at++] = parts[i].id;
+		memcpy(buf + at, parts[i].data, parts[i].len);
+		at += parts[i].len;
+		uint16_t crc = dxl2_crc_update(0, buf, at);
+		buf[at++] = (uint8_t)(crc & 0xFF);
+		buf[at++] = (uint8_t)(crc >> 8);
+		if (ends)
+			ends[i] = at;
+	}
+	return (int)total;
 }
 
 int dxl2_encode_status(uint8_t *buf, size_t cap, uint8_t id, uint8_t err,
@@ -451,6 +533,11 @@ void dxl2_parser_reset(struct dxl2_parser *p)
 	p->checked = 0;
 }
 
+void dxl2_parser_expect_fast(struct dxl2_parser *p, bool on)
+{
+	p->fast = on && p->kind == DXL2_PARSE_STATUS;
+}
+
 static void dxl2_parser_drop(struct dxl2_parser *p, size_t n)
 {
 	dxl_lex_drop(p->buf, &p->have, n);
@@ -474,8 +561,22 @@ static bool dxl2_parser_id_ok(const struct dxl2_parser *p, uint8_t id)
 {
 	if (id <= DXL2_MAX_ID)
 		return true;
-	/* instructions may be broadcast; a status never comes from 0xFE */
-	return p->kind == DXL2_PARSE_INSTRUCTION && id == DXL2_BROADCAST_ID;
+	/* instructions may be broadcast; a status from 0xFE is a fast read's */
+	return id == DXL2_BROADCAST_ID && (p->kind == DXL2_PARSE_INSTRUCTION || p->fast);
+}
+
+/* A status from 0xFE: the servos' shared reply to a fast read. */
+static bool dxl2_parser_fast(const struct dxl2_parser *p)
+{
+	return p->kind == DXL2_PARSE_STATUS && p->buf[OFF_ID] == DXL2_BROADCAST_ID;
+}
+
+/* The shortest LEN the packet's kind allows. */
+static size_t dxl2_parser_min_len(const struct dxl2_parser *p)
+{
+	if (p->kind == DXL2_PARSE_INSTRUCTION)
+		return MIN_LEN_INSTRUCTION;
+	return dxl2_parser_fast(p) ? MIN_LEN_FAST_STATUS : MIN_LEN_STATUS;
 }
 
 static bool is_pattern(const uint8_t *b, size_t j)
@@ -514,9 +615,10 @@ static bool dxl2_parser_unstuff(const struct dxl2_parser *p, size_t body_end, st
 	size_t n = 0;
 	uint8_t first[2] = { 0, 0 };
 	size_t nfirst = p->kind == DXL2_PARSE_STATUS ? 2 : 1;  /* INST (+ ERR) */
+	bool stuffed = !dxl2_parser_fast(p);
 	for (size_t j = OFF_INST; j < body_end; j++) {
 		uint8_t b = p->buf[j];
-		if (is_pattern(p->buf, j))
+		if (stuffed && is_pattern(p->buf, j))
 			j++;  /* checked already: the next byte is the stuffed FD */
 		if (n < nfirst)
 			first[n] = b;
@@ -559,8 +661,7 @@ static int dxl2_parser_scan(struct dxl2_parser *p, struct dxl2_packet *out)
 		if (p->have <= OFF_LEN_H)
 			return DXL_NEED_MORE;
 		size_t len = (size_t)b[OFF_LEN_L] | ((size_t)b[OFF_LEN_H] << 8);
-		size_t min = p->kind == DXL2_PARSE_STATUS ? MIN_LEN_STATUS : MIN_LEN_INSTRUCTION;
-		if (len < min || len > DXL2_MAX_LEN)
+		if (len < dxl2_parser_min_len(p) || len > DXL2_MAX_LEN)
 			return dxl2_parser_reject(p, DXL_E_HEADER);
 		if (p->have <= OFF_INST)
 			return DXL_NEED_MORE;
@@ -569,7 +670,7 @@ static int dxl2_parser_scan(struct dxl2_parser *p, struct dxl2_packet *out)
 			return dxl2_parser_reject(p, DXL_E_HEADER);
 		size_t total = DXL2_HEADER_BYTES + len;
 		size_t body_end = total - DXL2_CRC_BYTES;
-		int r = dxl2_parser_check_stuffing(p, body_end);
+		int r = dxl2_parser_fast(p) ? DXL_OK : dxl2_parser_check_stuffing(p, body_end);
 		if (r != DXL_OK)
 			return dxl2_parser_reject(p, r);
 		if (p->have < total)
@@ -681,6 +782,63 @@ int dxl2_multi_read_take(struct dxl2_multi_read *m, uint8_t id, uint16_t nparams
 	if (slot)
 		*slot = i;
 	return DXL_OK;
+}
+
+/* The header a fast status of nparams parameters (after its first ERR)
+ * began with: the parts' CRCs start from it. */
+static uint16_t dxl2_fast_head_crc(const struct dxl2_packet *pkt)
+{
+	size_t len = 1u + 1u + pkt->nparams + DXL2_CRC_BYTES;  /* INST ERR params CRC */
+	const uint8_t head[FAST_HEAD_BYTES + 1] = { H1, H2, H3, RESERVED, DXL2_BROADCAST_ID, (uint8_t)(len & 0xFF),
+		                                    (uint8_t)(len >> 8), DXL2_INST_STATUS, pkt->err };
+	return dxl2_crc_update(0, head, sizeof head);
+}
+
+int dxl2_fast_status_split(const struct dxl2_packet *pkt, const struct dxl2_multi_read *m,
+                           struct dxl2_fast_part *parts, size_t *good)
+{
+	size_t ok = 0, at = 0, want = 0;
+	if (good)
+		*good = 0;
+	if (pkt == NULL || m == NULL || parts == NULL || m->n == 0)
+		return DXL_E_ARG;
+	if (pkt->id != DXL2_BROADCAST_ID || pkt->instr != DXL2_INST_STATUS)
+		return DXL_E_WRONG_ID;
+	for (size_t i = 0; i < m->n; i++)
+		want += (size_t)m->len[i] + FAST_PART_EXTRA;
+	/* the first ERR is the packet's err, the last CRC the parser's */
+	if (pkt->nparams + 3u != want)
+		return DXL_E_WRONG_LENGTH;
+	uint16_t crc = dxl2_fast_head_crc(pkt);
+	int r = DXL_OK;
+	for (size_t i = 0; i < m->n; i++) {
+		const uint8_t *p = pkt->params;
+		uint8_t err = pkt->err;
+		if (i > 0) {
+			err = p[at];
+			crc = dxl2_crc_update(crc, p + at, 1);
+			at++;
+		}
+		parts[i] = (struct dxl2_fast_part){ p[at], err, m->len[i], p + at + 1 };
+		crc = dxl2_crc_update(crc, p + at, 1u + m->len[i]);
+		at += 1u + m->len[i];
+		if (parts[i].id != m->ids[i]) {
+			r = DXL_E_WRONG_ID;
+			break;
+		}
+		if (i + 1 < m->n) {
+			if ((uint16_t)(p[at] | (p[at + 1] << 8)) != crc) {
+				r = DXL_E_CHECKSUM;
+				break;
+			}
+			crc = dxl2_crc_update(crc, p + at, DXL2_CRC_BYTES);
+			at += DXL2_CRC_BYTES;
+		}
+		ok++;
+	}
+	if (good)
+		*good = ok;
+	return r;
 }
 
 size_t dxl2_multi_read_missing(const struct dxl2_multi_read *m, uint8_t *ids, size_t cap)

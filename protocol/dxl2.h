@@ -60,8 +60,10 @@ enum dxl2_instruction {
 	DXL2_INST_STATUS        = 0x55,  /* the INST field of every status packet */
 	DXL2_INST_SYNC_READ     = 0x82,
 	DXL2_INST_SYNC_WRITE    = 0x83,
+	DXL2_INST_FAST_SYNC_READ = 0x8A, /* one status packet for all servos (see below) */
 	DXL2_INST_BULK_READ     = 0x92,
 	DXL2_INST_BULK_WRITE    = 0x93,
+	DXL2_INST_FAST_BULK_READ = 0x9A,
 };
 /* "SYNC_READ", ..., or "UNKNOWN". */
 const char *dxl2_instruction_name(uint8_t instr);
@@ -142,6 +144,40 @@ struct dxl2_bulk_item {
 /* BULK_READ: one status packet per item, in the order of items[]. */
 int dxl2_encode_bulk_read(uint8_t *buf, size_t cap, const struct dxl2_bulk_item *items, size_t n);
 int dxl2_encode_bulk_write(uint8_t *buf, size_t cap, const struct dxl2_bulk_item *items, size_t n);
+/*
+ * Fast Sync Read (0x8A) and Fast Bulk Read (0x9A) (e-manual, Protocol 2.0;
+ * X430/X540 from firmware 45, not the 2XL/2XC): the request is SYNC_READ's
+ * or BULK_READ's with another code, but the servos answer with ONE status
+ * packet, from ID 0xFE, that they build together, each its part in turn:
+ *
+ *   FF FF FD 00 FE LEN_L LEN_H 55 | ERR ID data CRC | ERR ID data CRC | ...
+ *
+ * The first servo sends the header (LEN counts every servo asked) and its
+ * part, each next one its part as soon as the one before has ended. A
+ * part's CRC is the CRC of every byte of the packet before it (header and
+ * the earlier parts with their CRCs), so the last part's CRC is the
+ * packet's. The packet is never stuffed ("Fast Sync Read Status Packet does
+ * not perform Byte Stuffing"). The encoders refuse (DXL_E_ARG) a request
+ * whose reply would not fit DXL2_MAX_PACKET.
+ */
+int dxl2_encode_fast_sync_read(uint8_t *buf, size_t cap, uint16_t addr, uint16_t len,
+                               const uint8_t *ids, size_t n);
+int dxl2_encode_fast_bulk_read(uint8_t *buf, size_t cap, const struct dxl2_bulk_item *items, size_t n);
+/* One servo's part of a fast read's status. */
+struct dxl2_fast_part {
+	uint8_t id;            /* 0-252 */
+	uint8_t err;           /* its own ERR field (data, as in any status) */
+	uint16_t len;
+	const uint8_t *data;
+};
+/* Bytes on the wire of the status answering parts of these lengths. */
+size_t dxl2_fast_status_bytes(const uint16_t *lens, size_t n);
+/* The simulator's side: the whole status packet of n parts, in request
+ * order; ends[i] (when not NULL) gets the offset just past part i, so that
+ * each servo's part can go out in its turn (and a chain that stops at a
+ * silent servo is the packet cut at ends[k - 1]). */
+int dxl2_encode_fast_status(uint8_t *buf, size_t cap, const struct dxl2_fast_part *parts, size_t n,
+                            size_t *ends);
 /* A status packet (the simulator's side): id 0-252, any err byte. */
 int dxl2_encode_status(uint8_t *buf, size_t cap, uint8_t id, uint8_t err,
                        const uint8_t *params, size_t nparams);
@@ -184,6 +220,11 @@ struct dxl2_parser {
 	size_t checked;          /* body bytes of the buffered candidate already
 	                            checked for stuffing (0 = none yet) */
 	uint8_t buf[DXL2_MAX_PACKET];
+	/* A status from 0xFE (a Fast Sync/Bulk Read's) is taken only while
+	 * one is expected (dxl2_parser_expect_fast): it is not stuffed, so a
+	 * header inside it cannot be told from data, and a candidate that long
+	 * could hold back a good packet after it until its CRC fails. */
+	bool fast;
 	/* Counters since init (never reset by the parser itself). */
 	uint32_t frames;
 	uint32_t checksum_errors;   /* CRC mismatch */
@@ -197,6 +238,9 @@ struct dxl2_parser {
 void dxl2_parser_init(struct dxl2_parser *p, enum dxl2_parse_kind kind);
 /* Discard buffered bytes (before a new request); counters are kept. */
 void dxl2_parser_reset(struct dxl2_parser *p);
+/* Take a status from 0xFE, a fast read's, from now on (on) or refuse it as
+ * a bad header (off, the initial state). The status side only. */
+void dxl2_parser_expect_fast(struct dxl2_parser *p, bool on);
 /*
  * Feed up to n bytes; *used tells how many were consumed. The contract is
  * 1.0's (dxl_parser_feed): call again after a frame or an error — even with
@@ -207,9 +251,16 @@ void dxl2_parser_reset(struct dxl2_parser *p);
  * Resync rules (gpsd: on an unexpected byte go back to the start state):
  *  - bytes before FF FF FD are dropped silently (bytes_dropped);
  *  - FF FF FD FD is stuffed data, not a header: dropped silently;
- *  - reserved byte not 00, ID 253/255 (or broadcast on the status side), LEN
- *    too short for the kind or longer than DXL2_MAX_LEN, INST 0x55 on the
- *    instruction side or not 0x55 on the status side: DXL_E_HEADER;
+ *  - reserved byte not 00, ID 253/255 (or broadcast on the status side
+ *    unless a fast read's status is expected), LEN too short for the kind
+ *    (a fast read's status must hold one part) or longer than
+ *    DXL2_MAX_LEN, INST 0x55 on the instruction side or not 0x55 on the
+ *    status side: DXL_E_HEADER;
+ *  - an expected status from 0xFE is a fast read's: not stuffed, so its
+ *    body is not checked for stuffing and is delivered as it came — `err`
+ *    the first part's ERR, `params` the rest up to the last CRC
+ *    (dxl2_fast_status_split); while it is buffered, a packet after it
+ *    comes out only once its CRC has failed;
  *  - FF FF FD followed by anything but FD inside the body: DXL_E_STUFFING,
  *    reported as soon as that byte arrives, so a reply cut short does not
  *    swallow the good one that follows it;
@@ -258,6 +309,18 @@ int dxl2_multi_read_accept(struct dxl2_multi_read *m, const struct dxl2_packet *
  * frames are either protocol's). */
 int dxl2_multi_read_take(struct dxl2_multi_read *m, uint8_t id, uint16_t nparams, size_t *slot);
 static inline bool dxl2_multi_read_done(const struct dxl2_multi_read *m) { return m->answered == m->n; }
+/*
+ * A fast read's status (a frame from 0xFE) against the request's tracker
+ * (dxl2_multi_read_sync/_bulk, untouched here): parts[i] gets slot i's ID,
+ * ERR, length and data (pointing into pkt). Returns DXL_OK when every part
+ * is there; else *good is how many parts from the front are sound and the
+ * return says what is wrong with the next: DXL_E_WRONG_ID (not a fast
+ * status, or another servo in that place), DXL_E_WRONG_LENGTH (the packet's
+ * size is not the request's: *good is 0), DXL_E_CHECKSUM (that part's CRC).
+ * The final CRC was the parser's to check; the parts' CRCs are checked here.
+ */
+int dxl2_fast_status_split(const struct dxl2_packet *pkt, const struct dxl2_multi_read *m,
+                           struct dxl2_fast_part *parts, size_t *good);
 /* Copies the IDs not answered (in request order) into ids (up to cap);
  * returns how many are missing. */
 size_t dxl2_multi_read_missing(const struct dxl2_multi_read *m, uint8_t *ids, size_t cap);

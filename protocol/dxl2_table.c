@@ -260,6 +260,9 @@ static const struct dxl2_reg xm430_regs[] = {
 /* What every X servo here can do beyond its table. */
 #define X_CAPS (DXL2_CAP_HWERR_STATUS | DXL2_CAP_WATCHDOG | DXL2_CAP_REBOOT | DXL2_CAP_OPMODE | \
                 DXL2_CAP_FACTORY_RESET_KEEP)
+/* e-manual, Protocol 2.0, "Fast Sync Read (0x8A)" and "Fast Bulk Read
+ * (0x9A)": "X430/540 Series (Fw v45 or above, 2XL/2XC Not Supported)". */
+#define X430_FAST_READ_FIRMWARE 45
 static const struct dxl2_model dxl2_models[] = {
 	/* e-manual (docs/en/dxl/ax/ax-12a.md): 1.5 N·m at 12 V (1.5 A), 59 rpm
 	 * at 12 V, 254:1, 9-12 V (11.1 recommended); rotor 4.6e-8 kg·m², the
@@ -278,7 +281,7 @@ static const struct dxl2_model dxl2_models[] = {
 	  .opmodes = OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
 	  .sheet = { .stall_torque_nm = 1.5, .stall_current_a = 1.4, .no_load_speed_rpm = 61.0, .gear_ratio = 258.5,
 	             .rotor_inertia = 4.6e-8, .rated_min_v = 6.5, .rated_rec_v = 11.1, .rated_max_v = 12.0 },
-	  .factory_baud = 57600, .firmware = 46 },
+	  .factory_baud = 57600, .firmware = 46, .fast_read_firmware = X430_FAST_READ_FIRMWARE },
 	/* 4.1 N·m at 12 V (2.3 A), 46 rpm at 12 V, 353.5:1, 10.0-14.8 V (12.0
 	 * recommended); a coreless (Maxon) motor: 0.5 g·cm² taken for its rotor */
 	{ .protocol = 2, .number = DXL2_MODEL_XM430_W350, .name = "XM430-W350", ROWS(xm430_regs),
@@ -287,7 +290,7 @@ static const struct dxl2_model dxl2_models[] = {
 	  .current_sensing = true,
 	  .sheet = { .stall_torque_nm = 4.1, .stall_current_a = 2.3, .no_load_speed_rpm = 46.0, .gear_ratio = 353.5,
 	             .rotor_inertia = 5.0e-8, .rated_min_v = 10.0, .rated_rec_v = 12.0, .rated_max_v = 14.8 },
-	  .factory_baud = 57600, .firmware = 46 },
+	  .factory_baud = 57600, .firmware = 46, .fast_read_firmware = X430_FAST_READ_FIRMWARE },
 	/* docs/en/dxl/x/xc430-w150.md: 1.6 N·m at 12 V (1.4 A), 106 rpm at
 	 * 12 V, 159.59:1, 6.5-14.8 V (12.0 recommended); velocity, position,
 	 * extended position and PWM control, Present Load (no current sensing);
@@ -297,7 +300,7 @@ static const struct dxl2_model dxl2_models[] = {
 	  .opmodes = OPMODE_BIT(1) | OPMODE_BIT(3) | OPMODE_BIT(4) | OPMODE_BIT(16), .current_sensing = false,
 	  .sheet = { .stall_torque_nm = 1.6, .stall_current_a = 1.4, .no_load_speed_rpm = 106.0, .gear_ratio = 159.59,
 	             .rotor_inertia = 5.0e-8, .rated_min_v = 6.5, .rated_rec_v = 12.0, .rated_max_v = 14.8 },
-	  .factory_baud = 57600, .firmware = 46 },
+	  .factory_baud = 57600, .firmware = 46, .fast_read_firmware = X430_FAST_READ_FIRMWARE },
 };
 #define NMODELS (sizeof dxl2_models / sizeof dxl2_models[0])
 
@@ -395,6 +398,11 @@ const struct dxl2_model *dxl2_model_first(int protocol)
 		if (dxl2_model_at(i)->protocol == protocol)
 			return dxl2_model_at(i);
 	return NULL;
+}
+
+bool dxl2_model_fast_read(const struct dxl2_model *m, uint8_t firmware)
+{
+	return m != NULL && m->fast_read_firmware != 0 && firmware >= m->fast_read_firmware;
 }
 
 bool dxl2_model_can(const struct dxl2_model *m, enum dxl2_cap cap)

@@ -219,6 +219,9 @@ struct dxl2_model {
 	struct dxl2_datasheet sheet;
 	long factory_baud;     /* Baud Rate 1 */
 	uint8_t firmware;      /* the firmware a simulated one reports */
+	/* The first firmware that answers Fast Sync/Bulk Read (0 never): a
+	 * servo's own property, beside the protocol's DXL_CAP_FAST_READ. */
+	uint8_t fast_read_firmware;
 };
 
 /* The models known, in a fixed order (0 .. dxl2_model_count() - 1): the
@@ -229,6 +232,9 @@ const struct dxl2_model *dxl2_model_at(size_t i);
  * "XL430-W250, XM430-W350, ..." into buf. */
 char *dxl2_model_names(int protocol, char *buf, size_t cap);
 bool dxl2_model_can(const struct dxl2_model *m, enum dxl2_cap cap);
+/* Whether a servo of this model on this firmware (register 6, or a PING's
+ * third byte) answers Fast Sync Read and Fast Bulk Read; false for NULL. */
+bool dxl2_model_fast_read(const struct dxl2_model *m, uint8_t firmware);
 
 /* NULL when unknown. Model numbers are unique across ROBOTIS's servos
  * (register 0 on either protocol); names compare case-insensitively

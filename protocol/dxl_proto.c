@@ -162,6 +162,8 @@ static int v2_instr_replies(uint8_t instr)
 	switch (instr) {
 	case DXL2_INST_SYNC_READ:
 	case DXL2_INST_BULK_READ:
+	case DXL2_INST_FAST_SYNC_READ:
+	case DXL2_INST_FAST_BULK_READ:
 		return DXL_E_ARG;
 	case DXL2_INST_SYNC_WRITE:
 	case DXL2_INST_BULK_WRITE:
@@ -171,24 +173,33 @@ static int v2_instr_replies(uint8_t instr)
 	}
 }
 
-static int v2_encode_bulk(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n, bool write)
+static int v2_encode_bulk(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n, uint8_t instr)
 {
 	struct dxl2_bulk_item v2[DXL2_MULTI_MAX];
 	if (items == NULL || n == 0 || n > DXL2_MULTI_MAX)
 		return DXL_E_ARG;
 	for (size_t i = 0; i < n; i++)
 		v2[i] = (struct dxl2_bulk_item){ items[i].id, items[i].addr, items[i].len, items[i].data };
-	return write ? dxl2_encode_bulk_write(buf, cap, v2, n) : dxl2_encode_bulk_read(buf, cap, v2, n);
+	if (instr == DXL2_INST_BULK_WRITE)
+		return dxl2_encode_bulk_write(buf, cap, v2, n);
+	if (instr == DXL2_INST_FAST_BULK_READ)
+		return dxl2_encode_fast_bulk_read(buf, cap, v2, n);
+	return dxl2_encode_bulk_read(buf, cap, v2, n);
 }
 
 static int v2_encode_bulk_read(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n)
 {
-	return v2_encode_bulk(buf, cap, items, n, false);
+	return v2_encode_bulk(buf, cap, items, n, DXL2_INST_BULK_READ);
+}
+
+static int v2_encode_fast_bulk_read(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n)
+{
+	return v2_encode_bulk(buf, cap, items, n, DXL2_INST_FAST_BULK_READ);
 }
 
 static int v2_encode_bulk_write(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n)
 {
-	return v2_encode_bulk(buf, cap, items, n, true);
+	return v2_encode_bulk(buf, cap, items, n, DXL2_INST_BULK_WRITE);
 }
 
 static void v2_parser_init(union dxl_proto_parser *p, bool instructions)
@@ -217,6 +228,11 @@ static int v2_parser_feed(union dxl_proto_parser *p, const uint8_t *data, size_t
 	return r;
 }
 
+static void v2_parser_expect_fast(union dxl_proto_parser *p, bool on)
+{
+	dxl2_parser_expect_fast(&p->v2, on);
+}
+
 static void v2_parser_counts(const union dxl_proto_parser *p, struct dxl_parser_counts *out)
 {
 	*out = (struct dxl_parser_counts){ p->v2.frames, p->v2.checksum_errors, p->v2.header_errors,
@@ -240,16 +256,16 @@ static bool v2_damaged_packet(const uint8_t *bytes, size_t n, uint8_t *id, uint8
 	return false;
 }
 
-/* SYNC_READ and BULK_READ are answered in the order the request lists the
+/* SYNC_READ and BULK_READ (and their fast forms' parts) are answered in the order the request lists the
  * servos, a broadcast PING in the order of their IDs (e-manual, Protocol
  * 2.0): a servo's slot in the list, or its ID. */
 static int v2_reply_order(const struct dxl_frame *req, uint8_t id)
 {
-	if (req->instr == DXL2_INST_SYNC_READ) {
+	if (req->instr == DXL2_INST_SYNC_READ || req->instr == DXL2_INST_FAST_SYNC_READ) {
 		for (size_t k = 4; k < req->nparams; k++)
 			if (req->params[k] == id)
 				return (int)k;
-	} else if (req->instr == DXL2_INST_BULK_READ) {
+	} else if (req->instr == DXL2_INST_BULK_READ || req->instr == DXL2_INST_FAST_BULK_READ) {
 		for (size_t k = 0; k + 5 <= req->nparams; k += 5)
 			if (req->params[k] == id)
 				return (int)k;
@@ -263,7 +279,7 @@ const struct dxl_proto dxl_proto_v2 = {
 	.name = "2.0",
 	.number = 2,
 	.caps = DXL_CAP_SYNC_READ | DXL_CAP_BULK_READ | DXL_CAP_BULK_WRITE | DXL_CAP_REBOOT | DXL_CAP_CLEAR |
-	        DXL_CAP_PING_MODEL | DXL_CAP_BROADCAST_PING | DXL_CAP_RESET_OPTIONS,
+	        DXL_CAP_PING_MODEL | DXL_CAP_BROADCAST_PING | DXL_CAP_RESET_OPTIONS | DXL_CAP_FAST_READ,
 	.max_id = DXL2_MAX_ID,
 	.broadcast_id = DXL2_BROADCAST_ID,
 	.max_packet = DXL2_MAX_PACKET,
@@ -289,11 +305,14 @@ const struct dxl_proto dxl_proto_v2 = {
 	.encode_sync_read = dxl2_encode_sync_read,
 	.encode_bulk_read = v2_encode_bulk_read,
 	.encode_bulk_write = v2_encode_bulk_write,
+	.encode_fast_sync_read = dxl2_encode_fast_sync_read,
+	.encode_fast_bulk_read = v2_encode_fast_bulk_read,
 	.encode_status = dxl2_encode_status,
 	.parser_init = v2_parser_init,
 	.parser_reset = v2_parser_reset,
 	.parser_feed = v2_parser_feed,
 	.parser_counts = v2_parser_counts,
+	.parser_expect_fast = v2_parser_expect_fast,
 	.damaged_packet = v2_damaged_packet,
 	.reply_order = v2_reply_order,
 	.check_name = "CRC",

@@ -31,6 +31,10 @@ enum dxl_cap {
 	DXL_CAP_PING_MODEL     = 1u << 5,  /* a PING's reply carries model number and firmware */
 	DXL_CAP_BROADCAST_PING = 1u << 6,  /* every servo answers a broadcast PING in turn */
 	DXL_CAP_RESET_OPTIONS  = 1u << 7,  /* FACTORY_RESET can keep the ID (and baud) */
+	/* Fast Sync Read / Fast Bulk Read: one status packet for all servos.
+	 * The protocol has them; whether the servos do is their firmware's
+	 * (X430/X540 from 45): ask them (dxl2_model_fast_read). */
+	DXL_CAP_FAST_READ      = 1u << 8,
 };
 
 /* FACTORY_RESET's option: 2.0's parameter byte. 1.0 resets everything and
@@ -123,6 +127,9 @@ struct dxl_proto {
 	                        size_t n);
 	int (*encode_bulk_read)(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n);
 	int (*encode_bulk_write)(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n);
+	int (*encode_fast_sync_read)(uint8_t *buf, size_t cap, uint16_t addr, uint16_t len, const uint8_t *ids,
+	                             size_t n);
+	int (*encode_fast_bulk_read)(uint8_t *buf, size_t cap, const struct dxl_item *items, size_t n);
 	/* the simulator's side */
 	int (*encode_status)(uint8_t *buf, size_t cap, uint8_t id, uint8_t err, const uint8_t *params,
 	                     size_t nparams);
@@ -135,6 +142,9 @@ struct dxl_proto {
 	int (*parser_feed)(union dxl_proto_parser *p, const uint8_t *data, size_t n, size_t *used,
 	                   struct dxl_frame *out);
 	void (*parser_counts)(const union dxl_proto_parser *p, struct dxl_parser_counts *out);
+	/* DXL_CAP_FAST_READ: take the one status packet of a fast read (a
+	 * status from the broadcast ID) while on; NULL where there is none. */
+	void (*parser_expect_fast)(union dxl_proto_parser *p, bool on);
 
 	/* The simulator's side: a packet that just failed its checksum ends at
 	 * bytes[n - 1] (the bytes the parser consumed last). Its ID and

@@ -186,6 +186,8 @@ static void usage(FILE *f)
 	        "  --baud BPS           the controller's rate on every bus (default: the servos'\n"
 	        "                       factory rate, 1000000 for the AX-12A, 57600 for X servos)\n"
 	        "  --return-delay US    initial return delay of every servo (default: factory 500)\n"
+	        "  --firmware N         X series: the firmware every servo reports and acts as\n"
+	        "                       (default 46; below 45 no Fast Sync/Bulk Read)\n"
 	        "  --latency-ms MS      USB adapter hold time toward the controller (FTDI: 16)\n"
 	        "  --echo               single-wire adapter: requests come back before replies\n"
 	        "  --rate-hz HZ         physics steps per second (default 1000)\n"
@@ -209,7 +211,7 @@ enum {
 	OPT_LINK = 256, OPT_IDS, OPT_NAME, OPT_SCENARIO, OPT_SET, OPT_LINK_DIR, OPT_LCM_URL, OPT_CONTROL,
 	OPT_SEED, OPT_DURATION, OPT_BAUD, OPT_RETURN_DELAY, OPT_LATENCY, OPT_ECHO, OPT_RATE, OPT_TRUTH,
 	OPT_TEMP, OPT_VOLTAGE, OPT_TX_SLICE, OPT_BENCH, OPT_QUIET, OPT_HELP, OPT_CMD, OPT_REALTIME,
-	OPT_LOCKSTEP, OPT_LOCKSTEP_GRACE, OPT_MODEL,
+	OPT_LOCKSTEP, OPT_LOCKSTEP_GRACE, OPT_MODEL, OPT_FIRMWARE,
 };
 
 /* Options that are [sim] keys go through the same parser as the file. */
@@ -221,7 +223,7 @@ static const struct {
 	{ OPT_SEED, "sim.seed" }, { OPT_DURATION, "sim.duration" }, { OPT_BAUD, "sim.baud" },
 	{ OPT_RETURN_DELAY, "sim.return_delay_us" }, { OPT_LATENCY, "sim.latency_ms" },
 	{ OPT_RATE, "sim.rate_hz" }, { OPT_TRUTH, "sim.truth_hz" }, { OPT_TEMP, "sim.temperature" },
-	{ OPT_VOLTAGE, "sim.voltage" }, { OPT_MODEL, "sim.model" },
+	{ OPT_VOLTAGE, "sim.voltage" }, { OPT_MODEL, "sim.model" }, { OPT_FIRMWARE, "sim.firmware" },
 };
 
 static char set_store[MAIN_MAX_KEYS][SIM_CMD_MAX + SIM_PATH_MAX];
@@ -256,6 +258,7 @@ static int parse_args(int argc, char **argv, struct options *o)
 		{ "lockstep", required_argument, 0, OPT_LOCKSTEP },
 		{ "lockstep-grace", required_argument, 0, OPT_LOCKSTEP_GRACE },
 		{ "model", required_argument, 0, OPT_MODEL },
+		{ "firmware", required_argument, 0, OPT_FIRMWARE },
 		{ 0, 0, 0, 0 },
 	};
 	memset(o, 0, sizeof(*o));

@@ -195,6 +195,9 @@ static int set_sim(struct sim_config *c, const char *k, const char *v, char *err
 	if (!strcmp(k, "return_delay_us"))
 		return parse_long(v, 0, 508, &n) ? (c->return_delay_us = (int)n, 0)
 		                                 : ERR("return_delay_us: '%s' is not a whole number 0..508", v);
+	if (!strcmp(k, "firmware"))
+		return parse_long(v, 1, 255, &n) ? (c->firmware = (int)n, 0)
+		                                 : ERR("firmware: '%s' is not a version 1..255", v);
 	if (!parse_num(v, &d))
 		return ERR("%s: '%s' is not a number", k, v);
 	if (!strcmp(k, "rate_hz"))
@@ -409,6 +412,9 @@ static int robot_key(struct sim_robot_config *r, const char *name, const char *k
 	if (!strcmp(k, "return_delay_us"))
 		return parse_long(v, 0, 508, &n) ? (r->return_delay_us = (int)n, 0)
 		                                 : ERR("return_delay_us: '%s' is not a whole number 0..508", v);
+	if (!strcmp(k, "firmware"))
+		return parse_long(v, 1, 255, &n) ? (r->firmware = (int)n, 0)
+		                                 : ERR("firmware: '%s' is not a version 1..255", v);
 	if (!strcmp(k, "position")) {
 		double x, y;
 		char first[64];

@@ -40,6 +40,7 @@ struct sim_robot_config {
 	int echo;                    /* -1: the [sim] value */
 	int return_delay_us;         /* < 0: the [sim] value */
 	int servo_baud_reg;          /* < 0: the register matching the bus baud */
+	int firmware;                /* X series' firmware version; 0: the model's (46) */
 	bool mirror;                 /* the body moves left for a positive angle (facing rigs) */
 	bool beta_set;               /* the robot's own mobility, in place of world.beta */
 	double beta;                 /* s */
@@ -73,6 +74,7 @@ struct sim_config {
 	double latency_ms;
 	bool echo;
 	int return_delay_us;         /* initial EEPROM value of every servo; < 0 = factory 500 µs */
+	int firmware;                /* X series' firmware version of every servo; 0: the model's (46) */
 	double ambient_c;
 	double initial_spread;       /* rad: initial angles uniform in ±spread (seeded) */
 	bool eeprom_needs_torque_off;

@@ -176,6 +176,149 @@ static void bus_send_replies(struct sim_bus *b, struct bus_reply *r, size_t n, i
 	}
 }
 
+/* ---- Fast Sync/Bulk Read: one packet, each servo its part in turn ---------------- */
+
+static uint16_t fast_le16(const uint8_t *p)
+{
+	return (uint16_t)(p[0] | (p[1] << 8));
+}
+
+/* The parts a fast read asks for, in its order (IDs and lengths; the data
+ * placeholders until the servos' own): 0 when the request does not parse,
+ * which no servo answers either. */
+static size_t fast_asked(const struct dxl_frame *req, struct dxl2_fast_part *parts, const uint8_t *zeros)
+{
+	size_t n = 0;
+	if (req->instr == DXL2_INST_FAST_SYNC_READ) {
+		if (req->nparams < 5)
+			return 0;
+		for (size_t k = 4; k < req->nparams && n < DXL2_MULTI_MAX; k++)
+			parts[n++] = (struct dxl2_fast_part){ req->params[k], 0, fast_le16(req->params + 2), zeros };
+		return n;
+	}
+	if (req->nparams % 5 != 0)
+		return 0;
+	for (size_t k = 0; k + 5 <= req->nparams && n < DXL2_MULTI_MAX; k += 5)
+		parts[n++] = (struct dxl2_fast_part){ req->params[k], 0, fast_le16(req->params + k + 3), zeros };
+	return n;
+}
+
+/* What a servo's reply (its part as an ordinary status, after the line's
+ * faults) puts in its slot: its ID and ERR, its data moved to the front of
+ * bytes. A reply whose CRC a fault broke is its part with a broken CRC
+ * (*bad_crc). False when a fault left no whole packet (silenced, cut): the
+ * servo sends no part and the chain stops there. */
+static bool fast_part_of(uint8_t *bytes, size_t len, struct dxl2_fast_part *part, const uint8_t *zeros,
+                         bool *bad_crc)
+{
+	struct dxl2_parser p;
+	struct dxl2_packet st;
+	size_t used = 0;
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	int r = dxl2_parser_feed(&p, bytes, len, &used, &st);
+	*bad_crc = false;
+	if (r == DXL_E_CHECKSUM && len >= DXL2_HEADER_BYTES + DXL2_CRC_BYTES) {
+		uint16_t crc = dxl2_crc_update(0, bytes, len - DXL2_CRC_BYTES);
+		bytes[len - 2] = (uint8_t)crc;
+		bytes[len - 1] = (uint8_t)(crc >> 8);
+		dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+		r = dxl2_parser_feed(&p, bytes, len, &used, &st);
+		*bad_crc = true;
+	}
+	if (r != DXL_FRAME)
+		return false;
+	part->id = st.id;
+	part->err = st.err;
+	if (st.nparams == part->len) {
+		memcpy(bytes, st.params, st.nparams);
+		part->data = bytes;
+	} else {
+		part->data = zeros;   /* an error status: the servo's ERR says why */
+	}
+	return true;
+}
+
+/* A bad-checksum fault on a servo's part: its CRC goes out wrong, and each
+ * servo after it computes its own CRC over the bytes it heard, the wrong
+ * one among them (so the last CRC, the packet's, checks: the controller
+ * finds the damage at that part, dxl2_fast_status_split). */
+static void fast_break_crcs(uint8_t *pkt, const size_t *ends, const bool *bad_crc, size_t n)
+{
+	bool broken = false;
+	for (size_t k = 0; k < n; k++) {
+		if (broken) {
+			uint16_t crc = dxl2_crc_update(0, pkt, ends[k] - DXL2_CRC_BYTES);
+			pkt[ends[k] - 2] = (uint8_t)crc;
+			pkt[ends[k] - 1] = (uint8_t)(crc >> 8);
+		}
+		if (bad_crc[k]) {
+			pkt[ends[k] - 2] ^= 0xFF;
+			pkt[ends[k] - 1] ^= 0xFF;
+			broken = true;
+		}
+	}
+}
+
+/* The servos that answered a fast read build one status packet: the first
+ * sends the header and its part after its return delay, each next one its
+ * part as soon as the one before has ended (no return delay of its own). A
+ * servo asked that sends nothing (not on the bus, below firmware 45, a
+ * fault) stops the chain: the packet ends with the part before it (README:
+ * the manual does not say what the others do). Slow and garbage faults act
+ * on a servo's turn, a bad checksum on its part's CRC (fast_break_crcs). */
+static void bus_send_fast(struct sim_bus *b, const struct dxl_frame *req, struct bus_reply *r, size_t n,
+                          int64_t req_end)
+{
+	static const uint8_t zeros[DXL2_MAX_PACKET];
+	uint8_t pkt[DXL2_MAX_PACKET];
+	struct dxl2_fast_part parts[DXL2_MULTI_MAX];
+	size_t ends[DXL2_MULTI_MAX];
+	int who[DXL2_MULTI_MAX];
+	bool bad_crc[DXL2_MULTI_MAX];
+	uint8_t garbage[SIM_BUS_MAX_SERVOS][SIM_FAULT_MAX_GARBAGE];
+	size_t ngarbage[SIM_BUS_MAX_SERVOS];
+	int64_t extra[SIM_BUS_MAX_SERVOS];
+	size_t nasked = fast_asked(req, parts, zeros);
+	for (size_t k = 0; k < nasked; k++) {
+		who[k] = -1;
+		bad_crc[k] = false;
+	}
+	for (size_t i = 0; i < n; i++) {
+		struct sim_joint *j = &b->joints[r[i].joint];
+		uint8_t id = j->ops->id(j);
+		size_t k = 0;
+		j->ops->reply_faults(j, &b->rng, r[i].bytes, &r[i].len, BUS_REPLY_MAX, garbage[i], &ngarbage[i], &extra[i]);
+		while (k < nasked && parts[k].id != id)
+			k++;
+		if (k < nasked && who[k] < 0 && fast_part_of(r[i].bytes, r[i].len, &parts[k], zeros, &bad_crc[k]))
+			who[k] = (int)i;
+	}
+	if (nasked == 0 || dxl2_encode_fast_status(pkt, sizeof pkt, parts, nasked, ends) < 0)
+		return;
+	fast_break_crcs(pkt, ends, bad_crc, nasked);
+	int64_t t = req_end;
+	size_t from = 0;
+	for (size_t k = 0; k < nasked && who[k] >= 0; k++) {
+		size_t i = (size_t)who[k];
+		struct sim_joint *j = &b->joints[r[i].joint];
+		int64_t first = (k == 0 ? t + j->ops->return_delay_ns(j) : t) + extra[i] + b->byte_ns;
+		if (ngarbage[i]) {
+			sim_line_put(&b->line, first + b->latency_ns, b->byte_ns, garbage[i], ngarbage[i]);
+			first += (int64_t)ngarbage[i] * b->byte_ns;
+		}
+		size_t len = ends[k] - from;
+		sim_line_put(&b->line, first + b->latency_ns, b->byte_ns, pkt + from, len);
+		b->count.replies++;
+		t = first + (int64_t)len * b->byte_ns - b->byte_ns;
+		from = ends[k];
+	}
+}
+
+static bool is_fast_read(uint8_t instr)
+{
+	return instr == DXL2_INST_FAST_SYNC_READ || instr == DXL2_INST_FAST_BULK_READ;
+}
+
 static void bus_dispatch(struct sim_bus *b, const struct dxl_frame *req, int64_t req_end)
 {
 	struct bus_reply r[SIM_BUS_MAX_SERVOS];
@@ -198,7 +341,10 @@ static void bus_dispatch(struct sim_bus *b, const struct dxl_frame *req, int64_t
 			n++;
 		}
 	}
-	bus_send_replies(b, r, n, req_end);
+	if (dxl_proto_can(b->proto, DXL_CAP_FAST_READ) && is_fast_read(req->instr))
+		bus_send_fast(b, req, r, n, req_end);
+	else
+		bus_send_replies(b, r, n, req_end);
 }
 
 /* The parser dropped a packet for its checksum: find it in the bytes just

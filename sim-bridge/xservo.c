@@ -37,6 +37,7 @@ static const double pulses_per_rad = DXL2_POS_PER_REV / (2.0 * DXL2_PI);
 void sim_xservo_default_options(struct sim_xservo_options *o)
 {
 	o->overload_time_s = 0.5;
+	o->firmware = 0;
 }
 
 /* ---- the table ------------------------------------------------------------------ */
@@ -171,7 +172,8 @@ static void xservo_load_defaults(struct sim_xservo *s, enum dxl_area area)
 			dxl2_reg_encode(r, r->def, &s->mem[r->addr]);
 	}
 	if (area == DXL_AREA_EEPROM)
-		s->mem[DXL2_X_FIRMWARE_VERSION] = sim_model_info(s->model)->firmware;
+		s->mem[DXL2_X_FIRMWARE_VERSION] = s->opt.firmware > 0 ? (uint8_t)s->opt.firmware
+		                                                      : sim_model_info(s->model)->firmware;
 }
 
 /* The gains the manual resets when the Operating Mode changes (the table's
@@ -253,7 +255,8 @@ static bool xservo_level_allows(const struct sim_xservo *s, uint8_t instr)
 	uint8_t level = s->mem[A_LEVEL];
 	if (instr == DXL2_INST_PING)
 		return true;
-	if (instr == DXL2_INST_READ || instr == DXL2_INST_SYNC_READ || instr == DXL2_INST_BULK_READ)
+	if (instr == DXL2_INST_READ || instr == DXL2_INST_SYNC_READ || instr == DXL2_INST_BULK_READ ||
+	    instr == DXL2_INST_FAST_SYNC_READ || instr == DXL2_INST_FAST_BULK_READ)
 		return level >= 1;
 	return level >= 2;
 }
@@ -566,15 +569,27 @@ static bool xservo_bulk_part(const struct sim_xservo *s, const struct dxl2_packe
 
 static bool xservo_part(const struct sim_xservo *s, const struct dxl2_packet *req, struct xservo_part *part)
 {
-	if (req->instr == DXL2_INST_SYNC_READ || req->instr == DXL2_INST_SYNC_WRITE)
+	if (req->instr == DXL2_INST_SYNC_READ || req->instr == DXL2_INST_SYNC_WRITE ||
+	    req->instr == DXL2_INST_FAST_SYNC_READ)
 		return xservo_sync_part(s, req, part);
 	return xservo_bulk_part(s, req, part);
+}
+
+static bool is_fast(uint8_t instr)
+{
+	return instr == DXL2_INST_FAST_SYNC_READ || instr == DXL2_INST_FAST_BULK_READ;
 }
 
 static bool is_multi(uint8_t instr)
 {
 	return instr == DXL2_INST_SYNC_READ || instr == DXL2_INST_SYNC_WRITE || instr == DXL2_INST_BULK_READ ||
-	       instr == DXL2_INST_BULK_WRITE;
+	       instr == DXL2_INST_BULK_WRITE || is_fast(instr);
+}
+
+bool sim_xservo_fast_read(const struct sim_xservo *s)
+{
+	const struct dxl2_model *m = dxl2_model_by_number(sim_model_info(s->model)->model_number);
+	return dxl2_model_fast_read(m, s->mem[DXL2_X_FIRMWARE_VERSION]);
 }
 
 bool sim_xservo_addressed(const struct sim_xservo *s, const struct dxl2_packet *req)
@@ -595,7 +610,13 @@ bool sim_xservo_addressed(const struct sim_xservo *s, const struct dxl2_packet *
 static int xservo_multi(struct sim_xservo *s, const struct dxl2_packet *req, uint8_t id, uint8_t *out, size_t cap)
 {
 	struct xservo_part part;
-	bool read = req->instr == DXL2_INST_SYNC_READ || req->instr == DXL2_INST_BULK_READ;
+	bool read = req->instr == DXL2_INST_SYNC_READ || req->instr == DXL2_INST_BULK_READ || is_fast(req->instr);
+	if (is_fast(req->instr) && !sim_xservo_fast_read(s)) {
+		/* an instruction this firmware does not know (below 45): sent to
+		 * broadcast, it gets no status */
+		xservo_count(s, DXL2_ERRNUM_INSTRUCTION);
+		return 0;
+	}
 	if (req->id != DXL2_BROADCAST_ID) {
 		xservo_count(s, DXL2_ERRNUM_INSTRUCTION);
 		return xservo_level_allows(s, req->instr) ? xservo_reply(s, id, DXL2_ERRNUM_INSTRUCTION, NULL, 0, out, cap) : 0;
@@ -680,6 +701,8 @@ int sim_xservo_handle(struct sim_xservo *s, const struct dxl2_packet *req, uint8
 	case DXL2_INST_SYNC_WRITE:
 	case DXL2_INST_BULK_READ:
 	case DXL2_INST_BULK_WRITE:
+	case DXL2_INST_FAST_SYNC_READ:
+	case DXL2_INST_FAST_BULK_READ:
 		return xservo_multi(s, req, id, out, cap);
 	default:
 		err = DXL2_ERRNUM_INSTRUCTION;

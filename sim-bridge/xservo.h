@@ -48,6 +48,10 @@ struct sim_xservo_options {
 	/* How long (s) the motor must sit at its torque cap before the overload
 	 * error (the manual gives no figure; default 0.5 s, as the AX-12A's). */
 	double overload_time_s;
+	/* The firmware version it reports (register 6, PING) and acts as: Fast
+	 * Sync/Bulk Read from the model's first (X430: 45). 0: the model's
+	 * (dxl2_model.firmware, 46). */
+	int firmware;
 };
 
 struct sim_xservo_counters {
@@ -110,9 +114,15 @@ bool sim_xservo_addressed(const struct sim_xservo *s, const struct dxl2_packet *
  * (and built) before the instruction acts: a write of the ID is answered
  * under the old ID, REBOOT and FACTORY_RESET answer before they boot the
  * servo. SYNC_READ and BULK_READ are answered as a READ; the bus orders the
- * replies of several servos.
+ * replies of several servos. FAST_SYNC_READ and FAST_BULK_READ too (the
+ * servo's part as an ordinary status packet: the bus builds the one packet
+ * of all parts, dxl2_encode_fast_status), when the firmware has them
+ * (sim_xservo_fast_read); below that the servo does not answer them.
  */
 int sim_xservo_handle(struct sim_xservo *s, const struct dxl2_packet *req, uint8_t *out, size_t cap);
+/* Whether this servo answers Fast Sync/Bulk Read: its model's, from its
+ * firmware (register 6). */
+bool sim_xservo_fast_read(const struct sim_xservo *s);
 /* A packet to `id` with instruction `instr` arrived with a bad CRC: the
  * servo answers with the CRC error (3) where it would answer instr. */
 int sim_xservo_handle_bad_crc(struct sim_xservo *s, uint8_t id, uint8_t instr, uint8_t *out, size_t cap);

@@ -3,7 +3,10 @@
  * (both kinds), the SYNC_READ reply tracker, and the bus layer's 2.0
  * transactions (a READ, a SYNC_READ of four servos, a broadcast PING) whose
  * replies are the input. The body, shared with the 1.0 target, is
- * tests/fuzz/protocol_fuzz.h; here is what only 2.0 checks and does.
+ * tests/fuzz/protocol_fuzz.h; here is what only 2.0 checks and does,
+ * Fast Sync/Bulk Read included: a status from 0xFE is the bytes it came
+ * from unstuffed, and splits against a request of four servos into sound
+ * parts up to the first failure; the bus runs a Fast Sync Read too.
  *
  *   make fuzz-build && build/fuzz/fuzz_protocol_parser2 -max_total_time=60
  */
@@ -35,6 +38,74 @@ static void v2_tracker_frame(const struct dxl_frame *f)
 	int a = dxl2_multi_read_accept(&tracker, &pkt, &slot);
 	CHECK(a == DXL_OK || a == DXL_E_WRONG_ID || a == DXL_E_WRONG_LENGTH);
 	CHECK(a != DXL_OK || (slot < 4 && tracked_ids[slot] == pkt.id));
+}
+
+/* A fast read's status: not stuffed, so its frame is its bytes (header,
+ * INST, ERR, params, CRC); split against a Fast Sync Read of IDs 1-4 (4
+ * bytes each) and a Fast Bulk Read, it gives sound parts up to the first
+ * failure. */
+static void v2_check_fast(const struct dxl2_packet *f)
+{
+	static struct dxl2_packet pkt, back;
+	static struct dxl2_multi_read m;
+	static struct dxl2_parser again;
+	static uint8_t wire[DXL2_MAX_PACKET];
+	struct dxl2_fast_part parts[4];
+	const struct dxl2_bulk_item items[4] = { { 1, 0, 1, NULL }, { 2, 0, 2, NULL }, { 3, 0, 4, NULL },
+		                                 { 4, 0, 3, NULL } };
+	size_t good = 99, used = 0, len = 2u + f->nparams + DXL2_CRC_BYTES;  /* INST ERR params CRC */
+	CHECK(f->wire_bytes == DXL2_HEADER_BYTES + len);
+	const uint8_t head[9] = { 0xFF, 0xFF, 0xFD, 0x00, 0xFE, (uint8_t)len, (uint8_t)(len >> 8), 0x55, f->err };
+	memcpy(wire, head, sizeof head);
+	memcpy(wire + sizeof head, f->params, f->nparams);
+	uint16_t crc = dxl2_crc_update(0, wire, sizeof head + f->nparams);
+	wire[f->wire_bytes - 2] = (uint8_t)crc;
+	wire[f->wire_bytes - 1] = (uint8_t)(crc >> 8);
+	dxl2_parser_init(&again, DXL2_PARSE_STATUS);
+	dxl2_parser_expect_fast(&again, true);
+	CHECK(dxl2_parser_feed(&again, wire, f->wire_bytes, &used, &back) == DXL_FRAME && used == f->wire_bytes);
+	CHECK(back.nparams == f->nparams && memcmp(back.params, f->params, f->nparams) == 0);
+	pkt = *f;
+	CHECK(dxl2_multi_read_sync(&m, 4, tracked_ids, 4) == DXL_OK);
+	for (int round = 0; round < 2; round++) {
+		int r = dxl2_fast_status_split(&pkt, &m, parts, &good);
+		CHECK(r == DXL_OK || r == DXL_E_WRONG_ID || r == DXL_E_WRONG_LENGTH || r == DXL_E_CHECKSUM);
+		CHECK(good <= m.n && (r == DXL_OK) == (good == m.n));
+		for (size_t i = 0; i < good; i++) {
+			CHECK(parts[i].id == m.ids[i] && parts[i].len == m.len[i]);
+			CHECK(parts[i].data >= pkt.params && parts[i].data + parts[i].len <= pkt.params + pkt.nparams);
+		}
+		CHECK(dxl2_multi_read_bulk(&m, items, 4) == DXL_OK);
+	}
+}
+
+/* The status parser awaiting a fast read, fed the input in chunks: frames
+ * and errors only, every fast frame re-read from its bytes and split. */
+static void v2_run_fast_parser(const uint8_t *data, size_t size)
+{
+	static struct dxl2_parser p;
+	static struct dxl2_packet f;
+	size_t off = 0;
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	dxl2_parser_expect_fast(&p, true);
+	while (off < size) {
+		size_t chunk = 1 + (data[off] % 64), used = 0;
+		if (chunk > size - off)
+			chunk = size - off;
+		int r = dxl2_parser_feed(&p, data + off, chunk, &used, &f);
+		off += used;
+		for (;;) {
+			if (r == DXL_FRAME && f.id == DXL2_BROADCAST_ID)
+				v2_check_fast(&f);
+			else
+				CHECK(r == DXL_FRAME || r == DXL_NEED_MORE || r == DXL_E_CHECKSUM || r == DXL_E_HEADER ||
+				      r == DXL_E_STUFFING);
+			if (r == DXL_NEED_MORE)
+				break;
+			r = dxl2_parser_feed(&p, NULL, 0, &used, &f);
+		}
+	}
+	CHECK(p.have <= DXL2_MAX_PACKET);
 }
 
 static void v2_tracker_end(void)
@@ -78,6 +149,12 @@ static void v2_run_bus(const uint8_t *data, size_t size, uint32_t seed, bool ech
 	memset(&m, 0, sizeof m);
 	m.data = buf;
 	m.cap = sizeof buf;
+	check_multi(&b, &m, bus_fast_sync_read(&b, 132, 4, ids, 4, &m));
+	for (size_t i = 0; i < m.n; i++)
+		CHECK(m.status[i] != DXL_OK || b.servo[m.id[i]].replies > 0);
+	memset(&m, 0, sizeof m);
+	m.data = buf;
+	m.cap = sizeof buf;
 	r = bus_ping_all_begin(&b, &m);
 	if (r == DXL_OK)
 		r = bus_wait_done(&b, NULL);
@@ -101,5 +178,6 @@ static const struct fuzz_backend v2 = {
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+	v2_run_fast_parser(data, size);
 	return fuzz_protocol_one(&v2, data, size);
 }

@@ -11,7 +11,10 @@
 #  - an Operating Mode changed behind the daemon's back is put back;
 #  - torque actuation: an XM430 in current control (the paper's rig), an
 #    XL430 in PWM control, each back in position control on HOLD and at
-#    the safe stop; current control asked of an XL430 is refused.
+#    the safe stop; current control asked of an XL430 is refused;
+#  - the cycle's read: the XM430s run firmware 44 (no Fast Sync Read: the
+#    plain SYNC_READ, said at start), the XL430 46 (Fast Sync Read, said;
+#    its servo silent for a while: back to SYNC_READ, said, still read).
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
@@ -33,6 +36,7 @@ return_delay_us = 0
 link = $T/xm
 ids = 1,2
 model = xm430-w350
+firmware = 44
 contact = none
 [robot r2]
 link = $T/xl
@@ -57,6 +61,9 @@ if grep -qE "protocol: servo [12] answered a Protocol 2.0 PING on $T/xm at 10000
 	grep -q "Protocol 2.0 (XM430-W350), mode HOLD" "$T/d.log"; then
 	tap_ok "protocol auto: Protocol 2.0 found by PING, the model named"
 else tap_fail "protocol auto" "$(head -5 "$T/d.log")"; fi
+if grep -q "bus: the cycle reads by SYNC_READ, a status packet per servo: no Fast Sync Read, as servo 1 (XM430-W350, firmware 44) does not answer it" "$T/d.log"; then
+	tap_ok "servos on firmware 44: the cycle reads by SYNC_READ, and the log says why"
+else tap_fail "firmware 44: SYNC_READ said" "$(grep -a 'bus:' "$T/d.log" | head -3)"; fi
 
 # ---- start-up: what the servos hold -------------------------------------------------------------------
 got="$(peek r1 1 operating_mode) $(peek r1 2 operating_mode) $(peek r1 1 min_position_limit) $(peek r1 1 max_position_limit)"
@@ -177,6 +184,18 @@ if grep -q "joint 1: position actuation's default k 0.0105, mu 0.036 are the XL4
 	[ "$n1" = "$n0" ] && over "$sw" 1.2; then
 	tap_ok "one XL430 joint on its own defaults: swings $sw rad peak to peak, no stall in 8 s"
 else tap_fail "XL430 on its defaults" "swing $sw rad, $((n1 - n0)) stall(s); $(grep -a default "$T/dp.log" | head -2)"; fi
+if grep -q "bus: the cycle reads by Fast Sync Read, one status packet for all servos (servo 1 XL430-W250 firmware 46)" "$T/dp.log"; then
+	tap_ok "firmware 46: the cycle reads by Fast Sync Read, said at start (the swing above ran on it)"
+else tap_fail "Fast Sync Read said" "$(grep -a 'bus:' "$T/dp.log" | head -3)"; fi
+ctl fault r2 1 no-reply count=5 >/dev/null
+wait_cycles 100
+# 5 cycles without a reading may stop the gait for a moment (the starter
+# restarts it): swinging again is waited for, not assumed at once
+swings_again() { over "$(swing 0 100)" 0.3; }
+if wait_log dp "Fast Sync Read read nobody 3 cycles in a row: reading by SYNC_READ" 5 && state_is ' mode=3 ' 1 &&
+	wait_for 15 swings_again; then
+	tap_ok "its servo silent 5 cycles: back to SYNC_READ after 3, said; the joint read and swinging again"
+else tap_fail "fast read fallback" "$(grep -a 'Fast Sync Read' "$T/dp.log" | tail -3); swing $(swing 0 100)"; fi
 stop dp >/dev/null
 
 # ---- --tune on an X servo: from the model's defaults, and the file says so ----------------------------------

@@ -121,6 +121,31 @@ if wait_log dhalf "ready: t$$.STATE" 15; then
 		test "$(grep -cE '^OK +ID [12] position limits +1723\.\.2373, around the configuration.s 1723\.\.2373' "$T/halfdoc.out")" = 2
 else tap_fail "undulated sets +-0.5 rad up on the X bus" "$(cat "$T/dhalf.log")"; fi
 
+# sync-read: one SYNC_READ of a register from several servos; --fast: one
+# Fast Sync Read (one status packet for all). On firmware 44 nobody
+# answers the fast one, and dxl says why and what to do.
+run sread --port "$xl" --baud 1000000 sync-read present_position 1 2
+run fread --port "$xl" --baud 1000000 sync-read present_position 1 2 --fast
+ids_of() { awk '{ print $1 }' "$T/$1.out" | tr '\n' ' '; }
+check "sync-read and sync-read --fast: one line per servo, IDs 1 then 2, each a position" fread \
+	test "$rc" -eq 0 -a "$(grep -cE '^[12] [0-9]+$' "$T/fread.out")" = 2 -a "$(grep -cE '^[12] [0-9]+$' "$T/sread.out")" = 2 \
+	-a "$(ids_of sread)" = "1 2 " -a "$(ids_of fread)" = "1 2 "
+run fvolt --port "$xl" --baud 1000000 sync-read present_input_voltage 2 1 --fast --units
+check "sync-read --fast --units: in request order, in volts" fvolt \
+	test "$(ids_of fvolt)" = "2 1 " -a "$(grep -cE '^[12] [0-9]+ \([0-9]+\.[0-9] V\)$' "$T/fvolt.out")" = 2
+old="$T/old"
+spawn simold "$sim" --model xl430-w250 --link "$old" --ids 1,2 --baud 1000000 --firmware 44 --lcm-url "$(lcm_url 7642)" --quiet
+if wait_log simold 'ready' 10; then
+	run oping --port "$old" --baud 1000000 ping 1
+	run ofast --port "$old" --baud 1000000 sync-read present_position 1 2 --fast
+	orc=$rc
+	run oslow --port "$old" --baud 1000000 sync-read present_position 1 2
+	check "firmware 44: ping says 44, --fast gets no answer (exit 4, says firmware 45), plain sync-read works" ofast \
+		test "$orc" -eq 4 -a "$rc" -eq 0 -a "$(grep -cE '^[12] [0-9]+$' "$T/oslow.out")" = 2 \
+		-a -n "$(grep 'firmware 44' "$T/oping.out")" -a -n "$(grep 'firmware 45' "$T/ofast.err")"
+	stop simold
+else tap_fail "simulator on firmware 44 ready" "$(cat "$T/simold.log")"; fi
+
 xm="$T/xm"
 spawn simxm "$sim" --model xm430-w350 --link "$xm" --ids 3 --baud 1000000 --lcm-url "$(lcm_url 7641)" --quiet
 if wait_log simxm 'ready' 10; then

@@ -57,6 +57,15 @@ contact = none
 model = xc430-w150
 ids = 5,6
 contact = none
+[robot fx]
+model = xm430-w350
+ids = 7,8,9
+contact = none
+[robot old]
+model = xl430-w250
+ids = 10,11
+firmware = 44
+contact = none
 EOT
 spawn sim "$B/undulate-sim" --scenario "$T/sdk.scenario" --link-dir "$T/bus" --control "$T/ctl" \
 	--lcm-url "$(lcm_url 7698)" --seed 3
@@ -81,6 +90,28 @@ run_client sdk_p1 "$T/bus/ax" 3 4
 run_client sdk_p2 "$T/bus/x" 1 2
 # the model added as data only (protocol/dxl2_table.c), through the same SDK
 run_client sdk_p2 "$T/bus/xc" --xc430 5 6
+
+# ---- the Python SDK's Fast Sync Read / Fast Bulk Read (its C port has none) ----------
+# Where the checkout has python/src and a python3 has pyserial (Debian:
+# python3-serial): the one status packet of the fast reads, parsed by them.
+py_src="${1%/}/python/src"; [ -d "$py_src" ] || py_src="${1%/}/../python/src"
+py=""
+for p in python3 /usr/bin/python3; do "$p" -c 'import serial' 2>/dev/null && { py=$p; break; }; done
+if [ ! -d "$py_src/dynamixel_sdk" ] || [ -z "$py" ]; then
+	echo "# the Python SDK's fast reads not tried: no $py_src/dynamixel_sdk or no python3 with pyserial (python3-serial)"
+else
+	for run in "fx fast 7 8 9" "old none 10 11"; do
+		set -- $run
+		while IFS= read -r line; do
+			case "$line" in
+			"ok "*) tap_ok "sdk_fast ($1): ${line#ok [0-9]* - }" ;;
+			"not ok "*) tap_fail "sdk_fast ($1): ${line#not ok [0-9]* - }" ;;
+			"1.."*) ;;
+			*) echo "# sdk_fast: $line" ;;
+			esac
+		done < <(timeout 60 "$py" "$here/sdk_fast.py" "$py_src" "$T/bus/$1" 57600 "${@:2}" 2>&1)
+	done
+fi
 
 # ---- what the simulator saw: every SDK packet parsed, nothing malformed ---------------
 stop sim >/dev/null

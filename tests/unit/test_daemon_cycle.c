@@ -36,6 +36,7 @@
 
 #include "../../daemon/control.h"
 #include "../../daemon/cycle.h"
+#include "../../daemon/setup.h"
 #include "bus.h"
 #include "dxl.h"
 #include "dxl2.h"
@@ -1234,6 +1235,58 @@ static void test_writes_are_the_models_x(void **state)
 	}
 }
 
+/* Fast Sync Read: where every servo answers it (model and firmware, as read
+ * at start-up), one a cycle in place of the SYNC_READ, the same readings in
+ * a shorter bus time; a servo on firmware 44 keeps the SYNC_READ. A servo
+ * lost takes every joint's reading with it (the chain stops at its part),
+ * until after CYC_FAST_FAILS_MAX cycles the SYNC_READ reads the others
+ * again, said once. */
+static void test_fast_sync_read(void **state)
+{
+	(void)state;
+	char why[256];
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	run(20);
+	double sync_bus_us = y.bus_us;
+	c.j[0].servo.firmware = 46;
+	c.j[1].servo.firmware = 44;
+	assert_false(setup_fast_read(&bus, &c, why, sizeof why));
+	assert_non_null(strstr(why, "servo 2 (XM430-W350, firmware 44)"));
+	c.j[1].servo.firmware = 45;
+	assert_true(setup_fast_read(&bus, &c, why, sizeof why));
+	cyc_set_fast_read(&y, true);
+	unsigned before = atomic_load(&xb.sync_reads);
+	run(100);
+	assert_int_equal(atomic_load(&xb.fast_reads), 100);
+	assert_int_equal(atomic_load(&xb.sync_reads), before);
+	assert_int_equal(y.errors, 0);
+	assert_int_equal(cuts, 0);
+	for (size_t j = 0; j < 2; j++) {
+		assert_int_equal(c.j[j].stale_cycles, 0);
+		assert_true(fabs(c.j[j].voltage - 12.0) < 1e-9 && fabs(c.j[j].temperature - 36) < 1e-9);
+	}
+	/* one header and one return delay fewer per servo: 2 x 11 bytes less */
+	print_message("# bus time: SYNC_READ cycle %.0f us, Fast Sync Read cycle %.0f us\n", sync_bus_us, y.bus_us);
+	assert_true(y.bus_us < sync_bus_us);
+	/* servo 1 lost: neither joint is read, three cycles; then SYNC_READ */
+	xs(1)->powered = false;
+	run(CYC_FAST_FAILS_MAX);
+	assert_int_equal(y.fast_fallbacks, 1);
+	assert_false(y.fast_read);
+	assert_int_equal(c.j[1].stale_cycles, CYC_FAST_FAILS_MAX);
+	run(2);
+	assert_int_equal(c.j[1].stale_cycles, 0);   /* read again */
+	assert_int_equal(c.j[0].stale_cycles, CYC_FAST_FAILS_MAX + 2);
+	assert_int_equal(atomic_load(&xb.fast_reads), 100 + CYC_FAST_FAILS_MAX);
+	xs(1)->powered = true;
+	/* not on a 1.0 bus */
+	cyc_set_fast_read(&y, true);
+	assert_int_equal(bus_set_protocol(&bus, BUS_PROTOCOL_1), DXL_OK);
+	cyc_set_fast_read(&y, true);
+	assert_false(y.fast_read);
+	assert_false(setup_fast_read(&bus, &c, why, sizeof why));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1262,6 +1315,7 @@ int main(void)
 		cmocka_unit_test(test_switch_stops_half_way),
 		cmocka_unit_test(test_drive_only_where_ready),
 		cmocka_unit_test(test_writes_are_the_models_x),
+		cmocka_unit_test(test_fast_sync_read),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -658,6 +658,97 @@ static void test_v2_sync_read_order_and_missing(void **state)
 	assert_int_equal(st[1].nparams, 1);
 }
 
+/* Fast Sync Read / Fast Bulk Read (e-manual, Protocol 2.0): one status
+ * packet from 0xFE, the servos' parts in the request's order, each going
+ * out as soon as the one before it has ended: one return delay (the
+ * first's) for all. A servo below firmware 45 does not know the
+ * instruction and stays silent: the chain stops at its part. */
+static void test_v2_fast_read(void **state)
+{
+	(void)state;
+	struct sim_bus b;
+	uint8_t req[64], out[128];
+	int64_t first, last;
+	struct dxl2_parser p;
+	struct dxl2_packet st;
+	struct dxl2_multi_read m;
+	struct dxl2_fast_part parts[3];
+	size_t used = 0, good = 0;
+	static const uint8_t ids[] = { 3, 7, 4 };
+	bus_x(&b, ids, 3, 1000000);
+	for (size_t k = 0; k < 3; k++) {
+		sim_xservo_poke(&b.joints[k].xservo, DXL2_X_RETURN_DELAY_TIME, 50);   /* 100 µs */
+		sim_xservo_poke(&b.joints[k].xservo, DXL2_X_PRESENT_POSITION, k == 0 ? 166 : k == 1 ? 2079 : 1023);
+	}
+	int n = dxl2_encode_fast_sync_read(req, sizeof req, DXL2_X_PRESENT_POSITION, 4, ids, 3);
+	sim_bus_feed(&b, req, (size_t)n, 0);
+	size_t got = drain(&b, out, sizeof out, &first, &last);
+	/* the e-manual's example, byte for byte (its XC330s at these positions) */
+	static const uint8_t manual[] = { HDR, 0xFE, 0x19, 0x00, 0x55, 0x00, 0x03, 0xA6, 0x00, 0x00, 0x00, 0x84, 0x08,
+		                          0x00, 0x07, 0x1F, 0x08, 0x00, 0x00, 0x16, 0xCA, 0x00, 0x04, 0xFF, 0x03,
+		                          0x00, 0x00, 0xD1, 0x9E };
+	assert_int_equal(got, sizeof manual);
+	assert_memory_equal(out, manual, sizeof manual);
+	/* one return delay, then 32 bytes back to back */
+	assert_int_equal(first, (int64_t)(n + 1) * 10 * US + 100 * US);
+	assert_int_equal(last - first, 31 * 10 * US);
+	assert_int_equal(b.line.collisions, 0);
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	dxl2_parser_expect_fast(&p, true);
+	assert_int_equal(dxl2_parser_feed(&p, out, got, &used, &st), DXL_FRAME);
+	assert_int_equal(dxl2_multi_read_sync(&m, 4, ids, 3), DXL_OK);
+	assert_int_equal(dxl2_fast_status_split(&st, &m, parts, &good), DXL_OK);
+
+	/* Fast Bulk Read: the manual's request, each servo its own register */
+	sim_xservo_poke(&b.joints[1].xservo, DXL2_X_PRESENT_PWM, 421);
+	sim_xservo_poke(&b.joints[2].xservo, DXL2_X_PRESENT_TEMPERATURE, 31);
+	static const uint8_t bulk[] = { HDR, 0xFE, 0x12, 0x00, 0x9A, 0x03, 0x84, 0x00, 0x04, 0x00, 0x07, 0x7C, 0x00,
+		                        0x02, 0x00, 0x04, 0x92, 0x00, 0x01, 0x00, 0xDA, 0x2D };
+	static const uint8_t bulk_status[] = { HDR, 0xFE, 0x14, 0x00, 0x55, 0x00, 0x03, 0xA6, 0x00, 0x00, 0x00, 0x67,
+		                               0xA4, 0x00, 0x07, 0xA5, 0x01, 0x24, 0x74, 0x00, 0x04, 0x1F, 0xD9, 0xC1 };
+	sim_bus_feed(&b, bulk, sizeof bulk, 10 * MS);
+	got = drain(&b, out, sizeof out, &first, &last);
+	assert_int_equal(got, sizeof bulk_status);
+	assert_memory_equal(out, bulk_status, sizeof bulk_status);
+
+	/* ID 7 on firmware 44: it does not answer, and ID 4 after it cannot
+	 * take its turn; ID 3's part went out (the packet cut after it) */
+	sim_xservo_poke(&b.joints[1].xservo, DXL2_X_FIRMWARE_VERSION, 44);
+	sim_bus_feed(&b, req, (size_t)n, 20 * MS);
+	got = drain(&b, out, sizeof out, &first, &last);
+	assert_int_equal(got, 16);
+	assert_memory_equal(out, manual, 16);
+	/* ID 3 on firmware 44: nothing at all; the plain SYNC_READ still works */
+	sim_xservo_poke(&b.joints[1].xservo, DXL2_X_FIRMWARE_VERSION, 46);
+	sim_xservo_poke(&b.joints[0].xservo, DXL2_X_FIRMWARE_VERSION, 44);
+	sim_bus_feed(&b, req, (size_t)n, 30 * MS);
+	assert_int_equal(drain(&b, out, sizeof out, &first, &last), 0);
+	n = dxl2_encode_sync_read(req, sizeof req, DXL2_X_PRESENT_POSITION, 4, ids, 3);
+	sim_bus_feed(&b, req, (size_t)n, 40 * MS);
+	assert_int_equal(drain(&b, out, sizeof out, &first, &last), 3 * 15);
+
+	/* a bad-checksum fault on ID 7's part: its CRC goes out wrong, and ID
+	 * 4's (the packet's), computed over what it heard, checks: the
+	 * controller finds the damage at ID 7's part, ID 3's part sound */
+	sim_xservo_poke(&b.joints[0].xservo, DXL2_X_FIRMWARE_VERSION, 46);
+	set_fault(&b, "bad-checksum count=1");
+	b.joints[1].faults = b.joints[0].faults;
+	sim_faults_clear(&b.joints[0].faults);
+	n = dxl2_encode_fast_sync_read(req, sizeof req, DXL2_X_PRESENT_POSITION, 4, ids, 3);
+	sim_bus_feed(&b, req, (size_t)n, 50 * MS);
+	got = drain(&b, out, sizeof out, &first, &last);
+	assert_int_equal(got, sizeof manual);
+	assert_memory_equal(out, manual, 22);
+	assert_int_equal(out[22], manual[22] ^ 0xFF);
+	assert_int_equal(out[23], manual[23] ^ 0xFF);
+	assert_memory_equal(out + 24, manual + 24, 6);
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	dxl2_parser_expect_fast(&p, true);
+	assert_int_equal(dxl2_parser_feed(&p, out, got, &used, &st), DXL_FRAME);
+	assert_int_equal(dxl2_fast_status_split(&st, &m, parts, &good), DXL_E_CHECKSUM);
+	assert_int_equal(good, 1);
+}
+
 /* A broadcast PING: every servo answers, lowest ID first (e-manual: "in
  * their arranged order"), without colliding, whatever the wiring order. */
 static void test_v2_broadcast_ping_in_id_order(void **state)
@@ -968,6 +1059,7 @@ int main(void)
 		ONE(test_v1_packet_inside_a_bad_packet),
 		ONE(test_v2_ping_at_57600),
 		ONE(test_v2_sync_read_order_and_missing),
+		ONE(test_v2_fast_read),
 		ONE(test_v2_broadcast_ping_in_id_order),
 		ONE(test_v2_bad_crc_broadcast),
 		ONE(test_v2_bad_input_counters),

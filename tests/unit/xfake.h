@@ -64,6 +64,7 @@ struct xfake {
 	atomic_uint writes;          /* WRITEs executed (SYNC_WRITE parts too) */
 	atomic_uint reboots;
 	atomic_uint sync_reads, sync_writes;
+	atomic_uint fast_reads;      /* Fast Sync Reads heard (firmware or not) */
 };
 
 static inline uint16_t xfake_crc(const uint8_t *p, size_t n)
@@ -274,11 +275,54 @@ static inline void xfake_sync(struct xfake *fb, uint8_t instr, const uint8_t *p,
 	}
 }
 
+/* FAST_SYNC_READ (0x8A): addr(2) len(2) IDs — ONE status packet from 0xFE
+ * (e-manual, Protocol 2.0): the first listed servo sends the header and its
+ * part after its return delay, each next one its part, every part ERR ID
+ * data CRC, the CRC over every byte before it; never stuffed. Built here on
+ * its own (this fake's CRC, not protocol/'s encoder). A servo below
+ * firmware 45, silent or not there ends the chain: the packet is cut. */
+#define XFAKE_FAST_READ_FIRMWARE 45
+static inline void xfake_fast_sync(struct xfake *fb, const uint8_t *p, size_t n)
+{
+	uint8_t pkt[1024];
+	if (n < 5)
+		return;
+	uint16_t addr = (uint16_t)xfake_get(p, 0, 2), len = (uint16_t)xfake_get(p, 2, 2);
+	size_t total = 8 + (n - 4) * ((size_t)len + 4), k = 8;
+	if (len == 0 || addr + len > XFAKE_TABLE || total > sizeof pkt)
+		return;
+	atomic_fetch_add(&fb->fast_reads, 1);
+	const uint8_t head[8] = { 0xFF, 0xFF, 0xFD, 0x00, 0xFE, (uint8_t)(total - 7), (uint8_t)((total - 7) >> 8), 0x55 };
+	memcpy(pkt, head, sizeof head);
+	unsigned delay_us = 0;
+	for (size_t off = 4; off < n; off++) {
+		struct xfake_servo *s = xfake_servo_by_id(fb, p[off]);
+		if (s == NULL || !xfake_hears(fb, s) || s->mem[68] < 1 || s->mem[6] < XFAKE_FAST_READ_FIRMWARE)
+			break;
+		if (off == 4)
+			delay_us = s->mem[9] * 2u;
+		uint8_t alert = fb->alert_from_hwerr && s->mem[70] ? 0x80 : 0;
+		pkt[k++] = (uint8_t)(s->err | alert);
+		pkt[k++] = s->mem[7];
+		memcpy(&pkt[k], &s->mem[addr], len);
+		k += len;
+		uint16_t crc = xfake_crc(pkt, k);
+		pkt[k++] = (uint8_t)crc;
+		pkt[k++] = (uint8_t)(crc >> 8);
+	}
+	if (k > 8)
+		fb->emit(fb->ctx, pkt, k, delay_us);
+}
+
 static inline void xfake_dispatch(struct xfake *fb, uint8_t id, uint8_t instr, const uint8_t *p, size_t n)
 {
 	atomic_fetch_add(&fb->packets, 1);
 	if (id == 0xFE && (instr == 0x82 || instr == 0x83)) {
 		xfake_sync(fb, instr, p, n);
+		return;
+	}
+	if (id == 0xFE && instr == 0x8A) {
+		xfake_fast_sync(fb, p, n);
 		return;
 	}
 	/* a broadcast PING is answered by every servo, in ID order */

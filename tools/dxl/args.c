@@ -119,6 +119,7 @@ static const struct dxlt_opt dxlt_opts[] = {
 	{ "--status-level", OPT_VALUE }, { "--help", OPT_FLAG },   { "-h", OPT_FLAG },
 	{ "--rs485", OPT_VALUE },      { "--config", OPT_VALUE },  { "--cycles", OPT_VALUE },
 	{ "--protocol", OPT_VALUE },   { "--size", OPT_VALUE },    { "--keep", OPT_VALUE },
+	{ "--fast", OPT_FLAG },
 };
 
 static const struct dxlt_opt *dxlt_find_opt(const char *arg, size_t len)
@@ -165,6 +166,8 @@ static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val
 		rc = dxlt_opt_long(err, name, val, 1, 10000, &a->timeout_ms);
 	} else if (strcmp(name, "--units") == 0) {
 		a->units = true;
+	} else if (strcmp(name, "--fast") == 0) {
+		a->fast = true;
 	} else if (strcmp(name, "--yes") == 0) {
 		a->yes = true;
 	} else if (strcmp(name, "--ids") == 0) {
@@ -285,6 +288,9 @@ void dxlt_help(FILE *f)
 	      "                             unless --protocol says one; each line names its protocol\n"
 	      "  ping ID                    ping one servo: model, firmware, round-trip time\n"
 	      "  read ID REG [--units]      print a register's raw value (REG: name or address)\n"
+	      "  sync-read REG ID... [--fast] [--units]   one SYNC_READ of REG from every servo listed\n"
+	      "                             (2.0), a line each: ID VALUE; --fast: one Fast Sync Read\n"
+	      "                             (one status packet for all; X430/X540 firmware 45 and later)\n"
 	      "  write ID REG VALUE         write a register (checked against the table first; a negative\n"
 	      "                             VALUE is a value) and print what the servo holds, read back\n"
 	      "  dump ID                    the whole control table, named, with units\n"

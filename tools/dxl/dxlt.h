@@ -72,6 +72,7 @@ struct dxlt_args {
 	long timeout_ms;         /* --timeout-ms; -1: derived + DXLT_DEFAULT_SLACK_MS, at least
 	                          * DXLT_ONESHOT_WAIT_MS outside scan */
 	bool units;              /* --units */
+	bool fast;               /* --fast: sync-read as a Fast Sync Read */
 	bool yes;                /* --yes */
 	int status_level;        /* --status-level for setup; -1: default */
 	uint8_t id_lo, id_hi;    /* --ids A-B */

@@ -144,6 +144,9 @@ int32_t dxlt_decode(const struct dxlt_reg *reg, const uint8_t *raw);
 size_t dxlt_image_len(const struct dxl2_model *m);
 int dxlt_cmd_ping(struct dxlt *t);
 int dxlt_cmd_read(struct dxlt *t);
+/* sync-read REG ID... [--fast] [--units]: one SYNC_READ (or Fast Sync Read)
+ * of REG from every servo listed, in the list's order. */
+int dxlt_cmd_sync_read(struct dxlt *t);
 int dxlt_cmd_dump(struct dxlt *t);
 int dxlt_cmd_write(struct dxlt *t);
 int dxlt_cmd_torque(struct dxlt *t);

@@ -172,6 +172,70 @@ int dxlt_cmd_read(struct dxlt *t)
 	return DXLT_EXIT_OK;
 }
 
+/* One servo's line of a sync-read: ID and value (in units with --units). */
+static void dxlt_sync_line(struct dxlt *t, uint8_t id, const struct dxlt_reg *reg, const uint8_t *raw)
+{
+	char text[96];
+	int32_t v = dxlt_decode(reg, raw);
+	if (t->a.units && reg->row != NULL)
+		fprintf(t->out, "%u %s\n", id, dxl2_reg_format(reg->row, v, text, sizeof text));
+	else if (reg->row == NULL || !reg->row->is_signed)
+		fprintf(t->out, "%u %lu\n", id, (unsigned long)(uint32_t)v);
+	else
+		fprintf(t->out, "%u %ld\n", id, (long)v);
+}
+
+/* Nobody answered a Fast Sync Read: the likely why, and what to do. */
+static void dxlt_fast_hint(struct dxlt *t, const uint8_t *ids)
+{
+	fprintf(t->err, "dxl: no reply to Fast Sync Read: servos answer it from firmware 45 (X430/X540; not "
+	        "the 2XL/2XC), and one that does not stops the others' turns; see each servo's firmware with "
+	        "dxl %s--port %s ping %u, or read without --fast\n", t->fam->opt, port_path(t->port), ids[0]);
+}
+
+int dxlt_cmd_sync_read(struct dxlt *t)
+{
+	struct dxlt_servo s;
+	struct dxlt_reg reg;
+	uint8_t ids[BUS_MULTI_MAX], data[BUS_MULTI_MAX * 4];
+	struct bus_multi m = { .data = data, .cap = sizeof data };
+	size_t n = 0;
+	int rc;
+	if (t->a.npos < 2 || t->a.npos - 1 > BUS_MULTI_MAX)
+		return dxlt_need_form(t, t->a.npos < 2 ? 2 : -1, "sync-read REG ID... [--fast] [--units]");
+	for (int i = 1; i < t->a.npos; i++)
+		if ((rc = dxlt_arg_servo_id(t, t->a.pos[i], &ids[n++])) != DXLT_EXIT_OK)
+			return rc;
+	if ((rc = dxlt_identify(t, ids[0], &s)) || (rc = dxlt_arg_reg(t, &s, t->a.pos[0], &reg)))
+		return rc;
+	int r = t->a.fast ? bus_fast_sync_read(&t->bus, reg.addr, reg.size, ids, n, &m)
+	                  : bus_sync_read(&t->bus, reg.addr, reg.size, ids, n, &m);
+	if (r == DXL_E_UNSUPPORTED) {
+		fprintf(t->err, "dxl: Protocol %s has no %s (--protocol 2 for X servos)\n", bus_proto(&t->bus)->name,
+		        t->a.fast ? "Fast Sync Read" : "SYNC_READ");
+		return DXLT_EXIT_USAGE;
+	}
+	if (r == DXL_E_ARG) {
+		fprintf(t->err, "dxl: sync-read: each servo once, at most %d\n", BUS_MULTI_MAX);
+		return DXLT_EXIT_USAGE;
+	}
+	for (size_t i = 0; i < m.n; i++) {
+		const uint8_t *p = bus_multi_data(&m, i);
+		if (p == NULL)
+			continue;
+		dxlt_seen(t, m.id[i], m.err[i]);
+		dxlt_sync_line(t, m.id[i], &reg, p);
+	}
+	if (m.answered == 0 && t->a.fast && bus_multi_failed(&m, NULL, 0) == m.n && m.status[0] == DXL_E_TIMEOUT) {
+		dxlt_fast_hint(t, ids);
+		return DXLT_EXIT_BUS;
+	}
+	for (size_t i = 0; i < m.n; i++)
+		if (m.status[i] != DXL_OK)
+			rc = dxlt_bus_fail(t, m.id[i], m.status[i]);
+	return rc;
+}
+
 static void dxlt_dump_raw(struct dxlt *t, const uint8_t *mem, size_t len)
 {
 	fprintf(t->out, "ADDR  BYTES (model not in dxl's tables: raw, little-endian)\n");
