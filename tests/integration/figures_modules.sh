@@ -284,7 +284,7 @@ else tap_fail "merge without gnuplot" "rc $rc: $(cat "$T/out")"; fi
 # the runs' folder first: the driver's --resume keeps it and runs the other three.
 if [ -x "$B/undulate-sim" ] && [ -x "$B/undulated" ] && [ -x "$B/undulate-analyze" ] && command -v parallel >/dev/null 2>&1; then
 	export FIG_TINY=1 FIG_PORT_LO FIG_PORT_SPAN=8
-	FIG_PORT_LO=$(lcm_port 7790)
+	FIG_PORT_LO=$(lcm_port 7910)
 	read -r id w seed <<<"$("$F/channel/fig.sh" jobs)"
 	R="$T/tiny/runs"
 	start=$(date +%s)

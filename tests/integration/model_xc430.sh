@@ -9,7 +9,7 @@
 D="$B/undulated"; S="$B/undulate-sim"; X="$B/dxl"
 if [ ! -x "$S" ] || [ ! -x "$D" ] || [ ! -x "$X" ]; then tap_skip_all "undulate-sim, undulated or dxl not built"; fi
 R="t$$"
-URL=$(lcm_url 7720)
+URL=$(lcm_url 7724)
 
 run() {   # run NAME ARGS...: dxl on Protocol 2.0 with 100 ms for replies (a loaded machine)
 	local name=$1; shift

@@ -7,7 +7,7 @@
 # here instead of hanging the suite.
 . "$(dirname "$0")/../lib.sh"
 S="$B/undulate-sim"
-URL=$(lcm_url 7652)
+URL=$(lcm_url 7654)
 
 # refused NAME PATH REGEX: exit 2 within 5 s, one stderr line naming PATH and matching REGEX
 refused() {
