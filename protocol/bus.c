@@ -791,22 +791,28 @@ static int bus_multi_ready(const struct bus *b, uint32_t cap)
 	return b->pending ? DXL_E_BUSY : DXL_OK;
 }
 
-int bus_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
-                        struct bus_multi *m)
+/* A SYNC_READ, plain or fast (one status packet from every servo): the same
+ * tracking and layout; the capability, encoder and instruction differ. */
+static int bus_sync_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
+                          struct bus_multi *m, bool fast)
 {
 	uint8_t pkt[BUS_MAX_PACKET];
 	if (m == NULL || dxl2_multi_read_sync(&m->track, len, ids, n) != DXL_OK)
 		return DXL_E_ARG;
 	int r = bus_multi_layout(m);
 	if (r == DXL_OK)
-		r = bus_multi_ready(b, DXL_CAP_SYNC_READ);
+		r = bus_multi_ready(b, fast ? DXL_CAP_FAST_READ : DXL_CAP_SYNC_READ);
 	if (r < 0)
 		return r;
-	return bus_multi_send(b, pkt, b->proto->encode_sync_read(pkt, sizeof pkt, addr, len, ids, n), m,
-	                      DXL2_INST_SYNC_READ);
+	if (fast)
+		m->fast = true;
+	int len_pkt = fast ? b->proto->encode_fast_sync_read(pkt, sizeof pkt, addr, len, ids, n)
+	                      : b->proto->encode_sync_read(pkt, sizeof pkt, addr, len, ids, n);
+	return bus_multi_send(b, pkt, len_pkt, m, fast ? DXL2_INST_FAST_SYNC_READ : DXL2_INST_SYNC_READ);
 }
 
-int bus_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
+/* A BULK_READ, plain or fast, as bus_sync_begin. */
+static int bus_bulk_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m, bool fast)
 {
 	uint8_t pkt[BUS_MAX_PACKET];
 	struct dxl2_bulk_item asked[DXL2_MULTI_MAX];
@@ -818,46 +824,36 @@ int bus_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, s
 		return DXL_E_ARG;
 	int r = bus_multi_layout(m);
 	if (r == DXL_OK)
-		r = bus_multi_ready(b, DXL_CAP_BULK_READ);
+		r = bus_multi_ready(b, fast ? DXL_CAP_FAST_READ : DXL_CAP_BULK_READ);
 	if (r < 0)
 		return r;
-	return bus_multi_send(b, pkt, b->proto->encode_bulk_read(pkt, sizeof pkt, items, n), m, DXL2_INST_BULK_READ);
+	if (fast)
+		m->fast = true;
+	int len_pkt = fast ? b->proto->encode_fast_bulk_read(pkt, sizeof pkt, items, n)
+	                      : b->proto->encode_bulk_read(pkt, sizeof pkt, items, n);
+	return bus_multi_send(b, pkt, len_pkt, m, fast ? DXL2_INST_FAST_BULK_READ : DXL2_INST_BULK_READ);
+}
+
+int bus_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
+                        struct bus_multi *m)
+{
+	return bus_sync_begin(b, addr, len, ids, n, m, false);
+}
+
+int bus_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
+{
+	return bus_bulk_begin(b, items, n, m, false);
 }
 
 int bus_fast_sync_read_begin(struct bus *b, uint16_t addr, uint16_t len, const uint8_t *ids, size_t n,
                              struct bus_multi *m)
 {
-	uint8_t pkt[BUS_MAX_PACKET];
-	if (m == NULL || dxl2_multi_read_sync(&m->track, len, ids, n) != DXL_OK)
-		return DXL_E_ARG;
-	int r = bus_multi_layout(m);
-	if (r == DXL_OK)
-		r = bus_multi_ready(b, DXL_CAP_FAST_READ);
-	if (r < 0)
-		return r;
-	m->fast = true;
-	return bus_multi_send(b, pkt, b->proto->encode_fast_sync_read(pkt, sizeof pkt, addr, len, ids, n), m,
-	                      DXL2_INST_FAST_SYNC_READ);
+	return bus_sync_begin(b, addr, len, ids, n, m, true);
 }
 
 int bus_fast_bulk_read_begin(struct bus *b, const struct dxl_item *items, size_t n, struct bus_multi *m)
 {
-	uint8_t pkt[BUS_MAX_PACKET];
-	struct dxl2_bulk_item asked[DXL2_MULTI_MAX];
-	if (m == NULL || items == NULL || n == 0 || n > DXL2_MULTI_MAX)
-		return DXL_E_ARG;
-	for (size_t i = 0; i < n; i++)
-		asked[i] = (struct dxl2_bulk_item){ items[i].id, items[i].addr, items[i].len, NULL };
-	if (dxl2_multi_read_bulk(&m->track, asked, n) != DXL_OK)
-		return DXL_E_ARG;
-	int r = bus_multi_layout(m);
-	if (r == DXL_OK)
-		r = bus_multi_ready(b, DXL_CAP_FAST_READ);
-	if (r < 0)
-		return r;
-	m->fast = true;
-	return bus_multi_send(b, pkt, b->proto->encode_fast_bulk_read(pkt, sizeof pkt, items, n), m,
-	                      DXL2_INST_FAST_BULK_READ);
+	return bus_bulk_begin(b, items, n, m, true);
 }
 
 int bus_ping_all_begin(struct bus *b, struct bus_multi *m)

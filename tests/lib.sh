@@ -94,6 +94,19 @@ needs_plotting() {
 	command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
 	[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
 }
+# fig_module_runs FIG_SH SET JOBS: a figure module's runs, one per job line
+# ("ID ARGS..."), into $T/runs, then its merge into $T/fig; a failed run is a
+# failure, and "merge of the SET set exits 0" a result (its log: $T/merge.log).
+fig_module_runs() {
+	local f=$1 set=$2 jobs=$3 id args rc
+	while read -r id args; do
+		# shellcheck disable=SC2086 # a job line's arguments are words
+		"$f" run "$T/runs/$id" $args >"$T/run-$id.log" 2>&1 || tap_fail "run $id" "$(tail -n 1 "$T/run-$id.log")"
+	done <<<"$jobs"
+	"$f" merge "$T/runs" "$T/fig" >"$T/merge.log" 2>&1
+	rc=$?
+	if [ "$rc" = 0 ]; then tap_ok "merge of the $set set exits 0"; else tap_fail "merge exits 0" "$(tail -n 3 "$T/merge.log")"; fi
+}
 # tap_refused PREFIX NAME CMD...: a usage refusal: CMD exits 2 and what it
 # says (stdout and stderr) begins with PREFIX, e.g. a figure module's "name:".
 tap_refused() {

@@ -20,12 +20,7 @@ refused "run: r above 1" run "$T/x" 1.5 11 12
 refused "run: too few points" run "$T/x" 0.5 1 12
 refused "run: missing argument" run "$T/x" 0.5 11
 
-while read -r id r nd na; do
-	"$F" run "$T/runs/$id" "$r" "$nd" "$na" >"$T/run-$id.log" 2>&1 || tap_fail "run $id" "$(tail -n 1 "$T/run-$id.log")"
-done <<<"$q"
-"$F" merge "$T/runs" "$T/fig" >"$T/merge.log" 2>&1
-rc=$?
-if [ "$rc" = 0 ]; then tap_ok "merge of the quick set exits 0"; else tap_fail "merge exits 0" "$(tail -n 3 "$T/merge.log")"; fi
+fig_module_runs "$F" quick "$q"
 tap_check "heatmap.csv: 4 x 26 x 36 points" test "$(tail -n +2 "$T/fig/heatmap.csv" | wc -l)" = $((4 * 26 * 36))
 tap_check "every touching point on theory.md's map (to the CSV's 6 digits)" awk -F, '
 	function abs(x) { return x < 0 ? -x : x }

@@ -10,9 +10,7 @@
 # the pictures (pixels of each series counted) and the section's numbers.
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures/lattice/fig.sh"
-PNG="$BUILD/tests/tools/pngdata"
-command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
-[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+needs_plotting
 [ -x "$B/undulate-model" ] || tap_skip_all "undulate-model is not built"
 
 a=$("$F" jobs) b=$("$F" jobs) q=$("$F" jobs --quick) t=$(FIG_TINY=1 "$F" jobs)
@@ -27,12 +25,7 @@ refused "run: too short" run "$T/x" 0.5 5 1 0
 refused "run: phases longer than the run" run "$T/x" 0.5 60 1 90
 refused "run: missing argument" run "$T/x" 0.5 60 1
 
-while read -r id d s seed st; do
-	"$F" run "$T/runs/$id" "$d" "$s" "$seed" "$st" >"$T/run-$id.log" 2>&1 || tap_fail "run $id" "$(tail -n 1 "$T/run-$id.log")"
-done <<<"$q"
-"$F" merge "$T/runs" "$T/fig" >"$T/merge.log" 2>&1
-rc=$?
-if [ "$rc" = 0 ]; then tap_ok "merge of the quick set exits 0"; else tap_fail "merge exits 0" "$(tail -n 3 "$T/merge.log")"; fi
+fig_module_runs "$F" quick "$q"
 C="$T/fig/lattice.csv"
 # columns: kind,dsep,seed,seconds,i,t,phase,abs_delta,pair_dsep,compat_limit,collisions,window_collisions,class,t_relax_s,last_collision_s
 tap_check "lattice.csv: 6 runs, 49 pairs each" \

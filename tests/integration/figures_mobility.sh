@@ -11,9 +11,7 @@
 # (pixels of each series counted) and the section's numbers.
 . "$(dirname "$0")/../lib.sh"
 F="$top/figures/mobility/fig.sh"
-PNG="$BUILD/tests/tools/pngdata"
-command -v gnuplot >/dev/null 2>&1 || tap_skip_all "gnuplot is not installed (Debian: gnuplot-nox)"
-[ -x "$PNG" ] || tap_skip_all "tests/tools/pngdata is not built"
+needs_plotting
 [ -x "$B/undulate-model" ] || tap_skip_all "undulate-model is not built"
 
 a=$("$F" jobs) b=$("$F" jobs) q=$("$F" jobs --quick) t=$(FIG_TINY=1 "$F" jobs)
@@ -29,18 +27,13 @@ refused "run: too short" run "$T/x" 0.07 5 1 0
 refused "run: DRIFT not 0 or 1" run "$T/x" 0.07 200 1 2
 refused "run: missing argument" run "$T/x" 0.07 200 1
 
-while read -r id beta s seed drift; do
-	"$F" run "$T/runs/$id" "$beta" "$s" "$seed" "$drift" >"$T/run-$id.log" 2>&1 || tap_fail "run $id" "$(tail -n 1 "$T/run-$id.log")"
-done <<<"$q"
 # the daemons' rows beside it: a rows.csv of our own (figures/rows' columns),
 # its relaxation runs at d̃ 0.78 and one sweep run at 0.7 that must not count
 H="dsep,beta,seconds,seed,pairs,colliding_pairs,pair_collisions_hz,compat_error_rad,compat_error_max_rad,compatible_pairs,antiphase_pairs,stopped_pairs,wall_collisions_hz,relax_s,censored,min_swing_rad,wall_s"
 printf '%s\n' "$H" "0.78,0.1,240,1,9,0,0,0,0,9,0,0,0,3,0,1.6,50" "0.78,0.02,240,1,9,0,0,0,0,9,0,0,0,40,0,1.6,50" \
 	"0.78,0.005,240,1,9,0,0,0,0,9,0,0,0,150,0,1.6,50" "0.78,0.002,240,1,9,1,0.1,0,0,8,0,0,0,236,1,1.6,50" \
 	"0.78,0.01,240,2,9,0,0,0,0,9,0,0,0,60,0,1.6,50" "0.7,0.1,60,1,9,0,0,0,0,9,0,0,0,99,0,1.6,14" >"$T/rows.csv"
-FIG_ROWS_CSV="$T/rows.csv" "$F" merge "$T/runs" "$T/fig" >"$T/merge.log" 2>&1
-rc=$?
-if [ "$rc" = 0 ]; then tap_ok "merge of the quick set exits 0"; else tap_fail "merge exits 0" "$(tail -n 3 "$T/merge.log")"; fi
+FIG_ROWS_CSV="$T/rows.csv" fig_module_runs "$F" quick "$q"
 C="$T/fig/mobility.csv"
 # columns: kind,dsep,beta,seed,seconds,t,collisions,mean_dsep_colliding,dsep_mean,dsep_sd,dsep_min,dsep_max,
 #          incompatible_pairs,colliding_pairs,t_relax_s,last_collision_s,neutral_error,dsep_min_run

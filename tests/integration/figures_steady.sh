@@ -22,12 +22,7 @@ refused "run: one d~ point" run "$T/x" 0.5 1 4 120
 refused "run: too short" run "$T/x" 0.5 6 4 5
 refused "run: missing argument" run "$T/x" 0.5 6 4
 
-while read -r id r nd na s; do
-	"$F" run "$T/runs/$id" "$r" "$nd" "$na" "$s" >"$T/run-$id.log" 2>&1 || tap_fail "run $id" "$(tail -n 1 "$T/run-$id.log")"
-done <<<"$t"
-"$F" merge "$T/runs" "$T/fig" >"$T/merge.log" 2>&1
-rc=$?
-if [ "$rc" = 0 ]; then tap_ok "merge of the tiny set exits 0"; else tap_fail "merge exits 0" "$(tail -n 3 "$T/merge.log")"; fi
+fig_module_runs "$F" tiny "$t"
 tap_check "steady.csv: 2 x 6 x 4 pairs" test "$(tail -n +2 "$T/fig/steady.csv" | wc -l)" = 48
 tap_check "every pair ends where the map from its start leads (|Δ| within 1e-3 rad)" awk -F, '
 	function abs(x) { return x < 0 ? -x : x }
