@@ -372,7 +372,7 @@ void cfg_defaults(struct cfg *c)
 	 * periods of 10 ms, longer than a late cycle on a loaded machine (tens of
 	 * ms), short enough that a joint at the gait's peak speed (≈ 4 rad/s)
 	 * moves at most about 0.4 rad under a controller that went quiet. */
-	c->bus_watchdog_ms = CFG_WATCHDOG_DEFAULT;
+	c->bus_watchdog_ms = CFG_WATCHDOG_UNSET;   /* CFG_WATCHDOG_DEFAULT, or ten periods: cfg_finish */
 	/* One REBOOT after a hardware-error shutdown: a transient (a collision's
 	 * overload, a supply dip) recovers without the operator; a second
 	 * shutdown means the cause is still there, and the fault latches. */
@@ -966,8 +966,9 @@ bool cfg_params_position_defaults(struct cfg_params *p, const struct cfg *c, siz
 static void cfg_check_rate(struct cfg *c, struct cfg_errors *e)
 {
 	const char *src = c->source[0] ? c->source : "command line";
-	if (c->bus_watchdog_ms == CFG_WATCHDOG_DEFAULT && c->period_ms * 10 > CFG_WATCHDOG_DEFAULT)
-		c->bus_watchdog_ms = (long)ceil(c->period_ms * 10);
+	if (c->bus_watchdog_ms == CFG_WATCHDOG_UNSET)
+		c->bus_watchdog_ms = c->period_ms * 10 > CFG_WATCHDOG_DEFAULT ? (long)ceil(c->period_ms * 10)
+		                                                            : CFG_WATCHDOG_DEFAULT;
 	if (c->bus_watchdog_ms > 0 && c->bus_watchdog_ms < CFG_MIN_PERIODS * c->period_ms)
 		cfg_error(e, "%s: [robot] bus_watchdog_ms = %ld is shorter than %d periods of %g ms: one late cycle "
 		          "would stop the servos (raise it, or 0 to leave the watchdog off)", src, c->bus_watchdog_ms,

@@ -196,8 +196,11 @@ struct cfg_params {
 /* The bus watchdog and silent_s against the period: each at least this many
  * periods, or one late cycle trips them (CONTROL.md, "Other rates"). */
 #define CFG_MIN_PERIODS 3
-/* bus_watchdog_ms when not set (ms); above a period of 10 ms, ten periods. */
+/* bus_watchdog_ms when not set (ms); above a period of 10 ms, ten periods.
+ * Until cfg_finish an unset one holds CFG_WATCHDOG_UNSET, so that a file's
+ * own 100 is kept as it says. */
 #define CFG_WATCHDOG_DEFAULT 100
+#define CFG_WATCHDOG_UNSET (-2)
 /* The one check of a change to a live parameter, by a command or the tuner:
  * `key` is a commandable parameter (cfg_param_commandable) or servo_lead_s;
  * joint -1 is every joint (a robot parameter takes -1 only); the value is

@@ -83,7 +83,7 @@ fig_top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 # first that is there and whose header matches; status 1 if none.
 fig_rows_csv() {
 	local c
-	for c in "${FIG_ROWS_CSV:-}" "${FIG_MERGE_DIR:-}/rows.csv" "$fig_top/docs/figures/rows.csv"; do
+	for c in "${FIG_ROWS_CSV:-}" "${FIG_MERGE_DIR:+$FIG_MERGE_DIR/rows.csv}" "$fig_top/docs/figures/rows.csv"; do
 		[ -n "$c" ] && [ -s "$c" ] && head -n 1 "$c" | grep -q "$1" && { echo "$c"; return 0; }
 	done
 	return 1

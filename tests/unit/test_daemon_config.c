@@ -630,6 +630,8 @@ static void test_other_rates(void **state)
 	assert_false(rate_config("50", "robot.bus_watchdog_ms=120", &c, &e));
 	assert_non_null(strstr(e.line[0], "bus_watchdog_ms = 120 is shorter than 3 periods of 50 ms"));
 	assert_true(rate_config("50", "robot.bus_watchdog_ms=0", &c, &e));   /* off */
+	assert_true(rate_config("20", "robot.bus_watchdog_ms=100", &c, &e));
+	assert_int_equal(c.bus_watchdog_ms, 100);    /* a set one is kept, even the default's value */
 	assert_true(rate_config("100", NULL, &c, &e));
 	assert_true(c.joint[0].max_step == 0.5);     /* the key's range */
 	assert_false(rate_config("100", "robot.silent_s=0.2", &c, &e));
