@@ -16,6 +16,9 @@
 #define SIM_CMD_MAX_WORDS 16
 /* Longest wall motion a command may ask for: a day of simulated time. */
 #define SIM_WALL_SPAN_MAX_S 86400.0
+/* Largest kick (rad/s): three times an AX-12A's no-load speed at 12 V; a
+ * link swinging 0.8 rad at 0.8 Hz peaks at 4 rad/s. */
+#define SIM_KICK_MAX 20.0
 
 /* ---- set-up ------------------------------------------------------------------- */
 
@@ -930,6 +933,37 @@ static int cmd_walls(struct sim_cmd_ctx *x)
 	             p->wall_right, l, r, span, now, now + span), 0;
 }
 
+/* kick BUS ID DW: a tap on the link, DW rad/s added to the joint's true
+ * speed before the next physics step — the paper's perturbation of a locked
+ * pair ("anti-phase is stable against perturbation"), made through the
+ * body as a hand would, so the daemon senses it only through the servo's
+ * readings. An event at a simulated time kicks the same way in real time and
+ * in lockstep. The row world only: the plane's bodies keep their speeds
+ * in the physics library, which takes no such impulse from here yet. */
+static int cmd_kick(struct sim_cmd_ctx *x)
+{
+	struct sim *s = x->s;
+	struct sim_bus *b = cmd_bus(x, "kick BUS ID DW");
+	if (!b)
+		return -1;
+	double dw = 0;
+	if (x->argc != 4)
+		return FAIL(x, "usage: kick BUS ID DW (rad/s added to the joint's speed, |DW| <= %g)", SIM_KICK_MAX);
+	struct sim_joint *j = cmd_joint(x, b, x->argv[2]);
+	if (!j)
+		return -1;
+	if (num_parse_double(x->argv[3], &dw) != NUM_OK || !(fabs(dw) <= SIM_KICK_MAX))
+		return FAIL(x, "kick: DW is rad/s added to the joint's speed, |DW| <= %g, not '%s'", SIM_KICK_MAX,
+		            x->argv[3]);
+	if (s->plane)
+		return FAIL(x, "kick: the plane world takes no kick (its bodies' speeds are the physics library's); "
+		            "kick in the row world");
+	double before = j->motor.speed;
+	j->motor.speed += dw;
+	return REPLY(x, "ok %s %u speed %.4f -> %.4f rad/s (simulated t = %.3f s)", b->name, sim_joint_id(j), before,
+	             j->motor.speed, (double)s->steps * s->dt), 0;
+}
+
 static int cmd_stats(struct sim_cmd_ctx *x)
 {
 	struct sim *s = x->s;
@@ -986,7 +1020,8 @@ static int cmd_help(struct sim_cmd_ctx *x)
 {
 	return REPLY(x, "ok commands: fault BUS ID KIND [ARG] [count=N] [prob=P] | clear BUS [ID] [KIND] | "
 	                "power BUS ID on|off | disconnect BUS | reconnect BUS | garbage BUS [N] | "
-	                "poke BUS ID REG VALUE | peek BUS ID REG | servo BUS ID | walls none|LEFT RIGHT [over S] | stats | list | "
+	                "poke BUS ID REG VALUE | peek BUS ID REG | servo BUS ID | walls none|LEFT RIGHT [over S] | kick BUS ID DW | "
+	                "stats | list | "
 	                "command ROBOT|* TEXT (lockstep) | help"), 0;
 }
 
@@ -996,7 +1031,7 @@ static const struct {
 } sim_verbs[] = {
 	{ "fault", cmd_fault }, { "clear", cmd_clear }, { "power", cmd_power },
 	{ "disconnect", cmd_disconnect }, { "reconnect", cmd_reconnect }, { "garbage", cmd_garbage },
-	{ "poke", cmd_poke }, { "peek", cmd_peek }, { "servo", cmd_servo }, { "walls", cmd_walls }, { "stats", cmd_stats },
+	{ "poke", cmd_poke }, { "peek", cmd_peek }, { "servo", cmd_servo }, { "walls", cmd_walls }, { "kick", cmd_kick }, { "stats", cmd_stats },
 	{ "list", cmd_list }, { "command", cmd_robot_command }, { "help", cmd_help },
 };
 

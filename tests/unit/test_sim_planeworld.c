@@ -158,6 +158,11 @@ static void test_closing_walls_squeeze(void **state)
 	assert_int_equal(plane(3, sets, 4), 0);
 	assert_int_equal(plane_walls(sim.plane), 4);
 	assert_int_equal(cmd("walls -0.12 0.12 over 2"), 0);
+	/* a kick is the row's: the plane says so, and changes nothing */
+	double v = sim.buses[0].joints[0].motor.speed;
+	assert_int_equal(cmd("kick r1 1 1"), -1);
+	assert_non_null(strstr(reply, "error: kick: the plane world takes no kick"));
+	assert_true(sim.buses[0].joints[0].motor.speed == v);
 	steps(&sim, 3000);
 	double ax, ay, bx, by;
 	plane_wall(sim.plane, 0, &ax, &ay, &bx, &by);

@@ -3,7 +3,8 @@
  * ("walls LEFT RIGHT over S"): where they stand at every physics step,
  * what stops or replaces a motion, the commands refused, and a row of
  * held joints on mobile bases squeezed between closing walls (the paper's
- * arena in one dimension).
+ * arena in one dimension). And the kick ("kick BUS ID DW"): a tap on a
+ * link, its speed changed at once by DW, the commands it refuses.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -175,6 +176,47 @@ static void test_closing_walls_squeeze_a_mobile_row(void **state)
 	assert_true(sim.world.resting_impulse > 0);
 }
 
+/* kick: the joint's true speed jumps by DW at once, nothing else does; the
+ * joint then swings further than its unkicked twin on the other robot. */
+static void test_kick(void **state)
+{
+	(void)state;
+	row(2, 2.0, 0, "none");
+	steps_to(0.5);
+	struct sim_joint *a = &sim.buses[0].joints[1], *b = &sim.buses[1].joints[1];
+	assert_double_equal(a->motor.speed, b->motor.speed, 1e-12);
+	double v = a->motor.speed, x = a->motor.angle;
+	assert_int_equal(cmd("kick r1 2 1.5"), 0);
+	assert_non_null(strstr(reply, "ok r1 2 speed"));
+	assert_double_equal(a->motor.speed, v + 1.5, 1e-12);
+	assert_double_equal(a->motor.angle, x, 0);
+	assert_double_equal(b->motor.speed, v, 0);
+	steps_to(0.6);
+	print_message("# kicked by 1.5 rad/s: 0.1 s later %.4f rad against its twin's %.4f\n", a->motor.angle,
+	              b->motor.angle);
+	assert_true(a->motor.angle - b->motor.angle > 0.02);
+	sim_free(&sim);
+}
+
+static void test_bad_kicks_refused(void **state)
+{
+	(void)state;
+	row(1, 2.0, 0, "none");
+	const char *bads[] = { "kick", "kick r1 2", "kick r1 2 1 2", "kick r9 2 1", "kick r1 7 1", "kick r1 2 nan",
+	                       "kick r1 2 inf", "kick r1 2 20.5", "kick r1 2 -21", "kick r1 2 1x", "kick r1 300 1" };
+	unsigned long long before = sim.bad_commands;
+	double v = sim.buses[0].joints[1].motor.speed;
+	for (size_t i = 0; i < sizeof bads / sizeof bads[0]; i++) {
+		assert_int_equal(cmd(bads[i]), -1);
+		print_message("# %-16s -> %s\n", bads[i], reply);
+		assert_non_null(strstr(reply, "error: "));
+	}
+	assert_int_equal(sim.bad_commands - before, sizeof bads / sizeof bads[0]);
+	assert_double_equal(sim.buses[0].joints[1].motor.speed, v, 0);
+	assert_int_equal(cmd("kick r1 2 -20"), 0);
+	sim_free(&sim);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -182,6 +224,8 @@ int main(void)
 		cmocka_unit_test(test_motion_replaced_or_stopped),
 		cmocka_unit_test(test_bad_motions_refused),
 		cmocka_unit_test(test_closing_walls_squeeze_a_mobile_row),
+		cmocka_unit_test(test_kick),
+		cmocka_unit_test(test_bad_kicks_refused),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
