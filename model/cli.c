@@ -16,7 +16,7 @@ const char cli_usage[] =
 	"       undulate-model map     [--restitution R] [--dsep D | --dsep-from A --dsep-to B] [--dsep-points K]\n"
 	"                              [--delta-points M]          (CSV on stdout)\n"
 	"OPTIONS: --duration S (60) --out DIR (.) --frequency HZ (0.8) --amplitude A (0.8) --sample-hz H (20)\n"
-	"         --window S (10) --tolerance T (1e-12) --no-samples --quiet\n"
+	"         --window S (10) --tolerance T (1e-12) --amplitude-rate R (0: the phase model) --no-samples --quiet\n"
 	"The paper's phase-oscillator model, integrated (README.md in the source's model/).\n";
 
 static int cli_err(char *err, size_t cap, const char *fmt, ...)
@@ -85,7 +85,7 @@ static void cli_defaults(struct cli_opts *o)
 enum {
 	OPT_N = 256, OPT_DSEP, OPT_R, OPT_BETA, OPT_FIXED, OPT_WALLS, OPT_SEED, OPT_PHASES, OPT_DELTA0, OPT_DUR,
 	OPT_FREQ, OPT_AMP, OPT_SAMPLE, OPT_WINDOW, OPT_TOL, OPT_NOSAMP, OPT_QUIET, OPT_OUT, OPT_DFROM, OPT_DTO,
-	OPT_DPTS, OPT_APTS, OPT_HELP
+	OPT_DPTS, OPT_APTS, OPT_ARATE, OPT_HELP
 };
 
 static const struct option cli_long[] = {
@@ -104,6 +104,7 @@ static const struct option cli_long[] = {
 	{ "sample-hz", required_argument, NULL, OPT_SAMPLE },
 	{ "window", required_argument, NULL, OPT_WINDOW },
 	{ "tolerance", required_argument, NULL, OPT_TOL },
+	{ "amplitude-rate", required_argument, NULL, OPT_ARATE },
 	{ "no-samples", no_argument, NULL, OPT_NOSAMP },
 	{ "quiet", no_argument, NULL, OPT_QUIET },
 	{ "out", required_argument, NULL, OPT_OUT },
@@ -169,6 +170,7 @@ static int cli_one(struct cli_opts *o, struct cli_lists *ls, int c, const char *
 	case OPT_SAMPLE: return cli_num("sample-hz", arg, 0.01, 1e5, &o->sample_hz, err, cap);
 	case OPT_WINDOW: return cli_num("window", arg, 0, 1e7, &o->window_s, err, cap);
 	case OPT_TOL: return cli_num("tolerance", arg, 1e-15, 1e-4, &o->tolerance, err, cap);
+	case OPT_ARATE: return cli_num("amplitude-rate", arg, 0, LAT_AMPLITUDE_RATE_MAX, &o->amplitude_rate, err, cap);
 	case OPT_NOSAMP: o->write_samples = false; return 0;
 	case OPT_QUIET: o->quiet = true; return 0;
 	case OPT_OUT:
@@ -270,6 +272,6 @@ void cli_lat_params(const struct cli_opts *o, struct lat_params *p)
 	*p = (struct lat_params){
 		.n = o->n, .frequency_hz = o->frequency_hz, .amplitude = o->amplitude,
 		.restitution = o->restitution, .dsep = o->dsep, .beta = o->beta, .walls = o->walls,
-		.wall_dsep = o->wall_dsep, .tolerance = o->tolerance,
+		.wall_dsep = o->wall_dsep, .tolerance = o->tolerance, .amplitude_rate = o->amplitude_rate,
 	};
 }

@@ -28,6 +28,7 @@ struct cli_opts {
 	double phases[CLI_MAX_OSC];
 	double delta0;               /* pair: the phase difference at the start */
 	double duration_s, sample_hz, window_s, tolerance;
+	double amplitude_rate;       /* 0: the phase model; else the limit cycle's (lat_params) */
 	bool write_samples;          /* states.csv and phase_diff.csv rows */
 	bool quiet;
 	const char *out_dir;

@@ -28,11 +28,13 @@
 
 struct lat {
 	int n;
+	int dim;                 /* state values per oscillator: 1 (phase) or 2 (x, v: its own amplitude) */
 	double omega, amp, r;
+	double rate;             /* the limit cycle's amplitude rate R, 1/s (dim 2) */
 	bool walls;
 	double wall[2];
 	double t;
-	double *phi;             /* the ODE's state: one phase each */
+	double *y;               /* the ODE's state: a phase each (the phase model), or x, v each (dim 2) */
 	double *neutral;
 	double *beta;
 	double *y0;              /* the state at the current step's start */
@@ -63,15 +65,34 @@ static int lat_err(char *err, size_t cap, const char *fmt, ...)
 }
 
 
-/* phi_i' = omega: the phase model. (Kept an ODE so that the oscillator's
- * law is one function, and the event machinery does not depend on it.) */
+/* The oscillators' law for m of them from y into dydt. The phase model:
+ * phi' = omega. With an amplitude (dim 2): the van der Pol limit cycle
+ *   x'' = -omega^2 x + R (1 - 4 x^2 / A^2) x'
+ * whose cycle has amplitude A (to O(R/omega)^2) and whose amplitude comes
+ * back at the rate R after a disturbance (linearised, averaged over a
+ * period) — the daemon's OSCILLATOR law for one joint, I x'' = -k x +
+ * (c - mu x^2) x', with R = c / I (daemon/osc.h). Kept an ODE either way so
+ * that the event machinery does not depend on the law. */
+static void lat_law(const struct lat *l, const double *y, double *dydt, int m)
+{
+	if (l->dim == 1) {
+		for (int i = 0; i < m; i++)
+			dydt[i] = l->omega;
+		return;
+	}
+	double w2 = l->omega * l->omega, q = 4 / (l->amp * l->amp);
+	for (int i = 0; i < m; i++) {
+		double x = y[2 * i], v = y[2 * i + 1];
+		dydt[2 * i] = v;
+		dydt[2 * i + 1] = -w2 * x + l->rate * (1 - q * x * x) * v;
+	}
+}
+
 static int lat_rhs(double t, const double y[], double dydt[], void *params)
 {
 	(void)t;
-	(void)y;
 	const struct lat *l = params;
-	for (int i = 0; i < l->n; i++)
-		dydt[i] = l->omega;
+	lat_law(l, y, dydt, l->n);
 	return GSL_SUCCESS;
 }
 
@@ -79,34 +100,43 @@ static int lat_rhs(double t, const double y[], double dydt[], void *params)
 static int lat_rhs1(double t, const double y[], double dydt[], void *params)
 {
 	(void)t;
-	(void)y;
-	const struct lat *l = params;
-	dydt[0] = l->omega;
+	lat_law(params, y, dydt, 1);
 	return GSL_SUCCESS;
 }
 
 static int lat_rhs2(double t, const double y[], double dydt[], void *params)
 {
 	(void)t;
-	(void)y;
-	const struct lat *l = params;
-	dydt[0] = dydt[1] = l->omega;
+	lat_law(params, y, dydt, 2);
 	return GSL_SUCCESS;
 }
 
-/* Contact k's gap (positive: apart) and its rate of change, for phases y. */
-static double lat_gap(const struct lat *l, const double *y, int k)
+/* Oscillator i's displacement, speed and phase in state y. The phase of an
+ * oscillator with an amplitude is read as the daemon's and the analyser's:
+ * clockwise in the (x, x'/omega) plane. */
+static double lat_x(const struct lat *l, const double *y, int i)
 {
-	if (k == 0)
-		return l->neutral[0] + l->amp * cos(y[0]) - l->wall[0];
-	if (k == l->n)
-		return l->wall[1] - (l->neutral[l->n - 1] + l->amp * cos(y[l->n - 1]));
-	return l->neutral[k] + l->amp * cos(y[k]) - l->neutral[k - 1] - l->amp * cos(y[k - 1]);
+	return l->dim == 1 ? l->amp * cos(y[i]) : y[2 * i];
 }
 
 static double lat_v(const struct lat *l, const double *y, int i)
 {
-	return -l->amp * l->omega * sin(y[i]);
+	return l->dim == 1 ? -l->amp * l->omega * sin(y[i]) : y[2 * i + 1];
+}
+
+static double lat_phi(const struct lat *l, const double *y, int i)
+{
+	return l->dim == 1 ? phase_wrap(y[i]) : atan2(-y[2 * i + 1] / l->omega, y[2 * i]);
+}
+
+/* Contact k's gap (positive: apart) and its rate of change, for state y. */
+static double lat_gap(const struct lat *l, const double *y, int k)
+{
+	if (k == 0)
+		return l->neutral[0] + lat_x(l, y, 0) - l->wall[0];
+	if (k == l->n)
+		return l->wall[1] - (l->neutral[l->n - 1] + lat_x(l, y, l->n - 1));
+	return l->neutral[k] + lat_x(l, y, k) - l->neutral[k - 1] - lat_x(l, y, k - 1);
 }
 
 static double lat_gap_rate(const struct lat *l, const double *y, int k)
@@ -123,6 +153,9 @@ static bool lat_has_contact(const struct lat *l, int k)
 	return (k > 0 && k < l->n) || (l->walls && (k == 0 || k == l->n));
 }
 
+/* Values in the whole state. */
+static size_t lat_len(const struct lat *l) { return (size_t)l->n * (size_t)l->dim; }
+
 /* Contact k's oscillators at time t inside the step that started at
  * (t0, y0), into their places in ytmp (the others' are stale). Between
  * impacts the oscillators do not interact: the two of a contact are
@@ -131,7 +164,9 @@ static bool lat_has_contact(const struct lat *l, int k)
 static int lat_contact_at(struct lat *l, double t0, double t, int k)
 {
 	int first = k == 0 ? 0 : k - 1, m = (k == 0 || k == l->n) ? 1 : 2;
-	double y[2] = { l->y0[first], m == 2 ? l->y0[first + 1] : 0 };
+	size_t off = (size_t)(first * l->dim), len = (size_t)(m * l->dim);
+	double y[4];
+	memcpy(y, l->y0 + off, len * sizeof *y);
 	l->root_evals++;
 	if (t > t0) {
 		gsl_odeiv2_driver_reset(l->pair_drv[m - 1]);
@@ -139,16 +174,14 @@ static int lat_contact_at(struct lat *l, double t0, double t, int k)
 		if (gsl_odeiv2_driver_apply(l->pair_drv[m - 1], &tt, t, y) != GSL_SUCCESS)
 			return -1;
 	}
-	l->ytmp[first] = y[0];
-	if (m == 2)
-		l->ytmp[first + 1] = y[1];
+	memcpy(l->ytmp + off, y, len * sizeof *y);
 	return 0;
 }
 
 /* The state at time t inside the step that started at (t0, y0): into ytmp. */
 static int lat_state_at(struct lat *l, double t0, double t)
 {
-	memcpy(l->ytmp, l->y0, (size_t)l->n * sizeof *l->ytmp);
+	memcpy(l->ytmp, l->y0, lat_len(l) * sizeof *l->ytmp);
 	l->root_evals++;
 	if (t <= t0)
 		return 0;
@@ -234,7 +267,7 @@ static double lat_hermite_min(double g0, double g1, double d0, double d1, double
  * (t1, phi), closes inside the step: *tc, and 1; 0 when it does not. */
 static int lat_crossing(struct lat *l, int k, double t0, double t1, double *tc)
 {
-	double g0 = lat_gap(l, l->y0, k), g1 = lat_gap(l, l->phi, k);
+	double g0 = lat_gap(l, l->y0, k), g1 = lat_gap(l, l->y, k);
 	if (!(g0 > 0))
 		return 0;   /* overlapping at the start: let through until apart */
 	struct lat_probe p = { .l = l, .t0 = t0, .k = k };
@@ -242,7 +275,7 @@ static int lat_crossing(struct lat *l, int k, double t0, double t1, double *tc)
 	if (!(g1 <= 0)) {
 		/* both ends apart: a dip below zero between them needs g' < 0
 		 * at the start and > 0 at the end (one extremum per step) */
-		double d0 = lat_gap_rate(l, l->y0, k), d1 = lat_gap_rate(l, l->phi, k);
+		double d0 = lat_gap_rate(l, l->y0, k), d1 = lat_gap_rate(l, l->y, k);
 		if (!(d0 < 0 && d1 > 0))
 			return 0;
 		/* and the cubic through the ends' values and rates within its
@@ -252,7 +285,9 @@ static int lat_crossing(struct lat *l, int k, double t0, double t1, double *tc)
 		 * in a row of a thousand it was most of the work. */
 		double h = t1 - t0, w2 = l->omega * l->omega;
 		double bound = 4 * l->amp * w2 * w2 * h * h * h * h / 384;
-		if (lat_hermite_min(g0, g1, d0, d1, h) > bound)
+		/* (the bound is the phase model's: with an amplitude of its own
+		 * every such step is searched) */
+		if (l->dim == 1 && lat_hermite_min(g0, g1, d0, d1, h) > bound)
 			return 0;
 		p.rate = true;
 		if (lat_brent(l, &p, t0, t1, &hi) != 0)
@@ -282,11 +317,17 @@ static void lat_mark_neighbours(struct lat *l, int k)
 		}
 }
 
-/* Body i back on its cycle with speed v: the new phase (mdl_lattice.h). */
+/* Body i given speed v by an impact. The phase model puts it back on its
+ * cycle at the new phase (mdl_lattice.h); an oscillator with an amplitude
+ * keeps its place and takes the speed, off its cycle. */
 static void lat_set_speed(struct lat *l, int i, double v)
 {
-	double x = l->amp * cos(l->phi[i]);
-	l->phi[i] = atan2(-v / l->omega, x);
+	if (l->dim == 2) {
+		l->y[2 * i + 1] = v;
+		return;
+	}
+	double x = l->amp * cos(l->y[i]);
+	l->y[i] = atan2(-v / l->omega, x);
 }
 
 /* Applies the impact at contact k now. */
@@ -296,11 +337,11 @@ static void lat_collide(struct lat *l, int k, struct lat_event *ev)
 	ev->t = l->t;
 	ev->contact = k;
 	ev->delta_before = ev->delta_after = ev->dsep_before = NAN;
-	ev->x_left = k > 0 ? l->amp * cos(l->phi[k - 1]) : NAN;
-	ev->x_right = k < l->n ? l->amp * cos(l->phi[k]) : NAN;
+	ev->x_left = k > 0 ? lat_x(l, l->y, k - 1) : NAN;
+	ev->x_right = k < l->n ? lat_x(l, l->y, k) : NAN;
 	if (k == 0 || k == l->n) {
 		int i = k == 0 ? 0 : l->n - 1;
-		double v = lat_v(l, l->phi, i), w = collide_wall(l->r, v);
+		double v = lat_v(l, l->y, i), w = collide_wall(l->r, v);
 		l->neutral[i] += l->beta[i] * (0 - v);
 		lat_set_speed(l, i, w);
 		ev->left = k == 0 ? -1 : i;
@@ -312,8 +353,8 @@ static void lat_collide(struct lat *l, int k, struct lat_event *ev)
 		ev->impulse = fabs(w - v);
 	} else {
 		int i = k - 1, j = k;
-		double vi = lat_v(l, l->phi, i), vj = lat_v(l, l->phi, j), pi_, pj;
-		ev->delta_before = phase_wrap(l->phi[j] - l->phi[i]);
+		double vi = lat_v(l, l->y, i), vj = lat_v(l, l->y, j), pi_, pj;
+		ev->delta_before = phase_wrap(lat_phi(l, l->y, j) - lat_phi(l, l->y, i));
 		ev->dsep_before = (l->neutral[j] - l->neutral[i]) / (2 * l->amp);
 		collide_pair(l->r, vi, vj, &pi_, &pj);
 		l->neutral[i] += l->beta[i] * (vj - vi);
@@ -327,7 +368,7 @@ static void lat_collide(struct lat *l, int k, struct lat_event *ev)
 		ev->post_left = pi_;
 		ev->post_right = pj;
 		ev->impulse = fabs(pi_ - vi);
-		ev->delta_after = phase_wrap(l->phi[j] - l->phi[i]);
+		ev->delta_after = phase_wrap(lat_phi(l, l->y, j) - lat_phi(l, l->y, i));
 	}
 	lat_jumped(l);
 	lat_mark_neighbours(l, k);
@@ -346,13 +387,13 @@ static int lat_pending(struct lat *l, struct lat_event *ev)
 		/* <= 0: a neighbour that reached contact at the very instant of
 		 * this impact (a symmetric row) would otherwise pass unseen, its
 		 * gap not > 0 at the next step's start */
-		if (!(lat_gap(l, l->phi, k) <= 0))
+		if (!(lat_gap(l, l->y, k) <= 0))
 			continue;
 		if (l->t != l->immediate_t) {
 			l->immediate_t = l->t;
 			l->immediate_n = 0;
 		}
-		if (lat_gap_rate(l, l->phi, k) < 0 && l->immediate_n < LAT_IMMEDIATE_PER_OSC * l->n) {
+		if (lat_gap_rate(l, l->y, k) < 0 && l->immediate_n < LAT_IMMEDIATE_PER_OSC * l->n) {
 			l->immediate_n++;
 			lat_collide(l, k, ev);
 			ev->immediate = true;
@@ -370,9 +411,9 @@ enum lat_status lat_advance(struct lat *l, double t_stop, struct lat_event *ev, 
 		return LAT_COLLISION;
 	while (l->t < t_stop) {
 		double t0 = l->t;
-		memcpy(l->y0, l->phi, (size_t)l->n * sizeof *l->y0);
+		memcpy(l->y0, l->y, lat_len(l) * sizeof *l->y0);
 		double t1 = fmin(t_stop, t0 + l->hmax);
-		int st = gsl_odeiv2_evolve_apply(l->evo, l->ctl, l->step, &l->sys, &l->t, t1, &l->h, l->phi);
+		int st = gsl_odeiv2_evolve_apply(l->evo, l->ctl, l->step, &l->sys, &l->t, t1, &l->h, l->y);
 		if (st != GSL_SUCCESS) {
 			lat_err(err, errcap, "the integrator failed at t = %.9g s: %s", t0, gsl_strerror(st));
 			return LAT_FAILED;
@@ -402,7 +443,7 @@ enum lat_status lat_advance(struct lat *l, double t_stop, struct lat_event *ev, 
 			lat_err(err, errcap, "the integrator failed at t = %.9g s", tfirst);
 			return LAT_FAILED;
 		}
-		memcpy(l->phi, l->ytmp, (size_t)l->n * sizeof *l->phi);
+		memcpy(l->y, l->ytmp, lat_len(l) * sizeof *l->y);
 		l->t = tfirst;
 		lat_collide(l, first, ev);
 		return LAT_COLLISION;
@@ -424,6 +465,9 @@ static int lat_check(const struct lat_params *p, char *err, size_t cap)
 		return lat_err(err, cap, "separation d~ %g: must be >= 0", p->dsep);
 	if (p->walls && (!(p->wall_dsep >= 0) || !isfinite(p->wall_dsep)))
 		return lat_err(err, cap, "wall separation %g: must be >= 0", p->wall_dsep);
+	if (!(p->amplitude_rate >= 0 && p->amplitude_rate <= LAT_AMPLITUDE_RATE_MAX))
+		return lat_err(err, cap, "amplitude rate %g /s: must be in [0, %g] (0: the phase model)", p->amplitude_rate,
+		               LAT_AMPLITUDE_RATE_MAX);
 	if (!(p->tolerance >= 0 && p->tolerance < 1e-3))
 		return lat_err(err, cap, "tolerance %g: must be in [0, 1e-3)", p->tolerance);
 	for (int i = 0; p->beta && i < p->n; i++)
@@ -434,27 +478,27 @@ static int lat_check(const struct lat_params *p, char *err, size_t cap)
 
 static int lat_alloc(struct lat *l, char *err, size_t cap)
 {
-	size_t n = (size_t)l->n;
-	l->phi = calloc(n, sizeof *l->phi);
+	size_t n = (size_t)l->n, len = lat_len(l), d = (size_t)l->dim;
+	l->y = calloc(len, sizeof *l->y);
 	l->neutral = calloc(n, sizeof *l->neutral);
 	l->beta = calloc(n, sizeof *l->beta);
-	l->y0 = calloc(n, sizeof *l->y0);
-	l->ytmp = calloc(n, sizeof *l->ytmp);
+	l->y0 = calloc(len, sizeof *l->y0);
+	l->ytmp = calloc(len, sizeof *l->ytmp);
 	l->pending = calloc(n + 1, sizeof *l->pending);
-	l->sys = (gsl_odeiv2_system){ .function = lat_rhs, .jacobian = NULL, .dimension = n, .params = l };
+	l->sys = (gsl_odeiv2_system){ .function = lat_rhs, .jacobian = NULL, .dimension = len, .params = l };
 	/* rkf45 with error control: the phases' law is smooth; the steps are
 	 * bounded by the period (LAT_STEPS_PER_PERIOD), not by accuracy */
-	l->step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rkf45, n);
+	l->step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rkf45, len);
 	l->ctl = gsl_odeiv2_control_y_new(l->tol, l->tol);
-	l->evo = gsl_odeiv2_evolve_alloc(n);
+	l->evo = gsl_odeiv2_evolve_alloc(len);
 	l->drv = gsl_odeiv2_driver_alloc_y_new(&l->sys, gsl_odeiv2_step_rkf45, l->hmax / 4, l->tol, l->tol);
 	l->root = gsl_root_fsolver_alloc(gsl_root_fsolver_brent);
-	l->pair_sys[0] = (gsl_odeiv2_system){ .function = lat_rhs1, .dimension = 1, .params = l };
-	l->pair_sys[1] = (gsl_odeiv2_system){ .function = lat_rhs2, .dimension = 2, .params = l };
+	l->pair_sys[0] = (gsl_odeiv2_system){ .function = lat_rhs1, .dimension = d, .params = l };
+	l->pair_sys[1] = (gsl_odeiv2_system){ .function = lat_rhs2, .dimension = 2 * d, .params = l };
 	for (int m = 0; m < 2; m++)
 		l->pair_drv[m] = gsl_odeiv2_driver_alloc_y_new(&l->pair_sys[m], gsl_odeiv2_step_rkf45, l->hmax / 4,
 							       l->tol, l->tol);
-	if (!l->pair_drv[0] || !l->pair_drv[1] || !l->phi || !l->neutral || !l->beta || !l->y0 || !l->ytmp || !l->pending || !l->step || !l->ctl ||
+	if (!l->pair_drv[0] || !l->pair_drv[1] || !l->y || !l->neutral || !l->beta || !l->y0 || !l->ytmp || !l->pending || !l->step || !l->ctl ||
 	    !l->evo || !l->drv || !l->root)
 		return lat_err(err, cap, "out of memory for %d oscillators", l->n);
 	gsl_odeiv2_driver_set_hmax(l->drv, l->hmax);
@@ -475,6 +519,8 @@ struct lat *lat_new(const struct lat_params *p, const double *phase0, char *err,
 		return NULL;
 	}
 	l->n = p->n;
+	l->dim = p->amplitude_rate > 0 ? 2 : 1;
+	l->rate = p->amplitude_rate;
 	l->omega = 2 * M_PI * p->frequency_hz;
 	l->amp = p->amplitude;
 	l->r = p->restitution;
@@ -489,7 +535,13 @@ struct lat *lat_new(const struct lat_params *p, const double *phase0, char *err,
 	}
 	double d = 2 * p->amplitude * p->dsep;
 	for (int i = 0; i < l->n; i++) {
-		l->phi[i] = phase_wrap(phase0[i]);
+		if (l->dim == 1) {
+			l->y[i] = phase_wrap(phase0[i]);
+		} else {
+			/* on the cycle of amplitude A at that phase */
+			l->y[2 * i] = l->amp * cos(phase0[i]);
+			l->y[2 * i + 1] = -l->amp * l->omega * sin(phase0[i]);
+		}
 		l->neutral[i] = i * d;
 		l->beta[i] = p->beta ? p->beta[i] : 0;
 	}
@@ -519,7 +571,7 @@ void lat_free(struct lat *l)
 		gsl_odeiv2_control_free(l->ctl);
 	if (l->step)
 		gsl_odeiv2_step_free(l->step);
-	free(l->phi);
+	free(l->y);
 	free(l->neutral);
 	free(l->beta);
 	free(l->y0);
@@ -531,9 +583,14 @@ void lat_free(struct lat *l)
 double lat_time(const struct lat *l) { return l->t; }
 int lat_count(const struct lat *l) { return l->n; }
 double lat_omega(const struct lat *l) { return l->omega; }
-double lat_phase(const struct lat *l, int i) { return phase_wrap(l->phi[i]); }
-double lat_displacement(const struct lat *l, int i) { return l->amp * cos(l->phi[i]); }
-double lat_speed(const struct lat *l, int i) { return lat_v(l, l->phi, i); }
+double lat_phase(const struct lat *l, int i) { return lat_phi(l, l->y, i); }
+double lat_displacement(const struct lat *l, int i) { return lat_x(l, l->y, i); }
+double lat_amplitude(const struct lat *l, int i)
+{
+	double x = lat_x(l, l->y, i), v = lat_v(l, l->y, i) / l->omega;
+	return l->dim == 1 ? l->amp : sqrt(x * x + v * v);
+}
+double lat_speed(const struct lat *l, int i) { return lat_v(l, l->y, i); }
 double lat_neutral(const struct lat *l, int i) { return l->neutral[i]; }
 double lat_wall(const struct lat *l, int right) { return l->wall[right ? 1 : 0]; }
 int64_t lat_overlaps(const struct lat *l) { return l->overlaps; }

@@ -3,7 +3,8 @@
  * phi_i' = omega; neighbours collide when their bodies X_i = n_i + x_i meet
  * while approaching, inelastically (mdl_collide.h), and the collision gives
  * each its new phase phi = atan2(-v/omega, x) back on its cycle of amplitude A
- * (theory.md: the phase model has no amplitude of its own). Mobility: at each
+ * (theory.md: the phase model has no amplitude of its own; lat_params.
+ * amplitude_rate gives each one, mdl_lattice.c lat_law). Mobility: at each
  * impact a body's neutral position moves by beta_i (v_other - v_self), with
  * the speeds before the impact (DESIGN.md; the simulator's rule); a wall's
  * speed is 0. Pure code: no I/O, no clock.
@@ -46,7 +47,14 @@ struct lat_params {
 	bool walls;             /* walls beyond both end oscillators */
 	double wall_dsep;       /* a wall stands 2 A wall_dsep beyond its end oscillator's neutral position */
 	double tolerance;       /* the integrator's absolute and relative error per step; 0: 1e-12 */
+	/* 0: the paper's phase model. > 0: each oscillator has an amplitude of
+	 * its own, a van der Pol limit cycle of amplitude A whose amplitude
+	 * comes back at this rate (1/s) after an impact takes some (mdl_lattice.c,
+	 * lat_law): an impact changes a body's speed only, not its place. */
+	double amplitude_rate;
 };
+/* Largest amplitude rate (1/s): far above any limit cycle a joint runs. */
+#define LAT_AMPLITUDE_RATE_MAX 1000.0
 
 /* One impact. Contact k (0..n): k = 0 the left wall, k = n the right wall,
  * else oscillators k-1 (left) and k (right). Speeds are dx/dt; a wall's are 0. */
@@ -86,6 +94,8 @@ double lat_omega(const struct lat *l);
  * neutral position, body position n_i + x_i */
 double lat_phase(const struct lat *l, int i);
 double lat_displacement(const struct lat *l, int i);
+/* its amplitude: A in the phase model, else |(x, x'/omega)| now */
+double lat_amplitude(const struct lat *l, int i);
 double lat_speed(const struct lat *l, int i);
 double lat_neutral(const struct lat *l, int i);
 double lat_wall(const struct lat *l, int right);      /* NAN without walls */

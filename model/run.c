@@ -106,7 +106,7 @@ static void mrun_sample(struct mrun *m, double t)
 		csvrow_num(m->states, lat_speed(m->lat, i));
 		fputs(",,,3", m->states);
 		csvrow_num(m->states, phi);
-		csvrow_num(m->states, o->amplitude);
+		csvrow_num(m->states, lat_amplitude(m->lat, i));
 		csvrow_num(m->states, o->frequency_hz);
 		fputs(",0", m->states);
 		csvrow_num(m->states, phi);
@@ -299,6 +299,7 @@ static void mrun_json_model(const struct mrun *m, struct json *j)
 	json_field_number(j, "duration_s", o->duration_s);
 	json_field_number(j, "sample_hz", o->sample_hz);
 	json_field_number(j, "tolerance", o->tolerance > 0 ? o->tolerance : 1e-12);
+	json_field_number(j, "amplitude_rate", o->amplitude_rate);
 	json_field_number(j, "t_relax_s", mrun_t_relax(m));
 	json_field_number(j, "last_collision_s", m->last_pair_collision);
 	json_field_int(j, "immediate_collisions", m->immediate);
@@ -391,6 +392,9 @@ static void mrun_summary_text(const struct mrun *m, FILE *f)
 	fprintf(f, "model: %s, %d oscillators at %.3g Hz, amplitude %.3g, r %.3g, d~ %.4g at the start%s\n",
 		o->cmd == CLI_PAIR ? "pair" : "lattice", o->n, o->frequency_hz, o->amplitude, o->restitution, o->dsep,
 		o->walls ? ", walls" : ", no walls");
+	if (o->amplitude_rate > 0)
+		fprintf(f, "law: a van der Pol limit cycle of amplitude %.3g, its amplitude back at %.3g /s after an impact\n",
+			o->amplitude, o->amplitude_rate);
 	fprintf(f, "span: %.2f s; final window %.2f .. %.2f s\n", o->duration_s, m->window_start, o->duration_s);
 	fprintf(f, "collisions: %lld (%lld with walls, %lld at once after a jump), %lld pairs let through overlapping\n",
 		(long long)m->collisions, (long long)m->wall_collisions, (long long)m->immediate,

@@ -119,6 +119,40 @@ tap_check "map at d~ = 0: |delta'| - |delta| = |2 atan(r tan(delta/2))| - delta"
 	NR > 1 { e = 2 * atan2(0.5 * sin($2 / 2), cos($2 / 2)); e = (e < 0 ? -e : e) - $2;
 		if ($2 < 3.14159 && ($4 - e)^2 > 1e-12) bad = 1; n++ } END { exit !(n == 30 && !bad) }' "$T/map.csv"
 
+# ---- an amplitude of its own (--amplitude-rate R: the van der Pol limit cycle) ----
+# A pair that collides once (d~ 0.3 from 1.0 rad): after the impact the
+# body's swing (its peaks of |x|) returns to the cycle's, the difference
+# shrinking as exp(-R t) once it is small (the linearised rate: from the
+# first peak within 1 % of A to the next, within 5 %; 0.90 and 1.67 /s from
+# the first peaks, where the difference is 17 % and 10 % of A); the cycle's
+# own peak within 0.2 % of A (0.8). The impact itself moves no body (the
+# phase model's jumps them back onto their cycle).
+# peaks RUN: "t peak" of |x| of r1 after the last impact
+peaks() { awk -F, -v after="$(awk -F, 'NR > 1 { t = $2 } END { print t }' "$1/collisions.csv")" '
+	NR > 1 && $3 == "\"r1\"" { x = $6 < 0 ? -$6 : $6
+		if (n >= 2 && px > x && px >= ppx && pt > after) printf "%.4f %.6f\n", pt, px
+		ppx = px; px = x; pt = $2; n++ }' "$1/states.csv"; }
+for R in 0.75 1.5; do
+	"$M" pair --dsep 0.3 --delta0 1.0 --duration 20 --amplitude-rate $R --sample-hz 1000 --out "$T/amp$R" --quiet \
+		>/dev/null 2>&1
+	got=$(peaks "$T/amp$R" | awk '{ t[NR] = $1; p[NR] = $2 } END { last = p[NR]
+		for (i = 1; i < NR - 1; i++) if (p[i] - last < 0.008) break
+		d1 = p[i] - last; d2 = p[i + 1] - last
+		if (!(d1 > 0 && d2 > 0)) { print "none none"; exit }
+		printf "%.3f %.6f", log(d1 / d2) / (t[i + 1] - t[i]), last }')
+	rate=${got% *} peak=${got#* }
+	tap_check "amplitude rate $R: one impact, the swing back at rate $rate /s (5 %), the cycle's peak $peak (A 0.8, 0.2 %)" \
+		awk -v r="$rate" -v p="$peak" -v R=$R 'BEGIN { exit !((r - R)^2 <= (0.05 * R)^2 && (p - 0.8)^2 <= (0.0016)^2) }'
+done
+tap_check "amplitude rate: the impact changes the speeds only (x_left, x_right continuous: the states' last sample before it and first after it within 2 ms of travel)" awk -F, '
+	function abs(v) { return v < 0 ? -v : v }
+	FNR == 1 { f++ } f == 1 && FNR == 2 { tc = $2 }
+	f == 2 && FNR > 1 && $3 == "\"r1\"" { if ($2 <= tc) { xb = $6; vb = $7 } else if (xa == "") { xa = $6; va = $7 } }
+	END { exit !(xa != "" && abs(xa - xb) <= 0.002 * (abs(va) + abs(vb)) + 1e-9) }' "$T/amp0.75/collisions.csv" "$T/amp0.75/states.csv"
+tap_check "amplitude rate 1.5: anti-phase at d~ 0.7 locks (the kick of 0.05 rad gone)" bash -c "
+	'$M' pair --dsep 0.7 --delta0 3.09159265358979 --duration 60 --amplitude-rate 1.5 --no-samples --out '$T/amp-anti' --quiet >/dev/null 2>&1 &&
+	jq -e '.pairs[0].class == \"anti-phase\" and 3.14159265 - .pairs[0].mean_abs_delta < 1e-4 and .model.amplitude_rate == 1.5' '$T/amp-anti/summary.json' >/dev/null"
+
 # ---- bad input: exit 2, a message naming the program, nothing written ----
 refused() {
 	local name=$1 out
@@ -148,6 +182,10 @@ refused "a stray argument" pair extra
 refused "duration 0" pair --duration 0
 refused "nan" pair --dsep nan
 refused "map: --dsep and a range" map --dsep 0.2 --dsep-from 0.1
+refused "amplitude rate negative" pair --amplitude-rate -1
+refused "amplitude rate nan" pair --amplitude-rate nan
+refused "amplitude rate too large" pair --amplitude-rate 2000
+refused "amplitude rate to map" map --amplitude-rate 1
 tap_check "a bad argument prints the usage" bash -c "'$M' pair --dsep x 2>&1 | grep -q '^usage: undulate-model pair'"
 # --out: the analyser's rules (common/outdir.h): another user's or a world-writable directory
 mkdir -p "$T/open" && chmod 0777 "$T/open"
