@@ -383,8 +383,7 @@ fig_force_time_plot() {
 	shift 9
 	for v in $(cut -d' ' -f1 "$t/summary"); do
 		fig_force_series "$runs" "$v" "$end" "$t/time.$tag$v.csv" || continue
-		fig_has "$t/time.$tag$v.csv" 1 && series+=(
-			"'$t/time.$tag$v.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colours[$((i % ${#colours[@]}))]}' title '$("$label" "$v")'")
+		fig_series series "$t/time.$tag$v.csv" 1 "using 1:2 with lines lw 1.5 lc rgb '${colours[$((i % ${#colours[@]}))]}' title '$("$label" "$v")'"
 		i=$((i + 1))
 	done
 	[ ${#series[@]} -gt 0 ] || { echo "$FIG_NAME: no series.csv in the runs: no time plot" >&2; return 0; }
@@ -477,6 +476,15 @@ fig_gnuplot() {
 # fig_has CSV CONDITION: a row of CSV (after its header) where the awk
 # CONDITION holds: a series that would draw something.
 fig_has() { awk -F, "NR > 1 && ($2) { found = 1; exit } END { exit !found }" "$1"; }
+# fig_series ARRAY CSV CONDITION SPEC: append "'CSV' every ::1 SPEC" (the
+# header line skipped) to the array named ARRAY when fig_has CSV CONDITION:
+# gnuplot's "warning: skipping data file with no valid points", which
+# fig_gnuplot takes for a failure, never meets a series that draws nothing.
+fig_series() {
+	local -n _fs_list=$1
+	fig_has "$2" "$3" && _fs_list+=("'$2' every ::1 $4")
+	return 0
+}
 # fig_plot SPEC...: a gnuplot plot command of the series given (the modules
 # pass only those fig_has found; an empty panel without any).
 fig_plot() {

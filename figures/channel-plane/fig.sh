@@ -158,8 +158,7 @@ draw() {
 	local fig=$1 t=$2 series
 	fig_channel_series "$t/main.csv" "$t" curve 1.0 "$SWEPT_M" >"$t/series" || return 1
 	mapfile -t series <"$t/series"
-	fig_has "$t/control.csv" "\$13 != \"nan\"" && series+=(
-		"'$t/control.csv' every ::1 using 13:(abs(\$6)) with points pt 6 ps 0.9 lc rgb '#888888' title 'control: no end walls, all widths'")
+	fig_series series "$t/control.csv" "\$13 != \"nan\"" "using 13:(abs(\$6)) with points pt 6 ps 0.9 lc rgb '#888888' title 'control: no end walls, all widths'"
 	{
 		fig_gp_head 900 600
 		echo "set output '$fig/channel-plane.png'"
