@@ -1,5 +1,6 @@
 # figures/lib.sh — shared by the figure modules (figures/<name>/fig.sh) and by
-# scripts/figures.sh, the driver of `make figures`. Source it; bash, set -u.
+# scripts/figures.sh, the driver of `make figures`. Source it (bash): it turns
+# on set -u for its caller, so that in every module an unset variable is an error.
 #
 #   fig_init NAME               the module's name, which starts its messages
 #   fig_main USAGE CMD ARG...   runs the module's subcommand CMD (jobs, run, merge,
@@ -75,6 +76,7 @@
 # modules use nothing else outside their OUTDIR, so a run goes to any machine
 # with the same checkout built (docs/CLUSTER.md).
 
+set -u
 fig_top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # fig_rows_csv HEADER_REGEX: the daemons' rows (figures/rows' rows.csv) for a

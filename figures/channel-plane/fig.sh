@@ -41,9 +41,7 @@
 # in lockstep on one plane robot, its joints 2 pi / 3 apart by coupling_phase
 # +-0.30 rad: figures/lib.sh, fig_plane_tune), passed to every daemon as
 # --daemon-set values; the clock (SINUSOID) at the gait the tuner measured.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init channel-plane
 
 WIDTHS_CM="16 18 20 22 24"

@@ -24,9 +24,7 @@
 # bases slide a little when pushed (channel4's beta = 0.02 s), so each pair's
 # final d̃ is the analyser's, from the final neutral positions and measured
 # amplitudes, and differs from the nominal one.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init channel
 
 WIDTHS_CM="16 18 20 22 24"

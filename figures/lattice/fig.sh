@@ -28,9 +28,7 @@
 #   phase  (SPACETIME runs) one an oscillator (i = 1..50) a sample: φ − ωt
 #
 # FIG_TINY=1: `jobs` gives two short runs (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init lattice
 
 OSCILLATORS=50

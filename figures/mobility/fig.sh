@@ -32,9 +32,7 @@
 #          least, greatest)
 #
 # FIG_TINY=1: `jobs` gives two short runs (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init mobility
 
 OSCILLATORS=50

@@ -32,9 +32,7 @@
 # 2026-11-27). Ten give nine pairs and eleven contacts (walls included) per
 # run at under half the cost of twenty, whose relaxation, being the last of
 # more pairs, also takes longer.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init rows
 
 SWITCH=3
