@@ -55,12 +55,15 @@
 #   fig_gnuplot SCRIPT          runs gnuplot on SCRIPT (messages in SCRIPT.log);
 #                               1 also when a series drew nothing
 #   fig_has CSV CONDITION      a row of CSV where the awk CONDITION holds
+#   fig_series ARRAY CSV COND SPEC  ARRAY gets "'CSV' every ::1 SPEC" when fig_has CSV COND
 #   fig_plot SPEC...            a gnuplot plot command of the series (empty ones left out)
 #   fig_theory ARG...           undulate-analyze --theory ARG... (tools/analyze/theory.c)
 #   FIG_PAIR_SCENARIO, FIG_PAIR_DRIVE  the pair rig's scenario and its robots' drive
 #                               (demo.sh --daemon-set words), shared by pair and returnmap
 #   fig_pair_switch DSEP DELTA0 when to switch a pair started on the full sinusoid to the
 #                               oscillator: just after the clock last pressed them together
+#   FIG_CHANNEL_* (widths, timeline, swept width), fig_channel_demo OUTDIR WIDTH_CM SEED
+#   SCENARIO ARG...             the channel modules' trial, one run of it
 #   fig_channel_series CSV TMP WORD PS SWEPT_M, fig_channel_axes WINDOW,
 #   fig_channel_widths CSV, fig_channel_table CSV LAST [above], fig_channel_counts CSV,
 #   fig_channel_trials CSV      the channel modules' figure
@@ -544,6 +547,30 @@ fig_pair_switch() {
 # fields: $5 the class, $6 the mean Δ, $9 the collisions in the final window,
 # $13 the analyser's d̃, $14 its bound 2 asin(d̃). The row world's robots and
 # the plane's are drawn and tabled alike, so that the two pages compare.
+
+# The paper's channel trial, the same in both modules (the plane's page sets
+# its numbers beside the row's): four robots in a channel of these widths
+# (cm); 2 s on the clock sets each robot's random phase, then 30 s on the
+# oscillator (the paper's trials: 30 s); the final window the last 5 s (4
+# periods at 0.8 Hz). FIG_CHANNEL_SWEPT_M, the nominal d̃'s unit: the width a
+# row robot sweeps, 2 x 0.1865 m/rad x 0.8 rad.
+FIG_CHANNEL_WIDTHS_CM="16 18 20 22 24"
+FIG_CHANNEL_SWITCH=2
+FIG_CHANNEL_SECONDS=32
+FIG_CHANNEL_WINDOW=5
+FIG_CHANNEL_SWEPT_M=0.2984
+
+# fig_channel_demo OUTDIR WIDTH_CM SEED SCENARIO ARG...: one trial (fig_demo)
+# in sim-bridge/scenarios/SCENARIO with the channel WIDTH_CM wide, the ARGs
+# added; FIG_CHANNEL_NOMINAL its nominal d̃. 1 when the run failed.
+fig_channel_demo() {
+	local out=$1 width=$2 seed=$3 scenario=$4 spacing
+	shift 4
+	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
+	FIG_CHANNEL_NOMINAL=$(awk -v d="$spacing" -v s="$FIG_CHANNEL_SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
+	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/$scenario" --seconds "$FIG_CHANNEL_SECONDS" \
+		--switch-at "$FIG_CHANNEL_SWITCH" --seed "$seed" --window "$FIG_CHANNEL_WINDOW" --set "world.spacing=$spacing" "$@"
+}
 
 # fig_channel_series CSV TMP WORD PS SWEPT_M: the figure's series, one a line
 # (for mapfile): the compatibility curve from the theory's own code
