@@ -1,5 +1,6 @@
 # figures/lib.sh — shared by the figure modules (figures/<name>/fig.sh) and by
-# scripts/figures.sh, the driver of `make figures`. Source it; bash, set -u.
+# scripts/figures.sh, the driver of `make figures`. Source it (bash): it turns
+# on set -u for its caller, so that in every module an unset variable is an error.
 #
 #   fig_init NAME               the module's name, which starts its messages
 #   fig_main USAGE CMD ARG...   runs the module's subcommand CMD (jobs, run, merge,
@@ -54,12 +55,15 @@
 #   fig_gnuplot SCRIPT          runs gnuplot on SCRIPT (messages in SCRIPT.log);
 #                               1 also when a series drew nothing
 #   fig_has CSV CONDITION      a row of CSV where the awk CONDITION holds
+#   fig_series ARRAY CSV COND SPEC  ARRAY gets "'CSV' every ::1 SPEC" when fig_has CSV COND
 #   fig_plot SPEC...            a gnuplot plot command of the series (empty ones left out)
 #   fig_theory ARG...           undulate-analyze --theory ARG... (tools/analyze/theory.c)
 #   FIG_PAIR_SCENARIO, FIG_PAIR_DRIVE  the pair rig's scenario and its robots' drive
 #                               (demo.sh --daemon-set words), shared by pair and returnmap
 #   fig_pair_switch DSEP DELTA0 when to switch a pair started on the full sinusoid to the
 #                               oscillator: just after the clock last pressed them together
+#   FIG_CHANNEL_* (widths, timeline, swept width), fig_channel_demo OUTDIR WIDTH_CM SEED
+#   SCENARIO ARG...             the channel modules' trial, one run of it
 #   fig_channel_series CSV TMP WORD PS SWEPT_M, fig_channel_axes WINDOW,
 #   fig_channel_widths CSV, fig_channel_table CSV LAST [above], fig_channel_counts CSV,
 #   fig_channel_trials CSV      the channel modules' figure
@@ -75,6 +79,7 @@
 # modules use nothing else outside their OUTDIR, so a run goes to any machine
 # with the same checkout built (docs/CLUSTER.md).
 
+set -u
 fig_top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # fig_rows_csv HEADER_REGEX: the daemons' rows (figures/rows' rows.csv) for a
@@ -383,8 +388,7 @@ fig_force_time_plot() {
 	shift 9
 	for v in $(cut -d' ' -f1 "$t/summary"); do
 		fig_force_series "$runs" "$v" "$end" "$t/time.$tag$v.csv" || continue
-		fig_has "$t/time.$tag$v.csv" 1 && series+=(
-			"'$t/time.$tag$v.csv' every ::1 using 1:2 with lines lw 1.5 lc rgb '${colours[$((i % ${#colours[@]}))]}' title '$("$label" "$v")'")
+		fig_series series "$t/time.$tag$v.csv" 1 "using 1:2 with lines lw 1.5 lc rgb '${colours[$((i % ${#colours[@]}))]}' title '$("$label" "$v")'"
 		i=$((i + 1))
 	done
 	[ ${#series[@]} -gt 0 ] || { echo "$FIG_NAME: no series.csv in the runs: no time plot" >&2; return 0; }
@@ -477,6 +481,15 @@ fig_gnuplot() {
 # fig_has CSV CONDITION: a row of CSV (after its header) where the awk
 # CONDITION holds: a series that would draw something.
 fig_has() { awk -F, "NR > 1 && ($2) { found = 1; exit } END { exit !found }" "$1"; }
+# fig_series ARRAY CSV CONDITION SPEC: append "'CSV' every ::1 SPEC" (the
+# header line skipped) to the array named ARRAY when fig_has CSV CONDITION:
+# gnuplot's "warning: skipping data file with no valid points", which
+# fig_gnuplot takes for a failure, never meets a series that draws nothing.
+fig_series() {
+	local -n _fs_list=$1
+	fig_has "$2" "$3" && _fs_list+=("'$2' every ::1 $4")
+	return 0
+}
 # fig_plot SPEC...: a gnuplot plot command of the series given (the modules
 # pass only those fig_has found; an empty panel without any).
 fig_plot() {
@@ -534,6 +547,30 @@ fig_pair_switch() {
 # fields: $5 the class, $6 the mean Δ, $9 the collisions in the final window,
 # $13 the analyser's d̃, $14 its bound 2 asin(d̃). The row world's robots and
 # the plane's are drawn and tabled alike, so that the two pages compare.
+
+# The paper's channel trial, the same in both modules (the plane's page sets
+# its numbers beside the row's): four robots in a channel of these widths
+# (cm); 2 s on the clock sets each robot's random phase, then 30 s on the
+# oscillator (the paper's trials: 30 s); the final window the last 5 s (4
+# periods at 0.8 Hz). FIG_CHANNEL_SWEPT_M, the nominal d̃'s unit: the width a
+# row robot sweeps, 2 x 0.1865 m/rad x 0.8 rad.
+FIG_CHANNEL_WIDTHS_CM="16 18 20 22 24"
+FIG_CHANNEL_SWITCH=2
+FIG_CHANNEL_SECONDS=32
+FIG_CHANNEL_WINDOW=5
+FIG_CHANNEL_SWEPT_M=0.2984
+
+# fig_channel_demo OUTDIR WIDTH_CM SEED SCENARIO ARG...: one trial (fig_demo)
+# in sim-bridge/scenarios/SCENARIO with the channel WIDTH_CM wide, the ARGs
+# added; FIG_CHANNEL_NOMINAL its nominal d̃. 1 when the run failed.
+fig_channel_demo() {
+	local out=$1 width=$2 seed=$3 scenario=$4 spacing
+	shift 4
+	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
+	FIG_CHANNEL_NOMINAL=$(awk -v d="$spacing" -v s="$FIG_CHANNEL_SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
+	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/$scenario" --seconds "$FIG_CHANNEL_SECONDS" \
+		--switch-at "$FIG_CHANNEL_SWITCH" --seed "$seed" --window "$FIG_CHANNEL_WINDOW" --set "world.spacing=$spacing" "$@"
+}
 
 # fig_channel_series CSV TMP WORD PS SWEPT_M: the figure's series, one a line
 # (for mapfile): the compatibility curve from the theory's own code

@@ -41,20 +41,14 @@
 # in lockstep on one plane robot, its joints 2 pi / 3 apart by coupling_phase
 # +-0.30 rad: figures/lib.sh, fig_plane_tune), passed to every daemon as
 # --daemon-set values; the clock (SINUSOID) at the gait the tuner measured.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init channel-plane
 
-WIDTHS_CM="16 18 20 22 24"
+# the trial's widths and timeline: lib.sh's (FIG_CHANNEL_*), as figures/channel's.
 # 42 trials a width: 210 runs, the paper's number of simulated trials
 TRIALS=42
 QUICK_TRIALS=3
 CONTROL_TRIALS=6
-SWITCH=2
-SECONDS_TOTAL=32
-WINDOW=5
-SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
 # A free plane robot on this oscillator sweeps 0.159 m across its heading per
 # period (its links' centre lines: figures/swimmer's sweep_m, 3 runs, 0.1590-
 # 0.1595 m, 2026-11-28; 0.189 m with the joints 103 deg apart); two robots side by side, their centre lines a width less
@@ -69,9 +63,9 @@ jobs() {
 	local trials=$TRIALS
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel-plane tiny) ends"; return; fi
-	fig_grid 'w{v}cm-t{i}' "$WIDTHS_CM" "$trials" channel-plane '{v}' '{seed}' ends
+	fig_grid 'w{v}cm-t{i}' "$FIG_CHANNEL_WIDTHS_CM" "$trials" channel-plane '{v}' '{seed}' ends
 	[ "${1:-}" = --quick ] && return
-	fig_grid 'noends-w{v}cm-t{i}' "$WIDTHS_CM" "$CONTROL_TRIALS" 'channel-plane none' '{v}' '{seed}' none
+	fig_grid 'noends-w{v}cm-t{i}' "$FIG_CHANNEL_WIDTHS_CM" "$CONTROL_TRIALS" 'channel-plane none' '{v}' '{seed}' none
 }
 
 # robot_stats PLANE_CSV FROM: per robot over t >= FROM, from the analyser's
@@ -100,19 +94,16 @@ run() {
 	mapfile -t sets < <(fig_plane_sets) && [ ${#sets[@]} -gt 0 ] || exit 1
 	fig_run_start "$out"
 	out=$FIG_RUN
-	local spacing nominal r="$out/demo"
-	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
-	nominal=$(awk -v d="$spacing" -v s="$SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
-	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/plane-channel4.scenario" --seconds "$SECONDS_TOTAL" \
-		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.spacing=$spacing" \
-		${ends_set[@]+"${ends_set[@]}"} "${sets[@]}" || exit 1
+	local r="$out/demo" nominal
+	fig_channel_demo "$out" "$width" "$seed" plane-channel4.scenario ${ends_set[@]+"${ends_set[@]}"} "${sets[@]}" || exit 1
+	nominal=$FIG_CHANNEL_NOMINAL
 	[ -s "$r/plane.csv" ] || fig_die "the run's analysis has no plane.csv (a plane world's log gives one)"
 	outdir_new "$out/pairs.csv" "$out/robots.txt" "$out/frames.csv" "$out/result.csv" || fig_die "cannot write in $out"
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"
 	[ -s "$out/pairs.csv" ] || fig_die "the analysis has no neighbouring pairs"
 	local t_end swing wall
 	t_end=$(fig_json "$r" .t_end)
-	robot_stats "$r/plane.csv" "$(awk -v t="$t_end" -v w="$WINDOW" 'BEGIN { print t - w }')" >"$out/robots.txt"
+	robot_stats "$r/plane.csv" "$(awk -v t="$t_end" -v w="$FIG_CHANNEL_WINDOW" 'BEGIN { print t - w }')" >"$out/robots.txt"
 	# the links and walls at the picture's moments (the pose of the 0.1 s
 	# grid that ends at each: plane.csv's poses are at most 0.1 s apart)
 	awk -F, -v want="$FRAMES" 'BEGIN { n = split(want, m, " ") }
@@ -156,17 +147,16 @@ merge() {
 # one colour per width, beside the compatibility curve (the paper's Fig. 9).
 draw() {
 	local fig=$1 t=$2 series
-	fig_channel_series "$t/main.csv" "$t" curve 1.0 "$SWEPT_M" >"$t/series" || return 1
+	fig_channel_series "$t/main.csv" "$t" curve 1.0 "$FIG_CHANNEL_SWEPT_M" >"$t/series" || return 1
 	mapfile -t series <"$t/series"
-	fig_has "$t/control.csv" "\$13 != \"nan\"" && series+=(
-		"'$t/control.csv' every ::1 using 13:(abs(\$6)) with points pt 6 ps 0.9 lc rgb '#888888' title 'control: no end walls, all widths'")
+	fig_series series "$t/control.csv" "\$13 != \"nan\"" "using 13:(abs(\$6)) with points pt 6 ps 0.9 lc rgb '#888888' title 'control: no end walls, all widths'"
 	{
 		fig_gp_head 900 600
 		echo "set output '$fig/channel-plane.png'"
 		echo "set termoption noenhanced"
 		echo "set xlabel 'd̃ of the pair at the end (analyser: final centres, measured amplitude)'"
 		echo "set title 'Four three-link robots in a channel (plane world), 30 s on the oscillator from random phases'"
-		fig_channel_axes "$WINDOW"
+		fig_channel_axes "$FIG_CHANNEL_WINDOW"
 		fig_plot "${series[@]}"
 	} >"$t/channel-plane.gp"
 	fig_gnuplot "$t/channel-plane.gp"
@@ -201,7 +191,7 @@ frames() {
 		fig_gp_head $((300 * nf)) $((330 * rows + 60))
 		echo "set output '$fig/channel-plane-frames.png'"
 		echo "set termoption noenhanced"
-		echo "set multiplot layout $rows,$nf title 'The robots in the channel (links from SIM.TRUTH): the oscillator from ${SWITCH} s'"
+		echo "set multiplot layout $rows,$nf title 'The robots in the channel (links from SIM.TRUTH): the oscillator from ${FIG_CHANNEL_SWITCH} s'"
 		echo "unset key"
 		echo "set size ratio -1"
 		echo "set xtics 0.2 font ',8'; set ytics 0.1 font ',8'"
@@ -239,15 +229,15 @@ fragment() {
 		echo "their length 0.61 m apart (the paper's channel is 55 cm long: it keeps the robots side by side;"
 		echo "0.61 m is the least that holds a straight robot, as they start). The oscillator tuned for this robot"
 		echo "(\`figures/plane-oscillator.conf\`, \`undulated --tune\` in lockstep: 0.82 Hz, 0.78 rad, the joints 2π/3 apart"
-		echo "through the coupling's phase, the swimmer's section above); $SWITCH s on"
-		echo "the clock at random phases, then $((SECONDS_TOTAL - SWITCH)) s on the oscillator; $pairs neighbouring pairs. Final Δ: the"
-		echo "pair's mean over the last $WINDOW s; d̃ and 2 asin(d̃): the analyser's per pair (final centres,"
+		echo "through the coupling's phase, the swimmer's section above); $FIG_CHANNEL_SWITCH s on"
+		echo "the clock at random phases, then $((FIG_CHANNEL_SECONDS - FIG_CHANNEL_SWITCH)) s on the oscillator; $pairs neighbouring pairs. Final Δ: the"
+		echo "pair's mean over the last $FIG_CHANNEL_WINDOW s; d̃ and 2 asin(d̃): the analyser's per pair (final centres,"
 		echo "lever 0.1865 m/rad, measured amplitude)."
 		if [ "$(fig_channel_trials "$csv")" -le "$QUICK_TRIALS" ]; then
 			echo "(\`make figures QUICK=1\`: $QUICK_TRIALS trials a width; the full set runs $TRIALS, the paper's 210 simulated trials.)"
 		fi
 		echo
-		fig_channel_table "$csv" "still touching in the last $WINDOW s" above
+		fig_channel_table "$csv" "still touching in the last $FIG_CHANNEL_WINDOW s" above
 		echo
 		local sweep dy
 		sweep=$(awk -F, 'NR > 1 { print $18; print $19 }' "$csv" | grep -v nan | fig_median)
@@ -256,7 +246,7 @@ fragment() {
 		plane=$(for w in $(awk -F, 'NR > 1 { print $1 }' "$csv" | sort -gu); do
 			awk -v w="$w" -v lw="$LINK_WIDTH_M" -v f="$FREE_SWEEP_M" 'BEGIN { printf "%s cm %.2f, ", w, (w / 100 - lw) / f }'
 		done | sed 's/, $//')
-		awk -F, -v sweep="$sweep" -v dy="$dy" -v swept="$SWEPT_M" -v free="$FREE_SWEEP_M" -v lw="$LINK_WIDTH_M" -v plane="$plane" 'NR > 1 { n++; d = $6 < 0 ? -$6 : $6
+		awk -F, -v sweep="$sweep" -v dy="$dy" -v swept="$FIG_CHANNEL_SWEPT_M" -v free="$FREE_SWEEP_M" -v lw="$LINK_WIDTH_M" -v plane="$plane" 'NR > 1 { n++; d = $6 < 0 ? -$6 : $6
 				if ($5 == "anti-phase") { a++; if ($9 > 0) ac++; ad = ad sprintf(" %.2f", $13) }
 				if ($14 != "nan" && d <= $14 + 0.1) b++
 				else { over++; ex = ex sprintf(" %.2f", d - $14) }
@@ -269,8 +259,8 @@ fragment() {
 				printf "**Beside the paper.** The paper'"'"'s four robots (210 simulated trials and 50 experiments) ended near or below the compatibility curve, never in anti-phase. Here %d of %d pairs ended above 2 asin(d̃) + 0.1 rad", over, n
 				if (over && over <= 40) printf " (by%s rad)", ex
 				printf "; %d in anti-phase", a
-				if (a) printf " (at d̃%s; %d of them still touching in the last '"$WINDOW"' s)", ad, ac
-				printf "; %d of %d pairs still touched in the last '"$WINDOW"' s. ", c, n
+				if (a) printf " (at d̃%s; %d of them still touching in the last '"$FIG_CHANNEL_WINDOW"' s)", ad, ac
+				printf "; %d of %d pairs still touched in the last '"$FIG_CHANNEL_WINDOW"' s. ", c, n
 				printf "The d̃ is the row'"'"'s reading of the plane, a contact body sweeping 2 x 0.1865 m/rad x 0.8 rad = %.3f m. A free robot on this oscillator sweeps %.3f m across its heading per period (its links'"'"' centre lines: the swimmer'"'"'s section above), so two of them side by side and aligned could touch at all only while (width - %.3f m) / %.3f m is below 1 (%s), and then only out of phase. Here they touched far more than that: in the channel a robot occupied %.3f m across it over the final window (the median over the robots, width included: it turns and is pushed about as well as swinging), the side walls stand half a width beyond the end robots, and the robots pressed together (the d̃ at the end below the nominal, the table). Neighbours'"'"' centres ended %.3f m apart along the channel (median): the end walls hold them side by side.\n", swept, free, lw, free, plane, sweep, dy
 			}' "$csv"
 		if [ "$(wc -l <"$control")" -gt 1 ]; then
@@ -284,7 +274,7 @@ fragment() {
 					if ($9 > 0) c++
 					if ($17 > mx) mx = $17 }
 				END {
-					printf "**Without end walls** (the control, %d run%s at the same widths and timeline, grey circles in the figure): %d of %d pairs ended at or below the curve, %d in anti-phase, %d still touched in the last '"$WINDOW"' s. Their neighbours'"'"' centres ended %.3f m apart along the channel (median; up to %.3f m), against %.3f m with the ends: the end walls are what keeps the robots side by side, as the paper'"'"'s 55 cm channel does.\n", runs, runs == 1 ? "" : "s", b, n, a, c, cdy, mx, dy
+					printf "**Without end walls** (the control, %d run%s at the same widths and timeline, grey circles in the figure): %d of %d pairs ended at or below the curve, %d in anti-phase, %d still touched in the last '"$FIG_CHANNEL_WINDOW"' s. Their neighbours'"'"' centres ended %.3f m apart along the channel (median; up to %.3f m), against %.3f m with the ends: the end walls are what keeps the robots side by side, as the paper'"'"'s 55 cm channel does.\n", runs, runs == 1 ? "" : "s", b, n, a, c, cdy, mx, dy
 				}' "$control"
 		fi
 	} >"$fig/channel-plane.md"

@@ -24,28 +24,19 @@
 # bases slide a little when pushed (channel4's beta = 0.02 s), so each pair's
 # final d̃ is the analyser's, from the final neutral positions and measured
 # amplitudes, and differs from the nominal one.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init channel
 
-WIDTHS_CM="16 18 20 22 24"
+# the trial's widths and timeline: lib.sh's (FIG_CHANNEL_*)
 TRIALS=12
 QUICK_TRIALS=3
-# 2 s on the clock sets each robot's random phase; then 30 s on the
-# oscillator (the paper's trials: 30 s). The final window: the last 5 s
-# (4 periods at 0.8 Hz).
-SWITCH=2
-SECONDS_TOTAL=32
-WINDOW=5
-SWEPT_M=0.2984   # 2 x 0.1865 m/rad x 0.8 rad
 
 jobs() {
 	local trials=$TRIALS
 	[ "${1:-}" = --quick ] && trials=$QUICK_TRIALS
 	# FIG_TINY=1 (the tests): one run at the middle width
 	if [ "${FIG_TINY:-0}" = 1 ]; then echo "w20cm-t0 20 $(fig_seed channel tiny)"; return; fi
-	fig_grid 'w{v}cm-t{i}' "$WIDTHS_CM" "$trials" channel '{v}' '{seed}'
+	fig_grid 'w{v}cm-t{i}' "$FIG_CHANNEL_WIDTHS_CM" "$trials" channel '{v}' '{seed}'
 }
 
 run() {
@@ -55,12 +46,8 @@ run() {
 	fig_uint SEED "$seed" 1 999999999
 	fig_run_start "$out"
 	out=$FIG_RUN
-	local spacing nominal
-	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
-	nominal=$(awk -v d="$spacing" -v s="$SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
-	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/channel4.scenario" --seconds "$SECONDS_TOTAL" \
-		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.spacing=$spacing" || exit 1
-	local r="$out/demo" wall swing
+	fig_channel_demo "$out" "$width" "$seed" channel4.scenario || exit 1
+	local r="$out/demo" wall swing nominal=$FIG_CHANNEL_NOMINAL
 	swing=$(fig_min_swing "$r/summary.json")
 	wall=$(fig_wall)
 	outdir_new "$out/pairs.csv" "$out/result.csv" || fig_die "cannot write in $out"
@@ -86,7 +73,7 @@ merge() {
 # colour per width, beside the compatibility bound.
 draw() {
 	local fig=$1 t=$2 series
-	fig_channel_series "$fig/channel.csv" "$t" bound 1.1 "$SWEPT_M" >"$t/series" || return 1
+	fig_channel_series "$fig/channel.csv" "$t" bound 1.1 "$FIG_CHANNEL_SWEPT_M" >"$t/series" || return 1
 	mapfile -t series <"$t/series"
 	{
 		fig_gp_head 900 600
@@ -94,7 +81,7 @@ draw() {
 		echo "set termoption noenhanced"
 		echo "set xlabel 'd̃ of the pair at the end (analyser: final neutral positions, measured amplitude)'"
 		echo "set title 'Four robots in a channel, 30 s on the oscillator from random phases'"
-		fig_channel_axes "$WINDOW"
+		fig_channel_axes "$FIG_CHANNEL_WINDOW"
 		fig_plot "${series[@]}"
 	} >"$t/channel.gp"
 	fig_gnuplot "$t/channel.gp"
@@ -111,15 +98,15 @@ fragment() {
 		echo
 		echo "What ran: $runs lockstep runs of \`sim-bridge/scenarios/channel4.scenario\` (four two-joint"
 		echo "robots, position servos, bases that slide a little: β = 0.02 s, walls at the channel's"
-		echo "sides), $SWITCH s on the clock at random phases, then $((SECONDS_TOTAL - SWITCH)) s on the oscillator; $pairs"
+		echo "sides), $FIG_CHANNEL_SWITCH s on the clock at random phases, then $((FIG_CHANNEL_SECONDS - FIG_CHANNEL_SWITCH)) s on the oscillator; $pairs"
 		echo "neighbouring pairs. Channel width = the distance between neighbouring robots (d̃ ="
 		echo "width / 0.298 m, the swept width of a contact body). Final Δ: the pair's mean over the"
-		echo "last $WINDOW s; d̃ and 2 asin(d̃): the analyser's, per pair."
+		echo "last $FIG_CHANNEL_WINDOW s; d̃ and 2 asin(d̃): the analyser's, per pair."
 		if [ "$(fig_channel_trials "$csv")" -le "$QUICK_TRIALS" ]; then
 			echo "(\`make figures QUICK=1\`: $QUICK_TRIALS trials a width; the full set runs $TRIALS.)"
 		fi
 		echo
-		fig_channel_table "$csv" "still colliding in the last $WINDOW s"
+		fig_channel_table "$csv" "still colliding in the last $FIG_CHANNEL_WINDOW s"
 		echo
 		awk -F, 'NR > 1 { n++; d = $6 < 0 ? -$6 : $6; if ($5 == "anti-phase") a++; if ($14 != "nan" && d <= $14 + 0.1) b++
 				if ($15 < 0.2 || $16 < 0.2) s++; t += $18 } END {
@@ -133,7 +120,7 @@ fragment() {
 			END {
 				printf "**Beside the paper.** The paper'"'"'s four robots ended near or below the compatibility curve in every trial, never in anti-phase. Here %d of %d pairs ended above 2 asin(d̃) + 0.1 rad", over, n
 				if (over) printf " (by%s rad)", ex
-				printf "; %d anti-phase (%d of them still colliding, a lock the paper never saw); %d of %d pairs still touched in the last '"$WINDOW"' s: through position servos a pair often settles grazing at its bound once a cycle (docs/EXPERIMENTS.md, section 1), which the paper'"'"'s \"near the curve\" may include.\n", a, ac, c, n
+				printf "; %d anti-phase (%d of them still colliding, a lock the paper never saw); %d of %d pairs still touched in the last '"$FIG_CHANNEL_WINDOW"' s: through position servos a pair often settles grazing at its bound once a cycle (docs/EXPERIMENTS.md, section 1), which the paper'"'"'s \"near the curve\" may include.\n", a, ac, c, n
 			}' "$csv"
 	} >"$fig/channel.md"
 }

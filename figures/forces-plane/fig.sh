@@ -24,9 +24,7 @@
 # parameters undulated --tune found on the plane robot (CONTROL.md, "The
 # joints' lag"). The simulated joints are AX-12As whose wheel mode is a
 # current drive (motor.drive = current), as the paper's torque control.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init forces-plane
 
 END_FULL=300

@@ -25,9 +25,7 @@
 # the way a lab would (undulated --tune on one robot, target 0.8 Hz and
 # 0.8 rad; the tuner also sets the clock's amplitude and frequency to the gait
 # it measured) and runs all ten robots with those parameters.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init forces
 
 # The experiment's timeline, as the paper's: END = 300 s of simulated time,

@@ -16,9 +16,7 @@
 # simulated servos, about a second. The map is odd in Δ, so (0, π] is all of it.
 #
 # FIG_TINY=1: `jobs` gives two small grids (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init heatmap
 
 RESTITUTIONS="0.3 0.5 0.67 0.9"

@@ -28,9 +28,7 @@
 #   phase  (SPACETIME runs) one an oscillator (i = 1..50) a sample: φ − ωt
 #
 # FIG_TINY=1: `jobs` gives two short runs (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init lattice
 
 OSCILLATORS=50
@@ -168,14 +166,11 @@ pairs_plot() {
 	awk -F, -v k=$C_KIND -v cd=$C_D -v ci=$C_I -v ca=$C_ABS -v cw=$C_WIN -v cs=$C_SEED '
 		$k == "pair" { printf "%s,%.5f,%s,%d\n", $cd, $cd + 0.02 * (($ci - 25) / 49 + ($cs % 5 - 2) / 250), $ca, ($cw > 0) }' "$csv" |
 		{ echo "dsep,x,abs_delta,colliding"; cat; } >"$t/pairs.csv"
-	fig_has "$t/pairs.csv" '$4 == 0' && series+=(
-		"'$t/pairs.csv' every ::1 using (\$4 == 0 ? \$2 : 1/0):3 with points pt 7 ps 0.35 lc rgb '#1f77b4' title 'a pair, no collision in the last $WINDOW s'")
-	fig_has "$t/pairs.csv" '$4 == 1' && series+=(
-		"'$t/pairs.csv' every ::1 using (\$4 == 1 ? \$2 : 1/0):3 with points pt 7 ps 0.35 lc rgb '#d62728' title 'a pair still colliding'")
+	fig_series series "$t/pairs.csv" '$4 == 0' "using (\$4 == 0 ? \$2 : 1/0):3 with points pt 7 ps 0.35 lc rgb '#1f77b4' title 'a pair, no collision in the last $WINDOW s'"
+	fig_series series "$t/pairs.csv" '$4 == 1' "using (\$4 == 1 ? \$2 : 1/0):3 with points pt 7 ps 0.35 lc rgb '#d62728' title 'a pair still colliding'"
 	series+=("'$t/curves.csv' every ::1 using 1:2 with lines lw 2 lc rgb 'black' title 'compatibility limit 2 asin(d̃)'")
 	local share=("'$t/dseps.csv' every ::1 using 1:5 with linespoints lw 2 pt 7 lc rgb '#d62728' title 'model: 50 oscillators, no walls'")
-	fig_has "$t/daemons.csv" 1 && share+=(
-		"'$t/daemons.csv' every ::1 using 1:5 with linespoints lw 2 dt 2 pt 5 ps 1.2 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, no walls'")
+	fig_series share "$t/daemons.csv" 1 "using 1:5 with linespoints lw 2 dt 2 pt 5 ps 1.2 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, no walls'"
 	{
 		fig_gp_head 1000 900
 		echo "set encoding utf8"

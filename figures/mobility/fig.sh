@@ -32,9 +32,7 @@
 #          least, greatest)
 #
 # FIG_TINY=1: `jobs` gives two short runs (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init mobility
 
 OSCILLATORS=50
@@ -218,18 +216,12 @@ relax_plot() {
 	awk -F, -v k=$C_KIND -v cb=$C_B -v cs=$C_SEED -v ctr=$C_TR -v cl=$C_SECS -v clo=$C_LORUN '
 		$k == "run" { x = $cb * exp(0.04 * (($cs % 10) - 4.5)); printf "%s,%.6g,%s,%s,%d\n", $cb, x, ($ctr == "") ? "" : ($ctr > 0.05 ? $ctr : 0.05), ($ctr == "") ? $cl : "", $clo < 0 }' "$csv" |
 		{ echo "beta,x,t_relax,censored_at,crossed"; cat; } >"$t/runs.csv"
-	fig_has "$t/runs.csv" '$3 != "" && $5 == 0' && series+=(
-		"'$t/runs.csv' every ::1 using 2:(\$5 == 0 ? \$3 : 1/0) with points pt 7 ps 0.8 lc rgb '#1f77b4' title 'model: a run (50 oscillators, ends held, d̃ 0.78)'")
-	fig_has "$t/runs.csv" '$3 != "" && $5 == 1' && series+=(
-		"'$t/runs.csv' every ::1 using 2:(\$5 == 1 ? \$3 : 1/0) with points pt 6 ps 0.8 lc rgb '#1f77b4' title 'model: a run in which two bases passed each other (d̃ < 0)'")
-	fig_has "$t/betas.csv" '$5 !~ />/ && $3 > 0' && series+=(
-		"'$t/betas.csv' every ::1 using 1:(strstrt(strcol(5), '>') > 0 ? 1/0 : \$5) with linespoints lw 2 pt 6 ps 1.6 lc rgb '#1f77b4' title 'model: median over the seeds'")
-	fig_has "$t/runs.csv" '$4 != ""' && series+=(
-		"'$t/runs.csv' every ::1 using 2:4 with points pt 8 ps 1.4 lw 1.5 lc rgb '#d62728' title 'model: censored, still colliding at the end of its run (drawn there)'")
-	fig_has "$t/daemons.csv" '$3 == 0' && series+=(
-		"'$t/daemons.csv' every ::1 using (\$3 == 0 ? \$1 : 1/0):(\$2 > 0.05 ? \$2 : 0.05) with points pt 5 ps 1.1 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, ends held (0 s drawn at 0.05)'")
-	fig_has "$t/daemons.csv" '$3 == 1' && series+=(
-		"'$t/daemons.csv' every ::1 using (\$3 == 1 ? \$1 : 1/0):4 with points pt 4 ps 1.3 lw 1.5 lc rgb '#555555' title 'daemons: censored (drawn at the length of the run)'")
+	fig_series series "$t/runs.csv" '$3 != "" && $5 == 0' "using 2:(\$5 == 0 ? \$3 : 1/0) with points pt 7 ps 0.8 lc rgb '#1f77b4' title 'model: a run (50 oscillators, ends held, d̃ 0.78)'"
+	fig_series series "$t/runs.csv" '$3 != "" && $5 == 1' "using 2:(\$5 == 1 ? \$3 : 1/0) with points pt 6 ps 0.8 lc rgb '#1f77b4' title 'model: a run in which two bases passed each other (d̃ < 0)'"
+	fig_series series "$t/betas.csv" '$5 !~ />/ && $3 > 0' "using 1:(strstrt(strcol(5), '>') > 0 ? 1/0 : \$5) with linespoints lw 2 pt 6 ps 1.6 lc rgb '#1f77b4' title 'model: median over the seeds'"
+	fig_series series "$t/runs.csv" '$4 != ""' "using 2:4 with points pt 8 ps 1.4 lw 1.5 lc rgb '#d62728' title 'model: censored, still colliding at the end of its run (drawn there)'"
+	fig_series series "$t/daemons.csv" '$3 == 0' "using (\$3 == 0 ? \$1 : 1/0):(\$2 > 0.05 ? \$2 : 0.05) with points pt 5 ps 1.1 lc rgb '#555555' title 'daemons (figures/rows): 10 robots, ends held (0 s drawn at 0.05)'"
+	fig_series series "$t/daemons.csv" '$3 == 1' "using (\$3 == 1 ? \$1 : 1/0):4 with points pt 4 ps 1.3 lw 1.5 lc rgb '#555555' title 'daemons: censored (drawn at the length of the run)'"
 	lo=$(awk -F, 'NR > 1 { if (m == "" || $1 < m) m = $1 } END { print m / 2 }' "$t/runs.csv")
 	hi=$(awk -F, 'NR > 1 { if ($1 > m) m = $1 } END { print m * 2 }' "$t/runs.csv")
 	{

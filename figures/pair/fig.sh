@@ -25,9 +25,7 @@
 # little less: 88 against 92, 2026-11-27.)
 #
 # FIG_TINY=1: `jobs` gives three short runs (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init pair
 
 SCENARIO=$FIG_PAIR_SCENARIO

@@ -22,9 +22,7 @@
 # which gives a phase at every collision.
 #
 # FIG_TINY=1: `jobs` gives two short runs (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init returnmap
 
 SCENARIO=$FIG_PAIR_SCENARIO

@@ -32,9 +32,7 @@
 # 2026-11-27). Ten give nine pairs and eleven contacts (walls included) per
 # run at under half the cost of twenty, whose relaxation, being the last of
 # more pairs, also takes longer.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init rows
 
 SWITCH=3
@@ -210,15 +208,11 @@ relax_plot() {
 		done
 	} >"$t/relax.csv"
 	fig_has "$t/relax.csv" 1 || { echo "rows: no mobile runs at d̃ = $RELAX_DSEP: no relaxation plot" >&2; return 0; }
-	fig_has "$csv" "\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0" && series+=(
-		"'$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0 ? \$2 : 1/0):(\$14 > 0 ? \$14 : 0.5) with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'relaxed (no collision in its last $CENSOR_S s)'")
-	fig_has "$csv" "\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1" && series+=(
-		"'$csv' every ::1 using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1 ? \$2 : 1/0):(\$3 - $SWITCH) with points pt 9 ps 1.6 lc rgb '#d62728' title 'censored: still colliding (drawn at its run length)'")
+	fig_series series "$csv" "\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0" "using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 0 ? \$2 : 1/0):(\$14 > 0 ? \$14 : 0.5) with points pt 7 ps 1.2 lc rgb '#1f77b4' title 'relaxed (no collision in its last $CENSOR_S s)'"
+	fig_series series "$csv" "\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1" "using (\$1 == $RELAX_DSEP && \$2 > 0 && \$15 == 1 ? \$2 : 1/0):(\$3 - $SWITCH) with points pt 9 ps 1.6 lc rgb '#d62728' title 'censored: still colliding (drawn at its run length)'"
 	# (log scale: a median of 0 s, a row that never collided after the switch, cannot be drawn)
-	fig_has "$t/relax.csv" '$2 != "nan" && $2 > 0' && series+=(
-		"'$t/relax.csv' every ::1 using 1:2 with linespoints lw 2 pt 6 ps 2 lc rgb '#1f77b4' title 'median (censored runs counted as longest)'")
-	fig_has "$t/relax.csv" '$3 != "nan"' && series+=(
-		"'$t/relax.csv' every ::1 using 1:3 with points pt 8 ps 2.5 lw 2 lc rgb '#d62728' title 'median censored: longer than its run'")
+	fig_series series "$t/relax.csv" '$2 != "nan" && $2 > 0' "using 1:2 with linespoints lw 2 pt 6 ps 2 lc rgb '#1f77b4' title 'median (censored runs counted as longest)'"
+	fig_series series "$t/relax.csv" '$3 != "nan"' "using 1:3 with points pt 8 ps 2.5 lw 2 lc rgb '#d62728' title 'median censored: longer than its run'"
 	{
 		fig_gp_head 900 600
 		echo "set output '$fig/rows_relax.png'"

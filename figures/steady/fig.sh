@@ -18,9 +18,7 @@
 # the last 10 s. No daemons.
 #
 # FIG_TINY=1: `jobs` gives two small grids (the driver's test).
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init steady
 
 # full: r every 0.1, d~ every 0.04, 16 starts (3744 pairs); quick: five r,

@@ -25,9 +25,7 @@
 # - 2 pi f t)). The seed sets the robot's random start (initial_spread
 # 0.3 rad). The numbers come from the steady part: the analyser's over the
 # last SECONDS - SETTLE s, the centre's path from SETTLE s to the end.
-set -u
-here=$(cd "$(dirname "$0")" && pwd)
-source "$here/../lib.sh"
+source "$(dirname "$0")/../lib.sh"
 fig_init swimmer
 
 MODES="oscillator sinusoid"

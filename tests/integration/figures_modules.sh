@@ -90,6 +90,20 @@ done' _ "$F")
 if [ -z "$diff" ]; then tap_ok "fig_hash is cksum's CRC (empty, ASCII, bytes above 127, 300+ bytes)"
 else tap_fail "fig_hash is cksum's CRC" "$diff"; fi
 
+# ---- a series only where it draws something ------------------------------------------
+# gnuplot warns of a series with no points, and fig_gnuplot takes the
+# warning for a failure: fig_series adds a series only when its CSV has a row
+# (below the header) where the condition holds, the file named once.
+printf 'x,y\n1,0\n2,5\n' >"$T/series.csv"
+got=$(bash -c '. "$1/lib.sh"; s=("first")
+	fig_series s "$2" "\$2 > 4" "using 1:2 title '"'"'big'"'"'"
+	fig_series s "$2" "\$2 > 9" "using 1:2 title '"'"'none'"'"'"
+	fig_series s "$2" 1 "using 1:(\$2 * 2)" || echo "status $?"
+	printf "%s|" "${s[@]}"' _ "$F" "$T/series.csv" 2>&1)
+want="first|'$T/series.csv' every ::1 using 1:2 title 'big'|'$T/series.csv' every ::1 using 1:(\$2 * 2)|"
+if [ "$got" = "$want" ]; then tap_ok "fig_series: a series where its CSV has a matching row, none where not"
+else tap_fail "fig_series: series where a row matches" "got '$got', want '$want'"; fi
+
 # ---- bad arguments: one line, exit 2, nothing run --------------------------------
 refused() { # NAME WANT CMD...
 	local name=$1 want=$2 rc; shift 2

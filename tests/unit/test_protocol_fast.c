@@ -261,46 +261,60 @@ static void test_no_stuffing(void **state)
 	assert_int_equal(parts[1].err, 0x80);   /* each servo's own ERR */
 }
 
+/* split_fast: BYTES (N of them), fed 7 bytes at a time to a status parser
+ * awaiting a fast status, must give one frame; its split against a Sync
+ * Read of LEN bytes each from fsr_ids (the manual's request) is returned,
+ * GOOD the parts that stand. */
+static int split_fast(const uint8_t *bytes, size_t n, uint16_t len, size_t *good)
+{
+	struct dxl2_parser p;
+	struct dxl2_multi_read m;
+	struct dxl2_fast_part parts[3];
+	assert_int_equal(dxl2_multi_read_sync(&m, len, fsr_ids, 3), DXL_OK);
+	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
+	dxl2_parser_expect_fast(&p, true);
+	assert_int_equal(feed(&p, bytes, n, 7, frames, 4), 1);
+	return dxl2_fast_status_split(&frames[0], &m, parts, good);
+}
+
 /* A part's CRC that does not check, the final one made good: the parts
  * before it stand, the rest are damaged. Servos in another order than
  * asked, or another size, are not taken. */
 static void test_split_rejects(void **state)
 {
 	(void)state;
-	uint8_t b[sizeof fsr_status];
-	struct dxl2_parser p;
-	struct dxl2_multi_read m;
-	struct dxl2_fast_part parts[3];
-	size_t good = 99;
-	assert_int_equal(dxl2_multi_read_sync(&m, 4, fsr_ids, 3), DXL_OK);
-
-	memcpy(b, fsr_status, sizeof b);
-	b[23] ^= 0x01;   /* ID 7's CRC */
-	seal(b, sizeof b);
-	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
-	dxl2_parser_expect_fast(&p, true);
-	assert_int_equal(feed(&p, b, sizeof b, 7, frames, 4), 1);
-	assert_int_equal(dxl2_fast_status_split(&frames[0], &m, parts, &good), DXL_E_CHECKSUM);
-	assert_int_equal(good, 1);
-
-	memcpy(b, fsr_status, sizeof b);
-	b[17] = 9;   /* ID 9 answers in ID 7's place */
-	seal(b, sizeof b);
-	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
-	dxl2_parser_expect_fast(&p, true);
-	assert_int_equal(feed(&p, b, sizeof b, 7, frames, 4), 1);
-	assert_int_equal(dxl2_fast_status_split(&frames[0], &m, parts, &good), DXL_E_WRONG_ID);
-	assert_int_equal(good, 1);
+	/* the manual's packet with one byte changed, the final CRC made good */
+	const struct {
+		size_t at;
+		uint8_t value;
+		int want;
+		size_t good;
+		const char *legend;
+	} cases[] = {
+		{ 23, fsr_status[23] ^ 0x01, DXL_E_CHECKSUM, 1, "ID 7's CRC" },
+		{ 17, 9, DXL_E_WRONG_ID, 1, "ID 9 answers in ID 7's place" },
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		uint8_t b[sizeof fsr_status];
+		size_t good = 99;
+		memcpy(b, fsr_status, sizeof b);
+		b[cases[i].at] = cases[i].value;
+		seal(b, sizeof b);
+		print_message("%s\n", cases[i].legend);
+		assert_int_equal(split_fast(b, sizeof b, 4, &good), cases[i].want);
+		assert_int_equal(good, cases[i].good);
+	}
 
 	/* a request for 2 bytes each: the manual's packet is the wrong size */
-	assert_int_equal(dxl2_multi_read_sync(&m, 2, fsr_ids, 3), DXL_OK);
-	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
-	dxl2_parser_expect_fast(&p, true);
-	assert_int_equal(feed(&p, fsr_status, sizeof fsr_status, 7, frames, 4), 1);
-	assert_int_equal(dxl2_fast_status_split(&frames[0], &m, parts, &good), DXL_E_WRONG_LENGTH);
+	size_t good = 99;
+	assert_int_equal(split_fast(fsr_status, sizeof fsr_status, 2, &good), DXL_E_WRONG_LENGTH);
 	assert_int_equal(good, 0);
 
 	/* an ordinary status is not a fast one */
+	struct dxl2_parser p;
+	struct dxl2_multi_read m;
+	struct dxl2_fast_part parts[3];
+	assert_int_equal(dxl2_multi_read_sync(&m, 2, fsr_ids, 3), DXL_OK);
 	const uint8_t plain[] = { HDR, 0x01, 0x08, 0x00, 0x55, 0x00, 0xA6, 0x00, 0x00, 0x00, 0x8C, 0xC0 };
 	dxl2_parser_init(&p, DXL2_PARSE_STATUS);
 	assert_int_equal(feed(&p, plain, sizeof plain, 7, frames, 4), 1);
@@ -319,15 +333,21 @@ static void test_split_rejects(void **state)
 static void test_model_firmware(void **state)
 {
 	(void)state;
-	const struct dxl2_model *xm = dxl2_model_by_name("XM430-W350"), *xl = dxl2_model_by_name("XL430-W250");
-	const struct dxl2_model *xc = dxl2_model_by_name("XC430-W150"), *ax = dxl2_model_by_name("AX-12A");
-	assert_false(dxl2_model_fast_read(xm, 44));
-	assert_true(dxl2_model_fast_read(xm, 45));
-	assert_true(dxl2_model_fast_read(xl, 46));
-	assert_true(dxl2_model_fast_read(xc, 45));
-	assert_false(dxl2_model_fast_read(xc, 0));
-	assert_false(dxl2_model_fast_read(ax, 255));
-	assert_false(dxl2_model_fast_read(NULL, 46));
+	const struct {
+		const char *model;   /* NULL: no model */
+		uint8_t firmware;
+		bool fast;
+	} cases[] = {
+		{ "XM430-W350", 44, false }, { "XM430-W350", 45, true }, { "XL430-W250", 46, true },
+		{ "XC430-W150", 45, true },  { "XC430-W150", 0, false }, { "AX-12A", 255, false },
+		{ NULL, 46, false },
+	};
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		const struct dxl2_model *model = cases[i].model ? dxl2_model_by_name(cases[i].model) : NULL;
+		print_message("%s, firmware %u\n", cases[i].model ? cases[i].model : "no model", cases[i].firmware);
+		assert_true(cases[i].model == NULL || model != NULL);
+		assert_int_equal(dxl2_model_fast_read(model, cases[i].firmware), cases[i].fast);
+	}
 }
 
 /* ---- the bus: one transaction, one packet, every servo's slot ------------------- */

@@ -615,24 +615,31 @@ static void test_list_without_sysfs(void **state)
 static void test_rs485_names(void **state)
 {
 	(void)state;
-	enum port_rs485 m = PORT_RS485_OFF;
-
-	assert_true(port_rs485_parse("rts-on-send", &m));
-	assert_int_equal(m, PORT_RS485_RTS_ON_SEND);
-	assert_true(port_rs485_parse("rts-after-send", &m));
-	assert_int_equal(m, PORT_RS485_RTS_AFTER_SEND);
-	assert_true(port_rs485_parse("off", &m));
-	assert_int_equal(m, PORT_RS485_OFF);
-	/* "rts" is the common wiring: transmitter enabled while RTS is high */
-	assert_true(port_rs485_parse("rts", &m));
-	assert_int_equal(m, PORT_RS485_RTS_ON_SEND);
-	m = PORT_RS485_RTS_AFTER_SEND;
-	assert_false(port_rs485_parse("RTS", &m));
-	assert_false(port_rs485_parse("", &m));
-	assert_false(port_rs485_parse("rts-on-send ", &m));
-	assert_false(port_rs485_parse("on", &m));
-	assert_false(port_rs485_parse(NULL, &m));
-	assert_int_equal(m, PORT_RS485_RTS_AFTER_SEND);   /* untouched by a refusal */
+	/* ok: the name gives MODE (the parse starts from another mode); a
+	 * refusal leaves the mode as it was, MODE */
+	const struct {
+		const char *text;
+		bool ok;
+		enum port_rs485 mode;
+	} cases[] = {
+		{ "rts-on-send", true, PORT_RS485_RTS_ON_SEND },
+		{ "rts-after-send", true, PORT_RS485_RTS_AFTER_SEND },
+		{ "off", true, PORT_RS485_OFF },
+		/* "rts" is the common wiring: transmitter enabled while RTS is high */
+		{ "rts", true, PORT_RS485_RTS_ON_SEND },
+		{ "RTS", false, PORT_RS485_RTS_AFTER_SEND },
+		{ "", false, PORT_RS485_RTS_AFTER_SEND },
+		{ "rts-on-send ", false, PORT_RS485_RTS_AFTER_SEND },
+		{ "on", false, PORT_RS485_RTS_AFTER_SEND },
+		{ NULL, false, PORT_RS485_RTS_AFTER_SEND },
+	};
+	enum port_rs485 m;
+	for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+		m = !cases[i].ok ? cases[i].mode : cases[i].mode == PORT_RS485_OFF ? PORT_RS485_RTS_ON_SEND : PORT_RS485_OFF;
+		print_message("'%s'\n", cases[i].text ? cases[i].text : "(null)");
+		assert_int_equal(port_rs485_parse(cases[i].text, &m), cases[i].ok);
+		assert_int_equal(m, cases[i].mode);
+	}
 	for (int i = PORT_RS485_OFF; i <= PORT_RS485_RTS_AFTER_SEND; i++) {
 		assert_true(port_rs485_parse(port_rs485_name((enum port_rs485)i), &m));
 		assert_int_equal(m, i);
