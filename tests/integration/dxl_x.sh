@@ -133,6 +133,27 @@ check "sync-read and sync-read --fast: one line per servo, IDs 1 then 2, each a 
 run fvolt --port "$xl" --baud 1000000 sync-read present_input_voltage 2 1 --fast --units
 check "sync-read --fast --units: in request order, in volts" fvolt \
 	test "$(ids_of fvolt)" = "2 1 " -a "$(grep -cE '^[12] [0-9]+ \([0-9]+\.[0-9] V\)$' "$T/fvolt.out")" = 2
+# bulk-read: one BULK_READ of a register per servo, each its own; --fast:
+# one Fast Bulk Read. A line per servo: ID REGISTER VALUE, in request order,
+# the same values as read one by one (the servos hold still: torque off).
+run bread --port "$xl" --baud 1000000 bulk-read 2:present_input_voltage 1:present_position
+run fbread --port "$xl" --baud 1000000 bulk-read 2:present_input_voltage 1:present_position --fast
+run r1pos --port "$xl" --baud 1000000 read 1 present_position
+run r2volt --port "$xl" --baud 1000000 read 2 present_input_voltage
+want="2 present_input_voltage $(cat "$T/r2volt.out")
+1 present_position $(cat "$T/r1pos.out")"
+check "bulk-read and bulk-read --fast: ID REGISTER VALUE per servo in request order, the values read one by one" fbread \
+	test "$rc" -eq 0 -a "$(cat "$T/fbread.out")" = "$want" -a "$(cat "$T/bread.out")" = "$want"
+run bunits --port "$xl" --baud 1000000 bulk-read 1:present_input_voltage 2:model_number --fast --units
+check "bulk-read --units: each register in its own units" bunits \
+	test "$(grep -cE '^1 present_input_voltage [0-9]+ \([0-9]+\.[0-9] V\)$' "$T/bunits.out")" = 1 -a \
+	"$(grep -cE '^2 model_number 1060$' "$T/bunits.out")" = 1
+run btwice --port "$xl" --baud 1000000 bulk-read 1:present_position 1:present_input_voltage
+check "bulk-read: a servo twice is refused (exit 2: one item per servo)" btwice \
+	test "$rc" -eq 2 -a -n "$(grep 'each servo once' "$T/btwice.err")"
+run bbad --port "$xl" --baud 1000000 bulk-read 1-present_position
+check "bulk-read: an item that is not ID:REG is refused (exit 2)" bbad \
+	test "$rc" -eq 2 -a -n "$(grep 'ID:REG' "$T/bbad.err")"
 old="$T/old"
 spawn simold "$sim" --model xl430-w250 --link "$old" --ids 1,2 --baud 1000000 --firmware 44 --lcm-url "$(lcm_url 7642)" --quiet
 if wait_log simold 'ready' 10; then
@@ -143,6 +164,9 @@ if wait_log simold 'ready' 10; then
 	check "firmware 44: ping says 44, --fast gets no answer (exit 4, says firmware 45), plain sync-read works" ofast \
 		test "$orc" -eq 4 -a "$rc" -eq 0 -a "$(grep -cE '^[12] [0-9]+$' "$T/oslow.out")" = 2 \
 		-a -n "$(grep 'firmware 44' "$T/oping.out")" -a -n "$(grep 'firmware 45' "$T/ofast.err")"
+	run obfast --port "$old" --baud 1000000 bulk-read 1:present_position 2:present_position --fast
+	check "firmware 44: bulk-read --fast gets no answer (exit 4, says Fast Bulk Read and firmware 45)" obfast \
+		test "$rc" -eq 4 -a -n "$(grep 'Fast Bulk Read' "$T/obfast.err" | grep 'firmware 45')"
 	stop simold
 else tap_fail "simulator on firmware 44 ready" "$(cat "$T/simold.log")"; fi
 

@@ -291,6 +291,8 @@ void dxlt_help(FILE *f)
 	      "  sync-read REG ID... [--fast] [--units]   one SYNC_READ of REG from every servo listed\n"
 	      "                             (2.0), a line each: ID VALUE; --fast: one Fast Sync Read\n"
 	      "                             (one status packet for all; X430/X540 firmware 45 and later)\n"
+	      "  bulk-read ID:REG... [--fast] [--units]   one BULK_READ, each servo its own register\n"
+	      "                             (2.0), a line each: ID REG VALUE; --fast: one Fast Bulk Read\n"
 	      "  write ID REG VALUE         write a register (checked against the table first; a negative\n"
 	      "                             VALUE is a value) and print what the servo holds, read back\n"
 	      "  dump ID                    the whole control table, named, with units\n"

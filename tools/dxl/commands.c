@@ -449,6 +449,7 @@ static const struct dxlt_command dxlt_commands[] = {
 	{ "set-baud", { dxlt_cmd_set_baud, dxlt_cmd_set_baud } }, { "torque", { dxlt_cmd_torque, dxlt_cmd_torque } },
 	{ "reset", { dxlt_cmd_reset, dxlt_cmd_reset } },      { "setup", { dxlt_cmd_setup, dxlt_cmd_setup } },
 	{ "reboot", { dxlt_cmd_reboot, dxlt_cmd_reboot } },    { "sync-read", { dxlt_cmd_sync_read, dxlt_cmd_sync_read } },
+	{ "bulk-read", { dxlt_cmd_bulk_read, dxlt_cmd_bulk_read } },
 };
 
 static int dxlt_dispatch(struct dxlt *t)

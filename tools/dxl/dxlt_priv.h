@@ -147,6 +147,9 @@ int dxlt_cmd_read(struct dxlt *t);
 /* sync-read REG ID... [--fast] [--units]: one SYNC_READ (or Fast Sync Read)
  * of REG from every servo listed, in the list's order. */
 int dxlt_cmd_sync_read(struct dxlt *t);
+/* bulk-read ID:REG... [--fast] [--units]: one BULK_READ (or Fast Bulk Read),
+ * each servo's own register, in the list's order: ID REG VALUE a line. */
+int dxlt_cmd_bulk_read(struct dxlt *t);
 int dxlt_cmd_dump(struct dxlt *t);
 int dxlt_cmd_write(struct dxlt *t);
 int dxlt_cmd_torque(struct dxlt *t);

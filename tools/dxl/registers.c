@@ -172,25 +172,62 @@ int dxlt_cmd_read(struct dxlt *t)
 	return DXLT_EXIT_OK;
 }
 
-/* One servo's line of a sync-read: ID and value (in units with --units). */
-static void dxlt_sync_line(struct dxlt *t, uint8_t id, const struct dxlt_reg *reg, const uint8_t *raw)
+/* One servo's line of a sync-read or bulk-read: ID, the register's name
+ * (bulk-read: each servo its own), and the value (in units with --units). */
+static void dxlt_multi_line(struct dxlt *t, uint8_t id, const struct dxlt_reg *reg, const uint8_t *raw, bool named)
 {
 	char text[96];
 	int32_t v = dxlt_decode(reg, raw);
+	fprintf(t->out, "%u ", id);
+	if (named)
+		fprintf(t->out, "%s ", reg->row != NULL ? reg->row->name : reg->name);
 	if (t->a.units && reg->row != NULL)
-		fprintf(t->out, "%u %s\n", id, dxl2_reg_format(reg->row, v, text, sizeof text));
+		fprintf(t->out, "%s\n", dxl2_reg_format(reg->row, v, text, sizeof text));
 	else if (reg->row == NULL || !reg->row->is_signed)
-		fprintf(t->out, "%u %lu\n", id, (unsigned long)(uint32_t)v);
+		fprintf(t->out, "%lu\n", (unsigned long)(uint32_t)v);
 	else
-		fprintf(t->out, "%u %ld\n", id, (long)v);
+		fprintf(t->out, "%ld\n", (long)v);
 }
 
-/* Nobody answered a Fast Sync Read: the likely why, and what to do. */
-static void dxlt_fast_hint(struct dxlt *t, const uint8_t *ids)
+/* Nobody answered a fast read: the likely why, and what to do. */
+static void dxlt_fast_hint(struct dxlt *t, const char *what, const uint8_t *ids)
 {
-	fprintf(t->err, "dxl: no reply to Fast Sync Read: servos answer it from firmware 45 (X430/X540; not "
+	fprintf(t->err, "dxl: no reply to %s: servos answer it from firmware 45 (X430/X540; not "
 	        "the 2XL/2XC), and one that does not stops the others' turns; see each servo's firmware with "
-	        "dxl %s--port %s ping %u, or read without --fast\n", t->fam->opt, port_path(t->port), ids[0]);
+	        "dxl %s--port %s ping %u, or read without --fast\n", what, t->fam->opt, port_path(t->port), ids[0]);
+}
+
+/* A sync-read's or bulk-read's outcome: the lines of the servos that
+ * answered, then each failure said (the exit of the last). each: a
+ * register per slot (bulk-read), named on its line; else regs[0] for all. */
+static int dxlt_multi_report(struct dxlt *t, const struct bus_multi *m, int r, const struct dxlt_reg *regs,
+                             bool each, const char *cmd, const char *instr, const uint8_t *ids)
+{
+	int rc = DXLT_EXIT_OK;
+	if (r == DXL_E_UNSUPPORTED) {
+		fprintf(t->err, "dxl: Protocol %s has no %s (--protocol 2 for X servos)\n", bus_proto(&t->bus)->name,
+		        instr);
+		return DXLT_EXIT_USAGE;
+	}
+	if (r == DXL_E_ARG) {
+		fprintf(t->err, "dxl: %s: each servo once, at most %d\n", cmd, BUS_MULTI_MAX);
+		return DXLT_EXIT_USAGE;
+	}
+	for (size_t i = 0; i < m->n; i++) {
+		const uint8_t *p = bus_multi_data(m, i);
+		if (p == NULL)
+			continue;
+		dxlt_seen(t, m->id[i], m->err[i]);
+		dxlt_multi_line(t, m->id[i], &regs[each ? i : 0], p, each);
+	}
+	if (m->answered == 0 && t->a.fast && bus_multi_failed(m, NULL, 0) == m->n && m->status[0] == DXL_E_TIMEOUT) {
+		dxlt_fast_hint(t, instr, ids);
+		return DXLT_EXIT_BUS;
+	}
+	for (size_t i = 0; i < m->n; i++)
+		if (m->status[i] != DXL_OK)
+			rc = dxlt_bus_fail(t, m->id[i], m->status[i]);
+	return rc;
 }
 
 int dxlt_cmd_sync_read(struct dxlt *t)
@@ -210,30 +247,40 @@ int dxlt_cmd_sync_read(struct dxlt *t)
 		return rc;
 	int r = t->a.fast ? bus_fast_sync_read(&t->bus, reg.addr, reg.size, ids, n, &m)
 	                  : bus_sync_read(&t->bus, reg.addr, reg.size, ids, n, &m);
-	if (r == DXL_E_UNSUPPORTED) {
-		fprintf(t->err, "dxl: Protocol %s has no %s (--protocol 2 for X servos)\n", bus_proto(&t->bus)->name,
-		        t->a.fast ? "Fast Sync Read" : "SYNC_READ");
-		return DXLT_EXIT_USAGE;
+	return dxlt_multi_report(t, &m, r, &reg, false, "sync-read", t->a.fast ? "Fast Sync Read" : "SYNC_READ", ids);
+}
+
+/* bulk-read ID:REG...: each servo's register named by its own model. */
+int dxlt_cmd_bulk_read(struct dxlt *t)
+{
+	struct dxlt_servo s;
+	struct dxlt_reg regs[BUS_MULTI_MAX];
+	struct dxl_item items[BUS_MULTI_MAX];
+	uint8_t ids[BUS_MULTI_MAX], data[BUS_MULTI_MAX * 4];
+	struct bus_multi m = { .data = data, .cap = sizeof data };
+	size_t n = 0;
+	int rc;
+	if (t->a.npos < 1 || t->a.npos > BUS_MULTI_MAX)
+		return dxlt_need_form(t, t->a.npos < 1 ? 1 : -1, "bulk-read ID:REG... [--fast] [--units]");
+	for (int i = 0; i < t->a.npos; i++, n++) {
+		char id_text[8];
+		const char *arg = t->a.pos[i], *colon = strchr(arg, ':');
+		if (colon == NULL || colon == arg || (size_t)(colon - arg) >= sizeof id_text || colon[1] == '\0') {
+			fprintf(t->err, "dxl: bulk-read: '%s' is not ID:REG (e.g. 1:present_position 2:present_current)\n",
+			        arg);
+			return DXLT_EXIT_USAGE;
+		}
+		memcpy(id_text, arg, (size_t)(colon - arg));
+		id_text[colon - arg] = '\0';
+		if ((rc = dxlt_arg_servo_id(t, id_text, &ids[n])) != DXLT_EXIT_OK)
+			return rc;
+		if ((rc = dxlt_identify(t, ids[n], &s)) || (rc = dxlt_arg_reg(t, &s, colon + 1, &regs[n])))
+			return rc;
+		items[n] = (struct dxl_item){ .id = ids[n], .addr = regs[n].addr, .len = regs[n].size };
 	}
-	if (r == DXL_E_ARG) {
-		fprintf(t->err, "dxl: sync-read: each servo once, at most %d\n", BUS_MULTI_MAX);
-		return DXLT_EXIT_USAGE;
-	}
-	for (size_t i = 0; i < m.n; i++) {
-		const uint8_t *p = bus_multi_data(&m, i);
-		if (p == NULL)
-			continue;
-		dxlt_seen(t, m.id[i], m.err[i]);
-		dxlt_sync_line(t, m.id[i], &reg, p);
-	}
-	if (m.answered == 0 && t->a.fast && bus_multi_failed(&m, NULL, 0) == m.n && m.status[0] == DXL_E_TIMEOUT) {
-		dxlt_fast_hint(t, ids);
-		return DXLT_EXIT_BUS;
-	}
-	for (size_t i = 0; i < m.n; i++)
-		if (m.status[i] != DXL_OK)
-			rc = dxlt_bus_fail(t, m.id[i], m.status[i]);
-	return rc;
+	int r = t->a.fast ? bus_fast_bulk_read(&t->bus, items, n, &m) : bus_bulk_read(&t->bus, items, n, &m);
+	return dxlt_multi_report(t, &m, r, regs, true, "bulk-read",
+	                         t->a.fast ? "Fast Bulk Read" : "BULK_READ", ids);
 }
 
 static void dxlt_dump_raw(struct dxlt *t, const uint8_t *mem, size_t len)
