@@ -490,6 +490,7 @@ static bool dr_servo_info(const struct dr *d, size_t j, struct ctl_servo_info *i
 		/* an output limit of 0: refused, or run at full output (as setup.c does) */
 		.max_torque = s->max_output ? s->max_output : m->setup->strict ? 0 : (uint16_t)m->torque_full,
 		.return_delay = s->return_delay, .status_return_level = s->status_return_level, .model = m,
+		.firmware = s->firmware,
 	};
 	return info->max_torque != 0;
 }
@@ -568,6 +569,16 @@ static void dr_record(struct dr_run *r, const struct bus *bus)
 	double floor_us = (double)bus_wire_time_us(bus, (size_t)(out + in));
 	for (size_t k = 0; k < r->cfg.njoints; k++)
 		floor_us += (double)(bus->servo[r->cfg.ids[k]].replies - r->replies0[k]) * r->rd_us[k];
+	/* a Fast Sync Read's parts are counted as replies, but only its first
+	 * servo waits its return delay: the others send theirs at once */
+	const struct bus_multi *m = &r->cyc.multi;
+	bool first = true;
+	for (size_t k = 0; r->cyc.fast_read && m->fast && k < m->n && k < r->cfg.njoints; k++)
+		if (m->status[k] == DXL_OK) {
+			if (!first)
+				floor_us -= r->rd_us[k];
+			first = false;
+		}
 	r->bus_ms[r->done] = 1e-3 * r->cyc.bus_us;
 	r->floor_ms[r->done] = 1e-3 * floor_us;
 	r->done++;
@@ -755,6 +766,17 @@ static int dr_time(struct dr *d, struct dr_run *r, long n, struct dr_budget *b)
 
 	dr_daemon_timing(d, r);
 	cyc_init(&r->cyc, &d->t->bus, &r->ctl, (uint64_t)llround(d->cfg.period_ms * 1000.0), NULL);
+	/* read as undulated will: by Fast Sync Read where every servo answers
+	 * it (daemon/setup.c decides, from the models and firmware read) */
+	if (dxl_proto_can(bus_proto(&d->t->bus), DXL_CAP_SYNC_READ)) {
+		char why[160];
+		bool fast = setup_fast_read(&d->t->bus, &r->ctl, why, sizeof why);
+		cyc_set_fast_read(&r->cyc, fast);
+		snprintf(b->read_by, sizeof b->read_by, "%s, as undulated reads these servos%s%s",
+		         fast ? "Fast Sync Read" : "SYNC_READ", fast ? "" : ": no Fast Sync Read, as ", fast ? "" : why);
+	} else {
+		snprintf(b->read_by, sizeof b->read_by, "a READ a servo, as undulated reads these servos");
+	}
 	r->epoch_us = port_now_us();
 	ctl_start(&r->ctl, 0.0, "start");
 	dr_events(r);

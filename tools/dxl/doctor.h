@@ -198,6 +198,7 @@ struct dr_budget {
 	long long cut_off;               /* cycles still on the bus at the next tick */
 	long long errors, transactions;  /* failed transactions (timeouts, bad replies) of all begun */
 	const char *skipped;             /* not timed, and why (NULL: timed) */
+	char read_by[320];               /* how the cycles read ("Fast Sync Read, as undulated ...") */
 };
 /* Share of transactions failed or cycles cut off that is a warning, and a
  * failure: one in a hundred is a joint holding for a period now and then. */

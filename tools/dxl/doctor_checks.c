@@ -620,9 +620,10 @@ void dr_check_budget(const struct dr_budget *b, struct dr_verdict *v)
 	}
 	dr_set(v, lv, "bus time per cycle p50 %.2f / p99 %.2f / max %.2f ms; wire floor %.2f ms (p50 %.1fx it); "
 	       "period %g ms (p99 %.0f%% of it); %u cycles of undulated's own loop on %u joint(s), holding: "
-	       "%lld of %lld transactions failed, %lld cycle(s) cut off by the next tick", b->p50_ms, b->p99_ms,
+	       "%lld of %lld transactions failed, %lld cycle(s) cut off by the next tick%s%s", b->p50_ms, b->p99_ms,
 	       b->max_ms, b->floor_ms, b->floor_ms > 0 ? b->p50_ms / b->floor_ms : 0.0, b->period_ms,
-	       100.0 * b->p99_ms / b->period_ms, b->cycles, b->joints, b->errors, b->transactions, b->cut_off);
+	       100.0 * b->p99_ms / b->period_ms, b->cycles, b->joints, b->errors, b->transactions, b->cut_off,
+	       b->read_by[0] ? "; read by " : "", b->read_by);
 	if (lv != DR_OK)
 		dr_add(v, "; fix:%s", why[0] ? why + 1 : " see the lines above");
 }
