@@ -998,6 +998,11 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 {
 	static struct dmn dmn;   /* large (bus stats per ID): not on the stack */
 	struct dmn *d = &dmn;
+	if (cfg_buses_used(cfg) != 1 || cfg->bus[CFG_BUS_ROBOT].njoints != cfg->njoints) {
+		log_error("the configuration puts the robot's joints on %zu bus(es) ([bus.NAME]): this undulated drives "
+		          "the [robot] port only", cfg_buses_used(cfg));
+		return 2;
+	}
 	memset(d, 0, sizeof *d);
 	d->lks.fd = -1;
 	d->cfg = cfg;
