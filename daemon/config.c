@@ -1090,6 +1090,9 @@ size_t cfg_buses_used(const struct cfg *c)
 
 bool cfg_bus_has_joint(const struct cfg *c, size_t bus, size_t joint)
 {
+	/* a configuration built without cfg_defaults (nbuses 0) has one bus */
+	if (c->nbuses <= 1)
+		return bus == CFG_BUS_ROBOT && joint < c->njoints;
 	return bus < c->nbuses && joint < c->njoints && c->joint_bus[joint] == bus;
 }
 
@@ -1208,6 +1211,45 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 		cfg_error(e, "%s: [robot] commands = network needs command_key = FILE (the shared key: "
 		          "`undulated --gen-key FILE` makes one)", c->source[0] ? c->source : "command line");
 	return e->count == before;
+}
+
+bool cfg_only_bus(struct cfg *c, const char *name, char *why, size_t cap)
+{
+	size_t b = 0;
+	while (b < c->nbuses && (strcmp(c->bus[b].name, name) != 0 || c->bus[b].njoints == 0))
+		b++;
+	if (b == c->nbuses) {
+		size_t used = (size_t)snprintf(why, cap, "no bus '%.48s' with joints; the robot's buses: ", name);
+		for (size_t i = 0, n = 0; i < c->nbuses && used < cap; i++) {
+			if (c->bus[i].njoints == 0)
+				continue;
+			int w = snprintf(why + used, cap - used, "%s%s (%s)", n++ ? ", " : "", c->bus[i].name,
+			                 c->bus[i].port[0] ? c->bus[i].port : c->bus[i].usb_serial);
+			used += w > 0 ? (size_t)w : 0;
+		}
+		return false;
+	}
+	struct cfg_bus keep = c->bus[b];
+	struct cfg_joint joints[CFG_MAX_JOINTS];
+	uint8_t ids[CFG_MAX_JOINTS];
+	for (size_t k = 0; k < keep.njoints; k++) {
+		joints[k] = c->joint[keep.joints[k]];
+		ids[k] = c->ids[keep.joints[k]];
+	}
+	memcpy(c->joint, joints, keep.njoints * sizeof joints[0]);
+	memcpy(c->ids, ids, keep.njoints);
+	c->njoints = keep.njoints;
+	snprintf(c->port, sizeof c->port, "%s", keep.port);
+	snprintf(c->usb_serial, sizeof c->usb_serial, "%s", keep.usb_serial);
+	c->baud = keep.baud;
+	c->nbuses = 1;
+	c->bus[CFG_BUS_ROBOT] = keep;
+	snprintf(c->bus[CFG_BUS_ROBOT].name, sizeof c->bus[CFG_BUS_ROBOT].name, "robot");
+	for (size_t k = 0; k < keep.njoints; k++) {
+		c->bus[CFG_BUS_ROBOT].joints[k] = k;
+		c->joint_bus[k] = CFG_BUS_ROBOT;
+	}
+	return true;
 }
 
 void cfg_print(const struct cfg *c, void *file)

@@ -263,6 +263,14 @@ size_t cfg_buses_used(const struct cfg *c);
 /* Joint `joint` is on bus `bus` (after cfg_finish). */
 bool cfg_bus_has_joint(const struct cfg *c, size_t bus, size_t joint);
 
+/* The robot reduced to one of its buses, as if it had only that one: its
+ * joints (in the robot's order, their [joint.N] with them), its IDs, its
+ * port and baud on the [robot] section; `dxl doctor --bus NAME` checks a bus
+ * at a time. After cfg_finish. The bus is named (its [bus.NAME], or "robot");
+ * false with *why (the buses there are) when there is none of that name or
+ * it has no joint. */
+bool cfg_only_bus(struct cfg *c, const char *name, char *why, size_t cap);
+
 /* Print every key with its current value as INI (for --check-config -v). */
 void cfg_print(const struct cfg *c, void *file);
 

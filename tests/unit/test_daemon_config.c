@@ -851,6 +851,33 @@ static void test_bus_errors(void **state)
 	assert_int_equal(c.joint_bus[1], 1);
 }
 
+/* dxl doctor --bus NAME: the robot seen as one of its buses, joints with
+ * their [joint.N] in the robot's order. */
+static void test_only_bus(void **state)
+{
+	(void)state;
+	static struct cfg c;
+	load_ok(&c, "[robot]\nport = /dev/ttyUSB0\nids = 1, tail:7, 2, tail:8\n[bus.tail]\nport = /dev/ttyUSB1\n"
+	            "baud = 57600\n[joint.4]\nlimit_max = 0.5\n");
+	char why[256];
+	assert_false(cfg_only_bus(&c, "head", why, sizeof why));
+	assert_string_equal(why, "no bus 'head' with joints; the robot's buses: robot (/dev/ttyUSB0), tail (/dev/ttyUSB1)");
+	assert_true(cfg_only_bus(&c, "tail", why, sizeof why));
+	assert_int_equal(c.njoints, 2);
+	assert_int_equal(c.ids[0], 7);
+	assert_int_equal(c.ids[1], 8);
+	assert_true(c.joint[1].limit_max == 0.5);
+	assert_string_equal(c.port, "/dev/ttyUSB1");
+	assert_int_equal(c.baud, 57600);
+	assert_int_equal(c.nbuses, 1);
+	assert_int_equal(cfg_buses_used(&c), 1);
+	assert_true(cfg_bus_has_joint(&c, 0, 1));
+	load_ok(&c, two_buses);
+	assert_true(cfg_only_bus(&c, "robot", why, sizeof why));
+	assert_int_equal(c.njoints, 2);
+	assert_string_equal(c.port, "/dev/ttyUSB0");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -875,6 +902,7 @@ int main(void)
 		cmocka_unit_test(test_rs485),
 		cmocka_unit_test(test_buses),
 		cmocka_unit_test(test_bus_errors),
+		cmocka_unit_test(test_only_bus),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
