@@ -18,6 +18,8 @@
 #include "udpm.h"
 
 #define CFG_PI PARAM_PI
+/* LCM's longest channel name (lcm.h LCM_MAX_CHANNEL_NAME_LENGTH). */
+#define CFG_LCM_CHANNEL_MAX 63
 /* The AX-12 turns 300°: ±150° = ±2.618 rad around its centre. */
 #define CFG_SERVO_HALF_RANGE PARAM_SERVO_HALF_RANGE
 
@@ -1139,6 +1141,15 @@ static void cfg_check_buses(struct cfg *c, struct cfg_errors *e)
 				cfg_error(e, "%s: [bus.%s] usb_serial: %s is bus %s's adapter too: each bus is a port of its own",
 				          src, y->name, y->usb_serial, x->name);
 		}
+	}
+	/* each bus of several publishes on "<robot>.BUS.<bus>": LCM takes
+	 * channel names of at most CFG_LCM_CHANNEL_MAX characters */
+	for (size_t b = 0; b < c->nbuses && cfg_buses_used(c) > 1; b++) {
+		size_t len = strlen(c->name) + strlen(".BUS.") + strlen(c->bus[b].name);
+		if (c->bus[b].njoints > 0 && len > CFG_LCM_CHANNEL_MAX)
+			cfg_error(e, "%s: [bus.%s]: its channel %s.BUS.%s is %zu characters, LCM takes at most %d: give the "
+			          "bus or the robot a shorter name", src, c->bus[b].name, c->name, c->bus[b].name, len,
+			          CFG_LCM_CHANNEL_MAX);
 	}
 	if (cfg_buses_used(c) > 1 && c->lockstep[0] != '\0')
 		cfg_error(e, "%s: [robot] lockstep: a robot on several buses cannot run in lockstep (the simulator's "

@@ -840,6 +840,13 @@ static void test_bus_errors(void **state)
 	                               b, sizeof b),
 	                    "command line: [robot] lockstep: a robot on several buses cannot run in lockstep (the simulator's "
 	                    "clock serves one port per daemon): run it in real time, or on one bus");
+	/* each bus's channel "<robot>.BUS.<bus>" fits LCM's 63 characters */
+	assert_string_equal(load_error("[robot]\nname=r0123456789012345678901234567890\nport=/dev/null\nids=1,"
+	                               "b0123456789012345678901234567890:2\n[bus.b0123456789012345678901234567890]\n"
+	                               "port=/dev/pts/1\n", b, sizeof b),
+	                    "command line: [bus.b0123456789012345678901234567890]: its channel "
+	                    "r0123456789012345678901234567890.BUS.b0123456789012345678901234567890 is 69 characters, LCM "
+	                    "takes at most 63: give the bus or the robot a shorter name");
 	/* a refused list leaves the buses' joints as they were */
 	struct cfg c;
 	struct cfg_errors e = { 0 };
