@@ -6,8 +6,14 @@
  *   controller steps (control.c) ─→ its goals and writes go out ─→ the
  *   state is published (publish.c).
  *
+ * A robot on several buses ([bus.NAME]) has a cycle per bus (struct
+ * dmn_bus), all begun at the tick and driven in parallel; the control step
+ * runs once, when every connected bus's readings are in, and each bus then
+ * sends its joints' share (dmn_maybe_control). One bus has one dmn_bus, and
+ * runs as it always did.
+ *
  * One thread, one loop, one poll() over the command sockets, signals and the
- * clock's descriptors: the control timer, the bus and its deadline timer in
+ * clock's descriptors: the control timer, every bus and the deadline timer in
  * real time, the simulator's socket in lockstep (struct dmn_clock: the clock
  * is a source of ticks, not a second loop). Start-up checks and the safe stop
  * (setup.c) block; nothing else does. Nothing here writes the controller's
