@@ -18,6 +18,8 @@
 #include "udpm.h"
 
 #define CFG_PI PARAM_PI
+/* LCM's longest channel name (lcm.h LCM_MAX_CHANNEL_NAME_LENGTH). */
+#define CFG_LCM_CHANNEL_MAX 63
 /* The AX-12 turns 300°: ±150° = ±2.618 rad around its centre. */
 #define CFG_SERVO_HALF_RANGE PARAM_SERVO_HALF_RANGE
 
@@ -107,12 +109,17 @@ static bool parse_bool(const char *s, bool *out)
 	return false;
 }
 
-/* "1,2" or "1 2": servo IDs 0..253, no duplicates. */
-/* Parses into a list of its own and copies it out only when the whole list is
- * good: a refused value leaves the configured IDs as they were. */
-static bool parse_ids(const char *s, uint8_t *out, size_t *n, char *why, size_t cap)
+static struct cfg_bus *cfg_bus_named(struct cfg *c, const char *name, size_t len, char *why, size_t cap);
+
+/* "1,2" or "1 2": servo IDs 0..253, in the robot's joint order; "NAME:3" is
+ * servo 3 on the bus of [bus.NAME] (without a name: the [robot] port). An ID
+ * twice on one bus is refused; different buses may reuse IDs. */
+/* Parses into lists of its own and copies them out only when the whole list
+ * is good: a refused value leaves the configured IDs as they were. */
+static bool parse_ids(struct cfg *c, const char *s, char *why, size_t cap)
 {
 	uint8_t ids[CFG_MAX_JOINTS];
+	size_t bus[CFG_MAX_JOINTS];
 	size_t count = 0;
 	const char *p = s;
 	while (*p) {
@@ -120,6 +127,17 @@ static bool parse_ids(const char *s, uint8_t *out, size_t *n, char *why, size_t 
 			p++;
 		if (!*p)
 			break;
+		size_t b = CFG_BUS_ROBOT;
+		const char *colon = p;
+		while (*colon && *colon != ':' && *colon != ',' && *colon != ' ' && *colon != '\t')
+			colon++;
+		if (*colon == ':') {
+			const struct cfg_bus *named = cfg_bus_named(c, p, (size_t)(colon - p), why, cap);
+			if (named == NULL)
+				return false;
+			b = (size_t)(named - c->bus);
+			p = colon + 1;
+		}
 		char *end;
 		errno = 0;
 		long v = strtol(p, &end, 10);
@@ -136,11 +154,16 @@ static bool parse_ids(const char *s, uint8_t *out, size_t *n, char *why, size_t 
 			return false;
 		}
 		for (size_t i = 0; i < count; i++) {
-			if (ids[i] == v) {
-				snprintf(why, cap, "servo ID %ld listed twice", v);
+			if (ids[i] == v && bus[i] == b) {
+				if (b == CFG_BUS_ROBOT)
+					snprintf(why, cap, "servo ID %ld listed twice", v);
+				else
+					snprintf(why, cap, "servo ID %ld listed twice on bus %s (an ID may repeat only on "
+					         "different buses)", v, c->bus[b].name);
 				return false;
 			}
 		}
+		bus[count] = b;
 		ids[count++] = (uint8_t)v;
 		p = end;
 	}
@@ -148,8 +171,9 @@ static bool parse_ids(const char *s, uint8_t *out, size_t *n, char *why, size_t 
 		snprintf(why, cap, "no servo IDs in '%s'", s);
 		return false;
 	}
-	memcpy(out, ids, count);
-	*n = count;
+	memcpy(c->ids, ids, count);
+	memcpy(c->joint_bus, bus, count * sizeof bus[0]);
+	c->njoints = count;
 	return true;
 }
 
@@ -338,6 +362,8 @@ void cfg_defaults(struct cfg *c)
 {
 	memset(c, 0, sizeof *c);
 	snprintf(c->name, sizeof c->name, "robot");
+	snprintf(c->bus[CFG_BUS_ROBOT].name, sizeof c->bus[CFG_BUS_ROBOT].name, "robot");
+	c->nbuses = 1;
 	c->baud = 1000000;
 	/* A robot started without a mode (the first `undulated --port ... --ids
 	 * ...` on new hardware) holds where it stands: nothing swings before the
@@ -529,7 +555,7 @@ static bool cfg_set_robot(struct cfg *c, const char *where, const char *key, con
 		*(bool *)field = bv;
 		return true;
 	case T_IDS:
-		if (!parse_ids(value, c->ids, &c->njoints, why, sizeof why)) {
+		if (!parse_ids(c, value, why, sizeof why)) {
 			cfg_error(e, "%s: [robot] ids: %s", where, why);
 			return false;
 		}
@@ -636,6 +662,82 @@ static bool cfg_set_param(double *field, const char *where, const char *section,
 	return true;
 }
 
+/* ---- [bus.NAME]: a port of its own for some of the robot's joints ------------------------- */
+/* The bus named `name` (len characters): found, or a new one (at most
+ * CFG_MAX_BUSES - 1 beside the [robot] port), named in [robot] ids before
+ * its section or by its section. NULL with *why. */
+static struct cfg_bus *cfg_bus_named(struct cfg *c, const char *name, size_t len, char *why, size_t cap)
+{
+	char own[CFG_NAME_MAX];
+	if (len == 0 || len >= sizeof own) {
+		snprintf(why, cap, "a bus name is 1..%d characters", CFG_NAME_MAX - 1);
+		return NULL;
+	}
+	memcpy(own, name, len);
+	own[len] = '\0';
+	if (!text_is_name(own, CFG_NAME_MAX - 1) || strcmp(own, "robot") == 0) {
+		char shown[CFG_NAME_MAX];
+		snprintf(why, cap, "bus '%s': a bus is named by letters, digits, '_' or '-', and not 'robot' (the [robot] "
+		         "section's own port)", text_line(shown, sizeof shown, own));
+		return NULL;
+	}
+	for (size_t b = 1; b < c->nbuses; b++)
+		if (strcmp(c->bus[b].name, own) == 0)
+			return &c->bus[b];
+	if (c->nbuses >= CFG_MAX_BUSES) {
+		snprintf(why, cap, "bus %s: more than %d buses: a robot has at most %d ports (the [robot] port and %d "
+		         "[bus.NAME] sections)", own, CFG_MAX_BUSES, CFG_MAX_BUSES, CFG_MAX_BUSES - 1);
+		return NULL;
+	}
+	struct cfg_bus *bus = &c->bus[c->nbuses++];
+	memset(bus, 0, sizeof *bus);
+	snprintf(bus->name, sizeof bus->name, "%s", own);
+	return bus;
+}
+
+static bool cfg_bus_string(char *field, size_t size, const char *where, const char *section, const char *key,
+                           const char *value, struct cfg_errors *e)
+{
+	if (strlen(value) >= size) {
+		cfg_error(e, "%s: [%s] %s: longer than %zu characters", where, section, key, size - 1);
+		return false;
+	}
+	memcpy(field, value, strlen(value) + 1);
+	return true;
+}
+
+static bool cfg_set_bus(struct cfg *c, const char *where, const char *section, const char *key, const char *value,
+                        struct cfg_errors *e)
+{
+	char why[200];
+	struct cfg_bus *bus = cfg_bus_named(c, section + 4, strlen(section + 4), why, sizeof why);
+	if (bus == NULL) {
+		char shown[CFG_NAME_MAX + 8];
+		cfg_error(e, "%s: [%s]: %s", where, text_line(shown, sizeof shown, section), why);
+		return false;
+	}
+	long lv;
+	if (strcmp(key, "port") == 0)
+		return cfg_bus_string(bus->port, sizeof bus->port, where, section, key, value, e);
+	if (strcmp(key, "usb_serial") == 0)
+		return cfg_bus_string(bus->usb_serial, sizeof bus->usb_serial, where, section, key, value, e);
+	if (strcmp(key, "baud") == 0) {
+		if (!parse_long(value, &lv)) {
+			cfg_error(e, "%s: [%s] baud: not an integer '%s'", where, section, value);
+			return false;
+		}
+		if (lv < 9600 || lv > 4500000) {
+			cfg_error(e, "%s: [%s] baud: %ld out of range 9600..4500000", where, section, lv);
+			return false;
+		}
+		bus->baud = lv;
+		return true;
+	}
+	cfg_error(e, "%s: [%s] %s: unknown key (port, usb_serial, baud; its joints are named in [robot] ids, "
+	          "e.g. ids = 1, 2, %s:1, %s:2)", where, section, key, bus->name, bus->name);
+	return false;
+}
+
 bool cfg_set(struct cfg *c, const char *where, const char *section, const char *key,
              const char *value, struct cfg_errors *e)
 {
@@ -664,6 +766,8 @@ bool cfg_set(struct cfg *c, const char *where, const char *section, const char *
 		}
 		return cfg_set_param(f, where, section, key, value, e);
 	}
+	if (strncmp(section, "bus.", 4) == 0)
+		return cfg_set_bus(c, where, section, key, value, e);
 	cfg_error(e, "%s: [%s]: unknown section (robot, joint.N, sinusoid)", where, section);
 	return false;
 }
@@ -978,15 +1082,95 @@ static void cfg_check_rate(struct cfg *c, struct cfg_errors *e)
 		          "latch a fault", src, c->silent_s, CFG_MIN_PERIODS, c->period_ms);
 }
 
+size_t cfg_buses_used(const struct cfg *c)
+{
+	size_t n = 0;
+	for (size_t b = 0; b < c->nbuses; b++)
+		n += c->bus[b].njoints > 0;
+	return n;
+}
+
+bool cfg_bus_has_joint(const struct cfg *c, size_t bus, size_t joint)
+{
+	/* a configuration built without cfg_defaults (nbuses 0) has one bus */
+	if (c->nbuses <= 1)
+		return bus == CFG_BUS_ROBOT && joint < c->njoints;
+	return bus < c->nbuses && joint < c->njoints && c->joint_bus[joint] == bus;
+}
+
+/* Each bus's joints, from [robot] ids (a joint is on one bus by
+ * construction); a bus without a port or without joints is an error. */
+static void cfg_assign_buses(struct cfg *c, struct cfg_errors *e)
+{
+	const char *src = c->source[0] ? c->source : "command line";
+	struct cfg_bus *robot = &c->bus[CFG_BUS_ROBOT];
+	snprintf(robot->port, sizeof robot->port, "%s", c->port);
+	snprintf(robot->usb_serial, sizeof robot->usb_serial, "%s", c->usb_serial);
+	robot->baud = c->baud;
+	for (size_t b = 0; b < c->nbuses; b++)
+		c->bus[b].njoints = 0;
+	for (size_t j = 0; j < c->njoints; j++) {
+		struct cfg_bus *bus = &c->bus[c->joint_bus[j]];
+		bus->joints[bus->njoints++] = j;
+	}
+	for (size_t b = 1; b < c->nbuses; b++) {
+		struct cfg_bus *bus = &c->bus[b];
+		if (bus->njoints == 0)
+			cfg_error(e, "%s: [bus.%s]: no joint is on it: name its servos in [robot] ids (e.g. ids = 1, 2, "
+			          "%s:1, %s:2)", src, bus->name, bus->name, bus->name);
+		if (bus->port[0] == '\0' && bus->usb_serial[0] == '\0')
+			cfg_error(e, "%s: [bus.%s] port: no port configured (a [bus.%s] section with port = /dev/ttyUSB1 or "
+			          "usb_serial = ..., or --set bus.%s.port=PATH)", src, bus->name, bus->name, bus->name);
+		if (bus->baud == 0)
+			bus->baud = c->baud;
+	}
+}
+
+/* Every bus a port of its own. */
+static void cfg_check_buses(struct cfg *c, struct cfg_errors *e)
+{
+	const char *src = c->source[0] ? c->source : "command line";
+	for (size_t a = 0; a < c->nbuses; a++) {
+		const struct cfg_bus *x = &c->bus[a];
+		for (size_t b = a + 1; b < c->nbuses && x->njoints > 0; b++) {
+			const struct cfg_bus *y = &c->bus[b];
+			if (x->port[0] != '\0' && strcmp(x->port, y->port) == 0)
+				cfg_error(e, "%s: [bus.%s] port: %s is bus %s's port too: each bus is a port of its own", src,
+				          y->name, y->port, x->name);
+			if (x->usb_serial[0] != '\0' && strcmp(x->usb_serial, y->usb_serial) == 0)
+				cfg_error(e, "%s: [bus.%s] usb_serial: %s is bus %s's adapter too: each bus is a port of its own",
+				          src, y->name, y->usb_serial, x->name);
+		}
+	}
+	/* each bus of several publishes on "<robot>.BUS.<bus>": LCM takes
+	 * channel names of at most CFG_LCM_CHANNEL_MAX characters */
+	for (size_t b = 0; b < c->nbuses && cfg_buses_used(c) > 1; b++) {
+		size_t len = strlen(c->name) + strlen(".BUS.") + strlen(c->bus[b].name);
+		if (c->bus[b].njoints > 0 && len > CFG_LCM_CHANNEL_MAX)
+			cfg_error(e, "%s: [bus.%s]: its channel %s.BUS.%s is %zu characters, LCM takes at most %d: give the "
+			          "bus or the robot a shorter name", src, c->bus[b].name, c->name, c->bus[b].name, len,
+			          CFG_LCM_CHANNEL_MAX);
+	}
+	if (cfg_buses_used(c) > 1 && c->lockstep[0] != '\0')
+		cfg_error(e, "%s: [robot] lockstep: a robot on several buses cannot run in lockstep (the simulator's "
+		          "clock serves one port per daemon): run it in real time, or on one bus", src);
+}
+
 bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 {
 	size_t before = e->count;
 	if (c->njoints == 0)
 		cfg_error(e, "%s: [robot] ids: no servo IDs configured (e.g. ids = 1,2 or --ids 1,2)",
 		          c->source[0] ? c->source : "command line");
-	if (c->port[0] == '\0' && c->usb_serial[0] == '\0')
+	cfg_assign_buses(c, e);
+	if (c->port[0] == '\0' && c->usb_serial[0] == '\0' && (c->nbuses == 1 || c->bus[CFG_BUS_ROBOT].njoints > 0))
 		cfg_error(e, "%s: [robot] port: no port configured (port = /dev/ttyUSB0, usb_serial = ..., "
 		          "or --port PATH)", c->source[0] ? c->source : "command line");
+	if (c->nbuses > 1 && c->njoints > 0 && c->bus[CFG_BUS_ROBOT].njoints == 0 &&
+	    (c->port[0] != '\0' || c->usb_serial[0] != '\0'))
+		cfg_error(e, "%s: [robot] port: no joint is left on it (each is on a [bus.NAME]): remove it, or leave "
+		          "some joints out of the [bus.NAME] sections", c->source[0] ? c->source : "command line");
+	cfg_check_buses(c, e);
 	for (size_t j = c->njoints; j < CFG_MAX_JOINTS; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		if (!isnan(jt->osc.k) || !isnan(jt->osc.c) || !isnan(jt->osc.mu) || !isnan(jt->osc.lambda) ||
@@ -1040,6 +1224,45 @@ bool cfg_finish(struct cfg *c, struct cfg_errors *e)
 	return e->count == before;
 }
 
+bool cfg_only_bus(struct cfg *c, const char *name, char *why, size_t cap)
+{
+	size_t b = 0;
+	while (b < c->nbuses && (strcmp(c->bus[b].name, name) != 0 || c->bus[b].njoints == 0))
+		b++;
+	if (b == c->nbuses) {
+		size_t used = (size_t)snprintf(why, cap, "no bus '%.48s' with joints; the robot's buses: ", name);
+		for (size_t i = 0, n = 0; i < c->nbuses && used < cap; i++) {
+			if (c->bus[i].njoints == 0)
+				continue;
+			int w = snprintf(why + used, cap - used, "%s%s (%s)", n++ ? ", " : "", c->bus[i].name,
+			                 c->bus[i].port[0] ? c->bus[i].port : c->bus[i].usb_serial);
+			used += w > 0 ? (size_t)w : 0;
+		}
+		return false;
+	}
+	struct cfg_bus keep = c->bus[b];
+	struct cfg_joint joints[CFG_MAX_JOINTS];
+	uint8_t ids[CFG_MAX_JOINTS];
+	for (size_t k = 0; k < keep.njoints; k++) {
+		joints[k] = c->joint[keep.joints[k]];
+		ids[k] = c->ids[keep.joints[k]];
+	}
+	memcpy(c->joint, joints, keep.njoints * sizeof joints[0]);
+	memcpy(c->ids, ids, keep.njoints);
+	c->njoints = keep.njoints;
+	snprintf(c->port, sizeof c->port, "%s", keep.port);
+	snprintf(c->usb_serial, sizeof c->usb_serial, "%s", keep.usb_serial);
+	c->baud = keep.baud;
+	c->nbuses = 1;
+	c->bus[CFG_BUS_ROBOT] = keep;
+	snprintf(c->bus[CFG_BUS_ROBOT].name, sizeof c->bus[CFG_BUS_ROBOT].name, "robot");
+	for (size_t k = 0; k < keep.njoints; k++) {
+		c->bus[CFG_BUS_ROBOT].joints[k] = k;
+		c->joint_bus[k] = CFG_BUS_ROBOT;
+	}
+	return true;
+}
+
 void cfg_print(const struct cfg *c, void *file)
 {
 	FILE *f = file;
@@ -1047,7 +1270,8 @@ void cfg_print(const struct cfg *c, void *file)
 	fprintf(f, "[robot]\nname = %s\nport = %s\nusb_serial = %s\nbaud = %ld\nids = ", c->name, c->port,
 	        c->usb_serial, c->baud);
 	for (size_t j = 0; j < c->njoints; j++)
-		fprintf(f, "%s%u", j ? "," : "", c->ids[j]);
+		fprintf(f, "%s%s%s%u", j ? "," : "", c->joint_bus[j] != CFG_BUS_ROBOT ? c->bus[c->joint_bus[j]].name : "",
+		        c->joint_bus[j] != CFG_BUS_ROBOT ? ":" : "", c->ids[j]);
 	fprintf(f, "\nprotocol = %s\nbus_watchdog_ms = %ld\nfault_reboots = %d\n", cfg_protocol_name(c->protocol),
 	        c->bus_watchdog_ms, c->fault_reboots);
 	if (c->stall_torque_given)
@@ -1071,6 +1295,11 @@ void cfg_print(const struct cfg *c, void *file)
 	        c->bus_margin_us,
 	        c->ramp_s, c->backoff_torque, c->fault_backoff_s, c->fault_retries, c->stale_limit, c->silent_s,
 	        c->command_key, c->command_window_s, c->run_dir, c->lockstep);
+	for (size_t b = 1; b < c->nbuses; b++) {
+		const struct cfg_bus *bus = &c->bus[b];
+		fprintf(f, "\n[bus.%s]\nport = %s\nusb_serial = %s\nbaud = %ld\n", bus->name, bus->port, bus->usb_serial,
+		        bus->baud ? bus->baud : c->baud);
+	}
 	for (size_t j = 0; j < c->njoints; j++) {
 		const struct cfg_joint *jt = &c->joint[j];
 		fprintf(f, "\n[joint.%zu]\nk = %g\nc = %g\nmu = %g\nlambda = %g\ncoupling_phase = %g\ninertia = %g\n"

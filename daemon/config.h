@@ -21,6 +21,12 @@
 #define CFG_PATH_MAX     256              /* port path, LCM URL */
 #define CFG_ERR_MAX      256              /* one error line */
 #define CFG_MAX_ERRORS   16               /* errors kept for reporting (all are counted) */
+/* Ports (buses) per robot, the [robot] section's own included: each is a
+ * cycle of its own on the one loop (daemon/README.md, "Several buses"). Four
+ * covers a 24-joint robot at 6 servos a bus, and keeps the loop's poll()
+ * small. */
+#define CFG_MAX_BUSES    4
+#define CFG_BUS_ROBOT    0                /* bus index of the [robot] section's port */
 
 enum cfg_mode { CFG_MODE_LIMP = 0, CFG_MODE_HOLD = 1, CFG_MODE_SINUSOID = 2, CFG_MODE_OSCILLATOR = 3 };
 #define CFG_NMODES 4
@@ -61,6 +67,20 @@ struct cfg_joint {
 #define CFG_TQ_MU       (1u << 2)
 #define CFG_TQ_INERTIA  (1u << 3)
 #define CFG_TQ_FRICTION (1u << 4)
+
+/* One port of the robot. Bus CFG_BUS_ROBOT is the [robot] section's port
+ * (filled by cfg_finish); the others are [bus.NAME] sections. Which joint is
+ * on which bus says [robot] ids ("1, 2, tail:1, tail:2": joints 3 and 4 are
+ * servos 1 and 2 on bus tail), so joint numbers stay the robot's whatever the
+ * bus, and IDs may repeat on different buses. */
+struct cfg_bus {
+	char name[CFG_NAME_MAX];       /* "robot" for the [robot] port, else NAME of [bus.NAME] */
+	char port[CFG_PATH_MAX];
+	char usb_serial[64];
+	long baud;                     /* 0 until cfg_finish: the robot's */
+	size_t joints[CFG_MAX_JOINTS]; /* cfg_finish: the robot's joint indices on it, in the robot's order */
+	size_t njoints;
+};
 
 struct cfg {
 	/* [robot] */
@@ -111,6 +131,11 @@ struct cfg {
 	double silent_s;               /* a joint without a valid reading this long latches the fault action */
 	/* [joint.N], N = 1..njoints */
 	struct cfg_joint joint[CFG_MAX_JOINTS];
+	/* the ports: bus[CFG_BUS_ROBOT] is [robot]'s (complete after cfg_finish),
+	 * bus[1..nbuses-1] the [bus.NAME] sections in the order they came */
+	struct cfg_bus bus[CFG_MAX_BUSES];
+	size_t nbuses;                 /* 1 + the [bus.NAME] sections */
+	size_t joint_bus[CFG_MAX_JOINTS];   /* each joint's bus index ([robot] ids: "NAME:ID") */
 	/* [sinusoid] */
 	double amplitude, frequency, phase;
 	/* torque actuation: the clock as a torque law (osc_clock_torque); 0: the
@@ -231,6 +256,20 @@ void cfg_params_scale_torque_defaults(struct cfg_params *p, const struct cfg *c,
  * the joint in p, where they took the defaults in c, become these. True when
  * anything changed. */
 bool cfg_params_position_defaults(struct cfg_params *p, const struct cfg *c, size_t joint, double k, double mu);
+
+/* Buses that carry joints (after cfg_finish): 1 for a one-port robot.
+ * Bus CFG_BUS_ROBOT may carry none when every joint is on a [bus.NAME]. */
+size_t cfg_buses_used(const struct cfg *c);
+/* Joint `joint` is on bus `bus` (after cfg_finish). */
+bool cfg_bus_has_joint(const struct cfg *c, size_t bus, size_t joint);
+
+/* The robot reduced to one of its buses, as if it had only that one: its
+ * joints (in the robot's order, their [joint.N] with them), its IDs, its
+ * port and baud on the [robot] section; `dxl doctor --bus NAME` checks a bus
+ * at a time. After cfg_finish. The bus is named (its [bus.NAME], or "robot");
+ * false with *why (the buses there are) when there is none of that name or
+ * it has no joint. */
+bool cfg_only_bus(struct cfg *c, const char *name, char *why, size_t cap);
 
 /* Print every key with its current value as INI (for --check-config -v). */
 void cfg_print(const struct cfg *c, void *file);

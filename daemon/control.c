@@ -77,6 +77,11 @@ const struct wq_write *ctl_take_write(struct ctl *c)
 	return wq_take(&c->wq);
 }
 
+const struct wq_write *ctl_next_write(const struct ctl *c)
+{
+	return wq_peek(&c->wq);
+}
+
 static const char *ctl_register_name(const struct sm_model *m, const struct wq_write *w)
 {
 	return w->len == 0 ? "REBOOT" : sm_register_name(m, w->addr);
@@ -368,6 +373,7 @@ static void ctl_servo_setup(struct ctl *c, size_t j, bool torque)
 void ctl_start(struct ctl *c, double t, const char *reason)
 {
 	c->t = t;
+	c->bus_hold = false;
 	/* the daemon's start-up checks leave every servo in joint mode, with its
 	 * margins and moving speed set */
 	c->wheel = false;
@@ -397,20 +403,47 @@ void ctl_start(struct ctl *c, double t, const char *reason)
 	          c->latched ? "; fault latched: " : "", c->latched ? c->latch : "");
 }
 
+static void ctl_joint_lost(struct ctl *c, size_t j)
+{
+	c->j[j].fresh = false;
+	c->j[j].torque_read = -1;
+	c->j[j].torque_limit_read = -1;
+	c->j[j].hwerr = c->j[j].watchdog_read = c->j[j].opmode_read = -1;
+	c->j[j].hwerr_at = -INFINITY;
+	c->j[j].readback_due = false;
+	c->j[j].drive_ready = false;
+	/* the next reading after reconnecting starts a new difference */
+	osc_velocity_filter_init(&c->j[j].vfilter, c->cfg->velocity_cutoff_hz);
+}
+
 void ctl_bus_lost(struct ctl *c)
 {
-	for (size_t j = 0; j < c->n; j++) {
-		c->j[j].fresh = false;
-		c->j[j].torque_read = -1;
-		c->j[j].torque_limit_read = -1;
-		c->j[j].hwerr = c->j[j].watchdog_read = c->j[j].opmode_read = -1;
-		c->j[j].hwerr_at = -INFINITY;
-		c->j[j].readback_due = false;
-		c->j[j].drive_ready = false;
-		/* the next reading after reconnecting starts a new difference */
-		osc_velocity_filter_init(&c->j[j].vfilter, c->cfg->velocity_cutoff_hz);
-	}
+	for (size_t j = 0; j < c->n; j++)
+		ctl_joint_lost(c, j);
 	wq_clear(&c->wq);
+	ctl_blend_stop(c);
+	c->fade_mode = CFG_NMODES;
+}
+
+bool ctl_on_bus(const struct ctl *c, size_t joint, size_t bus)
+{
+	return cfg_bus_has_joint(c->cfg, bus, joint);
+}
+
+void ctl_bus_lost_on(struct ctl *c, size_t bus)
+{
+	for (size_t j = 0; j < c->n; j++) {
+		if (!ctl_on_bus(c, j, bus))
+			continue;
+		ctl_joint_lost(c, j);
+		/* a write on the wire stays: its own bus reports how it went */
+		wq_drop_id(&c->wq, c->j[j].id);
+	}
+	if (!c->bus_hold) {
+		for (size_t j = 0; j < c->n; j++)
+			c->hold[j] = isfinite(c->j[j].goal) ? c->j[j].goal : c->j[j].angle;
+		c->bus_hold = true;
+	}
 	ctl_blend_stop(c);
 	c->fade_mode = CFG_NMODES;
 }
@@ -1370,7 +1403,7 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 	if (!want && c->wheel)
 		tq_leave_wheel(c);
 	double target[CFG_MAX_JOINTS];
-	ctl_targets(c, c->mode, dt, t_real, target);
+	ctl_targets(c, c->bus_hold && c->mode != CFG_MODE_LIMP ? CFG_MODE_HOLD : c->mode, dt, t_real, target);
 	ctl_crossfade(c, dt, t_real, target);
 	for (size_t j = 0; j < c->n; j++) {
 		double w = ctl_blend_weight(c, j);

@@ -188,6 +188,7 @@ struct ctl {
 	long long resets;               /* servos found reset */
 	long long watchdog_trips;       /* X series: servos found stopped by their bus watchdog */
 	long long reboots;              /* X series: REBOOTs sent */
+	bool bus_hold;                  /* a bus of several is lost: every joint holds (ctl_bus_lost_on) */
 	unsigned char defaults_done[CFG_MAX_JOINTS];   /* CTL_DEFAULTS_* given to the joint (once) */
 };
 #define CTL_DEFAULTS_TORQUE   1u
@@ -217,6 +218,14 @@ void ctl_start(struct ctl *c, double t, const char *reason);
 /* The bus went away: every joint is stale, torque state unknown, queued
  * writes forgotten (the start-up sequence rewrites what matters). */
 void ctl_bus_lost(struct ctl *c);
+/* One bus of several went away (config.h, [bus.NAME]): its joints are as in
+ * ctl_bus_lost, their queued writes forgotten; the chain of oscillators is
+ * broken, so every other joint holds where its last goal put it (HOLD's
+ * target, whatever the mode) until ctl_start() — called when the bus is back
+ * — ramps the robot into its mode again (docs/SAFETY.md, "Several buses"). */
+void ctl_bus_lost_on(struct ctl *c, size_t bus);
+/* The joint is on that bus (the configuration's wiring). */
+bool ctl_on_bus(const struct ctl *c, size_t joint, size_t bus);
 
 /* ---- inputs ------------------------------------------------------------------------- */
 /* This cycle's reading of joint j (raw registers 36..41 and the error byte:
@@ -274,6 +283,9 @@ bool ctl_clear_faults(struct ctl *c, char *why, size_t cap);
 /* The next register write to send, NULL when none. It is on the wire until
  * ctl_write_result() says how it went; nothing changes it meanwhile. */
 const struct wq_write *ctl_take_write(struct ctl *c);
+/* The write ctl_take_write() would give, not taken (NULL: none, or one is on
+ * the wire): on a robot of several buses, the servo's bus takes it. */
+const struct wq_write *ctl_next_write(const struct ctl *c);
 /* ok: the servo acknowledged it (or no reply was due). A failed write is
  * sent again, up to WQ_TRIES times; then it is reported as an event. */
 void ctl_write_result(struct ctl *c, bool ok);

@@ -20,6 +20,42 @@ void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_u
 		y->hooks = *hooks;
 }
 
+void cyc_set_bus(struct cyc *y, size_t bus)
+{
+	y->own = true;
+	y->n = 0;
+	for (size_t j = 0; j < y->ctl->n; j++)
+		if (ctl_on_bus(y->ctl, j, bus))
+			y->joint[y->n++] = j;
+}
+
+/* The joints this cycle reads: its bus's (cyc_set_bus), else every one. */
+static size_t cyc_count(const struct cyc *y)
+{
+	return y->own ? y->n : y->ctl->n;
+}
+
+static size_t cyc_joint(const struct cyc *y, size_t i)
+{
+	return y->own ? y->joint[i] : i;
+}
+
+static bool cyc_has_joint(const struct cyc *y, size_t j)
+{
+	for (size_t i = 0; i < cyc_count(y); i++)
+		if (cyc_joint(y, i) == j)
+			return true;
+	return false;
+}
+
+static bool cyc_has_id(const struct cyc *y, uint8_t id)
+{
+	for (size_t i = 0; i < cyc_count(y); i++)
+		if (y->ctl->j[cyc_joint(y, i)].id == id)
+			return true;
+	return false;
+}
+
 static uint64_t cyc_now(const struct cyc *y)
 {
 	return y->bus->io.now_us(y->bus->io.ctx);
@@ -114,8 +150,8 @@ static int cyc_begin_write(struct cyc *y, const struct wq_write *w)
 	uint8_t data[4] = { (uint8_t)(w->value & 0xFF), (uint8_t)(w->value >> 8), (uint8_t)(w->value >> 16),
 	                    (uint8_t)(w->value >> 24) };
 	bool reply = false;
-	for (size_t j = 0; j < y->ctl->n; j++)
-		if (y->ctl->j[j].id == w->id && y->ctl->j[j].servo.status_return_level >= 2)
+	for (size_t i = 0; i < cyc_count(y); i++)
+		if (y->ctl->j[cyc_joint(y, i)].id == w->id && y->ctl->j[cyc_joint(y, i)].servo.status_return_level >= 2)
 			reply = true;
 	if (w->len == 0)
 		return bus_reboot_begin(y->bus, w->id, reply);
@@ -126,14 +162,15 @@ static int cyc_begin_write(struct cyc *y, const struct wq_write *w)
 static int cyc_begin_sync_read(struct cyc *y)
 {
 	uint8_t ids[CFG_MAX_JOINTS];
-	for (size_t j = 0; j < y->ctl->n; j++)
-		ids[j] = y->ctl->j[j].id;
+	size_t n = cyc_count(y);
+	for (size_t i = 0; i < n; i++)
+		ids[i] = y->ctl->j[cyc_joint(y, i)].id;
 	y->multi.data = y->multi_buf;
 	y->multi.cap = sizeof y->multi_buf;
+	const struct sm_model *m = ctl_model(y->ctl, cyc_joint(y, 0));
 	if (y->fast_read)
-		return bus_fast_sync_read_begin(y->bus, ctl_model(y->ctl, 0)->present, y->read_len, ids, y->ctl->n,
-		                                &y->multi);
-	return bus_sync_read_begin(y->bus, ctl_model(y->ctl, 0)->present, y->read_len, ids, y->ctl->n, &y->multi);
+		return bus_fast_sync_read_begin(y->bus, m->present, y->read_len, ids, n, &y->multi);
+	return bus_sync_read_begin(y->bus, m->present, y->read_len, ids, n, &y->multi);
 }
 
 /* A Fast Sync Read that read nobody, CYC_FAST_FAILS_MAX times in a row: a
@@ -160,18 +197,18 @@ static void cyc_fast_outcome(struct cyc *y)
 static bool cyc_pick_readback(struct cyc *y)
 {
 	size_t due;
-	if (ctl_readback_due(y->ctl, &due)) {
+	if (ctl_readback_due(y->ctl, &due) && cyc_has_joint(y, due)) {
 		y->readback_now_joint = due;
 		y->readback_now_block = 0;
 		return true;
 	}
 	if (y->count % CYC_READBACK_EVERY != 0)
 		return false;
-	y->readback_joint = (y->readback_joint + 1) % y->ctl->n;
+	y->readback_joint = (y->readback_joint + 1) % cyc_count(y);
 	if (y->readback_joint == 0)
 		y->readback_block++;
-	size_t nblocks = ctl_model(y->ctl, y->readback_joint)->nreadback;
-	y->readback_now_joint = y->readback_joint;
+	size_t nblocks = ctl_model(y->ctl, cyc_joint(y, y->readback_joint))->nreadback;
+	y->readback_now_joint = cyc_joint(y, y->readback_joint);
 	y->readback_now_block = nblocks > 0 ? y->readback_block % nblocks : 0;
 	return true;
 }
@@ -187,7 +224,7 @@ static enum cyc_status cyc_advance(struct cyc *y)
 		case CYC_CONTROL_STEP:
 			return CYC_CONTROL;
 		case CYC_READ:
-			if (y->idx >= y->ctl->n) {
+			if (y->idx >= cyc_count(y)) {
 				y->phase = CYC_CONTROL_STEP;
 				y->control_start_us = cyc_now(y);
 				return CYC_CONTROL;
@@ -199,15 +236,15 @@ static enum cyc_status cyc_advance(struct cyc *y)
 				if (r == DXL_OK && bus_is_pending(y->bus))
 					return CYC_PENDING;
 				cyc_error(y, DXL2_BROADCAST_ID, "SYNC_READ", r);
-				y->idx = y->ctl->n;
+				y->idx = cyc_count(y);
 				continue;
 			}
-			r = cyc_begin_read(y, y->ctl->j[y->idx].id, DXL_AX_PRESENT_POSITION, y->read_len);
+			r = cyc_begin_read(y, y->ctl->j[cyc_joint(y, y->idx)].id, DXL_AX_PRESENT_POSITION, y->read_len);
 			if (cyc_port_gone(r))
 				return cyc_lost(y, r);
 			if (r == DXL_OK && bus_is_pending(y->bus))
 				return CYC_PENDING;
-			cyc_error(y, y->ctl->j[y->idx].id, "READ", r);
+			cyc_error(y, y->ctl->j[cyc_joint(y, y->idx)].id, "READ", r);
 			y->idx++;
 			continue;
 		case CYC_WRITE_FIRST:
@@ -218,7 +255,9 @@ static enum cyc_status cyc_advance(struct cyc *y)
 					y->deferred++;
 				return cyc_finish(y, CYC_DONE);
 			}
-			const struct wq_write *w = ctl_take_write(y->ctl);
+			/* another bus's servo: its own cycle sends it */
+			const struct wq_write *next = ctl_next_write(y->ctl);
+			const struct wq_write *w = next != NULL && cyc_has_id(y, next->id) ? ctl_take_write(y->ctl) : NULL;
 			if (w == NULL) {
 				y->phase = y->phase == CYC_WRITE_FIRST ? CYC_READ : CYC_READBACK;
 				continue;
@@ -240,7 +279,7 @@ static enum cyc_status cyc_advance(struct cyc *y)
 			continue;
 		}
 		case CYC_READBACK: {
-			if (y->ctl->n == 0 || cyc_late(y) || !cyc_pick_readback(y))
+			if (cyc_count(y) == 0 || cyc_late(y) || !cyc_pick_readback(y))
 				return cyc_finish(y, CYC_DONE);
 			const struct sm_block *blk = &ctl_model(y->ctl, y->readback_now_joint)->readback[y->readback_now_block];
 			uint8_t id = y->ctl->j[y->readback_now_joint].id;
@@ -266,7 +305,7 @@ enum cyc_status cyc_start(struct cyc *y)
 	y->start_us = cyc_now(y);
 	y->control_us = 0.0;
 	y->bus_us = 0.0;
-	const struct sm_model *m = ctl_model(y->ctl, 0);
+	const struct sm_model *m = ctl_model(y->ctl, cyc_joint(y, 0));
 	y->read_len = (y->count & 1) ? m->present_len_slow : m->present_len;
 	if (y->starved >= CYC_STARVED_CYCLES && wq_pending(&y->ctl->wq) > 0) {
 		y->phase = CYC_WRITE_FIRST;
@@ -280,24 +319,25 @@ enum cyc_status cyc_start(struct cyc *y)
 static void cyc_readings2(struct cyc *y)
 {
 	uint64_t now = cyc_now(y);
-	for (size_t j = 0; j < y->ctl->n && j < y->multi.n; j++) {
-		const uint8_t *bytes = bus_multi_data(&y->multi, j);
+	for (size_t i = 0; i < cyc_count(y) && i < y->multi.n; i++) {
+		size_t j = cyc_joint(y, i);
+		const uint8_t *bytes = bus_multi_data(&y->multi, i);
 		struct sm_present p;
-		if (bytes == NULL || !sm_decode_present(ctl_model(y->ctl, j), bytes, y->multi.len[j], &p)) {
-			cyc_error(y, y->multi.id[j], y->multi.fast ? "Fast Sync Read" : "SYNC_READ",
-			          y->multi.status[j] != DXL_OK ? y->multi.status[j] : DXL_E_WRONG_LENGTH);
+		if (bytes == NULL || !sm_decode_present(ctl_model(y->ctl, j), bytes, y->multi.len[i], &p)) {
+			cyc_error(y, y->multi.id[i], y->multi.fast ? "Fast Sync Read" : "SYNC_READ",
+			          y->multi.status[i] != DXL_OK ? y->multi.status[i] : DXL_E_WRONG_LENGTH);
 			continue;
 		}
 		uint64_t last = y->read_at_us[j];
 		double dt = last != 0 && now > last ? 1e-6 * (double)(now - last) : 1e-6 * (double)y->period_us;
 		y->read_at_us[j] = now;
-		ctl_measure_present(y->ctl, j, &p, y->multi.err[j], dt);
+		ctl_measure_present(y->ctl, j, &p, y->multi.err[i], dt);
 	}
 }
 
 static void cyc_reading(struct cyc *y, const struct dxl_packet *p)
 {
-	size_t j = y->idx;
+	size_t j = cyc_joint(y, y->idx);
 	/* the position difference is over the time between this joint's own
 	 * replies: a timeout earlier in the cycle shifts them */
 	uint64_t now = cyc_now(y), last = y->read_at_us[j];
@@ -324,19 +364,19 @@ enum cyc_status cyc_step(struct cyc *y)
 		if (cyc_sync_reads(y)) {
 			cyc_readings2(y);
 			cyc_fast_outcome(y);
-			y->idx = y->ctl->n;
+			y->idx = cyc_count(y);
 			break;
 		}
 		if (r == DXL_OK)
 			cyc_reading(y, &reply);
 		else
-			cyc_error(y, y->ctl->j[y->idx].id, "READ", r);
+			cyc_error(y, y->ctl->j[cyc_joint(y, y->idx)].id, "READ", r);
 		y->idx++;
 		break;
 	case CYC_WRITE_FIRST:
 	case CYC_WRITES: {
 		uint8_t id = y->bus->req_id;
-		const struct sm_model *m = ctl_model(y->ctl, 0);
+		const struct sm_model *m = ctl_model(y->ctl, cyc_joint(y, 0));
 		bool ok = r == DXL_OK && !sm_write_refused(m, reply.code);
 		if (r != DXL_OK)
 			cyc_error(y, id, y->bus->req_instr == DXL_INST_REBOOT ? "REBOOT" : "WRITE", r);
@@ -368,6 +408,20 @@ enum cyc_status cyc_step(struct cyc *y)
 	return cyc_advance(y);
 }
 
+/* The SYNC_WRITE's share of this bus: its servos' slots, in order. */
+static size_t cyc_own_sync(const struct cyc *y, uint8_t width, uint8_t *ids, uint8_t *data, size_t n)
+{
+	size_t kept = 0;
+	for (size_t k = 0; k < n; k++) {
+		if (!cyc_has_id(y, ids[k]))
+			continue;
+		ids[kept] = ids[k];
+		memmove(data + (size_t)width * kept, data + (size_t)width * k, width);
+		kept++;
+	}
+	return kept;
+}
+
 enum cyc_status cyc_resume(struct cyc *y)
 {
 	if (y->phase != CYC_CONTROL_STEP)
@@ -377,6 +431,8 @@ enum cyc_status cyc_resume(struct cyc *y)
 	uint16_t addr;
 	uint8_t width, ids[CFG_MAX_JOINTS], data[CTL_SYNC_MAX_WIDTH * CFG_MAX_JOINTS];
 	size_t n = ctl_sync(y->ctl, &addr, &width, ids, data);
+	if (y->own)
+		n = cyc_own_sync(y, width, ids, data, n);
 	if (n > 0) {
 		int r = bus_sync_write(y->bus, addr, width, ids, data, n);
 		if (cyc_port_gone(r))

@@ -116,6 +116,11 @@ struct cyc {
 	int starved;                  /* cycles in a row that ended with writes waiting */
 	/* counters */
 	long long errors, cut_off, deferred, readbacks, writes_first, fast_fallbacks;
+	/* a robot on several buses (cyc_set_bus): the joints on this one, in the
+	 * robot's order; without it every joint of the controller */
+	bool own;
+	size_t joint[CFG_MAX_JOINTS];
+	size_t n;
 };
 
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks);
@@ -130,6 +135,12 @@ enum cyc_status cyc_resume(struct cyc *y);
 /* Read by Fast Sync Read (on: every servo answers it, and the protocol has
  * it) or by SYNC_READ, from the next cycle on. */
 void cyc_set_fast_read(struct cyc *y, bool on);
+/* A robot on several buses: this cycle drives the joints of bus `bus` only
+ * (ctl_on_bus) — their reads, their share of the SYNC_WRITE, the writes and
+ * read-backs of their servos — and leaves the others to their buses' cycles.
+ * The control step stays the robot's: the daemon runs it once every bus's
+ * cycle has reached CYC_CONTROL. */
+void cyc_set_bus(struct cyc *y, size_t bus);
 /* A cycle is under way (not idle). */
 bool cyc_busy(const struct cyc *y);
 /* End the cycle under way now: the next tick came first, or the daemon stops

@@ -6,8 +6,14 @@
  *   controller steps (control.c) ─→ its goals and writes go out ─→ the
  *   state is published (publish.c).
  *
+ * A robot on several buses ([bus.NAME]) has a cycle per bus (struct
+ * dmn_bus), all begun at the tick and driven in parallel; the control step
+ * runs once, when every connected bus's readings are in, and each bus then
+ * sends its joints' share (dmn_maybe_control). One bus has one dmn_bus, and
+ * runs as it always did.
+ *
  * One thread, one loop, one poll() over the command sockets, signals and the
- * clock's descriptors: the control timer, the bus and its deadline timer in
+ * clock's descriptors: the control timer, every bus and the deadline timer in
  * real time, the simulator's socket in lockstep (struct dmn_clock: the clock
  * is a source of ticks, not a second loop). Start-up checks and the safe stop
  * (setup.c) block; nothing else does. Nothing here writes the controller's
@@ -56,15 +62,16 @@ struct dmn;
 
 /* What a wake-up of the loop brought (filled by the clock, below). */
 struct dmn_wake {
-	bool bus_hup;        /* the port hung up */
-	bool bus_in;         /* reply bytes may be there */
-	bool bus_deadline;   /* the bus's deadline passed */
+	bool bus_hup[CFG_MAX_BUSES];   /* the port hung up */
+	bool bus_in[CFG_MAX_BUSES];    /* reply bytes may be there */
+	bool bus_deadline;   /* a bus's deadline passed */
 	uint64_t ticks;      /* periods since the last tick: 0 none, more than 1 some were missed */
 	uint64_t now;        /* the tick's time */
 };
 
-/* Descriptors a clock adds to the loop's poll(), at most. */
-#define DMN_CLOCK_FDS 3
+/* Descriptors a clock adds to the loop's poll(), at most: two timers and
+ * every bus's port. */
+#define DMN_CLOCK_FDS (2 + CFG_MAX_BUSES)
 
 /* What paces the loop: the system's clock (timerfds, the bus fd) or, in
  * lockstep, the simulator's (common/lockstep.h). The loop and everything
@@ -74,7 +81,7 @@ struct dmn_wake {
 struct dmn_clock {
 	/* the ticks start at d->first_tick_us, one period apart */
 	void (*start)(struct dmn *d);
-	/* the bus's deadline is now d->cyc's (0: none) */
+	/* the buses' deadline is now the earliest of their cycles' (0: none) */
 	void (*arm_deadline)(struct dmn *d);
 	/* about to block: may end the run (d->stop) when the clock is gone */
 	void (*before_wait)(struct dmn *d);
@@ -84,23 +91,37 @@ struct dmn_clock {
 	void (*woke)(struct dmn *d, const struct pollfd *pfd, struct dmn_wake *w);
 };
 
-struct dmn {
-	const struct cfg *cfg;        /* never written: the live parameters are the controller's */
-	struct ctl ctl;
+/* One port of the robot and the cycle's work on it: one for most robots,
+ * one per [bus.NAME] on a robot whose joints are on several (config.h).
+ * Each is driven on its own, in parallel, within the robot's one cycle. */
+struct dmn_bus {
+	size_t index;                 /* the configuration's bus: cfg->bus[index] */
+	const struct cfg_bus *cb;
 	struct cyc cyc;
-	struct cin cin;
-	struct pub pub;
-	struct notify notify;
-	/* the port */
 	struct port *port;
 	struct bus bus;
 	char port_path[CFG_PATH_MAX];
 	bool connected;
+	bool at_control;              /* its reads are in: waiting for the robot's control step */
 	uint64_t reconnect_at_us;
 	uint32_t backoff_ms;
 	long long reconnects;
 	double adapter_latency_ms;
 	int max_return_delay_us;
+	struct stats_window w_bus;
+};
+
+struct dmn {
+	const struct cfg *cfg;        /* never written: the live parameters are the controller's */
+	struct ctl ctl;
+	struct cin cin;
+	struct pub pub;
+	struct notify notify;
+	/* the ports: the buses that carry joints, in the configuration's order */
+	struct dmn_bus buses[CFG_MAX_BUSES];
+	size_t nbuses;
+	bool cycle_open;              /* a cycle started at the tick has not been published yet */
+	bool in_control;              /* the control step and the resumes are under way */
 	bool wiring_refused;          /* the port refused the configured rs485 mode */
 	enum bus_protocol protocol;   /* found (or configured) at the first connect; 0 until then */
 	/* timing */
@@ -113,7 +134,7 @@ struct dmn {
 	uint64_t cycle_start_us, last_cycle_start_us;
 	double period_meas_us, jitter_us;
 	long long overruns;
-	struct stats_window w_period, w_jitter, w_bus;
+	struct stats_window w_period, w_jitter, w_bus;   /* w_bus: the cycle's, the slowest bus's */
 	uint64_t second_start_us;
 	struct rusage ru_last;
 	bool params_dirty;
@@ -184,17 +205,57 @@ static void dmn_notice_hook(void *ctx, const char *text)
 	log_warn("%s", text);
 }
 
+/* ---- the buses, as a whole ------------------------------------------------------------------------ */
+/* Every bus connected: the robot runs whole (notify, --tune, the state's bus time). */
+static bool dmn_connected(const struct dmn *d)
+{
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (!d->buses[b].connected)
+			return false;
+	return true;
+}
+
+static bool dmn_any_connected(const struct dmn *d)
+{
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (d->buses[b].connected)
+			return true;
+	return false;
+}
+
+/* The buses work in parallel: the cycle's bus time is the slowest one's. */
+static double dmn_cycle_bus_us(const struct dmn *d)
+{
+	double us = 0.0;
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (d->buses[b].connected && d->buses[b].cyc.bus_us > us)
+			us = d->buses[b].cyc.bus_us;
+	return us;
+}
+
+static double dmn_control_us(const struct dmn *d)
+{
+	double us = 0.0;
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (d->buses[b].connected && d->buses[b].cyc.control_us > us)
+			us = d->buses[b].cyc.control_us;
+	return us;
+}
+
 /* ---- publishing --------------------------------------------------------------------------------- */
 static long long dmn_bus_errors(const struct dmn *d)
 {
-	return d->cyc.errors;
+	long long n = 0;
+	for (size_t b = 0; b < d->nbuses; b++)
+		n += d->buses[b].cyc.errors;
+	return n;
 }
 
 static void dmn_publish_state(struct dmn *d)
 {
 	struct pub_cycle f = {
 		.cycle = (int64_t)d->cycle, .period_us = d->period_meas_us, .jitter_us = d->jitter_us,
-		.bus_us = d->connected ? d->cyc.bus_us : 0.0, .control_us = d->cyc.control_us,
+		.bus_us = dmn_cycle_bus_us(d), .control_us = dmn_control_us(d),
 		.overruns = d->overruns, .bus_errors = dmn_bus_errors(d), .bad_commands = cin_refused(&d->cin),
 	};
 	pub_state(&d->pub, &d->ctl, &f);
@@ -213,19 +274,77 @@ static double dmn_cpu_percent(struct dmn *d, double wall_s)
 	return 100.0 * used / wall_s;
 }
 
+/* A robot on several buses: each bus's own figures on "<robot>.BUS.<bus>"
+ * (its port, connection, reconnects, bus time, its servos), beside the
+ * robot's message on "<robot>.BUS" (every servo, the slowest bus's time): the
+ * message is the one monitors and logs know, on a channel of its own. */
+static void dmn_publish_each_bus(struct dmn *d, const struct pub_bus *robot)
+{
+	for (size_t b = 0; b < d->nbuses; b++) {
+		struct dmn_bus *db = &d->buses[b];
+		struct stats_summary sb;
+		stats_summarize(&db->w_bus, &sb);
+		struct pub_bus f = *robot;
+		f.port = db->port_path;
+		f.connected = db->connected;
+		f.reconnects = db->reconnects;
+		f.adapter_latency_ms = db->adapter_latency_ms;
+		f.return_delay_us = db->max_return_delay_us;
+		f.bus_p99_us = sb.p99;
+		const struct bus *bus_of[CFG_MAX_JOINTS];
+		for (size_t j = 0; j < d->ctl.n; j++)
+			bus_of[j] = ctl_on_bus(&d->ctl, j, db->index) ? &db->bus : NULL;
+		struct pub_bus_lines lines = { .stray_packets = db->bus.stray_packets, .io_errors = db->bus.io_errors,
+		                               .baud = (int32_t)db->cb->baud };
+		char channel[PUB_CHANNEL_MAX + CFG_NAME_MAX];
+		snprintf(channel, sizeof channel, "%s.%s", d->pub.ch_bus, db->cb->name);
+		pub_bus_joints(&d->pub, &f, &lines, bus_of, &d->ctl, channel);
+		stats_reset(&db->w_bus);
+	}
+}
+
 static void dmn_publish_bus(struct dmn *d, double wall_s)
 {
 	struct stats_summary sp, sj, sb;
 	stats_summarize(&d->w_period, &sp);
 	stats_summarize(&d->w_jitter, &sj);
 	stats_summarize(&d->w_bus, &sb);
+	const struct dmn_bus *first = &d->buses[0];
 	struct pub_bus f = {
-		.port = d->port_path, .connected = d->connected, .reconnects = d->reconnects, .overruns = d->overruns,
-		.adapter_latency_ms = d->adapter_latency_ms, .return_delay_us = d->max_return_delay_us,
-		.period_p50_us = sp.p50, .period_p99_us = sp.p99, .period_max_us = sp.max, .jitter_p99_us = sj.p99,
-		.bus_p99_us = sb.p99, .cpu_percent = dmn_cpu_percent(d, wall_s),
+		.port = first->port_path, .connected = dmn_connected(d), .reconnects = first->reconnects,
+		.overruns = d->overruns, .adapter_latency_ms = first->adapter_latency_ms,
+		.return_delay_us = first->max_return_delay_us, .period_p50_us = sp.p50, .period_p99_us = sp.p99,
+		.period_max_us = sp.max, .jitter_p99_us = sj.p99, .bus_p99_us = sb.p99,
+		.cpu_percent = dmn_cpu_percent(d, wall_s),
 	};
-	pub_bus(&d->pub, &f, &d->bus, &d->ctl);
+	if (d->nbuses == 1) {
+		pub_bus(&d->pub, &f, &first->bus, &d->ctl);
+	} else {
+		/* the robot's: every port named, every servo from its own bus */
+		char ports[CFG_PATH_MAX];
+		size_t used = 0;
+		const struct bus *bus_of[CFG_MAX_JOINTS] = { NULL };
+		struct pub_bus_lines lines = { .baud = (int32_t)d->cfg->baud };
+		f.reconnects = 0;
+		for (size_t b = 0; b < d->nbuses; b++) {
+			const struct dmn_bus *db = &d->buses[b];
+			int w = snprintf(ports + used, sizeof ports - used, "%s%s", b ? "," : "", db->port_path);
+			used = w > 0 && used + (size_t)w < sizeof ports ? used + (size_t)w : used;
+			f.reconnects += db->reconnects;
+			if (db->max_return_delay_us > f.return_delay_us)
+				f.return_delay_us = db->max_return_delay_us;
+			if (db->adapter_latency_ms > f.adapter_latency_ms)
+				f.adapter_latency_ms = db->adapter_latency_ms;
+			lines.stray_packets += db->bus.stray_packets;
+			lines.io_errors += db->bus.io_errors;
+			for (size_t j = 0; j < d->ctl.n; j++)
+				if (ctl_on_bus(&d->ctl, j, db->index))
+					bus_of[j] = &db->bus;
+		}
+		f.port = ports;
+		pub_bus_joints(&d->pub, &f, &lines, bus_of, &d->ctl, d->pub.ch_bus);
+		dmn_publish_each_bus(d, &f);
+	}
 	stats_reset(&d->w_period);
 	stats_reset(&d->w_jitter);
 	stats_reset(&d->w_bus);
@@ -240,7 +359,7 @@ static void dmn_notify_status(struct dmn *d)
 	struct notify_status s = {
 		.mode = cfg_mode_name(d->ctl.mode),
 		.rate_hz = 1e6 / (d->period_meas_us > 0 ? d->period_meas_us : (double)d->period_us),
-		.njoints = d->ctl.n, .bus_connected = d->connected, .overruns = d->overruns,
+		.njoints = d->ctl.n, .bus_connected = dmn_connected(d), .overruns = d->overruns,
 		.bus_errors = dmn_bus_errors(d), .faults = d->ctl.faults, .bad_commands = cin_refused(&d->cin),
 	};
 	notify_format_status(buf, sizeof buf, &s);
@@ -260,51 +379,52 @@ static void dmn_watchdog(struct dmn *d, uint64_t now)
 }
 
 /* ---- the port --------------------------------------------------------------------------------- */
-static void dmn_close_port(struct dmn *d)
+static void dmn_close_port(struct dmn_bus *b)
 {
-	cyc_cut(&d->cyc);
-	if (d->port != NULL) {
-		bus_abort(&d->bus);
-		port_close(d->port);
+	cyc_cut(&b->cyc);
+	b->at_control = false;
+	if (b->port != NULL) {
+		bus_abort(&b->bus);
+		port_close(b->port);
 	}
-	d->port = NULL;
-	d->connected = false;
+	b->port = NULL;
+	b->connected = false;
 }
 
 /* The bus timeouts: the adapter's latency (the FTDI latency timer, read and
  * lowered by port_open() on the fd it holds, or as configured), the servos'
  * return delay. `dxl doctor` derives them the same way (port.h). */
-static void dmn_latency(struct dmn *d)
+static void dmn_latency(struct dmn *d, struct dmn_bus *b)
 {
 	struct port_latency lat;
 	long configured = d->cfg->adapter_latency_us;
-	long us = port_adapter_latency_us(d->port, configured, &lat);
-	d->adapter_latency_ms = configured >= 0 ? 1e-3 * (double)us : lat.known ? (double)lat.timer_ms : -1.0;
+	long us = port_adapter_latency_us(b->port, configured, &lat);
+	b->adapter_latency_ms = configured >= 0 ? 1e-3 * (double)us : lat.known ? (double)lat.timer_ms : -1.0;
 	if (lat.known && lat.timer_ms > 1)
 		log_warn("%s: adapter latency timer %d ms (%s): replies wait that long, 100 Hz is out of "
-		         "reach; set it to 1 ms (`dxl --port PATH setup`, or the udev rule in systemd/)", d->port_path,
+		         "reach; set it to 1 ms (`dxl --port PATH setup`, or the udev rule in systemd/)", b->port_path,
 		         lat.timer_ms, lat.note);
 	if (configured > 1000)
 		log_warn("adapter_latency_us = %ld: replies wait that long, 100 Hz needs <= 1000 µs "
 		         "(`dxl --port PATH setup`)", configured);
 	struct bus_timing tm = {
-		.baud = d->cfg->baud, .return_delay_us = (uint32_t)d->max_return_delay_us,
+		.baud = b->cb->baud, .return_delay_us = (uint32_t)b->max_return_delay_us,
 		.adapter_latency_us = (uint32_t)us, .margin_us = (uint32_t)d->cfg->bus_margin_us,
 	};
-	bus_set_timing(&d->bus, &tm);
+	bus_set_timing(&b->bus, &tm);
 }
 
 /* usb_serial = ...: the adapter with that USB serial number, wherever it is
  * enumerated now (ttyUSB numbers change on replugging). */
-static bool dmn_find_port(struct dmn *d, char *err, size_t cap)
+static bool dmn_find_port(struct dmn_bus *b, char *err, size_t cap)
 {
-	if (d->cfg->usb_serial[0] == '\0')
+	if (b->cb->usb_serial[0] == '\0')
 		return true;
 	int n = 0;
-	if (port_find_by_serial(d->cfg->usb_serial, d->port_path, sizeof d->port_path, &n))
+	if (port_find_by_serial(b->cb->usb_serial, b->port_path, sizeof b->port_path, &n))
 		return true;
 	snprintf(err, cap, "no serial port with USB serial number '%s' (%d port(s) found; `dxl ports` lists them)",
-	         d->cfg->usb_serial, n);
+	         b->cb->usb_serial, n);
 	return false;
 }
 
@@ -318,7 +438,7 @@ _Static_assert((int)CFG_PROTO_1 == (int)BUS_PROTOCOL_1 && (int)CFG_PROTO_2 == (i
 
 /* The bus's protocol: configured, or found by PINGs at the first connect
  * (setup_protocol) and kept for every reconnect. */
-static bool dmn_protocol(struct dmn *d, char *err, size_t cap)
+static bool dmn_protocol(struct dmn *d, struct dmn_bus *b, char *err, size_t cap)
 {
 	/* The daemon's two branches on the protocol, both choosing the backend
 	 * at start-up; everything after asks the servo's model. 1: a configured
@@ -328,9 +448,9 @@ static bool dmn_protocol(struct dmn *d, char *err, size_t cap)
 		d->protocol = (enum bus_protocol)d->cfg->protocol;
 	/* 2: protocol = auto, none found yet: PINGs find it (setup_protocol,
 	 * its backends in a table, the AX-12's first) */
-	if (d->protocol == 0 && !setup_protocol(&d->bus, d->cfg, d->port_path, &d->protocol, err, cap))
+	if (d->protocol == 0 && !setup_protocol(&b->bus, d->cfg, b->port_path, &d->protocol, err, cap))
 		return false;
-	bus_set_protocol(&d->bus, d->protocol);
+	bus_set_protocol(&b->bus, d->protocol);
 	return true;
 }
 
@@ -414,6 +534,32 @@ static void dmn_tune_rebase(struct dmn *d)
 	}
 }
 
+/* "/dev/ttyUSB0 at 1000000 bps", or with several buses "bus robot
+ * /dev/ttyUSB0 at 1000000 bps (joints 1,2), bus tail ..." */
+static void dmn_ports_text(const struct dmn *d, char *out, size_t cap)
+{
+	size_t used = 0;
+	out[0] = '\0';
+	for (size_t b = 0; b < d->nbuses && used + 1 < cap; b++) {
+		const struct dmn_bus *db = &d->buses[b];
+		int w;
+		if (d->nbuses == 1) {
+			w = snprintf(out + used, cap - used, "%s at %ld bps", db->port_path, db->cb->baud);
+		} else {
+			w = snprintf(out + used, cap - used, "%sbus %s %s at %ld bps (joint%s", b ? ", " : "", db->cb->name,
+			             db->port_path, db->cb->baud, db->cb->njoints > 1 ? "s " : " ");
+			for (size_t i = 0; w > 0 && i < db->cb->njoints && used + (size_t)w + 1 < cap; i++) {
+				int k = snprintf(out + used + (size_t)w, cap - used - (size_t)w, "%s%zu", i ? "," : "",
+				                 db->cb->joints[i] + 1);
+				w += k > 0 ? k : 0;
+			}
+			if (w > 0 && used + (size_t)w + 1 < cap)
+				w += snprintf(out + used + (size_t)w, cap - used - (size_t)w, ")");
+		}
+		used += w > 0 && used + (size_t)w < cap ? (size_t)w : cap - used - 1;
+	}
+}
+
 /* "AX-12A" or "XL430-W250, XM430-W350": the models found. */
 static void dmn_models(const struct dmn *d, char *out, size_t cap)
 {
@@ -428,36 +574,38 @@ static void dmn_models(const struct dmn *d, char *out, size_t cap)
 	}
 }
 
-/* Open the port and run every start-up check. On failure *err says why. */
 /* The cycle's read on a bus that can read every servo with one request:
  * a Fast Sync Read when every servo answers it (model and firmware, read
  * at start-up), the plain SYNC_READ otherwise; said either way. */
-static void dmn_fast_read(struct dmn *d)
+static void dmn_fast_read(struct dmn *d, struct dmn_bus *b)
 {
 	char why[CFG_MAX_JOINTS * 48 + 160];
-	if (!dxl_proto_can(bus_proto(&d->bus), DXL_CAP_SYNC_READ))
+	if (!dxl_proto_can(bus_proto(&b->bus), DXL_CAP_SYNC_READ))
 		return;
-	bool fast = setup_fast_read(&d->bus, &d->ctl, why, sizeof why);
-	cyc_set_fast_read(&d->cyc, fast);
+	bool fast = setup_fast_read_on(&b->bus, &d->ctl, b->index, why, sizeof why);
+	cyc_set_fast_read(&b->cyc, fast);
 	if (fast)
 		log_info("bus: the cycle reads by Fast Sync Read, one status packet for all servos (%s)", why);
 	else
 		log_info("bus: the cycle reads by SYNC_READ, a status packet per servo: no Fast Sync Read, as %s", why);
 }
 
-static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap)
+/* Open one bus's port and run its start-up checks; the controller starts
+ * (ctl_start) once every bus is in (dmn_connect, dmn_try_reconnect). On
+ * failure *err says why. */
+static bool dmn_connect_bus(struct dmn *d, struct dmn_bus *b, char *err, size_t cap)
 {
-	if (!dmn_find_port(d, err, cap))
+	if (!dmn_find_port(b, err, cap))
 		return false;
 	/* the port is this robot's alone (protocol/io/port_lock.c): what the
 	 * lock names, so that a program refused beside us can say who holds it */
 	char owner[CFG_NAME_MAX + 8];
 	struct holder held;
 	snprintf(owner, sizeof owner, "robot %s", d->cfg->name);
-	struct port_options opt = { .baud = d->cfg->baud, .force_termios = false, .low_latency = true,
+	struct port_options opt = { .baud = b->cb->baud, .force_termios = false, .low_latency = true,
 	                            .owner = owner, .holder = &held };
-	d->port = port_open(d->port_path, &opt, err, cap);
-	if (d->port == NULL) {
+	b->port = port_open(b->port_path, &opt, err, cap);
+	if (b->port == NULL) {
 		size_t len = strlen(err);
 		if ((held.pid > 0 || held.program[0] != '\0') && len < cap)
 			snprintf(err + len, cap - len, ": one program drives a bus at a time; stop that one first, or give "
@@ -467,73 +615,122 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 	/* A UART behind a half-duplex buffer: the kernel switches the direction
 	 * around every packet. A device that cannot (a USB adapter, a pty) must
 	 * not run with the wiring silently wrong: one error, and no start. */
-	if (port_set_rs485(d->port, d->cfg->rs485, err, cap) != DXL_OK) {
+	if (port_set_rs485(b->port, d->cfg->rs485, err, cap) != DXL_OK) {
 		d->wiring_refused = true;
-		dmn_close_port(d);
+		dmn_close_port(b);
 		return false;
 	}
 	struct bus_io io;
 	if (d->lockstep) {
 		/* what was announced for a port closed since is not coming */
 		d->lks.consumed = d->lks.delivered;
-		port_bus_io_lockstep(&d->lks_port, d->port, &d->lks, &io);
+		port_bus_io_lockstep(&d->lks_port, b->port, &d->lks, &io);
 	} else {
-		port_bus_io(d->port, &io);
+		port_bus_io(b->port, &io);
 	}
 	struct bus_timing tm = {
-		.baud = d->cfg->baud, .return_delay_us = DMN_DEFAULT_RETURN_DELAY_US,
+		.baud = b->cb->baud, .return_delay_us = DMN_DEFAULT_RETURN_DELAY_US,
 		.adapter_latency_us = d->cfg->adapter_latency_us > 0 ? (uint32_t)d->cfg->adapter_latency_us : 0,
 		.margin_us = (uint32_t)d->cfg->bus_margin_us,
 	};
-	bus_init(&d->bus, &io, &tm, d->cfg->echo);
-	bool ok = dmn_protocol(d, err, cap) &&
-	          setup_servos(&d->bus, &d->ctl, d->cfg, d->port_path, &d->max_return_delay_us, err, cap);
+	bus_init(&b->bus, &io, &tm, d->cfg->echo);
+	bool ok = dmn_protocol(d, b, err, cap) &&
+	          setup_servos(&b->bus, &d->ctl, d->cfg, b->index, b->port_path, &b->max_return_delay_us, err, cap);
 	if (ok) {
-		dmn_latency(d);
-		ok = setup_read_present(&d->bus, &d->ctl, 1e-6 * (double)d->period_us, err, cap);
+		dmn_latency(d, b);
+		ok = setup_read_present(&b->bus, &d->ctl, b->index, 1e-6 * (double)d->period_us, err, cap);
 	}
 	if (!ok) {
-		dmn_close_port(d);
+		dmn_close_port(b);
 		return false;
 	}
-	d->connected = true;
-	d->backoff_ms = DMN_BACKOFF_MIN_MS;
-	dmn_fast_read(d);
+	b->connected = true;
+	b->backoff_ms = DMN_BACKOFF_MIN_MS;
+	dmn_fast_read(d, b);
+	return true;
+}
+
+/* A message about one bus names it when the robot has several. */
+static void dmn_bus_prefix(const struct dmn *d, const struct dmn_bus *b, char *out, size_t cap)
+{
+	if (d->nbuses > 1)
+		snprintf(out, cap, "bus %s, %s", b->cb->name, b->port_path);
+	else
+		snprintf(out, cap, "%s", b->port_path);
+}
+
+/* Every bus, then the controller: at start-up. */
+static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap)
+{
+	for (size_t i = 0; i < d->nbuses; i++) {
+		struct dmn_bus *b = &d->buses[i];
+		if (dmn_connect_bus(d, b, err, cap))
+			continue;
+		if (d->nbuses > 1) {
+			/* "bus tail, /dev/ttyUSB1: " before the reason, when it fits */
+			char what[CFG_PATH_MAX + 64];
+			dmn_bus_prefix(d, b, what, sizeof what);
+			size_t pl = strlen(what) + 2, el = strlen(err);
+			if (pl + el < cap) {
+				memmove(err + pl, err, el + 1);
+				memcpy(err, what, pl - 2);
+				memcpy(err + pl - 2, ": ", 2);
+			}
+		}
+		for (size_t k = 0; k < i; k++)
+			dmn_close_port(&d->buses[k]);
+		return false;
+	}
 	ctl_start(&d->ctl, dmn_ctl_time(d, now_us()), reason);
 	return true;
 }
 
-static void dmn_bus_lost(struct dmn *d, int why)
+static void dmn_bus_lost(struct dmn *d, struct dmn_bus *b, int why)
 {
-	char text[CFG_PATH_MAX + 96];
-	snprintf(text, sizeof text, "%s: %s: bus lost, joints hold; reconnecting every %.1f..%.1f s",
-	         d->port_path, dxl_strerror(why), 1e-3 * DMN_BACKOFF_MIN_MS, 1e-3 * DMN_BACKOFF_MAX_MS);
-	dmn_close_port(d);
-	ctl_bus_lost(&d->ctl);
-	d->backoff_ms = DMN_BACKOFF_MIN_MS;
-	d->reconnect_at_us = now_us() + 1000ULL * d->backoff_ms;
+	char text[CFG_PATH_MAX + 256], what[CFG_PATH_MAX + 64];
+	dmn_bus_prefix(d, b, what, sizeof what);
+	if (d->nbuses > 1)
+		snprintf(text, sizeof text, "%s: %s: bus lost, its joints hold and so do the other buses' (the robot's "
+		         "joints move together or not at all); reconnecting every %.1f..%.1f s", what, dxl_strerror(why),
+		         1e-3 * DMN_BACKOFF_MIN_MS, 1e-3 * DMN_BACKOFF_MAX_MS);
+	else
+		snprintf(text, sizeof text, "%s: %s: bus lost, joints hold; reconnecting every %.1f..%.1f s", what,
+		         dxl_strerror(why), 1e-3 * DMN_BACKOFF_MIN_MS, 1e-3 * DMN_BACKOFF_MAX_MS);
+	dmn_close_port(b);
+	if (d->nbuses > 1)
+		ctl_bus_lost_on(&d->ctl, b->index);
+	else
+		ctl_bus_lost(&d->ctl);
+	b->backoff_ms = DMN_BACKOFF_MIN_MS;
+	b->reconnect_at_us = now_us() + 1000ULL * b->backoff_ms;
 	dmn_event(d, 0, 2, "bus-lost", text);
 	dmn_notify_status(d);
 }
 
-static void dmn_try_reconnect(struct dmn *d, uint64_t now)
+static void dmn_try_reconnect(struct dmn *d, struct dmn_bus *b, uint64_t now)
 {
-	if (d->connected || now < d->reconnect_at_us)
+	if (b->connected || now < b->reconnect_at_us)
 		return;
-	char err[512];
-	if (dmn_connect(d, "reconnected", err, sizeof err)) {
-		d->reconnects++;
-		char text[CFG_PATH_MAX + 96];
-		snprintf(text, sizeof text, "%s: bus back (reconnect %lld), start-up checks passed", d->port_path,
-		         d->reconnects);
+	char err[512], what[CFG_PATH_MAX + 64];
+	dmn_bus_prefix(d, b, what, sizeof what);
+	if (dmn_connect_bus(d, b, err, sizeof err)) {
+		b->reconnects++;
+		char text[CFG_PATH_MAX + 512];
+		bool whole = dmn_connected(d);
+		snprintf(text, sizeof text, "%s: bus back (reconnect %lld), start-up checks passed%s", what, b->reconnects,
+		         whole ? "" : "; the robot holds until its other buses are back");
+		/* the robot moves again when every bus is back: ramped in from
+		 * where the joints are */
+		if (whole)
+			ctl_start(&d->ctl, dmn_ctl_time(d, now_us()), "reconnected");
 		dmn_event(d, 0, 0, "bus-back", text);
 		dmn_notify_status(d);
 		return;
 	}
-	log_limited(&d->lim_bus, now, LOG_LVL_WARN, "reconnect failed: %s (next try in %.1f s)", err,
-	            1e-3 * d->backoff_ms);
-	d->reconnect_at_us = now + 1000ULL * d->backoff_ms;
-	d->backoff_ms = d->backoff_ms * 2 > DMN_BACKOFF_MAX_MS ? DMN_BACKOFF_MAX_MS : d->backoff_ms * 2;
+	log_limited(&d->lim_bus, now, LOG_LVL_WARN, "%s%sreconnect failed: %s (next try in %.1f s)",
+	            d->nbuses > 1 ? what : "", d->nbuses > 1 ? ": " : "", err, 1e-3 * b->backoff_ms);
+	b->reconnect_at_us = now + 1000ULL * b->backoff_ms;
+	b->backoff_ms = b->backoff_ms * 2 > DMN_BACKOFF_MAX_MS ? DMN_BACKOFF_MAX_MS : b->backoff_ms * 2;
 }
 
 /* ---- the cycle ---------------------------------------------------------------------------------- */
@@ -594,45 +791,128 @@ static void dmn_tune_cycle(struct dmn *d)
 
 static void dmn_cycle_done(struct dmn *d)
 {
-	if (d->connected)
-		stats_add(&d->w_bus, d->cyc.bus_us);
+	d->cycle_open = false;
+	if (dmn_any_connected(d))
+		stats_add(&d->w_bus, dmn_cycle_bus_us(d));
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (d->buses[b].connected)
+			stats_add(&d->buses[b].w_bus, d->buses[b].cyc.bus_us);
 	dmn_flush_ctl_events(d);
 	dmn_publish_state(d);
-	if (d->tune && d->connected)
+	if (d->tune && dmn_connected(d))
 		dmn_tune_cycle(d);
 	d->cycle++;
 }
 
-/* Follow the cycle until it waits for the bus or ends. */
-static void dmn_drive(struct dmn *d, enum cyc_status st)
+/* What a lost bus's joints would have written is forgotten, every cycle (the
+ * start-up sequence writes what matters): it would wait at the head of the
+ * robot's write queue for a bus that is not there. */
+static void dmn_forget_lost(struct dmn *d)
 {
-	for (;;) {
-		switch (st) {
-		case CYC_PENDING:
-			dmn_arm_deadline(d);
+	if (d->nbuses == 1) {
+		if (!d->buses[0].connected)
+			ctl_bus_lost(&d->ctl);
+		return;
+	}
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (!d->buses[b].connected)
+			ctl_bus_lost_on(&d->ctl, d->buses[b].index);
+}
+
+/* The cycle is over when every bus's part of it is. */
+static void dmn_maybe_done(struct dmn *d)
+{
+	if (!d->cycle_open || d->in_control)
+		return;
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (d->buses[b].connected && cyc_busy(&d->buses[b].cyc))
 			return;
-		case CYC_CONTROL:
-			dmn_control(d);
-			st = cyc_resume(&d->cyc);
+	dmn_cycle_done(d);
+}
+
+static void dmn_drive(struct dmn *d, struct dmn_bus *b, enum cyc_status st);
+
+/* The control step runs once a cycle, when every connected bus's reads are
+ * in (or timed out: a cycle reaches CYC_CONTROL either way); then each bus
+ * sends its share of the outputs. */
+static void dmn_maybe_control(struct dmn *d)
+{
+	if (d->in_control)
+		return;
+	bool waiting = false;
+	for (size_t i = 0; i < d->nbuses; i++) {
+		const struct dmn_bus *b = &d->buses[i];
+		if (b->connected && cyc_busy(&b->cyc) && !b->at_control)
+			return;   /* still reading */
+		waiting = waiting || b->at_control;
+	}
+	if (!waiting)
+		return;
+	d->in_control = true;
+	dmn_control(d);
+	dmn_forget_lost(d);
+	for (size_t i = 0; i < d->nbuses; i++) {
+		struct dmn_bus *b = &d->buses[i];
+		if (!b->at_control)
 			continue;
-		case CYC_DONE:
-			dmn_arm_deadline(d);
-			dmn_cycle_done(d);
-			return;
-		case CYC_LOST:
-			dmn_bus_lost(d, d->cyc.lost);
-			dmn_arm_deadline(d);
-			dmn_cycle_done(d);
-			return;
-		}
+		b->at_control = false;
+		dmn_drive(d, b, cyc_resume(&b->cyc));
+	}
+	d->in_control = false;
+	dmn_maybe_done(d);
+}
+
+/* Follow a bus's cycle until it waits for the bus, for the control step, or
+ * ends. */
+static void dmn_drive(struct dmn *d, struct dmn_bus *b, enum cyc_status st)
+{
+	switch (st) {
+	case CYC_PENDING:
+		dmn_arm_deadline(d);
+		return;
+	case CYC_CONTROL:
+		b->at_control = true;
+		dmn_maybe_control(d);
+		return;
+	case CYC_DONE:
+		dmn_arm_deadline(d);
+		dmn_maybe_done(d);
+		return;
+	case CYC_LOST:
+		dmn_bus_lost(d, b, b->cyc.lost);
+		dmn_arm_deadline(d);
+		dmn_maybe_control(d);   /* the others may be waiting for it */
+		dmn_maybe_done(d);
+		return;
 	}
 }
 
-static void dmn_bus_event(struct dmn *d)
+static void dmn_bus_event(struct dmn *d, struct dmn_bus *b)
 {
-	if (!d->connected || !cyc_busy(&d->cyc))
+	if (!b->connected || !cyc_busy(&b->cyc) || b->at_control)
 		return;
-	dmn_drive(d, cyc_step(&d->cyc));
+	dmn_drive(d, b, cyc_step(&b->cyc));
+}
+
+/* The previous cycle's bus work is still going at the tick: it ends here (a
+ * write cut off is sent again next cycle). */
+static void dmn_cut_cycle(struct dmn *d, uint64_t now)
+{
+	bool busy = false;
+	for (size_t b = 0; b < d->nbuses; b++) {
+		struct dmn_bus *db = &d->buses[b];
+		if (!cyc_busy(&db->cyc))
+			continue;
+		busy = true;
+		cyc_cut(&db->cyc);
+		db->at_control = false;
+	}
+	if (!busy)
+		return;
+	d->overruns++;
+	log_limited(&d->lim_overrun, now, LOG_LVL_WARN, "cycle %" PRIu64 " still on the bus at the next tick", d->cycle);
+	dmn_arm_deadline(d);
+	dmn_cycle_done(d);
 }
 
 /* A tick at now; exp periods have passed since the last (more than one:
@@ -646,16 +926,7 @@ static void dmn_tick_at(struct dmn *d, uint64_t exp, uint64_t now)
 		log_limited(&d->lim_overrun, now, LOG_LVL_WARN, "overrun: %" PRIu64 " period(s) skipped", exp - 1);
 	}
 	uint64_t scheduled = d->first_tick_us + (d->ticks - 1) * d->period_us;
-	if (cyc_busy(&d->cyc)) {
-		/* the previous cycle's bus work is still going: it ends here (a write
-		 * cut off is sent again next cycle) */
-		cyc_cut(&d->cyc);
-		d->overruns++;
-		log_limited(&d->lim_overrun, now, LOG_LVL_WARN, "cycle %" PRIu64 " still on the bus at the next tick",
-		            d->cycle);
-		dmn_arm_deadline(d);
-		dmn_cycle_done(d);
-	}
+	dmn_cut_cycle(d, now);
 	d->last_cycle_start_us = d->cycle_start_us ? d->cycle_start_us : now - d->period_us;
 	d->cycle_start_us = now;
 	d->jitter_us = (double)(now - scheduled);
@@ -663,8 +934,8 @@ static void dmn_tick_at(struct dmn *d, uint64_t exp, uint64_t now)
 	stats_add(&d->w_period, d->period_meas_us);
 	stats_add(&d->w_jitter, d->jitter_us);
 
-	if (!d->connected)
-		dmn_try_reconnect(d, now);
+	for (size_t b = 0; b < d->nbuses; b++)
+		dmn_try_reconnect(d, &d->buses[b], now);
 	if (now - d->second_start_us >= 1000000) {
 		dmn_publish_bus(d, 1e-6 * (double)(now - d->second_start_us));
 		pub_params(&d->pub);
@@ -677,16 +948,25 @@ static void dmn_tick_at(struct dmn *d, uint64_t exp, uint64_t now)
 	}
 	dmn_watchdog(d, now);
 
-	if (!d->connected) {
+	if (!dmn_any_connected(d)) {
 		/* no bus: the controller still runs (joints stale: they go silent,
 		 * and the state keeps flowing at the period), and what it would
 		 * write is forgotten: the start-up sequence writes what matters */
 		dmn_control(d);
-		ctl_bus_lost(&d->ctl);
+		dmn_forget_lost(d);
 		dmn_cycle_done(d);
 		return;
 	}
-	dmn_drive(d, cyc_start(&d->cyc));
+	/* every bus's cycle begun before any is followed: the control step
+	 * waits for the reads of every bus that is under way */
+	enum cyc_status st[CFG_MAX_BUSES];
+	d->cycle_open = true;
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (d->buses[b].connected)
+			st[b] = cyc_start(&d->buses[b].cyc);
+	for (size_t b = 0; b < d->nbuses; b++)
+		if (d->buses[b].connected)
+			dmn_drive(d, &d->buses[b], st[b]);
 }
 
 /* ---- set-up and the loop ----------------------------------------------------------------------- */
@@ -786,20 +1066,24 @@ static void dmn_take_commands(struct dmn *d, const struct pollfd *pfd)
  * the tick ends whole instead of being cut by it. */
 static void dmn_woke(struct dmn *d, const struct dmn_wake *w)
 {
-	if (w->bus_hup) {
-		if (bus_is_pending(&d->bus))
-			dmn_bus_event(d);   /* reads the remaining bytes, then reports the loss */
-		if (d->connected) {
-			bool busy = cyc_busy(&d->cyc);
-			dmn_bus_lost(d, DXL_E_DISCONNECTED);
-			if (busy)
-				dmn_cycle_done(d);
+	for (size_t i = 0; i < d->nbuses; i++) {
+		struct dmn_bus *b = &d->buses[i];
+		if (w->bus_hup[i]) {
+			if (b->connected && bus_is_pending(&b->bus))
+				dmn_bus_event(d, b);   /* reads the remaining bytes, then reports the loss */
+			if (b->connected) {
+				dmn_bus_lost(d, b, DXL_E_DISCONNECTED);
+				dmn_maybe_control(d);   /* the others may be waiting for it */
+				dmn_maybe_done(d);
+			}
+		} else if (w->bus_in[i]) {
+			dmn_bus_event(d, b);
 		}
-	} else if (w->bus_in) {
-		dmn_bus_event(d);
 	}
+	/* one deadline timer for every bus: each looks whether its own passed */
 	if (w->bus_deadline)
-		dmn_bus_event(d);
+		for (size_t i = 0; i < d->nbuses; i++)
+			dmn_bus_event(d, &d->buses[i]);
 	if (w->ticks > 0)
 		dmn_tick_at(d, w->ticks, w->now);
 }
@@ -828,7 +1112,7 @@ static void dmn_loop(struct dmn *d)
 }
 
 /* ---- the system's clock: a periodic timerfd, a deadline timerfd, the bus fd ------------------- */
-enum { DMN_RT_TIMER, DMN_RT_DEADLINE, DMN_RT_BUS, DMN_RT_N };
+enum { DMN_RT_TIMER, DMN_RT_DEADLINE, DMN_RT_BUS };   /* DMN_RT_BUS + i: bus i */
 
 static struct timespec dmn_timespec(uint64_t us)
 {
@@ -841,10 +1125,22 @@ static void dmn_rt_start(struct dmn *d)
 	timerfd_settime(d->timer_fd, TFD_TIMER_ABSTIME, &its, NULL);
 }
 
+/* The earliest deadline of the buses' pending transactions (0: none). */
+static uint64_t dmn_deadline_us(const struct dmn *d)
+{
+	uint64_t dl = 0;
+	for (size_t b = 0; b < d->nbuses; b++) {
+		uint64_t t = d->buses[b].connected ? cyc_deadline_us(&d->buses[b].cyc) : 0;
+		if (t != 0 && (dl == 0 || t < dl))
+			dl = t;
+	}
+	return dl;
+}
+
 static void dmn_rt_arm_deadline(struct dmn *d)
 {
 	struct itimerspec its = { 0 };
-	uint64_t dl = d->connected ? cyc_deadline_us(&d->cyc) : 0;
+	uint64_t dl = dmn_deadline_us(d);
 	if (dl != 0) {
 		its.it_value = dmn_timespec(dl);
 		if (its.it_value.tv_sec == 0 && its.it_value.tv_nsec == 0)
@@ -859,16 +1155,21 @@ static nfds_t dmn_rt_fds(struct dmn *d, struct pollfd *pfd)
 {
 	pfd[DMN_RT_TIMER] = (struct pollfd){ .fd = d->timer_fd, .events = POLLIN };
 	pfd[DMN_RT_DEADLINE] = (struct pollfd){ .fd = d->deadline_fd, .events = POLLIN };
-	/* bus fd: readable only matters while a reply is awaited; HUP/ERR always */
-	pfd[DMN_RT_BUS] = (struct pollfd){ .fd = d->connected ? port_fd(d->port) : -1,
-	                                   .events = (short)(bus_is_pending(&d->bus) ? POLLIN : 0) };
-	return DMN_RT_N;
+	/* bus fds: readable only matters while a reply is awaited; HUP/ERR always */
+	for (size_t i = 0; i < d->nbuses; i++) {
+		const struct dmn_bus *b = &d->buses[i];
+		pfd[DMN_RT_BUS + i] = (struct pollfd){ .fd = b->connected ? port_fd(b->port) : -1,
+		                                       .events = (short)(b->connected && bus_is_pending(&b->bus) ? POLLIN : 0) };
+	}
+	return DMN_RT_BUS + d->nbuses;
 }
 
 static void dmn_rt_woke(struct dmn *d, const struct pollfd *pfd, struct dmn_wake *w)
 {
-	w->bus_hup = (pfd[DMN_RT_BUS].revents & (POLLHUP | POLLERR | POLLNVAL)) != 0;
-	w->bus_in = (pfd[DMN_RT_BUS].revents & POLLIN) != 0;
+	for (size_t i = 0; i < d->nbuses; i++) {
+		w->bus_hup[i] = (pfd[DMN_RT_BUS + i].revents & (POLLHUP | POLLERR | POLLNVAL)) != 0;
+		w->bus_in[i] = (pfd[DMN_RT_BUS + i].revents & POLLIN) != 0;
+	}
 	if (pfd[DMN_RT_DEADLINE].revents & POLLIN) {
 		uint64_t x;
 		if (read(d->deadline_fd, &x, sizeof x) < 0 && errno != EAGAIN)
@@ -915,11 +1216,13 @@ static void dmn_lks_arm_deadline(struct dmn *d) { (void)d; }
  * every daemon has said so. */
 static void dmn_lks_before_wait(struct dmn *d)
 {
+	/* one bus: a robot on several cannot run in lockstep (cfg_finish) */
+	const struct dmn_bus *b = &d->buses[0];
 	uint64_t wake = d->next_tick_us;
-	uint64_t dl = d->connected ? cyc_deadline_us(&d->cyc) : 0;
+	uint64_t dl = dmn_deadline_us(d);
 	if (dl != 0 && dl < wake)
 		wake = dl;
-	if (lks_client_wait(&d->lks, wake, d->connected && bus_is_pending(&d->bus)) != 0)
+	if (lks_client_wait(&d->lks, wake, b->connected && bus_is_pending(&b->bus)) != 0)
 		dmn_clock_lost(d, "lockstep: the simulator is gone");
 }
 
@@ -951,7 +1254,7 @@ static void dmn_lks_woke(struct dmn *d, const struct pollfd *pfd, struct dmn_wak
 	if (!lks_client_take_time(&d->lks))
 		return;
 	uint64_t now = now_us();
-	w->bus_in = d->connected && bus_is_pending(&d->bus);
+	w->bus_in[0] = d->buses[0].connected && bus_is_pending(&d->buses[0].bus);
 	if (now >= d->next_tick_us) {
 		w->ticks = 1 + (now - d->next_tick_us) / d->period_us;
 		w->now = now;
@@ -987,6 +1290,25 @@ static bool dmn_open(struct dmn *d, int *status)
 
 static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out);
 
+/* The configuration lets buses reuse servo IDs (each is its own wire); the
+ * controller still keys its register writes and its reports by servo ID, so
+ * this daemon refuses a robot whose IDs repeat, saying so. */
+static bool dmn_ids_unique(const struct cfg *cfg, char *why, size_t cap)
+{
+	for (size_t j = 0; j < cfg->njoints; j++) {
+		for (size_t k = j + 1; k < cfg->njoints; k++) {
+			if (cfg->ids[j] != cfg->ids[k])
+				continue;
+			snprintf(why, cap, "servo ID %u is joint %zu (bus %s) and joint %zu (bus %s): the configuration "
+			         "allows it, but undulated needs each servo of a robot to have an ID of its own (set one with "
+			         "`dxl --port PATH set-id OLD NEW`)", cfg->ids[j], j + 1, cfg->bus[cfg->joint_bus[j]].name, k + 1,
+			         cfg->bus[cfg->joint_bus[k]].name);
+			return false;
+		}
+	}
+	return true;
+}
+
 int dmn_run(const struct cfg *cfg) { return dmn_run_with(cfg, NULL, NULL); }
 
 int dmn_run_tune(const struct cfg *cfg, struct tune *t, void *progress)
@@ -998,6 +1320,11 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 {
 	static struct dmn dmn;   /* large (bus stats per ID): not on the stack */
 	struct dmn *d = &dmn;
+	char why[512];
+	if (!dmn_ids_unique(cfg, why, sizeof why)) {
+		log_error("%s", why);
+		return 2;
+	}
 	memset(d, 0, sizeof *d);
 	d->lks.fd = -1;
 	d->cfg = cfg;
@@ -1009,10 +1336,20 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	d->period_us = (uint64_t)llround(cfg->period_ms * 1000.0);
 	d->timer_fd = d->deadline_fd = d->signal_fd = -1;
 	d->clock = &dmn_clock_real;
-	snprintf(d->port_path, sizeof d->port_path, "%s", cfg->port);
 	ctl_init(&d->ctl, cfg);
 	struct cyc_hooks ch = { .ctx = d, .bus_error = dmn_bus_error_hook, .notice = dmn_notice_hook };
-	cyc_init(&d->cyc, &d->bus, &d->ctl, d->period_us, &ch);
+	for (size_t i = 0; i < cfg->nbuses; i++) {
+		if (cfg->bus[i].njoints == 0)
+			continue;   /* every joint on a [bus.NAME]: the [robot] port carries none */
+		struct dmn_bus *b = &d->buses[d->nbuses++];
+		b->index = i;
+		b->cb = &cfg->bus[i];
+		snprintf(b->port_path, sizeof b->port_path, "%s", b->cb->port);
+		cyc_init(&b->cyc, &b->bus, &d->ctl, d->period_us, &ch);
+		/* one bus: every joint, as ever; several: each cycle its own */
+		if (cfg_buses_used(cfg) > 1)
+			cyc_set_bus(&b->cyc, i);
+	}
 	notify_init(&d->notify);
 	d->watchdog_interval_us = notify_watchdog_interval_us(&d->notify);
 	int status;
@@ -1028,7 +1365,7 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	if (cfg->lockstep[0] != '\0') {
 		/* from here on the clock is the simulator's: before the start-up
 		 * checks, whose bus transactions take virtual time too */
-		if (lks_client_open(&d->lks, cfg->lockstep, d->port_path, cfg->name, err, sizeof err) != 0) {
+		if (lks_client_open(&d->lks, cfg->lockstep, d->buses[0].port_path, cfg->name, err, sizeof err) != 0) {
 			log_error("%s", err);
 			cin_close(&d->cin);
 			pub_close(&d->pub);
@@ -1054,9 +1391,11 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	dmn_torque_defaults(d);
 	dmn_position_defaults(d);
 	dmn_tune_rebase(d);
-	log_info("robot %s: %zu joint(s) on %s at %ld bps, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints,
-	         d->port_path, cfg->baud, bus_proto(&d->bus)->name, models,
-	         cfg_mode_name(d->ctl.mode), cfg->lcm_url[0] ? cfg->lcm_url : "default");
+	char ports[CFG_MAX_BUSES * (CFG_PATH_MAX + 64)];
+	dmn_ports_text(d, ports, sizeof ports);
+	log_info("robot %s: %zu joint(s) on %s, Protocol %s (%s), mode %s, LCM %s", cfg->name, cfg->njoints, ports,
+	         bus_proto(&d->buses[0].bus)->name, models, cfg_mode_name(d->ctl.mode),
+	         cfg->lcm_url[0] ? cfg->lcm_url : "default");
 	log_info("commands: %s (local socket %s%s)", cfg_commands_name(cfg->commands), cin_local_path(&d->cin),
 	         cfg->commands == CFG_CMD_NETWORK ? "; signed commands from the LCM group" : "");
 	if (!cfg->mode_given)
@@ -1077,15 +1416,19 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	dmn_loop(d);
 
 	notify_send(&d->notify, "STOPPING=1");
-	cyc_cut(&d->cyc);
-	if (d->connected && !d->clock_lost)
-		setup_safe_stop(&d->bus, &d->ctl, cfg);
+	for (size_t b = 0; b < d->nbuses; b++) {
+		struct dmn_bus *db = &d->buses[b];
+		cyc_cut(&db->cyc);
+		if (db->connected && !d->clock_lost)
+			setup_safe_stop(&db->bus, &d->ctl, cfg, db->index);
+	}
 	char text[96];
 	snprintf(text, sizeof text, "%s",
 	         cfg->safe_stop == CFG_SAFE_LIMP || d->ctl.mode == CFG_MODE_LIMP ? "joints limp (torque off)"
 	                                                                         : "joints holding (torque on)");
 	dmn_event(d, 0, 0, "stop", text);
-	dmn_close_port(d);
+	for (size_t b = 0; b < d->nbuses; b++)
+		dmn_close_port(&d->buses[b]);
 	if (d->lks.resyncs > 0 || d->lks.cmds_dropped > 0)
 		log_warn("lockstep: %lld announced bus byte count(s) set right, %lld clock command(s) dropped",
 		         d->lks.resyncs, d->lks.cmds_dropped);

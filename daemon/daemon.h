@@ -1,6 +1,7 @@
 /*
  * daemon.h — undulated's event loop: one thread, one poll() over the control
- * timer, the bus and its deadline timer, the command sockets and signals.
+ * timer, the bus (every bus, for a robot on several) and the deadline timer,
+ * the command sockets and signals.
  * Owns the port and reconnecting; the cycle's bus work is cycle.h's, the
  * control the controller's (control.h), commands cmdin.h's, publishing
  * publish.h's, start-up and the safe stop setup.h's.

@@ -133,11 +133,15 @@ void pub_params(struct pub *p)
 	PUB_SEND(p, undulate_osc_params_t, p->ch_params, &m);
 }
 
-void pub_bus(struct pub *p, const struct pub_bus *f, const struct bus *bus, const struct ctl *c)
+void pub_bus_joints(struct pub *p, const struct pub_bus *f, const struct pub_bus_lines *lines,
+                    const struct bus *const *bus_of, const struct ctl *c, const char *channel)
 {
+	size_t n = 0;
 	for (size_t j = 0; j < c->n; j++) {
-		const struct bus_servo_stats *s = &bus->servo[c->j[j].id];
-		p->ss[j] = (undulate_servo_stats_t){
+		if (bus_of[j] == NULL)
+			continue;
+		const struct bus_servo_stats *s = &bus_of[j]->servo[c->j[j].id];
+		p->ss[n++] = (undulate_servo_stats_t){
 			.servo_id = c->j[j].id, .transactions = s->transactions, .replies = s->replies,
 			.timeouts = s->timeouts, .checksum_errors = s->checksum_errors, .resyncs = s->resyncs,
 			.wrong_id = s->wrong_id, .wrong_length = s->wrong_length, .error_replies = s->error_replies,
@@ -150,13 +154,23 @@ void pub_bus(struct pub *p, const struct pub_bus *f, const struct bus *bus, cons
 	snprintf(robot, sizeof robot, "%s", p->cfg->name);
 	snprintf(port, sizeof port, "%s", f->port);
 	undulate_bus_stats_t m = {
-		.utime = clock_wall_us(), .robot = robot, .port = port, .baud = (int32_t)p->cfg->baud,
+		.utime = clock_wall_us(), .robot = robot, .port = port, .baud = lines->baud,
 		.connected = f->connected, .reconnects = f->reconnects, .adapter_latency_ms = f->adapter_latency_ms,
 		.return_delay_us = f->return_delay_us, .period_p50_us = f->period_p50_us,
 		.period_p99_us = f->period_p99_us, .period_max_us = f->period_max_us, .jitter_p99_us = f->jitter_p99_us,
 		.bus_p99_us = f->bus_p99_us, .cpu_percent = f->cpu_percent, .overruns = f->overruns,
-		.stray_packets = bus->stray_packets, .io_errors = bus->io_errors, .nservos = (int32_t)c->n,
+		.stray_packets = lines->stray_packets, .io_errors = lines->io_errors, .nservos = (int32_t)n,
 		.servos = p->ss,
 	};
-	PUB_SEND(p, undulate_bus_stats_t, p->ch_bus, &m);
+	PUB_SEND(p, undulate_bus_stats_t, channel, &m);
+}
+
+void pub_bus(struct pub *p, const struct pub_bus *f, const struct bus *bus, const struct ctl *c)
+{
+	const struct bus *bus_of[CFG_MAX_JOINTS];
+	for (size_t j = 0; j < c->n; j++)
+		bus_of[j] = bus;
+	struct pub_bus_lines lines = { .stray_packets = bus->stray_packets, .io_errors = bus->io_errors,
+	                               .baud = (int32_t)p->cfg->baud };
+	pub_bus_joints(p, f, &lines, bus_of, c, p->ch_bus);
 }

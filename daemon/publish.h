@@ -63,5 +63,12 @@ void pub_event(struct pub *p, int64_t seq, int level, const char *kind, const ch
 void pub_state(struct pub *p, const struct ctl *c, const struct pub_cycle *f);
 void pub_params(struct pub *p);
 void pub_bus(struct pub *p, const struct pub_bus *f, const struct bus *bus, const struct ctl *c);
+/* A robot on several buses (config.h, [bus.NAME]): the same message with
+ * each joint's servo counters from its own bus, bus_of[j] (NULL: the joint
+ * is left out), the port and line counters as f says, on `channel` (the
+ * robot's ch_bus for all its buses; "<robot>.BUS.<bus>" for one of them). */
+struct pub_bus_lines { long long stray_packets, io_errors; int32_t baud; };
+void pub_bus_joints(struct pub *p, const struct pub_bus *f, const struct pub_bus_lines *lines,
+                    const struct bus *const *bus_of, const struct ctl *c, const char *channel);
 
 #endif

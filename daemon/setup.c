@@ -11,12 +11,14 @@
 #include "log.h"
 #include "setup_priv.h"
 
-static bool setup_find(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg, const char *port_path,
-                       char *err, size_t cap)
+static bool setup_find(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg, size_t on_bus,
+                       const char *port_path, char *err, size_t cap)
 {
 	char missing[128] = "";
 	size_t nmissing = 0;
 	for (size_t j = 0; j < ctl->n; j++) {
+		if (!ctl_on_bus(ctl, j, on_bus))
+			continue;
 		uint8_t id = ctl->j[j].id, eb = 0;
 		int r = DXL_E_TIMEOUT;
 		for (int t = 0; t < SETUP_TRIES && r != DXL_OK; t++) {
@@ -421,12 +423,19 @@ static bool setup_servo(struct bus *bus, struct ctl *ctl, size_t j, const struct
 
 bool setup_fast_read(const struct bus *bus, const struct ctl *ctl, char *why, size_t cap)
 {
+	return setup_fast_read_on(bus, ctl, CFG_BUS_ROBOT, why, cap);
+}
+
+bool setup_fast_read_on(const struct bus *bus, const struct ctl *ctl, size_t on_bus, char *why, size_t cap)
+{
 	if (!dxl_proto_can(bus_proto(bus), DXL_CAP_FAST_READ)) {
 		snprintf(why, cap, "Protocol %s has none", bus_proto(bus)->name);
 		return false;
 	}
 	size_t at = 0;
 	for (size_t j = 0; j < ctl->n; j++) {
+		if (!ctl_on_bus(ctl, j, on_bus))
+			continue;
 		const struct ctl_servo_info *s = &ctl->j[j].servo;
 		const char *name = s->model != NULL ? s->model->name : "?";
 		if (!dxl2_model_fast_read(s->model != NULL ? s->model->desc : NULL, s->firmware)) {
@@ -434,28 +443,30 @@ bool setup_fast_read(const struct bus *bus, const struct ctl *ctl, char *why, si
 			         "firmware 45)", ctl->j[j].id, name, s->firmware);
 			return false;
 		}
-		int w = snprintf(why + at, at < cap ? cap - at : 0, "%sservo %u %s firmware %u", j ? ", " : "",
+		int w = snprintf(why + at, at < cap ? cap - at : 0, "%sservo %u %s firmware %u", at ? ", " : "",
 		                 ctl->j[j].id, name, s->firmware);
 		at += w > 0 ? (size_t)w : 0;
 	}
-	return ctl->n > 0;
+	return at > 0;
 }
 
-bool setup_servos(struct bus *bus, struct ctl *ctl, const struct cfg *cfg, const char *port_path,
+bool setup_servos(struct bus *bus, struct ctl *ctl, const struct cfg *cfg, size_t on_bus, const char *port_path,
                   int *max_return_delay_us, char *err, size_t cap)
 {
 	*max_return_delay_us = 0;
-	if (!setup_find(bus, ctl, cfg, port_path, err, cap))
+	if (!setup_find(bus, ctl, cfg, on_bus, port_path, err, cap))
 		return false;
 	for (size_t j = 0; j < ctl->n; j++)
-		if (!setup_servo(bus, ctl, j, cfg, port_path, max_return_delay_us, err, cap))
+		if (ctl_on_bus(ctl, j, on_bus) && !setup_servo(bus, ctl, j, cfg, port_path, max_return_delay_us, err, cap))
 			return false;
 	return true;
 }
 
-bool setup_read_present(struct bus *bus, struct ctl *ctl, double dt, char *err, size_t cap)
+bool setup_read_present(struct bus *bus, struct ctl *ctl, size_t on_bus, double dt, char *err, size_t cap)
 {
 	for (size_t j = 0; j < ctl->n; j++) {
+		if (!ctl_on_bus(ctl, j, on_bus))
+			continue;
 		const struct sm_model *m = ctl_model(ctl, j);
 		uint8_t id = ctl->j[j].id, eb = 0, p[32];
 		struct sm_present pr;
@@ -514,24 +525,29 @@ static void setup_stop_drive_joint(struct bus *bus, const struct ctl *ctl, size_
 /* Torque actuation at exit: no servo may be left driving. Every drive
  * stopped at once (one packet), then each servo back in joint mode; the
  * safe state then holds or goes limp. */
-static void setup_stop_drive(struct bus *bus, const struct ctl *ctl, bool limp)
+static void setup_stop_drive(struct bus *bus, const struct ctl *ctl, size_t on_bus, bool limp)
 {
 	uint8_t ids[CFG_MAX_JOINTS], zero[2 * CFG_MAX_JOINTS] = { 0 };
 	const struct sm_model *m = ctl_model(ctl, 0);
+	size_t n = 0;
 	for (size_t j = 0; j < ctl->n; j++)
-		ids[j] = ctl->j[j].id;
-	bus_sync_write(bus, sm_drive_register(m, ctl->cfg->torque_drive == CFG_DRIVE_CURRENT), 2, ids, zero, ctl->n);
+		if (ctl_on_bus(ctl, j, on_bus))
+			ids[n++] = ctl->j[j].id;
+	bus_sync_write(bus, sm_drive_register(m, ctl->cfg->torque_drive == CFG_DRIVE_CURRENT), 2, ids, zero, n);
 	for (size_t j = 0; j < ctl->n; j++)
-		setup_stop_drive_joint(bus, ctl, j, limp);
+		if (ctl_on_bus(ctl, j, on_bus))
+			setup_stop_drive_joint(bus, ctl, j, limp);
 	log_info("safe stop: torque actuation ended, servos back in %s",
 	         sm_has(m, SM_CAP_OPMODE) ? "position control" : "joint mode");
 }
 
 /* A bus watchdog left set would stop the servos by itself once this daemon
  * is gone (and after a trip the goals refuse writes): cleared first. */
-static void setup_stop_watchdogs(struct bus *bus, const struct ctl *ctl)
+static void setup_stop_watchdogs(struct bus *bus, const struct ctl *ctl, size_t on_bus)
 {
 	for (size_t j = 0; j < ctl->n; j++) {
+		if (!ctl_on_bus(ctl, j, on_bus))
+			continue;
 		const struct ctl_joint *jt = &ctl->j[j];
 		const struct sm_model *m = ctl_model(ctl, j);
 		char err[160];
@@ -541,18 +557,20 @@ static void setup_stop_watchdogs(struct bus *bus, const struct ctl *ctl)
 	}
 }
 
-void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg)
+void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg, size_t on_bus)
 {
 	bus_abort(bus);
 	/* a robot that is limp stays limp: writing goals could bring torque back */
 	bool limp = cfg->safe_stop == CFG_SAFE_LIMP || ctl->mode == CFG_MODE_LIMP;
 	const struct sm_model *m0 = ctl_model(ctl, 0);
-	setup_stop_watchdogs(bus, ctl);
+	setup_stop_watchdogs(bus, ctl, on_bus);
 	if (ctl->wheel)
-		setup_stop_drive(bus, ctl, limp);
+		setup_stop_drive(bus, ctl, on_bus, limp);
 	uint8_t ids[CFG_MAX_JOINTS], data[4 * CFG_MAX_JOINTS];
 	size_t n = 0;
 	for (size_t j = 0; j < ctl->n; j++) {
+		if (!ctl_on_bus(ctl, j, on_bus))
+			continue;
 		const struct ctl_joint *jt = &ctl->j[j];
 		const struct sm_model *m = ctl_model(ctl, j);
 		int32_t pos = 0;

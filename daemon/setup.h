@@ -56,14 +56,17 @@ bool setup_protocol(struct bus *bus, const struct cfg *cfg, const char *port_pat
 /* Every start-up check; *max_return_delay_us gets the largest return delay
  * found (for the bus timeouts). False with *err (one line, with the command
  * that fixes it where there is one). */
-bool setup_servos(struct bus *bus, struct ctl *ctl, const struct cfg *cfg, const char *port_path,
+/* on_bus: a robot on several buses (config.h, [bus.NAME]) is set up, read
+ * and stopped a bus at a time; these functions touch the joints of bus
+ * `on_bus` only (ctl_on_bus: every joint when the robot has one bus). */
+bool setup_servos(struct bus *bus, struct ctl *ctl, const struct cfg *cfg, size_t on_bus, const char *port_path,
                   int *max_return_delay_us, char *err, size_t cap);
 /* Reads every joint's present position, speed and load into the controller. */
-bool setup_read_present(struct bus *bus, struct ctl *ctl, double dt, char *err, size_t cap);
+bool setup_read_present(struct bus *bus, struct ctl *ctl, size_t on_bus, double dt, char *err, size_t cap);
 /* Leaves the configured safe state on the bus (LIMP when the robot is limp
  * already: writing goals could bring torque back). Logs what it did and
  * what failed. */
-void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg);
+void setup_safe_stop(struct bus *bus, const struct ctl *ctl, const struct cfg *cfg, size_t on_bus);
 /* One joint limp: torque off, read back (tried SETUP_TRIES times) — a lost
  * write must not leave a robot that says it is limp torqued. False, logged,
  * when it does not read back off. */
@@ -82,5 +85,7 @@ void setup_joint_limits_model(const struct sm_model *m, const struct cfg_joint *
  * cycle's read (cyc_set_fast_read); why says which servos, or which one
  * does not and why, for the log. */
 bool setup_fast_read(const struct bus *bus, const struct ctl *ctl, char *why, size_t cap);
+/* The same for the joints of bus `on_bus` (a robot on several buses). */
+bool setup_fast_read_on(const struct bus *bus, const struct ctl *ctl, size_t on_bus, char *why, size_t cap);
 
 #endif

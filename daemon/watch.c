@@ -97,12 +97,22 @@ static void watch_event_raw(const undulate_event_t *m)
 	       m->seq, m->level, text_line(kind, sizeof kind, m->kind), text_line(text, sizeof text, m->text));
 }
 
+/* The bus of a robot on several (its "<robot>.BUS.<bus>" channel): "" for
+ * the robot's own message. Set per message by watch_on_lcm. */
+static char watch_bus_name[48];
+
 static void watch_bus_raw(const undulate_bus_stats_t *m)
 {
-	char robot[64];
-	printf("BUS %s connected=%d reconnects=%" PRId64 " p50=%.0f p99=%.0f max=%.0f jitter99=%.0f bus99=%.0f "
-	       "cpu=%.2f overruns=%" PRId64 " stray=%" PRId64 " io_errors=%" PRId64, text_line(robot, sizeof robot, m->robot),
-	       m->connected,
+	char robot[64], port[96];
+	/* one bus of several: "BUS robot/bus port=..." (scripts that read the
+	 * robot's "BUS robot " lines do not take it for the robot's) */
+	if (watch_bus_name[0] != '\0')
+		printf("BUS %s/%s port=%s", text_line(robot, sizeof robot, m->robot), watch_bus_name,
+		       text_line(port, sizeof port, m->port));
+	else
+		printf("BUS %s", text_line(robot, sizeof robot, m->robot));
+	printf(" connected=%d reconnects=%" PRId64 " p50=%.0f p99=%.0f max=%.0f jitter99=%.0f bus99=%.0f "
+	       "cpu=%.2f overruns=%" PRId64 " stray=%" PRId64 " io_errors=%" PRId64, m->connected,
 	       m->reconnects, m->period_p50_us, m->period_p99_us, m->period_max_us, m->jitter_p99_us,
 	       m->bus_p99_us, m->cpu_percent, m->overruns, m->stray_packets, m->io_errors);
 	for (int j = 0; j < m->nservos; j++)
@@ -266,10 +276,15 @@ static void watch_event_words(const undulate_event_t *m)
 static void watch_bus_words(const undulate_bus_stats_t *m)
 {
 	char robot[64];
-	printf("%s bus: %s, period median %.2f ms (p99 %.2f, max %.2f), late p99 %.2f ms, bus p99 %.2f ms, cpu %.1f %%",
-	       text_line(robot, sizeof robot, m->robot), m->connected ? "connected" : "DISCONNECTED",
-	       1e-3 * m->period_p50_us, 1e-3 * m->period_p99_us, 1e-3 * m->period_max_us, 1e-3 * m->jitter_p99_us,
-	       1e-3 * m->bus_p99_us, m->cpu_percent);
+	if (watch_bus_name[0] != '\0') {
+		printf("%s bus %s: %s, bus p99 %.2f ms", text_line(robot, sizeof robot, m->robot), watch_bus_name,
+		       m->connected ? "connected" : "DISCONNECTED", 1e-3 * m->bus_p99_us);
+	} else {
+		printf("%s bus: %s, period median %.2f ms (p99 %.2f, max %.2f), late p99 %.2f ms, bus p99 %.2f ms, cpu %.1f %%",
+		       text_line(robot, sizeof robot, m->robot), m->connected ? "connected" : "DISCONNECTED",
+		       1e-3 * m->period_p50_us, 1e-3 * m->period_p99_us, 1e-3 * m->period_max_us, 1e-3 * m->jitter_p99_us,
+		       1e-3 * m->bus_p99_us, m->cpu_percent);
+	}
 	if (m->reconnects > 0)
 		printf(", %" PRId64 " reconnects", m->reconnects);
 	if (m->overruns > 0)
@@ -370,6 +385,13 @@ static void watch_on_lcm(const lcm_recv_buf_t *rb, const char *ch, void *u)
 	while (k < sizeof kinds / sizeof kinds[0] &&
 	       (n < strlen(kinds[k].suffix) || strcmp(ch + n - strlen(kinds[k].suffix), kinds[k].suffix) != 0))
 		k++;
+	/* "<robot>.BUS.<bus>": one bus of a robot on several */
+	const char *busch = strstr(ch, ".BUS.");
+	watch_bus_name[0] = '\0';
+	if (k == sizeof kinds / sizeof kinds[0] && busch != NULL) {
+		k = 2;
+		text_line(watch_bus_name, sizeof watch_bus_name, busch + 5);
+	}
 	if (k == sizeof kinds / sizeof kinds[0])
 		return;
 	union watch_msg m;
@@ -400,13 +422,14 @@ int dmn_watch(const struct watch_opts *o)
 		fprintf(stderr, "undulated --watch: cannot create LCM (url %s)\n", lcm_url ? lcm_url : "default");
 		return 2;
 	}
-	char ch[4][96];
+	char ch[5][96];
 	const char *r = strcmp(robot, "*") == 0 ? "[^.]*" : robot;
 	snprintf(ch[0], sizeof ch[0], "%s\\.STATE", r);
 	snprintf(ch[1], sizeof ch[1], "%s\\.EVENT", r);
 	snprintf(ch[2], sizeof ch[2], "%s\\.BUS", r);
 	snprintf(ch[3], sizeof ch[3], "%s\\.PARAMS", r);
-	for (int i = 0; i < 4; i++)
+	snprintf(ch[4], sizeof ch[4], "%s\\.BUS\\.[^.]*", r);   /* a robot on several buses: each one's */
+	for (int i = 0; i < 5; i++)
 		lcm_subscribe(lcm, ch[i], watch_on_lcm, &w);
 	signal(SIGINT, watch_on_signal);
 	signal(SIGTERM, watch_on_signal);

@@ -72,6 +72,11 @@ bool wq_has_id(const struct wq *q, uint8_t id)
 	return false;
 }
 
+const struct wq_write *wq_peek(const struct wq *q)
+{
+	return q->n == 0 || q->taken ? NULL : &q->w[0];
+}
+
 const struct wq_write *wq_take(struct wq *q)
 {
 	if (q->n == 0 || q->taken)

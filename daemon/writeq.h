@@ -87,6 +87,9 @@ bool wq_has_id(const struct wq *q, uint8_t id);
 /* The next write to send (NULL: none, or one is already taken). From now on
  * it is on the wire: call wq_done() with the outcome. */
 const struct wq_write *wq_take(struct wq *q);
+/* The next write wq_take would give, without taking it (NULL: none, or one
+ * is on the wire): a robot on several buses sends it on its servo's bus. */
+const struct wq_write *wq_peek(const struct wq *q);
 /* The outcome of the taken write; *w (may be NULL) gets a copy of it. A
  * chained write given up (WQ_FAILED) takes the rest of its chain with it. */
 enum wq_outcome wq_done(struct wq *q, bool ok, struct wq_write *w);

@@ -715,6 +715,176 @@ static void test_param_ranges(void **state)
 	assert_false(cfg_mode_parse("run", &m));
 }
 
+/* Several buses: [robot] ids names each joint's bus ("tail:1": servo 1 on
+ * the port of [bus.tail]; no name: the [robot] port), so joint order stays
+ * the robot's and IDs may repeat on different buses. */
+static const char two_buses[] =
+	"[robot]\nname = r2\nport = /dev/ttyUSB0\nids = 1, 2, tail:1, tail:2\nbaud = 57600\n"
+	"[bus.tail]\nport = /dev/ttyUSB1\nbaud = 1000000\n";
+
+static void test_buses(void **state)
+{
+	(void)state;
+	static struct cfg c;
+	load_ok(&c, two_buses);
+	assert_int_equal(c.njoints, 4);
+	assert_int_equal(c.nbuses, 2);
+	assert_int_equal(cfg_buses_used(&c), 2);
+	assert_string_equal(c.bus[0].name, "robot");
+	assert_string_equal(c.bus[0].port, "/dev/ttyUSB0");
+	assert_int_equal(c.bus[0].baud, 57600);
+	assert_int_equal(c.bus[0].njoints, 2);
+	assert_string_equal(c.bus[1].name, "tail");
+	assert_string_equal(c.bus[1].port, "/dev/ttyUSB1");
+	assert_int_equal(c.bus[1].baud, 1000000);
+	assert_int_equal(c.bus[1].njoints, 2);
+	assert_int_equal(c.bus[1].joints[0], 2);
+	assert_int_equal(c.bus[1].joints[1], 3);
+	assert_int_equal(c.ids[2], 1);
+	assert_int_equal(c.joint_bus[0], 0);
+	assert_int_equal(c.joint_bus[1], 0);
+	assert_int_equal(c.joint_bus[2], 1);
+	assert_int_equal(c.joint_bus[3], 1);
+	assert_true(cfg_bus_has_joint(&c, 1, 3));
+	assert_false(cfg_bus_has_joint(&c, 0, 3));
+	/* printed, it reads back the same */
+	char *text = printed(&c);
+	assert_non_null(strstr(text, "ids = 1,2,tail:1,tail:2\n"));
+	assert_non_null(strstr(text, "[bus.tail]\nport = /dev/ttyUSB1\nusb_serial = \nbaud = 1000000\n"));
+	static struct cfg again;
+	load_ok(&again, text);
+	free(text);
+	assert_int_equal(again.nbuses, 2);
+	assert_int_equal(again.joint_bus[3], 1);
+
+	/* the joints in any order, every one on a bus of its own: the [robot]
+	 * port is not needed; a bus's baud is the robot's unless it says */
+	load_ok(&c, "[bus.a]\nport = /dev/pts/1\n[robot]\nids = b:5, a:5\n[bus.b]\nusb_serial = A1\n");
+	assert_int_equal(c.bus[0].njoints, 0);
+	assert_int_equal(cfg_buses_used(&c), 2);
+	assert_int_equal(c.joint_bus[0], 2);
+	assert_int_equal(c.joint_bus[1], 1);
+	assert_int_equal(c.bus[1].baud, 1000000);
+
+	/* one-port configurations are what they were: one bus, every joint on it */
+	load_ok(&c, good);
+	assert_int_equal(c.nbuses, 1);
+	assert_int_equal(cfg_buses_used(&c), 1);
+	assert_int_equal(c.bus[0].njoints, 2);
+	text = printed(&c);
+	assert_null(strstr(text, "[bus."));
+	assert_non_null(strstr(text, "ids = 3,4\n"));
+	free(text);
+
+	/* the command line: --ids with names, --set bus.NAME.key=value */
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.port=/dev/pts/9", &e));
+	assert_true(cfg_override(&c, "robot.ids=1,b:1", &e));
+	assert_true(cfg_override(&c, "bus.b.port=/dev/pts/10", &e));
+	assert_true(cfg_finish(&c, &e));
+	assert_int_equal(c.joint_bus[1], 1);
+	assert_string_equal(c.bus[1].port, "/dev/pts/10");
+}
+
+static void test_bus_errors(void **state)
+{
+	(void)state;
+	char b[CFG_ERR_MAX];
+	/* an ID twice on one bus; on two buses it is fine (above) */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:2,a:2\n[bus.a]\nport=/dev/pts/1\n", b, sizeof b),
+	                    "robot1.conf:3: [robot] ids: servo ID 2 listed twice on bus a (an ID may repeat only on "
+	                    "different buses)");
+	/* the same port twice */
+	assert_string_equal(load_error("[robot]\nport=/dev/pts/1\nids=1,a:2\n[bus.a]\nport=/dev/pts/1\n", b, sizeof b),
+	                    "command line: [bus.a] port: /dev/pts/1 is bus robot's port too: each bus is a port of its own");
+	assert_string_equal(load_error("[robot]\nusb_serial=X9\nids=1,a:2\n[bus.a]\nusb_serial=X9\n", b, sizeof b),
+	                    "command line: [bus.a] usb_serial: X9 is bus robot's adapter too: each bus is a port of its own");
+	/* too many buses */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:1,b:1,c:1,d:1\n", b, sizeof b),
+	                    "robot1.conf:3: [robot] ids: bus d: more than 4 buses: a robot has at most 4 ports (the [robot] "
+	                    "port and 3 [bus.NAME] sections)");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:1,b:1,c:1\n[bus.a]\nport=/dev/pts/1\n"
+	                               "[bus.b]\nport=/dev/pts/2\n[bus.c]\nport=/dev/pts/3\n[bus.d]\nport=/dev/pts/4\n",
+	                               b, sizeof b),
+	                    "robot1.conf:11: [bus.d]: bus d: more than 4 buses: a robot has at most 4 ports (the [robot] "
+	                    "port and 3 [bus.NAME] sections)");
+	/* a bus without joints, a bus without a port */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,2\n[bus.a]\nport=/dev/pts/1\n", b, sizeof b),
+	                    "command line: [bus.a]: no joint is on it: name its servos in [robot] ids (e.g. ids = 1, 2, "
+	                    "a:1, a:2)");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,tail:2\n", b, sizeof b),
+	                    "command line: [bus.tail] port: no port configured (a [bus.tail] section with port = "
+	                    "/dev/ttyUSB1 or usb_serial = ..., or --set bus.tail.port=PATH)");
+	/* the [robot] port with nothing left on it */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=a:1\n[bus.a]\nport=/dev/pts/1\n", b, sizeof b),
+	                    "command line: [robot] port: no joint is left on it (each is on a [bus.NAME]): remove it, or "
+	                    "leave some joints out of the [bus.NAME] sections");
+	/* bad values, names and keys */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:x\n[bus.a]\nport=/dev/pts/1\n", b, sizeof b),
+	                    "robot1.conf:3: [robot] ids: not a list of servo IDs '1,a:x'");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,:2\n", b, sizeof b),
+	                    "robot1.conf:3: [robot] ids: a bus name is 1..47 characters");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,robot:2\n", b, sizeof b),
+	                    "robot1.conf:3: [robot] ids: bus 'robot': a bus is named by letters, digits, '_' or '-', and "
+	                    "not 'robot' (the [robot] section's own port)");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:2\n[bus.a]\nport=/dev/pts/1\nbaud=12\n", b,
+	                               sizeof b),
+	                    "robot1.conf:6: [bus.a] baud: 12 out of range 9600..4500000");
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:2\n[bus.a]\nport=/dev/pts/1\nids=2\n", b,
+	                               sizeof b),
+	                    "robot1.conf:6: [bus.a] ids: unknown key (port, usb_serial, baud; its joints are named in "
+	                    "[robot] ids, e.g. ids = 1, 2, a:1, a:2)");
+	/* lockstep serves one port per daemon: refused, said why */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:2\nlockstep=/tmp/x.sock\n[bus.a]\nport=/dev/pts/1\n",
+	                               b, sizeof b),
+	                    "command line: [robot] lockstep: a robot on several buses cannot run in lockstep (the simulator's "
+	                    "clock serves one port per daemon): run it in real time, or on one bus");
+	/* each bus's channel "<robot>.BUS.<bus>" fits LCM's 63 characters */
+	assert_string_equal(load_error("[robot]\nname=r0123456789012345678901234567890\nport=/dev/null\nids=1,"
+	                               "b0123456789012345678901234567890:2\n[bus.b0123456789012345678901234567890]\n"
+	                               "port=/dev/pts/1\n", b, sizeof b),
+	                    "command line: [bus.b0123456789012345678901234567890]: its channel "
+	                    "r0123456789012345678901234567890.BUS.b0123456789012345678901234567890 is 69 characters, LCM "
+	                    "takes at most 63: give the bus or the robot a shorter name");
+	/* a refused list leaves the buses' joints as they were */
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_override(&c, "robot.ids=1,a:1", &e));
+	assert_false(cfg_override(&c, "robot.ids=a:1,1,a:1", &e));
+	assert_int_equal(c.njoints, 2);
+	assert_int_equal(c.joint_bus[0], 0);
+	assert_int_equal(c.joint_bus[1], 1);
+}
+
+/* dxl doctor --bus NAME: the robot seen as one of its buses, joints with
+ * their [joint.N] in the robot's order. */
+static void test_only_bus(void **state)
+{
+	(void)state;
+	static struct cfg c;
+	load_ok(&c, "[robot]\nport = /dev/ttyUSB0\nids = 1, tail:7, 2, tail:8\n[bus.tail]\nport = /dev/ttyUSB1\n"
+	            "baud = 57600\n[joint.4]\nlimit_max = 0.5\n");
+	char why[256];
+	assert_false(cfg_only_bus(&c, "head", why, sizeof why));
+	assert_string_equal(why, "no bus 'head' with joints; the robot's buses: robot (/dev/ttyUSB0), tail (/dev/ttyUSB1)");
+	assert_true(cfg_only_bus(&c, "tail", why, sizeof why));
+	assert_int_equal(c.njoints, 2);
+	assert_int_equal(c.ids[0], 7);
+	assert_int_equal(c.ids[1], 8);
+	assert_true(c.joint[1].limit_max == 0.5);
+	assert_string_equal(c.port, "/dev/ttyUSB1");
+	assert_int_equal(c.baud, 57600);
+	assert_int_equal(c.nbuses, 1);
+	assert_int_equal(cfg_buses_used(&c), 1);
+	assert_true(cfg_bus_has_joint(&c, 0, 1));
+	load_ok(&c, two_buses);
+	assert_true(cfg_only_bus(&c, "robot", why, sizeof why));
+	assert_int_equal(c.njoints, 2);
+	assert_string_equal(c.port, "/dev/ttyUSB0");
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -737,6 +907,9 @@ int main(void)
 		cmocka_unit_test(test_compliance_slope),
 		cmocka_unit_test(test_param_ranges),
 		cmocka_unit_test(test_rs485),
+		cmocka_unit_test(test_buses),
+		cmocka_unit_test(test_bus_errors),
+		cmocka_unit_test(test_only_bus),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1287,6 +1287,50 @@ static void test_fast_sync_read(void **state)
 	assert_false(setup_fast_read(&bus, &c, why, sizeof why));
 }
 
+/* A robot on two buses ([robot] ids = 1,b:2): the cycle of bus 0 reads,
+ * writes and reads back servo 1 only, sends only servo 1's slot of the
+ * SYNC_WRITE and leaves servo 2's register writes queued for bus b's cycle
+ * (here the fake line carries both servos: whatever reaches servo 2 went to
+ * the wrong bus). */
+static void test_one_bus_of_two(void **state)
+{
+	(void)state;
+	memset(&f, 0, sizeof f);
+	dxl_parser_init(&f.parser, DXL_PARSE_INSTRUCTION);
+	nsv = 2;
+	servo_init(&sv[0], 1);
+	servo_init(&sv[1], 2);
+	on_plant_write = NULL;
+	static const char *const sets[] = { "robot.ids=1,b:2", "bus.b.port=/dev/zero", NULL };
+	setup_common(2, CFG_MODE_HOLD, sets);
+	assert_int_equal(cfg.joint_bus[1], 1);
+	char why[256];
+	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
+	for (size_t j = 0; j < 2; j++) {
+		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
+		ctl_measure(&c, j, 512, 0, 0, 0, 0.01);
+	}
+	setup_start(500, BUS_PROTOCOL_1);
+	cyc_set_bus(&y, 0);
+	assert_int_equal(y.n, 1);
+	run(60);
+	assert_int_equal(cuts, 0);
+	assert_int_equal(y.errors, 0);
+	/* servo 1: torque on, goals every cycle, read every cycle, read back */
+	assert_int_equal(sv[0].mem[DXL_AX_TORQUE_ENABLE], 1);
+	assert_int_equal(sv[0].writes[DXL_AX_GOAL_POSITION], 60);
+	assert_int_equal(c.j[0].stale_cycles, 0);
+	assert_int_equal(y.readbacks, 12);
+	/* servo 2: nothing at all from this bus; its writes wait for its own */
+	for (size_t a = 0; a < DXL_AX_TABLE_SIZE; a++)
+		assert_int_equal(sv[1].writes[a], 0);
+	assert_true(c.j[1].stale_cycles >= 59);
+	assert_int_equal(wq_pending(&c.wq), 2);
+	const struct wq_write *next = ctl_next_write(&c);
+	assert_non_null(next);
+	assert_int_equal(next->id, 2);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1316,6 +1360,7 @@ int main(void)
 		cmocka_unit_test(test_drive_only_where_ready),
 		cmocka_unit_test(test_writes_are_the_models_x),
 		cmocka_unit_test(test_fast_sync_read),
+		cmocka_unit_test(test_one_bus_of_two),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -117,7 +117,7 @@ static const struct dxlt_opt dxlt_opts[] = {
 	{ "--latency-us", OPT_VALUE }, { "--timeout-ms", OPT_VALUE }, { "--units", OPT_FLAG },
 	{ "--yes", OPT_FLAG },         { "--ids", OPT_VALUE },     { "--bauds", OPT_VALUE },
 	{ "--status-level", OPT_VALUE }, { "--help", OPT_FLAG },   { "-h", OPT_FLAG },
-	{ "--rs485", OPT_VALUE },      { "--config", OPT_VALUE },  { "--cycles", OPT_VALUE },
+	{ "--rs485", OPT_VALUE },      { "--config", OPT_VALUE },  { "--bus", OPT_VALUE },  { "--cycles", OPT_VALUE },
 	{ "--protocol", OPT_VALUE },   { "--size", OPT_VALUE },    { "--keep", OPT_VALUE },
 	{ "--fast", OPT_FLAG },
 };
@@ -200,6 +200,8 @@ static int dxlt_apply_opt(struct dxlt_args *a, const char *name, const char *val
 		a->rs485_given = true;
 	} else if (strcmp(name, "--config") == 0) {
 		a->config_path = val;
+	} else if (strcmp(name, "--bus") == 0) {
+		a->bus_name = val;
 	} else if (strcmp(name, "--cycles") == 0) {
 		rc = dxlt_opt_long(err, name, val, 0, DXLT_DOCTOR_MAX_CYCLES, &a->cycles);
 	} else if (strcmp(name, "--status-level") == 0) {
@@ -304,11 +306,12 @@ void dxlt_help(FILE *f)
 	      "  reboot ID                  restart a servo (2.0 only): clears its hardware error\n"
 	      "  setup ID... [--status-level N] [--yes]   prepare servos and adapter for a 100 Hz\n"
 	      "                             loop (--yes: turn torque off first; the joint goes limp)\n"
-	      "  doctor [ID...] [--config FILE] [--cycles N]   the first-run hardware check: adapter,\n"
+	      "  doctor [ID...] [--config FILE [--bus NAME]] [--cycles N]   the first-run hardware check: adapter,\n"
 	      "                             latency, baud, every servo's settings against the\n"
 	      "                             configuration, then N (300) of undulated's own cycles timed,\n"
 	      "                             holding each joint where it stands; one line per check\n"
-	      "                             (OK/WARN/FAIL) with its fix\n"
+	      "                             (OK/WARN/FAIL) with its fix; a robot on several buses\n"
+	      "                             is checked a bus at a time (--bus NAME)\n"
 	      "\noptions:\n"
 	      "  --port PATH        serial device or pty (e.g. /dev/ttyUSB0, /dev/serial/by-id/...)\n"
 	      "  --protocol 1|2     Dynamixel Protocol 1.0 (default; AX-12) or 2.0 (X series); registers\n"

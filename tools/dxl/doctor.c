@@ -121,6 +121,28 @@ static int dr_cli_ids(const struct dxlt_args *a, char *buf, size_t cap)
 	return off > 0;
 }
 
+/* A robot on several buses ([bus.NAME]) is checked a bus at a time: --bus
+ * NAME picks one, and the doctor sees the robot as that bus alone. */
+static int dr_one_bus(struct dr *d)
+{
+	struct dxlt *t = d->t;
+	struct cfg *c = &d->cfg;
+	char why[CFG_MAX_BUSES * (CFG_PATH_MAX + CFG_NAME_MAX + 8) + 64];
+	if (t->a.bus_name == NULL && cfg_buses_used(c) <= 1)
+		return DXLT_EXIT_OK;
+	if (t->a.bus_name == NULL) {
+		cfg_only_bus(c, "", why, sizeof why);
+		fprintf(t->err, "dxl: the robot's joints are on %zu buses: doctor checks one at a time, with --bus NAME "
+		        "(%s)\n", cfg_buses_used(c), strstr(why, "buses: ") ? strstr(why, "buses: ") + 7 : why);
+		return DXLT_EXIT_USAGE;
+	}
+	if (!cfg_only_bus(c, t->a.bus_name, why, sizeof why)) {
+		fprintf(t->err, "dxl: --bus: %s\n", why);
+		return DXLT_EXIT_USAGE;
+	}
+	return DXLT_EXIT_OK;
+}
+
 static int dr_configure(struct dr *d)
 {
 	struct dxlt *t = d->t;
@@ -158,6 +180,8 @@ static int dr_configure(struct dr *d)
 	}
 	if (!cfg_finish(c, &e))
 		return dr_cfg_errors(d, &e);
+	if (dr_one_bus(d) != DXLT_EXIT_OK)
+		return DXLT_EXIT_USAGE;
 	if (c->port[0] == '\0') {
 		int n = 0;
 		if (!port_find_by_serial(c->usb_serial, c->port, sizeof c->port, &n)) {
@@ -734,7 +758,7 @@ static const char *dr_budget_prepare(struct dr *d, struct dr_run *r, long n, str
 	if ((b->joints = dr_pick_joints(d, r)) == 0)
 		return "no servo passed what the loop needs (a PING, READ, angle limits with room)";
 	/* the controller starts from where the joints are, as after start-up */
-	if (!setup_read_present(&d->t->bus, &r->ctl, 1e-3 * d->cfg.period_ms, err, sizeof err)) {
+	if (!setup_read_present(&d->t->bus, &r->ctl, CFG_BUS_ROBOT, 1e-3 * d->cfg.period_ms, err, sizeof err)) {
 		snprintf(why, cap, "reading the present positions failed: %s", err);
 		return why;
 	}

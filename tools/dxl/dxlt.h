@@ -78,6 +78,7 @@ struct dxlt_args {
 	uint8_t id_lo, id_hi;    /* --ids A-B */
 	bool ids_given;
 	const char *config_path; /* --config FILE: undulated's configuration (doctor) */
+	const char *bus_name;    /* --bus NAME: the configuration's bus to check (doctor; several buses) */
 	long cycles;             /* --cycles N (doctor); -1: DXLT_DOCTOR_CYCLES */
 	long bauds[DXLT_MAX_BAUDS];
 	size_t nbauds;           /* --bauds LIST; 0: just --baud */
