@@ -103,7 +103,7 @@ static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char 
 		struct sim_joint_place place = {
 			.id = rc->ids[k], .baud_reg = baud_reg, .delay_us = delay_us,
 			.eeprom_needs_torque_off = c->eeprom_needs_torque_off, .overload_time_s = c->overload_time_s,
-			.firmware = rc->firmware > 0 ? rc->firmware : c->firmware,
+			.firmware = rc->firmware > 0 ? rc->firmware : c->firmware, .no_indirect = c->no_indirect,
 		};
 		sim_joint_place(j, robot_model(rc, k), &place);
 		sim_config_motor_params(c, j->model, &j->params);

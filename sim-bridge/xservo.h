@@ -21,7 +21,12 @@
  *    stays, with the alert bit in every status packet, until REBOOT;
  *  - the bus watchdog (98): with torque on, no instruction for the set time
  *    stops the servo, the register reads -1 (0xFF) and the goal registers
- *    refuse writes (data range error) until 0 is written.
+ *    refuse writes (data range error) until 0 is written;
+ *  - the indirect areas (168-251, 578-661): Indirect Data n reads and writes
+ *    the byte Indirect Address n holds (64..661, else data range), under
+ *    that byte's own rules (access, part of a register, range, limit);
+ *    the Indirect Address registers are written only with torque off and
+ *    kept over a REBOOT, as EEPROM.
  */
 #ifndef UNDULATE_SIM_XSERVO_H
 #define UNDULATE_SIM_XSERVO_H
@@ -52,6 +57,10 @@ struct sim_xservo_options {
 	 * Sync/Bulk Read from the model's first (X430: 45). 0: the model's
 	 * (dxl2_model.firmware, 46). */
 	int firmware;
+	/* No indirect areas: 168-661 answer the access error, as an X firmware
+	 * (or clone) without them would, and as this simulator did before it
+	 * had them (the [sim] key indirect = false). */
+	bool no_indirect;
 };
 
 struct sim_xservo_counters {

@@ -30,7 +30,7 @@
 #include "dxl2_table.h"
 
 #define XFAKE_MAX_SERVOS 8
-#define XFAKE_TABLE 160
+#define XFAKE_TABLE DXL2_X_TABLE_SIZE
 #define XFAKE_RX_MAX 2048
 #define XFAKE_FIRMWARE 46
 
