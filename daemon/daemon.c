@@ -445,6 +445,31 @@ static void dmn_fast_read(struct dmn *d)
 		log_info("bus: the cycle reads by SYNC_READ, a status packet per servo: no Fast Sync Read, as %s", why);
 }
 
+/* The cycle's read through the indirect block where every servo has it and
+ * reads its map back (indirect = on, the default); else, said why, the
+ * present registers where they lie. Either way the log says which. */
+static void dmn_indirect(struct dmn *d)
+{
+	char why[256];
+	const struct sm_model *m = ctl_model(&d->ctl, 0);
+	struct sm_read direct = sm_direct_read(m);
+	bool on = false;
+	if (!d->cfg->indirect)
+		snprintf(why, sizeof why, "indirect = off");
+	else if (m->indirect.len == 0)
+		snprintf(why, sizeof why, "the %s has no indirect area", m->name);
+	else
+		on = setup_indirect(&d->bus, &d->ctl, why, sizeof why);
+	cyc_set_indirect(&d->cyc, on);
+	if (on)
+		log_info("bus: the cycle reads the indirect block at %u, %u or %u bytes a servo where the present "
+		         "registers at %u take %u or %u (%s)", m->indirect.addr, m->indirect.len, m->indirect.len_slow,
+		         direct.addr, direct.len, direct.len_slow, why);
+	else if (m->protocol == 2)
+		log_info("bus: the cycle reads the present registers at %u, %u or %u bytes a servo: no indirect block, "
+		         "as %s", direct.addr, direct.len, direct.len_slow, why);
+}
+
 static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap)
 {
 	if (!dmn_find_port(d, err, cap))
@@ -498,6 +523,7 @@ static bool dmn_connect(struct dmn *d, const char *reason, char *err, size_t cap
 	}
 	d->connected = true;
 	d->backoff_ms = DMN_BACKOFF_MIN_MS;
+	dmn_indirect(d);
 	dmn_fast_read(d);
 	ctl_start(&d->ctl, dmn_ctl_time(d, now_us()), reason);
 	return true;
