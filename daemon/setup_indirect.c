@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "dxl.h"
+#include "dxl2.h"
 #include "dxl2_table.h"
 #include "servo_model.h"
 
@@ -34,6 +35,24 @@ static int ind_first_difference(const uint8_t *got, const uint8_t *want, size_t 
 	return 0;
 }
 
+/* READ of the map. */
+static int ind_read(struct bus *bus, uint8_t id, size_t n, uint8_t *got, uint8_t *eb)
+{
+	return setup_read(bus, id, DXL2_X_INDIRECT_ADDRESS_1, (uint16_t)n, got, eb);
+}
+
+/* What a failed transaction was: the servo's error number, else ours. A
+ * READ refused comes back as a status without its data, which the bus
+ * takes for the wrong length: said as what it most likely is. */
+static const char *ind_failure(int r, uint8_t eb)
+{
+	if (eb & DXL2_ERR_NUMBER_MASK)
+		return dxl2_error_name(eb & DXL2_ERR_NUMBER_MASK);
+	if (r == DXL_E_WRONG_LENGTH)
+		return "answered without the data: refused, no indirect area?";
+	return dxl_strerror(r);
+}
+
 /* One servo: read the map; if another is there, torque off (the registers
  * are written with torque off: ROBOTIS's SDK example says they are not
  * accessible with torque on), write it, read it back. */
@@ -43,10 +62,10 @@ static bool ind_servo(struct bus *bus, const struct ctl_joint *jt, const struct 
 	uint8_t want[2 * SM_READ_MAX], got[2 * SM_READ_MAX], eb = 0, off = 0;
 	size_t n = ind_map_bytes(rd, want);
 	bool reply = jt->servo.status_return_level >= 2;
-	int r = setup_read(bus, jt->id, DXL2_X_INDIRECT_ADDRESS_1, (uint16_t)n, got, &eb);
+	int r = ind_read(bus, jt->id, n, got, &eb);
 	if (r != DXL_OK || eb != 0) {
-		snprintf(why, cap, "servo %u (%s): reading Indirect Address 1..%u failed (%s, ERR 0x%02X)", jt->id,
-		         m->name, rd->len_slow, dxl_strerror(r), eb);
+		snprintf(why, cap, "servo %u (%s): reading Indirect Address 1..%u failed (%s)", jt->id, m->name,
+		         rd->len_slow, ind_failure(r, eb));
 		return false;
 	}
 	*wrote = ind_first_difference(got, want, n) != 0;
@@ -55,11 +74,11 @@ static bool ind_servo(struct bus *bus, const struct ctl_joint *jt, const struct 
 		if (r == DXL_OK && (!reply || eb == 0))
 			r = setup_write(bus, jt->id, DXL2_X_INDIRECT_ADDRESS_1, want, n, reply, &eb);
 		if (r != DXL_OK || (reply && eb != 0)) {
-			snprintf(why, cap, "servo %u (%s): writing Indirect Address 1..%u failed (%s, ERR 0x%02X)", jt->id,
-			         m->name, rd->len_slow, dxl_strerror(r), eb);
+			snprintf(why, cap, "servo %u (%s): writing Indirect Address 1..%u failed (%s)", jt->id, m->name,
+			         rd->len_slow, ind_failure(r, eb));
 			return false;
 		}
-		r = setup_read(bus, jt->id, DXL2_X_INDIRECT_ADDRESS_1, (uint16_t)n, got, &eb);
+		r = ind_read(bus, jt->id, n, got, &eb);
 	}
 	int slot = r == DXL_OK && eb == 0 ? ind_first_difference(got, want, n) : 1;
 	if (r != DXL_OK || eb != 0 || slot != 0) {
@@ -67,8 +86,8 @@ static bool ind_servo(struct bus *bus, const struct ctl_joint *jt, const struct 
 			snprintf(why, cap, "servo %u (%s): Indirect Address %d reads %u where %u was written", jt->id,
 			         m->name, slot, (unsigned)(got[2 * slot - 2] | got[2 * slot - 1] << 8), rd->src[slot - 1]);
 		else
-			snprintf(why, cap, "servo %u (%s): reading Indirect Address 1..%u back failed (%s, ERR 0x%02X)",
-			         jt->id, m->name, rd->len_slow, dxl_strerror(r), eb);
+			snprintf(why, cap, "servo %u (%s): reading Indirect Address 1..%u back failed (%s)", jt->id,
+			         m->name, rd->len_slow, ind_failure(r, eb));
 		return false;
 	}
 	return true;
