@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# run.sh: realtime — it measures a gait and bytes in real time (tests/run.sh)
 # undulated's cycle read through the X series' indirect block, against
 # undulate-sim (XM430-W350s, firmware 46: Fast Sync Read):
 #  - start-up maps Indirect Address 1..13 to the present registers the
@@ -9,7 +10,10 @@
 #  - a second start finds the map in place and writes nothing;
 #  - bytes on the wire (the simulator's counters) with the indirect block and
 #    with indirect = off, on servos of firmware 44 (plain SYNC_READ: a status
-#    packet a servo): fewer bytes a status packet through the indirect block;
+#    packet a servo): fewer bytes a status packet through the indirect block
+#    (printed; in real time the mix of read-backs and writes moves with the
+#    machine's load, so only the direction is asserted here: the exact 8
+#    bytes a servo every slow cycle is test_daemon_cycle's, on its fake bus);
 #  - a simulator whose servos have no indirect area ([sim] indirect = false):
 #    the map's read is refused, said, the cycle reads the registers where
 #    they lie, the robot runs;
@@ -55,12 +59,12 @@ model = xm430-w350
 firmware = 44
 contact = none
 EOF
-spawn sim "$S" --scenario "$T/x.scenario" --lcm-url "$URL" --control "$T/ctl"
+spawn_rt sim "$S" --scenario "$T/x.scenario" --lcm-url "$URL" --control "$T/ctl"
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
 
 # ---- mapped, read back, read ------------------------------------------------------------------------
-spawn d "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
+spawn_rt d "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
 wait_log d "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts on the X bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
 if grep -q "bus: the cycle reads the indirect block at 224, 10 or 13 bytes a servo where the present registers at 126 take 10 or 21 (Indirect Address 1..13 on every servo read back as mapped (2 written, 0 kept))" "$T/d.log" &&
@@ -84,7 +88,7 @@ else tap_fail "voltage through the block" "v0=$v; $(last_state | cut -c1-300)"; 
 
 # ---- a second start keeps the map; a REBOOT ends the indirect read ---------------------------------------
 stop d >/dev/null
-spawn d3 "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
+spawn_rt d3 "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
 wait_log d3 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon restarts" "$(cat "$T/d3.log")"; tap_done; exit 1; }
 if grep -q "read back as mapped (0 written, 2 kept)" "$T/d3.log"; then
@@ -105,14 +109,14 @@ stop d3 >/dev/null
 
 # ---- what it saves on the wire ------------------------------------------------------------------------
 # firmware 44: SYNC_READ, one status packet a servo; each daemon alone on the simulator
-spawn d4 "$D" --port "$T/xs" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
+spawn_rt d4 "$D" --port "$T/xs" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
 wait_log d4 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts on firmware 44" "$(cat "$T/d4.log")"; tap_done; exit 1; }
 cmd 'mode oscillator' >/dev/null
 wait_cycles 100
 ind=$(per_reply 400)
 stop d4 >/dev/null
-spawn d5 "$D" --port "$T/xs" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold --set robot.indirect=off
+spawn_rt d5 "$D" --port "$T/xs" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold --set robot.indirect=off
 wait_log d5 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon restarts with indirect = off" "$(cat "$T/d5.log")"; tap_done; exit 1; }
 cmd 'mode oscillator' >/dev/null
@@ -122,7 +126,7 @@ stop d5 >/dev/null
 echo "# servo bytes a status packet (SYNC_READ, read-backs and acknowledgements included): indirect block $ind, direct $dir"
 if grep -q "bus: the cycle reads the indirect block at 224" "$T/d4.log" && grep -q "bus: the cycle reads by SYNC_READ" "$T/d4.log" &&
 	grep -q "bus: the cycle reads the present registers at 126, 10 or 21 bytes a servo: no indirect block, as indirect = off" "$T/d5.log" &&
-	awk -v a="$ind" -v b="$dir" 'BEGIN { exit !(a > 0 && a + 2 < b) }'; then
+	awk -v a="$ind" -v b="$dir" 'BEGIN { exit !(a > 0 && a < b) }'; then
 	tap_ok "the indirect block saves servo bytes: $ind a status packet where the direct read takes $dir (indirect = off, said)"
 else tap_fail "indirect = off and the saving" "indirect $ind, direct $dir; $(grep -a 'bus:' "$T/d4.log" "$T/d5.log" | head -4)"; fi
 stop sim >/dev/null
@@ -140,9 +144,9 @@ ids = 1,2
 model = xl430-w250
 contact = none
 EOF
-spawn sim2 "$S" --scenario "$T/n.scenario" --lcm-url "$URL" --control "$T/ctl2"
+spawn_rt sim2 "$S" --scenario "$T/n.scenario" --lcm-url "$URL" --control "$T/ctl2"
 wait_log sim2 'ready' 10 || { tap_fail "simulator without indirect areas ready" "$(cat "$T/sim2.log")"; tap_done; exit 1; }
-spawn d6 "$D" --port "$T/xn" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
+spawn_rt d6 "$D" --port "$T/xn" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
 wait_log d6 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
 	{ tap_fail "daemon starts on servos without indirect areas" "$(cat "$T/d6.log")"; tap_done; exit 1; }
 if grep -q "bus: the cycle reads the present registers at 126, 10 or 21 bytes a servo: no indirect block, as servo 1 (XL430-W250): reading Indirect Address 1..13 failed" "$T/d6.log"; then
