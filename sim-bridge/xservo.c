@@ -311,6 +311,11 @@ static uint16_t xservo_target(const struct sim_xservo *s, uint16_t addr)
 	return to >= DXL2_X_INDIRECT_MIN && to <= DXL2_X_INDIRECT_MAX ? to : addr;
 }
 
+uint8_t sim_xservo_byte(const struct sim_xservo *s, uint16_t addr)
+{
+	return addr < DXL2_X_TABLE_SIZE ? s->mem[xservo_target(s, addr)] : 0;
+}
+
 /* A write as the bytes it reaches: the new table image and which bytes of
  * it were written (through the indirect slots, each at its target). */
 struct xservo_wr {
@@ -479,7 +484,7 @@ static int xservo_read_reply(struct sim_xservo *s, uint8_t id, uint16_t addr, ui
 		return xservo_reply(s, id, err, NULL, 0, out, cap);
 	uint8_t data[DXL2_X_TABLE_SIZE];
 	for (size_t i = 0; i < len; i++)
-		data[i] = s->mem[xservo_target(s, (uint16_t)(addr + i))];
+		data[i] = sim_xservo_byte(s, (uint16_t)(addr + i));
 	return xservo_reply(s, id, 0, data, len, out, cap);
 }
 

@@ -103,6 +103,9 @@ uint8_t sim_xservo_id(const struct sim_xservo *s);
 /* A register's value by its address (sign-extended); DXL_E_ARG and 0 when no
  * register starts there. */
 int sim_xservo_peek(const struct sim_xservo *s, uint16_t addr, int32_t *value);
+/* The byte a READ answers at addr (< DXL2_X_TABLE_SIZE): through an
+ * indirect slot, the byte its Indirect Address holds. */
+uint8_t sim_xservo_byte(const struct sim_xservo *s, uint16_t addr);
 /* Set a register without the write rules (set-up, the poke command). Hardware
  * Error Status (70) poked non-zero is a hardware error the servo detected
  * (shutdown if in the mask). DXL_E_ARG for no register at addr. */
