@@ -36,6 +36,8 @@ static const uint16_t sm_x_indirect_src[] = {
 	126, 127, 128, 129, 130, 131, 132, 133, 134, 135, 144, 145, 146,
 };
 #define SM_X_INDIRECT_SLOW (sizeof sm_x_indirect_src / sizeof sm_x_indirect_src[0])
+_Static_assert(SM_X_INDIRECT_SLOW <= SM_READ_MAX && SM_X_INDIRECT_SLOW <= DXL2_X_INDIRECT_PER_BLOCK,
+               "the indirect block fits one block of slots and setup_indirect's buffers");
 #define SM_X_RAM_ADDR DXL2_X_TORQUE_ENABLE
 #define SM_X_RAM_LEN (DXL2_X_PROFILE_VELOCITY + 4 - DXL2_X_TORQUE_ENABLE)
 #define SM_X_EEPROM_ADDR DXL2_X_OPERATING_MODE

@@ -35,10 +35,17 @@ static int ind_first_difference(const uint8_t *got, const uint8_t *want, size_t 
 	return 0;
 }
 
-/* READ of the map. */
-static int ind_read(struct bus *bus, uint8_t id, size_t n, uint8_t *got, uint8_t *eb)
+/* The Indirect Address register of the block's first slot (168 for the
+ * block at 224). */
+static uint16_t ind_map_addr(const struct sm_read *rd)
 {
-	return setup_read(bus, id, DXL2_X_INDIRECT_ADDRESS_1, (uint16_t)n, got, eb);
+	return dxl2_indirect_address_reg(dxl2_indirect_slot(rd->addr));
+}
+
+/* READ of the map. */
+static int ind_read(struct bus *bus, uint8_t id, const struct sm_read *rd, size_t n, uint8_t *got, uint8_t *eb)
+{
+	return setup_read(bus, id, ind_map_addr(rd), (uint16_t)n, got, eb);
 }
 
 /* What a failed transaction was: the servo's error number, else ours. A
@@ -62,7 +69,7 @@ static bool ind_servo(struct bus *bus, const struct ctl_joint *jt, const struct 
 	uint8_t want[2 * SM_READ_MAX], got[2 * SM_READ_MAX], eb = 0, off = 0;
 	size_t n = ind_map_bytes(rd, want);
 	bool reply = jt->servo.status_return_level >= 2;
-	int r = ind_read(bus, jt->id, n, got, &eb);
+	int r = ind_read(bus, jt->id, rd, n, got, &eb);
 	if (r != DXL_OK || eb != 0) {
 		snprintf(why, cap, "servo %u (%s): reading Indirect Address 1..%u failed (%s)", jt->id, m->name,
 		         rd->len_slow, ind_failure(r, eb));
@@ -72,13 +79,13 @@ static bool ind_servo(struct bus *bus, const struct ctl_joint *jt, const struct 
 	if (*wrote) {
 		r = setup_write(bus, jt->id, m->torque_enable, &off, 1, reply, &eb);
 		if (r == DXL_OK && (!reply || eb == 0))
-			r = setup_write(bus, jt->id, DXL2_X_INDIRECT_ADDRESS_1, want, n, reply, &eb);
+			r = setup_write(bus, jt->id, ind_map_addr(rd), want, n, reply, &eb);
 		if (r != DXL_OK || (reply && eb != 0)) {
 			snprintf(why, cap, "servo %u (%s): writing Indirect Address 1..%u failed (%s)", jt->id, m->name,
 			         rd->len_slow, ind_failure(r, eb));
 			return false;
 		}
-		r = ind_read(bus, jt->id, n, got, &eb);
+		r = ind_read(bus, jt->id, rd, n, got, &eb);
 	}
 	int slot = r == DXL_OK && eb == 0 ? ind_first_difference(got, want, n) : 1;
 	if (r != DXL_OK || eb != 0 || slot != 0) {
@@ -101,6 +108,10 @@ bool setup_indirect(struct bus *bus, const struct ctl *ctl, char *why, size_t ca
 		return false;
 	}
 	const struct sm_read *rd = &ctl_model(ctl, 0)->indirect;
+	if (rd->len_slow > SM_READ_MAX || ind_map_addr(rd) == 0) {
+		snprintf(why, cap, "the %s's indirect block is not one this daemon can map", ctl_model(ctl, 0)->name);
+		return false;
+	}
 	for (size_t j = 0; j < ctl->n; j++) {
 		const struct sm_model *m = ctl_model(ctl, j);
 		/* one SYNC_READ asks every servo for one address and length */
