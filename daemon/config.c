@@ -403,6 +403,7 @@ void cfg_defaults(struct cfg *c)
 	 * overload, a supply dip) recovers without the operator; a second
 	 * shutdown means the cause is still there, and the fault latches. */
 	c->fault_reboots = 1;
+	c->indirect = true;   /* 8 bytes a servo less every other cycle (daemon/CONTROL.md) */
 	c->adapter_latency_us = -1;
 	c->period_ms = 10.0;
 	c->ramp_s = 1.5;
@@ -482,6 +483,7 @@ static const struct cfg_key cfg_robot_keys[] = {
 	K("silent_s", T_DOUBLE, silent_s, 0.05, 60),
 	K("bus_watchdog_ms", T_LONG, bus_watchdog_ms, -1, 2540),
 	K("fault_reboots", T_LONG, fault_reboots, 0, 100),
+	K("indirect", T_BOOL, indirect, 0, 0),
 };
 #undef K
 #define CFG_NROBOT_KEYS (sizeof cfg_robot_keys / sizeof cfg_robot_keys[0])
@@ -1272,8 +1274,8 @@ void cfg_print(const struct cfg *c, void *file)
 	for (size_t j = 0; j < c->njoints; j++)
 		fprintf(f, "%s%s%s%u", j ? "," : "", c->joint_bus[j] != CFG_BUS_ROBOT ? c->bus[c->joint_bus[j]].name : "",
 		        c->joint_bus[j] != CFG_BUS_ROBOT ? ":" : "", c->ids[j]);
-	fprintf(f, "\nprotocol = %s\nbus_watchdog_ms = %ld\nfault_reboots = %d\n", cfg_protocol_name(c->protocol),
-	        c->bus_watchdog_ms, c->fault_reboots);
+	fprintf(f, "\nprotocol = %s\nbus_watchdog_ms = %ld\nfault_reboots = %d\nindirect = %s\n",
+	        cfg_protocol_name(c->protocol), c->bus_watchdog_ms, c->fault_reboots, c->indirect ? "on" : "off");
 	if (c->stall_torque_given)
 		fprintf(f, "stall_torque = %g\n", c->stall_torque);
 	if (c->no_load_speed_given)

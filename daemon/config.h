@@ -121,6 +121,10 @@ struct cfg {
 	bool stall_torque_given, no_load_speed_given;   /* else the servo model's datasheet line */
 	long bus_watchdog_ms;          /* X series: Bus Watchdog (98), 0 = off, in 20 ms steps; -1 = the servo's own */
 	int fault_reboots;             /* X series: REBOOTs of one servo after a shutdown, per 'clear' */
+	/* X series: the cycle reads the present values through the indirect
+	 * block start-up maps (setup_indirect: 13 bytes on slow cycles where
+	 * the direct block is 21); off: the registers where they lie */
+	bool indirect;
 	long bus_margin_us;            /* slack added to every bus timeout */
 	char lockstep[CFG_PATH_MAX];   /* the simulator's lockstep socket: virtual time ("": real time) */
 	double ramp_s;                 /* blend time for start-up and mode switches */

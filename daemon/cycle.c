@@ -74,6 +74,17 @@ void cyc_set_fast_read(struct cyc *y, bool on)
 	y->fast_fails = 0;
 }
 
+void cyc_set_indirect(struct cyc *y, bool on)
+{
+	y->indirect = on;
+}
+
+struct sm_read cyc_read_of(const struct cyc *y)
+{
+	const struct sm_model *m = ctl_model(y->ctl, cyc_joint(y, 0));
+	return y->indirect && m->indirect.len > 0 ? m->indirect : sm_direct_read(m);
+}
+
 bool cyc_busy(const struct cyc *y)
 {
 	return y->phase != CYC_IDLE;
@@ -144,6 +155,24 @@ static int cyc_begin_read(struct cyc *y, uint8_t id, uint16_t addr, uint16_t len
 	return bus_read_begin(y->bus, id, addr, len);
 }
 
+/* A REBOOT ends the indirect read: the servo may boot with the factory map
+ * (the e-manual lists the Indirect Address registers in the RAM area), and
+ * its indirect block would then read its own bytes, not the present values. */
+static void cyc_reboot_ends_indirect(struct cyc *y, uint8_t id)
+{
+	if (!y->indirect)
+		return;
+	y->indirect = false;
+	y->indirect_fallbacks++;
+	if (y->hooks.notice != NULL) {
+		char text[200];
+		snprintf(text, sizeof text, "bus: servo %u is rebooted and may come back without its indirect map: the "
+		         "cycle reads the present registers where they lie from now on (until the next start or reconnect)",
+		         id);
+		y->hooks.notice(y->hooks.ctx, text);
+	}
+}
+
 /* A queued write; one of no bytes is a REBOOT (the X series' recovery). */
 static int cyc_begin_write(struct cyc *y, const struct wq_write *w)
 {
@@ -153,8 +182,10 @@ static int cyc_begin_write(struct cyc *y, const struct wq_write *w)
 	for (size_t i = 0; i < cyc_count(y); i++)
 		if (y->ctl->j[cyc_joint(y, i)].id == w->id && y->ctl->j[cyc_joint(y, i)].servo.status_return_level >= 2)
 			reply = true;
-	if (w->len == 0)
+	if (w->len == 0) {
+		cyc_reboot_ends_indirect(y, w->id);
 		return bus_reboot_begin(y->bus, w->id, reply);
+	}
 	return bus_write_begin(y->bus, w->id, w->addr, data, w->len, reply);
 }
 
@@ -167,10 +198,10 @@ static int cyc_begin_sync_read(struct cyc *y)
 		ids[i] = y->ctl->j[cyc_joint(y, i)].id;
 	y->multi.data = y->multi_buf;
 	y->multi.cap = sizeof y->multi_buf;
-	const struct sm_model *m = ctl_model(y->ctl, cyc_joint(y, 0));
+	uint16_t addr = cyc_read_of(y).addr;
 	if (y->fast_read)
-		return bus_fast_sync_read_begin(y->bus, m->present, y->read_len, ids, n, &y->multi);
-	return bus_sync_read_begin(y->bus, m->present, y->read_len, ids, n, &y->multi);
+		return bus_fast_sync_read_begin(y->bus, addr, y->read_len, ids, n, &y->multi);
+	return bus_sync_read_begin(y->bus, addr, y->read_len, ids, n, &y->multi);
 }
 
 /* A Fast Sync Read that read nobody, CYC_FAST_FAILS_MAX times in a row: a
@@ -305,8 +336,8 @@ enum cyc_status cyc_start(struct cyc *y)
 	y->start_us = cyc_now(y);
 	y->control_us = 0.0;
 	y->bus_us = 0.0;
-	const struct sm_model *m = ctl_model(y->ctl, cyc_joint(y, 0));
-	y->read_len = (y->count & 1) ? m->present_len_slow : m->present_len;
+	struct sm_read rd = cyc_read_of(y);
+	y->read_len = (y->count & 1) ? rd.len_slow : rd.len;
 	if (y->starved >= CYC_STARVED_CYCLES && wq_pending(&y->ctl->wq) > 0) {
 		y->phase = CYC_WRITE_FIRST;
 		y->writes_first++;
@@ -319,11 +350,12 @@ enum cyc_status cyc_start(struct cyc *y)
 static void cyc_readings2(struct cyc *y)
 {
 	uint64_t now = cyc_now(y);
+	struct sm_read rd = cyc_read_of(y);
 	for (size_t i = 0; i < cyc_count(y) && i < y->multi.n; i++) {
 		size_t j = cyc_joint(y, i);
 		const uint8_t *bytes = bus_multi_data(&y->multi, i);
 		struct sm_present p;
-		if (bytes == NULL || !sm_decode_present(ctl_model(y->ctl, j), bytes, y->multi.len[i], &p)) {
+		if (bytes == NULL || !sm_decode_read(ctl_model(y->ctl, j), &rd, bytes, y->multi.len[i], &p)) {
 			cyc_error(y, y->multi.id[i], y->multi.fast ? "Fast Sync Read" : "SYNC_READ",
 			          y->multi.status[i] != DXL_OK ? y->multi.status[i] : DXL_E_WRONG_LENGTH);
 			continue;

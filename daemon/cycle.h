@@ -41,6 +41,15 @@
  * at its part): after CYC_FAST_FAILS_MAX cycles in a row without a single
  * reading the cycle goes back to SYNC_READ, so the other servos are read
  * again, and says so (the notice hook).
+ *
+ * Where start-up mapped the present values into every servo's indirect
+ * block and read the map back (cyc_set_indirect, setup_indirect), the
+ * SYNC_READ or Fast Sync Read asks for that block instead (servo_model.h,
+ * sm_read: 10 or 13 bytes at 224 where the direct block is 10 or 21 at
+ * 126): the same values, decoded by the same decoder. A REBOOT the cycle
+ * sends ends it: the e-manual lists the Indirect Address registers in the
+ * RAM area, so a servo may come back with the factory map, and the cycle
+ * reads the registers where they lie from then on (said by the notice hook).
  */
 #ifndef UNDULATE_DAEMON_CYCLE_H
 #define UNDULATE_DAEMON_CYCLE_H
@@ -51,6 +60,7 @@
 #include "bus.h"
 #include "control.h"
 #include "dxl2.h"
+#include "servo_model.h"
 
 /* Read-back of one joint every CYC_READBACK_EVERY cycles, round-robin: each
  * of two joints every 0.1 s at 100 Hz (a servo reset is found within that),
@@ -104,6 +114,7 @@ struct cyc {
 	uint8_t read_len;             /* this cycle's READ length, 6 or 8 (2.0: the model's, 10 or 21) */
 	/* Protocol 2.0: this cycle's SYNC_READ (or Fast Sync Read) and its replies */
 	bool fast_read;               /* the read is a Fast Sync Read (cyc_set_fast_read) */
+	bool indirect;                /* the read is of the indirect block (cyc_set_indirect) */
 	int fast_fails;               /* Fast Sync Reads in a row that read nobody */
 	struct bus_multi multi;
 	uint8_t multi_buf[CFG_MAX_JOINTS * 32];
@@ -115,7 +126,7 @@ struct cyc {
 	double bus_us, control_us;
 	int starved;                  /* cycles in a row that ended with writes waiting */
 	/* counters */
-	long long errors, cut_off, deferred, readbacks, writes_first, fast_fallbacks;
+	long long errors, cut_off, deferred, readbacks, writes_first, fast_fallbacks, indirect_fallbacks;
 	/* a robot on several buses (cyc_set_bus): the joints on this one, in the
 	 * robot's order; without it every joint of the controller */
 	bool own;
@@ -141,6 +152,13 @@ void cyc_set_fast_read(struct cyc *y, bool on);
  * The control step stays the robot's: the daemon runs it once every bus's
  * cycle has reached CYC_CONTROL. */
 void cyc_set_bus(struct cyc *y, size_t bus);
+/* Read the present values from every servo's indirect block (on: start-up
+ * mapped and verified it on every servo, setup_indirect) or from the
+ * registers where they lie, from the next cycle on. */
+void cyc_set_indirect(struct cyc *y, bool on);
+/* What this cycle's read asks for (its first joint's model: one SYNC_READ,
+ * one address and length for every servo on its bus). */
+struct sm_read cyc_read_of(const struct cyc *y);
 /* A cycle is under way (not idle). */
 bool cyc_busy(const struct cyc *y);
 /* End the cycle under way now: the next tick came first, or the daemon stops

@@ -590,6 +590,35 @@ static void dmn_fast_read(struct dmn *d, struct dmn_bus *b)
 		log_info("bus: the cycle reads by SYNC_READ, a status packet per servo: no Fast Sync Read, as %s", why);
 }
 
+/* The cycle's read on bus b through the indirect block where every servo
+ * on it has one and reads its map back (indirect = on, the default); else,
+ * said why, the present registers where they lie. Either way the log says
+ * which. */
+static void dmn_indirect(struct dmn *d, struct dmn_bus *b)
+{
+	char why[256];
+	size_t j0 = 0;
+	while (j0 + 1 < d->ctl.n && !ctl_on_bus(&d->ctl, j0, b->index))
+		j0++;
+	const struct sm_model *m = ctl_model(&d->ctl, j0);
+	struct sm_read direct = sm_direct_read(m);
+	bool on = false;
+	if (!d->cfg->indirect)
+		snprintf(why, sizeof why, "indirect = off");
+	else if (m->indirect.len == 0)
+		snprintf(why, sizeof why, "the %s has no indirect area", m->name);
+	else
+		on = setup_indirect_on(&b->bus, &d->ctl, b->index, why, sizeof why);
+	cyc_set_indirect(&b->cyc, on);
+	if (on)
+		log_info("bus: the cycle reads the indirect block at %u, %u or %u bytes a servo where the present "
+		         "registers at %u take %u or %u (%s)", m->indirect.addr, m->indirect.len, m->indirect.len_slow,
+		         direct.addr, direct.len, direct.len_slow, why);
+	else if (m->protocol == 2)
+		log_info("bus: the cycle reads the present registers at %u, %u or %u bytes a servo: no indirect block, "
+		         "as %s", direct.addr, direct.len, direct.len_slow, why);
+}
+
 /* Open one bus's port and run its start-up checks; the controller starts
  * (ctl_start) once every bus is in (dmn_connect, dmn_try_reconnect). On
  * failure *err says why. */
@@ -646,6 +675,7 @@ static bool dmn_connect_bus(struct dmn *d, struct dmn_bus *b, char *err, size_t 
 	}
 	b->connected = true;
 	b->backoff_ms = DMN_BACKOFF_MIN_MS;
+	dmn_indirect(d, b);
 	dmn_fast_read(d, b);
 	return true;
 }

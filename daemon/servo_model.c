@@ -26,6 +26,18 @@
  * Mode (11) to Min Position Limit (52..55): the mode and the limits. */
 #define SM_X_PRESENT_LEN 10
 #define SM_X_PRESENT_LEN_SLOW 21
+/* The same values through the indirect areas (start-up maps them,
+ * setup_indirect): Present Current/Load, Velocity, Position (126..135) in
+ * Indirect Data 1..10, Present Input Voltage and Temperature (144..146) in
+ * 11..13 — the slow read without the 8 bytes of trajectories it does not
+ * use: 13 bytes, not 21, still unlike the fast 10 so a late reply is
+ * refused for its length. */
+static const uint16_t sm_x_indirect_src[] = {
+	126, 127, 128, 129, 130, 131, 132, 133, 134, 135, 144, 145, 146,
+};
+#define SM_X_INDIRECT_SLOW (sizeof sm_x_indirect_src / sizeof sm_x_indirect_src[0])
+_Static_assert(SM_X_INDIRECT_SLOW <= SM_READ_MAX && SM_X_INDIRECT_SLOW <= DXL2_X_INDIRECT_PER_BLOCK,
+               "the indirect block fits one block of slots and setup_indirect's buffers");
 #define SM_X_RAM_ADDR DXL2_X_TORQUE_ENABLE
 #define SM_X_RAM_LEN (DXL2_X_PROFILE_VELOCITY + 4 - DXL2_X_TORQUE_ENABLE)
 #define SM_X_EEPROM_ADDR DXL2_X_OPERATING_MODE
@@ -101,8 +113,10 @@ _Static_assert(DXL_AX_STATUS_RETURN_LEVEL + 1 <= SM_SETTINGS_MAX && DXL2_X_BUS_W
 
 /* Each family's decoders and drive units (below): the model table names
  * them, the calls never ask which family. */
-static void sm_ax_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out);
-static void sm_x_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out);
+static void sm_ax_present(const struct sm_model *m, const struct sm_read *rd, const uint8_t *b,
+                          struct sm_present *out);
+static void sm_x_present(const struct sm_model *m, const struct sm_read *rd, const uint8_t *b,
+                         struct sm_present *out);
 static void sm_ax_readback(const struct sm_model *m, const uint8_t *ram, struct sm_state *s);
 static void sm_x_ram(const struct sm_model *m, const uint8_t *b, struct sm_state *s);
 static void sm_x_eeprom(const struct sm_model *m, const uint8_t *b, struct sm_state *s);
@@ -160,6 +174,7 @@ static const struct sm_model *sm_x_model(size_t i)
 		.goal = DXL2_X_GOAL_POSITION, .goal_size = 4,
 		/* Present Current where it senses current, Present Load else: 126 */
 		.present = DXL2_X_PRESENT_LOAD, .present_len = SM_X_PRESENT_LEN, .present_len_slow = SM_X_PRESENT_LEN_SLOW,
+		.indirect = { DXL2_X_INDIRECT_DATA_1, SM_X_PRESENT_LEN, (uint8_t)SM_X_INDIRECT_SLOW, sm_x_indirect_src },
 		.readback = { { SM_X_RAM_ADDR, SM_X_RAM_LEN, "RAM", sm_x_ram },
 		              { SM_X_EEPROM_ADDR, SM_X_EEPROM_LEN, "EEPROM", sm_x_eeprom } },
 		.decode_present = sm_x_present, .drive_raw = sm_x_drive_raw,
@@ -173,6 +188,8 @@ static const struct sm_model *sm_x_model(size_t i)
 		.reflected_inertia = SM_REFLECTED(d->sheet.rotor_inertia, d->sheet.gear_ratio),
 		.position = SM_XL430_POSITION,
 	};
+	if (!dxl2_model_can(d, DXL2_CAP_INDIRECT))
+		m->indirect = (struct sm_read){ 0 };
 	m->position_from = "XL430-W250";
 	for (size_t t = 0; t < sizeof sm_tuned / sizeof sm_tuned[0]; t++)
 		if (sm_tuned[t].number == d->number) {
@@ -226,6 +243,20 @@ static int32_t sm_x_get(const struct sm_model *m, const uint8_t *block, uint16_t
 	return r != NULL ? dxl2_reg_decode(r, &block[addr - block_addr]) : 0;
 }
 
+/* A present register's value from the cycle's block, wherever rd puts it:
+ * at its offset from the block's start (the direct read), or where its
+ * first byte's slot is in the indirect block (its bytes are mapped in
+ * order, setup_indirect). 0 when the block does not hold it. */
+static int32_t sm_x_read_get(const struct sm_model *m, const struct sm_read *rd, const uint8_t *b, uint16_t addr)
+{
+	if (rd->src == NULL)
+		return sm_x_get(m, b, rd->addr, addr);
+	for (size_t k = 0; k < rd->len_slow; k++)
+		if (rd->src[k] == addr)
+			return sm_x_get(m, b + k, addr, addr);
+	return 0;
+}
+
 /* ---- units ------------------------------------------------------------------------------------- */
 double sm_pos_to_rad(const struct sm_model *m, int32_t raw)
 {
@@ -269,9 +300,11 @@ bool sm_limit_is_pwm_drive(const struct sm_model *m)
 	return m->torque_limit == sm_drive_register(m, false);
 }
 
-static void sm_ax_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out)
+static void sm_ax_present(const struct sm_model *m, const struct sm_read *rd, const uint8_t *b,
+                          struct sm_present *out)
 {
 	(void)m;
+	(void)rd;   /* no indirect areas: the registers where they lie */
 	out->pos_raw = dxl_get_u16(b);
 	out->angle = dxl_pos_to_rad(dxl_get_u16(b));
 	out->speed = dxl_speed_to_rad_s(dxl_get_u16(b + 2));
@@ -282,27 +315,40 @@ static void sm_ax_present(const struct sm_model *m, const uint8_t *b, struct sm_
 	}
 }
 
-static void sm_x_present(const struct sm_model *m, const uint8_t *b, struct sm_present *out)
+static void sm_x_present(const struct sm_model *m, const struct sm_read *rd, const uint8_t *b,
+                         struct sm_present *out)
 {
-	int32_t load = sm_x_get(m, b, m->present, DXL2_X_PRESENT_LOAD);
-	out->pos_raw = sm_x_get(m, b, m->present, DXL2_X_PRESENT_POSITION);
+	int32_t load = sm_x_read_get(m, rd, b, DXL2_X_PRESENT_LOAD);
+	out->pos_raw = sm_x_read_get(m, rd, b, DXL2_X_PRESENT_POSITION);
 	out->angle = dxl2_pos_to_rad(out->pos_raw);
-	out->speed = dxl2_velocity_to_rad_s(sm_x_get(m, b, m->present, DXL2_X_PRESENT_VELOCITY));
+	out->speed = dxl2_velocity_to_rad_s(sm_x_read_get(m, rd, b, DXL2_X_PRESENT_VELOCITY));
 	out->load = m->current_control ? dxl2_current_to_amps(load) / m->stall_current_a : dxl2_load_to_fraction(load);
 	if (out->slow) {
-		out->voltage = dxl2_voltage_to_volts(sm_x_get(m, b, m->present, DXL2_X_PRESENT_INPUT_VOLTAGE));
-		out->temperature = sm_x_get(m, b, m->present, DXL2_X_PRESENT_TEMPERATURE);
+		out->voltage = dxl2_voltage_to_volts(sm_x_read_get(m, rd, b, DXL2_X_PRESENT_INPUT_VOLTAGE));
+		out->temperature = sm_x_read_get(m, rd, b, DXL2_X_PRESENT_TEMPERATURE);
 	}
+}
+
+struct sm_read sm_direct_read(const struct sm_model *m)
+{
+	return (struct sm_read){ m->present, m->present_len, m->present_len_slow, NULL };
+}
+
+bool sm_decode_read(const struct sm_model *m, const struct sm_read *rd, const uint8_t *b, size_t n,
+                    struct sm_present *out)
+{
+	if (n != rd->len && n != rd->len_slow)
+		return false;
+	out->slow = n == rd->len_slow;
+	out->voltage = out->temperature = NAN;
+	m->decode_present(m, rd, b, out);
+	return true;
 }
 
 bool sm_decode_present(const struct sm_model *m, const uint8_t *b, size_t n, struct sm_present *out)
 {
-	if (n != m->present_len && n != m->present_len_slow)
-		return false;
-	out->slow = n == m->present_len_slow;
-	out->voltage = out->temperature = NAN;
-	m->decode_present(m, b, out);
-	return true;
+	struct sm_read direct = sm_direct_read(m);
+	return sm_decode_read(m, &direct, b, n, out);
 }
 
 void sm_state_unknown(struct sm_state *s)

@@ -59,6 +59,18 @@ enum sm_cap {
 struct sm_model;
 struct sm_state;
 struct sm_present;
+/* Where the cycle reads the present values: a block of the control table,
+ * len bytes (fast) or len_slow (slow: voltage and temperature too). The
+ * model's own present registers where they lie (src NULL), or the indirect
+ * block start-up maps (setup_indirect): Indirect Data 1.. at addr, byte k
+ * standing for the address src[k] (the value Indirect Address k+1 holds).
+ * One decoder reads both (sm_decode_read). */
+#define SM_READ_MAX 32
+struct sm_read {
+	uint16_t addr;
+	uint8_t len, len_slow;
+	const uint16_t *src;
+};
 /* A register block read in one READ, and what fills sm_state from it. */
 struct sm_block {
 	uint16_t addr, len;
@@ -137,6 +149,10 @@ struct sm_model {
 	 * temperature (slow) */
 	uint16_t present;               /* 36 | 126 */
 	uint8_t present_len, present_len_slow;
+	/* the same values through the indirect areas (DXL2_CAP_INDIRECT): the
+	 * block start-up maps (len 0: the model has none | Indirect Data 1 at
+	 * 224, 10 or 13 bytes: the present block without its trajectories) */
+	struct sm_read indirect;
 	struct sm_block readback[SM_MAX_BLOCKS];
 	size_t nreadback;
 	int32_t pos_max;                /* 1023 | 4095 */
@@ -154,7 +170,8 @@ struct sm_model {
 	uint16_t drive, drive_current;
 	/* the family's decoders and the drive's units (sm_decode_present,
 	 * sm_drive_raw: their contracts) */
-	void (*decode_present)(const struct sm_model *m, const uint8_t *b, struct sm_present *out);
+	void (*decode_present)(const struct sm_model *m, const struct sm_read *rd, const uint8_t *b,
+	                       struct sm_present *out);
 	uint16_t (*drive_raw)(const struct sm_model *m, bool current, double ratio, int32_t limit);
 	uint32_t torque_full;           /* full output in torque-limit units: 1023 | 885 */
 	/* the datasheet's line at ref_voltage (the simulator's motors use the same) */
@@ -216,6 +233,12 @@ struct sm_present {
 };
 /* False (nothing decoded) when n is neither length. */
 bool sm_decode_present(const struct sm_model *m, const uint8_t *bytes, size_t n, struct sm_present *out);
+/* The model's direct read: its present registers where they lie. */
+struct sm_read sm_direct_read(const struct sm_model *m);
+/* The same from a block read as rd says (the direct read or the indirect
+ * block); false when n is neither of rd's lengths. */
+bool sm_decode_read(const struct sm_model *m, const struct sm_read *rd, const uint8_t *bytes, size_t n,
+                    struct sm_present *out);
 
 /* What a read-back says about the servo; -1 (NaN) for what the block did not
  * hold. Each family fills what it has. */

@@ -88,4 +88,17 @@ bool setup_fast_read(const struct bus *bus, const struct ctl *ctl, char *why, si
 /* The same for the joints of bus `on_bus` (a robot on several buses). */
 bool setup_fast_read_on(const struct bus *bus, const struct ctl *ctl, size_t on_bus, char *why, size_t cap);
 
+/* Map the present values the cycle decodes into every servo's indirect
+ * block (servo_model.h, sm_model.indirect: Indirect Address 1..13 set to
+ * 126..135 and 144..146) and read the map back, for the cycle's read
+ * (cyc_set_indirect). A servo already holding the map is left as it is;
+ * else its torque is turned off (ctl_start turns it on again) and the map
+ * written. False, with why (which servo, which slot, what it answered),
+ * when a servo has no indirect area, refuses, or reads back another map:
+ * the cycle then reads the registers where they lie. true: why says how
+ * many were written. Never a failed start. */
+bool setup_indirect(struct bus *bus, const struct ctl *ctl, char *why, size_t cap);
+/* The same for the joints of bus `on_bus` (a robot on several buses). */
+bool setup_indirect_on(struct bus *bus, const struct ctl *ctl, size_t on_bus, char *why, size_t cap);
+
 #endif

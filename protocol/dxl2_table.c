@@ -135,7 +135,58 @@
 	{ "present_temperature", 146, 1, false, R, RAM, RO_U8, false, 0, U(TEMPERATURE), NOLIM, \
 	    "internal temperature" }, \
 	{ "backup_ready",     147, 1, false, R,  RAM, RO_U8, false, 0, U(BOOL), NOLIM, \
-	    "a RAM backup is stored" }
+	    "a RAM backup is stored" }, \
+	X_IND_ROWS
+
+/* The indirect areas (e-manual, "Indirect Address, Indirect Data", the
+ * XL430-W250/XM430-W350 pages: rows 168-251 and 578-661): Indirect Address n
+ * (2 bytes) holds the address of the byte Indirect Data n (1 byte) stands
+ * for; the factory value is Indirect Data n's own address. The page prints
+ * the range of an Indirect Address as 64 ~ 661 ("EEPROM address can't be
+ * assigned to Indirect Address") and lists both in its RAM table; ROBOTIS's
+ * DynamixelSDK indirect example turns the torque off first because
+ * "Indirect address would not accessible when the torque is already
+ * enabled": the address rows are kept here as EEPROM (written with torque
+ * off, kept over a reboot, sim-bridge/README.md says the choice). */
+#define X_IND_ADDR(n, addr, def) \
+	{ "indirect_address_" #n, addr, 2, false, RW, EE, DXL2_X_INDIRECT_MIN, DXL2_X_INDIRECT_MAX, true, def, \
+	  U(RAW), NOLIM, "address of the byte indirect_data_" #n " stands for (64-661)" }
+#define X_IND_DATA(n, addr) \
+	{ "indirect_data_" #n, addr, 1, false, RW, RAM, 0, 255, true, 0, U(RAW), NOLIM, \
+	  "the byte at indirect_address_" #n }
+#define X_IND_ADDR_1 \
+	X_IND_ADDR(1, 168, 224), X_IND_ADDR(2, 170, 225), X_IND_ADDR(3, 172, 226), X_IND_ADDR(4, 174, 227), \
+	X_IND_ADDR(5, 176, 228), X_IND_ADDR(6, 178, 229), X_IND_ADDR(7, 180, 230), X_IND_ADDR(8, 182, 231), \
+	X_IND_ADDR(9, 184, 232), X_IND_ADDR(10, 186, 233), X_IND_ADDR(11, 188, 234), X_IND_ADDR(12, 190, 235), \
+	X_IND_ADDR(13, 192, 236), X_IND_ADDR(14, 194, 237), X_IND_ADDR(15, 196, 238), X_IND_ADDR(16, 198, 239), \
+	X_IND_ADDR(17, 200, 240), X_IND_ADDR(18, 202, 241), X_IND_ADDR(19, 204, 242), X_IND_ADDR(20, 206, 243), \
+	X_IND_ADDR(21, 208, 244), X_IND_ADDR(22, 210, 245), X_IND_ADDR(23, 212, 246), X_IND_ADDR(24, 214, 247), \
+	X_IND_ADDR(25, 216, 248), X_IND_ADDR(26, 218, 249), X_IND_ADDR(27, 220, 250), X_IND_ADDR(28, 222, 251)
+#define X_IND_DATA_1 \
+	X_IND_DATA(1, 224), X_IND_DATA(2, 225), X_IND_DATA(3, 226), X_IND_DATA(4, 227), \
+	X_IND_DATA(5, 228), X_IND_DATA(6, 229), X_IND_DATA(7, 230), X_IND_DATA(8, 231), \
+	X_IND_DATA(9, 232), X_IND_DATA(10, 233), X_IND_DATA(11, 234), X_IND_DATA(12, 235), \
+	X_IND_DATA(13, 236), X_IND_DATA(14, 237), X_IND_DATA(15, 238), X_IND_DATA(16, 239), \
+	X_IND_DATA(17, 240), X_IND_DATA(18, 241), X_IND_DATA(19, 242), X_IND_DATA(20, 243), \
+	X_IND_DATA(21, 244), X_IND_DATA(22, 245), X_IND_DATA(23, 246), X_IND_DATA(24, 247), \
+	X_IND_DATA(25, 248), X_IND_DATA(26, 249), X_IND_DATA(27, 250), X_IND_DATA(28, 251)
+#define X_IND_ADDR_29 \
+	X_IND_ADDR(29, 578, 634), X_IND_ADDR(30, 580, 635), X_IND_ADDR(31, 582, 636), X_IND_ADDR(32, 584, 637), \
+	X_IND_ADDR(33, 586, 638), X_IND_ADDR(34, 588, 639), X_IND_ADDR(35, 590, 640), X_IND_ADDR(36, 592, 641), \
+	X_IND_ADDR(37, 594, 642), X_IND_ADDR(38, 596, 643), X_IND_ADDR(39, 598, 644), X_IND_ADDR(40, 600, 645), \
+	X_IND_ADDR(41, 602, 646), X_IND_ADDR(42, 604, 647), X_IND_ADDR(43, 606, 648), X_IND_ADDR(44, 608, 649), \
+	X_IND_ADDR(45, 610, 650), X_IND_ADDR(46, 612, 651), X_IND_ADDR(47, 614, 652), X_IND_ADDR(48, 616, 653), \
+	X_IND_ADDR(49, 618, 654), X_IND_ADDR(50, 620, 655), X_IND_ADDR(51, 622, 656), X_IND_ADDR(52, 624, 657), \
+	X_IND_ADDR(53, 626, 658), X_IND_ADDR(54, 628, 659), X_IND_ADDR(55, 630, 660), X_IND_ADDR(56, 632, 661)
+#define X_IND_DATA_29 \
+	X_IND_DATA(29, 634), X_IND_DATA(30, 635), X_IND_DATA(31, 636), X_IND_DATA(32, 637), \
+	X_IND_DATA(33, 638), X_IND_DATA(34, 639), X_IND_DATA(35, 640), X_IND_DATA(36, 641), \
+	X_IND_DATA(37, 642), X_IND_DATA(38, 643), X_IND_DATA(39, 644), X_IND_DATA(40, 645), \
+	X_IND_DATA(41, 646), X_IND_DATA(42, 647), X_IND_DATA(43, 648), X_IND_DATA(44, 649), \
+	X_IND_DATA(45, 650), X_IND_DATA(46, 651), X_IND_DATA(47, 652), X_IND_DATA(48, 653), \
+	X_IND_DATA(49, 654), X_IND_DATA(50, 655), X_IND_DATA(51, 656), X_IND_DATA(52, 657), \
+	X_IND_DATA(53, 658), X_IND_DATA(54, 659), X_IND_DATA(55, 660), X_IND_DATA(56, 661)
+#define X_IND_ROWS X_IND_ADDR_1, X_IND_DATA_1, X_IND_ADDR_29, X_IND_DATA_29
 
 /* The AX-12A's rows: dxl_ax12_rows.h's, in the units of Protocol 1.0's
  * servo; Moving Speed narrower in joint mode. */
@@ -253,13 +304,14 @@ static const struct dxl2_reg xm430_regs[] = {
 	{ "present_input_voltage", 144, 2, false, R, RAM, RO_U16, false, 0, U(VOLTAGE), NOLIM, "supply voltage" },
 	{ "present_temperature", 146, 1, false, R, RAM, RO_U8, false, 0, U(TEMPERATURE), NOLIM,
 	    "internal temperature" },
+	X_IND_ROWS,
 };
 
 #define OPMODE_BIT(m) (1u << (m))
 #define ROWS(a) .regs = (a), .nregs = sizeof (a) / sizeof (a)[0]
 /* What every X servo here can do beyond its table. */
 #define X_CAPS (DXL2_CAP_HWERR_STATUS | DXL2_CAP_WATCHDOG | DXL2_CAP_REBOOT | DXL2_CAP_OPMODE | \
-                DXL2_CAP_FACTORY_RESET_KEEP)
+                DXL2_CAP_FACTORY_RESET_KEEP | DXL2_CAP_INDIRECT)
 /* e-manual, Protocol 2.0, "Fast Sync Read (0x8A)" and "Fast Bulk Read
  * (0x9A)": "X430/540 Series (Fw v45 or above, 2XL/2XC Not Supported)". */
 #define X430_FAST_READ_FIRMWARE 45
@@ -493,6 +545,31 @@ const struct dxl2_reg *dxl2_reg_lookup(const struct dxl2_model *m, const char *n
 		return dxl2_reg_at(m, (uint16_t)v);
 	}
 	return dxl2_reg_by_name(m, name_or_addr);
+}
+
+int dxl2_indirect_slot(uint16_t addr)
+{
+	if (addr >= DXL2_X_INDIRECT_DATA_1 && addr < DXL2_X_INDIRECT_DATA_1 + DXL2_X_INDIRECT_PER_BLOCK)
+		return addr - DXL2_X_INDIRECT_DATA_1 + 1;
+	if (addr >= DXL2_X_INDIRECT_DATA_29 && addr < DXL2_X_INDIRECT_DATA_29 + DXL2_X_INDIRECT_PER_BLOCK)
+		return addr - DXL2_X_INDIRECT_DATA_29 + DXL2_X_INDIRECT_PER_BLOCK + 1;
+	return 0;
+}
+
+uint16_t dxl2_indirect_address_reg(int n)
+{
+	if (n < 1 || n > DXL2_X_INDIRECT_COUNT)
+		return 0;
+	return n <= DXL2_X_INDIRECT_PER_BLOCK ? (uint16_t)(DXL2_X_INDIRECT_ADDRESS_1 + 2 * (n - 1))
+	                                      : (uint16_t)(DXL2_X_INDIRECT_ADDRESS_29 + 2 * (n - 29));
+}
+
+uint16_t dxl2_indirect_data_addr(int n)
+{
+	if (n < 1 || n > DXL2_X_INDIRECT_COUNT)
+		return 0;
+	return n <= DXL2_X_INDIRECT_PER_BLOCK ? (uint16_t)(DXL2_X_INDIRECT_DATA_1 + n - 1)
+	                                      : (uint16_t)(DXL2_X_INDIRECT_DATA_29 + n - 29);
 }
 
 int32_t dxl2_reg_decode(const struct dxl2_reg *r, const uint8_t *b)

@@ -14,7 +14,9 @@
  * which was taken. Values are little-endian; registers marked signed are
  * two's complement of their size. EEPROM (addresses below 64) is writable
  * only with Torque Enable (64) = 0; the servo answers an access error else.
- * Not described: the indirect address/data areas (168-251, 578-661).
+ * The indirect areas (168-251, 578-661) are rows too: indirect_address_1..56
+ * (kept as EEPROM: see dxl2_table.c) and indirect_data_1..56, with
+ * dxl2_indirect_* below to find one from the other.
  */
 #ifndef UNDULATE_DXL2_TABLE_H
 #define UNDULATE_DXL2_TABLE_H
@@ -83,7 +85,21 @@ enum dxl2_x_addr {
 	DXL2_X_BACKUP_READY          = 147,  /* XL430 page only */
 };
 #define DXL2_X_EEPROM_END  64     /* addresses below are EEPROM */
-#define DXL2_X_TABLE_SIZE  148    /* bytes 0..147 described here */
+/* The X series' indirect areas (e-manual, "Indirect Address, Indirect
+ * Data"): two blocks of 28 two-byte Indirect Address registers, each
+ * followed by its 28 one-byte Indirect Data registers. Indirect Address n
+ * holds the address (64..661) of the byte Indirect Data n reads and writes;
+ * its factory value is Indirect Data n's own address. */
+#define DXL2_X_INDIRECT_ADDRESS_1  168
+#define DXL2_X_INDIRECT_DATA_1     224
+#define DXL2_X_INDIRECT_ADDRESS_29 578
+#define DXL2_X_INDIRECT_DATA_29    634
+#define DXL2_X_INDIRECT_PER_BLOCK  28
+#define DXL2_X_INDIRECT_COUNT      56
+#define DXL2_X_INDIRECT_MIN        64    /* the RAM area: no EEPROM address */
+#define DXL2_X_INDIRECT_MAX        661
+#define DXL2_X_PRESENT_END 148    /* bytes 0..147: the registers before the indirect areas */
+#define DXL2_X_TABLE_SIZE  662    /* bytes 0..661 described here */
 
 /* Model numbers (register 0). */
 #define DXL2_MODEL_XL430_W250 1060
@@ -197,6 +213,7 @@ enum dxl2_cap {
 	 * rotation, Moving Speed the output), else a joint */
 	DXL2_CAP_WHEEL_BY_ANGLE_LIMITS = 1u << 4,
 	DXL2_CAP_FACTORY_RESET_KEEP = 1u << 5,  /* FACTORY_RESET's keep-ID / keep-ID-and-baud forms */
+	DXL2_CAP_INDIRECT     = 1u << 6,  /* the indirect areas (DXL2_X_INDIRECT_*) */
 };
 
 /* One servo model: everything a program needs to know of it. A new model
@@ -254,6 +271,13 @@ double dxl2_sheet_no_load_rad_s(const struct dxl2_datasheet *s);
 const struct dxl2_reg *dxl2_reg_lookup(const struct dxl2_model *m, const char *name_or_addr);
 /* The register starting at addr; NULL inside a register or in a gap. */
 const struct dxl2_reg *dxl2_reg_at(const struct dxl2_model *m, uint16_t addr);
+
+/* The indirect areas: slot n (1..DXL2_X_INDIRECT_COUNT) of an Indirect Data
+ * byte's address, 0 for any other address; the addresses of slot n's
+ * Indirect Address register and Indirect Data byte (0 for no such slot). */
+int dxl2_indirect_slot(uint16_t addr);
+uint16_t dxl2_indirect_address_reg(int n);
+uint16_t dxl2_indirect_data_addr(int n);
 
 /* Raw bytes <-> value, sign-extended for signed registers. */
 int32_t dxl2_reg_decode(const struct dxl2_reg *r, const uint8_t *bytes);

@@ -163,7 +163,7 @@ static const struct sim_joint_ops ax_ops = {
 
 static void x_place(struct sim_joint *j, enum sim_model m, const struct sim_joint_place *p)
 {
-	struct sim_xservo_options xo = { p->overload_time_s, p->firmware };
+	struct sim_xservo_options xo = { p->overload_time_s, p->firmware, p->no_indirect };
 	sim_xservo_init(&j->xservo, m, &xo, 0.0);
 	sim_xservo_poke(&j->xservo, DXL2_X_ID, p->id);
 	sim_xservo_poke(&j->xservo, DXL2_X_BAUD_RATE, p->baud_reg);

@@ -30,6 +30,7 @@ struct sim_joint_place {
 	bool eeprom_needs_torque_off;   /* AX-12A */
 	double overload_time_s;
 	int firmware;                   /* X series: the version it reports and acts as; 0 the model's */
+	bool no_indirect;               /* X series: without the indirect areas (sim_xservo_options) */
 };
 
 /* A register by name for the simulator's poke and peek: its address, its

@@ -168,6 +168,10 @@ static int set_sim(struct sim_config *c, const char *k, const char *v, char *err
 		return set_text(c->control, sizeof(c->control), v) ? 0 : ERR("control: too long");
 	if (!strcmp(k, "echo"))
 		return parse_bool(v, &c->echo) ? 0 : ERR("echo: want true/false");
+	if (!strcmp(k, "indirect")) {
+		bool on;
+		return parse_bool(v, &on) ? (c->no_indirect = !on, 0) : ERR("indirect: want true/false");
+	}
 	if (!strcmp(k, "baud_follows_tty"))
 		return parse_bool(v, &c->baud_follows_tty) ? 0 : ERR("%s: want true/false", k);
 	if (!strcmp(k, "eeprom_needs_torque_off"))

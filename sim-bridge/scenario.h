@@ -75,6 +75,10 @@ struct sim_config {
 	bool echo;
 	int return_delay_us;         /* initial EEPROM value of every servo; < 0 = factory 500 µs */
 	int firmware;                /* X series' firmware version of every servo; 0: the model's (46) */
+	/* X series: the servos have no indirect areas (168-661 answer the
+	 * access error): a firmware or clone without them, for the daemon's
+	 * fallback to the direct read */
+	bool no_indirect;
 	double ambient_c;
 	double initial_spread;       /* rad: initial angles uniform in ±spread (seeded) */
 	bool eeprom_needs_torque_off;

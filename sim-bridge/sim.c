@@ -106,7 +106,7 @@ static int sim_add_robot(struct sim *s, const struct sim_robot_config *rc, char 
 		struct sim_joint_place place = {
 			.id = rc->ids[k], .baud_reg = baud_reg, .delay_us = delay_us,
 			.eeprom_needs_torque_off = c->eeprom_needs_torque_off, .overload_time_s = c->overload_time_s,
-			.firmware = rc->firmware > 0 ? rc->firmware : c->firmware,
+			.firmware = rc->firmware > 0 ? rc->firmware : c->firmware, .no_indirect = c->no_indirect,
 		};
 		sim_joint_place(j, robot_model(rc, k), &place);
 		sim_config_motor_params(c, j->model, &j->params);
@@ -967,14 +967,19 @@ static int cmd_kick(struct sim_cmd_ctx *x)
 static int cmd_stats(struct sim_cmd_ctx *x)
 {
 	struct sim *s = x->s;
-	uint64_t packets = 0, replies = 0;
-	for (size_t i = 0; i < s->nbuses; i++)
+	uint64_t packets = 0, replies = 0, rx = 0, tx = 0;
+	for (size_t i = 0; i < s->nbuses; i++) {
 		packets += s->buses[i].count.packets, replies += s->buses[i].count.replies;
-	return REPLY(x, "ok steps=%llu time=%.3f collisions=%llu impulse=%.6f resting_impulse=%.6f packets=%llu replies=%llu commands=%llu bad_commands=%llu",
+		rx += s->buses[i].count.rx_bytes, tx += s->buses[i].count.tx_bytes;
+	}
+	/* rx_bytes, tx_bytes: the bytes the controllers sent and the servos
+	 * answered, every bus (what a change of the daemon's reads costs) */
+	return REPLY(x, "ok steps=%llu time=%.3f collisions=%llu impulse=%.6f resting_impulse=%.6f packets=%llu replies=%llu commands=%llu bad_commands=%llu rx_bytes=%llu tx_bytes=%llu",
 	             (unsigned long long)s->steps, (double)s->steps * s->dt,
 	             s->world.total_collisions - s->world.resting_contacts,
 	             s->world.total_impulse, s->world.resting_impulse, (unsigned long long)packets, (unsigned long long)replies,
-	             (unsigned long long)s->commands, (unsigned long long)s->bad_commands), 0;
+	             (unsigned long long)s->commands, (unsigned long long)s->bad_commands, (unsigned long long)rx,
+	             (unsigned long long)tx), 0;
 }
 
 /* command ROBOT|* TEXT...: to the robots' daemons, at this simulated time

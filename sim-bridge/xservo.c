@@ -38,6 +38,14 @@ void sim_xservo_default_options(struct sim_xservo_options *o)
 {
 	o->overload_time_s = 0.5;
 	o->firmware = 0;
+	o->no_indirect = false;
+}
+
+/* The end of the table this servo answers: without the indirect areas,
+ * the registers before them. */
+static size_t xservo_table_end(const struct sim_xservo *s)
+{
+	return s->opt.no_indirect ? DXL2_X_PRESENT_END : DXL2_X_TABLE_SIZE;
 }
 
 /* ---- the table ------------------------------------------------------------------ */
@@ -286,11 +294,42 @@ static void xservo_count(struct sim_xservo *s, uint8_t errnum)
 
 /* ---- writes ----------------------------------------------------------------------- */
 
-/* Every byte of [addr, addr+n) in a register the servo lets be written now:
- * read-only, undefined, or EEPROM with torque on is the access error. */
-static uint8_t xservo_access_error(const struct sim_xservo *s, uint16_t addr, size_t n)
+/* The byte a table address stands for: Indirect Data n stands for the byte
+ * Indirect Address n holds (e-manual, "Indirect Address, Indirect Data":
+ * "Indirect Data 1(224) can perform exactly same as LED(65)"), one byte
+ * each; every other address for itself. One level only: a slot naming
+ * another Indirect Data byte (or itself, the factory value) is that byte's
+ * own storage. An address outside 64..661 (only a poke puts one there: the
+ * write is refused) leaves the slot its own byte. */
+static uint16_t xservo_target(const struct sim_xservo *s, uint16_t addr)
 {
-	for (size_t a = addr; a < addr + n; a++) {
+	int n = dxl2_indirect_slot(addr);
+	if (n == 0 || !dxl2_model_can(s->table, DXL2_CAP_INDIRECT) || s->opt.no_indirect)
+		return addr;
+	const uint8_t *p = &s->mem[dxl2_indirect_address_reg(n)];
+	uint16_t to = (uint16_t)(p[0] | p[1] << 8);
+	return to >= DXL2_X_INDIRECT_MIN && to <= DXL2_X_INDIRECT_MAX ? to : addr;
+}
+
+uint8_t sim_xservo_byte(const struct sim_xservo *s, uint16_t addr)
+{
+	return addr < DXL2_X_TABLE_SIZE ? s->mem[xservo_target(s, addr)] : 0;
+}
+
+/* A write as the bytes it reaches: the new table image and which bytes of
+ * it were written (through the indirect slots, each at its target). */
+struct xservo_wr {
+	uint8_t img[DXL2_X_TABLE_SIZE];
+	bool hit[DXL2_X_TABLE_SIZE];
+};
+
+/* Every byte written in a register the servo lets be written now:
+ * read-only, undefined, or EEPROM with torque on is the access error. */
+static uint8_t xservo_access_error(const struct sim_xservo *s, const struct xservo_wr *w)
+{
+	for (size_t a = 0; a < DXL2_X_TABLE_SIZE; a++) {
+		if (!w->hit[a])
+			continue;
 		const struct dxl2_reg *r = xservo_reg_covering(s, (uint16_t)a);
 		if (!r || r->access != DXL_ACCESS_RW)
 			return DXL2_ERRNUM_ACCESS;
@@ -301,13 +340,18 @@ static uint8_t xservo_access_error(const struct sim_xservo *s, uint16_t addr, si
 }
 
 /* A register written in part: the data length error (e-manual: "only 2
- * bytes of a item that has been defined as 4 bytes"). */
-static uint8_t xservo_length_error(const struct sim_xservo *s, uint16_t addr, size_t n)
+ * bytes of a item that has been defined as 4 bytes"); through the indirect
+ * slots too (e-manual: a register longer than a byte needs all its
+ * addresses allocated). */
+static uint8_t xservo_length_error(const struct sim_xservo *s, const struct xservo_wr *w)
 {
-	for (size_t a = addr; a < addr + n; a++) {
+	for (size_t a = 0; a < DXL2_X_TABLE_SIZE; a++) {
+		if (!w->hit[a])
+			continue;
 		const struct dxl2_reg *r = xservo_reg_covering(s, (uint16_t)a);
-		if (r->addr < addr || (size_t)r->addr + r->size > addr + n)
-			return DXL2_ERRNUM_DATA_LENGTH;
+		for (size_t k = r->addr; k < (size_t)r->addr + r->size; k++)
+			if (!w->hit[k])
+				return DXL2_ERRNUM_DATA_LENGTH;
 	}
 	return 0;
 }
@@ -324,11 +368,12 @@ static uint8_t xservo_length_error(const struct sim_xservo *s, uint16_t addr, si
  * exceeds a PWM Limit of 500); the data range error is for a register whose
  * range is printed as numbers (PWM Limit itself, Operating Mode, Goal
  * Position in Extended Position Control Mode). */
-static uint8_t xservo_value_error(const struct sim_xservo *s, uint16_t addr, size_t n, const uint8_t *img)
+static uint8_t xservo_value_error(const struct sim_xservo *s, const struct xservo_wr *w)
 {
 	uint8_t err = 0;
-	for (size_t a = addr; a < addr + n; a++) {
-		const struct dxl2_reg *r = dxl2_reg_at(s->table, (uint16_t)a);
+	const uint8_t *img = w->img;
+	for (size_t a = 0; a < DXL2_X_TABLE_SIZE; a++) {
+		const struct dxl2_reg *r = w->hit[a] ? dxl2_reg_at(s->table, (uint16_t)a) : NULL;
 		if (!r)
 			continue;
 		int32_t v = dxl2_reg_decode(r, &img[a]);
@@ -347,27 +392,28 @@ static uint8_t xservo_value_error(const struct sim_xservo *s, uint16_t addr, siz
 	return err;
 }
 
-/* Whether a write of n bytes at addr would be taken; the new table in img. */
+/* Whether a write of n bytes at addr would be taken; what it writes in *w.
+ * Through an indirect slot the target's own rules apply (e-manual: the
+ * slot "inherits features and properties" of the address it holds: size,
+ * value range, access). */
 static uint8_t xservo_check_write(const struct sim_xservo *s, uint16_t addr, const uint8_t *data, size_t n,
-                                  uint8_t *img)
+                                  struct xservo_wr *w)
 {
 	if (n == 0)
 		return DXL2_ERRNUM_DATA_LENGTH;
-	if ((size_t)addr + n > DXL2_X_TABLE_SIZE)
+	if ((size_t)addr + n > xservo_table_end(s))
 		return DXL2_ERRNUM_ACCESS;
-	uint8_t err = xservo_access_error(s, addr, n);
+	memcpy(w->img, s->mem, DXL2_X_TABLE_SIZE);
+	memset(w->hit, 0, sizeof w->hit);
+	for (size_t i = 0; i < n; i++) {
+		uint16_t to = xservo_target(s, (uint16_t)(addr + i));
+		w->img[to] = data[i];
+		w->hit[to] = true;
+	}
+	uint8_t err = xservo_access_error(s, w);
 	if (!err)
-		err = xservo_length_error(s, addr, n);
-	if (err)
-		return err;
-	memcpy(img, s->mem, DXL2_X_TABLE_SIZE);
-	memcpy(&img[addr], data, n);
-	return xservo_value_error(s, addr, n, img);
-}
-
-static bool touches(uint16_t addr, size_t n, uint16_t reg)
-{
-	return reg >= addr && reg < addr + n;
+		err = xservo_length_error(s, w);
+	return err ? err : xservo_value_error(s, w);
 }
 
 /* A new Operating Mode (e-manual, Operating Mode): the gains back to the
@@ -383,14 +429,13 @@ static void xservo_mode_changed(struct sim_xservo *s)
 		xservo_one_turn(s);
 }
 
-/* Commit a checked image and act on what changed. */
-static void xservo_commit(struct sim_xservo *s, uint16_t addr, size_t n, const uint8_t *img)
+/* Commit a checked write and act on what changed. */
+static void xservo_commit(struct sim_xservo *s, const struct xservo_wr *w)
 {
 	uint8_t torque0 = s->mem[A_TORQUE], mode0 = s->mem[A_MODE];
-	memcpy(s->mem, img, DXL2_X_TABLE_SIZE);
-	bool goal = touches(addr, n, DXL2_X_GOAL_PWM) || touches(addr, n, DXL2_X_GOAL_VELOCITY) ||
-	            touches(addr, n, DXL2_X_GOAL_POSITION) ||
-	            (has_reg(s, DXL2_X_GOAL_CURRENT) && touches(addr, n, DXL2_X_GOAL_CURRENT));
+	memcpy(s->mem, w->img, DXL2_X_TABLE_SIZE);
+	bool goal = w->hit[DXL2_X_GOAL_PWM] || w->hit[DXL2_X_GOAL_VELOCITY] || w->hit[DXL2_X_GOAL_POSITION] ||
+	            (has_reg(s, DXL2_X_GOAL_CURRENT) && w->hit[DXL2_X_GOAL_CURRENT]);
 	if (goal) {
 		s->goal_seq++;
 		/* Drive Mode bit 3 (firmware 45): a goal turns the torque on */
@@ -408,22 +453,22 @@ static void xservo_commit(struct sim_xservo *s, uint16_t addr, size_t n, const u
 /* A WRITE (or an executed REG_WRITE): all of it or none. Returns the error number. */
 static uint8_t xservo_write(struct sim_xservo *s, uint16_t addr, const uint8_t *data, size_t n)
 {
-	uint8_t img[DXL2_X_TABLE_SIZE];
-	uint8_t err = xservo_check_write(s, addr, data, n, img);
+	struct xservo_wr w;
+	uint8_t err = xservo_check_write(s, addr, data, n, &w);
 	if (!err)
-		xservo_commit(s, addr, n, img);
+		xservo_commit(s, &w);
 	return err;
 }
 
 /* ---- instructions ------------------------------------------------------------------ */
 
-/* READ's range: within the table the simulator describes (0-147); reserved
+/* READ's range: within the table the simulator describes (0-661); reserved
  * bytes inside it read 0. */
-static uint8_t xservo_read_error(uint16_t addr, uint16_t len)
+static uint8_t xservo_read_error(const struct sim_xservo *s, uint16_t addr, uint16_t len)
 {
 	if (len == 0)
 		return DXL2_ERRNUM_DATA_LENGTH;
-	if ((size_t)addr + len > DXL2_X_TABLE_SIZE)
+	if ((size_t)addr + len > xservo_table_end(s))
 		return DXL2_ERRNUM_ACCESS;
 	return 0;
 }
@@ -431,26 +476,29 @@ static uint8_t xservo_read_error(uint16_t addr, uint16_t len)
 static int xservo_read_reply(struct sim_xservo *s, uint8_t id, uint16_t addr, uint16_t len, bool answer,
                              uint8_t *out, size_t cap)
 {
-	uint8_t err = xservo_read_error(addr, len);
+	uint8_t err = xservo_read_error(s, addr, len);
 	xservo_count(s, err);
 	if (!answer)
 		return 0;
 	if (err)
 		return xservo_reply(s, id, err, NULL, 0, out, cap);
-	return xservo_reply(s, id, 0, &s->mem[addr], len, out, cap);
+	uint8_t data[DXL2_X_TABLE_SIZE];
+	for (size_t i = 0; i < len; i++)
+		data[i] = sim_xservo_byte(s, (uint16_t)(addr + i));
+	return xservo_reply(s, id, 0, data, len, out, cap);
 }
 
 static uint16_t le16(const uint8_t *p) { return (uint16_t)(p[0] | (p[1] << 8)); }
 
 static uint8_t xservo_reg_write(struct sim_xservo *s, const struct dxl2_packet *req)
 {
-	uint8_t img[DXL2_X_TABLE_SIZE];
+	struct xservo_wr w;
 	if (req->nparams < 2)
 		return DXL2_ERRNUM_INSTRUCTION;
 	uint16_t addr = le16(req->params);
 	size_t n = req->nparams - 2u;
 	/* checked now, so its reply tells; checked again at ACTION */
-	uint8_t err = xservo_check_write(s, addr, &req->params[2], n, img);
+	uint8_t err = xservo_check_write(s, addr, &req->params[2], n, &w);
 	if (err)
 		return err;
 	s->reg_addr = addr;

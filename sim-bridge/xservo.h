@@ -21,7 +21,12 @@
  *    stays, with the alert bit in every status packet, until REBOOT;
  *  - the bus watchdog (98): with torque on, no instruction for the set time
  *    stops the servo, the register reads -1 (0xFF) and the goal registers
- *    refuse writes (data range error) until 0 is written.
+ *    refuse writes (data range error) until 0 is written;
+ *  - the indirect areas (168-251, 578-661): Indirect Data n reads and writes
+ *    the byte Indirect Address n holds (64..661, else data range), under
+ *    that byte's own rules (access, part of a register, range, limit);
+ *    the Indirect Address registers are written only with torque off and
+ *    kept over a REBOOT, as EEPROM.
  */
 #ifndef UNDULATE_SIM_XSERVO_H
 #define UNDULATE_SIM_XSERVO_H
@@ -52,6 +57,10 @@ struct sim_xservo_options {
 	 * Sync/Bulk Read from the model's first (X430: 45). 0: the model's
 	 * (dxl2_model.firmware, 46). */
 	int firmware;
+	/* No indirect areas: 168-661 answer the access error, as an X firmware
+	 * (or clone) without them would, and as this simulator did before it
+	 * had them (the [sim] key indirect = false). */
+	bool no_indirect;
 };
 
 struct sim_xservo_counters {
@@ -94,6 +103,9 @@ uint8_t sim_xservo_id(const struct sim_xservo *s);
 /* A register's value by its address (sign-extended); DXL_E_ARG and 0 when no
  * register starts there. */
 int sim_xservo_peek(const struct sim_xservo *s, uint16_t addr, int32_t *value);
+/* The byte a READ answers at addr (< DXL2_X_TABLE_SIZE): through an
+ * indirect slot, the byte its Indirect Address holds. */
+uint8_t sim_xservo_byte(const struct sim_xservo *s, uint16_t addr);
 /* Set a register without the write rules (set-up, the poke command). Hardware
  * Error Status (70) poked non-zero is a hardware error the servo detected
  * (shutdown if in the mask). DXL_E_ARG for no register at addr. */

@@ -375,9 +375,13 @@ static void model_handle2(int k, const struct dxl2_packet *req)
 		check_reply2(out, len, sim_xservo_id(&before), &reply);
 		if (req->instr == DXL2_INST_PING)
 			CHECK(reply.nparams == 3 && dxl2_err_number(reply.err) == 0);
-		if (req->instr == DXL2_INST_READ && reply.err == sim_xservo_alert(&before))
-			CHECK(reply.nparams == (uint16_t)(req->params[2] | (req->params[3] << 8)) &&
-			      memcmp(reply.params, &s->mem[req->params[0] | (req->params[1] << 8)], reply.nparams) == 0);
+		if (req->instr == DXL2_INST_READ && reply.err == sim_xservo_alert(&before)) {
+			uint16_t addr = (uint16_t)(req->params[0] | (req->params[1] << 8));
+			CHECK(reply.nparams == (uint16_t)(req->params[2] | (req->params[3] << 8)));
+			/* what the table holds there, through the indirect slots */
+			for (uint16_t i = 0; i < reply.nparams; i++)
+				CHECK(reply.params[i] == sim_xservo_byte(s, (uint16_t)(addr + i)));
+		}
 	} else if (req->instr == DXL2_INST_PING) {
 		CHECK(0);   /* PING is always answered */
 	}
@@ -392,8 +396,14 @@ static void model_handle2(int k, const struct dxl2_packet *req)
 		CHECK(memcmp(a, s->mem, sizeof(a)) == 0);
 	}
 	/* torque on locks the EEPROM */
-	if (before.mem[DXL2_X_TORQUE_ENABLE])
+	if (before.mem[DXL2_X_TORQUE_ENABLE]) {
 		CHECK(memcmp(before.mem, s->mem, DXL2_X_EEPROM_END) == 0);
+		/* and the Indirect Address registers (kept as EEPROM) */
+		CHECK(memcmp(&before.mem[DXL2_X_INDIRECT_ADDRESS_1], &s->mem[DXL2_X_INDIRECT_ADDRESS_1],
+		             2 * DXL2_X_INDIRECT_PER_BLOCK) == 0);
+		CHECK(memcmp(&before.mem[DXL2_X_INDIRECT_ADDRESS_29], &s->mem[DXL2_X_INDIRECT_ADDRESS_29],
+		             2 * DXL2_X_INDIRECT_PER_BLOCK) == 0);
+	}
 }
 
 /* A packet with a bad CRC just ended: its header and LEN span the bytes up

@@ -1,7 +1,7 @@
 """sdk_fast.py — ROBOTIS's Python DynamixelSDK (its python/src, which has Fast
 Sync Read and Fast Bulk Read; its C port has not) against undulate-sim's X
-servos: the fast reads beside the plain SYNC_READ, and on firmware below 45
-no answer. Code we did not write parses the one status packet the simulated
+servos: the fast reads beside the plain SYNC_READ, of the present registers and
+of the indirect block mapped to them, and on firmware below 45 no answer. Code we did not write parses the one status packet the simulated
 servos build together. Prints "ok"/"not ok" lines (tests/sdk/run.sh).
 usage: sdk_fast.py SDK_PYTHON_SRC PORT BAUD fast|none ID..."""
 import sys
@@ -45,6 +45,23 @@ if expect == "fast":
     temps = [bulk.getData(i, 146, 1) for i in ids[1:]] if ok else []
     result(ok and all(10 <= t <= 80 for t in temps),
            "fastBulkRead (0x9A): position of %d, temperature of the others %s" % (ids[0], temps), ph.getTxRxResult(rc))
+    # undulated's read: Indirect Address 1..4 (168..) = Present Position's
+    # bytes (132..135), torque off, then one fastSyncRead of Indirect Data 1..4
+    mapped = True
+    for i in ids:
+        ph.write1ByteTxRx(port, i, 64, 0)
+        for k in range(4):
+            rc, err = ph.write2ByteTxRx(port, i, 168 + 2 * k, 132 + k)
+            mapped = mapped and rc == COMM_SUCCESS and err == 0
+    ind = GroupSyncRead(port, ph, 224, 4)
+    for i in ids:
+        ind.addParam(i)
+    rc = ind.fastSyncRead()
+    got = {i: ind.getData(i, 224, 4) for i in ids if ind.isAvailable(i, 224, 4)}
+    near = all(abs(int(got.get(i, -99999)) - int(pos.get(i, 0))) < 50 for i in ids)
+    result(mapped and rc == COMM_SUCCESS and len(got) == len(ids) and near,
+           "fastSyncRead of Indirect Data 1..4 (224) mapped to 132..135: the present positions %s" % got,
+           ph.getTxRxResult(rc))
 else:
     result(rc != COMM_SUCCESS, "firmware below 45: fastSyncRead gets no answer (%s)" % ph.getTxRxResult(rc))
 print("1..%d" % n)

@@ -53,6 +53,8 @@
 #define A_PRESENT_POS  132
 #define A_VOLTAGE      144
 #define A_TEMPERATURE  146
+#define A_IND_ADDR_1   168
+#define A_IND_DATA_1   224
 
 static uint8_t xl, xm;
 
@@ -200,6 +202,47 @@ static void group_bulk(void)
 	ms(10);
 	result(sent && read1ByteTxRx(port, P2, xl, A_LED) == 1 && read2ByteTxRx(port, P2, xm, A_POS_P) == 700,
 	       "groupBulkWrite: LED of one, position P gain of the other", "%s", said());
+}
+
+/* The indirect areas as ROBOTIS's own indirect_address example uses them:
+ * torque off, Indirect Address 1..4 = Present Position's four bytes (one
+ * write2ByteTxRx each), then a groupSyncRead of Indirect Data 1..4 (224) of
+ * both servos: their present positions; with torque on the registers are
+ * refused (the example: "Indirect address would not accessible when the
+ * torque is already enabled"). What undulated's cycle does, read by code we
+ * did not write. */
+static void indirect(void)
+{
+	uint16_t first = read2ByteTxRx(port, P2, xl, A_IND_ADDR_1);
+	result(good() && first == A_IND_DATA_1, "read2ByteTxRx: Indirect Address 1 holds 224 at the factory",
+	       "read %u; %s", first, said());
+	bool mapped = true;
+	for (uint8_t id = xl; ; id = xm) {
+		write1ByteTxRx(port, P2, id, A_TORQUE, 0);
+		for (uint16_t k = 0; k < 4; k++) {
+			write2ByteTxRx(port, P2, id, (uint16_t)(A_IND_ADDR_1 + 2 * k), (uint16_t)(A_PRESENT_POS + k));
+			mapped = mapped && good();
+		}
+		if (id == xm)
+			break;
+	}
+	result(mapped, "write2ByteTxRx: Indirect Address 1..4 = 132..135 on both, torque off", "%s", said());
+	int gr = groupSyncRead(port, P2, A_IND_DATA_1, 4);
+	groupSyncReadAddParam(gr, xl);
+	groupSyncReadAddParam(gr, xm);
+	groupSyncReadTxRxPacket(gr);
+	bool ok = comm() == COMM_SUCCESS && groupSyncReadIsAvailable(gr, xl, A_IND_DATA_1, 4) &&
+	          groupSyncReadIsAvailable(gr, xm, A_IND_DATA_1, 4);
+	uint32_t ia = groupSyncReadGetData(gr, xl, A_IND_DATA_1, 4), ib = groupSyncReadGetData(gr, xm, A_IND_DATA_1, 4);
+	uint32_t pa = read4ByteTxRx(port, P2, xl, A_PRESENT_POS), pb = read4ByteTxRx(port, P2, xm, A_PRESENT_POS);
+	result(ok && ia == pa && ib == pb, "groupSyncRead of Indirect Data 1..4: both present positions",
+	       "indirect %u, %u; direct %u, %u; %s", ia, ib, pa, pb, said());
+	write1ByteTxRx(port, P2, xl, A_TORQUE, 1);
+	write2ByteTxRx(port, P2, xl, A_IND_ADDR_1, A_LED);
+	result(comm() == COMM_SUCCESS && err() == 7, "Indirect Address with torque on: access error (7)", "%s", said());
+	write1ByteTxRx(port, P2, xl, A_TORQUE, 0);
+	ms(50);
+	clearPort(port);
 }
 
 /* The servo's ERR field through the SDK's getRxPacketError. */
@@ -382,6 +425,7 @@ int main(int argc, char **argv)
 	reg_write_action();
 	group_sync();
 	group_bulk();
+	indirect();
 	errors();
 	reboot_clear_reset();
 	baud_change();

@@ -249,6 +249,25 @@ static void test_whole_config_errors(void **state)
 
 /* [sinusoid] stiffness and damping: the clock as a torque law (CONTROL.md,
  * "The clock as a torque law"), off (0) unless given, printed back. */
+/* indirect: on by default (the X cycle reads the indirect block), off by
+ * the key, anything else refused with the key named. */
+static void test_indirect_key(void **state)
+{
+	(void)state;
+	struct cfg c;
+	struct cfg_errors e = { 0 };
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1,2\n", &e) && cfg_finish(&c, &e));
+	assert_true(c.indirect);
+	cfg_defaults(&c);
+	assert_true(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1,2\nindirect = off\n", &e) &&
+	            cfg_finish(&c, &e));
+	assert_false(c.indirect);
+	cfg_defaults(&c);
+	struct cfg_errors e2 = { 0 };
+	assert_false(cfg_load_string(&c, "r.conf", "[robot]\nport=/dev/null\nids=1,2\nindirect = maybe\n", &e2));
+}
+
 static void test_sinusoid_stiffness(void **state)
 {
 	(void)state;
@@ -894,6 +913,7 @@ int main(void)
 		cmocka_unit_test(test_errors_name_file_line_key),
 		cmocka_unit_test(test_whole_config_errors),
 		cmocka_unit_test(test_sinusoid_stiffness),
+		cmocka_unit_test(test_indirect_key),
 		cmocka_unit_test(test_every_error_reported),
 		cmocka_unit_test(test_repeated_keys_and_sections),
 		cmocka_unit_test(test_long_line),

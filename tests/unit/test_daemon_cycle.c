@@ -65,6 +65,7 @@ struct fake {
 	uint64_t line_free;        /* when the last reply queued ends */
 	uint64_t late_us;          /* the next reply this much later */
 	int corrupt;               /* replies to damage (a bit of their CRC) */
+	uint64_t bytes_out, bytes_in;   /* on the wire: the controller's, the servos' */
 };
 
 static struct fake f;
@@ -223,6 +224,7 @@ static void emit(void *ctx, const uint8_t *pkt, size_t n, unsigned delay_us)
 	(void)ctx;
 	uint64_t start = (f.request_end > f.line_free ? f.request_end : f.line_free) + delay_us + f.late_us;
 	f.late_us = 0;
+	f.bytes_in += n;
 	rx_room(n);
 	for (size_t i = 0; i < n; i++) {
 		f.rx[f.tail] = pkt[i];
@@ -256,6 +258,7 @@ static void fake_write_x(const uint8_t *buf, size_t n)
 {
 	f.request_end = f.now + wire_us(n);
 	f.line_free = f.request_end;
+	f.bytes_out += n;
 	unsigned writes = atomic_load(&xb.writes) + atomic_load(&xb.reboots);
 	xfake_feed(&xb, buf, n);
 	if (on_write_sent != NULL && atomic_load(&xb.writes) + atomic_load(&xb.reboots) != writes)
@@ -405,6 +408,14 @@ static void setup_common(size_t n, enum cfg_mode mode, const char *const *sets)
 	ctl_init(&c, &cfg);
 }
 
+/* the cycle's notices (a change of how it reads), the last one */
+static char last_notice[256];
+static void on_notice(void *ctx, const char *text)
+{
+	(void)ctx;
+	snprintf(last_notice, sizeof last_notice, "%s", text);
+}
+
 static void setup_start(uint32_t margin_us, enum bus_protocol protocol)
 {
 	struct bus_io io = { .ctx = &f, .write = fake_write, .read = fake_read, .wait = fake_wait, .now_us = fake_now,
@@ -412,7 +423,7 @@ static void setup_start(uint32_t margin_us, enum bus_protocol protocol)
 	struct bus_timing tm = { .baud = 1000000, .return_delay_us = 0, .adapter_latency_us = 0, .margin_us = margin_us };
 	bus_init(&bus, &io, &tm, false);
 	assert_int_equal(bus_set_protocol(&bus, protocol), DXL_OK);
-	struct cyc_hooks hooks = { .bus_error = on_bus_error };
+	struct cyc_hooks hooks = { .bus_error = on_bus_error, .notice = on_notice };
 	cyc_init(&y, &bus, &c, PERIOD_US, &hooks);
 	next_tick = 1000000;
 	f.now = next_tick - PERIOD_US;
@@ -1331,6 +1342,101 @@ static void test_one_bus_of_two(void **state)
 	assert_int_equal(next->id, 2);
 }
 
+/* The indirect block (setup_indirect, cyc_set_indirect): start-up maps
+ * Indirect Address 1..13 to 126..135 and 144..146 on every servo and reads
+ * the map back; the cycle's SYNC_READ then asks for 224, 10 or 13 bytes,
+ * decoded as the direct block's 10 or 21 were (the same values), and the
+ * servos send 8 bytes fewer every other cycle. A servo without the areas,
+ * or one that reads back another map, leaves the direct read, said why;
+ * a map in place is kept (nothing written); a REBOOT ends the indirect read. */
+static void test_indirect_block(void **state)
+{
+	(void)state;
+	char why[256];
+	const char *sets[] = { "robot.fault_backoff_s=0.2", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	run(10);
+	uint64_t in0 = f.bytes_in, out0 = f.bytes_out;
+	run(100);
+	uint64_t direct_in = f.bytes_in - in0, direct_out = f.bytes_out - out0;
+	/* mapped: torque off for it, the map in both servos, read back */
+	assert_true(setup_indirect(&bus, &c, why, sizeof why));
+	assert_string_equal(why, "Indirect Address 1..13 on every servo read back as mapped (2 written, 0 kept)");
+	for (uint8_t id = 1; id <= 2; id++) {
+		assert_int_equal(xreg(id, 168, 2), 126);
+		assert_int_equal(xreg(id, 186, 2), 135);
+		assert_int_equal(xreg(id, 188, 2), 144);
+		assert_int_equal(xreg(id, 192, 2), 146);
+		assert_int_equal(xreg(id, 194, 2), 237);   /* slot 14: its factory value */
+		assert_int_equal(xs(id)->mem[64], 0);
+		xs(id)->mem[64] = 1;   /* ctl_start's torque on, as the daemon's next step */
+	}
+	cyc_set_indirect(&y, true);
+	struct sm_read rd = cyc_read_of(&y);
+	assert_int_equal(rd.addr, 224);
+	assert_int_equal(rd.len, 10);
+	assert_int_equal(rd.len_slow, 13);
+	x_put(2, 132, 2048 + 300, 4);
+	x_put(2, 144, 118, 2);
+	run(10);
+	in0 = f.bytes_in;
+	out0 = f.bytes_out;
+	unsigned reads0 = atomic_load(&xb.sync_reads);
+	run(100);
+	uint64_t ind_in = f.bytes_in - in0, ind_out = f.bytes_out - out0;
+	assert_int_equal(atomic_load(&xb.sync_reads) - reads0, 100);
+	assert_int_equal(y.errors, 0);
+	for (size_t j = 0; j < 2; j++)
+		assert_int_equal(c.j[j].stale_cycles, 0);
+	assert_true(fabs(c.j[1].angle - 300 * DXL2_POS_RAD_PER_UNIT) < 1e-9);
+	assert_true(fabs(c.j[1].voltage - 11.8) < 1e-9 && fabs(c.j[1].temperature - 36) < 1e-9);
+	assert_true(fabs(c.j[0].voltage - 12.0) < 1e-9);
+	/* 8 bytes a servo fewer on each of the 50 slow cycles; the requests the same */
+	print_message("# 100 cycles, 2 servos: servo bytes %llu direct, %llu indirect; controller bytes %llu, %llu\n",
+	              (unsigned long long)direct_in, (unsigned long long)ind_in, (unsigned long long)direct_out,
+	              (unsigned long long)ind_out);
+	assert_int_equal(direct_in - ind_in, 50 * 2 * 8);
+	assert_int_equal(direct_out, ind_out);
+	/* a second start: the map is there, nothing written, torque untouched */
+	unsigned writes0 = atomic_load(&xb.writes);
+	assert_true(setup_indirect(&bus, &c, why, sizeof why));
+	assert_non_null(strstr(why, "(0 written, 2 kept)"));
+	assert_int_equal(atomic_load(&xb.writes), writes0);
+	assert_int_equal(xs(1)->mem[64], 1);
+	/* a REBOOT ends the indirect read, said */
+	xs(2)->mem[70] = DXL2_HWERR_OVERLOAD;   /* shut down: torque off until REBOOT */
+	xs(2)->mem[64] = 0;
+	run(100);
+	assert_int_equal(atomic_load(&xb.reboots), 1);
+	assert_false(y.indirect);
+	assert_int_equal(y.indirect_fallbacks, 1);
+	assert_non_null(strstr(last_notice, "servo 2 is rebooted and may come back without its indirect map"));
+	assert_int_equal(cyc_read_of(&y).addr, 126);
+	assert_non_null(find_event("servo 2: recovered"));
+	assert_int_equal(c.j[1].stale_cycles, 0);
+}
+
+/* A servo that keeps slot 7 at its factory value: the read-back says so,
+ * false; one without the areas: the READ refused, false. */
+static void test_indirect_refused(void **state)
+{
+	(void)state;
+	char why[256];
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	xs(2)->ind_stuck = 7;
+	assert_false(setup_indirect(&bus, &c, why, sizeof why));
+	assert_string_equal(why, "servo 2 (XM430-W350): Indirect Address 7 reads 230 where 132 was written");
+	xs(2)->ind_stuck = 0;
+	xs(1)->no_indirect = true;
+	assert_false(setup_indirect(&bus, &c, why, sizeof why));
+	assert_non_null(strstr(why, "servo 1 (XM430-W350): reading Indirect Address 1..13 failed"));
+	assert_non_null(strstr(why, "(answered without the data: refused, no indirect area?)"));
+	/* the cycle reads the registers where they lie */
+	assert_int_equal(cyc_read_of(&y).addr, 126);
+	run(20);
+	assert_int_equal(y.errors, 0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1361,6 +1467,8 @@ int main(void)
 		cmocka_unit_test(test_writes_are_the_models_x),
 		cmocka_unit_test(test_fast_sync_read),
 		cmocka_unit_test(test_one_bus_of_two),
+		cmocka_unit_test(test_indirect_block),
+		cmocka_unit_test(test_indirect_refused),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -129,6 +129,43 @@ static void test_present_block_x(void **state)
 	assert_false(sm_decode_present(xm, fast, 6, &p));
 }
 
+/* The indirect block (Indirect Data 1.. at 224): 126..135 then 144..146, 10
+ * or 13 bytes, decoded by the same decoder to the same values as the direct
+ * block's 10 or 21; the AX-12A has none. */
+static void test_present_block_indirect(void **state)
+{
+	(void)state;
+	const struct sm_model *xm = sm_by_number(2, 1020);
+	const struct sm_read *rd = &xm->indirect;
+	assert_int_equal(rd->addr, 224);
+	assert_int_equal(rd->len, 10);
+	assert_int_equal(rd->len_slow, 13);
+	assert_int_equal(rd->src[0], 126);
+	assert_int_equal(rd->src[9], 135);
+	assert_int_equal(rd->src[10], 144);
+	assert_int_equal(rd->src[12], 146);
+	assert_int_equal(sm_ax12()->indirect.len, 0);
+	uint8_t direct[21] = { 0x9C, 0xFF, 0xFD, 0xFF, 0xFF, 0xFF, 0xA6, 0x00, 0x00, 0x00 }, block[13];
+	direct[18] = 118;
+	direct[20] = 41;
+	for (size_t k = 0; k < rd->len_slow; k++)
+		block[k] = direct[rd->src[k] - 126];
+	struct sm_present a, b;
+	struct sm_read dr = sm_direct_read(xm);
+	assert_true(sm_decode_read(xm, &dr, direct, 21, &a));
+	assert_true(sm_decode_read(xm, rd, block, 13, &b));
+	assert_true(a.slow && b.slow);
+	assert_int_equal(a.pos_raw, b.pos_raw);
+	assert_true(a.speed == b.speed && a.load == b.load && a.voltage == b.voltage && a.temperature == b.temperature);
+	assert_true(fabs(b.voltage - 11.8) < 1e-9 && fabs(b.temperature - 41) < 1e-12);
+	assert_true(sm_decode_read(xm, rd, block, 10, &b));
+	assert_false(b.slow);
+	assert_int_equal(b.pos_raw, 166);
+	assert_true(isnan(b.voltage));
+	/* the direct block's slow length is not the indirect block's */
+	assert_false(sm_decode_read(xm, rd, direct, 21, &b));
+}
+
 /* The AX-12's 36..43: as control.c always decoded it. */
 static void test_present_block_ax(void **state)
 {
@@ -395,6 +432,7 @@ int main(void)
 		cmocka_unit_test(test_capabilities),
 		cmocka_unit_test(test_positions_both_ways),
 		cmocka_unit_test(test_present_block_x),
+		cmocka_unit_test(test_present_block_indirect),
 		cmocka_unit_test(test_present_block_ax),
 		cmocka_unit_test(test_readback_blocks_x),
 		cmocka_unit_test(test_readback_block_ax),

@@ -1200,6 +1200,23 @@ static void test_x_read_by_name(void **state)
 	assert_non_null(strstr(f->err, "no reply from ID 9"));
 }
 
+/* The indirect areas by name (protocol/dxl2_table.c's rows): the factory map,
+ * a slot pointed at Present Temperature, read through its data byte. */
+static void test_x_indirect_by_name(void **state)
+{
+	struct fixture *f = *state;
+
+	assert_int_equal(run_dxl(f, "--protocol", "2", "read", "1", "indirect_address_1", NULL), 0);
+	assert_string_equal(f->out, "224\n");
+	assert_int_equal(run_dxl(f, "--protocol", "2", "read", "1", "indirect_address_29", NULL), 0);
+	assert_string_equal(f->out, "634\n");
+	assert_int_equal(run_dxl(f, "--protocol", "2", "write", "1", "indirect_address_1", "146", NULL), 0);
+	assert_int_equal(run_dxl(f, "--protocol", "2", "read", "1", "indirect_data_1", NULL), 0);
+	assert_string_equal(f->out, "36\n");
+	/* outside 64..661: refused before anything is sent */
+	assert_int_equal(run_dxl(f, "--protocol", "2", "write", "1", "indirect_address_2", "63", NULL), DXLT_EXIT_USAGE);
+}
+
 static void test_x_write_checks_first(void **state)
 {
 	struct fixture *f = *state;
@@ -1416,6 +1433,7 @@ int main(int argc, char **argv)
 		cmocka_unit_test_setup_teardown(test_x_fake_answers_manual_vectors, setup_x, teardown),
 		cmocka_unit_test_setup_teardown(test_x_scan_all_bauds, setup_x, teardown),
 		cmocka_unit_test_setup_teardown(test_x_read_by_name, setup_x, teardown),
+		cmocka_unit_test_setup_teardown(test_x_indirect_by_name, setup_x, teardown),
 		cmocka_unit_test_setup_teardown(test_x_write_checks_first, setup_x, teardown),
 		cmocka_unit_test_setup_teardown(test_x_unknown_model, setup_x, teardown),
 		cmocka_unit_test_setup_teardown(test_x_dump, setup_x, teardown),

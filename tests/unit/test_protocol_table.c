@@ -526,7 +526,33 @@ static void test_x_lookup(void **state)
 	assert_int_equal(dxl2_reg_lookup(m, "0116")->addr, 116);  /* decimal, not octal */
 	assert_null(dxl2_reg_lookup(m, "133"));     /* inside a register */
 	assert_null(dxl2_reg_lookup(m, "14"));      /* a gap */
-	assert_null(dxl2_reg_lookup(m, "168"));     /* indirect area: not described */
+	/* the indirect areas (e-manual): addresses 168.. and 578.., 64..661,
+	 * each Indirect Data n's own address at the factory; data 224.., 634.. */
+	r = dxl2_reg_lookup(m, "168");
+	assert_non_null(r);
+	assert_string_equal(r->name, "indirect_address_1");
+	assert_int_equal(r->size, 2);
+	assert_int_equal(r->def, 224);
+	assert_int_equal(r->min, 64);
+	assert_int_equal(r->max, 661);
+	assert_int_equal(r->area, DXL_AREA_EEPROM);
+	assert_int_equal(dxl2_reg_lookup(m, "indirect_address_29")->addr, 578);
+	assert_int_equal(dxl2_reg_lookup(m, "indirect_address_29")->def, 634);
+	assert_int_equal(dxl2_reg_lookup(m, "indirect_data_28")->addr, 251);
+	assert_int_equal(dxl2_reg_lookup(m, "661")->size, 1);
+	assert_string_equal(dxl2_reg_lookup(m, "661")->name, "indirect_data_56");
+	assert_null(dxl2_reg_lookup(m, "252"));     /* a gap between the blocks */
+	assert_null(dxl2_reg_lookup(m, "662"));
+	assert_true(dxl2_model_can(m, DXL2_CAP_INDIRECT));
+	assert_int_equal(dxl2_indirect_slot(224), 1);
+	assert_int_equal(dxl2_indirect_slot(251), 28);
+	assert_int_equal(dxl2_indirect_slot(634), 29);
+	assert_int_equal(dxl2_indirect_slot(661), 56);
+	assert_int_equal(dxl2_indirect_slot(223), 0);
+	assert_int_equal(dxl2_indirect_slot(252), 0);
+	assert_int_equal(dxl2_indirect_address_reg(29), 578);
+	assert_int_equal(dxl2_indirect_data_addr(56), 661);
+	assert_int_equal(dxl2_indirect_data_addr(57), 0);
 	assert_null(dxl2_reg_lookup(m, "65536"));
 	assert_null(dxl2_reg_lookup(m, "nonsense"));
 	assert_null(dxl2_reg_lookup(m, ""));

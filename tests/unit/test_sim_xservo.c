@@ -117,6 +117,155 @@ static void manual_servo(struct sim_xservo *s, uint8_t id, double pulses)
 	sense_at(s, pulses, 12.0, 25.0, 0.001);
 }
 
+/* ---- the indirect areas (e-manual, "Indirect Address, Indirect Data") ------------- */
+
+/* A READ of n bytes at addr: the ERR field, the bytes in data. */
+static int rd(struct sim_xservo *s, uint16_t addr, uint16_t n, uint8_t *data)
+{
+	uint8_t p[4] = { (uint8_t)addr, (uint8_t)(addr >> 8), (uint8_t)n, (uint8_t)(n >> 8) }, out[OUT];
+	struct dxl2_packet st;
+	int err = status(out, req(s, 1, DXL2_INST_READ, p, 4, out), 1, &st);
+	if (err == 0) {
+		assert_int_equal(st.nparams, n);
+		memcpy(data, st.params, n);
+	}
+	return err;
+}
+
+/* A WRITE of n raw bytes at addr: the ERR field. */
+static int wr_bytes(struct sim_xservo *s, uint16_t addr, const uint8_t *data, size_t n)
+{
+	uint8_t p[64] = { (uint8_t)addr, (uint8_t)(addr >> 8) }, out[OUT];
+	struct dxl2_packet st;
+	memcpy(&p[2], data, n);
+	return status(out, req(s, 1, DXL2_INST_WRITE, p, 2 + n, out), 1, &st);
+}
+
+/* Factory values: Indirect Address n holds Indirect Data n's own address
+ * (224.. and 634..), the data bytes read 0 and keep what is written (each
+ * points at itself). The SDK's checks read 168 first: no access error. */
+static void test_indirect_factory(void **state)
+{
+	(void)state;
+	struct sim_xservo s;
+	uint8_t b[56];
+	sim_xservo_init(&s, SIM_MODEL_XL430_W250, NULL, 0.0);
+	assert_int_equal(rd(&s, DXL2_X_INDIRECT_ADDRESS_1, 56, b), 0);
+	for (int n = 0; n < 28; n++)
+		assert_int_equal(b[2 * n] | b[2 * n + 1] << 8, 224 + n);
+	assert_int_equal(peek(&s, DXL2_X_INDIRECT_ADDRESS_29), 634);
+	assert_int_equal(peek(&s, 632), 661);    /* Indirect Address 56 */
+	assert_int_equal(rd(&s, DXL2_X_INDIRECT_DATA_1, 28, b), 0);
+	for (int n = 0; n < 28; n++)
+		assert_int_equal(b[n], 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1 + 3, 0xA5, 1), 0);
+	assert_int_equal(rd(&s, DXL2_X_INDIRECT_DATA_1 + 3, 1, b), 0);
+	assert_int_equal(b[0], 0xA5);
+	assert_int_equal(wr(&s, 1, 661, 0x5A, 1), 0);
+	assert_int_equal(peek(&s, 661), 0x5A);
+}
+
+/* Mapped: Indirect Data n reads and writes the byte Indirect Address n
+ * names, one byte each; the manual's examples (LED, then Goal Position by
+ * four consecutive slots), Present Position read through four slots. */
+static void test_indirect_read_write_through(void **state)
+{
+	(void)state;
+	struct sim_xservo s;
+	uint8_t b[8];
+	sim_xservo_init(&s, SIM_MODEL_XM430_W350, NULL, 0.0);
+	sense_at(&s, 3000, 12.0, 25.0, 0.001);
+	/* Example 1: LED (65) in slot 1 */
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, DXL2_X_LED, 2), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1, 1, 1), 0);
+	assert_int_equal(peek(&s, DXL2_X_LED), 1);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1, 0, 1), 0);
+	assert_int_equal(peek(&s, DXL2_X_LED), 0);
+	/* Example 2: Goal Position (116..119) in slots 2..5, written as one */
+	uint8_t map[8] = { 116, 0, 117, 0, 118, 0, 119, 0 };
+	assert_int_equal(wr_bytes(&s, DXL2_X_INDIRECT_ADDRESS_1 + 2, map, 8), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1 + 1, 1024, 4), 0);
+	assert_int_equal(peek(&s, DXL2_X_GOAL_POSITION), 1024);
+	assert_int_equal(rd(&s, DXL2_X_INDIRECT_DATA_1 + 1, 4, b), 0);
+	assert_int_equal(dxl2_get_u32(b), 1024);
+	/* Present Position (132..135) in slots 29..32: the second block */
+	uint8_t pos[8] = { 132, 0, 133, 0, 134, 0, 135, 0 };
+	assert_int_equal(wr_bytes(&s, DXL2_X_INDIRECT_ADDRESS_29, pos, 8), 0);
+	assert_int_equal(rd(&s, DXL2_X_INDIRECT_DATA_29, 4, b), 0);
+	assert_int_equal((int32_t)dxl2_get_u32(b), peek(&s, DXL2_X_PRESENT_POSITION));
+	assert_int_equal((int32_t)dxl2_get_u32(b), 3000);
+	/* a SYNC_READ of the indirect block answers the mapped bytes too */
+	uint8_t sp[5] = { (uint8_t)DXL2_X_INDIRECT_DATA_29, DXL2_X_INDIRECT_DATA_29 >> 8, 4, 0, 1 }, out[OUT];
+	struct dxl2_packet st;
+	assert_int_equal(status(out, req(&s, DXL2_BROADCAST_ID, DXL2_INST_SYNC_READ, sp, 5, out), 1, &st), 0);
+	assert_int_equal((int32_t)dxl2_get_u32(st.params), 3000);
+}
+
+/* The rules: an Indirect Address takes 64..661 only (data range error); it
+ * is written with the torque off (access error else, as EEPROM, and kept
+ * over a REBOOT); a write through Indirect Data obeys the target's own
+ * rules: read-only (access), part of a register (data length), its range
+ * and limit, EEPROM under torque. */
+static void test_indirect_rules(void **state)
+{
+	(void)state;
+	struct sim_xservo s;
+	uint8_t b[4], out[OUT];
+	sim_xservo_init(&s, SIM_MODEL_XM430_W350, NULL, 0.0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, 63, 2), DXL2_ERRNUM_DATA_RANGE);   /* EEPROM */
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, 662, 2), DXL2_ERRNUM_DATA_RANGE);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, 64, 1), DXL2_ERRNUM_DATA_LENGTH);
+	assert_int_equal(peek(&s, DXL2_X_INDIRECT_ADDRESS_1), 224);
+	/* read-only target: Present Position's first byte */
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, DXL2_X_PRESENT_POSITION, 2), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1, 0, 1), DXL2_ERRNUM_ACCESS);
+	/* one byte of a 4-byte register: data length */
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, DXL2_X_GOAL_POSITION, 2), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1, 0, 1), DXL2_ERRNUM_DATA_LENGTH);
+	/* range: Status Return Level takes 0..2 */
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, DXL2_X_STATUS_RETURN_LEVEL, 2), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1, 3, 1), DXL2_ERRNUM_DATA_RANGE);
+	assert_int_equal(peek(&s, DXL2_X_STATUS_RETURN_LEVEL), 2);
+	/* limit: Goal PWM (2 slots) beyond PWM Limit */
+	uint8_t pwm[4] = { 100, 0, 101, 0 };
+	assert_int_equal(wr_bytes(&s, DXL2_X_INDIRECT_ADDRESS_1 + 2, pwm, 4), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1 + 1, 900, 2), DXL2_ERRNUM_DATA_LIMIT);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1 + 1, 500, 2), 0);
+	assert_int_equal(peek(&s, DXL2_X_GOAL_PWM), 500);
+	/* torque on: the Indirect Address registers are locked, the data is not */
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, DXL2_X_LED, 2), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_TORQUE_ENABLE, 1, 1), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, 224, 2), DXL2_ERRNUM_ACCESS);
+	assert_int_equal(peek(&s, DXL2_X_INDIRECT_ADDRESS_1), DXL2_X_LED);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_1, 1, 1), 0);
+	assert_int_equal(peek(&s, DXL2_X_LED), 1);
+	/* an indirect byte pointing at an Indirect Address register (168..,
+	 * inside 64..661) writes it as that register: locked under torque too */
+	assert_int_equal(wr(&s, 1, DXL2_X_TORQUE_ENABLE, 0, 1), 0);
+	uint8_t ia[4] = { 170, 0, 171, 0 };
+	assert_int_equal(wr_bytes(&s, DXL2_X_INDIRECT_ADDRESS_29, ia, 4), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_TORQUE_ENABLE, 1, 1), 0);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_DATA_29, 65, 2), DXL2_ERRNUM_ACCESS);
+	/* REBOOT keeps the mapping (kept as EEPROM) and answers first */
+	uint8_t none[1];
+	assert_int_equal(status(out, req(&s, 1, DXL2_INST_REBOOT, none, 0, out), 1, &(struct dxl2_packet){ 0 }), 0);
+	assert_int_equal(peek(&s, DXL2_X_INDIRECT_ADDRESS_1), DXL2_X_LED);
+	assert_int_equal(rd(&s, DXL2_X_INDIRECT_DATA_1, 1, b), 0);
+	assert_int_equal(b[0], 0);   /* LED back to its RAM default */
+	/* FACTORY_RESET puts the factory mapping back */
+	uint8_t all[1] = { DXL2_RESET_ALL };
+	assert_int_equal(status(out, req(&s, 1, DXL2_INST_FACTORY_RESET, all, 1, out), 1, &(struct dxl2_packet){ 0 }), 0);
+	assert_int_equal(peek(&s, DXL2_X_INDIRECT_ADDRESS_1), 224);
+	/* a servo without the areas ([sim] indirect = false): the access error */
+	struct sim_xservo_options o;
+	sim_xservo_default_options(&o);
+	o.no_indirect = true;
+	sim_xservo_init(&s, SIM_MODEL_XL430_W250, &o, 0.0);
+	assert_int_equal(rd(&s, DXL2_X_INDIRECT_ADDRESS_1, 2, b), DXL2_ERRNUM_ACCESS);
+	assert_int_equal(wr(&s, 1, DXL2_X_INDIRECT_ADDRESS_1, DXL2_X_LED, 2), DXL2_ERRNUM_ACCESS);
+	assert_int_equal(rd(&s, DXL2_X_PRESENT_TEMPERATURE, 1, b), 0);
+}
+
 /* ---- the e-manual's examples --------------------------------------------------- */
 
 static void test_golden_ping(void **state)
@@ -320,7 +469,7 @@ static void test_error_numbers(void **state)
 	assert_int_equal(wr(&s, 1, DXL2_X_TORQUE_ENABLE, 1, 1), 0);
 	assert_int_equal(wr(&s, 1, DXL2_X_RETURN_DELAY_TIME, 0, 1), DXL2_ERRNUM_ACCESS);
 	assert_int_equal(peek(&s, DXL2_X_RETURN_DELAY_TIME), 250);
-	uint8_t past[4] = { 146, 0, 4, 0 };
+	uint8_t past[4] = { 0x94, 0x02, 4, 0 };   /* 660..663: the table ends at 661 */
 	assert_int_equal(status(out, req(&s, 1, DXL2_INST_READ, past, 4, out), 1, &st), DXL2_ERRNUM_ACCESS);
 	/* a write is atomic: one refused byte refuses it all (LED 1, then a read-only byte) */
 	uint8_t p[5] = { DXL2_X_LED, 0, 1, 0, 0 };
@@ -636,6 +785,9 @@ int main(void)
 		cmocka_unit_test(test_operating_modes),
 		cmocka_unit_test(test_present_values),
 		cmocka_unit_test(test_malformed_multi),
+		cmocka_unit_test(test_indirect_factory),
+		cmocka_unit_test(test_indirect_read_write_through),
+		cmocka_unit_test(test_indirect_rules),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -14,6 +14,10 @@
  * too. It answers PING, READ, WRITE, FACTORY_RESET, REBOOT (a boot: RAM to
  * its defaults), SYNC_READ (each listed servo in the list's order) and
  * SYNC_WRITE; it hears only at its own baud rate when line_baud is set.
+ * The indirect areas: a READ of Indirect Data n gives the byte Indirect
+ * Address n holds (one level), and the Indirect Address registers are
+ * refused with torque on, as EEPROM; a servo may have none (no_indirect:
+ * 148.. refused) or keep one slot at its factory value (ind_stuck).
  * Header-only (static inline, as busfake.h): a helper .c would be linked
  * into every unit test, also those that do not link the protocol library.
  */
@@ -30,7 +34,7 @@
 #include "dxl2_table.h"
 
 #define XFAKE_MAX_SERVOS 8
-#define XFAKE_TABLE 160
+#define XFAKE_TABLE DXL2_X_TABLE_SIZE
 #define XFAKE_RX_MAX 2048
 #define XFAKE_FIRMWARE 46
 
@@ -41,6 +45,8 @@ struct xfake_servo {
 	bool powered;                /* false: hears nothing */
 	bool refuse_writes;          /* every write refused (access error), nothing written */
 	unsigned drive_parts;        /* SYNC_WRITE parts naming it with a non-zero Goal PWM or Current */
+	bool no_indirect;            /* no indirect areas: 148.. answers the access error */
+	int ind_stuck;               /* 1..56: that Indirect Address keeps its value, the write acknowledged */
 };
 
 struct xfake {
@@ -127,6 +133,25 @@ static inline void xfake_servo_defaults(struct xfake_servo *s, uint8_t id, uint1
 	s->mem[146] = 36;                         /* 36 °C */
 }
 
+/* len bytes from addr as a READ answers them: Indirect Data n as the byte
+ * Indirect Address n holds (within 64..661), every other byte itself. */
+static inline const uint8_t *xfake_view(const struct xfake_servo *s, uint16_t addr, uint16_t len, uint8_t *buf)
+{
+	for (uint16_t i = 0; i < len; i++) {
+		uint16_t a = (uint16_t)(addr + i);
+		int n = dxl2_indirect_slot(a);
+		uint16_t to = n ? (uint16_t)xfake_get(s->mem, dxl2_indirect_address_reg(n), 2) : a;
+		buf[i] = s->mem[to >= DXL2_X_INDIRECT_MIN && to <= DXL2_X_INDIRECT_MAX ? to : a];
+	}
+	return buf;
+}
+
+/* The end of what the servo answers. */
+static inline size_t xfake_end(const struct xfake_servo *s)
+{
+	return s->no_indirect ? DXL2_X_PRESENT_END : XFAKE_TABLE;
+}
+
 static inline bool xfake_hears(const struct xfake *fb, const struct xfake_servo *s)
 {
 	static const long rates[8] = { 9600, 57600, 115200, 1000000, 2000000, 3000000, 4000000, 4500000 };
@@ -176,9 +201,13 @@ static inline uint8_t xfake_write_error(const struct xfake_servo *s, uint16_t ad
 {
 	if (addr + n > XFAKE_TABLE)
 		return DXL2_ERRNUM_DATA_LENGTH;
-	if (s->refuse_writes)
+	if (s->refuse_writes || addr + n > xfake_end(s))
 		return DXL2_ERRNUM_ACCESS;
 	if (addr < DXL2_X_EEPROM_END && s->mem[64])
+		return DXL2_ERRNUM_ACCESS;
+	bool ind_addr = (addr + n > DXL2_X_INDIRECT_ADDRESS_1 && addr < DXL2_X_INDIRECT_DATA_1) ||
+	                (addr + n > DXL2_X_INDIRECT_ADDRESS_29 && addr < DXL2_X_INDIRECT_DATA_29);
+	if (ind_addr && s->mem[64])
 		return DXL2_ERRNUM_ACCESS;
 	if (addr <= 64 && addr + n > 64 && data[64 - addr] && (s->mem[70] & s->mem[63]))
 		return DXL2_ERRNUM_RESULT_FAIL;
@@ -192,8 +221,12 @@ static inline void xfake_write(struct xfake *fb, struct xfake_servo *s, const ui
 		fb->on_write(fb->ctx, s, addr, n - 2);
 	uint8_t err = n < 3 ? DXL2_ERRNUM_DATA_LENGTH : xfake_write_error(s, addr, n - 2, p + 2);
 	if (err == 0) {
+		uint16_t stuck = dxl2_indirect_address_reg(s->ind_stuck);
+		uint8_t keep[2] = { stuck ? s->mem[stuck] : 0, stuck ? s->mem[stuck + 1] : 0 };
 		atomic_fetch_add(&fb->writes, 1);
 		memcpy(&s->mem[addr], p + 2, n - 2);
+		if (stuck)
+			memcpy(&s->mem[stuck], keep, 2);
 	}
 	xfake_reply(fb, s, broadcast, 2, err, NULL, 0);
 }
@@ -213,10 +246,13 @@ static inline void xfake_execute(struct xfake *fb, struct xfake_servo *s, uint8_
 	switch (instr) {   /* PING is the dispatch's: answered at every level */
 	case 0x02: { /* READ addr(2) len(2) */
 		uint16_t addr = (uint16_t)xfake_get(p, 0, 2), len = (uint16_t)xfake_get(p, 2, 2);
+		uint8_t buf[XFAKE_TABLE];
 		if (n != 4 || len == 0 || addr + len > XFAKE_TABLE)
 			xfake_reply(fb, s, broadcast, 1, DXL2_ERRNUM_DATA_RANGE, NULL, 0);
+		else if (addr + len > xfake_end(s))
+			xfake_reply(fb, s, broadcast, 1, DXL2_ERRNUM_ACCESS, NULL, 0);
 		else
-			xfake_reply(fb, s, broadcast, 1, 0, &s->mem[addr], len);
+			xfake_reply(fb, s, broadcast, 1, 0, xfake_view(s, addr, len, buf), len);
 		break;
 	}
 	case 0x03:
@@ -266,8 +302,11 @@ static inline void xfake_sync(struct xfake *fb, uint8_t instr, const uint8_t *p,
 		if (instr == 0x83 && fb->on_write != NULL)
 			fb->on_write(fb->ctx, s, addr, len);
 		if (instr == 0x82) {
-			if (s->mem[68] >= 1)
-				xfake_send_status(fb, s, 0, &s->mem[addr], len);
+			uint8_t buf[XFAKE_TABLE];
+			if (s->mem[68] >= 1 && addr + len > xfake_end(s))
+				xfake_send_status(fb, s, DXL2_ERRNUM_ACCESS, NULL, 0);
+			else if (s->mem[68] >= 1)
+				xfake_send_status(fb, s, 0, xfake_view(s, addr, len, buf), len);
 		} else if (xfake_write_error(s, addr, len, &p[off + 1]) == 0) {
 			atomic_fetch_add(&fb->writes, 1);
 			memcpy(&s->mem[addr], &p[off + 1], len);
@@ -304,7 +343,8 @@ static inline void xfake_fast_sync(struct xfake *fb, const uint8_t *p, size_t n)
 		uint8_t alert = fb->alert_from_hwerr && s->mem[70] ? 0x80 : 0;
 		pkt[k++] = (uint8_t)(s->err | alert);
 		pkt[k++] = s->mem[7];
-		memcpy(&pkt[k], &s->mem[addr], len);
+		uint8_t buf[XFAKE_TABLE];
+		memcpy(&pkt[k], xfake_view(s, addr, len, buf), len);
 		k += len;
 		uint16_t crc = xfake_crc(pkt, k);
 		pkt[k++] = (uint8_t)crc;

@@ -113,8 +113,11 @@ int dxlt2_ping(struct dxlt *t, uint8_t id, uint16_t *model, uint8_t *firmware);
 
 /* ---- registers.c: the commands that go by the control table ---- */
 /* The longest image of a control table read in one READ (`dump`, `write`'s
- * checks, `setup`): the X series' 0..147, model number .. present temperature. */
-#define DXLT_IMAGE_MAX DXL2_X_TABLE_SIZE
+ * checks, `setup`): the X series' 0..147, model number .. present temperature.
+ * The indirect areas past it (168-661) are read and written by name, one
+ * register at a time, never dumped: 514 more bytes a READ for rows that
+ * only repeat other registers. */
+#define DXLT_IMAGE_MAX DXL2_X_PRESENT_END
 
 /* A servo a command addresses, and the model whose table it goes by. */
 struct dxlt_servo {
