@@ -9,13 +9,13 @@
 #include "dxl_table.h"
 #include "servo_model.h"
 
-#define CYC_STR(x) #x
-#define CYC_XSTR(x) CYC_STR(x)
-#define CYC_FAST_FAILS_TEXT CYC_XSTR(CYC_FAST_FAILS_MAX)
-
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks)
 {
 	*y = (struct cyc){ .bus = bus, .ctl = ctl, .period_us = period_us, .phase = CYC_IDLE };
+	uint64_t period = period_us > 0 ? period_us : 1;
+	y->readback_every = CYC_READBACK_US / period > 0 ? CYC_READBACK_US / period : 1;
+	y->fast_fails_max = CYC_FAST_FAILS_US / period > CYC_FAST_FAILS_MAX ? (int)(CYC_FAST_FAILS_US / period)
+	                                                                    : CYC_FAST_FAILS_MAX;
 	if (hooks != NULL)
 		y->hooks = *hooks;
 }
@@ -144,18 +144,22 @@ static void cyc_fast_outcome(struct cyc *y)
 	if (!y->fast_read)
 		return;
 	y->fast_fails = y->multi.answered == 0 ? y->fast_fails + 1 : 0;
-	if (y->fast_fails < CYC_FAST_FAILS_MAX)
+	if (y->fast_fails < y->fast_fails_max)
 		return;
 	y->fast_read = false;
 	y->fast_fallbacks++;
-	if (y->hooks.notice != NULL)
-		y->hooks.notice(y->hooks.ctx, "bus: Fast Sync Read read nobody " CYC_FAST_FAILS_TEXT " cycles in a row: "
-		                "reading by SYNC_READ from now on, each servo's own status packet (until the next "
-		                "start or reconnect)");
+	if (y->hooks.notice == NULL)
+		return;
+	char text[256];
+	snprintf(text, sizeof text,
+	         "bus: Fast Sync Read read nobody %d cycles in a row (%.0f ms): reading by SYNC_READ from now on, each "
+	         "servo's own status packet (until the next start or reconnect)",
+	         y->fast_fails, 1e-3 * (double)((uint64_t)y->fast_fails * y->period_us));
+	y->hooks.notice(y->hooks.ctx, text);
 }
 
 /* This cycle's read-back, if any: a joint the controller asks for now (its
- * RAM block), else every CYC_READBACK_EVERY cycles the next joint in turn,
+ * RAM block), else every CYC_READBACK_US the next joint in turn,
  * and after the last joint the model's next block. */
 static bool cyc_pick_readback(struct cyc *y)
 {
@@ -165,7 +169,7 @@ static bool cyc_pick_readback(struct cyc *y)
 		y->readback_now_block = 0;
 		return true;
 	}
-	if (y->count % CYC_READBACK_EVERY != 0)
+	if (y->count % y->readback_every != 0)
 		return false;
 	y->readback_joint = (y->readback_joint + 1) % y->ctl->n;
 	if (y->readback_joint == 0)

@@ -5,7 +5,7 @@
  *   READ(36, n) of every joint ─→ CYC_CONTROL: the daemon applies commands
  *   and runs the control step ─→ SYNC_WRITE of the goals (or duties) ─→ the
  *   controller's register writes, one at a time, while the period allows ─→
- *   every CYC_READBACK_EVERY cycles, while the period allows, one joint's
+ *   every CYC_READBACK_US (50 ms), while the period allows, one joint's
  *   RAM block read back (ctl_readback) ─→ CYC_DONE. Writes never starve:
  *   when the reads leave no room for them cycle after cycle, one is sent
  *   before the reads (CYC_STARVED_CYCLES).
@@ -52,10 +52,12 @@
 #include "control.h"
 #include "dxl2.h"
 
-/* Read-back of one joint every CYC_READBACK_EVERY cycles, round-robin: each
- * of two joints every 0.1 s at 100 Hz (a servo reset is found within that),
- * for 340 µs of bus time at 1 Mbps. */
-#define CYC_READBACK_EVERY 5
+/* Read-back of one joint every CYC_READBACK_US, round-robin: each of two
+ * joints every 0.1 s (a servo reset is found within that), for 340 µs of bus
+ * time at 1 Mbps; every 5 cycles at 100 Hz, every 50 at 1 kHz. A time, not a
+ * count of cycles: at 1 kHz a read-back every 5 cycles was 200 transactions
+ * a second, each one a cycle that did not fit the period. */
+#define CYC_READBACK_US 50000
 /* Past this share of the period no new write or read-back is begun: a
  * transaction cut off by the next tick leaves its reply on the line. */
 #define CYC_LATE_SHARE 0.7
@@ -75,9 +77,12 @@ enum cyc_phase { CYC_IDLE, CYC_WRITE_FIRST, CYC_READ, CYC_CONTROL_STEP, CYC_WRIT
  * its reads. */
 #define CYC_STARVED_CYCLES 2
 /* Fast Sync Reads in a row that read nobody before the plain SYNC_READ is
- * used again: a lost servo then costs the others 30 ms at 100 Hz, and a
- * single damaged packet (every joint stale for one cycle) changes nothing. */
+ * used again: CYC_FAST_FAILS_US of them, at least CYC_FAST_FAILS_MAX cycles.
+ * A lost servo then costs the others 30 ms (3 cycles at 100 Hz, 30 at
+ * 1 kHz), and a single damaged packet, or a stall of the machine of a few
+ * milliseconds at 1 kHz, changes nothing. */
 #define CYC_FAST_FAILS_MAX 3
+#define CYC_FAST_FAILS_US 30000
 
 struct cyc_hooks {
 	void *ctx;
@@ -105,6 +110,8 @@ struct cyc {
 	/* Protocol 2.0: this cycle's SYNC_READ (or Fast Sync Read) and its replies */
 	bool fast_read;               /* the read is a Fast Sync Read (cyc_set_fast_read) */
 	int fast_fails;               /* Fast Sync Reads in a row that read nobody */
+	int fast_fails_max;           /* CYC_FAST_FAILS_US in cycles of this period */
+	uint64_t readback_every;      /* CYC_READBACK_US in cycles of this period, at least 1 */
 	struct bus_multi multi;
 	uint8_t multi_buf[CFG_MAX_JOINTS * 32];
 	uint64_t start_us;            /* this cycle's start (the tick) */
