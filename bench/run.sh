@@ -1071,6 +1071,7 @@ RATE_READS="sync fast"
 RATE_SERVOS=${BENCH_RATE_SERVOS:-2 6 12 18}
 RATE_BAUDS=${BENCH_RATE_BAUDS:-1000000 2000000 4000000}
 RATE_PERIODS_MS="10 5 4 2 1"
+RATE_DMN_ARGS=()
 PORT_RATE=7910
 rate_read_label() { case $1 in sync) echo "SYNC_READ" ;; fast) echo "Fast Sync Read" ;; *) echo "$1" ;; esac; }
 # The simulator's options that make the daemon read that way: it reads by Fast
@@ -1103,7 +1104,7 @@ rate_daemon() {
 	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
 	wait_file "$out.lcm" 10
 	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" \
-		--lcm-url "$u" --mode oscillator --set robot.period_ms="$p"; then
+		--lcm-url "$u" --mode oscillator --set robot.period_ms="$p" ${RATE_DMN_ARGS[@]+"${RATE_DMN_ARGS[@]}"}; then
 		sleep "$RATE_SETTLE_S"
 		t0=$(now_us)
 		sleep "$w"
@@ -1119,16 +1120,51 @@ rate_daemon() {
 	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
 }
 
-# rate_search NAME N BAUD FLOOR_US: the shortest period of RATE_PERIODS_MS
-# with no overrun over RATE_S seconds; writes "best P" and "next P OVERRUNS"
-# (the next shorter period tried and its overruns) to $T/rate/NAME.best.
+# rate_lockstep NAME N BAUD PERIOD_MS READ: the same robot in the simulator's
+# virtual time (lockstep), RATE_S simulated seconds after 2: neither program
+# can be late there, so an overrun is the cycle not fitting the period.
+# Results in $T/rate/NAME-PERIOD like rate_daemon's.
+rate_lockstep() {
+	local name=$1 n=$2 baud=$3 p=$4 read=$5 d=$T/rate u out
+	u=$(url $PORT_RATE)
+	out=$d/$name-$p
+	rm -f "$d/$name.clock"
+	# shellcheck disable=SC2046 # the read's options are words
+	start "sim-$name" "$SIM" --model xm430-w350 --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
+		--baud "$baud" $(rate_sim_args "$read") --lcm-url "$u" --quiet --lockstep "$d/$name.clock" \
+		--duration "$((RATE_S + 2))"
+	if ! wait_file "$d/$name.clock" 10; then
+		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
+		stop "sim-$name"
+		return 0
+	fi
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
+	wait_file "$out.lcm" 10
+	"$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" --lcm-url "$u" \
+		--mode oscillator --set robot.period_ms="$p" --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
+	wait "${PID[sim-$name]}" 2>/dev/null
+	unset "PID[sim-$name]"
+	stop "log-$name"
+	"$HB/logstat" --skip 1 "$out.lcm" >"$out"
+	grep -q 'reading by SYNC_READ from now on' "$T/dmn-$name.log" && echo "fell_back 1" >>"$out"
+	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
+}
+
+# rate_search NAME N BAUD FLOOR_US RUNNER [READ]: the shortest period of
+# RATE_PERIODS_MS with no overrun over RATE_S seconds, each run by RUNNER
+# (rate_daemon or rate_lockstep); writes "best P" and "next P OVERRUNS" (the
+# next shorter period tried and its overruns) to $T/rate/NAME.best.
 rate_search() {
-	local name=$1 n=$2 baud=$3 floor=$4 ps i start=0 best="" next="" o
+	local name=$1 n=$2 baud=$3 floor=$4 runner=$5 read=${6:-} ps i start=0 best="" next="" o
 	read -r -a ps <<<"$RATE_PERIODS_MS"
 	for i in "${!ps[@]}"; do [ $((ps[i] * 1000)) -ge $((floor * 3 / 2)) ] && start=$i; done
 	i=$start
 	while [ "$i" -ge 0 ] && [ "$i" -lt ${#ps[@]} ]; do
-		rate_daemon "$name" "$n" "$baud" "${ps[i]}" "$RATE_S"
+		if [ "$runner" = rate_lockstep ]; then
+			rate_lockstep "$name" "$n" "$baud" "${ps[i]}" "$read"
+		else
+			rate_daemon "$name" "$n" "$baud" "${ps[i]}" "$RATE_S"
+		fi
 		o=$(v "$T/rate/$name-${ps[i]}" all.overruns)
 		if [ "$o" = 0 ]; then
 			best=${ps[i]}
@@ -1171,7 +1207,7 @@ rate_best_cell() {
 
 section_rate() {
 	local n baud read name loads=""
-	progress "rate: ${RATE_SERVOS// /\/} X servos x 1/2/4 Mbps x ${RATE_READS// /, }: buscycle $RATE_CYCLES cycles, undulated ${RATE_S} s a period"
+	progress "rate: ${RATE_SERVOS// /\/} X servos x 1/2/4 Mbps x ${RATE_READS// /, }: buscycle $RATE_CYCLES cycles, undulated ${RATE_S} s a period, in real time and in lockstep"
 	for n in $RATE_SERVOS; do
 		for baud in $RATE_BAUDS; do
 			for read in $RATE_READS; do
@@ -1185,8 +1221,9 @@ section_rate() {
 				local floor
 				floor=$(v "$T/rate/$name.bc" floor_us)
 				[ "$floor" = nan ] && floor=1000
-				rate_search "$name" "$n" "$baud" "$floor"
+				rate_search "$name" "$n" "$baud" "$floor" rate_daemon
 				stop "sim-$name"
+				rate_search "lock-$name" "$n" "$baud" "$floor" rate_lockstep "$read"
 			done
 		done
 	done
@@ -1197,7 +1234,9 @@ section_rate() {
 	say "current, velocity, position) and one SYNC_WRITE of goals. **Bus time**: buscycle's cycle at"
 	say "$((RATE_CYCLE_US / 1000)) ms for $RATE_CYCLES cycles, p50 against the wire floor of its own read (bench/README.md, \"Rates\")."
 	say "**Highest rate**: undulated (OSCILLATOR) at period_ms ${RATE_PERIODS_MS// /, }, ${RATE_S} s each after ${RATE_SETTLE_S} s;"
-	say "the shortest period with 0 overruns in that window, and the next shorter one tried with its overruns."
+	say "the shortest period with 0 overruns in that window, and the next shorter one tried with its overruns;"
+	say "normal scheduling. **In lockstep**: the same search in the simulator's virtual time ($RATE_S simulated s"
+	say "after 2), where neither program can be late: an overrun there is the cycle not fitting the period."
 	say "Load average (1 min) during the section: $(echo "$loads" | awk '{ lo = $1; hi = $1; for (i = 2; i <= NF; i++) { if ($i < lo) lo = $i; if ($i > hi) hi = $i } print lo "–" hi }')."
 	say ""
 	local hdr="| servos | Mbps" sep="|---|---" cells
@@ -1215,39 +1254,92 @@ section_rate() {
 	done
 	say ""
 	hdr="| servos | Mbps"; sep="|---|---"
-	for read in $RATE_READS; do hdr="$hdr | $(rate_read_label "$read"): highest rate, no overrun"; sep="$sep|---"; done
+	for read in $RATE_READS; do
+		hdr="$hdr | $(rate_read_label "$read"): highest rate, no overrun | the same in lockstep"
+		sep="$sep|---|---"
+	done
 	say "$hdr |"; say "$sep|"
 	for n in $RATE_SERVOS; do
 		for baud in $RATE_BAUDS; do
 			cells="| $n | $((baud / 1000000))"
-			for read in $RATE_READS; do cells="$cells | $(rate_best_cell "$read-$n-$baud")"; done
+			for read in $RATE_READS; do
+				cells="$cells | $(rate_best_cell "$read-$n-$baud") | $(rate_best_cell "lock-$read-$n-$baud")"
+			done
 			say "$cells |"
 		done
 	done
 	cells="| 12 on two buses | 4"
-	for read in $RATE_READS; do cells="$cells | not measured: one bus per robot today"; done
+	for read in $RATE_READS; do cells="$cells | not measured: one bus per robot today | –"; done
 	say "$cells |"
 	say ""
 	rate_1k_table
 }
 
-# The budget: six XM430-W350 on one 4 Mbps bus at 1 kHz, RATE_1K_S seconds.
+# The budget: six XM430-W350 on one 4 Mbps bus at 1 kHz, RATE_1K_S seconds,
+# twice: in real time (both programs under SCHED_FIFO where permitted, as a
+# robot at 1 kHz would run: robot.priority), and in the simulator's virtual
+# time (lockstep), where neither program can be late: what is left there is
+# the cycle itself not fitting the period.
 rate_1k() {
-	local name=1k-6 n=6 baud=4000000
-	progress "rate: 6 X servos, 4 Mbps, Fast Sync Read, undulated at 1 kHz for ${RATE_1K_S} s"
+	local name=1k-6 n=6 baud=4000000 d=$T/rate u extra=()
+	u=$(url $PORT_RATE)
+	progress "rate: 6 X servos, 4 Mbps, Fast Sync Read, undulated at 1 kHz for ${RATE_1K_S} s, then as long in lockstep"
 	RATE_1K_LOAD0=$(cut -d' ' -f1-3 /proc/loadavg)
-	rate_sim "$name" "$n" "$baud" fast || return 0
-	"$HB/buscycle" --port "$T/rate/$name.pty" --protocol 2 --read-len 10 --read fast --baud "$baud" \
+	RATE_1K_POLICY="SCHED_OTHER (SCHED_FIFO not permitted)"
+	if chrt -f 1 true 2>/dev/null; then
+		RATE_1K_POLICY="SCHED_FIFO: undulated $FIFO_PRIORITY, undulate-sim $SIM_RT_PRIORITY"
+		extra=(--realtime "$SIM_RT_PRIORITY")
+	fi
+	local model=(--model xm430-w350 "${extra[@]}")
+	mkdir -p "$d"
+	start "sim-$name" "$SIM" --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 --baud "$baud" \
+		--lcm-url "$u" --quiet "${model[@]}"
+	if ! wait_ready "sim-$name" 'ready:' 10; then
+		echo "status not measured: the simulator refused $n X servos at $baud bps ($(why "sim-$name"))" >"$d/$name.sim"
+		stop "sim-$name"
+		return 0
+	fi
+	"$HB/buscycle" --port "$d/$name.pty" --protocol 2 --read-len 10 --read fast --baud "$baud" \
 		--ids "$(ids_upto "$n")" --cycles 20 --period-us "$RATE_CYCLE_US" --margin-us "$MARGIN_US" \
-		>"$T/rate/$name.bc" 2>"$T/rate/$name.err" ||
-		echo "status not measured: buscycle failed ($(tail -n1 "$T/rate/$name.err"))" >"$T/rate/$name.bc"
+		>"$d/$name.bc" 2>"$d/$name.err" ||
+		echo "status not measured: buscycle failed ($(tail -n1 "$d/$name.err"))" >"$d/$name.bc"
+	RATE_DMN_ARGS=()
+	[ ${#extra[@]} -gt 0 ] && RATE_DMN_ARGS=(--set "robot.priority=$FIFO_PRIORITY" --set robot.mlockall=true)
 	rate_daemon "$name" "$n" "$baud" 1 "$RATE_1K_S"
+	RATE_DMN_ARGS=()
 	stop "sim-$name"
 	RATE_1K_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
+	rate_1k_lockstep
+}
+
+# rate_1k_lockstep: the same robot in virtual time, RATE_1K_S simulated seconds
+rate_1k_lockstep() {
+	local name=1k-lock n=6 d=$T/rate u out
+	u=$(url $PORT_RATE)
+	out=$d/$name
+	start "sim-$name" "$SIM" --model xm430-w350 --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
+		--baud 4000000 --lcm-url "$u" --quiet --lockstep "$d/$name.clock" --duration "$((RATE_1K_S + 2))"
+	if ! wait_file "$d/$name.clock" 10; then
+		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
+		stop "sim-$name"
+		return 0
+	fi
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
+	wait_file "$out.lcm" 10
+	"$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud 4000000 --robot "r$n" --lcm-url "$u" \
+		--mode oscillator --set robot.period_ms=1 --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
+	wait "${PID[sim-$name]}" 2>/dev/null
+	unset "PID[sim-$name]"
+	stop "log-$name"
+	# the first 2 simulated seconds (start-up, ramp) left out: at 1.5x or more real time, 1 s of the logger's
+	"$HB/logstat" --skip 1 "$out.lcm" >"$out"
+	sed -n 's/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time in \([0-9.]*\) s.*/lockstep_sim_s \1\nlockstep_wall_s \2/p' \
+		"$T/sim-$name.log" >>"$out"
+	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
 }
 
 rate_1k_table() {
-	local f=$T/rate/1k-6-1 b=$T/rate/1k-6.bc floor what
+	local f=$T/rate/1k-6-1 b=$T/rate/1k-6.bc lk=$T/rate/1k-lock floor what lwhat
 	floor=$(v "$b" floor_us)
 	say "### The budget: six XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s"
 	say ""
@@ -1258,21 +1350,31 @@ rate_1k_table() {
 		what=$(sed -n 's/^status //p' "$f")
 		say "$what"
 	else
-		say "Load average at start $RATE_1K_LOAD0, at the end $RATE_1K_LOAD1. Fast Sync Read floor of the cycle"
-		say "(10 bytes a servo): $floor µs; the daemon reads 21 bytes every other cycle and one servo's"
-		say "registers back every $((5)) cycles, so its own p50 sits above it even on an idle machine."
+		say "Real time, $RATE_1K_POLICY; load average at start $RATE_1K_LOAD0, at the end $RATE_1K_LOAD1."
+		say "Fast Sync Read floor of the 10-byte cycle: $floor µs. At 1 ms undulated publishes every 10th cycle's"
+		say "STATE: the percentiles below are over those (the cycles that read 21 bytes a servo, floor 555 µs);"
+		say "the overruns are its counter, over every cycle. Lockstep: the same, in the simulator's virtual time."
 		say ""
-		say "| cycles | overruns | period p50 | p99 | max | bus p50 | p99 | max | bus p50/floor | control p99 | simulator step lateness p99 | max |"
+		say "| run | STATEs | overruns | period p50 | p99 | max | bus p50 | p99 | max | bus p50/floor | simulator step lateness p99 | max |"
 		say "|---|---|---|---|---|---|---|---|---|---|---|---|"
-		say "| $(v "$f" all.n) | $(v "$f" all.overruns) | $(fmt "$(v "$f" all.period_p50)") | $(fmt "$(v "$f" all.period_p99)") |" \
+		say "| real time | $(v "$f" all.n) | $(v "$f" all.overruns) | $(fmt "$(v "$f" all.period_p50)") | $(fmt "$(v "$f" all.period_p99)") |" \
 			"$(fmt "$(v "$f" all.period_max)") | $(fmt "$(v "$f" all.bus_p50)") | $(fmt "$(v "$f" all.bus_p99)") |" \
-			"$(fmt "$(v "$f" all.bus_max)") | $(ratio "$(v "$f" all.bus_p50)" "$floor") | $(fmt "$(v "$f" all.control_p99)") |" \
+			"$(fmt "$(v "$f" all.bus_max)") | $(ratio "$(v "$f" all.bus_p50)" "$floor") |" \
 			"$(fmt "$(v "$f" truth.late_p99)") | $(fmt "$(v "$f" truth.late_max)") |"
-		what="$(v "$f" all.overruns) overruns in ${RATE_1K_S} s; bus p50 $(fmt "$(v "$f" all.bus_p50)") µs = $(ratio "$(v "$f" all.bus_p50)" "$floor") the floor ($floor µs); load $RATE_1K_LOAD0"
+		what="real time ($RATE_1K_POLICY): $(v "$f" all.overruns) overruns in ${RATE_1K_S} s; bus p50 $(fmt "$(v "$f" all.bus_p50)") µs = $(ratio "$(v "$f" all.bus_p50)" "$floor") the floor ($floor µs); simulator step lateness p99 $(fmt "$(v "$f" truth.late_p99)") µs; load $RATE_1K_LOAD0"
 		grep -q '^fell_back' "$f" && what="$what; Fast Sync Read given up during the run"
 	fi
+	if [ "$(v "$lk" status)" = not ]; then
+		lwhat="lockstep: $(sed -n 's/^status //p' "$lk")"
+	else
+		say "| lockstep, $(fmt "$(v "$lk" lockstep_sim_s)" 1) s in $(fmt "$(v "$lk" lockstep_wall_s)" 1) s | $(v "$lk" all.n) | $(v "$lk" all.overruns) |" \
+			"$(fmt "$(v "$lk" all.period_p50)") | $(fmt "$(v "$lk" all.period_p99)") | $(fmt "$(v "$lk" all.period_max)") |" \
+			"$(fmt "$(v "$lk" all.bus_p50)") | $(fmt "$(v "$lk" all.bus_p99)") | $(fmt "$(v "$lk" all.bus_max)") |" \
+			"$(ratio "$(v "$lk" all.bus_p50)" "$floor") | – | – |"
+		lwhat="lockstep (virtual time): $(v "$lk" all.overruns) overruns, bus p50 $(fmt "$(v "$lk" all.bus_p50)") µs"
+	fi
 	say ""
-	sum "6 XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s" "no overrun; bus time ≤ 1.3× the Fast Sync Read wire floor" "$what"
+	sum "6 XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s" "no overrun; bus time ≤ 1.3× the Fast Sync Read wire floor" "$what; $lwhat"
 	sum "12 servos on two buses at 500 Hz" "no overrun" "not measured: one bus per robot today"
 }
 
