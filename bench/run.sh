@@ -1145,7 +1145,7 @@ rate_lockstep() {
 	wait "${PID[sim-$name]}" 2>/dev/null
 	unset "PID[sim-$name]"
 	stop "log-$name"
-	"$HB/logstat" --skip 1 "$out.lcm" >"$out"
+	"$HB/logstat" --sender-time --skip 2 "$out.lcm" >"$out"
 	grep -q 'reading by SYNC_READ from now on' "$T/dmn-$name.log" && echo "fell_back 1" >>"$out"
 	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
 }
@@ -1166,6 +1166,8 @@ rate_search() {
 			rate_daemon "$name" "$n" "$baud" "${ps[i]}" "$RATE_S"
 		fi
 		o=$(v "$T/rate/$name-${ps[i]}" all.overruns)
+		# no STATE in the window: nothing was measured, which is not "no overrun"
+		[ "$(v "$T/rate/$name-${ps[i]}" all.n)" = 0 ] && o=nan
 		if [ "$o" = 0 ]; then
 			best=${ps[i]}
 			[ -n "$next" ] && break
@@ -1331,8 +1333,8 @@ rate_1k_lockstep() {
 	wait "${PID[sim-$name]}" 2>/dev/null
 	unset "PID[sim-$name]"
 	stop "log-$name"
-	# the first 2 simulated seconds (start-up, ramp) left out: at 1.5x or more real time, 1 s of the logger's
-	"$HB/logstat" --skip 1 "$out.lcm" >"$out"
+	# the first 2 simulated seconds (start-up, ramp) left out
+	"$HB/logstat" --sender-time --skip 2 "$out.lcm" >"$out"
 	sed -n 's/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time in \([0-9.]*\) s.*/lockstep_sim_s \1\nlockstep_wall_s \2/p' \
 		"$T/sim-$name.log" >>"$out"
 	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
