@@ -158,25 +158,51 @@ static void cyc_fast_outcome(struct cyc *y)
 	y->hooks.notice(y->hooks.ctx, text);
 }
 
+/* The read-back of this block would end on the wire before CYC_LATE_SHARE
+ * of the period: its request (a READ's, sized as a status packet of its two
+ * parameters: never less) and its reply at their largest, the return delay. */
+static bool cyc_readback_fits(const struct cyc *y, const struct sm_block *blk)
+{
+	const struct dxl_proto *p = bus_proto(y->bus);
+	size_t bytes = p->status_bytes_max(2u * p->addr_bytes) + p->status_bytes_max(blk->len);
+	uint64_t end = cyc_now(y) + bus_wire_time_us(y->bus, bytes) + y->bus->timing.return_delay_us;
+	return (double)(end - y->start_us) <= CYC_LATE_SHARE * (double)y->period_us;
+}
+
 /* This cycle's read-back, if any: a joint the controller asks for now (its
- * RAM block), else every CYC_READBACK_US the next joint in turn,
- * and after the last joint the model's next block. */
+ * RAM block), else every CYC_READBACK_US the next joint in turn, and after
+ * the last joint the model's next block, once it fits the period's rest
+ * (or has waited CYC_READBACK_WAIT_US). */
 static bool cyc_pick_readback(struct cyc *y)
 {
 	size_t due;
 	if (ctl_readback_due(y->ctl, &due)) {
 		y->readback_now_joint = due;
 		y->readback_now_block = 0;
-		return true;
+		return !cyc_late(y);
 	}
-	if (y->count % y->readback_every != 0)
+	if (!y->readback_owed && y->count % y->readback_every == 0) {
+		y->readback_owed = true;
+		y->readback_owed_at = y->count;
+	}
+	if (!y->readback_owed || cyc_late(y))
 		return false;
-	y->readback_joint = (y->readback_joint + 1) % y->ctl->n;
-	if (y->readback_joint == 0)
-		y->readback_block++;
-	size_t nblocks = ctl_model(y->ctl, y->readback_joint)->nreadback;
-	y->readback_now_joint = y->readback_joint;
-	y->readback_now_block = nblocks > 0 ? y->readback_block % nblocks : 0;
+	size_t joint = (y->readback_joint + 1) % y->ctl->n;
+	size_t block = y->readback_block + (joint == 0);
+	size_t nblocks = ctl_model(y->ctl, joint)->nreadback;
+	size_t b = nblocks > 0 ? block % nblocks : 0;
+	bool fits = nblocks == 0 || cyc_readback_fits(y, &ctl_model(y->ctl, joint)->readback[b]);
+	if (!fits && (y->count - y->readback_owed_at) * y->period_us < CYC_READBACK_WAIT_US) {
+		y->readbacks_waiting++;
+		return false;
+	}
+	if (!fits)
+		y->readbacks_forced++;
+	y->readback_owed = false;
+	y->readback_joint = joint;
+	y->readback_block = block;
+	y->readback_now_joint = joint;
+	y->readback_now_block = b;
 	return true;
 }
 
@@ -244,7 +270,7 @@ static enum cyc_status cyc_advance(struct cyc *y)
 			continue;
 		}
 		case CYC_READBACK: {
-			if (y->ctl->n == 0 || cyc_late(y) || !cyc_pick_readback(y))
+			if (y->ctl->n == 0 || !cyc_pick_readback(y))
 				return cyc_finish(y, CYC_DONE);
 			const struct sm_block *blk = &ctl_model(y->ctl, y->readback_now_joint)->readback[y->readback_now_block];
 			uint8_t id = y->ctl->j[y->readback_now_joint].id;

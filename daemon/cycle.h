@@ -58,6 +58,13 @@
  * count of cycles: at 1 kHz a read-back every 5 cycles was 200 transactions
  * a second, each one a cycle that did not fit the period. */
 #define CYC_READBACK_US 50000
+/* A read-back is begun only where it ends on the wire (request, reply,
+ * return delay) before CYC_LATE_SHARE of the period: begun later it runs
+ * past the next tick, is cut off, and its reply meets the next cycle's
+ * request on the line. One that has found no room for this long is begun
+ * anyway, where the old rule allows (before CYC_LATE_SHARE): a period too
+ * short for any read-back still finds a reset servo within about a second. */
+#define CYC_READBACK_WAIT_US 1000000
 /* Past this share of the period no new write or read-back is begun: a
  * transaction cut off by the next tick leaves its reply on the line. */
 #define CYC_LATE_SHARE 0.7
@@ -105,6 +112,8 @@ struct cyc {
 	size_t readback_joint;
 	size_t readback_block;        /* the model's read-back block of the round-robin */
 	size_t readback_now_joint, readback_now_block;   /* the read-back on the wire */
+	bool readback_owed;           /* a read-back of the round-robin is due */
+	uint64_t readback_owed_at;    /* since this cycle (count) */
 	uint64_t count;               /* cycles started */
 	uint8_t read_len;             /* this cycle's READ length, 6 or 8 (2.0: the model's, 10 or 21) */
 	/* Protocol 2.0: this cycle's SYNC_READ (or Fast Sync Read) and its replies */
@@ -123,6 +132,8 @@ struct cyc {
 	int starved;                  /* cycles in a row that ended with writes waiting */
 	/* counters */
 	long long errors, cut_off, deferred, readbacks, writes_first, fast_fallbacks;
+	long long readbacks_waiting;  /* cycles a read-back due waited for room */
+	long long readbacks_forced;   /* read-backs begun without room, after CYC_READBACK_WAIT_US */
 };
 
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks);

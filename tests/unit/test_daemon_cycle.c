@@ -1338,11 +1338,38 @@ static void test_fast_read_kept_through_a_short_stall(void **state)
 	xs(1)->powered = true;
 }
 
+/* A read-back that cannot end on the wire before CYC_LATE_SHARE of the
+ * period is not begun: it waits for a cycle with room, at most
+ * CYC_READBACK_WAIT_US, and is then sent anyway (a servo reset must still be
+ * found). Begun by the old rule (before 70 % of the period) it ran past the
+ * next tick, was cut off, and its reply met the next cycle's request on the
+ * line. Two XM430s at 1 Mbps, 1 ms: the SYNC_READ and SYNC_WRITE fit (580 to
+ * 800 µs), a read-back of the RAM block (770 µs on the wire) never does:
+ * one cut a second instead of one every 50 ms. */
+static void test_readback_only_where_it_fits(void **state)
+{
+	(void)state;
+	static const char *const at1ms[] = { "robot.period_ms=1", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, at1ms);
+	run(20);    /* the start's torque-on writes go first and may cost a cycle or two */
+	cuts = 0;
+	y.readbacks = 0;
+	y.readbacks_waiting = 0;
+	run(500);   /* 0.5 s: ten read-backs due, none with room */
+	assert_int_equal(cuts, 0);
+	assert_int_equal(y.readbacks, 0);
+	assert_true(y.readbacks_waiting > 0);
+	run(600);   /* past a second of waiting: one is sent anyway, and costs its cycle */
+	assert_int_equal(y.readbacks_forced, 1);
+	assert_true(cuts <= 1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_readback_pace_is_a_time),
 		cmocka_unit_test(test_fast_read_kept_through_a_short_stall),
+		cmocka_unit_test(test_readback_only_where_it_fits),
 		{ "normal_cycles (AX-12A)", test_normal_cycles, NULL, NULL, (void *)&ax_bus },
 		{ "normal_cycles (XL430-W250 + XM430-W350)", test_normal_cycles, NULL, NULL, (void *)&x_mixed_bus },
 		{ "lost_and_damaged_replies (AX-12A)", test_lost_and_damaged_replies, NULL, NULL, (void *)&ax_bus },
