@@ -5,8 +5,9 @@
  *   READ(36, n) of every joint ─→ CYC_CONTROL: the daemon applies commands
  *   and runs the control step ─→ SYNC_WRITE of the goals (or duties) ─→ the
  *   controller's register writes, one at a time, while the period allows ─→
- *   every CYC_READBACK_US (50 ms), while the period allows, one joint's
- *   RAM block read back (ctl_readback) ─→ CYC_DONE. Writes never starve:
+ *   every CYC_READBACK_US (50 ms), in a cycle where it ends in time
+ *   (CYC_READBACK_WAIT_US at most), one joint's block read back
+ *   (ctl_readback) ─→ CYC_DONE. Writes never starve:
  *   when the reads leave no room for them cycle after cycle, one is sent
  *   before the reads (CYC_STARVED_CYCLES).
  *
