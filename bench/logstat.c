@@ -2,7 +2,7 @@
  * logstat.c — loop statistics from an LCM log (lcm-logger output), for the
  * benchmark suite. Built by bench/run.sh, not by the Makefile's programs.
  *
- *   logstat [--skip S] [--window S] [--from-us T] [--to-us T] [--missing-id ID] LOGFILE
+ *   logstat [--skip S] [--window S] [--from-us T] [--to-us T] [--missing-id ID] [--sender-time] LOGFILE
  *
  * Reads every "<robot>.STATE" (robot_state_t), "<robot>.BUS" (bus_stats_t)
  * and "SIM.TRUTH" (sim_truth_t) message and prints "key value" lines:
@@ -20,6 +20,10 @@
  * --window S    then keep S seconds (0: to the end of the log)
  * --from-us T, --to-us T   keep only messages logged in [T, T') (µs since
  *               the epoch, the logger's clock): a window the caller timed
+ * --sender-time --skip and --window count a robot's STATE by its own utime
+ *               (the start of its cycle), not by the logger's clock: in
+ *               lockstep the daemon's clock is the simulator's virtual time,
+ *               which runs faster than the logger's
  * --missing-id  also split the cycles by whether that servo's reading was
  *               stale this cycle: <robot>.missing_* and <robot>.healthy_*
  *
@@ -66,6 +70,7 @@ struct ls_robot {
 struct ls_state {
 	double skip_s, window_s;
 	int64_t from_us, to_us;     /* 0: no bound */
+	bool sender_time;           /* --sender-time */
 	int missing_id;             /* -1: no split */
 	struct ls_robot robots[LS_MAX_ROBOTS];
 	size_t nrobots;
@@ -165,8 +170,9 @@ static void ls_state_msg(struct ls_state *st, const lcm_eventlog_event_t *ev, si
 		st->decode_errors++;
 		return;
 	}
-	struct ls_robot *r = ls_robot(st, ev->channel, namelen, ev->timestamp);
-	if (r && ls_in_window(st, r->t0_us, ev->timestamp)) {
+	int64_t t_us = st->sender_time ? m.utime : ev->timestamp;
+	struct ls_robot *r = ls_robot(st, ev->channel, namelen, t_us);
+	if (r && ls_in_window(st, r->t0_us, t_us)) {
 		ls_add_cycle(&r->c[LS_ALL], &m);
 		if (st->missing_id >= 0)
 			ls_add_cycle(&r->c[ls_is_missing(&m, st->missing_id) ? LS_MISSING : LS_HEALTHY], &m);
@@ -323,7 +329,8 @@ static void ls_print(struct ls_state *st)
 
 static void ls_usage(void)
 {
-	fprintf(stderr, "usage: logstat [--skip S] [--window S] [--from-us T] [--to-us T] [--missing-id ID] LOGFILE\n");
+	fprintf(stderr, "usage: logstat [--skip S] [--window S] [--from-us T] [--to-us T] [--missing-id ID] [--sender-time] "
+	        "LOGFILE\n");
 }
 
 int main(int argc, char **argv)
@@ -341,6 +348,8 @@ int main(int argc, char **argv)
 			st.from_us = atoll(argv[++i]);
 		else if (!strcmp(argv[i], "--to-us") && has_val)
 			st.to_us = atoll(argv[++i]);
+		else if (!strcmp(argv[i], "--sender-time"))
+			st.sender_time = true;
 		else if (!strcmp(argv[i], "--missing-id") && has_val)
 			st.missing_id = atoi(argv[++i]);
 		else if (argv[i][0] != '-' && !path)

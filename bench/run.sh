@@ -33,7 +33,7 @@ CYCLES=${BENCH_CYCLES:-300}
 CAP_S=${BENCH_CAP_S:-8}
 CG_S=${BENCH_CG_S:-3}
 FLEET_S=${BENCH_FLEET_S:-15}
-ONLY=${BENCH_ONLY:-loop bus missing cap plane codec cg web lockstep model}
+ONLY=${BENCH_ONLY:-loop bus missing rate cap plane codec cg web lockstep model}
 MODEL_REPS=${BENCH_MODEL_REPS:-3}
 LOCK_REPS=${BENCH_LOCK_REPS:-3}
 WEB_S=${BENCH_WEB_S:-15}
@@ -1052,6 +1052,334 @@ section_model() {
 	sum "undulate-model: 50 oscillators, 600 s lattice" "< 10 s on one core" "$worst"
 }
 
+# ---- rate: the highest control rate one bus of X servos holds ------------------------
+# For N XM430-W350 (2/6/12/18) at 1, 2 and 4 Mbps, each way of reading the
+# joints (RATE_READS; a third, "indirect", is being added elsewhere: a read's
+# column comes from rate_read_label and rate_sim_args alone):
+#  - buscycle's cycle (one read of 10 bytes a servo, one SYNC_WRITE) at
+#    RATE_CYCLE_US for RATE_CYCLES cycles, against that read's wire floor;
+#  - undulated itself at period_ms 10, 5, 4, 2, 1: RATE_S seconds each after
+#    RATE_SETTLE_S, its overruns counted from its STATE (logstat). The search
+#    starts at the shortest period above 1.5x the floor and walks from there,
+#    so a configuration costs two or three runs, not five.
+RATE_S=${BENCH_RATE_S:-2}
+RATE_1K_S=${BENCH_RATE_1K_S:-60}
+RATE_CYCLES=${BENCH_RATE_CYCLES:-200}
+RATE_SETTLE_S=1
+RATE_CYCLE_US=5000
+RATE_READS="sync fast"
+RATE_SERVOS=${BENCH_RATE_SERVOS:-2 6 12 18}
+RATE_BAUDS=${BENCH_RATE_BAUDS:-1000000 2000000 4000000}
+RATE_PERIODS_MS="10 5 4 2 1"
+RATE_DMN_ARGS=()
+PORT_RATE=7910
+rate_read_label() { case $1 in sync) echo "SYNC_READ" ;; fast) echo "Fast Sync Read" ;; *) echo "$1" ;; esac; }
+# The simulator's options that make the daemon read that way: it reads by Fast
+# Sync Read when every servo has firmware 45 or later (the simulator's 46).
+rate_sim_args() { case $1 in sync) echo "--firmware 44" ;; *) ;; esac; }
+
+# rate_sim NAME N BAUD READ: an X-servo simulator for one configuration, its
+# LCM logged (for its SIM.TRUTH lateness). 1 when it does not start ("status"
+# into $T/rate/NAME.sim).
+rate_sim() {
+	local name=$1 n=$2 baud=$3 read=$4 d=$T/rate u model=(--model xm430-w350)
+	u=$(url $PORT_RATE)
+	mkdir -p "$d"
+	# shellcheck disable=SC2046 # the read's options are words
+	start "sim-$name" "$SIM" --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 --baud "$baud" \
+		$(rate_sim_args "$read") --lcm-url "$u" --quiet "${model[@]}"
+	if ! wait_ready "sim-$name" 'ready:' 10; then
+		echo "status not measured: the simulator refused $n X servos at $baud bps ($(why "sim-$name"))" >"$d/$name.sim"
+		stop "sim-$name"
+		return 1
+	fi
+}
+
+# rate_daemon NAME N BAUD PERIOD_MS WINDOW_S: undulated on sim-NAME's bus at
+# that period; logstat's figures of WINDOW_S seconds into $T/rate/NAME-PERIOD.
+rate_daemon() {
+	local name=$1 n=$2 baud=$3 p=$4 w=$5 d=$T/rate u out t0 t1
+	u=$(url $PORT_RATE)
+	out=$d/$name-$p
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
+	wait_file "$out.lcm" 10
+	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" \
+		--lcm-url "$u" --mode oscillator --set robot.period_ms="$p" ${RATE_DMN_ARGS[@]+"${RATE_DMN_ARGS[@]}"}; then
+		sleep "$RATE_SETTLE_S"
+		t0=$(now_us)
+		sleep "$w"
+		t1=$(now_us)
+		stop "dmn-$name"; stop "log-$name"
+		"$HB/logstat" --from-us "$t0" --to-us "$t1" "$out.lcm" >"$out"
+		echo "start_retries $RETRIES" >>"$out"
+		grep -q 'reading by SYNC_READ from now on' "$T/dmn-$name.log" && echo "fell_back 1" >>"$out"
+	else
+		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$name"))" >"$out"
+		stop "log-$name"
+	fi
+	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
+}
+
+# rate_lockstep NAME N BAUD PERIOD_MS READ: the same robot in the simulator's
+# virtual time (lockstep), RATE_S simulated seconds after 2: neither program
+# can be late there, so an overrun is the cycle not fitting the period.
+# Results in $T/rate/NAME-PERIOD like rate_daemon's.
+rate_lockstep() {
+	local name=$1 n=$2 baud=$3 p=$4 read=$5 d=$T/rate u out
+	u=$(url $PORT_RATE)
+	out=$d/$name-$p
+	rm -f "$d/$name.clock"
+	# shellcheck disable=SC2046 # the read's options are words
+	start "sim-$name" "$SIM" --model xm430-w350 --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
+		--baud "$baud" $(rate_sim_args "$read") --lcm-url "$u" --quiet --lockstep "$d/$name.clock" \
+		--duration "$((RATE_S + 2))"
+	if ! wait_file "$d/$name.clock" 10; then
+		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
+		stop "sim-$name"
+		return 0
+	fi
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
+	wait_file "$out.lcm" 10
+	"$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" --lcm-url "$u" \
+		--mode oscillator --set robot.period_ms="$p" --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
+	wait "${PID[sim-$name]}" 2>/dev/null
+	unset "PID[sim-$name]"
+	stop "log-$name"
+	"$HB/logstat" --sender-time --skip 2 "$out.lcm" >"$out"
+	grep -q 'reading by SYNC_READ from now on' "$T/dmn-$name.log" && echo "fell_back 1" >>"$out"
+	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
+}
+
+# rate_search NAME N BAUD FLOOR_US RUNNER [READ]: the shortest period of
+# RATE_PERIODS_MS with no overrun over RATE_S seconds, each run by RUNNER
+# (rate_daemon or rate_lockstep); writes "best P" and "next P OVERRUNS" (the
+# next shorter period tried and its overruns) to $T/rate/NAME.best.
+rate_search() {
+	local name=$1 n=$2 baud=$3 floor=$4 runner=$5 read=${6:-} ps i start=0 best="" next="" o
+	read -r -a ps <<<"$RATE_PERIODS_MS"
+	for i in "${!ps[@]}"; do [ $((ps[i] * 1000)) -ge $((floor * 3 / 2)) ] && start=$i; done
+	i=$start
+	while [ "$i" -ge 0 ] && [ "$i" -lt ${#ps[@]} ]; do
+		if [ "$runner" = rate_lockstep ]; then
+			rate_lockstep "$name" "$n" "$baud" "${ps[i]}" "$read"
+		else
+			rate_daemon "$name" "$n" "$baud" "${ps[i]}" "$RATE_S"
+		fi
+		o=$(v "$T/rate/$name-${ps[i]}" all.overruns)
+		# no STATE in the window: nothing was measured, which is not "no overrun"
+		[ "$(v "$T/rate/$name-${ps[i]}" all.n)" = 0 ] && o=nan
+		if [ "$o" = 0 ]; then
+			best=${ps[i]}
+			[ -n "$next" ] && break
+			i=$((i + 1))
+		else
+			next="${ps[i]} $o"
+			[ -n "$best" ] && break
+			i=$((i - 1))
+		fi
+	done
+	{ echo "best ${best:-none}"; echo "next ${next:-none}"; } >"$T/rate/$name.best"
+}
+
+# rate_hz PERIOD_MS: the rate it is
+rate_hz() { awk -v p="$1" 'BEGIN { printf "%g Hz", 1000 / p }'; }
+
+# rate_cells NAME: "floor | p50 | p50/floor" of buscycle, then the highest rate
+rate_bus_cells() {
+	local b=$T/rate/$1.bc
+	if [ "$(v "$b" status)" = not ]; then
+		echo "– | $(sed -n 's/^status //p' "$b") | –"
+	else
+		echo "$(v "$b" floor_us) | $(v "$b" bus_p50) | $(ratio "$(v "$b" bus_p50)" "$(v "$b" floor_us)")"
+	fi
+}
+rate_best_cell() {
+	local f=$T/rate/$1.best best nx np no
+	[ -e "$T/rate/$1.sim" ] && { sed -n 's/^status //p' "$T/rate/$1.sim"; return; }
+	best=$(v "$f" best)
+	read -r _ np no < <(grep '^next ' "$f")
+	case $best in
+	none) nx="none of ${RATE_PERIODS_MS// /, } ms" ;;
+	*) nx="$(rate_hz "$best") ($best ms)" ;;
+	esac
+	[ "$np" != none ] && [ -n "$np" ] && nx="$nx; $np ms: $no overruns"
+	grep -q '^fell_back' "$T/rate/$1-"* 2>/dev/null && nx="$nx; Fast Sync Read given up in a run"
+	echo "$nx"
+}
+
+section_rate() {
+	local n baud read name loads=""
+	progress "rate: ${RATE_SERVOS// /\/} X servos x 1/2/4 Mbps x ${RATE_READS// /, }: buscycle $RATE_CYCLES cycles, undulated ${RATE_S} s a period, in real time and in lockstep"
+	for n in $RATE_SERVOS; do
+		for baud in $RATE_BAUDS; do
+			for read in $RATE_READS; do
+				name="$read-$n-$baud"
+				loads="$loads $(cut -d' ' -f1 /proc/loadavg)"
+				rate_sim "$name" "$n" "$baud" "$read" || continue
+				"$HB/buscycle" --port "$T/rate/$name.pty" --protocol 2 --read-len 10 --read "$read" --baud "$baud" \
+					--ids "$(ids_upto "$n")" --cycles "$RATE_CYCLES" --period-us "$RATE_CYCLE_US" \
+					--margin-us "$MARGIN_US" >"$T/rate/$name.bc" 2>"$T/rate/$name.err" ||
+					echo "status not measured: buscycle failed ($(tail -n1 "$T/rate/$name.err"))" >"$T/rate/$name.bc"
+				local floor
+				floor=$(v "$T/rate/$name.bc" floor_us)
+				[ "$floor" = nan ] && floor=1000
+				rate_search "$name" "$n" "$baud" "$floor" rate_daemon
+				stop "sim-$name"
+				rate_search "lock-$name" "$n" "$baud" "$floor" rate_lockstep "$read"
+			done
+		done
+	done
+	rate_1k
+	say "## Rates above 100 Hz: X servos on one bus (simulated, return delay 0)"
+	say ""
+	say "XM430-W350 servos on \`undulate-sim --model xm430-w350 --baud B\`, 10 bytes a servo read (present"
+	say "current, velocity, position) and one SYNC_WRITE of goals. **Bus time**: buscycle's cycle at"
+	say "$((RATE_CYCLE_US / 1000)) ms for $RATE_CYCLES cycles, p50 against the wire floor of its own read (bench/README.md, \"Rates\")."
+	say "**Highest rate**: undulated (OSCILLATOR) at period_ms ${RATE_PERIODS_MS// /, }, ${RATE_S} s each after ${RATE_SETTLE_S} s;"
+	say "the shortest period with 0 overruns in that window, and the next shorter one tried with its overruns;"
+	say "normal scheduling. **In lockstep**: the same search in the simulator's virtual time ($RATE_S simulated s"
+	say "after 2), where neither program can be late: an overrun there is the cycle not fitting the period."
+	say "Load average (1 min) during the section: $(echo "$loads" | awk '{ lo = $1; hi = $1; for (i = 2; i <= NF; i++) { if ($i < lo) lo = $i; if ($i > hi) hi = $i } print lo "–" hi }')."
+	say ""
+	local hdr="| servos | Mbps" sep="|---|---" cells
+	for read in $RATE_READS; do
+		hdr="$hdr | $(rate_read_label "$read") floor (µs) | p50 | p50/floor"
+		sep="$sep|---|---|---"
+	done
+	say "$hdr |"; say "$sep|"
+	for n in $RATE_SERVOS; do
+		for baud in $RATE_BAUDS; do
+			cells="| $n | $((baud / 1000000))"
+			for read in $RATE_READS; do cells="$cells | $(rate_bus_cells "$read-$n-$baud")"; done
+			say "$cells |"
+		done
+	done
+	say ""
+	hdr="| servos | Mbps"; sep="|---|---"
+	for read in $RATE_READS; do
+		hdr="$hdr | $(rate_read_label "$read"): highest rate, no overrun | the same in lockstep"
+		sep="$sep|---|---"
+	done
+	say "$hdr |"; say "$sep|"
+	for n in $RATE_SERVOS; do
+		for baud in $RATE_BAUDS; do
+			cells="| $n | $((baud / 1000000))"
+			for read in $RATE_READS; do
+				cells="$cells | $(rate_best_cell "$read-$n-$baud") | $(rate_best_cell "lock-$read-$n-$baud")"
+			done
+			say "$cells |"
+		done
+	done
+	cells="| 12 on two buses | 4"
+	for read in $RATE_READS; do cells="$cells | not measured: one bus per robot today | –"; done
+	say "$cells |"
+	say ""
+	rate_1k_table
+}
+
+# The budget: six XM430-W350 on one 4 Mbps bus at 1 kHz, RATE_1K_S seconds,
+# twice: in real time (both programs under SCHED_FIFO where permitted, as a
+# robot at 1 kHz would run: robot.priority), and in the simulator's virtual
+# time (lockstep), where neither program can be late: what is left there is
+# the cycle itself not fitting the period.
+rate_1k() {
+	local name=1k-6 n=6 baud=4000000 d=$T/rate u extra=()
+	u=$(url $PORT_RATE)
+	progress "rate: 6 X servos, 4 Mbps, Fast Sync Read, undulated at 1 kHz for ${RATE_1K_S} s, then as long in lockstep"
+	RATE_1K_LOAD0=$(cut -d' ' -f1-3 /proc/loadavg)
+	RATE_1K_POLICY="SCHED_OTHER (SCHED_FIFO not permitted)"
+	if chrt -f 1 true 2>/dev/null; then
+		RATE_1K_POLICY="SCHED_FIFO: undulated $FIFO_PRIORITY, undulate-sim $SIM_RT_PRIORITY"
+		extra=(--realtime "$SIM_RT_PRIORITY")
+	fi
+	local model=(--model xm430-w350 "${extra[@]}")
+	mkdir -p "$d"
+	start "sim-$name" "$SIM" --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 --baud "$baud" \
+		--lcm-url "$u" --quiet "${model[@]}"
+	if ! wait_ready "sim-$name" 'ready:' 10; then
+		echo "status not measured: the simulator refused $n X servos at $baud bps ($(why "sim-$name"))" >"$d/$name.sim"
+		stop "sim-$name"
+		return 0
+	fi
+	"$HB/buscycle" --port "$d/$name.pty" --protocol 2 --read-len 10 --read fast --baud "$baud" \
+		--ids "$(ids_upto "$n")" --cycles 20 --period-us "$RATE_CYCLE_US" --margin-us "$MARGIN_US" \
+		>"$d/$name.bc" 2>"$d/$name.err" ||
+		echo "status not measured: buscycle failed ($(tail -n1 "$d/$name.err"))" >"$d/$name.bc"
+	RATE_DMN_ARGS=()
+	[ ${#extra[@]} -gt 0 ] && RATE_DMN_ARGS=(--set "robot.priority=$FIFO_PRIORITY" --set robot.mlockall=true)
+	rate_daemon "$name" "$n" "$baud" 1 "$RATE_1K_S"
+	RATE_DMN_ARGS=()
+	stop "sim-$name"
+	RATE_1K_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
+	rate_1k_lockstep
+}
+
+# rate_1k_lockstep: the same robot in virtual time, RATE_1K_S simulated seconds
+rate_1k_lockstep() {
+	local name=1k-lock n=6 d=$T/rate u out
+	u=$(url $PORT_RATE)
+	out=$d/$name
+	start "sim-$name" "$SIM" --model xm430-w350 --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
+		--baud 4000000 --lcm-url "$u" --quiet --lockstep "$d/$name.clock" --duration "$((RATE_1K_S + 2))"
+	if ! wait_file "$d/$name.clock" 10; then
+		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
+		stop "sim-$name"
+		return 0
+	fi
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
+	wait_file "$out.lcm" 10
+	"$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud 4000000 --robot "r$n" --lcm-url "$u" \
+		--mode oscillator --set robot.period_ms=1 --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
+	wait "${PID[sim-$name]}" 2>/dev/null
+	unset "PID[sim-$name]"
+	stop "log-$name"
+	# the first 2 simulated seconds (start-up, ramp) left out
+	"$HB/logstat" --sender-time --skip 2 "$out.lcm" >"$out"
+	sed -n 's/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time in \([0-9.]*\) s.*/lockstep_sim_s \1\nlockstep_wall_s \2/p' \
+		"$T/sim-$name.log" >>"$out"
+	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
+}
+
+rate_1k_table() {
+	local f=$T/rate/1k-6-1 b=$T/rate/1k-6.bc lk=$T/rate/1k-lock floor what lwhat
+	floor=$(v "$b" floor_us)
+	say "### The budget: six XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s"
+	say ""
+	if [ -e "$T/rate/1k-6.sim" ]; then
+		what=$(sed -n 's/^status //p' "$T/rate/1k-6.sim")
+		say "$what"
+	elif [ "$(v "$f" status)" = not ]; then
+		what=$(sed -n 's/^status //p' "$f")
+		say "$what"
+	else
+		say "Real time, $RATE_1K_POLICY; load average at start $RATE_1K_LOAD0, at the end $RATE_1K_LOAD1."
+		say "Fast Sync Read floor of the 10-byte cycle: $floor µs. At 1 ms undulated publishes every 10th cycle's"
+		say "STATE: the percentiles below are over those (the cycles that read 21 bytes a servo, floor 555 µs);"
+		say "the overruns are its counter, over every cycle. Lockstep: the same, in the simulator's virtual time."
+		say ""
+		say "| run | STATEs | overruns | period p50 | p99 | max | bus p50 | p99 | max | bus p50/floor | simulator step lateness p99 | max |"
+		say "|---|---|---|---|---|---|---|---|---|---|---|---|"
+		say "| real time | $(v "$f" all.n) | $(v "$f" all.overruns) | $(fmt "$(v "$f" all.period_p50)") | $(fmt "$(v "$f" all.period_p99)") |" \
+			"$(fmt "$(v "$f" all.period_max)") | $(fmt "$(v "$f" all.bus_p50)") | $(fmt "$(v "$f" all.bus_p99)") |" \
+			"$(fmt "$(v "$f" all.bus_max)") | $(ratio "$(v "$f" all.bus_p50)" "$floor") |" \
+			"$(fmt "$(v "$f" truth.late_p99)") | $(fmt "$(v "$f" truth.late_max)") |"
+		what="real time ($RATE_1K_POLICY): $(v "$f" all.overruns) overruns in ${RATE_1K_S} s; bus p50 $(fmt "$(v "$f" all.bus_p50)") µs = $(ratio "$(v "$f" all.bus_p50)" "$floor") the floor ($floor µs); simulator step lateness p99 $(fmt "$(v "$f" truth.late_p99)") µs; load $RATE_1K_LOAD0"
+		grep -q '^fell_back' "$f" && what="$what; Fast Sync Read given up during the run"
+	fi
+	if [ "$(v "$lk" status)" = not ]; then
+		lwhat="lockstep: $(sed -n 's/^status //p' "$lk")"
+	else
+		say "| lockstep, $(fmt "$(v "$lk" lockstep_sim_s)" 1) s in $(fmt "$(v "$lk" lockstep_wall_s)" 1) s | $(v "$lk" all.n) | $(v "$lk" all.overruns) |" \
+			"$(fmt "$(v "$lk" all.period_p50)") | $(fmt "$(v "$lk" all.period_p99)") | $(fmt "$(v "$lk" all.period_max)") |" \
+			"$(fmt "$(v "$lk" all.bus_p50)") | $(fmt "$(v "$lk" all.bus_p99)") | $(fmt "$(v "$lk" all.bus_max)") |" \
+			"$(ratio "$(v "$lk" all.bus_p50)" "$floor") | – | – |"
+		lwhat="lockstep (virtual time): $(v "$lk" all.overruns) overruns, bus p50 $(fmt "$(v "$lk" all.bus_p50)") µs"
+	fi
+	say ""
+	sum "6 XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s" "no overrun; bus time ≤ 1.3× the Fast Sync Read wire floor" "$what; $lwhat"
+	sum "12 servos on two buses at 500 Hz" "no overrun" "not measured: one bus per robot today"
+}
+
 # ---- main -------------------------------------------------------------------------
 main() {
 	local missing=()
@@ -1085,6 +1413,7 @@ main() {
 	wants loop && section_loop
 	wants bus && section_bus
 	wants missing && section_missing
+	wants rate && section_rate
 	wants loop && section_resources
 	wants cap && section_cap
 	wants plane && section_plane

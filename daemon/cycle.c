@@ -9,13 +9,13 @@
 #include "dxl_table.h"
 #include "servo_model.h"
 
-#define CYC_STR(x) #x
-#define CYC_XSTR(x) CYC_STR(x)
-#define CYC_FAST_FAILS_TEXT CYC_XSTR(CYC_FAST_FAILS_MAX)
-
 void cyc_init(struct cyc *y, struct bus *bus, struct ctl *ctl, uint64_t period_us, const struct cyc_hooks *hooks)
 {
 	*y = (struct cyc){ .bus = bus, .ctl = ctl, .period_us = period_us, .phase = CYC_IDLE };
+	uint64_t period = period_us > 0 ? period_us : 1;
+	y->readback_every = CYC_READBACK_US / period > 0 ? CYC_READBACK_US / period : 1;
+	y->fast_fails_max = CYC_FAST_FAILS_US / period > CYC_FAST_FAILS_MAX ? (int)(CYC_FAST_FAILS_US / period)
+	                                                                    : CYC_FAST_FAILS_MAX;
 	if (hooks != NULL)
 		y->hooks = *hooks;
 }
@@ -212,35 +212,66 @@ static void cyc_fast_outcome(struct cyc *y)
 	if (!y->fast_read)
 		return;
 	y->fast_fails = y->multi.answered == 0 ? y->fast_fails + 1 : 0;
-	if (y->fast_fails < CYC_FAST_FAILS_MAX)
+	if (y->fast_fails < y->fast_fails_max)
 		return;
 	y->fast_read = false;
 	y->fast_fallbacks++;
-	if (y->hooks.notice != NULL)
-		y->hooks.notice(y->hooks.ctx, "bus: Fast Sync Read read nobody " CYC_FAST_FAILS_TEXT " cycles in a row: "
-		                "reading by SYNC_READ from now on, each servo's own status packet (until the next "
-		                "start or reconnect)");
+	if (y->hooks.notice == NULL)
+		return;
+	char text[256];
+	snprintf(text, sizeof text,
+	         "bus: Fast Sync Read read nobody %d cycles in a row (%.0f ms): reading by SYNC_READ from now on, each "
+	         "servo's own status packet (until the next start or reconnect)",
+	         y->fast_fails, 1e-3 * (double)((uint64_t)y->fast_fails * y->period_us));
+	y->hooks.notice(y->hooks.ctx, text);
+}
+
+/* The read-back of this block would end on the wire before CYC_LATE_SHARE
+ * of the period: its request (a READ's, sized as a status packet of its two
+ * parameters: never less) and its reply at their largest, the return delay. */
+static bool cyc_readback_fits(const struct cyc *y, const struct sm_block *blk)
+{
+	const struct dxl_proto *p = bus_proto(y->bus);
+	size_t bytes = p->status_bytes_max(2u * p->addr_bytes) + p->status_bytes_max(blk->len);
+	uint64_t end = cyc_now(y) + bus_wire_time_us(y->bus, bytes) + y->bus->timing.return_delay_us;
+	return (double)(end - y->start_us) <= CYC_LATE_SHARE * (double)y->period_us;
 }
 
 /* This cycle's read-back, if any: a joint the controller asks for now (its
- * RAM block), else every CYC_READBACK_EVERY cycles the next joint in turn,
- * and after the last joint the model's next block. */
+ * RAM block), else every CYC_READBACK_US the next joint in turn, and after
+ * the last joint the model's next block, once it fits the period's rest
+ * (or has waited CYC_READBACK_WAIT_US). */
 static bool cyc_pick_readback(struct cyc *y)
 {
 	size_t due;
 	if (ctl_readback_due(y->ctl, &due) && cyc_has_joint(y, due)) {
 		y->readback_now_joint = due;
 		y->readback_now_block = 0;
-		return true;
+		return !cyc_late(y);
 	}
-	if (y->count % CYC_READBACK_EVERY != 0)
+	if (!y->readback_owed && y->count % y->readback_every == 0) {
+		y->readback_owed = true;
+		y->readback_owed_at = y->count;
+	}
+	if (!y->readback_owed || cyc_late(y))
 		return false;
-	y->readback_joint = (y->readback_joint + 1) % cyc_count(y);
-	if (y->readback_joint == 0)
-		y->readback_block++;
-	size_t nblocks = ctl_model(y->ctl, cyc_joint(y, y->readback_joint))->nreadback;
-	y->readback_now_joint = cyc_joint(y, y->readback_joint);
-	y->readback_now_block = nblocks > 0 ? y->readback_block % nblocks : 0;
+	size_t idx = (y->readback_joint + 1) % cyc_count(y);
+	size_t block = y->readback_block + (idx == 0);
+	size_t joint = cyc_joint(y, idx);
+	size_t nblocks = ctl_model(y->ctl, joint)->nreadback;
+	size_t b = nblocks > 0 ? block % nblocks : 0;
+	bool fits = nblocks == 0 || cyc_readback_fits(y, &ctl_model(y->ctl, joint)->readback[b]);
+	if (!fits && (y->count - y->readback_owed_at) * y->period_us < CYC_READBACK_WAIT_US) {
+		y->readbacks_waiting++;
+		return false;
+	}
+	if (!fits)
+		y->readbacks_forced++;
+	y->readback_owed = false;
+	y->readback_joint = idx;
+	y->readback_block = block;
+	y->readback_now_joint = joint;
+	y->readback_now_block = b;
 	return true;
 }
 
@@ -310,7 +341,7 @@ static enum cyc_status cyc_advance(struct cyc *y)
 			continue;
 		}
 		case CYC_READBACK: {
-			if (cyc_count(y) == 0 || cyc_late(y) || !cyc_pick_readback(y))
+			if (cyc_count(y) == 0 || !cyc_pick_readback(y))
 				return cyc_finish(y, CYC_DONE);
 			const struct sm_block *blk = &ctl_model(y->ctl, y->readback_now_joint)->readback[y->readback_now_block];
 			uint8_t id = y->ctl->j[y->readback_now_joint].id;

@@ -5,8 +5,9 @@
  *   READ(36, n) of every joint ─→ CYC_CONTROL: the daemon applies commands
  *   and runs the control step ─→ SYNC_WRITE of the goals (or duties) ─→ the
  *   controller's register writes, one at a time, while the period allows ─→
- *   every CYC_READBACK_EVERY cycles, while the period allows, one joint's
- *   RAM block read back (ctl_readback) ─→ CYC_DONE. Writes never starve:
+ *   every CYC_READBACK_US (50 ms), in a cycle where it ends in time
+ *   (CYC_READBACK_WAIT_US at most), one joint's block read back
+ *   (ctl_readback) ─→ CYC_DONE. Writes never starve:
  *   when the reads leave no room for them cycle after cycle, one is sent
  *   before the reads (CYC_STARVED_CYCLES).
  *
@@ -62,10 +63,19 @@
 #include "dxl2.h"
 #include "servo_model.h"
 
-/* Read-back of one joint every CYC_READBACK_EVERY cycles, round-robin: each
- * of two joints every 0.1 s at 100 Hz (a servo reset is found within that),
- * for 340 µs of bus time at 1 Mbps. */
-#define CYC_READBACK_EVERY 5
+/* Read-back of one joint every CYC_READBACK_US, round-robin: each of two
+ * joints every 0.1 s (a servo reset is found within that), for 340 µs of bus
+ * time at 1 Mbps; every 5 cycles at 100 Hz, every 50 at 1 kHz. A time, not a
+ * count of cycles: at 1 kHz a read-back every 5 cycles was 200 transactions
+ * a second, each one a cycle that did not fit the period. */
+#define CYC_READBACK_US 50000
+/* A read-back is begun only where it ends on the wire (request, reply,
+ * return delay) before CYC_LATE_SHARE of the period: begun later it runs
+ * past the next tick, is cut off, and its reply meets the next cycle's
+ * request on the line. One that has found no room for this long is begun
+ * anyway, where the old rule allows (before CYC_LATE_SHARE): a period too
+ * short for any read-back still finds a reset servo within about a second. */
+#define CYC_READBACK_WAIT_US 1000000
 /* Past this share of the period no new write or read-back is begun: a
  * transaction cut off by the next tick leaves its reply on the line. */
 #define CYC_LATE_SHARE 0.7
@@ -85,9 +95,12 @@ enum cyc_phase { CYC_IDLE, CYC_WRITE_FIRST, CYC_READ, CYC_CONTROL_STEP, CYC_WRIT
  * its reads. */
 #define CYC_STARVED_CYCLES 2
 /* Fast Sync Reads in a row that read nobody before the plain SYNC_READ is
- * used again: a lost servo then costs the others 30 ms at 100 Hz, and a
- * single damaged packet (every joint stale for one cycle) changes nothing. */
+ * used again: CYC_FAST_FAILS_US of them, at least CYC_FAST_FAILS_MAX cycles.
+ * A lost servo then costs the others 30 ms (3 cycles at 100 Hz, 30 at
+ * 1 kHz), and a single damaged packet, or a stall of the machine of a few
+ * milliseconds at 1 kHz, changes nothing. */
 #define CYC_FAST_FAILS_MAX 3
+#define CYC_FAST_FAILS_US 30000
 
 struct cyc_hooks {
 	void *ctx;
@@ -110,12 +123,16 @@ struct cyc {
 	size_t readback_joint;
 	size_t readback_block;        /* the model's read-back block of the round-robin */
 	size_t readback_now_joint, readback_now_block;   /* the read-back on the wire */
+	bool readback_owed;           /* a read-back of the round-robin is due */
+	uint64_t readback_owed_at;    /* since this cycle (count) */
 	uint64_t count;               /* cycles started */
 	uint8_t read_len;             /* this cycle's READ length, 6 or 8 (2.0: the model's, 10 or 21) */
 	/* Protocol 2.0: this cycle's SYNC_READ (or Fast Sync Read) and its replies */
 	bool fast_read;               /* the read is a Fast Sync Read (cyc_set_fast_read) */
 	bool indirect;                /* the read is of the indirect block (cyc_set_indirect) */
 	int fast_fails;               /* Fast Sync Reads in a row that read nobody */
+	int fast_fails_max;           /* CYC_FAST_FAILS_US in cycles of this period */
+	uint64_t readback_every;      /* CYC_READBACK_US in cycles of this period, at least 1 */
 	struct bus_multi multi;
 	uint8_t multi_buf[CFG_MAX_JOINTS * 32];
 	uint64_t start_us;            /* this cycle's start (the tick) */
@@ -127,6 +144,8 @@ struct cyc {
 	int starved;                  /* cycles in a row that ended with writes waiting */
 	/* counters */
 	long long errors, cut_off, deferred, readbacks, writes_first, fast_fallbacks, indirect_fallbacks;
+	long long readbacks_waiting;  /* cycles a read-back due waited for room */
+	long long readbacks_forced;   /* read-backs begun without room, after CYC_READBACK_WAIT_US */
 	/* a robot on several buses (cyc_set_bus): the joints on this one, in the
 	 * robot's order; without it every joint of the controller */
 	bool own;

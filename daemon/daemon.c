@@ -134,6 +134,9 @@ struct dmn {
 	uint64_t cycle_start_us, last_cycle_start_us;
 	double period_meas_us, jitter_us;
 	long long overruns;
+	uint64_t state_every;         /* STATE every this many cycles (pub_state_every) */
+	enum cfg_mode state_mode;     /* the mode and fault of the last STATE published */
+	bool state_latched, state_sent;
 	struct stats_window w_period, w_jitter, w_bus;   /* w_bus: the cycle's, the slowest bus's */
 	uint64_t second_start_us;
 	struct rusage ru_last;
@@ -251,8 +254,21 @@ static long long dmn_bus_errors(const struct dmn *d)
 	return n;
 }
 
+/* Every state_every-th cycle, and at once when the mode or the fault changed
+ * (a monitor sees a LIMP or a fault in the cycle it happened). */
+static bool dmn_state_due(const struct dmn *d)
+{
+	return d->cycle % d->state_every == 0 || !d->state_sent || d->ctl.mode != d->state_mode ||
+	       d->ctl.latched != d->state_latched;
+}
+
 static void dmn_publish_state(struct dmn *d)
 {
+	if (!dmn_state_due(d))
+		return;
+	d->state_sent = true;
+	d->state_mode = d->ctl.mode;
+	d->state_latched = d->ctl.latched;
 	struct pub_cycle f = {
 		.cycle = (int64_t)d->cycle, .period_us = d->period_meas_us, .jitter_us = d->jitter_us,
 		.bus_us = dmn_cycle_bus_us(d), .control_us = dmn_control_us(d),
@@ -1364,6 +1380,7 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	d->lim_overrun = (struct log_limit)LOG_LIMIT_INIT(5, 5000000);
 	d->lim_events = (struct log_limit)LOG_LIMIT_INIT(30, 100000);
 	d->period_us = (uint64_t)llround(cfg->period_ms * 1000.0);
+	d->state_every = pub_state_every(d->period_us);
 	d->timer_fd = d->deadline_fd = d->signal_fd = -1;
 	d->clock = &dmn_clock_real;
 	ctl_init(&d->ctl, cfg);
@@ -1441,7 +1458,11 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	pub_params(&d->pub);
 	notify_send(&d->notify, "READY=1");
 	dmn_notify_status(d);
-	log_info("ready: %s, %.0f Hz", d->pub.ch_state, 1e6 / (double)d->period_us);
+	if (d->state_every > 1)
+		log_info("ready: %s, %.0f Hz (STATE every %" PRIu64 "th cycle: %.0f a second)", d->pub.ch_state,
+		         1e6 / (double)d->period_us, d->state_every, 1e6 / (double)(d->period_us * d->state_every));
+	else
+		log_info("ready: %s, %.0f Hz", d->pub.ch_state, 1e6 / (double)d->period_us);
 
 	dmn_loop(d);
 

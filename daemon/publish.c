@@ -174,3 +174,10 @@ void pub_bus(struct pub *p, const struct pub_bus *f, const struct bus *bus, cons
 	                               .baud = (int32_t)p->cfg->baud };
 	pub_bus_joints(p, f, &lines, bus_of, c, p->ch_bus);
 }
+
+uint64_t pub_state_every(uint64_t period_us)
+{
+	if (period_us == 0 || period_us >= PUB_STATE_MIN_US)
+		return 1;
+	return (PUB_STATE_MIN_US + period_us - 1) / period_us;
+}

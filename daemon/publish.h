@@ -1,6 +1,7 @@
 /*
- * publish.h — what a robot tells the LCM network: <robot>.STATE every cycle,
- * .BUS once a second, .PARAMS when they change (and once a second), .EVENT
+ * publish.h — what a robot tells the LCM network: <robot>.STATE every cycle
+ * up to 100 a second (at shorter periods every pub_state_every()-th cycle,
+ * and any cycle whose mode or fault changed), .BUS once a second, .PARAMS when they change (and once a second), .EVENT
  * when something happens. Publish only: the daemon never subscribes, so LCM
  * opens no receive socket in it (commands come in through cmdin.h).
  * Messages are encoded into one buffer allocated at start-up (lcm-gen's
@@ -24,6 +25,18 @@
 /* Encode buffer: a robot_state_t of 24 joints is ~2.4 kB, a bus_stats_t ~2 kB. */
 #define PUB_ENCODE_CAP 16384
 #define PUB_CHANNEL_MAX (CFG_NAME_MAX + 16)
+
+/* STATE at most once every PUB_STATE_MIN_US: 100 a second. Every process on
+ * an LCM udpm group receives every datagram sent to it, whatever its
+ * channel, so a STATE every cycle at 1 kHz would cost each monitor, logger
+ * and the simulator on the group a thousand wake-ups a second; the gait
+ * (about 1 Hz) needs far fewer, and .BUS's figures (period, jitter and bus
+ * time percentiles, overruns) are over every cycle. */
+#define PUB_STATE_MIN_US 10000
+
+/* Publish STATE every this many cycles at this period (µs): 1 up to 10 ms,
+ * 10 at 1 ms, the smallest count that keeps to PUB_STATE_MIN_US. */
+uint64_t pub_state_every(uint64_t period_us);
 
 /* One cycle's figures for the state message. */
 struct pub_cycle {

@@ -192,7 +192,7 @@ wait_cycles 100
 # 5 cycles without a reading may stop the gait for a moment (the starter
 # restarts it): swinging again is waited for, not assumed at once
 swings_again() { over "$(swing 0 100)" 0.3; }
-if wait_log dp "Fast Sync Read read nobody 3 cycles in a row: reading by SYNC_READ" 5 && state_is ' mode=3 ' 1 &&
+if wait_log dp "Fast Sync Read read nobody 3 cycles in a row \(30 ms\): reading by SYNC_READ" 5 && state_is ' mode=3 ' 1 &&
 	wait_for 15 swings_again; then
 	tap_ok "its servo silent 5 cycles: back to SYNC_READ after 3, said; the joint read and swinging again"
 else tap_fail "fast read fallback" "$(grep -a 'Fast Sync Read' "$T/dp.log" | tail -3); swing $(swing 0 100)"; fi

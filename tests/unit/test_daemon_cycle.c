@@ -74,6 +74,8 @@ static struct ctl c;
 static struct bus bus;
 static struct cyc y;
 static uint64_t next_tick;
+/* the period of the test's cycle: the configuration's (robot.period_ms, 10 ms unless set) */
+static uint64_t period_us = PERIOD_US;
 static unsigned cuts;
 static void (*at_control)(void);   /* run at the cycle boundary, before the step */
 static void (*on_write_sent)(void);   /* run when a WRITE goes out (mid-cycle) */
@@ -319,7 +321,7 @@ static void drive(enum cyc_status st)
 		if (st == CYC_CONTROL) {
 			if (at_control != NULL)
 				at_control();
-			ctl_step(&c, 1e-6 * (double)f.now, 1e-6 * PERIOD_US, 1e-6 * (double)f.now);
+			ctl_step(&c, 1e-6 * (double)f.now, 1e-6 * (double)period_us, 1e-6 * (double)f.now);
 			st = cyc_resume(&y);
 			continue;
 		}
@@ -366,7 +368,7 @@ static const char *find_event(const char *needle)
 static bool tick(const char *kind)
 {
 	f.now = next_tick;
-	next_tick += PERIOD_US;
+	next_tick += period_us;
 	if (cyc_busy(&y)) {
 		cyc_cut(&y);
 		cuts++;
@@ -424,9 +426,10 @@ static void setup_start(uint32_t margin_us, enum bus_protocol protocol)
 	bus_init(&bus, &io, &tm, false);
 	assert_int_equal(bus_set_protocol(&bus, protocol), DXL_OK);
 	struct cyc_hooks hooks = { .bus_error = on_bus_error, .notice = on_notice };
-	cyc_init(&y, &bus, &c, PERIOD_US, &hooks);
+	period_us = (uint64_t)(cfg.period_ms * 1000.0 + 0.5);
+	cyc_init(&y, &bus, &c, period_us, &hooks);
 	next_tick = 1000000;
-	f.now = next_tick - PERIOD_US;
+	f.now = next_tick - period_us;
 	cuts = 0;
 	nevents = 0;
 	bus_error_count = 0;
@@ -1437,9 +1440,86 @@ static void test_indirect_refused(void **state)
 	assert_int_equal(y.errors, 0);
 }
 
+/* The read-back's pace is a time, not a count of cycles: one joint every
+ * 50 ms (5 cycles at 100 Hz). Counted in cycles it read back ten times as
+ * often at 1 kHz, 200 transactions a second on the bus, each a cut cycle
+ * when it did not fit (make bench, section rate). */
+static void test_readback_pace_is_a_time(void **state)
+{
+	(void)state;
+	static const char *const at5ms[] = { "robot.period_ms=5", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, at5ms);
+	run(200);   /* 1 s */
+	assert_int_equal(cuts, 0);
+	assert_int_equal(y.readbacks, 20);
+	for (size_t j = 0; j < 2; j++)
+		assert_int_equal(c.j[j].torque_read, 1);   /* both joints still read back */
+}
+
+/* Fast Sync Read is given up after 30 ms of cycles that read nobody (three
+ * cycles at 100 Hz), not after three cycles whatever the period: at 1 kHz,
+ * three cycles are one stall of a busy machine, and the fast read was lost
+ * for good after it (make bench, section rate). */
+static void test_fast_read_kept_through_a_short_stall(void **state)
+{
+	(void)state;
+	static const char *const at2ms[] = { "robot.period_ms=2", NULL };
+	char why[256];
+	setup_x(xm2, 2, CFG_MODE_HOLD, at2ms);
+	c.j[0].servo.firmware = 46;
+	c.j[1].servo.firmware = 46;
+	assert_true(setup_fast_read(&bus, &c, why, sizeof why));
+	cyc_set_fast_read(&y, true);
+	run(20);
+	xs(1)->powered = false;
+	run(5);   /* 10 ms */
+	assert_true(y.fast_read);
+	assert_int_equal(y.fast_fallbacks, 0);
+	xs(1)->powered = true;
+	run(2);
+	assert_int_equal(c.j[1].stale_cycles, 0);
+	assert_true(y.fast_read);
+	xs(1)->powered = false;
+	run(14);   /* 28 ms: still kept */
+	assert_true(y.fast_read);
+	run(1);    /* 30 ms */
+	assert_false(y.fast_read);
+	assert_int_equal(y.fast_fallbacks, 1);
+	xs(1)->powered = true;
+}
+
+/* A read-back that cannot end on the wire before CYC_LATE_SHARE of the
+ * period is not begun: it waits for a cycle with room, at most
+ * CYC_READBACK_WAIT_US, and is then sent anyway (a servo reset must still be
+ * found). Begun by the old rule (before 70 % of the period) it ran past the
+ * next tick, was cut off, and its reply met the next cycle's request on the
+ * line. Two XM430s at 1 Mbps, 1 ms: the SYNC_READ and SYNC_WRITE fit (580 to
+ * 800 µs), a read-back of the RAM block (770 µs on the wire) never does:
+ * one cut a second instead of one every 50 ms. */
+static void test_readback_only_where_it_fits(void **state)
+{
+	(void)state;
+	static const char *const at1ms[] = { "robot.period_ms=1", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, at1ms);
+	run(20);    /* the start's torque-on writes go first and may cost a cycle or two */
+	cuts = 0;
+	y.readbacks = 0;
+	y.readbacks_waiting = 0;
+	run(500);   /* 0.5 s: ten read-backs due, none with room */
+	assert_int_equal(cuts, 0);
+	assert_int_equal(y.readbacks, 0);
+	assert_true(y.readbacks_waiting > 0);
+	run(600);   /* past a second of waiting: one is sent anyway, and costs its cycle */
+	assert_int_equal(y.readbacks_forced, 1);
+	assert_true(cuts <= 1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_readback_pace_is_a_time),
+		cmocka_unit_test(test_fast_read_kept_through_a_short_stall),
+		cmocka_unit_test(test_readback_only_where_it_fits),
 		{ "normal_cycles (AX-12A)", test_normal_cycles, NULL, NULL, (void *)&ax_bus },
 		{ "normal_cycles (XL430-W250 + XM430-W350)", test_normal_cycles, NULL, NULL, (void *)&x_mixed_bus },
 		{ "lost_and_damaged_replies (AX-12A)", test_lost_and_damaged_replies, NULL, NULL, (void *)&ax_bus },
