@@ -1153,6 +1153,13 @@ static void cfg_check_buses(struct cfg *c, struct cfg_errors *e)
 			          "bus or the robot a shorter name", src, c->bus[b].name, c->name, c->bus[b].name, len,
 			          CFG_LCM_CHANNEL_MAX);
 	}
+	/* On a bus lost the other buses' joints hold by their goals (the
+	 * oscillators are one chain); torque actuation sends no goal, so they
+	 * would go on being driven against a stale reading. */
+	if (cfg_buses_used(c) > 1 && c->actuation == CFG_ACT_TORQUE)
+		cfg_error(e, "%s: [robot] actuation: torque actuation on several buses is refused: a lost bus holds the "
+		          "other buses' joints by their goals, which torque actuation does not send; run it on one bus, "
+		          "or in position actuation", src);
 	if (cfg_buses_used(c) > 1 && c->lockstep[0] != '\0')
 		cfg_error(e, "%s: [robot] lockstep: a robot on several buses cannot run in lockstep (the simulator's "
 		          "clock serves one port per daemon): run it in real time, or on one bus", src);

@@ -835,6 +835,13 @@ static void test_bus_errors(void **state)
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,tail:2\n", b, sizeof b),
 	                    "command line: [bus.tail] port: no port configured (a [bus.tail] section with port = "
 	                    "/dev/ttyUSB1 or usb_serial = ..., or --set bus.tail.port=PATH)");
+	/* torque actuation on several buses: a lost bus would leave the others'
+	 * joints driven by torque against a stale reading (the hold is a goal) */
+	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=1,a:2\nactuation=torque\n[bus.a]\nport=/dev/pts/1\n",
+	                               b, sizeof b),
+	                    "command line: [robot] actuation: torque actuation on several buses is refused: a lost bus "
+	                    "holds the other buses' joints by their goals, which torque actuation does not send; run it "
+	                    "on one bus, or in position actuation");
 	/* the [robot] port with nothing left on it */
 	assert_string_equal(load_error("[robot]\nport=/dev/null\nids=a:1\n[bus.a]\nport=/dev/pts/1\n", b, sizeof b),
 	                    "command line: [robot] port: no joint is left on it (each is on a [bus.NAME]): remove it, or "
