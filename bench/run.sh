@@ -1064,6 +1064,7 @@ section_model() {
 #    so a configuration costs two or three runs, not five.
 RATE_S=${BENCH_RATE_S:-2}
 RATE_1K_S=${BENCH_RATE_1K_S:-60}
+RATE_2BUS_S=${BENCH_RATE_2BUS_S:-30}
 RATE_CYCLES=${BENCH_RATE_CYCLES:-200}
 RATE_SETTLE_S=1
 RATE_CYCLE_US=5000
@@ -1072,7 +1073,7 @@ RATE_SERVOS=${BENCH_RATE_SERVOS:-2 6 12 18}
 RATE_BAUDS=${BENCH_RATE_BAUDS:-1000000 2000000 4000000}
 RATE_PERIODS_MS="10 5 4 2 1"
 RATE_DMN_ARGS=()
-PORT_RATE=7910
+PORT_RATE=7910 PORT_RATE_B=7911
 rate_read_label() { case $1 in sync) echo "SYNC_READ" ;; fast) echo "Fast Sync Read" ;; *) echo "$1" ;; esac; }
 # The simulator's options that make the daemon read that way: it reads by Fast
 # Sync Read when every servo has firmware 45 or later (the simulator's 46).
@@ -1230,6 +1231,7 @@ section_rate() {
 		done
 	done
 	rate_1k
+	rate_2bus
 	say "## Rates above 100 Hz: X servos on one bus (simulated, return delay 0)"
 	say ""
 	say "XM430-W350 servos on \`undulate-sim --model xm430-w350 --baud B\`, 10 bytes a servo read (present"
@@ -1270,11 +1272,12 @@ section_rate() {
 			say "$cells |"
 		done
 	done
-	cells="| 12 on two buses | 4"
-	for read in $RATE_READS; do cells="$cells | not measured: one bus per robot today | –"; done
-	say "$cells |"
+	say ""
+	say "Twelve on two buses: the budget's table below (real time only: a robot on several buses does not"
+	say "run in lockstep)."
 	say ""
 	rate_1k_table
+	rate_2bus_table
 }
 
 # The budget: six XM430-W350 on one 4 Mbps bus at 1 kHz, RATE_1K_S seconds,
@@ -1312,6 +1315,90 @@ rate_1k() {
 	stop "sim-$name"
 	RATE_1K_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
 	rate_1k_lockstep
+}
+
+# rate_2bus: the second budget, twelve XM430-W350 on two 4 Mbps buses (six
+# each, IDs 1-6 and 7-12, two simulators: one robot's joints on two ports,
+# daemon/README.md "Several buses") at 500 Hz, RATE_2BUS_S seconds, both
+# programs under SCHED_FIFO where permitted. Real time only: a robot on
+# several buses does not run in lockstep. Beside it, the same twelve on one
+# bus, for the difference.
+rate_2bus() {
+	local d=$T/rate u ub extra=() dargs=() out name
+	u=$(url $PORT_RATE); ub=$(url $PORT_RATE_B)
+	progress "rate: 12 X servos on two 4 Mbps buses, undulated at 500 Hz for ${RATE_2BUS_S} s, then on one bus"
+	RATE_2BUS_POLICY="SCHED_OTHER (SCHED_FIFO not permitted)"
+	if chrt -f 1 true 2>/dev/null; then
+		RATE_2BUS_POLICY="SCHED_FIFO: undulated $FIFO_PRIORITY, undulate-sim $SIM_RT_PRIORITY"
+		extra=(--realtime "$SIM_RT_PRIORITY")
+		dargs=(--set "robot.priority=$FIFO_PRIORITY" --set robot.mlockall=true)
+	fi
+	mkdir -p "$d"
+	RATE_2BUS_LOAD0=$(cut -d' ' -f1-3 /proc/loadavg)
+	start sim-2a "$SIM" --model xm430-w350 --link "$d/2a.pty" --ids 1-6 --return-delay 0 --baud 4000000 \
+		--lcm-url "$u" --quiet "${extra[@]}"
+	start sim-2b "$SIM" --model xm430-w350 --link "$d/2b.pty" --ids 7-12 --return-delay 0 --baud 4000000 \
+		--lcm-url "$ub" --quiet "${extra[@]}"
+	for name in 2bus 1bus; do
+		out=$d/$name
+		if ! wait_ready sim-2a 'ready:' 10 || { [ "$name" = 2bus ] && ! wait_ready sim-2b 'ready:' 10; }; then
+			echo "status not measured: the simulators did not start ($(why sim-2a); $(why sim-2b))" >"$out"
+			continue
+		fi
+		start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
+		wait_file "$out.lcm" 10
+		local ports=(--port "$d/2a.pty" --ids 1,2,3,4,5,6,b:7,b:8,b:9,b:10,b:11,b:12 --set "bus.b.port=$d/2b.pty"
+			--set bus.b.baud=4000000)
+		[ "$name" = 1bus ] && ports=(--port "$d/1.pty" --ids "$(ids_upto 12)")
+		if start_daemon "dmn-$name" "$DMN" "${ports[@]}" --baud 4000000 --robot r12 --lcm-url "$u" \
+			--mode oscillator --set robot.period_ms=2 "${dargs[@]}"; then
+			sleep "$RATE_SETTLE_S"
+			local t0 t1
+			t0=$(now_us); sleep "$RATE_2BUS_S"; t1=$(now_us)
+			stop "dmn-$name"; stop "log-$name"
+			"$HB/logstat" --from-us "$t0" --to-us "$t1" "$out.lcm" >"$out"
+		else
+			echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$name"))" >"$out"
+			stop "log-$name"
+		fi
+		[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
+		if [ "$name" = 2bus ]; then
+			# the same twelve on one bus: one simulator with all of them
+			stop sim-2a; stop sim-2b
+			start sim-2a "$SIM" --model xm430-w350 --link "$d/1.pty" --ids 1-12 --return-delay 0 --baud 4000000 \
+				--lcm-url "$ub" --quiet "${extra[@]}"
+		fi
+	done
+	stop sim-2a; stop sim-2b
+	RATE_2BUS_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
+}
+
+rate_2bus_table() {
+	local f=$T/rate/2bus g=$T/rate/1bus what
+	say "### The budget: twelve XM430-W350 on two 4 Mbps buses, 500 Hz, ${RATE_2BUS_S} s"
+	say ""
+	if [ "$(v "$f" status)" = not ]; then
+		what=$(sed -n 's/^status //p' "$f")
+		say "$what"
+	else
+		say "Real time, $RATE_2BUS_POLICY; load average at start $RATE_2BUS_LOAD0, at the end $RATE_2BUS_LOAD1."
+		say "Six servos a bus (IDs 1-6 and b:7-12, two simulators), the daemon's reads in parallel; beside it the"
+		say "same twelve on one bus. Bus time is the cycle's, the slower bus's."
+		say ""
+		say "| run | STATEs | overruns | period p50 | p99 | max | bus p50 | p99 | max |"
+		say "|---|---|---|---|---|---|---|---|---|"
+		local r
+		for r in "two buses:$f" "one bus:$g"; do
+			local x=${r#*:}
+			[ "$(v "$x" status)" = not ] && { say "| ${r%%:*} | $(sed -n 's/^status //p' "$x") |"; continue; }
+			say "| ${r%%:*} | $(v "$x" all.n) | $(v "$x" all.overruns) | $(fmt "$(v "$x" all.period_p50)") |" \
+				"$(fmt "$(v "$x" all.period_p99)") | $(fmt "$(v "$x" all.period_max)") | $(fmt "$(v "$x" all.bus_p50)") |" \
+				"$(fmt "$(v "$x" all.bus_p99)") | $(fmt "$(v "$x" all.bus_max)") |"
+		done
+		what="real time ($RATE_2BUS_POLICY): $(v "$f" all.overruns) overruns in ${RATE_2BUS_S} s, bus p50 $(fmt "$(v "$f" all.bus_p50)") µs (one bus: $(v "$g" all.overruns) overruns, $(fmt "$(v "$g" all.bus_p50)") µs); load $RATE_2BUS_LOAD0"
+	fi
+	say ""
+	sum "12 servos on two buses at 500 Hz" "no overrun" "$what"
 }
 
 # rate_1k_lockstep: the same robot in virtual time, RATE_1K_S simulated seconds
@@ -1377,7 +1464,6 @@ rate_1k_table() {
 	fi
 	say ""
 	sum "6 XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s" "no overrun; bus time ≤ 1.3× the Fast Sync Read wire floor" "$what; $lwhat"
-	sum "12 servos on two buses at 500 Hz" "no overrun" "not measured: one bus per robot today"
 }
 
 # ---- main -------------------------------------------------------------------------
