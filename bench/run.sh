@@ -1183,6 +1183,27 @@ rate_search() {
 }
 
 # rate_hz PERIOD_MS: the rate it is
+# rate_table COLUMNS K CELLS: a table by servos and rate with K columns a read
+# (COLUMNS, READ standing for the read's name), each row's cells of a read
+# from CELLS READ SERVOS BAUD
+rate_table() {
+	local cols=$1 k=$2 fn=$3 hdr="| servos | Mbps" sep="|---|---" cells read n baud i
+	for read in $RATE_READS; do
+		hdr="$hdr | ${cols//READ/$(rate_read_label "$read")}"
+		for ((i = 0; i < k; i++)); do sep="$sep|---"; done
+	done
+	say "$hdr |"; say "$sep|"
+	for n in $RATE_SERVOS; do
+		for baud in $RATE_BAUDS; do
+			cells="| $n | $((baud / 1000000))"
+			for read in $RATE_READS; do cells="$cells | $("$fn" "$read" "$n" "$baud")"; done
+			say "$cells |"
+		done
+	done
+}
+rate_cells_bus() { rate_bus_cells "$1-$2-$3"; }
+rate_cells_best() { echo "$(rate_best_cell "$1-$2-$3") | $(rate_best_cell "lock-$1-$2-$3")"; }
+
 rate_hz() { awk -v p="$1" 'BEGIN { printf "%g Hz", 1000 / p }'; }
 
 # rate_cells NAME: "floor | p50 | p50/floor" of buscycle, then the highest rate
@@ -1243,35 +1264,9 @@ section_rate() {
 	say "after 2), where neither program can be late: an overrun there is the cycle not fitting the period."
 	say "Load average (1 min) during the section: $(echo "$loads" | awk '{ lo = $1; hi = $1; for (i = 2; i <= NF; i++) { if ($i < lo) lo = $i; if ($i > hi) hi = $i } print lo "–" hi }')."
 	say ""
-	local hdr="| servos | Mbps" sep="|---|---" cells
-	for read in $RATE_READS; do
-		hdr="$hdr | $(rate_read_label "$read") floor (µs) | p50 | p50/floor"
-		sep="$sep|---|---|---"
-	done
-	say "$hdr |"; say "$sep|"
-	for n in $RATE_SERVOS; do
-		for baud in $RATE_BAUDS; do
-			cells="| $n | $((baud / 1000000))"
-			for read in $RATE_READS; do cells="$cells | $(rate_bus_cells "$read-$n-$baud")"; done
-			say "$cells |"
-		done
-	done
+	rate_table "READ floor (µs) | p50 | p50/floor" 3 rate_cells_bus
 	say ""
-	hdr="| servos | Mbps"; sep="|---|---"
-	for read in $RATE_READS; do
-		hdr="$hdr | $(rate_read_label "$read"): highest rate, no overrun | the same in lockstep"
-		sep="$sep|---|---"
-	done
-	say "$hdr |"; say "$sep|"
-	for n in $RATE_SERVOS; do
-		for baud in $RATE_BAUDS; do
-			cells="| $n | $((baud / 1000000))"
-			for read in $RATE_READS; do
-				cells="$cells | $(rate_best_cell "$read-$n-$baud") | $(rate_best_cell "lock-$read-$n-$baud")"
-			done
-			say "$cells |"
-		done
-	done
+	rate_table "READ: highest rate, no overrun | the same in lockstep" 2 rate_cells_best
 	say ""
 	say "Twelve on two buses: the budget's table below (real time only: a robot on several buses does not"
 	say "run in lockstep)."

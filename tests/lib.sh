@@ -238,6 +238,7 @@ lcm_url() { echo "udpm://239.255.76.67:$(lcm_port "$1")?ttl=0"; }
 #   cmd COMMAND [OPT...]  one command to the robot $R over $URL; prints the answers
 #   field NAME            the value of NAME=... in the line on stdin
 #   states / last_state   robot $R's STATE lines / the last one
+#   sim_peek / swing / over  a simulated servo's register / a joint's peak-to-peak / A > B
 #   cycle_at_least N      its last published cycle is >= N
 #   wait_cycles N         wait (up to 10 s) until N more cycles were published
 #   mark_states           after stopping $R's daemon: what it published is old
@@ -251,6 +252,15 @@ ctl() { echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/ctl"; }
 cmd() { "$B/undulated" --command "$1" --robot "$R" --lcm-url "$URL" --timeout 2 "${@:2}"; }
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 states() { grep -a "^STATE $R " "$T/watch.log"; }
+# sim_peek BUS ID REG: a register of a simulated servo (the simulator's socket $T/ctl)
+sim_peek() { local v; v=$(ctl peek "$1" "$2" "$3"); echo "${v#ok }"; }
+# swing J [N]: peak-to-peak (rad) of joint J's angle over robot $R's last N (150) states
+swing() {
+	states | tail -"${2:-150}" | awk -v k="a$1=" '{ for (i = 1; i <= NF; i++) if (index($i, k) == 1) { v = substr($i, 4) + 0
+		if (!n++) { lo = v; hi = v } if (v < lo) lo = v; if (v > hi) hi = v } } END { printf "%.3f", hi - lo }'
+}
+# over A B: the number A is above B
+over() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a > b) }'; }
 # The watcher prints 100 lines a second, and these run in every poll: read
 # the log from its end (tac), not all of it each time.
 last_state() { tac "$T/watch.log" 2>/dev/null | grep -a -m1 "^STATE $R "; }

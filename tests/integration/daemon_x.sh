@@ -20,12 +20,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
 URL=$(lcm_url 7730)
 R="dx$$"
-peek() { local v; v=$(ctl peek "$1" "$2" "$3"); echo "${v#ok }"; }
-swing() {   # peak-to-peak of joint $1's angle over the last $2 states
-	states | tail -"$2" | awk -v k="a$1=" '{ for (i = 1; i <= NF; i++) if (index($i, k) == 1) { v = substr($i, 4) + 0
-		if (!n++) { lo = v; hi = v } if (v < lo) lo = v; if (v > hi) hi = v } } END { printf "%.3f", hi - lo }'
-}
-over() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a > b) }'; }
 
 cat >"$T/x.scenario" <<EOF
 [sim]
@@ -66,8 +60,8 @@ if grep -q "bus: the cycle reads by SYNC_READ, a status packet per servo: no Fas
 else tap_fail "firmware 44: SYNC_READ said" "$(grep -a 'bus:' "$T/d.log" | head -3)"; fi
 
 # ---- start-up: what the servos hold -------------------------------------------------------------------
-got="$(peek r1 1 operating_mode) $(peek r1 2 operating_mode) $(peek r1 1 min_position_limit) $(peek r1 1 max_position_limit)"
-got="$got $(peek r1 2 bus_watchdog) $(peek r1 1 torque_enable) $(peek r1 2 torque_enable)"
+got="$(sim_peek r1 1 operating_mode) $(sim_peek r1 2 operating_mode) $(sim_peek r1 1 min_position_limit) $(sim_peek r1 1 max_position_limit)"
+got="$got $(sim_peek r1 2 bus_watchdog) $(sim_peek r1 1 torque_enable) $(sim_peek r1 2 torque_enable)"
 if [ "$got" = "3 3 1201 2895 5 1 1" ] && state_is ' tq0=1 tr0=1 tl0=885 .* tq1=1 tr1=1 tl1=885 ' 3; then
 	tap_ok "start-up: position control, limits 1201..2895 (±1.3 rad), watchdog 100 ms, torque on, read back"
 else tap_fail "start-up" "servos: $got; $(last_state | cut -c1-300)"; fi
@@ -125,7 +119,7 @@ if event 'kind=readback text="servo 1: operating mode changed' 5 &&
 	wait_for 10 sh -c "[ \"\$(echo 'peek r1 1 operating_mode' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ]" &&
 	wait_for 10 sh -c "[ \"\$(echo 'peek r1 1 torque_enable' | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ]"; then
 	tap_ok "operating mode changed behind its back: found in the read-back, position control and torque again"
-else tap_fail "operating mode put back" "$(events | tail -3); mode $(peek r1 1 operating_mode)"; fi
+else tap_fail "operating mode put back" "$(events | tail -3); mode $(sim_peek r1 1 operating_mode)"; fi
 stop d >/dev/null
 
 # ---- torque actuation on the XM430: current control ----------------------------------------------------
@@ -135,18 +129,18 @@ spawn dt "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --mode osci
 	--set robot.actuation=torque --set robot.torque_drive=current
 wait_log dt "ready: $R.STATE" 15 && wait_restarted 100 || { tap_fail "torque daemon starts" "$(cat "$T/dt.log")"; tap_done; exit 1; }
 wait_cycles 500
-gc=$(peek r1 1 goal_current)
-if [ "$(peek r1 1 operating_mode)" = 0 ] && [ "$(peek r1 2 operating_mode)" = 0 ] && [ "${gc#-}" -le 1193 ] &&
+gc=$(sim_peek r1 1 goal_current)
+if [ "$(sim_peek r1 1 operating_mode)" = 0 ] && [ "$(sim_peek r1 2 operating_mode)" = 0 ] && [ "${gc#-}" -le 1193 ] &&
 	state_is ' g0=nan .* dr0=[-0-9]' 1 && over "$(swing 0 300)" 0.5; then
 	tap_ok "torque actuation on the XM430: current control, the law's current ($gc now), joint 1 swings $(swing 0 300) rad"
-else tap_fail "current control" "modes $(peek r1 1 operating_mode)/$(peek r1 2 operating_mode), current $gc, swing $(swing 0 300); $(last_state | cut -c1-200)"; fi
+else tap_fail "current control" "modes $(sim_peek r1 1 operating_mode)/$(sim_peek r1 2 operating_mode), current $gc, swing $(swing 0 300); $(last_state | cut -c1-200)"; fi
 cmd 'mode hold' >/dev/null
 # The daemon writes each joint's mode in turn (torque off, mode, torque on, a
 # chain per joint over cycles): wait for the last of them, not the first.
 if wait_for 10 sh -c "for j in 1 2; do [ \"\$(echo \"peek r1 \$j operating_mode\" | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 3' ] &&
 		[ \"\$(echo \"peek r1 \$j torque_enable\" | socat -t 2 - UNIX-CONNECT:'$T/ctl')\" = 'ok 1' ] || exit 1; done"; then
 	tap_ok "HOLD: back in position control, torque on"
-else tap_fail "back to position control" "modes $(peek r1 1 operating_mode)/$(peek r1 2 operating_mode)"; fi
+else tap_fail "back to position control" "modes $(sim_peek r1 1 operating_mode)/$(sim_peek r1 2 operating_mode)"; fi
 stop dt >/dev/null
 
 # ---- the XL430: no current control; PWM control -----------------------------------------------------------
@@ -161,14 +155,14 @@ spawn dl "$D" --port "$T/xl" --ids 1 --robot "$R" --lcm-url "$URL" --mode oscill
 	--set robot.actuation=torque --set robot.torque_drive=pwm
 wait_log dl "ready: $R.STATE" 15 && wait_restarted 100 || { tap_fail "XL430 daemon starts" "$(cat "$T/dl.log")"; tap_done; exit 1; }
 wait_cycles 400
-if [ "$(peek r2 1 operating_mode)" = 16 ] && over "$(swing 0 300)" 0.4; then
+if [ "$(sim_peek r2 1 operating_mode)" = 16 ] && over "$(swing 0 300)" 0.4; then
 	tap_ok "torque actuation on the XL430: PWM control, joint swings $(swing 0 300) rad"
-else tap_fail "PWM control" "mode $(peek r2 1 operating_mode), swing $(swing 0 300)"; fi
+else tap_fail "PWM control" "mode $(sim_peek r2 1 operating_mode), swing $(swing 0 300)"; fi
 stop dl >/dev/null
-if [ "$stop_rc" = 0 ] && [ "$(peek r2 1 operating_mode)" = 3 ] && [ "$(peek r2 1 torque_enable)" = 1 ] &&
-	[ "$(peek r2 1 bus_watchdog)" = 0 ]; then
+if [ "$stop_rc" = 0 ] && [ "$(sim_peek r2 1 operating_mode)" = 3 ] && [ "$(sim_peek r2 1 torque_enable)" = 1 ] &&
+	[ "$(sim_peek r2 1 bus_watchdog)" = 0 ]; then
 	tap_ok "safe stop after torque actuation: position control, holding, watchdog off"
-else tap_fail "safe stop" "exit $stop_rc, mode $(peek r2 1 operating_mode), torque $(peek r2 1 torque_enable)"; fi
+else tap_fail "safe stop" "exit $stop_rc, mode $(sim_peek r2 1 operating_mode), torque $(sim_peek r2 1 torque_enable)"; fi
 
 # ---- one XL430 joint in position control on its own defaults ------------------------------------------------
 # The XL430's position loop lags most: on the AX-12A's defaults a single joint

@@ -24,12 +24,6 @@ D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
 URL=$(lcm_url 7735)
 R="di$$"
-peek() { local v; v=$(ctl peek "$1" "$2" "$3"); echo "${v#ok }"; }
-swing() {   # peak-to-peak of joint $1's angle over the last $2 states
-	states | tail -"$2" | awk -v k="a$1=" '{ for (i = 1; i <= NF; i++) if (index($i, k) == 1) { v = substr($i, 4) + 0
-		if (!n++) { lo = v; hi = v } if (v < lo) lo = v; if (v > hi) hi = v } } END { printf "%.3f", hi - lo }'
-}
-over() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a > b) }'; }
 sim_stat() { ctl stats | sed -n "s/.* $1=\([0-9]*\).*/\1/p"; }
 # the servos' bytes a status packet over the next $1 cycles (read-backs and
 # acknowledgements included): per packet, so that replies a loaded machine
@@ -71,7 +65,7 @@ if grep -q "bus: the cycle reads the indirect block at 224, 10 or 13 bytes a ser
 	grep -q "bus: the cycle reads by Fast Sync Read" "$T/d.log"; then
 	tap_ok "start-up maps Indirect Address 1..13 on both servos, reads the map back, says the cycle reads the block by Fast Sync Read"
 else tap_fail "the indirect map said" "$(grep -a 'bus:' "$T/d.log" | head -4)"; fi
-got="$(peek r1 1 indirect_address_1) $(peek r1 1 indirect_address_7) $(peek r1 2 indirect_address_10) $(peek r1 2 indirect_address_11) $(peek r1 2 indirect_address_13) $(peek r1 2 indirect_address_14)"
+got="$(sim_peek r1 1 indirect_address_1) $(sim_peek r1 1 indirect_address_7) $(sim_peek r1 2 indirect_address_10) $(sim_peek r1 2 indirect_address_11) $(sim_peek r1 2 indirect_address_13) $(sim_peek r1 2 indirect_address_14)"
 if [ "$got" = "126 132 135 144 146 237" ]; then
 	tap_ok "the servos hold the map: slots 1..10 = 126..135, 11..13 = 144..146, slot 14 its factory value"
 else tap_fail "the servos' map" "$got"; fi

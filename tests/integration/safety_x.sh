@@ -24,10 +24,6 @@ URL=$(lcm_url 7731)
 R="sx$$"
 peek() { local v; v=$(ctl peek r1 "$1" "$2"); echo "${v#ok }"; }
 torque() { echo "$(peek 1 torque_enable) $(peek 2 torque_enable)"; }
-swing() {   # peak-to-peak of joint $1's angle over the last $2 states (150)
-	states | tail -"${2:-150}" | awk -v k="a$1=" '{ for (i = 1; i <= NF; i++) if (index($i, k) == 1) { v = substr($i, 4) + 0
-		if (!n++) { lo = v; hi = v } if (v < lo) lo = v; if (v > hi) hi = v } } END { printf "%.3f", hi - lo }'
-}
 
 spawn sim "$S" --model xm430-w350 --link "$T/bus" --ids 1,2 --name r1 --baud 1000000 --return-delay 0 \
 	--lcm-url "$URL" --control "$T/ctl" --seed 6
