@@ -226,23 +226,25 @@ static bool dmn_any_connected(const struct dmn *d)
 	return false;
 }
 
-/* The buses work in parallel: the cycle's bus time is the slowest one's. */
-static double dmn_cycle_bus_us(const struct dmn *d)
+/* The buses work in parallel: the cycle's bus time is the slowest one's,
+ * and its control time the longest any bus's cycle measured. */
+static void dmn_cycle_times(const struct dmn *d, double *bus_us, double *control_us)
 {
-	double us = 0.0;
-	for (size_t b = 0; b < d->nbuses; b++)
-		if (d->buses[b].connected && d->buses[b].cyc.bus_us > us)
-			us = d->buses[b].cyc.bus_us;
-	return us;
+	*bus_us = *control_us = 0.0;
+	for (size_t b = 0; b < d->nbuses; b++) {
+		const struct cyc *y = &d->buses[b].cyc;
+		if (!d->buses[b].connected)
+			continue;
+		*bus_us = fmax(*bus_us, y->bus_us);
+		*control_us = fmax(*control_us, y->control_us);
+	}
 }
 
-static double dmn_control_us(const struct dmn *d)
+static double dmn_cycle_bus_us(const struct dmn *d)
 {
-	double us = 0.0;
-	for (size_t b = 0; b < d->nbuses; b++)
-		if (d->buses[b].connected && d->buses[b].cyc.control_us > us)
-			us = d->buses[b].cyc.control_us;
-	return us;
+	double bus_us, control_us;
+	dmn_cycle_times(d, &bus_us, &control_us);
+	return bus_us;
 }
 
 /* ---- publishing --------------------------------------------------------------------------------- */
@@ -269,9 +271,11 @@ static void dmn_publish_state(struct dmn *d)
 	d->state_sent = true;
 	d->state_mode = d->ctl.mode;
 	d->state_latched = d->ctl.latched;
+	double bus_us, control_us;
+	dmn_cycle_times(d, &bus_us, &control_us);
 	struct pub_cycle f = {
 		.cycle = (int64_t)d->cycle, .period_us = d->period_meas_us, .jitter_us = d->jitter_us,
-		.bus_us = dmn_cycle_bus_us(d), .control_us = dmn_control_us(d),
+		.bus_us = bus_us, .control_us = control_us,
 		.overruns = d->overruns, .bus_errors = dmn_bus_errors(d), .bad_commands = cin_refused(&d->cin),
 	};
 	pub_state(&d->pub, &d->ctl, &f);
