@@ -70,8 +70,20 @@ static bool cyc_sync_reads(const struct cyc *y)
 
 void cyc_set_fast_read(struct cyc *y, bool on)
 {
-	y->fast_read = on && dxl_proto_can(bus_proto(y->bus), DXL_CAP_FAST_READ);
+	y->fast_read = y->fast_able = on && dxl_proto_can(bus_proto(y->bus), DXL_CAP_FAST_READ);
 	y->fast_fails = 0;
+	y->fast_trial = false;
+}
+
+/* Back on SYNC_READ after a fallback: this cycle tries the Fast Sync Read
+ * again when it is time and the last plain read read every servo (a servo
+ * still silent would stop the chain again). */
+static void cyc_fast_retry(struct cyc *y)
+{
+	if (!y->fast_able || y->fast_read || y->count < y->fast_retry_at || y->multi.fast ||
+	    y->multi.answered != cyc_count(y) || cyc_count(y) == 0)
+		return;
+	y->fast_read = y->fast_trial = true;
 }
 
 void cyc_set_indirect(struct cyc *y, bool on)
@@ -211,18 +223,35 @@ static void cyc_fast_outcome(struct cyc *y)
 {
 	if (!y->fast_read)
 		return;
+	uint64_t retry = CYC_FAST_RETRY_US / (y->period_us > 0 ? y->period_us : 1);
+	char text[256];
+	if (y->fast_trial) {
+		/* a try after a fallback: kept only when it read every servo */
+		y->fast_trial = false;
+		if (y->multi.answered != cyc_count(y)) {
+			y->fast_read = false;
+			y->fast_retry_at = y->count + retry;
+			return;
+		}
+		y->fast_fails = 0;
+		y->fast_retries++;
+		snprintf(text, sizeof text, "bus: Fast Sync Read read every servo again: reading by it from now on");
+		if (y->hooks.notice != NULL)
+			y->hooks.notice(y->hooks.ctx, text);
+		return;
+	}
 	y->fast_fails = y->multi.answered == 0 ? y->fast_fails + 1 : 0;
 	if (y->fast_fails < y->fast_fails_max)
 		return;
 	y->fast_read = false;
 	y->fast_fallbacks++;
+	y->fast_retry_at = y->count + retry;
 	if (y->hooks.notice == NULL)
 		return;
-	char text[256];
 	snprintf(text, sizeof text,
 	         "bus: Fast Sync Read read nobody %d cycles in a row (%.0f ms): reading by SYNC_READ from now on, each "
-	         "servo's own status packet (until the next start or reconnect)",
-	         y->fast_fails, 1e-3 * (double)((uint64_t)y->fast_fails * y->period_us));
+	         "servo's own status packet (trying it again every %.0f s)",
+	         y->fast_fails, 1e-3 * (double)((uint64_t)y->fast_fails * y->period_us), 1e-6 * CYC_FAST_RETRY_US);
 	y->hooks.notice(y->hooks.ctx, text);
 }
 
@@ -369,6 +398,7 @@ enum cyc_status cyc_start(struct cyc *y)
 	y->bus_us = 0.0;
 	struct sm_read rd = cyc_read_of(y);
 	y->read_len = (y->count & 1) ? rd.len_slow : rd.len;
+	cyc_fast_retry(y);
 	if (y->starved >= CYC_STARVED_CYCLES && wq_pending(&y->ctl->wq) > 0) {
 		y->phase = CYC_WRITE_FIRST;
 		y->writes_first++;

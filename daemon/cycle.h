@@ -39,9 +39,11 @@
  * Sync Read instead: one status packet for all servos, one return delay and
  * one header for the lot. Its parts are read as the SYNC_READ's slots. A
  * servo that stops answering takes the whole packet with it (the chain stops
- * at its part): after CYC_FAST_FAILS_MAX cycles in a row without a single
- * reading the cycle goes back to SYNC_READ, so the other servos are read
- * again, and says so (the notice hook).
+ * at its part): after CYC_FAST_FAILS_US of cycles in a row without a single
+ * reading (at least CYC_FAST_FAILS_MAX) the cycle goes back to SYNC_READ, so
+ * the other servos are read again, and says so (the notice hook). Every
+ * CYC_FAST_RETRY_US after that, where the plain read read every servo, one
+ * cycle tries the Fast Sync Read again: read whole, it is kept (said).
  *
  * Where start-up mapped the present values into every servo's indirect
  * block and read the map back (cyc_set_indirect, setup_indirect), the
@@ -101,6 +103,12 @@ enum cyc_phase { CYC_IDLE, CYC_WRITE_FIRST, CYC_READ, CYC_CONTROL_STEP, CYC_WRIT
  * milliseconds at 1 kHz, changes nothing. */
 #define CYC_FAST_FAILS_MAX 3
 #define CYC_FAST_FAILS_US 30000
+/* Back on SYNC_READ, the Fast Sync Read is tried again this often, for one
+ * cycle, where the last plain read read every servo (a servo back after a
+ * power loss or a loose cable): one cycle's readings at stake every 10 s,
+ * and a robot that lost a servo for a moment does not pay a header and a
+ * return delay a servo until its next start. */
+#define CYC_FAST_RETRY_US 10000000
 
 struct cyc_hooks {
 	void *ctx;
@@ -132,6 +140,9 @@ struct cyc {
 	bool indirect;                /* the read is of the indirect block (cyc_set_indirect) */
 	int fast_fails;               /* Fast Sync Reads in a row that read nobody */
 	int fast_fails_max;           /* CYC_FAST_FAILS_US in cycles of this period */
+	bool fast_able;               /* every servo answers it (cyc_set_fast_read): worth a try again */
+	bool fast_trial;              /* this cycle's Fast Sync Read is a try after a fallback */
+	uint64_t fast_retry_at;       /* the cycle count of the next try */
 	uint64_t readback_every;      /* CYC_READBACK_US in cycles of this period, at least 1 */
 	struct bus_multi multi;
 	uint8_t multi_buf[CFG_MAX_JOINTS * 32];
@@ -144,6 +155,7 @@ struct cyc {
 	int starved;                  /* cycles in a row that ended with writes waiting */
 	/* counters */
 	long long errors, cut_off, deferred, readbacks, writes_first, fast_fallbacks, indirect_fallbacks;
+	long long fast_retries;       /* Fast Sync Read taken up again after a fallback */
 	long long readbacks_waiting;  /* cycles a read-back due waited for room */
 	long long readbacks_forced;   /* read-backs begun without room, after CYC_READBACK_WAIT_US */
 	/* a robot on several buses (cyc_set_bus): the joints on this one, in the

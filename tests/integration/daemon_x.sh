@@ -14,7 +14,8 @@
 #    the safe stop; current control asked of an XL430 is refused;
 #  - the cycle's read: the XM430s run firmware 44 (no Fast Sync Read: the
 #    plain SYNC_READ, said at start), the XL430 46 (Fast Sync Read, said;
-#    its servo silent for a while: back to SYNC_READ, said, still read).
+#    its servo silent for a while: back to SYNC_READ, said, still read;
+#    answering again: the fast read taken up again within 10 s, said).
 . "$(dirname "$0")/../lib.sh"
 D="$B/undulated"; S="$B/undulate-sim"
 if [ ! -x "$S" ] || [ ! -x "$D" ]; then tap_skip_all "undulate-sim or undulated not built"; fi
@@ -190,6 +191,10 @@ if wait_log dp "Fast Sync Read read nobody 3 cycles in a row \(30 ms\): reading 
 	wait_for 15 swings_again; then
 	tap_ok "its servo silent 5 cycles: back to SYNC_READ after 3, said; the joint read and swinging again"
 else tap_fail "fast read fallback" "$(grep -a 'Fast Sync Read' "$T/dp.log" | tail -3); swing $(swing 0 100)"; fi
+# its servo answering again: the Fast Sync Read is tried again within 10 s and kept
+if wait_log dp "Fast Sync Read read every servo again: reading by it from now on" 15; then
+	tap_ok "the servo answering again: the Fast Sync Read taken up again within 10 s, said"
+else tap_fail "fast read taken up again" "$(grep -a 'Fast Sync Read' "$T/dp.log" | tail -3)"; fi
 stop dp >/dev/null
 
 # ---- --tune on an X servo: from the model's defaults, and the file says so ----------------------------------

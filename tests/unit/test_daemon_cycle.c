@@ -410,12 +410,14 @@ static void setup_common(size_t n, enum cfg_mode mode, const char *const *sets)
 	ctl_init(&c, &cfg);
 }
 
-/* the cycle's notices (a change of how it reads), the last one */
+/* the cycle's notices (a change of how it reads): the last one, and how many */
 static char last_notice[256];
+static int notices;
 static void on_notice(void *ctx, const char *text)
 {
 	(void)ctx;
 	snprintf(last_notice, sizeof last_notice, "%s", text);
+	notices++;
 }
 
 static void setup_start(uint32_t margin_us, enum bus_protocol protocol)
@@ -1292,7 +1294,24 @@ static void test_fast_sync_read(void **state)
 	assert_int_equal(c.j[1].stale_cycles, 0);   /* read again */
 	assert_int_equal(c.j[0].stale_cycles, CYC_FAST_FAILS_MAX + 2);
 	assert_int_equal(atomic_load(&xb.fast_reads), 100 + CYC_FAST_FAILS_MAX);
+	/* tried again every CYC_FAST_RETRY_US while the plain read reads every
+	 * servo: with servo 1 still silent, never; back, at the next try, and
+	 * kept (said: the notice) */
+	run(CYC_FAST_RETRY_US / PERIOD_US + 5);
+	assert_false(y.fast_read);
+	assert_int_equal(atomic_load(&xb.fast_reads), 100 + CYC_FAST_FAILS_MAX);
 	xs(1)->powered = true;
+	notices = 0;
+	run(CYC_FAST_RETRY_US / PERIOD_US + 5);
+	assert_true(y.fast_read);
+	assert_int_equal(y.fast_retries, 1);
+	assert_int_equal(notices, 1);
+	assert_non_null(strstr(last_notice, "Fast Sync Read read every servo again"));
+	unsigned fast_now = atomic_load(&xb.fast_reads);
+	run(10);
+	assert_int_equal(atomic_load(&xb.fast_reads), fast_now + 10);
+	assert_int_equal(c.j[0].stale_cycles, 0);
+	assert_int_equal(c.j[1].stale_cycles, 0);
 	/* not on a 1.0 bus */
 	cyc_set_fast_read(&y, true);
 	assert_int_equal(bus_set_protocol(&bus, BUS_PROTOCOL_1), DXL_OK);
