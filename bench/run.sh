@@ -1121,19 +1121,19 @@ rate_daemon() {
 	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
 }
 
-# rate_lockstep NAME N BAUD PERIOD_MS READ: the same robot in the simulator's
-# virtual time (lockstep), RATE_S simulated seconds after 2: neither program
+# rate_lockstep NAME N BAUD PERIOD_MS READ [SECONDS]: the same robot in the
+# simulator's virtual time (lockstep), SECONDS (RATE_S) simulated seconds after 2: neither program
 # can be late there, so an overrun is the cycle not fitting the period.
 # Results in $T/rate/NAME-PERIOD like rate_daemon's.
 rate_lockstep() {
-	local name=$1 n=$2 baud=$3 p=$4 read=$5 d=$T/rate u out
+	local name=$1 n=$2 baud=$3 p=$4 read=$5 secs=${6:-$RATE_S} d=$T/rate u out
 	u=$(url $PORT_RATE)
 	out=$d/$name-$p
 	rm -f "$d/$name.clock"
 	# shellcheck disable=SC2046 # the read's options are words
 	start "sim-$name" "$SIM" --model xm430-w350 --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
 		--baud "$baud" $(rate_sim_args "$read") --lcm-url "$u" --quiet --lockstep "$d/$name.clock" \
-		--duration "$((RATE_S + 2))"
+		--duration "$((secs + 2))"
 	if ! wait_file "$d/$name.clock" 10; then
 		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
 		stop "sim-$name"
@@ -1146,7 +1146,10 @@ rate_lockstep() {
 	wait "${PID[sim-$name]}" 2>/dev/null
 	unset "PID[sim-$name]"
 	stop "log-$name"
+	# the first 2 simulated seconds (start-up, ramp) left out
 	"$HB/logstat" --sender-time --skip 2 "$out.lcm" >"$out"
+	sed -n 's/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time in \([0-9.]*\) s.*/lockstep_sim_s \1\nlockstep_wall_s \2/p' \
+		"$T/sim-$name.log" >>"$out"
 	grep -q 'reading by SYNC_READ from now on' "$T/dmn-$name.log" && echo "fell_back 1" >>"$out"
 	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
 }
@@ -1397,33 +1400,10 @@ rate_2bus_table() {
 }
 
 # rate_1k_lockstep: the same robot in virtual time, RATE_1K_S simulated seconds
-rate_1k_lockstep() {
-	local name=1k-lock n=6 d=$T/rate u out
-	u=$(url $PORT_RATE)
-	out=$d/$name
-	start "sim-$name" "$SIM" --model xm430-w350 --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
-		--baud 4000000 --lcm-url "$u" --quiet --lockstep "$d/$name.clock" --duration "$((RATE_1K_S + 2))"
-	if ! wait_file "$d/$name.clock" 10; then
-		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
-		stop "sim-$name"
-		return 0
-	fi
-	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
-	wait_file "$out.lcm" 10
-	"$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud 4000000 --robot "r$n" --lcm-url "$u" \
-		--mode oscillator --set robot.period_ms=1 --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
-	wait "${PID[sim-$name]}" 2>/dev/null
-	unset "PID[sim-$name]"
-	stop "log-$name"
-	# the first 2 simulated seconds (start-up, ramp) left out
-	"$HB/logstat" --sender-time --skip 2 "$out.lcm" >"$out"
-	sed -n 's/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time in \([0-9.]*\) s.*/lockstep_sim_s \1\nlockstep_wall_s \2/p' \
-		"$T/sim-$name.log" >>"$out"
-	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
-}
+rate_1k_lockstep() { rate_lockstep 1k-lock 6 4000000 1 fast "$RATE_1K_S"; }
 
 rate_1k_table() {
-	local f=$T/rate/1k-6-1 b=$T/rate/1k-6.bc lk=$T/rate/1k-lock floor what lwhat
+	local f=$T/rate/1k-6-1 b=$T/rate/1k-6.bc lk=$T/rate/1k-lock-1 floor what lwhat
 	floor=$(v "$b" floor_us)
 	say "### The budget: six XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s"
 	say ""

@@ -14,7 +14,7 @@ if [ ! -x "$S" ] || [ ! -x "$D" ]; then
 	tap_skip_all "undulate-sim or undulated not built"
 fi
 R="mb$$"
-URL=$(lcm_url 7731)
+URL=$(lcm_url 7611)
 ctl_at() { local sock=$1; shift; echo "$*" | socat -t 2 - UNIX-CONNECT:"$T/$sock"; }
 # range (max - min) of field $1 over the states from cycle $2 on
 range_since() {

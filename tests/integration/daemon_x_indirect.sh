@@ -56,11 +56,18 @@ EOF
 spawn_rt sim "$S" --scenario "$T/x.scenario" --lcm-url "$URL" --control "$T/ctl"
 wait_log sim 'ready' 10 || { tap_fail "simulator ready" "$(cat "$T/sim.log")"; tap_done; exit 1; }
 spawn watch "$D" --watch "$R" --raw --lcm-url "$URL"
+# robot NAME PORT WHAT [OPTION...]: undulated on PORT, ready and 50 cycles
+# published, or WHAT failed and the test ends
+robot() {
+	local name=$1 port=$2 what=$3
+	shift 3
+	spawn_rt "$name" "$D" --port "$port" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold "$@"
+	wait_log "$name" "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
+		{ tap_fail "$what" "$(cat "$T/$name.log")"; tap_done; exit 1; }
+}
 
 # ---- mapped, read back, read ------------------------------------------------------------------------
-spawn_rt d "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
-wait_log d "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
-	{ tap_fail "daemon starts on the X bus" "$(cat "$T/d.log")"; tap_done; exit 1; }
+robot d "$T/xm" "daemon starts on the X bus"
 if grep -q "bus: the cycle reads the indirect block at 224, 10 or 13 bytes a servo where the present registers at 126 take 10 or 21 (Indirect Address 1..13 on every servo read back as mapped (2 written, 0 kept))" "$T/d.log" &&
 	grep -q "bus: the cycle reads by Fast Sync Read" "$T/d.log"; then
 	tap_ok "start-up maps Indirect Address 1..13 on both servos, reads the map back, says the cycle reads the block by Fast Sync Read"
@@ -82,9 +89,7 @@ else tap_fail "voltage through the block" "v0=$v; $(last_state | cut -c1-300)"; 
 
 # ---- a second start keeps the map; a REBOOT ends the indirect read ---------------------------------------
 stop d >/dev/null
-spawn_rt d3 "$D" --port "$T/xm" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
-wait_log d3 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
-	{ tap_fail "daemon restarts" "$(cat "$T/d3.log")"; tap_done; exit 1; }
+robot d3 "$T/xm" "daemon restarts"
 if grep -q "read back as mapped (0 written, 2 kept)" "$T/d3.log"; then
 	tap_ok "a second start finds the map in place and keeps it (nothing written)"
 else tap_fail "the map kept" "$(grep -a 'bus:' "$T/d3.log" | head -3)"; fi
@@ -103,16 +108,12 @@ stop d3 >/dev/null
 
 # ---- what it saves on the wire ------------------------------------------------------------------------
 # firmware 44: SYNC_READ, one status packet a servo; each daemon alone on the simulator
-spawn_rt d4 "$D" --port "$T/xs" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
-wait_log d4 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
-	{ tap_fail "daemon starts on firmware 44" "$(cat "$T/d4.log")"; tap_done; exit 1; }
+robot d4 "$T/xs" "daemon starts on firmware 44"
 cmd 'mode oscillator' >/dev/null
 wait_cycles 100
 ind=$(per_reply 400)
 stop d4 >/dev/null
-spawn_rt d5 "$D" --port "$T/xs" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold --set robot.indirect=off
-wait_log d5 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
-	{ tap_fail "daemon restarts with indirect = off" "$(cat "$T/d5.log")"; tap_done; exit 1; }
+robot d5 "$T/xs" "daemon restarts with indirect = off" --set robot.indirect=off
 cmd 'mode oscillator' >/dev/null
 wait_cycles 100
 dir=$(per_reply 400)
@@ -140,9 +141,7 @@ contact = none
 EOF
 spawn_rt sim2 "$S" --scenario "$T/n.scenario" --lcm-url "$URL" --control "$T/ctl2"
 wait_log sim2 'ready' 10 || { tap_fail "simulator without indirect areas ready" "$(cat "$T/sim2.log")"; tap_done; exit 1; }
-spawn_rt d6 "$D" --port "$T/xn" --ids 1,2 --robot "$R" --lcm-url "$URL" --set robot.fault_action=hold
-wait_log d6 "ready: $R.STATE" 15 && wait_for 10 cycle_at_least 50 ||
-	{ tap_fail "daemon starts on servos without indirect areas" "$(cat "$T/d6.log")"; tap_done; exit 1; }
+robot d6 "$T/xn" "daemon starts on servos without indirect areas"
 if grep -q "bus: the cycle reads the present registers at 126, 10 or 21 bytes a servo: no indirect block, as servo 1 (XL430-W250): reading Indirect Address 1..13 failed" "$T/d6.log"; then
 	tap_ok "servos without indirect areas: the map's read refused, said, the cycle reads the registers where they lie"
 else tap_fail "no indirect areas" "$(grep -a 'bus:' "$T/d6.log" | head -3)"; fi

@@ -6,8 +6,8 @@
 # and a bus that does not exist is named with the ones that do.
 . "$(dirname "$0")/../lib.sh"
 dxl_sim_built
-spawn simA "$sim" --link "$T/a.bus" --ids 1 --name ra --lcm-url "$(lcm_url 7765)" --quiet --return-delay 0
-spawn simB "$sim" --link "$T/b.bus" --ids 2 --name rb --lcm-url "$(lcm_url 7765)" --quiet --return-delay 0
+spawn simA "$sim" --link "$T/a.bus" --ids 1 --name ra --lcm-url "$(lcm_url 7612)" --quiet --return-delay 0
+spawn simB "$sim" --link "$T/b.bus" --ids 2 --name rb --lcm-url "$(lcm_url 7612)" --quiet --return-delay 0
 if ! wait_log simA 'ready' 10 || ! wait_log simB 'ready' 10; then
 	tap_fail "simulators ready" "$(cat "$T/simA.log" "$T/simB.log")"; tap_done; exit 1
 fi
