@@ -1371,15 +1371,27 @@ rate_2bus() {
 	RATE_2BUS_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
 }
 
+# rate_unmeasured FILE...: the first of the files that says "status not
+# measured: ..." said, into $what; 1 when every one was measured
+rate_unmeasured() {
+	local f
+	for f in "$@"; do
+		[ -e "$f" ] && [ "$(v "$f" status)" = not ] || continue
+		what=$(sed -n 's/^status //p' "$f")
+		say "$what"
+		return 0
+	done
+	return 1
+}
+# rate_realtime POLICY LOAD0 LOAD1: a budget run's first line
+rate_realtime() { say "Real time, $1; load average at start $2, at the end $3."; }
+
 rate_2bus_table() {
 	local f=$T/rate/2bus g=$T/rate/1bus what
 	say "### The budget: twelve XM430-W350 on two 4 Mbps buses, 500 Hz, ${RATE_2BUS_S} s"
 	say ""
-	if [ "$(v "$f" status)" = not ]; then
-		what=$(sed -n 's/^status //p' "$f")
-		say "$what"
-	else
-		say "Real time, $RATE_2BUS_POLICY; load average at start $RATE_2BUS_LOAD0, at the end $RATE_2BUS_LOAD1."
+	if ! rate_unmeasured "$f"; then
+		rate_realtime "$RATE_2BUS_POLICY" "$RATE_2BUS_LOAD0" "$RATE_2BUS_LOAD1"
 		say "Six servos a bus (IDs 1-6 and b:7-12, two simulators), the daemon's reads in parallel; beside it the"
 		say "same twelve on one bus. Bus time is the cycle's, the slower bus's."
 		say ""
@@ -1407,14 +1419,8 @@ rate_1k_table() {
 	floor=$(v "$b" floor_us)
 	say "### The budget: six XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s"
 	say ""
-	if [ -e "$T/rate/1k-6.sim" ]; then
-		what=$(sed -n 's/^status //p' "$T/rate/1k-6.sim")
-		say "$what"
-	elif [ "$(v "$f" status)" = not ]; then
-		what=$(sed -n 's/^status //p' "$f")
-		say "$what"
-	else
-		say "Real time, $RATE_1K_POLICY; load average at start $RATE_1K_LOAD0, at the end $RATE_1K_LOAD1."
+	if ! rate_unmeasured "$T/rate/1k-6.sim" "$f"; then
+		rate_realtime "$RATE_1K_POLICY" "$RATE_1K_LOAD0" "$RATE_1K_LOAD1"
 		say "Fast Sync Read floor of the 10-byte cycle: $floor µs. At 1 ms undulated publishes every 10th cycle's"
 		say "STATE: the percentiles below are over those (the cycles that read 21 bytes a servo, floor 555 µs);"
 		say "the overruns are its counter, over every cycle. Lockstep: the same, in the simulator's virtual time."
