@@ -114,6 +114,19 @@ start_daemon() {
 	done
 	return 1
 }
+# daemon_window NAME SETTLE_S WINDOW_S LCMLOG OUT: after SETTLE_S, WINDOW_S
+# seconds of daemon dmn-NAME's run (its LCM logged by log-NAME into LCMLOG);
+# both stopped, logstat's figures of the window into OUT
+daemon_window() {
+	local t0 t1
+	sleep "$2"
+	t0=$(now_us)
+	sleep "$3"
+	t1=$(now_us)
+	stop "dmn-$1"; stop "log-$1"
+	"$HB/logstat" --from-us "$t0" --to-us "$t1" "$4" >"$5"
+	echo "start_retries $RETRIES" >>"$5"
+}
 # retried: " (N start-up retried)" or nothing
 retried() { [ "${1:-0}" != nan ] && [ "${1:-0}" -gt 0 ] && echo "; $1 start-up retried"; }
 
@@ -416,14 +429,7 @@ daemon_bus_run() {
 	sim_logged "$name" "$d/$name" "the simulator refused $n servos on one bus" "$d/$name.lcm" --link "$d/$name.pty" \
 		--ids "$(ids_upto "$n")" --return-delay "$rd" || return 1
 	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --robot "r$n" --lcm-url "$u" --mode oscillator; then
-		sleep "$RAMP_S"
-		local t0 t1
-		t0=$(now_us)
-		sleep "$WINDOW_S"
-		t1=$(now_us)
-		stop "dmn-$name"; stop "log-$name"
-		"$HB/logstat" --from-us "$t0" --to-us "$t1" "$d/$name.lcm" >"$d/$name"
-		echo "start_retries $RETRIES" >>"$d/$name"
+		daemon_window "$name" "$RAMP_S" "$WINDOW_S" "$d/$name.lcm" "$d/$name"
 	else
 		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$name"))" >"$d/$name"
 		stop "log-$name"
@@ -1099,20 +1105,14 @@ rate_sim() {
 # rate_daemon NAME N BAUD PERIOD_MS WINDOW_S: undulated on sim-NAME's bus at
 # that period; logstat's figures of WINDOW_S seconds into $T/rate/NAME-PERIOD.
 rate_daemon() {
-	local name=$1 n=$2 baud=$3 p=$4 w=$5 d=$T/rate u out t0 t1
+	local name=$1 n=$2 baud=$3 p=$4 w=$5 d=$T/rate u out
 	u=$(url $PORT_RATE)
 	out=$d/$name-$p
 	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
 	wait_file "$out.lcm" 10
 	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" \
 		--lcm-url "$u" --mode oscillator --set robot.period_ms="$p" ${RATE_DMN_ARGS[@]+"${RATE_DMN_ARGS[@]}"}; then
-		sleep "$RATE_SETTLE_S"
-		t0=$(now_us)
-		sleep "$w"
-		t1=$(now_us)
-		stop "dmn-$name"; stop "log-$name"
-		"$HB/logstat" --from-us "$t0" --to-us "$t1" "$out.lcm" >"$out"
-		echo "start_retries $RETRIES" >>"$out"
+		daemon_window "$name" "$RATE_SETTLE_S" "$w" "$out.lcm" "$out"
 		grep -q 'reading by SYNC_READ from now on' "$T/dmn-$name.log" && echo "fell_back 1" >>"$out"
 	else
 		echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$name"))" >"$out"
@@ -1350,11 +1350,7 @@ rate_2bus() {
 		[ "$name" = 1bus ] && ports=(--port "$d/1.pty" --ids "$(ids_upto 12)")
 		if start_daemon "dmn-$name" "$DMN" "${ports[@]}" --baud 4000000 --robot r12 --lcm-url "$u" \
 			--mode oscillator --set robot.period_ms=2 "${dargs[@]}"; then
-			sleep "$RATE_SETTLE_S"
-			local t0 t1
-			t0=$(now_us); sleep "$RATE_2BUS_S"; t1=$(now_us)
-			stop "dmn-$name"; stop "log-$name"
-			"$HB/logstat" --from-us "$t0" --to-us "$t1" "$out.lcm" >"$out"
+			daemon_window "$name" "$RATE_SETTLE_S" "$RATE_2BUS_S" "$out.lcm" "$out"
 		else
 			echo "status not measured: undulated did not start in $START_TRIES tries ($(why "dmn-$name"))" >"$out"
 			stop "log-$name"
