@@ -634,7 +634,7 @@ static void dmn_indirect(struct dmn *d, struct dmn_bus *b)
 		log_info("bus: the cycle reads the indirect block at %u, %u or %u bytes a servo where the present "
 		         "registers at %u take %u or %u (%s)", m->indirect.addr, m->indirect.len, m->indirect.len_slow,
 		         direct.addr, direct.len, direct.len_slow, why);
-	else if (m->protocol == 2)
+	else if (dxl_proto_can(bus_proto(&b->bus), DXL_CAP_SYNC_READ))
 		log_info("bus: the cycle reads the present registers at %u, %u or %u bytes a servo: no indirect block, "
 		         "as %s", direct.addr, direct.len, direct.len_slow, why);
 }
