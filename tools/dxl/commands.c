@@ -147,23 +147,6 @@ static size_t dxlt_scan_bauds(const struct dxlt *t, const struct dxlt_family *f,
 	return n;
 }
 
-/* setup's last line: the bus time of one 100 Hz cycle of undulated's for n
- * servos (doctor.h's dr_cycle_wire_us: the model's present block read, one
- * READ a servo or one SYNC_READ as the protocol can, and one SYNC_WRITE of
- * goals), plus the adapter's hold time for each read. */
-void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int latency_ms)
-{
-	const struct dxl_proto *p = bus_proto(&t->bus);
-	bool sync = dxl_proto_can(p, DXL_CAP_SYNC_READ);
-	double wire_ms = 1e-3 * dr_cycle_wire_us(p, n, m->present_len, m->goal_size, port_baud(t->port));
-	double total_ms = wire_ms + (sync ? 1.0 : (double)n) * latency_ms;
-
-	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire (%s of %u bytes each, one "
-	        "SYNC_WRITE) + %d ms adapter latency %s = %.2f ms of the 10 ms period%s\n", n, n == 1 ? "" : "s",
-	        port_baud(t->port), wire_ms, sync ? "one SYNC_READ" : "a READ", m->present_len, latency_ms,
-	        sync ? "for it" : "per read", total_ms, total_ms > 5.0 ? " (too much for 100 Hz)" : "");
-}
-
 /* The two families `dxl` speaks to, in scan order. */
 static const struct dxlt_family dxlt_families[] = {
 	{ .protocol = 1, .bus = BUS_PROTOCOL_1, .label = "Protocol 1.0", .opt = "", .max_id = DXL_MAX_ID,

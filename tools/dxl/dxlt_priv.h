@@ -158,10 +158,6 @@ int dxlt_cmd_write(struct dxlt *t);
 int dxlt_cmd_torque(struct dxlt *t);
 int dxlt_cmd_setup(struct dxlt *t);
 /* ---- commands.c ---- */
-struct sm_model;
-/* setup's last line: the bus time of one cycle of undulated's loop for n
- * servos of model m (the one whose cycle reads the most). */
-void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int latency_ms);
 
 /* ---- Protocol 2.0 (commands2.c) ---- */
 /* Broadcast PING at the current rate: one scan line per servo in the ID range. */

@@ -15,6 +15,7 @@
 #include "dxl2_table.h"
 #include "dxl_proto.h"
 #include "daemon/servo_model.h"
+#include "doctor.h"
 #include "dxlt_priv.h"
 #include "num.h"
 
@@ -711,6 +712,23 @@ static int dxlt_setup_baud(struct dxlt *t, const uint8_t *ids, int n)
 		        "undulated's configuration needs baud = %ld)\n", ids[i], before, DXLT_SETUP_BAUD, DXLT_SETUP_BAUD);
 	}
 	return DXLT_EXIT_OK;
+}
+
+/* setup's last line: the bus time of one 100 Hz cycle of undulated's for n
+ * servos (doctor.h's dr_cycle_wire_us: the model's present block read, one
+ * READ a servo or one SYNC_READ as the protocol can, and one SYNC_WRITE of
+ * goals), plus the adapter's hold time for each read. */
+static void dxlt_setup_budget(struct dxlt *t, unsigned n, const struct sm_model *m, int latency_ms)
+{
+	const struct dxl_proto *p = bus_proto(&t->bus);
+	bool sync = dxl_proto_can(p, DXL_CAP_SYNC_READ);
+	double wire_ms = 1e-3 * dr_cycle_wire_us(p, n, m->present_len, m->goal_size, port_baud(t->port));
+	double total_ms = wire_ms + (sync ? 1.0 : (double)n) * latency_ms;
+
+	fprintf(t->out, "bus time per cycle for %u servo%s at %ld bps: %.2f ms on the wire (%s of %u bytes each, one "
+	        "SYNC_WRITE) + %d ms adapter latency %s = %.2f ms of the 10 ms period%s\n", n, n == 1 ? "" : "s",
+	        port_baud(t->port), wire_ms, sync ? "one SYNC_READ" : "a READ", m->present_len, latency_ms,
+	        sync ? "for it" : "per read", total_ms, total_ms > 5.0 ? " (too much for 100 Hz)" : "");
 }
 
 int dxlt_cmd_setup(struct dxlt *t)
