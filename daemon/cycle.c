@@ -40,13 +40,6 @@ static size_t cyc_joint(const struct cyc *y, size_t i)
 	return y->own ? y->joint[i] : i;
 }
 
-static bool cyc_has_joint(const struct cyc *y, size_t j)
-{
-	for (size_t i = 0; i < cyc_count(y); i++)
-		if (cyc_joint(y, i) == j)
-			return true;
-	return false;
-}
 
 static bool cyc_has_id(const struct cyc *y, uint8_t id)
 {
@@ -176,6 +169,10 @@ static void cyc_reboot_ends_indirect(struct cyc *y, uint8_t id)
 		return;
 	y->indirect = false;
 	y->indirect_fallbacks++;
+	/* before this cycle's reads (a starved cycle writes first): they ask
+	 * the registers where they lie for their own length */
+	struct sm_read rd = cyc_read_of(y);
+	y->read_len = (y->count & 1) ? rd.len_slow : rd.len;
 	if (y->hooks.notice != NULL) {
 		char text[200];
 		snprintf(text, sizeof text, "bus: servo %u is rebooted and may come back without its indirect map: the "
@@ -183,6 +180,32 @@ static void cyc_reboot_ends_indirect(struct cyc *y, uint8_t id)
 		         id);
 		y->hooks.notice(y->hooks.ctx, text);
 	}
+}
+
+/* An indirect block read all zeros: the servo's map is gone. A power loss
+ * or brown-out puts Indirect Address back at its factory values (the
+ * e-manual lists them in the RAM area), each Indirect Data byte then reading
+ * itself, 0 — and raw position 0 is -pi, outside any joint's limits, not a
+ * reading. The indirect read ends (as after a REBOOT) and the zeros are kept
+ * from the controller: the next cycle reads the present registers where they
+ * lie, and a servo found reset is set up again where it really stands. */
+static bool cyc_map_lost(struct cyc *y, uint8_t id, const uint8_t *bytes, size_t len)
+{
+	if (!y->indirect)
+		return false;
+	for (size_t k = 0; k < len; k++)
+		if (bytes[k] != 0)
+			return false;
+	y->indirect = false;
+	y->indirect_fallbacks++;
+	if (y->hooks.notice != NULL) {
+		char text[220];
+		snprintf(text, sizeof text, "bus: servo %u's indirect block read all zeros: its map is gone (a power loss "
+		         "or brown-out resets it): the cycle reads the present registers where they lie from now on "
+		         "(until the next start or reconnect)", id);
+		y->hooks.notice(y->hooks.ctx, text);
+	}
+	return true;
 }
 
 /* A queued write; one of no bytes is a REBOOT (the X series' recovery). */
@@ -270,14 +293,52 @@ static bool cyc_readback_fits(const struct cyc *y, const struct sm_block *blk)
  * RAM block), else every CYC_READBACK_US the next joint in turn, and after
  * the last joint the model's next block, once it fits the period's rest
  * (or has waited CYC_READBACK_WAIT_US). */
+/* A joint of this cycle's whose RAM block is wanted at once (an alert, a
+ * fault's check: ctl's readback_due): this bus's own, whatever another
+ * bus's. */
+static bool cyc_due_joint(const struct cyc *y, size_t *joint)
+{
+	for (size_t i = 0; i < cyc_count(y); i++)
+		if (y->ctl->j[cyc_joint(y, i)].readback_due) {
+			*joint = cyc_joint(y, i);
+			return true;
+		}
+	return false;
+}
+
+/* Whether read-back block b of joint j may begin now: it ends on the wire
+ * before CYC_LATE_SHARE of the period, or it has waited CYC_READBACK_WAIT_US
+ * since `since` (a cycle count) and goes anyway, so that a reset servo is
+ * still found on a bus too slow for its period. */
+static bool cyc_readback_may(struct cyc *y, size_t j, size_t b, uint64_t since)
+{
+	size_t nblocks = ctl_model(y->ctl, j)->nreadback;
+	if (nblocks == 0 || cyc_readback_fits(y, &ctl_model(y->ctl, j)->readback[b]))
+		return true;
+	if ((y->count - since) * y->period_us < CYC_READBACK_WAIT_US) {
+		y->readbacks_waiting++;
+		return false;
+	}
+	y->readbacks_forced++;
+	return true;
+}
+
 static bool cyc_pick_readback(struct cyc *y)
 {
 	size_t due;
-	if (ctl_readback_due(y->ctl, &due) && cyc_has_joint(y, due)) {
+	if (cyc_due_joint(y, &due)) {
+		if (!y->due_waiting) {
+			y->due_waiting = true;
+			y->due_since = y->count;
+		}
+		if (cyc_late(y) || !cyc_readback_may(y, due, 0, y->due_since))
+			return false;
+		y->due_waiting = false;
 		y->readback_now_joint = due;
 		y->readback_now_block = 0;
-		return !cyc_late(y);
+		return true;
 	}
+	y->due_waiting = false;
 	if (!y->readback_owed && y->count % y->readback_every == 0) {
 		y->readback_owed = true;
 		y->readback_owed_at = y->count;
@@ -289,13 +350,8 @@ static bool cyc_pick_readback(struct cyc *y)
 	size_t joint = cyc_joint(y, idx);
 	size_t nblocks = ctl_model(y->ctl, joint)->nreadback;
 	size_t b = nblocks > 0 ? block % nblocks : 0;
-	bool fits = nblocks == 0 || cyc_readback_fits(y, &ctl_model(y->ctl, joint)->readback[b]);
-	if (!fits && (y->count - y->readback_owed_at) * y->period_us < CYC_READBACK_WAIT_US) {
-		y->readbacks_waiting++;
+	if (!cyc_readback_may(y, joint, b, y->readback_owed_at))
 		return false;
-	}
-	if (!fits)
-		y->readbacks_forced++;
 	y->readback_owed = false;
 	y->readback_joint = idx;
 	y->readback_block = block;
@@ -416,6 +472,8 @@ static void cyc_readings2(struct cyc *y)
 		size_t j = cyc_joint(y, i);
 		const uint8_t *bytes = bus_multi_data(&y->multi, i);
 		struct sm_present p;
+		if (bytes != NULL && cyc_map_lost(y, y->multi.id[i], bytes, y->multi.len[i]))
+			continue;   /* stale this cycle: its servo's next reading is direct */
 		if (bytes == NULL || !sm_decode_read(ctl_model(y->ctl, j), &rd, bytes, y->multi.len[i], &p)) {
 			cyc_error(y, y->multi.id[i], y->multi.fast ? "Fast Sync Read" : "SYNC_READ",
 			          y->multi.status[i] != DXL_OK ? y->multi.status[i] : DXL_E_WRONG_LENGTH);

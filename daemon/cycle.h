@@ -143,6 +143,8 @@ struct cyc {
 	bool fast_able;               /* every servo answers it (cyc_set_fast_read): worth a try again */
 	bool fast_trial;              /* this cycle's Fast Sync Read is a try after a fallback */
 	uint64_t fast_retry_at;       /* the cycle count of the next try */
+	bool due_waiting;             /* a read-back wanted at once waits for room (cyc_readback_may) */
+	uint64_t due_since;           /* since this cycle count */
 	uint64_t readback_every;      /* CYC_READBACK_US in cycles of this period, at least 1 */
 	struct bus_multi multi;
 	uint8_t multi_buf[CFG_MAX_JOINTS * 32];

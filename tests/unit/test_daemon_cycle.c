@@ -1459,6 +1459,122 @@ static void test_indirect_refused(void **state)
 	assert_int_equal(y.errors, 0);
 }
 
+/* A power loss (no REBOOT sent) puts a real servo's Indirect Address back at
+ * its factory values, each Indirect Data byte then reading itself (0): a
+ * block of zeros is a map gone, not a reading (raw position 0 is -pi, far
+ * outside any joint's limits). The cycle leaves the indirect read at once,
+ * keeps the zeros from the controller, and the servo, found reset, is set up
+ * again where it really stands. (Found by review: the zeros were taken for
+ * -pi and the servo set up again to its lower limit, 100 degrees away.) */
+static void test_indirect_map_lost_to_power_loss(void **state)
+{
+	(void)state;
+	char why[256];
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	run(10);
+	assert_true(setup_indirect(&bus, &c, why, sizeof why));
+	for (uint8_t id = 1; id <= 2; id++)
+		xs(id)->mem[64] = 1;
+	cyc_set_indirect(&y, true);
+	x_put(2, 132, 2048 + 300, 4);
+	run(20);
+	assert_true(fabs(c.j[1].angle - 300 * DXL2_POS_RAD_PER_UNIT) < 1e-9);
+	xfake_boot(xs(2));   /* power loss of servo 2: RAM (and the map) at factory values */
+	double min_angle = 1e9;
+	int32_t min_goal = 1 << 30;
+	for (int i = 0; i < 240; i++) {
+		run(1);
+		if (c.j[1].have_reading && c.j[1].angle < min_angle)
+			min_angle = c.j[1].angle;
+		int32_t g = (int32_t)xreg(2, 116, 4);
+		if (xs(2)->mem[64] && g < min_goal)
+			min_goal = g;
+	}
+	print_message("# power loss under the indirect read: lowest angle %.3f rad (truth %.3f), lowest goal with "
+	              "torque on %d (stands at %d)\n", min_angle, 300 * DXL2_POS_RAD_PER_UNIT, min_goal, 2048 + 300);
+	assert_true(fabs(min_angle - 300 * DXL2_POS_RAD_PER_UNIT) < 0.05);
+	assert_false(y.indirect);
+	assert_int_equal(y.indirect_fallbacks, 1);
+	assert_non_null(strstr(last_notice, "servo 2's indirect block read all zeros"));
+	assert_int_equal(xs(2)->mem[64], 1);                 /* set up again ... */
+	assert_true(fabs((double)(min_goal - (2048 + 300))) < 60);   /* ... where it stands */
+}
+
+/* A read-back asked for at once (an alert, a fault's check) obeys the fit
+ * rule too: at 1 ms the RAM block of two XM430s never fits, and begun
+ * anyway it was cut at every tick and, never answered, stayed due: a cut
+ * every cycle (found by review: 749 cuts in 1500 cycles, 0 read-backs). It
+ * waits for room, and after CYC_READBACK_WAIT_US is sent anyway — where the
+ * block can never fit in the period, as here, that one is cut too, as the
+ * round-robin's are: a cut a second, not every cycle. */
+static void test_due_readback_fits_too(void **state)
+{
+	(void)state;
+	static const char *const at1ms[] = { "robot.period_ms=1", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, at1ms);
+	run(20);
+	cuts = 0;
+	y.readbacks = 0;
+	c.j[0].readback_due = true;   /* as ctl_x_status sets it on an alert */
+	run(1500);
+	print_message("# due read-back at 1 ms: %u cuts in 1500 cycles, %lld read-backs (%lld forced), still due %d\n",
+	              cuts, y.readbacks, y.readbacks_forced, (int)c.j[0].readback_due);
+	assert_true(cuts <= 2);
+	assert_true(y.readbacks_forced >= 1);
+	/* where it fits (10 ms), it goes at once */
+	static const char *const at10ms[] = { "robot.period_ms=10", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, at10ms);
+	run(20);
+	y.readbacks = 0;
+	c.j[0].readback_due = true;
+	run(1);
+	assert_false(c.j[0].readback_due);
+	assert_int_equal(y.readbacks, 1);
+}
+
+/* A robot on two buses: each bus's cycle reads back its own due joints,
+ * whatever the other bus's (ctl_readback_due gave the robot's first due
+ * joint, and bus b never saw its own behind bus 0's: found by review). */
+static void test_due_readback_of_its_own_bus(void **state)
+{
+	(void)state;
+	static const char *const sets[] = { "robot.ids=1,b:2", "bus.b.port=/dev/zero", NULL };
+	setup_x(xm2, 2, CFG_MODE_HOLD, sets);
+	cyc_set_bus(&y, 1);
+	assert_int_equal(y.n, 1);
+	run(20);
+	y.readbacks = 0;
+	c.j[0].readback_due = true;   /* bus 0's joint: its own cycle's (not run here) */
+	c.j[1].readback_due = true;   /* bus b's joint: this cycle's */
+	run(3);
+	assert_false(c.j[1].readback_due);
+	assert_true(c.j[0].readback_due);
+}
+
+/* A REBOOT sent before the reads (a starved cycle) ends the indirect read
+ * after the cycle chose its read's length from the indirect block: the read
+ * then asks the registers where they lie for their own length, and every
+ * servo is read (it asked 13 bytes at 126, refused: found by review). */
+static void test_reboot_first_reads_direct(void **state)
+{
+	(void)state;
+	char why[256];
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	run(10);
+	assert_true(setup_indirect(&bus, &c, why, sizeof why));
+	for (uint8_t id = 1; id <= 2; id++)
+		xs(id)->mem[64] = 1;
+	cyc_set_indirect(&y, true);
+	run(10);
+	if ((y.count + 1) % 2 == 0)
+		run(1);   /* the next cycle is a slow one (13 bytes) */
+	assert_true(wq_put_chain(&c.wq, wq_chain(&c.wq), 2, 0, 0, 0));
+	y.starved = CYC_STARVED_CYCLES;
+	run(1);
+	assert_false(y.indirect);
+	assert_int_equal(c.j[0].stale_cycles, 0);
+}
+
 /* The read-back's pace is a time, not a count of cycles: one joint every
  * 50 ms (5 cycles at 100 Hz). Counted in cycles it read back ten times as
  * often at 1 kHz, 200 transactions a second on the bus, each a cut cycle
@@ -1568,6 +1684,10 @@ int main(void)
 		cmocka_unit_test(test_one_bus_of_two),
 		cmocka_unit_test(test_indirect_block),
 		cmocka_unit_test(test_indirect_refused),
+		cmocka_unit_test(test_indirect_map_lost_to_power_loss),
+		cmocka_unit_test(test_due_readback_fits_too),
+		cmocka_unit_test(test_due_readback_of_its_own_bus),
+		cmocka_unit_test(test_reboot_first_reads_direct),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
