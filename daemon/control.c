@@ -448,6 +448,13 @@ void ctl_bus_lost_on(struct ctl *c, size_t bus)
 	c->fade_mode = CFG_NMODES;
 }
 
+void ctl_bus_back_on(struct ctl *c, size_t bus)
+{
+	for (size_t j = 0; j < c->n; j++)
+		if (ctl_on_bus(c, j, bus) && !c->j[j].torque)
+			ctl_torque_write(c, j, false);
+}
+
 /* ---- inputs ----------------------------------------------------------------------------------- */
 void ctl_measure(struct ctl *c, size_t j, uint16_t pos_raw, uint16_t speed_raw, uint16_t load_raw,
                  uint8_t errbits, double dt)

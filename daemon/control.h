@@ -224,6 +224,11 @@ void ctl_bus_lost(struct ctl *c);
  * target, whatever the mode) until ctl_start() — called when the bus is back
  * — ramps the robot into its mode again (docs/SAFETY.md, "Several buses"). */
 void ctl_bus_lost_on(struct ctl *c, size_t bus);
+/* Bus `bus` is back while another is still lost (the robot holds until
+ * every bus is): its servos get the torque the controller wants now — a LIMP
+ * commanded while they were out of reach, whose writes went with the bus,
+ * reaches them at once. */
+void ctl_bus_back_on(struct ctl *c, size_t bus);
 /* The joint is on that bus (the configuration's wiring). */
 bool ctl_on_bus(const struct ctl *c, size_t joint, size_t bus);
 

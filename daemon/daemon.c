@@ -773,6 +773,8 @@ static void dmn_try_reconnect(struct dmn *d, struct dmn_bus *b, uint64_t now)
 		 * where the joints are */
 		if (whole)
 			ctl_start(&d->ctl, dmn_ctl_time(d, now_us()), "reconnected");
+		else
+			ctl_bus_back_on(&d->ctl, b->index);   /* a LIMP meanwhile reaches it now */
 		dmn_event(d, 0, 0, "bus-back", text);
 		dmn_notify_status(d);
 		return;

@@ -1575,6 +1575,42 @@ static void test_reboot_first_reads_direct(void **state)
 	assert_int_equal(c.j[0].stale_cycles, 0);
 }
 
+/* A robot on two buses, both lost; LIMP commanded meanwhile (its torque-off
+ * writes dropped with the lost servos'); bus 0 back first: its servo goes
+ * limp at once, not when the read-back finds it torqued (found by review:
+ * the reconnect sent nothing until every bus was back). */
+static void test_limp_reaches_a_bus_back_first(void **state)
+{
+	(void)state;
+	memset(&f, 0, sizeof f);
+	dxl_parser_init(&f.parser, DXL_PARSE_INSTRUCTION);
+	nsv = 2;
+	servo_init(&sv[0], 1);
+	servo_init(&sv[1], 2);
+	on_plant_write = NULL;
+	static const char *const sets[] = { "robot.ids=1,b:2", "bus.b.port=/dev/zero", NULL };
+	setup_common(2, CFG_MODE_HOLD, sets);
+	char why[256];
+	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
+	for (size_t j = 0; j < 2; j++) {
+		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
+		ctl_measure(&c, j, 512, 0, 0, 0, 0.01);
+	}
+	setup_start(500, BUS_PROTOCOL_1);
+	cyc_set_bus(&y, 0);
+	run(20);
+	assert_int_equal(sv[0].mem[DXL_AX_TORQUE_ENABLE], 1);
+	ctl_bus_lost_on(&c, 0);
+	ctl_bus_lost_on(&c, 1);
+	ctl_set_mode(&c, CFG_MODE_LIMP, "test: while both buses are lost");
+	wq_drop_id(&c.wq, 1);   /* what the lost buses' writes come to */
+	wq_drop_id(&c.wq, 2);
+	assert_int_equal(sv[0].mem[DXL_AX_TORQUE_ENABLE], 1);
+	ctl_bus_back_on(&c, 0);   /* bus 0 back, bus b still lost */
+	run(1);
+	assert_int_equal(sv[0].mem[DXL_AX_TORQUE_ENABLE], 0);
+}
+
 /* The read-back's pace is a time, not a count of cycles: one joint every
  * 50 ms (5 cycles at 100 Hz). Counted in cycles it read back ten times as
  * often at 1 kHz, 200 transactions a second on the bus, each a cut cycle
@@ -1688,6 +1724,7 @@ int main(void)
 		cmocka_unit_test(test_due_readback_fits_too),
 		cmocka_unit_test(test_due_readback_of_its_own_bus),
 		cmocka_unit_test(test_reboot_first_reads_direct),
+		cmocka_unit_test(test_limp_reaches_a_bus_back_first),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
