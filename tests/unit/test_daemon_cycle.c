@@ -1320,14 +1320,11 @@ static void test_fast_sync_read(void **state)
 	assert_false(setup_fast_read(&bus, &c, why, sizeof why));
 }
 
-/* A robot on two buses ([robot] ids = 1,b:2): the cycle of bus 0 reads,
- * writes and reads back servo 1 only, sends only servo 1's slot of the
- * SYNC_WRITE and leaves servo 2's register writes queued for bus b's cycle
- * (here the fake line carries both servos: whatever reaches servo 2 went to
- * the wrong bus). */
-static void test_one_bus_of_two(void **state)
+/* Two AX-12As, a robot on two buses ([robot] ids = 1,b:2), both set up
+ * and read at 512 (the fake line carries both: a test says which bus's
+ * cycle it runs, cyc_set_bus). */
+static void setup_two_buses(void)
 {
-	(void)state;
 	memset(&f, 0, sizeof f);
 	dxl_parser_init(&f.parser, DXL_PARSE_INSTRUCTION);
 	nsv = 2;
@@ -1336,7 +1333,6 @@ static void test_one_bus_of_two(void **state)
 	on_plant_write = NULL;
 	static const char *const sets[] = { "robot.ids=1,b:2", "bus.b.port=/dev/zero", NULL };
 	setup_common(2, CFG_MODE_HOLD, sets);
-	assert_int_equal(cfg.joint_bus[1], 1);
 	char why[256];
 	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
 	for (size_t j = 0; j < 2; j++) {
@@ -1344,6 +1340,18 @@ static void test_one_bus_of_two(void **state)
 		ctl_measure(&c, j, 512, 0, 0, 0, 0.01);
 	}
 	setup_start(500, BUS_PROTOCOL_1);
+}
+
+/* A robot on two buses ([robot] ids = 1,b:2): the cycle of bus 0 reads,
+ * writes and reads back servo 1 only, sends only servo 1's slot of the
+ * SYNC_WRITE and leaves servo 2's register writes queued for bus b's cycle
+ * (here the fake line carries both servos: whatever reaches servo 2 went to
+ * the wrong bus). */
+static void test_one_bus_of_two(void **state)
+{
+	(void)state;
+	setup_two_buses();
+	assert_int_equal(cfg.joint_bus[1], 1);
 	cyc_set_bus(&y, 0);
 	assert_int_equal(y.n, 1);
 	run(60);
@@ -1582,21 +1590,7 @@ static void test_reboot_first_reads_direct(void **state)
 static void test_limp_reaches_a_bus_back_first(void **state)
 {
 	(void)state;
-	memset(&f, 0, sizeof f);
-	dxl_parser_init(&f.parser, DXL_PARSE_INSTRUCTION);
-	nsv = 2;
-	servo_init(&sv[0], 1);
-	servo_init(&sv[1], 2);
-	on_plant_write = NULL;
-	static const char *const sets[] = { "robot.ids=1,b:2", "bus.b.port=/dev/zero", NULL };
-	setup_common(2, CFG_MODE_HOLD, sets);
-	char why[256];
-	struct ctl_servo_info info = { .cw_limit = 0, .ccw_limit = 1023, .max_torque = 1023, .status_return_level = 2 };
-	for (size_t j = 0; j < 2; j++) {
-		assert_true(ctl_set_servo(&c, j, &info, why, sizeof why));
-		ctl_measure(&c, j, 512, 0, 0, 0, 0.01);
-	}
-	setup_start(500, BUS_PROTOCOL_1);
+	setup_two_buses();
 	cyc_set_bus(&y, 0);
 	run(20);
 	assert_int_equal(sv[0].mem[DXL_AX_TORQUE_ENABLE], 1);
