@@ -1467,6 +1467,19 @@ static void test_indirect_refused(void **state)
 	assert_int_equal(y.errors, 0);
 }
 
+/* Two XM430s read through their indirect blocks: mapped, torque on (as
+ * ctl_start's), the cycle told. */
+static void setup_indirect_xm2(void)
+{
+	char why[256];
+	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
+	run(10);
+	assert_true(setup_indirect(&bus, &c, why, sizeof why));
+	for (uint8_t id = 1; id <= 2; id++)
+		xs(id)->mem[64] = 1;
+	cyc_set_indirect(&y, true);
+}
+
 /* A power loss (no REBOOT sent) puts a real servo's Indirect Address back at
  * its factory values, each Indirect Data byte then reading itself (0): a
  * block of zeros is a map gone, not a reading (raw position 0 is -pi, far
@@ -1477,13 +1490,7 @@ static void test_indirect_refused(void **state)
 static void test_indirect_map_lost_to_power_loss(void **state)
 {
 	(void)state;
-	char why[256];
-	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
-	run(10);
-	assert_true(setup_indirect(&bus, &c, why, sizeof why));
-	for (uint8_t id = 1; id <= 2; id++)
-		xs(id)->mem[64] = 1;
-	cyc_set_indirect(&y, true);
+	setup_indirect_xm2();
 	x_put(2, 132, 2048 + 300, 4);
 	run(20);
 	assert_true(fabs(c.j[1].angle - 300 * DXL2_POS_RAD_PER_UNIT) < 1e-9);
@@ -1566,13 +1573,7 @@ static void test_due_readback_of_its_own_bus(void **state)
 static void test_reboot_first_reads_direct(void **state)
 {
 	(void)state;
-	char why[256];
-	setup_x(xm2, 2, CFG_MODE_HOLD, NULL);
-	run(10);
-	assert_true(setup_indirect(&bus, &c, why, sizeof why));
-	for (uint8_t id = 1; id <= 2; id++)
-		xs(id)->mem[64] = 1;
-	cyc_set_indirect(&y, true);
+	setup_indirect_xm2();
 	run(10);
 	if ((y.count + 1) % 2 == 0)
 		run(1);   /* the next cycle is a slow one (13 bytes) */
