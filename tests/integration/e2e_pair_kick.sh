@@ -35,6 +35,8 @@ scenario="$top/sim-bridge/scenarios/pair-rig.scenario"
 rig=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current --daemon-set sinusoid.amplitude=0.25)
 KICK=2.0 KICK1_T=25 KICK2_T=45 SECONDS_RUN=65
 LOCK=0.1 SEEN=0.2 BACK=15
+# d~_c at the rig's r = 0.67 (theory.md)
+dc=$(awk 'BEGIN { r = 0.67; printf "%.3f", sqrt(r * (r - 1) / (r * r - r - 2)) }')
 # one LCM port per run: the three run side by side (a robot's command
 # socket is named by its LCM URL)
 urls=("$(lcm_url 7606)" "$(lcm_url 7607)" "$(lcm_url 7608)" "$(lcm_url 7609)")
@@ -109,7 +111,7 @@ for spec in "${runs[@]}"; do
 	else
 		tap_fail "$name: both kicks delivered" "$(grep "event 'kick" "$T/$name/logs/sim.log")"
 	fi
-	d=$(col "$name" d~) dc=$(awk 'BEGIN { r = 0.67; printf "%.3f", sqrt(r * (r - 1) / (r * r - r - 2)) }')
+	d=$(col "$name" d~)
 	for k in "$KICK1_T $KICK2_T" "$KICK2_T $SECONDS_RUN"; do
 		read -r tk te <<<"$k"
 		if out=$(judge_kick "$name" "$tk" "$te"); then
