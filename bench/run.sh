@@ -126,6 +126,33 @@ daemon_window() {
 	stop "dmn-$1"; stop "log-$1"
 	"$HB/logstat" --from-us "$t0" --to-us "$t1" "$4" >"$5"
 	echo "start_retries $RETRIES" >>"$5"
+	overrun_split "$T/dmn-$1.log" >>"$5"
+}
+# overrun_split DAEMON_LOG: the daemon's exit line on its overruns (the whole
+# run, start-up included) as ov_total, ov_skipped (periods skipped: the loop
+# woke a period or more late), ov_cut (cycles still on the bus at the next
+# tick) and ov_cut_late (of those, begun over half a period late); nothing
+# when it had none
+overrun_split() {
+	sed -n 's/.*overruns: \([0-9]*\) in [0-9]* cycles: \([0-9]*\) period(s) skipped.*, \([0-9]*\) cycle(s) still on the bus at the next tick (\([0-9]*\) of them.*/ov_total \1\nov_skipped \2\nov_cut \3\nov_cut_late \4/p' "$1" 2>/dev/null
+}
+# os_floor OUT PERIOD_US SECONDS SLACK_US: what this machine gives any thread
+# at that period: cyclictest alone (no simulator, no daemon beside it), at the
+# daemon's policy (SCHED_FIFO FIFO_PRIORITY where permitted), for as long as
+# the daemon's window. Into OUT: ct_n (wake-ups), ct_slack (later than
+# SLACK_US: the period less the cycle's bus time, too late for the cycle to
+# fit), ct_period (a whole period or more late), ct_max (µs). An overrun count
+# of the same order is the machine's, not the daemon's or the bus's.
+os_floor() {
+	local out=$1 p=$2 secs=$3 slack=$4 pol=(--policy=other)
+	chrt -f 1 true 2>/dev/null && pol=(--policy=fifo -p "$FIFO_PRIORITY")
+	cyclictest -q -m -i "$p" -l $((secs * 1000000 / p)) -h 20000 "${pol[@]}" >"$out.ct" 2>&1 || {
+		echo "ct_status not measured: cyclictest failed ($(tail -n1 "$out.ct"))" >>"$out"
+		return 0
+	}
+	awk -v s="$slack" -v p="$p" '/^[0-9]/ { n += $2; if ($1 + 0 > s) a += $2; if ($1 + 0 >= p) b += $2 }
+		/Max Latencies/ { m = $NF + 0 } /Histogram Overflows/ { o = $NF + 0 }
+		END { printf "ct_n %d\nct_slack %d\nct_period %d\nct_max %d\n", n + o, a + o, b + o, m }' "$out.ct" >>"$out"
 }
 # retried: " (N start-up retried)" or nothing
 retried() { [ "${1:-0}" != nan ] && [ "${1:-0}" -gt 0 ] && echo "; $1 start-up retried"; }
@@ -1311,8 +1338,21 @@ rate_1k() {
 	rate_daemon "$name" "$n" "$baud" 1 "$RATE_1K_S"
 	RATE_DMN_ARGS=()
 	stop "sim-$name"
+	rate_os_floor "$d/$name-1" 1000 "$RATE_1K_S"
 	RATE_1K_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
 	rate_1k_lockstep
+}
+
+# rate_os_floor OUT PERIOD_US SECONDS: os_floor after a measured real-time
+# window, its slack the period less the window's bus p50
+rate_os_floor() {
+	[ "$(v "$1" status)" = not ] && return 0
+	local bus slack
+	bus=$(v "$1" all.bus_p50)
+	[ "$bus" = nan ] && return 0
+	slack=$(awk -v p="$2" -v b="$bus" 'BEGIN { printf "%d", p - b }')
+	progress "rate: cyclictest alone at ${2} µs for ${3} s (the machine's own lateness)"
+	os_floor "$1" "$2" "$3" "$slack"
 }
 
 # rate_2bus: the second budget, twelve XM430-W350 on two 4 Mbps buses (six
@@ -1364,6 +1404,7 @@ rate_2bus() {
 		fi
 	done
 	stop sim-2a; stop sim-2b
+	rate_os_floor "$d/2bus" 2000 "$RATE_2BUS_S"
 	RATE_2BUS_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
 }
 
@@ -1381,6 +1422,34 @@ rate_unmeasured() {
 }
 # rate_realtime POLICY LOAD0 LOAD1: a budget run's first line
 rate_realtime() { say "Real time, $1; load average at start $2, at the end $3."; }
+
+# rate_why FILE PERIOD_US: why the real-time run overran, by the daemon's own
+# count and beside what the machine gives a thread with nothing else running
+rate_why() {
+	local f=$1 p=$2 slack
+	slack=$(awk -v p="$p" -v b="$(v "$f" all.bus_p50)" 'BEGIN { if (b == "nan") print "–"; else printf "%d", p - b }')
+	if [ "$(v "$f" ov_total)" != nan ]; then
+		say "Why, by undulated's own count over its whole run (start-up included): $(v "$f" ov_total) overruns, of"
+		say "which $(v "$f" ov_skipped) periods skipped (the loop woke a period or more late) and $(v "$f" ov_cut) cycles still on the"
+		say "bus at the next tick ($(v "$f" ov_cut_late) of them begun over half a period late)."
+	else
+		say "undulated counted no overrun over its whole run."
+	fi
+	if [ "$(v "$f" ct_n)" != nan ]; then
+		say "The machine alone: cyclictest at the same period and policy for as long, nothing beside it, woke"
+		say "$(v "$f" ct_slack) of $(v "$f" ct_n) times later than the cycle's slack ($p µs less the bus p50: $slack µs), $(v "$f" ct_period)"
+		say "times a whole period or more late, at worst $(v "$f" ct_max) µs. The simulator's replies come from a second"
+		say "thread open to the same lateness (its step lateness, where the table has it). The lockstep run, where"
+		say "neither program can be late, is the cycle's own figure."
+	elif [ "$(v "$f" ct_status)" = not ]; then
+		say "The machine alone: $(sed -n 's/^ct_status //p' "$f")."
+	fi
+}
+# rate_ct_what FILE: the summary's words on the machine's own lateness
+rate_ct_what() {
+	[ "$(v "$1" ct_n)" = nan ] && return 0
+	echo "; cyclictest alone: $(v "$1" ct_slack) of $(v "$1" ct_n) wake-ups too late for the cycle to fit"
+}
 
 rate_2bus_table() {
 	local f=$T/rate/2bus g=$T/rate/1bus what
@@ -1401,7 +1470,9 @@ rate_2bus_table() {
 				"$(fmt "$(v "$x" all.period_p99)") | $(fmt "$(v "$x" all.period_max)") | $(fmt "$(v "$x" all.bus_p50)") |" \
 				"$(fmt "$(v "$x" all.bus_p99)") | $(fmt "$(v "$x" all.bus_max)") |"
 		done
-		what="real time ($RATE_2BUS_POLICY): $(v "$f" all.overruns) overruns in ${RATE_2BUS_S} s, bus p50 $(fmt "$(v "$f" all.bus_p50)") µs (one bus: $(v "$g" all.overruns) overruns, $(fmt "$(v "$g" all.bus_p50)") µs); load $RATE_2BUS_LOAD0"
+		what="real time ($RATE_2BUS_POLICY): $(v "$f" all.overruns) overruns in ${RATE_2BUS_S} s, bus p50 $(fmt "$(v "$f" all.bus_p50)") µs (one bus: $(v "$g" all.overruns) overruns, $(fmt "$(v "$g" all.bus_p50)") µs)$(rate_ct_what "$f"); load $RATE_2BUS_LOAD0"
+		say ""
+		rate_why "$f" 2000
 	fi
 	say ""
 	sum "12 servos on two buses at 500 Hz" "no overrun" "$what"
@@ -1429,6 +1500,7 @@ rate_1k_table() {
 			"$(fmt "$(v "$f" truth.late_p99)") | $(fmt "$(v "$f" truth.late_max)") |"
 		what="real time ($RATE_1K_POLICY): $(v "$f" all.overruns) overruns in ${RATE_1K_S} s; bus p50 $(fmt "$(v "$f" all.bus_p50)") µs = $(ratio "$(v "$f" all.bus_p50)" "$floor") the floor ($floor µs); simulator step lateness p99 $(fmt "$(v "$f" truth.late_p99)") µs; load $RATE_1K_LOAD0"
 		grep -q '^fell_back' "$f" && what="$what; Fast Sync Read given up during the run"
+		what="$what$(rate_ct_what "$f")"
 	fi
 	if [ "$(v "$lk" status)" = not ]; then
 		lwhat="lockstep: $(sed -n 's/^status //p' "$lk")"
@@ -1440,6 +1512,7 @@ rate_1k_table() {
 		lwhat="lockstep (virtual time): $(v "$lk" all.overruns) overruns, bus p50 $(fmt "$(v "$lk" all.bus_p50)") µs"
 	fi
 	say ""
+	[ -e "$f" ] && [ "$(v "$f" status)" != not ] && { rate_why "$f" 1000; say ""; }
 	sum "6 XM430-W350, one 4 Mbps bus, 1 kHz, ${RATE_1K_S} s" "no overrun; bus time ≤ 1.3× the Fast Sync Read wire floor" "$what; $lwhat"
 }
 

@@ -134,6 +134,11 @@ struct dmn {
 	uint64_t cycle_start_us, last_cycle_start_us;
 	double period_meas_us, jitter_us;
 	long long overruns;
+	/* why (the exit line, so that a user can tell the machine from the bus):
+	 * periods skipped because the loop woke a whole period late or more;
+	 * cycles still on the bus at the next tick, and of those the ones that
+	 * had begun over half a period late (the loop woke late, not the bus) */
+	long long overruns_skipped, overruns_cut, overruns_cut_late;
 	uint64_t state_every;         /* STATE every this many cycles (pub_state_every) */
 	enum cfg_mode state_mode;     /* the mode and fault of the last STATE published */
 	bool state_latched, state_sent;
@@ -962,6 +967,9 @@ static void dmn_cut_cycle(struct dmn *d, uint64_t now)
 	if (!busy)
 		return;
 	d->overruns++;
+	d->overruns_cut++;
+	if (d->jitter_us > 0.5 * (double)d->period_us)
+		d->overruns_cut_late++;
 	log_limited(&d->lim_overrun, now, LOG_LVL_WARN, "cycle %" PRIu64 " still on the bus at the next tick", d->cycle);
 	dmn_arm_deadline(d);
 	dmn_cycle_done(d);
@@ -975,6 +983,7 @@ static void dmn_tick_at(struct dmn *d, uint64_t exp, uint64_t now)
 	if (exp > 1) {
 		/* whole periods were missed: skip them, keep the phase */
 		d->overruns += (long long)(exp - 1);
+		d->overruns_skipped += (long long)(exp - 1);
 		log_limited(&d->lim_overrun, now, LOG_LVL_WARN, "overrun: %" PRIu64 " period(s) skipped", exp - 1);
 	}
 	uint64_t scheduled = d->first_tick_us + (d->ticks - 1) * d->period_us;
@@ -1486,6 +1495,11 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	dmn_event(d, 0, 0, "stop", text);
 	for (size_t b = 0; b < d->nbuses; b++)
 		dmn_close_port(&d->buses[b]);
+	if (d->overruns > 0)
+		log_info("overruns: %lld in %" PRIu64 " cycles: %lld period(s) skipped (the loop woke a period or more "
+		         "late), %lld cycle(s) still on the bus at the next tick (%lld of them had begun over half a "
+		         "period late)",
+		         d->overruns, d->cycle, d->overruns_skipped, d->overruns_cut, d->overruns_cut_late);
 	if (d->lks.resyncs > 0 || d->lks.cmds_dropped > 0)
 		log_warn("lockstep: %lld announced bus byte count(s) set right, %lld clock command(s) dropped",
 		         d->lks.resyncs, d->lks.cmds_dropped);
