@@ -127,6 +127,25 @@ write_jobs() {
 	done
 }
 
+# longest_first JOBFILE MODULE...: the lines reordered, the modules with the
+# longest runs (their `seconds`) first, each module's runs in its own order.
+# GNU parallel starts them in file order: long runs left to the end would
+# leave a core idle while the last of them finish (forces-plane's five-minute
+# timelines after a thousand short pair runs); started first, the short runs
+# fill in around them.
+longest_first() {
+	local f=$1 m s; shift
+	local secs=()
+	for m in "$@"; do
+		s=$(fig "$m" seconds ${quick_flag[@]+"${quick_flag[@]}"} 2>/dev/null) || s=10
+		secs+=("$m=$s")
+	done
+	outdir_new "$f.sorted" || return 1
+	awk -v list="${secs[*]}" 'BEGIN { n = split(list, kv, " "); for (i = 1; i <= n; i++) { split(kv[i], a, "="); s[a[1]] = a[2] } }
+		{ printf "%s\t%d\t%s\n", ($3 in s ? s[$3] : 10), NR, $0 }' "$f" |
+		sort -t "$(printf '\t')" -k1,1gr -k2,2n | cut -f3- >"$f.sorted" && outdir_mv "$f.sorted" "$f"
+}
+
 # ---- progress ------------------------------------------------------------------------
 human() { awk -v s="$1" 'BEGIN { s = int(s + 0.5); if (s >= 3600) printf "%d h %02d min", s / 3600, (s % 3600) / 60; else if (s >= 60) printf "%d min %02d s", s / 60, s % 60; else printf "%d s", s }'; }
 # progress JOBLOG TOTAL T0 ESTIMATE_S: one line: runs done/total, failures,
@@ -308,6 +327,7 @@ fi
 if [ -n "$export_file" ]; then
 	outdir_check "$(dirname "$export_file")" "figures: --export-jobs" && outdir_new "$export_file" || exit 1
 	write_jobs "$runs" $mods >"$export_file" || exit 1
+	longest_first "$export_file" $mods || exit 1
 	echo "figures: $(wc -l <"$export_file") runs in $export_file; from the top of the checkout ($top):"
 	echo "  parallel --joblog runs.joblog < $export_file                    (here, or --sshloginfile HOSTS)"
 	echo "  sbatch --array=1-$(wc -l <"$export_file")%50 --output=$runs/slurm-%A_%a.out scripts/figures-slurm.sh $export_file   (Slurm)"
@@ -333,6 +353,7 @@ done
 jobfile="$runs/jobs.txt"
 outdir_new "$jobfile.all" "$jobfile" "$runs/failures.txt" || fig_die "cannot write in $runs"
 write_jobs "$runs" $mods >"$jobfile.all" || exit 1
+longest_first "$jobfile.all" $mods || exit 1
 if [ "$resume" = 1 ]; then
 	# keep the runs that have their result
 	while read -r _ _ _ dir _; do

@@ -40,6 +40,15 @@ tap_check "FIG_TINY=1: every module a tiny set, 1-3 runs ($counts)" awk -v c="$c
 	n = split(c, f, " "); if (n != 24) exit 1
 	for (i = 2; i <= n; i += 2) if (f[i] < 1 || f[i] > 3) exit 1 }'
 
+# the longest runs first (each module's `seconds`), so that no core idles
+# while the last long runs finish: a module's runs never follow a module's
+# whose runs are shorter
+secs_of() { FIG_TINY=0 "$top/figures/$1/fig.sh" seconds; }
+seq_secs=$(awk '{ print $3 }' "$T/tiny.txt" | uniq | while read -r m; do echo "$m $(secs_of "$m")"; done | tr '\n' ' ')
+tap_check "the exported runs go longest first, by module ($seq_secs)" awk -v s="$seq_secs" 'BEGIN {
+	n = split(s, f, " "); if (n != 24) exit 1
+	for (i = 4; i <= n; i += 2) if (f[i] + 0 > f[i - 2] + 0) exit 1 }'
+
 # ---- exported jobs, run by GNU parallel as on a cluster --------------------------------
 "$F" --export-jobs "$T/jobs.txt" --runs "$T/runs" --only "$ONLY" >"$T/export.out" 2>&1
 rc=$?
