@@ -7,7 +7,7 @@
  *
  *   buscycle --port PATH|fake --ids 1,2,3 [--protocol 1|2] [--read-len 8|10]
  *            [--baud BPS] [--cycles N] [--period-us P] [--latency-us L] [--margin-us M]
- *            [--read sync|fast]
+ *            [--read sync|fast|indirect]
  *
  * --protocol 2: the X series' cycle instead — one SYNC_READ of read_len
  * bytes from every servo (present velocity + position at 128, 8 bytes; with
@@ -15,7 +15,12 @@
  * of 4-byte goal positions. --read fast: the SYNC_READ is a Fast Sync Read
  * (one status packet for all servos: one header and one return delay for the
  * lot; its floor: a request of 14 + N bytes, one reply of 8 + N (4 +
- * read_len), one return delay). --port fake serves that bus in-process: a pty
+ * read_len), one return delay). --read indirect: what undulated's slow cycle
+ * reads (present current, velocity, position at 126..135, input voltage and
+ * temperature at 144..146: 21 bytes where they lie) mapped at start into
+ * every servo's Indirect Data 1..13 (224) and read there by Fast Sync Read,
+ * 13 bytes a servo (the map is written and read back first; a servo that
+ * refuses it ends the run: nothing is measured). --port fake serves that bus in-process: a pty
  * whose other end answers as X servos with return delay 0, holding each
  * reply until the wire time of the request and the replies at the baud has
  * passed (what undulate-sim does for the AX-12; its X servos come with the
@@ -77,7 +82,14 @@ struct bc_opts {
 	int protocol;
 	unsigned read_len;                  /* 2.0: bytes a servo in the SYNC_READ */
 	bool fast;                          /* 2.0: --read fast, a Fast Sync Read */
+	bool indirect;                      /* 2.0: --read indirect, Fast Sync Read of the indirect block */
 };
+
+/* undulated's indirect map on the X series (daemon/servo_model.c,
+ * sm_x_indirect_src): present current, velocity, position, then input
+ * voltage and temperature, each byte one slot. */
+static const uint16_t bc_indirect_src[] = { 126, 127, 128, 129, 130, 131, 132, 133, 134, 135, 144, 145, 146 };
+#define BC_INDIRECT_LEN (sizeof bc_indirect_src / sizeof bc_indirect_src[0])
 
 struct bc_run {
 	struct bus bus;
@@ -145,11 +157,15 @@ static int bc_parse(int argc, char **argv, struct bc_opts *o)
 			o->protocol = atoi(v);
 		else if (!strcmp(k, "--read-len"))
 			o->read_len = (unsigned)atoi(v);
-		else if (!strcmp(k, "--read") && (!strcmp(v, "fast") || !strcmp(v, "sync")))
-			o->fast = !strcmp(v, "fast");
-		else
+		else if (!strcmp(k, "--read") && (!strcmp(v, "fast") || !strcmp(v, "sync") || !strcmp(v, "indirect"))) {
+			o->fast = strcmp(v, "sync") != 0;
+			o->indirect = !strcmp(v, "indirect");
+		} else
 			return -1;
 	}
+	/* the indirect block's length is the map's, whatever --read-len said */
+	if (o->indirect)
+		o->read_len = BC_INDIRECT_LEN;
 	return o->port && o->nids && o->baud > 0 && o->cycles > 0 && o->period_us > 0 ? 0 : -1;
 }
 
@@ -203,16 +219,26 @@ static void bc_sync_write(struct bc_run *r, const struct bc_opts *o)
 /* ---- Protocol 2.0 ------------------------------------------------------------------ */
 
 /* The SYNC_READ's first address: present velocity (128), or the present
- * current before it (126) when 10 bytes are read. */
+ * current before it (126) when 10 bytes are read; Indirect Data 1 (224) for
+ * the indirect block. */
 static uint16_t bc2_read_addr(const struct bc_opts *o)
 {
+	if (o->indirect)
+		return DXL2_X_INDIRECT_DATA_1;
 	return o->read_len == 10 ? DXL2_X_PRESENT_CURRENT : DXL2_X_PRESENT_VELOCITY;
+}
+
+/* Where the present position lies in a servo's data: last of 8 or 10 bytes,
+ * slots 7..10 of the indirect block. */
+static size_t bc2_position_at(const struct bc_opts *o)
+{
+	return o->indirect ? 6 : o->read_len - 4;
 }
 
 /* One cycle: every servo's state in one SYNC_READ, every goal in one SYNC_WRITE. */
 static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
 {
-	uint8_t data[BC_MAX_IDS * 10], goals[BC_MAX_IDS * 4];
+	uint8_t data[BC_MAX_IDS * BC_INDIRECT_LEN], goals[BC_MAX_IDS * 4];
 	struct bus_multi m = { .data = data, .cap = sizeof data };
 	int rc = o->fast ? bus_fast_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m)
 	                 : bus_sync_read(&r->bus, bc2_read_addr(o), (uint16_t)o->read_len, o->ids, o->nids, &m);
@@ -221,7 +247,7 @@ static void bc2_cycle(struct bc_run *r, const struct bc_opts *o)
 	for (size_t i = 0; i < m.n; i++) {
 		const uint8_t *p = bus_multi_data(&m, i);
 		if (p != NULL)
-			r->position[i] = (uint16_t)dxl2_get_u32(p + o->read_len - 4);
+			r->position[i] = (uint16_t)dxl2_get_u32(p + bc2_position_at(o));
 		else if (m.status[i] == DXL_E_TIMEOUT)
 			r->timeouts++;
 		dxl2_put_u32(goals + 4 * i, r->position[i]);
@@ -284,10 +310,40 @@ static void bc_floor(const struct bc_run *r, const struct bc_opts *o, size_t npr
 	*timeout = bus_timeout_us(&r->bus, BC_READ_REQ_BYTES, BC_READ_REPLY_BYTES);
 }
 
-/* present velocity + position (8 bytes), or with the present current before them (10) */
+/* present velocity + position (8 bytes), or with the present current before
+ * them (10); the indirect block's 13 (set by --read indirect) */
 static bool bc2_read_len_ok(unsigned len)
 {
-	return len == 8 || len == 10;
+	return len == 8 || len == 10 || len == BC_INDIRECT_LEN;
+}
+
+/* --read indirect: every present servo's Indirect Address 1..13 set to the
+ * map (torque is off on a servo just found: the registers are writable),
+ * then read back. 0, or -1 with why. */
+static int bc2_map_indirect(struct bc_run *r, const struct bc_opts *o, char *why, size_t cap)
+{
+	uint8_t want[2 * BC_INDIRECT_LEN], got[2 * BC_INDIRECT_LEN], eb = 0;
+	for (size_t k = 0; k < BC_INDIRECT_LEN; k++) {
+		want[2 * k] = (uint8_t)(bc_indirect_src[k] & 0xFF);
+		want[2 * k + 1] = (uint8_t)(bc_indirect_src[k] >> 8);
+	}
+	/* set-up, not the cycle: the discovery's patience (a late reply here
+	 * would end the run) */
+	bc_timing(r, o, r->return_delay_us, o->margin_us > BC_DISCOVERY_MARGIN_US ? o->margin_us : BC_DISCOVERY_MARGIN_US);
+	for (size_t i = 0; i < o->nids; i++) {
+		if (!r->present[i])
+			continue;
+		int rc = bus_write(&r->bus, o->ids[i], DXL2_X_INDIRECT_ADDRESS_1, want, sizeof want, true, &eb);
+		if (rc == DXL_OK)
+			rc = bus_read(&r->bus, o->ids[i], DXL2_X_INDIRECT_ADDRESS_1, sizeof got, got, &eb);
+		if (rc != DXL_OK || (eb & DXL2_ERR_NUMBER_MASK) || memcmp(got, want, sizeof want) != 0) {
+			snprintf(why, cap, "servo %u did not take the indirect map (%s)", o->ids[i],
+			         rc != DXL_OK ? dxl_strerror(rc) : (eb & DXL2_ERR_NUMBER_MASK) ? dxl2_error_name(eb & DXL2_ERR_NUMBER_MASK) : "read back otherwise");
+			return -1;
+		}
+	}
+	bc_timing(r, o, r->return_delay_us, o->margin_us);
+	return 0;
 }
 
 static void bc2_floor_timeout(const struct bc_run *r, const struct bc_opts *o, size_t npresent, uint32_t *reads,
@@ -519,7 +575,8 @@ static void bc_report(struct bc_run *r, const struct bc_opts *o, const struct bc
 	uint32_t reads, sync, timeout;
 	bp->floor(r, o, npresent, &reads, &sync, &timeout);
 	printf("protocol %d\n", o->protocol);
-	printf("read %s\n", o->fast ? "fast" : "sync");
+	printf("read %s\n", o->indirect ? "indirect" : o->fast ? "fast" : "sync");
+	printf("read_len %u\n", o->read_len);
 	qsort(r->cycle_us, (size_t)o->cycles, sizeof(double), bc_cmp);
 	printf("servos %zu\npresent %zu\nabsent %zu\n", o->nids, npresent, o->nids - npresent);
 	printf("return_delay_us %u\n", r->return_delay_us);
@@ -545,10 +602,15 @@ int main(int argc, char **argv)
 	const struct bc_proto *bp = NULL;
 	if (bc_parse(argc, argv, &o) != 0 || (bp = bc_proto_of(o.protocol)) == NULL || !bp->read_len_ok(o.read_len)) {
 		fprintf(stderr, "usage: buscycle --port PATH|fake --ids 1,2 [--protocol 1|2] [--read-len 8|10] [--baud BPS] "
-		                "[--cycles N] [--period-us P] [--latency-us L] [--margin-us M]\n");
+		                "[--cycles N] [--period-us P] [--latency-us L] [--margin-us M] [--read sync|fast|indirect]\n");
 		return 2;
 	}
 	bool fake_bus = strcmp(o.port, "fake") == 0;
+	if (o.indirect && (fake_bus || o.protocol != 2)) {
+		fprintf(stderr, "buscycle: --read indirect wants X servos on a real bus or undulate-sim (--protocol 2; the "
+		                "in-process fake has no indirect area)\n");
+		return 2;
+	}
 	if (fake_bus && (!bp->fake || bc_fake_start(&fake, &o, fake_path, sizeof fake_path) != 0)) {
 		fprintf(stderr, "buscycle: the in-process fake serves Protocol 2.0 only (--protocol 2)\n");
 		return 1;
@@ -570,6 +632,12 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	bc_discover(&r, &o, bp);
+	if (o.indirect && bc2_map_indirect(&r, &o, err, sizeof err) != 0) {
+		fprintf(stderr, "buscycle: %s\n", err);
+		free(r.cycle_us);
+		port_close(p);
+		return 1;
+	}
 	bc_cycles(&r, &o, bp);
 	bc_report(&r, &o, bp);
 	free(r.cycle_us);

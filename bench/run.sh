@@ -1087,8 +1087,8 @@ section_model() {
 
 # ---- rate: the highest control rate one bus of X servos holds ------------------------
 # For N XM430-W350 (2/6/12/18) at 1, 2 and 4 Mbps, each way of reading the
-# joints (RATE_READS; a third, "indirect", is being added elsewhere: a read's
-# column comes from rate_read_label and rate_sim_args alone):
+# joints (RATE_READS: a read's columns come from rate_read_label,
+# rate_sim_args and rate_dmn_args alone):
 #  - buscycle's cycle (one read of 10 bytes a servo, one SYNC_WRITE) at
 #    RATE_CYCLE_US for RATE_CYCLES cycles, against that read's wire floor;
 #  - undulated itself at period_ms 10, 5, 4, 2, 1: RATE_S seconds each after
@@ -1101,16 +1101,20 @@ RATE_2BUS_S=${BENCH_RATE_2BUS_S:-30}
 RATE_CYCLES=${BENCH_RATE_CYCLES:-200}
 RATE_SETTLE_S=1
 RATE_CYCLE_US=5000
-RATE_READS="sync fast"
+RATE_READS="sync fast indirect"
 RATE_SERVOS=${BENCH_RATE_SERVOS:-2 6 12 18}
 RATE_BAUDS=${BENCH_RATE_BAUDS:-1000000 2000000 4000000}
 RATE_PERIODS_MS="10 5 4 2 1"
 RATE_DMN_ARGS=()
 PORT_RATE=7910 PORT_RATE_B=7911
-rate_read_label() { case $1 in sync) echo "SYNC_READ" ;; fast) echo "Fast Sync Read" ;; *) echo "$1" ;; esac; }
+rate_read_label() { case $1 in sync) echo "SYNC_READ" ;; fast) echo "Fast Sync Read" ;; indirect) echo "indirect + Fast Sync Read" ;; *) echo "$1" ;; esac; }
 # The simulator's options that make the daemon read that way: it reads by Fast
 # Sync Read when every servo has firmware 45 or later (the simulator's 46).
 rate_sim_args() { case $1 in sync) echo "--firmware 44" ;; *) ;; esac; }
+# The daemon's: the indirect block (robot.indirect, on by default) for the
+# third read alone, so that the first two read the registers where they lie
+# (21 bytes a servo on the slow cycles, 13 through the block).
+rate_dmn_args() { case $1 in indirect) ;; *) echo "--set robot.indirect=off" ;; esac; }
 
 # rate_sim NAME N BAUD READ: an X-servo simulator for one configuration, its
 # LCM logged (for its SIM.TRUTH lateness). 1 when it does not start ("status"
@@ -1129,16 +1133,19 @@ rate_sim() {
 	fi
 }
 
-# rate_daemon NAME N BAUD PERIOD_MS WINDOW_S: undulated on sim-NAME's bus at
-# that period; logstat's figures of WINDOW_S seconds into $T/rate/NAME-PERIOD.
+# rate_daemon NAME N BAUD PERIOD_MS WINDOW_S [READ]: undulated on sim-NAME's
+# bus at that period, reading as READ says (rate_dmn_args; its own default
+# without); logstat's figures of WINDOW_S seconds into $T/rate/NAME-PERIOD.
 rate_daemon() {
-	local name=$1 n=$2 baud=$3 p=$4 w=$5 d=$T/rate u out
+	local name=$1 n=$2 baud=$3 p=$4 w=$5 read=${6:-} d=$T/rate u out rargs=()
+	[ -n "$read" ] && read -r -a rargs <<<"$(rate_dmn_args "$read")"
 	u=$(url $PORT_RATE)
 	out=$d/$name-$p
 	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
 	wait_file "$out.lcm" 10
 	if start_daemon "dmn-$name" "$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" \
-		--lcm-url "$u" --mode oscillator --set robot.period_ms="$p" ${RATE_DMN_ARGS[@]+"${RATE_DMN_ARGS[@]}"}; then
+		--lcm-url "$u" --mode oscillator --set robot.period_ms="$p" ${rargs[@]+"${rargs[@]}"} \
+		${RATE_DMN_ARGS[@]+"${RATE_DMN_ARGS[@]}"}; then
 		daemon_window "$name" "$RATE_SETTLE_S" "$w" "$out.lcm" "$out"
 		grep -q 'reading by SYNC_READ from now on' "$T/dmn-$name.log" && echo "fell_back 1" >>"$out"
 	else
@@ -1168,8 +1175,10 @@ rate_lockstep() {
 	fi
 	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
 	wait_file "$out.lcm" 10
+	# shellcheck disable=SC2046 # the read's options are words
 	"$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" --lcm-url "$u" \
-		--mode oscillator --set robot.period_ms="$p" --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
+		--mode oscillator --set robot.period_ms="$p" $(rate_dmn_args "$read") --lockstep "$d/$name.clock" \
+		>"$T/dmn-$name.log" 2>&1
 	wait "${PID[sim-$name]}" 2>/dev/null
 	unset "PID[sim-$name]"
 	stop "log-$name"
@@ -1194,7 +1203,7 @@ rate_search() {
 		if [ "$runner" = rate_lockstep ]; then
 			rate_lockstep "$name" "$n" "$baud" "${ps[i]}" "$read"
 		else
-			rate_daemon "$name" "$n" "$baud" "${ps[i]}" "$RATE_S"
+			rate_daemon "$name" "$n" "$baud" "${ps[i]}" "$RATE_S" "$read"
 		fi
 		o=$(v "$T/rate/$name-${ps[i]}" all.overruns)
 		# no STATE in the window: nothing was measured, which is not "no overrun"
@@ -1275,7 +1284,7 @@ section_rate() {
 				local floor
 				floor=$(v "$T/rate/$name.bc" floor_us)
 				[ "$floor" = nan ] && floor=1000
-				rate_search "$name" "$n" "$baud" "$floor" rate_daemon
+				rate_search "$name" "$n" "$baud" "$floor" rate_daemon "$read"
 				stop "sim-$name"
 				rate_search "lock-$name" "$n" "$baud" "$floor" rate_lockstep "$read"
 			done
@@ -1286,7 +1295,10 @@ section_rate() {
 	say "## Rates above 100 Hz: X servos on one bus (simulated, return delay 0)"
 	say ""
 	say "XM430-W350 servos on \`undulate-sim --model xm430-w350 --baud B\`, 10 bytes a servo read (present"
-	say "current, velocity, position) and one SYNC_WRITE of goals. **Bus time**: buscycle's cycle at"
+	say "current, velocity, position; through the indirect block 13, with input voltage and temperature: what"
+	say "undulated's slow cycle reads, 21 bytes a servo where they lie) and one SYNC_WRITE of goals. undulated reads"
+	say "the registers where they lie in the first two reads (\`robot.indirect = off\`), its indirect block in the"
+	say "third (its default). **Bus time**: buscycle's cycle at"
 	say "$((RATE_CYCLE_US / 1000)) ms for $RATE_CYCLES cycles, p50 against the wire floor of its own read (bench/README.md, \"Rates\")."
 	say "**Highest rate**: undulated (OSCILLATOR) at period_ms ${RATE_PERIODS_MS// /, }, ${RATE_S} s each after ${RATE_SETTLE_S} s;"
 	say "the shortest period with 0 overruns in that window, and the next shorter one tried with its overruns;"
@@ -1489,8 +1501,9 @@ rate_1k_table() {
 	if ! rate_unmeasured "$T/rate/1k-6.sim" "$f"; then
 		rate_realtime "$RATE_1K_POLICY" "$RATE_1K_LOAD0" "$RATE_1K_LOAD1"
 		say "Fast Sync Read floor of the 10-byte cycle: $floor µs. At 1 ms undulated publishes every 10th cycle's"
-		say "STATE: the percentiles below are over those (the cycles that read 21 bytes a servo, floor 555 µs);"
-		say "the overruns are its counter, over every cycle. Lockstep: the same, in the simulator's virtual time."
+		say "STATE: the percentiles below are over those, its slow cycles (13 bytes a servo through its indirect"
+		say "block, the default: floor 435 µs; 21 bytes, 555 µs, without it); the overruns are its counter, over"
+		say "every cycle. Lockstep: the same, in the simulator's virtual time."
 		say ""
 		say "| run | STATEs | overruns | period p50 | p99 | max | bus p50 | p99 | max | bus p50/floor | simulator step lateness p99 | max |"
 		say "|---|---|---|---|---|---|---|---|---|---|---|---|"
