@@ -231,7 +231,7 @@ if [ -z "${UNDULATE_DEMO_RUN:-}" ]; then
 	trap 'sv_stop 129 "SIGHUP: the terminal closed"' HUP
 	sv_rc=0
 	wait "$sv_worker" || sv_rc=$?
-	rm -rf "$sv_run"   # normally gone already: the worker removes it
+	[ ! -e "$sv_run" ] || rm -rf "$sv_run"   # normally gone already: the worker removes it
 	exit "$sv_rc"
 fi
 scenario="$top/sim-bridge/scenarios/plane-demo.scenario"
@@ -505,7 +505,8 @@ if [ "$phases" = random ]; then
 	done
 	# one awk for every robot's phase
 	read -r -a robot_phase < <(awk -v rs="${draws[*]}" 'BEGIN { n = split(rs, r, " ")
-		for (i = 1; i <= n; i++) printf "%s%.3f", i > 1 ? " " : "", (r[i] / 32768.0) * 6.283185 - 3.141593; print "" }')
+		for (i = 1; i <= n; i++) printf "%s%.3f", (i > 1 ? " " : ""), (r[i] / 32768.0) * 6.283185 - 3.141593; print "" }')
+	[ ${#robot_phase[@]} -eq ${#robots[@]} ] || die "could not draw the robots' random phases (awk)"
 else
 	IFS=, read -r -a robot_phase <<<"$phases"
 	[ ${#robot_phase[@]} -eq ${#robots[@]} ] || die "--phases: ${#robots[@]} robots, ${#robot_phase[@]} phases"
@@ -792,7 +793,16 @@ echo "=== undulate demo summary: ${#robots[@]} robots, $seconds s, ${scenario##*
 # A run that broke says so first: what follows describes a broken run
 # (the analyser's "broken": latched faults, robots that stopped publishing,
 # a simulator that fell behind real time).
-broken=$(jq -r '.broken[]?' "$analysis/summary.json" 2>/dev/null)
+# One jq for the two things read from summary.json (jq's start is its cost):
+# the "broken" lines, then, after a record separator, the median contact
+# force's line (said below, when there was a switch).
+from_json=$(jq -r --arg from "$start_mode" --arg to "$switch_to" '(.broken[]?), "\u001e",
+	(.force | select(.median_before_n != null and .median_after_n != null) |
+	"  Median contact force of \(if .of == "contacts" then "all contacts (each touching pair over each 10 ms)" else "the 10 ms periods with contact" end): \(.median_before_n * 1000 | round / 1000) N on the \($from) (\(.samples_before) before the switch) -> \(.median_after_n * 1000 | round / 1000) N on the \($to) (\(.samples_after) in the final window).")' \
+	"$analysis/summary.json" 2>/dev/null)
+broken=${from_json%%$'\x1e'*} median_line=""
+[[ $from_json == *$'\x1e'* ]] && median_line=${from_json#*$'\x1e'} && median_line=${median_line#$'\n'}
+while [[ $broken == *$'\n' ]]; do broken=${broken%$'\n'}; done
 if [ -n "$broken" ]; then
 	echo "THIS RUN BROKE: what follows is not the experiment's result:"
 	sed 's/^/  - /' <<<"$broken"
@@ -832,9 +842,7 @@ if [ -n "$switch_t" ]; then
 			printf "  Collisions between robots per 10 s: %.0f -> %.0f; against the walls: %.0f -> %.0f.\n", bp * 10 / bs, ap * 10 / as, bw * 10 / bs, aw * 10 / as
 		}' "$analysis/collision_rate.csv"
 	# the median contact force of the 10 ms periods with contact (the analyser's)
-	jq -r --arg from "$start_mode" --arg to "$switch_to" '.force | select(.median_before_n != null and .median_after_n != null) |
-		"  Median contact force of \(if .of == "contacts" then "all contacts (each touching pair over each 10 ms)" else "the 10 ms periods with contact" end): \(.median_before_n * 1000 | round / 1000) N on the \($from) (\(.samples_before) before the switch) -> \(.median_after_n * 1000 | round / 1000) N on the \($to) (\(.samples_after) in the final window)."' \
-		"$analysis/summary.json" 2>/dev/null
+	[ -z "$median_line" ] || echo "$median_line"
 fi
 awk '
 	$1 == "pair" && !hdr {
