@@ -330,7 +330,7 @@ fig_json() { jq -r "$2" "$1/summary.json"; }
 # (tools/analyze/README.md, "End state of a pair"). null becomes nan.
 fig_pairs_header="pair,class,mean_delta,mean_abs_delta,spread,window_collisions,collisions,impulse,distance_m,dsep,compat_limit,swing_a,swing_b"
 fig_pairs() {
-	sed -e 's/.*"pairs":\[{//' -e 's/}\],"min_swing".*//' "$1" | sed 's/},{/\n/g' |
+	sed -e 's/.*"pairs":\[{//' -e 's/}\],"min_swing".*//' -e 's/},{/\n/g' "$1" |
 		awk -v keys="$fig_pairs_header" 'BEGIN { nk = split(keys, want, ",") }
 		{
 			delete v
@@ -350,8 +350,11 @@ fig_pairs() {
 }
 
 fig_min_swing() {
-	grep -o '"swing_rad":[^,}]*' "$1" | awk -F: '{ x = ($2 == "null") ? 0 : $2 + 0; if (NR == 1 || x < m) m = x }
-		END { if (NR) printf "%.3f\n", m; else print "nan" }'
+	# every "swing_rad":VALUE (grep -o's matches, in one awk)
+	awk '{ while (match($0, /"swing_rad":[^,}]*/)) {
+			v = substr($0, RSTART + 12, RLENGTH - 12); $0 = substr($0, RSTART + RLENGTH)
+			x = (v == "null") ? 0 : v + 0; if (n++ == 0 || x < m) m = x } }
+		END { if (n) printf "%.3f\n", m; else print "nan" }' "$1"
 }
 
 # fig_delta_trace DIR OUT STEP: the followed pair's (the first neighbour
@@ -623,8 +626,9 @@ FIG_CHANNEL_SWEPT_M=0.2984
 fig_channel_demo() {
 	local out=$1 width=$2 seed=$3 scenario=$4 spacing
 	shift 4
-	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
-	FIG_CHANNEL_NOMINAL=$(awk -v d="$spacing" -v s="$FIG_CHANNEL_SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
+	# the spacing (m) and from it the nominal d~, in one awk
+	read -r spacing FIG_CHANNEL_NOMINAL < <(awk -v w="$width" -v s="$FIG_CHANNEL_SWEPT_M" \
+		'BEGIN { d = sprintf("%.4f", w / 100); printf "%s %.4f\n", d, d / s }')
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/$scenario" --seconds "$FIG_CHANNEL_SECONDS" \
 		--switch-at "$FIG_CHANNEL_SWITCH" --seed "$seed" --window "$FIG_CHANNEL_WINDOW" --set "world.spacing=$spacing" "$@"
 }
@@ -731,12 +735,20 @@ fig_ini() {
 fig_plane_sets() {
 	local conf=${1:-$FIG_PLANE_CONF} k sec key v
 	[ -f "$conf" ] || { echo "$FIG_NAME: no tuned configuration $conf (figures/lib.sh, fig_plane_tune)" >&2; return 1; }
-	for k in $FIG_PLANE_KEYS; do
+	# every key's value as fig_ini finds it (the first "KEY = VALUE" in its
+	# section, VALUE's first word), in one awk rather than one per key: a
+	# plane run reads 13; "K V" a line, in FIG_PLANE_KEYS' order
+	local values
+	values=$(awk -v keys="$FIG_PLANE_KEYS" 'BEGIN { n = split(keys, k, " ")
+			for (i = 1; i <= n; i++) { s = k[i]; sub(/\.[^.]*$/, "", s); sec[i] = "[" s "]"; key[i] = k[i]; sub(/.*\./, "", key[i]) } }
+		/^\[/ { cur = $1; next }
+		{ for (i = 1; i <= n; i++) if (!(i in v) && cur == sec[i] && $1 == key[i] && $2 == "=") v[i] = $3 }
+		END { for (i = 1; i <= n; i++) print k[i], v[i] }' "$conf")
+	while read -r k v; do
 		sec=${k%.*} key=${k##*.}
-		v=$(fig_ini "$conf" "$sec" "$key")
 		[ -n "$v" ] || { echo "$FIG_NAME: $conf has no [$sec] $key" >&2; return 1; }
 		printf -- '--daemon-set\n%s=%s\n' "$k" "$v"
-	done
+	done <<<"$values"
 }
 
 # fig_plane_tune OUT [SEED] [TUNE_S]: one plane robot (two joints, no walls:

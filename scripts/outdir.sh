@@ -130,11 +130,37 @@ _outdir_tmp() {
 }
 
 outdir_new() {
-	local f tmp
+	local f tmp rc=0
+	_outdir_new_together "$@" || rc=$?
+	[ "$rc" = 2 ] || return "$rc"
 	for f in "$@"; do
 		_outdir_tmp tmp "$f" || return 1
 		mv -f -T -- "$tmp" "$f" || { rm -f -- "$tmp"; return 1; }
 	done
+}
+# _outdir_new_together FILE...: several new files of one folder made in a
+# private folder beside them (mktemp -d: no one else can place anything in
+# it, and a file the shell creates there has 0666 less the umask) and moved
+# in with one mv, each replacing what has its name, never followed: three
+# programs for any number of files. 1 when one could not be made; 2, having
+# done nothing, for one file, files of several folders or a name given twice.
+_outdir_new_together() {
+	[ $# -gt 1 ] || return 2
+	local f dir d tmp made=()
+	local -A seen=()
+	case "$1" in */*) dir=${1%/*}; [ -n "$dir" ] || dir=/ ;; *) dir=. ;; esac
+	for f in "$@"; do
+		case "$f" in */*) d=${f%/*}; [ -n "$d" ] || d=/ ;; *) d=. ;; esac
+		[ "$d" = "$dir" ] && [ -n "${f##*/}" ] && [ -z "${seen[${f##*/}]:-}" ] || return 2
+		seen[${f##*/}]=1
+	done
+	tmp=$(mktemp -d -- "$dir/.outdir.XXXXXX") || return 1
+	for f in "$@"; do
+		made+=("$tmp/${f##*/}")
+		: >"$tmp/${f##*/}" || { rm -rf -- "$tmp"; return 1; }
+	done
+	mv -f -t "$dir" -- "${made[@]}" || { rm -rf -- "$tmp"; return 1; }
+	rmdir -- "$tmp"
 }
 
 outdir_put() {
