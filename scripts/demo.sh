@@ -84,6 +84,15 @@ B="$BUILD/bin"
 # now_ns VAR: the wall clock in ns (date +%s%N's number, to the microsecond),
 # without a process.
 now_ns() { local -n _now=$1; _now=${EPOCHREALTIME//[!0-9]/}000; }
+# parent_of VAR PATH: VAR = dirname PATH, without a process.
+parent_of() {
+	local -n _par=$1
+	local p=$2
+	while [[ $p == */ && $p != / ]]; do p=${p%/}; done
+	case "$p" in */*) p=${p%/*} ;; *) p=. ;; esac
+	while [[ $p == */ && $p != / ]]; do p=${p%/}; done
+	_par=${p:-/}
+}
 # nap S: a pause of S seconds without a process: read's timeout on a pipe
 # no one writes (opened once, read and written by this shell alone).
 nap_fd=""
@@ -298,15 +307,6 @@ done
 die() { echo "demo: $*" >&2; exit 1; }
 [ "$default_scenario" = 1 ] && daemon_sets=("${plane_demo_sets[@]}" ${daemon_sets[@]+"${daemon_sets[@]}"})
 is_number() { [[ "$1" =~ ^-?[0-9]+([.][0-9]+)?$ ]]; }
-# parent_of VAR PATH: VAR = dirname PATH, without a process.
-parent_of() {
-	local -n _par=$1
-	local p=$2
-	while [[ $p == */ && $p != / ]]; do p=${p%/}; done
-	case "$p" in */*) p=${p%/*} ;; *) p=. ;; esac
-	while [[ $p == */ && $p != / ]]; do p=${p%/}; done
-	_par=${p:-/}
-}
 # fixed9 VAR X: VAR = X (is_number's) in billionths, when it has at most 9
 # digits either side of the point; else 1.
 fixed9() {
