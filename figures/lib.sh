@@ -16,9 +16,11 @@
 #   fig_seed WORDS...           a seed in 1..999999 from the words (a run's name)
 #   FIG_GOLDEN                  the golden ratio's fraction: i * FIG_GOLDEN mod 1 spreads
 #                               run i's initial phase evenly, the same on every machine
+#   fig_basename VAR PATH       VAR = basename PATH (without running it)
 #   fig_lcm_url OUTDIR [TRY]    a private udpm URL (ttl=0) on a port in 30000-59999
 #                               from GNU parallel's job slot, else OUTDIR's name and
 #                               the PID, and TRY; one nothing here is bound to yet
+#                               (fig_lcm_url_v VAR OUTDIR [TRY]: the same into VAR)
 #   fig_run_dir OUTDIR          a run's folder: made when missing, else it must be
 #                               ours and writable by no other user (exit 1 saying
 #                               why: scripts/outdir.sh); every file a run writes
