@@ -5,7 +5,7 @@
 # pair module's), each through figures/lib.sh's fig_demo and scripts/demo.sh;
 # every program they start for a small job (awk for arithmetic, date, seq,
 # grep, dirname, a sleep per poll, one mv per file) costs 5-20 ms of CPU on a
-# busy two-core machine. A 4 s pair run started about 130 such programs,
+# busy two-core machine. A 4 s pair run started 119 such programs,
 # about half its CPU time; the scripts now do that work in the shell. Here
 # one pair run, traced (strace -f, execve), starts at most HELPERS_MAX
 # programs besides the project's own (undulate-sim, undulated,
@@ -19,7 +19,7 @@ command -v strace >/dev/null 2>&1 || tap_skip_all "strace is not installed (Debi
 strace -f -qq -e trace=execve -o /dev/null true 2>/dev/null || tap_skip_all "strace cannot trace here (ptrace not allowed)"
 command -v jq >/dev/null 2>&1 || tap_skip_all "jq is not installed"
 for p in undulate-sim undulated undulate-analyze; do [ -x "$B/$p" ] || tap_skip_all "$B/$p is not built (make)"; done
-# measured: 47 after the change, about 130 before it
+# measured: 45 after the change, 119 before it
 HELPERS_MAX=70
 
 # The run's ports (end-to-end range), moved by TEST_PORT_OFFSET like every test's.
