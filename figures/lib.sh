@@ -16,9 +16,11 @@
 #   fig_seed WORDS...           a seed in 1..999999 from the words (a run's name)
 #   FIG_GOLDEN                  the golden ratio's fraction: i * FIG_GOLDEN mod 1 spreads
 #                               run i's initial phase evenly, the same on every machine
+#   fig_basename VAR PATH       VAR = basename PATH (without running it)
 #   fig_lcm_url OUTDIR [TRY]    a private udpm URL (ttl=0) on a port in 30000-59999
 #                               from GNU parallel's job slot, else OUTDIR's name and
 #                               the PID, and TRY; one nothing here is bound to yet
+#                               (fig_lcm_url_v VAR OUTDIR [TRY]: the same into VAR)
 #   fig_run_dir OUTDIR          a run's folder: made when missing, else it must be
 #                               ours and writable by no other user (exit 1 saying
 #                               why: scripts/outdir.sh); every file a run writes
@@ -80,7 +82,9 @@
 # with the same checkout built (docs/CLUSTER.md).
 
 set -u
-fig_top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+# (dirname's answer without running it: every figure run sources this)
+case "${BASH_SOURCE[0]}" in */*) fig_top=${BASH_SOURCE[0]%/*} ;; *) fig_top=. ;; esac
+fig_top=$(cd "${fig_top:-/}/.." && pwd)
 
 # fig_rows_csv HEADER_REGEX: the daemons' rows (figures/rows' rows.csv) for a
 # module that draws the model beside them: FIG_ROWS_CSV, else the rows.csv of
@@ -101,6 +105,14 @@ FIG_BIN="$BUILD/bin"
 FIG_NAME=fig
 
 fig_init() { FIG_NAME=$1; }
+# fig_basename VAR PATH: VAR = basename PATH, without running it.
+fig_basename() {
+	local -n _base=$1
+	local p=$2
+	while [[ $p == */ && $p != / ]]; do p=${p%/}; done
+	[ "$p" = / ] && { _base=/; return; }
+	_base=${p##*/}
+}
 fig_die() { echo "$FIG_NAME: $*" >&2; exit 1; }
 fig_usage() { echo "$FIG_NAME: $*" >&2; exit 2; }
 
@@ -143,28 +155,50 @@ fig_uint() {
 		fig_usage "$1: want a whole number from $3 to $4, got '$2'"
 }
 fig_num() {
-	[[ "$2" =~ ^-?[0-9]+([.][0-9]+)?$ ]] && awk -v x="$2" -v a="$3" -v b="$4" 'BEGIN { exit !(x >= a && x <= b) }' ||
-		fig_usage "$1: want a number from $3 to $4, got '$2'"
+	local x a b
+	if [[ "$2" =~ ^-?[0-9]+([.][0-9]+)?$ ]]; then
+		# in the shell (a figure run checks a few numbers, each an awk
+		# before) when all three fit _fig_fixed, else awk
+		if _fig_fixed x "$2" && _fig_fixed a "$3" && _fig_fixed b "$4"; then
+			[ "$x" -ge "$a" ] && [ "$x" -le "$b" ] && return 0
+		elif awk -v x="$2" -v a="$3" -v b="$4" 'BEGIN { exit !(x >= a && x <= b) }'; then
+			return 0
+		fi
+	fi
+	fig_usage "$1: want a number from $3 to $4, got '$2'"
+}
+# _fig_fixed VAR X: VAR = the decimal number X in billionths, exactly, when
+# it has at most 9 digits either side of the point; else 1.
+_fig_fixed() {
+	local -n _fx=$1
+	[[ $2 =~ ^(-?)([0-9]{1,9})([.]([0-9]{1,9}))?$ ]] || return 1
+	local frac=${BASH_REMATCH[4]}000000000
+	_fx=$(( 10#${BASH_REMATCH[2]} * 1000000000 + 10#${frac:0:9} ))
+	[ -z "${BASH_REMATCH[1]}" ] || _fx=$(( -_fx ))
 }
 
 # fig_hash is POSIX cksum's CRC (the seeds of every recorded run came from
 # `cksum`), computed in the shell: a module lists its jobs with one seed each,
 # hundreds of them, and a pipe of printf, cksum and cut per seed cost seconds
 # on a loaded machine. The table (CRC-32, polynomial 0x04C11DB7, most
-# significant bit first) is made once, when this file is sourced.
+# significant bit first) is made once, at the first hash: a figure run under
+# GNU parallel needs none, and the table costs 10 ms of CPU a run.
 _fig_crc=()
-for ((_i = 0; _i < 256; _i++)); do
-	_c=$(( _i << 24 ))
-	for ((_k = 0; _k < 8; _k++)); do
-		if (( _c & 0x80000000 )); then _c=$(( ((_c << 1) ^ 0x04C11DB7) & 0xFFFFFFFF )); else _c=$(( (_c << 1) & 0xFFFFFFFF )); fi
+_fig_crc_table() {
+	local i k c
+	for ((i = 0; i < 256; i++)); do
+		c=$(( i << 24 ))
+		for ((k = 0; k < 8; k++)); do
+			if (( c & 0x80000000 )); then c=$(( ((c << 1) ^ 0x04C11DB7) & 0xFFFFFFFF )); else c=$(( (c << 1) & 0xFFFFFFFF )); fi
+		done
+		_fig_crc[i]=$c
 	done
-	_fig_crc[_i]=$_c
-done
-unset _i _k _c
+}
 # fig_hash_v VAR TEXT: VAR = TEXT's cksum, without a subshell
 fig_hash_v() {
 	local -n _h=$1
 	local s=$2 crc=0 i c n LC_ALL=C   # bytes, as cksum counts them
+	[ ${#_fig_crc[@]} -eq 256 ] || _fig_crc_table
 	for ((i = 0; i < ${#s}; i++)); do
 		printf -v c '%d' "'${s:i:1}"
 		crc=$(( ((crc << 8) & 0xFFFFFFFF) ^ _fig_crc[((crc >> 24) ^ c) & 0xFF] ))
@@ -189,11 +223,17 @@ FIG_GOLDEN=0.6180339887498949
 FIG_PORT_LO=${FIG_PORT_LO:-30000}
 FIG_PORT_SPAN=${FIG_PORT_SPAN:-30000}
 
-# fig_port_bound PORT: some UDP socket of this host is bound to PORT.
+# fig_port_bound PORT: some UDP socket of this host is bound to PORT (the
+# tables read by the shell: a few hundred lines, no process).
 fig_port_bound() {
-	local hex
-	hex=$(printf ':%04X ' "$1")
-	grep -q "$hex" /proc/net/udp /proc/net/udp6 2>/dev/null
+	local hex f table
+	printf -v hex ':%04X ' "$1"
+	for f in /proc/net/udp /proc/net/udp6; do
+		table=""
+		{ IFS= read -r -d '' table; } 2>/dev/null <"$f"
+		[[ $table == *"$hex"* ]] && return 0
+	done
+	return 1
 }
 # Each run records the LCM traffic of its own port; a port is only taken when
 # nothing is bound to it yet. Under GNU parallel the job's slot (a number no
@@ -201,18 +241,22 @@ fig_port_bound() {
 # do. Two runs that pick the same free port at the same instant are noticed
 # (a daemon finds another with its name on that network, or demo.sh sees
 # more states than one daemon sends) and fig_demo runs again on another.
-fig_lcm_url() {
-	local out=$1 try=${2:-0} port k
+fig_lcm_url() { local url; fig_lcm_url_v url "$@"; echo "$url"; }
+# fig_lcm_url_v VAR OUTDIR [TRY]: the same into VAR, without a subshell
+fig_lcm_url_v() {
+	local -n _url=$1
+	local out=$2 try=${3:-0} port k h
 	if [[ "${PARALLEL_JOBSLOT:-}" =~ ^[0-9]+$ ]]; then
 		port=$(( FIG_PORT_LO + (PARALLEL_JOBSLOT - 1 + try * 7) % FIG_PORT_SPAN ))
 	else
-		port=$(( FIG_PORT_LO + ($(fig_hash "$out") + $$ * 7919 + try * 104729) % FIG_PORT_SPAN ))
+		fig_hash_v h "$out"
+		port=$(( FIG_PORT_LO + (h + $$ * 7919 + try * 104729) % FIG_PORT_SPAN ))
 	fi
-	for k in $(seq 0 50); do
+	for ((k = 0; k <= 50; k++)); do
 		fig_port_bound "$port" || break
 		port=$(( FIG_PORT_LO + (port - FIG_PORT_LO + 1) % FIG_PORT_SPAN ))
 	done
-	echo "udpm://239.255.76.67:$port?ttl=0"
+	_url="udpm://239.255.76.67:$port?ttl=0"
 }
 
 # A program started here runs in a session of its own where setsid exists,
@@ -224,8 +268,12 @@ command -v setsid >/dev/null 2>&1 && FIG_SESSION=(setsid)
 # made): in another user's folder, or one others may write, the names a run
 # writes may be links to our files already (scripts/outdir.sh).
 fig_run_dir() {
-	local parent
-	parent=$(dirname "$1")
+	local parent=$1
+	# dirname's answer, without running it
+	while [[ $parent == */ && $parent != / ]]; do parent=${parent%/}; done
+	case "$parent" in */*) parent=${parent%/*} ;; *) parent=. ;; esac
+	while [[ $parent == */ && $parent != / ]]; do parent=${parent%/}; done
+	parent=${parent:-/}
 	[ -d "$parent" ] || mkdir -p -- "$parent" || fig_die "cannot create $parent"
 	outdir_check "$1" "$FIG_NAME:" || exit 1
 }
@@ -237,24 +285,35 @@ fig_run_dir() {
 fig_run_start() {
 	fig_run_dir "$1"
 	FIG_RUN=$(cd "$1" && pwd) || fig_die "cannot enter $1"
-	FIG_T0=$(date +%s.%N)
+	FIG_T0=$EPOCHREALTIME
 }
-fig_wall() { awk -v a="$FIG_T0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }'; }
+# (the clock is the shell's: microseconds, "s.us" or "s,us" by the locale)
+fig_wall() {
+	local a=${FIG_T0//[!0-9]/} b=${EPOCHREALTIME//[!0-9]/} d
+	d=$(( (10#$b - 10#$a + 50000) / 100000 ))
+	echo "$((d / 10)).$((d % 10))"
+}
 
 # Attempts of one run when it heard another run on its port.
 FIG_PORT_TRIES=3
 fig_demo() {
 	local out=$1; shift
-	local try rc
+	local try rc url line crossed
 	fig_run_dir "$out"
-	for try in $(seq 0 $((FIG_PORT_TRIES - 1))); do
-		rm -rf "$out/demo"
+	for ((try = 0; try < FIG_PORT_TRIES; try++)); do
+		if [ -e "$out/demo" ] || [ -L "$out/demo" ]; then rm -rf "$out/demo"; fi
 		outdir_new "$out/demo.out" || { echo "$FIG_NAME: cannot write $out/demo.out" >&2; return 1; }
 		rc=0
-		"$fig_top/scripts/demo.sh" --lockstep --out "$out/demo" --lcm-url "$(fig_lcm_url "$out" "$try")" \
+		fig_lcm_url_v url "$out" "$try"
+		"$fig_top/scripts/demo.sh" --lockstep --out "$out/demo" --lcm-url "$url" \
 			"$@" >"$out/demo.out" 2>&1 </dev/null || rc=$?
 		# another run took the same port at the same moment: again, elsewhere
-		grep -q 'another undulated for this robot runs on this computer' "$out/demo.out" && continue
+		# (demo.out, a few dozen lines, read by the shell)
+		crossed=0
+		while IFS= read -r line || [ -n "$line" ]; do
+			[[ $line == *'another undulated for this robot runs on this computer'* ]] && { crossed=1; break; }
+		done <"$out/demo.out"
+		[ "$crossed" = 0 ] || continue
 		if [ "$rc" -ne 0 ] || [ ! -f "$out/demo/summary.json" ]; then
 			echo "$FIG_NAME: $out: the lockstep run failed (demo.sh exit $rc): $( { grep -m1 '^demo: ' "$out/demo.out" ||
 				tail -n 1 "$out/demo.out"; } | cut -c1-300)" >&2
@@ -273,7 +332,7 @@ fig_json() { jq -r "$2" "$1/summary.json"; }
 # (tools/analyze/README.md, "End state of a pair"). null becomes nan.
 fig_pairs_header="pair,class,mean_delta,mean_abs_delta,spread,window_collisions,collisions,impulse,distance_m,dsep,compat_limit,swing_a,swing_b"
 fig_pairs() {
-	sed -e 's/.*"pairs":\[{//' -e 's/}\],"min_swing".*//' "$1" | sed 's/},{/\n/g' |
+	sed -e 's/.*"pairs":\[{//' -e 's/}\],"min_swing".*//' -e 's/},{/\n/g' "$1" |
 		awk -v keys="$fig_pairs_header" 'BEGIN { nk = split(keys, want, ",") }
 		{
 			delete v
@@ -293,17 +352,20 @@ fig_pairs() {
 }
 
 fig_min_swing() {
-	grep -o '"swing_rad":[^,}]*' "$1" | awk -F: '{ x = ($2 == "null") ? 0 : $2 + 0; if (NR == 1 || x < m) m = x }
-		END { if (NR) printf "%.3f\n", m; else print "nan" }'
+	# every "swing_rad":VALUE (grep -o's matches, in one awk)
+	awk '{ while (match($0, /"swing_rad":[^,}]*/)) {
+			v = substr($0, RSTART + 12, RLENGTH - 12); $0 = substr($0, RSTART + RLENGTH)
+			x = (v == "null") ? 0 : v + 0; if (n++ == 0 || x < m) m = x } }
+		END { if (n) printf "%.3f\n", m; else print "nan" }' "$1"
 }
 
 # fig_delta_trace DIR OUT STEP: the followed pair's (the first neighbour
 # pair's) phase difference from DIR/phase_diff.csv, one sample per STEP s.
 fig_delta_trace() {
-	awk -F, -v step="$3" 'NR == 1 { next }
+	awk -F, -v step="$3" 'BEGIN { print "t,delta" } NR == 1 { next }
 		$4 == "neighbour" && (pair == "" || $3 == pair) && $9 != "" && $2 >= next_t {
 			pair = $3; printf "%.2f,%s\n", $2, $9; next_t = $2 + step }' "$1/phase_diff.csv" |
-		{ echo "t,delta"; cat; } | outdir_put "$2"
+		outdir_put "$2"
 }
 
 # What a run keeps: its result, the analyser's summary and per-second rates,
@@ -566,8 +628,9 @@ FIG_CHANNEL_SWEPT_M=0.2984
 fig_channel_demo() {
 	local out=$1 width=$2 seed=$3 scenario=$4 spacing
 	shift 4
-	spacing=$(awk -v w="$width" 'BEGIN { printf "%.4f", w / 100 }')
-	FIG_CHANNEL_NOMINAL=$(awk -v d="$spacing" -v s="$FIG_CHANNEL_SWEPT_M" 'BEGIN { printf "%.4f", d / s }')
+	# the spacing (m) and from it the nominal d~, in one awk
+	read -r spacing FIG_CHANNEL_NOMINAL < <(awk -v w="$width" -v s="$FIG_CHANNEL_SWEPT_M" \
+		'BEGIN { d = sprintf("%.4f", w / 100); printf "%s %.4f\n", d, d / s }')
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/$scenario" --seconds "$FIG_CHANNEL_SECONDS" \
 		--switch-at "$FIG_CHANNEL_SWITCH" --seed "$seed" --window "$FIG_CHANNEL_WINDOW" --set "world.spacing=$spacing" "$@"
 }
@@ -674,12 +737,20 @@ fig_ini() {
 fig_plane_sets() {
 	local conf=${1:-$FIG_PLANE_CONF} k sec key v
 	[ -f "$conf" ] || { echo "$FIG_NAME: no tuned configuration $conf (figures/lib.sh, fig_plane_tune)" >&2; return 1; }
-	for k in $FIG_PLANE_KEYS; do
+	# every key's value as fig_ini finds it (the first "KEY = VALUE" in its
+	# section, VALUE's first word), in one awk rather than one per key: a
+	# plane run reads 13; "K V" a line, in FIG_PLANE_KEYS' order
+	local values
+	values=$(awk -v keys="$FIG_PLANE_KEYS" 'BEGIN { n = split(keys, k, " ")
+			for (i = 1; i <= n; i++) { s = k[i]; sub(/\.[^.]*$/, "", s); sec[i] = "[" s "]"; key[i] = k[i]; sub(/.*\./, "", key[i]) } }
+		/^\[/ { cur = $1; next }
+		{ for (i = 1; i <= n; i++) if (!(i in v) && cur == sec[i] && $1 == key[i] && $2 == "=") v[i] = $3 }
+		END { for (i = 1; i <= n; i++) print k[i], v[i] }' "$conf")
+	while read -r k v; do
 		sec=${k%.*} key=${k##*.}
-		v=$(fig_ini "$conf" "$sec" "$key")
 		[ -n "$v" ] || { echo "$FIG_NAME: $conf has no [$sec] $key" >&2; return 1; }
 		printf -- '--daemon-set\n%s=%s\n' "$k" "$v"
-	done
+	done <<<"$values"
 }
 
 # fig_plane_tune OUT [SEED] [TUNE_S]: one plane robot (two joints, no walls:

@@ -70,12 +70,36 @@
 # early-stop.txt with those lines, unanalysed, and the command that analyses it.
 set -u
 
-top=$(cd "$(dirname "$0")/.." && pwd)
+# Every process this script starts costs a few milliseconds: `make figures`
+# runs it about 1,600 times, so what the shell can do itself (clock, arithmetic,
+# names, reading a short log) it does without starting one.
+case "$0" in */*) top=${0%/*} ;; *) top=. ;; esac
+top=$(cd "${top:-/}/.." && pwd)
 source "$top/scripts/outdir.sh"
 
 BUILD=${BUILD:-build}
 case "$BUILD" in /*) ;; *) BUILD="$top/$BUILD" ;; esac
 B="$BUILD/bin"
+
+# now_ns VAR: the wall clock in ns (date +%s%N's number, to the microsecond),
+# without a process.
+now_ns() { local -n _now=$1; _now=${EPOCHREALTIME//[!0-9]/}000; }
+# parent_of VAR PATH: VAR = dirname PATH, without a process.
+parent_of() {
+	local -n _par=$1
+	local p=$2
+	while [[ $p == */ && $p != / ]]; do p=${p%/}; done
+	case "$p" in */*) p=${p%/*} ;; *) p=. ;; esac
+	while [[ $p == */ && $p != / ]]; do p=${p%/}; done
+	_par=${p:-/}
+}
+# nap S: a pause of S seconds without a process: read's timeout on a pipe
+# no one writes (opened once, read and written by this shell alone).
+nap_fd=""
+nap() {
+	[ -n "$nap_fd" ] || exec {nap_fd}<> <(:)
+	read -r -t "$1" -u "$nap_fd" _ || :
+}
 
 # ---- a run that ends early ------------------------------------------------------
 # early_keep RUN WHY [VERB]: the run in RUN stopped before its end, its
@@ -137,7 +161,7 @@ early_keep() {
 	fi
 	printf '%s\n' "${report[@]}" >&2
 	local parent keep
-	parent=$(dirname "$out")
+	parent_of parent "$out"
 	{ [ -d "$parent" ] || mkdir -p -- "$parent"; } && outdir_check "$out" "demo: --out" ||
 		{ echo "demo: the run could not be kept (above)" >&2; return 1; }
 	keep="$run/keep"
@@ -172,13 +196,13 @@ early_keep() {
 # stop_pids PID...: SIGTERM to all at once, up to 3 s, then SIGKILL. Watched
 # with kill -0, which works for the supervisor too (they are not its children).
 stop_pids() {
-	local pid
+	local pid k
 	[ $# -gt 0 ] || return 0
 	kill -TERM "$@" 2>/dev/null
-	for _ in $(seq 150); do
+	for ((k = 0; k < 600; k++)); do
 		for pid in "$@"; do kill -0 "$pid" 2>/dev/null && break; pid=""; done
 		[ -z "$pid" ] && return 0
-		sleep 0.02
+		nap 0.005
 	done
 	for pid in "$@"; do
 		kill -0 "$pid" 2>/dev/null && echo "demo: pid $pid ignored SIGTERM for 3 s; killing it" >&2
@@ -216,7 +240,7 @@ if [ -z "${UNDULATE_DEMO_RUN:-}" ]; then
 	trap 'sv_stop 129 "SIGHUP: the terminal closed"' HUP
 	sv_rc=0
 	wait "$sv_worker" || sv_rc=$?
-	rm -rf "$sv_run"   # normally gone already: the worker removes it
+	[ ! -e "$sv_run" ] || rm -rf "$sv_run"   # normally gone already: the worker removes it
 	exit "$sv_rc"
 fi
 scenario="$top/sim-bridge/scenarios/plane-demo.scenario"
@@ -283,6 +307,25 @@ done
 die() { echo "demo: $*" >&2; exit 1; }
 [ "$default_scenario" = 1 ] && daemon_sets=("${plane_demo_sets[@]}" ${daemon_sets[@]+"${daemon_sets[@]}"})
 is_number() { [[ "$1" =~ ^-?[0-9]+([.][0-9]+)?$ ]]; }
+# fixed9 VAR X: VAR = X (is_number's) in billionths, when it has at most 9
+# digits either side of the point; else 1.
+fixed9() {
+	local -n _f=$1
+	[[ $2 =~ ^(-?)([0-9]{1,9})([.]([0-9]{1,9}))?$ ]] || return 1
+	local frac=${BASH_REMATCH[4]}000000000
+	_f=$(( 10#${BASH_REMATCH[2]} * 1000000000 + 10#${frac:0:9} ))
+	[ -z "${BASH_REMATCH[1]}" ] || _f=$(( -_f ))
+}
+# num_lt A B: A < B for numbers is_number accepts: in the shell for every
+# setting with at most 9 digits either side of the point, else by awk.
+num_lt() {
+	local x y
+	if fixed9 x "$1" && fixed9 y "$2"; then
+		[ "$x" -lt "$y" ]
+	else
+		awk -v a="$1" -v b="$2" 'BEGIN { exit !(a < b) }'
+	fi
+}
 
 [ -f "$scenario" ] || die "no scenario file '$scenario'"
 for p in undulate-sim undulated undulate-analyze undulate-top; do
@@ -310,6 +353,8 @@ if [ -e "$out" ] || [ -L "$out" ]; then outdir_check "$out" "demo: --out" || exi
 
 run=$UNDULATE_DEMO_RUN
 links="$run/links"
+# nap's pipe, opened before anything is started (start closes it for them)
+exec {nap_fd}<> <(:)
 mkdir -p "$links"
 # what an early stop (early_keep, above) needs to say what ran and to keep it
 echo "$out" >"$run/out"
@@ -366,25 +411,44 @@ record() {
 }
 start() {
 	local name=$1; shift
-	${own_session[@]+"${own_session[@]}"} "$@" >"$run/$name.log" 2>&1 &
+	${own_session[@]+"${own_session[@]}"} "$@" >"$run/$name.log" 2>&1 {nap_fd}<&- &
 	record "$!" "$name"
 }
 
-# pid_of NAME: the PID of a process we started.
-pid_of() { local i; for i in "${!names[@]}"; do [ "${names[$i]}" = "$1" ] && echo "${pids[$i]}"; done; }
+# pid_of VAR NAME: VAR = the PID of a process we started ("" if none).
+pid_of() {
+	local -n _pid=$1
+	local i
+	_pid=""
+	for i in "${!names[@]}"; do [ "${names[$i]}" = "$2" ] && _pid=${pids[$i]}; done
+	return 0
+}
+# log_has FILE REGEX: a line of FILE (a program's log, short while it starts)
+# matches the extended REGEX, as grep -qE finds it, read by the shell itself;
+# the first such line in log_line.
+log_line=""
+log_has() {
+	local line
+	while IFS= read -r line || [ -n "$line" ]; do
+		[[ $line =~ $2 ]] && { log_line=$line; return 0; }
+	done 2>/dev/null <"$1"
+	return 1
+}
 # wait_ready NAME REGEX: poll NAME's log until REGEX appears; 1 (with its log's
 # tail) if it exits or takes longer than READY_TIMEOUT_S.
 wait_ready() {
-	local name=$1 re=$2 pid
-	pid=$(pid_of "$name")
-	local deadline=$(( $(date +%s%N) + READY_TIMEOUT_S * 1000000000 ))
-	until grep -qE "$re" "$run/$name.log" 2>/dev/null; do
-		if ! kill -0 "$pid" 2>/dev/null || [ "$(date +%s%N)" -ge "$deadline" ]; then
+	local name=$1 re=$2 pid now deadline
+	pid_of pid "$name"
+	now_ns now
+	deadline=$(( now + READY_TIMEOUT_S * 1000000000 ))
+	until log_has "$run/$name.log" "$re"; do
+		now_ns now
+		if ! kill -0 "$pid" 2>/dev/null || [ "$now" -ge "$deadline" ]; then
 			echo "demo: $name did not become ready; its log:" >&2
 			tail -n 15 "$run/$name.log" | sed 's/^/    /' >&2
 			return 1
 		fi
-		sleep 0.02
+		nap 0.005
 	done
 }
 
@@ -407,12 +471,11 @@ if [ "$lockstep" = 1 ]; then
 	# contact samples (every CONTACT_SAMPLE_S, one just before the switch)
 	# and the switch are its scheduled events, at simulated times.
 	lk_sim=(--lockstep "$run/clock" --duration "$seconds")
-	t=0
-	while awk -v t="$t" -v s="$seconds" 'BEGIN { exit !(t <= s) }'; do
+	# (t is whole: t <= seconds is t <= its whole part, a positive number)
+	for ((t = 0; t <= 10#${seconds%.*}; t += 5)); do
 		lk_sim+=(--set "events.$t=stats")
-		t=$(awk -v t="$t" 'BEGIN { print t + 5 }')
 	done
-	if [ "$switch_at" != never ] && awk -v a="$switch_at" -v s="$seconds" 'BEGIN { exit !(a < s) }'; then
+	if [ "$switch_at" != never ] && num_lt "$switch_at" "$seconds"; then
 		lk_sim+=(--set "events.$switch_at=stats" --set "events.$switch_at=command * mode $switch_to")
 	fi
 	lk_daemon=(--lockstep "$run/clock")
@@ -422,7 +485,7 @@ start sim "$B/undulate-sim" --scenario "$scenario" --link-dir "$links" --lcm-url
 wait_ready sim '^undulate-sim: ready:' || exit 1
 # "ready: 4 buses: r1=/path/r1[1,2] r2=... bodies=..." names every robot, its
 # pty and its servo IDs, in scenario (left to right) order.
-ready_line=$(grep -m1 '^undulate-sim: ready:' "$run/sim.log")
+ready_line=$log_line   # the line wait_ready found
 robots=() ports=() ids=()
 for word in $ready_line; do
 	[[ "$word" =~ ^([A-Za-z0-9_-]+)=(/[^[]+)\[([0-9,]+)\]$ ]] || continue
@@ -434,12 +497,16 @@ done
 robot_phase=()
 if [ "$phases" = random ]; then
 	RANDOM=$seed
+	draws=()
 	for _ in "${robots[@]}"; do
 		# drawn here, not inside $(...): bash reseeds RANDOM in every
 		# subshell, and the seed would not fix the phases
-		r=$RANDOM
-		robot_phase+=("$(awk -v r="$r" 'BEGIN { printf "%.3f", (r / 32768.0) * 6.283185 - 3.141593 }')")
+		draws+=("$RANDOM")
 	done
+	# one awk for every robot's phase
+	read -r -a robot_phase < <(awk -v rs="${draws[*]}" 'BEGIN { n = split(rs, r, " ")
+		for (i = 1; i <= n; i++) printf "%s%.3f", (i > 1 ? " " : ""), (r[i] / 32768.0) * 6.283185 - 3.141593; print "" }')
+	[ ${#robot_phase[@]} -eq ${#robots[@]} ] || die "could not draw the robots' random phases (awk)"
 else
 	IFS=, read -r -a robot_phase <<<"$phases"
 	[ ${#robot_phase[@]} -eq ${#robots[@]} ] || die "--phases: ${#robots[@]} robots, ${#robot_phase[@]} phases"
@@ -470,14 +537,15 @@ for i in "${!robots[@]}"; do
 	[ "$lockstep" = 1 ] && break
 	name="undulated-${robots[$i]}"
 	start_daemon "$i"
-	for attempt in $(seq "$START_ATTEMPTS"); do
+	for ((attempt = 1; attempt <= START_ATTEMPTS; attempt++)); do
 		wait_ready "$name" 'ready:' && continue 2
 		# A start-up transaction that fails for good (a reply lost or
 		# garbled more often than undulated retries it: "... failed: no
 		# reply / bad checksum / unexpected length") ends undulated's start;
 		# on a heavily loaded machine the simulated bus can answer late. Say
 		# so and try again; anything else (e.g. a bad setting) is fatal.
-		kill -0 "$(pid_of "$name")" 2>/dev/null && break
+		pid_of pid "$name"
+		kill -0 "$pid" 2>/dev/null && break
 		grep -qE 'failed: |did not answer a PING' "$run/$name.log" || break
 		[ "$attempt" -lt "$START_ATTEMPTS" ] || break
 		echo "demo: $name: the simulated bus answered too late during start-up; starting it again" >&2
@@ -493,7 +561,7 @@ for i in "${!robots[@]}"; do
 	done
 	exit 1
 done
-t_ready=$(date +%s%N)
+now_ns t_ready
 echo "$t_ready" >"$run/t_ready"
 
 # ---- the web dashboard, beside the terminal view --------------------------------
@@ -512,7 +580,7 @@ if [ -x "$B/undulate-web" ] && [ "$lockstep" != 1 ]; then
 fi
 
 say() { [ "$interactive" -eq 1 ] || echo "demo: $*"; }
-say "scenario $(basename "$scenario"), ${#robots[@]} robots (${robots[*]}), seed $seed, LCM $url"
+say "scenario ${scenario##*/}, ${#robots[@]} robots (${robots[*]}), seed $seed, LCM $url"
 say "phases at start (rad): ${robot_phase[*]}; $start_mode until +${switch_at} s, then $switch_to"
 [ -n "$web_url" ] && echo "demo: the dashboard: open $web_url in a browser (undulate-web; undulate-top is the terminal view)"
 
@@ -520,7 +588,9 @@ say "phases at start (rad): ${robot_phase[*]}; $start_mode until +${switch_at} s
 switch_modes() {
 	if "$B/undulated" --command "mode $switch_to" --robot '*' --lcm-url "$url" --timeout 2 \
 		>"$run/switch.log" 2>&1; then
-		echo "$(date +%s%N)" >"$run/switch.time"
+		local now
+		now_ns now
+		echo "$now" >"$run/switch.time"
 	else
 		echo "demo: the switch to $switch_to was not accepted by every robot:" >&2
 		sed 's/^/    /' "$run/switch.log" >&2
@@ -530,7 +600,7 @@ switch_modes() {
 # sleep_until T_NS: sleep until the monotonic-enough wall time T_NS.
 sleep_until() {
 	local now left
-	now=$(date +%s%N)
+	now_ns now
 	left=$(( $1 - now ))
 	[ "$left" -gt 0 ] || return 0
 	# In the background and waited for: a trapped SIGTERM/SIGINT interrupts
@@ -550,7 +620,7 @@ banner_loop() {
 	local now el left
 	trap '[ -n "${sleep_pid:-}" ] && kill "$sleep_pid" 2>/dev/null; exit 143' TERM
 	while :; do
-		now=$(date +%s%N)
+		now_ns now
 		el=$(( (now - t_ready) / 1000000000 ))
 		if [ -n "$web_url" ] && [ $((el % 5)) -eq 4 ]; then
 			echo "DEMO ${el}s | in a browser: $web_url | ? legend  q end" >"$run/banner.new"
@@ -586,22 +656,35 @@ if [ "$interactive" -eq 1 ]; then
 	# 130: Ctrl-C (a key to undulate-top's raw terminal): stop at once, keep
 	# the run unanalysed and say what ran
 	if [ "$top_rc" -ne 0 ]; then
-		date +%s%N >"$run/t_end"
+		now_ns now
+		echo "$now" >"$run/t_end"
 		# undulate-top leaves the cursor at the end of its last line
 		[ -t 2 ] && echo >&2
 		stop_children
 		early_keep "$run" "$([ "$top_rc" -eq 130 ] && echo Ctrl-C || echo "undulate-top exit $top_rc")"
 		exit "$top_rc"
 	fi
-	seconds=$(awk -v n="$(( $(date +%s%N) - t_ready ))" 'BEGIN { printf "%.0f", n / 1e9 }')
+	now_ns now
+	seconds=$(awk -v n="$(( now - t_ready ))" 'BEGIN { printf "%.0f", n / 1e9 }')
 fi
 
 # ---- lockstep: the simulator runs the schedule and ends the run -------------------
 if [ "$lockstep" = 1 ]; then
 	sim_rc=0
-	wait "$(pid_of sim)" || sim_rc=$?
-	for i in "${!robots[@]}"; do wait "$(pid_of "undulated-${robots[$i]}")" 2>/dev/null; done
-	ended=$(sed -n 's/^undulate-sim: lockstep: .*; ended: //p' "$run/sim.log")
+	pid_of pid sim
+	wait "$pid" || sim_rc=$?
+	for i in "${!robots[@]}"; do pid_of pid "undulated-${robots[$i]}"; wait "$pid" 2>/dev/null; done
+	# what the simulator's log (a few dozen lines) says, read once by the
+	# shell: why the run ended, whether the switch was delivered, its speed
+	ended="" switched=0 speed=""
+	re_ended='^undulate-sim: lockstep: .*; ended: (.*)$'
+	re_speed='^undulate-sim: lockstep: ([0-9.]* s of simulated time in [0-9.]* s \([0-9.]*x real time)'
+	while IFS= read -r line || [ -n "$line" ]; do
+		[[ $line == *"event 'command * mode $switch_to': ok"* ]] && switched=1
+		[[ $line == "undulate-sim: lockstep: "* ]] || continue
+		[[ $line =~ $re_ended ]] && ended+=${ended:+$'\n'}${BASH_REMATCH[1]}
+		[[ $line =~ $re_speed ]] && speed+=${speed:+$'\n'}${BASH_REMATCH[1]}")"
+	done 2>/dev/null <"$run/sim.log"
 	if [ "$sim_rc" -ne 0 ]; then
 		# a daemon killed stalls the lockstep clock: the simulator ends the run
 		echo "demo: the lockstep run failed (undulate-sim exit $sim_rc): ${ended:-see its log}; its log ends:" >&2
@@ -610,8 +693,8 @@ if [ "$lockstep" = 1 ]; then
 		early_keep "$run" "the lockstep run failed: ${ended:-undulate-sim exit $sim_rc}"
 		exit 1
 	fi
-	grep -q "event 'command \* mode $switch_to': ok" "$run/sim.log" && echo lockstep >"$run/switch.time"
-	say "lockstep: $(sed -n 's/^undulate-sim: lockstep: \([0-9.]* s of simulated time in [0-9.]* s ([0-9.]*x real time\).*/\1)/p' "$run/sim.log")"
+	[ "$switched" = 1 ] && echo lockstep >"$run/switch.time"
+	say "lockstep: $speed"
 fi
 
 # check_alive: a program that stopped during the run (a daemon killed, the
@@ -619,7 +702,7 @@ fi
 # is (early_keep) and end with exit 1. Checked at every contact sample and at
 # the end (in lockstep the simulator ends a run whose daemon is gone).
 check_alive() {
-	local i gone gone_rc how
+	local i gone gone_rc how now
 	for i in "${!pids[@]}"; do
 		[ "$lockstep" = 1 ] && return 0
 		case "${names[$i]}" in "switch timer"|banner|top|web|analyze) continue ;; esac
@@ -629,7 +712,8 @@ check_alive() {
 		wait "${pids[$i]}" 2>/dev/null || gone_rc=$?
 		how="exit $gone_rc"
 		[ "$gone_rc" -gt 128 ] && how="killed by SIG$(kill -l $((gone_rc - 128)) 2>/dev/null || echo $((gone_rc - 128)))"
-		date +%s%N >"$run/t_end"
+		now_ns now
+		echo "$now" >"$run/t_end"
 		echo "demo: $gone stopped during the run ($how); its log ends:" >&2
 		tail -n 8 "$run/$gone.log" | sed 's/^/    /' >&2
 		stop_children
@@ -679,7 +763,7 @@ stop_children
 # else is made in $keep, inside our private $run, and moved into $out at the
 # end, replacing whatever has those names there (scripts/outdir.sh): nothing
 # is written through a link or read back from a file another user placed.
-parent=$(dirname "$out")
+parent_of parent "$out"
 [ -d "$parent" ] || mkdir -p -- "$parent" || die "cannot create $parent (DEMO_OUT / --out)"
 outdir_check "$out" "demo: --out" || exit 1
 keep="$run/keep"
@@ -698,18 +782,27 @@ wait "$!" || rc=$?
 # Seconds from the start of the log to the switch: the daemons' "mode" events.
 switch_t=""
 if [ -f "$run/switch.time" ]; then
-	switch_t=$(awk -F, -v to="-> $(echo "$switch_to" | tr a-z A-Z)" \
+	switch_t=$(awk -F, -v to="-> ${switch_to^^}" \
 		'$6 == "\"mode\"" && index($0, to) { printf "%.1f", $2; exit }' "$analysis/events.csv")
 fi
 
 # ---- summary --------------------------------------------------------------------
 summary() {
 echo
-echo "=== undulate demo summary: ${#robots[@]} robots, $seconds s, $(basename "$scenario") ==="
+echo "=== undulate demo summary: ${#robots[@]} robots, $seconds s, ${scenario##*/} ==="
 # A run that broke says so first: what follows describes a broken run
 # (the analyser's "broken": latched faults, robots that stopped publishing,
 # a simulator that fell behind real time).
-broken=$(jq -r '.broken[]?' "$analysis/summary.json" 2>/dev/null)
+# One jq for the two things read from summary.json (jq's start is its cost):
+# the "broken" lines, then, after a record separator, the median contact
+# force's line (said below, when there was a switch).
+from_json=$(jq -r --arg from "$start_mode" --arg to "$switch_to" '(.broken[]?), "\u001e",
+	(.force | select(.median_before_n != null and .median_after_n != null) |
+	"  Median contact force of \(if .of == "contacts" then "all contacts (each touching pair over each 10 ms)" else "the 10 ms periods with contact" end): \(.median_before_n * 1000 | round / 1000) N on the \($from) (\(.samples_before) before the switch) -> \(.median_after_n * 1000 | round / 1000) N on the \($to) (\(.samples_after) in the final window).")' \
+	"$analysis/summary.json" 2>/dev/null)
+broken=${from_json%%$'\x1e'*} median_line=""
+[[ $from_json == *$'\x1e'* ]] && median_line=${from_json#*$'\x1e'} && median_line=${median_line#$'\n'}
+while [[ $broken == *$'\n' ]]; do broken=${broken%$'\n'}; done
 if [ -n "$broken" ]; then
 	echo "THIS RUN BROKE: what follows is not the experiment's result:"
 	sed 's/^/  - /' <<<"$broken"
@@ -749,9 +842,7 @@ if [ -n "$switch_t" ]; then
 			printf "  Collisions between robots per 10 s: %.0f -> %.0f; against the walls: %.0f -> %.0f.\n", bp * 10 / bs, ap * 10 / as, bw * 10 / bs, aw * 10 / as
 		}' "$analysis/collision_rate.csv"
 	# the median contact force of the 10 ms periods with contact (the analyser's)
-	jq -r --arg from "$start_mode" --arg to "$switch_to" '.force | select(.median_before_n != null and .median_after_n != null) |
-		"  Median contact force of \(if .of == "contacts" then "all contacts (each touching pair over each 10 ms)" else "the 10 ms periods with contact" end): \(.median_before_n * 1000 | round / 1000) N on the \($from) (\(.samples_before) before the switch) -> \(.median_after_n * 1000 | round / 1000) N on the \($to) (\(.samples_after) in the final window)."' \
-		"$analysis/summary.json" 2>/dev/null
+	[ -z "$median_line" ] || echo "$median_line"
 fi
 awk '
 	$1 == "pair" && !hdr {
@@ -794,9 +885,11 @@ awk -F, 'NR > 1 { b = int($1 / 10); n[b] += $2; imp[b] += $3; if (b > last) last
 
 # Contact force from the simulator's samples: "t,impacts,impulse,resting_impulse"
 # (simulated seconds since its start, running totals).
-sed -nE "s/^undulate-sim: (SIM.CMD seq [0-9]* 'stats *'|t=[0-9.]* event 'stats'): ok steps=[0-9]* time=([0-9.]*) collisions=([0-9]*) impulse=([0-9.]*) resting_impulse=([0-9.]*).*/\2,\3,\4,\5/p" \
-	"$run/sim.log" | sort -t, -k1,1n | { echo "t,impacts,impulse,resting_impulse"; cat; } >"$analysis/contact.csv"
-if [ "$(wc -l <"$analysis/contact.csv")" -gt 2 ]; then
+{ echo "t,impacts,impulse,resting_impulse"
+  sed -nE "s/^undulate-sim: (SIM.CMD seq [0-9]* 'stats *'|t=[0-9.]* event 'stats'): ok steps=[0-9]* time=([0-9.]*) collisions=([0-9]*) impulse=([0-9.]*) resting_impulse=([0-9.]*).*/\2,\3,\4,\5/p" \
+	"$run/sim.log" | sort -t, -k1,1n; } >"$analysis/contact.csv"
+mapfile -t contact_rows <"$analysis/contact.csv"
+if [ "${#contact_rows[@]}" -gt 2 ]; then
 	echo
 	echo "mean contact force between samples (simulator ground truth: impacts + resting contact):"
 	awk -F, 'NR > 2 && $1 >= t0 + 1 { printf "  %6.1f-%-6.1f s  %9.4f N  (%d impacts)\n", t0, $1, ($3 - i0) / ($1 - t0), $2 - n0 }
@@ -807,8 +900,8 @@ fi
 # One daemon publishes 100 STATE messages a second: many more means another
 # program publishes on this LCM URL (e.g. the same test run twice at once),
 # and the analysis mixes two runs.
-crosstalk=$(awk '/^span:/ { span = $2 } $2 == "joints" && $4 == "states" && span > 0 && $5 > 1.15 * 100 * span { print $1 }' \
-	"$analysis/summary.txt" | tr '\n' ' ')
+crosstalk=$(awk -v ORS=' ' '/^span:/ { span = $2 } $2 == "joints" && $4 == "states" && span > 0 && $5 > 1.15 * 100 * span { print $1 }' \
+	"$analysis/summary.txt")
 if [ -n "$crosstalk" ]; then
 	echo
 	echo "WARNING: more STATE messages from ${crosstalk}than one daemon sends: another program uses $url; these results mix two runs"
@@ -816,7 +909,7 @@ if [ -n "$crosstalk" ]; then
 fi
 
 # The simulator's own count over the whole run (ground truth, SIM.TRUTH).
-truth=$(grep -m1 '^undulate-sim: exit:' "$run/sim.log" | sed 's/^undulate-sim: exit: //')
+truth=$(sed -n '/^undulate-sim: exit:/{s/^undulate-sim: exit: //;p;q}' "$run/sim.log")
 [ -n "$truth" ] && echo "simulator: $truth"
 
 }

@@ -65,7 +65,7 @@ _outdir_walk() {
 		next="$cur/$comp"
 		if [ -L "$next" ]; then
 			owner=$(command stat -c %u -- "$next") || return 1
-			if [ "$owner" != 0 ] && [ "$owner" != "$(id -u)" ]; then
+			if [ "$owner" != 0 ] && [ "$owner" != "$EUID" ]; then
 				echo "$_outdir_path: the symbolic link $comp on the way is owned by $(_outdir_who "$owner"), not by you or root: another user chooses where it leads; give the directory itself"
 				return 1
 			fi
@@ -88,18 +88,23 @@ _outdir_walk() {
 }
 
 outdir_check() {
-	local dir=$1 prefix=${2:-} res uid gid mode why=""
+	local dir=$1 prefix=${2:-} res uid gid mode why="" base dmode
 	local _outdir_path=$dir
 	[ -n "$dir" ] || { echo "${prefix:+$prefix }an empty directory name" >&2; return 1; }
-	res=$(_outdir_walk "$(pwd -P)" "$dir" 1 0) || { echo "${prefix:+$prefix }$res" >&2; return 1; }
+	# the working directory matters only to a relative DIR (a process fewer
+	# for an absolute one: make figures checks a few thousand folders)
+	case "$dir" in /*) base="" ;; *) base=$(pwd -P) ;; esac
+	res=$(_outdir_walk "$base" "$dir" 1 0) || { echo "${prefix:+$prefix }$res" >&2; return 1; }
 	[ -n "$res" ] || res=/
 	if [ ! -e "$res" ]; then
-		mkdir -m "$(printf '%o' $((0755 & ~0$(umask))))" -- "$res" 2>/dev/null || [ -d "$res" ] ||
+		printf -v dmode '%o' $((0755 & ~0$(umask)))
+		mkdir -m "$dmode" -- "$res" 2>/dev/null || [ -d "$res" ] ||
 			{ echo "${prefix:+$prefix }$dir: cannot create it" >&2; return 1; }
 	fi
 	read -r uid gid mode < <(command stat -L -c '%u %g %a' -- "$res") || return 1
 	mode=$((8#$mode))
-	if [ "$uid" != "$(id -u)" ]; then
+	# $EUID: what `id -u` prints, without running it
+	if [ "$uid" != "$EUID" ]; then
 		why="owned by $(_outdir_who "$uid"), not by you ($(id -un)): another user could put links or FIFOs in it under the names written there; choose a directory of yours (a new one is made)"
 	elif [ $((mode & 01000)) = 0 ]; then
 		if [ $((mode & 02)) != 0 ]; then
@@ -111,35 +116,63 @@ outdir_check() {
 	[ -z "$why" ] || { echo "${prefix:+$prefix }$dir: $why" >&2; return 1; }
 }
 
-# _outdir_tmp FILE: a new file of ours beside FILE (mktemp: O_EXCL), 0666
-# less the umask as a file made by > would be; its name on stdout.
+# _outdir_tmp VAR FILE: a new file of ours beside FILE (mktemp: O_EXCL), 0666
+# less the umask as a file made by > would be; its name in VAR (no
+# subshell: a figure run writes a few of these).
 _outdir_tmp() {
-	local dir base tmp
-	case "$1" in */*) dir=${1%/*}; [ -n "$dir" ] || dir=/ ;; *) dir=. ;; esac
-	base=${1##*/}
-	tmp=$(mktemp -- "$dir/.$base.XXXXXX") || return 1
-	chmod "$(printf '%o' $((0666 & ~0$(umask))))" -- "$tmp" || { rm -f -- "$tmp"; return 1; }
-	echo "$tmp"
+	local -n _ot_tmp=$1
+	local dir base fmode
+	case "$2" in */*) dir=${2%/*}; [ -n "$dir" ] || dir=/ ;; *) dir=. ;; esac
+	base=${2##*/}
+	_ot_tmp=$(mktemp -- "$dir/.$base.XXXXXX") || return 1
+	printf -v fmode '%o' $((0666 & ~0$(umask)))
+	chmod "$fmode" -- "$_ot_tmp" || { rm -f -- "$_ot_tmp"; return 1; }
 }
 
 outdir_new() {
-	local f tmp
+	local f tmp rc=0
+	_outdir_new_together "$@" || rc=$?
+	[ "$rc" = 2 ] || return "$rc"
 	for f in "$@"; do
-		tmp=$(_outdir_tmp "$f") || return 1
+		_outdir_tmp tmp "$f" || return 1
 		mv -f -T -- "$tmp" "$f" || { rm -f -- "$tmp"; return 1; }
 	done
+}
+# _outdir_new_together FILE...: several new files of one folder made in a
+# private folder beside them (mktemp -d: no one else can place anything in
+# it, and a file the shell creates there has 0666 less the umask) and moved
+# in with one mv, each replacing what has its name, never followed: three
+# programs for any number of files. 1 when one could not be made; 2, having
+# done nothing, for one file, files of several folders or a name given twice.
+_outdir_new_together() {
+	[ $# -gt 1 ] || return 2
+	local f dir d tmp made=()
+	local -A seen=()
+	case "$1" in */*) dir=${1%/*}; [ -n "$dir" ] || dir=/ ;; *) dir=. ;; esac
+	for f in "$@"; do
+		case "$f" in */*) d=${f%/*}; [ -n "$d" ] || d=/ ;; *) d=. ;; esac
+		[ "$d" = "$dir" ] && [ -n "${f##*/}" ] && [ -z "${seen[${f##*/}]:-}" ] || return 2
+		seen[${f##*/}]=1
+	done
+	tmp=$(mktemp -d -- "$dir/.outdir.XXXXXX") || return 1
+	for f in "$@"; do
+		made+=("$tmp/${f##*/}")
+		: >"$tmp/${f##*/}" || { rm -rf -- "$tmp"; return 1; }
+	done
+	mv -f -t "$dir" -- "${made[@]}" || { rm -rf -- "$tmp"; return 1; }
+	rmdir -- "$tmp"
 }
 
 outdir_put() {
 	local tmp
-	tmp=$(_outdir_tmp "$1") || return 1
+	_outdir_tmp tmp "$1" || return 1
 	cat >"$tmp" && mv -f -T -- "$tmp" "$1" || { rm -f -- "$tmp"; return 1; }
 }
 
 outdir_mv() { mv -f -T -- "$1" "$2"; }
 
 outdir_publish() {
-	local src=$1 dir=$2 p name rc=0
+	local src=$1 dir=$2 p name rc=0 files=()
 	for p in "$src"/* "$src"/.[!.]*; do
 		[ -e "$p" ] || [ -L "$p" ] || continue
 		name=${p##*/}
@@ -150,9 +183,13 @@ outdir_publish() {
 			fi
 			outdir_check "$dir/$name" && outdir_publish "$p" "$dir/$name" || rc=1
 		elif [ -f "$p" ]; then
-			outdir_mv "$p" "$dir/$name" || rc=1
+			files+=("$p")
 		fi
 	done
+	# the files in one mv (a run publishes about twenty): each is renamed to
+	# its name in DIR as outdir_mv does, replacing a link there, never
+	# following it; a directory under that name is refused, as with -T
+	if [ ${#files[@]} -gt 0 ]; then mv -f -t "$dir" -- "${files[@]}" || rc=1; fi
 	rm -rf -- "$src"
 	return "$rc"
 }

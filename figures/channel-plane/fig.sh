@@ -106,16 +106,18 @@ run() {
 	robot_stats "$r/plane.csv" "$(awk -v t="$t_end" -v w="$FIG_CHANNEL_WINDOW" 'BEGIN { print t - w }')" >"$out/robots.txt"
 	# the links and walls at the picture's moments (the pose of the 0.1 s
 	# grid that ends at each: plane.csv's poses are at most 0.1 s apart)
-	awk -F, -v want="$FRAMES" 'BEGIN { n = split(want, m, " ") }
-		FNR == 1 { next }
-		{ for (i = 1; i <= n; i++) if ($2 > m[i] - 0.099 && $2 <= m[i] + 0.001) print m[i] ",link," $5 "," $6 "," $7 "," $8 "," $9 "," $4 }' \
-		"$r/plane.csv" >"$out/frames.tmp"
-	awk -F, -v want="$FRAMES" 'BEGIN { n = split(want, m, " ") }
-		FNR == 1 { next }
-		{ for (i = 1; i <= n; i++) if ($2 > m[i] - 0.099 && $2 <= m[i] + 0.001) print m[i] ",wall," $3 "," $4 "," $5 "," $6 "," $7 ",-1" }' \
-		"$r/plane_walls.csv" >>"$out/frames.tmp"
-	{ echo "moment,kind,index,x,y,angle_or_bx,length_or_by,robot_index"; cat "$out/frames.tmp"; } >"$out/frames.csv"
-	rm -f "$out/frames.tmp"
+	# (straight into frames.csv, made above: no temporary file beside it)
+	{
+		echo "moment,kind,index,x,y,angle_or_bx,length_or_by,robot_index"
+		awk -F, -v want="$FRAMES" 'BEGIN { n = split(want, m, " ") }
+			FNR == 1 { next }
+			{ for (i = 1; i <= n; i++) if ($2 > m[i] - 0.099 && $2 <= m[i] + 0.001) print m[i] ",link," $5 "," $6 "," $7 "," $8 "," $9 "," $4 }' \
+			"$r/plane.csv"
+		awk -F, -v want="$FRAMES" 'BEGIN { n = split(want, m, " ") }
+			FNR == 1 { next }
+			{ for (i = 1; i <= n; i++) if ($2 > m[i] - 0.099 && $2 <= m[i] + 0.001) print m[i] ",wall," $3 "," $4 "," $5 "," $6 "," $7 ",-1" }' \
+			"$r/plane_walls.csv"
+	} >"$out/frames.csv"
 	swing=$(fig_min_swing "$r/summary.json")
 	wall=$(fig_wall)
 	{

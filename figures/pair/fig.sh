@@ -49,8 +49,9 @@ FULL_067=1000 FULL_090=120 FULL_CTRL=4
 QUICK_067=80 QUICK_090=30 QUICK_CTRL=2
 R09_DMAX=0.8
 CTRL_DSEP=2
-# The scenario's nominal amplitude, for which world.separation is d~.
-NOMINAL_AMP=$(awk -F= '$1 ~ /^amplitude *$/ { gsub(/ /, "", $2); print $2 }' "$SCENARIO")
+# The scenario's nominal amplitude, for which world.separation is d~: read
+# by merge (set there), not by each of the 1,124 runs.
+nominal_amp() { awk -F= '$1 ~ /^amplitude *$/ { gsub(/ /, "", $2); print $2 }' "$SCENARIO"; }
 
 # series TAG R N DMAX: N runs at restitution R, d~ = (i + 0.5) / N * DMAX.
 series() {
@@ -91,6 +92,19 @@ seconds() { echo 4.5; }
 # ---- run ------------------------------------------------------------------------
 RESULT_HEADER="run,r,dsep_set,delta0,seed,seconds,class,delta_final,spread,dsep_final,amp_left,amp_right,freq,collisions,window_collisions,last_collision_t,delta_first,swing_min,sim_speed,wall_s,switch_s"
 
+# neg4 VAR X: VAR = awk's printf "%.4f" of -X (X a number fig_num took): by
+# the shell for X with at most 4 decimals (every job's), else by awk.
+neg4() {
+	local -n _n=$1
+	if [[ $2 =~ ^(-?)0*([0-9]+)(\.([0-9]{1,4}))?$ ]]; then
+		local frac=${BASH_REMATCH[4]}0000 sign=-
+		[ -z "${BASH_REMATCH[1]}" ] || sign=""
+		_n="$sign${BASH_REMATCH[2]}.${frac:0:4}"
+	else
+		_n=$(awk -v d="$2" 'BEGIN { printf "%.4f", -d }')
+	fi
+}
+
 run() {
 	[ $# -eq 6 ] || fig_usage "run: want OUTDIR R DSEP DELTA0 SEED SECONDS, got $*"
 	local out=$1 r=$2 dsep=$3 delta0=$4 seed=$5 secs=$6
@@ -99,23 +113,27 @@ run() {
 	fig_num DELTA0 "$delta0" -3.1416 3.1416
 	fig_uint SEED "$seed" 1 999999999
 	fig_uint SECONDS "$secs" $((SWITCH_S + 1)) 3600
-	local t0 right sw
-	t0=$(date +%s%N)
-	right=$(awk -v d="$delta0" 'BEGIN { printf "%.4f", -d }')
+	local t0=$EPOCHREALTIME right sw
+	neg4 right "$delta0"
 	sw=$SWITCH_S
 	fig_demo "$out" --scenario "$SCENARIO" --seconds "$secs" --switch-at "$sw" --seed "$seed" \
 		--phases "0,$right" --set "world.separation=$dsep" --set "world.restitution=$r" "${RIG[@]}" || return 1
 	local d="$out/demo"
 	fig_delta_trace "$d" "$out/delta_t.csv" 0.25
-	local speed wall last first
-	speed=$(sed -n 's/.*(\([0-9.]*\)x real time.*/\1/p' "$d/logs/sim.log" | head -1)
-	last=$(awk -F, 'NR > 1 { t = $2 } END { print t }' "$d/collisions.csv")
-	first=$(awk -F, 'NR == 2 { print $5 }' "$d/return_map.csv")
-	wall=$(awk -v a="$t0" -v b="$(date +%s%N)" 'BEGIN { printf "%.2f", (b - a) / 1e9 }')
+	local speed wall last first us
+	speed=$(sed -n 's/.*(\([0-9.]*\)x real time.*/\1/;T;p;q' "$d/logs/sim.log")
+	# the last collision's time and the return map's first delta: one awk
+	{ IFS= read -r last; IFS= read -r first; } < <(awk -F, 'FNR == 1 { f++ }
+		f == 1 && FNR > 1 { t = $2 } f == 2 && FNR == 2 { r = $5 } END { print t; print r }' \
+		"$d/collisions.csv" "$d/return_map.csv")
+	us=$(( (10#${EPOCHREALTIME//[!0-9]/} - 10#${t0//[!0-9]/} + 5000) / 10000 ))
+	printf -v wall '%d.%02d' $((us / 100)) $((us % 100))
 	outdir_new "$out/result.csv" || { echo "$FIG_NAME: $out: cannot write result.csv" >&2; return 1; }
+	local name
+	fig_basename name "$out"
 	{
 		echo "$RESULT_HEADER"
-		jq -r --arg run "$(basename "$out")" --arg r "$r" --arg ds "$dsep" --arg d0 "$delta0" --arg seed "$seed" \
+		jq -r --arg run "$name" --arg r "$r" --arg ds "$dsep" --arg d0 "$delta0" --arg seed "$seed" \
 			--arg secs "$secs" --arg last "$last" --arg first "$first" --arg speed "$speed" --arg wall "$wall" --arg sw "$sw" '
 			.pairs[0] as $p | [$run, $r, $ds, $d0, $seed, $secs, $p.class, $p.mean_delta, $p.spread, $p.dsep,
 			 .robots[0].joints[0].amplitude_rad, .robots[1].joints[0].amplitude_rad,
@@ -140,6 +158,7 @@ merge() {
 	fig_results "$runs" >"$tmp/runs.csv"
 	amp=$(free_amplitude "$tmp/runs.csv")
 	[ -n "$amp" ] || fig_die "no run ended without contact: cannot measure the free amplitude"
+	NOMINAL_AMP=$(nominal_amp)
 	predict "$tmp" || fig_die "undulate-analyze --theory failed"
 	join_runs "$tmp" >"$fig/pair.csv"
 	cp "$fig/pair.csv" "$tmp/pair.csv"

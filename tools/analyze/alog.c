@@ -5,6 +5,7 @@
 #include "outdir.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <lzma.h>
 #include <stdio.h>
@@ -116,6 +117,123 @@ static int alog_xz_close(void *cookie)
 	return rc;
 }
 
+/* A plain log, read through a stdio stream of our own (fopencookie) over a
+ * window of the file. liblcm 1.3's reader seeks back 4 bytes after every
+ * event (fseeko), and glibc turns that seek into a system call (lseek to
+ * where the descriptor already is), as it did ftello (alog_next): two an
+ * event, 151 k for a 10-robot run's 75 k events; glibc also drops its buffer
+ * at every seek of a cookie stream, which refills from the window here by
+ * copying. The file is read in ALOG_WIN pieces; a seek within the window
+ * costs no system call; one outside it (never, reading a log) seeks the
+ * descriptor. A log read while it is recorded reads on as before. */
+#define ALOG_WIN (256 * 1024)
+/* Bytes kept before the read position when the window moves on: liblcm
+ * seeks back 4 bytes, glibc by up to its buffer (8 KiB). */
+#define ALOG_WIN_BACK (16 * 1024)
+struct alog_plain {
+	int fd;
+	int64_t base;   /* the file offset of win[0] */
+	size_t len;     /* bytes of the file in win[] */
+	int64_t pos;    /* the stream's position */
+	uint8_t win[ALOG_WIN];
+};
+
+/* More of the file into the window at pos: 0 at its end, -1 on an error. */
+static ssize_t alog_plain_fill(struct alog_plain *p)
+{
+	if (p->pos < p->base || p->pos > p->base + (int64_t)p->len) {
+		if (lseek(p->fd, (off_t)p->pos, SEEK_SET) < 0)
+			return -1;
+		p->base = p->pos;
+		p->len = 0;
+	} else if (p->len == ALOG_WIN) {
+		size_t keep = (size_t)(p->base + (int64_t)p->len - p->pos) + ALOG_WIN_BACK;
+		if (keep > p->len)
+			keep = p->len;
+		memmove(p->win, p->win + p->len - keep, keep);
+		p->base += (int64_t)(p->len - keep);
+		p->len = keep;
+	}
+	ssize_t n;
+	do
+		n = read(p->fd, p->win + p->len, ALOG_WIN - p->len);
+	while (n < 0 && errno == EINTR);
+	if (n > 0)
+		p->len += (size_t)n;
+	return n;
+}
+
+static ssize_t alog_plain_read(void *cookie, char *buf, size_t size)
+{
+	struct alog_plain *p = cookie;
+	if (p->pos < p->base || p->pos >= p->base + (int64_t)p->len) {
+		ssize_t n = alog_plain_fill(p);
+		if (n <= 0)
+			return n;
+	}
+	size_t m = (size_t)(p->base + (int64_t)p->len - p->pos);
+	if (m > size)
+		m = size;
+	memcpy(buf, p->win + (p->pos - p->base), m);
+	p->pos += (int64_t)m;
+	return (ssize_t)m;
+}
+
+static int alog_plain_seek(void *cookie, off64_t *off, int whence)
+{
+	struct alog_plain *p = cookie;
+	int64_t to;
+	if (whence == SEEK_SET)
+		to = (int64_t)*off;
+	else if (whence == SEEK_CUR)
+		to = p->pos + (int64_t)*off;
+	else {
+		struct stat st;
+		if (fstat(p->fd, &st) != 0)
+			return -1;
+		to = (int64_t)st.st_size + (int64_t)*off;
+	}
+	if (to < 0) {
+		errno = EINVAL;
+		return -1;
+	}
+	p->pos = to;
+	*off = to;
+	return 0;
+}
+
+static int alog_plain_close(void *cookie)
+{
+	struct alog_plain *p = cookie;
+	int rc = close(p->fd);
+	free(p);
+	return rc;
+}
+
+/* F (a plain file) as such a stream, from its start; F itself when that
+ * cannot be made (it reads the same, with more system calls). */
+static FILE *alog_plain_stream(FILE *f)
+{
+	struct alog_plain *p = malloc(sizeof *p);
+	int fd = p ? dup(fileno(f)) : -1;
+	if (fd < 0) {
+		free(p);
+		return f;
+	}
+	p->fd = fd;
+	p->base = -1;   /* nothing in the window: the first read seeks to 0 */
+	p->len = 0;
+	p->pos = 0;
+	cookie_io_functions_t io = { .read = alog_plain_read, .seek = alog_plain_seek, .close = alog_plain_close };
+	FILE *c = fopencookie(p, "rb", io);
+	if (c == NULL) {
+		alog_plain_close(p);
+		return f;
+	}
+	fclose(f);
+	return c;
+}
+
 /* PATH for reading: the file itself, or its decompressed bytes when it is an
  * xz file (*xz set). NULL with errno on failure. */
 static FILE *alog_fopen(const char *path, bool *xz, void **state)
@@ -129,7 +247,7 @@ static FILE *alog_fopen(const char *path, bool *xz, void **state)
 	*xz = n == sizeof head && memcmp(head, alog_xz_magic, sizeof head) == 0;
 	rewind(f);
 	if (!*xz)
-		return f;
+		return state != NULL ? alog_plain_stream(f) : f;
 	struct alog_xz *x = calloc(1, sizeof *x);
 	lzma_stream init = LZMA_STREAM_INIT;
 	if (x == NULL) {
