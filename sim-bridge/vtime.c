@@ -171,7 +171,7 @@ static void vt_bytes_in(struct vt *v, struct sim *s, struct vt_client *c, const 
 	if (!c->said_lost)
 		fprintf(stderr, "undulate-sim: lockstep: robot %s's daemon (pid %ld) sent %u bus byte(s) in a %s %s; "
 		        "dropped (counted; said once)\n", c->robot, c->pid, m->nbytes, lks_type_name(m->type),
-		        !v->inband ? "on the pty transport, which carries them through the pty" : "for a port that is gone");
+		        !v->inband ? "on the pty transport, which carries them through the pty" : "for a port not open (or gone)");
 	c->said_lost = true;
 }
 

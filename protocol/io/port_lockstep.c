@@ -133,7 +133,7 @@ static int pl_band_write(void *ctx, const uint8_t *buf, size_t n)
 	if (n > sizeof c->out - c->nout) {
 		if (c->too_long++ == 0)
 			fprintf(stderr, "lockstep: %zu bus bytes after %zu already written since the last wait: more than "
-			        "the %d one clock message carries; the write is refused (counted; see common/lockstep.h "
+			        "the %d bytes one clock message carries; the write is refused (counted; see common/lockstep.h "
 			        "LKS_BYTES_MAX)\n", n, c->nout, LKS_BYTES_MAX);
 		return DXL_E_BUFFER;
 	}
