@@ -265,12 +265,14 @@ int lks_client_wait(struct lks_client *c, uint64_t wake_us, bool want_input)
 		wake_ns = wake_us > c->mono0_us ? (wake_us - c->mono0_us) * 1000u : 0;
 	struct lks_msg m = {
 		.type = LKS_WAIT, .a = wake_ns, .b = c->written,
-		.flags = (want_input ? LKS_WANT_INPUT : 0u) | (c->port_opened ? LKS_PORT_OPENED : 0u),
+		.flags = (want_input ? LKS_WANT_INPUT : 0u) | (c->port_opened ? LKS_PORT_OPENED : 0u) |
+		         (c->rate_set ? LKS_RATE_SET : 0u),
 	};
 	lks_client_take_out(c, &m);
 	if (lks_send(c->fd, &m) != 0)
 		return -1;
 	c->port_opened = false;
+	c->rate_set = false;
 	c->waiting = true;
 	return 0;
 }

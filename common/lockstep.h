@@ -46,7 +46,13 @@
  *                        flags LKS_WANT_INPUT: wake up as soon as bytes
  *                        arrive; LKS_PORT_OPENED: the daemon (re)opened its
  *                        port since its last WAIT (in-band: its bytes are for
- *                        the pty the link points at now);
+ *                        the pty the link points at now); LKS_RATE_SET: it
+ *                        set its port's rate since (in-band: the simulator
+ *                        reads the rate off the pty before it takes the next
+ *                        bytes, as the pty transport does before every read;
+ *                        the rate only changes when the daemon sets it, and
+ *                        one ioctl per transaction was a fifth of the
+ *                        simulator's system calls);
  *                        payload (in-band): the bytes written since the last WAIT
  *                 BYE    the daemon is leaving (after its safe stop);
  *                        payload (in-band): its last bytes, not waited on
@@ -78,6 +84,7 @@
 #define LKS_PORT_OPENED 2u           /* WAIT */
 #define LKS_INBAND 4u                /* WELCOME */
 #define LKS_BUS_GONE 8u              /* TIME */
+#define LKS_RATE_SET 16u             /* WAIT */
 /* The most bus bytes one message carries. A daemon writes between two
  * WAITs at most one cycle's packets before it waits for a reply: the
  * largest is a Protocol 2.0 sync write of every joint (a daemon's 24
@@ -156,6 +163,7 @@ struct lks_client {
 	uint8_t in[LKS_BYTES_MAX];
 	size_t in_off, nin;
 	bool port_opened;           /* LKS_PORT_OPENED goes with the next WAIT */
+	bool rate_set;              /* LKS_RATE_SET goes with the next WAIT */
 	bool bus_gone;              /* the last TIME said LKS_BUS_GONE */
 	long long too_long;         /* writes refused: more than LKS_BYTES_MAX between two WAITs */
 	long long in_dropped;       /* delivered bytes that did not fit unread ones */

@@ -584,9 +584,10 @@ static void bus_follow_tty(struct sim_bus *b)
 		sim_bus_set_baud(b, bps);
 }
 
-void sim_bus_receive(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now)
+void sim_bus_receive(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now, bool rate_may_differ)
 {
-	bus_follow_tty(b);
+	if (rate_may_differ)
+		bus_follow_tty(b);
 	sim_bus_feed(b, data, n, now);
 }
 

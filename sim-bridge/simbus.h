@@ -128,9 +128,11 @@ bool sim_bus_connected(const struct sim_bus *b);
 /* Read whatever the controller wrote and feed it. */
 void sim_bus_read(struct sim_bus *b, int64_t now);
 /* Lockstep's in-band transport (common/lockstep.h): the controller's bytes
- * come in its clock message instead of the pty, into the same input path
- * (the rate it set on the pty followed first, as sim_bus_read does). */
-void sim_bus_receive(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now);
+ * come in its clock message instead of the pty, into the same input path.
+ * rate_may_differ: the controller opened its port or set its rate since its
+ * last bytes: the rate on the pty is followed first, as sim_bus_read does
+ * before every read (only then can it have changed). */
+void sim_bus_receive(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now, bool rate_may_differ);
 /* ... and the bytes due at now go to out (up to cap) instead of the pty:
  * counted as sent; what does not fit, or finds the bus disconnected, is
  * dropped and counted as the pty's would be. The count copied. */

@@ -164,7 +164,8 @@ static void vt_bytes_in(struct vt *v, struct sim *s, struct vt_client *c, const 
 	if (m->nbytes == 0)
 		return;
 	if (v->inband && vt_attached(c, s)) {
-		sim_bus_receive(&s->buses[c->bus], m->bytes, m->nbytes, (int64_t)v->t_ns);
+		sim_bus_receive(&s->buses[c->bus], m->bytes, m->nbytes, (int64_t)v->t_ns, c->rate_unread);
+		c->rate_unread = false;
 		return;
 	}
 	v->bytes_lost += m->nbytes;
@@ -211,6 +212,8 @@ void vt_on_client(struct vt *v, struct sim *s, size_t i, int64_t wall_ns)
 		c->port_open = sim_bus_connected(b) ? b->opens : 0;
 		c->nout = 0;   /* released for the port before, which the daemon closed */
 	}
+	if (m.flags & (LKS_PORT_OPENED | LKS_RATE_SET))
+		c->rate_unread = true;
 	vt_bytes_in(v, s, c, &m);
 	c->blocked = true;
 	c->wake_ns = m.a;

@@ -44,6 +44,7 @@ struct vt_client {
 	uint8_t out[LKS_BYTES_MAX];
 	size_t nout;
 	bool said_lost;             /* bytes for a port gone said once */
+	bool rate_unread;           /* in-band: it opened its port or set its rate since its last bytes */
 	char cmds[LKS_CMD_QUEUE][LKS_TEXT_MAX];
 	size_t ncmds;
 	bool stop_pending;          /* STOP goes with its next TIME */

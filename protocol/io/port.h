@@ -74,6 +74,7 @@ struct lks_client;
 struct port_lockstep {
 	struct port *port;
 	struct lks_client *clock;
+	long rate_told;             /* in-band: the port's rate the simulator was last told of */
 };
 void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_client *clock, struct bus_io *io);
 

@@ -130,6 +130,12 @@ static int pl_band_write(void *ctx, const uint8_t *buf, size_t n)
 	struct lks_client *c = pl->clock;
 	if (c->bus_gone)
 		return DXL_E_DISCONNECTED;
+	/* a new rate on the pty: the simulator reads it before these bytes */
+	long rate = pl->port ? port_baud(pl->port) : 0;
+	if (rate != pl->rate_told) {
+		c->rate_set = true;
+		pl->rate_told = rate;
+	}
 	if (n > sizeof c->out - c->nout) {
 		if (c->too_long++ == 0)
 			fprintf(stderr, "lockstep: %zu bus bytes after %zu already written since the last wait: more than "
@@ -171,6 +177,7 @@ void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_c
 {
 	pl->port = p;
 	pl->clock = clock;
+	pl->rate_told = p ? port_baud(p) : 0;   /* the opening says so: LKS_PORT_OPENED */
 	lks_client_port_opened(clock);
 	if (clock->inband)
 		*io = (struct bus_io){
