@@ -72,7 +72,7 @@ int lks_recv(int fd, struct lks_msg *m, char *why, size_t cap)
 		return -1;
 	}
 	if (n > (ssize_t)sizeof *m || m->nbytes > LKS_BYTES_MAX) {
-		snprintf(why, cap, "lockstep socket: a %s of %zd bytes (%u of bus bytes): at most %d bus bytes a "
+		snprintf(why, cap, "lockstep socket: a %s of %zd bytes (it says %u bus bytes): at most %d bus bytes a "
 		         "message", lks_type_name(m->type), n, m->nbytes, LKS_BYTES_MAX);
 		errno = EPROTO;
 		return -1;

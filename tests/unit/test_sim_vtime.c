@@ -321,6 +321,49 @@ static void test_inband(void **state)
 	close(a), close(b);
 }
 
+/* Bad input on the clock: bytes from a connection with no bus (no HELLO
+ * yet), a payload that is not the length it says, one longer than a message
+ * carries: each refused with why and counted, the daemon's part over. */
+static void test_inband_bad_input(void **state)
+{
+	(void)state;
+	make_sim();
+	vt.inband = true;
+	int x = connect_slot(3);
+	daemon_send_bytes(x, LKS_WAIT, LKS_NEVER, 0, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 3, 1000);
+	struct lks_msg m = daemon_recv(x);
+	assert_int_equal(m.type, LKS_REFUSED);
+	assert_non_null(strstr(m.text, "WAIT out of turn"));
+	assert_int_equal(vt.bad_messages, 1);
+	assert_int_equal(vt.c[3].fd, -1);
+	assert_int_equal(sim.buses[0].count.rx_bytes, 0);
+	/* a joined daemon's malformed message ends its part, and the run as failed */
+	int a = join(0, "/tmp/vt-test/a");
+	daemon_recv(a);
+	struct lks_msg bad = { .magic = LKS_MAGIC, .type = LKS_WAIT, .nbytes = 100 };
+	assert_int_equal(send(a, &bad, LKS_HEADER_SIZE + 6, 0), (ssize_t)(LKS_HEADER_SIZE + 6));
+	vt_on_client(&vt, &sim, 0, 2000);
+	assert_int_equal(vt.bad_messages, 2);
+	assert_int_equal(vt.c[0].fd, -1);
+	assert_true(vt.ending && vt.failed);
+	assert_int_equal(sim.buses[0].count.rx_bytes, 0);
+	vt_close(&vt);
+	close(x), close(a);
+	make_sim();
+	vt.inband = true;
+	int b = join(1, "/tmp/vt-test/b");
+	daemon_recv(b);
+	static uint8_t huge[sizeof(struct lks_msg) + 64];
+	memcpy(huge, &bad, LKS_HEADER_SIZE);
+	assert_int_equal(send(b, huge, sizeof huge, 0), (ssize_t)sizeof huge);
+	vt_on_client(&vt, &sim, 1, 3000);
+	assert_int_equal(vt.bad_messages, 1);
+	assert_true(vt.ending && vt.failed);
+	vt_close(&vt);
+	close(b);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -328,6 +371,7 @@ int main(void)
 		cmocka_unit_test(test_barrier_and_release),
 		cmocka_unit_test(test_leave_and_stall),
 		cmocka_unit_test(test_inband),
+		cmocka_unit_test(test_inband_bad_input),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
