@@ -14,6 +14,10 @@
 #  - the analysis (summary, phase differences, collisions, states, events),
 #    the demo's summary, and the simulator's exit line and bus counters;
 #  - each log says which transport ran.
+# The same with the right bus disconnected at 6 s and reconnected at 7 s (the
+# daemon's write fails as on a hung-up pty, it reopens the new one): the
+# ground truth and the states the same, the events the same but for the
+# run's directory in their text.
 # And the baud the daemon sets on its pty is still followed in-band: a bus
 # whose pty starts at 57600 bps with servos at 1 Mbps answers a daemon that
 # set 1 Mbps (without the follow, nothing answers and the daemon cannot start).
@@ -28,6 +32,14 @@ run() {
 	env "$@" BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --lockstep --scenario "$scenario" \
 		--lcm-url "$(lcm_url "$port")" --out "$T/$name" --seconds 14 --switch-at 3 --seed 11 --phases 0,2.5 \
 		--set world.separation=0.7 --set 'events.8=fault right 1 no-reply' "${rig[@]}" >"$T/$name.out" 2>&1
+}
+# run_dc NAME PORT [ENV...]: another seed, the right bus unplugged from 6 s to 7 s.
+run_dc() {
+	local name=$1 port=$2; shift 2
+	env "$@" BUILD="$BUILD" TMPDIR="$T" "$top/scripts/demo.sh" --lockstep --scenario "$scenario" \
+		--lcm-url "$(lcm_url "$port")" --out "$T/$name" --seconds 12 --switch-at 3 --seed 5 --phases 0,2 \
+		--set world.separation=0.7 --set 'events.6=disconnect right' --set 'events.7=reconnect right' "${rig[@]}" \
+		>"$T/$name.out" 2>&1
 }
 
 # Per LCM channel of a log: the count and a digest of its messages' bytes in order.
@@ -93,6 +105,20 @@ else
 	tap_fail "... with the daemon's time-outs in it" "no silent-joint event: $(tail -n 5 "$T/band/events.csv")"
 fi
 
+# ---- a bus unplugged and plugged in again -------------------------------------------
+run_dc dc-band 7673 && run_dc dc-pty 7674 UNDULATE_LOCKSTEP_PTY=1
+rc=$?
+channels "$T/dc-band/demo.lcmlog" | grep -E '^(SIM\.|[a-z]+\.STATE )' >"$T/dc-band.ch"
+channels "$T/dc-pty/demo.lcmlog" | grep -E '^(SIM\.|[a-z]+\.STATE )' >"$T/dc-pty.ch"
+undir() { sed 's/undulate-demo\.[A-Za-z0-9]*//g' "$1"; }
+if [ "$rc" = 0 ] && grep -q 'bus-lost' "$T/dc-band/events.csv" && grep -q 'bus-back' "$T/dc-band/events.csv" &&
+	cmp -s "$T/dc-band.ch" "$T/dc-pty.ch" && cmp -s "$T/dc-band/states.csv" "$T/dc-pty/states.csv" &&
+	diff <(undir "$T/dc-band/events.csv") <(undir "$T/dc-pty/events.csv") >/dev/null; then
+	tap_ok "a bus unplugged and plugged in again: the same ground truth, states and events on both transports"
+else
+	tap_fail "a bus unplugged and plugged in again: the same run on both transports" "exit $rc; $(diff "$T/dc-band.ch" "$T/dc-pty.ch" | head -6); $(diff <(undir "$T/dc-band/events.csv") <(undir "$T/dc-pty/events.csv") | head -6)"
+fi
+
 # ---- the baud the daemon set, followed in-band ---------------------------------------
 URL=$(lcm_url 7672)
 cat >"$T/baud.scenario" <<EOS
@@ -114,5 +140,5 @@ if [ "$rc" = 0 ] && grep -q 'ready:' "$T/d.log" && grep -q 'bus bytes in-band' "
 else
 	tap_fail "in-band, the simulator follows the baud the daemon set on its pty" "exit $rc; $(grep -E 'bus solo|lockstep:' "$T/sim.log" | tail -n 3); daemon: $(tail -n 3 "$T/d.log")"
 fi
-keep_runs band pty
+keep_runs band pty dc-band dc-pty
 tap_done
