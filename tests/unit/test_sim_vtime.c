@@ -242,7 +242,8 @@ static const uint8_t status1[] = { 0xff, 0xff, 0x01, 0x02, 0x00, 0xfc };
 static void daemon_send_bytes(int fd, uint32_t type, uint64_t a, uint32_t flags, const uint8_t *bytes, size_t n)
 {
 	struct lks_msg m = { .type = type, .a = a, .flags = flags, .nbytes = (uint32_t)n };
-	memcpy(m.bytes, bytes, n);
+	if (n > 0)
+		memcpy(m.bytes, bytes, n);
 	assert_int_equal(lks_send(fd, &m), 0);
 }
 
