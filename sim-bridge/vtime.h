@@ -88,8 +88,9 @@ void vt_on_client(struct vt *v, struct sim *s, size_t i, int64_t wall_ns);
 /* Daemons connected and joined to a bus. */
 size_t vt_clients(const struct vt *v);
 /* Time may move: every expected daemon has joined (unless the run is
- * ending), every one is blocked, and every byte each has written to its bus
- * has been read by the simulator. */
+ * ending), every one is blocked, and (pty transport) every byte each has
+ * written to its bus has been read by the simulator; in-band they came with
+ * its WAIT. */
 bool vt_all_blocked(const struct vt *v, const struct sim *s);
 /* The earliest virtual time a blocked daemon must be woken at (ns):
  * its wake-up, or now when it has something to receive. LKS_NEVER if none. */
