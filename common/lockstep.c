@@ -7,9 +7,11 @@
 #include <poll.h>
 #include <stdlib.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <string.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/uio.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -26,13 +28,25 @@ const char *lks_type_name(uint32_t type)
 
 int lks_send(int fd, const struct lks_msg *m)
 {
-	struct lks_msg out = *m;
-	out.magic = LKS_MAGIC;
+	if (m->nbytes > LKS_BYTES_MAX) {
+		errno = EMSGSIZE;
+		return -1;
+	}
+	/* the header with the magic set, then only the payload's used part */
+	struct lks_msg hdr;
+	memcpy(&hdr, m, LKS_HEADER_SIZE);
+	hdr.magic = LKS_MAGIC;
+	struct iovec iov[2] = {
+		{ .iov_base = &hdr, .iov_len = LKS_HEADER_SIZE },
+		{ .iov_base = (void *)(uintptr_t)m->bytes, .iov_len = m->nbytes },
+	};
+	struct msghdr mh = { .msg_iov = iov, .msg_iovlen = m->nbytes > 0 ? 2 : 1 };
+	size_t want = LKS_HEADER_SIZE + m->nbytes;
 	ssize_t n;
 	do {
-		n = send(fd, &out, sizeof out, MSG_NOSIGNAL);
+		n = sendmsg(fd, &mh, MSG_NOSIGNAL);
 	} while (n < 0 && errno == EINTR);
-	if (n == (ssize_t)sizeof out)
+	if (n == (ssize_t)want)
 		return 0;
 	if (n >= 0)
 		errno = EMSGSIZE;
@@ -51,9 +65,22 @@ int lks_recv(int fd, struct lks_msg *m, char *why, size_t cap)
 		snprintf(why, cap, "lockstep socket: %s", strerror(errno));
 		return -1;
 	}
-	if (n != (ssize_t)sizeof *m || m->magic != LKS_MAGIC || m->type < LKS_HELLO || m->type > LKS_BYE) {
+	if (n < (ssize_t)LKS_HEADER_SIZE || m->magic != LKS_MAGIC || m->type < LKS_HELLO || m->type > LKS_BYE) {
 		snprintf(why, cap, "lockstep socket: not a lockstep message (%zd bytes, magic %08x): the two "
 		         "programs are from different builds?", n, n >= 4 ? m->magic : 0u);
+		errno = EPROTO;
+		return -1;
+	}
+	if (n > (ssize_t)sizeof *m || m->nbytes > LKS_BYTES_MAX) {
+		snprintf(why, cap, "lockstep socket: a %s of %zd bytes (it says %u bus bytes): at most %d bus bytes a "
+		         "message", lks_type_name(m->type), n, m->nbytes, LKS_BYTES_MAX);
+		errno = EPROTO;
+		return -1;
+	}
+	if ((size_t)n != LKS_HEADER_SIZE + m->nbytes) {
+		snprintf(why, cap, "lockstep socket: a %s of %zd bytes says it carries %u bus bytes (%zu would be "
+		         "%zu bytes)", lks_type_name(m->type), n, m->nbytes, (size_t)m->nbytes,
+		         LKS_HEADER_SIZE + m->nbytes);
 		errno = EPROTO;
 		return -1;
 	}
@@ -172,6 +199,7 @@ int lks_client_open(struct lks_client *c, const char *sock_path, const char *por
 	} else {
 		c->mono0_us = m.b;
 		c->wall0_us = (int64_t)m.c;
+		c->inband = (m.flags & LKS_INBAND) != 0;
 		lks_client_set_clock(c, m.a);
 		return 0;
 	}
@@ -179,11 +207,48 @@ int lks_client_open(struct lks_client *c, const char *sock_path, const char *por
 	return -1;
 }
 
+/* In-band: what was written since the last WAIT goes with this message. */
+static void lks_client_take_out(struct lks_client *c, struct lks_msg *m)
+{
+	if (!c->inband)
+		return;
+	memcpy(m->bytes, c->out, c->nout);
+	m->nbytes = (uint32_t)c->nout;
+	c->nout = 0;
+}
+
+/* In-band: a TIME's bytes after the ones not read yet; what does not fit is
+ * counted (the daemon reads every TIME's bytes before it waits again, so
+ * this takes a bus that talks without being asked). */
+static void lks_client_deliver(struct lks_client *c, const uint8_t *bytes, size_t n)
+{
+	if (c->in_off > 0) {
+		memmove(c->in, c->in + c->in_off, c->nin - c->in_off);
+		c->nin -= c->in_off;
+		c->in_off = 0;
+	}
+	size_t room = sizeof c->in - c->nin;
+	size_t take = n < room ? n : room;
+	memcpy(c->in + c->nin, bytes, take);
+	c->nin += take;
+	c->in_dropped += (long long)(n - take);
+}
+
+void lks_client_port_opened(struct lks_client *c)
+{
+	c->consumed = c->delivered;
+	c->in_off = c->nin = 0;
+	c->nout = 0;
+	c->bus_gone = false;
+	c->port_opened = true;
+}
+
 void lks_client_close(struct lks_client *c)
 {
 	if (c->fd < 0)
 		return;
 	struct lks_msg m = { .type = LKS_BYE };
+	lks_client_take_out(c, &m);
 	(void)lks_send(c->fd, &m);
 	close(c->fd);
 	c->fd = -1;
@@ -199,10 +264,15 @@ int lks_client_wait(struct lks_client *c, uint64_t wake_us, bool want_input)
 	if (wake_us != UINT64_MAX)
 		wake_ns = wake_us > c->mono0_us ? (wake_us - c->mono0_us) * 1000u : 0;
 	struct lks_msg m = {
-		.type = LKS_WAIT, .a = wake_ns, .b = c->written, .flags = want_input ? LKS_WANT_INPUT : 0,
+		.type = LKS_WAIT, .a = wake_ns, .b = c->written,
+		.flags = (want_input ? LKS_WANT_INPUT : 0u) | (c->port_opened ? LKS_PORT_OPENED : 0u) |
+		         (c->rate_set ? LKS_RATE_SET : 0u),
 	};
+	lks_client_take_out(c, &m);
 	if (lks_send(c->fd, &m) != 0)
 		return -1;
+	c->port_opened = false;
+	c->rate_set = false;
 	c->waiting = true;
 	return 0;
 }
@@ -213,11 +283,19 @@ int lks_client_read(struct lks_client *c, char *why, size_t cap)
 	int r = lks_recv(c->fd, &m, why, cap);
 	if (r <= 0)
 		return r;
+	if (m.nbytes > 0 && (m.type != LKS_TIME || !c->inband)) {
+		snprintf(why, cap, "lockstep: a %s from the simulator carries %u bus bytes (%s)", lks_type_name(m.type),
+		         m.nbytes, c->inband ? "only a TIME does" : "the bytes go through the pty in this run");
+		errno = EPROTO;
+		return -1;
+	}
 	switch (m.type) {
 	case LKS_TIME:
 		c->waiting = false;
 		c->time_moved = true;
 		c->delivered = m.b;
+		c->bus_gone = (m.flags & LKS_BUS_GONE) != 0;
+		lks_client_deliver(c, m.bytes, m.nbytes);
 		lks_client_set_clock(c, m.a > c->t_ns ? m.a : c->t_ns);
 		break;
 	case LKS_CMD:

@@ -676,8 +676,6 @@ static bool dmn_connect_bus(struct dmn *d, struct dmn_bus *b, char *err, size_t 
 	}
 	struct bus_io io;
 	if (d->lockstep) {
-		/* what was announced for a port closed since is not coming */
-		d->lks.consumed = d->lks.delivered;
 		port_bus_io_lockstep(&d->lks_port, b->port, &d->lks, &io);
 	} else {
 		port_bus_io(b->port, &io);
@@ -1500,9 +1498,10 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 		         "late), %lld cycle(s) still on the bus at the next tick (%lld of them had begun over half a "
 		         "period late)",
 		         d->overruns, d->cycle, d->overruns_skipped, d->overruns_cut, d->overruns_cut_late);
-	if (d->lks.resyncs > 0 || d->lks.cmds_dropped > 0)
-		log_warn("lockstep: %lld announced bus byte count(s) set right, %lld clock command(s) dropped",
-		         d->lks.resyncs, d->lks.cmds_dropped);
+	if (d->lks.resyncs > 0 || d->lks.cmds_dropped > 0 || d->lks.too_long > 0 || d->lks.in_dropped > 0)
+		log_warn("lockstep: %lld announced bus byte count(s) set right, %lld clock command(s) dropped, %lld bus "
+		         "write(s) refused as longer than a clock message carries, %lld delivered bus byte(s) dropped "
+		         "unread", d->lks.resyncs, d->lks.cmds_dropped, d->lks.too_long, d->lks.in_dropped);
 	lks_client_close(&d->lks);
 	cin_close(&d->cin);
 	pub_close(&d->pub);

@@ -163,6 +163,7 @@ struct options {
 	int nsim_opts;          /* options other than --cmd/--lcm-url (--cmd takes none) */
 	const char *lockstep;   /* the lockstep socket: virtual time */
 	double lockstep_grace_s;
+	bool lockstep_pty;      /* the bus bytes through the ptys, not in the clock's messages */
 };
 
 static void usage(FILE *f)
@@ -203,6 +204,9 @@ static void usage(FILE *f)
 	        "                       --duration is simulated seconds (README: Lockstep)\n"
 	        "  --lockstep-grace S   wall-clock seconds a daemon may take to join or to answer before\n"
 	        "                       the run is ended as stalled (default 10)\n"
+	        "  --lockstep-pty       the bus bytes through the ptys, not in the clock's messages (the\n"
+	        "                       earlier transport, kept one release to compare the two; also\n"
+	        "                       UNDULATE_LOCKSTEP_PTY=1 in the environment)\n"
 	        "  --cmd 'VERB ARGS'    send one command to a running simulator on SIM.CMD and exit\n",
 	        sim_model_names() + strlen("ax12a, "));
 }
@@ -211,7 +215,7 @@ enum {
 	OPT_LINK = 256, OPT_IDS, OPT_NAME, OPT_SCENARIO, OPT_SET, OPT_LINK_DIR, OPT_LCM_URL, OPT_CONTROL,
 	OPT_SEED, OPT_DURATION, OPT_BAUD, OPT_RETURN_DELAY, OPT_LATENCY, OPT_ECHO, OPT_RATE, OPT_TRUTH,
 	OPT_TEMP, OPT_VOLTAGE, OPT_TX_SLICE, OPT_BENCH, OPT_QUIET, OPT_HELP, OPT_CMD, OPT_REALTIME,
-	OPT_LOCKSTEP, OPT_LOCKSTEP_GRACE, OPT_MODEL, OPT_FIRMWARE,
+	OPT_LOCKSTEP, OPT_LOCKSTEP_GRACE, OPT_LOCKSTEP_PTY, OPT_MODEL, OPT_FIRMWARE,
 };
 
 /* Options that are [sim] keys go through the same parser as the file. */
@@ -257,6 +261,7 @@ static int parse_args(int argc, char **argv, struct options *o)
 		{ "cmd", required_argument, 0, OPT_CMD }, { "realtime", required_argument, 0, OPT_REALTIME },
 		{ "lockstep", required_argument, 0, OPT_LOCKSTEP },
 		{ "lockstep-grace", required_argument, 0, OPT_LOCKSTEP_GRACE },
+		{ "lockstep-pty", no_argument, 0, OPT_LOCKSTEP_PTY },
 		{ "model", required_argument, 0, OPT_MODEL },
 		{ "firmware", required_argument, 0, OPT_FIRMWARE },
 		{ 0, 0, 0, 0 },
@@ -320,6 +325,9 @@ static int parse_args(int argc, char **argv, struct options *o)
 		case OPT_LOCKSTEP_GRACE:
 			if (!opt_number(optarg, 0.1, 3600, &o->lockstep_grace_s, "--lockstep-grace: seconds, 0.1..3600"))
 				return -1;
+			break;
+		case OPT_LOCKSTEP_PTY:
+			o->lockstep_pty = true;
 			break;
 		case OPT_HELP: case 'h': usage(stdout); exit(0);
 		default: usage(stderr); return -1;
@@ -1020,8 +1028,11 @@ static void advance(struct app *a, struct sched *sc, int64_t now)
 			report_bad_input(a);
 		sc->next_world += 1000000000;
 	}
-	for (size_t i = 0; i < s->nbuses; i++)
-		sim_bus_flush(&s->buses[i], now);
+	if (a->lockstep && a->vt.inband)
+		vt_hand_over(&a->vt, s, now);
+	else
+		for (size_t i = 0; i < s->nbuses; i++)
+			sim_bus_flush(&s->buses[i], now);
 	a->clock->moved(a, now);
 }
 
@@ -1249,11 +1260,17 @@ static void print_summary_lockstep(const struct app *a, int64_t now)
 	       (unsigned long long)s->bad_commands, (unsigned long long)a->truth_sent);
 	printf("undulate-sim: lockstep: %.3f s of simulated time in %.3f s (%.1fx real time; %.3f s before it waiting "
 	       "for the daemons to join, %.3f s in all, cpu %.1f%%); %llu daemon(s) joined, %llu wake-up(s), %llu "
-	       "command(s) sent; ended: %s%s\n",
+	       "command(s) sent, bus bytes %s; ended: %s%s\n",
 	       virt, run, run > 0 ? virt / run : 0.0, joining, (double)(now - a->t0) / 1e9,
 	       now > a->t0 ? 100.0 * cpu_seconds() / ((double)(now - a->t0) / 1e9) : 0.0,
 	       (unsigned long long)a->vt.joined, (unsigned long long)a->vt.wakes, (unsigned long long)a->vt.commands,
-	       a->vt.end_why[0] ? a->vt.end_why : "-", a->vt.failed ? " (FAILED)" : "");
+	       a->vt.inband ? "in-band" : "through the ptys", a->vt.end_why[0] ? a->vt.end_why : "-",
+	       a->vt.failed ? " (FAILED)" : "");
+	if (a->vt.bytes_lost > 0 || a->vt.bytes_dropped > 0 || a->vt.bad_messages > 0)
+		printf("undulate-sim: lockstep: %llu bus byte(s) from daemons dropped (a port gone, or sent in a message "
+		       "on the pty transport), %llu toward daemons dropped (more than a message carries), %llu bad "
+		       "message(s)\n", (unsigned long long)a->vt.bytes_lost, (unsigned long long)a->vt.bytes_dropped,
+		       (unsigned long long)a->vt.bad_messages);
 	print_bus_summary(a);
 }
 
@@ -1371,6 +1388,9 @@ int main(int argc, char **argv)
 			sim_close(&sim);
 			return 1;
 		}
+		/* the environment reaches runs started by scripts (figures, demo) */
+		const char *env_pty = getenv("UNDULATE_LOCKSTEP_PTY");
+		app.vt.inband = !opt.lockstep_pty && !(env_pty && !strcmp(env_pty, "1"));
 		app.lockstep = true;
 		app.lockstep_grace_ns = (int64_t)llround(opt.lockstep_grace_s * 1e9);
 		if (app.tx_slice_ns < MAIN_LOCKSTEP_SLICE_NS)

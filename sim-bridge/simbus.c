@@ -532,6 +532,7 @@ int sim_bus_open(struct sim_bus *b, char *err, size_t errcap)
 	snprintf(b->slave_path, sizeof(b->slave_path), "%s", sp);
 	b->master = m;
 	b->slave = s;
+	b->opens++;
 	if (bus_link(b, err, errcap) != 0) {
 		sim_bus_close(b);
 		return -1;
@@ -572,16 +573,50 @@ void sim_bus_release(struct sim_bus *b)
 
 bool sim_bus_connected(const struct sim_bus *b) { return b->master >= 0; }
 
+/* The rate the controller set on its side of the pty, when the bus follows
+ * it: taken when its bytes come, whichever way they come. */
+static void bus_follow_tty(struct sim_bus *b)
+{
+	if (!b->follow_tty || b->slave < 0)
+		return;
+	long bps = port_termios2_get_baud(b->slave);
+	if (bps > 0 && bps != b->baud)
+		sim_bus_set_baud(b, bps);
+}
+
+void sim_bus_receive(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now, bool rate_may_differ)
+{
+	if (rate_may_differ)
+		bus_follow_tty(b);
+	sim_bus_feed(b, data, n, now);
+}
+
+size_t sim_bus_hand_over(struct sim_bus *b, int64_t now, uint8_t *out, size_t cap)
+{
+	uint8_t buf[BUS_READ_CHUNK];
+	size_t given = 0;
+	for (;;) {
+		size_t n = sim_line_take(&b->line, now, buf, sizeof(buf));
+		if (n == 0)
+			return given;
+		if (b->master < 0) {
+			b->count.tx_dropped += n;
+			continue;
+		}
+		size_t take = n < cap - given ? n : cap - given;
+		memcpy(out + given, buf, take);
+		given += take;
+		b->count.tx_bytes += take;
+		b->count.tx_dropped += n - take;
+	}
+}
+
 void sim_bus_read(struct sim_bus *b, int64_t now)
 {
 	uint8_t buf[BUS_READ_CHUNK];
 	if (b->master < 0)
 		return;
-	if (b->follow_tty) {
-		long bps = port_termios2_get_baud(b->slave);
-		if (bps > 0 && bps != b->baud)
-			sim_bus_set_baud(b, bps);
-	}
+	bus_follow_tty(b);
 	for (;;) {
 		ssize_t n = read(b->master, buf, sizeof(buf));
 		if (n <= 0)

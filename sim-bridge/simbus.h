@@ -69,6 +69,7 @@ struct sim_bus {
 	const struct dxl_proto *proto;   /* what the bus speaks: 1.0 (AX-12A) or 2.0 (X series) */
 	int master, slave;         /* -1 when disconnected */
 	int link_lock;             /* the lock on the link (LINK.lock), held from the first open to release; -1 none */
+	uint64_t opens;            /* ptys opened so far: which one a lockstep daemon's port is on */
 	union dxl_proto_parser parser;   /* proto's, instruction side */
 	struct dxl_frame frame;          /* the request parsed last */
 	struct sim_line line;
@@ -126,6 +127,16 @@ void sim_bus_release(struct sim_bus *b);
 bool sim_bus_connected(const struct sim_bus *b);
 /* Read whatever the controller wrote and feed it. */
 void sim_bus_read(struct sim_bus *b, int64_t now);
+/* Lockstep's in-band transport (common/lockstep.h): the controller's bytes
+ * come in its clock message instead of the pty, into the same input path.
+ * rate_may_differ: the controller opened its port or set its rate since its
+ * last bytes: the rate on the pty is followed first, as sim_bus_read does
+ * before every read (only then can it have changed). */
+void sim_bus_receive(struct sim_bus *b, const uint8_t *data, size_t n, int64_t now, bool rate_may_differ);
+/* ... and the bytes due at now go to out (up to cap) instead of the pty:
+ * counted as sent; what does not fit, or finds the bus disconnected, is
+ * dropped and counted as the pty's would be. The count copied. */
+size_t sim_bus_hand_over(struct sim_bus *b, int64_t now, uint8_t *out, size_t cap);
 /* Write the bytes due at now to the pty. */
 void sim_bus_flush(struct sim_bus *b, int64_t now);
 /* Next time (ns) to release bytes, in chunks of up to slice_ns (see

@@ -17,6 +17,7 @@ int vt_open(struct vt *v, const char *path, size_t expected, uint64_t mono0_us, 
 	for (size_t i = 0; i < VT_MAX_CLIENTS; i++)
 		v->c[i].fd = -1;
 	v->expected = expected;
+	v->inband = true;
 	v->mono0_us = mono0_us;
 	v->wall0_us = wall0_us;
 	snprintf(v->path, sizeof v->path, "%s", path);
@@ -122,7 +123,8 @@ static void vt_hello(struct vt *v, const struct sim *s, struct vt_client *c, con
 	c->rx_base = s->buses[bus].count.rx_bytes;
 	c->tx_base = s->buses[bus].count.tx_bytes;
 	c->running_since_ns = wall_ns;
-	struct lks_msg w = { .type = LKS_WELCOME, .a = v->t_ns, .b = v->mono0_us, .c = (uint64_t)v->wall0_us };
+	struct lks_msg w = { .type = LKS_WELCOME, .a = v->t_ns, .b = v->mono0_us, .c = (uint64_t)v->wall0_us,
+	                     .flags = v->inband ? LKS_INBAND : 0 };
 	if (lks_send(c->fd, &w) != 0) {
 		vt_drop(v, c);
 		return;
@@ -146,12 +148,42 @@ void vt_end(struct vt *v, bool failed, const char *why)
 			v->c[i].stop_pending = true;
 }
 
-void vt_on_client(struct vt *v, const struct sim *s, size_t i, int64_t wall_ns)
+/* Its port is on the bus's pty now (in-band: the one the bytes are for). */
+static bool vt_attached(const struct vt_client *c, const struct sim *s)
+{
+	const struct sim_bus *b = &s->buses[c->bus];
+	return sim_bus_connected(b) && c->port_open == b->opens;
+}
+
+/* In-band: the bytes a daemon wrote, into its bus at the time it wrote them
+ * (now: time has not moved since its last TIME). Bytes for a port that is
+ * gone are lost, as the pty's write would have failed; bytes on the pty
+ * transport do not belong in a message. Both counted, said once. */
+static void vt_bytes_in(struct vt *v, struct sim *s, struct vt_client *c, const struct lks_msg *m)
+{
+	if (m->nbytes == 0)
+		return;
+	if (v->inband && vt_attached(c, s)) {
+		sim_bus_receive(&s->buses[c->bus], m->bytes, m->nbytes, (int64_t)v->t_ns, c->rate_unread);
+		c->rate_unread = false;
+		return;
+	}
+	v->bytes_lost += m->nbytes;
+	if (!c->said_lost)
+		fprintf(stderr, "undulate-sim: lockstep: robot %s's daemon (pid %ld) sent %u bus byte(s) in a %s %s; "
+		        "dropped (counted; said once)\n", c->robot, c->pid, m->nbytes, lks_type_name(m->type),
+		        !v->inband ? "on the pty transport, which carries them through the pty" : "for a port not open (or gone)");
+	c->said_lost = true;
+}
+
+void vt_on_client(struct vt *v, struct sim *s, size_t i, int64_t wall_ns)
 {
 	struct vt_client *c = &v->c[i];
 	struct lks_msg m;
 	char why[200];
 	int r = lks_recv(c->fd, &m, why, sizeof why);
+	if (r > 0 && m.type == LKS_BYE && c->bus >= 0)
+		vt_bytes_in(v, s, c, &m);   /* its safe stop's last bytes, not waited on */
 	if (r <= 0 || m.type == LKS_BYE) {
 		if (r < 0) {
 			v->bad_messages++;
@@ -175,17 +207,50 @@ void vt_on_client(struct vt *v, const struct sim *s, size_t i, int64_t wall_ns)
 		snprintf(why, sizeof why, "%s out of turn", lks_type_name(m.type));
 		return vt_refuse(v, c, why);
 	}
+	if (m.flags & LKS_PORT_OPENED) {
+		const struct sim_bus *b = &s->buses[c->bus];
+		c->port_open = sim_bus_connected(b) ? b->opens : 0;
+		c->nout = 0;   /* released for the port before, which the daemon closed */
+	}
+	if (m.flags & (LKS_PORT_OPENED | LKS_RATE_SET))
+		c->rate_unread = true;
+	vt_bytes_in(v, s, c, &m);
 	c->blocked = true;
 	c->wake_ns = m.a;
 	c->want_input = (m.flags & LKS_WANT_INPUT) != 0;
 	c->written = m.b;
 }
 
-/* Every byte the daemon wrote has reached our side of its pty. */
-static bool vt_caught_up(const struct vt_client *c, const struct sim *s)
+void vt_hand_over(struct vt *v, struct sim *s, int64_t now)
+{
+	uint8_t scratch[LKS_BYTES_MAX];
+	for (size_t bus = 0; bus < s->nbuses; bus++) {
+		struct vt_client *to = NULL;
+		for (size_t i = 0; i < VT_MAX_CLIENTS && !to; i++)
+			if (v->c[i].fd >= 0 && v->c[i].bus == (int)bus && vt_attached(&v->c[i], s))
+				to = &v->c[i];
+		struct sim_bus *b = &s->buses[bus];
+		if (to == NULL) {
+			/* no port open on it: the bytes go, as into a pty nobody reads */
+			(void)sim_bus_hand_over(b, now, scratch, sizeof scratch);
+			continue;
+		}
+		uint64_t dropped = b->count.tx_dropped;
+		to->nout += sim_bus_hand_over(b, now, to->out + to->nout, sizeof to->out - to->nout);
+		if (b->count.tx_dropped > dropped && v->bytes_dropped == 0)
+			fprintf(stderr, "undulate-sim: lockstep: bus %s: more bytes toward robot %s's daemon than a clock "
+			        "message carries (%d) before it woke; dropped (counted in the bus's tx_dropped)\n", b->name,
+			        to->robot, LKS_BYTES_MAX);
+		v->bytes_dropped += b->count.tx_dropped - dropped;
+	}
+}
+
+/* Every byte the daemon wrote has reached our side of its pty (in-band
+ * they came with its WAIT). */
+static bool vt_caught_up(const struct vt *v, const struct vt_client *c, const struct sim *s)
 {
 	const struct sim_bus *b = &s->buses[c->bus];
-	return !sim_bus_connected(b) || b->count.rx_bytes - c->rx_base >= c->written;
+	return v->inband || !sim_bus_connected(b) || b->count.rx_bytes - c->rx_base >= c->written;
 }
 
 bool vt_all_blocked(const struct vt *v, const struct sim *s)
@@ -196,7 +261,7 @@ bool vt_all_blocked(const struct vt *v, const struct sim *s)
 		const struct vt_client *c = &v->c[i];
 		if (c->fd < 0)
 			continue;
-		if (c->bus < 0 || !c->blocked || !vt_caught_up(c, s))
+		if (c->bus < 0 || !c->blocked || !vt_caught_up(v, c, s))
 			return false;
 	}
 	return true;
@@ -207,10 +272,16 @@ static uint64_t vt_delivered(const struct vt_client *c, const struct sim *s)
 	return s->buses[c->bus].count.tx_bytes - c->tx_base;
 }
 
-/* Something to tell it now, whatever its wake-up. */
-static bool vt_due_now(const struct vt_client *c, const struct sim *s)
+/* Bytes released toward it that it has not been told of. */
+static bool vt_news(const struct vt *v, const struct vt_client *c, const struct sim *s)
 {
-	return c->ncmds > 0 || c->stop_pending || (c->want_input && vt_delivered(c, s) > c->told);
+	return v->inband ? c->nout > 0 : vt_delivered(c, s) > c->told;
+}
+
+/* Something to tell it now, whatever its wake-up. */
+static bool vt_due_now(const struct vt *v, const struct vt_client *c, const struct sim *s)
+{
+	return c->ncmds > 0 || c->stop_pending || (c->want_input && vt_news(v, c, s));
 }
 
 uint64_t vt_next_wake(const struct vt *v, const struct sim *s)
@@ -220,7 +291,7 @@ uint64_t vt_next_wake(const struct vt *v, const struct sim *s)
 		const struct vt_client *c = &v->c[i];
 		if (c->fd < 0 || c->bus < 0 || !c->blocked)
 			continue;
-		uint64_t w = vt_due_now(c, s) ? v->t_ns : c->wake_ns;
+		uint64_t w = vt_due_now(v, c, s) ? v->t_ns : c->wake_ns;
 		if (w < t)
 			t = w;
 	}
@@ -232,7 +303,7 @@ void vt_release(struct vt *v, const struct sim *s, uint64_t t, int64_t wall_ns)
 	v->t_ns = t;
 	for (size_t i = 0; i < VT_MAX_CLIENTS; i++) {
 		struct vt_client *c = &v->c[i];
-		if (c->fd < 0 || c->bus < 0 || !c->blocked || (c->wake_ns > t && !vt_due_now(c, s)))
+		if (c->fd < 0 || c->bus < 0 || !c->blocked || (c->wake_ns > t && !vt_due_now(v, c, s)))
 			continue;
 		bool ok = true;
 		for (size_t k = 0; k < c->ncmds && ok; k++) {
@@ -250,6 +321,14 @@ void vt_release(struct vt *v, const struct sim *s, uint64_t t, int64_t wall_ns)
 		}
 		c->told = vt_delivered(c, s);
 		struct lks_msg m = { .type = LKS_TIME, .a = t, .b = c->told };
+		if (v->inband) {
+			/* what the pty's EIO says on the other transport */
+			if (c->port_open != 0 && !vt_attached(c, s))
+				m.flags |= LKS_BUS_GONE;
+			memcpy(m.bytes, c->out, c->nout);
+			m.nbytes = (uint32_t)c->nout;
+			c->nout = 0;
+		}
 		if (!ok || lks_send(c->fd, &m) != 0) {
 			/* it is gone: its socket's end is read next, and says so */
 			c->blocked = false;
@@ -308,7 +387,7 @@ bool vt_stalled(const struct vt *v, const struct sim *s, int64_t wall_ns, int64_
 			         "at t=%.3f s: stalled", c->robot, c->pid, 1e-9 * (double)grace_ns, 1e-9 * (double)v->t_ns);
 			return true;
 		}
-		if (!vt_caught_up(c, s)) {
+		if (!vt_caught_up(v, c, s)) {
 			const struct sim_bus *b = &s->buses[c->bus];
 			snprintf(why, cap, "lockstep: robot %s's daemon (pid %ld) wrote %llu byte(s) to bus %s, %llu arrived in "
 			         "%.0f s of wall time (t=%.3f s)", c->robot, c->pid, (unsigned long long)c->written, b->name,

@@ -38,6 +38,13 @@ struct vt_client {
 	uint64_t written;           /* bus bytes it has written (its last WAIT) */
 	uint64_t rx_base, tx_base;  /* the bus's counters when it joined */
 	uint64_t told;              /* bus bytes released toward it, as its last TIME said */
+	/* in-band: which of the bus's ptys its port is on (sim_bus.opens; 0:
+	 * none yet), and the bytes released toward it since its last TIME */
+	uint64_t port_open;
+	uint8_t out[LKS_BYTES_MAX];
+	size_t nout;
+	bool said_lost;             /* bytes for a port gone said once */
+	bool rate_unread;           /* in-band: it opened its port or set its rate since its last bytes */
 	char cmds[LKS_CMD_QUEUE][LKS_TEXT_MAX];
 	size_t ncmds;
 	bool stop_pending;          /* STOP goes with its next TIME */
@@ -54,14 +61,20 @@ struct vt {
 	uint64_t t_ns;              /* virtual now */
 	uint64_t mono0_us;          /* the daemons' monotonic clock at virtual 0 */
 	int64_t wall0_us;           /* and the wall clock */
+	bool inband;                /* the bus bytes travel in WAIT and TIME (else through the ptys) */
 	bool ending;                /* STOP sent (or to be sent) to everyone */
 	bool failed;                /* the run ended because something went wrong */
 	char end_why[VT_WHY_MAX];
 	uint64_t joined, left, refused, bad_messages, commands, wakes;
+	/* in-band: bytes a daemon wrote to a port that is gone (the pty's EIO),
+	 * or on the pty transport in a WAIT; bytes toward a daemon its TIME could
+	 * not hold */
+	uint64_t bytes_lost, bytes_dropped;
 };
 
 /* Listen at path for `expected` daemons. mono0_us / wall0_us: the clocks'
- * values at virtual time 0. 0, or -1 with err. */
+ * values at virtual time 0. The bytes go in-band unless v->inband is
+ * cleared before the first daemon joins. 0, or -1 with err. */
 int vt_open(struct vt *v, const char *path, size_t expected, uint64_t mono0_us, int64_t wall0_us, char *err,
             size_t cap);
 /* Close every connection and remove the socket file. */
@@ -69,17 +82,22 @@ void vt_close(struct vt *v);
 /* A connection waits on the listening socket. */
 void vt_accept(struct vt *v);
 /* Client i's socket is readable: take one message (HELLO, WAIT, BYE, or its
- * end). wall_ns: the wall clock now. */
-void vt_on_client(struct vt *v, const struct sim *s, size_t i, int64_t wall_ns);
+ * end). In-band, the bytes a WAIT or BYE carries go into its bus now
+ * (sim_bus_receive). wall_ns: the wall clock now. */
+void vt_on_client(struct vt *v, struct sim *s, size_t i, int64_t wall_ns);
 /* Daemons connected and joined to a bus. */
 size_t vt_clients(const struct vt *v);
 /* Time may move: every expected daemon has joined (unless the run is
- * ending), every one is blocked, and every byte each has written to its bus
- * has been read by the simulator. */
+ * ending), every one is blocked, and (pty transport) every byte each has
+ * written to its bus has been read by the simulator; in-band they came with
+ * its WAIT. */
 bool vt_all_blocked(const struct vt *v, const struct sim *s);
 /* The earliest virtual time a blocked daemon must be woken at (ns):
  * its wake-up, or now when it has something to receive. LKS_NEVER if none. */
 uint64_t vt_next_wake(const struct vt *v, const struct sim *s);
+/* In-band: the bytes due at now on every bus go to the bus's daemon, for
+ * its next TIME (instead of sim_bus_flush's pty). */
+void vt_hand_over(struct vt *v, struct sim *s, int64_t now);
 /* Time is t now: wake the daemons that are due (commands, STOP, TIME). */
 void vt_release(struct vt *v, const struct sim *s, uint64_t t, int64_t wall_ns);
 /* Queue a command for the daemon of bus (or of every bus: -1). 0, or -1 with

@@ -62,14 +62,19 @@ void port_bus_io(struct port *p, struct bus_io *io);
 uint64_t port_now_us(void);
 
 /* The same port in lockstep (common/lockstep.h): time is the simulator's,
- * waiting is a WAIT to it, and what is read is exactly what it announced
- * (bytes it released and the tty worker has not handed over yet are waited
- * for, not taken for silence). Every byte written is counted for its WAITs.
- * The caller owns *pl for as long as the bus_io is used. */
+ * and waiting is a WAIT to it. In-band (the simulator's WELCOME says so)
+ * the bytes written go with the next WAIT and what is read is what the
+ * TIMEs carried: the pty is not read or written. On the pty transport what
+ * is read is exactly what the simulator announced (bytes it released and
+ * the tty worker has not handed over yet are waited for, not taken for
+ * silence), and every byte written is counted for its WAITs. Call it each
+ * time the port is (re)opened: what was delivered for an earlier one is
+ * dropped. The caller owns *pl for as long as the bus_io is used. */
 struct lks_client;
 struct port_lockstep {
 	struct port *port;
 	struct lks_client *clock;
+	long rate_told;             /* in-band: the port's rate the simulator was last told of */
 };
 void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_client *clock, struct bus_io *io);
 

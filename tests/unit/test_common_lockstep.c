@@ -5,7 +5,12 @@
  * (clock.h) and the announced byte count, commands are queued (and counted
  * when too many), STOP is noted, a closed socket ends a blocking wait; and
  * the whole join (HELLO, WELCOME or REFUSED) against a listening socket
- * served by a child process. */
+ * served by a child process. In-band (LKS2): a message is its header and
+ * the payload it says, nothing more or less (a payload too long is refused
+ * when sent; a datagram too long, or not the length its header says, when
+ * received); the client's WAIT carries what was written since the last one
+ * and a TIME's bytes wait, unread ones first, for the daemon's reads; bytes
+ * in a message that should have none are a protocol error. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -275,6 +280,145 @@ static void test_join(void **state)
 	unlink(live);
 }
 
+/* Send raw bytes as one datagram. */
+static void raw_send(int fd, const void *p, size_t n)
+{
+	assert_int_equal(send(fd, p, n, 0), (ssize_t)n);
+}
+
+static void test_payload_framing(void **state)
+{
+	(void)state;
+	int sv[2];
+	assert_int_equal(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
+	struct lks_msg m = { .type = LKS_WAIT, .a = 1, .nbytes = 3, .bytes = { 0xff, 0xff, 0x01 } };
+	assert_int_equal(lks_send(sv[0], &m), 0);
+	/* only the header and the payload used went on the wire */
+	struct lks_msg r;
+	assert_int_equal(recv(sv[1], &r, sizeof r, MSG_PEEK | MSG_TRUNC), (ssize_t)(LKS_HEADER_SIZE + 3));
+	char why[200];
+	assert_int_equal(lks_recv(sv[1], &r, why, sizeof why), 1);
+	assert_int_equal(r.nbytes, 3);
+	assert_memory_equal(r.bytes, m.bytes, 3);
+	/* the most a message carries goes; one more is refused, not cut short */
+	m.nbytes = LKS_BYTES_MAX;
+	memset(m.bytes, 0x5a, sizeof m.bytes);
+	assert_int_equal(lks_send(sv[0], &m), 0);
+	assert_int_equal(lks_recv(sv[1], &r, why, sizeof why), 1);
+	assert_int_equal(r.nbytes, LKS_BYTES_MAX);
+	m.nbytes = LKS_BYTES_MAX + 1;
+	assert_int_equal(lks_send(sv[0], &m), -1);
+	assert_int_equal(errno, EMSGSIZE);
+	/* a header that says more than came, or less */
+	struct lks_msg bad = { .magic = LKS_MAGIC, .type = LKS_WAIT, .nbytes = 10 };
+	raw_send(sv[0], &bad, LKS_HEADER_SIZE + 5);
+	assert_int_equal(lks_recv(sv[1], &r, why, sizeof why), -1);
+	assert_int_equal(errno, EPROTO);
+	assert_non_null(strstr(why, "says it carries 10 bus bytes"));
+	bad.nbytes = 0;
+	raw_send(sv[0], &bad, LKS_HEADER_SIZE + 5);
+	assert_int_equal(lks_recv(sv[1], &r, why, sizeof why), -1);
+	assert_non_null(strstr(why, "says it carries 0 bus bytes"));
+	/* a length beyond the largest, and a datagram longer than any message */
+	bad.nbytes = LKS_BYTES_MAX + 1;
+	raw_send(sv[0], &bad, LKS_HEADER_SIZE);
+	assert_int_equal(lks_recv(sv[1], &r, why, sizeof why), -1);
+	assert_non_null(strstr(why, "at most 4096 bus bytes"));
+	static uint8_t huge[sizeof(struct lks_msg) + 100];
+	memcpy(huge, &bad, LKS_HEADER_SIZE);
+	raw_send(sv[0], huge, sizeof huge);
+	assert_int_equal(lks_recv(sv[1], &r, why, sizeof why), -1);
+	assert_non_null(strstr(why, "at most 4096 bus bytes"));
+	/* shorter than a header */
+	raw_send(sv[0], &bad, LKS_HEADER_SIZE - 1);
+	assert_int_equal(lks_recv(sv[1], &r, why, sizeof why), -1);
+	assert_non_null(strstr(why, "not a lockstep message"));
+	close(sv[0]);
+	close(sv[1]);
+}
+
+static void sim_send_bytes(int fd, uint64_t t, uint32_t flags, const void *bytes, size_t n)
+{
+	struct lks_msg m = { .type = LKS_TIME, .a = t, .flags = flags, .nbytes = (uint32_t)n };
+	memcpy(m.bytes, bytes, n);
+	assert_int_equal(lks_send(fd, &m), 0);
+}
+
+static void test_inband_client(void **state)
+{
+	(void)state;
+	struct lks_client c;
+	int sim;
+	client_pair(&c, &sim);
+	c.inband = true;
+	/* what was written goes with the WAIT, once; the port's opening too */
+	memcpy(c.out, "\xff\xff\x01\x02", 4);
+	c.nout = 4;
+	lks_client_port_opened(&c);
+	assert_int_equal(c.nout, 0);   /* written for the port before: not for this one */
+	memcpy(c.out, "ping", 4);
+	c.nout = 4;
+	assert_int_equal(lks_client_wait(&c, LKS_MONO0_US + 1000, true), 0);
+	struct lks_msg m;
+	char why[200];
+	assert_int_equal(lks_recv(sim, &m, why, sizeof why), 1);
+	assert_int_equal(m.type, LKS_WAIT);
+	assert_int_equal(m.flags, LKS_WANT_INPUT | LKS_PORT_OPENED);
+	assert_int_equal(m.nbytes, 4);
+	assert_memory_equal(m.bytes, "ping", 4);
+	assert_int_equal(c.nout, 0);
+	/* TIMEs' bytes queue behind the unread ones */
+	sim_send_bytes(sim, 1000, 0, "abc", 3);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
+	assert_int_equal(c.nin - c.in_off, 3);
+	c.in_off = 1;   /* the daemon read one */
+	sim_send_bytes(sim, 2000, 0, "de", 2);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
+	assert_int_equal(c.nin - c.in_off, 4);
+	assert_memory_equal(c.in + c.in_off, "bcde", 4);
+	assert_false(c.bus_gone);
+	/* more than fits unread is counted, not overrun */
+	static uint8_t many[LKS_BYTES_MAX];
+	sim_send_bytes(sim, 3000, LKS_BUS_GONE, many, sizeof many);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
+	assert_int_equal(c.nin, LKS_BYTES_MAX);
+	assert_int_equal(c.in_dropped, 4);
+	assert_true(c.bus_gone);
+	/* a (re)opened port starts clean */
+	lks_client_port_opened(&c);
+	assert_int_equal(c.nin, 0);
+	assert_false(c.bus_gone);
+	/* bytes in a message that carries none */
+	struct lks_msg cmd = { .type = LKS_CMD, .nbytes = 1 };
+	assert_int_equal(lks_send(sim, &cmd), 0);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), -1);
+	assert_non_null(strstr(why, "a CMD from the simulator carries 1 bus bytes"));
+	/* the last bytes go with BYE */
+	memcpy(c.out, "bye", 3);
+	c.nout = 3;
+	lks_client_close(&c);
+	assert_int_equal(lks_recv(sim, &m, why, sizeof why), 1);
+	assert_int_equal(m.type, LKS_BYE);
+	assert_int_equal(m.nbytes, 3);
+	close(sim);
+}
+
+static void test_pty_transport_refuses_bytes(void **state)
+{
+	(void)state;
+	struct lks_client c;
+	int sim;
+	client_pair(&c, &sim);   /* WELCOME said nothing of in-band */
+	c.nout = 0;
+	sim_send_bytes(sim, 1000, 0, "x", 1);
+	char why[200];
+	assert_int_equal(lks_client_read(&c, why, sizeof why), -1);
+	assert_int_equal(errno, EPROTO);
+	assert_non_null(strstr(why, "through the pty"));
+	close(sim);
+	close(c.fd);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -283,6 +427,9 @@ int main(void)
 		cmocka_unit_test(test_commands_and_stop),
 		cmocka_unit_test(test_block),
 		cmocka_unit_test(test_join),
+		cmocka_unit_test(test_payload_framing),
+		cmocka_unit_test(test_inband_client),
+		cmocka_unit_test(test_pty_transport_refuses_bytes),
 	};
 	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

@@ -5,13 +5,20 @@
  * wake-up (its own, or now for input it has not been told of, a command, the
  * end), what a release sends and to whom (CMD and STOP before TIME, only the
  * daemons due), commands to one robot or all, a daemon that leaves early or
- * stalls ending the run with its name. */
+ * stalls ending the run with its name. In-band (the default transport):
+ * WELCOME says so, a WAIT's bytes go into its bus at the virtual now (a
+ * PING from the AX-12 manual is answered), the reply goes to its daemon in
+ * the TIME due when its last byte is on the wire, nothing waits on a byte
+ * count; bytes before the daemon opened its port, or after its port went
+ * away, are dropped and counted; a port gone is said in the TIME; a BYE's
+ * last bytes still go into the bus. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/socket.h>
@@ -228,12 +235,144 @@ static void test_leave_and_stall(void **state)
 	close(b);
 }
 
+/* AX-12 manual, PING: "FF FF 01 02 01 FB"; its status "FF FF 01 02 00 FC". */
+static const uint8_t ping1[] = { 0xff, 0xff, 0x01, 0x02, 0x01, 0xfb };
+static const uint8_t status1[] = { 0xff, 0xff, 0x01, 0x02, 0x00, 0xfc };
+
+static void daemon_send_bytes(int fd, uint32_t type, uint64_t a, uint32_t flags, const uint8_t *bytes, size_t n)
+{
+	struct lks_msg m = { .type = type, .a = a, .flags = flags, .nbytes = (uint32_t)n };
+	if (n > 0)
+		memcpy(m.bytes, bytes, n);
+	assert_int_equal(lks_send(fd, &m), 0);
+}
+
+static void test_inband(void **state)
+{
+	(void)state;
+	make_sim();
+	vt.inband = true;
+	/* bus a "connected" (a descriptor that is not a pty: nothing is written to it) */
+	int null_fd = open("/dev/null", O_RDWR);
+	sim.buses[0].master = null_fd;
+	sim.buses[0].opens = 1;
+	int a = join(0, "/tmp/vt-test/a");
+	struct lks_msg m = daemon_recv(a);
+	assert_int_equal(m.type, LKS_WELCOME);
+	assert_int_equal(m.flags, LKS_INBAND);
+	int b = join(1, "/tmp/vt-test/b");
+	daemon_recv(b);
+	/* bytes before its port is open are not for this pty: dropped, counted */
+	daemon_send_bytes(a, LKS_WAIT, LKS_NEVER, 0, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 0, 1000);
+	assert_int_equal(vt.bytes_lost, sizeof ping1);
+	assert_int_equal(sim.buses[0].count.rx_bytes, 0);
+	/* the port opened: a PING at virtual 1 ms goes into the bus then */
+	vt.t_ns = 1000000;
+	daemon_send_bytes(a, LKS_WAIT, 50000000, LKS_WANT_INPUT | LKS_PORT_OPENED, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 0, 1000);
+	daemon_send(b, LKS_WAIT, LKS_NEVER, 0, 0, NULL);
+	vt_on_client(&vt, &sim, 1, 1000);
+	assert_int_equal(sim.buses[0].count.rx_bytes, sizeof ping1);
+	assert_int_equal(sim.buses[0].count.packets, 1);
+	/* no byte count to wait for: blocked as soon as it said so */
+	assert_true(vt_all_blocked(&vt, &sim));
+	/* the status is on the line: its bytes go to a when they are due */
+	int64_t due = sim_line_chunk_end(&sim.buses[0].line, 1000000000);
+	assert_true(due > 1000000 && due < 2000000);
+	vt_hand_over(&vt, &sim, sim_line_next(&sim.buses[0].line) - 1);
+	assert_int_equal(vt.c[0].nout, 0);
+	vt_hand_over(&vt, &sim, due);
+	assert_int_equal(vt.c[0].nout, sizeof status1);
+	assert_int_equal(sim.buses[0].count.tx_bytes, sizeof status1);
+	assert_int_equal(vt_next_wake(&vt, &sim), vt.t_ns);   /* input it waits for: now */
+	vt_release(&vt, &sim, (uint64_t)due, 2000);
+	m = daemon_recv(a);
+	assert_int_equal(m.type, LKS_TIME);
+	assert_int_equal(m.nbytes, sizeof status1);
+	assert_memory_equal(m.bytes, status1, sizeof status1);
+	assert_int_equal(m.flags, 0);
+	assert_int_equal(vt.c[0].nout, 0);
+	/* the disconnect fault: the port a has open is gone, and the TIME says so */
+	sim.buses[0].master = -1;
+	daemon_send(a, LKS_WAIT, 3000000, 0, 0, NULL);
+	vt_on_client(&vt, &sim, 0, 3000);
+	vt_release(&vt, &sim, 3000000, 4000);
+	m = daemon_recv(a);
+	assert_int_equal(m.type, LKS_TIME);
+	assert_int_equal(m.flags, LKS_BUS_GONE);
+	/* bytes for the port gone: dropped, counted */
+	daemon_send_bytes(a, LKS_WAIT, LKS_NEVER, 0, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 0, 5000);
+	assert_int_equal(vt.bytes_lost, 2 * sizeof ping1);
+	/* reconnected (another pty) and the port opened again: its last bytes,
+	 * sent with its BYE, still go into the bus */
+	sim.buses[0].master = null_fd;
+	sim.buses[0].opens = 2;
+	daemon_send_bytes(a, LKS_WAIT, LKS_NEVER, LKS_PORT_OPENED, NULL, 0);
+	vt_on_client(&vt, &sim, 0, 6000);
+	daemon_send_bytes(a, LKS_BYE, 0, 0, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 0, 7000);
+	assert_int_equal(sim.buses[0].count.rx_bytes, 2 * sizeof ping1);
+	assert_int_equal(vt.c[0].fd, -1);
+	assert_true(vt.ending);   /* it left before the end */
+	sim.buses[0].master = -1;
+	vt_close(&vt);
+	close(null_fd);
+	close(a), close(b);
+}
+
+/* Bad input on the clock: bytes from a connection with no bus (no HELLO
+ * yet), a payload that is not the length it says, one longer than a message
+ * carries: each refused with why and counted, the daemon's part over. */
+static void test_inband_bad_input(void **state)
+{
+	(void)state;
+	make_sim();
+	vt.inband = true;
+	int x = connect_slot(3);
+	daemon_send_bytes(x, LKS_WAIT, LKS_NEVER, 0, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 3, 1000);
+	struct lks_msg m = daemon_recv(x);
+	assert_int_equal(m.type, LKS_REFUSED);
+	assert_non_null(strstr(m.text, "WAIT out of turn"));
+	assert_int_equal(vt.bad_messages, 1);
+	assert_int_equal(vt.c[3].fd, -1);
+	assert_int_equal(sim.buses[0].count.rx_bytes, 0);
+	/* a joined daemon's malformed message ends its part, and the run as failed */
+	int a = join(0, "/tmp/vt-test/a");
+	daemon_recv(a);
+	struct lks_msg bad = { .magic = LKS_MAGIC, .type = LKS_WAIT, .nbytes = 100 };
+	assert_int_equal(send(a, &bad, LKS_HEADER_SIZE + 6, 0), (ssize_t)(LKS_HEADER_SIZE + 6));
+	vt_on_client(&vt, &sim, 0, 2000);
+	assert_int_equal(vt.bad_messages, 2);
+	assert_int_equal(vt.c[0].fd, -1);
+	assert_true(vt.ending && vt.failed);
+	assert_int_equal(sim.buses[0].count.rx_bytes, 0);
+	vt_close(&vt);
+	close(x), close(a);
+	make_sim();
+	vt.inband = true;
+	int b = join(1, "/tmp/vt-test/b");
+	daemon_recv(b);
+	static uint8_t huge[sizeof(struct lks_msg) + 64];
+	memcpy(huge, &bad, LKS_HEADER_SIZE);
+	assert_int_equal(send(b, huge, sizeof huge, 0), (ssize_t)sizeof huge);
+	vt_on_client(&vt, &sim, 1, 3000);
+	assert_int_equal(vt.bad_messages, 1);
+	assert_true(vt.ending && vt.failed);
+	vt_close(&vt);
+	close(b);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_join),
 		cmocka_unit_test(test_barrier_and_release),
 		cmocka_unit_test(test_leave_and_stall),
+		cmocka_unit_test(test_inband),
+		cmocka_unit_test(test_inband_bad_input),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }
