@@ -5,8 +5,8 @@
  *
  * The simulator owns time. Each daemon connects to its lockstep socket (a
  * local SOCK_SEQPACKET socket: one message a datagram, in order, and the end
- * of a peer is seen as the end of the stream), names the bus it drives, and
- * from then on never reads the system's clock: when it has nothing to do
+ * of a peer is seen as the end of the stream), names the bus (or buses:
+ * "Several buses" below) it drives, and from then on never reads the system's clock: when it has nothing to do
  * until some time, or until its bus answers, it says so (WAIT) and blocks
  * until the simulator says what time it is (TIME). The simulator advances
  * its time only while every daemon is blocked, to the earliest of: its next

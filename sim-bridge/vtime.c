@@ -466,8 +466,9 @@ bool vt_stalled(const struct vt *v, const struct sim *s, int64_t wall_ns, int64_
                 char *why, size_t cap)
 {
 	if (!v->ending && vt_buses_covered(v) < v->expected && wall_ns - start_wall_ns > grace_ns && v->t_ns == 0) {
-		size_t off = (size_t)snprintf(why, cap, "lockstep: daemons joined on %zu of %zu bus(es) within %.0f s; "
-		                              "missing:", vt_buses_covered(v), v->expected, 1e-9 * (double)grace_ns);
+		/* counted by bus (a daemon on two counts two): the missing are buses */
+		size_t off = (size_t)snprintf(why, cap, "lockstep: %zu of %zu daemon(s) joined within %.0f s; missing:",
+		                              vt_buses_covered(v), v->expected, 1e-9 * (double)grace_ns);
 		for (size_t b = 0; b < s->nbuses && off < cap; b++) {
 			int o = vt_owner_at(v, (int)b, NULL);
 			if (o < 0 || v->c[o].bus < 0)

@@ -210,7 +210,7 @@ static void test_leave_and_stall(void **state)
 	/* nobody joined within the grace: the missing ones are named */
 	assert_false(vt_stalled(&vt, &sim, 5000000000, 0, 10000000000, why, sizeof why));
 	assert_true(vt_stalled(&vt, &sim, 11000000000, 0, 10000000000, why, sizeof why));
-	assert_non_null(strstr(why, "joined on 0 of 2 bus(es)"));
+	assert_non_null(strstr(why, "0 of 2 daemon(s) joined"));
 	assert_non_null(strstr(why, "a (/tmp/vt-test/a)"));
 	int a = join(0, "/tmp/vt-test/a");
 	int b = join(1, "/tmp/vt-test/b");
