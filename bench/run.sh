@@ -1310,8 +1310,7 @@ section_rate() {
 	say ""
 	rate_table "READ: highest rate, no overrun | the same in lockstep" 2 rate_cells_best
 	say ""
-	say "Twelve on two buses: the budget's table below (real time only: a robot on several buses does not"
-	say "run in lockstep)."
+	say "Twelve on two buses: the budget's table below (real time and lockstep)."
 	say ""
 	rate_1k_table
 	rate_2bus_table
@@ -1370,9 +1369,8 @@ rate_os_floor() {
 # rate_2bus: the second budget, twelve XM430-W350 on two 4 Mbps buses (six
 # each, IDs 1-6 and 7-12, two simulators: one robot's joints on two ports,
 # daemon/README.md "Several buses") at 500 Hz, RATE_2BUS_S seconds, both
-# programs under SCHED_FIFO where permitted. Real time only: a robot on
-# several buses does not run in lockstep. Beside it, the same twelve on one
-# bus, for the difference.
+# programs under SCHED_FIFO where permitted. Beside it, the same twelve on one
+# bus, for the difference; then the two-bus run in lockstep (rate_2bus_lockstep).
 rate_2bus() {
 	local d=$T/rate u ub extra=() dargs=() out name
 	u=$(url $PORT_RATE); ub=$(url $PORT_RATE_B)
@@ -1418,6 +1416,44 @@ rate_2bus() {
 	stop sim-2a; stop sim-2b
 	rate_os_floor "$d/2bus" 2000 "$RATE_2BUS_S"
 	RATE_2BUS_LOAD1=$(cut -d' ' -f1-3 /proc/loadavg)
+	rate_2bus_lockstep
+}
+
+# rate_2bus_lockstep: the same twelve on two buses in the simulator's virtual
+# time, RATE_2BUS_S simulated seconds after 2: one simulator serving both
+# links (a scenario with a robot a bus), one daemon on both over its one
+# connection to the clock (common/lockstep.h "Several buses"). Neither
+# program can be late there: an overrun is the cycle not fitting the period.
+# Results in $T/rate/2bus-lock, like rate_lockstep's.
+rate_2bus_lockstep() {
+	local name=2bus-lock d=$T/rate u out
+	u=$(url $PORT_RATE)
+	out=$d/$name
+	progress "rate: the same 12 X servos on two buses in lockstep, ${RATE_2BUS_S} simulated s"
+	mkdir -p "$d"
+	rm -f "$d/$name.clock"
+	printf '[sim]\nmodel = xm430-w350\nbaud = 4000000\nreturn_delay_us = 0\n[robot a]\nids = 1,2,3,4,5,6\nlink = %s\n[robot b]\nids = 7,8,9,10,11,12\nlink = %s\n' \
+		"$d/$name-a.pty" "$d/$name-b.pty" >"$d/$name.scenario"
+	start "sim-$name" "$SIM" --scenario "$d/$name.scenario" --lcm-url "$u" --quiet --lockstep "$d/$name.clock" \
+		--duration "$((RATE_2BUS_S + 2))"
+	if ! wait_file "$d/$name.clock" 10; then
+		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
+		stop "sim-$name"
+		return 0
+	fi
+	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
+	wait_file "$out.lcm" 10
+	"$DMN" --port "$d/$name-a.pty" --ids 1,2,3,4,5,6,b:7,b:8,b:9,b:10,b:11,b:12 --set "bus.b.port=$d/$name-b.pty" \
+		--set bus.b.baud=4000000 --baud 4000000 --robot r12 --lcm-url "$u" --mode oscillator \
+		--set robot.period_ms=2 --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
+	wait "${PID[sim-$name]}" 2>/dev/null
+	unset "PID[sim-$name]"
+	stop "log-$name"
+	# the first 2 simulated seconds (start-up, ramp) left out
+	"$HB/logstat" --sender-time --skip 2 "$out.lcm" >"$out"
+	sed -n 's/^undulate-sim: lockstep: \([0-9.]*\) s of simulated time in \([0-9.]*\) s.*/lockstep_sim_s \1\nlockstep_wall_s \2/p' \
+		"$T/sim-$name.log" >>"$out"
+	[ -n "${KEEP_BENCH_DIR:-}" ] || rm -f "$out.lcm"
 }
 
 # rate_unmeasured FILE...: the first of the files that says "status not
@@ -1464,18 +1500,20 @@ rate_ct_what() {
 }
 
 rate_2bus_table() {
-	local f=$T/rate/2bus g=$T/rate/1bus what
+	local f=$T/rate/2bus g=$T/rate/1bus lk=$T/rate/2bus-lock what lwhat
 	say "### The budget: twelve XM430-W350 on two 4 Mbps buses, 500 Hz, ${RATE_2BUS_S} s"
 	say ""
 	if ! rate_unmeasured "$f"; then
 		rate_realtime "$RATE_2BUS_POLICY" "$RATE_2BUS_LOAD0" "$RATE_2BUS_LOAD1"
 		say "Six servos a bus (IDs 1-6 and b:7-12, two simulators), the daemon's reads in parallel; beside it the"
-		say "same twelve on one bus. Bus time is the cycle's, the slower bus's."
+		say "same twelve on one bus. Bus time is the cycle's, the slower bus's. Lockstep: the two-bus run in"
+		say "the simulator's virtual time (one simulator serving both links, one daemon on both over one"
+		say "connection to the clock), where neither program can be late."
 		say ""
 		say "| run | STATEs | overruns | period p50 | p99 | max | bus p50 | p99 | max |"
 		say "|---|---|---|---|---|---|---|---|---|"
 		local r
-		for r in "two buses:$f" "one bus:$g"; do
+		for r in "two buses:$f" "one bus:$g" "two buses, lockstep:$lk"; do
 			local x=${r#*:}
 			[ "$(v "$x" status)" = not ] && { say "| ${r%%:*} | $(sed -n 's/^status //p' "$x") |"; continue; }
 			say "| ${r%%:*} | $(v "$x" all.n) | $(v "$x" all.overruns) | $(fmt "$(v "$x" all.period_p50)") |" \
@@ -1486,8 +1524,13 @@ rate_2bus_table() {
 		say ""
 		rate_why "$f" 2000
 	fi
+	if [ "$(v "$lk" status)" = not ]; then
+		lwhat="lockstep: $(sed -n 's/^status //p' "$lk")"
+	else
+		lwhat="lockstep (virtual time, $(fmt "$(v "$lk" lockstep_sim_s)" 1) s in $(fmt "$(v "$lk" lockstep_wall_s)" 1) s): $(v "$lk" all.overruns) overruns, bus p50 $(fmt "$(v "$lk" all.bus_p50)") µs"
+	fi
 	say ""
-	sum "12 servos on two buses at 500 Hz" "no overrun" "$what"
+	sum "12 servos on two buses at 500 Hz" "no overrun" "$what; $lwhat"
 }
 
 # rate_1k_lockstep: the same robot in virtual time, RATE_1K_S simulated seconds

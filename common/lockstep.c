@@ -21,7 +21,7 @@ const char *lks_type_name(uint32_t type)
 {
 	static const char *const names[] = {
 		[LKS_HELLO] = "HELLO", [LKS_WELCOME] = "WELCOME", [LKS_WAIT] = "WAIT", [LKS_TIME] = "TIME",
-		[LKS_CMD] = "CMD", [LKS_STOP] = "STOP", [LKS_REFUSED] = "REFUSED", [LKS_BYE] = "BYE",
+		[LKS_CMD] = "CMD", [LKS_STOP] = "STOP", [LKS_REFUSED] = "REFUSED", [LKS_BYE] = "BYE", [LKS_PART] = "PART",
 	};
 	return type < sizeof names / sizeof names[0] && names[type] ? names[type] : "UNKNOWN";
 }
@@ -65,7 +65,7 @@ int lks_recv(int fd, struct lks_msg *m, char *why, size_t cap)
 		snprintf(why, cap, "lockstep socket: %s", strerror(errno));
 		return -1;
 	}
-	if (n < (ssize_t)LKS_HEADER_SIZE || m->magic != LKS_MAGIC || m->type < LKS_HELLO || m->type > LKS_BYE) {
+	if (n < (ssize_t)LKS_HEADER_SIZE || m->magic != LKS_MAGIC || m->type < LKS_HELLO || m->type > LKS_PART) {
 		snprintf(why, cap, "lockstep socket: not a lockstep message (%zd bytes, magic %08x): the two "
 		         "programs are from different builds?", n, n >= 4 ? m->magic : 0u);
 		errno = EPROTO;
@@ -156,38 +156,36 @@ static int lks_poll_in(int fd, int ms)
 	return r;
 }
 
-int lks_client_open(struct lks_client *c, const char *sock_path, const char *port_path, const char *robot,
-                    char *err, size_t cap)
+/* One HELLO for ports[i], index i of n. 0, or -1 with err. */
+static int lks_client_hello(struct lks_client *c, const char *port_path, size_t i, size_t n, const char *robot,
+                            char *err, size_t cap)
 {
-	memset(c, 0, sizeof *c);
-	c->fd = -1;
-	struct sockaddr_un sa;
-	if (lks_address(sock_path, &sa, err, cap) != 0)
-		return -1;
-	c->fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
-	if (c->fd < 0 || connect(c->fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
-		snprintf(err, cap, "lockstep: cannot reach the simulator at %s: %s (is undulate-sim running with "
-		         "--lockstep %s?)", sock_path, strerror(errno), sock_path);
-		lks_client_close(c);
-		return -1;
-	}
 	/* the simulator knows its buses by their pty: name the device the link
 	 * points at, wherever either program was started */
 	char resolved[PATH_MAX];
-	struct lks_msg m = { .type = LKS_HELLO, .a = (uint64_t)getpid() };
+	struct lks_msg m = { .type = LKS_HELLO, .a = (uint64_t)getpid(), .b = n, .c = i };
 	const char *name = realpath(port_path, resolved) ? resolved : port_path;
 	if (strlen(name) >= sizeof m.text) {
 		snprintf(err, cap, "lockstep: port path longer than %zu bytes", sizeof m.text - 1);
-		lks_client_close(c);
 		return -1;
 	}
 	memcpy(m.text, name, strlen(name) + 1);
 	snprintf(m.name, sizeof m.name, "%s", robot);
+	if (lks_send(c->fd, &m) != 0) {
+		snprintf(err, cap, "lockstep: %s", strerror(errno));
+		return -1;
+	}
+	return 0;
+}
+
+/* The answer to HELLO i: 0 (WELCOME), or -1 with err. */
+static int lks_client_welcome(struct lks_client *c, const char *sock_path, const char *port_path, char *err,
+                              size_t cap)
+{
+	struct lks_msg m;
 	char why[200];
 	int r;
-	if (lks_send(c->fd, &m) != 0) {
-		snprintf(err, cap, "lockstep: %s: %s", sock_path, strerror(errno));
-	} else if ((r = lks_poll_in(c->fd, LKS_CLIENT_GRACE_MS)) <= 0) {
+	if ((r = lks_poll_in(c->fd, LKS_CLIENT_GRACE_MS)) <= 0) {
 		snprintf(err, cap, "lockstep: the simulator at %s did not answer in %d s", sock_path,
 		         LKS_CLIENT_GRACE_MS / 1000);
 	} else if ((r = lks_recv(c->fd, &m, why, sizeof why)) <= 0) {
@@ -203,24 +201,82 @@ int lks_client_open(struct lks_client *c, const char *sock_path, const char *por
 		lks_client_set_clock(c, m.a);
 		return 0;
 	}
-	lks_client_close(c);
 	return -1;
 }
 
-/* In-band: what was written since the last WAIT goes with this message. */
-static void lks_client_take_out(struct lks_client *c, struct lks_msg *m)
+int lks_client_open_buses(struct lks_client *c, const char *sock_path, const char *const *ports, size_t nports,
+                          const char *robot, char *err, size_t cap)
 {
+	memset(c, 0, sizeof *c);
+	c->fd = -1;
+	if (nports == 0 || nports > LKS_BUSES_MAX) {
+		snprintf(err, cap, "lockstep: %zu buses: a daemon drives 1 to %d", nports, LKS_BUSES_MAX);
+		return -1;
+	}
+	struct sockaddr_un sa;
+	if (lks_address(sock_path, &sa, err, cap) != 0)
+		return -1;
+	c->fd = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+	if (c->fd < 0 || connect(c->fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
+		snprintf(err, cap, "lockstep: cannot reach the simulator at %s: %s (is undulate-sim running with "
+		         "--lockstep %s?)", sock_path, strerror(errno), sock_path);
+		lks_client_close(c);
+		return -1;
+	}
+	/* each answered before the next goes: a refusal names its port */
+	for (size_t i = 0; i < nports; i++)
+		if (lks_client_hello(c, ports[i], i, nports, robot, err, cap) != 0 ||
+		    lks_client_welcome(c, sock_path, ports[i], err, cap) != 0) {
+			lks_client_close(c);
+			return -1;
+		}
+	c->nbuses = nports;
+	return 0;
+}
+
+int lks_client_open(struct lks_client *c, const char *sock_path, const char *port_path, const char *robot,
+                    char *err, size_t cap)
+{
+	return lks_client_open_buses(c, sock_path, &port_path, 1, robot, err, cap);
+}
+
+/* In-band: what was written on bus since the last WAIT goes with this message. */
+static void lks_client_take_out(struct lks_client *c, size_t bus, struct lks_msg *m)
+{
+	struct lks_bus *b = &c->bus[bus];
 	if (!c->inband)
 		return;
-	memcpy(m->bytes, c->out, c->nout);
-	m->nbytes = (uint32_t)c->nout;
-	c->nout = 0;
+	memcpy(m->bytes, b->out, b->nout);
+	m->nbytes = (uint32_t)b->nout;
+	b->nout = 0;
+}
+
+/* A WAIT's or BYE's news for bus (its flags; the message's own for bus 0). */
+static uint32_t lks_client_flags(struct lks_client *c, size_t bus, unsigned want_input)
+{
+	struct lks_bus *b = &c->bus[bus];
+	uint32_t f = ((want_input >> bus) & 1u ? LKS_WANT_INPUT : 0u) | (b->port_opened ? LKS_PORT_OPENED : 0u) |
+	             (b->rate_set ? LKS_RATE_SET : 0u);
+	b->port_opened = b->rate_set = false;
+	return f;
+}
+
+/* The PARTs that go before a WAIT or BYE: every bus but the first. */
+static int lks_client_parts(struct lks_client *c, unsigned want_input)
+{
+	for (size_t i = 1; i < c->nbuses; i++) {
+		struct lks_msg m = { .type = LKS_PART, .c = i, .flags = lks_client_flags(c, i, want_input) };
+		lks_client_take_out(c, i, &m);
+		if (lks_send(c->fd, &m) != 0)
+			return -1;
+	}
+	return 0;
 }
 
 /* In-band: a TIME's bytes after the ones not read yet; what does not fit is
  * counted (the daemon reads every TIME's bytes before it waits again, so
  * this takes a bus that talks without being asked). */
-static void lks_client_deliver(struct lks_client *c, const uint8_t *bytes, size_t n)
+static void lks_client_deliver(struct lks_bus *c, const uint8_t *bytes, size_t n)
 {
 	if (c->in_off > 0) {
 		memmove(c->in, c->in + c->in_off, c->nin - c->in_off);
@@ -234,13 +290,15 @@ static void lks_client_deliver(struct lks_client *c, const uint8_t *bytes, size_
 	c->in_dropped += (long long)(n - take);
 }
 
-void lks_client_port_opened(struct lks_client *c)
+void lks_client_port_opened(struct lks_client *c, size_t bus)
 {
-	c->consumed = c->delivered;
-	c->in_off = c->nin = 0;
-	c->nout = 0;
-	c->bus_gone = false;
-	c->port_opened = true;
+	struct lks_bus *b = &c->bus[bus];
+	if (bus == 0)
+		c->consumed = c->delivered;
+	b->in_off = b->nin = 0;
+	b->nout = 0;
+	b->bus_gone = false;
+	b->port_opened = true;
 }
 
 void lks_client_close(struct lks_client *c)
@@ -248,13 +306,18 @@ void lks_client_close(struct lks_client *c)
 	if (c->fd < 0)
 		return;
 	struct lks_msg m = { .type = LKS_BYE };
-	lks_client_take_out(c, &m);
-	(void)lks_send(c->fd, &m);
+	lks_client_take_out(c, 0, &m);
+	/* the other buses' last bytes in PARTs before it; not while a WAIT is
+	 * out: the simulator takes a PART only before a WAIT or BYE of a
+	 * daemon it is not holding, and a daemon that left without its TIME
+	 * wrote nothing since that WAIT */
+	if (c->waiting || lks_client_parts(c, 0) == 0)
+		(void)lks_send(c->fd, &m);
 	close(c->fd);
 	c->fd = -1;
 }
 
-int lks_client_wait(struct lks_client *c, uint64_t wake_us, bool want_input)
+int lks_client_wait(struct lks_client *c, uint64_t wake_us, unsigned want_input)
 {
 	if (c->fd < 0)
 		return -1;
@@ -263,16 +326,12 @@ int lks_client_wait(struct lks_client *c, uint64_t wake_us, bool want_input)
 	uint64_t wake_ns = LKS_NEVER;
 	if (wake_us != UINT64_MAX)
 		wake_ns = wake_us > c->mono0_us ? (wake_us - c->mono0_us) * 1000u : 0;
-	struct lks_msg m = {
-		.type = LKS_WAIT, .a = wake_ns, .b = c->written,
-		.flags = (want_input ? LKS_WANT_INPUT : 0u) | (c->port_opened ? LKS_PORT_OPENED : 0u) |
-		         (c->rate_set ? LKS_RATE_SET : 0u),
-	};
-	lks_client_take_out(c, &m);
+	if (lks_client_parts(c, want_input) != 0)
+		return -1;
+	struct lks_msg m = { .type = LKS_WAIT, .a = wake_ns, .b = c->written, .flags = lks_client_flags(c, 0, want_input) };
+	lks_client_take_out(c, 0, &m);
 	if (lks_send(c->fd, &m) != 0)
 		return -1;
-	c->port_opened = false;
-	c->rate_set = false;
 	c->waiting = true;
 	return 0;
 }
@@ -283,19 +342,30 @@ int lks_client_read(struct lks_client *c, char *why, size_t cap)
 	int r = lks_recv(c->fd, &m, why, cap);
 	if (r <= 0)
 		return r;
-	if (m.nbytes > 0 && (m.type != LKS_TIME || !c->inband)) {
+	if (m.nbytes > 0 && ((m.type != LKS_TIME && m.type != LKS_PART) || !c->inband)) {
 		snprintf(why, cap, "lockstep: a %s from the simulator carries %u bus bytes (%s)", lks_type_name(m.type),
-		         m.nbytes, c->inband ? "only a TIME does" : "the bytes go through the pty in this run");
+		         m.nbytes, c->inband ? "only a TIME or a PART does" : "the bytes go through the pty in this run");
 		errno = EPROTO;
 		return -1;
 	}
 	switch (m.type) {
+	case LKS_PART:
+		if (m.c < 1 || m.c >= c->nbuses) {
+			c->bad_parts++;
+			snprintf(why, cap, "lockstep: a PART from the simulator for bus %llu; this daemon named %zu bus(es)",
+			         (unsigned long long)m.c, c->nbuses);
+			errno = EPROTO;
+			return -1;
+		}
+		c->bus[m.c].bus_gone = (m.flags & LKS_BUS_GONE) != 0;
+		lks_client_deliver(&c->bus[m.c], m.bytes, m.nbytes);
+		break;
 	case LKS_TIME:
 		c->waiting = false;
 		c->time_moved = true;
 		c->delivered = m.b;
-		c->bus_gone = (m.flags & LKS_BUS_GONE) != 0;
-		lks_client_deliver(c, m.bytes, m.nbytes);
+		c->bus[0].bus_gone = (m.flags & LKS_BUS_GONE) != 0;
+		lks_client_deliver(&c->bus[0], m.bytes, m.nbytes);
 		lks_client_set_clock(c, m.a > c->t_ns ? m.a : c->t_ns);
 		break;
 	case LKS_CMD:
@@ -316,7 +386,7 @@ int lks_client_read(struct lks_client *c, char *why, size_t cap)
 	return (int)m.type;
 }
 
-int lks_client_block(struct lks_client *c, uint64_t wake_us, bool want_input, char *why, size_t cap)
+int lks_client_block(struct lks_client *c, uint64_t wake_us, unsigned want_input, char *why, size_t cap)
 {
 	if (lks_client_wait(c, wake_us, want_input) != 0) {
 		snprintf(why, cap, "lockstep: the simulator is gone (%s)", strerror(errno));

@@ -5,8 +5,8 @@
  *
  * The simulator owns time. Each daemon connects to its lockstep socket (a
  * local SOCK_SEQPACKET socket: one message a datagram, in order, and the end
- * of a peer is seen as the end of the stream), names the bus it drives, and
- * from then on never reads the system's clock: when it has nothing to do
+ * of a peer is seen as the end of the stream), names the bus (or buses:
+ * "Several buses" below) it drives, and from then on never reads the system's clock: when it has nothing to do
  * until some time, or until its bus answers, it says so (WAIT) and blocks
  * until the simulator says what time it is (TIME). The simulator advances
  * its time only while every daemon is blocked, to the earliest of: its next
@@ -41,7 +41,11 @@
  *
  * Messages (struct lks_msg: a fixed header and, on the wire, only nbytes of
  * its payload; same machine so host byte order):
- *   daemon → sim: HELLO  a = pid, text = the bus's port path, name = robot
+ *   daemon → sim: HELLO  a = pid, text = the bus's port path, name = robot,
+ *                        b = buses this daemon drives (0 is taken for 1),
+ *                        c = this bus's index among them (0 .. b - 1):
+ *                        one HELLO a bus, in index order, each answered
+ *                        (WELCOME or REFUSED; see "Several buses" below)
  *                 WAIT   a = wake-up (virtual ns, LKS_NEVER: none),
  *                        b = bytes written to the bus (pty transport),
  *                        flags LKS_WANT_INPUT: wake up as soon as bytes
@@ -69,6 +73,28 @@
  *                        the robot's local socket (sent just before a TIME)
  *                 STOP   text = why: the run is over, stop as on SIGTERM
  *                 REFUSED text = why the daemon cannot join
+ *   both ways:    PART   c = a bus index (1 .. buses - 1), flags and payload
+ *                        as a WAIT's (daemon → sim) or a TIME's (sim →
+ *                        daemon) say them for bus 0: the part of the WAIT,
+ *                        BYE or TIME that follows it that is that bus's
+ *
+ * Several buses (a robot whose joints are on several ports, daemon/README.md
+ * "Several buses"): one daemon, one connection, one clock. The daemon is
+ * blocked or not as a whole (its one loop drives every bus), so the
+ * simulator's barrier counts it once, and keeps per bus what each port did
+ * (opened, rate set, bytes owed, gone). It names each bus with its own HELLO
+ * (index c of b): a list would not fit one HELLO's text (four paths of up to
+ * 255 bytes), and each bus is found, refused ("no bus there", "already has
+ * a daemon") and answered as a lone daemon's is. Each WAIT (and BYE) is
+ * preceded by one PART for every bus but the first, each TIME likewise: the
+ * message itself is bus 0's, unchanged, so a one-bus daemon's messages are
+ * exactly what they were (its runs stay byte-identical), and a bus's bytes
+ * keep the framing and the limit (LKS_BYTES_MAX) they have on one bus. The
+ * socket keeps the order of datagrams, and time moves only once the WAIT
+ * itself has come: a WAIT's PARTs are all in by then, at the same virtual
+ * time. A PART for a bus index the daemon did not name is refused and
+ * counted on either side. The pty transport carries one bus a daemon (its
+ * counts are the bus's): a daemon naming several is refused there.
  */
 #ifndef UNDULATE_COMMON_LOCKSTEP_H
 #define UNDULATE_COMMON_LOCKSTEP_H
@@ -77,10 +103,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define LKS_MAGIC 0x4c4b5332u        /* "LKS2": a version change changes it (2: bytes in band) */
+#define LKS_MAGIC 0x4c4b5333u        /* "LKS3": a version change changes it (2: bytes in band, 3: PART) */
 #define LKS_TEXT_MAX 256             /* a port path, a command, a reason */
 #define LKS_NAME_MAX 32
 #define LKS_NEVER UINT64_MAX
+/* Buses one daemon drives (its configuration's CFG_MAX_BUSES). */
+#define LKS_BUSES_MAX 4
 #define LKS_WANT_INPUT 1u            /* WAIT */
 #define LKS_PORT_OPENED 2u           /* WAIT */
 #define LKS_INBAND 4u                /* WELCOME */
@@ -117,7 +145,7 @@
 #define LKS_MONO0_US 1000000000ULL
 
 enum lks_type {
-	LKS_HELLO = 1, LKS_WELCOME, LKS_WAIT, LKS_TIME, LKS_CMD, LKS_STOP, LKS_REFUSED, LKS_BYE,
+	LKS_HELLO = 1, LKS_WELCOME, LKS_WAIT, LKS_TIME, LKS_CMD, LKS_STOP, LKS_REFUSED, LKS_BYE, LKS_PART,
 };
 
 struct lks_msg {
@@ -150,16 +178,11 @@ int lks_recv(int fd, struct lks_msg *m, char *why, size_t cap);
 int lks_listen(const char *path, char *err, size_t cap);
 
 /* ---- the daemon's side -------------------------------------------------------- */
-struct lks_client {
-	int fd;
-	uint64_t mono0_us;          /* the daemon's monotonic clock at virtual 0 */
-	int64_t wall0_us;
-	uint64_t t_ns;              /* virtual now */
-	bool inband;                /* the bus bytes travel in WAIT and TIME (WELCOME said so) */
-	/* pty transport: bus bytes written by us, released by the simulator, read by us */
-	uint64_t written, delivered, consumed;
-	/* in-band transport: bytes written since the last WAIT; bytes the
-	 * TIMEs delivered, in[in_off .. nin) not read yet */
+/* One bus's bytes and news (in-band): bus 0's go in the WAIT and TIME
+ * themselves, the others' in the PARTs before them. */
+struct lks_bus {
+	/* bytes written since the last WAIT; bytes the TIMEs (PARTs) delivered,
+	 * in[in_off .. nin) not read yet */
 	uint8_t out[LKS_BYTES_MAX];
 	size_t nout;
 	uint8_t in[LKS_BYTES_MAX];
@@ -169,6 +192,20 @@ struct lks_client {
 	bool bus_gone;              /* the last TIME said LKS_BUS_GONE */
 	long long too_long;         /* writes refused: more than LKS_BYTES_MAX between two WAITs */
 	long long in_dropped;       /* delivered bytes that did not fit unread ones */
+};
+
+struct lks_client {
+	int fd;
+	uint64_t mono0_us;          /* the daemon's monotonic clock at virtual 0 */
+	int64_t wall0_us;
+	uint64_t t_ns;              /* virtual now */
+	bool inband;                /* the bus bytes travel in WAIT and TIME (WELCOME said so) */
+	/* pty transport (one bus): bus bytes written by us, released by the
+	 * simulator, read by us */
+	uint64_t written, delivered, consumed;
+	struct lks_bus bus[LKS_BUSES_MAX];
+	size_t nbuses;              /* named in HELLOs (1 when opened with one port) */
+	long long bad_parts;        /* PARTs from the simulator for a bus we did not name */
 	bool waiting;               /* a WAIT is out and no TIME has answered it */
 	bool time_moved;            /* a TIME came since lks_client_take_time() */
 	bool stop;                  /* the simulator ended the run */
@@ -184,14 +221,19 @@ struct lks_client {
  * -1 with err (no simulator there, refused, or no answer in time). */
 int lks_client_open(struct lks_client *c, const char *sock_path, const char *port_path, const char *robot,
                     char *err, size_t cap);
+/* The same for a daemon driving nports buses (1 .. LKS_BUSES_MAX): one HELLO
+ * each, index i for ports[i]; every one must be welcomed. */
+int lks_client_open_buses(struct lks_client *c, const char *sock_path, const char *const *ports, size_t nports,
+                          const char *robot, char *err, size_t cap);
 /* Say goodbye and close (nothing if not open). */
 void lks_client_close(struct lks_client *c);
 /* Virtual now on the daemon's monotonic clock (µs). */
 uint64_t lks_client_now_us(const struct lks_client *c);
-/* Block until wake_us (the daemon's monotonic µs) or, with want_input, until
- * bus bytes arrive: send the WAIT (once: a WAIT already out is not sent
- * again). 0, or -1 when the simulator is gone. */
-int lks_client_wait(struct lks_client *c, uint64_t wake_us, bool want_input);
+/* Block until wake_us (the daemon's monotonic µs) or until bus bytes arrive
+ * on a bus whose bit is set in want_input (bit i: bus i; true is bus 0):
+ * send the WAIT, after a PART for every bus but the first (once: a WAIT
+ * already out is not sent again). 0, or -1 when the simulator is gone. */
+int lks_client_wait(struct lks_client *c, uint64_t wake_us, unsigned want_input);
 /* The socket is readable: take one message. Returns its type, 0 when the
  * simulator closed the socket, -1 on an error (with why). TIME sets the
  * virtual clock; CMD is queued; STOP sets c->stop. */
@@ -199,11 +241,11 @@ int lks_client_read(struct lks_client *c, char *why, size_t cap);
 /* Send a WAIT and read until the TIME that answers it (queueing commands,
  * noting STOP): what a blocking bus call does. 0, or -1 (simulator gone or
  * silent for LKS_CLIENT_GRACE_MS; why says which). */
-int lks_client_block(struct lks_client *c, uint64_t wake_us, bool want_input, char *why, size_t cap);
-/* The daemon (re)opened its bus's port: what was delivered for the one
- * before is not for it (both transports), and the simulator hears so with
- * the next WAIT. */
-void lks_client_port_opened(struct lks_client *c);
+int lks_client_block(struct lks_client *c, uint64_t wake_us, unsigned want_input, char *why, size_t cap);
+/* The daemon (re)opened bus's port: what was delivered for the one before
+ * is not for it (both transports), and the simulator hears so with the next
+ * WAIT. */
+void lks_client_port_opened(struct lks_client *c, size_t bus);
 /* True once after each TIME: the daemon's loop has a new "now" to act on. */
 bool lks_client_take_time(struct lks_client *c);
 /* The next queued command into out (false when none). */

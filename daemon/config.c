@@ -1160,9 +1160,6 @@ static void cfg_check_buses(struct cfg *c, struct cfg_errors *e)
 		cfg_error(e, "%s: [robot] actuation: torque actuation on several buses is refused: a lost bus holds the "
 		          "other buses' joints by their goals, which torque actuation does not send; run it on one bus, "
 		          "or in position actuation", src);
-	if (cfg_buses_used(c) > 1 && c->lockstep[0] != '\0')
-		cfg_error(e, "%s: [robot] lockstep: a robot on several buses cannot run in lockstep (the simulator's "
-		          "clock serves one port per daemon): run it in real time, or on one bus", src);
 }
 
 bool cfg_finish(struct cfg *c, struct cfg_errors *e)

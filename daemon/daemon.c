@@ -153,7 +153,7 @@ struct dmn {
 	/* lockstep: the simulator's clock paces the loop (common/lockstep.h) */
 	bool lockstep;
 	struct lks_client lks;
-	struct port_lockstep lks_port;
+	struct port_lockstep lks_port[CFG_MAX_BUSES];   /* bus i's, clock bus i */
 	uint64_t next_tick_us;        /* lockstep: the next tick on the period's grid */
 	bool clock_lost;              /* lockstep: the simulator went away mid-run */
 	/* --tune: the tuner, fed every cycle (NULL in normal runs) */
@@ -458,6 +458,7 @@ static double dmn_ctl_time(const struct dmn *d, uint64_t t_us)
 	return 1e-6 * (double)(t_us - d->epoch_us);
 }
 
+_Static_assert(CFG_MAX_BUSES <= LKS_BUSES_MAX, "the clock carries every bus a robot may have");
 _Static_assert((int)CFG_PROTO_1 == (int)BUS_PROTOCOL_1 && (int)CFG_PROTO_2 == (int)BUS_PROTOCOL_2,
                "a configured protocol is the bus's by its number");
 
@@ -676,7 +677,8 @@ static bool dmn_connect_bus(struct dmn *d, struct dmn_bus *b, char *err, size_t 
 	}
 	struct bus_io io;
 	if (d->lockstep) {
-		port_bus_io_lockstep(&d->lks_port, b->port, &d->lks, &io);
+		size_t i = (size_t)(b - d->buses);
+		port_bus_io_lockstep(&d->lks_port[i], b->port, &d->lks, i, &io);
 	} else {
 		port_bus_io(b->port, &io);
 	}
@@ -1271,17 +1273,19 @@ static void dmn_lks_start(struct dmn *d) { (void)d; }
 static void dmn_lks_arm_deadline(struct dmn *d) { (void)d; }
 
 /* Tell the simulator until when there is nothing to do (the next tick, the
- * bus deadline) and whether the bus awaits a reply: time moves only while
- * every daemon has said so. */
+ * earliest bus deadline) and which buses await a reply (bit i: bus i, the
+ * clock's bus i): time moves only while every daemon has said so. */
 static void dmn_lks_before_wait(struct dmn *d)
 {
-	/* one bus: a robot on several cannot run in lockstep (cfg_finish) */
-	const struct dmn_bus *b = &d->buses[0];
+	unsigned want = 0;
+	for (size_t i = 0; i < d->nbuses; i++)
+		if (d->buses[i].connected && bus_is_pending(&d->buses[i].bus))
+			want |= 1u << i;
 	uint64_t wake = d->next_tick_us;
 	uint64_t dl = dmn_deadline_us(d);
 	if (dl != 0 && dl < wake)
 		wake = dl;
-	if (lks_client_wait(&d->lks, wake, b->connected && bus_is_pending(&b->bus)) != 0)
+	if (lks_client_wait(&d->lks, wake, want) != 0)
 		dmn_clock_lost(d, "lockstep: the simulator is gone");
 }
 
@@ -1313,7 +1317,8 @@ static void dmn_lks_woke(struct dmn *d, const struct pollfd *pfd, struct dmn_wak
 	if (!lks_client_take_time(&d->lks))
 		return;
 	uint64_t now = now_us();
-	w->bus_in[0] = d->buses[0].connected && bus_is_pending(&d->buses[0].bus);
+	for (size_t i = 0; i < d->nbuses; i++)
+		w->bus_in[i] = d->buses[i].connected && bus_is_pending(&d->buses[i].bus);
 	if (now >= d->next_tick_us) {
 		w->ticks = 1 + (now - d->next_tick_us) / d->period_us;
 		w->now = now;
@@ -1425,7 +1430,10 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 	if (cfg->lockstep[0] != '\0') {
 		/* from here on the clock is the simulator's: before the start-up
 		 * checks, whose bus transactions take virtual time too */
-		if (lks_client_open(&d->lks, cfg->lockstep, d->buses[0].port_path, cfg->name, err, sizeof err) != 0) {
+		const char *ports[CFG_MAX_BUSES];
+		for (size_t i = 0; i < d->nbuses; i++)
+			ports[i] = d->buses[i].port_path;
+		if (lks_client_open_buses(&d->lks, cfg->lockstep, ports, d->nbuses, cfg->name, err, sizeof err) != 0) {
 			log_error("%s", err);
 			cin_close(&d->cin);
 			pub_close(&d->pub);
@@ -1498,10 +1506,16 @@ static int dmn_run_with(const struct cfg *cfg, struct tune *tune, FILE *tune_out
 		         "late), %lld cycle(s) still on the bus at the next tick (%lld of them had begun over half a "
 		         "period late)",
 		         d->overruns, d->cycle, d->overruns_skipped, d->overruns_cut, d->overruns_cut_late);
-	if (d->lks.resyncs > 0 || d->lks.cmds_dropped > 0 || d->lks.too_long > 0 || d->lks.in_dropped > 0)
+	long long too_long = 0, in_dropped = 0;
+	for (size_t b = 0; b < LKS_BUSES_MAX; b++) {
+		too_long += d->lks.bus[b].too_long;
+		in_dropped += d->lks.bus[b].in_dropped;
+	}
+	if (d->lks.resyncs > 0 || d->lks.cmds_dropped > 0 || too_long > 0 || in_dropped > 0 || d->lks.bad_parts > 0)
 		log_warn("lockstep: %lld announced bus byte count(s) set right, %lld clock command(s) dropped, %lld bus "
 		         "write(s) refused as longer than a clock message carries, %lld delivered bus byte(s) dropped "
-		         "unread", d->lks.resyncs, d->lks.cmds_dropped, d->lks.too_long, d->lks.in_dropped);
+		         "unread, %lld message(s) for a bus not named", d->lks.resyncs, d->lks.cmds_dropped, too_long,
+		         in_dropped, d->lks.bad_parts);
 	lks_client_close(&d->lks);
 	cin_close(&d->cin);
 	pub_close(&d->pub);

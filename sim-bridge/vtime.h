@@ -23,21 +23,14 @@
 #include "lockstep.h"
 #include "sim.h"
 
-/* One daemon per bus, and a few connections that are not (yet) one. */
+/* At most one daemon per bus, and a few connections that are not (yet) one. */
 #define VT_MAX_CLIENTS (SIM_MAX_BUSES + 4)
 #define VT_WHY_MAX 400
 
-struct vt_client {
-	int fd;                     /* -1: free */
-	int bus;                    /* index into sim->buses; -1 before HELLO */
-	char robot[LKS_NAME_MAX];
-	long pid;
-	bool blocked;               /* its WAIT is the last word: it does nothing until woken */
-	uint64_t wake_ns;           /* LKS_NEVER: only input or a command wakes it */
-	bool want_input;
-	uint64_t written;           /* bus bytes it has written (its last WAIT) */
-	uint64_t rx_base, tx_base;  /* the bus's counters when it joined */
-	uint64_t told;              /* bus bytes released toward it, as its last TIME said */
+/* One bus of a daemon's (its index on the connection: the HELLO's c). */
+struct vt_link {
+	int bus;                    /* index into sim->buses */
+	bool want_input;            /* its last WAIT (PART) asked to be woken by this bus's bytes */
 	/* in-band: which of the bus's ptys its port is on (sim_bus.opens; 0:
 	 * none yet), and the bytes released toward it since its last TIME */
 	uint64_t port_open;
@@ -45,6 +38,23 @@ struct vt_client {
 	size_t nout;
 	bool said_lost;             /* bytes for a port gone said once */
 	bool rate_unread;           /* in-band: it opened its port or set its rate since its last bytes */
+};
+
+/* A daemon: one connection, one barrier entry, one or several buses. */
+struct vt_client {
+	int fd;                     /* -1: free */
+	int bus;                    /* its first bus (l[0].bus); -1 until every HELLO came */
+	struct vt_link l[LKS_BUSES_MAX];
+	size_t nl;                  /* buses named so far */
+	size_t nnamed;              /* buses it said it drives (its first HELLO's b) */
+	char robot[LKS_NAME_MAX];
+	long pid;
+	bool blocked;               /* its WAIT is the last word: it does nothing until woken */
+	uint64_t wake_ns;           /* LKS_NEVER: only input or a command wakes it */
+	/* the pty transport (one bus): */
+	uint64_t written;           /* bus bytes it has written (its last WAIT) */
+	uint64_t rx_base, tx_base;  /* the bus's counters when it joined */
+	uint64_t told;              /* bus bytes released toward it, as its last TIME said */
 	char cmds[LKS_CMD_QUEUE][LKS_TEXT_MAX];
 	size_t ncmds;
 	bool stop_pending;          /* STOP goes with its next TIME */
@@ -57,7 +67,7 @@ struct vt {
 	int listen_fd;
 	char path[256];
 	struct vt_client c[VT_MAX_CLIENTS];
-	size_t expected;            /* daemons the run waits for: one per bus */
+	size_t expected;            /* buses the run waits for daemons on: every one */
 	uint64_t t_ns;              /* virtual now */
 	uint64_t mono0_us;          /* the daemons' monotonic clock at virtual 0 */
 	int64_t wall0_us;           /* and the wall clock */
@@ -66,13 +76,14 @@ struct vt {
 	bool failed;                /* the run ended because something went wrong */
 	char end_why[VT_WHY_MAX];
 	uint64_t joined, left, refused, bad_messages, commands, wakes;
+	uint64_t bad_parts;         /* PARTs for a bus index the daemon did not name (also in bad_messages) */
 	/* in-band: bytes a daemon wrote to a port that is gone (the pty's EIO),
 	 * or on the pty transport in a WAIT; bytes toward a daemon its TIME could
 	 * not hold */
 	uint64_t bytes_lost, bytes_dropped;
 };
 
-/* Listen at path for `expected` daemons. mono0_us / wall0_us: the clocks'
+/* Listen at path for daemons on `expected` buses. mono0_us / wall0_us: the clocks'
  * values at virtual time 0. The bytes go in-band unless v->inband is
  * cleared before the first daemon joins. 0, or -1 with err. */
 int vt_open(struct vt *v, const char *path, size_t expected, uint64_t mono0_us, int64_t wall0_us, char *err,
@@ -81,13 +92,15 @@ int vt_open(struct vt *v, const char *path, size_t expected, uint64_t mono0_us, 
 void vt_close(struct vt *v);
 /* A connection waits on the listening socket. */
 void vt_accept(struct vt *v);
-/* Client i's socket is readable: take one message (HELLO, WAIT, BYE, or its
- * end). In-band, the bytes a WAIT or BYE carries go into its bus now
+/* Client i's socket is readable: take one message (HELLO, PART, WAIT, BYE,
+ * or its end). In-band, the bytes a WAIT or BYE carries go into its bus now
  * (sim_bus_receive). wall_ns: the wall clock now. */
 void vt_on_client(struct vt *v, struct sim *s, size_t i, int64_t wall_ns);
-/* Daemons connected and joined to a bus. */
+/* Daemons connected and joined (every bus each named). */
 size_t vt_clients(const struct vt *v);
-/* Time may move: every expected daemon has joined (unless the run is
+/* Buses those daemons cover. */
+size_t vt_buses_covered(const struct vt *v);
+/* Time may move: daemons on every expected bus have joined (unless the run is
  * ending), every one is blocked, and (pty transport) every byte each has
  * written to its bus has been read by the simulator; in-band they came with
  * its WAIT. */

@@ -75,8 +75,10 @@ struct port_lockstep {
 	struct port *port;
 	struct lks_client *clock;
 	long rate_told;             /* in-band: the port's rate the simulator was last told of */
+	size_t bus;                 /* which of the clock's buses (lks_client_open_buses); the pty transport: 0 */
 };
-void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_client *clock, struct bus_io *io);
+void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_client *clock, size_t bus,
+                          struct bus_io *io);
 
 /* ---- RS-485 direction control (an on-board UART with a half-duplex buffer) ---- */
 /* A single-board computer's UART drives the Dynamixel line through a tri-state

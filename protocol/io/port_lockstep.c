@@ -101,7 +101,9 @@ static uint64_t pl_now(void *ctx)
 
 /* ---- in-band: the bytes travel in WAIT and TIME ------------------------------------ */
 
-static size_t pl_unread(const struct lks_client *c) { return c->nin - c->in_off; }
+static size_t pl_unread(const struct lks_bus *c) { return c->nin - c->in_off; }
+
+static struct lks_bus *pl_bus(struct port_lockstep *pl) { return &pl->clock->bus[pl->bus]; }
 
 /* What the TIMEs delivered: all of it is here already. Nothing is nothing,
  * even on a port the simulator took away: the pty transport reads only
@@ -110,7 +112,7 @@ static size_t pl_unread(const struct lks_client *c) { return c->nin - c->in_off;
 static long pl_band_read(void *ctx, uint8_t *buf, size_t cap)
 {
 	struct port_lockstep *pl = ctx;
-	struct lks_client *c = pl->clock;
+	struct lks_bus *c = pl_bus(pl);
 	size_t n = pl_unread(c);
 	if (n == 0)
 		return 0;
@@ -129,7 +131,7 @@ static long pl_band_read(void *ctx, uint8_t *buf, size_t cap)
 static int pl_band_write(void *ctx, const uint8_t *buf, size_t n)
 {
 	struct port_lockstep *pl = ctx;
-	struct lks_client *c = pl->clock;
+	struct lks_bus *c = pl_bus(pl);
 	if (c->bus_gone)
 		return DXL_E_DISCONNECTED;
 	/* a new rate on the pty: the simulator reads it before these bytes */
@@ -147,7 +149,7 @@ static int pl_band_write(void *ctx, const uint8_t *buf, size_t n)
 	}
 	memcpy(c->out + c->nout, buf, n);
 	c->nout += n;
-	c->written += n;
+	pl->clock->written += n;
 	return DXL_OK;
 }
 
@@ -155,32 +157,35 @@ static int pl_band_wait(void *ctx, uint32_t timeout_us)
 {
 	struct port_lockstep *pl = ctx;
 	struct lks_client *c = pl->clock;
-	if (pl_unread(c) > 0)
+	if (pl_unread(pl_bus(pl)) > 0)
 		return 1;
+	/* the whole daemon waits: only this bus's bytes wake it early */
 	char why[160];
-	if (lks_client_block(c, lks_client_now_us(c) + timeout_us, true, why, sizeof why) != 0)
+	if (lks_client_block(c, lks_client_now_us(c) + timeout_us, 1u << pl->bus, why, sizeof why) != 0)
 		return DXL_E_DISCONNECTED;
-	return pl_unread(c) > 0 ? 1 : 0;
+	return pl_unread(pl_bus(pl)) > 0 ? 1 : 0;
 }
 
 static void pl_band_flush(void *ctx)
 {
 	struct port_lockstep *pl = ctx;
-	pl->clock->in_off = pl->clock->nin = 0;
+	pl_bus(pl)->in_off = pl_bus(pl)->nin = 0;
 }
 
 static long pl_band_pending(void *ctx)
 {
 	struct port_lockstep *pl = ctx;
-	return (long)pl_unread(pl->clock);
+	return (long)pl_unread(pl_bus(pl));
 }
 
-void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_client *clock, struct bus_io *io)
+void port_bus_io_lockstep(struct port_lockstep *pl, struct port *p, struct lks_client *clock, size_t bus,
+                          struct bus_io *io)
 {
 	pl->port = p;
 	pl->clock = clock;
+	pl->bus = bus < LKS_BUSES_MAX ? bus : 0;
 	pl->rate_told = p ? port_baud(p) : 0;   /* the opening says so: LKS_PORT_OPENED */
-	lks_client_port_opened(clock);
+	lks_client_port_opened(clock, pl->bus);
 	if (clock->inband)
 		*io = (struct bus_io){
 			.ctx = pl, .write = pl_band_write, .read = pl_band_read, .wait = pl_band_wait, .now_us = pl_now,

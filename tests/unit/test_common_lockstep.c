@@ -352,12 +352,12 @@ static void test_inband_client(void **state)
 	client_pair(&c, &sim);
 	c.inband = true;
 	/* what was written goes with the WAIT, once; the port's opening too */
-	memcpy(c.out, "\xff\xff\x01\x02", 4);
-	c.nout = 4;
-	lks_client_port_opened(&c);
-	assert_int_equal(c.nout, 0);   /* written for the port before: not for this one */
-	memcpy(c.out, "ping", 4);
-	c.nout = 4;
+	memcpy(c.bus[0].out, "\xff\xff\x01\x02", 4);
+	c.bus[0].nout = 4;
+	lks_client_port_opened(&c, 0);
+	assert_int_equal(c.bus[0].nout, 0);   /* written for the port before: not for this one */
+	memcpy(c.bus[0].out, "ping", 4);
+	c.bus[0].nout = 4;
 	assert_int_equal(lks_client_wait(&c, LKS_MONO0_US + 1000, true), 0);
 	struct lks_msg m;
 	char why[200];
@@ -366,36 +366,36 @@ static void test_inband_client(void **state)
 	assert_int_equal(m.flags, LKS_WANT_INPUT | LKS_PORT_OPENED);
 	assert_int_equal(m.nbytes, 4);
 	assert_memory_equal(m.bytes, "ping", 4);
-	assert_int_equal(c.nout, 0);
+	assert_int_equal(c.bus[0].nout, 0);
 	/* TIMEs' bytes queue behind the unread ones */
 	sim_send_bytes(sim, 1000, 0, "abc", 3);
 	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
-	assert_int_equal(c.nin - c.in_off, 3);
-	c.in_off = 1;   /* the daemon read one */
+	assert_int_equal(c.bus[0].nin - c.bus[0].in_off, 3);
+	c.bus[0].in_off = 1;   /* the daemon read one */
 	sim_send_bytes(sim, 2000, 0, "de", 2);
 	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
-	assert_int_equal(c.nin - c.in_off, 4);
-	assert_memory_equal(c.in + c.in_off, "bcde", 4);
-	assert_false(c.bus_gone);
+	assert_int_equal(c.bus[0].nin - c.bus[0].in_off, 4);
+	assert_memory_equal(c.bus[0].in + c.bus[0].in_off, "bcde", 4);
+	assert_false(c.bus[0].bus_gone);
 	/* more than fits unread is counted, not overrun */
 	static uint8_t many[LKS_BYTES_MAX];
 	sim_send_bytes(sim, 3000, LKS_BUS_GONE, many, sizeof many);
 	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
-	assert_int_equal(c.nin, LKS_BYTES_MAX);
-	assert_int_equal(c.in_dropped, 4);
-	assert_true(c.bus_gone);
+	assert_int_equal(c.bus[0].nin, LKS_BYTES_MAX);
+	assert_int_equal(c.bus[0].in_dropped, 4);
+	assert_true(c.bus[0].bus_gone);
 	/* a (re)opened port starts clean */
-	lks_client_port_opened(&c);
-	assert_int_equal(c.nin, 0);
-	assert_false(c.bus_gone);
+	lks_client_port_opened(&c, 0);
+	assert_int_equal(c.bus[0].nin, 0);
+	assert_false(c.bus[0].bus_gone);
 	/* bytes in a message that carries none */
 	struct lks_msg cmd = { .type = LKS_CMD, .nbytes = 1 };
 	assert_int_equal(lks_send(sim, &cmd), 0);
 	assert_int_equal(lks_client_read(&c, why, sizeof why), -1);
 	assert_non_null(strstr(why, "a CMD from the simulator carries 1 bus bytes"));
 	/* the last bytes go with BYE */
-	memcpy(c.out, "bye", 3);
-	c.nout = 3;
+	memcpy(c.bus[0].out, "bye", 3);
+	c.bus[0].nout = 3;
 	lks_client_close(&c);
 	assert_int_equal(lks_recv(sim, &m, why, sizeof why), 1);
 	assert_int_equal(m.type, LKS_BYE);
@@ -409,7 +409,7 @@ static void test_pty_transport_refuses_bytes(void **state)
 	struct lks_client c;
 	int sim;
 	client_pair(&c, &sim);   /* WELCOME said nothing of in-band */
-	c.nout = 0;
+	c.bus[0].nout = 0;
 	sim_send_bytes(sim, 1000, 0, "x", 1);
 	char why[200];
 	assert_int_equal(lks_client_read(&c, why, sizeof why), -1);
@@ -417,6 +417,98 @@ static void test_pty_transport_refuses_bytes(void **state)
 	assert_non_null(strstr(why, "through the pty"));
 	close(sim);
 	close(c.fd);
+}
+
+static void sim_recv(int fd, struct lks_msg *m)
+{
+	char why[200];
+	assert_int_equal(lks_recv(fd, m, why, sizeof why), 1);
+}
+
+/* A daemon on two buses: each WAIT goes after a PART for bus 1 (its flags
+ * and bytes), bus 0's in the WAIT itself; a PART before the TIME delivers
+ * bus 1's bytes to bus 1 only; a PART for a bus it did not name is refused
+ * and counted. */
+static void test_two_buses(void **state)
+{
+	(void)state;
+	struct lks_client c;
+	int sim;
+	char why[200];
+	client_pair(&c, &sim);
+	c.inband = true;
+	c.nbuses = 2;
+	lks_client_port_opened(&c, 1);
+	memcpy(c.bus[0].out, "zero", 4);
+	c.bus[0].nout = 4;
+	memcpy(c.bus[1].out, "one!!", 5);
+	c.bus[1].nout = 5;
+	/* only bus 1 awaits a reply */
+	assert_int_equal(lks_client_wait(&c, LKS_MONO0_US + 7000, 1u << 1), 0);
+	struct lks_msg m;
+	sim_recv(sim, &m);
+	assert_int_equal(m.type, LKS_PART);
+	assert_int_equal(m.c, 1);
+	assert_int_equal(m.flags, LKS_WANT_INPUT | LKS_PORT_OPENED);
+	assert_int_equal(m.nbytes, 5);
+	assert_memory_equal(m.bytes, "one!!", 5);
+	sim_recv(sim, &m);
+	assert_int_equal(m.type, LKS_WAIT);
+	assert_int_equal(m.a, 7000000);
+	assert_int_equal(m.flags, 0);
+	assert_int_equal(m.nbytes, 4);
+	assert_memory_equal(m.bytes, "zero", 4);
+	assert_int_equal(c.bus[0].nout + c.bus[1].nout, 0);
+	/* the answer: bus 1's bytes and its loss in a PART, then the TIME */
+	struct lks_msg part = { .type = LKS_PART, .c = 1, .flags = LKS_BUS_GONE, .nbytes = 3 };
+	memcpy(part.bytes, "abc", 3);
+	assert_int_equal(lks_send(sim, &part), 0);
+	sim_send_bytes(sim, 7000000, 0, "xy", 2);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_PART);
+	assert_true(c.waiting);   /* a PART is not the answer */
+	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
+	assert_false(c.waiting);
+	assert_int_equal(c.bus[1].nin, 3);
+	assert_memory_equal(c.bus[1].in, "abc", 3);
+	assert_true(c.bus[1].bus_gone);
+	assert_int_equal(c.bus[0].nin, 2);
+	assert_memory_equal(c.bus[0].in, "xy", 2);
+	assert_false(c.bus[0].bus_gone);
+	/* the next WAIT has nothing new to say for bus 1, but its PART still goes */
+	assert_int_equal(lks_client_wait(&c, UINT64_MAX, 1u), 0);
+	sim_recv(sim, &m);
+	assert_int_equal(m.type, LKS_PART);
+	assert_int_equal(m.flags, 0);
+	assert_int_equal(m.nbytes, 0);
+	sim_recv(sim, &m);
+	assert_int_equal(m.type, LKS_WAIT);
+	assert_int_equal(m.a, LKS_NEVER);
+	assert_int_equal(m.flags, LKS_WANT_INPUT);
+	/* bytes for a bus it did not name: refused, counted */
+	part.c = 2;
+	assert_int_equal(lks_send(sim, &part), 0);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), -1);
+	assert_int_equal(errno, EPROTO);
+	assert_non_null(strstr(why, "PART from the simulator for bus 2"));
+	assert_int_equal(c.bad_parts, 1);
+	part.c = 0;   /* bus 0's go in the TIME itself */
+	assert_int_equal(lks_send(sim, &part), 0);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), -1);
+	assert_int_equal(c.bad_parts, 2);
+	/* BYE: bus 1's last bytes in a PART before it (once its WAIT is
+	 * answered: while one is out, the simulator takes no PART, and the BYE
+	 * goes alone) */
+	sim_send_bytes(sim, 8000000, 0, "", 0);
+	assert_int_equal(lks_client_read(&c, why, sizeof why), LKS_TIME);
+	memcpy(c.bus[1].out, "end", 3);
+	c.bus[1].nout = 3;
+	lks_client_close(&c);
+	sim_recv(sim, &m);
+	assert_int_equal(m.type, LKS_PART);
+	assert_int_equal(m.nbytes, 3);
+	sim_recv(sim, &m);
+	assert_int_equal(m.type, LKS_BYE);
+	close(sim);
 }
 
 int main(void)
@@ -430,6 +522,7 @@ int main(void)
 		cmocka_unit_test(test_payload_framing),
 		cmocka_unit_test(test_inband_client),
 		cmocka_unit_test(test_pty_transport_refuses_bytes),
+		cmocka_unit_test(test_two_buses),
 	};
 	return cmocka_run_group_tests(tests, scratch_group_setup, scratch_group_teardown);
 }

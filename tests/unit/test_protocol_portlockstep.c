@@ -42,7 +42,7 @@ static void rig_open(struct rig *r)
 	r->c.wall0_us = LKS_WALL0_US;
 	r->c.inband = true;
 	r->sim = sv[1];
-	port_bus_io_lockstep(&r->pl, NULL, &r->c, &r->io);
+	port_bus_io_lockstep(&r->pl, NULL, &r->c, 0, &r->io);
 	struct bus_timing tm = { .baud = 1000000, .return_delay_us = 500 };
 	bus_init(&r->bus, &r->io, &tm, false);
 }
@@ -116,10 +116,10 @@ static void test_too_long_and_gone(void **state)
 	static uint8_t big[LKS_BYTES_MAX];
 	assert_int_equal(r.io.write(r.io.ctx, big, 100), DXL_OK);
 	assert_int_equal(r.io.write(r.io.ctx, big, LKS_BYTES_MAX - 99), DXL_E_BUFFER);   /* whole, not cut */
-	assert_int_equal(r.c.too_long, 1);
-	assert_int_equal(r.c.nout, 100);
+	assert_int_equal(r.c.bus[0].too_long, 1);
+	assert_int_equal(r.c.bus[0].nout, 100);
 	assert_int_equal(r.io.write(r.io.ctx, big, LKS_BYTES_MAX - 100), DXL_OK);   /* exactly full */
-	assert_int_equal(r.c.nout, LKS_BYTES_MAX);
+	assert_int_equal(r.c.bus[0].nout, LKS_BYTES_MAX);
 	/* the simulator took the port away (disconnect fault): a write fails as
 	 * on a hung-up pty, until the port is opened again; a read finds nothing,
 	 * as the pty transport's does (it reads only what was announced) */
@@ -129,7 +129,7 @@ static void test_too_long_and_gone(void **state)
 	assert_int_equal(r.io.write(r.io.ctx, ping1, sizeof ping1), DXL_E_DISCONNECTED);
 	uint8_t buf[16];
 	assert_int_equal(r.io.read(r.io.ctx, buf, sizeof buf), 0);
-	port_bus_io_lockstep(&r.pl, NULL, &r.c, &r.io);
+	port_bus_io_lockstep(&r.pl, NULL, &r.c, 0, &r.io);
 	assert_int_equal(r.io.write(r.io.ctx, ping1, sizeof ping1), DXL_OK);
 	assert_int_equal(r.io.read(r.io.ctx, buf, sizeof buf), 0);
 	/* pending and flush see only what was delivered */

@@ -281,9 +281,9 @@ static void test_inband(void **state)
 	int64_t due = sim_line_chunk_end(&sim.buses[0].line, 1000000000);
 	assert_true(due > 1000000 && due < 2000000);
 	vt_hand_over(&vt, &sim, sim_line_next(&sim.buses[0].line) - 1);
-	assert_int_equal(vt.c[0].nout, 0);
+	assert_int_equal(vt.c[0].l[0].nout, 0);
 	vt_hand_over(&vt, &sim, due);
-	assert_int_equal(vt.c[0].nout, sizeof status1);
+	assert_int_equal(vt.c[0].l[0].nout, sizeof status1);
 	assert_int_equal(sim.buses[0].count.tx_bytes, sizeof status1);
 	assert_int_equal(vt_next_wake(&vt, &sim), vt.t_ns);   /* input it waits for: now */
 	vt_release(&vt, &sim, (uint64_t)due, 2000);
@@ -292,7 +292,7 @@ static void test_inband(void **state)
 	assert_int_equal(m.nbytes, sizeof status1);
 	assert_memory_equal(m.bytes, status1, sizeof status1);
 	assert_int_equal(m.flags, 0);
-	assert_int_equal(vt.c[0].nout, 0);
+	assert_int_equal(vt.c[0].l[0].nout, 0);
 	/* the disconnect fault: the port a has open is gone, and the TIME says so */
 	sim.buses[0].master = -1;
 	daemon_send(a, LKS_WAIT, 3000000, 0, 0, NULL);
@@ -365,6 +365,126 @@ static void test_inband_bad_input(void **state)
 	close(b);
 }
 
+static void send_part(int fd, uint64_t bus, uint32_t flags, const uint8_t *bytes, size_t n)
+{
+	struct lks_msg m = { .type = LKS_PART, .c = bus, .flags = flags, .nbytes = (uint32_t)n };
+	if (n > 0)
+		memcpy(m.bytes, bytes, n);
+	assert_int_equal(lks_send(fd, &m), 0);
+}
+
+/* One daemon on both buses: it joins with a HELLO a bus on one connection,
+ * counts once in the barrier and for both buses in `expected`; bus b's
+ * bytes come in the PART before its WAIT and go back in the PART before its
+ * TIME; a PART for a bus it did not name is refused and counted. */
+static void test_one_daemon_two_buses(void **state)
+{
+	(void)state;
+	make_sim();
+	vt.inband = true;
+	int null_fd = open("/dev/null", O_RDWR);
+	for (int i = 0; i < 2; i++) {
+		sim.buses[i].master = null_fd;
+		sim.buses[i].opens = 1;
+	}
+	int d = connect_slot(0);
+	struct lks_msg h = { .type = LKS_HELLO, .a = 4242, .b = 2, .c = 0 };
+	snprintf(h.text, sizeof h.text, "/tmp/vt-test/a");
+	assert_int_equal(lks_send(d, &h), 0);
+	vt_on_client(&vt, &sim, 0, 1000);
+	assert_int_equal(daemon_recv(d).type, LKS_WELCOME);
+	assert_int_equal(vt.c[0].bus, -1);   /* not joined until it named both */
+	assert_int_equal(vt_buses_covered(&vt), 0);
+	h.c = 1;
+	snprintf(h.text, sizeof h.text, "/tmp/vt-test/b");
+	assert_int_equal(lks_send(d, &h), 0);
+	vt_on_client(&vt, &sim, 0, 1000);
+	assert_int_equal(daemon_recv(d).type, LKS_WELCOME);
+	assert_int_equal(vt_clients(&vt), 1);
+	assert_int_equal(vt_buses_covered(&vt), 2);   /* the run needs nobody else */
+	assert_int_equal(vt.joined, 1);
+	/* a second daemon for bus b is refused */
+	int other = join(1, "/tmp/vt-test/b");
+	assert_int_equal(daemon_recv(other).type, LKS_REFUSED);
+	close(other);
+	/* a PING on each bus: b's in the PART, a's in the WAIT; blocked only once the WAIT came */
+	vt.t_ns = 1000000;
+	send_part(d, 1, LKS_WANT_INPUT | LKS_PORT_OPENED, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 0, 1000);
+	assert_false(vt_all_blocked(&vt, &sim));
+	assert_int_equal(sim.buses[1].count.rx_bytes, sizeof ping1);
+	daemon_send_bytes(d, LKS_WAIT, 50000000, LKS_PORT_OPENED, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 0, 1000);
+	assert_true(vt_all_blocked(&vt, &sim));
+	assert_int_equal(sim.buses[0].count.rx_bytes, sizeof ping1);
+	/* both statuses come back; only b's wakes it (a did not ask) */
+	int64_t due = sim_line_chunk_end(&sim.buses[1].line, 1000000000);
+	vt_hand_over(&vt, &sim, due);
+	assert_int_equal(vt.c[0].l[1].nout, sizeof status1);
+	assert_int_equal(vt_next_wake(&vt, &sim), vt.t_ns);
+	/* bus a goes (the disconnect fault): the PART says nothing of it, the TIME does */
+	sim.buses[0].master = -1;
+	vt_release(&vt, &sim, (uint64_t)due, 2000);
+	struct lks_msg m = daemon_recv(d);
+	assert_int_equal(m.type, LKS_PART);
+	assert_int_equal(m.c, 1);
+	assert_int_equal(m.flags, 0);
+	assert_int_equal(m.nbytes, sizeof status1);
+	assert_memory_equal(m.bytes, status1, sizeof status1);
+	m = daemon_recv(d);
+	assert_int_equal(m.type, LKS_TIME);
+	assert_int_equal(m.flags, LKS_BUS_GONE);
+	assert_false(vt.c[0].blocked);
+	/* commands for bus b's robot reach the one daemon, once */
+	char why[200];
+	assert_int_equal(vt_command(&vt, 1, "freeze", why, sizeof why), 1);
+	assert_int_equal(vt_command(&vt, -1, "go", why, sizeof why), 1);
+	/* a PART for bus 2, which it did not name: refused, counted, the run ends */
+	send_part(d, 2, 0, ping1, sizeof ping1);
+	vt_on_client(&vt, &sim, 0, 3000);
+	assert_int_equal(vt.bad_parts, 1);
+	assert_true(vt.bad_messages >= 1);
+	assert_int_equal(vt.c[0].fd, -1);
+	assert_true(vt.ending);
+	assert_true(vt.failed);
+	m = daemon_recv(d);
+	assert_int_equal(m.type, LKS_REFUSED);
+	assert_non_null(strstr(m.text, "PART for bus 2"));
+	close(d);
+	close(null_fd);
+	sim.buses[1].master = -1;
+	vt_close(&vt);
+}
+
+/* The pty transport carries one bus a daemon: two are refused, said why;
+ * HELLOs out of order too. */
+static void test_two_buses_refused(void **state)
+{
+	(void)state;
+	make_sim();
+	vt.inband = false;
+	int d = connect_slot(0);
+	struct lks_msg h = { .type = LKS_HELLO, .a = 4242, .b = 2, .c = 0 };
+	snprintf(h.text, sizeof h.text, "/tmp/vt-test/a");
+	assert_int_equal(lks_send(d, &h), 0);
+	vt_on_client(&vt, &sim, 0, 1000);
+	struct lks_msg m = daemon_recv(d);
+	assert_int_equal(m.type, LKS_REFUSED);
+	assert_non_null(strstr(m.text, "one bus a daemon"));
+	close(d);
+	vt.inband = true;
+	d = connect_slot(0);
+	h.c = 1;   /* bus 1 first */
+	assert_int_equal(lks_send(d, &h), 0);
+	vt_on_client(&vt, &sim, 0, 1000);
+	m = daemon_recv(d);
+	assert_int_equal(m.type, LKS_REFUSED);
+	assert_non_null(strstr(m.text, "in index order"));
+	assert_false(vt.ending);   /* it never joined */
+	close(d);
+	vt_close(&vt);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -372,6 +492,8 @@ int main(void)
 		cmocka_unit_test(test_barrier_and_release),
 		cmocka_unit_test(test_leave_and_stall),
 		cmocka_unit_test(test_inband),
+		cmocka_unit_test(test_one_daemon_two_buses),
+		cmocka_unit_test(test_two_buses_refused),
 		cmocka_unit_test(test_inband_bad_input),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
