@@ -285,7 +285,7 @@ fragment() {
 # Measured 2026-11-28: a run took 16-17 s of wall time alone (2.1x real
 # time), beside other work (load average 6-9).
 seconds() {
-	echo 20
+	echo 4.1
 }
 
 fig_main "jobs [--quick] | run OUTDIR WIDTH_CM SEED [ENDS] | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

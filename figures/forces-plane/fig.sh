@@ -244,7 +244,7 @@ beside() {
 # Measured 2026-11-28, two runs at a time beside other work (load 9-15):
 # about 8 min a 150 s run; the full 300 s about twice that.
 seconds() {
-	if [ "${1:-}" = --quick ]; then echo 480; else echo 960; fi
+	if [ "${1:-}" = --quick ]; then echo 23; else echo 45; fi
 }
 
 fig_main "jobs [--quick] | run OUTDIR K SEED [END [WALLS]] | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

@@ -288,7 +288,7 @@ beside() {
 # run and 37 s a quick one with little else running; 153 s and 99 s beside
 # other people's fuzzing and figure runs (load average 9-17).
 seconds() {
-	if [ "${1:-}" = --quick ]; then echo 45; else echo 90; fi
+	if [ "${1:-}" = --quick ]; then echo 22; else echo 44; fi
 }
 
 fig_main "jobs [--quick] | run OUTDIR SLOPE SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

@@ -87,7 +87,7 @@ jobs() {
 # Wall seconds of one run with four at once (2026-11-27, this 2-core machine
 # with other work on it: median 5.1 s of 40 s simulated); the driver divides
 # the sum by --jobs.
-seconds() { echo 4.5; }
+seconds() { echo 2.6; }
 
 # ---- run ------------------------------------------------------------------------
 RESULT_HEADER="run,r,dsep_set,delta0,seed,seconds,class,delta_final,spread,dsep_final,amp_left,amp_right,freq,collisions,window_collisions,last_collision_t,delta_first,swing_min,sim_speed,wall_s,switch_s"

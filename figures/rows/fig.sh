@@ -318,7 +318,7 @@ beside() {
 # quick with little else running; 49 s (27 s for a 60 s sweep, 94 s for a
 # 240 s relaxation) and 31 s beside other work (load average 9-17).
 seconds() {
-	if [ "${1:-}" = --quick ]; then echo 18; else echo 25; fi
+	if [ "${1:-}" = --quick ]; then echo 8; else echo 11; fi
 }
 
 fig_main "jobs [--quick] | run OUTDIR DSEP BETA SECONDS SEED | merge RUNS_DIR FIGDIR | seconds [--quick]" "$@"

@@ -44,7 +44,7 @@ jobs() {
 
 # Wall seconds of one run (2026-11-28, two at once at load 5-12: 21 s for the
 # full grid's 416 pairs, 8 s for the quick grid's 88; 50-90 ms a pair).
-seconds() { [ "${1:-}" = --quick ] && echo 8 || echo 21; }
+seconds() { [ "${1:-}" = --quick ] && echo 5 || echo 11; }
 
 RESULT_HEADER="r,dsep,delta0,class,final_abs_delta,collisions,window_collisions,theory_final,theory_collisions"
 

@@ -251,7 +251,7 @@ fragment() {
 # Measured 2026-11-28: a 20 s run took 8-9 s of wall time, two at once
 # with other work beside them (load average 6-9).
 seconds() {
-	if [ "${1:-}" = --quick ]; then echo 8; else echo 11; fi
+	if [ "${1:-}" = --quick ]; then echo 1.5; else echo 2; fi
 }
 
 # tune OUT.conf [SEED]: figures/plane-oscillator.conf made again (fig_plane_tune)
