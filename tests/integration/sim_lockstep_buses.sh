@@ -58,25 +58,6 @@ run() {
 	return "$rc"
 }
 
-# Per LCM channel of a log: the count and a digest of its messages' bytes in order.
-channels() {
-	python3 - "$1" <<'PY'
-import collections, hashlib, struct, sys
-buf = open(sys.argv[1], 'rb').read()
-off, dig, n = 0, {}, collections.Counter()
-while off + 28 <= len(buf):
-    sync, _, _, cl, dl = struct.unpack_from('>IqqII', buf, off)
-    if sync != 0xEDA1DA01:
-        sys.exit('not an LCM log at byte %d' % off)
-    off += 28
-    ch = buf[off:off + cl].decode(); off += cl
-    dig.setdefault(ch, hashlib.sha256()).update(buf[off:off + dl]); off += dl
-    n[ch] += 1
-for ch in sorted(dig):
-    print(ch, n[ch], dig[ch].hexdigest())
-PY
-}
-
 # ---- one daemon, two buses, one run, twice ----------------------------------------------
 for name in one two; do
 	rc=0; run $name 7690 6 --seed 7 || rc=$?
