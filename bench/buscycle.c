@@ -163,9 +163,12 @@ static int bc_parse(int argc, char **argv, struct bc_opts *o)
 		} else
 			return -1;
 	}
-	/* the indirect block's length is the map's, whatever --read-len said */
+	/* the indirect block's length is the map's, whatever --read-len said;
+	 * its 13 bytes read where the registers lie would be another block */
 	if (o->indirect)
 		o->read_len = BC_INDIRECT_LEN;
+	else if (o->read_len == BC_INDIRECT_LEN)
+		return -1;
 	return o->port && o->nids && o->baud > 0 && o->cycles > 0 && o->period_us > 0 ? 0 : -1;
 }
 
