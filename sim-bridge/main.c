@@ -99,6 +99,7 @@ struct app {
 	struct sim *sim;
 	const struct sim_clock *clock;   /* what paces the loop (run) */
 	lcm_t *lcm;
+	bool lcm_listen;                 /* SIM.CMD is read (never in lockstep: main) */
 	int listen_fd;
 	char control_path[SIM_PATH_MAX];
 	struct client clients[MAIN_MAX_CLIENTS];
@@ -842,7 +843,7 @@ static int build_pollset(struct app *a, struct pollfd *fds, int *bus_of)
 			bus_of[n] = (int)i;
 			fds[n++] = (struct pollfd){ .fd = a->sim->buses[i].master, .events = POLLIN };
 		}
-	if (a->lcm) {
+	if (a->lcm_listen) {
 		bus_of[n] = -1;
 		fds[n++] = (struct pollfd){ .fd = lcm_get_fileno(a->lcm), .events = POLLIN };
 	}
@@ -1370,7 +1371,19 @@ int main(int argc, char **argv)
 	if (!app.lcm)
 		fprintf(stderr, "undulate-sim: LCM (%s) unavailable: no ground truth, no SIM.CMD\n",
 		        cfg.lcm_url[0] ? cfg.lcm_url : "default");
-	lcm_subscription_t *sub = app.lcm ? lcm_subscribe(app.lcm, "SIM.CMD", on_sim_cmd, &app) : NULL;
+	/* In lockstep the simulator does not listen on LCM. A SIM.CMD comes at a
+	 * wall-clock moment, which in virtual time is any moment, and a lockstep
+	 * run is the same run for the same seed: its commands go in the
+	 * scenario's [events]. Not listening also spares liblcm's receive
+	 * thread (started by the first subscribe or lcm_get_fileno), which woke
+	 * for every message on the group and dropped it: 69 000 wake-ups in a
+	 * 45 s run of ten plane robots, a third of them the simulator's own
+	 * collisions (measured: 4 % of the run's CPU). */
+	app.lcm_listen = app.lcm != NULL && !opt.lockstep;
+	lcm_subscription_t *sub = app.lcm_listen ? lcm_subscribe(app.lcm, "SIM.CMD", on_sim_cmd, &app) : NULL;
+	if (app.lcm && opt.lockstep)
+		printf("undulate-sim: lockstep: SIM.CMD is not listened to (a command from the network would land "
+		       "at any simulated time): a run's commands go in its scenario's [events]\n");
 	/* the links first: a simulator refused its links (another one serves
 	 * them) must not have touched that one's control socket either */
 	bool opened = app.truth_buf && sim_open(&sim, err, sizeof(err)) == 0;

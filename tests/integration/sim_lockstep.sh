@@ -134,6 +134,18 @@ sim_ends_run() {
 }
 
 start_rig || tap_fail "rig started in lockstep" "$(tail -n 5 "$T/sim.log" "$T/d_left.log")"
+# No SIM.CMD in lockstep (a command from the network would land at any
+# simulated time), so no liblcm receive thread waking for every message on
+# the group: the simulator is one thread, says why, and a SIM.CMD client
+# gets no answer (exit 3).
+threads=$(ls "/proc/$pid_sim/task" 2>/dev/null | wc -l)
+rc=0; "$B/undulate-sim" --cmd stats --lcm-url "$URL" >"$T/cmd.log" 2>&1 || rc=$?
+if [ "$threads" = 1 ] && [ "$rc" = 3 ] && grep -q 'lockstep: SIM.CMD is not listened to' "$T/sim.log"; then
+	tap_ok "in lockstep the simulator listens to no SIM.CMD, says so, and runs one thread"
+else
+	tap_fail "in lockstep the simulator listens to no SIM.CMD, says so, and runs one thread" \
+		"threads $threads, --cmd exit $rc: $(head -c 300 "$T/cmd.log"); $(grep -c 'not listened' "$T/sim.log") line(s) saying so"
+fi
 kill -KILL "$pid_d_left"
 sim_ends_run 15 "robot left's daemon (pid $pid_d_left) left the run at t=" \
 	"a daemon killed: the simulator ends the run, naming it (exit 1)"
