@@ -1400,7 +1400,7 @@ void ctl_step(struct ctl *c, double t, double dt, double t_real)
 	bool want = tq_want_wheel(c);
 	if (want && c->wheel) {
 		c->sync = CTL_SYNC_DUTY;
-		tq_duties(c, t_real);
+		tq_duties(c, dt, t_real);
 		for (size_t j = 0; j < c->n; j++) {
 			ctl_update_estimates(c, j);
 			c->j[j].fresh = false;

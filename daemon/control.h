@@ -177,6 +177,7 @@ struct ctl {
 	 * writes went), and what this cycle's SYNC_WRITE carries */
 	bool wheel;
 	enum ctl_sync sync;
+	double late_s;                  /* how late the cycles have come lately (torque.c's guard) */
 	bool starter_active;            /* OSCILLATOR runs the sinusoid starter ... */
 	double starter_offset;          /* rad added to its phase after a stall */
 	double starter_until;           /* ... until then */

@@ -64,7 +64,7 @@ bool tq_check_limits(struct ctl *c, char *what, size_t cap);
 bool tq_check_supply(struct ctl *c, char *what, size_t cap);
 /* This cycle's duties from the mode's law (wheel mode); t_real is the
  * SINUSOID's shared clock (ctl_step). */
-void tq_duties(struct ctl *c, double t_real);
+void tq_duties(struct ctl *c, double dt, double t_real);
 /* Wheel-mode switches, queued after this cycle's SYNC_WRITE. */
 void tq_enter_wheel(struct ctl *c);
 void tq_leave_wheel(struct ctl *c);
