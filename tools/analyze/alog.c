@@ -401,7 +401,14 @@ int alog_writer_open(struct alog_writer *w, const char *path, char *err, size_t 
 
 void alog_writer_buffer(struct alog_writer *w)
 {
-	w->buffered = setvbuf(w->log->f, NULL, _IOFBF, ALOG_WRITE_BUFFER) == 0;
+	/* glibc takes setvbuf's size only with a buffer: given none, it
+	 * allocates st_blksize (4 kB, a write() every 4 kB: 6 400 in a run) */
+	w->buf = malloc(ALOG_WRITE_BUFFER);
+	w->buffered = w->buf != NULL && setvbuf(w->log->f, w->buf, _IOFBF, ALOG_WRITE_BUFFER) == 0;
+	if (!w->buffered) {
+		free(w->buf);
+		w->buf = NULL;
+	}
 }
 
 int alog_flush(struct alog_writer *w)
@@ -465,5 +472,7 @@ int alog_writer_close(struct alog_writer *w)
 	int rc = fflush(w->log->f) == 0 ? 0 : -1;
 	lcm_eventlog_destroy(w->log);
 	w->log = NULL;
+	free(w->buf);
+	w->buf = NULL;
 	return rc;
 }

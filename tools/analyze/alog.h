@@ -41,6 +41,7 @@ struct alog_writer {
 	int64_t events;
 	bool buffered;      /* alog_writer_buffer(): events wait for alog_flush */
 	int64_t unflushed;  /* events written since the last flush (buffered) */
+	char *buf;          /* the stream's buffer (buffered), freed after it */
 };
 /* Creates PATH for writing (--record, --synth). Its directory must be ours
  * and no one else's to write (common/outdir.h); what has its name (a file, a
