@@ -58,6 +58,7 @@ static bool udpm_options(const char *opts, struct udpm_url *out, char *why, size
 				snprintf(why, cap, "recv_buf_size must be a byte count");
 				return false;
 			}
+			out->recv_buf_size = v;
 		} else {
 			snprintf(why, cap, "unknown option '%.*s' (LCM 1.3.1's udpm knows ttl and recv_buf_size)",
 			         (int)klen, opts);

@@ -23,6 +23,7 @@ struct udpm_url {
 	struct in_addr group;       /* udpm only */
 	uint16_t port;
 	int ttl;                    /* -1 when not given */
+	long recv_buf_size;         /* bytes; 0 when not given */
 };
 
 /* The URL a program with `url` (NULL or "": LCM's default, $LCM_DEFAULT_URL

@@ -137,6 +137,44 @@ bool wire_udpm_parse(const uint8_t *dgram, size_t n, struct wire_udpm *out, cons
 	return true;
 }
 
+bool wire_udpm_frag_parse(const uint8_t *dgram, size_t n, struct wire_udpm_frag *out, const char **why)
+{
+	struct wire_reader r;
+	wire_reader_init(&r, dgram, n);
+	uint32_t magic = (uint32_t)wire_take(&r, 4);
+	out->seqno = (uint32_t)wire_take(&r, 4);
+	out->msg_size = (uint32_t)wire_take(&r, 4);
+	out->offset = (uint32_t)wire_take(&r, 4);
+	out->fragment_no = (uint16_t)wire_take(&r, 2);
+	out->fragments = (uint16_t)wire_take(&r, 2);
+	out->channel = NULL;
+	if (r.bad) {
+		*why = "shorter than an LCM fragment header";
+		return false;
+	}
+	if (magic != WIRE_UDPM_MAGIC_LONG) {
+		*why = "not an LCM fragment (magic)";
+		return false;
+	}
+	if (out->fragment_no >= out->fragments) {
+		*why = "fragment number beyond the fragment count";
+		return false;
+	}
+	if (out->fragment_no == 0) {
+		size_t len = strnlen((const char *)r.p, r.left < WIRE_CHANNEL_MAX ? r.left : WIRE_CHANNEL_MAX);
+		if (len == 0 || len >= WIRE_CHANNEL_MAX || len >= r.left) {
+			*why = "channel name empty, unterminated or too long";
+			return false;
+		}
+		out->channel = (const char *)r.p;
+		r.p += len + 1;
+		r.left -= len + 1;
+	}
+	out->data = r.p;
+	out->data_len = r.left;
+	return true;
+}
+
 size_t wire_udpm_build(uint8_t *buf, size_t cap, uint32_t seqno, const char *channel, const uint8_t *payload,
                        size_t payload_len)
 {

@@ -48,8 +48,8 @@ void wire_put_bytes(struct wire_writer *w, const uint8_t *src, size_t n);
 
 /* udpm small message (lcm_udpm.c): uint32 magic 0x4c433032 "LC02", uint32
  * sequence number, the channel NUL-terminated (at most WIRE_CHANNEL_MAX bytes
- * with the NUL), then the payload. Fragmented messages ("LC03") are not
- * handled: the messages read from the network here are small. */
+ * with the NUL), then the payload. Fragmented messages ("LC03") are parsed by
+ * wire_udpm_frag_parse below; only the recorder reassembles them. */
 #define WIRE_UDPM_MAGIC_SHORT 0x4c433032u
 #define WIRE_CHANNEL_MAX 64
 struct wire_udpm {
@@ -60,6 +60,25 @@ struct wire_udpm {
 };
 /* False (with *why) unless the datagram is a well-formed small message. */
 bool wire_udpm_parse(const uint8_t *dgram, size_t n, struct wire_udpm *out, const char **why);
+/* udpm fragment (lcm_udpm.c, LCM 1.3.1's lcm2_header_long_t): a message too
+ * large for one datagram (over about 64 kB) is sent as fragments, each uint32
+ * magic 0x4c433033 "LC03", uint32 msg_seqno, uint32 msg_size (the payload's
+ * whole size, channel not counted), uint32 fragment_offset (into the
+ * payload), uint16 fragment_no, uint16 fragments_in_msg, then for fragment 0
+ * the channel NUL-terminated, then the fragment's share of the payload. */
+#define WIRE_UDPM_MAGIC_LONG 0x4c433033u
+#define WIRE_UDPM_FRAG_HEADER 20
+struct wire_udpm_frag {
+	uint32_t seqno, msg_size, offset;
+	uint16_t fragment_no, fragments;
+	const char *channel;      /* fragment 0 only (else NULL), into the datagram */
+	const uint8_t *data;
+	size_t data_len;
+};
+/* False (with *why) unless the datagram is a well-formed fragment: its
+ * number below the count, and fragment 0 with a channel. Whether it fits
+ * the message is the reassembler's to check. */
+bool wire_udpm_frag_parse(const uint8_t *dgram, size_t n, struct wire_udpm_frag *out, const char **why);
 /* Builds one; returns the datagram's length, 0 if it does not fit in cap. */
 size_t wire_udpm_build(uint8_t *buf, size_t cap, uint32_t seqno, const char *channel, const uint8_t *payload,
                        size_t payload_len);

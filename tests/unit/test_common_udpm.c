@@ -70,6 +70,13 @@ static void test_good_urls(void **state)
 	expect_udpm("udpm://239.255.255.255:65535?ttl=255", "239.255.255.255", 65535, 255);
 	expect_udpm("udpm://239.1.2.3:7700?ttl=2&recv_buf_size=2097152", "239.1.2.3", 7700, 2);
 	expect_udpm("udpm://239.1.2.3:7700?recv_buf_size=1&ttl=3", "239.1.2.3", 7700, 3);
+	/* recv_buf_size is kept (the recorder asks the kernel for it); 0 when absent */
+	struct udpm_url u;
+	char why[200] = "";
+	assert_true(udpm_parse_url("udpm://239.1.2.3:7700?ttl=2&recv_buf_size=2097152", &u, why, sizeof why));
+	assert_int_equal(u.recv_buf_size, 2097152);
+	assert_true(udpm_parse_url("udpm://239.1.2.3:7700?ttl=2", &u, why, sizeof why));
+	assert_int_equal(u.recv_buf_size, 0);
 	/* NULL and "": LCM's default ($LCM_DEFAULT_URL unset here) */
 	expect_udpm(NULL, "239.255.76.67", 7667, 0);
 	expect_udpm("", "239.255.76.67", 7667, 0);

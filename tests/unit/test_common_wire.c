@@ -2,7 +2,8 @@
  * bytes, writer/reader round trips, every short read marks the reader bad
  * and it stays bad, every string a sender can forge (length 0, negative,
  * past the end, no NUL, a NUL inside, longer than the caller's array), a
- * writer that runs out of room, and the udpm small message both ways. */
+ * writer that runs out of room, the udpm small message both ways, and the
+ * udpm fragment header (LC03) read. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -413,6 +414,66 @@ static void test_udpm_parse_refuses(void **state)
 	expect_parse_fails(d, 8 + WIRE_CHANNEL_MAX - 1, "channel");
 }
 
+/* ---- udpm fragments ------------------------------------------------------------------------ */
+
+/* LCM 1.3.1's lcm2_header_long_t, written out by hand (lcm_udpm.c): magic
+ * "LC03", seqno 7, msg_size 70000, offset 0, fragment 0 of 2, "CH\0", data. */
+static const uint8_t frag0[] = { 0x4c, 0x43, 0x30, 0x33, 0, 0, 0, 7, 0, 1, 0x11, 0x70, 0, 0, 0, 0,
+				 0, 0, 0, 2, 'C', 'H', 0, 0xaa, 0xbb };
+
+static void test_udpm_frag_parse(void **state)
+{
+	(void)state;
+	struct wire_udpm_frag f;
+	const char *why = NULL;
+	assert_true(wire_udpm_frag_parse(frag0, sizeof frag0, &f, &why));
+	assert_int_equal(f.seqno, 7);
+	assert_int_equal(f.msg_size, 70000);
+	assert_int_equal(f.offset, 0);
+	assert_int_equal(f.fragment_no, 0);
+	assert_int_equal(f.fragments, 2);
+	assert_string_equal(f.channel, "CH");
+	assert_int_equal(f.data_len, 2);
+	assert_int_equal(f.data[0], 0xaa);
+	/* fragment 1 at offset 65000: no channel, the rest is data */
+	uint8_t d[sizeof frag0];
+	memcpy(d, frag0, sizeof d);
+	d[14] = 0xfd, d[15] = 0xe8; /* offset 0x0000fde8 = 65000 */
+	d[17] = 1;
+	assert_true(wire_udpm_frag_parse(d, sizeof d, &f, &why));
+	assert_int_equal(f.offset, 65000);
+	assert_int_equal(f.fragment_no, 1);
+	assert_null(f.channel);
+	assert_int_equal(f.data_len, sizeof d - WIRE_UDPM_FRAG_HEADER);
+}
+
+static void test_udpm_frag_refuses(void **state)
+{
+	(void)state;
+	struct wire_udpm_frag f;
+	const char *why = NULL;
+	uint8_t d[sizeof frag0];
+	assert_false(wire_udpm_frag_parse(frag0, WIRE_UDPM_FRAG_HEADER - 1, &f, &why));
+	assert_non_null(strstr(why, "shorter"));
+	memcpy(d, frag0, sizeof d);
+	d[3] = 0x32; /* LC02 */
+	assert_false(wire_udpm_frag_parse(d, sizeof d, &f, &why));
+	assert_non_null(strstr(why, "magic"));
+	memcpy(d, frag0, sizeof d);
+	d[17] = 2; /* fragment 2 of 2 */
+	assert_false(wire_udpm_frag_parse(d, sizeof d, &f, &why));
+	assert_non_null(strstr(why, "beyond"));
+	d[19] = 0; d[17] = 0; /* fragment 0 of 0 */
+	assert_false(wire_udpm_frag_parse(d, sizeof d, &f, &why));
+	/* fragment 0 whose channel is not ended, or empty */
+	assert_false(wire_udpm_frag_parse(frag0, WIRE_UDPM_FRAG_HEADER + 2, &f, &why));
+	assert_non_null(strstr(why, "channel"));
+	memcpy(d, frag0, sizeof d);
+	d[20] = 0;
+	assert_false(wire_udpm_frag_parse(d, sizeof d, &f, &why));
+	assert_non_null(strstr(why, "channel"));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -425,6 +486,8 @@ int main(void)
 		cmocka_unit_test(test_udpm_build_golden),
 		cmocka_unit_test(test_udpm_parse),
 		cmocka_unit_test(test_udpm_parse_refuses),
+		cmocka_unit_test(test_udpm_frag_parse),
+		cmocka_unit_test(test_udpm_frag_refuses),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
 }

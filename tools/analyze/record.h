@@ -5,8 +5,16 @@
  * behind. LCM 1.3.1 queues at most 30 messages per subscription and drops the
  * rest silently; lcm-logger keeps that default, and a lockstep run on two
  * busy cores (ten robots publishing seven times faster than in real time)
- * lost about one message in a thousand to it. Here the queue is bounded only
- * by REC_QUEUE and the kernel's receive buffer is asked for REC_RCVBUF.
+ * lost about one message in a thousand to it.
+ *
+ * A udpm group is read here without liblcm: one socket on the group, read
+ * with recvmmsg() in batches in the recorder's own poll() loop, LCM's
+ * datagrams parsed (common/wire.h) and fragmented messages reassembled per
+ * sender, events written through a large buffer. liblcm's receive thread cost
+ * about seven system calls a message (its select, recvmsg, notify pipe and
+ * futexes, and the main thread's poll, pipe read and futex, and a write per
+ * event): a third of a lockstep run's system calls. Other URLs (file://,
+ * memq://) go through liblcm, its queue bounded only by REC_QUEUE.
  */
 #ifndef UNDULATE_ANALYZE_RECORD_H
 #define UNDULATE_ANALYZE_RECORD_H
@@ -17,6 +25,20 @@
 /* Kernel receive buffer asked for (bytes; the kernel caps it at
  * net.core.rmem_max) when the URL does not say recv_buf_size. */
 #define REC_RCVBUF 4194304
+
+/* A udpm message is at most this large (bytes of payload); a larger one is
+ * refused and counted. LCM 1.3.1 allows 256 MB; undulate's messages are a few
+ * kB, and a sender may hold one message in reassembly at a time. */
+#define REC_MSG_MAX (4 << 20)
+/* Senders (address and port) whose fragmented messages are reassembled at
+ * once: a run has one process per robot and a few tools. One more evicts
+ * the sender heard from least recently (its message in progress is lost). */
+#define REC_SENDERS 32
+/* Datagrams read by one recvmmsg(). */
+#define REC_BATCH 64
+/* Events reach the file at most this long (ms) after they arrive, the
+ * socket drained first. */
+#define REC_FLUSH_MS 100
 
 /* Record until SIGINT or SIGTERM. Prints a readiness line ("recording ...")
  * on stdout once subscribed, and a summary at the end. Returns an
