@@ -307,8 +307,14 @@ static void rec_loop_udpm(struct rec *r, int fd, int sfd)
 			break;
 		/* what arrived before the signal is kept */
 		stop = n > 0 && (p[1].revents & POLLIN);
-		if (stop || (n > 0 && (p[0].revents & POLLIN)))
+		if (stop || (n > 0 && (p[0].revents & POLLIN))) {
 			rec_drain(r, fd);
+			/* gather (REC_GATHER_MS); a signal meanwhile ends it at once */
+			if (!stop && poll(&p[1], 1, REC_GATHER_MS) > 0 && (p[1].revents & POLLIN)) {
+				stop = true;
+				rec_drain(r, fd);
+			}
+		}
 		if (r->w.unflushed > 0 && rec_ms() - flushed >= REC_FLUSH_MS) {
 			rec_flush(r);
 			flushed = rec_ms();
