@@ -48,7 +48,7 @@ fig_init channel-plane
 # 42 trials a width: 210 runs, the paper's number of simulated trials
 TRIALS=42
 QUICK_TRIALS=3
-CONTROL_TRIALS=6
+CONTROL_TRIALS=3   # 6 until 2026-11-29: `make figures` had to fit its hour
 # A free plane robot on this oscillator sweeps 0.159 m across its heading per
 # period (its links' centre lines: figures/swimmer's sweep_m, 3 runs, 0.1590-
 # 0.1595 m, 2026-11-28; 0.189 m with the joints 103 deg apart); two robots side by side, their centre lines a width less

@@ -45,12 +45,15 @@ SECONDS_RUN=40
 # Initial phase differences: the golden-ratio sequence (figures/lib.sh),
 # spread evenly over (-pi, pi] without following d~. The quick set fits the
 # figures' share of `make figures QUICK=1` (a few minutes here).
-FULL_067=1000 FULL_090=120 FULL_CTRL=4
+# 600 at r = 0.67: thirty runs in each 0.05 of d~ for the anti-phase
+# share (the page's onset bins); 1000 (until 2026-11-29) were about 37 of
+# `make figures`'s CPU-minutes, and the whole was over its hour.
+FULL_067=600 FULL_090=120 FULL_CTRL=4
 QUICK_067=80 QUICK_090=30 QUICK_CTRL=2
 R09_DMAX=0.8
 CTRL_DSEP=2
 # The scenario's nominal amplitude, for which world.separation is d~: read
-# by merge (set there), not by each of the 1,124 runs.
+# by merge (set there), not by each of the 724 runs.
 nominal_amp() { awk -F= '$1 ~ /^amplitude *$/ { gsub(/ /, "", $2); print $2 }' "$SCENARIO"; }
 
 # series TAG R N DMAX: N runs at restitution R, d~ = (i + 0.5) / N * DMAX.
