@@ -62,6 +62,12 @@ QUICK_RELAX_SECONDS=120
 TINY_SWEEP_SECONDS=14
 TINY_RELAX_SECONDS=16
 RIG=(--daemon-set robot.actuation=torque --daemon-set robot.torque_drive=current)
+# FIG_ROWS_ARGS: more scripts/demo.sh words for every run, after the module's
+# own (a later --set or --daemon-set of the same key wins), split at blanks:
+# e.g. "--daemon-set robot.period_ms=5" or "--set motor.drive=pwm". Unset (the
+# default, as `make figures` runs) adds nothing. For measuring what the rows
+# depend on (figures/model-vs-daemons.md), not for the figure.
+read -r -a ROWS_ARGS <<<"${FIG_ROWS_ARGS:-}"
 
 jobs() {
 	local d seeds=$SWEEP_SEEDS rseeds=$RELAX_SEEDS dseps=$SWEEP_DSEPS secs=$SWEEP_SECONDS
@@ -94,7 +100,7 @@ run() {
 	fig_demo "$out" --scenario "$fig_top/sim-bridge/scenarios/lattice10.scenario" --seconds "$secs" \
 		--switch-at "$SWITCH" --seed "$seed" --window "$WINDOW" --set "world.separation=$dsep" \
 		--set "world.beta=$beta" --set "world.walls=none" --set "robot r1.beta=0" --set "robot r$ROBOTS.beta=0" \
-		"${RIG[@]}" || exit 1
+		"${RIG[@]}" ${ROWS_ARGS[@]+"${ROWS_ARGS[@]}"} || exit 1
 	local r="$out/demo" swing wall
 	outdir_new "$out/pairs.csv" "$out/result.csv" || fig_die "cannot write in $out"
 	fig_pairs "$r/summary.json" >"$out/pairs.csv"

@@ -124,6 +124,12 @@ refused "forces-plane: k 2" "K: want a number from 0 to 1, got '2'" "$F/forces-p
 refused "forces-plane: walls 0.1 m" "WALLS: want a number from 0.3 to 2" "$F/forces-plane/fig.sh" run "$T/bad" 0.1 1 150 0.1
 refused "an unknown subcommand" "usage: fig.sh" "$F/rows/fig.sh" draw
 [ ! -e "$T/bad" ] && tap_ok "no run folder made by a refused run" || tap_fail "no run folder made by a refused run"
+# FIG_ROWS_ARGS reaches demo.sh after the module's own words: a word demo.sh
+# does not know stops the run there, before anything starts
+FIG_ROWS_ARGS="--daemon-set robot.period_ms=5 --no-such-word" "$F/rows/fig.sh" run "$T/hook" 0.5 0 14 1 >"$T/out" 2>"$T/err"
+rc=$?
+if [ "$rc" = 1 ] && grep -q "demo: unknown argument '--no-such-word'" "$T/err"; then tap_ok "rows: FIG_ROWS_ARGS's words go to demo.sh ($(head -c 160 "$T/err"))"
+else tap_fail "rows: FIG_ROWS_ARGS's words go to demo.sh (exit 1, demo.sh refusing the unknown word)" "rc $rc: $(cat "$T/err" "$T/out" | head -3)"; fi
 
 # ---- forces: merge on fixed rows -----------------------------------------------------
 H="slope,stiffness_nm_rad,seed,lead_s,k,sin_amplitude,sin_frequency,force_clock_n,force_osc_n,mean_clock_n,mean_osc_n,pair_impacts_clock_hz,pair_impacts_osc_hz,wall_impacts_clock_hz,wall_impacts_osc_hz,min_swing_rad,wall_s,end_s"
