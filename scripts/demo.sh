@@ -152,7 +152,7 @@ early_keep() {
 	else
 		report+=("demo: $verb ($why) after $el s $of")
 		if [ -n "$sw" ]; then
-			report+=("demo: ran: $start_mode (the clock) for $sw s, then $switch_to for $(awk -v e="$el" -v s="$sw" 'BEGIN { printf "%.0f", e > s ? e - s : 0 }') s")
+			report+=("demo: ran: $start_mode (the clock) for $sw s, then $switch_to for $(awk -v e="$el" -v s="$sw" 'BEGIN { printf "%.0f", (e > s ? e - s : 0) }') s")
 		elif [ "$switch_at" = never ]; then
 			report+=("demo: ran: $start_mode for $el s (no switch planned)")
 		else
