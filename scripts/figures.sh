@@ -222,7 +222,11 @@ merge_module() {
 		echo "hosts=$hosts"
 		echo "how=$how"
 	} | outdir_put "$figdir/$m.run"
-	echo "figures: $m: $ok of $n runs merged into $figdir ($(ls "$figdir/$m"*.png 2>/dev/null | xargs -n1 basename | tr '\n' ' '))"
+	# its pictures: those its section shows (a glob on its name took
+	# channel-plane's for channel's, forces-plane's for forces')
+	local pngs
+	pngs=$(grep -o '(figures/[^)/]*\.png)' "$figdir/$m.md" 2>/dev/null | sed 's|^(figures/||; s|)$||' | tr '\n' ' ')
+	echo "figures: $m: $ok of $n runs merged into $figdir (${pngs% })"
 }
 
 # The machine, in one line, for the page's header.

@@ -96,6 +96,10 @@ if [ "$rc" = 0 ] && [ -s "$T/docs/FIGURES.md" ]; then
 else
 	tap_fail "--merge: exit 0, FIGURES.md written" "exit $rc: $(tail -8 "$T/merge.out")"
 fi
+# each module's pictures as its section shows them (a glob on the name once
+# listed channel-plane's under channel)
+tap_check "--merge names the pictures of each figure's section: pair (pair.png pair-onset.png)" \
+	grep -q '^figures: pair: 3 of 3 runs merged into .* (pair.png pair-onset.png)$' "$T/merge.out"
 # drawn NAME FILE MIN: at least MIN data pixels (coloured, not the frame's greys)
 drawn() {
 	local px
