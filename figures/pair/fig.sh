@@ -433,7 +433,7 @@ golden-ratio sequence), d̃ evenly over [0, 1] at r = 0.67 and over [0, $R09_DMA
 (Started on the full 0.8 rad sinusoid instead and switched as the clock released the bodies,
 the 100 runs of the quick set at r = 0.67 agreed with the map in 88 cases against 92 this
 way, 2026-11-27.) A run took
-$wall s of wall time (median, four at once; $speed× real time in lockstep). d̃ is the
+$wall s of wall time (median, with the invocation's other runs beside it: the table at the top of the page says how many at once; $speed× real time in lockstep). d̃ is the
 separation over twice the *free* amplitude, A = $(printf '%.3f' "$amp") rad (the median of the runs that
 ended without contact); in anti-phase the swing shrinks (to $(v "$a" anti_amp) rad at r = 0.67),
 so the analyser's final-window d̃ reads higher there (\`dsep_final\` in pair.csv). Controls, as
