@@ -7,7 +7,7 @@
 # in a few write() calls (a large buffer), with the drop counters on its
 # last line.
 . "$(dirname "$0")/../lib.sh"
-url=$(lcm_url 7761)
+url=$(lcm_url 7768)
 A="$B/undulate-analyze"
 
 # A log of N events: channel, payload (bytes that say which event they are),
@@ -32,7 +32,7 @@ wait_log rec '^undulate-analyze: recording' 10 || tap_fail "recorder ready" "$(c
 threads=$(ls "/proc/$pid_rec/task" | wc -l)
 # lcm-logger subscribes, and liblcm then sends its self-test to the group
 spawn logger lcm-logger --lcm-url="$url" -q "$T/logger.lcmlog"
-hexport=$(printf '%04X' "$(lcm_port 7761)")
+hexport=$(printf '%04X' "$(lcm_port 7768)")
 # its socket is bound once it has subscribed: two sockets on the port then
 wait_for 5 test "$(grep -c ":$hexport " /proc/net/udp)" -ge 2 || tap_fail "lcm-logger did not bind"
 lcm-logplayer --lcm-url="$url" --speed=1 "$T/src.log" >"$T/player.out" 2>&1
@@ -93,7 +93,7 @@ tap_check "last line: 150 events, nothing dropped: $last" \
 # bad datagrams on the group are counted, not recorded, and survived
 spawn rec2 "$A" --record "$T/rec2.lcmlog" --lcm-url "$url"
 wait_log rec2 '^undulate-analyze: recording' 10 || tap_fail "second recorder ready"
-python3 - "$(lcm_port 7761)" <<'EOF'
+python3 - "$(lcm_port 7768)" <<'EOF'
 import socket, struct, sys
 s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
