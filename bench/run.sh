@@ -1108,6 +1108,19 @@ RATE_PERIODS_MS="10 5 4 2 1"
 RATE_DMN_ARGS=()
 PORT_RATE=7910 PORT_RATE_B=7911
 rate_read_label() { case $1 in sync) echo "SYNC_READ" ;; fast) echo "Fast Sync Read" ;; indirect) echo "indirect + Fast Sync Read" ;; *) echo "$1" ;; esac; }
+# lockstep_up CLOCK NAME OUT URL: the simulator sim-NAME has opened its lockstep
+# socket CLOCK, and an lcm-logger log-NAME records URL into OUT.lcm; else OUT
+# says why the status was not measured and the simulator is stopped (status 1).
+lockstep_up() {
+	if ! wait_file "$1" 10; then
+		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$2"))" >"$3"
+		stop "sim-$2"
+		return 1
+	fi
+	start "log-$2" lcm-logger --lcm-url="$4" -f "$3.lcm"
+	wait_file "$3.lcm" 10
+}
+
 # The simulator's options that make the daemon read that way: it reads by Fast
 # Sync Read when every servo has firmware 45 or later (the simulator's 46).
 rate_sim_args() { case $1 in sync) echo "--firmware 44" ;; *) ;; esac; }
@@ -1168,13 +1181,7 @@ rate_lockstep() {
 	start "sim-$name" "$SIM" --model xm430-w350 --link "$d/$name.pty" --ids "$(ids_upto "$n")" --return-delay 0 \
 		--baud "$baud" $(rate_sim_args "$read") --lcm-url "$u" --quiet --lockstep "$d/$name.clock" \
 		--duration "$((secs + 2))"
-	if ! wait_file "$d/$name.clock" 10; then
-		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
-		stop "sim-$name"
-		return 0
-	fi
-	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
-	wait_file "$out.lcm" 10
+	lockstep_up "$d/$name.clock" "$name" "$out" "$u" || return 0
 	# shellcheck disable=SC2046 # the read's options are words
 	"$DMN" --port "$d/$name.pty" --ids "$(ids_upto "$n")" --baud "$baud" --robot "r$n" --lcm-url "$u" \
 		--mode oscillator --set robot.period_ms="$p" $(rate_dmn_args "$read") --lockstep "$d/$name.clock" \
@@ -1436,13 +1443,7 @@ rate_2bus_lockstep() {
 		"$d/$name-a.pty" "$d/$name-b.pty" >"$d/$name.scenario"
 	start "sim-$name" "$SIM" --scenario "$d/$name.scenario" --lcm-url "$u" --quiet --lockstep "$d/$name.clock" \
 		--duration "$((RATE_2BUS_S + 2))"
-	if ! wait_file "$d/$name.clock" 10; then
-		echo "status not measured: the simulator did not start in lockstep ($(why "sim-$name"))" >"$out"
-		stop "sim-$name"
-		return 0
-	fi
-	start "log-$name" lcm-logger --lcm-url="$u" -f "$out.lcm"
-	wait_file "$out.lcm" 10
+	lockstep_up "$d/$name.clock" "$name" "$out" "$u" || return 0
 	"$DMN" --port "$d/$name-a.pty" --ids 1,2,3,4,5,6,b:7,b:8,b:9,b:10,b:11,b:12 --set "bus.b.port=$d/$name-b.pty" \
 		--set bus.b.baud=4000000 --baud 4000000 --robot r12 --lcm-url "$u" --mode oscillator \
 		--set robot.period_ms=2 --lockstep "$d/$name.clock" >"$T/dmn-$name.log" 2>&1
