@@ -14,10 +14,10 @@
 #include <sys/signalfd.h>
 #include <sys/socket.h>
 #include <sys/time.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "alog.h"
+#include "clock.h"
 #include "analyze.h"
 #include "udpm.h"
 #include "wire.h"
@@ -187,13 +187,6 @@ static void rec_datagram(struct rec *r, const struct sockaddr_in *from, int64_t 
 		r->bad++;
 }
 
-static int64_t rec_wall_utime(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_REALTIME, &ts);
-	return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
-
 /* The kernel's receive time (SO_TIMESTAMP, as liblcm takes it), and the
  * socket's drop count if it has changed (SO_RXQ_OVFL, cumulative). */
 static int64_t rec_control(struct rec *r, struct msghdr *h, int64_t fallback)
@@ -233,7 +226,7 @@ static void rec_drain(struct rec *r, int fd)
 		int n = recvmmsg(fd, r->msgs, REC_BATCH, MSG_DONTWAIT, NULL);
 		if (n <= 0)
 			return;
-		int64_t fallback = rec_wall_utime();
+		int64_t fallback = clock_wall_us();
 		for (int i = 0; i < n && !r->failed; i++) {
 			struct msghdr *h = &r->msgs[i].msg_hdr;
 			int64_t utime = rec_control(r, h, fallback);
@@ -279,12 +272,8 @@ static int rec_open_udpm(const char *url, const struct udpm_url *u)
 	return fd;
 }
 
-static int64_t rec_ms(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
-}
+/* milliseconds on the monotonic clock (common/clock.h) */
+static int64_t rec_ms(void) { return (int64_t)(clock_mono_us() / 1000); }
 
 static void rec_flush(struct rec *r)
 {
